@@ -1,0 +1,748 @@
+//! From the syntax tree to the kernel IR: names are resolved, each definition is
+//! expanded into monomials (calls of earlier forms are substituted), the arity of every
+//! term is checked, terms that vanish for the chosen elements are dropped, and the rest
+//! is grouped into (test field, trial field) blocks.
+
+use crate::diagnostic::{closest, Diagnostic, Loc};
+use crate::parser::{Definition, Expr, ExprKind, IntegralKind, Name};
+use crate::symbolic::{self, ArgFactor, DerivativeError, Expansion, Monomial};
+use fem_reference::ElementKind;
+
+/// Highest derivative order of the language.
+pub const MAX_DERIVATIVE: u8 = 4;
+
+/// A field of the model: an unknown with its test function.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Field {
+    /// Name of the unknown (trial function).
+    pub name: String,
+    /// Name of the paired test function.
+    pub test_name: String,
+    /// Its element.
+    pub element: ElementKind,
+    /// Whether it is a multiplier constrained `≥ 0`.
+    pub nonnegative: bool,
+}
+
+/// The names a model declares.
+#[derive(Clone, Debug, Default)]
+pub struct Symbols {
+    /// Fields in declaration order.
+    pub fields: Vec<Field>,
+    /// Parameter names.
+    pub params: Vec<String>,
+    /// Data names with the polynomial degree assumed for quadrature.
+    pub data: Vec<(String, usize)>,
+}
+
+impl Symbols {
+    /// Function symbol `k` is unknown `k` for `k < F`, test `k − F` otherwise.
+    pub fn function_name(&self, symbol: usize) -> &str {
+        let f = self.fields.len();
+        if symbol < f {
+            &self.fields[symbol].name
+        } else {
+            &self.fields[symbol - f].test_name
+        }
+    }
+
+    /// The field a function symbol belongs to.
+    pub fn field_of(&self, symbol: usize) -> usize {
+        symbol % self.fields.len().max(1)
+    }
+
+    fn function_symbol(&self, name: &str) -> Option<usize> {
+        let f = self.fields.len();
+        self.fields
+            .iter()
+            .position(|x| x.name == name)
+            .or_else(|| {
+                self.fields
+                    .iter()
+                    .position(|x| x.test_name == name)
+                    .map(|k| k + f)
+            })
+    }
+
+    fn all_names(&self) -> Vec<&str> {
+        let mut v: Vec<&str> = Vec::new();
+        for f in &self.fields {
+            v.push(&f.name);
+            v.push(&f.test_name);
+        }
+        v.extend(self.params.iter().map(String::as_str));
+        v.extend(self.data.iter().map(|d| d.0.as_str()));
+        v.extend(["h", "h_T"]);
+        v
+    }
+}
+
+/// One term of a block: `coefficient · params · h^k · data · D^test φ_i · D^trial φ_j`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Term {
+    /// The numeric coefficient.
+    pub coefficient: f64,
+    /// `(parameter index, exponent)`.
+    pub params: Vec<(usize, i32)>,
+    /// Power of the element size.
+    pub h_power: i32,
+    /// Data factors (indices).
+    pub data: Vec<usize>,
+    /// Derivative order on the test function.
+    pub test_derivative: u8,
+    /// Derivative order on the trial function (bilinear forms only).
+    pub trial_derivative: Option<u8>,
+    /// Explicit quadrature degree.
+    pub quadrature_degree: Option<usize>,
+}
+
+/// The nonzero part of a form for one (test field, trial field) pair.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// Field of the test function: the rows.
+    pub test_field: usize,
+    /// Field of the trial function: the columns (`None` for linear forms).
+    pub trial_field: Option<usize>,
+    /// Its terms.
+    pub terms: Vec<Term>,
+}
+
+/// An analysed form.
+#[derive(Clone, Debug)]
+pub struct Form {
+    /// Its name.
+    pub name: String,
+    /// The definition as written (for docs).
+    pub source: String,
+    /// Argument groups as function symbols.
+    pub groups: Vec<Vec<usize>>,
+    /// The expansion with the form's own symbols (for substitution into later forms).
+    pub terms: Expansion,
+    /// Terms dropped because they vanish for the chosen elements.
+    pub dropped: usize,
+    /// Nonzero blocks.
+    pub blocks: Vec<Block>,
+}
+
+impl Form {
+    /// 1 for linear forms, 2 for bilinear ones.
+    pub fn arity(&self) -> usize {
+        self.groups.len()
+    }
+}
+
+/// Analyses every definition in order; a definition may call those above it.
+pub fn analyse(
+    symbols: &Symbols,
+    definitions: &[Definition],
+    forms_text: &str,
+) -> (Vec<Form>, Vec<Diagnostic>) {
+    let mut forms: Vec<Form> = Vec::new();
+    let mut errors = Vec::new();
+    let all_names: Vec<&str> = definitions.iter().map(|d| d.name.text.as_str()).collect();
+    for (k, definition) in definitions.iter().enumerate() {
+        if let Some(first) = definitions[..k]
+            .iter()
+            .find(|d| d.name.text == definition.name.text)
+        {
+            errors.push(
+                Diagnostic::text(
+                    definition.name.loc,
+                    format!("form `{}` is defined twice", definition.name.text),
+                )
+                .help(format!("the first definition is on line {}", first.name.loc.line)),
+            );
+            continue;
+        }
+        if symbols.all_names().contains(&definition.name.text.as_str()) {
+            errors.push(Diagnostic::text(
+                definition.name.loc,
+                format!(
+                    "form name `{}` is already the name of a field, parameter or data",
+                    definition.name.text
+                ),
+            ));
+            continue;
+        }
+        let mut context = Context {
+            symbols,
+            forms: &forms,
+            later_forms: &all_names[k..],
+            errors: Vec::new(),
+        };
+        let form = context.definition(definition, forms_text);
+        let failed = !context.errors.is_empty();
+        errors.append(&mut context.errors);
+        match form {
+            Some(form) if !failed => forms.push(form),
+            // Keep a placeholder so later calls do not report "unknown form" again.
+            _ => forms.push(Form {
+                name: definition.name.text.clone(),
+                source: String::new(),
+                groups: Vec::new(),
+                terms: Vec::new(),
+                dropped: 0,
+                blocks: Vec::new(),
+            }),
+        }
+    }
+    (forms, errors)
+}
+
+/// Expands a lone integrand-level expression (used by the tests of the symbolic layer).
+#[cfg(test)]
+pub(crate) fn expand_expression(symbols: &Symbols, text: &str) -> Result<Expansion, Vec<Diagnostic>> {
+    let (tokens, errors) = crate::lexer::tokenize(text);
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let expr = crate::parser::parse_expression(&tokens).map_err(|e| vec![e])?;
+    let mut context = Context {
+        symbols,
+        forms: &[],
+        later_forms: &[],
+        errors: Vec::new(),
+    };
+    context.expand(&expr, true).ok_or(context.errors)
+}
+
+struct Context<'a> {
+    symbols: &'a Symbols,
+    forms: &'a [Form],
+    later_forms: &'a [&'a str],
+    errors: Vec<Diagnostic>,
+}
+
+fn scalar(loc: Loc) -> Monomial {
+    Monomial::constant(1.0, loc)
+}
+
+impl Context<'_> {
+    fn definition(&mut self, d: &Definition, forms_text: &str) -> Option<Form> {
+        let source = forms_text
+            .lines()
+            .skip(d.lines.0 - 1)
+            .take(d.lines.1 + 1 - d.lines.0)
+            .map(str::trim)
+            .collect::<Vec<_>>()
+            .join(" ");
+        let groups = self.signature(&d.name, &d.groups)?;
+        let terms = self.expand(&d.body, false)?;
+        let mut kept = Vec::new();
+        let mut dropped = 0;
+        let group_text = |g: &[usize]| {
+            g.iter()
+                .map(|&s| self.symbols.function_name(s).to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let signature = format!(
+            "{}({})",
+            d.name.text,
+            groups.iter().map(|g| group_text(g)).collect::<Vec<_>>().join("; ")
+        );
+        for t in terms {
+            if !t.integrated {
+                self.errors.push(
+                    Diagnostic::text(t.origin, format!("term of `{}` outside an integral", d.name.text))
+                        .help("every term of a form stands under ∫ (or Σ_T), or is a call of another form"),
+                );
+                continue;
+            }
+            // Each argument must belong to the form; count per group.
+            let mut counts = vec![0usize; groups.len()];
+            let mut ok = true;
+            for a in &t.args {
+                match groups.iter().position(|g| g.contains(&a.symbol)) {
+                    Some(g) => counts[g] += 1,
+                    None => {
+                        ok = false;
+                        self.errors.push(
+                            Diagnostic::text(
+                                t.origin,
+                                format!(
+                                    "`{}` is not an argument of {signature}",
+                                    self.symbols.function_name(a.symbol)
+                                ),
+                            )
+                            .help("add it to the form's argument list, or use one of the listed arguments"),
+                        );
+                    }
+                }
+            }
+            if !ok {
+                continue;
+            }
+            let kind = if groups.len() == 2 { "bilinear" } else { "linear" };
+            for (g, &count) in counts.iter().enumerate() {
+                let which = match (groups.len(), g) {
+                    (2, 0) => "first argument group (trial functions",
+                    (2, _) => "second argument group (test functions",
+                    _ => "arguments (test functions",
+                };
+                if count > 1 {
+                    let product = t
+                        .args
+                        .iter()
+                        .filter(|a| groups[g].contains(&a.symbol))
+                        .map(|a| self.symbols.function_name(a.symbol))
+                        .collect::<Vec<_>>()
+                        .join("·");
+                    self.errors.push(
+                        Diagnostic::text(
+                            t.origin,
+                            format!(
+                                "nonlinear term in the {kind} form `{}`: {product} is a product of {count} functions of its {which} {})",
+                                d.name.text,
+                                group_text(&groups[g])
+                            ),
+                        )
+                        .help(format!("a {kind} form is linear in each argument group: every term has exactly one function from each group")),
+                    );
+                    ok = false;
+                } else if count == 0 {
+                    self.errors.push(
+                        Diagnostic::text(
+                            t.origin,
+                            format!(
+                                "term of the {kind} form `{}` contains no function of its {which} {})",
+                                d.name.text,
+                                group_text(&groups[g])
+                            ),
+                        )
+                        .help(format!("a {kind} form is linear in each argument group: every term has exactly one function from each group")),
+                    );
+                    ok = false;
+                }
+            }
+            if !ok {
+                continue;
+            }
+            let mut vanishes = false;
+            for a in &t.args {
+                let field = &self.symbols.fields[self.symbols.field_of(a.symbol)];
+                let name = self.symbols.function_name(a.symbol);
+                if a.derivative > MAX_DERIVATIVE {
+                    ok = false;
+                    self.errors.push(
+                        Diagnostic::text(
+                            t.origin,
+                            format!("derivative of order {} of `{name}`: the DSL supports up to order {MAX_DERIVATIVE}", a.derivative),
+                        )
+                        .help("write at most four primes (w'''')"),
+                    );
+                } else if a.derivative as usize > field.element.max_derivative() {
+                    ok = false;
+                    self.errors.push(
+                        Diagnostic::text(
+                            t.origin,
+                            format!(
+                                "`{name}` is a {} field: derivative of order {} is more than the element supports (at most {})",
+                                field.element.name(),
+                                a.derivative,
+                                field.element.max_derivative()
+                            ),
+                        )
+                        .help("P0 is piecewise constant and discontinuous: drop the derivative, or choose a continuous element (P1, P2, P3, Hermite)"),
+                    );
+                } else if a.derivative as usize > field.element.degree() {
+                    vanishes = true;
+                }
+            }
+            if !ok {
+                continue;
+            }
+            if vanishes {
+                dropped += 1;
+            } else {
+                kept.push(t);
+            }
+        }
+        let blocks = self.blocks(&groups, &kept);
+        Some(Form {
+            name: d.name.text.clone(),
+            source,
+            groups,
+            terms: kept,
+            dropped,
+            blocks,
+        })
+    }
+
+    fn blocks(&self, groups: &[Vec<usize>], terms: &[Monomial]) -> Vec<Block> {
+        let mut blocks: Vec<Block> = Vec::new();
+        for t in terms {
+            let find = |g: usize| *t.args.iter().find(|a| groups[g].contains(&a.symbol)).unwrap();
+            let test = find(groups.len() - 1);
+            let trial = (groups.len() == 2).then(|| find(0));
+            let test_field = self.symbols.field_of(test.symbol);
+            let trial_field = trial.map(|a| self.symbols.field_of(a.symbol));
+            let term = Term {
+                coefficient: t.coefficient,
+                params: t.params.clone(),
+                h_power: t.h_power,
+                data: t.data.clone(),
+                test_derivative: test.derivative,
+                trial_derivative: trial.map(|a| a.derivative),
+                quadrature_degree: t.quadrature_degree,
+            };
+            match blocks
+                .iter_mut()
+                .find(|b| b.test_field == test_field && b.trial_field == trial_field)
+            {
+                Some(b) => b.terms.push(term),
+                None => blocks.push(Block {
+                    test_field,
+                    trial_field,
+                    terms: vec![term],
+                }),
+            }
+        }
+        blocks.sort_by_key(|b| (b.test_field, b.trial_field));
+        blocks
+    }
+
+    fn signature(&mut self, name: &Name, groups: &[Vec<Name>]) -> Option<Vec<Vec<usize>>> {
+        let mut out = Vec::new();
+        let mut ok = true;
+        let mut seen: Vec<usize> = Vec::new();
+        if groups.iter().all(|g| g.is_empty()) {
+            self.errors.push(
+                Diagnostic::text(name.loc, format!("form `{}` has no arguments", name.text))
+                    .help("a bilinear form is written `a(trial args; test args)`, a linear one `ℓ(test args)`"),
+            );
+            return None;
+        }
+        for g in groups {
+            let mut group = Vec::new();
+            for n in g {
+                match self.symbols.function_symbol(&n.text) {
+                    Some(s) if seen.contains(&s) => {
+                        ok = false;
+                        self.errors.push(Diagnostic::text(
+                            n.loc,
+                            format!("`{}` appears twice among the arguments of `{}`", n.text, name.text),
+                        ));
+                    }
+                    Some(s) => {
+                        seen.push(s);
+                        group.push(s);
+                    }
+                    None => {
+                        ok = false;
+                        self.errors.push(self.not_a_function(n, &name.text));
+                    }
+                }
+            }
+            out.push(group);
+        }
+        ok.then_some(out)
+    }
+
+    fn not_a_function(&self, n: &Name, form: &str) -> Diagnostic {
+        let candidates: Vec<&str> = self
+            .symbols
+            .fields
+            .iter()
+            .flat_map(|f| [f.name.as_str(), f.test_name.as_str()])
+            .collect();
+        let hint = closest(&n.text, candidates.iter().copied())
+            .map(|c| format!(" Did you mean `{c}`?"))
+            .unwrap_or_default();
+        Diagnostic::text(
+            n.loc,
+            format!(
+                "`{}` in the arguments of `{form}` is not a declared unknown or test function",
+                n.text
+            ),
+        )
+        .help(format!(
+            "the model declares the functions {}.{hint}",
+            candidates.join(", ")
+        ))
+    }
+
+    fn fail(&mut self, d: Diagnostic) -> Option<Expansion> {
+        self.errors.push(d);
+        None
+    }
+
+    /// Resolves a name: a declared symbol, `h`, or declared symbols written together (`sλ`).
+    fn symbol(&mut self, name: &str, loc: Loc, inside_integral: bool) -> Option<Expansion> {
+        if let Some(e) = self.single_symbol(name, loc, inside_integral) {
+            return e;
+        }
+        if let Some(parts) = self.split(name) {
+            let mut product = vec![scalar(loc)];
+            for part in parts {
+                let factor = self.single_symbol(&part, loc, inside_integral)??;
+                product = symbolic::mul(&product, &factor, loc);
+            }
+            return Some(product);
+        }
+        if self.later_forms.contains(&name) || self.forms.iter().any(|f| f.name == name) {
+            return self.fail(
+                Diagnostic::text(loc, format!("form `{name}` used without its arguments"))
+                    .help(format!("call it with arguments, e.g. `{name}(u; v)`")),
+            );
+        }
+        let names = self.symbols.all_names();
+        let hint = closest(name, names.iter().copied())
+            .map(|c| format!("did you mean `{c}`? "))
+            .unwrap_or_default();
+        self.fail(
+            Diagnostic::text(loc, format!("unknown symbol `{name}`")).help(format!(
+                "{hint}declared names are {}; declare new parameters under `params:` and functions of x under `data:`",
+                names.join(", ")
+            )),
+        )
+    }
+
+    /// `Some(result)` when `name` is one declared symbol.
+    fn single_symbol(&mut self, name: &str, loc: Loc, inside_integral: bool) -> Option<Option<Expansion>> {
+        let mut m = scalar(loc);
+        if name == "h" || name == "h_T" {
+            if !inside_integral {
+                return Some(self.fail(
+                    Diagnostic::text(loc, "`h` is the size of an element: it has a meaning only inside ∫ or Σ_T")
+                        .help("move the factor into the integrand"),
+                ));
+            }
+            m.h_power = 1;
+        } else if let Some(s) = self.symbols.function_symbol(name) {
+            m.args = vec![ArgFactor {
+                symbol: s,
+                derivative: 0,
+            }];
+        } else if let Some(i) = self.symbols.params.iter().position(|p| p == name) {
+            m.params = vec![(i, 1)];
+        } else if let Some(i) = self.symbols.data.iter().position(|d| d.0 == name) {
+            m.data = vec![i];
+        } else {
+            return None;
+        }
+        Some(Some(vec![m]))
+    }
+
+    /// Splits `sλ` into declared names (longest first), if it can be done.
+    fn split(&self, name: &str) -> Option<Vec<String>> {
+        let names = self.symbols.all_names();
+        fn go(rest: &str, names: &[&str], out: &mut Vec<String>) -> bool {
+            if rest.is_empty() {
+                return true;
+            }
+            let mut candidates: Vec<&&str> =
+                names.iter().filter(|n| !n.is_empty() && rest.starts_with(**n)).collect();
+            candidates.sort_by_key(|n| std::cmp::Reverse(n.len()));
+            for c in candidates {
+                out.push(c.to_string());
+                if go(&rest[c.len()..], names, out) {
+                    return true;
+                }
+                out.pop();
+            }
+            false
+        }
+        let mut out = Vec::new();
+        (go(name, &names, &mut out) && out.len() > 1).then_some(out)
+    }
+
+    fn expand(&mut self, e: &Expr, inside_integral: bool) -> Option<Expansion> {
+        let loc = e.loc;
+        match &e.kind {
+            ExprKind::Number(v) => Some(vec![Monomial::constant(*v, loc)]),
+            ExprKind::Symbol(name) => self.symbol(name, loc, inside_integral),
+            ExprKind::Neg(a) => Some(symbolic::neg(self.expand(a, inside_integral)?)),
+            ExprKind::Add(a, b) | ExprKind::Sub(a, b) => {
+                let x = self.expand(a, inside_integral);
+                let y = self.expand(b, inside_integral);
+                let (x, y) = (x?, y?);
+                let y = if matches!(e.kind, ExprKind::Sub(..)) {
+                    symbolic::neg(y)
+                } else {
+                    y
+                };
+                Some(symbolic::add(x, y))
+            }
+            ExprKind::Mul(a, b) => {
+                let x = self.expand(a, inside_integral);
+                let y = self.expand(b, inside_integral);
+                let (x, y) = (x?, y?);
+                let integrated = |v: &Expansion| v.iter().any(|t| t.integrated);
+                let all_scalar = |v: &Expansion| v.iter().all(Monomial::is_scalar);
+                if integrated(&x) && integrated(&y) {
+                    return self.fail(
+                        Diagnostic::text(loc, "product of two integrals")
+                            .help("a form is a sum of integrals; multiply integrands inside one ∫"),
+                    );
+                }
+                if (integrated(&x) && !all_scalar(&y)) || (integrated(&y) && !all_scalar(&x)) {
+                    return self.fail(
+                        Diagnostic::text(loc, "an integral or form call multiplied by a function")
+                            .help("outside ∫ only numbers and parameters may scale a term; move functions into the integrand"),
+                    );
+                }
+                Some(symbolic::mul(&x, &y, loc))
+            }
+            ExprKind::Div(a, b) => {
+                let x = self.expand(a, inside_integral);
+                let y = self.expand(b, inside_integral);
+                let (x, y) = (x?, y?);
+                match symbolic::pow(&y, -1, loc) {
+                    Some(inverse) => Some(symbolic::mul(&x, &inverse, loc)),
+                    None => self.fail(
+                        Diagnostic::text(b.loc, "division by an expression that is not a non-zero number, parameter or power of h")
+                            .help("forms are polynomial in the arguments and data; divide only by numbers, parameters and h"),
+                    ),
+                }
+            }
+            ExprKind::Pow(a, n) => {
+                let x = self.expand(a, inside_integral)?;
+                if x.iter().any(|t| t.integrated) {
+                    return self.fail(Diagnostic::text(loc, "power of an integral"));
+                }
+                match symbolic::pow(&x, *n, loc) {
+                    Some(p) => Some(p),
+                    None => self.fail(
+                        Diagnostic::text(loc, format!("negative power {n} of an expression that is not a non-zero number, parameter or h"))
+                            .help("only numbers, parameters and h may carry negative exponents (t⁻², h⁻¹)"),
+                    ),
+                }
+            }
+            ExprKind::Derivative(a, k) => {
+                let x = self.expand(a, inside_integral)?;
+                if x.iter().any(|t| t.integrated) {
+                    return self.fail(Diagnostic::text(loc, "derivative of an integral"));
+                }
+                match symbolic::derivative(&x, *k) {
+                    Ok(d) => Some(d),
+                    Err(DerivativeError::OfData(at)) => self.fail(
+                        Diagnostic::text(at.to(loc), "derivative of a term with data (or of data alone)")
+                            .help("data functions are given by value only; differentiate the arguments, not the data"),
+                    ),
+                    Err(DerivativeError::OfProduct(at)) => self.fail(
+                        Diagnostic::text(at.to(loc), "derivative of a product of functions")
+                            .help("expand it with the product rule by hand"),
+                    ),
+                }
+            }
+            ExprKind::InnerProduct(a, b) => {
+                let x = self.expand(a, inside_integral);
+                let y = self.expand(b, inside_integral);
+                let (x, y) = (x?, y?);
+                let mut p = symbolic::mul(&x, &y, loc);
+                for t in &mut p {
+                    t.inner_products += 1;
+                }
+                Some(p)
+            }
+            ExprKind::Integral { kind, degree, body } => {
+                if inside_integral {
+                    return self.fail(
+                        Diagnostic::text(loc, "integral inside an integral")
+                            .help("a form is a sum of single integrals: `∫ A + ∫ B`"),
+                    );
+                }
+                let mut x = self.expand(body, true)?;
+                for t in &mut x {
+                    match (kind, t.inner_products) {
+                        (IntegralKind::Integral, 0) | (IntegralKind::SumOverElements, 1) => {}
+                        (IntegralKind::Integral, _) => {
+                            return self.fail(
+                                Diagnostic::text(t.origin, "an L² product (X, Y)_T is already an integral over T")
+                                    .help("write `∫ X·Y`, or `Σ_T (X, Y)_T`"),
+                            )
+                        }
+                        (IntegralKind::SumOverElements, 0) => {
+                            return self.fail(
+                                Diagnostic::text(t.origin, "a term of Σ_T without an L² product (X, Y)_T")
+                                    .help("write every term of Σ_T as weight·(X, Y)_T, or use ∫"),
+                            )
+                        }
+                        (IntegralKind::SumOverElements, _) => {
+                            return self.fail(Diagnostic::text(
+                                t.origin,
+                                "a term of Σ_T with more than one L² product",
+                            ))
+                        }
+                    }
+                    t.integrated = true;
+                    t.inner_products = 0;
+                    t.quadrature_degree = *degree;
+                }
+                Some(x)
+            }
+            ExprKind::Call { name, groups } => self.call(name, groups, loc),
+        }
+    }
+
+    fn call(&mut self, name: &str, groups: &[Vec<Name>], loc: Loc) -> Option<Expansion> {
+        let Some(callee) = self.forms.iter().find(|f| f.name == name) else {
+            return self.fail(
+                Diagnostic::text(loc, format!("form `{name}` is used before its definition"))
+                    .help("define a form above the forms that call it"),
+            );
+        };
+        if callee.groups.is_empty() {
+            return None; // its own definition failed and was reported
+        }
+        let show = |g: &[usize]| {
+            g.iter()
+                .map(|&s| self.symbols.function_name(s))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let callee_signature = format!(
+            "{name}({})",
+            callee.groups.iter().map(|g| show(g)).collect::<Vec<_>>().join("; ")
+        );
+        if groups.len() != callee.groups.len()
+            || groups.iter().zip(&callee.groups).any(|(a, b)| a.len() != b.len())
+        {
+            let counts = |v: Vec<usize>| v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(";");
+            return self.fail(
+                Diagnostic::text(
+                    loc,
+                    format!(
+                        "wrong number of arguments for `{name}`: it is defined as {callee_signature} ({} arguments), called with {}",
+                        counts(callee.groups.iter().map(Vec::len).collect()),
+                        counts(groups.iter().map(Vec::len).collect()),
+                    ),
+                )
+                .help("pass one function per argument, with `;` between the trial and the test group"),
+            );
+        }
+        let mut mapping: Vec<(usize, usize)> = Vec::new();
+        for (g, group) in groups.iter().enumerate() {
+            for (k, n) in group.iter().enumerate() {
+                let formal = callee.groups[g][k];
+                let Some(actual) = self.symbols.function_symbol(&n.text) else {
+                    let d = self.not_a_function(n, name);
+                    return self.fail(d);
+                };
+                if self.symbols.field_of(actual) != self.symbols.field_of(formal) {
+                    let field = &self.symbols.fields[self.symbols.field_of(formal)];
+                    return self.fail(
+                        Diagnostic::text(
+                            n.loc,
+                            format!(
+                                "argument `{}` of `{name}` must be a function of the field `{}` (`{}` or `{}`), as in {callee_signature}",
+                                n.text, field.name, field.name, field.test_name
+                            ),
+                        ),
+                    );
+                }
+                mapping.push((formal, actual));
+            }
+        }
+        let mut out = callee.terms.clone();
+        for t in &mut out {
+            for a in &mut t.args {
+                a.symbol = mapping.iter().find(|(f, _)| *f == a.symbol).unwrap().1;
+            }
+            t.args.sort();
+            t.origin = loc;
+        }
+        Some(out)
+    }
+}

@@ -1,0 +1,323 @@
+//! The model declaration around the forms text, written in Rust tokens:
+//!
+//! ```text
+//! /// docs
+//! pub mod NAME on interval {
+//!     unknowns: θ: P2, w: P2, λ: P0 >= 0;
+//!     tests:    η, v, μ;
+//!     params:   t, α, s;
+//!     data:     f, ψ;          // `f: 0` declares f constant for quadrature (default degree 2)
+//!     forms:    "…";
+//! }
+//! ```
+
+use crate::diagnostic::{closest, Diagnostic};
+use fem_reference::reference_element::ALL_ELEMENTS;
+use fem_reference::{CellKind, ElementKind};
+use proc_macro2::{Span, TokenStream, TokenTree};
+use syn::parse::{Parse, ParseStream};
+use syn::{Attribute, Ident, LitInt, LitStr, Token, Visibility};
+
+/// An unknown field: `θ: P2` or `λ: P0 >= 0`.
+#[derive(Clone, Debug)]
+pub struct UnknownDecl {
+    /// The unknown's name.
+    pub name: Ident,
+    /// Its element, when the name is one fem-forms knows.
+    pub element: Option<ElementKind>,
+    /// The element name as written.
+    pub element_name: Ident,
+    /// `>= 0`: the field is a multiplier constrained to be non-negative.
+    pub nonnegative: bool,
+}
+
+/// A data function: `f` or `f: 0`.
+#[derive(Clone, Debug)]
+pub struct DataDecl {
+    /// Its name.
+    pub name: Ident,
+    /// Polynomial degree assumed when choosing quadrature.
+    pub degree: usize,
+}
+
+/// Everything the macro input declares.
+#[derive(Clone)]
+pub struct Declaration {
+    /// Path of the runtime crate that the generated code names (`$crate` of `fem_runtime::model!`).
+    pub runtime: TokenStream,
+    /// Doc comments and other outer attributes.
+    pub attrs: Vec<Attribute>,
+    /// Visibility of the generated module.
+    pub vis: Visibility,
+    /// Name of the generated module.
+    pub name: Ident,
+    /// The reference cell.
+    pub cell: Option<CellKind>,
+    /// The cell name as written.
+    pub cell_name: Ident,
+    /// Unknown fields.
+    pub unknowns: Vec<UnknownDecl>,
+    /// Test functions, paired with the unknowns in order.
+    pub tests: Vec<Ident>,
+    /// Runtime scalar parameters.
+    pub params: Vec<Ident>,
+    /// Data functions of x.
+    pub data: Vec<DataDecl>,
+    /// The forms text.
+    pub forms: LitStr,
+    /// Span of the section list, for "missing section" errors.
+    pub body_span: Span,
+}
+
+fn comma_list<T>(
+    input: ParseStream,
+    mut item: impl FnMut(ParseStream) -> syn::Result<T>,
+) -> syn::Result<Vec<T>> {
+    let mut out = Vec::new();
+    loop {
+        out.push(item(input)?);
+        if input.peek(Token![,]) {
+            input.parse::<Token![,]>()?;
+            if input.peek(Token![;]) {
+                break;
+            }
+        } else {
+            break;
+        }
+    }
+    Ok(out)
+}
+
+impl Parse for Declaration {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let runtime = if input.peek(Token![@]) {
+            input.parse::<Token![@]>()?;
+            input.parse::<Token![crate]>()?;
+            let mut path = TokenStream::new();
+            while !input.peek(Token![;]) {
+                path.extend([input.parse::<TokenTree>()?]);
+            }
+            input.parse::<Token![;]>()?;
+            path
+        } else {
+            quote::quote!(::fem_runtime)
+        };
+        let attrs = input.call(Attribute::parse_outer)?;
+        let vis: Visibility = input.parse()?;
+        input.parse::<Token![mod]>().map_err(|e| {
+            syn::Error::new(
+                e.span(),
+                "expected `mod NAME on CELL { … }`, e.g. `pub mod timoshenko on interval { … }`",
+            )
+        })?;
+        let name: Ident = input.parse()?;
+        let on: Ident = input.parse()?;
+        if on != "on" {
+            return Err(syn::Error::new(
+                on.span(),
+                "expected `on`, as in `mod timoshenko on interval { … }`",
+            ));
+        }
+        let cell_name: Ident = input.parse()?;
+        let cell = match cell_name.to_string().as_str() {
+            "interval" => Some(CellKind::Interval),
+            "triangle" => Some(CellKind::Triangle),
+            _ => None,
+        };
+        let content;
+        let brace = syn::braced!(content in input);
+        let mut declaration = Declaration {
+            runtime,
+            attrs,
+            vis,
+            name,
+            cell,
+            cell_name,
+            unknowns: Vec::new(),
+            tests: Vec::new(),
+            params: Vec::new(),
+            data: Vec::new(),
+            forms: LitStr::new("", brace.span.join()),
+            body_span: brace.span.join(),
+        };
+        let mut seen: Vec<Ident> = Vec::new();
+        let mut have_forms = false;
+        while !content.is_empty() {
+            let key: Ident = content.parse()?;
+            if let Some(previous) = seen.iter().find(|k| **k == key) {
+                let mut e = syn::Error::new(key.span(), format!("section `{key}` is given twice"));
+                e.combine(syn::Error::new(previous.span(), "first given here"));
+                return Err(e);
+            }
+            content.parse::<Token![:]>()?;
+            match key.to_string().as_str() {
+                "unknowns" => {
+                    declaration.unknowns = comma_list(&content, |s| {
+                        let name: Ident = s.parse()?;
+                        s.parse::<Token![:]>()?;
+                        let element_name: Ident = s.parse()?;
+                        let nonnegative = if s.peek(Token![>=]) {
+                            s.parse::<Token![>=]>()?;
+                            let zero: LitInt = s.parse()?;
+                            if zero.base10_parse::<u64>()? != 0 {
+                                return Err(syn::Error::new(
+                                    zero.span(),
+                                    "only `>= 0` constraints are supported (multipliers λ ≥ 0)",
+                                ));
+                            }
+                            true
+                        } else {
+                            false
+                        };
+                        Ok(UnknownDecl {
+                            element: ElementKind::from_name(&element_name.to_string()),
+                            name,
+                            element_name,
+                            nonnegative,
+                        })
+                    })?
+                }
+                "tests" => declaration.tests = comma_list(&content, |s| s.parse())?,
+                "params" => declaration.params = comma_list(&content, |s| s.parse())?,
+                "data" => {
+                    declaration.data = comma_list(&content, |s| {
+                        let name: Ident = s.parse()?;
+                        let degree = if s.peek(Token![:]) {
+                            s.parse::<Token![:]>()?;
+                            s.parse::<LitInt>()?.base10_parse::<usize>()?
+                        } else {
+                            2
+                        };
+                        Ok(DataDecl { name, degree })
+                    })?
+                }
+                "forms" => {
+                    declaration.forms = content.parse()?;
+                    have_forms = true;
+                }
+                other => {
+                    let sections = ["unknowns", "tests", "params", "data", "forms"];
+                    let hint = closest(other, sections)
+                        .map(|s| format!("; did you mean `{s}`?"))
+                        .unwrap_or_default();
+                    return Err(syn::Error::new(
+                        key.span(),
+                        format!("unknown section `{other}`: expected one of unknowns, tests, params, data, forms{hint}"),
+                    ));
+                }
+            }
+            seen.push(key);
+            content.parse::<Token![;]>()?;
+        }
+        for required in ["unknowns", "tests", "forms"] {
+            if !seen.iter().any(|k| k == required) {
+                return Err(syn::Error::new(
+                    declaration.body_span,
+                    format!("the model declares no `{required}:` section"),
+                ));
+            }
+        }
+        debug_assert!(have_forms);
+        Ok(declaration)
+    }
+}
+
+impl Declaration {
+    /// Meaning-level checks of the declaration: elements, cells, pairing of tests, names.
+    pub fn check(&self) -> Vec<Diagnostic> {
+        let mut errors = Vec::new();
+        let cell = match self.cell {
+            Some(c) => Some(c),
+            None => {
+                errors.push(
+                    Diagnostic::token(
+                        self.cell_name.span(),
+                        format!("unknown cell `{}`", self.cell_name),
+                    )
+                    .help("expected `interval` (triangles are the next cell to come)"),
+                );
+                None
+            }
+        };
+        for u in &self.unknowns {
+            match u.element {
+                None => {
+                    let names = ALL_ELEMENTS.map(|e| e.name());
+                    let hint = closest(&u.element_name.to_string(), names)
+                        .map(|s| format!(" Did you mean `{s}`?"))
+                        .unwrap_or_default();
+                    errors.push(
+                        Diagnostic::token(
+                            u.element_name.span(),
+                            format!("unknown element `{}` for `{}`", u.element_name, u.name),
+                        )
+                        .help(format!("expected one of {}.{hint}", names.join(", "))),
+                    );
+                }
+                Some(e) => {
+                    if let Some(c) = cell {
+                        if !e.supports(c) {
+                            errors.push(Diagnostic::token(
+                                u.element_name.span(),
+                                format!("element {} is not available on {} cells", e.name(), c.name()),
+                            ));
+                        }
+                    }
+                    if u.nonnegative && e.is_continuous() {
+                        errors.push(
+                            Diagnostic::token(
+                                u.element_name.span(),
+                                format!("`{} >= 0` on a continuous {} field: a multiplier constrained coefficient-wise must be P0", u.name, e.name()),
+                            )
+                            .help("declare the multiplier as `λ: P0 >= 0`"),
+                        );
+                    }
+                }
+            }
+        }
+        if self.tests.len() != self.unknowns.len() {
+            let span = self
+                .tests
+                .get(self.unknowns.len())
+                .or(self.tests.last())
+                .map_or(self.body_span, |t| t.span());
+            errors.push(
+                Diagnostic::token(
+                    span,
+                    format!(
+                        "{} test functions for {} unknowns",
+                        self.tests.len(),
+                        self.unknowns.len()
+                    ),
+                )
+                .help("list one test function per unknown, in the same order (`unknowns: θ: P2, w: P2; tests: η, v;`)"),
+            );
+        }
+        // Every name means one thing.
+        let reserved = ["h", "h_T", "int", "sum_T", "Σ_T", "degree", "Model"];
+        let mut names: Vec<&Ident> = Vec::new();
+        let all = self
+            .unknowns
+            .iter()
+            .map(|u| &u.name)
+            .chain(&self.tests)
+            .chain(&self.params)
+            .chain(self.data.iter().map(|d| &d.name));
+        for name in all {
+            let text = name.to_string();
+            if reserved.contains(&text.as_str()) {
+                errors.push(
+                    Diagnostic::token(name.span(), format!("`{text}` is reserved"))
+                        .help("`h`/`h_T` is the element size, `int`/`sum_T` are ∫ and Σ_T; pick another name"),
+                );
+            } else if names.iter().any(|n| **n == *name) {
+                errors.push(Diagnostic::token(
+                    name.span(),
+                    format!("`{text}` is declared twice"),
+                ));
+            }
+            names.push(name);
+        }
+        errors
+    }
+}

@@ -1,0 +1,340 @@
+//! Tokens of the forms text: the math notation with its Unicode and ASCII spellings.
+//!
+//! | meaning            | Unicode            | ASCII            |
+//! |--------------------|--------------------|------------------|
+//! | integral           | `∫`                | `int`            |
+//! | sum over elements  | `Σ_T`, `∑_T`       | `sum_T`          |
+//! | derivative         | `′ ″ ‴ ⁗`, `'`     | `'`, `''`, …     |
+//! | power              | `⁻² ³ ⁴`           | `^-2`, `^(-2)`   |
+//! | minus              | `−` (U+2212), `–`  | `-`              |
+//! | product            | `·`, `⋅`, `×`, juxtaposition | `*`    |
+
+use crate::diagnostic::{Diagnostic, Loc};
+
+/// A token kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Tok {
+    /// A name: a letter or `_`, then letters, digits, `_`.
+    Ident(String),
+    /// A decimal number.
+    Number(f64),
+    /// `∫` or `int`.
+    Integral,
+    /// `Σ_T`, `∑_T` or `sum_T`.
+    SumT,
+    /// A run of primes: the derivative order.
+    Prime(u8),
+    /// A run of superscript characters, e.g. `⁻²`; `None` when malformed.
+    Superscript(Option<i32>, String),
+    /// `^`
+    Caret,
+    /// `+`
+    Plus,
+    /// `-`, `−`, `–`
+    Minus,
+    /// `*`, `·`, `⋅`, `×`
+    Star,
+    /// `/`
+    Slash,
+    /// `(`
+    LParen,
+    /// `)`
+    RParen,
+    /// `[`
+    LBracket,
+    /// `]`
+    RBracket,
+    /// `{`
+    LBrace,
+    /// `}`
+    RBrace,
+    /// `,`
+    Comma,
+    /// `;`
+    Semicolon,
+    /// `=`
+    Equals,
+    /// `_T` right after `)`: closes an L² product `(X, Y)_T`.
+    SubscriptT,
+    /// End of a line (definitions start at the beginning of a line).
+    Newline,
+}
+
+/// A token with its place.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Token {
+    /// What it is.
+    pub tok: Tok,
+    /// Where it is.
+    pub loc: Loc,
+}
+
+fn superscript_value(c: char) -> Option<char> {
+    Some(match c {
+        '⁰' => '0',
+        '¹' => '1',
+        '²' => '2',
+        '³' => '3',
+        '⁴' => '4',
+        '⁵' => '5',
+        '⁶' => '6',
+        '⁷' => '7',
+        '⁸' => '8',
+        '⁹' => '9',
+        '⁻' => '-',
+        '⁺' => '+',
+        _ => return None,
+    })
+}
+
+fn prime_count(c: char) -> Option<u8> {
+    match c {
+        '\'' | '′' => Some(1),
+        '″' => Some(2),
+        '‴' => Some(3),
+        '⁗' => Some(4),
+        _ => None,
+    }
+}
+
+fn is_ident_start(c: char) -> bool {
+    (c.is_alphabetic() || c == '_') && superscript_value(c).is_none()
+}
+
+fn is_ident_continue(c: char) -> bool {
+    (c.is_alphanumeric() || c == '_') && superscript_value(c).is_none()
+}
+
+/// Splits the forms text into tokens; unknown characters become errors (lexing goes on).
+pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
+    let chars: Vec<char> = text.chars().collect();
+    let mut tokens = Vec::new();
+    let mut errors = Vec::new();
+    let (mut i, mut line, mut column) = (0usize, 1usize, 1usize);
+    while i < chars.len() {
+        let c = chars[i];
+        let start = Loc {
+            line,
+            column,
+            len: 1,
+        };
+        let push = |tok: Tok, len: usize, tokens: &mut Vec<Token>| {
+            tokens.push(Token {
+                tok,
+                loc: Loc { len, ..start },
+            });
+        };
+        if c == '\n' {
+            push(Tok::Newline, 1, &mut tokens);
+            i += 1;
+            line += 1;
+            column = 1;
+            continue;
+        }
+        if c.is_whitespace() {
+            i += 1;
+            column += 1;
+            continue;
+        }
+        if c == '#' {
+            while i < chars.len() && chars[i] != '\n' {
+                i += 1;
+                column += 1;
+            }
+            continue;
+        }
+        let mut j = i + 1;
+        if let Some(n) = prime_count(c) {
+            let mut order = n as usize;
+            while j < chars.len() {
+                match prime_count(chars[j]) {
+                    Some(m) => order += m as usize,
+                    None => break,
+                }
+                j += 1;
+            }
+            push(Tok::Prime(order.min(255) as u8), j - i, &mut tokens);
+        } else if superscript_value(c).is_some() {
+            while j < chars.len() && superscript_value(chars[j]).is_some() {
+                j += 1;
+            }
+            let raw: String = chars[i..j].iter().collect();
+            let ascii: String = raw.chars().filter_map(superscript_value).collect();
+            let value = ascii.trim_start_matches('+').parse::<i32>().ok();
+            push(Tok::Superscript(value, raw), j - i, &mut tokens);
+        } else if c.is_ascii_digit()
+            || (c == '.' && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit()))
+        {
+            while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
+                j += 1;
+            }
+            // exponent part: 1e-3, 2.5E+4
+            if j < chars.len() && (chars[j] == 'e' || chars[j] == 'E') {
+                let mut k = j + 1;
+                if k < chars.len() && (chars[k] == '-' || chars[k] == '+') {
+                    k += 1;
+                }
+                if k < chars.len() && chars[k].is_ascii_digit() {
+                    while k < chars.len() && chars[k].is_ascii_digit() {
+                        k += 1;
+                    }
+                    j = k;
+                }
+            }
+            let raw: String = chars[i..j].iter().collect();
+            match raw.parse::<f64>() {
+                Ok(v) => push(Tok::Number(v), j - i, &mut tokens),
+                Err(_) => errors.push(
+                    Diagnostic::text(
+                        Loc {
+                            len: j - i,
+                            ..start
+                        },
+                        format!("malformed number `{raw}`"),
+                    )
+                    .help("write numbers like 2, 0.5 or 1e-3"),
+                ),
+            }
+        } else if c == '_'
+            && chars.get(i + 1) == Some(&'T')
+            && !chars.get(i + 2).is_some_and(|&d| is_ident_continue(d))
+            && matches!(tokens.last(), Some(Token { tok: Tok::RParen, .. }))
+        {
+            j = i + 2;
+            push(Tok::SubscriptT, 2, &mut tokens);
+        } else if is_ident_start(c) {
+            while j < chars.len() && is_ident_continue(chars[j]) {
+                j += 1;
+            }
+            let name: String = chars[i..j].iter().collect();
+            let tok = match name.as_str() {
+                "int" => Tok::Integral,
+                "Σ_T" | "sum_T" => Tok::SumT,
+                _ => Tok::Ident(name),
+            };
+            push(tok, j - i, &mut tokens);
+        } else {
+            let tok = match c {
+                '∫' => Some(Tok::Integral),
+                '∑' if chars.get(i + 1) == Some(&'_') && chars.get(i + 2) == Some(&'T') => {
+                    j = i + 3;
+                    Some(Tok::SumT)
+                }
+                '^' => Some(Tok::Caret),
+                '+' => Some(Tok::Plus),
+                '-' | '−' | '–' => Some(Tok::Minus),
+                '*' | '·' | '⋅' | '×' => Some(Tok::Star),
+                '/' => Some(Tok::Slash),
+                '(' => Some(Tok::LParen),
+                ')' => Some(Tok::RParen),
+                '[' => Some(Tok::LBracket),
+                ']' => Some(Tok::RBracket),
+                '{' => Some(Tok::LBrace),
+                '}' => Some(Tok::RBrace),
+                ',' => Some(Tok::Comma),
+                ';' => Some(Tok::Semicolon),
+                '=' => Some(Tok::Equals),
+                _ => None,
+            };
+            match tok {
+                Some(tok) => push(tok, j - i, &mut tokens),
+                None => errors.push(
+                    Diagnostic::text(start, format!("unexpected character `{c}` (U+{:04X})", c as u32))
+                        .help("the forms use ∫ (or int), Σ_T (or sum_T), + − · /, primes ' for derivatives, ⁻² or ^-2 for powers, and (X, Y)_T for L² products"),
+                ),
+            }
+        }
+        column += j - i;
+        i = j;
+    }
+    (tokens, errors)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kinds(text: &str) -> Vec<Tok> {
+        let (tokens, errors) = tokenize(text);
+        assert!(errors.is_empty(), "{errors:?}");
+        tokens.into_iter().map(|t| t.tok).collect()
+    }
+
+    #[test]
+    fn unicode_and_ascii_spellings_agree() {
+        let unicode = kinds("a(θ,w;η,v) = ∫θ′η′ + t⁻²(w′−θ)(v'−η)");
+        let ascii = kinds("a(θ,w;η,v) = int θ'η' + t^-2 (w'-θ)(v'-η)");
+        let strip = |v: Vec<Tok>| -> Vec<Tok> {
+            v.into_iter()
+                .map(|t| match t {
+                    Tok::Superscript(Some(n), _) => Tok::Superscript(Some(n), String::new()),
+                    t => t,
+                })
+                .collect()
+        };
+        let unicode = strip(unicode);
+        // The ASCII power is Caret, Minus, Number: compare everything else.
+        assert_eq!(unicode[0], Tok::Ident("a".into()));
+        assert!(unicode.contains(&Tok::Superscript(Some(-2), String::new())));
+        assert_eq!(
+            unicode.iter().filter(|t| **t == Tok::Prime(1)).count(),
+            ascii.iter().filter(|t| **t == Tok::Prime(1)).count()
+        );
+        assert_eq!(ascii[11], Tok::Integral);
+    }
+
+    #[test]
+    fn primes_merge_into_an_order() {
+        assert_eq!(
+            kinds("w'''' θ‴ u″"),
+            vec![
+                Tok::Ident("w".into()),
+                Tok::Prime(4),
+                Tok::Ident("θ".into()),
+                Tok::Prime(3),
+                Tok::Ident("u".into()),
+                Tok::Prime(2)
+            ]
+        );
+    }
+
+    #[test]
+    fn places_are_lines_and_character_columns() {
+        let (tokens, _) = tokenize("∫ a\n  θ⁴ 1e-3");
+        let theta = tokens.iter().find(|t| t.tok == Tok::Ident("θ".into())).unwrap();
+        assert_eq!((theta.loc.line, theta.loc.column), (2, 3));
+        let number = tokens.iter().find(|t| matches!(t.tok, Tok::Number(_))).unwrap();
+        assert_eq!(number.tok, Tok::Number(1e-3));
+        assert_eq!((number.loc.column, number.loc.len), (6, 4));
+    }
+
+    #[test]
+    fn subscript_t_and_sums() {
+        assert_eq!(
+            kinds("Σ_T (a, b)_T sum_T h_T"),
+            vec![
+                Tok::SumT,
+                Tok::LParen,
+                Tok::Ident("a".into()),
+                Tok::Comma,
+                Tok::Ident("b".into()),
+                Tok::RParen,
+                Tok::SubscriptT,
+                Tok::SumT,
+                Tok::Ident("h_T".into())
+            ]
+        );
+    }
+
+    #[test]
+    fn bad_characters_are_reported_with_their_place() {
+        let (_, errors) = tokenize("a(u;v) = ∫ u ≥ v");
+        assert_eq!(errors.len(), 1);
+        let crate::diagnostic::Place::Text(loc) = errors[0].place else {
+            panic!()
+        };
+        assert_eq!(loc.column, 14);
+        let (_, errors) = tokenize("t⁻");
+        assert!(errors.is_empty()); // a malformed exponent is the parser's to report
+    }
+}

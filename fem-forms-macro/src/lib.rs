@@ -1,0 +1,160 @@
+#![cfg_attr(test, allow(mixed_script_confusables, confusable_idents))]
+//! The fem-forms DSL: a model file's forms in math notation, compiled at `cargo build`
+//! into plain Rust element kernels.
+//!
+//! Use it through `fem_forms::model!` (or `fem_runtime::model!`), which passes the
+//! runtime's path to this macro. The pipeline is three pure stages, each unit-tested on
+//! `proc_macro2` types: [`parser`] (text → syntax tree), [`analysis`] with the
+//! [`symbolic`] IR (syntax tree → blocks of expanded monomials), [`codegen`] (blocks →
+//! Rust).
+//!
+//! # A model file
+//!
+//! ```text
+//! fem_forms::model! {
+//!     /// Timoshenko beam over a rigid obstacle (MODELS.md §3), P2–P2–P0.
+//!     pub mod timoshenko on interval {
+//!         unknowns: θ: P2, w: P2, λ: P0 >= 0;
+//!         tests: η, v, μ;
+//!         params: t, α, s;
+//!         data: f, ψ;
+//!         forms: "
+//!             a(θ,w;η,v) = ∫θ'η' + t⁻²(w'−θ)(v'−η)
+//!             b(η,v;μ)   = ∫ s v μ
+//!             S(θ,λ;η,μ) = Σ_T h_T⁴ (θ''' − sλ, η''' − sμ)_T
+//!             ℓ(η,v)     = ∫ f v
+//!             B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(η,v;λ) − b(θ,w;μ) − α S(θ,λ;η,μ)
+//!         ";
+//!     }
+//! }
+//! ```
+//!
+//! ## Declarations (Rust tokens)
+//! - `unknowns: NAME: ELEMENT, …` with elements `P0 P1 P2 P3 Hermite`; `λ: P0 >= 0`
+//!   marks a multiplier constrained to be non-negative.
+//! - `tests: …` one test function per unknown, in order: `η` goes with `θ`.
+//! - `params: …` runtime scalars; `data: f, ψ: 0` functions of x (the number is the
+//!   polynomial degree assumed for quadrature, default 2).
+//! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may
+//!   want `#![allow(mixed_script_confusables)]`.
+//!
+//! ## The forms text
+//! One definition per line (a line that does not start with `name(…) =` continues the
+//! previous one; `#` starts a comment):
+//! - `a(θ,w;η,v) = …` a **bilinear** form: trial arguments, `;`, test arguments. Each term
+//!   must hold exactly one function of each group; block (row, column) = (field of the test
+//!   function, field of the trial function). `ℓ(η,v) = …` a **linear** form.
+//! - `∫ integrand` (ASCII `int`) integrates over the domain, element by element; its
+//!   integrand runs over the whole sum to its right, up to a `+`/`−` that starts another
+//!   integral or form call. `∫[degree=N]` overrides the quadrature (e.g. `∫[degree=1]` for
+//!   one-point reduced integration).
+//! - `Σ_T w (X, Y)_T` (ASCII `sum_T`) is the sum over elements of weighted L² products.
+//! - Derivatives: `w'`, `w''`, …, `w''''` (also `′ ″ ‴ ⁗`), of arguments or of linear
+//!   combinations `(w'−θ)'`; taken element-wise. A derivative above the element's degree
+//!   is zero and the term is dropped (`θ'''` of P2); P0 fields have no derivative.
+//! - Products by juxtaposition, `·`, `⋅`, `×` or `*`; `/` by numbers and parameters;
+//!   powers `t⁻²`, `h⁴` or `t^-2`, `h^4`, `t^(-2)`; minus `−` or `-`.
+//! - Names: declared symbols, `h` or `h_T` (element size); names written together that
+//!   are declared symbols multiply (`sλ` = `s·λ`).
+//! - A form may call forms defined above it with other arguments:
+//!   `B_h(…) = a(θ,w;η,v) − b(η,v;λ)` substitutes the arguments positionally (each must
+//!   belong to the same field as the formal argument it replaces).
+//!
+//! ## What is generated
+//! A module `NAME` with `Model` (implementing the runtime's `Model` trait), and per form
+//! a module with one kernel per nonzero block: `a::matrix_η_θ(x, p, d) -> [[f64; 3]; 3]`
+//! (rows η, columns θ) and `ℓ::vector_v(x, p, d) -> [f64; 3]`. Constant-coefficient
+//! terms are integrated exactly at compile time; data terms use Gauss–Legendre rules
+//! exact for the term's degree (data counted with their declared degree).
+//!
+//! To read the generated code, build with `FEM_FORMS_DUMP_DIR=some/dir`: each model is
+//! written there, formatted, as `NAME.rs` (touch the model file first if it is already
+//! built, so that the macro runs again).
+//!
+//! ## Errors
+//! Every mistake is a compile error at the token, or for the forms text at the string
+//! literal with the line, the column and a caret in the message, plus a hint; errors in
+//! several definitions are reported together.
+
+mod analysis;
+mod codegen;
+mod declaration;
+mod diagnostic;
+mod lexer;
+mod parser;
+mod symbolic;
+
+use analysis::{Field, Symbols};
+use declaration::Declaration;
+use fem_reference::ElementKind;
+use proc_macro2::TokenStream;
+
+/// Compiles a model declaration into element kernels (see the crate docs).
+#[proc_macro]
+pub fn model(input: proc_macro::TokenStream) -> proc_macro::TokenStream {
+    expand(input.into()).into()
+}
+
+/// The macro on `proc_macro2` types: declaration → analysis → code, or compile errors.
+fn expand(input: TokenStream) -> TokenStream {
+    let declaration = match syn::parse2::<Declaration>(input) {
+        Ok(d) => d,
+        Err(e) => return e.to_compile_error(),
+    };
+    let mut errors = declaration.check();
+    let symbols = Symbols {
+        fields: declaration
+            .unknowns
+            .iter()
+            .enumerate()
+            .map(|(k, u)| Field {
+                name: u.name.to_string(),
+                test_name: declaration
+                    .tests
+                    .get(k)
+                    .map_or_else(|| format!("{}_test", u.name), |t| t.to_string()),
+                // An unknown element is reported above; P1 lets the analysis go on.
+                element: u.element.unwrap_or(ElementKind::P1),
+                nonnegative: u.nonnegative,
+            })
+            .collect(),
+        params: declaration.params.iter().map(|p| p.to_string()).collect(),
+        data: declaration
+            .data
+            .iter()
+            .map(|d| (d.name.to_string(), d.degree))
+            .collect(),
+    };
+    let text = declaration.forms.value();
+    let (tokens, lex_errors) = lexer::tokenize(&text);
+    let (definitions, parse_errors) = parser::parse_forms(&tokens);
+    let (forms, analysis_errors) = analysis::analyse(&symbols, &definitions, &text);
+    errors.extend(lex_errors);
+    errors.extend(parse_errors);
+    errors.extend(analysis_errors);
+    if !errors.is_empty() {
+        let span = declaration.forms.span();
+        return errors
+            .iter()
+            .map(|e| e.to_compile_error(&text, span))
+            .collect();
+    }
+    let code = codegen::generate(&declaration, &symbols, &forms);
+    if let Ok(dir) = std::env::var("FEM_FORMS_DUMP_DIR") {
+        dump(&dir, &declaration.name.to_string(), &code);
+    }
+    code
+}
+
+fn dump(dir: &str, name: &str, code: &TokenStream) {
+    let text = match syn::parse2::<syn::File>(code.clone()) {
+        Ok(file) => prettyplease::unparse(&file),
+        Err(_) => code.to_string(),
+    };
+    let path = std::path::Path::new(dir).join(format!("{name}.rs"));
+    // Dumping is a debugging aid: failing to write must not fail the build.
+    let _ = std::fs::create_dir_all(dir).and_then(|_| std::fs::write(path, text));
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,781 @@
+//! The forms text → a syntax tree of form definitions.
+//!
+//! ```text
+//! definition := NAME '(' args [';' args] ')' '=' sum
+//! sum        := term (('+' | '−') term)*
+//! term       := ('+' | '−')* product
+//! product    := factor (('·' | '*' | '/')? factor)*        juxtaposition multiplies
+//! factor     := primary (prime | superscript | '^' exponent)*
+//! primary    := number | name | form '(' args ')' | '(' sum ')' | '(' sum ',' sum ')_T'
+//!             | '∫' ['[' 'degree' '=' integer ']'] sum | 'Σ_T' sum
+//! ```
+//! An integral's integrand extends to the right over the whole sum, up to a `+`/`−` that
+//! starts a new integral or form call (`∫ A + ∫[degree=1] B`, `a(…) − α S(…)`).
+//! A definition starts at the beginning of a line with `NAME(args) =`; anything else
+//! continues the previous line, so long forms may wrap.
+
+use crate::diagnostic::{Diagnostic, Loc};
+use crate::lexer::{Tok, Token};
+use std::collections::HashSet;
+
+/// A name with its place.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Name {
+    /// The name as written.
+    pub text: String,
+    /// Where it is written.
+    pub loc: Loc,
+}
+
+/// Integral or sum over elements (the same thing for element-wise integrands; only the
+/// L² products `(X, Y)_T` differ in where they may appear).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegralKind {
+    /// `∫ …`
+    Integral,
+    /// `Σ_T …`
+    SumOverElements,
+}
+
+/// An expression node.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    /// A literal number.
+    Number(f64),
+    /// A name: parameter, data, argument, `h`, or juxtaposed names (`sλ`).
+    Symbol(String),
+    /// `−x`
+    Neg(Box<Expr>),
+    /// `x + y`
+    Add(Box<Expr>, Box<Expr>),
+    /// `x − y`
+    Sub(Box<Expr>, Box<Expr>),
+    /// `x · y`
+    Mul(Box<Expr>, Box<Expr>),
+    /// `x / y`
+    Div(Box<Expr>, Box<Expr>),
+    /// `x^n`
+    Pow(Box<Expr>, i32),
+    /// `x'`, `x''`, …
+    Derivative(Box<Expr>, u8),
+    /// `(x, y)_T`
+    InnerProduct(Box<Expr>, Box<Expr>),
+    /// `∫ body` or `Σ_T body`
+    Integral {
+        /// Which notation.
+        kind: IntegralKind,
+        /// Explicit quadrature degree (`∫[degree=1]`).
+        degree: Option<usize>,
+        /// The integrand.
+        body: Box<Expr>,
+    },
+    /// `b(η,v;λ)`: a previously defined form applied to arguments.
+    Call {
+        /// Form name.
+        name: String,
+        /// Argument groups (one for linear forms, two for bilinear ones).
+        groups: Vec<Vec<Name>>,
+    },
+}
+
+/// An expression with its place.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    /// The node.
+    pub kind: ExprKind,
+    /// Where it is written.
+    pub loc: Loc,
+}
+
+impl Expr {
+    fn new(kind: ExprKind, loc: Loc) -> Self {
+        Self { kind, loc }
+    }
+}
+
+/// `name(groups) = body`
+#[derive(Clone, Debug, PartialEq)]
+pub struct Definition {
+    /// The form's name.
+    pub name: Name,
+    /// Its argument groups: `[trial…]; [test…]` for bilinear forms, `[test…]` for linear ones.
+    pub groups: Vec<Vec<Name>>,
+    /// The right-hand side.
+    pub body: Expr,
+    /// First and last line of the definition in the forms text.
+    pub lines: (usize, usize),
+}
+
+/// Parses every definition of the forms text, collecting errors across definitions.
+pub fn parse_forms(tokens: &[Token]) -> (Vec<Definition>, Vec<Diagnostic>) {
+    let mut errors = Vec::new();
+    let starts: Vec<usize> = (0..tokens.len())
+        .filter(|&i| {
+            (i == 0 || tokens[i - 1].tok == Tok::Newline) && header_end(tokens, i).is_some()
+        })
+        .collect();
+    let first = starts.first().copied().unwrap_or(tokens.len());
+    if let Some(stray) = tokens[..first].iter().find(|t| t.tok != Tok::Newline) {
+        errors.push(
+            Diagnostic::text(stray.loc, "expected a form definition")
+                .help("each definition starts a line with `name(trial args; test args) =`, e.g. `a(u;v) = ∫ u'v'`"),
+        );
+    }
+    let form_names: HashSet<String> = starts
+        .iter()
+        .filter_map(|&i| match &tokens[i].tok {
+            Tok::Ident(name) => Some(name.clone()),
+            _ => None,
+        })
+        .collect();
+    let mut definitions = Vec::new();
+    for (k, &start) in starts.iter().enumerate() {
+        let end = starts.get(k + 1).copied().unwrap_or(tokens.len());
+        let slice: Vec<Token> = tokens[start..end]
+            .iter()
+            .filter(|t| t.tok != Tok::Newline)
+            .cloned()
+            .collect();
+        let last_line = slice.last().map_or(tokens[start].loc.line, |t| t.loc.line);
+        let mut parser = Parser {
+            tokens: &slice,
+            pos: 0,
+            form_names: &form_names,
+        };
+        match parser.definition() {
+            Ok(mut d) => {
+                d.lines = (tokens[start].loc.line, last_line);
+                definitions.push(d);
+            }
+            Err(e) => errors.push(e),
+        }
+    }
+    if starts.is_empty() && errors.is_empty() {
+        errors.push(
+            Diagnostic::text(Loc { line: 1, column: 1, len: 1 }, "the forms text defines no form")
+                .help("write definitions like `a(u;v) = ∫ u'v'` and `ℓ(v) = ∫ f v`, one per line"),
+        );
+    }
+    (definitions, errors)
+}
+
+/// Parses a lone expression (used by the tests of the symbolic layer).
+#[cfg(test)]
+pub(crate) fn parse_expression(tokens: &[Token]) -> Result<Expr> {
+    let names = HashSet::new();
+    let mut parser = Parser {
+        tokens,
+        pos: 0,
+        form_names: &names,
+    };
+    let e = parser.sum(false)?;
+    match parser.peek() {
+        None => Ok(e),
+        Some(_) => Err(parser.unexpected("the end of the expression")),
+    }
+}
+
+/// If a definition header `NAME ( … ) =` starts at `i`, the index of its `=`.
+fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
+    matches!(tokens.get(i)?.tok, Tok::Ident(_)).then_some(())?;
+    (tokens.get(i + 1)?.tok == Tok::LParen).then_some(())?;
+    let mut j = i + 2;
+    while let Some(t) = tokens.get(j) {
+        match t.tok {
+            Tok::Ident(_) | Tok::Comma | Tok::Semicolon => j += 1,
+            Tok::RParen => {
+                return (tokens.get(j + 1)?.tok == Tok::Equals).then_some(j + 1);
+            }
+            _ => return None,
+        }
+    }
+    None
+}
+
+struct Parser<'a> {
+    tokens: &'a [Token],
+    pos: usize,
+    form_names: &'a HashSet<String>,
+}
+
+type Result<T> = std::result::Result<T, Diagnostic>;
+
+fn describe(tok: &Tok) -> String {
+    match tok {
+        Tok::Ident(s) => format!("`{s}`"),
+        Tok::Number(v) => format!("the number {v}"),
+        Tok::Integral => "`∫`".into(),
+        Tok::SumT => "`Σ_T`".into(),
+        Tok::Prime(n) => format!("a derivative mark ({n} prime(s))"),
+        Tok::Superscript(_, raw) => format!("the exponent `{raw}`"),
+        Tok::Caret => "`^`".into(),
+        Tok::Plus => "`+`".into(),
+        Tok::Minus => "`−`".into(),
+        Tok::Star => "`·`".into(),
+        Tok::Slash => "`/`".into(),
+        Tok::LParen => "`(`".into(),
+        Tok::RParen => "`)`".into(),
+        Tok::LBracket => "`[`".into(),
+        Tok::RBracket => "`]`".into(),
+        Tok::LBrace => "`{`".into(),
+        Tok::RBrace => "`}`".into(),
+        Tok::Comma => "`,`".into(),
+        Tok::Semicolon => "`;`".into(),
+        Tok::Equals => "`=`".into(),
+        Tok::SubscriptT => "`_T`".into(),
+        Tok::Newline => "the end of the line".into(),
+    }
+}
+
+impl<'a> Parser<'a> {
+    fn peek(&self) -> Option<&'a Token> {
+        self.tokens.get(self.pos)
+    }
+
+    fn peek_tok(&self) -> Option<&'a Tok> {
+        self.peek().map(|t| &t.tok)
+    }
+
+    fn bump(&mut self) -> Option<&'a Token> {
+        let t = self.tokens.get(self.pos);
+        self.pos += 1;
+        t
+    }
+
+    /// Place of the current token, or just past the last one.
+    fn here(&self) -> Loc {
+        match self.peek() {
+            Some(t) => t.loc,
+            None => self.tokens.last().map_or(Loc::default(), |t| Loc {
+                column: t.loc.column + t.loc.len,
+                len: 1,
+                ..t.loc
+            }),
+        }
+    }
+
+    fn previous_loc(&self) -> Loc {
+        self.tokens[self.pos.saturating_sub(1).min(self.tokens.len() - 1)].loc
+    }
+
+    fn unexpected(&self, expected: &str) -> Diagnostic {
+        match self.peek() {
+            Some(t) => Diagnostic::text(
+                t.loc,
+                format!("expected {expected}, found {}", describe(&t.tok)),
+            ),
+            None => Diagnostic::text(
+                self.here(),
+                format!("expected {expected}, found the end of the definition"),
+            ),
+        }
+    }
+
+    fn expect(&mut self, tok: Tok, expected: &str) -> Result<&'a Token> {
+        if self.peek_tok() == Some(&tok) {
+            Ok(self.bump().unwrap())
+        } else {
+            Err(self.unexpected(expected))
+        }
+    }
+
+    fn definition(&mut self) -> Result<Definition> {
+        let name = self.name("a form name")?;
+        self.expect(Tok::LParen, "`(`")?;
+        let groups = self.argument_groups()?;
+        self.expect(Tok::Equals, "`=`")?;
+        if self.peek().is_none() {
+            return Err(self.unexpected("the form's right-hand side"));
+        }
+        let body = self.sum(false)?;
+        if let Some(t) = self.peek() {
+            let d = match t.tok {
+                Tok::RParen => Diagnostic::text(t.loc, "unmatched `)`")
+                    .help("remove it, or add the `(` it was meant to close"),
+                _ => self.unexpected("an operator (+, −, ·, /) or the end of the definition"),
+            };
+            return Err(d);
+        }
+        Ok(Definition {
+            name,
+            groups,
+            body,
+            lines: (0, 0),
+        })
+    }
+
+    fn name(&mut self, what: &str) -> Result<Name> {
+        match self.peek() {
+            Some(Token {
+                tok: Tok::Ident(s),
+                loc,
+            }) => {
+                self.pos += 1;
+                Ok(Name {
+                    text: s.clone(),
+                    loc: *loc,
+                })
+            }
+            _ => Err(self.unexpected(what)),
+        }
+    }
+
+    /// `a, b; c)` after the opening parenthesis.
+    fn argument_groups(&mut self) -> Result<Vec<Vec<Name>>> {
+        let mut groups = vec![Vec::new()];
+        loop {
+            match self.peek_tok() {
+                Some(Tok::RParen) => {
+                    self.pos += 1;
+                    return Ok(groups);
+                }
+                Some(Tok::Ident(_)) => {
+                    let n = self.name("an argument name")?;
+                    groups.last_mut().unwrap().push(n);
+                    match self.peek_tok() {
+                        Some(Tok::Comma) => self.pos += 1,
+                        Some(Tok::Semicolon) => {
+                            if groups.len() == 2 {
+                                return Err(self.unexpected("`,` or `)` (a form has at most two argument groups)"));
+                            }
+                            self.pos += 1;
+                            groups.push(Vec::new());
+                        }
+                        Some(Tok::RParen) => {}
+                        _ => return Err(self.unexpected("`,`, `;` or `)`")),
+                    }
+                }
+                _ => return Err(self.unexpected("an argument name or `)`")),
+            }
+        }
+    }
+
+    /// Whether the term after a `+`/`−` at `start` is a new integral or form call.
+    fn starts_form_term(&self, start: usize) -> bool {
+        let mut depth = 0usize;
+        let mut i = start;
+        while matches!(
+            self.tokens.get(i).map(|t| &t.tok),
+            Some(Tok::Plus | Tok::Minus)
+        ) {
+            i += 1;
+        }
+        while let Some(t) = self.tokens.get(i) {
+            match &t.tok {
+                Tok::LParen | Tok::LBracket => depth += 1,
+                Tok::RParen | Tok::RBracket => {
+                    if depth == 0 {
+                        return false;
+                    }
+                    depth -= 1;
+                }
+                Tok::Caret => {
+                    // `t^-2`: the sign belongs to the exponent
+                    if matches!(
+                        self.tokens.get(i + 1).map(|t| &t.tok),
+                        Some(Tok::Minus | Tok::Plus)
+                    ) {
+                        i += 1;
+                    }
+                }
+                Tok::Plus | Tok::Minus | Tok::Comma if depth == 0 => return false,
+                Tok::Integral | Tok::SumT if depth == 0 => return true,
+                Tok::Ident(name)
+                    if depth == 0
+                        && self.form_names.contains(name)
+                        && self.tokens.get(i + 1).map(|t| &t.tok) == Some(&Tok::LParen) =>
+                {
+                    return true
+                }
+                _ => {}
+            }
+            i += 1;
+        }
+        false
+    }
+
+    fn sum(&mut self, integrand: bool) -> Result<Expr> {
+        let mut lhs = self.term(integrand)?;
+        while let Some(Tok::Plus | Tok::Minus) = self.peek_tok() {
+            if integrand && self.starts_form_term(self.pos + 1) {
+                break;
+            }
+            let op = self.bump().unwrap().tok.clone();
+            let rhs = self.term(integrand)?;
+            let loc = lhs.loc.to(rhs.loc);
+            lhs = Expr::new(
+                if op == Tok::Plus {
+                    ExprKind::Add(Box::new(lhs), Box::new(rhs))
+                } else {
+                    ExprKind::Sub(Box::new(lhs), Box::new(rhs))
+                },
+                loc,
+            );
+        }
+        Ok(lhs)
+    }
+
+    fn term(&mut self, integrand: bool) -> Result<Expr> {
+        match self.peek_tok() {
+            Some(Tok::Minus) => {
+                let loc = self.bump().unwrap().loc;
+                let inner = self.term(integrand)?;
+                let loc = loc.to(inner.loc);
+                Ok(Expr::new(ExprKind::Neg(Box::new(inner)), loc))
+            }
+            Some(Tok::Plus) => {
+                self.pos += 1;
+                self.term(integrand)
+            }
+            _ => self.product(),
+        }
+    }
+
+    fn starts_factor(tok: &Tok) -> bool {
+        matches!(
+            tok,
+            Tok::Ident(_) | Tok::Number(_) | Tok::LParen | Tok::Integral | Tok::SumT
+        )
+    }
+
+    fn product(&mut self) -> Result<Expr> {
+        let mut lhs = self.factor()?;
+        loop {
+            let (is_div, explicit) = match self.peek_tok() {
+                Some(Tok::Star) => (false, true),
+                Some(Tok::Slash) => (true, true),
+                Some(t) if Self::starts_factor(t) => (false, false),
+                _ => break,
+            };
+            if explicit {
+                self.pos += 1;
+            }
+            let rhs = if explicit && self.peek_tok() == Some(&Tok::Minus) {
+                let loc = self.bump().unwrap().loc;
+                let f = self.factor()?;
+                let loc = loc.to(f.loc);
+                Expr::new(ExprKind::Neg(Box::new(f)), loc)
+            } else {
+                self.factor()?
+            };
+            let loc = lhs.loc.to(rhs.loc);
+            lhs = Expr::new(
+                if is_div {
+                    ExprKind::Div(Box::new(lhs), Box::new(rhs))
+                } else {
+                    ExprKind::Mul(Box::new(lhs), Box::new(rhs))
+                },
+                loc,
+            );
+        }
+        Ok(lhs)
+    }
+
+    fn factor(&mut self) -> Result<Expr> {
+        let mut e = self.primary()?;
+        loop {
+            match self.peek() {
+                Some(Token {
+                    tok: Tok::Prime(n),
+                    loc,
+                }) => {
+                    self.pos += 1;
+                    let l = e.loc.to(*loc);
+                    e = Expr::new(ExprKind::Derivative(Box::new(e), *n), l);
+                }
+                Some(Token {
+                    tok: Tok::Superscript(value, raw),
+                    loc,
+                }) => {
+                    self.pos += 1;
+                    let Some(n) = value else {
+                        return Err(Diagnostic::text(*loc, format!("malformed exponent `{raw}`"))
+                            .help("write an integer exponent such as ² or ⁻² (ASCII: ^2, ^-2)"));
+                    };
+                    let l = e.loc.to(*loc);
+                    e = Expr::new(ExprKind::Pow(Box::new(e), *n), l);
+                }
+                Some(Token {
+                    tok: Tok::Caret,
+                    loc,
+                }) => {
+                    self.pos += 1;
+                    let (n, end) = self.ascii_exponent(*loc)?;
+                    let l = e.loc.to(end);
+                    e = Expr::new(ExprKind::Pow(Box::new(e), n), l);
+                }
+                _ => return Ok(e),
+            }
+        }
+    }
+
+    /// After `^`: `2`, `-2`, `(-2)`, `{-2}`.
+    fn ascii_exponent(&mut self, caret: Loc) -> Result<(i32, Loc)> {
+        let malformed = |loc: Loc| {
+            Diagnostic::text(loc, "malformed exponent after `^`")
+                .help("write an integer exponent: t^2, t^-2, t^(-2), or the superscripts t² t⁻²")
+        };
+        let close = match self.peek_tok() {
+            Some(Tok::LParen) => Some(Tok::RParen),
+            Some(Tok::LBrace) => Some(Tok::RBrace),
+            _ => None,
+        };
+        if close.is_some() {
+            self.pos += 1;
+        }
+        let mut sign = 1.0;
+        match self.peek_tok() {
+            Some(Tok::Minus) => {
+                sign = -1.0;
+                self.pos += 1;
+            }
+            Some(Tok::Plus) => self.pos += 1,
+            _ => {}
+        }
+        let (value, mut end) = match self.peek() {
+            Some(Token {
+                tok: Tok::Number(v),
+                loc,
+            }) if v.fract() == 0.0 && v.abs() < 1e6 => (sign * v, *loc),
+            Some(t) => return Err(malformed(caret.to(t.loc))),
+            None => return Err(malformed(caret)),
+        };
+        self.pos += 1;
+        if let Some(close) = close {
+            match self.peek() {
+                Some(t) if t.tok == close => {
+                    end = t.loc;
+                    self.pos += 1;
+                }
+                _ => return Err(malformed(caret.to(end))),
+            }
+        }
+        Ok((value as i32, end))
+    }
+
+    fn primary(&mut self) -> Result<Expr> {
+        let Some(token) = self.peek() else {
+            return Err(self.unexpected("an expression"));
+        };
+        let loc = token.loc;
+        match &token.tok {
+            Tok::Number(v) => {
+                self.pos += 1;
+                Ok(Expr::new(ExprKind::Number(*v), loc))
+            }
+            Tok::Ident(name) => {
+                self.pos += 1;
+                if self.form_names.contains(name) && self.peek_tok() == Some(&Tok::LParen) {
+                    self.pos += 1;
+                    let groups = self.argument_groups()?;
+                    let l = loc.to(self.previous_loc());
+                    return Ok(Expr::new(
+                        ExprKind::Call {
+                            name: name.clone(),
+                            groups,
+                        },
+                        l,
+                    ));
+                }
+                Ok(Expr::new(ExprKind::Symbol(name.clone()), loc))
+            }
+            Tok::LParen => {
+                self.pos += 1;
+                let first = self.sum(false)?;
+                let second = if self.peek_tok() == Some(&Tok::Comma) {
+                    self.pos += 1;
+                    Some(self.sum(false)?)
+                } else {
+                    None
+                };
+                match self.peek_tok() {
+                    Some(Tok::RParen) => {}
+                    None => {
+                        return Err(Diagnostic::text(loc, "this `(` is never closed")
+                            .help("add the matching `)`"))
+                    }
+                    Some(_) => {
+                        return Err(self.unexpected("`)`").help(format!(
+                            "the `(` at line {}, column {} is still open",
+                            loc.line, loc.column
+                        )))
+                    }
+                }
+                let close = self.bump().unwrap().loc;
+                let subscript = self.peek_tok() == Some(&Tok::SubscriptT);
+                match (second, subscript) {
+                    (Some(second), true) => {
+                        let end = self.bump().unwrap().loc;
+                        Ok(Expr::new(
+                            ExprKind::InnerProduct(Box::new(first), Box::new(second)),
+                            loc.to(end),
+                        ))
+                    }
+                    (Some(_), false) => Err(Diagnostic::text(loc.to(close), "a pair `(X, Y)` is only meaningful as an L² product over elements")
+                        .help("write `(X, Y)_T` inside `Σ_T`, or `∫ X·Y`")),
+                    (None, true) => Err(Diagnostic::text(self.here(), "`(X)_T` needs two arguments")
+                        .help("an L² product over an element is written `(X, Y)_T`")),
+                    (None, false) => Ok(Expr::new(first.kind, loc.to(close))),
+                }
+            }
+            Tok::Integral | Tok::SumT => {
+                let kind = if token.tok == Tok::Integral {
+                    IntegralKind::Integral
+                } else {
+                    IntegralKind::SumOverElements
+                };
+                self.pos += 1;
+                let degree = if self.peek_tok() == Some(&Tok::LBracket) {
+                    Some(self.quadrature_option()?)
+                } else {
+                    None
+                };
+                if self.peek().is_none() {
+                    return Err(self.unexpected("an integrand"));
+                }
+                let body = self.sum(true)?;
+                let l = loc.to(body.loc);
+                Ok(Expr::new(
+                    ExprKind::Integral {
+                        kind,
+                        degree,
+                        body: Box::new(body),
+                    },
+                    l,
+                ))
+            }
+            Tok::RParen => Err(Diagnostic::text(loc, "unmatched `)`")
+                .help("remove it, or add the `(` it was meant to close")),
+            _ => Err(self.unexpected("an expression")),
+        }
+    }
+
+    /// `[degree=N]` after `∫`.
+    fn quadrature_option(&mut self) -> Result<usize> {
+        let open = self.bump().unwrap().loc;
+        let bad = |loc: Loc| {
+            Diagnostic::text(loc, "malformed quadrature option")
+                .help("write `∫[degree=N]` to integrate exactly polynomials of degree N (e.g. ∫[degree=1] for one-point reduced integration)")
+        };
+        match self.peek_tok() {
+            Some(Tok::Ident(k)) if k == "degree" => self.pos += 1,
+            _ => return Err(bad(self.here())),
+        }
+        if self.peek_tok() != Some(&Tok::Equals) {
+            return Err(bad(self.here()));
+        }
+        self.pos += 1;
+        let degree = match self.peek_tok() {
+            Some(Tok::Number(v)) if v.fract() == 0.0 && *v >= 0.0 && *v <= 40.0 => *v as usize,
+            _ => return Err(bad(self.here())),
+        };
+        self.pos += 1;
+        if self.peek_tok() != Some(&Tok::RBracket) {
+            return Err(bad(open.to(self.here())));
+        }
+        self.pos += 1;
+        Ok(degree)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lexer::tokenize;
+
+    fn parse(text: &str) -> (Vec<Definition>, Vec<Diagnostic>) {
+        let (tokens, errors) = tokenize(text);
+        assert!(errors.is_empty());
+        parse_forms(&tokens)
+    }
+
+    fn sexpr(e: &Expr) -> String {
+        use ExprKind::*;
+        match &e.kind {
+            Number(v) => format!("{v}"),
+            Symbol(s) => s.clone(),
+            Neg(a) => format!("(- {})", sexpr(a)),
+            Add(a, b) => format!("(+ {} {})", sexpr(a), sexpr(b)),
+            Sub(a, b) => format!("(- {} {})", sexpr(a), sexpr(b)),
+            Mul(a, b) => format!("(* {} {})", sexpr(a), sexpr(b)),
+            Div(a, b) => format!("(/ {} {})", sexpr(a), sexpr(b)),
+            Pow(a, n) => format!("(^ {} {n})", sexpr(a)),
+            Derivative(a, n) => format!("(d{n} {})", sexpr(a)),
+            InnerProduct(a, b) => format!("(ip {} {})", sexpr(a), sexpr(b)),
+            Integral { degree, body, .. } => format!("(int{degree:?} {})", sexpr(body)),
+            Call { name, groups } => format!(
+                "(call {name} {})",
+                groups
+                    .iter()
+                    .map(|g| g.iter().map(|n| n.text.clone()).collect::<Vec<_>>().join(","))
+                    .collect::<Vec<_>>()
+                    .join(";")
+            ),
+        }
+    }
+
+    #[test]
+    fn the_users_timoshenko_line() {
+        let (defs, errors) = parse("a(θ,w;η,v) = ∫θ'η' + t⁻²(w'−θ)(v'−η)");
+        assert!(errors.is_empty(), "{errors:?}");
+        assert_eq!(defs[0].name.text, "a");
+        assert_eq!(defs[0].groups.len(), 2);
+        assert_eq!(
+            sexpr(&defs[0].body),
+            "(intNone (+ (* (d1 θ) (d1 η)) (* (* (^ t -2) (- (d1 w) θ)) (- (d1 v) η))))"
+        );
+        let (ascii, errors) = parse("a(θ,w;η,v) = int θ'η' + t^-2 (w'-θ)(v'-η)");
+        assert!(errors.is_empty());
+        assert_eq!(sexpr(&ascii[0].body), sexpr(&defs[0].body));
+    }
+
+    #[test]
+    fn integrals_and_calls_split_at_new_form_terms() {
+        let text = "a(u;v) = ∫ u'v' + ∫[degree=1] u v\n\
+                    b(u;v) = ∫ u v\n\
+                    B(u;v) = a(u;v) − 2 α b(u;v)\n\
+                    S(u;v) = Σ_T h_T⁴ (u'' − 1, v'')_T";
+        let (defs, errors) = parse(text);
+        assert!(errors.is_empty(), "{errors:?}");
+        assert_eq!(
+            sexpr(&defs[0].body),
+            "(+ (intNone (* (d1 u) (d1 v))) (intSome(1) (* u v)))"
+        );
+        assert_eq!(
+            sexpr(&defs[2].body),
+            "(- (call a u;v) (* (* 2 α) (call b u;v)))"
+        );
+        assert_eq!(
+            sexpr(&defs[3].body),
+            "(intNone (* (^ h_T 4) (ip (- (d2 u) 1) (d2 v))))"
+        );
+    }
+
+    #[test]
+    fn definitions_may_wrap_lines() {
+        let (defs, errors) = parse("a(u;v) = ∫ u'v'\n    + u v\nℓ(v) = ∫ f v");
+        assert!(errors.is_empty());
+        assert_eq!(defs.len(), 2);
+        assert_eq!(defs[0].lines, (1, 2));
+        assert_eq!(sexpr(&defs[0].body), "(intNone (+ (* (d1 u) (d1 v)) (* u v)))");
+    }
+
+    #[test]
+    fn errors_in_several_definitions_are_all_reported() {
+        let (_, errors) = parse("a(u;v) = ∫ (u v\nb(u;v) = ∫ u v)\nc(u;v) = ∫ t^ u v");
+        assert_eq!(errors.len(), 3, "{errors:?}");
+        assert!(errors[0].message.contains("never closed"));
+        assert!(errors[1].message.contains("unmatched `)`"));
+        assert!(errors[2].message.contains("malformed exponent"));
+    }
+
+    #[test]
+    fn powers_and_signs() {
+        let (defs, errors) = parse("a(u;v) = ∫ −2·t^(-2) h^{3} u/4 v + -u v");
+        assert!(errors.is_empty(), "{errors:?}");
+        assert_eq!(
+            sexpr(&defs[0].body),
+            "(intNone (+ (- (* (/ (* (* (* 2 (^ t -2)) (^ h 3)) u) 4) v)) (- (* u v))))"
+        );
+    }
+}

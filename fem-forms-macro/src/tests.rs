@@ -1,0 +1,284 @@
+//! End-to-end tests of the macro on `proc_macro2` input, and property tests of the
+//! symbolic layer.
+
+
+use super::*;
+use quote::quote;
+
+fn timoshenko(forms: &str) -> TokenStream {
+    quote! {
+        /// Timoshenko beam.
+        pub mod timoshenko on interval {
+            unknowns: θ: P2, w: P2, λ: P0 >= 0;
+            tests: η, v, μ;
+            params: t, α, s;
+            data: f, ψ;
+            forms: #forms;
+        }
+    }
+}
+
+const TIMOSHENKO: &str = "
+    a(θ,w;η,v) = ∫θ'η' + t⁻²(w'−θ)(v'−η)
+    b(η,v;μ)   = ∫ s v μ
+    S(θ,λ;η,μ) = Σ_T h_T⁴ (θ''' − sλ, η''' − sμ)_T
+    ℓ(η,v)     = ∫ f v
+    B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(η,v;λ) − b(θ,w;μ) − α S(θ,λ;η,μ)
+";
+
+fn rendered_errors(out: &TokenStream) -> Vec<String> {
+    // compile_error!{ "…" } invocations, one per error
+    let text = out.to_string();
+    text.split("compile_error")
+        .skip(1)
+        .map(|s| s.to_string())
+        .collect()
+}
+
+#[test]
+fn the_users_model_expands_to_valid_rust() {
+    let out = expand(timoshenko(TIMOSHENKO));
+    let file: syn::File = syn::parse2(out.clone()).expect("generated code parses");
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    assert_eq!(file.items.len(), 1);
+    for kernel in [
+        "fn matrix_η_θ",
+        "fn matrix_v_w",
+        "fn matrix_v_θ",
+        "fn matrix_η_w",
+        "fn matrix_μ_w",
+        "fn matrix_μ_λ",
+        "fn vector_v",
+    ] {
+        assert!(text.contains(kernel), "missing {kernel}");
+    }
+    // θ''' of P2 vanishes: S has only the (μ, λ) block, no (η, ·) or (·, θ) blocks.
+    let s_module = text.split("pub mod S").nth(1).unwrap().split("pub mod").next().unwrap();
+    assert!(s_module.contains("fn matrix_μ_λ"));
+    assert!(!s_module.contains("fn matrix_η_θ") && !s_module.contains("fn matrix_μ_θ"));
+}
+
+#[test]
+fn unicode_and_ascii_spellings_give_the_same_blocks() {
+    let ascii = "
+        a(θ,w;η,v) = int θ'η' + t^-2 (w'-θ)*(v'-η)
+        b(η,v;μ) = int s*v*μ
+        S(θ,λ;η,μ) = sum_T h^4 (θ''' - s λ, η''' - s μ)_T
+        ℓ(η,v) = int f v
+        B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) - b(η,v;λ) - b(θ,w;μ) - α S(θ,λ;η,μ)
+    ";
+    let analyse_text = |text: &str| {
+        let symbols = Symbols {
+            fields: vec![
+                Field { name: "θ".into(), test_name: "η".into(), element: ElementKind::P2, nonnegative: false },
+                Field { name: "w".into(), test_name: "v".into(), element: ElementKind::P2, nonnegative: false },
+                Field { name: "λ".into(), test_name: "μ".into(), element: ElementKind::P0, nonnegative: true },
+            ],
+            params: vec!["t".into(), "α".into(), "s".into()],
+            data: vec![("f".into(), 2), ("ψ".into(), 2)],
+        };
+        let (tokens, e1) = lexer::tokenize(text);
+        let (defs, e2) = parser::parse_forms(&tokens);
+        let (forms, e3) = analysis::analyse(&symbols, &defs, text);
+        assert!(e1.is_empty() && e2.is_empty() && e3.is_empty());
+        forms.into_iter().map(|f| f.blocks).collect::<Vec<_>>()
+    };
+    assert_eq!(analyse_text(TIMOSHENKO), analyse_text(ascii));
+}
+
+#[test]
+fn several_errors_are_reported_together_with_places() {
+    let out = expand(timoshenko(
+        "a(θ,w;η,v) = ∫ θ'η' + q(w'−θ)(v'−η)\n\
+         b(η,v;μ) = ∫ s v μ μ\n\
+         c(λ;η) = ∫ λ' η",
+    ));
+    let errors = rendered_errors(&out);
+    assert_eq!(errors.len(), 3, "{out}");
+    assert!(errors[0].contains("unknown symbol `q`") && errors[0].contains("line 1, column 23"));
+    assert!(errors[1].contains("nonlinear term"));
+    assert!(errors[2].contains("P0 field"));
+}
+
+#[test]
+fn declaration_errors_point_at_tokens() {
+    let out = expand(quote! {
+        pub mod m on interval {
+            unknowns: w: P7, λ: P0 >= 0;
+            tests: v;
+            forms: "a(w;v) = ∫ w'v'";
+        }
+    });
+    let errors = rendered_errors(&out);
+    assert_eq!(errors.len(), 2, "{out}");
+    assert!(errors[0].contains("unknown element `P7`"));
+    assert!(errors[1].contains("1 test functions for 2 unknowns"));
+}
+
+mod symbolic_properties {
+    use super::*;
+    use crate::symbolic::{evaluate, ArgFactor};
+    use proptest::prelude::*;
+
+    /// A random expression, to be written in one of the spellings and evaluated directly.
+    #[derive(Clone, Debug)]
+    enum Gen {
+        Number(i32),
+        Param(usize),
+        H,
+        Data,
+        /// argument symbol (0 = u, 1 = v) with derivative order
+        Arg(usize, u8),
+        /// (a·u + b·v)' with integer coefficients
+        DerivativeOfCombination(i32, i32, u8),
+        Add(Box<Gen>, Box<Gen>),
+        Sub(Box<Gen>, Box<Gen>),
+        Mul(Box<Gen>, Box<Gen>),
+        Neg(Box<Gen>),
+        Pow(Box<Gen>, u8),
+        ParamInversePower(usize, u8),
+    }
+
+    struct Values {
+        params: [f64; 2],
+        h: f64,
+        f: f64,
+        /// [symbol][derivative]
+        args: [[f64; 3]; 2],
+    }
+
+    fn primes(n: u8, ascii: bool) -> String {
+        if ascii {
+            "'".repeat(n as usize)
+        } else {
+            ["", "′", "″", "‴"][n as usize].to_string()
+        }
+    }
+
+    fn write(g: &Gen, ascii: bool) -> String {
+        let params = ["t", "α"];
+        let args = ["u", "v"];
+        match g {
+            Gen::Number(n) if *n < 0 => format!("({})", n),
+            Gen::Number(n) => format!("{n}"),
+            Gen::Param(i) => params[*i].to_string(),
+            Gen::H => if ascii { "h".into() } else { "h_T".into() },
+            Gen::Data => "f".into(),
+            Gen::Arg(s, d) => format!("{}{}", args[*s], primes(*d, ascii)),
+            Gen::DerivativeOfCombination(a, b, d) => {
+                format!("({a} u + ({b}) v){}", primes(*d, ascii))
+            }
+            Gen::Add(a, b) => format!("({} + {})", write(a, ascii), write(b, ascii)),
+            Gen::Sub(a, b) => {
+                let minus = if ascii { "-" } else { "−" };
+                format!("({} {minus} {})", write(a, ascii), write(b, ascii))
+            }
+            Gen::Mul(a, b) => {
+                let times = if ascii { "*" } else { "·" };
+                format!("{}{times}{}", write(a, ascii), write(b, ascii))
+            }
+            Gen::Neg(a) => format!("(-{})", write(a, ascii)),
+            Gen::Pow(a, n) => {
+                if ascii {
+                    format!("({})^{n}", write(a, ascii))
+                } else {
+                    format!("({}){}", write(a, ascii), ["⁰", "¹", "²", "³"][*n as usize])
+                }
+            }
+            Gen::ParamInversePower(i, n) => {
+                if ascii {
+                    format!("{}^(-{n})", params[*i])
+                } else {
+                    format!("{}⁻{}", params[*i], ["⁰", "¹", "²", "³"][*n as usize])
+                }
+            }
+        }
+    }
+
+    fn value(g: &Gen, v: &Values) -> f64 {
+        match g {
+            Gen::Number(n) => *n as f64,
+            Gen::Param(i) => v.params[*i],
+            Gen::H => v.h,
+            Gen::Data => v.f,
+            Gen::Arg(s, d) => v.args[*s][*d as usize],
+            Gen::DerivativeOfCombination(a, b, d) => {
+                *a as f64 * v.args[0][*d as usize] + *b as f64 * v.args[1][*d as usize]
+            }
+            Gen::Add(a, b) => value(a, v) + value(b, v),
+            Gen::Sub(a, b) => value(a, v) - value(b, v),
+            Gen::Mul(a, b) => value(a, v) * value(b, v),
+            Gen::Neg(a) => -value(a, v),
+            Gen::Pow(a, n) => value(a, v).powi(*n as i32),
+            Gen::ParamInversePower(i, n) => v.params[*i].powi(-(*n as i32)),
+        }
+    }
+
+    fn generator() -> impl Strategy<Value = Gen> {
+        let leaf = prop_oneof![
+            (-3i32..=5).prop_map(Gen::Number),
+            (0usize..2).prop_map(Gen::Param),
+            Just(Gen::H),
+            Just(Gen::Data),
+            (0usize..2, 0u8..3).prop_map(|(s, d)| Gen::Arg(s, d)),
+            (-3i32..4, -3i32..4, 1u8..3).prop_map(|(a, b, d)| Gen::DerivativeOfCombination(a, b, d)),
+            (0usize..2, 1u8..4).prop_map(|(i, n)| Gen::ParamInversePower(i, n)),
+        ];
+        leaf.prop_recursive(4, 24, 2, |inner| {
+            prop_oneof![
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| Gen::Add(Box::new(a), Box::new(b))),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| Gen::Sub(Box::new(a), Box::new(b))),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| Gen::Mul(Box::new(a), Box::new(b))),
+                inner.clone().prop_map(|a| Gen::Neg(Box::new(a))),
+                (inner, 0u8..4).prop_map(|(a, n)| Gen::Pow(Box::new(a), n)),
+            ]
+        })
+    }
+
+    fn symbols() -> Symbols {
+        Symbols {
+            fields: vec![Field {
+                name: "u".into(),
+                test_name: "v".into(),
+                element: ElementKind::P3,
+                nonnegative: false,
+            }],
+            params: vec!["t".into(), "α".into()],
+            data: vec![("f".into(), 2)],
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        /// Parsing, expanding into monomials and evaluating the monomials agrees with
+        /// evaluating the expression directly, in both spellings.
+        #[test]
+        fn expansion_agrees_with_direct_evaluation(
+            g in generator(),
+            params in prop::array::uniform2(0.3f64..2.0),
+            h in 0.1f64..2.0,
+            f in -2.0f64..2.0,
+            args in prop::array::uniform2(prop::array::uniform3(-2.0f64..2.0)),
+            ascii in any::<bool>(),
+        ) {
+            let text = write(&g, ascii);
+            let values = Values { params, h, f, args };
+            let expansion = analysis::expand_expression(&symbols(), &text)
+                .map_err(|e| TestCaseError::fail(format!("{text}: {e:?}")))?;
+            let direct = value(&g, &values);
+            // symbol 0 is u (the unknown), symbol 1 is v (its test function)
+            let arg = |a: ArgFactor| values.args[a.symbol][a.derivative as usize];
+            let expanded = evaluate(&expansion, &|i| values.params[i], values.h, &|_| values.f, &arg);
+            let scale: f64 = expansion
+                .iter()
+                .map(|m| m.evaluate(&|i| values.params[i], values.h, &|_| values.f, &arg).abs())
+                .sum::<f64>()
+                .max(direct.abs())
+                .max(1.0);
+            prop_assert!((expanded - direct).abs() <= 1e-10 * scale,
+                "{text}: expanded {expanded} direct {direct}");
+        }
+    }
+}

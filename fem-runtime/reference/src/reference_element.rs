@@ -1,0 +1,303 @@
+//! Reference elements on the reference interval `[0, 1]`.
+//!
+//! An element is declarative data: its degree, its DOF layout (which DOFs sit on which
+//! vertex and which are interior), and its basis as polynomials on the reference cell.
+//! Local DOFs are ordered vertex 0, vertex 1, then interior, so that a DOF map can
+//! share vertex DOFs between neighbouring cells.
+
+use crate::polynomial::Polynomial;
+
+/// The reference cell a model is posed on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CellKind {
+    /// The interval `[0, 1]` (beams).
+    Interval,
+    /// The triangle with vertices `(0,0), (1,0), (0,1)` (membranes and plates).
+    Triangle,
+}
+
+impl CellKind {
+    /// Spatial dimension of the cell.
+    pub fn dimension(self) -> usize {
+        match self {
+            CellKind::Interval => 1,
+            CellKind::Triangle => 2,
+        }
+    }
+
+    /// Number of vertices of the cell.
+    pub fn vertex_count(self) -> usize {
+        match self {
+            CellKind::Interval => 2,
+            CellKind::Triangle => 3,
+        }
+    }
+
+    /// The cell's name as written in a model file.
+    pub fn name(self) -> &'static str {
+        match self {
+            CellKind::Interval => "interval",
+            CellKind::Triangle => "triangle",
+        }
+    }
+}
+
+/// Where a degree of freedom lives on the reference cell and what it measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DofLocation {
+    /// The value (`derivative = 0`) or the first derivative (`derivative = 1`) at a vertex.
+    Vertex {
+        /// Local vertex number.
+        vertex: usize,
+        /// Order of the derivative this DOF measures.
+        derivative: usize,
+    },
+    /// A DOF owned by the cell alone (not shared with neighbours).
+    Interior,
+}
+
+/// The finite elements fem-forms knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ElementKind {
+    /// Piecewise constants, discontinuous (multipliers).
+    P0,
+    /// Continuous piecewise linear Lagrange.
+    P1,
+    /// Continuous piecewise quadratic Lagrange.
+    P2,
+    /// Continuous piecewise cubic Lagrange.
+    P3,
+    /// C¹ Hermite cubic on intervals: value and slope at both vertices.
+    Hermite,
+}
+
+/// Every element, in the order the DSL lists them in error messages.
+pub const ALL_ELEMENTS: [ElementKind; 5] = [
+    ElementKind::P0,
+    ElementKind::P1,
+    ElementKind::P2,
+    ElementKind::P3,
+    ElementKind::Hermite,
+];
+
+impl ElementKind {
+    /// The element's name as written in a model file.
+    pub fn name(self) -> &'static str {
+        match self {
+            ElementKind::P0 => "P0",
+            ElementKind::P1 => "P1",
+            ElementKind::P2 => "P2",
+            ElementKind::P3 => "P3",
+            ElementKind::Hermite => "Hermite",
+        }
+    }
+
+    /// Parses an element name (`P0`…`P3`, `Hermite`, `H3`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "P0" => Some(ElementKind::P0),
+            "P1" => Some(ElementKind::P1),
+            "P2" => Some(ElementKind::P2),
+            "P3" => Some(ElementKind::P3),
+            "Hermite" | "H3" => Some(ElementKind::Hermite),
+            _ => None,
+        }
+    }
+
+    /// Whether the element exists on the given cell (only intervals so far).
+    pub fn supports(self, cell: CellKind) -> bool {
+        cell == CellKind::Interval
+    }
+
+    /// Polynomial degree of the basis.
+    pub fn degree(self) -> usize {
+        match self {
+            ElementKind::P0 => 0,
+            ElementKind::P1 => 1,
+            ElementKind::P2 => 2,
+            ElementKind::P3 | ElementKind::Hermite => 3,
+        }
+    }
+
+    /// Highest derivative order the DSL may apply to a field of this element.
+    ///
+    /// Derivatives are taken element by element (broken); a piecewise constant field is
+    /// discontinuous, and its derivative is not a function, so P0 admits none.
+    pub fn max_derivative(self) -> usize {
+        match self {
+            ElementKind::P0 => 0,
+            _ => 4,
+        }
+    }
+
+    /// Whether neighbouring cells share the vertex DOFs.
+    pub fn is_continuous(self) -> bool {
+        self != ElementKind::P0
+    }
+
+    /// The DOF layout, in local order.
+    pub fn dofs(self) -> &'static [DofLocation] {
+        use DofLocation::*;
+        const V0: DofLocation = Vertex {
+            vertex: 0,
+            derivative: 0,
+        };
+        const V1: DofLocation = Vertex {
+            vertex: 1,
+            derivative: 0,
+        };
+        match self {
+            ElementKind::P0 => &[Interior],
+            ElementKind::P1 => &[V0, V1],
+            ElementKind::P2 => &[V0, V1, Interior],
+            ElementKind::P3 => &[V0, V1, Interior, Interior],
+            ElementKind::Hermite => &[
+                V0,
+                Vertex {
+                    vertex: 0,
+                    derivative: 1,
+                },
+                V1,
+                Vertex {
+                    vertex: 1,
+                    derivative: 1,
+                },
+            ],
+        }
+    }
+
+    /// Number of local DOFs.
+    pub fn dof_count(self) -> usize {
+        self.dofs().len()
+    }
+
+    /// Number of DOFs at each vertex (shared between neighbours for continuous elements).
+    pub fn dofs_per_vertex(self) -> usize {
+        if !self.is_continuous() {
+            return 0;
+        }
+        self.dofs()
+            .iter()
+            .filter(|d| matches!(d, DofLocation::Vertex { vertex: 0, .. }))
+            .count()
+    }
+
+    /// Number of interior DOFs of a cell.
+    pub fn interior_dof_count(self) -> usize {
+        self.dofs()
+            .iter()
+            .filter(|d| matches!(d, DofLocation::Interior))
+            .count()
+    }
+
+    /// Nodes of the Lagrange elements on `[0, 1]`, in local DOF order.
+    pub fn lagrange_nodes(self) -> Option<&'static [f64]> {
+        match self {
+            ElementKind::P0 => Some(&[0.5]),
+            ElementKind::P1 => Some(&[0.0, 1.0]),
+            ElementKind::P2 => Some(&[0.0, 1.0, 0.5]),
+            ElementKind::P3 => Some(&[0.0, 1.0, 1.0 / 3.0, 2.0 / 3.0]),
+            ElementKind::Hermite => None,
+        }
+    }
+
+    /// The reference basis as polynomials on `[0, 1]`, in local DOF order.
+    pub fn basis(self) -> Vec<Polynomial> {
+        match self.lagrange_nodes() {
+            Some(nodes) if nodes.len() == 1 => vec![Polynomial::constant(1.0)],
+            Some(nodes) => (0..nodes.len())
+                .map(|i| {
+                    let others: Vec<f64> = (0..nodes.len())
+                        .filter(|&j| j != i)
+                        .map(|j| nodes[j])
+                        .collect();
+                    let denominator: f64 = others.iter().map(|&xj| nodes[i] - xj).product();
+                    Polynomial::from_roots(&others, 1.0 / denominator)
+                })
+                .collect(),
+            None => vec![
+                Polynomial::new(vec![1.0, 0.0, -3.0, 2.0]),
+                Polynomial::new(vec![0.0, 1.0, -2.0, 1.0]),
+                Polynomial::new(vec![0.0, 0.0, 3.0, -2.0]),
+                Polynomial::new(vec![0.0, 0.0, -1.0, 1.0]),
+            ],
+        }
+    }
+
+    /// Power of the cell length `h` that maps reference DOF `i` to its physical DOF.
+    ///
+    /// A Hermite slope DOF measures `dφ/dx = h⁻¹ dφ/dξ`, so its physical basis function is
+    /// `h` times the reference one; every other DOF maps with power 0.
+    pub fn dof_scaling_power(self, i: usize) -> i32 {
+        match self.dofs()[i] {
+            DofLocation::Vertex { derivative, .. } => derivative as i32,
+            DofLocation::Interior => 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defining property of every basis: DOF functional j applied to basis i is δ_ij.
+    #[test]
+    fn basis_is_dual_to_the_dofs() {
+        for element in ALL_ELEMENTS {
+            let basis = element.basis();
+            assert_eq!(basis.len(), element.dof_count());
+            let mut interior_nodes = element
+                .lagrange_nodes()
+                .map(|n| n.to_vec())
+                .unwrap_or_default()
+                .into_iter();
+            let functionals: Vec<Box<dyn Fn(&Polynomial) -> f64>> = element
+                .dofs()
+                .iter()
+                .map(|d| -> Box<dyn Fn(&Polynomial) -> f64> {
+                    match *d {
+                        DofLocation::Vertex { vertex, derivative } => {
+                            let _ = interior_nodes.next();
+                            Box::new(move |p: &Polynomial| {
+                                p.derivative(derivative).eval(vertex as f64)
+                            })
+                        }
+                        DofLocation::Interior => {
+                            let x = interior_nodes.next().unwrap();
+                            Box::new(move |p: &Polynomial| p.eval(x))
+                        }
+                    }
+                })
+                .collect();
+            for (i, phi) in basis.iter().enumerate() {
+                for (j, functional) in functionals.iter().enumerate() {
+                    let expected = if i == j { 1.0 } else { 0.0 };
+                    assert!(
+                        (functional(phi) - expected).abs() < 1e-13,
+                        "{element:?}: dof {j} of basis {i}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn degrees_and_layouts() {
+        for element in ALL_ELEMENTS {
+            for phi in element.basis() {
+                assert!(phi.derivative(element.degree() + 1).is_zero());
+            }
+            let per_vertex = element.dofs_per_vertex();
+            assert_eq!(
+                2 * per_vertex + element.interior_dof_count(),
+                element.dof_count()
+            );
+            assert_eq!(ElementKind::from_name(element.name()), Some(element));
+        }
+        // Partition of unity for the Lagrange elements.
+        for element in [ElementKind::P1, ElementKind::P2, ElementKind::P3] {
+            let sum: f64 = element.basis().iter().map(|p| p.eval(0.3141)).sum();
+            assert!((sum - 1.0).abs() < 1e-14);
+        }
+    }
+}
