@@ -59,6 +59,25 @@ fn table(element: ElementKind, derivative: u8, rule: &QuadratureRule) -> Vec<Vec
         .collect()
 }
 
+fn derivatives(element: ElementKind, derivative: u8) -> Vec<Polynomial> {
+    element
+        .basis()
+        .iter()
+        .map(|p| p.derivative(derivative as usize))
+        .collect()
+}
+
+/// `∫₀¹ p q dξ`, summed from the coefficients.
+fn integral_of_product(p: &Polynomial, q: &Polynomial) -> f64 {
+    let mut sum = 0.0;
+    for (k, a) in p.coefficients.iter().enumerate() {
+        for (l, b) in q.coefficients.iter().enumerate() {
+            sum += a * b / (k + l + 1) as f64;
+        }
+    }
+    sum
+}
+
 /// `base^e` as straight-line code.
 fn power(base: TokenStream, e: i32) -> Option<TokenStream> {
     let positive = |n: i32| -> TokenStream {
@@ -162,7 +181,9 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
             continue;
         }
         let rule = QuadratureRule::exact_for_degree(term_degree(term, block, symbols));
-        quadrature_points = quadrature_points.max(rule.len());
+        if term.quadrature_degree.is_some() {
+            quadrature_points = quadrature_points.max(rule.len());
+        }
         let test = table(test_element, term.test_derivative, &rule);
         let trial = match (trial_element, term.trial_derivative) {
             (Some(e), Some(d)) => table(e, d, &rule),
@@ -185,10 +206,26 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
                 groups.len() - 1
             }
         };
-        for (q, w) in rule.weights.iter().enumerate() {
-            for i in 0..rows {
-                for j in 0..cols {
-                    groups[idx].reference[i][j] += term.coefficient * w * test[q][i] * trial[q][j];
+        if term.quadrature_degree.is_some() {
+            // An explicit rule (e.g. reduced integration) is the point: use it as given.
+            for (q, w) in rule.weights.iter().enumerate() {
+                for i in 0..rows {
+                    for j in 0..cols {
+                        groups[idx].reference[i][j] +=
+                            term.coefficient * w * test[q][i] * trial[q][j];
+                    }
+                }
+            }
+        } else {
+            // Exact: integrate the polynomial products coefficient by coefficient.
+            let test_basis = derivatives(test_element, term.test_derivative);
+            let trial_basis = match (trial_element, term.trial_derivative) {
+                (Some(e), Some(d)) => derivatives(e, d),
+                _ => vec![Polynomial::constant(1.0)],
+            };
+            for (i, p) in test_basis.iter().enumerate() {
+                for (j, q) in trial_basis.iter().enumerate() {
+                    groups[idx].reference[i][j] += term.coefficient * integral_of_product(p, q);
                 }
             }
         }

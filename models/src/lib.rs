@@ -1,1 +1,11 @@
+//! fem-forms model files, one DSL file per model (MODELS.md has the mathematics).
+//!
+//! Each model declares its fields, parameters, data and the stabilized forms
+//! `B_h = a − b − bᵀ − α S_h` and `L_h = ℓ − ⟨sψ, μ⟩ − α ℓ_S` of the obstacle problem.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+pub mod euler_bernoulli;
+pub mod timoshenko;
+
+pub use euler_bernoulli::bernoulli;
+pub use timoshenko::{timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};

@@ -1,0 +1,214 @@
+//! Global assembly of generated element kernels into faer sparse matrices.
+//!
+//! The sparsity pattern of a form on a mesh is built once ([`MatrixAssembler::new`]),
+//! together with the position in the value array of every element-matrix entry; each
+//! assembly then only zeroes the values and adds the element matrices in place.
+
+use crate::dof_map::SystemDofs;
+use crate::error::{Error, Result};
+use crate::mesh::IntervalMesh;
+use crate::model::{Coefficients, Model};
+use crate::SparseMatrix;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+
+#[derive(Clone, Debug)]
+struct BlockPlan {
+    block: usize,
+    test_field: usize,
+    trial_field: usize,
+    rows: usize,
+    cols: usize,
+    row_offset: usize,
+    col_offset: usize,
+}
+
+fn block_plans<M: Model>(form: usize, dofs: &SystemDofs, bilinear: bool) -> Result<Vec<BlockPlan>> {
+    let info = &M::FORMS[form];
+    let expected = if bilinear { 2 } else { 1 };
+    if info.arity != expected {
+        return Err(Error::Input(format!(
+            "form `{}` of `{}` is {}, not {}",
+            info.name,
+            M::NAME,
+            if info.arity == 2 { "bilinear" } else { "linear" },
+            if bilinear { "bilinear" } else { "linear" },
+        )));
+    }
+    info.blocks
+        .iter()
+        .enumerate()
+        .map(|(b, block)| {
+            let trial_field = block.trial_field.unwrap_or(block.test_field);
+            let missing = [block.test_field, trial_field]
+                .into_iter()
+                .find(|&f| dofs.position(f).is_none());
+            if let Some(f) = missing {
+                return Err(Error::Input(format!(
+                    "form `{}` couples field `{}`, which this system leaves out",
+                    info.name,
+                    M::FIELDS[f].name
+                )));
+            }
+            Ok(BlockPlan {
+                block: b,
+                test_field: block.test_field,
+                trial_field,
+                rows: M::FIELDS[block.test_field].element.dof_count(),
+                cols: M::FIELDS[trial_field].element.dof_count(),
+                row_offset: dofs.offset(block.test_field).unwrap(),
+                col_offset: dofs.offset(trial_field).unwrap(),
+            })
+        })
+        .collect()
+}
+
+/// Assembles one bilinear form of a model on a mesh, reusing its sparsity pattern.
+#[derive(Clone, Debug)]
+pub struct MatrixAssembler {
+    form: usize,
+    plans: Vec<BlockPlan>,
+    symbolic: SymbolicSparseColMat<usize>,
+    positions: Vec<usize>,
+    largest_block: usize,
+}
+
+impl MatrixAssembler {
+    /// Builds the pattern of bilinear form `form_name` of `M` on the system `dofs`.
+    pub fn new<M: Model>(form_name: &str, mesh: &IntervalMesh, dofs: &SystemDofs) -> Result<Self> {
+        let form = M::form(form_name)?;
+        let plans = block_plans::<M>(form, dofs, true)?;
+        let n = dofs.dof_count();
+        let mut keys: Vec<u64> = Vec::new();
+        for c in 0..mesh.cell_count() {
+            for plan in &plans {
+                let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
+                let cols = dofs.map(plan.trial_field).unwrap().cell_dofs(c);
+                for &r in rows {
+                    for &col in cols {
+                        keys.push(((col + plan.col_offset) * n + r + plan.row_offset) as u64);
+                    }
+                }
+            }
+        }
+        let mut unique = keys.clone();
+        unique.sort_unstable();
+        unique.dedup();
+        let positions: Vec<usize> = keys
+            .iter()
+            .map(|k| unique.binary_search(k).expect("every key is in the pattern"))
+            .collect();
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = Vec::with_capacity(unique.len());
+        for &k in &unique {
+            let (col, row) = ((k as usize) / n.max(1), (k as usize) % n.max(1));
+            col_ptr[col + 1] += 1;
+            row_idx.push(row);
+        }
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let largest_block = plans.iter().map(|p| p.rows * p.cols).max().unwrap_or(0);
+        Ok(Self {
+            form,
+            plans,
+            symbolic,
+            positions,
+            largest_block,
+        })
+    }
+
+    /// The sparsity pattern.
+    pub fn symbolic(&self) -> &SymbolicSparseColMat<usize> {
+        &self.symbolic
+    }
+
+    /// Number of stored entries.
+    pub fn nonzero_count(&self) -> usize {
+        self.symbolic.row_idx().len()
+    }
+
+    /// Fills `values` (resized to the pattern) with the assembled matrix.
+    pub fn assemble_values<M: Model>(
+        &self,
+        mesh: &IntervalMesh,
+        coefficients: &Coefficients,
+        values: &mut Vec<f64>,
+    ) -> Result<()> {
+        values.clear();
+        values.resize(self.nonzero_count(), 0.0);
+        let mut local = vec![0.0; self.largest_block];
+        let mut k = 0;
+        for c in 0..mesh.cell_count() {
+            let x = mesh.cell(c);
+            for plan in &self.plans {
+                let len = plan.rows * plan.cols;
+                M::element_matrix(
+                    self.form,
+                    plan.block,
+                    &x,
+                    &coefficients.params,
+                    &coefficients.data,
+                    &mut local[..len],
+                );
+                for &v in &local[..len] {
+                    values[self.positions[k]] += v;
+                    k += 1;
+                }
+            }
+        }
+        if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
+            let cell = self.positions.iter().position(|&p| p == bad).unwrap_or(0);
+            let per_cell: usize = self.plans.iter().map(|p| p.rows * p.cols).sum();
+            return Err(Error::NonFinite {
+                what: "matrix",
+                cell: cell / per_cell.max(1),
+            });
+        }
+        Ok(())
+    }
+
+    /// The assembled matrix.
+    pub fn assemble<M: Model>(&self, mesh: &IntervalMesh, coefficients: &Coefficients) -> Result<SparseMatrix> {
+        let mut values = Vec::new();
+        self.assemble_values::<M>(mesh, coefficients, &mut values)?;
+        Ok(SparseColMat::new(self.symbolic.clone(), values))
+    }
+}
+
+/// Assembles linear form `form_name` of `M` on the system `dofs`.
+pub fn assemble_vector<M: Model>(
+    form_name: &str,
+    mesh: &IntervalMesh,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+) -> Result<Vec<f64>> {
+    let form = M::form(form_name)?;
+    let plans = block_plans::<M>(form, dofs, false)?;
+    let mut out = vec![0.0; dofs.dof_count()];
+    let mut local = vec![0.0; plans.iter().map(|p| p.rows).max().unwrap_or(0)];
+    for c in 0..mesh.cell_count() {
+        let x = mesh.cell(c);
+        for plan in &plans {
+            M::element_vector(
+                form,
+                plan.block,
+                &x,
+                &coefficients.params,
+                &coefficients.data,
+                &mut local[..plan.rows],
+            );
+            let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
+            for (&r, &v) in rows.iter().zip(&local[..plan.rows]) {
+                out[r + plan.row_offset] += v;
+            }
+            if local[..plan.rows].iter().any(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "vector",
+                    cell: c,
+                });
+            }
+        }
+    }
+    Ok(out)
+}

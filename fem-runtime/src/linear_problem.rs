@@ -1,0 +1,43 @@
+//! A linear variational problem `a(u, v) = ℓ(v)` with fixed DOFs, solved directly.
+
+use crate::assembly::{assemble_vector, MatrixAssembler};
+use crate::boundary::Constraints;
+use crate::dof_map::SystemDofs;
+use crate::error::Result;
+use crate::linear_solve::{Cholesky, LuSolver};
+use crate::mesh::IntervalMesh;
+use crate::model::{Coefficients, Model};
+
+/// Which factorization to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Factorization {
+    /// Sparse Cholesky: for symmetric positive definite forms.
+    Cholesky,
+    /// Sparse LU: for anything square and non-singular.
+    Lu,
+}
+
+/// Solves `bilinear(u, v) = linear(v)` on the fields of `dofs` with the fixed DOFs of
+/// `constraints`; returns the full coefficient vector.
+pub fn solve_linear<M: Model>(
+    mesh: &IntervalMesh,
+    dofs: &SystemDofs,
+    bilinear: &str,
+    linear: &str,
+    constraints: &Constraints,
+    coefficients: &Coefficients,
+    factorization: Factorization,
+) -> Result<Vec<f64>> {
+    let a = MatrixAssembler::new::<M>(bilinear, mesh, dofs)?.assemble::<M>(mesh, coefficients)?;
+    let b = assemble_vector::<M>(linear, mesh, dofs, coefficients)?;
+    let reduction = constraints.reduction(dofs.dof_count())?;
+    let a_free = reduction.matrix(&a);
+    let b_free = reduction.rhs(&a, &b);
+    let pattern = a_free.symbolic().to_owned().expect("an owned pattern");
+    let factor = match factorization {
+        Factorization::Cholesky => Cholesky::analyse(&pattern)?.factor(&a_free)?,
+        Factorization::Lu => LuSolver::analyse(&pattern)?.factor(&a_free)?,
+    };
+    let u = factor.solve_refined(&a_free, &b_free, 1)?;
+    Ok(reduction.expand(&u))
+}

@@ -1,0 +1,66 @@
+//! Errors of finite element functions against exact solutions, by quadrature.
+
+use crate::dof_map::DofMap;
+use crate::element::PhysicalBasis;
+use crate::mesh::IntervalMesh;
+use fem_reference::gauss_legendre;
+
+/// A field's coefficients with its DOF map, evaluated cell by cell.
+pub struct FieldView<'a> {
+    /// The mesh.
+    pub mesh: &'a IntervalMesh,
+    /// The field's DOF map.
+    pub map: &'a DofMap,
+    /// The field's coefficients (in the map's numbering).
+    pub coefficients: &'a [f64],
+}
+
+impl FieldView<'_> {
+    /// Local coefficients of cell `c`.
+    pub fn local(&self, c: usize) -> Vec<f64> {
+        self.map.cell_dofs(c).iter().map(|&d| self.coefficients[d]).collect()
+    }
+
+    /// `d^k/dx^k` of the field at `x` (from the left cell at a vertex); `None` outside.
+    pub fn at(&self, x: f64, derivative: usize) -> Option<f64> {
+        let c = self.mesh.locate(x)?;
+        let cell = self.mesh.cell(c);
+        let basis = PhysicalBasis::new(self.map.element(), derivative);
+        let xi = (x - cell[0]) / (cell[1] - cell[0]);
+        Some(basis.evaluate(&self.local(c), derivative, cell, xi))
+    }
+
+    /// `(Σ_T ∫_T |dᵏ(u − u_h)|²)^{1/2}` with an `n`-point Gauss rule per cell.
+    pub fn error(&self, derivative: usize, exact: &dyn Fn(f64) -> f64, points: usize) -> f64 {
+        let rule = gauss_legendre(points);
+        let basis = PhysicalBasis::new(self.map.element(), derivative);
+        let mut sum = 0.0;
+        for c in 0..self.mesh.cell_count() {
+            let cell = self.mesh.cell(c);
+            let h = cell[1] - cell[0];
+            let local = self.local(c);
+            for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+                let e = exact(cell[0] + h * xi) - basis.evaluate(&local, derivative, cell, xi);
+                sum += w * h * e * e;
+            }
+        }
+        sum.sqrt()
+    }
+
+    /// `∫ u_h` (e.g. the total contact force of a multiplier).
+    pub fn integral(&self) -> f64 {
+        let rule = gauss_legendre(3);
+        let basis = PhysicalBasis::new(self.map.element(), 0);
+        (0..self.mesh.cell_count())
+            .map(|c| {
+                let cell = self.mesh.cell(c);
+                let local = self.local(c);
+                rule.points
+                    .iter()
+                    .zip(&rule.weights)
+                    .map(|(&xi, &w)| w * (cell[1] - cell[0]) * basis.evaluate(&local, 0, cell, xi))
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+}

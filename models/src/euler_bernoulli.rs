@@ -1,0 +1,25 @@
+//! Euler–Bernoulli beam over a rigid obstacle (MODELS.md §4): deflection w in C¹
+//! Hermite cubics, contact multiplier λ ∈ P0, obstacle side s = ±1.
+//!
+//! `w'''' ≡ 0` for cubics, so `S_h = Σ h⁴ s²(λ, μ)`; α ≤ 1e-2 keeps the obstacle shift
+//! `α h⁴ |f|` negligible.
+
+fem_runtime::model! {
+    /// Euler–Bernoulli beam obstacle problem, w ∈ Hermite cubics, λ ∈ P0.
+    pub mod bernoulli on interval {
+        unknowns: w: Hermite, λ: P0 >= 0;
+        tests: v, μ;
+        params: α, s;
+        data: f, ψ;
+        forms: "
+            a(w;v)     = ∫ w''v''
+            b(v;μ)     = ∫ s v μ
+            S(w,λ;v,μ) = Σ_T h_T⁴ (w'''' − sλ, v'''' − sμ)_T
+            ℓ(v)       = ∫ f v
+            ℓ_S(v,μ)   = Σ_T h_T⁴ (f, v'''' − sμ)_T
+            g(μ)       = ∫ s ψ μ
+            B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
+            L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
+        ";
+    }
+}
