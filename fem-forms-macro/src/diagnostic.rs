@@ -134,13 +134,18 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 /// The candidate closest to `name`, if it is close enough to be a likely typo.
+///
+/// No hint when several candidates are equally close: a guess would mislead.
 pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    candidates
+    let close: Vec<(usize, &str)> = candidates
         .into_iter()
         .map(|c| (edit_distance(name, c), c))
         .filter(|&(d, c)| d <= 2 && d < c.chars().count().max(name.chars().count()))
-        .min_by_key(|&(d, _)| d)
-        .map(|(_, c)| c)
+        .collect();
+    let best = close.iter().map(|&(d, _)| d).min()?;
+    let mut at_best = close.iter().filter(|&&(d, _)| d == best);
+    let first = at_best.next()?;
+    at_best.next().is_none().then_some(first.1)
 }
 
 #[cfg(test)]
@@ -171,5 +176,6 @@ mod tests {
         assert_eq!(edit_distance("kitten", "sitting"), 3);
         assert_eq!(closest("psi", ["ψ", "psy", "t"]), Some("psy"));
         assert_eq!(closest("x", ["t", "α"]), None);
+        assert_eq!(closest("P7", ["P0", "P1", "P2"]), None);
     }
 }

@@ -1,0 +1,15 @@
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+fem_forms_macro::model! {
+    pub mod beam on interval {
+        unknowns: θ: P2, w: P2;
+        tests: η, v;
+        params: t;
+        data: f;
+        forms: "
+            a(θ,z;η,v) = ∫ θ'η' + t⁻²(z'−θ)(v'−η)
+        ";
+    }
+}
+
+fn main() {}
