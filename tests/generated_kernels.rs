@@ -19,7 +19,9 @@ fn generated_matrix<M: Model>(form: &str, test: usize, trial: usize, st: Setting
     );
     let mut out = vec![vec![0.0; cols]; rows];
     let params = params::<M>(st);
-    let data: [&DataFn; 2] = [&|x: &[f64]| hand_coded::load(x[0]), &|x: &[f64]| hand_coded::obstacle(x[0])];
+    let data: [&DataFn; 2] = [&|x: &[f64]| hand_coded::load(x[0]), &|x: &[f64]| {
+        hand_coded::obstacle(x[0])
+    }];
     if let Some(b) = M::FORMS[f]
         .blocks
         .iter()
@@ -39,7 +41,9 @@ fn generated_vector<M: Model>(form: &str, test: usize, st: Setting) -> Vec<f64> 
     let rows = M::FIELDS[test].element.dof_count();
     let mut out = vec![0.0; rows];
     let params = params::<M>(st);
-    let data: [&DataFn; 2] = [&|x: &[f64]| hand_coded::load(x[0]), &|x: &[f64]| hand_coded::obstacle(x[0])];
+    let data: [&DataFn; 2] = [&|x: &[f64]| hand_coded::load(x[0]), &|x: &[f64]| {
+        hand_coded::obstacle(x[0])
+    }];
     if let Some(b) = M::FORMS[f].blocks.iter().position(|b| b.test_field == test) {
         M::element_vector(f, b, &[st.x0, st.x0 + st.h], &params, &data, &mut out);
     }
@@ -92,14 +96,22 @@ fn setting() -> impl Strategy<Value = Setting> {
 
 const MIDPOINT: [(f64, f64); 1] = [(0.0, 2.0)];
 
-fn check_timoshenko<M: Model>(elements: [HandElement; 3], shear_rule: &[(f64, f64)], st: Setting) -> Result<(), TestCaseError> {
+fn check_timoshenko<M: Model>(
+    elements: [HandElement; 3],
+    shear_rule: &[(f64, f64)],
+    st: Setting,
+) -> Result<(), TestCaseError> {
     for form in ["a", "b", "S", "B_h"] {
         for test in 0..3 {
             for trial in 0..3 {
                 let g = generated_matrix::<M>(form, test, trial, st);
                 let h = hand_coded::timoshenko_matrix(form, &elements, test, trial, st, shear_rule);
                 let d = relative_difference(&g, &h);
-                prop_assert!(d <= 1e-12, "{} {form} ({test},{trial}) {st:?}: {d:e}\n{g:?}\n{h:?}", M::NAME);
+                prop_assert!(
+                    d <= 1e-12,
+                    "{} {form} ({test},{trial}) {st:?}: {d:e}\n{g:?}\n{h:?}",
+                    M::NAME
+                );
             }
         }
     }
@@ -108,7 +120,11 @@ fn check_timoshenko<M: Model>(elements: [HandElement; 3], shear_rule: &[(f64, f6
             let g = generated_vector::<M>(form, test, st);
             let h = hand_coded::timoshenko_vector(form, &elements, test, st);
             let d = relative_difference(&[g.clone()], &[h.clone()]);
-            prop_assert!(d <= 1e-12, "{} {form} ({test}) {st:?}: {d:e}\n{g:?}\n{h:?}", M::NAME);
+            prop_assert!(
+                d <= 1e-12,
+                "{} {form} ({test}) {st:?}: {d:e}\n{g:?}\n{h:?}",
+                M::NAME
+            );
         }
     }
     Ok(())
@@ -184,7 +200,10 @@ proptest! {
 fn forms_drop_the_terms_that_vanish_for_their_elements() {
     // θ''' ≡ 0 for P2 and P1, w'''' ≡ 0 for Hermite cubics: S keeps only (μ, λ).
     for (name, form) in [
-        ("timoshenko_p2", timoshenko_p2::Model::FORMS[timoshenko_p2::S::INDEX]),
+        (
+            "timoshenko_p2",
+            timoshenko_p2::Model::FORMS[timoshenko_p2::S::INDEX],
+        ),
         ("bernoulli", bernoulli::Model::FORMS[bernoulli::S::INDEX]),
     ] {
         assert_eq!(form.blocks.len(), 1, "{name}: {:?}", form.blocks);

@@ -6,8 +6,8 @@ use fem_forms::linear_solve::asymmetry;
 use fem_forms::models::{bernoulli, timoshenko_p1_reduced, timoshenko_p2};
 use fem_forms::norms::FieldView;
 use fem_forms::{
-    solve_linear, Coefficients, Constraints, DataFn, Factorization, IntervalMesh, MatrixAssembler, Model, Side,
-    SystemDofs,
+    solve_linear, Coefficients, Constraints, DataFn, Factorization, IntervalMesh, MatrixAssembler,
+    Model, Side, SystemDofs,
 };
 
 const Q: f64 = 1.0;
@@ -56,14 +56,27 @@ fn solve_bernoulli(n: usize) -> (IntervalMesh, SystemDofs, Vec<f64>) {
     let mesh = IntervalMesh::uniform(0.0, 1.0, n).unwrap();
     let dofs = SystemDofs::named::<M>(&mesh, &["w"]).unwrap();
     let (f, psi): (&DataFn, &DataFn) = (&|_| Q, &|_| -1.0);
-    let coefficients = Coefficients::new::<M>(&[("α", 0.0), ("s", 1.0)], &[("f", f), ("ψ", psi)]).unwrap();
+    let coefficients =
+        Coefficients::new::<M>(&[("α", 0.0), ("s", 1.0)], &[("f", f), ("ψ", psi)]).unwrap();
     let mut constraints = Constraints::new();
     for side in [Side::Left, Side::Right] {
         constraints.clamp::<M>(&mesh, &dofs, "w", side).unwrap();
     }
-    let a = MatrixAssembler::new::<M>("a", &mesh, &dofs).unwrap().assemble::<M>(&mesh, &coefficients).unwrap();
+    let a = MatrixAssembler::new::<M>("a", &mesh, &dofs)
+        .unwrap()
+        .assemble::<M>(&mesh, &coefficients)
+        .unwrap();
     assert!(asymmetry(&a) < 1e-14, "the bending matrix is symmetric");
-    let u = solve_linear::<M>(&mesh, &dofs, "a", "ℓ", &constraints, &coefficients, Factorization::Cholesky).unwrap();
+    let u = solve_linear::<M>(
+        &mesh,
+        &dofs,
+        "a",
+        "ℓ",
+        &constraints,
+        &coefficients,
+        Factorization::Cholesky,
+    )
+    .unwrap();
     (mesh, dofs, u)
 }
 
@@ -73,7 +86,11 @@ fn clamped_euler_bernoulli_beam_converges_at_hermite_rates() {
     for n in [4, 8, 16, 32, 64] {
         let (mesh, dofs, u) = solve_bernoulli(n);
         let map = dofs.map(0).unwrap();
-        let view = FieldView { mesh: &mesh, map, coefficients: &u };
+        let view = FieldView {
+            mesh: &mesh,
+            map,
+            coefficients: &u,
+        };
         for (k, e) in errors.iter_mut().enumerate() {
             e.push(view.error(k, &|x| bernoulli_exact(x, k), 6));
         }
@@ -91,15 +108,28 @@ fn solve_timoshenko<M: Model>(n: usize, t: f64) -> (IntervalMesh, SystemDofs, Ve
     let dofs = SystemDofs::named::<M>(&mesh, &["θ", "w"]).unwrap();
     let (f, psi): (&DataFn, &DataFn) = (&|_| Q, &|_| -1.0);
     let coefficients =
-        Coefficients::new::<M>(&[("t", t), ("α", 1.0), ("s", 1.0)], &[("f", f), ("ψ", psi)]).unwrap();
+        Coefficients::new::<M>(&[("t", t), ("α", 1.0), ("s", 1.0)], &[("f", f), ("ψ", psi)])
+            .unwrap();
     let mut constraints = Constraints::new();
     for side in [Side::Left, Side::Right] {
         constraints.clamp::<M>(&mesh, &dofs, "θ", side).unwrap();
         constraints.clamp::<M>(&mesh, &dofs, "w", side).unwrap();
     }
-    let a = MatrixAssembler::new::<M>("a", &mesh, &dofs).unwrap().assemble::<M>(&mesh, &coefficients).unwrap();
+    let a = MatrixAssembler::new::<M>("a", &mesh, &dofs)
+        .unwrap()
+        .assemble::<M>(&mesh, &coefficients)
+        .unwrap();
     assert!(asymmetry(&a) < 1e-14, "the Timoshenko matrix is symmetric");
-    let u = solve_linear::<M>(&mesh, &dofs, "a", "ℓ", &constraints, &coefficients, Factorization::Cholesky).unwrap();
+    let u = solve_linear::<M>(
+        &mesh,
+        &dofs,
+        "a",
+        "ℓ",
+        &constraints,
+        &coefficients,
+        Factorization::Cholesky,
+    )
+    .unwrap();
     (mesh, dofs, u)
 }
 
@@ -109,8 +139,16 @@ fn timoshenko_errors<M: Model>(t: f64, meshes: &[usize]) -> [Vec<f64>; 3] {
         let (mesh, dofs, u) = solve_timoshenko::<M>(n, t);
         let theta = &u[dofs.range(0).unwrap()];
         let w = &u[dofs.range(1).unwrap()];
-        let view_w = FieldView { mesh: &mesh, map: dofs.map(1).unwrap(), coefficients: w };
-        let view_theta = FieldView { mesh: &mesh, map: dofs.map(0).unwrap(), coefficients: theta };
+        let view_w = FieldView {
+            mesh: &mesh,
+            map: dofs.map(1).unwrap(),
+            coefficients: w,
+        };
+        let view_theta = FieldView {
+            mesh: &mesh,
+            map: dofs.map(0).unwrap(),
+            coefficients: theta,
+        };
         errors[0].push(view_w.error(0, &|x| timoshenko_w(x, 0, t), 6));
         errors[1].push(view_w.error(1, &|x| timoshenko_w(x, 1, t), 6));
         errors[2].push(view_theta.error(1, &|x| timoshenko_theta(x, 1), 6));
@@ -135,7 +173,10 @@ fn clamped_timoshenko_beam_p2_converges_for_thick_and_thin_beams() {
     let thinner = timoshenko_errors::<timoshenko_p2::Model>(1e-5, &[4, 8, 16, 32]);
     for k in 0..3 {
         for (a, b) in thin[k].iter().zip(&thinner[k]) {
-            assert!(b / a < 1.1, "error grows as t → 0: {a:e} at t = 1e-3, {b:e} at t = 1e-5");
+            assert!(
+                b / a < 1.1,
+                "error grows as t → 0: {a:e} at t = 1e-3, {b:e} at t = 1e-5"
+            );
         }
     }
 }
@@ -149,13 +190,24 @@ fn timoshenko_midpoint_deflection_matches_q_over_384_plus_q_t2_over_8() {
             .map(|&n| {
                 let (mesh, dofs, u) = solve_timoshenko::<timoshenko_p2::Model>(n, t);
                 let w = &u[dofs.range(1).unwrap()];
-                let view = FieldView { mesh: &mesh, map: dofs.map(1).unwrap(), coefficients: w };
+                let view = FieldView {
+                    mesh: &mesh,
+                    map: dofs.map(1).unwrap(),
+                    coefficients: w,
+                };
                 (view.at(0.5, 0).unwrap() - exact).abs() / exact
             })
             .collect();
         println!("t = {t}: relative error of w(½) {errors:?}");
-        assert!(errors[2] < 1e-3, "t = {t}: w(½) relative error {:e}", errors[2]);
-        assert!(errors.windows(2).all(|e| e[1] < e[0] / 3.5 || e[1] < 1e-12), "t = {t}: {errors:?}");
+        assert!(
+            errors[2] < 1e-3,
+            "t = {t}: w(½) relative error {:e}",
+            errors[2]
+        );
+        assert!(
+            errors.windows(2).all(|e| e[1] < e[0] / 3.5 || e[1] < 1e-12),
+            "t = {t}: {errors:?}"
+        );
     }
 }
 
@@ -164,7 +216,17 @@ fn reduced_integration_p1_converges_without_locking() {
     // One-point shear integration: the P1 pair converges at O(h²) in w, L2, even for thin beams.
     for t in [1e-1, 1e-3] {
         let errors = timoshenko_errors::<timoshenko_p1_reduced::Model>(t, &[8, 16, 32, 64, 128]);
-        assert_rate(&format!("Timoshenko P1 reduced t={t} w L2"), &errors[0], 2.0, 0.2);
-        assert_rate(&format!("Timoshenko P1 reduced t={t} θ H1"), &errors[2], 1.0, 0.2);
+        assert_rate(
+            &format!("Timoshenko P1 reduced t={t} w L2"),
+            &errors[0],
+            2.0,
+            0.2,
+        );
+        assert_rate(
+            &format!("Timoshenko P1 reduced t={t} θ H1"),
+            &errors[2],
+            1.0,
+            0.2,
+        );
     }
 }

@@ -53,15 +53,12 @@ impl Symbols {
 
     fn function_symbol(&self, name: &str) -> Option<usize> {
         let f = self.fields.len();
-        self.fields
-            .iter()
-            .position(|x| x.name == name)
-            .or_else(|| {
-                self.fields
-                    .iter()
-                    .position(|x| x.test_name == name)
-                    .map(|k| k + f)
-            })
+        self.fields.iter().position(|x| x.name == name).or_else(|| {
+            self.fields
+                .iter()
+                .position(|x| x.test_name == name)
+                .map(|k| k + f)
+        })
     }
 
     fn all_names(&self) -> Vec<&str> {
@@ -150,7 +147,10 @@ pub fn analyse(
                     definition.name.loc,
                     format!("form `{}` is defined twice", definition.name.text),
                 )
-                .help(format!("the first definition is on line {}", first.name.loc.line)),
+                .help(format!(
+                    "the first definition is on line {}",
+                    first.name.loc.line
+                )),
             );
             continue;
         }
@@ -191,7 +191,10 @@ pub fn analyse(
 
 /// Expands a lone integrand-level expression (used by the tests of the symbolic layer).
 #[cfg(test)]
-pub(crate) fn expand_expression(symbols: &Symbols, text: &str) -> Result<Expansion, Vec<Diagnostic>> {
+pub(crate) fn expand_expression(
+    symbols: &Symbols,
+    text: &str,
+) -> Result<Expansion, Vec<Diagnostic>> {
     let (tokens, errors) = crate::lexer::tokenize(text);
     if !errors.is_empty() {
         return Err(errors);
@@ -239,7 +242,11 @@ impl Context<'_> {
         let signature = format!(
             "{}({})",
             d.name.text,
-            groups.iter().map(|g| group_text(g)).collect::<Vec<_>>().join("; ")
+            groups
+                .iter()
+                .map(|g| group_text(g))
+                .collect::<Vec<_>>()
+                .join("; ")
         );
         for t in terms {
             if !t.integrated {
@@ -273,7 +280,11 @@ impl Context<'_> {
             if !ok {
                 continue;
             }
-            let kind = if groups.len() == 2 { "bilinear" } else { "linear" };
+            let kind = if groups.len() == 2 {
+                "bilinear"
+            } else {
+                "linear"
+            };
             for (g, &count) in counts.iter().enumerate() {
                 let which = match (groups.len(), g) {
                     (2, 0) => "first argument group (trial functions",
@@ -372,7 +383,12 @@ impl Context<'_> {
     fn blocks(&self, groups: &[Vec<usize>], terms: &[Monomial]) -> Vec<Block> {
         let mut blocks: Vec<Block> = Vec::new();
         for t in terms {
-            let find = |g: usize| *t.args.iter().find(|a| groups[g].contains(&a.symbol)).unwrap();
+            let find = |g: usize| {
+                *t.args
+                    .iter()
+                    .find(|a| groups[g].contains(&a.symbol))
+                    .unwrap()
+            };
             let test = find(groups.len() - 1);
             let trial = (groups.len() == 2).then(|| find(0));
             let test_field = self.symbols.field_of(test.symbol);
@@ -421,7 +437,10 @@ impl Context<'_> {
                         ok = false;
                         self.errors.push(Diagnostic::text(
                             n.loc,
-                            format!("`{}` appears twice among the arguments of `{}`", n.text, name.text),
+                            format!(
+                                "`{}` appears twice among the arguments of `{}`",
+                                n.text, name.text
+                            ),
                         ));
                     }
                     Some(s) => {
@@ -499,14 +518,24 @@ impl Context<'_> {
     }
 
     /// `Some(result)` when `name` is one declared symbol.
-    fn single_symbol(&mut self, name: &str, loc: Loc, inside_integral: bool) -> Option<Option<Expansion>> {
+    fn single_symbol(
+        &mut self,
+        name: &str,
+        loc: Loc,
+        inside_integral: bool,
+    ) -> Option<Option<Expansion>> {
         let mut m = scalar(loc);
         if name == "h" || name == "h_T" {
             if !inside_integral {
-                return Some(self.fail(
-                    Diagnostic::text(loc, "`h` is the size of an element: it has a meaning only inside ∫ or Σ_T")
+                return Some(
+                    self.fail(
+                        Diagnostic::text(
+                            loc,
+                            "`h` is the size of an element: it has a meaning only inside ∫ or Σ_T",
+                        )
                         .help("move the factor into the integrand"),
-                ));
+                    ),
+                );
             }
             m.h_power = 1;
         } else if let Some(s) = self.symbols.function_symbol(name) {
@@ -531,8 +560,10 @@ impl Context<'_> {
             if rest.is_empty() {
                 return true;
             }
-            let mut candidates: Vec<&&str> =
-                names.iter().filter(|n| !n.is_empty() && rest.starts_with(**n)).collect();
+            let mut candidates: Vec<&&str> = names
+                .iter()
+                .filter(|n| !n.is_empty() && rest.starts_with(**n))
+                .collect();
             candidates.sort_by_key(|n| std::cmp::Reverse(n.len()));
             for c in candidates {
                 out.push(c.to_string());
@@ -571,10 +602,10 @@ impl Context<'_> {
                 let integrated = |v: &Expansion| v.iter().any(|t| t.integrated);
                 let all_scalar = |v: &Expansion| v.iter().all(Monomial::is_scalar);
                 if integrated(&x) && integrated(&y) {
-                    return self.fail(
-                        Diagnostic::text(loc, "product of two integrals")
-                            .help("a form is a sum of integrals; multiply integrands inside one ∫"),
-                    );
+                    return self
+                        .fail(Diagnostic::text(loc, "product of two integrals").help(
+                            "a form is a sum of integrals; multiply integrands inside one ∫",
+                        ));
                 }
                 if (integrated(&x) && !all_scalar(&y)) || (integrated(&y) && !all_scalar(&x)) {
                     return self.fail(
@@ -649,14 +680,20 @@ impl Context<'_> {
                         (IntegralKind::Integral, 0) | (IntegralKind::SumOverElements, 1) => {}
                         (IntegralKind::Integral, _) => {
                             return self.fail(
-                                Diagnostic::text(t.origin, "an L² product (X, Y)_T is already an integral over T")
-                                    .help("write `∫ X·Y`, or `Σ_T (X, Y)_T`"),
+                                Diagnostic::text(
+                                    t.origin,
+                                    "an L² product (X, Y)_T is already an integral over T",
+                                )
+                                .help("write `∫ X·Y`, or `Σ_T (X, Y)_T`"),
                             )
                         }
                         (IntegralKind::SumOverElements, 0) => {
                             return self.fail(
-                                Diagnostic::text(t.origin, "a term of Σ_T without an L² product (X, Y)_T")
-                                    .help("write every term of Σ_T as weight·(X, Y)_T, or use ∫"),
+                                Diagnostic::text(
+                                    t.origin,
+                                    "a term of Σ_T without an L² product (X, Y)_T",
+                                )
+                                .help("write every term of Σ_T as weight·(X, Y)_T, or use ∫"),
                             )
                         }
                         (IntegralKind::SumOverElements, _) => {
@@ -694,12 +731,25 @@ impl Context<'_> {
         };
         let callee_signature = format!(
             "{name}({})",
-            callee.groups.iter().map(|g| show(g)).collect::<Vec<_>>().join("; ")
+            callee
+                .groups
+                .iter()
+                .map(|g| show(g))
+                .collect::<Vec<_>>()
+                .join("; ")
         );
         if groups.len() != callee.groups.len()
-            || groups.iter().zip(&callee.groups).any(|(a, b)| a.len() != b.len())
+            || groups
+                .iter()
+                .zip(&callee.groups)
+                .any(|(a, b)| a.len() != b.len())
         {
-            let counts = |v: Vec<usize>| v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(";");
+            let counts = |v: Vec<usize>| {
+                v.iter()
+                    .map(|c| c.to_string())
+                    .collect::<Vec<_>>()
+                    .join(";")
+            };
             return self.fail(
                 Diagnostic::text(
                     loc,

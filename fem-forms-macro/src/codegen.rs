@@ -18,7 +18,10 @@ use quote::{format_ident, quote};
 
 /// A float literal (with a leading minus for negative values).
 pub fn float(v: f64) -> TokenStream {
-    assert!(v.is_finite(), "non-finite constant {v} in a generated kernel");
+    assert!(
+        v.is_finite(),
+        "non-finite constant {v} in a generated kernel"
+    );
     let lit = proc_macro2::Literal::f64_suffixed(v.abs());
     if v.is_sign_negative() && v != 0.0 {
         quote!(-#lit)
@@ -263,22 +266,23 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
         let mut body = Vec::new();
         let mut tables = Vec::new();
         let mut tables_made: Vec<(usize, ElementKind, u8)> = Vec::new();
-        let mut table_ident = |element: ElementKind, derivative: u8, tables: &mut Vec<TokenStream>| {
-            let ident = format_ident!("PHI_{}_D{}", element.name().to_uppercase(), derivative);
-            if !tables_made.contains(&(nq, element, derivative)) {
-                tables_made.push((nq, element, derivative));
-                let t = table(element, derivative, &rule);
-                let n = element.dof_count();
-                let rows_code = t.iter().map(|row| {
-                    let vals = row.iter().map(|&v| float(v));
-                    quote!([#(#vals),*])
-                });
-                tables.push(quote! {
-                    const #ident: [[f64; #n]; #nq] = [#(#rows_code),*];
-                });
-            }
-            ident
-        };
+        let mut table_ident =
+            |element: ElementKind, derivative: u8, tables: &mut Vec<TokenStream>| {
+                let ident = format_ident!("PHI_{}_D{}", element.name().to_uppercase(), derivative);
+                if !tables_made.contains(&(nq, element, derivative)) {
+                    tables_made.push((nq, element, derivative));
+                    let t = table(element, derivative, &rule);
+                    let n = element.dof_count();
+                    let rows_code = t.iter().map(|row| {
+                        let vals = row.iter().map(|&v| float(v));
+                        quote!([#(#vals),*])
+                    });
+                    tables.push(quote! {
+                        const #ident: [[f64; #n]; #nq] = [#(#rows_code),*];
+                    });
+                }
+                ident
+            };
         let data_product: TokenStream = {
             let mut it = data.iter().map(|&i| quote!(d[#i](&[xq])));
             let first = it.next().expect("a data group has data");

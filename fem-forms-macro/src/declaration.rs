@@ -259,7 +259,11 @@ impl Declaration {
                         if !e.supports(c) {
                             errors.push(Diagnostic::token(
                                 u.element_name.span(),
-                                format!("element {} is not available on {} cells", e.name(), c.name()),
+                                format!(
+                                    "element {} is not available on {} cells",
+                                    e.name(),
+                                    c.name()
+                                ),
                             ));
                         }
                     }

@@ -84,7 +84,10 @@ impl Diagnostic {
     pub fn render(&self, forms_text: &str) -> String {
         let mut out = self.message.clone();
         if let Place::Text(loc) = self.place {
-            let line_text = forms_text.lines().nth(loc.line.saturating_sub(1)).unwrap_or("");
+            let line_text = forms_text
+                .lines()
+                .nth(loc.line.saturating_sub(1))
+                .unwrap_or("");
             let gutter = format!("{}", loc.line).len();
             out.push_str(&format!(
                 "\n{:gutter$}--> forms, line {}, column {}\n{:gutter$} |\n{} | {}\n{:gutter$} | {}{}",

@@ -198,7 +198,13 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
         } else if c == '_'
             && chars.get(i + 1) == Some(&'T')
             && !chars.get(i + 2).is_some_and(|&d| is_ident_continue(d))
-            && matches!(tokens.last(), Some(Token { tok: Tok::RParen, .. }))
+            && matches!(
+                tokens.last(),
+                Some(Token {
+                    tok: Tok::RParen,
+                    ..
+                })
+            )
         {
             j = i + 2;
             push(Tok::SubscriptT, 2, &mut tokens);
@@ -301,9 +307,15 @@ mod tests {
     #[test]
     fn places_are_lines_and_character_columns() {
         let (tokens, _) = tokenize("∫ a\n  θ⁴ 1e-3");
-        let theta = tokens.iter().find(|t| t.tok == Tok::Ident("θ".into())).unwrap();
+        let theta = tokens
+            .iter()
+            .find(|t| t.tok == Tok::Ident("θ".into()))
+            .unwrap();
         assert_eq!((theta.loc.line, theta.loc.column), (2, 3));
-        let number = tokens.iter().find(|t| matches!(t.tok, Tok::Number(_))).unwrap();
+        let number = tokens
+            .iter()
+            .find(|t| matches!(t.tok, Tok::Number(_)))
+            .unwrap();
         assert_eq!(number.tok, Tok::Number(1e-3));
         assert_eq!((number.loc.column, number.loc.len), (6, 4));
     }

@@ -152,8 +152,15 @@ pub fn parse_forms(tokens: &[Token]) -> (Vec<Definition>, Vec<Diagnostic>) {
     }
     if starts.is_empty() && errors.is_empty() {
         errors.push(
-            Diagnostic::text(Loc { line: 1, column: 1, len: 1 }, "the forms text defines no form")
-                .help("write definitions like `a(u;v) = ∫ u'v'` and `ℓ(v) = ∫ f v`, one per line"),
+            Diagnostic::text(
+                Loc {
+                    line: 1,
+                    column: 1,
+                    len: 1,
+                },
+                "the forms text defines no form",
+            )
+            .help("write definitions like `a(u;v) = ∫ u'v'` and `ℓ(v) = ∫ f v`, one per line"),
         );
     }
     (definitions, errors)
@@ -336,7 +343,9 @@ impl<'a> Parser<'a> {
                         Some(Tok::Comma) => self.pos += 1,
                         Some(Tok::Semicolon) => {
                             if groups.len() == 2 {
-                                return Err(self.unexpected("`,` or `)` (a form has at most two argument groups)"));
+                                return Err(self.unexpected(
+                                    "`,` or `)` (a form has at most two argument groups)",
+                                ));
                             }
                             self.pos += 1;
                             groups.push(Vec::new());
@@ -489,8 +498,10 @@ impl<'a> Parser<'a> {
                 }) => {
                     self.pos += 1;
                     let Some(n) = value else {
-                        return Err(Diagnostic::text(*loc, format!("malformed exponent `{raw}`"))
-                            .help("write an integer exponent such as ² or ⁻² (ASCII: ^2, ^-2)"));
+                        return Err(
+                            Diagnostic::text(*loc, format!("malformed exponent `{raw}`"))
+                                .help("write an integer exponent such as ² or ⁻² (ASCII: ^2, ^-2)"),
+                        );
                     };
                     let l = e.loc.to(*loc);
                     e = Expr::new(ExprKind::Pow(Box::new(e), *n), l);
@@ -611,10 +622,15 @@ impl<'a> Parser<'a> {
                             loc.to(end),
                         ))
                     }
-                    (Some(_), false) => Err(Diagnostic::text(loc.to(close), "a pair `(X, Y)` is only meaningful as an L² product over elements")
-                        .help("write `(X, Y)_T` inside `Σ_T`, or `∫ X·Y`")),
-                    (None, true) => Err(Diagnostic::text(self.here(), "`(X)_T` needs two arguments")
-                        .help("an L² product over an element is written `(X, Y)_T`")),
+                    (Some(_), false) => Err(Diagnostic::text(
+                        loc.to(close),
+                        "a pair `(X, Y)` is only meaningful as an L² product over elements",
+                    )
+                    .help("write `(X, Y)_T` inside `Σ_T`, or `∫ X·Y`")),
+                    (None, true) => {
+                        Err(Diagnostic::text(self.here(), "`(X)_T` needs two arguments")
+                            .help("an L² product over an element is written `(X, Y)_T`"))
+                    }
                     (None, false) => Ok(Expr::new(first.kind, loc.to(close))),
                 }
             }
@@ -707,7 +723,11 @@ mod tests {
                 "(call {name} {})",
                 groups
                     .iter()
-                    .map(|g| g.iter().map(|n| n.text.clone()).collect::<Vec<_>>().join(","))
+                    .map(|g| g
+                        .iter()
+                        .map(|n| n.text.clone())
+                        .collect::<Vec<_>>()
+                        .join(","))
                     .collect::<Vec<_>>()
                     .join(";")
             ),
@@ -757,7 +777,10 @@ mod tests {
         assert!(errors.is_empty());
         assert_eq!(defs.len(), 2);
         assert_eq!(defs[0].lines, (1, 2));
-        assert_eq!(sexpr(&defs[0].body), "(intNone (+ (* (d1 u) (d1 v)) (* u v)))");
+        assert_eq!(
+            sexpr(&defs[0].body),
+            "(intNone (+ (* (d1 u) (d1 v)) (* u v)))"
+        );
     }
 
     #[test]

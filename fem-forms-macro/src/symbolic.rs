@@ -261,7 +261,9 @@ mod tests {
         let product = mul(&plus, &minus, l);
         // (x+y)(x−y) = x² − y²: the mixed terms cancel and are dropped
         assert_eq!(product.len(), 2);
-        assert!(product.iter().all(|t| t.args.len() == 2 && t.args[0] == t.args[1]));
+        assert!(product
+            .iter()
+            .all(|t| t.args.len() == 2 && t.args[0] == t.args[1]));
     }
 
     #[test]
@@ -278,7 +280,14 @@ mod tests {
         let l = Loc::default();
         // (2t·w − θ)'' = 2t·w'' − θ''; constants vanish
         let e = add(
-            add(mul(&mul(&vec![Monomial::constant(2.0, l)], &param(0), l), &arg(1), l), neg(arg(0))),
+            add(
+                mul(
+                    &mul(&vec![Monomial::constant(2.0, l)], &param(0), l),
+                    &arg(1),
+                    l,
+                ),
+                neg(arg(0)),
+            ),
             param(0),
         );
         let d = derivative(&e, 2).unwrap();

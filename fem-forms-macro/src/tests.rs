@@ -1,7 +1,6 @@
 //! End-to-end tests of the macro on `proc_macro2` input, and property tests of the
 //! symbolic layer.
 
-
 use super::*;
 use quote::quote;
 
@@ -54,7 +53,13 @@ fn the_users_model_expands_to_valid_rust() {
         assert!(text.contains(kernel), "missing {kernel}");
     }
     // θ''' of P2 vanishes: S has only the (μ, λ) block, no (η, ·) or (·, θ) blocks.
-    let s_module = text.split("pub mod S").nth(1).unwrap().split("pub mod").next().unwrap();
+    let s_module = text
+        .split("pub mod S")
+        .nth(1)
+        .unwrap()
+        .split("pub mod")
+        .next()
+        .unwrap();
     assert!(s_module.contains("fn matrix_μ_λ"));
     assert!(!s_module.contains("fn matrix_η_θ") && !s_module.contains("fn matrix_μ_θ"));
 }
@@ -71,9 +76,24 @@ fn unicode_and_ascii_spellings_give_the_same_blocks() {
     let analyse_text = |text: &str| {
         let symbols = Symbols {
             fields: vec![
-                Field { name: "θ".into(), test_name: "η".into(), element: ElementKind::P2, nonnegative: false },
-                Field { name: "w".into(), test_name: "v".into(), element: ElementKind::P2, nonnegative: false },
-                Field { name: "λ".into(), test_name: "μ".into(), element: ElementKind::P0, nonnegative: true },
+                Field {
+                    name: "θ".into(),
+                    test_name: "η".into(),
+                    element: ElementKind::P2,
+                    nonnegative: false,
+                },
+                Field {
+                    name: "w".into(),
+                    test_name: "v".into(),
+                    element: ElementKind::P2,
+                    nonnegative: false,
+                },
+                Field {
+                    name: "λ".into(),
+                    test_name: "μ".into(),
+                    element: ElementKind::P0,
+                    nonnegative: true,
+                },
             ],
             params: vec!["t".into(), "α".into(), "s".into()],
             data: vec![("f".into(), 2), ("ψ".into(), 2)],
@@ -163,7 +183,13 @@ mod symbolic_properties {
             Gen::Number(n) if *n < 0 => format!("({})", n),
             Gen::Number(n) => format!("{n}"),
             Gen::Param(i) => params[*i].to_string(),
-            Gen::H => if ascii { "h".into() } else { "h_T".into() },
+            Gen::H => {
+                if ascii {
+                    "h".into()
+                } else {
+                    "h_T".into()
+                }
+            }
             Gen::Data => "f".into(),
             Gen::Arg(s, d) => format!("{}{}", args[*s], primes(*d, ascii)),
             Gen::DerivativeOfCombination(a, b, d) => {
@@ -222,14 +248,18 @@ mod symbolic_properties {
             Just(Gen::H),
             Just(Gen::Data),
             (0usize..2, 0u8..3).prop_map(|(s, d)| Gen::Arg(s, d)),
-            (-3i32..4, -3i32..4, 1u8..3).prop_map(|(a, b, d)| Gen::DerivativeOfCombination(a, b, d)),
+            (-3i32..4, -3i32..4, 1u8..3)
+                .prop_map(|(a, b, d)| Gen::DerivativeOfCombination(a, b, d)),
             (0usize..2, 1u8..4).prop_map(|(i, n)| Gen::ParamInversePower(i, n)),
         ];
         leaf.prop_recursive(4, 24, 2, |inner| {
             prop_oneof![
-                (inner.clone(), inner.clone()).prop_map(|(a, b)| Gen::Add(Box::new(a), Box::new(b))),
-                (inner.clone(), inner.clone()).prop_map(|(a, b)| Gen::Sub(Box::new(a), Box::new(b))),
-                (inner.clone(), inner.clone()).prop_map(|(a, b)| Gen::Mul(Box::new(a), Box::new(b))),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, b)| Gen::Add(Box::new(a), Box::new(b))),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, b)| Gen::Sub(Box::new(a), Box::new(b))),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, b)| Gen::Mul(Box::new(a), Box::new(b))),
                 inner.clone().prop_map(|a| Gen::Neg(Box::new(a))),
                 (inner, 0u8..4).prop_map(|(a, n)| Gen::Pow(Box::new(a), n)),
             ]

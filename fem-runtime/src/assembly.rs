@@ -30,7 +30,11 @@ fn block_plans<M: Model>(form: usize, dofs: &SystemDofs, bilinear: bool) -> Resu
             "form `{}` of `{}` is {}, not {}",
             info.name,
             M::NAME,
-            if info.arity == 2 { "bilinear" } else { "linear" },
+            if info.arity == 2 {
+                "bilinear"
+            } else {
+                "linear"
+            },
             if bilinear { "bilinear" } else { "linear" },
         )));
     }
@@ -78,35 +82,56 @@ impl MatrixAssembler {
         let form = M::form(form_name)?;
         let plans = block_plans::<M>(form, dofs, true)?;
         let n = dofs.dof_count();
-        let mut keys: Vec<u64> = Vec::new();
-        for c in 0..mesh.cell_count() {
-            for plan in &plans {
-                let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
-                let cols = dofs.map(plan.trial_field).unwrap().cell_dofs(c);
-                for &r in rows {
-                    for &col in cols {
-                        keys.push(((col + plan.col_offset) * n + r + plan.row_offset) as u64);
+        // Every (row, col) of every element matrix, in assembly order.
+        let for_each_entry = |visit: &mut dyn FnMut(usize, usize)| {
+            for c in 0..mesh.cell_count() {
+                for plan in &plans {
+                    let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
+                    let cols = dofs.map(plan.trial_field).unwrap().cell_dofs(c);
+                    for &r in rows {
+                        for &col in cols {
+                            visit(r + plan.row_offset, col + plan.col_offset);
+                        }
                     }
                 }
             }
-        }
-        let mut unique = keys.clone();
-        unique.sort_unstable();
-        unique.dedup();
-        let positions: Vec<usize> = keys
-            .iter()
-            .map(|k| unique.binary_search(k).expect("every key is in the pattern"))
-            .collect();
-        let mut col_ptr = vec![0usize; n + 1];
-        let mut row_idx = Vec::with_capacity(unique.len());
-        for &k in &unique {
-            let (col, row) = ((k as usize) / n.max(1), (k as usize) % n.max(1));
-            col_ptr[col + 1] += 1;
-            row_idx.push(row);
-        }
+        };
+        // Bucket the rows by column (counting sort), then sort and dedup each column:
+        // O(entries), where a global sort of the keys was the cost of the whole setup.
+        let mut bucket_ptr = vec![0usize; n + 1];
+        for_each_entry(&mut |_, col| bucket_ptr[col + 1] += 1);
         for j in 0..n {
-            col_ptr[j + 1] += col_ptr[j];
+            bucket_ptr[j + 1] += bucket_ptr[j];
         }
+        let mut fill = bucket_ptr.clone();
+        let mut bucket = vec![0usize; bucket_ptr[n]];
+        for_each_entry(&mut |row, col| {
+            bucket[fill[col]] = row;
+            fill[col] += 1;
+        });
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = Vec::with_capacity(bucket.len() / 2);
+        for j in 0..n {
+            let column = &mut bucket[bucket_ptr[j]..bucket_ptr[j + 1]];
+            column.sort_unstable();
+            let mut last = usize::MAX;
+            for &r in column.iter() {
+                if r != last {
+                    row_idx.push(r);
+                    last = r;
+                }
+            }
+            col_ptr[j + 1] = row_idx.len();
+        }
+        drop(bucket);
+        let mut positions = Vec::with_capacity(bucket_ptr[n]);
+        for_each_entry(&mut |row, col| {
+            let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+            let k = column
+                .binary_search(&row)
+                .expect("every entry is in the pattern");
+            positions.push(col_ptr[col] + k);
+        });
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let largest_block = plans.iter().map(|p| p.rows * p.cols).max().unwrap_or(0);
         Ok(Self {
@@ -169,7 +194,11 @@ impl MatrixAssembler {
     }
 
     /// The assembled matrix.
-    pub fn assemble<M: Model>(&self, mesh: &IntervalMesh, coefficients: &Coefficients) -> Result<SparseMatrix> {
+    pub fn assemble<M: Model>(
+        &self,
+        mesh: &IntervalMesh,
+        coefficients: &Coefficients,
+    ) -> Result<SparseMatrix> {
         let mut values = Vec::new();
         self.assemble_values::<M>(mesh, coefficients, &mut values)?;
         Ok(SparseColMat::new(self.symbolic.clone(), values))

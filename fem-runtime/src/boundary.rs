@@ -60,7 +60,9 @@ impl Constraints {
             .dofs()
             .iter()
             .filter(|d| matches!(d, DofLocation::Vertex { vertex: 0, .. }))
-            .position(|d| matches!(d, DofLocation::Vertex { derivative: o, .. } if *o == derivative))
+            .position(
+                |d| matches!(d, DofLocation::Vertex { derivative: o, .. } if *o == derivative),
+            )
             .ok_or_else(|| {
                 Error::Input(format!(
                     "field `{field}` ({}) has no {} DOF at the boundary",
@@ -69,7 +71,9 @@ impl Constraints {
                 ))
             })?;
         if !value.is_finite() {
-            return Err(Error::Input(format!("boundary value {value} for `{field}` is not finite")));
+            return Err(Error::Input(format!(
+                "boundary value {value} for `{field}` is not finite"
+            )));
         }
         let dof = dofs.offset(f).unwrap() + vertex_dofs.start + k;
         self.fixed.retain(|&(d, _)| d != dof);
@@ -103,7 +107,13 @@ impl Constraints {
 
     /// Clamps `field` at the `side` end: its value, and its slope when the element has a
     /// slope DOF, are zero.
-    pub fn clamp<M: Model>(&mut self, mesh: &IntervalMesh, dofs: &SystemDofs, field: &str, side: Side) -> Result<()> {
+    pub fn clamp<M: Model>(
+        &mut self,
+        mesh: &IntervalMesh,
+        dofs: &SystemDofs,
+        field: &str,
+        side: Side,
+    ) -> Result<()> {
         self.dirichlet::<M>(mesh, dofs, field, side, 0.0)?;
         let f = M::field(field)?;
         if M::FIELDS[f].element.dofs_per_vertex() > 1 {
@@ -121,7 +131,10 @@ impl Constraints {
     pub fn reduction(&self, n: usize) -> Result<Reduction> {
         let mut value = vec![None; n];
         for &(d, v) in &self.fixed {
-            *value.get_mut(d).ok_or_else(|| Error::Input(format!("fixed DOF {d} outside a system of {n}")))? = Some(v);
+            *value
+                .get_mut(d)
+                .ok_or_else(|| Error::Input(format!("fixed DOF {d} outside a system of {n}")))? =
+                Some(v);
         }
         let mut free_index = vec![usize::MAX; n];
         let mut free = Vec::new();
@@ -176,7 +189,10 @@ impl Reduction {
             }
             col_ptr.push(row_idx.len());
         }
-        SparseColMat::new(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), values)
+        SparseColMat::new(
+            SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
+            values,
+        )
     }
 
     /// The free part of `b − A u_fixed`.

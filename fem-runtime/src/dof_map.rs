@@ -82,9 +82,9 @@ impl SystemDofs {
         let mut offsets = Vec::new();
         let mut total = 0;
         for (k, &f) in fields.iter().enumerate() {
-            let info = M::FIELDS.get(f).ok_or_else(|| {
-                Error::Input(format!("model `{}` has no field {f}", M::NAME))
-            })?;
+            let info = M::FIELDS
+                .get(f)
+                .ok_or_else(|| Error::Input(format!("model `{}` has no field {f}", M::NAME)))?;
             if fields[..k].contains(&f) {
                 return Err(Error::Input(format!("field `{}` listed twice", info.name)));
             }
@@ -109,7 +109,10 @@ impl SystemDofs {
 
     /// Fields by the names of their unknowns.
     pub fn named<M: Model>(mesh: &IntervalMesh, names: &[&str]) -> Result<Self> {
-        let fields = names.iter().map(|n| M::field(n)).collect::<Result<Vec<_>>>()?;
+        let fields = names
+            .iter()
+            .map(|n| M::field(n))
+            .collect::<Result<Vec<_>>>()?;
         Self::new::<M>(mesh, &fields)
     }
 

@@ -17,7 +17,10 @@ impl PhysicalBasis {
         let derivatives = (0..=max_derivative)
             .map(|k| basis.iter().map(|p| p.derivative(k)).collect())
             .collect();
-        Self { element, derivatives }
+        Self {
+            element,
+            derivatives,
+        }
     }
 
     /// The element.
@@ -35,7 +38,13 @@ impl PhysicalBasis {
     }
 
     /// `d^k/dx^k` of `Σ cᵢ φᵢ` on a cell at reference point `ξ`.
-    pub fn evaluate(&self, coefficients: &[f64], derivative: usize, cell: [f64; 2], xi: f64) -> f64 {
+    pub fn evaluate(
+        &self,
+        coefficients: &[f64],
+        derivative: usize,
+        cell: [f64; 2],
+        xi: f64,
+    ) -> f64 {
         coefficients
             .iter()
             .enumerate()

@@ -64,9 +64,10 @@ impl Cholesky {
 
     /// The numeric factorization of `a` (same pattern as analysed).
     pub fn factor(&self, a: &SparseMatrix) -> Result<Factor> {
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), a.as_ref(), Side::Lower).map_err(|e| {
-            Error::LinearSolve(format!("the matrix is not positive definite ({e:?})"))
-        })?;
+        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), a.as_ref(), Side::Lower)
+            .map_err(|e| {
+                Error::LinearSolve(format!("the matrix is not positive definite ({e:?})"))
+            })?;
         Ok(Factor::Cholesky(llt))
     }
 }
@@ -111,7 +112,9 @@ impl Factor {
         if x.iter().all(|v| v.is_finite()) {
             Ok(x)
         } else {
-            Err(Error::LinearSolve("the solution is not finite: the matrix is numerically singular".into()))
+            Err(Error::LinearSolve(
+                "the solution is not finite: the matrix is numerically singular".into(),
+            ))
         }
     }
 
@@ -133,14 +136,22 @@ impl Factor {
 
 /// Solves an SPD system by sparse Cholesky.
 pub fn solve_spd(a: &SparseMatrix, b: &[f64]) -> Result<Vec<f64>> {
-    Cholesky::analyse(&a.symbolic().to_owned().map_err(|e| Error::LinearSolve(format!("{e:?}")))?)?
-        .factor(a)?
-        .solve(b)
+    Cholesky::analyse(
+        &a.symbolic()
+            .to_owned()
+            .map_err(|e| Error::LinearSolve(format!("{e:?}")))?,
+    )?
+    .factor(a)?
+    .solve(b)
 }
 
 /// Solves a general square system by sparse LU.
 pub fn solve_lu(a: &SparseMatrix, b: &[f64]) -> Result<Vec<f64>> {
-    LuSolver::analyse(&a.symbolic().to_owned().map_err(|e| Error::LinearSolve(format!("{e:?}")))?)?
-        .factor(a)?
-        .solve(b)
+    LuSolver::analyse(
+        &a.symbolic()
+            .to_owned()
+            .map_err(|e| Error::LinearSolve(format!("{e:?}")))?,
+    )?
+    .factor(a)?
+    .solve(b)
 }

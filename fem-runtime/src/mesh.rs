@@ -42,7 +42,13 @@ impl IntervalMesh {
         }
         Self::new(
             (0..=n)
-                .map(|i| if i == n { b } else { a + (b - a) * i as f64 / n as f64 })
+                .map(|i| {
+                    if i == n {
+                        b
+                    } else {
+                        a + (b - a) * i as f64 / n as f64
+                    }
+                })
                 .collect(),
         )
     }
@@ -51,7 +57,9 @@ impl IntervalMesh {
     /// `g(s) = ½(2s)^γ` on the left half and symmetric on the right (`γ = 1` is uniform).
     pub fn graded(a: f64, b: f64, n: usize, grading: f64) -> Result<Self> {
         if !(grading >= 1.0 && grading.is_finite()) {
-            return Err(Error::Mesh(format!("grading exponent {grading} must be ≥ 1")));
+            return Err(Error::Mesh(format!(
+                "grading exponent {grading} must be ≥ 1"
+            )));
         }
         if n == 0 {
             return Err(Error::Mesh("a mesh needs at least one cell".into()));
@@ -65,7 +73,13 @@ impl IntervalMesh {
         };
         Self::new(
             (0..=n)
-                .map(|i| if i == n { b } else { a + (b - a) * g(i as f64 / n as f64) })
+                .map(|i| {
+                    if i == n {
+                        b
+                    } else {
+                        a + (b - a) * g(i as f64 / n as f64)
+                    }
+                })
                 .collect(),
         )
     }
@@ -96,7 +110,8 @@ impl IntervalMesh {
     /// Bisects every cell.
     pub fn refine_uniformly(&self) -> Self {
         let all: Vec<usize> = (0..self.cell_count()).collect();
-        self.refine(&all).expect("bisecting a valid mesh gives a valid mesh")
+        self.refine(&all)
+            .expect("bisecting a valid mesh gives a valid mesh")
     }
 
     /// The vertices, increasing.
@@ -127,7 +142,9 @@ impl IntervalMesh {
 
     /// Largest cell length.
     pub fn max_h(&self) -> f64 {
-        (0..self.cell_count()).map(|c| self.h(c)).fold(0.0, f64::max)
+        (0..self.cell_count())
+            .map(|c| self.h(c))
+            .fold(0.0, f64::max)
     }
 
     /// The cell containing `x` (the left one at a vertex), or `None` outside the mesh.

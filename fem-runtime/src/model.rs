@@ -129,11 +129,14 @@ impl<'a> Coefficients<'a> {
     pub fn new<M: Model>(params: &[(&str, f64)], data: &[(&str, &'a DataFn)]) -> Result<Self> {
         let mut values = vec![None; M::PARAMS.len()];
         for &(name, v) in params {
-            let i = M::PARAMS.iter().position(|p| *p == name).ok_or_else(|| {
-                unknown::<M>("parameter", name, M::PARAMS.iter().copied())
-            })?;
+            let i = M::PARAMS
+                .iter()
+                .position(|p| *p == name)
+                .ok_or_else(|| unknown::<M>("parameter", name, M::PARAMS.iter().copied()))?;
             if !v.is_finite() {
-                return Err(Error::Input(format!("parameter `{name}` = {v} is not finite")));
+                return Err(Error::Input(format!(
+                    "parameter `{name}` = {v} is not finite"
+                )));
             }
             if values[i].replace(v).is_some() {
                 return Err(Error::Input(format!("parameter `{name}` given twice")));
@@ -141,9 +144,10 @@ impl<'a> Coefficients<'a> {
         }
         let mut functions: Vec<Option<&'a DataFn>> = vec![None; M::DATA.len()];
         for &(name, f) in data {
-            let i = M::DATA.iter().position(|p| *p == name).ok_or_else(|| {
-                unknown::<M>("data function", name, M::DATA.iter().copied())
-            })?;
+            let i = M::DATA
+                .iter()
+                .position(|p| *p == name)
+                .ok_or_else(|| unknown::<M>("data function", name, M::DATA.iter().copied()))?;
             if functions[i].replace(f).is_some() {
                 return Err(Error::Input(format!("data function `{name}` given twice")));
             }

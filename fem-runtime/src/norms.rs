@@ -18,7 +18,11 @@ pub struct FieldView<'a> {
 impl FieldView<'_> {
     /// Local coefficients of cell `c`.
     pub fn local(&self, c: usize) -> Vec<f64> {
-        self.map.cell_dofs(c).iter().map(|&d| self.coefficients[d]).collect()
+        self.map
+            .cell_dofs(c)
+            .iter()
+            .map(|&d| self.coefficients[d])
+            .collect()
     }
 
     /// `d^k/dx^k` of the field at `x` (from the left cell at a vertex); `None` outside.

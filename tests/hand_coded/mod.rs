@@ -83,7 +83,11 @@ impl HandElement {
     /// DOF's function is `h` times the reference one, and `d/dx = h⁻¹ d/dξ`.
     pub fn physical(self, i: usize, h: f64, x: f64) -> [f64; 5] {
         let r = self.reference(i, x);
-        let scale = if self == HandElement::Hermite && i % 2 == 1 { h } else { 1.0 };
+        let scale = if self == HandElement::Hermite && i % 2 == 1 {
+            h
+        } else {
+            1.0
+        };
         std::array::from_fn(|k| r[k] * scale / h.powi(k as i32))
     }
 }
@@ -217,7 +221,12 @@ pub fn timoshenko_matrix(
 }
 
 /// The Timoshenko linear forms: ℓ, ℓ_S, g, L_h.
-pub fn timoshenko_vector(form: &str, elements: &[HandElement; 3], test_field: usize, st: Setting) -> Vec<f64> {
+pub fn timoshenko_vector(
+    form: &str,
+    elements: &[HandElement; 3],
+    test_field: usize,
+    st: Setting,
+) -> Vec<f64> {
     let (s, h4, alpha) = (st.s, st.h.powi(4), st.alpha);
     let l = |v: &FieldValues, x: f64| load(x) * v[W][0];
     let ls = |v: &FieldValues, x: f64| h4 * load(x) * (v[THETA][3] - s * v[LAMBDA][0]);
@@ -234,7 +243,12 @@ pub fn timoshenko_vector(form: &str, elements: &[HandElement; 3], test_field: us
 }
 
 /// The Euler–Bernoulli forms of MODELS.md §4.
-pub fn bernoulli_matrix(form: &str, test_field: usize, trial_field: usize, st: Setting) -> Vec<Vec<f64>> {
+pub fn bernoulli_matrix(
+    form: &str,
+    test_field: usize,
+    trial_field: usize,
+    st: Setting,
+) -> Vec<Vec<f64>> {
     let elements = [HandElement::Hermite, HandElement::P0];
     let (s, h4) = (st.s, st.h.powi(4));
     let a = |u: &FieldValues, v: &FieldValues, _x: f64| u[BW][2] * v[BW][2];

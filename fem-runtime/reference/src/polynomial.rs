@@ -40,7 +40,10 @@ impl Polynomial {
 
     /// Value at `x` (Horner's scheme).
     pub fn eval(&self, x: f64) -> f64 {
-        self.coefficients.iter().rev().fold(0.0, |acc, &c| acc * x + c)
+        self.coefficients
+            .iter()
+            .rev()
+            .fold(0.0, |acc, &c| acc * x + c)
     }
 
     /// The derivative of order `order`.
