@@ -2,7 +2,11 @@
 //! obstacle and contact problems of thin structures.
 //!
 //! This crate re-exports the runtime ([`fem_runtime`]), the `model!` macro that compiles
-//! model files, and the model files of [`fem_models`].
+//! model files, and the model files and scenes of [`fem_models`]; it adds the beam scene
+//! solver ([`beams`]), the studies and charts ([`studies`], [`plot`]) behind the CLI.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+pub mod beams;
 
 pub use fem_models as models;
 pub use fem_runtime::*;

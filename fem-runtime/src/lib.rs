@@ -6,6 +6,7 @@
 
 pub mod assembly;
 pub mod boundary;
+pub mod complementarity;
 pub mod dof_map;
 pub mod element;
 pub mod error;
@@ -15,6 +16,7 @@ pub mod linear_solve;
 pub mod mesh;
 pub mod model;
 pub mod norms;
+pub mod obstacle;
 
 pub use assembly::{assemble_vector, MatrixAssembler};
 pub use boundary::{Constraints, Reduction, Side};

@@ -27,11 +27,22 @@ impl FieldView<'_> {
 
     /// `d^k/dx^k` of the field at `x` (from the left cell at a vertex); `None` outside.
     pub fn at(&self, x: f64, derivative: usize) -> Option<f64> {
+        let basis = PhysicalBasis::new(self.map.element(), derivative);
+        self.at_with(&basis, x, derivative)
+    }
+
+    /// [`FieldView::at`] with a basis built once by the caller (for many points).
+    pub fn at_with(&self, basis: &PhysicalBasis, x: f64, derivative: usize) -> Option<f64> {
         let c = self.mesh.locate(x)?;
         let cell = self.mesh.cell(c);
-        let basis = PhysicalBasis::new(self.map.element(), derivative);
         let xi = (x - cell[0]) / (cell[1] - cell[0]);
-        Some(basis.evaluate(&self.local(c), derivative, cell, xi))
+        let dofs = self.map.cell_dofs(c);
+        Some(
+            dofs.iter()
+                .enumerate()
+                .map(|(i, &d)| self.coefficients[d] * basis.value(i, derivative, cell, xi))
+                .sum(),
+        )
     }
 
     /// `(Σ_T ∫_T |dᵏ(u − u_h)|²)^{1/2}` with an `n`-point Gauss rule per cell.

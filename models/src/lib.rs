@@ -9,3 +9,4 @@ pub mod timoshenko;
 
 pub use euler_bernoulli::bernoulli;
 pub use timoshenko::{timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
+pub mod scenes;

@@ -1,0 +1,508 @@
+//! The discrete variational inequality as a linear complementarity problem, and its
+//! solvers (MODELS.md §1):
+//!
+//! ```text
+//! A U − Bᵀ Λ = F,   Λ ≥ 0,   R := B U + C Λ − G ≥ 0,   Λ·R = 0
+//! ```
+//!
+//! With `C` diagonal and positive (P0 multipliers, α > 0), `Λ = C⁻¹(G − B U)₊`, and `U`
+//! minimizes the convex C¹ function `Φ(U) = ½UᵀAU − FᵀU + ½ Σ_k (G − BU)²₊,k / C_k`.
+//! [`semismooth_newton`] is Newton's method on Φ (the primal–dual active set method with
+//! `c_k = 1/C_k` per constraint) with an Armijo line search on Φ, so it cannot cycle;
+//! the Hessian's pattern and symbolic Cholesky factorization are computed once.
+//! [`quadratic_program`] solves the same problem with clarabel as an independent check,
+//! and also the plain mixed method (`C = 0`). Every result carries its KKT residual.
+
+use crate::error::{Error, Result};
+use crate::linear_solve::{multiply, Cholesky};
+use crate::SparseMatrix;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use std::time::Instant;
+
+/// `A U − Bᵀ Λ = F, 0 ≤ Λ ⊥ B U + C Λ − G ≥ 0`.
+#[derive(Clone, Debug)]
+pub struct Lcp {
+    /// The primal matrix `A` (n × n, symmetric).
+    pub a: SparseMatrix,
+    /// Rows of `B` (m rows): `(column, value)` pairs.
+    pub b_rows: Vec<Vec<(usize, f64)>>,
+    /// Diagonal of `C` (m), ≥ 0.
+    pub c: Vec<f64>,
+    /// Primal right-hand side (n).
+    pub f: Vec<f64>,
+    /// Constraint right-hand side (m).
+    pub g: Vec<f64>,
+}
+
+/// A solution of the LCP with how it was obtained.
+#[derive(Clone, Debug)]
+pub struct LcpSolution {
+    /// Primal unknowns.
+    pub u: Vec<f64>,
+    /// Multipliers, ≥ 0.
+    pub lambda: Vec<f64>,
+    /// Iterations of the solver.
+    pub iterations: usize,
+    /// KKT residual ([`Lcp::kkt_residual`]).
+    pub kkt_residual: f64,
+    /// Wall time of the solve.
+    pub seconds: f64,
+    /// Number of numeric factorizations.
+    pub factorizations: usize,
+}
+
+impl Lcp {
+    /// Number of primal unknowns.
+    pub fn n(&self) -> usize {
+        self.f.len()
+    }
+
+    /// Number of constraints.
+    pub fn m(&self) -> usize {
+        self.g.len()
+    }
+
+    /// `B u`.
+    pub fn b_times(&self, u: &[f64]) -> Vec<f64> {
+        self.b_rows
+            .iter()
+            .map(|row| row.iter().map(|&(j, v)| v * u[j]).sum())
+            .collect()
+    }
+
+    /// `Bᵀ y`.
+    pub fn bt_times(&self, y: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.n()];
+        for (row, &yk) in self.b_rows.iter().zip(y) {
+            if yk != 0.0 {
+                for &(j, v) in row {
+                    out[j] += v * yk;
+                }
+            }
+        }
+        out
+    }
+
+    /// The natural size of a multiplier: `‖F‖∞ / ‖Bᵀ‖∞` (equilibrium `BᵀΛ ~ F`), so that
+    /// "λ is zero" is judged against the load, not against λ itself.
+    pub fn multiplier_scale(&self) -> f64 {
+        let mut bt_col_sums = vec![0.0; self.n()];
+        for row in &self.b_rows {
+            for &(j, v) in row {
+                bt_col_sums[j] += v.abs();
+            }
+        }
+        let bt = bt_col_sums.iter().fold(0.0f64, |m, x| m.max(*x));
+        let f = self.f.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if bt > 0.0 {
+            f / bt
+        } else {
+            0.0
+        }
+    }
+
+    /// The KKT residual of `(u, λ)`, scale-invariant: the largest of
+    /// - the normwise backward error of the equilibrium
+    ///   `‖AU − BᵀΛ − F‖∞ / (‖A‖∞‖U‖∞ + ‖Bᵀ‖∞‖Λ‖∞ + ‖F‖∞)`,
+    /// - the complementarity `max_k |min(Λ_k/Λ*, r_k)|` (`Λ*` the larger of ‖Λ‖∞ and
+    ///   [`Lcp::multiplier_scale`]) with the componentwise relative
+    ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + C_k|Λ_k| + |G_k|)`,
+    /// - the infeasibilities `(−Λ_k)₊/‖Λ‖∞` and `(−r_k)₊`.
+    pub fn kkt_residual(&self, u: &[f64], lambda: &[f64]) -> f64 {
+        let au = multiply(&self.a, u);
+        let btl = self.bt_times(lambda);
+        let norm_inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let a_norm = row_sum_norm(&self.a);
+        let mut bt_col_sums = vec![0.0; self.n()];
+        for row in &self.b_rows {
+            for &(j, v) in row {
+                bt_col_sums[j] += v.abs();
+            }
+        }
+        let bt_norm = norm_inf(&bt_col_sums);
+        let equilibrium: f64 = au
+            .iter()
+            .zip(&btl)
+            .zip(&self.f)
+            .map(|((a, b), f)| (a - b - f).abs())
+            .fold(0.0, f64::max);
+        let scale = a_norm * norm_inf(u) + bt_norm * norm_inf(lambda) + norm_inf(&self.f);
+        let backward = if scale > 0.0 {
+            equilibrium / scale
+        } else {
+            equilibrium
+        };
+        let lambda_norm = norm_inf(lambda).max(self.multiplier_scale());
+        let mut complementarity = 0.0f64;
+        for (k, row) in self.b_rows.iter().enumerate() {
+            let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
+                + (self.c[k] * lambda[k]).abs()
+                + self.g[k].abs();
+            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
+            let residual = bu + self.c[k] * lambda[k] - self.g[k];
+            let r = if terms > 0.0 {
+                residual / terms
+            } else {
+                residual
+            };
+            let l = if lambda_norm > 0.0 {
+                lambda[k] / lambda_norm
+            } else {
+                lambda[k]
+            };
+            complementarity = complementarity.max(l.min(r).abs()).max(-l).max(-r);
+        }
+        backward.max(complementarity)
+    }
+}
+
+fn row_sum_norm(a: &SparseMatrix) -> f64 {
+    // symmetric: the largest column sum equals the largest row sum
+    let (col_ptr, vals) = (a.symbolic().col_ptr(), a.val());
+    (0..a.ncols())
+        .map(|j| {
+            vals[col_ptr[j]..col_ptr[j + 1]]
+                .iter()
+                .map(|v| v.abs())
+                .sum::<f64>()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Options of the semismooth Newton method.
+#[derive(Clone, Copy, Debug)]
+pub struct NewtonOptions {
+    /// Iteration limit (an error beyond it).
+    pub max_iterations: usize,
+    /// Rounds of iterative refinement of each linear solve (thin structures need 1–2).
+    pub refinement_steps: usize,
+    /// KKT residual accepted at convergence.
+    pub tolerance: f64,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        Self {
+            max_iterations: 500,
+            refinement_steps: 1,
+            tolerance: 1e-10,
+        }
+    }
+}
+
+/// The Hessian `A + Σ_{k active} b_k b_kᵀ / C_k` with a fixed pattern.
+struct Hessian {
+    symbolic: SymbolicSparseColMat<usize>,
+    a_positions: Vec<usize>,
+    /// For row k of B, the value positions of its outer product entries (i-major).
+    row_positions: Vec<Vec<usize>>,
+}
+
+impl Hessian {
+    fn new(lcp: &Lcp) -> Self {
+        let n = lcp.n();
+        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n];
+        let a = &lcp.a;
+        let (col_ptr, rows) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+        for (j, column) in columns.iter_mut().enumerate() {
+            column.extend_from_slice(&rows[col_ptr[j]..col_ptr[j + 1]]);
+        }
+        for row in &lcp.b_rows {
+            for &(i, _) in row {
+                for &(j, _) in row {
+                    columns[j].push(i);
+                }
+            }
+        }
+        let mut new_ptr = vec![0usize; n + 1];
+        let mut new_rows = Vec::new();
+        for (j, column) in columns.iter_mut().enumerate() {
+            column.sort_unstable();
+            column.dedup();
+            new_rows.extend_from_slice(column);
+            new_ptr[j + 1] = new_rows.len();
+        }
+        let find = |i: usize, j: usize| {
+            new_ptr[j]
+                + new_rows[new_ptr[j]..new_ptr[j + 1]]
+                    .binary_search(&i)
+                    .unwrap()
+        };
+        let mut a_positions = Vec::with_capacity(rows.len());
+        for j in 0..n {
+            for &i in &rows[col_ptr[j]..col_ptr[j + 1]] {
+                a_positions.push(find(i, j));
+            }
+        }
+        let row_positions = lcp
+            .b_rows
+            .iter()
+            .map(|row| {
+                let mut p = Vec::with_capacity(row.len() * row.len());
+                for &(i, _) in row {
+                    for &(j, _) in row {
+                        p.push(find(i, j));
+                    }
+                }
+                p
+            })
+            .collect();
+        Self {
+            symbolic: SymbolicSparseColMat::new_checked(n, n, new_ptr, None, new_rows),
+            a_positions,
+            row_positions,
+        }
+    }
+
+    fn matrix(&self, lcp: &Lcp, active: &[bool]) -> SparseMatrix {
+        let mut values = vec![0.0; self.symbolic.row_idx().len()];
+        for (&p, &v) in self.a_positions.iter().zip(lcp.a.val()) {
+            values[p] += v;
+        }
+        for (k, row) in lcp.b_rows.iter().enumerate() {
+            if active[k] {
+                let w = 1.0 / lcp.c[k];
+                let mut q = 0;
+                for &(_, vi) in row {
+                    for &(_, vj) in row {
+                        values[self.row_positions[k][q]] += w * vi * vj;
+                        q += 1;
+                    }
+                }
+            }
+        }
+        SparseColMat::new(self.symbolic.clone(), values)
+    }
+}
+
+/// Semismooth Newton (primal–dual active set) on Φ with an Armijo line search, from
+/// `start` (e.g. the prolonged solution of a coarser mesh) or from zero.
+pub fn semismooth_newton(
+    lcp: &Lcp,
+    start: Option<&[f64]>,
+    options: NewtonOptions,
+) -> Result<LcpSolution> {
+    let clock = Instant::now();
+    if let Some(k) = lcp.c.iter().position(|&c| !(c > 0.0)) {
+        return Err(Error::Input(format!(
+            "semismooth Newton eliminates Λ = C⁻¹(G − BU)₊ and needs C > 0; C_{k} = {} (α ≤ 0 gives the plain mixed method: use the QP solver)",
+            lcp.c[k]
+        )));
+    }
+    let n = lcp.n();
+    let mut u = match start {
+        Some(s) if s.len() == n => s.to_vec(),
+        Some(s) => {
+            return Err(Error::Input(format!(
+                "start vector has {} entries, the problem {n}",
+                s.len()
+            )))
+        }
+        None => vec![0.0; n],
+    };
+    let hessian = Hessian::new(lcp);
+    let cholesky = Cholesky::analyse(&hessian.symbolic)?;
+    let phi = |u: &[f64], au: &[f64], bu: &[f64]| -> f64 {
+        let quadratic: f64 = u
+            .iter()
+            .zip(au)
+            .zip(&lcp.f)
+            .map(|((u, au), f)| 0.5 * u * au - f * u)
+            .sum();
+        let penalty: f64 = (0..lcp.m())
+            .map(|k| {
+                let r = (lcp.g[k] - bu[k]).max(0.0);
+                0.5 * r * r / lcp.c[k]
+            })
+            .sum();
+        quadratic + penalty
+    };
+    let mut previous_active: Option<Vec<bool>> = None;
+    let mut factorizations = 0;
+    for iteration in 1..=options.max_iterations {
+        let au = multiply(&lcp.a, &u);
+        let bu = lcp.b_times(&u);
+        let active: Vec<bool> = (0..lcp.m()).map(|k| lcp.g[k] - bu[k] > 0.0).collect();
+        let lambda: Vec<f64> = (0..lcp.m())
+            .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
+            .collect();
+        // Converged: the active set did not change over a full step, so u is the exact
+        // minimizer of the quadratic that Φ is on this active set.
+        if previous_active.as_ref() == Some(&active) {
+            let residual = lcp.kkt_residual(&u, &lambda);
+            if residual <= options.tolerance {
+                return Ok(LcpSolution {
+                    u,
+                    lambda,
+                    iterations: iteration - 1,
+                    kkt_residual: residual,
+                    seconds: clock.elapsed().as_secs_f64(),
+                    factorizations,
+                });
+            }
+        }
+        let btl = lcp.bt_times(&lambda);
+        let gradient: Vec<f64> = (0..n).map(|i| au[i] - lcp.f[i] - btl[i]).collect();
+        let h = hessian.matrix(lcp, &active);
+        let factor = cholesky.factor(&h)?;
+        factorizations += 1;
+        let minus_gradient: Vec<f64> = gradient.iter().map(|g| -g).collect();
+        let d = factor.solve_refined(&h, &minus_gradient, options.refinement_steps)?;
+        // Armijo backtracking on Φ along d (exact products, so Φ is cheap to re-evaluate).
+        let ad = multiply(&lcp.a, &d);
+        let bd = lcp.b_times(&d);
+        let phi0 = phi(&u, &au, &bu);
+        let slope: f64 = gradient.iter().zip(&d).map(|(g, d)| g * d).sum();
+        let mut step = 1.0;
+        let mut accepted = false;
+        for _ in 0..60 {
+            let ut: Vec<f64> = u.iter().zip(&d).map(|(u, d)| u + step * d).collect();
+            let aut: Vec<f64> = au.iter().zip(&ad).map(|(a, b)| a + step * b).collect();
+            let but: Vec<f64> = bu.iter().zip(&bd).map(|(a, b)| a + step * b).collect();
+            if phi(&ut, &aut, &but) <= phi0 + 1e-4 * step * slope + 1e-14 * phi0.abs() {
+                u = ut;
+                accepted = true;
+                break;
+            }
+            step *= 0.5;
+        }
+        if !accepted {
+            // No decrease along a Newton direction: at the minimizer up to rounding.
+            let residual = lcp.kkt_residual(&u, &lambda);
+            if residual <= options.tolerance.max(1e-8) {
+                return Ok(LcpSolution {
+                    u,
+                    lambda,
+                    iterations: iteration,
+                    kkt_residual: residual,
+                    seconds: clock.elapsed().as_secs_f64(),
+                    factorizations,
+                });
+            }
+            return Err(Error::NotConverged {
+                solver: "semismooth Newton",
+                detail: format!(
+                    "line search failed at iteration {iteration} with KKT residual {residual:e}"
+                ),
+            });
+        }
+        previous_active = (step == 1.0).then_some(active);
+    }
+    let bu = lcp.b_times(&u);
+    let lambda: Vec<f64> = (0..lcp.m())
+        .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
+        .collect();
+    Err(Error::NotConverged {
+        solver: "semismooth Newton",
+        detail: format!(
+            "{} iterations without a settled active set (KKT residual {:e})",
+            options.max_iterations,
+            lcp.kkt_residual(&u, &lambda)
+        ),
+    })
+}
+
+/// The LCP as a convex QP solved by clarabel (an interior-point method independent of
+/// the Newton path): `min ½UᵀAU − FᵀU + ½ΛᵀCΛ` over `BU + CΛ ≥ G`. Its KKT conditions
+/// are the LCP with `Λ` the constraint's multiplier (for `C > 0` also `Λ = C⁻¹CΛ`, the
+/// primal Λ); with `C = 0` it is the plain mixed method `min ½UᵀAU − FᵀU` over `BU ≥ G`.
+/// Unlike a formulation with `C⁻¹`, nothing here grows like `h⁻⁵`.
+pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
+    use clarabel::algebra::CscMatrix;
+    use clarabel::solver::{
+        DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
+    };
+    let clock = Instant::now();
+    let (n, m) = (lcp.n(), lcp.m());
+    if lcp.c.iter().any(|&c| !(c >= 0.0)) {
+        return Err(Error::Input("C must be non-negative".into()));
+    }
+    let with_lambda = lcp.c.iter().any(|&c| c > 0.0);
+    let nx = if with_lambda { n + m } else { n };
+    // P: upper triangle of blockdiag(A, C)
+    let (col_ptr, rows, vals) = (
+        lcp.a.symbolic().col_ptr(),
+        lcp.a.symbolic().row_idx(),
+        lcp.a.val(),
+    );
+    let mut p_ptr = vec![0usize];
+    let mut p_rows = Vec::new();
+    let mut p_vals = Vec::new();
+    for j in 0..n {
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            if rows[k] <= j {
+                p_rows.push(rows[k]);
+                p_vals.push(vals[k]);
+            }
+        }
+        p_ptr.push(p_rows.len());
+    }
+    if with_lambda {
+        for k in 0..m {
+            p_rows.push(n + k);
+            p_vals.push(lcp.c[k]);
+            p_ptr.push(p_rows.len());
+        }
+    }
+    let p = CscMatrix::new(nx, nx, p_ptr, p_rows, p_vals);
+    let mut q: Vec<f64> = lcp.f.iter().map(|f| -f).collect();
+    q.resize(nx, 0.0);
+    // −BU − CΛ + s = −G, s ≥ 0
+    let (mut ti, mut tj, mut tv) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, row) in lcp.b_rows.iter().enumerate() {
+        for &(j, v) in row {
+            ti.push(k);
+            tj.push(j);
+            tv.push(-v);
+        }
+        if with_lambda {
+            ti.push(k);
+            tj.push(n + k);
+            tv.push(-lcp.c[k]);
+        }
+    }
+    let b: Vec<f64> = lcp.g.iter().map(|g| -g).collect();
+    let a_c = CscMatrix::new_from_triplets(m, nx, ti, tj, tv);
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(400)
+        .tol_gap_abs(1e-13)
+        .tol_gap_rel(1e-13)
+        .tol_feas(1e-13)
+        .tol_ktratio(1e-10)
+        .build()
+        .map_err(|e| Error::Input(format!("clarabel settings: {e:?}")))?;
+    let cones = [NonnegativeConeT(m)];
+    let mut solver = DefaultSolver::new(&p, &q, &a_c, &b, &cones, settings)
+        .map_err(|e| Error::Input(format!("clarabel rejected the problem: {e:?}")))?;
+    solver.solve();
+    let status = solver.solution.status;
+    if !matches!(status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
+        let infeasible = matches!(
+            status,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible
+        );
+        return Err(if infeasible {
+            Error::Input("the constraints are infeasible (clarabel found a certificate)".into())
+        } else {
+            Error::NotConverged {
+                solver: "clarabel",
+                detail: format!(
+                    "status {status:?} after {} iterations",
+                    solver.solution.iterations
+                ),
+            }
+        });
+    }
+    let u = solver.solution.x[..n].to_vec();
+    let lambda: Vec<f64> = solver.solution.z[..m].iter().map(|z| z.max(0.0)).collect();
+    let kkt_residual = lcp.kkt_residual(&u, &lambda);
+    Ok(LcpSolution {
+        u,
+        lambda,
+        iterations: solver.solution.iterations as usize,
+        kkt_residual,
+        seconds: clock.elapsed().as_secs_f64(),
+        factorizations: solver.solution.iterations as usize,
+    })
+}

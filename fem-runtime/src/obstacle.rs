@@ -1,0 +1,400 @@
+//! Obstacle problems of a model: the stabilized saddle-point system `B_h`, `L_h` is
+//! assembled, boundary DOFs are eliminated, and the system is split into the LCP blocks
+//! `A_α, B_α, C_α, F_α, G_α` of MODELS.md §1 (the KKT matrix is
+//! `[[A_α, −B_αᵀ], [−B_α, −C_α]]`, its right-hand side `[F_α; −G_α]`).
+
+use crate::assembly::{assemble_vector, MatrixAssembler};
+use crate::boundary::{Constraints, Reduction, Side};
+use crate::complementarity::{
+    quadratic_program, semismooth_newton, Lcp, LcpSolution, NewtonOptions,
+};
+use crate::dof_map::SystemDofs;
+use crate::element::PhysicalBasis;
+use crate::error::{Error, Result};
+use crate::mesh::IntervalMesh;
+use crate::model::{Coefficients, Model};
+use crate::norms::FieldView;
+use crate::SparseMatrix;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use fem_reference::DofLocation;
+use std::time::Instant;
+
+/// Which algorithm solves the LCP.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VariationalSolver {
+    /// Semismooth Newton / primal–dual active set on Φ, globalized by a line search.
+    SemismoothNewton,
+    /// clarabel's interior-point method on the equivalent QP.
+    Clarabel,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Role {
+    Primal(usize),
+    Multiplier(usize),
+}
+
+/// The discrete obstacle problem of a model on one mesh.
+pub struct Discretization {
+    /// The mesh.
+    pub mesh: IntervalMesh,
+    /// DOFs of all fields of the model.
+    pub dofs: SystemDofs,
+    /// Elimination of the boundary DOFs.
+    pub reduction: Reduction,
+    /// The LCP blocks.
+    pub lcp: Lcp,
+    /// The model field that holds the multiplier.
+    pub multiplier_field: usize,
+    roles: Vec<Role>,
+    primal_reduced: Vec<usize>,
+    multiplier_reduced: Vec<usize>,
+}
+
+/// The multiplier field of a model: the one declared `>= 0`.
+pub fn multiplier_field<M: Model>() -> Result<usize> {
+    let fields: Vec<usize> = (0..M::FIELDS.len())
+        .filter(|&f| M::FIELDS[f].nonnegative)
+        .collect();
+    match fields.as_slice() {
+        [f] => Ok(*f),
+        _ => Err(Error::Input(format!(
+            "model `{}` must declare exactly one multiplier `λ: P0 >= 0`, it declares {}",
+            M::NAME,
+            fields.len()
+        ))),
+    }
+}
+
+impl Discretization {
+    /// Assembles `bilinear` and `linear` (normally `B_h`, `L_h`) of `M` on `mesh`, with the
+    /// fields in `clamped` clamped at both ends.
+    pub fn new<M: Model>(
+        mesh: &IntervalMesh,
+        coefficients: &Coefficients,
+        clamped: &[&str],
+        bilinear: &str,
+        linear: &str,
+    ) -> Result<Self> {
+        let multiplier = multiplier_field::<M>()?;
+        let dofs = SystemDofs::all::<M>(mesh);
+        let mut constraints = Constraints::new();
+        for field in clamped {
+            for side in [Side::Left, Side::Right] {
+                constraints.clamp::<M>(mesh, &dofs, field, side)?;
+            }
+        }
+        let k =
+            MatrixAssembler::new::<M>(bilinear, mesh, &dofs)?.assemble::<M>(mesh, coefficients)?;
+        let rhs = assemble_vector::<M>(linear, mesh, &dofs, coefficients)?;
+        let reduction = constraints.reduction(dofs.dof_count())?;
+        let rhs = reduction.rhs(&k, &rhs);
+        let k = reduction.matrix(&k);
+        let multiplier_range = dofs.range(multiplier).unwrap();
+        let mut roles = Vec::with_capacity(reduction.free().len());
+        let (mut primal_reduced, mut multiplier_reduced) = (Vec::new(), Vec::new());
+        for (r, &d) in reduction.free().iter().enumerate() {
+            if multiplier_range.contains(&d) {
+                roles.push(Role::Multiplier(multiplier_reduced.len()));
+                multiplier_reduced.push(r);
+            } else {
+                roles.push(Role::Primal(primal_reduced.len()));
+                primal_reduced.push(r);
+            }
+        }
+        let (n, m) = (primal_reduced.len(), multiplier_reduced.len());
+        let mut b_rows = vec![Vec::new(); m];
+        let mut c = vec![0.0; m];
+        let mut a_ptr = vec![0usize];
+        let (mut a_rows, mut a_vals) = (Vec::new(), Vec::new());
+        let (col_ptr, rows, vals) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
+        for (j, role_j) in roles.iter().enumerate() {
+            for idx in col_ptr[j]..col_ptr[j + 1] {
+                let (i, v) = (rows[idx], vals[idx]);
+                match (roles[i], *role_j) {
+                    (Role::Primal(p), Role::Primal(_)) => {
+                        a_rows.push(p);
+                        a_vals.push(v);
+                    }
+                    (Role::Multiplier(mk), Role::Primal(p)) => b_rows[mk].push((p, -v)),
+                    (Role::Multiplier(mi), Role::Multiplier(mj)) => {
+                        if mi == mj {
+                            c[mi] = -v;
+                        } else if v != 0.0 {
+                            return Err(Error::Input(format!(
+                                "the multiplier block of `{bilinear}` is not diagonal: P0 multipliers are needed to eliminate Λ"
+                            )));
+                        }
+                    }
+                    (Role::Primal(_), Role::Multiplier(_)) => {}
+                }
+            }
+            if let Role::Primal(_) = role_j {
+                a_ptr.push(a_rows.len());
+            }
+        }
+        for row in &mut b_rows {
+            row.retain(|&(_, v)| v != 0.0);
+        }
+        let a: SparseMatrix = SparseColMat::new(
+            SymbolicSparseColMat::new_checked(n, n, a_ptr, None, a_rows),
+            a_vals,
+        );
+        let f = primal_reduced.iter().map(|&r| rhs[r]).collect();
+        let g = multiplier_reduced.iter().map(|&r| -rhs[r]).collect();
+        Ok(Self {
+            mesh: mesh.clone(),
+            dofs,
+            reduction,
+            lcp: Lcp { a, b_rows, c, f, g },
+            multiplier_field: multiplier,
+            roles,
+            primal_reduced,
+            multiplier_reduced,
+        })
+    }
+
+    /// The full coefficient vector (all fields, boundary values included) of an LCP solution.
+    pub fn full(&self, solution: &LcpSolution) -> Vec<f64> {
+        let mut reduced = vec![0.0; self.roles.len()];
+        for (p, &r) in self.primal_reduced.iter().enumerate() {
+            reduced[r] = solution.u[p];
+        }
+        for (k, &r) in self.multiplier_reduced.iter().enumerate() {
+            reduced[r] = solution.lambda[k];
+        }
+        self.reduction.expand(&reduced)
+    }
+
+    /// The primal unknowns of a full coefficient vector (a start for Newton).
+    pub fn primal_part(&self, full: &[f64]) -> Vec<f64> {
+        self.primal_reduced
+            .iter()
+            .map(|&r| full[self.reduction.free()[r]])
+            .collect()
+    }
+}
+
+/// Interpolates the fields of `coarse` (a coefficient vector on `coarse_dofs`) at the DOFs
+/// of a finer mesh: values and slopes at vertices, Lagrange nodes, P0 cell midpoints.
+pub fn prolong<M: Model>(
+    coarse_mesh: &IntervalMesh,
+    coarse_dofs: &SystemDofs,
+    coarse: &[f64],
+    fine_mesh: &IntervalMesh,
+    fine_dofs: &SystemDofs,
+) -> Vec<f64> {
+    let mut fine = vec![0.0; fine_dofs.dof_count()];
+    for &field in fine_dofs.fields() {
+        let (Some(map_c), Some(map_f)) = (coarse_dofs.map(field), fine_dofs.map(field)) else {
+            continue;
+        };
+        let range = coarse_dofs.range(field).unwrap();
+        let view = FieldView {
+            mesh: coarse_mesh,
+            map: map_c,
+            coefficients: &coarse[range],
+        };
+        let element = map_f.element();
+        let basis = PhysicalBasis::new(element, 1);
+        let offset = fine_dofs.offset(field).unwrap();
+        let nodes = element.lagrange_nodes();
+        for c in 0..fine_mesh.cell_count() {
+            let cell = fine_mesh.cell(c);
+            let mut interior = 0;
+            for (i, location) in element.dofs().iter().enumerate() {
+                let (x, derivative) = match *location {
+                    DofLocation::Vertex { vertex, derivative } => (cell[vertex], derivative),
+                    DofLocation::Interior => {
+                        let xi = nodes.map_or(0.5, |n| n[2 * element.dofs_per_vertex() + interior]);
+                        interior += 1;
+                        (cell[0] + (cell[1] - cell[0]) * xi, 0)
+                    }
+                };
+                // P0: its single "interior" node is the midpoint
+                let x = if element.dofs_per_vertex() == 0 {
+                    0.5 * (cell[0] + cell[1])
+                } else {
+                    x
+                };
+                fine[offset + map_f.cell_dofs(c)[i]] =
+                    view.at_with(&basis, x, derivative).unwrap_or(0.0);
+            }
+        }
+    }
+    fine
+}
+
+/// A solved obstacle problem.
+pub struct ObstacleSolution {
+    /// The discrete problem on the finest mesh.
+    pub discretization: Discretization,
+    /// Coefficients of all fields (multiplier included).
+    pub values: Vec<f64>,
+    /// Iterations on the finest mesh.
+    pub iterations: usize,
+    /// `(cells, iterations)` of every level of the nested iteration.
+    pub levels: Vec<(usize, usize)>,
+    /// KKT residual of the result.
+    pub kkt_residual: f64,
+    /// Wall time of the whole solve (assembly included).
+    pub seconds: f64,
+    /// Wall time of the LCP solve on the finest mesh alone.
+    pub solve_seconds: f64,
+}
+
+/// Options of [`solve_obstacle`].
+#[derive(Clone, Copy, Debug)]
+pub struct ObstacleOptions {
+    /// The algorithm.
+    pub solver: VariationalSolver,
+    /// Nested iteration from meshes of at least this many cells (uniform meshes only;
+    /// `None`: a cold start on the final mesh).
+    pub nested_from: Option<usize>,
+    /// Newton options.
+    pub newton: NewtonOptions,
+}
+
+impl Default for ObstacleOptions {
+    fn default() -> Self {
+        Self {
+            solver: VariationalSolver::SemismoothNewton,
+            nested_from: Some(16),
+            newton: NewtonOptions::default(),
+        }
+    }
+}
+
+/// Solves the obstacle problem `B_h`, `L_h` of `M` on `mesh`.
+pub fn solve_obstacle<M: Model>(
+    mesh: &IntervalMesh,
+    coefficients: &Coefficients,
+    clamped: &[&str],
+    options: ObstacleOptions,
+) -> Result<ObstacleSolution> {
+    let clock = Instant::now();
+    let solve = |d: &Discretization, start: Option<&[f64]>| -> Result<LcpSolution> {
+        match options.solver {
+            VariationalSolver::SemismoothNewton => semismooth_newton(&d.lcp, start, options.newton),
+            VariationalSolver::Clarabel => quadratic_program(&d.lcp),
+        }
+    };
+    // Nested iteration over uniform meshes: N/2^k, …, N/2, N.
+    let uniform = IntervalMesh::uniform(
+        mesh.vertices()[0],
+        *mesh.vertices().last().unwrap(),
+        mesh.cell_count(),
+    )
+    .map(|u| {
+        u.vertices()
+            .iter()
+            .zip(mesh.vertices())
+            .all(|(a, b)| (a - b).abs() <= 1e-12 * (1.0 + a.abs()))
+    })
+    .unwrap_or(false);
+    let mut sizes = vec![mesh.cell_count()];
+    if let (Some(min), true, VariationalSolver::SemismoothNewton) =
+        (options.nested_from, uniform, options.solver)
+    {
+        while sizes[0] % 2 == 0 && sizes[0] / 2 >= min.max(1) {
+            sizes.insert(0, sizes[0] / 2);
+        }
+    }
+    let (a, b) = (mesh.vertices()[0], *mesh.vertices().last().unwrap());
+    let mut levels = Vec::new();
+    let mut previous: Option<(Discretization, Vec<f64>)> = None;
+    for (level, &cells) in sizes.iter().enumerate() {
+        let level_mesh = if level + 1 == sizes.len() {
+            mesh.clone()
+        } else {
+            IntervalMesh::uniform(a, b, cells)?
+        };
+        let d = Discretization::new::<M>(&level_mesh, coefficients, clamped, "B_h", "L_h")?;
+        let start = previous.as_ref().map(|(pd, values)| {
+            let fine = prolong::<M>(&pd.mesh, &pd.dofs, values, &d.mesh, &d.dofs);
+            d.primal_part(&fine)
+        });
+        let solution = solve(&d, start.as_deref())?;
+        levels.push((cells, solution.iterations));
+        let values = d.full(&solution);
+        if level + 1 == sizes.len() {
+            return Ok(ObstacleSolution {
+                iterations: solution.iterations,
+                kkt_residual: solution.kkt_residual,
+                solve_seconds: solution.seconds,
+                discretization: d,
+                values,
+                levels,
+                seconds: clock.elapsed().as_secs_f64(),
+            });
+        }
+        previous = Some((d, values));
+    }
+    unreachable!("the last level returns")
+}
+
+impl ObstacleSolution {
+    /// The coefficients of model field `field`.
+    pub fn field(&self, field: usize) -> &[f64] {
+        &self.values[self.discretization.dofs.range(field).unwrap()]
+    }
+
+    /// A view of model field `field` for evaluation and norms.
+    pub fn view(&self, field: usize) -> FieldView<'_> {
+        FieldView {
+            mesh: &self.discretization.mesh,
+            map: self.discretization.dofs.map(field).unwrap(),
+            coefficients: self.field(field),
+        }
+    }
+
+    /// The multiplier per cell (P0).
+    pub fn multiplier(&self) -> &[f64] {
+        self.field(self.discretization.multiplier_field)
+    }
+
+    /// `∫ λ_h`: the total contact force.
+    pub fn total_contact_force(&self) -> f64 {
+        self.view(self.discretization.multiplier_field).integral()
+    }
+
+    /// The contact set: runs of cells with `λ_h > 0` (above 1e-8 of the larger of its
+    /// maximum and the load's multiplier scale, so solver noise is not contact), single
+    /// holes between runs filled, and a run at most two cells wide reported as a point
+    /// contact at its λ-weighted centre.
+    pub fn contact_set(&self) -> Vec<[f64; 2]> {
+        let lambda = self.multiplier();
+        let mesh = &self.discretization.mesh;
+        let largest = lambda.iter().cloned().fold(0.0, f64::max);
+        let scale = largest.max(self.discretization.lcp.multiplier_scale());
+        if largest <= 1e-8 * scale {
+            return Vec::new();
+        }
+        let active: Vec<bool> = lambda.iter().map(|&l| l > 1e-8 * scale).collect();
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        for (c, &on) in active.iter().enumerate() {
+            if on {
+                match runs.last_mut() {
+                    Some((_, end)) if *end + 2 >= c => *end = c,
+                    _ => runs.push((c, c)),
+                }
+            }
+        }
+        runs.into_iter()
+            .map(|(first, last)| {
+                if last - first < 2 {
+                    let (mut weight, mut moment) = (0.0, 0.0);
+                    for c in first..=last {
+                        let x = 0.5 * (mesh.cell(c)[0] + mesh.cell(c)[1]);
+                        weight += lambda[c] * mesh.h(c);
+                        moment += lambda[c] * mesh.h(c) * x;
+                    }
+                    let x = moment / weight;
+                    [x, x]
+                } else {
+                    [mesh.cell(first)[0], mesh.cell(last)[1]]
+                }
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,371 @@
+//! Solving a beam scene with a chosen element pair and solver, and what a solve reports.
+
+use crate::models::scenes::{exact_solution, Beam, Scene};
+use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
+use fem_runtime::complementarity::NewtonOptions;
+use fem_runtime::obstacle::{solve_obstacle, ObstacleOptions, ObstacleSolution, VariationalSolver};
+use fem_runtime::{
+    assemble_vector, Coefficients, DataFn, Error, IntervalMesh, MatrixAssembler, Model, Result,
+    SystemDofs,
+};
+use serde::Serialize;
+
+/// The element pairs a beam scene can be solved with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pair {
+    /// Timoshenko θ, w ∈ P2, λ ∈ P0 (default for Timoshenko).
+    TimoshenkoP2,
+    /// Timoshenko θ, w ∈ P1 with one-point shear integration, λ ∈ P0.
+    TimoshenkoP1Reduced,
+    /// Timoshenko θ, w ∈ P1 with exact shear integration (locks as t → 0).
+    TimoshenkoP1Full,
+    /// Euler–Bernoulli w ∈ Hermite cubics, λ ∈ P0.
+    BernoulliHermite,
+}
+
+impl Pair {
+    /// Every pair.
+    pub const ALL: [Pair; 4] = [
+        Pair::TimoshenkoP2,
+        Pair::TimoshenkoP1Reduced,
+        Pair::TimoshenkoP1Full,
+        Pair::BernoulliHermite,
+    ];
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pair::TimoshenkoP2 => "p2-p2-p0",
+            Pair::TimoshenkoP1Reduced => "p1-p1-p0-reduced",
+            Pair::TimoshenkoP1Full => "p1-p1-p0-full",
+            Pair::BernoulliHermite => "hermite-p0",
+        }
+    }
+
+    /// The beam theory it discretizes.
+    pub fn beam(self) -> Beam {
+        match self {
+            Pair::BernoulliHermite => Beam::EulerBernoulli,
+            _ => Beam::Timoshenko,
+        }
+    }
+
+    /// The default pair of a beam theory.
+    pub fn default_for(beam: Beam) -> Pair {
+        match beam {
+            Beam::Timoshenko => Pair::TimoshenkoP2,
+            Beam::EulerBernoulli => Pair::BernoulliHermite,
+        }
+    }
+
+    /// The pair called `name`, which must discretize `beam`.
+    pub fn parse(name: &str, beam: Beam) -> Result<Pair> {
+        let pairs: Vec<&str> = Pair::ALL
+            .iter()
+            .filter(|p| p.beam() == beam)
+            .map(|p| p.name())
+            .collect();
+        match Pair::ALL.iter().find(|p| p.name() == name) {
+            Some(&p) if p.beam() == beam => Ok(p),
+            Some(_) => Err(Error::Input(format!(
+                "pair `{name}` is for the other beam theory; this scene takes {}",
+                pairs.join(", ")
+            ))),
+            None => Err(Error::Input(format!(
+                "unknown pair `{name}`; this scene takes {}",
+                pairs.join(", ")
+            ))),
+        }
+    }
+
+    /// The default stabilization parameter (MODELS.md: α ≈ 1 for Timoshenko, ≤ 1e-2 for
+    /// Euler–Bernoulli so that the obstacle shift α h⁴|f| stays negligible).
+    pub fn default_alpha(self) -> f64 {
+        match self {
+            Pair::BernoulliHermite => 1e-2,
+            _ => 1.0,
+        }
+    }
+}
+
+/// What to solve.
+#[derive(Clone, Copy, Debug)]
+pub struct Request {
+    /// The scene.
+    pub scene: Scene,
+    /// Number of elements of the uniform mesh on (0, 1).
+    pub elements: usize,
+    /// Load magnitude q.
+    pub load: f64,
+    /// Thickness (Timoshenko); the scene's by default.
+    pub thickness: Option<f64>,
+    /// Stabilization parameter; the pair's default otherwise.
+    pub alpha: Option<f64>,
+    /// Element pair; the beam's default otherwise.
+    pub pair: Option<Pair>,
+    /// LCP solver.
+    pub solver: VariationalSolver,
+    /// Nested iteration from meshes of at least this many cells (Newton only).
+    pub nested_from: Option<usize>,
+    /// Iterative refinement rounds per linear solve.
+    pub refinement_steps: usize,
+}
+
+impl Request {
+    /// The defaults for a scene: 256 elements, q = 1, nested Newton.
+    pub fn new(scene: Scene) -> Self {
+        Self {
+            scene,
+            elements: 256,
+            load: 1.0,
+            thickness: None,
+            alpha: None,
+            pair: None,
+            solver: VariationalSolver::SemismoothNewton,
+            nested_from: Some(16),
+            refinement_steps: 1,
+        }
+    }
+}
+
+/// What a solve reports (the CLI's `--json` object).
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Scene name.
+    pub scene: String,
+    /// Element pair.
+    pub pair: String,
+    /// LCP solver.
+    pub solver: String,
+    /// Load q.
+    pub load: f64,
+    /// Thickness (Timoshenko), `null` for Euler–Bernoulli.
+    pub thickness: Option<f64>,
+    /// Stabilization parameter.
+    pub alpha: f64,
+    /// Elements.
+    pub elements: usize,
+    /// Unknowns after eliminating boundary DOFs (primal and multiplier).
+    pub dofs: usize,
+    /// Solver iterations on the final mesh.
+    pub iterations: usize,
+    /// `[elements, iterations]` of each nested-iteration level.
+    pub levels: Vec<[usize; 2]>,
+    /// Wall time of the whole solve (assembly, all levels, post-processing excluded).
+    pub seconds: f64,
+    /// `½a(u,u) − ℓ(u)` of the discrete solution.
+    pub energy: f64,
+    /// Largest |w|.
+    pub max_deflection: f64,
+    /// Contact intervals `[start, end]`, a point contact as `[x, x]`.
+    pub contact_set: Vec<[f64; 2]>,
+    /// `∫ λ_h`.
+    pub total_contact_force: f64,
+    /// KKT residual (equilibrium backward error and complementarity).
+    pub complementarity_residual: f64,
+    /// `‖w − w_h‖_L2` where an exact solution exists.
+    pub error_l2: Option<f64>,
+    /// `‖(w − w_h)'‖_L2` where an exact solution exists.
+    pub error_h1: Option<f64>,
+}
+
+/// Sampled fields for plots.
+#[derive(Clone, Debug, Default)]
+pub struct Profiles {
+    /// Sample points.
+    pub x: Vec<f64>,
+    /// Deflection.
+    pub w: Vec<f64>,
+    /// Rotation (Timoshenko).
+    pub theta: Option<Vec<f64>>,
+    /// Obstacle.
+    pub psi: Vec<f64>,
+    /// Cell midpoints.
+    pub cell_x: Vec<f64>,
+    /// Multiplier per cell.
+    pub lambda: Vec<f64>,
+}
+
+/// Solves a request.
+pub fn solve(request: &Request) -> Result<(Report, Profiles)> {
+    let pair = request
+        .pair
+        .unwrap_or(Pair::default_for(request.scene.beam));
+    if pair.beam() != request.scene.beam {
+        return Err(Error::Input(format!(
+            "pair `{}` does not discretize scene `{}`",
+            pair.name(),
+            request.scene.name
+        )));
+    }
+    match pair {
+        Pair::TimoshenkoP2 => run::<timoshenko_p2::Model>(request, pair),
+        Pair::TimoshenkoP1Reduced => run::<timoshenko_p1_reduced::Model>(request, pair),
+        Pair::TimoshenkoP1Full => run::<timoshenko_p1_full::Model>(request, pair),
+        Pair::BernoulliHermite => run::<bernoulli::Model>(request, pair),
+    }
+}
+
+/// Checks what a model cannot check: obstacle data, feasibility at the clamped ends,
+/// the ranges of q, t, α.
+fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
+    let scene = &request.scene;
+    if request.elements == 0 || request.elements > 50_000_000 {
+        return Err(Error::Input(format!(
+            "--elements {} is out of range (1 to 50,000,000)",
+            request.elements
+        )));
+    }
+    if !request.load.is_finite() || request.load < 0.0 {
+        return Err(Error::Input(format!(
+            "load q = {} must be finite and ≥ 0 (the scene fixes its direction)",
+            request.load
+        )));
+    }
+    if scene.beam == Beam::Timoshenko && !(thickness > 0.0 && thickness.is_finite()) {
+        return Err(Error::Input(format!(
+            "thickness t = {thickness} must be positive and finite"
+        )));
+    }
+    if !(alpha > 0.0 && alpha.is_finite()) {
+        return Err(Error::Input(format!(
+            "α = {alpha}: the stabilized method needs 0 < α < 1/C_I; for the beam pairs C_I = 0 (the stabilized residual θ''' or w'''' vanishes on each element), so every finite α > 0 is stable, and α ≈ 1 (Timoshenko) or ≤ 1e-2 (Euler–Bernoulli) is accurate"
+        )));
+    }
+    for i in 0..=64 {
+        let x = i as f64 / 64.0;
+        if !scene.obstacle.at(x).is_finite() {
+            return Err(Error::Input(format!(
+                "the obstacle ψ({x}) = {} is not finite",
+                scene.obstacle.at(x)
+            )));
+        }
+    }
+    for x in [0.0, 1.0] {
+        let psi = scene.obstacle.at(x);
+        if scene.side * (0.0 - psi) < 0.0 {
+            return Err(Error::Input(format!(
+                "infeasible: the beam is clamped at x = {x} (w = 0) but the obstacle requires w {} ψ({x}) = {psi}",
+                if scene.side > 0.0 { "≥" } else { "≤" }
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
+    let scene = request.scene;
+    let alpha = request.alpha.unwrap_or(pair.default_alpha());
+    let thickness = request.thickness.unwrap_or(scene.thickness);
+    validate(request, alpha, thickness)?;
+    let q = request.load;
+    let load = scene.load_sign * q;
+    let f = move |_: &[f64]| load;
+    let obstacle = scene.obstacle;
+    let psi = move |x: &[f64]| obstacle.at(x[0]);
+    let mut params: Vec<(&str, f64)> = vec![("α", alpha), ("s", scene.side)];
+    if scene.beam == Beam::Timoshenko {
+        params.push(("t", thickness));
+    }
+    let coefficients =
+        Coefficients::new::<M>(&params, &[("f", &f as &DataFn), ("ψ", &psi as &DataFn)])?;
+    let clamped: &[&str] = match scene.beam {
+        Beam::Timoshenko => &["θ", "w"],
+        Beam::EulerBernoulli => &["w"],
+    };
+    let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
+    let options = ObstacleOptions {
+        solver: request.solver,
+        nested_from: request.nested_from,
+        newton: NewtonOptions {
+            refinement_steps: request.refinement_steps,
+            ..NewtonOptions::default()
+        },
+    };
+    let solution = solve_obstacle::<M>(&mesh, &coefficients, clamped, options)?;
+    let w_field = M::field("w")?;
+    let energy = energy::<M>(&solution, &coefficients)?;
+    let w = solution.view(w_field);
+    let exact = exact_solution(&scene, q, thickness);
+    let (error_l2, error_h1) = match &exact {
+        Some(e) => (
+            Some(w.error(0, &|x| (e.w)(x, 0), 6)),
+            Some(w.error(1, &|x| (e.w)(x, 1), 6)),
+        ),
+        None => (None, None),
+    };
+    let samples = 8 * request.elements.min(512) + 1;
+    let x: Vec<f64> = (0..samples)
+        .map(|i| i as f64 / (samples - 1) as f64)
+        .collect();
+    let w_values: Vec<f64> = x.iter().map(|&x| w.at(x, 0).unwrap_or(f64::NAN)).collect();
+    let max_deflection = (0..=4 * request.elements)
+        .map(|i| {
+            w.at(i as f64 / (4 * request.elements) as f64, 0)
+                .unwrap_or(0.0)
+                .abs()
+        })
+        .fold(0.0, f64::max);
+    let theta = M::field("θ").ok().map(|f| {
+        let view = solution.view(f);
+        x.iter()
+            .map(|&x| view.at(x, 0).unwrap_or(f64::NAN))
+            .collect()
+    });
+    let d = &solution.discretization;
+    let report = Report {
+        scene: scene.name.to_string(),
+        pair: pair.name().to_string(),
+        solver: match request.solver {
+            VariationalSolver::SemismoothNewton => "pdas".into(),
+            VariationalSolver::Clarabel => "clarabel".into(),
+        },
+        load: q,
+        thickness: (scene.beam == Beam::Timoshenko).then_some(thickness),
+        alpha,
+        elements: request.elements,
+        dofs: d.lcp.n() + d.lcp.m(),
+        iterations: solution.iterations,
+        levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
+        seconds: solution.seconds,
+        energy,
+        max_deflection,
+        contact_set: solution.contact_set(),
+        total_contact_force: solution.total_contact_force(),
+        complementarity_residual: solution.kkt_residual,
+        error_l2,
+        error_h1,
+    };
+    let profiles = Profiles {
+        psi: x.iter().map(|&x| scene.obstacle.at(x)).collect(),
+        w: w_values,
+        theta,
+        cell_x: (0..mesh.cell_count())
+            .map(|c| 0.5 * (mesh.cell(c)[0] + mesh.cell(c)[1]))
+            .collect(),
+        lambda: solution.multiplier().to_vec(),
+        x,
+    };
+    Ok((report, profiles))
+}
+
+/// `½ a(u,u) − ℓ(u)` of the primal fields of a solution.
+pub fn energy<M: Model>(solution: &ObstacleSolution, coefficients: &Coefficients) -> Result<f64> {
+    let d = &solution.discretization;
+    let primal: Vec<usize> = (0..M::FIELDS.len())
+        .filter(|&f| f != d.multiplier_field)
+        .collect();
+    let dofs = SystemDofs::new::<M>(&d.mesh, &primal)?;
+    let mut u = Vec::with_capacity(dofs.dof_count());
+    for &f in &primal {
+        u.extend_from_slice(solution.field(f));
+    }
+    let a = MatrixAssembler::new::<M>("a", &d.mesh, &dofs)?.assemble::<M>(&d.mesh, coefficients)?;
+    let l = assemble_vector::<M>("ℓ", &d.mesh, &dofs, coefficients)?;
+    let au = fem_runtime::linear_solve::multiply(&a, &u);
+    Ok(u.iter()
+        .zip(&au)
+        .zip(&l)
+        .map(|((u, au), l)| 0.5 * u * au - l * u)
+        .sum())
+}
