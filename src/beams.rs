@@ -3,7 +3,9 @@
 use crate::models::scenes::{exact_solution, Beam, Scene};
 use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
 use fem_runtime::complementarity::NewtonOptions;
-use fem_runtime::obstacle::{solve_obstacle, ObstacleOptions, ObstacleSolution, VariationalSolver};
+use fem_runtime::obstacle::{
+    solve_obstacle, Discretization, ObstacleOptions, ObstacleSolution, VariationalSolver,
+};
 use fem_runtime::{
     assemble_vector, Coefficients, DataFn, Error, IntervalMesh, MatrixAssembler, Model, Result,
     SystemDofs,
@@ -109,6 +111,9 @@ pub struct Request {
     pub nested_from: Option<usize>,
     /// Iterative refinement rounds per linear solve.
     pub refinement_steps: usize,
+    /// Allow α = 0: the plain (unstabilized) mixed method, for the stability studies;
+    /// only the QP solver handles it.
+    pub plain: bool,
 }
 
 impl Request {
@@ -124,6 +129,7 @@ impl Request {
             solver: VariationalSolver::SemismoothNewton,
             nested_from: Some(16),
             refinement_steps: 1,
+            plain: false,
         }
     }
 }
@@ -198,11 +204,86 @@ pub fn solve(request: &Request) -> Result<(Report, Profiles)> {
             request.scene.name
         )));
     }
-    match pair {
-        Pair::TimoshenkoP2 => run::<timoshenko_p2::Model>(request, pair),
-        Pair::TimoshenkoP1Reduced => run::<timoshenko_p1_reduced::Model>(request, pair),
-        Pair::TimoshenkoP1Full => run::<timoshenko_p1_full::Model>(request, pair),
-        Pair::BernoulliHermite => run::<bernoulli::Model>(request, pair),
+    dispatch!(pair, M => run::<M>(request, pair))
+}
+
+/// Runs `$body` with `M` the model type of `$pair`.
+macro_rules! dispatch {
+    ($pair:expr, $m:ident => $body:expr) => {
+        match $pair {
+            Pair::TimoshenkoP2 => {
+                type $m = timoshenko_p2::Model;
+                $body
+            }
+            Pair::TimoshenkoP1Reduced => {
+                type $m = timoshenko_p1_reduced::Model;
+                $body
+            }
+            Pair::TimoshenkoP1Full => {
+                type $m = timoshenko_p1_full::Model;
+                $body
+            }
+            Pair::BernoulliHermite => {
+                type $m = bernoulli::Model;
+                $body
+            }
+        }
+    };
+}
+use dispatch;
+
+/// The discrete problem of a request (for studies of its matrices), and its pair.
+pub fn discretize(request: &Request) -> Result<(Discretization, Pair)> {
+    let pair = request
+        .pair
+        .unwrap_or(Pair::default_for(request.scene.beam));
+    dispatch!(pair, M => {
+        let setup = Setup::new(request, pair)?;
+        let coefficients = setup.coefficients::<M>()?;
+        let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
+        Ok((Discretization::new::<M>(&mesh, &coefficients, setup.clamped, "B_h", "L_h")?, pair))
+    })
+}
+
+/// Parameters and data of a request, validated.
+struct Setup {
+    alpha: f64,
+    thickness: f64,
+    side: f64,
+    timoshenko: bool,
+    clamped: &'static [&'static str],
+    load: Box<DataFn>,
+    obstacle: Box<DataFn>,
+}
+
+impl Setup {
+    fn new(request: &Request, pair: Pair) -> Result<Self> {
+        let scene = request.scene;
+        let alpha = request.alpha.unwrap_or(pair.default_alpha());
+        let thickness = request.thickness.unwrap_or(scene.thickness);
+        validate(request, alpha, thickness)?;
+        let load = scene.load_sign * request.load;
+        let obstacle = scene.obstacle;
+        Ok(Self {
+            alpha,
+            thickness,
+            side: scene.side,
+            timoshenko: scene.beam == Beam::Timoshenko,
+            clamped: match scene.beam {
+                Beam::Timoshenko => &["θ", "w"],
+                Beam::EulerBernoulli => &["w"],
+            },
+            load: Box::new(move |_: &[f64]| load),
+            obstacle: Box::new(move |x: &[f64]| obstacle.at(x[0])),
+        })
+    }
+
+    fn coefficients<M: Model>(&self) -> Result<Coefficients<'_>> {
+        let mut params: Vec<(&str, f64)> = vec![("α", self.alpha), ("s", self.side)];
+        if self.timoshenko {
+            params.push(("t", self.thickness));
+        }
+        Coefficients::new::<M>(&params, &[("f", &*self.load), ("ψ", &*self.obstacle)])
     }
 }
 
@@ -227,7 +308,14 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
             "thickness t = {thickness} must be positive and finite"
         )));
     }
-    if !(alpha > 0.0 && alpha.is_finite()) {
+    if request.plain {
+        if alpha != 0.0 || request.solver != VariationalSolver::Clarabel {
+            return Err(Error::Input(
+                "the plain mixed method is α = 0, solved by the QP solver (--solver clarabel)"
+                    .into(),
+            ));
+        }
+    } else if !(alpha > 0.0 && alpha.is_finite()) {
         return Err(Error::Input(format!(
             "α = {alpha}: the stabilized method needs 0 < α < 1/C_I; for the beam pairs C_I = 0 (the stabilized residual θ''' or w'''' vanishes on each element), so every finite α > 0 is stable, and α ≈ 1 (Timoshenko) or ≤ 1e-2 (Euler–Bernoulli) is accurate"
         )));
@@ -255,24 +343,10 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
 
 fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     let scene = request.scene;
-    let alpha = request.alpha.unwrap_or(pair.default_alpha());
-    let thickness = request.thickness.unwrap_or(scene.thickness);
-    validate(request, alpha, thickness)?;
-    let q = request.load;
-    let load = scene.load_sign * q;
-    let f = move |_: &[f64]| load;
-    let obstacle = scene.obstacle;
-    let psi = move |x: &[f64]| obstacle.at(x[0]);
-    let mut params: Vec<(&str, f64)> = vec![("α", alpha), ("s", scene.side)];
-    if scene.beam == Beam::Timoshenko {
-        params.push(("t", thickness));
-    }
-    let coefficients =
-        Coefficients::new::<M>(&params, &[("f", &f as &DataFn), ("ψ", &psi as &DataFn)])?;
-    let clamped: &[&str] = match scene.beam {
-        Beam::Timoshenko => &["θ", "w"],
-        Beam::EulerBernoulli => &["w"],
-    };
+    let setup = Setup::new(request, pair)?;
+    let (alpha, thickness, q) = (setup.alpha, setup.thickness, request.load);
+    let coefficients = setup.coefficients::<M>()?;
+    let clamped = setup.clamped;
     let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
     let options = ObstacleOptions {
         solver: request.solver,

@@ -7,6 +7,8 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod beams;
+pub mod plot;
+pub mod studies;
 
 pub use fem_models as models;
 pub use fem_runtime::*;

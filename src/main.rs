@@ -1,1 +1,248 @@
-fn main() {}
+//! The fem-forms command line: solve the beam scenes, print tables, write charts.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use clap::{Parser, Subcommand, ValueEnum};
+use fem_forms::beams::{self, Pair, Report, Request};
+use fem_forms::models::scenes::{scene, SCENES};
+use fem_forms::obstacle::VariationalSolver;
+use fem_forms::{plot, studies};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "fem-forms",
+    version,
+    about = "Stabilized finite elements for obstacle problems of beams: solve scenes, print tables, write charts",
+    long_about = "Without a command: solves the default scenes at q = 1 (no contact) and q = 100 (contact), prints a table, writes plots of w, θ, λ and ψ and the study charts to out/."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Directory for charts and CSV files.
+    #[arg(long, global = true, default_value = "out")]
+    out: PathBuf,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SolverName {
+    /// Semismooth Newton / primal–dual active set (nested iteration).
+    Pdas,
+    /// clarabel's interior-point method on the equivalent QP.
+    Clarabel,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the scenes and the element pairs.
+    List,
+    /// Solve one scene.
+    Solve {
+        /// Scene name (see `list`).
+        scene: String,
+        /// Elements of the uniform mesh.
+        #[arg(long, default_value_t = 256)]
+        elements: usize,
+        /// Load magnitude q (1: no contact; 40 and 100: contact).
+        #[arg(long, default_value_t = 1.0)]
+        load: f64,
+        /// Beam thickness t (Timoshenko scenes).
+        #[arg(long)]
+        thickness: Option<f64>,
+        /// Stabilization parameter α.
+        #[arg(long)]
+        alpha: Option<f64>,
+        /// Element pair (p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0).
+        #[arg(long)]
+        pair: Option<String>,
+        /// LCP solver.
+        #[arg(long, value_enum, default_value = "pdas")]
+        solver: SolverName,
+        /// Start Newton from zero on the final mesh instead of nested iteration.
+        #[arg(long)]
+        cold: bool,
+        /// Rounds of iterative refinement per linear solve (t ≤ 1e-5 wants 2 or 3).
+        #[arg(long, default_value_t = 1)]
+        refinement: usize,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Also write the plot of w, θ, λ, ψ.
+        #[arg(long)]
+        plot: bool,
+    },
+    /// Run a study and write its chart and CSV.
+    Study {
+        /// Which study.
+        #[arg(value_enum)]
+        study: studies::Study,
+        /// Larger meshes (longer).
+        #[arg(long)]
+        full: bool,
+    },
+}
+
+fn table_header() {
+    println!(
+        "{:<15} {:>5} {:>7} {:>6} {:>6} {:>5} {:>8} {:>14} {:<24} {:>9} {:>10}",
+        "scene",
+        "q",
+        "t",
+        "elems",
+        "dofs",
+        "iter",
+        "seconds",
+        "energy",
+        "contact set",
+        "kkt res",
+        "L2 error"
+    );
+}
+
+fn fmt_contact(set: &[[f64; 2]]) -> String {
+    if set.is_empty() {
+        return "none".into();
+    }
+    set.iter()
+        .map(|[a, b]| {
+            if a == b {
+                format!("point {a:.4}")
+            } else {
+                format!("[{a:.4}, {b:.4}]")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn table_row(r: &Report) {
+    println!(
+        "{:<15} {:>5} {:>7} {:>6} {:>6} {:>5} {:>8.4} {:>14.8e} {:<24} {:>9.1e} {:>10}",
+        r.scene,
+        r.load,
+        r.thickness.map_or("-".into(), |t| format!("{t:.0e}")),
+        r.elements,
+        r.dofs,
+        r.iterations,
+        r.seconds,
+        r.energy,
+        fmt_contact(&r.contact_set),
+        r.complementarity_residual,
+        r.error_l2.map_or("-".into(), |e| format!("{e:.2e}")),
+    );
+}
+
+fn default_job(out: &Path) -> Result<(), String> {
+    println!("fem-forms: default beam scenes (clamped on (0,1), 256 elements, nested semismooth Newton)\n");
+    table_header();
+    for s in SCENES {
+        for q in [1.0, 100.0] {
+            let mut request = Request::new(s);
+            request.load = q;
+            let (report, profiles) =
+                beams::solve(&request).map_err(|e| format!("{}: {e}", s.name))?;
+            table_row(&report);
+            let path = out.join(format!("{}-q{q}.svg", s.name));
+            plot::profiles(&path, &format!("{} q = {q}", s.name), &profiles)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+    }
+    println!(
+        "\nplots of w, θ, λ, ψ: {}/<scene>-q<q>.svg\n",
+        out.display()
+    );
+    for study in studies::Study::DEFAULT {
+        studies::run(study, false, out).map_err(|e| format!("study {study:?}: {e}"))?;
+    }
+    Ok(())
+}
+
+fn run(cli: Cli) -> Result<(), String> {
+    match cli.command {
+        None => default_job(&cli.out),
+        Some(Command::List) => {
+            println!("scenes:");
+            for s in SCENES {
+                println!("  {:<15} {}", s.name, s.description);
+            }
+            println!("pairs:");
+            for p in Pair::ALL {
+                println!(
+                    "  {:<17} {:?} (default α = {})",
+                    p.name(),
+                    p.beam(),
+                    p.default_alpha()
+                );
+            }
+            Ok(())
+        }
+        Some(Command::Solve {
+            scene: name,
+            elements,
+            load,
+            thickness,
+            alpha,
+            pair,
+            solver,
+            cold,
+            refinement,
+            json,
+            plot: write_plot,
+        }) => {
+            let s = scene(&name).ok_or_else(|| {
+                format!(
+                    "unknown scene `{name}`; the scenes are {}",
+                    SCENES.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+                )
+            })?;
+            let pair = pair
+                .map(|p| Pair::parse(&p, s.beam))
+                .transpose()
+                .map_err(|e| e.to_string())?;
+            let request = Request {
+                scene: s,
+                elements,
+                load,
+                thickness,
+                alpha,
+                pair,
+                solver: match solver {
+                    SolverName::Pdas => VariationalSolver::SemismoothNewton,
+                    SolverName::Clarabel => VariationalSolver::Clarabel,
+                },
+                nested_from: (!cold).then_some(16),
+                refinement_steps: refinement,
+                plain: false,
+            };
+            let (report, profiles) = beams::solve(&request).map_err(|e| e.to_string())?;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+                );
+            } else {
+                table_header();
+                table_row(&report);
+            }
+            if write_plot {
+                let path = cli.out.join(format!("{}-q{load}.svg", s.name));
+                plot::profiles(&path, &format!("{} q = {load}", s.name), &profiles)
+                    .map_err(|e| e.to_string())?;
+            }
+            Ok(())
+        }
+        Some(Command::Study { study, full }) => {
+            studies::run(study, full, &cli.out).map_err(|e| e.to_string())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

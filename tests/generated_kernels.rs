@@ -119,7 +119,7 @@ fn check_timoshenko<M: Model>(
         for test in 0..3 {
             let g = generated_vector::<M>(form, test, st);
             let h = hand_coded::timoshenko_vector(form, &elements, test, st);
-            let d = relative_difference(&[g.clone()], &[h.clone()]);
+            let d = relative_difference(std::slice::from_ref(&g), std::slice::from_ref(&h));
             prop_assert!(
                 d <= 1e-12,
                 "{} {form} ({test}) {st:?}: {d:e}\n{g:?}\n{h:?}",
@@ -165,7 +165,7 @@ proptest! {
             for test in 0..2 {
                 let g = generated_vector::<M>(form, test, st);
                 let h = hand_coded::bernoulli_vector(form, test, st);
-                let d = relative_difference(&[g.clone()], &[h.clone()]);
+                let d = relative_difference(std::slice::from_ref(&g), std::slice::from_ref(&h));
                 prop_assert!(d <= 1e-12, "bernoulli {form} ({test}) {st:?}: {d:e}\n{g:?}\n{h:?}");
             }
         }
@@ -177,7 +177,8 @@ proptest! {
         let x = [st.x0, st.x0 + st.h];
         let p = [st.t, st.alpha, st.s];
         let d: [&DataFn; 2] = [&|x: &[f64]| hand_coded::load(x[0]), &|x: &[f64]| hand_coded::obstacle(x[0])];
-        let pairs: [([[f64; 3]; 3], [[f64; 3]; 3]); 3] = [
+        type Block3 = [[f64; 3]; 3];
+        let pairs: [(Block3, Block3); 3] = [
             (timoshenko_p2::a::matrix_η_θ(&x, &p, &d), hand_coded::timoshenko_p2_a_eta_theta(&x, st.t)),
             (timoshenko_p2::a::matrix_η_w(&x, &p, &d), hand_coded::timoshenko_p2_a_eta_w(st.t)),
             (timoshenko_p2::a::matrix_v_w(&x, &p, &d), hand_coded::timoshenko_p2_a_v_w(&x, st.t)),

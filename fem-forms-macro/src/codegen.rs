@@ -212,10 +212,9 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
         if term.quadrature_degree.is_some() {
             // An explicit rule (e.g. reduced integration) is the point: use it as given.
             for (q, w) in rule.weights.iter().enumerate() {
-                for i in 0..rows {
-                    for j in 0..cols {
-                        groups[idx].reference[i][j] +=
-                            term.coefficient * w * test[q][i] * trial[q][j];
+                for (row, test_value) in groups[idx].reference.iter_mut().zip(&test[q]) {
+                    for (entry, trial_value) in row.iter_mut().zip(&trial[q]) {
+                        *entry += term.coefficient * w * test_value * trial_value;
                     }
                 }
             }

@@ -404,13 +404,13 @@ impl<'a> Parser<'a> {
     }
 
     fn sum(&mut self, integrand: bool) -> Result<Expr> {
-        let mut lhs = self.term(integrand)?;
+        let mut lhs = self.term()?;
         while let Some(Tok::Plus | Tok::Minus) = self.peek_tok() {
             if integrand && self.starts_form_term(self.pos + 1) {
                 break;
             }
             let op = self.bump().unwrap().tok.clone();
-            let rhs = self.term(integrand)?;
+            let rhs = self.term()?;
             let loc = lhs.loc.to(rhs.loc);
             lhs = Expr::new(
                 if op == Tok::Plus {
@@ -424,17 +424,17 @@ impl<'a> Parser<'a> {
         Ok(lhs)
     }
 
-    fn term(&mut self, integrand: bool) -> Result<Expr> {
+    fn term(&mut self) -> Result<Expr> {
         match self.peek_tok() {
             Some(Tok::Minus) => {
                 let loc = self.bump().unwrap().loc;
-                let inner = self.term(integrand)?;
+                let inner = self.term()?;
                 let loc = loc.to(inner.loc);
                 Ok(Expr::new(ExprKind::Neg(Box::new(inner)), loc))
             }
             Some(Tok::Plus) => {
                 self.pos += 1;
-                self.term(integrand)
+                self.term()
             }
             _ => self.product(),
         }

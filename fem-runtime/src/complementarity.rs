@@ -156,6 +156,34 @@ impl Lcp {
     }
 }
 
+impl Lcp {
+    /// `‖d‖∞ / ‖U‖∞` for the Newton step `d = −H⁻¹∇Φ(U)` at `U`: a forward-error
+    /// certificate. The backward error alone cannot certify `U` when `A` is as badly
+    /// conditioned as a thin beam's (κ ~ 1e13: a backward error of 1e-11 allows an O(1)
+    /// error), and `Λ = C⁻¹(G − BU)₊` loses digits to cancellation when `C ~ αh⁵`; the
+    /// step is damped by the `BᵀC⁻¹B` part of `H` and has neither problem. Needs `C > 0`.
+    pub fn newton_correction(&self, u: &[f64]) -> Result<f64> {
+        if self.c.iter().any(|&c| c.is_nan() || c <= 0.0) {
+            return Err(Error::Input("the Newton correction needs C > 0".into()));
+        }
+        let hessian = Hessian::new(self);
+        let bu = self.b_times(u);
+        let active: Vec<bool> = (0..self.m()).map(|k| self.g[k] - bu[k] > 0.0).collect();
+        let lambda: Vec<f64> = (0..self.m())
+            .map(|k| (self.g[k] - bu[k]).max(0.0) / self.c[k])
+            .collect();
+        let au = multiply(&self.a, u);
+        let btl = self.bt_times(&lambda);
+        let minus_gradient: Vec<f64> = (0..self.n()).map(|i| self.f[i] + btl[i] - au[i]).collect();
+        let h = hessian.matrix(self, &active);
+        let d = Cholesky::analyse(&hessian.symbolic)?
+            .factor(&h)?
+            .solve_refined(&h, &minus_gradient, 2)?;
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        Ok(norm(&d) / norm(u).max(f64::MIN_POSITIVE))
+    }
+}
+
 fn row_sum_norm(a: &SparseMatrix) -> f64 {
     // symmetric: the largest column sum equals the largest row sum
     let (col_ptr, vals) = (a.symbolic().col_ptr(), a.val());
@@ -283,7 +311,7 @@ pub fn semismooth_newton(
     options: NewtonOptions,
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
-    if let Some(k) = lcp.c.iter().position(|&c| !(c > 0.0)) {
+    if let Some(k) = lcp.c.iter().position(|&c| c.is_nan() || c <= 0.0) {
         return Err(Error::Input(format!(
             "semismooth Newton eliminates Λ = C⁻¹(G − BU)₊ and needs C > 0; C_{k} = {} (α ≤ 0 gives the plain mixed method: use the QP solver)",
             lcp.c[k]
@@ -318,7 +346,6 @@ pub fn semismooth_newton(
         quadratic + penalty
     };
     let mut previous_active: Option<Vec<bool>> = None;
-    let mut factorizations = 0;
     for iteration in 1..=options.max_iterations {
         let au = multiply(&lcp.a, &u);
         let bu = lcp.b_times(&u);
@@ -337,7 +364,7 @@ pub fn semismooth_newton(
                     iterations: iteration - 1,
                     kkt_residual: residual,
                     seconds: clock.elapsed().as_secs_f64(),
-                    factorizations,
+                    factorizations: iteration - 1,
                 });
             }
         }
@@ -345,7 +372,6 @@ pub fn semismooth_newton(
         let gradient: Vec<f64> = (0..n).map(|i| au[i] - lcp.f[i] - btl[i]).collect();
         let h = hessian.matrix(lcp, &active);
         let factor = cholesky.factor(&h)?;
-        factorizations += 1;
         let minus_gradient: Vec<f64> = gradient.iter().map(|g| -g).collect();
         let d = factor.solve_refined(&h, &minus_gradient, options.refinement_steps)?;
         // Armijo backtracking on Φ along d (exact products, so Φ is cheap to re-evaluate).
@@ -376,7 +402,7 @@ pub fn semismooth_newton(
                     iterations: iteration,
                     kkt_residual: residual,
                     seconds: clock.elapsed().as_secs_f64(),
-                    factorizations,
+                    factorizations: iteration,
                 });
             }
             return Err(Error::NotConverged {
@@ -385,6 +411,26 @@ pub fn semismooth_newton(
                     "line search failed at iteration {iteration} with KKT residual {residual:e}"
                 ),
             });
+        }
+        // A full step of rounding size: constraints whose gap CΛ is below the rounding
+        // of G − BU (α h⁴ λ ≪ ε|ψ| on fine meshes) may flip forever without moving U.
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if step == 1.0 && norm(&d) <= 1e-13 * norm(&u) {
+            let bu = lcp.b_times(&u);
+            let lambda: Vec<f64> = (0..lcp.m())
+                .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
+                .collect();
+            let residual = lcp.kkt_residual(&u, &lambda);
+            if residual <= options.tolerance {
+                return Ok(LcpSolution {
+                    u,
+                    lambda,
+                    iterations: iteration,
+                    kkt_residual: residual,
+                    seconds: clock.elapsed().as_secs_f64(),
+                    factorizations: iteration,
+                });
+            }
         }
         previous_active = (step == 1.0).then_some(active);
     }
@@ -414,17 +460,41 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
     };
     let clock = Instant::now();
     let (n, m) = (lcp.n(), lcp.m());
-    if lcp.c.iter().any(|&c| !(c >= 0.0)) {
+    if lcp.c.iter().any(|&c| c.is_nan() || c < 0.0) {
         return Err(Error::Input("C must be non-negative".into()));
     }
     let with_lambda = lcp.c.iter().any(|&c| c > 0.0);
     let nx = if with_lambda { n + m } else { n };
-    // P: upper triangle of blockdiag(A, C)
+    // Symmetric Jacobi scaling U = D y (D = diag(A)^{-1/2}) and unit rows: thin beams
+    // have diag(A) spread over many decades (t⁻²h⁻¹ against h), which stalls the
+    // interior-point method unscaled.
     let (col_ptr, rows, vals) = (
         lcp.a.symbolic().col_ptr(),
         lcp.a.symbolic().row_idx(),
         lcp.a.val(),
     );
+    let mut scale = vec![1.0; n];
+    for j in 0..n {
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            if rows[k] == j && vals[k] > 0.0 {
+                scale[j] = 1.0 / vals[k].sqrt();
+            }
+        }
+    }
+    let row_scale: Vec<f64> = (0..m)
+        .map(|k| {
+            let largest = lcp.b_rows[k]
+                .iter()
+                .map(|&(j, v)| (v * scale[j]).abs())
+                .fold(lcp.c[k], f64::max);
+            if largest > 0.0 {
+                1.0 / largest
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    // P: upper triangle of blockdiag(DAD, C)
     let mut p_ptr = vec![0usize];
     let mut p_rows = Vec::new();
     let mut p_vals = Vec::new();
@@ -432,7 +502,7 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
         for k in col_ptr[j]..col_ptr[j + 1] {
             if rows[k] <= j {
                 p_rows.push(rows[k]);
-                p_vals.push(vals[k]);
+                p_vals.push(scale[rows[k]] * vals[k] * scale[j]);
             }
         }
         p_ptr.push(p_rows.len());
@@ -445,23 +515,23 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
         }
     }
     let p = CscMatrix::new(nx, nx, p_ptr, p_rows, p_vals);
-    let mut q: Vec<f64> = lcp.f.iter().map(|f| -f).collect();
+    let mut q: Vec<f64> = lcp.f.iter().zip(&scale).map(|(f, d)| -f * d).collect();
     q.resize(nx, 0.0);
-    // −BU − CΛ + s = −G, s ≥ 0
+    // −BU − CΛ + s = −G, s ≥ 0, row k scaled by r_k
     let (mut ti, mut tj, mut tv) = (Vec::new(), Vec::new(), Vec::new());
     for (k, row) in lcp.b_rows.iter().enumerate() {
         for &(j, v) in row {
             ti.push(k);
             tj.push(j);
-            tv.push(-v);
+            tv.push(-v * scale[j] * row_scale[k]);
         }
         if with_lambda {
             ti.push(k);
             tj.push(n + k);
-            tv.push(-lcp.c[k]);
+            tv.push(-lcp.c[k] * row_scale[k]);
         }
     }
-    let b: Vec<f64> = lcp.g.iter().map(|g| -g).collect();
+    let b: Vec<f64> = lcp.g.iter().zip(&row_scale).map(|(g, r)| -g * r).collect();
     let a_c = CscMatrix::new_from_triplets(m, nx, ti, tj, tv);
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
@@ -470,6 +540,13 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
         .tol_gap_rel(1e-13)
         .tol_feas(1e-13)
         .tol_ktratio(1e-10)
+        // The default static regularization (1e-8) perturbs systems whose smallest
+        // relative eigenvalue is ~h⁴ (bending) far more than that.
+        .static_regularization_constant(1e-15)
+        .static_regularization_proportional(f64::EPSILON * f64::EPSILON)
+        .iterative_refinement_reltol(1e-15)
+        .iterative_refinement_abstol(1e-15)
+        .iterative_refinement_max_iter(40)
         .build()
         .map_err(|e| Error::Input(format!("clarabel settings: {e:?}")))?;
     let cones = [NonnegativeConeT(m)];
@@ -494,9 +571,31 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
             }
         });
     }
-    let u = solver.solution.x[..n].to_vec();
-    let lambda: Vec<f64> = solver.solution.z[..m].iter().map(|z| z.max(0.0)).collect();
-    let kkt_residual = lcp.kkt_residual(&u, &lambda);
+    let u: Vec<f64> = solver.solution.x[..n]
+        .iter()
+        .zip(&scale)
+        .map(|(y, d)| y * d)
+        .collect();
+    // the multiplier of the scaled row k is Λ_k / r_k
+    let lambda: Vec<f64> = solver.solution.z[..m]
+        .iter()
+        .zip(&row_scale)
+        .map(|(z, r)| (z * r).max(0.0))
+        .collect();
+    let mut kkt_residual = lcp.kkt_residual(&u, &lambda);
+    if with_lambda {
+        // Check the result, not the solver's word (see `Lcp::newton_correction`).
+        let correction = lcp.newton_correction(&u)?;
+        if correction > 1e-6 {
+            return Err(Error::NotConverged {
+                solver: "clarabel",
+                detail: format!(
+                    "it reported {status:?}, but a Newton step from its point changes U by {correction:.1e} (relative): the QP is too ill-conditioned for the interior-point method in double precision at this size"
+                ),
+            });
+        }
+        kkt_residual = kkt_residual.max(correction);
+    }
     Ok(LcpSolution {
         u,
         lambda,

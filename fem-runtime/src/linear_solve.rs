@@ -89,7 +89,7 @@ impl LuSolver {
     pub fn factor(&self, a: &SparseMatrix) -> Result<Factor> {
         let lu = Lu::try_new_with_symbolic(self.symbolic.clone(), a.as_ref())
             .map_err(|e| Error::LinearSolve(format!("the matrix is singular ({e:?})")))?;
-        Ok(Factor::Lu(lu))
+        Ok(Factor::Lu(Box::new(lu)))
     }
 }
 
@@ -97,8 +97,8 @@ impl LuSolver {
 pub enum Factor {
     /// `L Lᵀ`
     Cholesky(Llt<usize, f64>),
-    /// `P L U Q`
-    Lu(Lu<usize, f64>),
+    /// `P L U Q` (boxed: it is much larger than the Cholesky factor)
+    Lu(Box<Lu<usize, f64>>),
 }
 
 impl Factor {
@@ -107,7 +107,7 @@ impl Factor {
         let mut x = b.to_vec();
         match self {
             Factor::Cholesky(f) => solve_in_place(f, &mut x),
-            Factor::Lu(f) => solve_in_place(f, &mut x),
+            Factor::Lu(f) => solve_in_place(f.as_ref(), &mut x),
         }
         if x.iter().all(|v| v.is_finite()) {
             Ok(x)

@@ -96,10 +96,10 @@ impl IntervalMesh {
             })? = true;
         }
         let mut vertices = Vec::with_capacity(self.vertices.len() + marked.len());
-        for c in 0..self.cell_count() {
+        for (c, &marked) in mark.iter().enumerate() {
             let [x0, x1] = self.cell(c);
             vertices.push(x0);
-            if mark[c] {
+            if marked {
                 vertices.push(0.5 * (x0 + x1));
             }
         }

@@ -359,8 +359,8 @@ impl ObstacleSolution {
     }
 
     /// The contact set: runs of cells with `λ_h > 0` (above 1e-8 of the larger of its
-    /// maximum and the load's multiplier scale, so solver noise is not contact), single
-    /// holes between runs filled, and a run at most two cells wide reported as a point
+    /// maximum and the load's multiplier scale, so solver noise is not contact), holes
+    /// between runs filled when the beam touches there (zero gap), and a run at most two cells wide reported as a point
     /// contact at its λ-weighted centre.
     pub fn contact_set(&self) -> Vec<[f64; 2]> {
         let lambda = self.multiplier();
@@ -371,11 +371,22 @@ impl ObstacleSolution {
             return Vec::new();
         }
         let active: Vec<bool> = lambda.iter().map(|&l| l > 1e-8 * scale).collect();
+        // A cell touches when its constraint residual R_k is negligible against the
+        // terms it is made of: holes of touching cells are filled, real gaps are not.
+        let lcp = &self.discretization.lcp;
+        let u = self.discretization.primal_part(&self.values);
+        let touching = |k: usize| {
+            let row = &lcp.b_rows[k];
+            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
+            let terms: f64 =
+                row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>() + lcp.g[k].abs();
+            (bu + lcp.c[k] * lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
+        };
         let mut runs: Vec<(usize, usize)> = Vec::new();
         for (c, &on) in active.iter().enumerate() {
             if on {
                 match runs.last_mut() {
-                    Some((_, end)) if *end + 2 >= c => *end = c,
+                    Some((_, end)) if (*end + 1..c).all(touching) => *end = c,
                     _ => runs.push((c, c)),
                 }
             }
@@ -384,10 +395,10 @@ impl ObstacleSolution {
             .map(|(first, last)| {
                 if last - first < 2 {
                     let (mut weight, mut moment) = (0.0, 0.0);
-                    for c in first..=last {
+                    for (c, l) in lambda.iter().enumerate().take(last + 1).skip(first) {
                         let x = 0.5 * (mesh.cell(c)[0] + mesh.cell(c)[1]);
-                        weight += lambda[c] * mesh.h(c);
-                        moment += lambda[c] * mesh.h(c) * x;
+                        weight += l * mesh.h(c);
+                        moment += l * mesh.h(c) * x;
                     }
                     let x = moment / weight;
                     [x, x]

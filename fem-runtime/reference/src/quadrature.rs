@@ -130,7 +130,8 @@ mod tests {
     fn degree_to_points() {
         for degree in 0..20 {
             let n = points_for_degree(degree);
-            assert!(2 * n - 1 >= degree && (n == 1 || 2 * (n - 1) - 1 < degree));
+            // 2n − 1 ≥ degree, and n − 1 points would not do
+            assert!(2 * n > degree && (n == 1 || 2 * (n - 1) - 1 < degree));
         }
     }
 }

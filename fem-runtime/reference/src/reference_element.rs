@@ -251,10 +251,11 @@ mod tests {
                 .map(|n| n.to_vec())
                 .unwrap_or_default()
                 .into_iter();
-            let functionals: Vec<Box<dyn Fn(&Polynomial) -> f64>> = element
+            type Functional = Box<dyn Fn(&Polynomial) -> f64>;
+            let functionals: Vec<Functional> = element
                 .dofs()
                 .iter()
-                .map(|d| -> Box<dyn Fn(&Polynomial) -> f64> {
+                .map(|d| -> Functional {
                     match *d {
                         DofLocation::Vertex { vertex, derivative } => {
                             let _ = interior_nodes.next();

@@ -1,0 +1,249 @@
+//! SVG charts (plotters). Each chart is drawn to a temporary file and renamed into
+//! place, so a failed run never leaves a chart that looks complete.
+
+use crate::beams::Profiles;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// A named curve.
+pub struct Series {
+    /// Legend text.
+    pub name: String,
+    /// Points.
+    pub points: Vec<(f64, f64)>,
+    /// Draw markers at the points as well as the line.
+    pub markers: bool,
+}
+
+impl Series {
+    /// A curve drawn as a line.
+    pub fn line(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            markers: false,
+        }
+    }
+
+    /// A curve drawn as a line with markers.
+    pub fn marked(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            markers: true,
+        }
+    }
+}
+
+/// Axis options of a chart.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Axes<'a> {
+    /// x label
+    pub x: &'a str,
+    /// y label
+    pub y: &'a str,
+    /// logarithmic x
+    pub log_x: bool,
+    /// logarithmic y
+    pub log_y: bool,
+}
+
+type DrawResult<T> = Result<T, Box<dyn std::error::Error>>;
+
+const COLORS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(80, 80, 80),
+];
+
+fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    if log {
+        (lo / 1.5, hi * 1.5)
+    } else if hi - lo < 1e-300 {
+        (lo - 1.0, hi + 1.0)
+    } else {
+        let pad = 0.05 * (hi - lo);
+        (lo - pad, hi + pad)
+    }
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    axes: Axes,
+    series: &[Series],
+) -> DrawResult<()>
+where
+    DB::ErrorType: 'static,
+{
+    let (x0, x1) = range(
+        series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
+        axes.log_x,
+    );
+    let (y0, y1) = range(
+        series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+        axes.log_y,
+    );
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(36)
+        .y_label_area_size(70);
+    macro_rules! finish {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .x_desc(axes.x)
+                .y_desc(axes.y)
+                .y_label_formatter(&|v| format!("{v:.3e}"))
+                .draw()?;
+            for (k, s) in series.iter().enumerate() {
+                let color = COLORS[k % COLORS.len()];
+                let points: Vec<(f64, f64)> = s
+                    .points
+                    .iter()
+                    .copied()
+                    .filter(|p| {
+                        p.0.is_finite()
+                            && p.1.is_finite()
+                            && (!axes.log_x || p.0 > 0.0)
+                            && (!axes.log_y || p.1 > 0.0)
+                    })
+                    .collect();
+                chart
+                    .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                    });
+                if s.markers {
+                    chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+                }
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()?;
+        }};
+    }
+    match (axes.log_x, axes.log_y) {
+        (false, false) => finish!(builder.build_cartesian_2d(x0..x1, y0..y1)?),
+        (true, false) => finish!(builder.build_cartesian_2d((x0..x1).log_scale(), y0..y1)?),
+        (false, true) => finish!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?),
+        (true, true) => {
+            finish!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?)
+        }
+    }
+    Ok(())
+}
+
+fn write_atomically(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> DrawResult<()>,
+) -> std::io::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let tmp = path.with_extension("svg.partial");
+    let result = draw(&tmp).map_err(|e| std::io::Error::other(e.to_string()));
+    match result {
+        Ok(()) => std::fs::rename(&tmp, path),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+/// One chart with several curves.
+pub fn chart(path: &Path, title: &str, axes: Axes, series: &[Series]) -> std::io::Result<()> {
+    write_atomically(path, |tmp| {
+        let root = SVGBackend::new(tmp, (900, 600)).into_drawing_area();
+        root.fill(&WHITE)?;
+        draw_panel(&root, title, axes, series)?;
+        root.present()?;
+        Ok(())
+    })
+}
+
+/// Several charts stacked in one file.
+pub fn stacked(path: &Path, panels: &[(String, Axes, Vec<Series>)]) -> std::io::Result<()> {
+    write_atomically(path, |tmp| {
+        let root = SVGBackend::new(tmp, (900, 330 * panels.len() as u32)).into_drawing_area();
+        root.fill(&WHITE)?;
+        for (area, (title, axes, series)) in root.split_evenly((panels.len(), 1)).iter().zip(panels)
+        {
+            draw_panel(area, title, *axes, series)?;
+        }
+        root.present()?;
+        Ok(())
+    })
+}
+
+/// w with ψ, θ (Timoshenko) and λ of a solved scene.
+pub fn profiles(path: &Path, title: &str, p: &Profiles) -> std::io::Result<()> {
+    let zip = |y: &[f64]| {
+        p.x.iter()
+            .copied()
+            .zip(y.iter().copied())
+            .collect::<Vec<_>>()
+    };
+    let mut panels = vec![(
+        format!("{title}: deflection"),
+        Axes {
+            x: "x",
+            y: "w",
+            ..Axes::default()
+        },
+        vec![
+            Series::line("w_h", zip(&p.w)),
+            Series::line("obstacle ψ", zip(&p.psi)),
+        ],
+    )];
+    if let Some(theta) = &p.theta {
+        panels.push((
+            format!("{title}: rotation"),
+            Axes {
+                x: "x",
+                y: "θ",
+                ..Axes::default()
+            },
+            vec![Series::line("θ_h", zip(theta))],
+        ));
+    }
+    // λ is piecewise constant: draw it as steps.
+    let mut steps = Vec::with_capacity(2 * p.lambda.len());
+    for (k, &l) in p.lambda.iter().enumerate() {
+        let half = if p.cell_x.len() > 1 {
+            0.5 * (p.cell_x[1] - p.cell_x[0])
+        } else {
+            0.5
+        };
+        steps.push((p.cell_x[k] - half, l));
+        steps.push((p.cell_x[k] + half, l));
+    }
+    panels.push((
+        format!("{title}: contact multiplier"),
+        Axes {
+            x: "x",
+            y: "λ",
+            ..Axes::default()
+        },
+        vec![Series::line("λ_h (P0)", steps)],
+    ));
+    stacked(path, &panels)
+}

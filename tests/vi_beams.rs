@@ -1,0 +1,352 @@
+//! The variational-inequality solvers on the beam scenes: exact solutions and rates,
+//! locking, two independent solvers, iteration counts, the sign test of MODELS.md §1,
+//! stability where methods fail, and bad input.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use fem_forms::beams::{solve, Pair, Request};
+use fem_forms::models::scenes::{exact_solution, scene, Beam, Obstacle, Scene, SCENES};
+use fem_forms::obstacle::VariationalSolver;
+use fem_forms::studies;
+use fem_forms::IntervalMesh;
+
+fn request(name: &str, elements: usize, q: f64) -> Request {
+    let mut r = Request::new(scene(name).unwrap());
+    r.elements = elements;
+    r.load = q;
+    r
+}
+
+/// Least-squares slope of log(error) against log(1/h): one rate for the whole sequence,
+/// robust to the oscillation caused by the free boundary moving inside the elements.
+fn fitted_rate(elements: &[usize], errors: &[f64]) -> f64 {
+    let x: Vec<f64> = elements.iter().map(|&n| (n as f64).ln()).collect();
+    let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
+    let (mx, my) = (
+        x.iter().sum::<f64>() / x.len() as f64,
+        y.iter().sum::<f64>() / y.len() as f64,
+    );
+    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+    -sxy / sxx
+}
+
+#[test]
+fn bernoulli_flat_converges_at_the_expected_rates() {
+    // The free boundary a = (72d/q)^{1/4} carries point forces that P0 multipliers resolve
+    // within a cell, so the error is O(h²) in L2 and H1 (the point forces' H⁻² error),
+    // below the O(h^{5/2}) that the regularity H^{7/2−ε} would allow.
+    let meshes = [32, 64, 128, 256, 512, 1024];
+    let rows = studies::convergence(&meshes).unwrap();
+    let l2: Vec<f64> = rows.iter().map(|r| r.error_l2).collect();
+    let h1: Vec<f64> = rows.iter().map(|r| r.error_h1).collect();
+    let force: Vec<f64> = rows.iter().map(|r| r.force_error).collect();
+    println!("L2 {l2:?}\nH1 {h1:?}\n∫λ {force:?}");
+    println!("pairwise L2 rates {:.2?}", studies::rates(&l2));
+    let (r2, r1, rf) = (
+        fitted_rate(&meshes, &l2),
+        fitted_rate(&meshes, &h1),
+        fitted_rate(&meshes, &force),
+    );
+    println!("fitted rates: L2 {r2:.2}, H1 {r1:.2}, total force {rf:.2}");
+    assert!((r2 - 2.0).abs() < 0.4, "L2 rate {r2}");
+    assert!((r1 - 2.0).abs() < 0.4, "H1 rate {r1}");
+    assert!(rf > 1.5, "total force rate {rf}");
+    // and the contact edge is found to within two cells
+    for r in &rows {
+        assert!(
+            r.edge_error <= 2.0 / r.elements as f64 + 1e-12,
+            "{} elements: edge error {}",
+            r.elements,
+            r.edge_error
+        );
+    }
+}
+
+#[test]
+fn every_scene_agrees_between_pdas_and_clarabel() {
+    for s in SCENES {
+        for q in [1.0, 40.0, 100.0] {
+            let mut newton = Request::new(s);
+            newton.elements = 128;
+            newton.load = q;
+            let (pdas, _) = solve(&newton).unwrap();
+            let mut qp = newton;
+            qp.solver = VariationalSolver::Clarabel;
+            let (clarabel, _) = solve(&qp).unwrap();
+            let relative = ((pdas.energy - clarabel.energy) / pdas.energy).abs();
+            assert!(
+                relative <= 1e-7,
+                "{} q = {q}: energies {} vs {} ({relative:e})",
+                s.name,
+                pdas.energy,
+                clarabel.energy
+            );
+            assert!(
+                pdas.complementarity_residual <= 1e-10,
+                "{} q = {q}: KKT residual {:e}",
+                s.name,
+                pdas.complementarity_residual
+            );
+            if q == 1.0 {
+                // the seed load never reaches the obstacle: the multiplier vanishes
+                assert_eq!(pdas.total_contact_force, 0.0, "{}", s.name);
+                assert!(
+                    pdas.contact_set.is_empty() && clarabel.contact_set.is_empty(),
+                    "{}",
+                    s.name
+                );
+                assert!(
+                    clarabel.total_contact_force.abs() < 1e-8,
+                    "{}: {}",
+                    s.name,
+                    clarabel.total_contact_force
+                );
+                // and the free beam is right: Hermite is exact at the nodes, P2 is O(h²)
+                assert!(
+                    pdas.error_l2.unwrap() < 1e-6,
+                    "{}: {:?}",
+                    s.name,
+                    pdas.error_l2
+                );
+            } else {
+                assert!(!pdas.contact_set.is_empty(), "{} q = {q} touches", s.name);
+                assert_eq!(
+                    pdas.contact_set.len(),
+                    clarabel.contact_set.len(),
+                    "{} q = {q}",
+                    s.name
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn bernoulli_flat_matches_the_exact_contact_set_and_force() {
+    let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
+    let (r, _) = solve(&request("bernoulli-flat", 512, 100.0)).unwrap();
+    let [a, b] = r.contact_set[0];
+    assert!((a - exact.contact_set[0][0]).abs() < 2.0 / 512.0, "{a}");
+    assert!((b - exact.contact_set[0][1]).abs() < 2.0 / 512.0, "{b}");
+    assert!(
+        ((r.total_contact_force - exact.total_contact_force) / exact.total_contact_force).abs()
+            < 1e-3
+    );
+    // point contact regime: q = 40 touches at ½ with force q/2 − 192 d
+    let (r, _) = solve(&request("bernoulli-flat", 512, 40.0)).unwrap();
+    assert_eq!(r.contact_set.len(), 1);
+    assert!((r.contact_set[0][0] - 0.5).abs() < 1e-6 && r.contact_set[0][0] == r.contact_set[0][1]);
+    assert!(
+        (r.total_contact_force - (20.0 - 9.6)).abs() < 1e-3,
+        "{}",
+        r.total_contact_force
+    );
+}
+
+#[test]
+fn sign_test_both_sides_press_onto_the_obstacle_everywhere() {
+    // MODELS.md §1: ψ = 0, f = −s·q: exact u = 0, λ = q, for both s and both beams.
+    for (beam, pairs) in [
+        (Beam::EulerBernoulli, vec![Pair::BernoulliHermite]),
+        (
+            Beam::Timoshenko,
+            vec![Pair::TimoshenkoP2, Pair::TimoshenkoP1Reduced],
+        ),
+    ] {
+        for s in [1.0, -1.0] {
+            for pair in &pairs {
+                let scene = Scene {
+                    name: "sign-test",
+                    description: "",
+                    beam,
+                    obstacle: Obstacle::Constant(0.0),
+                    side: s,
+                    load_sign: -s,
+                    thickness: 1e-2,
+                };
+                let mut r = Request::new(scene);
+                r.elements = 64;
+                r.load = 7.0;
+                r.pair = Some(*pair);
+                let (report, profiles) = solve(&r).unwrap();
+                assert!(
+                    report.max_deflection < 1e-9,
+                    "{beam:?} s = {s}: max |w| {}",
+                    report.max_deflection
+                );
+                for &l in &profiles.lambda {
+                    assert!(
+                        (l - 7.0).abs() < 1e-6 * 7.0,
+                        "{beam:?} {} s = {s}: λ = {l}",
+                        pair.name()
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn stabilized_timoshenko_does_not_lock_and_p1_full_integration_does() {
+    let thicknesses = [1e-1, 1e-2, 1e-3, 1e-4, 1e-5];
+    let (reference, rows) = studies::locking(
+        128,
+        &thicknesses,
+        &[Pair::TimoshenkoP2, Pair::TimoshenkoP1Full],
+    )
+    .unwrap();
+    let p2: Vec<_> = rows
+        .iter()
+        .filter(|r| r.pair == Pair::TimoshenkoP2)
+        .collect();
+    let full: Vec<_> = rows
+        .iter()
+        .filter(|r| r.pair == Pair::TimoshenkoP1Full)
+        .collect();
+    for r in &rows {
+        println!(
+            "{:<15} t = {:.0e}: max |w| {:.6e}, ‖w − w_EB‖ {:.3e}",
+            r.pair.name(),
+            r.thickness,
+            r.max_deflection,
+            r.difference_to_bernoulli
+        );
+    }
+    // Converges to Euler–Bernoulli: the difference falls by ~t² until the mesh error floor…
+    assert!(p2[1].difference_to_bernoulli < p2[0].difference_to_bernoulli / 50.0);
+    // …and at fixed h it does not grow as t → 0 (1e-3 … 1e-5, the last with refinement).
+    let floor = p2[2].difference_to_bernoulli;
+    for r in &p2[2..] {
+        assert!(
+            r.difference_to_bernoulli < 3.0 * floor.max(1e-5),
+            "t = {}: {}",
+            r.thickness,
+            r.difference_to_bernoulli
+        );
+        assert!((r.max_deflection / reference.max_deflection - 1.0).abs() < 1e-3);
+    }
+    // P1–P1 with exact shear integration locks: its deflection collapses.
+    assert!(
+        full[4].max_deflection < 0.01 * full[0].max_deflection,
+        "{} vs {}",
+        full[4].max_deflection,
+        full[0].max_deflection
+    );
+    assert!(full[3].max_deflection < 0.2 * reference.max_deflection);
+}
+
+#[test]
+fn nested_iteration_keeps_newton_iterations_flat() {
+    // Timoshenko from 32 to 32,768 elements; cold starts beside for the small meshes.
+    let meshes: Vec<usize> = (5..=15).map(|k| 1 << k).collect();
+    let rows = studies::iteration_counts("timoshenko-a", &meshes, 512).unwrap();
+    for (n, nested, cold) in &rows {
+        println!("{n:>6} elements: nested {nested:?}, cold {cold:?}");
+        let nested = nested.unwrap_or_else(|| panic!("nested Newton failed at {n} elements"));
+        assert!(nested <= 6, "{n} elements: {nested} iterations");
+    }
+    // From a cold start the active set creeps: many more iterations on the finer meshes.
+    let cold_512 = rows.iter().find(|r| r.0 == 512).unwrap().2.unwrap();
+    let nested_512 = rows.iter().find(|r| r.0 == 512).unwrap().1.unwrap();
+    assert!(
+        cold_512 > 2 * nested_512,
+        "cold {cold_512} vs nested {nested_512}"
+    );
+}
+
+#[test]
+fn euler_bernoulli_iterations_are_flat_until_double_precision_runs_out() {
+    // Hermite bending matrices have κ ~ h⁻⁴, past 1/ε near 10⁴ elements: up to 8192 the
+    // nested Newton count stays flat; beyond it the solve reports failure (never a wrong answer).
+    let meshes: Vec<usize> = (5..=13).map(|k| 1 << k).collect();
+    for (n, nested, _) in studies::iteration_counts("bernoulli-flat", &meshes, 0).unwrap() {
+        println!("{n:>6} elements: nested {nested:?}");
+        let nested = nested.unwrap_or_else(|| panic!("failed at {n}"));
+        assert!(nested <= 10, "{n}: {nested}");
+    }
+}
+
+#[test]
+fn plain_and_stabilized_multipliers_where_methods_fail() {
+    let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
+    let plain = studies::multiplier_profile("bernoulli-flat", 256, None).unwrap();
+    let weak = studies::multiplier_profile("bernoulli-flat", 256, Some(1e-2)).unwrap();
+    let strong = studies::multiplier_profile("bernoulli-flat", 256, Some(1.0)).unwrap();
+    let contact = exact.contact_set[0];
+    // The plain method's multiplier oscillates about the exact 100; stabilizing damps it.
+    let (op, ow) = (
+        studies::interior_oscillation(&plain, contact),
+        studies::interior_oscillation(&weak, contact),
+    );
+    assert!(ow < op / 2.0, "oscillation plain {op}, α = 1e-2 {ow}");
+    // Zero holes next to the contact edges: the plain method has them, α = 1 removes them.
+    assert!(studies::zero_holes(&plain.lambda) > 0);
+    assert_eq!(studies::zero_holes(&strong.lambda), 0);
+    // The conditioning of the LCP matrix: plain worse than stabilized, and growing as h → 0.
+    let mut r = request("timoshenko-a", 32, 100.0);
+    let stabilized = studies::lcp_condition(&r).unwrap();
+    r.alpha = Some(0.0);
+    r.plain = true;
+    r.solver = VariationalSolver::Clarabel;
+    let plain_32 = studies::lcp_condition(&r).unwrap();
+    r.elements = 64;
+    let plain_64 = studies::lcp_condition(&r).unwrap();
+    assert!(plain_32 > 100.0 * stabilized, "{plain_32} vs {stabilized}");
+    assert!(plain_64 > 4.0 * plain_32);
+}
+
+#[test]
+fn an_overlarge_alpha_shifts_the_contact_set() {
+    let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
+    let rows = studies::alpha_sweep(128, &[1e-2, 1e3]).unwrap();
+    let h = 1.0 / 128.0;
+    assert!((rows[0].contact_start - exact.contact_set[0][0]).abs() < 2.0 * h);
+    assert!(
+        (rows[1].contact_start - exact.contact_set[0][0]).abs() > 5.0 * h,
+        "{}",
+        rows[1].contact_start
+    );
+    assert!(rows[1].error_l2 > 10.0 * rows[0].error_l2);
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    // zero or negative element length
+    let e = IntervalMesh::new(vec![0.0, 0.5, 0.5, 1.0])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("zero length"), "{e}");
+    let e = IntervalMesh::new(vec![0.0, 0.6, 0.4, 1.0])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("negative length"), "{e}");
+    // an obstacle that contradicts the clamped ends
+    let mut infeasible = scene("bernoulli-flat").unwrap();
+    infeasible.obstacle = Obstacle::Constant(0.1);
+    let e = solve(&Request::new(infeasible)).unwrap_err().to_string();
+    assert!(e.contains("infeasible"), "{e}");
+    // NaN data
+    let mut nan = scene("timoshenko-a").unwrap();
+    nan.obstacle = Obstacle::Constant(f64::NAN);
+    assert!(solve(&Request::new(nan))
+        .unwrap_err()
+        .to_string()
+        .contains("not finite"));
+    let mut r = request("timoshenko-a", 64, f64::NAN);
+    assert!(solve(&r).unwrap_err().to_string().contains("load"));
+    // α ≤ 0, α not finite, thickness ≤ 0
+    for alpha in [0.0, -1.0, f64::INFINITY] {
+        r = request("bernoulli-a", 64, 40.0);
+        r.alpha = Some(alpha);
+        let e = solve(&r).unwrap_err().to_string();
+        assert!(e.contains("α"), "{e}");
+    }
+    r = request("timoshenko-a", 64, 40.0);
+    r.thickness = Some(0.0);
+    assert!(solve(&r).unwrap_err().to_string().contains("thickness"));
+    // a pair of the other beam theory
+    assert!(Pair::parse("hermite-p0", Beam::Timoshenko).is_err());
+    // zero elements
+    r = request("timoshenko-a", 0, 40.0);
+    assert!(solve(&r).is_err());
+}
