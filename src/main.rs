@@ -116,6 +116,9 @@ fn fmt_contact(set: &[[f64; 2]]) -> String {
 }
 
 fn table_row(r: &Report) {
+    for w in &r.warnings {
+        eprintln!("warning ({} q = {}): {w}", r.scene, r.load);
+    }
     println!(
         "{:<15} {:>5} {:>7} {:>6} {:>6} {:>5} {:>8.4} {:>14.8e} {:<24} {:>9.1e} {:>10}",
         r.scene,

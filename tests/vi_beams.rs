@@ -350,3 +350,56 @@ fn bad_input_is_a_clear_error() {
     r = request("timoshenko-a", 0, 40.0);
     assert!(solve(&r).is_err());
 }
+
+#[test]
+fn saddle_point_active_set_and_multiplier_recovery_agree_with_eliminated_newton() {
+    use fem_forms::complementarity::{
+        primal_dual_active_set, recover_multiplier, semismooth_newton, NewtonOptions,
+    };
+    for name in ["timoshenko-a", "bernoulli-flat"] {
+        let (d, _) = fem_forms::beams::discretize(&request(name, 128, 100.0)).unwrap();
+        let options = NewtonOptions::default();
+        let newton = semismooth_newton(&d.lcp, None, options).unwrap();
+        let saddle = primal_dual_active_set(&d.lcp, None, options).unwrap();
+        let recovered = recover_multiplier(&d.lcp, newton.clone(), 1).unwrap();
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let diff = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        };
+        for (label, other) in [("saddle", &saddle), ("recovered", &recovered)] {
+            assert!(
+                diff(&newton.u, &other.u) <= 1e-8 * norm(&newton.u),
+                "{name} {label}: U"
+            );
+            assert!(
+                diff(&newton.lambda, &other.lambda) <= 1e-6 * norm(&newton.lambda),
+                "{name} {label}: Λ"
+            );
+            assert!(
+                other.kkt_residual <= 1e-10,
+                "{name} {label}: {}",
+                other.kkt_residual
+            );
+        }
+    }
+}
+
+#[test]
+fn multiplier_noise_is_reported_where_the_eliminated_multiplier_loses_its_digits() {
+    let (coarse, _) = solve(&request("timoshenko-a", 1024, 100.0)).unwrap();
+    assert!(coarse.warnings.is_empty() && coarse.multiplier_noise == 0.0);
+    let (fine, _) = solve(&request("timoshenko-a", 16384, 100.0)).unwrap();
+    assert!(
+        fine.multiplier_noise > 1e-6 && !fine.warnings.is_empty(),
+        "{:?}",
+        fine.warnings
+    );
+    // the deflection, the contact set and the total force stay right
+    assert!(
+        (fine.total_contact_force - coarse.total_contact_force).abs()
+            < 1e-2 * coarse.total_contact_force
+    );
+    assert!(fine.complementarity_residual <= 1e-10);
+}

@@ -49,6 +49,9 @@ pub struct LcpSolution {
     pub seconds: f64,
     /// Number of numeric factorizations.
     pub factorizations: usize,
+    /// Estimated relative rounding noise of Λ (see [`Lcp::elimination_noise`]); 0 when Λ
+    /// comes from a linear solve or the QP's dual.
+    pub multiplier_noise: f64,
 }
 
 impl Lcp {
@@ -365,6 +368,7 @@ pub fn semismooth_newton(
                     kkt_residual: residual,
                     seconds: clock.elapsed().as_secs_f64(),
                     factorizations: iteration - 1,
+                    multiplier_noise: lcp.elimination_noise(),
                 });
             }
         }
@@ -403,6 +407,7 @@ pub fn semismooth_newton(
                     kkt_residual: residual,
                     seconds: clock.elapsed().as_secs_f64(),
                     factorizations: iteration,
+                    multiplier_noise: lcp.elimination_noise(),
                 });
             }
             return Err(Error::NotConverged {
@@ -429,6 +434,7 @@ pub fn semismooth_newton(
                     kkt_residual: residual,
                     seconds: clock.elapsed().as_secs_f64(),
                     factorizations: iteration,
+                    multiplier_noise: lcp.elimination_noise(),
                 });
             }
         }
@@ -444,6 +450,280 @@ pub fn semismooth_newton(
             "{} iterations without a settled active set (KKT residual {:e})",
             options.max_iterations,
             lcp.kkt_residual(&u, &lambda)
+        ),
+    })
+}
+
+impl Lcp {
+    /// How many digits `Λ = C⁻¹(G − BU)` loses to cancellation: `ε|G_k| / (C_k Λ*)` at its
+    /// worst (Λ* the multiplier scale). Near 1 the eliminated Λ is rounding noise: on fine
+    /// meshes `C = αh⁵` falls below the rounding of `G − BU ≈ CΛ`.
+    pub fn elimination_noise(&self) -> f64 {
+        let scale = self.multiplier_scale().max(f64::MIN_POSITIVE);
+        (0..self.m())
+            .filter(|&k| self.c[k] > 0.0)
+            .map(|k| f64::EPSILON * self.g[k].abs() / (self.c[k] * scale))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The saddle-point system `[[A, −B̃ᵀ], [−B̃, D]]` of the primal–dual active set method with
+/// a fixed pattern: active rows carry `B_k` and `D_kk = −C_k`, inactive rows `Λ_k = 0`
+/// (`B̃_k = 0`, `D_kk = −1`), so one symbolic LU serves every iteration.
+struct SaddlePoint {
+    symbolic: SymbolicSparseColMat<usize>,
+    a_positions: Vec<usize>,
+    /// For row k of B: positions of (n+k, j) and (j, n+k) per entry, and of (n+k, n+k).
+    b_positions: Vec<Vec<(usize, usize)>>,
+    diagonal: Vec<usize>,
+}
+
+impl SaddlePoint {
+    fn new(lcp: &Lcp) -> Self {
+        let (n, m) = (lcp.n(), lcp.m());
+        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n + m];
+        let (col_ptr, rows) = (lcp.a.symbolic().col_ptr(), lcp.a.symbolic().row_idx());
+        for (j, column) in columns.iter_mut().enumerate().take(n) {
+            column.extend_from_slice(&rows[col_ptr[j]..col_ptr[j + 1]]);
+        }
+        for (k, row) in lcp.b_rows.iter().enumerate() {
+            for &(j, _) in row {
+                columns[j].push(n + k);
+                columns[n + k].push(j);
+            }
+            columns[n + k].push(n + k);
+        }
+        let mut ptr = vec![0usize; n + m + 1];
+        let mut idx = Vec::new();
+        for (j, column) in columns.iter_mut().enumerate() {
+            column.sort_unstable();
+            column.dedup();
+            idx.extend_from_slice(column);
+            ptr[j + 1] = idx.len();
+        }
+        let find = |i: usize, j: usize| ptr[j] + idx[ptr[j]..ptr[j + 1]].binary_search(&i).unwrap();
+        let mut a_positions = Vec::new();
+        for j in 0..n {
+            for &i in &rows[col_ptr[j]..col_ptr[j + 1]] {
+                a_positions.push(find(i, j));
+            }
+        }
+        let b_positions = lcp
+            .b_rows
+            .iter()
+            .enumerate()
+            .map(|(k, row)| {
+                row.iter()
+                    .map(|&(j, _)| (find(n + k, j), find(j, n + k)))
+                    .collect()
+            })
+            .collect();
+        let diagonal = (0..m).map(|k| find(n + k, n + k)).collect();
+        Self {
+            symbolic: SymbolicSparseColMat::new_checked(n + m, n + m, ptr, None, idx),
+            a_positions,
+            b_positions,
+            diagonal,
+        }
+    }
+
+    fn matrix(&self, lcp: &Lcp, active: &[bool]) -> SparseMatrix {
+        let mut values = vec![0.0; self.symbolic.row_idx().len()];
+        for (&p, &v) in self.a_positions.iter().zip(lcp.a.val()) {
+            values[p] += v;
+        }
+        for (k, row) in lcp.b_rows.iter().enumerate() {
+            if active[k] {
+                for (&(_, v), &(p, q)) in row.iter().zip(&self.b_positions[k]) {
+                    values[p] = -v;
+                    values[q] = -v;
+                }
+                values[self.diagonal[k]] = -lcp.c[k];
+            } else {
+                // Λ_k = 0, scaled like the row so that the matrix stays balanced
+                let scale = row.iter().fold(0.0f64, |m, &(_, v)| m.max(v.abs()));
+                values[self.diagonal[k]] = -scale.max(lcp.c[k]).max(f64::MIN_POSITIVE);
+            }
+        }
+        SparseColMat::new(self.symbolic.clone(), values)
+    }
+}
+
+/// Recovers `(U, Λ)` on the active set `{Λ_k > 0}` of a converged solution from one
+/// saddle-point solve, in which Λ comes from the equilibrium instead of
+/// `C⁻¹(G − BU)`: on fine meshes, where `C = αh⁵` is below the rounding of `G − BU`, this is the
+/// difference between a multiplier and rounding noise. Keeps the solution it was given
+/// when the recovered one does not satisfy the KKT conditions as well.
+pub fn recover_multiplier(
+    lcp: &Lcp,
+    solution: LcpSolution,
+    refinement_steps: usize,
+) -> Result<LcpSolution> {
+    let clock = Instant::now();
+    let n = lcp.n();
+    let active: Vec<bool> = solution.lambda.iter().map(|&l| l > 0.0).collect();
+    let saddle = SaddlePoint::new(lcp);
+    let k_matrix = saddle.matrix(lcp, &active);
+    let factor = crate::linear_solve::LuSolver::analyse(&saddle.symbolic)?.factor(&k_matrix)?;
+    let mut rhs = lcp.f.clone();
+    rhs.extend((0..lcp.m()).map(|k| if active[k] { -lcp.g[k] } else { 0.0 }));
+    let x = factor.solve_refined(&k_matrix, &rhs, refinement_steps)?;
+    let u = x[..n].to_vec();
+    let lambda: Vec<f64> = x[n..]
+        .iter()
+        .zip(&active)
+        .map(|(&l, &a)| if a { l.max(0.0) } else { 0.0 })
+        .collect();
+    let residual = lcp.kkt_residual(&u, &lambda);
+    // The eliminated Λ's noise is invisible to the (backward-error) residual, so the
+    // recovered solution is taken whenever it satisfies the KKT conditions to 1e-8.
+    if residual <= 1e-8 {
+        Ok(LcpSolution {
+            u,
+            lambda,
+            kkt_residual: residual,
+            seconds: solution.seconds + clock.elapsed().as_secs_f64(),
+            factorizations: solution.factorizations + 1,
+            multiplier_noise: 0.0,
+            ..solution
+        })
+    } else {
+        Ok(solution)
+    }
+}
+
+/// The primal–dual active set method on the saddle-point system, for when eliminating
+/// `Λ = C⁻¹(G − BU)` would lose Λ to cancellation ([`Lcp::elimination_noise`]): Λ is an
+/// unknown of each linear solve, computed from the equilibrium. The step in U is the
+/// Newton step on Φ for the current active set, globalized by the same Armijo search;
+/// after a full step the next active set is `{Λ_k > 0} ∪ {G_k − B_kU > 0}`.
+pub fn primal_dual_active_set(
+    lcp: &Lcp,
+    start: Option<&[f64]>,
+    options: NewtonOptions,
+) -> Result<LcpSolution> {
+    let clock = Instant::now();
+    if let Some(k) = lcp.c.iter().position(|&c| c.is_nan() || c <= 0.0) {
+        return Err(Error::Input(format!(
+            "the active-set method globalizes with Φ and needs C > 0; C_{k} = {}",
+            lcp.c[k]
+        )));
+    }
+    let (n, m) = (lcp.n(), lcp.m());
+    let mut u = match start {
+        Some(s) if s.len() == n => s.to_vec(),
+        Some(s) => {
+            return Err(Error::Input(format!(
+                "start vector has {} entries, the problem {n}",
+                s.len()
+            )))
+        }
+        None => vec![0.0; n],
+    };
+    let saddle = SaddlePoint::new(lcp);
+    let lu = crate::linear_solve::LuSolver::analyse(&saddle.symbolic)?;
+    let phi = |u: &[f64], au: &[f64], bu: &[f64]| -> f64 {
+        let quadratic: f64 = u
+            .iter()
+            .zip(au)
+            .zip(&lcp.f)
+            .map(|((u, au), f)| 0.5 * u * au - f * u)
+            .sum();
+        let penalty: f64 = (0..m)
+            .map(|k| {
+                let r = (lcp.g[k] - bu[k]).max(0.0);
+                0.5 * r * r / lcp.c[k]
+            })
+            .sum();
+        quadratic + penalty
+    };
+    let norm = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let bu0 = lcp.b_times(&u);
+    let mut active: Vec<bool> = (0..m).map(|k| lcp.g[k] - bu0[k] > 0.0).collect();
+    let mut lambda = vec![0.0; m];
+    let mut two_ago: Option<Vec<bool>> = None;
+    for iteration in 1..=options.max_iterations {
+        let k_matrix = saddle.matrix(lcp, &active);
+        let factor = lu.factor(&k_matrix)?;
+        let mut rhs = lcp.f.clone();
+        rhs.extend((0..m).map(|k| if active[k] { -lcp.g[k] } else { 0.0 }));
+        let x = factor.solve_refined(&k_matrix, &rhs, options.refinement_steps)?;
+        let (u_new, lambda_new) = x.split_at(n);
+        let d: Vec<f64> = u_new.iter().zip(&u).map(|(a, b)| a - b).collect();
+        // Armijo on Φ along d (d is the Newton step of Φ for this active set).
+        let au = multiply(&lcp.a, &u);
+        let bu = lcp.b_times(&u);
+        let ad = multiply(&lcp.a, &d);
+        let bd = lcp.b_times(&d);
+        let phi0 = phi(&u, &au, &bu);
+        let lam: Vec<f64> = (0..m)
+            .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
+            .collect();
+        let btl = lcp.bt_times(&lam);
+        let slope: f64 = (0..n).map(|i| (au[i] - lcp.f[i] - btl[i]) * d[i]).sum();
+        let mut step = 1.0;
+        for _ in 0..60 {
+            let ut: Vec<f64> = u.iter().zip(&d).map(|(u, d)| u + step * d).collect();
+            let aut: Vec<f64> = au.iter().zip(&ad).map(|(a, b)| a + step * b).collect();
+            let but: Vec<f64> = bu.iter().zip(&bd).map(|(a, b)| a + step * b).collect();
+            if phi(&ut, &aut, &but) <= phi0 + 1e-4 * step * slope.min(0.0) + 1e-13 * phi0.abs() {
+                break;
+            }
+            step *= 0.5;
+        }
+        // On very fine meshes the cells at the free boundary have gaps below the rounding
+        // of G − BU and flip without moving U beyond the solve's own accuracy.
+        let small_step = norm(&d) <= 1e-10 * norm(u_new);
+        if step == 1.0 {
+            u = u_new.to_vec();
+            lambda = lambda_new
+                .iter()
+                .zip(&active)
+                .map(|(&l, &a)| if a { l } else { 0.0 })
+                .collect();
+            let bu = lcp.b_times(&u);
+            let next: Vec<bool> = (0..m)
+                .map(|k| {
+                    if active[k] {
+                        lambda[k] > 0.0
+                    } else {
+                        lcp.g[k] - bu[k] > 0.0
+                    }
+                })
+                .collect();
+            // Converged: the active set reproduces itself (U, Λ solve its equations), or
+            // only constraints whose gap is at rounding level keep flipping.
+            // A period-2 cycle of cells at the free boundary whose λ and gap are both at
+            // rounding level is the same fixed point seen twice.
+            let cycling = two_ago.as_ref() == Some(&next);
+            if next == active || small_step || cycling {
+                let positive: Vec<f64> = lambda.iter().map(|l| l.max(0.0)).collect();
+                let residual = lcp.kkt_residual(&u, &positive);
+                if residual <= options.tolerance || ((small_step || cycling) && residual <= 1e-8) {
+                    return Ok(LcpSolution {
+                        u,
+                        lambda: positive,
+                        iterations: iteration,
+                        kkt_residual: residual,
+                        seconds: clock.elapsed().as_secs_f64(),
+                        factorizations: iteration,
+                        multiplier_noise: 0.0,
+                    });
+                }
+            }
+            two_ago = Some(std::mem::replace(&mut active, next));
+        } else {
+            u = u.iter().zip(&d).map(|(u, d)| u + step * d).collect();
+            let bu = lcp.b_times(&u);
+            active = (0..m).map(|k| lcp.g[k] - bu[k] > 0.0).collect();
+        }
+    }
+    Err(Error::NotConverged {
+        solver: "primal–dual active set",
+        detail: format!(
+            "{} iterations without a settled active set (KKT residual {:e})",
+            options.max_iterations,
+            lcp.kkt_residual(&u, &lambda.iter().map(|l| l.max(0.0)).collect::<Vec<_>>())
         ),
     })
 }
@@ -603,5 +883,6 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
         kkt_residual,
         seconds: clock.elapsed().as_secs_f64(),
         factorizations: solver.solution.iterations as usize,
+        multiplier_noise: 0.0,
     })
 }

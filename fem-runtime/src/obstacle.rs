@@ -6,7 +6,8 @@
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::boundary::{Constraints, Reduction, Side};
 use crate::complementarity::{
-    quadratic_program, semismooth_newton, Lcp, LcpSolution, NewtonOptions,
+    primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton, Lcp,
+    LcpSolution, NewtonOptions,
 };
 use crate::dof_map::SystemDofs;
 use crate::element::PhysicalBasis;
@@ -241,6 +242,8 @@ pub struct ObstacleSolution {
     pub seconds: f64,
     /// Wall time of the LCP solve on the finest mesh alone.
     pub solve_seconds: f64,
+    /// Estimated relative rounding noise of the multiplier values (0: none).
+    pub multiplier_noise: f64,
 }
 
 /// Options of [`solve_obstacle`].
@@ -275,7 +278,26 @@ pub fn solve_obstacle<M: Model>(
     let clock = Instant::now();
     let solve = |d: &Discretization, start: Option<&[f64]>| -> Result<LcpSolution> {
         match options.solver {
-            VariationalSolver::SemismoothNewton => semismooth_newton(&d.lcp, start, options.newton),
+            // Newton with Λ eliminated (SPD Hessian, one symbolic Cholesky); if it fails,
+            // the active-set method on the saddle-point system. Where the eliminated Λ
+            // loses digits to cancellation (C = αh⁵ on fine meshes), Λ is recovered from
+            // one saddle-point solve on the converged active set.
+            VariationalSolver::SemismoothNewton => {
+                let solution =
+                    match semismooth_newton(&d.lcp, start, options.newton) {
+                        Ok(s) => s,
+                        Err(newton) => primal_dual_active_set(&d.lcp, start, options.newton)
+                            .map_err(|pdas| Error::NotConverged {
+                                solver: "semismooth Newton and the saddle-point active-set method",
+                                detail: format!("{newton}; {pdas}"),
+                            })?,
+                    };
+                if d.lcp.elimination_noise() > 1e-8 {
+                    recover_multiplier(&d.lcp, solution, options.newton.refinement_steps)
+                } else {
+                    Ok(solution)
+                }
+            }
             VariationalSolver::Clarabel => quadratic_program(&d.lcp),
         }
     };
@@ -322,6 +344,7 @@ pub fn solve_obstacle<M: Model>(
                 iterations: solution.iterations,
                 kkt_residual: solution.kkt_residual,
                 solve_seconds: solution.seconds,
+                multiplier_noise: solution.multiplier_noise,
                 discretization: d,
                 values,
                 levels,
