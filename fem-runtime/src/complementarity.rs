@@ -221,6 +221,61 @@ impl Default for NewtonOptions {
     }
 }
 
+/// A sparsity pattern built from the pattern of `A` in the leading block plus extra
+/// entries, with the lookup of each entry's position in the value array.
+struct Pattern {
+    ptr: Vec<usize>,
+    idx: Vec<usize>,
+}
+
+impl Pattern {
+    /// `A`'s pattern in a `size × size` matrix, then `extra(&mut columns)` adds entries.
+    fn new(a: &SparseMatrix, size: usize, extra: impl FnOnce(&mut [Vec<usize>])) -> Self {
+        let (col_ptr, rows) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); size];
+        for (j, column) in columns.iter_mut().enumerate().take(a.ncols()) {
+            column.extend_from_slice(&rows[col_ptr[j]..col_ptr[j + 1]]);
+        }
+        extra(&mut columns);
+        let mut ptr = vec![0usize; size + 1];
+        let mut idx = Vec::new();
+        for (j, column) in columns.iter_mut().enumerate() {
+            column.sort_unstable();
+            column.dedup();
+            idx.extend_from_slice(column);
+            ptr[j + 1] = idx.len();
+        }
+        Self { ptr, idx }
+    }
+
+    /// Position of entry `(i, j)` (it must be in the pattern).
+    fn position(&self, i: usize, j: usize) -> usize {
+        let column = &self.idx[self.ptr[j]..self.ptr[j + 1]];
+        self.ptr[j]
+            + column
+                .binary_search(&i)
+                .expect("the entry is in the pattern")
+    }
+
+    /// Positions of `A`'s entries, in `A`'s storage order.
+    fn positions_of(&self, a: &SparseMatrix) -> Vec<usize> {
+        let (col_ptr, rows) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+        (0..a.ncols())
+            .flat_map(|j| {
+                rows[col_ptr[j]..col_ptr[j + 1]]
+                    .iter()
+                    .map(move |&i| (i, j))
+            })
+            .map(|(i, j)| self.position(i, j))
+            .collect()
+    }
+
+    fn symbolic(self) -> SymbolicSparseColMat<usize> {
+        let size = self.ptr.len() - 1;
+        SymbolicSparseColMat::new_checked(size, size, self.ptr, None, self.idx)
+    }
+}
+
 /// The Hessian `A + Σ_{k active} b_k b_kᵀ / C_k` with a fixed pattern.
 struct Hessian {
     symbolic: SymbolicSparseColMat<usize>,
@@ -231,55 +286,28 @@ struct Hessian {
 
 impl Hessian {
     fn new(lcp: &Lcp) -> Self {
-        let n = lcp.n();
-        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n];
-        let a = &lcp.a;
-        let (col_ptr, rows) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
-        for (j, column) in columns.iter_mut().enumerate() {
-            column.extend_from_slice(&rows[col_ptr[j]..col_ptr[j + 1]]);
-        }
-        for row in &lcp.b_rows {
-            for &(i, _) in row {
-                for &(j, _) in row {
-                    columns[j].push(i);
+        let pattern = Pattern::new(&lcp.a, lcp.n(), |columns| {
+            for row in &lcp.b_rows {
+                for &(i, _) in row {
+                    for &(j, _) in row {
+                        columns[j].push(i);
+                    }
                 }
             }
-        }
-        let mut new_ptr = vec![0usize; n + 1];
-        let mut new_rows = Vec::new();
-        for (j, column) in columns.iter_mut().enumerate() {
-            column.sort_unstable();
-            column.dedup();
-            new_rows.extend_from_slice(column);
-            new_ptr[j + 1] = new_rows.len();
-        }
-        let find = |i: usize, j: usize| {
-            new_ptr[j]
-                + new_rows[new_ptr[j]..new_ptr[j + 1]]
-                    .binary_search(&i)
-                    .unwrap()
-        };
-        let mut a_positions = Vec::with_capacity(rows.len());
-        for j in 0..n {
-            for &i in &rows[col_ptr[j]..col_ptr[j + 1]] {
-                a_positions.push(find(i, j));
-            }
-        }
+        });
+        let a_positions = pattern.positions_of(&lcp.a);
         let row_positions = lcp
             .b_rows
             .iter()
             .map(|row| {
-                let mut p = Vec::with_capacity(row.len() * row.len());
-                for &(i, _) in row {
-                    for &(j, _) in row {
-                        p.push(find(i, j));
-                    }
-                }
-                p
+                row.iter()
+                    .flat_map(|&(i, _)| row.iter().map(move |&(j, _)| (i, j)))
+                    .map(|(i, j)| pattern.position(i, j))
+                    .collect()
             })
             .collect();
         Self {
-            symbolic: SymbolicSparseColMat::new_checked(n, n, new_ptr, None, new_rows),
+            symbolic: pattern.symbolic(),
             a_positions,
             row_positions,
         }
@@ -306,6 +334,82 @@ impl Hessian {
     }
 }
 
+impl Lcp {
+    /// An error unless every `C_k > 0` (Φ and the elimination of Λ need it).
+    fn require_positive_c(&self, method: &str) -> Result<()> {
+        match self.c.iter().position(|&c| c.is_nan() || c <= 0.0) {
+            Some(k) => Err(Error::Input(format!(
+                "{method} needs C > 0 (it uses Φ and Λ = C⁻¹(G − BU)₊); C_{k} = {}: α ≤ 0 gives the plain mixed method, solve it with the QP solver",
+                self.c[k]
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The start vector, or zero.
+    fn start_vector(&self, start: Option<&[f64]>) -> Result<Vec<f64>> {
+        match start {
+            Some(s) if s.len() == self.n() => Ok(s.to_vec()),
+            Some(s) => Err(Error::Input(format!(
+                "start vector has {} entries, the problem {}",
+                s.len(),
+                self.n()
+            ))),
+            None => Ok(vec![0.0; self.n()]),
+        }
+    }
+
+    /// `Λ = C⁻¹(G − BU)₊` from `bu = BU`.
+    pub fn eliminated_multiplier(&self, bu: &[f64]) -> Vec<f64> {
+        (0..self.m())
+            .map(|k| (self.g[k] - bu[k]).max(0.0) / self.c[k])
+            .collect()
+    }
+
+    /// The merit function `Φ(U) = ½UᵀAU − FᵀU + ½Σ_k (G − BU)²₊,k / C_k` from `au = AU`, `bu = BU`.
+    pub fn merit(&self, u: &[f64], au: &[f64], bu: &[f64]) -> f64 {
+        let quadratic: f64 = u
+            .iter()
+            .zip(au)
+            .zip(&self.f)
+            .map(|((u, au), f)| 0.5 * u * au - f * u)
+            .sum();
+        let penalty: f64 = (0..self.m())
+            .map(|k| {
+                let r = (self.g[k] - bu[k]).max(0.0);
+                0.5 * r * r / self.c[k]
+            })
+            .sum();
+        quadratic + penalty
+    }
+
+    /// Armijo backtracking on Φ from `u` along `d` (`slope = ∇Φ·d`); Φ is re-evaluated from
+    /// the products `AU, Ad, BU, Bd`, so each trial is cheap. The accepted step, if any.
+    fn armijo(&self, u: &[f64], au: &[f64], bu: &[f64], d: &[f64], slope: f64) -> Option<f64> {
+        let ad = multiply(&self.a, d);
+        let bd = self.b_times(d);
+        let phi0 = self.merit(u, au, bu);
+        let mut step = 1.0;
+        for _ in 0..60 {
+            let ut: Vec<f64> = u.iter().zip(d).map(|(u, d)| u + step * d).collect();
+            let aut: Vec<f64> = au.iter().zip(&ad).map(|(a, b)| a + step * b).collect();
+            let but: Vec<f64> = bu.iter().zip(&bd).map(|(a, b)| a + step * b).collect();
+            // the last term forgives rounding in Φ itself
+            if self.merit(&ut, &aut, &but)
+                <= phi0 + 1e-4 * step * slope.min(0.0) + 1e-14 * phi0.abs()
+            {
+                return Some(step);
+            }
+            step *= 0.5;
+        }
+        None
+    }
+}
+
+fn max_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
 /// Semismooth Newton (primal–dual active set) on Φ with an Armijo line search, from
 /// `start` (e.g. the prolonged solution of a coarser mesh) or from zero.
 pub fn semismooth_newton(
@@ -314,62 +418,32 @@ pub fn semismooth_newton(
     options: NewtonOptions,
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
-    if let Some(k) = lcp.c.iter().position(|&c| c.is_nan() || c <= 0.0) {
-        return Err(Error::Input(format!(
-            "semismooth Newton eliminates Λ = C⁻¹(G − BU)₊ and needs C > 0; C_{k} = {} (α ≤ 0 gives the plain mixed method: use the QP solver)",
-            lcp.c[k]
-        )));
-    }
+    lcp.require_positive_c("semismooth Newton")?;
     let n = lcp.n();
-    let mut u = match start {
-        Some(s) if s.len() == n => s.to_vec(),
-        Some(s) => {
-            return Err(Error::Input(format!(
-                "start vector has {} entries, the problem {n}",
-                s.len()
-            )))
-        }
-        None => vec![0.0; n],
-    };
+    let mut u = lcp.start_vector(start)?;
     let hessian = Hessian::new(lcp);
     let cholesky = Cholesky::analyse(&hessian.symbolic)?;
-    let phi = |u: &[f64], au: &[f64], bu: &[f64]| -> f64 {
-        let quadratic: f64 = u
-            .iter()
-            .zip(au)
-            .zip(&lcp.f)
-            .map(|((u, au), f)| 0.5 * u * au - f * u)
-            .sum();
-        let penalty: f64 = (0..lcp.m())
-            .map(|k| {
-                let r = (lcp.g[k] - bu[k]).max(0.0);
-                0.5 * r * r / lcp.c[k]
-            })
-            .sum();
-        quadratic + penalty
+    let done = |u: Vec<f64>, lambda: Vec<f64>, iterations: usize, residual: f64| LcpSolution {
+        u,
+        lambda,
+        iterations,
+        kkt_residual: residual,
+        seconds: clock.elapsed().as_secs_f64(),
+        factorizations: iterations,
+        multiplier_noise: lcp.elimination_noise(),
     };
     let mut previous_active: Option<Vec<bool>> = None;
     for iteration in 1..=options.max_iterations {
         let au = multiply(&lcp.a, &u);
         let bu = lcp.b_times(&u);
         let active: Vec<bool> = (0..lcp.m()).map(|k| lcp.g[k] - bu[k] > 0.0).collect();
-        let lambda: Vec<f64> = (0..lcp.m())
-            .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
-            .collect();
+        let lambda = lcp.eliminated_multiplier(&bu);
         // Converged: the active set did not change over a full step, so u is the exact
         // minimizer of the quadratic that Φ is on this active set.
         if previous_active.as_ref() == Some(&active) {
             let residual = lcp.kkt_residual(&u, &lambda);
             if residual <= options.tolerance {
-                return Ok(LcpSolution {
-                    u,
-                    lambda,
-                    iterations: iteration - 1,
-                    kkt_residual: residual,
-                    seconds: clock.elapsed().as_secs_f64(),
-                    factorizations: iteration - 1,
-                    multiplier_noise: lcp.elimination_noise(),
-                });
+                return Ok(done(u, lambda, iteration - 1, residual));
             }
         }
         let btl = lcp.bt_times(&lambda);
@@ -378,37 +452,12 @@ pub fn semismooth_newton(
         let factor = cholesky.factor(&h)?;
         let minus_gradient: Vec<f64> = gradient.iter().map(|g| -g).collect();
         let d = factor.solve_refined(&h, &minus_gradient, options.refinement_steps)?;
-        // Armijo backtracking on Φ along d (exact products, so Φ is cheap to re-evaluate).
-        let ad = multiply(&lcp.a, &d);
-        let bd = lcp.b_times(&d);
-        let phi0 = phi(&u, &au, &bu);
         let slope: f64 = gradient.iter().zip(&d).map(|(g, d)| g * d).sum();
-        let mut step = 1.0;
-        let mut accepted = false;
-        for _ in 0..60 {
-            let ut: Vec<f64> = u.iter().zip(&d).map(|(u, d)| u + step * d).collect();
-            let aut: Vec<f64> = au.iter().zip(&ad).map(|(a, b)| a + step * b).collect();
-            let but: Vec<f64> = bu.iter().zip(&bd).map(|(a, b)| a + step * b).collect();
-            if phi(&ut, &aut, &but) <= phi0 + 1e-4 * step * slope + 1e-14 * phi0.abs() {
-                u = ut;
-                accepted = true;
-                break;
-            }
-            step *= 0.5;
-        }
-        if !accepted {
+        let Some(step) = lcp.armijo(&u, &au, &bu, &d, slope) else {
             // No decrease along a Newton direction: at the minimizer up to rounding.
             let residual = lcp.kkt_residual(&u, &lambda);
             if residual <= options.tolerance.max(1e-8) {
-                return Ok(LcpSolution {
-                    u,
-                    lambda,
-                    iterations: iteration,
-                    kkt_residual: residual,
-                    seconds: clock.elapsed().as_secs_f64(),
-                    factorizations: iteration,
-                    multiplier_noise: lcp.elimination_noise(),
-                });
+                return Ok(done(u, lambda, iteration, residual));
             }
             return Err(Error::NotConverged {
                 solver: "semismooth Newton",
@@ -416,34 +465,22 @@ pub fn semismooth_newton(
                     "line search failed at iteration {iteration} with KKT residual {residual:e}"
                 ),
             });
+        };
+        for (u, d) in u.iter_mut().zip(&d) {
+            *u += step * d;
         }
         // A full step of rounding size: constraints whose gap CΛ is below the rounding
         // of G − BU (α h⁴ λ ≪ ε|ψ| on fine meshes) may flip forever without moving U.
-        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        if step == 1.0 && norm(&d) <= 1e-13 * norm(&u) {
-            let bu = lcp.b_times(&u);
-            let lambda: Vec<f64> = (0..lcp.m())
-                .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
-                .collect();
+        if step == 1.0 && max_norm(&d) <= 1e-13 * max_norm(&u) {
+            let lambda = lcp.eliminated_multiplier(&lcp.b_times(&u));
             let residual = lcp.kkt_residual(&u, &lambda);
             if residual <= options.tolerance {
-                return Ok(LcpSolution {
-                    u,
-                    lambda,
-                    iterations: iteration,
-                    kkt_residual: residual,
-                    seconds: clock.elapsed().as_secs_f64(),
-                    factorizations: iteration,
-                    multiplier_noise: lcp.elimination_noise(),
-                });
+                return Ok(done(u, lambda, iteration, residual));
             }
         }
         previous_active = (step == 1.0).then_some(active);
     }
-    let bu = lcp.b_times(&u);
-    let lambda: Vec<f64> = (0..lcp.m())
-        .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
-        .collect();
+    let lambda = lcp.eliminated_multiplier(&lcp.b_times(&u));
     Err(Error::NotConverged {
         solver: "semismooth Newton",
         detail: format!(
@@ -481,46 +518,29 @@ struct SaddlePoint {
 impl SaddlePoint {
     fn new(lcp: &Lcp) -> Self {
         let (n, m) = (lcp.n(), lcp.m());
-        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n + m];
-        let (col_ptr, rows) = (lcp.a.symbolic().col_ptr(), lcp.a.symbolic().row_idx());
-        for (j, column) in columns.iter_mut().enumerate().take(n) {
-            column.extend_from_slice(&rows[col_ptr[j]..col_ptr[j + 1]]);
-        }
-        for (k, row) in lcp.b_rows.iter().enumerate() {
-            for &(j, _) in row {
-                columns[j].push(n + k);
-                columns[n + k].push(j);
+        let pattern = Pattern::new(&lcp.a, n + m, |columns| {
+            for (k, row) in lcp.b_rows.iter().enumerate() {
+                for &(j, _) in row {
+                    columns[j].push(n + k);
+                    columns[n + k].push(j);
+                }
+                columns[n + k].push(n + k);
             }
-            columns[n + k].push(n + k);
-        }
-        let mut ptr = vec![0usize; n + m + 1];
-        let mut idx = Vec::new();
-        for (j, column) in columns.iter_mut().enumerate() {
-            column.sort_unstable();
-            column.dedup();
-            idx.extend_from_slice(column);
-            ptr[j + 1] = idx.len();
-        }
-        let find = |i: usize, j: usize| ptr[j] + idx[ptr[j]..ptr[j + 1]].binary_search(&i).unwrap();
-        let mut a_positions = Vec::new();
-        for j in 0..n {
-            for &i in &rows[col_ptr[j]..col_ptr[j + 1]] {
-                a_positions.push(find(i, j));
-            }
-        }
+        });
+        let a_positions = pattern.positions_of(&lcp.a);
         let b_positions = lcp
             .b_rows
             .iter()
             .enumerate()
             .map(|(k, row)| {
                 row.iter()
-                    .map(|&(j, _)| (find(n + k, j), find(j, n + k)))
+                    .map(|&(j, _)| (pattern.position(n + k, j), pattern.position(j, n + k)))
                     .collect()
             })
             .collect();
-        let diagonal = (0..m).map(|k| find(n + k, n + k)).collect();
+        let diagonal = (0..m).map(|k| pattern.position(n + k, n + k)).collect();
         Self {
-            symbolic: SymbolicSparseColMat::new_checked(n + m, n + m, ptr, None, idx),
+            symbolic: pattern.symbolic(),
             a_positions,
             b_positions,
             diagonal,
@@ -603,41 +623,11 @@ pub fn primal_dual_active_set(
     options: NewtonOptions,
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
-    if let Some(k) = lcp.c.iter().position(|&c| c.is_nan() || c <= 0.0) {
-        return Err(Error::Input(format!(
-            "the active-set method globalizes with Φ and needs C > 0; C_{k} = {}",
-            lcp.c[k]
-        )));
-    }
+    lcp.require_positive_c("the saddle-point active-set method")?;
     let (n, m) = (lcp.n(), lcp.m());
-    let mut u = match start {
-        Some(s) if s.len() == n => s.to_vec(),
-        Some(s) => {
-            return Err(Error::Input(format!(
-                "start vector has {} entries, the problem {n}",
-                s.len()
-            )))
-        }
-        None => vec![0.0; n],
-    };
+    let mut u = lcp.start_vector(start)?;
     let saddle = SaddlePoint::new(lcp);
     let lu = crate::linear_solve::LuSolver::analyse(&saddle.symbolic)?;
-    let phi = |u: &[f64], au: &[f64], bu: &[f64]| -> f64 {
-        let quadratic: f64 = u
-            .iter()
-            .zip(au)
-            .zip(&lcp.f)
-            .map(|((u, au), f)| 0.5 * u * au - f * u)
-            .sum();
-        let penalty: f64 = (0..m)
-            .map(|k| {
-                let r = (lcp.g[k] - bu[k]).max(0.0);
-                0.5 * r * r / lcp.c[k]
-            })
-            .sum();
-        quadratic + penalty
-    };
-    let norm = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     let bu0 = lcp.b_times(&u);
     let mut active: Vec<bool> = (0..m).map(|k| lcp.g[k] - bu0[k] > 0.0).collect();
     let mut lambda = vec![0.0; m];
@@ -653,27 +643,12 @@ pub fn primal_dual_active_set(
         // Armijo on Φ along d (d is the Newton step of Φ for this active set).
         let au = multiply(&lcp.a, &u);
         let bu = lcp.b_times(&u);
-        let ad = multiply(&lcp.a, &d);
-        let bd = lcp.b_times(&d);
-        let phi0 = phi(&u, &au, &bu);
-        let lam: Vec<f64> = (0..m)
-            .map(|k| (lcp.g[k] - bu[k]).max(0.0) / lcp.c[k])
-            .collect();
-        let btl = lcp.bt_times(&lam);
+        let btl = lcp.bt_times(&lcp.eliminated_multiplier(&bu));
         let slope: f64 = (0..n).map(|i| (au[i] - lcp.f[i] - btl[i]) * d[i]).sum();
-        let mut step = 1.0;
-        for _ in 0..60 {
-            let ut: Vec<f64> = u.iter().zip(&d).map(|(u, d)| u + step * d).collect();
-            let aut: Vec<f64> = au.iter().zip(&ad).map(|(a, b)| a + step * b).collect();
-            let but: Vec<f64> = bu.iter().zip(&bd).map(|(a, b)| a + step * b).collect();
-            if phi(&ut, &aut, &but) <= phi0 + 1e-4 * step * slope.min(0.0) + 1e-13 * phi0.abs() {
-                break;
-            }
-            step *= 0.5;
-        }
+        let step = lcp.armijo(&u, &au, &bu, &d, slope).unwrap_or(0.0);
         // On very fine meshes the cells at the free boundary have gaps below the rounding
         // of G − BU and flip without moving U beyond the solve's own accuracy.
-        let small_step = norm(&d) <= 1e-10 * norm(u_new);
+        let small_step = max_norm(&d) <= 1e-10 * max_norm(u_new);
         if step == 1.0 {
             u = u_new.to_vec();
             lambda = lambda_new
