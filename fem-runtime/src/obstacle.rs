@@ -283,15 +283,32 @@ pub fn solve_obstacle<M: Model>(
             // loses digits to cancellation (C = αh⁵ on fine meshes), Λ is recovered from
             // one saddle-point solve on the converged active set.
             VariationalSolver::SemismoothNewton => {
-                let solution =
-                    match semismooth_newton(&d.lcp, start, options.newton) {
-                        Ok(s) => s,
-                        Err(newton) => primal_dual_active_set(&d.lcp, start, options.newton)
-                            .map_err(|pdas| Error::NotConverged {
-                                solver: "semismooth Newton and the saddle-point active-set method",
-                                detail: format!("{newton}; {pdas}"),
-                            })?,
-                    };
+                // From a nested start Newton needs a handful of iterations where it works
+                // at all: fail over to the saddle-point method early.
+                let newton = NewtonOptions {
+                    max_iterations: if start.is_some() {
+                        options.newton.max_iterations.min(40)
+                    } else {
+                        options.newton.max_iterations
+                    },
+                    ..options.newton
+                };
+                let solution = match semismooth_newton(&d.lcp, start, newton) {
+                    Ok(s) => s,
+                    // the fallback factors an LU per iteration: give it fewer
+                    Err(newton) => primal_dual_active_set(
+                        &d.lcp,
+                        start,
+                        NewtonOptions {
+                            max_iterations: options.newton.max_iterations.min(50),
+                            ..options.newton
+                        },
+                    )
+                    .map_err(|pdas| Error::NotConverged {
+                        solver: "semismooth Newton and the saddle-point active-set method",
+                        detail: format!("{newton}; {pdas}"),
+                    })?,
+                };
                 if d.lcp.elimination_noise() > 1e-8 {
                     recover_multiplier(&d.lcp, solution, options.newton.refinement_steps)
                 } else {
