@@ -4,6 +4,7 @@
 //! This crate re-exports the runtime ([`fem_runtime`]), the `model!` macro that compiles
 //! model files, and the model files and scenes of [`fem_models`]; it adds the beam scene
 //! solver ([`beams`]), the studies and charts ([`studies`], [`plot`]) behind the CLI.
+#![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod beams;

@@ -3,6 +3,7 @@
 //!
 //! Reference elements and quadrature rules come from `fem-reference`, the same crate the
 //! form compiler evaluates at compile time, and are re-exported here.
+#![warn(missing_docs)]
 
 pub mod assembly;
 pub mod boundary;

@@ -2,6 +2,7 @@
 //!
 //! Each model declares its fields, parameters, data and the stabilized forms
 //! `B_h = a − b − bᵀ − α S_h` and `L_h = ℓ − ⟨sψ, μ⟩ − α ℓ_S` of the obstacle problem.
+#![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod euler_bernoulli;

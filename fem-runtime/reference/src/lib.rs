@@ -4,6 +4,7 @@
 //! evaluates these elements and rules at compile time to tabulate basis values as
 //! constants, and the runtime (`fem-runtime`) re-exports the very same definitions,
 //! so the generated kernels and the runtime can never disagree about a basis function.
+#![warn(missing_docs)]
 
 pub mod polynomial;
 pub mod quadrature;
