@@ -9,6 +9,7 @@
 pub mod polynomial;
 pub mod quadrature;
 pub mod reference_element;
+pub mod triangle;
 
 pub use polynomial::Polynomial;
 pub use quadrature::{gauss_legendre, QuadratureRule};
