@@ -417,7 +417,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         multiplier_noise: solution.multiplier_noise,
         warnings: if solution.multiplier_noise > 1e-6 {
             vec![format!(
-                "λ_h carries rounding noise of about {:.0e} relative: C = αh⁵ is below the rounding of G − BU at this mesh size (w, the contact set and the energy are unaffected; a larger α or a coarser mesh avoids it)",
+                "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁵ approaches the rounding of G − BU at this mesh size, and the saddle-point recovery of λ is no guarantee at this conditioning (w and the contact set are unaffected; a larger α or a coarser mesh avoids it)",
                 solution.multiplier_noise
             )]
         } else {

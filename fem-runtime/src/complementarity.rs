@@ -604,7 +604,8 @@ pub fn recover_multiplier(
             kkt_residual: residual,
             seconds: solution.seconds + clock.elapsed().as_secs_f64(),
             factorizations: solution.factorizations + 1,
-            multiplier_noise: 0.0,
+            // the recovery helps, but with κ this large it is no guarantee: keep the estimate
+            multiplier_noise: lcp.elimination_noise(),
             ..solution
         })
     } else {
@@ -633,22 +634,6 @@ pub fn primal_dual_active_set(
     let mut lambda: Vec<f64> = vec![0.0; m];
     let mut two_ago: Option<Vec<bool>> = None;
     for iteration in 1..=options.max_iterations {
-        // A certified pair is a solution however it was reached (damped steps included).
-        if iteration > 1 {
-            let positive: Vec<f64> = lambda.iter().map(|l| l.max(0.0)).collect();
-            let residual = lcp.kkt_residual(&u, &positive);
-            if residual <= options.tolerance {
-                return Ok(LcpSolution {
-                    u,
-                    lambda: positive,
-                    iterations: iteration - 1,
-                    kkt_residual: residual,
-                    seconds: clock.elapsed().as_secs_f64(),
-                    factorizations: iteration - 1,
-                    multiplier_noise: 0.0,
-                });
-            }
-        }
         let k_matrix = saddle.matrix(lcp, &active);
         let factor = lu.factor(&k_matrix)?;
         let mut rhs = lcp.f.clone();

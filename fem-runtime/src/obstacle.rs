@@ -309,7 +309,7 @@ pub fn solve_obstacle<M: Model>(
                         detail: format!("{newton}; {pdas}"),
                     })?,
                 };
-                if d.lcp.elimination_noise() > 1e-8 {
+                if d.lcp.elimination_noise() > 1e-6 {
                     recover_multiplier(&d.lcp, solution, options.newton.refinement_steps)
                 } else {
                     Ok(solution)
