@@ -51,22 +51,32 @@ fn assert_rate(name: &str, errors: &[f64], expected: f64, tolerance: f64) {
     );
 }
 
-fn solve_bernoulli(n: usize) -> (IntervalMesh, SystemDofs, Vec<f64>) {
-    type M = bernoulli::Model;
+/// The clamped beam `fields` of `M` under the uniform load Q: mesh, DOFs, solution.
+/// Asserts on the way that the assembled matrix is symmetric.
+fn solve_clamped<M: Model>(
+    n: usize,
+    fields: &[&str],
+    params: &[(&str, f64)],
+) -> (IntervalMesh, SystemDofs, Vec<f64>) {
     let mesh = IntervalMesh::uniform(0.0, 1.0, n).unwrap();
-    let dofs = SystemDofs::named::<M>(&mesh, &["w"]).unwrap();
+    let dofs = SystemDofs::named::<M>(&mesh, fields).unwrap();
     let (f, psi): (&DataFn, &DataFn) = (&|_| Q, &|_| -1.0);
-    let coefficients =
-        Coefficients::new::<M>(&[("α", 0.0), ("s", 1.0)], &[("f", f), ("ψ", psi)]).unwrap();
+    let coefficients = Coefficients::new::<M>(params, &[("f", f), ("ψ", psi)]).unwrap();
     let mut constraints = Constraints::new();
     for side in [Side::Left, Side::Right] {
-        constraints.clamp::<M>(&mesh, &dofs, "w", side).unwrap();
+        for field in fields {
+            constraints.clamp::<M>(&mesh, &dofs, field, side).unwrap();
+        }
     }
     let a = MatrixAssembler::new::<M>("a", &mesh, &dofs)
         .unwrap()
         .assemble::<M>(&mesh, &coefficients)
         .unwrap();
-    assert!(asymmetry(&a) < 1e-14, "the bending matrix is symmetric");
+    assert!(
+        asymmetry(&a) < 1e-14,
+        "{}: the stiffness matrix is symmetric",
+        M::NAME
+    );
     let u = solve_linear::<M>(
         &mesh,
         &dofs,
@@ -78,6 +88,10 @@ fn solve_bernoulli(n: usize) -> (IntervalMesh, SystemDofs, Vec<f64>) {
     )
     .unwrap();
     (mesh, dofs, u)
+}
+
+fn solve_bernoulli(n: usize) -> (IntervalMesh, SystemDofs, Vec<f64>) {
+    solve_clamped::<bernoulli::Model>(n, &["w"], &[("α", 0.0), ("s", 1.0)])
 }
 
 #[test]
@@ -104,33 +118,7 @@ fn clamped_euler_bernoulli_beam_converges_at_hermite_rates() {
 }
 
 fn solve_timoshenko<M: Model>(n: usize, t: f64) -> (IntervalMesh, SystemDofs, Vec<f64>) {
-    let mesh = IntervalMesh::uniform(0.0, 1.0, n).unwrap();
-    let dofs = SystemDofs::named::<M>(&mesh, &["θ", "w"]).unwrap();
-    let (f, psi): (&DataFn, &DataFn) = (&|_| Q, &|_| -1.0);
-    let coefficients =
-        Coefficients::new::<M>(&[("t", t), ("α", 1.0), ("s", 1.0)], &[("f", f), ("ψ", psi)])
-            .unwrap();
-    let mut constraints = Constraints::new();
-    for side in [Side::Left, Side::Right] {
-        constraints.clamp::<M>(&mesh, &dofs, "θ", side).unwrap();
-        constraints.clamp::<M>(&mesh, &dofs, "w", side).unwrap();
-    }
-    let a = MatrixAssembler::new::<M>("a", &mesh, &dofs)
-        .unwrap()
-        .assemble::<M>(&mesh, &coefficients)
-        .unwrap();
-    assert!(asymmetry(&a) < 1e-14, "the Timoshenko matrix is symmetric");
-    let u = solve_linear::<M>(
-        &mesh,
-        &dofs,
-        "a",
-        "ℓ",
-        &constraints,
-        &coefficients,
-        Factorization::Cholesky,
-    )
-    .unwrap();
-    (mesh, dofs, u)
+    solve_clamped::<M>(n, &["θ", "w"], &[("t", t), ("α", 1.0), ("s", 1.0)])
 }
 
 fn timoshenko_errors<M: Model>(t: f64, meshes: &[usize]) -> [Vec<f64>; 3] {

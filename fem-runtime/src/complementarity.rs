@@ -276,6 +276,19 @@ impl Pattern {
     }
 }
 
+/// A value array for `pattern` holding `A`'s entries at `positions` and zeros elsewhere.
+fn values_of_a(
+    pattern: &SymbolicSparseColMat<usize>,
+    positions: &[usize],
+    a: &SparseMatrix,
+) -> Vec<f64> {
+    let mut values = vec![0.0; pattern.row_idx().len()];
+    for (&p, &v) in positions.iter().zip(a.val()) {
+        values[p] += v;
+    }
+    values
+}
+
 /// The Hessian `A + Σ_{k active} b_k b_kᵀ / C_k` with a fixed pattern.
 struct Hessian {
     symbolic: SymbolicSparseColMat<usize>,
@@ -314,10 +327,7 @@ impl Hessian {
     }
 
     fn matrix(&self, lcp: &Lcp, active: &[bool]) -> SparseMatrix {
-        let mut values = vec![0.0; self.symbolic.row_idx().len()];
-        for (&p, &v) in self.a_positions.iter().zip(lcp.a.val()) {
-            values[p] += v;
-        }
+        let mut values = values_of_a(&self.symbolic, &self.a_positions, &lcp.a);
         for (k, row) in lcp.b_rows.iter().enumerate() {
             if active[k] {
                 let w = 1.0 / lcp.c[k];
@@ -548,10 +558,7 @@ impl SaddlePoint {
     }
 
     fn matrix(&self, lcp: &Lcp, active: &[bool]) -> SparseMatrix {
-        let mut values = vec![0.0; self.symbolic.row_idx().len()];
-        for (&p, &v) in self.a_positions.iter().zip(lcp.a.val()) {
-            values[p] += v;
-        }
+        let mut values = values_of_a(&self.symbolic, &self.a_positions, &lcp.a);
         for (k, row) in lcp.b_rows.iter().enumerate() {
             if active[k] {
                 for (&(_, v), &(p, q)) in row.iter().zip(&self.b_positions[k]) {
