@@ -3,6 +3,8 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
+use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
+use fem_forms::models::membrane_scenes::{membrane_scene, MEMBRANE_SCENES};
 use fem_forms::models::scenes::{scene, SCENES};
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::{plot, studies};
@@ -40,9 +42,16 @@ enum Command {
     Solve {
         /// Scene name (see `list`).
         scene: String,
-        /// Elements of the uniform mesh.
+        /// Elements of the uniform mesh (beams).
         #[arg(long, default_value_t = 256)]
         elements: usize,
+        /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
+        /// three quarters of it).
+        #[arg(long, default_value_t = 64)]
+        mesh_size: usize,
+        /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
+        #[arg(long)]
+        vtk: bool,
         /// Load magnitude q (1: no contact; 40 and 100: contact).
         #[arg(long, default_value_t = 1.0)]
         load: f64,
@@ -52,7 +61,8 @@ enum Command {
         /// Stabilization parameter α.
         #[arg(long)]
         alpha: Option<f64>,
-        /// Element pair (p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0).
+        /// Element pair (beams: p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0;
+        /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal).
         #[arg(long)]
         pair: Option<String>,
         /// LCP solver.
@@ -135,6 +145,50 @@ fn table_row(r: &Report) {
     );
 }
 
+fn membrane_header() {
+    println!(
+        "{:<16} {:<8} {:>5} {:>8} {:>8} {:>5} {:>8} {:>9} {:>10} {:>10} {:>10} {:>9} {:>8} {:>9}",
+        "scene",
+        "pair",
+        "N",
+        "triangles",
+        "dofs",
+        "iter",
+        "seconds",
+        "alpha",
+        "L2 error",
+        "H1 error",
+        "∫λ_h",
+        "area",
+        "kkt res",
+        "C_I"
+    );
+}
+
+fn membrane_row(r: &MembraneReport) {
+    for w in &r.warnings {
+        eprintln!("warning ({} {}): {w}", r.scene, r.pair);
+    }
+    let opt = |e: Option<f64>| e.map_or("-".into(), |e| format!("{e:.3e}"));
+    println!(
+        "{:<16} {:<8} {:>5} {:>8} {:>8} {:>5} {:>8.3} {:>9.2e} {:>10} {:>10} {:>10.5} {:>9.5} {:>8.1e} {:>9.3}",
+        r.scene,
+        r.pair,
+        r.mesh_size,
+        r.triangles,
+        r.dofs,
+        r.iterations,
+        r.seconds,
+        r.alpha,
+        opt(r.error_l2),
+        opt(r.error_h1),
+        r.total_contact_force,
+        r.contact_area,
+        r.complementarity_residual,
+        r.inverse_constant
+    );
+}
+
 fn default_job(out: &Path) -> Result<(), String> {
     println!("fem-forms: default beam scenes (clamped on (0,1), 256 elements, nested semismooth Newton)\n");
     table_header();
@@ -181,6 +235,49 @@ fn run(cli: Cli) -> Result<(), String> {
         }
         Some(Command::Solve {
             scene: name,
+            mesh_size,
+            alpha,
+            pair,
+            solver,
+            cold,
+            json,
+            vtk,
+            ..
+        }) if membrane_scene(&name).is_some() => {
+            let scene = membrane_scene(&name).expect("checked");
+            let mut request = MembraneRequest::new(scene);
+            request.mesh_size = mesh_size;
+            request.alpha = alpha;
+            if let Some(p) = pair {
+                request.pair = MembranePair::parse(&p).map_err(|e| e.to_string())?;
+            }
+            request.solver = match solver {
+                SolverName::Pdas => VariationalSolver::SemismoothNewton,
+                SolverName::Clarabel => VariationalSolver::Clarabel,
+            };
+            request.nested = !cold;
+            let (report, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+                );
+            } else {
+                membrane_header();
+                membrane_row(&report);
+            }
+            if vtk {
+                let path = cli
+                    .out
+                    .join(format!("{}-{}-{}.vtu", scene.name, report.pair, mesh_size));
+                std::fs::create_dir_all(&cli.out).map_err(|e| e.to_string())?;
+                membranes::write_vtk(&path, &fields).map_err(|e| e.to_string())?;
+                eprintln!("→ {}", path.display());
+            }
+            Ok(())
+        }
+        Some(Command::Solve {
+            scene: name,
             elements,
             load,
             thickness,
@@ -191,11 +288,17 @@ fn run(cli: Cli) -> Result<(), String> {
             refinement,
             json,
             plot: write_plot,
+            ..
         }) => {
             let s = scene(&name).ok_or_else(|| {
                 format!(
                     "unknown scene `{name}`; the scenes are {}",
-                    SCENES.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+                    SCENES
+                        .iter()
+                        .map(|s| s.name)
+                        .chain(MEMBRANE_SCENES.iter().map(|s| s.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )
             })?;
             let pair = pair

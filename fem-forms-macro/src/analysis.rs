@@ -33,6 +33,8 @@ pub struct Symbols {
     pub params: Vec<String>,
     /// Data names with the polynomial degree assumed for quadrature.
     pub data: Vec<(String, usize)>,
+    /// Spatial dimension of the cell (1 for intervals, 2 for triangles).
+    pub dimension: usize,
 }
 
 impl Symbols {
@@ -85,10 +87,10 @@ pub struct Term {
     pub h_power: i32,
     /// Data factors (indices).
     pub data: Vec<usize>,
-    /// Derivative order on the test function.
-    pub test_derivative: u8,
-    /// Derivative order on the trial function (bilinear forms only).
-    pub trial_derivative: Option<u8>,
+    /// Derivative multi-index on the test function.
+    pub test_derivative: [u8; 2],
+    /// Derivative multi-index on the trial function (bilinear forms only).
+    pub trial_derivative: Option<[u8; 2]>,
     /// Explicit quadrature degree.
     pub quadrature_degree: Option<usize>,
 }
@@ -207,6 +209,21 @@ pub(crate) fn expand_expression(
         errors: Vec::new(),
     };
     context.expand(&expr, true).ok_or(context.errors)
+}
+
+/// What an expression expands to: a scalar, or a vector of scalars (one per axis).
+enum Value {
+    Scalar(Expansion),
+    Vector(Vec<Expansion>),
+}
+
+impl Value {
+    fn map(self, f: impl Fn(Expansion) -> Expansion) -> Self {
+        match self {
+            Value::Scalar(x) => Value::Scalar(f(x)),
+            Value::Vector(v) => Value::Vector(v.into_iter().map(f).collect()),
+        }
+    }
 }
 
 struct Context<'a> {
@@ -333,16 +350,16 @@ impl Context<'_> {
             for a in &t.args {
                 let field = &self.symbols.fields[self.symbols.field_of(a.symbol)];
                 let name = self.symbols.function_name(a.symbol);
-                if a.derivative > MAX_DERIVATIVE {
+                if a.order() > MAX_DERIVATIVE {
                     ok = false;
                     self.errors.push(
                         Diagnostic::text(
                             t.origin,
-                            format!("derivative of order {} of `{name}`: the DSL supports up to order {MAX_DERIVATIVE}", a.derivative),
+                            format!("derivative of order {} of `{name}`: the DSL supports up to order {MAX_DERIVATIVE}", a.order()),
                         )
-                        .help("write at most four primes (w'''')"),
+                        .help("write at most four primes (w''''), or ∇/Δ of order ≤ 4"),
                     );
-                } else if a.derivative as usize > field.element.max_derivative() {
+                } else if a.order() as usize > field.element.max_derivative() {
                     ok = false;
                     self.errors.push(
                         Diagnostic::text(
@@ -350,13 +367,13 @@ impl Context<'_> {
                             format!(
                                 "`{name}` is a {} field: derivative of order {} is more than the element supports (at most {})",
                                 field.element.name(),
-                                a.derivative,
+                                a.order(),
                                 field.element.max_derivative()
                             ),
                         )
-                        .help("P0 is piecewise constant and discontinuous: drop the derivative, or choose a continuous element (P1, P2, P3, Hermite)"),
+                        .help("P0 and P1disc are discontinuous multiplier spaces: drop the derivative, or choose a continuous element (P1, P2, P3, Hermite)"),
                     );
-                } else if a.derivative as usize > field.element.degree() {
+                } else if a.order() as usize > field.element.degree() {
                     vanishes = true;
                 }
             }
@@ -541,7 +558,7 @@ impl Context<'_> {
         } else if let Some(s) = self.symbols.function_symbol(name) {
             m.args = vec![ArgFactor {
                 symbol: s,
-                derivative: 0,
+                derivative: [0, 0],
             }];
         } else if let Some(i) = self.symbols.params.iter().position(|p| p == name) {
             m.params = vec![(i, 1)];
@@ -578,55 +595,170 @@ impl Context<'_> {
         (go(name, &names, &mut out) && out.len() > 1).then_some(out)
     }
 
+    /// Expands a scalar expression; a vector here is an error.
     fn expand(&mut self, e: &Expr, inside_integral: bool) -> Option<Expansion> {
+        match self.value(e, inside_integral)? {
+            Value::Scalar(x) => Some(x),
+            Value::Vector(_) => self.fail(
+                Diagnostic::text(e.loc, "a vector where a scalar is needed")
+                    .help("take a dot product of two vectors (∇u·∇v, grad u dot grad v), or use Δ (lap) for the divergence of a gradient"),
+            ),
+        }
+    }
+
+    fn vector_mismatch(&mut self, loc: Loc, what: &str) -> Option<Value> {
+        self.errors.push(
+            Diagnostic::text(loc, format!("{what} of a vector and a scalar"))
+                .help("both sides must be scalars or both vectors (∇u + ∇v); a product of two vectors is their dot product"),
+        );
+        None
+    }
+
+    /// Expands an expression to a scalar or a vector (gradients and their combinations).
+    fn value(&mut self, e: &Expr, inside_integral: bool) -> Option<Value> {
+        let loc = e.loc;
+        match &e.kind {
+            ExprKind::Neg(a) => Some(self.value(a, inside_integral)?.map(symbolic::neg)),
+            ExprKind::Add(a, b) | ExprKind::Sub(a, b) => {
+                let x = self.value(a, inside_integral);
+                let y = self.value(b, inside_integral);
+                let (x, y) = (x?, y?);
+                let y = if matches!(e.kind, ExprKind::Sub(..)) {
+                    y.map(symbolic::neg)
+                } else {
+                    y
+                };
+                match (x, y) {
+                    (Value::Scalar(x), Value::Scalar(y)) => {
+                        Some(Value::Scalar(symbolic::add(x, y)))
+                    }
+                    (Value::Vector(x), Value::Vector(y)) => Some(Value::Vector(
+                        x.into_iter()
+                            .zip(y)
+                            .map(|(x, y)| symbolic::add(x, y))
+                            .collect(),
+                    )),
+                    _ => self.vector_mismatch(loc, "sum"),
+                }
+            }
+            ExprKind::Mul(a, b) => {
+                let x = self.value(a, inside_integral);
+                let y = self.value(b, inside_integral);
+                match (x?, y?) {
+                    (Value::Scalar(x), Value::Scalar(y)) => {
+                        self.scalar_product(&x, &y, loc).map(Value::Scalar)
+                    }
+                    (Value::Scalar(s), Value::Vector(v)) | (Value::Vector(v), Value::Scalar(s)) => {
+                        let mut out = Vec::new();
+                        for c in &v {
+                            out.push(self.scalar_product(&s, c, loc)?);
+                        }
+                        Some(Value::Vector(out))
+                    }
+                    (Value::Vector(x), Value::Vector(y)) => {
+                        let mut sum = Vec::new();
+                        for (a, b) in x.iter().zip(&y) {
+                            sum = symbolic::add(sum, self.scalar_product(a, b, loc)?);
+                        }
+                        Some(Value::Scalar(sum))
+                    }
+                }
+            }
+            ExprKind::Div(a, b) => {
+                let x = self.value(a, inside_integral);
+                let y = self.expand(b, inside_integral);
+                let (x, y) = (x?, y?);
+                match symbolic::pow(&y, -1, loc) {
+                    Some(inverse) => Some(x.map(|c| symbolic::mul(&c, &inverse, loc))),
+                    None => {
+                        self.errors.push(Diagnostic::text(b.loc, "division by an expression that is not a non-zero number, parameter or power of h")
+                            .help("forms are polynomial in the arguments and data; divide only by numbers, parameters and h"));
+                        None
+                    }
+                }
+            }
+            ExprKind::Gradient(a) => {
+                let x = self.expand(a, inside_integral)?;
+                let mut components = Vec::new();
+                for axis in 0..self.symbols.dimension {
+                    components.push(self.partial(&x, axis, 1, loc)?);
+                }
+                Some(Value::Vector(components))
+            }
+            ExprKind::Laplacian(a) => {
+                let x = self.expand(a, inside_integral)?;
+                let mut sum = Vec::new();
+                for axis in 0..self.symbols.dimension {
+                    sum = symbolic::add(sum, self.partial(&x, axis, 2, loc)?);
+                }
+                Some(Value::Scalar(sum))
+            }
+            ExprKind::InnerProduct(a, b) => {
+                let x = self.value(a, inside_integral);
+                let y = self.value(b, inside_integral);
+                let mut p = match (x?, y?) {
+                    (Value::Scalar(x), Value::Scalar(y)) => symbolic::mul(&x, &y, loc),
+                    (Value::Vector(x), Value::Vector(y)) => {
+                        let mut sum = Vec::new();
+                        for (a, b) in x.iter().zip(&y) {
+                            sum = symbolic::add(sum, symbolic::mul(a, b, loc));
+                        }
+                        sum
+                    }
+                    _ => return self.vector_mismatch(loc, "L² product"),
+                };
+                for t in &mut p {
+                    t.inner_products += 1;
+                }
+                Some(Value::Scalar(p))
+            }
+            _ => self.scalar_value(e, inside_integral).map(Value::Scalar),
+        }
+    }
+
+    /// `x·y` of two scalars, refusing integrals times functions.
+    fn scalar_product(&mut self, x: &Expansion, y: &Expansion, loc: Loc) -> Option<Expansion> {
+        let integrated = |v: &Expansion| v.iter().any(|t| t.integrated);
+        let all_scalar = |v: &Expansion| v.iter().all(Monomial::is_scalar);
+        if integrated(x) && integrated(y) {
+            return self.fail(
+                Diagnostic::text(loc, "product of two integrals")
+                    .help("a form is a sum of integrals; multiply integrands inside one ∫"),
+            );
+        }
+        if (integrated(x) && !all_scalar(y)) || (integrated(y) && !all_scalar(x)) {
+            return self.fail(
+                Diagnostic::text(loc, "an integral or form call multiplied by a function")
+                    .help("outside ∫ only numbers and parameters may scale a term; move functions into the integrand"),
+            );
+        }
+        Some(symbolic::mul(x, y, loc))
+    }
+
+    /// `∂^k/∂x_axis^k` of a scalar, with the DSL's errors.
+    fn partial(&mut self, x: &Expansion, axis: usize, k: u8, loc: Loc) -> Option<Expansion> {
+        if x.iter().any(|t| t.integrated) {
+            return self.fail(Diagnostic::text(loc, "derivative of an integral"));
+        }
+        match symbolic::derivative(x, axis, k) {
+            Ok(d) => Some(d),
+            Err(DerivativeError::OfData(at)) => self.fail(
+                Diagnostic::text(at.to(loc), "derivative of a term with data (or of data alone)")
+                    .help("data functions are given by value only; differentiate the arguments, not the data"),
+            ),
+            Err(DerivativeError::OfProduct(at)) => self.fail(
+                Diagnostic::text(at.to(loc), "derivative of a product of functions")
+                    .help("expand it with the product rule by hand"),
+            ),
+        }
+    }
+
+    /// Expands the scalar-only constructs.
+    fn scalar_value(&mut self, e: &Expr, inside_integral: bool) -> Option<Expansion> {
         let loc = e.loc;
         match &e.kind {
             ExprKind::Number(v) => Some(vec![Monomial::constant(*v, loc)]),
             ExprKind::Symbol(name) => self.symbol(name, loc, inside_integral),
-            ExprKind::Neg(a) => Some(symbolic::neg(self.expand(a, inside_integral)?)),
-            ExprKind::Add(a, b) | ExprKind::Sub(a, b) => {
-                let x = self.expand(a, inside_integral);
-                let y = self.expand(b, inside_integral);
-                let (x, y) = (x?, y?);
-                let y = if matches!(e.kind, ExprKind::Sub(..)) {
-                    symbolic::neg(y)
-                } else {
-                    y
-                };
-                Some(symbolic::add(x, y))
-            }
-            ExprKind::Mul(a, b) => {
-                let x = self.expand(a, inside_integral);
-                let y = self.expand(b, inside_integral);
-                let (x, y) = (x?, y?);
-                let integrated = |v: &Expansion| v.iter().any(|t| t.integrated);
-                let all_scalar = |v: &Expansion| v.iter().all(Monomial::is_scalar);
-                if integrated(&x) && integrated(&y) {
-                    return self
-                        .fail(Diagnostic::text(loc, "product of two integrals").help(
-                            "a form is a sum of integrals; multiply integrands inside one ∫",
-                        ));
-                }
-                if (integrated(&x) && !all_scalar(&y)) || (integrated(&y) && !all_scalar(&x)) {
-                    return self.fail(
-                        Diagnostic::text(loc, "an integral or form call multiplied by a function")
-                            .help("outside ∫ only numbers and parameters may scale a term; move functions into the integrand"),
-                    );
-                }
-                Some(symbolic::mul(&x, &y, loc))
-            }
-            ExprKind::Div(a, b) => {
-                let x = self.expand(a, inside_integral);
-                let y = self.expand(b, inside_integral);
-                let (x, y) = (x?, y?);
-                match symbolic::pow(&y, -1, loc) {
-                    Some(inverse) => Some(symbolic::mul(&x, &inverse, loc)),
-                    None => self.fail(
-                        Diagnostic::text(b.loc, "division by an expression that is not a non-zero number, parameter or power of h")
-                            .help("forms are polynomial in the arguments and data; divide only by numbers, parameters and h"),
-                    ),
-                }
-            }
             ExprKind::Pow(a, n) => {
                 let x = self.expand(a, inside_integral)?;
                 if x.iter().any(|t| t.integrated) {
@@ -641,31 +773,14 @@ impl Context<'_> {
                 }
             }
             ExprKind::Derivative(a, k) => {
+                if self.symbols.dimension > 1 {
+                    return self.fail(
+                        Diagnostic::text(loc, "a prime ′ is the derivative along an interval")
+                            .help("on triangles write ∇ (grad) for the gradient and Δ (lap) for the Laplacian"),
+                    );
+                }
                 let x = self.expand(a, inside_integral)?;
-                if x.iter().any(|t| t.integrated) {
-                    return self.fail(Diagnostic::text(loc, "derivative of an integral"));
-                }
-                match symbolic::derivative(&x, *k) {
-                    Ok(d) => Some(d),
-                    Err(DerivativeError::OfData(at)) => self.fail(
-                        Diagnostic::text(at.to(loc), "derivative of a term with data (or of data alone)")
-                            .help("data functions are given by value only; differentiate the arguments, not the data"),
-                    ),
-                    Err(DerivativeError::OfProduct(at)) => self.fail(
-                        Diagnostic::text(at.to(loc), "derivative of a product of functions")
-                            .help("expand it with the product rule by hand"),
-                    ),
-                }
-            }
-            ExprKind::InnerProduct(a, b) => {
-                let x = self.expand(a, inside_integral);
-                let y = self.expand(b, inside_integral);
-                let (x, y) = (x?, y?);
-                let mut p = symbolic::mul(&x, &y, loc);
-                for t in &mut p {
-                    t.inner_products += 1;
-                }
-                Some(p)
+                self.partial(&x, 0, *k, loc)
             }
             ExprKind::Integral { kind, degree, body } => {
                 if inside_integral {
@@ -710,6 +825,8 @@ impl Context<'_> {
                 Some(x)
             }
             ExprKind::Call { name, groups } => self.call(name, groups, loc),
+            // the vector-capable constructs, handled by `value`
+            _ => self.expand(e, inside_integral),
         }
     }
 

@@ -42,9 +42,9 @@ pub fn term_degree(term: &Term, block: &Block, symbols: &Symbols) -> usize {
         return d;
     }
     let element = |f: usize| symbols.fields[f].element;
-    let mut degree = factor_degree(element(block.test_field), term.test_derivative);
+    let mut degree = factor_degree(element(block.test_field), term.test_derivative[0]);
     if let (Some(f), Some(d)) = (block.trial_field, term.trial_derivative) {
-        degree += factor_degree(element(f), d);
+        degree += factor_degree(element(f), d[0]);
     }
     degree + term.data.iter().map(|&i| symbols.data[i].1).sum::<usize>()
 }
@@ -101,7 +101,7 @@ fn power(base: TokenStream, e: i32) -> Option<TokenStream> {
 }
 
 /// The coefficient `κ · Π pᵢ^eᵢ · h^k` of a term as code.
-fn coefficient(coefficient: f64, params: &[(usize, i32)], h_power: i32) -> TokenStream {
+pub(crate) fn coefficient(coefficient: f64, params: &[(usize, i32)], h_power: i32) -> TokenStream {
     let mut factors = Vec::new();
     for &(i, e) in params {
         factors.extend(power(quote!(p[#i]), e));
@@ -116,7 +116,7 @@ fn coefficient(coefficient: f64, params: &[(usize, i32)], h_power: i32) -> Token
 }
 
 /// A readable term: `2·t^-2·h^4·f·w'·v`.
-fn describe_term(term: &Term, block: &Block, symbols: &Symbols) -> String {
+pub(crate) fn describe_term(term: &Term, block: &Block, symbols: &Symbols) -> String {
     let mut parts = Vec::new();
     if term.coefficient != 1.0 {
         parts.push(format!("{}", term.coefficient));
@@ -134,14 +134,25 @@ fn describe_term(term: &Term, block: &Block, symbols: &Symbols) -> String {
     for &i in &term.data {
         parts.push(symbols.data[i].0.clone());
     }
-    let primes = |n: u8| "'".repeat(n as usize);
+    let derivative = |name: &str, d: [u8; 2]| -> String {
+        if symbols.dimension == 1 {
+            format!("{name}{}", "'".repeat(d[0] as usize))
+        } else if d == [0, 0] {
+            name.to_string()
+        } else {
+            format!(
+                "∂{}{}{name}",
+                "x".repeat(d[0] as usize),
+                "y".repeat(d[1] as usize)
+            )
+        }
+    };
     if let (Some(f), Some(d)) = (block.trial_field, term.trial_derivative) {
-        parts.push(format!("{}{}", symbols.fields[f].name, primes(d)));
+        parts.push(derivative(&symbols.fields[f].name, d));
     }
-    parts.push(format!(
-        "{}{}",
-        symbols.fields[block.test_field].test_name,
-        primes(term.test_derivative)
+    parts.push(derivative(
+        &symbols.fields[block.test_field].test_name,
+        term.test_derivative,
     ));
     parts.join("·")
 }
@@ -155,12 +166,18 @@ pub fn block_ident(block: &Block, symbols: &Symbols) -> Ident {
     }
 }
 
-struct BlockCode {
-    function: TokenStream,
-    quadrature_points: usize,
+/// One generated block kernel.
+pub(crate) struct BlockCode {
+    /// The kernel function.
+    pub function: TokenStream,
+    /// Points of its run-time quadrature loops.
+    pub quadrature_points: usize,
 }
 
 fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &str) -> BlockCode {
+    if symbols.dimension == 2 {
+        return crate::codegen_triangle::block_kernel(block, symbols, runtime, form);
+    }
     let test_element = symbols.fields[block.test_field].element;
     let trial_element = block.trial_field.map(|f| symbols.fields[f].element);
     let rows = test_element.dof_count();
@@ -187,14 +204,14 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
         if term.quadrature_degree.is_some() {
             quadrature_points = quadrature_points.max(rule.len());
         }
-        let test = table(test_element, term.test_derivative, &rule);
+        let test = table(test_element, term.test_derivative[0], &rule);
         let trial = match (trial_element, term.trial_derivative) {
-            (Some(e), Some(d)) => table(e, d, &rule),
+            (Some(e), Some(d)) => table(e, d[0], &rule),
             _ => vec![vec![1.0]; rule.len()],
         };
         let h_power = term.h_power + 1
-            - term.test_derivative as i32
-            - term.trial_derivative.unwrap_or(0) as i32;
+            - term.test_derivative[0] as i32
+            - term.trial_derivative.map_or(0, |d| d[0]) as i32;
         let idx = match groups
             .iter()
             .position(|g| g.params == term.params && g.h_power == h_power)
@@ -220,9 +237,9 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
             }
         } else {
             // Exact: integrate the polynomial products coefficient by coefficient.
-            let test_basis = derivatives(test_element, term.test_derivative);
+            let test_basis = derivatives(test_element, term.test_derivative[0]);
             let trial_basis = match (trial_element, term.trial_derivative) {
-                (Some(e), Some(d)) => derivatives(e, d),
+                (Some(e), Some(d)) => derivatives(e, d[0]),
                 _ => vec![Polynomial::constant(1.0)],
             };
             for (i, p) in test_basis.iter().enumerate() {
@@ -289,13 +306,13 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
         };
         for term in terms {
             let h_power = term.h_power + 1
-                - term.test_derivative as i32
-                - term.trial_derivative.unwrap_or(0) as i32;
+                - term.test_derivative[0] as i32
+                - term.trial_derivative.map_or(0, |d| d[0]) as i32;
             let c = coefficient(term.coefficient, &term.params, h_power);
-            let test = table_ident(test_element, term.test_derivative, &mut tables);
+            let test = table_ident(test_element, term.test_derivative[0], &mut tables);
             let accumulate = match (trial_element, term.trial_derivative) {
                 (Some(e), Some(dv)) => {
-                    let trial = table_ident(e, dv, &mut tables);
+                    let trial = table_ident(e, dv[0], &mut tables);
                     quote! {
                         for i in 0..#rows {
                             for j in 0..#cols {
@@ -425,6 +442,32 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
     let model_name = module.to_string();
     let np = symbols.params.len();
     let nd = symbols.data.len();
+    let (cell, coordinates, cell_text) = if symbols.dimension == 2 {
+        (
+            quote!(Triangle),
+            6usize,
+            "a triangle has six vertex coordinates",
+        )
+    } else {
+        (
+            quote!(Interval),
+            2usize,
+            "an interval has two vertex coordinates",
+        )
+    };
+    let dirichlet = declaration.dirichlet.iter().map(|(field, data)| {
+        let f = symbols
+            .fields
+            .iter()
+            .position(|x| x.name == field.to_string())
+            .unwrap_or(0);
+        let g = symbols
+            .data
+            .iter()
+            .position(|x| x.0 == data.to_string())
+            .unwrap_or(0);
+        quote!((#f, #g))
+    });
 
     let mut form_modules = Vec::new();
     let mut form_infos = Vec::new();
@@ -548,7 +591,8 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
             impl #runtime::Model for Model {
                 const NAME: &'static str = #model_name;
                 const DESCRIPTION: &'static str = #description;
-                const CELL: #runtime::CellKind = #runtime::CellKind::Interval;
+                const CELL: #runtime::CellKind = #runtime::CellKind::#cell;
+                const DIRICHLET: &'static [(usize, usize)] = &[#(#dirichlet),*];
                 const FIELDS: &'static [#runtime::FieldInfo] = &[#(#field_infos),*];
                 const PARAMS: &'static [&'static str] = &[#(#params),*];
                 const DATA: &'static [&'static str] = &[#(#data),*];
@@ -562,7 +606,7 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
                     data: &[&#runtime::DataFn],
                     out: &mut [f64],
                 ) {
-                    let x: &[f64; 2] = vertices.try_into().expect("an interval has two vertex coordinates");
+                    let x: &[f64; #coordinates] = vertices.try_into().expect(#cell_text);
                     let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
                     let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
                     match (form, block) {
@@ -579,7 +623,7 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
                     data: &[&#runtime::DataFn],
                     out: &mut [f64],
                 ) {
-                    let x: &[f64; 2] = vertices.try_into().expect("an interval has two vertex coordinates");
+                    let x: &[f64; #coordinates] = vertices.try_into().expect(#cell_text);
                     let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
                     let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
                     match (form, block) {

@@ -7,9 +7,12 @@
 //!     tests:    η, v, μ;
 //!     params:   t, α, s;
 //!     data:     f, ψ;          // `f: 0` declares f constant for quadrature (default degree 2)
+//!     boundary: w = g;         // optional: Dirichlet data, a declared data function
 //!     forms:    "…";
 //! }
 //! ```
+//!
+//! The cell is `interval` or `triangle`.
 
 use crate::diagnostic::{closest, Diagnostic};
 use fem_reference::reference_element::ALL_ELEMENTS;
@@ -63,6 +66,8 @@ pub struct Declaration {
     pub params: Vec<Ident>,
     /// Data functions of x.
     pub data: Vec<DataDecl>,
+    /// Dirichlet conditions `field = data` on the whole boundary.
+    pub dirichlet: Vec<(Ident, Ident)>,
     /// The forms text.
     pub forms: LitStr,
     /// Span of the section list, for "missing section" errors.
@@ -137,6 +142,7 @@ impl Parse for Declaration {
             tests: Vec::new(),
             params: Vec::new(),
             data: Vec::new(),
+            dirichlet: Vec::new(),
             forms: LitStr::new("", brace.span.join()),
             body_span: brace.span.join(),
         };
@@ -191,18 +197,26 @@ impl Parse for Declaration {
                         Ok(DataDecl { name, degree })
                     })?
                 }
+                "boundary" => {
+                    declaration.dirichlet = comma_list(&content, |s| {
+                        let field: Ident = s.parse()?;
+                        s.parse::<Token![=]>()?;
+                        let data: Ident = s.parse()?;
+                        Ok((field, data))
+                    })?
+                }
                 "forms" => {
                     declaration.forms = content.parse()?;
                     have_forms = true;
                 }
                 other => {
-                    let sections = ["unknowns", "tests", "params", "data", "forms"];
+                    let sections = ["unknowns", "tests", "params", "data", "boundary", "forms"];
                     let hint = closest(other, sections)
                         .map(|s| format!("; did you mean `{s}`?"))
                         .unwrap_or_default();
                     return Err(syn::Error::new(
                         key.span(),
-                        format!("unknown section `{other}`: expected one of unknowns, tests, params, data, forms{hint}"),
+                        format!("unknown section `{other}`: expected one of unknowns, tests, params, data, boundary, forms{hint}"),
                     ));
                 }
             }
@@ -234,7 +248,7 @@ impl Declaration {
                         self.cell_name.span(),
                         format!("unknown cell `{}`", self.cell_name),
                     )
-                    .help("expected `interval` (triangles are the next cell to come)"),
+                    .help("expected `interval` or `triangle`"),
                 );
                 None
             }
@@ -271,9 +285,9 @@ impl Declaration {
                         errors.push(
                             Diagnostic::token(
                                 u.element_name.span(),
-                                format!("`{} >= 0` on a continuous {} field: a multiplier constrained coefficient-wise must be P0", u.name, e.name()),
+                                format!("`{} >= 0` on a continuous {} field: a multiplier constrained coefficient-wise must be discontinuous", u.name, e.name()),
                             )
-                            .help("declare the multiplier as `λ: P0 >= 0`"),
+                            .help("declare the multiplier as `λ: P0 >= 0` or `λ: P1disc >= 0`"),
                         );
                     }
                 }
@@ -297,8 +311,37 @@ impl Declaration {
                 .help("list one test function per unknown, in the same order (`unknowns: θ: P2, w: P2; tests: η, v;`)"),
             );
         }
+        for (field, data) in &self.dirichlet {
+            match self.unknowns.iter().find(|u| u.name == *field) {
+                None => errors.push(
+                    Diagnostic::token(field.span(), format!("`{field}` is not an unknown")).help(
+                        "boundary data `w = g` prescribes an unknown declared under `unknowns:`",
+                    ),
+                ),
+                Some(u) if u.element.is_some_and(|e| !e.is_continuous()) => {
+                    errors.push(Diagnostic::token(
+                        field.span(),
+                        format!(
+                            "`{field}` is discontinuous: it has no boundary values to prescribe"
+                        ),
+                    ))
+                }
+                Some(_) => {}
+            }
+            if !self.data.iter().any(|d| d.name == *data) {
+                errors.push(
+                    Diagnostic::token(
+                        data.span(),
+                        format!("`{data}` is not declared under `data:`"),
+                    )
+                    .help("boundary values are a data function of x: declare it under `data:`"),
+                );
+            }
+        }
         // Every name means one thing.
-        let reserved = ["h", "h_T", "int", "sum_T", "Σ_T", "degree", "Model"];
+        let reserved = [
+            "h", "h_T", "int", "sum_T", "Σ_T", "degree", "Model", "grad", "lap", "dot",
+        ];
         let mut names: Vec<&Ident> = Vec::new();
         let all = self
             .unknowns
@@ -312,7 +355,7 @@ impl Declaration {
             if reserved.contains(&text.as_str()) {
                 errors.push(
                     Diagnostic::token(name.span(), format!("`{text}` is reserved"))
-                        .help("`h`/`h_T` is the element size, `int`/`sum_T` are ∫ and Σ_T; pick another name"),
+                        .help("`h`/`h_T` is the element size, `int`/`sum_T` are ∫ and Σ_T, `grad`/`lap`/`dot` are ∇, Δ and ·; pick another name"),
                 );
             } else if names.iter().any(|n| **n == *name) {
                 errors.push(Diagnostic::token(

@@ -7,7 +7,11 @@
 //! | derivative         | `′ ″ ‴ ⁗`, `'`     | `'`, `''`, …     |
 //! | power              | `⁻² ³ ⁴`           | `^-2`, `^(-2)`   |
 //! | minus              | `−` (U+2212), `–`  | `-`              |
-//! | product            | `·`, `⋅`, `×`, juxtaposition | `*`    |
+//! | product            | `·`, `⋅`, `×`, juxtaposition | `*`, `dot` |
+//! | gradient           | `∇`                | `grad`           |
+//! | Laplacian          | `Δ`                | `lap`            |
+//!
+//! A product of two vectors (`∇u·∇v`, `grad u dot grad v`) is their dot product.
 
 use crate::diagnostic::{Diagnostic, Loc};
 
@@ -32,8 +36,12 @@ pub enum Tok {
     Plus,
     /// `-`, `−`, `–`
     Minus,
-    /// `*`, `·`, `⋅`, `×`
+    /// `*`, `·`, `⋅`, `×`, `dot`
     Star,
+    /// `∇` or `grad`
+    Grad,
+    /// `Δ` or `lap`
+    Laplacian,
     /// `/`
     Slash,
     /// `(`
@@ -98,11 +106,11 @@ fn prime_count(c: char) -> Option<u8> {
 }
 
 fn is_ident_start(c: char) -> bool {
-    (c.is_alphabetic() || c == '_') && superscript_value(c).is_none()
+    (c.is_alphabetic() || c == '_') && superscript_value(c).is_none() && c != 'Δ'
 }
 
 fn is_ident_continue(c: char) -> bool {
-    (c.is_alphanumeric() || c == '_') && superscript_value(c).is_none()
+    (c.is_alphanumeric() || c == '_') && superscript_value(c).is_none() && c != 'Δ'
 }
 
 /// Splits the forms text into tokens; unknown characters become errors (lexing goes on).
@@ -216,12 +224,17 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             let tok = match name.as_str() {
                 "int" => Tok::Integral,
                 "Σ_T" | "sum_T" => Tok::SumT,
+                "grad" => Tok::Grad,
+                "lap" => Tok::Laplacian,
+                "dot" => Tok::Star,
                 _ => Tok::Ident(name),
             };
             push(tok, j - i, &mut tokens);
         } else {
             let tok = match c {
                 '∫' => Some(Tok::Integral),
+                '∇' => Some(Tok::Grad),
+                'Δ' => Some(Tok::Laplacian),
                 '∑' if chars.get(i + 1) == Some(&'_') && chars.get(i + 2) == Some(&'T') => {
                     j = i + 3;
                     Some(Tok::SumT)
@@ -246,7 +259,7 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 Some(tok) => push(tok, j - i, &mut tokens),
                 None => errors.push(
                     Diagnostic::text(start, format!("unexpected character `{c}` (U+{:04X})", c as u32))
-                        .help("the forms use ∫ (or int), Σ_T (or sum_T), + − · /, primes ' for derivatives, ⁻² or ^-2 for powers, and (X, Y)_T for L² products"),
+                        .help("the forms use ∫ (or int), Σ_T (or sum_T), + − · /, primes ' for derivatives (1D), ∇ Δ (grad, lap) on triangles, ⁻² or ^-2 for powers, and (X, Y)_T for L² products"),
                 ),
             }
         }
@@ -287,6 +300,13 @@ mod tests {
             ascii.iter().filter(|t| **t == Tok::Prime(1)).count()
         );
         assert_eq!(ascii[11], Tok::Integral);
+    }
+
+    #[test]
+    fn vector_calculus_spellings_agree() {
+        assert_eq!(kinds("∇u·∇v + Δw"), kinds("grad u dot grad v + lap w"));
+        assert_eq!(kinds("Δw")[0], Tok::Laplacian);
+        assert_eq!(kinds("∇")[0], Tok::Grad);
     }
 
     #[test]

@@ -78,6 +78,7 @@
 
 mod analysis;
 mod codegen;
+mod codegen_triangle;
 mod declaration;
 mod diagnostic;
 mod lexer;
@@ -124,6 +125,7 @@ fn expand(input: TokenStream) -> TokenStream {
             .iter()
             .map(|d| (d.name.to_string(), d.degree))
             .collect(),
+        dimension: declaration.cell.map_or(1, |c| c.dimension()),
     };
     let text = declaration.forms.value();
     let (tokens, lex_errors) = lexer::tokenize(&text);

@@ -58,6 +58,10 @@ pub enum ExprKind {
     Pow(Box<Expr>, i32),
     /// `x'`, `x''`, …
     Derivative(Box<Expr>, u8),
+    /// `∇x`
+    Gradient(Box<Expr>),
+    /// `Δx`
+    Laplacian(Box<Expr>),
     /// `(x, y)_T`
     InnerProduct(Box<Expr>, Box<Expr>),
     /// `∫ body` or `Σ_T body`
@@ -219,6 +223,8 @@ fn describe(tok: &Tok) -> String {
         Tok::Plus => "`+`".into(),
         Tok::Minus => "`−`".into(),
         Tok::Star => "`·`".into(),
+        Tok::Grad => "`∇`".into(),
+        Tok::Laplacian => "`Δ`".into(),
         Tok::Slash => "`/`".into(),
         Tok::LParen => "`(`".into(),
         Tok::RParen => "`)`".into(),
@@ -443,7 +449,13 @@ impl<'a> Parser<'a> {
     fn starts_factor(tok: &Tok) -> bool {
         matches!(
             tok,
-            Tok::Ident(_) | Tok::Number(_) | Tok::LParen | Tok::Integral | Tok::SumT
+            Tok::Ident(_)
+                | Tok::Number(_)
+                | Tok::LParen
+                | Tok::Integral
+                | Tok::SumT
+                | Tok::Grad
+                | Tok::Laplacian
         )
     }
 
@@ -481,6 +493,26 @@ impl<'a> Parser<'a> {
     }
 
     fn factor(&mut self) -> Result<Expr> {
+        // ∇ and Δ bind tighter than products and looser than primes and powers: ∇u·∇v
+        if let Some(op @ (Tok::Grad | Tok::Laplacian)) = self.peek_tok() {
+            let laplacian = *op == Tok::Laplacian;
+            let loc = self.bump().unwrap().loc;
+            if !self.peek_tok().is_some_and(Self::starts_factor) {
+                return Err(self.unexpected(if laplacian {
+                    "a function after Δ"
+                } else {
+                    "a function after ∇"
+                }));
+            }
+            let inner = self.factor()?;
+            let l = loc.to(inner.loc);
+            let kind = if laplacian {
+                ExprKind::Laplacian(Box::new(inner))
+            } else {
+                ExprKind::Gradient(Box::new(inner))
+            };
+            return Ok(Expr::new(kind, l));
+        }
         let mut e = self.primary()?;
         loop {
             match self.peek() {
@@ -717,6 +749,8 @@ mod tests {
             Div(a, b) => format!("(/ {} {})", sexpr(a), sexpr(b)),
             Pow(a, n) => format!("(^ {} {n})", sexpr(a)),
             Derivative(a, n) => format!("(d{n} {})", sexpr(a)),
+            Gradient(a) => format!("(grad {})", sexpr(a)),
+            Laplacian(a) => format!("(lap {})", sexpr(a)),
             InnerProduct(a, b) => format!("(ip {} {})", sexpr(a), sexpr(b)),
             Integral { degree, body, .. } => format!("(int{degree:?} {})", sexpr(body)),
             Call { name, groups } => format!(
@@ -790,6 +824,18 @@ mod tests {
         assert!(errors[0].message.contains("never closed"));
         assert!(errors[1].message.contains("unmatched `)`"));
         assert!(errors[2].message.contains("malformed exponent"));
+    }
+
+    #[test]
+    fn gradients_bind_tighter_than_products() {
+        let (defs, errors) = parse("a(u;v) = ∫ ∇u·∇v + h²(Δu + f, Δv)_T");
+        assert!(errors.is_empty(), "{errors:?}");
+        assert_eq!(
+            sexpr(&defs[0].body),
+            "(intNone (+ (* (grad u) (grad v)) (* (^ h 2) (ip (+ (lap u) f) (lap v)))))"
+        );
+        let (_, errors) = parse("a(u;v) = ∫ ∇ + v");
+        assert_eq!(errors.len(), 1);
     }
 
     #[test]

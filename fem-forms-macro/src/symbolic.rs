@@ -7,13 +7,20 @@
 
 use crate::diagnostic::Loc;
 
-/// A derivative of an argument (trial or test function): `symbol^(derivative)`.
+/// A partial derivative of an argument (trial or test function): `∂^derivative symbol`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct ArgFactor {
     /// Index of the function symbol (an unknown or a test function).
     pub symbol: usize,
-    /// Derivative order.
-    pub derivative: u8,
+    /// Multi-index of the derivative: orders in x and y (y is 0 on intervals).
+    pub derivative: [u8; 2],
+}
+
+impl ArgFactor {
+    /// Total order of the derivative.
+    pub fn order(&self) -> u8 {
+        self.derivative[0].saturating_add(self.derivative[1])
+    }
 }
 
 /// One term `c · Π pᵢ^eᵢ · h^k · Π data · Π args` of an expansion.
@@ -197,9 +204,9 @@ pub enum DerivativeError {
     OfProduct(Loc),
 }
 
-/// The derivative of order `k` of an expression linear in its arguments, with
-/// coefficients constant on the element (parameters, `h`, numbers).
-pub fn derivative(a: &Expansion, k: u8) -> Result<Expansion, DerivativeError> {
+/// The partial derivative of order `k` along `axis` (0: x, 1: y) of an expression linear
+/// in its arguments, with coefficients constant on the element (parameters, `h`, numbers).
+pub fn derivative(a: &Expansion, axis: usize, k: u8) -> Result<Expansion, DerivativeError> {
     let mut out = Vec::new();
     for t in a {
         match t.args.as_slice() {
@@ -209,9 +216,11 @@ pub fn derivative(a: &Expansion, k: u8) -> Result<Expansion, DerivativeError> {
             [] => return Err(DerivativeError::OfData(t.origin)),
             [arg] => {
                 let mut t = t.clone();
+                let mut derivative = arg.derivative;
+                derivative[axis] = derivative[axis].saturating_add(k);
                 t.args = vec![ArgFactor {
                     symbol: arg.symbol,
-                    derivative: arg.derivative.saturating_add(k),
+                    derivative,
                 }];
                 out.push(t);
             }
@@ -241,7 +250,7 @@ mod tests {
         let mut m = Monomial::constant(1.0, Loc::default());
         m.args = vec![ArgFactor {
             symbol,
-            derivative: 0,
+            derivative: [0, 0],
         }];
         vec![m]
     }
@@ -290,11 +299,13 @@ mod tests {
             ),
             param(0),
         );
-        let d = derivative(&e, 2).unwrap();
+        let d = derivative(&e, 0, 2).unwrap();
         assert_eq!(d.len(), 2);
-        assert!(d.iter().all(|t| t.args[0].derivative == 2));
+        assert!(d.iter().all(|t| t.args[0].derivative == [2, 0]));
+        let dxy = derivative(&d, 1, 1).unwrap();
+        assert!(dxy.iter().all(|t| t.args[0].derivative == [2, 1]));
         assert_eq!(
-            derivative(&mul(&arg(0), &arg(1), l), 1),
+            derivative(&mul(&arg(0), &arg(1), l), 0, 1),
             Err(DerivativeError::OfProduct(l))
         );
     }

@@ -97,6 +97,7 @@ fn unicode_and_ascii_spellings_give_the_same_blocks() {
             ],
             params: vec!["t".into(), "α".into(), "s".into()],
             data: vec![("f".into(), 2), ("ψ".into(), 2)],
+            dimension: 1,
         };
         let (tokens, e1) = lexer::tokenize(text);
         let (defs, e2) = parser::parse_forms(&tokens);
@@ -276,6 +277,7 @@ mod symbolic_properties {
             }],
             params: vec!["t".into(), "α".into()],
             data: vec![("f".into(), 2)],
+            dimension: 1,
         }
     }
 
@@ -299,7 +301,7 @@ mod symbolic_properties {
                 .map_err(|e| TestCaseError::fail(format!("{text}: {e:?}")))?;
             let direct = value(&g, &values);
             // symbol 0 is u (the unknown), symbol 1 is v (its test function)
-            let arg = |a: ArgFactor| values.args[a.symbol][a.derivative as usize];
+            let arg = |a: ArgFactor| values.args[a.symbol][a.derivative[0] as usize];
             let expanded = evaluate(&expansion, &|i| values.params[i], values.h, &|_| values.f, &arg);
             let scale: f64 = expansion
                 .iter()
@@ -310,5 +312,137 @@ mod symbolic_properties {
             prop_assert!((expanded - direct).abs() <= 1e-10 * scale,
                 "{text}: expanded {expanded} direct {direct}");
         }
+    }
+}
+
+fn membrane(element: &str, forms: &str) -> TokenStream {
+    let element = syn::Ident::new(element, proc_macro2::Span::call_site());
+    quote! {
+        /// Membrane.
+        pub mod membrane on triangle {
+            unknowns: u: #element, λ: P0 >= 0;
+            tests: v, μ;
+            params: α;
+            data: f, ψ, g;
+            boundary: u = g;
+            forms: #forms;
+        }
+    }
+}
+
+const MEMBRANE: &str = "
+    a(u;v)       = ∫ ∇u·∇v
+    b(v;μ)       = ∫ v μ
+    S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
+    ℓ(v)         = ∫ f v
+    B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
+";
+
+#[test]
+fn the_membrane_expands_to_valid_rust_on_triangles() {
+    let out = expand(membrane("P2", MEMBRANE));
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    let _: syn::File = syn::parse2(out).expect("generated code parses");
+    assert!(text.contains("CellKind :: Triangle"));
+    assert!(text.contains("DIRICHLET"));
+    // P2: Δu is a non-zero constant, so S couples (v, u)
+    let s_module = text.split("pub mod S").nth(1).unwrap();
+    assert!(s_module
+        .split("pub mod")
+        .next()
+        .unwrap()
+        .contains("fn matrix_v_u"));
+    // P1: Δ vanishes on each triangle and only the (μ, λ) block of S is left
+    let out = expand(membrane("P1", MEMBRANE)).to_string();
+    let s_module = out
+        .split("pub mod S")
+        .nth(1)
+        .unwrap()
+        .split("pub mod")
+        .next()
+        .unwrap();
+    assert!(s_module.contains("fn matrix_μ_λ") && !s_module.contains("fn matrix_v_u"));
+}
+
+#[test]
+fn vector_calculus_ascii_and_unicode_agree_and_expand_componentwise() {
+    let ascii = "
+        a(u;v)       = int grad u dot grad v
+        b(v;μ)       = int v*μ
+        S(u,λ;v,μ)   = sum_T h^2 (-lap u - λ, -lap v - μ)_T
+        ℓ(v)         = int f v
+        B_h(u,λ;v,μ) = a(u;v) - b(v;λ) - b(u;μ) - α S(u,λ;v,μ)
+    ";
+    let symbols = Symbols {
+        fields: vec![
+            Field {
+                name: "u".into(),
+                test_name: "v".into(),
+                element: ElementKind::P2,
+                nonnegative: false,
+            },
+            Field {
+                name: "λ".into(),
+                test_name: "μ".into(),
+                element: ElementKind::P0,
+                nonnegative: true,
+            },
+        ],
+        params: vec!["α".into()],
+        data: vec![("f".into(), 2)],
+        dimension: 2,
+    };
+    let blocks = |text: &str| {
+        let (tokens, errors) = lexer::tokenize(text);
+        assert!(errors.is_empty());
+        let (definitions, errors) = parser::parse_forms(&tokens);
+        assert!(errors.is_empty());
+        let (forms, errors) = analysis::analyse(&symbols, &definitions, text);
+        assert!(errors.is_empty(), "{errors:?}");
+        forms.into_iter().map(|f| f.blocks).collect::<Vec<_>>()
+    };
+    assert_eq!(blocks(MEMBRANE), blocks(ascii));
+    let symbols = Symbols {
+        fields: vec![Field {
+            name: "u".into(),
+            test_name: "v".into(),
+            element: ElementKind::P3,
+            nonnegative: false,
+        }],
+        params: vec![],
+        data: vec![],
+        dimension: 2,
+    };
+    let terms = analysis::expand_expression(&symbols, "∇u·∇v").unwrap();
+    let mut multi: Vec<Vec<[u8; 2]>> = terms
+        .iter()
+        .map(|t| t.args.iter().map(|a| a.derivative).collect())
+        .collect();
+    multi.sort();
+    assert_eq!(multi, vec![vec![[0, 1], [0, 1]], vec![[1, 0], [1, 0]]]);
+    let lap = analysis::expand_expression(&symbols, "Δu").unwrap();
+    let mut d: Vec<[u8; 2]> = lap.iter().map(|t| t.args[0].derivative).collect();
+    d.sort();
+    assert_eq!(d, vec![[0, 2], [2, 0]]);
+}
+
+#[test]
+fn vector_errors_point_at_the_expression() {
+    let cases = [
+        ("a(u;v) = ∫ ∇u + v", "sum of a vector and a scalar"),
+        ("a(u;v) = ∫ ∇u v", "a vector where a scalar is needed"),
+        (
+            "a(u;v) = ∫ u'v'",
+            "a prime ′ is the derivative along an interval",
+        ),
+        ("a(u;v) = ∫ ∇(∇u)·v", "a vector where a scalar is needed"),
+    ];
+    for (forms, message) in cases {
+        let errors = rendered_errors(&expand(membrane("P2", forms)));
+        assert!(
+            errors.iter().any(|e| e.contains(message)),
+            "{forms}: {errors:?}"
+        );
     }
 }

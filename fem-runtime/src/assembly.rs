@@ -6,7 +6,7 @@
 
 use crate::dof_map::SystemDofs;
 use crate::error::{Error, Result};
-use crate::mesh::IntervalMesh;
+use crate::mesh::Mesh;
 use crate::model::{Coefficients, Model};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -57,8 +57,8 @@ fn block_plans<M: Model>(form: usize, dofs: &SystemDofs, bilinear: bool) -> Resu
                 block: b,
                 test_field: block.test_field,
                 trial_field,
-                rows: M::FIELDS[block.test_field].element.dof_count(),
-                cols: M::FIELDS[trial_field].element.dof_count(),
+                rows: M::FIELDS[block.test_field].element.local_dof_count(M::CELL),
+                cols: M::FIELDS[trial_field].element.local_dof_count(M::CELL),
                 row_offset: dofs.offset(block.test_field).unwrap(),
                 col_offset: dofs.offset(trial_field).unwrap(),
             })
@@ -78,7 +78,7 @@ pub struct MatrixAssembler {
 
 impl MatrixAssembler {
     /// Builds the pattern of bilinear form `form_name` of `M` on the system `dofs`.
-    pub fn new<M: Model>(form_name: &str, mesh: &IntervalMesh, dofs: &SystemDofs) -> Result<Self> {
+    pub fn new<M: Model>(form_name: &str, mesh: &impl Mesh, dofs: &SystemDofs) -> Result<Self> {
         let form = M::form(form_name)?;
         let plans = block_plans::<M>(form, dofs, true)?;
         let n = dofs.dof_count();
@@ -156,7 +156,7 @@ impl MatrixAssembler {
     /// Fills `values` (resized to the pattern) with the assembled matrix.
     pub fn assemble_values<M: Model>(
         &self,
-        mesh: &IntervalMesh,
+        mesh: &impl Mesh,
         coefficients: &Coefficients,
         values: &mut Vec<f64>,
     ) -> Result<()> {
@@ -164,14 +164,16 @@ impl MatrixAssembler {
         values.resize(self.nonzero_count(), 0.0);
         let mut local = vec![0.0; self.largest_block];
         let mut k = 0;
+        let mut x = [0.0; 6];
+        let x = &mut x[..mesh.cell_kind().vertex_count() * mesh.cell_kind().dimension()];
         for c in 0..mesh.cell_count() {
-            let x = mesh.cell(c);
+            mesh.cell_coordinates_into(c, x);
             for plan in &self.plans {
                 let len = plan.rows * plan.cols;
                 M::element_matrix(
                     self.form,
                     plan.block,
-                    &x,
+                    x,
                     &coefficients.params,
                     &coefficients.data,
                     &mut local[..len],
@@ -196,7 +198,7 @@ impl MatrixAssembler {
     /// The assembled matrix.
     pub fn assemble<M: Model>(
         &self,
-        mesh: &IntervalMesh,
+        mesh: &impl Mesh,
         coefficients: &Coefficients,
     ) -> Result<SparseMatrix> {
         let mut values = Vec::new();
@@ -208,7 +210,7 @@ impl MatrixAssembler {
 /// Assembles linear form `form_name` of `M` on the system `dofs`.
 pub fn assemble_vector<M: Model>(
     form_name: &str,
-    mesh: &IntervalMesh,
+    mesh: &impl Mesh,
     dofs: &SystemDofs,
     coefficients: &Coefficients,
 ) -> Result<Vec<f64>> {
@@ -216,13 +218,15 @@ pub fn assemble_vector<M: Model>(
     let plans = block_plans::<M>(form, dofs, false)?;
     let mut out = vec![0.0; dofs.dof_count()];
     let mut local = vec![0.0; plans.iter().map(|p| p.rows).max().unwrap_or(0)];
+    let mut x = [0.0; 6];
+    let x = &mut x[..mesh.cell_kind().vertex_count() * mesh.cell_kind().dimension()];
     for c in 0..mesh.cell_count() {
-        let x = mesh.cell(c);
+        mesh.cell_coordinates_into(c, x);
         for plan in &plans {
             M::element_vector(
                 form,
                 plan.block,
-                &x,
+                x,
                 &coefficients.params,
                 &coefficients.data,
                 &mut local[..plan.rows],

@@ -122,6 +122,17 @@ impl Constraints {
         Ok(())
     }
 
+    /// Fixes global DOF `dof` to `value` (a later value for the same DOF wins).
+    pub fn fix_dof(&mut self, dof: usize, value: f64) -> Result<()> {
+        if !value.is_finite() {
+            return Err(Error::Input(format!(
+                "boundary value {value} at DOF {dof} is not finite"
+            )));
+        }
+        self.fixed.push((dof, value));
+        Ok(())
+    }
+
     /// The fixed DOFs and their values.
     pub fn fixed(&self) -> &[(usize, f64)] {
         &self.fixed

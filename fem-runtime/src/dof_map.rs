@@ -1,20 +1,24 @@
 //! Degrees of freedom: per field on a mesh, and for a system of several fields.
 //!
 //! On an interval mesh the DOFs of a field are numbered along the mesh: vertex 0,
-//! the interior DOFs of cell 0, vertex 1, … so that 1D matrices are banded.
+//! the interior DOFs of cell 0, vertex 1, … so that 1D matrices are banded. On a
+//! triangle mesh: all vertex DOFs, then edge DOFs, then interior DOFs.
 
 use crate::error::{Error, Result};
-use crate::mesh::IntervalMesh;
+use crate::mesh::{IntervalMesh, Mesh};
 use crate::model::Model;
-use fem_reference::ElementKind;
+use crate::triangle_mesh::TriangleMesh;
+use fem_reference::{CellKind, ElementKind};
 
 /// The DOFs of one field on a mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DofMap {
     element: ElementKind,
+    cell: CellKind,
     cell_dofs: Vec<usize>,
     dof_count: usize,
     per_vertex: usize,
+    per_edge: usize,
     interior: usize,
 }
 
@@ -35,11 +39,86 @@ impl DofMap {
         }
         Self {
             element,
+            cell: CellKind::Interval,
             cell_dofs,
             dof_count: (cells + 1) * per_vertex + cells * interior,
             per_vertex,
+            per_edge: 0,
             interior,
         }
+    }
+
+    /// Numbers the DOFs of `element` on a triangle mesh. Edge DOFs run from the edge's
+    /// lower-numbered vertex, and each cell lists them from its own first vertex of the
+    /// edge, so neighbours agree (P3 has two per edge).
+    pub fn on_triangles(mesh: &TriangleMesh, element: ElementKind) -> Self {
+        let [per_vertex, per_edge, interior] = element.triangle_layout();
+        let local = element.local_dof_count(CellKind::Triangle);
+        let (vertices, edges, cells) = (mesh.vertex_count(), mesh.edge_count(), mesh.cell_count());
+        let edge_base = vertices * per_vertex;
+        let interior_base = edge_base + edges * per_edge;
+        let mut cell_dofs = Vec::with_capacity(cells * local);
+        for c in 0..cells {
+            let v = mesh.cell(c);
+            for &vertex in &v {
+                cell_dofs.extend((0..per_vertex).map(|m| vertex * per_vertex + m));
+            }
+            let e = mesh.cell_edges(c);
+            for k in 0..3 {
+                let base = edge_base + e[k] * per_edge;
+                let forward = v[k] < v[(k + 1) % 3];
+                for m in 0..per_edge {
+                    cell_dofs.push(base + if forward { m } else { per_edge - 1 - m });
+                }
+            }
+            cell_dofs.extend((0..interior).map(|m| interior_base + c * interior + m));
+        }
+        Self {
+            element,
+            cell: CellKind::Triangle,
+            cell_dofs,
+            dof_count: interior_base + cells * interior,
+            per_vertex,
+            per_edge,
+            interior,
+        }
+    }
+
+    /// The DOFs on the boundary of a triangle mesh (vertex and edge DOFs of boundary
+    /// vertices and edges), sorted.
+    pub fn boundary_dofs(&self, mesh: &TriangleMesh) -> Vec<usize> {
+        if self.cell != CellKind::Triangle {
+            return Vec::new();
+        }
+        let mut out: Vec<usize> = mesh
+            .boundary_vertices()
+            .into_iter()
+            .flat_map(|v| (0..self.per_vertex).map(move |m| v * self.per_vertex + m))
+            .collect();
+        let edge_base = mesh.vertex_count() * self.per_vertex;
+        for &(e, _) in mesh.boundary_edges() {
+            out.extend((0..self.per_edge).map(|m| edge_base + e * self.per_edge + m));
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The point each DOF of a Lagrange-type element on a triangle mesh sits at (the
+    /// centroid for P0).
+    pub fn nodes(&self, mesh: &TriangleMesh) -> Vec<[f64; 2]> {
+        let reference = fem_reference::triangle::lagrange_nodes(self.element.degree());
+        let mut nodes = vec![[f64::NAN; 2]; self.dof_count];
+        for c in 0..mesh.cell_count() {
+            let x = mesh.cell_coordinates(c);
+            for (&dof, &[s, t]) in self.cell_dofs(c).iter().zip(&reference) {
+                nodes[dof] = [
+                    x[0] + (x[2] - x[0]) * s + (x[4] - x[0]) * t,
+                    x[1] + (x[3] - x[1]) * s + (x[5] - x[1]) * t,
+                ];
+            }
+        }
+        nodes
     }
 
     /// The element.
@@ -52,16 +131,24 @@ impl DofMap {
         self.dof_count
     }
 
+    /// Number of DOFs of one cell.
+    pub fn local_count(&self) -> usize {
+        self.element.local_dof_count(self.cell)
+    }
+
     /// Global DOFs of cell `c`, in the element's local order.
     #[inline]
     pub fn cell_dofs(&self, c: usize) -> &[usize] {
-        let n = self.element.dof_count();
+        let n = self.local_count();
         &self.cell_dofs[c * n..(c + 1) * n]
     }
 
     /// The DOFs at vertex `v` (value first, then slope for Hermite); empty for P0.
     pub fn vertex_dofs(&self, v: usize) -> std::ops::Range<usize> {
-        let start = v * (self.per_vertex + self.interior);
+        let start = match self.cell {
+            CellKind::Interval => v * (self.per_vertex + self.interior),
+            CellKind::Triangle => v * self.per_vertex,
+        };
         start..start + self.per_vertex
     }
 }
@@ -77,7 +164,7 @@ pub struct SystemDofs {
 
 impl SystemDofs {
     /// DOFs of the given fields of model `M` (by index, in the order given).
-    pub fn new<M: Model>(mesh: &IntervalMesh, fields: &[usize]) -> Result<Self> {
+    pub fn new<M: Model>(mesh: &impl Mesh, fields: &[usize]) -> Result<Self> {
         let mut maps = Vec::new();
         let mut offsets = Vec::new();
         let mut total = 0;
@@ -88,7 +175,15 @@ impl SystemDofs {
             if fields[..k].contains(&f) {
                 return Err(Error::Input(format!("field `{}` listed twice", info.name)));
             }
-            let map = DofMap::new(mesh, info.element);
+            if M::CELL != mesh.cell_kind() {
+                return Err(Error::Input(format!(
+                    "model `{}` is posed on {} cells, the mesh has {} cells",
+                    M::NAME,
+                    M::CELL.name(),
+                    mesh.cell_kind().name()
+                )));
+            }
+            let map = mesh.dof_map(info.element);
             offsets.push(total);
             total += map.dof_count();
             maps.push(map);
@@ -102,13 +197,13 @@ impl SystemDofs {
     }
 
     /// All fields of the model.
-    pub fn all<M: Model>(mesh: &IntervalMesh) -> Self {
+    pub fn all<M: Model>(mesh: &impl Mesh) -> Result<Self> {
         let fields: Vec<usize> = (0..M::FIELDS.len()).collect();
-        Self::new::<M>(mesh, &fields).expect("every field of a model exists once")
+        Self::new::<M>(mesh, &fields)
     }
 
     /// Fields by the names of their unknowns.
-    pub fn named<M: Model>(mesh: &IntervalMesh, names: &[&str]) -> Result<Self> {
+    pub fn named<M: Model>(mesh: &impl Mesh, names: &[&str]) -> Result<Self> {
         let fields = names
             .iter()
             .map(|n| M::field(n))

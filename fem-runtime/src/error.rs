@@ -34,6 +34,9 @@ pub enum Error {
     /// A linear solve that failed (singular or not positive definite).
     #[error("linear solve failed: {0}")]
     LinearSolve(String),
+    /// A file that cannot be read or written.
+    #[error("i/o: {0}")]
+    Io(String),
     /// An iterative solver that did not converge.
     #[error("{solver} did not converge: {detail}")]
     NotConverged {

@@ -11,6 +11,7 @@ pub mod complementarity;
 pub mod dof_map;
 pub mod element;
 pub mod error;
+pub mod gmsh;
 pub mod kernel;
 pub mod linear_problem;
 pub mod linear_solve;
@@ -18,6 +19,10 @@ pub mod mesh;
 pub mod model;
 pub mod norms;
 pub mod obstacle;
+pub mod obstacle_2d;
+pub mod triangle_field;
+pub mod triangle_mesh;
+pub mod vtk;
 
 pub use assembly::{assemble_vector, MatrixAssembler};
 pub use boundary::{Constraints, Reduction, Side};
@@ -28,6 +33,7 @@ pub use fem_reference::{gauss_legendre, CellKind, ElementKind, QuadratureRule};
 pub use linear_problem::{solve_linear, Factorization};
 pub use mesh::IntervalMesh;
 pub use model::{BlockInfo, Coefficients, DataFn, FieldInfo, FormInfo, Model};
+pub use triangle_mesh::{Diagonal, PointLocator, TriangleMesh};
 
 /// Re-exported sparse matrix type of the assembled systems.
 pub type SparseMatrix = faer::sparse::SparseColMat<usize, f64>;

@@ -1,6 +1,71 @@
-//! Interval meshes: uniform, graded, and refined by bisection.
+//! The mesh abstraction that assembly needs, and interval meshes: uniform, graded, and
+//! refined by bisection. Triangle meshes live in [`crate::triangle_mesh`].
 
+use crate::dof_map::DofMap;
 use crate::error::{Error, Result};
+use crate::triangle_mesh::TriangleMesh;
+use fem_reference::{CellKind, ElementKind};
+
+/// What assembly needs from a mesh: its cells' vertex coordinates as the element kernels
+/// take them, and DOF numbering.
+pub trait Mesh: Sync {
+    /// The reference cell of every cell.
+    const CELL: CellKind;
+    /// Number of cells.
+    fn cell_count(&self) -> usize;
+    /// Writes the vertex coordinates of cell `c` (`x₀ x₁` or `x₀ y₀ x₁ y₁ x₂ y₂`) into `out`.
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]);
+    /// Numbers the DOFs of `element` on this mesh.
+    fn dof_map(&self, element: ElementKind) -> DofMap;
+    /// Diameter of cell `c`.
+    fn diameter(&self, c: usize) -> f64;
+    /// Measure (length or area) of cell `c`.
+    fn measure(&self, c: usize) -> f64;
+    /// The reference cell (`Self::CELL`, callable where the mesh type is not named).
+    fn cell_kind(&self) -> CellKind {
+        Self::CELL
+    }
+}
+
+impl Mesh for IntervalMesh {
+    const CELL: CellKind = CellKind::Interval;
+    fn cell_count(&self) -> usize {
+        IntervalMesh::cell_count(self)
+    }
+    #[inline]
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
+        out[..2].copy_from_slice(&self.cell(c));
+    }
+    fn dof_map(&self, element: ElementKind) -> DofMap {
+        DofMap::new(self, element)
+    }
+    fn diameter(&self, c: usize) -> f64 {
+        self.h(c)
+    }
+    fn measure(&self, c: usize) -> f64 {
+        self.h(c)
+    }
+}
+
+impl Mesh for TriangleMesh {
+    const CELL: CellKind = CellKind::Triangle;
+    fn cell_count(&self) -> usize {
+        TriangleMesh::cell_count(self)
+    }
+    #[inline]
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
+        out[..6].copy_from_slice(&self.cell_coordinates(c));
+    }
+    fn dof_map(&self, element: ElementKind) -> DofMap {
+        DofMap::on_triangles(self, element)
+    }
+    fn diameter(&self, c: usize) -> f64 {
+        self.cell_diameter(c)
+    }
+    fn measure(&self, c: usize) -> f64 {
+        self.area(c)
+    }
+}
 
 /// A mesh of an interval: strictly increasing vertices; cell `c` is
 /// `[vertices[c], vertices[c + 1]]`.

@@ -64,6 +64,8 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     const DATA: &'static [&'static str];
     /// Forms in definition order.
     const FORMS: &'static [FormInfo];
+    /// Dirichlet conditions `(field, data function)` declared under `boundary:`.
+    const DIRICHLET: &'static [(usize, usize)] = &[];
 
     /// Element matrix of `block` of bilinear `form`, row-major into `out`.
     fn element_matrix(

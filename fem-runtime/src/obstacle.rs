@@ -12,7 +12,7 @@ use crate::complementarity::{
 use crate::dof_map::SystemDofs;
 use crate::element::PhysicalBasis;
 use crate::error::{Error, Result};
-use crate::mesh::IntervalMesh;
+use crate::mesh::{IntervalMesh, Mesh};
 use crate::model::{Coefficients, Model};
 use crate::norms::FieldView;
 use crate::SparseMatrix;
@@ -36,9 +36,9 @@ enum Role {
 }
 
 /// The discrete obstacle problem of a model on one mesh.
-pub struct Discretization {
+pub struct Discretization<G = IntervalMesh> {
     /// The mesh.
-    pub mesh: IntervalMesh,
+    pub mesh: G,
     /// DOFs of all fields of the model.
     pub dofs: SystemDofs,
     /// Elimination of the boundary DOFs.
@@ -67,7 +67,7 @@ pub fn multiplier_field<M: Model>() -> Result<usize> {
     }
 }
 
-impl Discretization {
+impl Discretization<IntervalMesh> {
     /// Assembles `bilinear` and `linear` (normally `B_h`, `L_h`) of `M` on `mesh`, with the
     /// fields in `clamped` clamped at both ends.
     pub fn new<M: Model>(
@@ -77,14 +77,29 @@ impl Discretization {
         bilinear: &str,
         linear: &str,
     ) -> Result<Self> {
-        let multiplier = multiplier_field::<M>()?;
-        let dofs = SystemDofs::all::<M>(mesh);
+        let dofs = SystemDofs::all::<M>(mesh)?;
         let mut constraints = Constraints::new();
         for field in clamped {
             for side in [Side::Left, Side::Right] {
                 constraints.clamp::<M>(mesh, &dofs, field, side)?;
             }
         }
+        Self::with_constraints::<M>(mesh, coefficients, dofs, &constraints, bilinear, linear)
+    }
+}
+
+impl<G: Mesh + Clone> Discretization<G> {
+    /// Assembles `bilinear` and `linear` of `M` on `mesh` with the DOFs `dofs`, eliminates
+    /// the fixed DOFs of `constraints` and splits the system into the LCP blocks.
+    pub fn with_constraints<M: Model>(
+        mesh: &G,
+        coefficients: &Coefficients,
+        dofs: SystemDofs,
+        constraints: &Constraints,
+        bilinear: &str,
+        linear: &str,
+    ) -> Result<Self> {
+        let multiplier = multiplier_field::<M>()?;
         let k =
             MatrixAssembler::new::<M>(bilinear, mesh, &dofs)?.assemble::<M>(mesh, coefficients)?;
         let rhs = assemble_vector::<M>(linear, mesh, &dofs, coefficients)?;
@@ -123,7 +138,7 @@ impl Discretization {
                             c[mi] = -v;
                         } else if v != 0.0 {
                             return Err(Error::Input(format!(
-                                "the multiplier block of `{bilinear}` is not diagonal: P0 multipliers are needed to eliminate Λ"
+                                "the multiplier block of `{bilinear}` is not diagonal: this LCP form needs P0 multipliers (or a diagonal multiplier mass)"
                             )));
                         }
                     }
@@ -153,6 +168,18 @@ impl Discretization {
             primal_reduced,
             multiplier_reduced,
         })
+    }
+}
+
+impl<G> Discretization<G> {
+    /// For each constraint of the LCP, the DOF (numbered within the multiplier field) of
+    /// its multiplier.
+    pub fn multiplier_dofs(&self) -> Vec<usize> {
+        let offset = self.dofs.offset(self.multiplier_field).unwrap_or(0);
+        self.multiplier_reduced
+            .iter()
+            .map(|&r| self.reduction.free()[r] - offset)
+            .collect()
     }
 
     /// The full coefficient vector (all fields, boundary values included) of an LCP solution.
@@ -268,6 +295,54 @@ impl Default for ObstacleOptions {
     }
 }
 
+/// Solves one LCP with the algorithm of `options`, from `start` (primal unknowns) if given.
+pub fn solve_lcp(
+    lcp: &Lcp,
+    start: Option<&[f64]>,
+    options: ObstacleOptions,
+) -> Result<LcpSolution> {
+    match options.solver {
+        // Newton with Λ eliminated (SPD Hessian, one symbolic Cholesky); if it fails,
+        // the active-set method on the saddle-point system. Where the eliminated Λ
+        // loses digits to cancellation (C = αh⁵ on fine meshes), Λ is recovered from
+        // one saddle-point solve on the converged active set.
+        VariationalSolver::SemismoothNewton => {
+            // From a nested start Newton needs a handful of iterations where it works
+            // at all: fail over to the saddle-point method early.
+            let newton = NewtonOptions {
+                max_iterations: if start.is_some() {
+                    options.newton.max_iterations.min(40)
+                } else {
+                    options.newton.max_iterations
+                },
+                ..options.newton
+            };
+            let solution = match semismooth_newton(lcp, start, newton) {
+                Ok(s) => s,
+                // the fallback factors an LU per iteration: give it fewer
+                Err(newton) => primal_dual_active_set(
+                    lcp,
+                    start,
+                    NewtonOptions {
+                        max_iterations: options.newton.max_iterations.min(50),
+                        ..options.newton
+                    },
+                )
+                .map_err(|pdas| Error::NotConverged {
+                    solver: "semismooth Newton and the saddle-point active-set method",
+                    detail: format!("{newton}; {pdas}"),
+                })?,
+            };
+            if lcp.elimination_noise() > 1e-6 {
+                recover_multiplier(lcp, solution, options.newton.refinement_steps)
+            } else {
+                Ok(solution)
+            }
+        }
+        VariationalSolver::Clarabel => quadratic_program(lcp),
+    }
+}
+
 /// Solves the obstacle problem `B_h`, `L_h` of `M` on `mesh`.
 pub fn solve_obstacle<M: Model>(
     mesh: &IntervalMesh,
@@ -276,48 +351,7 @@ pub fn solve_obstacle<M: Model>(
     options: ObstacleOptions,
 ) -> Result<ObstacleSolution> {
     let clock = Instant::now();
-    let solve = |d: &Discretization, start: Option<&[f64]>| -> Result<LcpSolution> {
-        match options.solver {
-            // Newton with Λ eliminated (SPD Hessian, one symbolic Cholesky); if it fails,
-            // the active-set method on the saddle-point system. Where the eliminated Λ
-            // loses digits to cancellation (C = αh⁵ on fine meshes), Λ is recovered from
-            // one saddle-point solve on the converged active set.
-            VariationalSolver::SemismoothNewton => {
-                // From a nested start Newton needs a handful of iterations where it works
-                // at all: fail over to the saddle-point method early.
-                let newton = NewtonOptions {
-                    max_iterations: if start.is_some() {
-                        options.newton.max_iterations.min(40)
-                    } else {
-                        options.newton.max_iterations
-                    },
-                    ..options.newton
-                };
-                let solution = match semismooth_newton(&d.lcp, start, newton) {
-                    Ok(s) => s,
-                    // the fallback factors an LU per iteration: give it fewer
-                    Err(newton) => primal_dual_active_set(
-                        &d.lcp,
-                        start,
-                        NewtonOptions {
-                            max_iterations: options.newton.max_iterations.min(50),
-                            ..options.newton
-                        },
-                    )
-                    .map_err(|pdas| Error::NotConverged {
-                        solver: "semismooth Newton and the saddle-point active-set method",
-                        detail: format!("{newton}; {pdas}"),
-                    })?,
-                };
-                if d.lcp.elimination_noise() > 1e-6 {
-                    recover_multiplier(&d.lcp, solution, options.newton.refinement_steps)
-                } else {
-                    Ok(solution)
-                }
-            }
-            VariationalSolver::Clarabel => quadratic_program(&d.lcp),
-        }
-    };
+    let solve = |d: &Discretization, start: Option<&[f64]>| solve_lcp(&d.lcp, start, options);
     // Nested iteration over uniform meshes: N/2^k, …, N/2, N.
     let uniform = IntervalMesh::uniform(
         mesh.vertices()[0],

@@ -6,8 +6,11 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod euler_bernoulli;
+pub mod membrane;
+pub mod membrane_scenes;
 pub mod timoshenko;
 
 pub use euler_bernoulli::bernoulli;
+pub use membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 pub use timoshenko::{timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
 pub mod scenes;

@@ -69,15 +69,19 @@ pub enum ElementKind {
     P3,
     /// C¹ Hermite cubic on intervals: value and slope at both vertices.
     Hermite,
+    /// Discontinuous piecewise linear Lagrange (multipliers): nodal values at the
+    /// cell's vertices, owned by the cell.
+    P1Disc,
 }
 
 /// Every element, in the order the DSL lists them in error messages.
-pub const ALL_ELEMENTS: [ElementKind; 5] = [
+pub const ALL_ELEMENTS: [ElementKind; 6] = [
     ElementKind::P0,
     ElementKind::P1,
     ElementKind::P2,
     ElementKind::P3,
     ElementKind::Hermite,
+    ElementKind::P1Disc,
 ];
 
 impl ElementKind {
@@ -89,6 +93,7 @@ impl ElementKind {
             ElementKind::P2 => "P2",
             ElementKind::P3 => "P3",
             ElementKind::Hermite => "Hermite",
+            ElementKind::P1Disc => "P1disc",
         }
     }
 
@@ -100,20 +105,56 @@ impl ElementKind {
             "P2" => Some(ElementKind::P2),
             "P3" => Some(ElementKind::P3),
             "Hermite" | "H3" => Some(ElementKind::Hermite),
+            "P1disc" | "P1d" | "DG1" => Some(ElementKind::P1Disc),
             _ => None,
         }
     }
 
-    /// Whether the element exists on the given cell (only intervals so far).
+    /// Whether the element exists on the given cell (Hermite only on intervals).
     pub fn supports(self, cell: CellKind) -> bool {
-        cell == CellKind::Interval
+        cell == CellKind::Interval || self != ElementKind::Hermite
+    }
+
+    /// Number of local DOFs on `cell`.
+    pub fn local_dof_count(self, cell: CellKind) -> usize {
+        match cell {
+            CellKind::Interval => self.dof_count(),
+            CellKind::Triangle => {
+                let [v, e, i] = self.triangle_layout();
+                3 * v + 3 * e + i
+            }
+        }
+    }
+
+    /// DOFs per vertex, per edge and in the interior of a triangle. Local order on the
+    /// triangle: vertices, then edges 0–1, 1–2, 2–0 (nodes from the edge's first
+    /// vertex), then interior, as in [`crate::triangle::lagrange_nodes`].
+    pub fn triangle_layout(self) -> [usize; 3] {
+        match self {
+            ElementKind::P0 => [0, 0, 1],
+            ElementKind::P1 => [1, 0, 0],
+            ElementKind::P2 => [1, 1, 0],
+            ElementKind::P3 => [1, 2, 1],
+            ElementKind::P1Disc => [0, 0, 3],
+            // Not available on triangles (see `supports`).
+            ElementKind::Hermite => [0, 0, 0],
+        }
+    }
+
+    /// The reference basis on the triangle, in local DOF order (empty where unsupported).
+    pub fn triangle_basis(self) -> Vec<crate::triangle::Polynomial2> {
+        match self {
+            ElementKind::Hermite => Vec::new(),
+            ElementKind::P1Disc => crate::triangle::lagrange_basis(1),
+            _ => crate::triangle::lagrange_basis(self.degree()),
+        }
     }
 
     /// Polynomial degree of the basis.
     pub fn degree(self) -> usize {
         match self {
             ElementKind::P0 => 0,
-            ElementKind::P1 => 1,
+            ElementKind::P1 | ElementKind::P1Disc => 1,
             ElementKind::P2 => 2,
             ElementKind::P3 | ElementKind::Hermite => 3,
         }
@@ -125,14 +166,14 @@ impl ElementKind {
     /// discontinuous, and its derivative is not a function, so P0 admits none.
     pub fn max_derivative(self) -> usize {
         match self {
-            ElementKind::P0 => 0,
+            ElementKind::P0 | ElementKind::P1Disc => 0,
             _ => 4,
         }
     }
 
     /// Whether neighbouring cells share the vertex DOFs.
     pub fn is_continuous(self) -> bool {
-        self != ElementKind::P0
+        !matches!(self, ElementKind::P0 | ElementKind::P1Disc)
     }
 
     /// The DOF layout, in local order.
@@ -149,6 +190,7 @@ impl ElementKind {
         match self {
             ElementKind::P0 => &[Interior],
             ElementKind::P1 => &[V0, V1],
+            ElementKind::P1Disc => &[Interior, Interior],
             ElementKind::P2 => &[V0, V1, Interior],
             ElementKind::P3 => &[V0, V1, Interior, Interior],
             ElementKind::Hermite => &[
@@ -194,7 +236,7 @@ impl ElementKind {
     pub fn lagrange_nodes(self) -> Option<&'static [f64]> {
         match self {
             ElementKind::P0 => Some(&[0.5]),
-            ElementKind::P1 => Some(&[0.0, 1.0]),
+            ElementKind::P1 | ElementKind::P1Disc => Some(&[0.0, 1.0]),
             ElementKind::P2 => Some(&[0.0, 1.0, 0.5]),
             ElementKind::P3 => Some(&[0.0, 1.0, 1.0 / 3.0, 2.0 / 3.0]),
             ElementKind::Hermite => None,
@@ -299,6 +341,34 @@ mod tests {
         for element in [ElementKind::P1, ElementKind::P2, ElementKind::P3] {
             let sum: f64 = element.basis().iter().map(|p| p.eval(0.3141)).sum();
             assert!((sum - 1.0).abs() < 1e-14);
+        }
+    }
+
+    /// On the triangle every supported basis is dual to its nodes in layout order, has
+    /// the element's degree and sums to one.
+    #[test]
+    fn triangle_bases_match_their_layouts() {
+        for element in ALL_ELEMENTS {
+            if !element.supports(CellKind::Triangle) {
+                assert!(element.triangle_basis().is_empty());
+                continue;
+            }
+            let basis = element.triangle_basis();
+            assert_eq!(basis.len(), element.local_dof_count(CellKind::Triangle));
+            let nodes = crate::triangle::lagrange_nodes(element.degree());
+            for (i, phi) in basis.iter().enumerate() {
+                for (j, &node) in nodes.iter().enumerate() {
+                    let expected = f64::from(u8::from(i == j));
+                    assert!(
+                        (phi.eval(node) - expected).abs() < 1e-12,
+                        "{element:?} {i} {j}"
+                    );
+                }
+                let top = element.degree() as u32;
+                assert!(phi.terms.iter().all(|&(a, b, _)| a + b <= top));
+            }
+            let sum: f64 = basis.iter().map(|p| p.eval([0.21, 0.37])).sum();
+            assert!((sum - 1.0).abs() < 1e-13);
         }
     }
 }

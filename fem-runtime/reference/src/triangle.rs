@@ -1,6 +1,6 @@
 //! The reference triangle `(0,0), (1,0), (0,1)`: quadrature rules exact to any degree and
-//! Lagrange bases. Groundwork for the 2D models (membrane, plates); the form compiler
-//! does not use it yet.
+//! Lagrange bases. The form compiler tabulates and integrates these at compile time for
+//! models `on triangle`.
 
 use crate::quadrature::gauss_legendre;
 

@@ -1,0 +1,810 @@
+//! Reading Gmsh `.msh` files into triangle meshes.
+//!
+//! The parser is `mshio`, which reads the MSH 4.1 format (ASCII and binary) only; files
+//! in the older 2.2 format are rejected with a hint to re-export them as 4.1.
+
+use std::path::Path;
+
+use mshio::{ElementType, MshFile};
+
+use crate::error::{Error, Result};
+use crate::triangle_mesh::TriangleMesh;
+
+/// Reads a Gmsh `.msh` file (MSH 4.1, ASCII or binary) into a [`TriangleMesh`].
+///
+/// See [`parse_msh`] for what is read and what is rejected.
+pub fn read_msh(path: &Path) -> Result<TriangleMesh> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::Io(format!("cannot read {}: {e}", path.display())))?;
+    parse_msh(&bytes).map_err(|e| match e {
+        Error::Mesh(message) => Error::Mesh(format!("{}: {message}", path.display())),
+        other => other,
+    })
+}
+
+/// Parses the contents of a Gmsh `.msh` file (MSH 4.1, ASCII or binary) into a [`TriangleMesh`].
+///
+/// 3-node triangles (Gmsh type 2) become the cells and 2-node lines (type 1) on boundary
+/// edges give the boundary markers: the first physical tag of the line's curve if it has
+/// one, else the curve's entity tag. Lines on interior edges (embedded curves) are
+/// ignored, and so are point elements. Nodes no triangle uses are dropped and the rest
+/// numbered compactly in increasing tag order. All nodes must lie in the plane `z = 0`
+/// (up to 1e-12 of the mesh's extent); if every triangle is clockwise (a surface whose
+/// normal is −z) all are flipped.
+pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
+    let binary = check_header(bytes)?;
+    let file = parse_with_mshio(bytes)?;
+    let nodes = node_table(&file, if binary { None } else { ascii_node_tags(bytes) })?;
+    let elements = collect_elements(&file)?;
+
+    // compact numbering of the nodes the triangles use, in increasing tag order
+    let mut used: Vec<u64> = elements.triangles.iter().flat_map(|t| t.1).collect();
+    used.sort_unstable();
+    used.dedup();
+    let mut vertices = Vec::with_capacity(used.len());
+    let mut zs = Vec::with_capacity(used.len());
+    for &tag in &used {
+        let Some(p) = nodes.get(tag) else {
+            let (element, _) = elements
+                .triangles
+                .iter()
+                .find(|t| t.1.contains(&tag))
+                .copied()
+                .unwrap_or((0, [0; 3]));
+            return Err(Error::Mesh(format!(
+                "element {element} references node {tag}, which the $Nodes section does not define"
+            )));
+        };
+        vertices.push([p[0], p[1]]);
+        zs.push(p[2]);
+    }
+    check_planar(&vertices, &zs, &used)?;
+    let index = |tag: u64| used.binary_search(&tag).ok();
+    let mut cells: Vec<[usize; 3]> = elements
+        .triangles
+        .iter()
+        .map(|(_, t)| t.map(|tag| index(tag).unwrap_or(usize::MAX)))
+        .collect();
+    orient(&vertices, &mut cells, &elements.triangles)?;
+
+    let element_of_cell: Vec<u64> = elements.triangles.iter().map(|t| t.0).collect();
+    let annotate = |e: Error| match e {
+        Error::Mesh(message) => Error::Mesh(annotate_indices(&message, &element_of_cell, &used)),
+        other => other,
+    };
+    let mut mesh = TriangleMesh::new(vertices, cells, &[]).map_err(annotate)?;
+
+    let mut markers = Vec::with_capacity(elements.lines.len());
+    for &(element, [n0, n1], marker) in &elements.lines {
+        for n in [n0, n1] {
+            if nodes.get(n).is_none() {
+                return Err(Error::Mesh(format!(
+                    "element {element} references node {n}, which the $Nodes section does not define"
+                )));
+            }
+        }
+        let (Some(a), Some(b)) = (index(n0), index(n1)) else {
+            return Err(Error::Mesh(format!(
+                "line element {element} (nodes {n0}, {n1}) is not an edge of the triangles: one of its nodes belongs to no triangle"
+            )));
+        };
+        let Some(edge) = mesh.find_edge(a, b) else {
+            return Err(Error::Mesh(format!(
+                "line element {element} (nodes {n0}, {n1}) is not an edge of the triangles"
+            )));
+        };
+        // Lines on interior edges belong to embedded curves, which carry no boundary marker.
+        if mesh.edge_cells(edge).1.is_none() {
+            markers.push((a, b, marker));
+        }
+    }
+    mesh.apply_markers(&markers).map_err(annotate)?;
+    Ok(mesh)
+}
+
+/// Checks the `$MeshFormat` header before `mshio` sees it, for clearer messages (and
+/// because `mshio` panics on binary files with unusual integer sizes). Returns whether
+/// the file is binary.
+fn check_header(bytes: &[u8]) -> Result<bool> {
+    let start = bytes
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .ok_or_else(|| Error::Mesh("the .msh input is empty".into()))?;
+    let rest = &bytes[start..];
+    if !rest.starts_with(b"$MeshFormat") {
+        return Err(Error::Mesh(
+            "not a Gmsh .msh file: it does not start with $MeshFormat".into(),
+        ));
+    }
+    // the header line after $MeshFormat: version, file type, data size
+    let line: Vec<&[u8]> = rest[b"$MeshFormat".len()..]
+        .split(|&b| b == b'\n')
+        .map(|l| l.trim_ascii())
+        .find(|l| !l.is_empty())
+        .unwrap_or(b"")
+        .split(|b| b.is_ascii_whitespace())
+        .filter(|t| !t.is_empty())
+        .collect();
+    let token = |i: usize| {
+        line.get(i)
+            .map(|t| String::from_utf8_lossy(t).into_owned())
+            .unwrap_or_default()
+    };
+    let version = token(0);
+    if version != "4.1" {
+        return Err(Error::Mesh(format!(
+            "MSH format version `{version}` is not supported: only version 4.1 can be read (in Gmsh, export with `-format msh41` or Mesh.MshFileVersion = 4.1)"
+        )));
+    }
+    match (token(1).as_str(), token(2).as_str()) {
+        ("0", _) => Ok(false),
+        ("1", "4" | "8") => Ok(true),
+        ("1", size) => Err(Error::Mesh(format!(
+            "binary .msh file with data size `{size}` is not supported (only 4 or 8)"
+        ))),
+        (kind, _) => Err(Error::Mesh(format!(
+            "invalid $MeshFormat header: file type `{kind}` must be 0 (ASCII) or 1 (binary)"
+        ))),
+    }
+}
+
+/// Runs `mshio`, turning its errors (and any panic inside it) into `Error::Mesh`.
+fn parse_with_mshio(bytes: &[u8]) -> Result<MshFile<u64, i32, f64>> {
+    match std::panic::catch_unwind(|| {
+        mshio::parse_msh_bytes(bytes).map_err(|e| describe(bytes, &e))
+    }) {
+        Ok(Ok(file)) => Ok(file),
+        Ok(Err(message)) => Err(Error::Mesh(message)),
+        Err(_) => Err(Error::Mesh(
+            "the .msh parser (mshio) failed on this input; the file is probably malformed".into(),
+        )),
+    }
+}
+
+/// `mshio`'s error as one line with its location; its own `Display` dumps the rest of
+/// the file in hex.
+fn describe(bytes: &[u8], error: &mshio::MshParserError<&[u8]>) -> String {
+    let filtered = error.filtered_backtrace();
+    // only nom's low-level errors: report the innermost of those
+    let trace = if filtered.is_empty() {
+        error.backtrace.iter().take(1).cloned().collect()
+    } else {
+        filtered
+    };
+    let Some((at, kind)) = trace.first() else {
+        return "cannot parse the .msh file (mshio gave no reason)".into();
+    };
+    let offset = (at.as_ptr() as usize)
+        .checked_sub(bytes.as_ptr() as usize)
+        .filter(|&o| o <= bytes.len())
+        .unwrap_or(0);
+    let line = bytes[..offset].iter().filter(|&&b| b == b'\n').count() + 1;
+    let context: Vec<String> = trace[1..]
+        .iter()
+        .rev()
+        .map(|(_, k)| k.context().map_or_else(|| k.to_string(), str::to_owned))
+        .collect();
+    let near: String = String::from_utf8_lossy(&bytes[offset..bytes.len().min(offset + 40)])
+        .lines()
+        .next()
+        .unwrap_or("")
+        .chars()
+        .filter(|c| !c.is_control())
+        .collect();
+    let reason = if kind.is_nom_error() {
+        format!("unexpected `{near}`")
+    } else {
+        format!("{kind} (near `{near}`)")
+    };
+    let mut message =
+        format!("cannot parse the .msh file at line {line} (byte {offset}): {reason}");
+    if !context.is_empty() {
+        message.push_str(&format!(" (in {})", context.join(" › ")));
+    }
+    message
+}
+
+/// Node coordinates by tag, sorted for binary search.
+struct NodeTable(Vec<(u64, [f64; 3])>);
+
+impl NodeTable {
+    fn get(&self, tag: u64) -> Option<[f64; 3]> {
+        self.0
+            .binary_search_by_key(&tag, |n| n.0)
+            .ok()
+            .map(|i| self.0[i].1)
+    }
+}
+
+/// The node table. `mshio` keeps node tags only when they are sparse, and otherwise
+/// assumes they run consecutively in file order; for ASCII files the tags read from the
+/// text (`ascii_tags`) are used instead, so out-of-order files are read correctly.
+fn node_table(file: &MshFile<u64, i32, f64>, ascii_tags: Option<Vec<u64>>) -> Result<NodeTable> {
+    let Some(nodes) = &file.data.nodes else {
+        return Err(Error::Mesh("the .msh file has no $Nodes section".into()));
+    };
+    let total: usize = nodes.node_blocks.iter().map(|b| b.nodes.len()).sum();
+    let ascii_tags = ascii_tags.filter(|t| t.len() == total);
+    let mut table = Vec::with_capacity(total);
+    let mut running = 0usize;
+    for block in &nodes.node_blocks {
+        let mut tags = vec![0u64; block.nodes.len()];
+        if let Some(all) = &ascii_tags {
+            tags.copy_from_slice(&all[running..running + block.nodes.len()]);
+        } else if let Some(map) = &block.node_tags {
+            for (&tag, &i) in map {
+                if let Some(slot) = tags.get_mut(i) {
+                    *slot = tag;
+                }
+            }
+        } else {
+            for (i, tag) in tags.iter_mut().enumerate() {
+                *tag = nodes.min_node_tag + (running + i) as u64;
+            }
+        }
+        for (node, tag) in block.nodes.iter().zip(tags) {
+            table.push((tag, [node.x, node.y, node.z]));
+        }
+        running += block.nodes.len();
+    }
+    table.sort_unstable_by_key(|n| n.0);
+    if let Some(w) = table.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(Error::Mesh(format!("node {} is defined twice", w[0].0)));
+    }
+    Ok(NodeTable(table))
+}
+
+/// The node tags of an ASCII file's `$Nodes` section in file order, or `None` if the
+/// section cannot be walked (then `mshio`'s numbering is used).
+fn ascii_node_tags(bytes: &[u8]) -> Option<Vec<u64>> {
+    let text = std::str::from_utf8(bytes).ok()?;
+    let mut offset = 0;
+    let mut start = None;
+    for line in text.split_inclusive('\n') {
+        offset += line.len();
+        if line.trim() == "$Nodes" {
+            start = Some(offset);
+            break;
+        }
+    }
+    let body = &text[start?..];
+    let body = &body[..body.find("$EndNodes")?];
+    let mut tokens = body.split_ascii_whitespace();
+    fn int(tokens: &mut std::str::SplitAsciiWhitespace) -> Option<u64> {
+        tokens.next()?.parse::<u64>().ok()
+    }
+    let blocks = int(&mut tokens)?;
+    let (_count, _min, _max) = (int(&mut tokens)?, int(&mut tokens)?, int(&mut tokens)?);
+    let mut tags = Vec::new();
+    for _ in 0..blocks {
+        let (_dim, _entity, parametric, n) = (
+            int(&mut tokens)?,
+            int(&mut tokens)?,
+            int(&mut tokens)?,
+            int(&mut tokens)?,
+        );
+        if parametric != 0 {
+            return None;
+        }
+        for _ in 0..n {
+            tags.push(int(&mut tokens)?);
+        }
+        // the coordinates are floats: skip them by position
+        for _ in 0..3 * n {
+            tokens.next()?;
+        }
+    }
+    Some(tags)
+}
+
+/// The elements the mesh is made of, with their Gmsh element tags.
+struct Elements {
+    /// (element tag, node tags)
+    triangles: Vec<(u64, [u64; 3])>,
+    /// (element tag, node tags, marker)
+    lines: Vec<(u64, [u64; 2], u32)>,
+}
+
+fn type_name(t: ElementType) -> String {
+    format!("{t:?} (Gmsh type {})", t as i32)
+}
+
+fn collect_elements(file: &MshFile<u64, i32, f64>) -> Result<Elements> {
+    let Some(elements) = &file.data.elements else {
+        return Err(Error::Mesh(
+            "the .msh file has no $Elements section, so no triangles".into(),
+        ));
+    };
+    // the marker of a line: its curve's first physical tag, else the curve's tag
+    let physical = |curve: i32| -> Option<i32> {
+        file.data
+            .entities
+            .as_ref()?
+            .curves
+            .iter()
+            .find(|c| c.tag == curve)?
+            .physical_tags
+            .first()
+            .copied()
+    };
+    let mut found: Vec<(ElementType, usize)> = Vec::new();
+    let mut triangles = Vec::new();
+    let mut lines = Vec::new();
+    for block in &elements.element_blocks {
+        match found.iter_mut().find(|(t, _)| *t == block.element_type) {
+            Some((_, n)) => *n += block.elements.len(),
+            None => found.push((block.element_type, block.elements.len())),
+        }
+        match block.element_type {
+            ElementType::Tri3 => {
+                for e in &block.elements {
+                    triangles.push((e.element_tag, [e.nodes[0], e.nodes[1], e.nodes[2]]));
+                }
+            }
+            ElementType::Lin2 => {
+                let tag = physical(block.entity_tag).unwrap_or(block.entity_tag);
+                let marker = u32::try_from(tag).map_err(|_| {
+                    Error::Mesh(format!(
+                        "curve {} has marker {tag}; boundary markers must be non-negative",
+                        block.entity_tag
+                    ))
+                })?;
+                for e in &block.elements {
+                    lines.push((e.element_tag, [e.nodes[0], e.nodes[1]], marker));
+                }
+            }
+            _ => {}
+        }
+    }
+    let list = |types: &[(ElementType, usize)]| {
+        types
+            .iter()
+            .map(|&(t, n)| format!("{} ×{n}", type_name(t)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let higher_order: Vec<(ElementType, usize)> = found
+        .iter()
+        .copied()
+        .filter(|&(t, _)| {
+            let name = format!("{t:?}");
+            let nodes = t.nodes().unwrap_or(0);
+            (name.starts_with("Tri") && nodes > 3) || (name.starts_with("Lin") && nodes > 2)
+        })
+        .collect();
+    if !higher_order.is_empty() {
+        return Err(Error::Mesh(format!(
+            "second- or higher-order elements are not supported (found {}); only 3-node triangles can be read: mesh with Mesh.ElementOrder = 1",
+            list(&higher_order)
+        )));
+    }
+    if triangles.is_empty() {
+        return Err(Error::Mesh(format!(
+            "the .msh file has no 3-node triangles (element types found: {}); only 3-node triangles (Gmsh type 2) are supported",
+            if found.is_empty() { "none".to_string() } else { list(&found) }
+        )));
+    }
+    let other: Vec<(ElementType, usize)> = found
+        .iter()
+        .copied()
+        .filter(|&(t, _)| !matches!(t, ElementType::Tri3 | ElementType::Lin2 | ElementType::Pnt))
+        .collect();
+    if !other.is_empty() {
+        return Err(Error::Mesh(format!(
+            "unsupported element types {}: only 3-node triangles (with 2-node boundary lines and points) can be read",
+            list(&other)
+        )));
+    }
+    Ok(Elements { triangles, lines })
+}
+
+/// All coordinates must have `z = 0` up to 1e-12 of the extent in the plane.
+fn check_planar(vertices: &[[f64; 2]], zs: &[f64], tags: &[u64]) -> Result<()> {
+    let mut lower = [f64::INFINITY; 2];
+    let mut upper = [f64::NEG_INFINITY; 2];
+    for v in vertices {
+        for d in 0..2 {
+            lower[d] = lower[d].min(v[d]);
+            upper[d] = upper[d].max(v[d]);
+        }
+    }
+    let extent = (upper[0] - lower[0]).max(upper[1] - lower[1]);
+    for (i, &z) in zs.iter().enumerate() {
+        let planar = z == 0.0 || z.abs() <= 1e-12 * extent;
+        if !planar {
+            return Err(Error::Mesh(format!(
+                "node {} has z = {z}: only meshes in the plane z = 0 are supported",
+                tags[i]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Flips every triangle if all are clockwise; mixed orientations are an error.
+fn orient(
+    vertices: &[[f64; 2]],
+    cells: &mut [[usize; 3]],
+    triangles: &[(u64, [u64; 3])],
+) -> Result<()> {
+    let sign = |c: &[usize; 3]| {
+        let (p, q, r) = (vertices[c[0]], vertices[c[1]], vertices[c[2]]);
+        let twice_area = (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1]);
+        twice_area.partial_cmp(&0.0)
+    };
+    let ccw = cells
+        .iter()
+        .filter(|c| sign(c) == Some(std::cmp::Ordering::Greater))
+        .count();
+    let cw = cells
+        .iter()
+        .filter(|c| sign(c) == Some(std::cmp::Ordering::Less))
+        .count();
+    if ccw > 0 && cw > 0 {
+        // name an element of the smaller group
+        let minority = if cw <= ccw {
+            std::cmp::Ordering::Less
+        } else {
+            std::cmp::Ordering::Greater
+        };
+        let i = cells
+            .iter()
+            .position(|c| sign(c) == Some(minority))
+            .unwrap_or(0);
+        let (odd, other) = if minority == std::cmp::Ordering::Less {
+            ("clockwise", "counter-clockwise")
+        } else {
+            ("counter-clockwise", "clockwise")
+        };
+        return Err(Error::Mesh(format!(
+            "element {} is inverted: it is {odd} while {} of the {} triangles are {other}; the surface's orientation is inconsistent",
+            triangles[i].0,
+            ccw.max(cw),
+            cells.len()
+        )));
+    }
+    if cw > 0 {
+        for c in cells.iter_mut() {
+            c.swap(1, 2);
+        }
+    }
+    Ok(())
+}
+
+/// Adds Gmsh's numbers to a mesh message: "cell 3" → "cell 3 (element 17)",
+/// "vertex 5" → "vertex 5 (node 12)".
+fn annotate_indices(message: &str, element_of_cell: &[u64], node_of_vertex: &[u64]) -> String {
+    let mut out = String::with_capacity(message.len() + 32);
+    let mut rest = message;
+    while !rest.is_empty() {
+        let found = [
+            ("cell ", element_of_cell, "element"),
+            ("vertex ", node_of_vertex, "node"),
+        ]
+        .into_iter()
+        .filter_map(|(word, table, name)| rest.find(word).map(|at| (at, word, table, name)))
+        .min_by_key(|f| f.0);
+        let Some((at, word, table, name)) = found else {
+            out.push_str(rest);
+            break;
+        };
+        let after = &rest[at + word.len()..];
+        let digits = after.len() - after.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+        out.push_str(&rest[..at + word.len() + digits]);
+        if let Some(tag) = after[..digits]
+            .parse::<usize>()
+            .ok()
+            .and_then(|i| table.get(i))
+        {
+            out.push_str(&format!(" ({name} {tag})"));
+        }
+        rest = &after[digits..];
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit square from two triangles, with boundary lines on four curves: curves 1
+    /// and 2 are in physical groups 10 and 20, curves 3 and 4 in none. Node 10 is a
+    /// geometry point no triangle uses; node tags are sparse (1–4, 10).
+    const SQUARE: &str = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$Entities
+5 4 1 0
+1 0 0 0 0
+2 1 0 0 0
+3 1 1 0 0
+4 0 1 0 0
+5 2 2 0 0
+1 0 0 0 1 0 0 1 10 2 1 -2
+2 1 0 0 1 1 0 1 20 2 2 -3
+3 0 1 0 1 1 0 0 2 3 -4
+4 0 0 0 0 1 0 0 2 4 -1
+1 0 0 0 1 1 0 1 100 4 1 2 3 4
+$EndEntities
+$Nodes
+5 5 1 10
+0 1 0 1
+1
+0 0 0
+0 2 0 1
+2
+1 0 0
+0 3 0 1
+3
+1 1 0
+0 4 0 1
+4
+0 1 0
+0 5 0 1
+10
+2 2 0
+$EndNodes
+$Elements
+7 8 1 8
+1 1 1 1
+1 1 2
+1 2 1 1
+2 2 3
+1 3 1 1
+3 3 4
+1 4 1 1
+4 4 1
+2 1 2 2
+5 1 2 3
+6 1 3 4
+0 1 15 1
+7 1
+0 5 15 1
+8 10
+$EndElements
+";
+
+    fn marker_of(m: &TriangleMesh, p: [f64; 2], q: [f64; 2]) -> u32 {
+        let find = |x: [f64; 2]| m.vertices().iter().position(|&v| v == x).unwrap();
+        let e = m.find_edge(find(p), find(q)).unwrap();
+        m.boundary_edges().iter().find(|b| b.0 == e).unwrap().1
+    }
+
+    fn error(text: &str) -> String {
+        match parse_msh(text.as_bytes()) {
+            Ok(_) => panic!("the file was accepted"),
+            Err(Error::Mesh(m)) => m,
+            Err(e) => panic!("not a mesh error: {e}"),
+        }
+    }
+
+    #[test]
+    fn reads_the_unit_square() {
+        let m = parse_msh(SQUARE.as_bytes()).unwrap();
+        assert_eq!(m.vertex_count(), 4, "node 10 is dropped");
+        assert_eq!(m.cell_count(), 2);
+        assert_eq!(
+            m.vertices(),
+            &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+        );
+        assert!((0..2).all(|c| m.area(c) > 0.0));
+        assert_eq!(marker_of(&m, [0.0, 0.0], [1.0, 0.0]), 10);
+        assert_eq!(marker_of(&m, [1.0, 0.0], [1.0, 1.0]), 20);
+        assert_eq!(marker_of(&m, [1.0, 1.0], [0.0, 1.0]), 3);
+        assert_eq!(marker_of(&m, [0.0, 1.0], [0.0, 0.0]), 4);
+    }
+
+    #[test]
+    fn reads_dense_tags_out_of_order_and_clockwise_triangles() {
+        // one node block with tags 1–4 listed out of order, clockwise triangles, and no
+        // $Entities section (markers are the curves' entity tags)
+        let text = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$Nodes
+1 4 1 4
+2 1 0 4
+3
+1
+4
+2
+1 1 0
+0 0 0
+0 1 0
+1 0 0
+$EndNodes
+$Elements
+2 3 1 3
+1 7 1 1
+1 1 2
+2 1 2 2
+2 1 3 2
+3 1 4 3
+$EndElements
+";
+        let m = parse_msh(text.as_bytes()).unwrap();
+        assert_eq!(
+            m.vertices(),
+            &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+        );
+        assert!((0..2).all(|c| m.area(c) > 0.0));
+        assert!(((0..2).map(|c| m.area(c)).sum::<f64>() - 1.0).abs() < 1e-15);
+        assert_eq!(marker_of(&m, [0.0, 0.0], [1.0, 0.0]), 7);
+        assert_eq!(marker_of(&m, [1.0, 0.0], [1.0, 1.0]), 0);
+    }
+
+    #[test]
+    fn reads_binary_files() {
+        // the unit square in binary MSH 4.1 (little endian, 8-byte size_t), no $Entities
+        let mut b: Vec<u8> = b"$MeshFormat\n4.1 1 8\n".to_vec();
+        b.extend(1i32.to_le_bytes());
+        b.extend(b"\n$EndMeshFormat\n$Nodes\n");
+        let size = |b: &mut Vec<u8>, x: u64| b.extend(x.to_le_bytes());
+        let int = |b: &mut Vec<u8>, x: i32| b.extend(x.to_le_bytes());
+        for x in [1, 4, 1, 4] {
+            size(&mut b, x);
+        }
+        for x in [2, 1, 0] {
+            int(&mut b, x);
+        }
+        size(&mut b, 4);
+        for tag in 1..=4 {
+            size(&mut b, tag);
+        }
+        for x in [
+            0.0f64, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0,
+        ] {
+            b.extend(x.to_le_bytes());
+        }
+        b.extend(b"\n$EndNodes\n$Elements\n");
+        for x in [2, 3, 1, 3] {
+            size(&mut b, x);
+        }
+        for x in [1, 5, 1] {
+            int(&mut b, x);
+        }
+        size(&mut b, 1);
+        for x in [1, 1, 2] {
+            size(&mut b, x);
+        }
+        for x in [2, 1, 2] {
+            int(&mut b, x);
+        }
+        size(&mut b, 2);
+        for x in [2, 1, 2, 3, 3, 1, 3, 4] {
+            size(&mut b, x);
+        }
+        b.extend(b"\n$EndElements\n");
+        let m = parse_msh(&b).unwrap();
+        assert_eq!(
+            m.vertices(),
+            &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+        );
+        assert_eq!(m.cell_count(), 2);
+        assert_eq!(marker_of(&m, [0.0, 0.0], [1.0, 0.0]), 5);
+        // a binary header with an integer size mshio cannot read is an error, not a panic
+        let mut odd = b.clone();
+        odd[18] = b'3';
+        assert!(error(std::str::from_utf8(&odd[..20]).unwrap()).contains("data size"));
+    }
+
+    #[test]
+    fn mixed_orientation_names_the_inverted_element() {
+        let text = SQUARE.replace("6 1 3 4", "6 1 4 3");
+        let e = error(&text);
+        assert!(e.contains("element 6") && e.contains("inverted"), "{e}");
+    }
+
+    #[test]
+    fn rejects_bad_files() {
+        assert!(error("").contains("empty"));
+        assert!(error("hello world\n").contains("$MeshFormat"));
+        let e = error("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n");
+        assert!(e.contains("2.2") && e.contains("4.1"), "{e}");
+        let e = error(&SQUARE.replace("1 0 0 0 1 0 0 1 10 2 1 -2", "1 0 0 zero"));
+        assert!(e.contains("cannot parse") && e.contains("line"), "{e}");
+        // cut inside the $Nodes section, and after $EndEntities
+        let e = error(&SQUARE[..SQUARE.find("$EndNodes").unwrap() - 5]);
+        assert!(e.contains("cannot parse"), "{e}");
+        let e = error(&SQUARE[..SQUARE.find("$Nodes").unwrap()]);
+        assert!(e.contains("no $Nodes"), "{e}");
+        let e = error(&SQUARE[..SQUARE.find("$Elements").unwrap()]);
+        assert!(e.contains("no $Elements"), "{e}");
+        let e = error(&SQUARE.replace("5 1 2 3", "5 1 2 33"));
+        assert!(e.contains("element 5") && e.contains("node 33"), "{e}");
+        let e = error(&SQUARE.replace("1 1 0\n0 4", "1 1 0.5\n0 4"));
+        assert!(e.contains("node 3") && e.contains("z = 0.5"), "{e}");
+    }
+
+    #[test]
+    fn rejects_quads_and_second_order() {
+        let quads = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$Nodes
+1 4 1 4
+2 1 0 4
+1
+2
+3
+4
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+$EndNodes
+$Elements
+1 1 1 1
+2 1 3 1
+1 1 2 3 4
+$EndElements
+";
+        let e = error(quads);
+        assert!(
+            e.contains("Qua4") && e.contains("no 3-node triangles"),
+            "{e}"
+        );
+        let tri6 = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$Nodes
+1 6 1 6
+2 1 0 6
+1
+2
+3
+4
+5
+6
+0 0 0
+1 0 0
+0 1 0
+0.5 0 0
+0.5 0.5 0
+0 0.5 0
+$EndNodes
+$Elements
+1 1 1 1
+2 1 9 1
+1 1 2 3 4 5 6
+$EndElements
+";
+        let e = error(tri6);
+        assert!(e.contains("Tri6") && e.contains("not supported"), "{e}");
+        let mixed = SQUARE.replace("7 8 1 8", "8 8 1 8").replace(
+            "2 1 2 2\n5 1 2 3\n6 1 3 4",
+            "2 1 2 1\n5 1 2 3\n2 1 3 1\n6 1 3 4 10",
+        );
+        let e = error(&mixed);
+        assert!(e.contains("Qua4") && e.contains("unsupported"), "{e}");
+    }
+
+    #[test]
+    fn mesh_errors_name_gmsh_elements() {
+        // a duplicate triangle: the message gives the Gmsh element tags too
+        let text = SQUARE.replace("7 8 1 8", "7 9 1 9").replace(
+            "2 1 2 2\n5 1 2 3\n6 1 3 4",
+            "2 1 2 3\n5 1 2 3\n6 1 3 4\n9 2 3 1",
+        );
+        let e = error(&text);
+        assert!(
+            e.contains("element 5") && e.contains("element 9") && e.contains("duplicates"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn read_msh_reads_files_and_reports_missing_ones() {
+        let dir = std::env::temp_dir().join(format!("fem-gmsh-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("square.msh");
+        std::fs::write(&path, SQUARE).unwrap();
+        assert_eq!(read_msh(&path).unwrap().cell_count(), 2);
+        let missing = read_msh(&dir.join("missing.msh")).unwrap_err();
+        assert!(matches!(missing, Error::Io(_)), "{missing}");
+        std::fs::write(&path, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n").unwrap();
+        let e = read_msh(&path).unwrap_err().to_string();
+        assert!(e.contains("square.msh") && e.contains("2.2"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,321 @@
+//! Obstacle problems on triangle meshes: the model's Dirichlet data (`boundary:`)
+//! interpolated at the boundary DOFs, nested iteration over a sequence of meshes, the
+//! classical nodal-constraint method for comparison, and the solution's contact force
+//! and contact area.
+
+use crate::boundary::Constraints;
+use crate::complementarity::{Lcp, LcpSolution};
+use crate::dof_map::SystemDofs;
+use crate::error::{Error, Result};
+use crate::linear_solve::{multiply, Cholesky};
+use crate::model::{Coefficients, Model};
+use crate::obstacle::{solve_lcp, Discretization, ObstacleOptions};
+use crate::triangle_field::{TriangleBasis, TriangleField};
+use crate::triangle_mesh::{PointLocator, TriangleMesh};
+use crate::SparseMatrix;
+use faer::sparse::SparseColMat;
+use std::time::Instant;
+
+/// The fixed DOFs of the model's `boundary:` conditions: each field's boundary DOFs get
+/// its data function's value at their nodes.
+pub fn dirichlet_constraints<M: Model>(
+    mesh: &TriangleMesh,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+) -> Result<Constraints> {
+    let mut constraints = Constraints::new();
+    for &(field, data) in M::DIRICHLET {
+        let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
+            continue;
+        };
+        let nodes = map.nodes(mesh);
+        let g = coefficients.data[data];
+        for dof in map.boundary_dofs(mesh) {
+            let x = nodes[dof];
+            let value = g(&x);
+            if !value.is_finite() {
+                return Err(Error::Input(format!(
+                    "boundary data `{}` of `{}` is {value} at ({}, {})",
+                    M::DATA[data],
+                    M::FIELDS[field].name,
+                    x[0],
+                    x[1]
+                )));
+            }
+            constraints.fix_dof(offset + dof, value)?;
+        }
+    }
+    Ok(constraints)
+}
+
+/// Assembles `bilinear`, `linear` (normally `B_h`, `L_h`) of `M` on a triangle mesh with
+/// the model's Dirichlet data, as an LCP.
+pub fn discretize_on_triangles<M: Model>(
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    bilinear: &str,
+    linear: &str,
+) -> Result<Discretization<TriangleMesh>> {
+    let dofs = SystemDofs::all::<M>(mesh)?;
+    let constraints = dirichlet_constraints::<M>(mesh, &dofs, coefficients)?;
+    Discretization::with_constraints::<M>(mesh, coefficients, dofs, &constraints, bilinear, linear)
+}
+
+/// Interpolates every field of `coarse_values` (on `coarse`) at the DOF nodes of `fine`
+/// (a start for nested iteration; nodes outside the coarse mesh get 0).
+pub fn prolong_on_triangles(
+    coarse: &Discretization<TriangleMesh>,
+    coarse_values: &[f64],
+    fine: &Discretization<TriangleMesh>,
+) -> Vec<f64> {
+    let locator = PointLocator::new(&coarse.mesh);
+    let mut out = vec![0.0; fine.dofs.dof_count()];
+    for &field in fine.dofs.fields() {
+        let (Some(map_c), Some(range_c)) = (coarse.dofs.map(field), coarse.dofs.range(field))
+        else {
+            continue;
+        };
+        let view = TriangleField {
+            mesh: &coarse.mesh,
+            map: map_c,
+            coefficients: &coarse_values[range_c],
+        };
+        let basis = TriangleBasis::new(map_c.element());
+        let map_f = fine.dofs.map(field).unwrap();
+        let offset = fine.dofs.offset(field).unwrap();
+        for (dof, x) in map_f.nodes(&fine.mesh).into_iter().enumerate() {
+            out[offset + dof] = view.at(&basis, &locator, x).unwrap_or(0.0);
+        }
+    }
+    out
+}
+
+/// A solved obstacle problem on a triangle mesh.
+pub struct TriangleObstacleSolution {
+    /// The discrete problem on the finest mesh.
+    pub discretization: Discretization<TriangleMesh>,
+    /// Coefficients of all fields (multiplier included).
+    pub values: Vec<f64>,
+    /// Iterations on the finest mesh.
+    pub iterations: usize,
+    /// `(cells, iterations)` of every level of the nested iteration.
+    pub levels: Vec<(usize, usize)>,
+    /// KKT residual of the result.
+    pub kkt_residual: f64,
+    /// Wall time of the whole solve (assembly included).
+    pub seconds: f64,
+    /// Wall time of the LCP solve on the finest mesh alone.
+    pub solve_seconds: f64,
+    /// Estimated relative rounding noise of the multiplier values (0: none).
+    pub multiplier_noise: f64,
+}
+
+/// Solves the obstacle problem `B_h`, `L_h` of `M` on the last of `meshes`, each mesh
+/// started from the solution on the one before (nested iteration).
+pub fn solve_obstacle_on_triangles<M: Model>(
+    meshes: &[TriangleMesh],
+    coefficients: &Coefficients,
+    options: ObstacleOptions,
+) -> Result<TriangleObstacleSolution> {
+    let clock = Instant::now();
+    if meshes.is_empty() {
+        return Err(Error::Input("no mesh to solve on".into()));
+    }
+    let mut levels = Vec::new();
+    let mut previous: Option<(Discretization<TriangleMesh>, Vec<f64>)> = None;
+    for (level, mesh) in meshes.iter().enumerate() {
+        let d = discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h")?;
+        let start = previous
+            .as_ref()
+            .map(|(pd, values)| d.primal_part(&prolong_on_triangles(pd, values, &d)));
+        let solution = solve_lcp(&d.lcp, start.as_deref(), options)?;
+        levels.push((mesh.cell_count(), solution.iterations));
+        let values = d.full(&solution);
+        if level + 1 == meshes.len() {
+            return Ok(TriangleObstacleSolution {
+                iterations: solution.iterations,
+                kkt_residual: solution.kkt_residual,
+                solve_seconds: solution.seconds,
+                multiplier_noise: solution.multiplier_noise,
+                discretization: d,
+                values,
+                levels,
+                seconds: clock.elapsed().as_secs_f64(),
+            });
+        }
+        previous = Some((d, values));
+    }
+    unreachable!("the last level returns")
+}
+
+impl TriangleObstacleSolution {
+    /// The coefficients of model field `field`.
+    pub fn field(&self, field: usize) -> &[f64] {
+        &self.values[self.discretization.dofs.range(field).unwrap()]
+    }
+
+    /// A view of model field `field` for evaluation and norms.
+    pub fn view(&self, field: usize) -> TriangleField<'_> {
+        TriangleField {
+            mesh: &self.discretization.mesh,
+            map: self.discretization.dofs.map(field).unwrap(),
+            coefficients: self.field(field),
+        }
+    }
+
+    /// `∫ λ_h`: the total contact force.
+    pub fn total_contact_force(&self) -> f64 {
+        self.view(self.discretization.multiplier_field).integral()
+    }
+
+    /// Area of the contact set: each cell counts with the share of its multiplier DOFs
+    /// that are active (λ above 1e-8 of the multiplier scale) or touching (constraint
+    /// residual negligible), so holes of zero λ_h where u_h lies on ψ are filled.
+    pub fn contact_area(&self) -> f64 {
+        let d = &self.discretization;
+        let lcp = &d.lcp;
+        let u = d.primal_part(&self.values);
+        let lambda: Vec<f64> = d
+            .multiplier_dofs()
+            .iter()
+            .map(|&k| self.field(d.multiplier_field)[k])
+            .collect();
+        let active = contact_indicator(lcp, &u, &lambda);
+        let map = d.dofs.map(d.multiplier_field).unwrap();
+        let per_cell = map.local_count();
+        let mut share = vec![0.0; d.mesh.cell_count()];
+        for (k, &dof) in d.multiplier_dofs().iter().enumerate() {
+            if active[k] {
+                share[dof / per_cell] += 1.0 / per_cell as f64;
+            }
+        }
+        share
+            .iter()
+            .enumerate()
+            .map(|(c, s)| s * d.mesh.area(c))
+            .sum()
+    }
+}
+
+/// Per constraint: active (λ_k above 1e-8 of the multiplier scale) or touching (its
+/// residual `R_k` negligible against the terms it is made of).
+pub fn contact_indicator(lcp: &Lcp, u: &[f64], lambda: &[f64]) -> Vec<bool> {
+    let largest = lambda.iter().cloned().fold(0.0, f64::max);
+    let scale = largest.max(lcp.multiplier_scale());
+    (0..lambda.len())
+        .map(|k| {
+            let row = &lcp.b_rows[k];
+            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
+            let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
+                + lcp.g[k].abs()
+                + (lcp.c[k] * lambda[k]).abs();
+            lambda[k] > 1e-8 * scale || (bu + lcp.c[k] * lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
+        })
+        .collect()
+}
+
+/// The classical nodal-constraint method: `A U = F` with `U_i ≥ ψ_i` at every free node,
+/// solved by the primal–dual active-set method of Hintermüller, Ito and Kunisch. The
+/// active DOFs are eliminated by replacing their rows and columns with the diagonal, so
+/// the sparsity pattern is fixed and one symbolic Cholesky serves every iteration.
+pub fn nodal_active_set(
+    a: &SparseMatrix,
+    f: &[f64],
+    psi: &[f64],
+    start: Option<&[f64]>,
+    max_iterations: usize,
+) -> Result<LcpSolution> {
+    let clock = Instant::now();
+    let n = f.len();
+    if psi.len() != n || a.nrows() != n {
+        return Err(Error::Input(format!(
+            "nodal obstacle: {} obstacle values for {n} unknowns",
+            psi.len()
+        )));
+    }
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let diagonal: Vec<f64> = (0..n)
+        .map(|j| {
+            (col_ptr[j]..col_ptr[j + 1])
+                .find(|&k| rows[k] == j)
+                .map_or(0.0, |k| vals[k])
+        })
+        .collect();
+    let pattern = a
+        .symbolic()
+        .to_owned()
+        .map_err(|e| Error::LinearSolve(format!("{e:?}")))?;
+    let cholesky = Cholesky::analyse(&pattern)?;
+    let mut u: Vec<f64> = match start {
+        Some(s) => s.iter().zip(psi).map(|(&x, &p)| x.max(p)).collect(),
+        None => psi.to_vec(),
+    };
+    let mut lambda: Vec<f64> = multiply(a, &u)
+        .iter()
+        .zip(f)
+        .map(|(au, fi)| au - fi)
+        .collect();
+    let mut active: Vec<bool> = (0..n)
+        .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
+        .collect();
+    let mut factorizations = 0;
+    for iteration in 1..=max_iterations {
+        let mut values = vals.to_vec();
+        let mut rhs = f.to_vec();
+        for j in 0..n {
+            for k in col_ptr[j]..col_ptr[j + 1] {
+                let i = rows[k];
+                if active[j] && !active[i] {
+                    rhs[i] -= vals[k] * psi[j];
+                }
+                if active[i] || active[j] {
+                    values[k] = if i == j { diagonal[j] } else { 0.0 };
+                }
+            }
+        }
+        for i in 0..n {
+            if active[i] {
+                rhs[i] = diagonal[i] * psi[i];
+            }
+        }
+        let matrix = SparseColMat::new(pattern.clone(), values);
+        u = cholesky.factor(&matrix)?.solve_refined(&matrix, &rhs, 1)?;
+        factorizations += 1;
+        let au = multiply(a, &u);
+        for i in 0..n {
+            lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
+        }
+        let next: Vec<bool> = (0..n)
+            .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
+            .collect();
+        if next == active {
+            let lcp = nodal_lcp(a, f, psi);
+            let kkt_residual = lcp.kkt_residual(&u, &lambda);
+            return Ok(LcpSolution {
+                u,
+                lambda,
+                iterations: iteration,
+                kkt_residual,
+                seconds: clock.elapsed().as_secs_f64(),
+                factorizations,
+                multiplier_noise: 0.0,
+            });
+        }
+        active = next;
+    }
+    Err(Error::NotConverged {
+        solver: "nodal primal-dual active set",
+        detail: format!("no fixed active set after {max_iterations} iterations"),
+    })
+}
+
+/// The LCP of the nodal method (`B = I`, `C = 0`, `G = ψ`), for its KKT residual.
+pub fn nodal_lcp(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
+    Lcp {
+        a: a.clone(),
+        b_rows: (0..f.len()).map(|i| vec![(i, 1.0)]).collect(),
+        c: vec![0.0; f.len()],
+        f: f.to_vec(),
+        g: psi.to_vec(),
+    }
+}

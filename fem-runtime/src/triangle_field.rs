@@ -1,0 +1,193 @@
+//! Finite element functions on triangle meshes: values and gradients on cells and at
+//! points, integrals, and errors against exact functions.
+
+use crate::dof_map::DofMap;
+use crate::triangle_mesh::{PointLocator, TriangleMesh};
+use fem_reference::triangle::{Polynomial2, TriangleRule};
+
+/// A field given by its coefficients on a DOF map of a triangle mesh.
+pub struct TriangleField<'a> {
+    /// The mesh.
+    pub mesh: &'a TriangleMesh,
+    /// The field's DOFs.
+    pub map: &'a DofMap,
+    /// Its coefficients (indexed by the map's DOFs).
+    pub coefficients: &'a [f64],
+}
+
+/// The affine map of a cell: `x = x₀ + J ξ`, and `K = J⁻¹`.
+#[derive(Clone, Copy, Debug)]
+pub struct AffineMap {
+    origin: [f64; 2],
+    j: [[f64; 2]; 2],
+    k: [[f64; 2]; 2],
+    /// `|det J|` = twice the area.
+    pub det: f64,
+}
+
+impl AffineMap {
+    /// The map of cell `c`.
+    pub fn of(mesh: &TriangleMesh, c: usize) -> Self {
+        let x = mesh.cell_coordinates(c);
+        let j = [[x[2] - x[0], x[4] - x[0]], [x[3] - x[1], x[5] - x[1]]];
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        let k = [
+            [j[1][1] / det, -j[0][1] / det],
+            [-j[1][0] / det, j[0][0] / det],
+        ];
+        Self {
+            origin: [x[0], x[1]],
+            j,
+            k,
+            det: det.abs(),
+        }
+    }
+
+    /// The physical point of reference point `ξ`.
+    pub fn point(&self, xi: [f64; 2]) -> [f64; 2] {
+        [
+            self.origin[0] + self.j[0][0] * xi[0] + self.j[0][1] * xi[1],
+            self.origin[1] + self.j[1][0] * xi[0] + self.j[1][1] * xi[1],
+        ]
+    }
+
+    /// The physical gradient from the reference gradient: `∇φ = Kᵀ ∇̂φ̂`.
+    pub fn gradient(&self, g: [f64; 2]) -> [f64; 2] {
+        [
+            self.k[0][0] * g[0] + self.k[1][0] * g[1],
+            self.k[0][1] * g[0] + self.k[1][1] * g[1],
+        ]
+    }
+}
+
+/// The reference basis of an element with its first derivatives.
+pub struct TriangleBasis {
+    values: Vec<Polynomial2>,
+    dx: Vec<Polynomial2>,
+    dy: Vec<Polynomial2>,
+}
+
+impl TriangleBasis {
+    /// The basis of `element` on the reference triangle.
+    pub fn new(element: fem_reference::ElementKind) -> Self {
+        let values = element.triangle_basis();
+        let dx = values.iter().map(|p| p.derivative(1, 0)).collect();
+        let dy = values.iter().map(|p| p.derivative(0, 1)).collect();
+        Self { values, dx, dy }
+    }
+}
+
+impl TriangleField<'_> {
+    /// Value at reference point `ξ` of cell `c`.
+    pub fn value(&self, basis: &TriangleBasis, c: usize, xi: [f64; 2]) -> f64 {
+        self.map
+            .cell_dofs(c)
+            .iter()
+            .zip(&basis.values)
+            .map(|(&d, p)| self.coefficients[d] * p.eval(xi))
+            .sum()
+    }
+
+    /// Gradient at reference point `ξ` of cell `c`.
+    pub fn gradient(
+        &self,
+        basis: &TriangleBasis,
+        map: &AffineMap,
+        c: usize,
+        xi: [f64; 2],
+    ) -> [f64; 2] {
+        let mut g = [0.0; 2];
+        for ((&d, px), py) in self.map.cell_dofs(c).iter().zip(&basis.dx).zip(&basis.dy) {
+            g[0] += self.coefficients[d] * px.eval(xi);
+            g[1] += self.coefficients[d] * py.eval(xi);
+        }
+        map.gradient(g)
+    }
+
+    /// Value at a physical point, `None` outside the mesh.
+    pub fn at(&self, basis: &TriangleBasis, locator: &PointLocator, x: [f64; 2]) -> Option<f64> {
+        let (c, b) = locator.locate(x)?;
+        Some(self.value(basis, c, [b[1], b[2]]))
+    }
+
+    /// `∫ u_h`.
+    pub fn integral(&self) -> f64 {
+        let basis = TriangleBasis::new(self.map.element());
+        let rule = TriangleRule::exact_for_degree(self.map.element().degree());
+        (0..self.mesh.cell_count())
+            .map(|c| {
+                let det = AffineMap::of(self.mesh, c).det;
+                rule.integrate(|xi| self.value(&basis, c, xi)) * det
+            })
+            .sum()
+    }
+
+    /// `‖u − u_h‖_{L²}` and `|u − u_h|_{H¹}` against `exact(x) = (u, ∇u)`, with a rule of
+    /// degree `degree` on each cell.
+    pub fn errors(&self, exact: &dyn Fn([f64; 2]) -> (f64, [f64; 2]), degree: usize) -> (f64, f64) {
+        let basis = TriangleBasis::new(self.map.element());
+        let rule = TriangleRule::exact_for_degree(degree);
+        let (mut l2, mut h1) = (0.0, 0.0);
+        for c in 0..self.mesh.cell_count() {
+            let map = AffineMap::of(self.mesh, c);
+            for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+                let (u, g) = exact(map.point(xi));
+                let e = u - self.value(&basis, c, xi);
+                let gh = self.gradient(&basis, &map, c, xi);
+                l2 += w * map.det * e * e;
+                h1 += w * map.det * ((g[0] - gh[0]).powi(2) + (g[1] - gh[1]).powi(2));
+            }
+        }
+        (l2.sqrt(), h1.sqrt())
+    }
+
+    /// `(Σ_T h_T^{2·power} ‖λ − λ_h‖²_T)^{1/2}` against `exact(x)`; `power = 0` is the L² norm.
+    pub fn weighted_error(
+        &self,
+        exact: &dyn Fn([f64; 2]) -> f64,
+        power: i32,
+        degree: usize,
+    ) -> f64 {
+        let basis = TriangleBasis::new(self.map.element());
+        let rule = TriangleRule::exact_for_degree(degree);
+        let mut sum = 0.0;
+        for c in 0..self.mesh.cell_count() {
+            let map = AffineMap::of(self.mesh, c);
+            let weight = self.mesh.cell_diameter(c).powi(2 * power);
+            let mut cell = 0.0;
+            for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+                let e = exact(map.point(xi)) - self.value(&basis, c, xi);
+                cell += w * map.det * e * e;
+            }
+            sum += weight * cell;
+        }
+        sum.sqrt()
+    }
+
+    /// The value at every mesh vertex (the mean over the cells around it for
+    /// discontinuous fields).
+    pub fn vertex_values(&self) -> Vec<f64> {
+        let basis = TriangleBasis::new(self.map.element());
+        let mut sum = vec![0.0; self.mesh.vertex_count()];
+        let mut count = vec![0usize; self.mesh.vertex_count()];
+        let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        for c in 0..self.mesh.cell_count() {
+            for (&v, &xi) in self.mesh.cell(c).iter().zip(&corners) {
+                sum[v] += self.value(&basis, c, xi);
+                count[v] += 1;
+            }
+        }
+        sum.iter()
+            .zip(&count)
+            .map(|(s, &n)| s / n.max(1) as f64)
+            .collect()
+    }
+
+    /// The value at every cell's centroid (its mean for P0 and P1 fields).
+    pub fn centroid_values(&self) -> Vec<f64> {
+        let basis = TriangleBasis::new(self.map.element());
+        (0..self.mesh.cell_count())
+            .map(|c| self.value(&basis, c, [1.0 / 3.0, 1.0 / 3.0]))
+            .collect()
+    }
+}

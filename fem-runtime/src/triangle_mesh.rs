@@ -1,0 +1,1456 @@
+//! Triangle meshes of polygonal domains: generators, validation, conforming
+//! newest-vertex bisection and point location.
+//!
+//! Every cell is stored counter-clockwise with its refinement edge opposite local
+//! vertex 0 (local edge 1, vertices 1–2). `new` chooses the longest edge as refinement
+//! edge; bisection then keeps the newest vertex at local position 0, so descendants
+//! fall into at most four similarity classes per initial cell.
+
+use crate::error::{Error, Result};
+
+/// Marks "no cell" / "no midpoint" in the index tables.
+const NONE: usize = usize::MAX;
+
+/// How [`TriangleMesh::rectangle`] splits each grid square into triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Diagonal {
+    /// The diagonal from the lower-left to the upper-right corner (`/`).
+    Right,
+    /// The diagonal from the lower-right to the upper-left corner (`\`).
+    Left,
+    /// `Right` and `Left` alternating like a checkerboard, `Right` in the lower-left square.
+    Alternating,
+    /// Both diagonals: four triangles per square around a centre vertex.
+    Crossed,
+}
+
+/// A conforming mesh of counter-clockwise triangles with its edges and boundary markers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    vertices: Vec<[f64; 2]>,
+    cells: Vec<[usize; 3]>,
+    /// Each edge as `[a, b]` with `a < b`, sorted lexicographically.
+    edges: Vec<[usize; 2]>,
+    /// The edges whose smaller vertex is `v` are `edges[edge_start[v]..edge_start[v + 1]]`,
+    /// sorted by the larger vertex, so an edge is found by a binary search.
+    edge_start: Vec<usize>,
+    cell_edges: Vec<[usize; 3]>,
+    /// The one or two cells of each edge; `NONE` in the second slot on the boundary.
+    edge_cells: Vec<[usize; 2]>,
+    /// Sorted by edge.
+    boundary_edges: Vec<(usize, u32)>,
+}
+
+fn mesh_error(message: String) -> Error {
+    Error::Mesh(message)
+}
+
+/// Twice the signed area of the triangle `p q r` (positive when counter-clockwise).
+#[inline]
+fn cross(p: [f64; 2], q: [f64; 2], r: [f64; 2]) -> f64 {
+    (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1])
+}
+
+#[inline]
+fn dist2(p: [f64; 2], q: [f64; 2]) -> f64 {
+    let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+    dx * dx + dy * dy
+}
+
+/// `a + (b − a) i / n`, exactly `b` at `i = n` so that generated meshes close up.
+fn lerp(a: f64, b: f64, i: usize, n: usize) -> f64 {
+    if i == n {
+        b
+    } else {
+        a + (b - a) * i as f64 / n as f64
+    }
+}
+
+impl TriangleMesh {
+    /// A validated mesh; `cells` are vertex triples that must be counter-clockwise.
+    ///
+    /// `boundary_markers` lists `(vertex a, vertex b, marker)` for boundary edges (in
+    /// either vertex order); boundary edges not listed get marker 0. Each cell is rotated
+    /// (keeping its orientation) so that its longest edge becomes the refinement edge,
+    /// with ties broken by the edge's vertex indices so neighbours agree.
+    pub fn new(
+        vertices: Vec<[f64; 2]>,
+        mut cells: Vec<[usize; 3]>,
+        boundary_markers: &[(usize, usize, u32)],
+    ) -> Result<Self> {
+        if cells.is_empty() {
+            return Err(mesh_error("a triangle mesh needs at least one cell".into()));
+        }
+        if let Some(i) = vertices
+            .iter()
+            .position(|v| !(v[0].is_finite() && v[1].is_finite()))
+        {
+            return Err(mesh_error(format!(
+                "vertex {i} has non-finite coordinates ({}, {})",
+                vertices[i][0], vertices[i][1]
+            )));
+        }
+        let nv = vertices.len();
+        let mut used = vec![false; nv];
+        for (c, cell) in cells.iter_mut().enumerate() {
+            if let Some(&v) = cell.iter().find(|&&v| v >= nv) {
+                return Err(mesh_error(format!(
+                    "cell {c} {cell:?} names vertex {v}, but the mesh has only {nv} vertices"
+                )));
+            }
+            let [a, b, d] = *cell;
+            if a == b || b == d || d == a {
+                let repeated = if a == b || a == d { a } else { b };
+                return Err(mesh_error(format!(
+                    "cell {c} {cell:?} repeats vertex {repeated}"
+                )));
+            }
+            let p = [vertices[a], vertices[b], vertices[d]];
+            let twice_area = cross(p[0], p[1], p[2]);
+            // opposite[i] = squared length of the edge opposite local vertex i
+            let opposite = [dist2(p[1], p[2]), dist2(p[2], p[0]), dist2(p[0], p[1])];
+            let longest = opposite.iter().copied().fold(0.0, f64::max);
+            if twice_area.abs() <= 2e-12 * longest {
+                return Err(mesh_error(format!(
+                    "cell {c} {cell:?} is degenerate: its area {:e} is at most 1e-12 × (longest edge {:e})²",
+                    0.5 * twice_area.abs(),
+                    longest.sqrt()
+                )));
+            }
+            if twice_area < 0.0 {
+                return Err(mesh_error(format!(
+                    "cell {c} {cell:?} is inverted (clockwise, signed area {:e}); cells must be counter-clockwise",
+                    0.5 * twice_area
+                )));
+            }
+            // The refinement edge is the longest; the tie-break is a function of the edge
+            // alone, so both cells of an edge rank it the same way.
+            let key = |i: usize| {
+                let (u, w) = (cell[(i + 1) % 3], cell[(i + 2) % 3]);
+                (opposite[i], u.min(w), u.max(w))
+            };
+            let top = (0..3)
+                .max_by(|&i, &j| {
+                    let (ki, kj) = (key(i), key(j));
+                    ki.0.total_cmp(&kj.0)
+                        .then(ki.1.cmp(&kj.1))
+                        .then(ki.2.cmp(&kj.2))
+                })
+                .unwrap_or(0);
+            *cell = [cell[top], cell[(top + 1) % 3], cell[(top + 2) % 3]];
+            for v in *cell {
+                used[v] = true;
+            }
+        }
+        if let Some(v) = used.iter().position(|&u| !u) {
+            return Err(mesh_error(format!(
+                "vertex {v} ({}, {}) belongs to no cell",
+                vertices[v][0], vertices[v][1]
+            )));
+        }
+        let mut mesh = Self::from_oriented(vertices, cells)?;
+        mesh.apply_markers(boundary_markers)?;
+        Ok(mesh)
+    }
+
+    /// The edge tables of counter-clockwise cells whose local order is kept as given.
+    ///
+    /// Edges are bucketed by their smaller vertex (a counting sort), so the build is
+    /// linear in the mesh size apart from sorting the few edges at each vertex.
+    fn from_oriented(vertices: Vec<[f64; 2]>, cells: Vec<[usize; 3]>) -> Result<Self> {
+        let nv = vertices.len();
+        let nc = cells.len();
+        let mut start = vec![0usize; nv + 1];
+        for cell in &cells {
+            for k in 0..3 {
+                start[cell[k].min(cell[(k + 1) % 3]) + 1] += 1;
+            }
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        // (larger vertex, 3·cell + local edge) per half-edge, grouped by smaller vertex
+        let mut slots = vec![(0usize, 0usize); 3 * nc];
+        let mut fill = start.clone();
+        for (c, cell) in cells.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (cell[k], cell[(k + 1) % 3]);
+                let lo = a.min(b);
+                slots[fill[lo]] = (a.max(b), 3 * c + k);
+                fill[lo] += 1;
+            }
+        }
+        drop(fill);
+        let estimated_edges = (3 * nc) / 2 + nv;
+        let mut edges = Vec::with_capacity(estimated_edges);
+        let mut edge_start = vec![0usize; nv + 1];
+        let mut edge_cells = Vec::with_capacity(estimated_edges);
+        let mut cell_edges = vec![[NONE; 3]; nc];
+        let mut boundary_edges = Vec::new();
+        for lo in 0..nv {
+            edge_start[lo] = edges.len();
+            let bucket = &mut slots[start[lo]..start[lo + 1]];
+            bucket.sort_unstable();
+            let mut i = 0;
+            while i < bucket.len() {
+                let hi = bucket[i].0;
+                let mut j = i + 1;
+                while j < bucket.len() && bucket[j].0 == hi {
+                    j += 1;
+                }
+                let group = &bucket[i..j];
+                Self::check_edge_group(&cells, lo, hi, group)?;
+                let e = edges.len();
+                edges.push([lo, hi]);
+                for &(_, s) in group {
+                    cell_edges[s / 3][s % 3] = e;
+                }
+                if group.len() == 1 {
+                    edge_cells.push([group[0].1 / 3, NONE]);
+                    boundary_edges.push((e, 0));
+                } else {
+                    edge_cells.push([group[0].1 / 3, group[1].1 / 3]);
+                }
+                i = j;
+            }
+        }
+        edge_start[nv] = edges.len();
+        Ok(Self {
+            vertices,
+            cells,
+            edges,
+            edge_start,
+            cell_edges,
+            edge_cells,
+            boundary_edges,
+        })
+    }
+
+    /// Rejects an edge `(lo, hi)` whose cells are duplicates, overlap, or number more than
+    /// two; `group` holds `(hi, 3·cell + local edge)` for each cell of the edge.
+    fn check_edge_group(
+        cells: &[[usize; 3]],
+        lo: usize,
+        hi: usize,
+        group: &[(usize, usize)],
+    ) -> Result<()> {
+        if group.len() == 1 {
+            return Ok(());
+        }
+        let owners: Vec<(usize, usize)> = group.iter().map(|&(_, s)| (s / 3, s % 3)).collect();
+        // Two counter-clockwise cells on the same side of an edge run it in the same
+        // direction; with the same third vertex they are the same triangle.
+        let third = |(c, k): (usize, usize)| cells[c][(k + 2) % 3];
+        let start = |(c, k): (usize, usize)| cells[c][k];
+        for (i, &x) in owners.iter().enumerate() {
+            for &y in &owners[i + 1..] {
+                if third(x) == third(y) {
+                    let mut set = cells[x.0];
+                    set.sort_unstable();
+                    return Err(mesh_error(format!(
+                        "cell {} and cell {} are duplicates: both have the vertices {set:?}",
+                        x.0, y.0
+                    )));
+                }
+            }
+        }
+        if owners.len() > 2 {
+            let names: Vec<String> = owners.iter().map(|&(c, _)| format!("cell {c}")).collect();
+            return Err(mesh_error(format!(
+                "the edge between vertex {lo} and vertex {hi} is shared by {} cells ({}); an edge may belong to at most two cells",
+                owners.len(),
+                names.join(", ")
+            )));
+        }
+        if owners.len() == 2 && start(owners[0]) == start(owners[1]) {
+            return Err(mesh_error(format!(
+                "cell {} and cell {} overlap: both lie on the same side of their common edge between vertex {lo} and vertex {hi}",
+                owners[0].0, owners[1].0
+            )));
+        }
+        Ok(())
+    }
+
+    /// Sets the markers of the listed boundary edges; the rest keep theirs.
+    pub(crate) fn apply_markers(&mut self, markers: &[(usize, usize, u32)]) -> Result<()> {
+        let mut set = vec![false; self.boundary_edges.len()];
+        for &(a, b, marker) in markers {
+            let e = self.find_edge(a, b).ok_or_else(|| {
+                mesh_error(format!(
+                    "boundary marker ({a}, {b}, {marker}): vertex {a} and vertex {b} are not joined by an edge of the mesh"
+                ))
+            })?;
+            let [c0, c1] = self.edge_cells[e];
+            if c1 != NONE {
+                return Err(mesh_error(format!(
+                    "boundary marker ({a}, {b}, {marker}) names an interior edge (shared by cell {c0} and cell {c1}), not a boundary edge"
+                )));
+            }
+            let Ok(slot) = self.boundary_edges.binary_search_by_key(&e, |&(e, _)| e) else {
+                return Err(mesh_error(format!(
+                    "boundary marker ({a}, {b}, {marker}): edge {e} is missing from the boundary table"
+                )));
+            };
+            if set[slot] && self.boundary_edges[slot].1 != marker {
+                return Err(mesh_error(format!(
+                    "boundary edge between vertex {a} and vertex {b} is given two markers, {} and {marker}",
+                    self.boundary_edges[slot].1
+                )));
+            }
+            set[slot] = true;
+            self.boundary_edges[slot].1 = marker;
+        }
+        Ok(())
+    }
+
+    /// The global edge joining vertices `a` and `b`, if there is one.
+    pub(crate) fn find_edge(&self, a: usize, b: usize) -> Option<usize> {
+        let (lo, hi) = (a.min(b), a.max(b));
+        if hi >= self.vertices.len() {
+            return None;
+        }
+        let range = self.edge_start[lo]..self.edge_start[lo + 1];
+        self.edges[range.clone()]
+            .binary_search_by_key(&hi, |e| e[1])
+            .ok()
+            .map(|i| range.start + i)
+    }
+
+    /// `nx × ny` squares on `[x0, x1] × [y0, y1]`, each split as `diagonal` says.
+    ///
+    /// Boundary markers: 1 bottom (`y = y0`), 2 right, 3 top, 4 left.
+    pub fn rectangle(
+        x0: f64,
+        x1: f64,
+        y0: f64,
+        y1: f64,
+        nx: usize,
+        ny: usize,
+        diagonal: Diagonal,
+    ) -> Result<Self> {
+        if !(x0.is_finite() && x1.is_finite() && y0.is_finite() && y1.is_finite())
+            || x0 >= x1
+            || y0 >= y1
+        {
+            return Err(mesh_error(format!(
+                "rectangle [{x0}, {x1}] × [{y0}, {y1}] needs finite bounds with x0 < x1 and y0 < y1"
+            )));
+        }
+        if nx == 0 || ny == 0 {
+            return Err(mesh_error(format!(
+                "rectangle needs at least one square in each direction, got {nx} × {ny}"
+            )));
+        }
+        let id = |i: usize, j: usize| j * (nx + 1) + i;
+        let mut vertices = Vec::with_capacity((nx + 1) * (ny + 1));
+        for j in 0..=ny {
+            let y = lerp(y0, y1, j, ny);
+            for i in 0..=nx {
+                vertices.push([lerp(x0, x1, i, nx), y]);
+            }
+        }
+        let per_square = if diagonal == Diagonal::Crossed { 4 } else { 2 };
+        let mut cells = Vec::with_capacity(per_square * nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                let right = match diagonal {
+                    Diagonal::Right => true,
+                    Diagonal::Left => false,
+                    Diagonal::Alternating => (i + j) % 2 == 0,
+                    Diagonal::Crossed => {
+                        let e = vertices.len();
+                        let (xa, ya) = (vertices[a][0], vertices[a][1]);
+                        let (xc, yc) = (vertices[c][0], vertices[c][1]);
+                        vertices.push([0.5 * (xa + xc), 0.5 * (ya + yc)]);
+                        cells.extend([[a, b, e], [b, c, e], [c, d, e], [d, a, e]]);
+                        continue;
+                    }
+                };
+                if right {
+                    cells.extend([[a, b, c], [a, c, d]]);
+                } else {
+                    cells.extend([[a, b, d], [b, c, d]]);
+                }
+            }
+        }
+        let mut markers = Vec::with_capacity(2 * (nx + ny));
+        for i in 0..nx {
+            markers.push((id(i, 0), id(i + 1, 0), 1));
+            markers.push((id(i, ny), id(i + 1, ny), 3));
+        }
+        for j in 0..ny {
+            markers.push((id(nx, j), id(nx, j + 1), 2));
+            markers.push((id(0, j), id(0, j + 1), 4));
+        }
+        Self::new(vertices, cells, &markers)
+    }
+
+    /// A disk: a centre vertex and `rings` rings, ring `k` with `6k` vertices at radius
+    /// `k/rings · radius`; neighbouring rings are zipped by angle. Boundary marker 1.
+    pub fn disk(centre: [f64; 2], radius: f64, rings: usize) -> Result<Self> {
+        if !(centre[0].is_finite() && centre[1].is_finite()) {
+            return Err(mesh_error(format!(
+                "disk centre ({}, {}) is not finite",
+                centre[0], centre[1]
+            )));
+        }
+        if !(radius > 0.0 && radius.is_finite()) {
+            return Err(mesh_error(format!(
+                "disk radius {radius} must be positive and finite"
+            )));
+        }
+        if rings == 0 {
+            return Err(mesh_error("a disk needs at least one ring".into()));
+        }
+        // ring k ≥ 1 starts at 1 + 6(1 + … + (k − 1)) = 1 + 3k(k − 1)
+        let ring_start = |k: usize| if k == 0 { 0 } else { 1 + 3 * k * (k - 1) };
+        let mut vertices = Vec::with_capacity(ring_start(rings + 1));
+        vertices.push(centre);
+        for k in 1..=rings {
+            let r = lerp(0.0, radius, k, rings);
+            let n = 6 * k;
+            for i in 0..n {
+                let t = std::f64::consts::TAU * i as f64 / n as f64;
+                vertices.push([centre[0] + r * t.cos(), centre[1] + r * t.sin()]);
+            }
+        }
+        let mut cells = Vec::with_capacity(6 * rings * rings);
+        for q in 0..6 {
+            cells.push([0, 1 + q, 1 + (q + 1) % 6]);
+        }
+        for k in 2..=rings {
+            let (n_in, n_out) = (6 * (k - 1), 6 * k);
+            let (s_in, s_out) = (ring_start(k - 1), ring_start(k));
+            let inner = |p: usize| s_in + p % n_in;
+            let outer = |q: usize| s_out + q % n_out;
+            let (mut p, mut q) = (0, 0);
+            while p < n_in || q < n_out {
+                // advance on the ring whose next vertex comes first by angle
+                let step_outer = p == n_in || (q < n_out && (q + 1) * n_in <= (p + 1) * n_out);
+                if step_outer {
+                    cells.push([inner(p), outer(q), outer(q + 1)]);
+                    q += 1;
+                } else {
+                    cells.push([inner(p), outer(q), inner(p + 1)]);
+                    p += 1;
+                }
+            }
+        }
+        let (s, n) = (ring_start(rings), 6 * rings);
+        let markers: Vec<_> = (0..n).map(|i| (s + i, s + (i + 1) % n, 1)).collect();
+        Self::new(vertices, cells, &markers)
+    }
+
+    /// The L-shaped domain `(−1, 1)² \ [0, 1] × [−1, 0]`: the `2n × 2n` grid of squares of
+    /// side `1/n` on `(−1, 1)²` with `Right` diagonals, less the lower-right quadrant.
+    ///
+    /// Marker 2 on the re-entrant edges (`{0} × [−1, 0]` and `[0, 1] × {0}`), 1 elsewhere.
+    pub fn l_shape(n: usize) -> Result<Self> {
+        if n == 0 {
+            return Err(mesh_error(
+                "an L-shape needs at least one square per unit length".into(),
+            ));
+        }
+        let m = 2 * n;
+        let removed_square = |i: usize, j: usize| i >= n && j < n;
+        let mut id = vec![NONE; (m + 1) * (m + 1)];
+        let mut vertices = Vec::new();
+        for j in 0..=m {
+            for i in 0..=m {
+                if !(i > n && j < n) {
+                    id[j * (m + 1) + i] = vertices.len();
+                    vertices.push([lerp(-1.0, 1.0, i, m), lerp(-1.0, 1.0, j, m)]);
+                }
+            }
+        }
+        let at = |i: usize, j: usize| id[j * (m + 1) + i];
+        let mut cells = Vec::with_capacity(6 * n * n);
+        for j in 0..m {
+            for i in 0..m {
+                if !removed_square(i, j) {
+                    let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                    cells.extend([[a, b, c], [a, c, d]]);
+                }
+            }
+        }
+        let mut markers = Vec::with_capacity(8 * n);
+        for i in 0..n {
+            markers.push((at(i, 0), at(i + 1, 0), 1)); // bottom of the left half
+            markers.push((at(n, i), at(n, i + 1), 2)); // re-entrant x = 0
+            markers.push((at(n + i, n), at(n + i + 1, n), 2)); // re-entrant y = 0
+            markers.push((at(m, n + i), at(m, n + i + 1), 1)); // right of the upper half
+        }
+        for k in 0..m {
+            markers.push((at(0, k), at(0, k + 1), 1)); // left
+            markers.push((at(k, m), at(k + 1, m), 1)); // top
+        }
+        Self::new(vertices, cells, &markers)
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.vertices.len()
+    }
+
+    /// Number of cells.
+    pub fn cell_count(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Number of edges.
+    pub fn edge_count(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// The vertex coordinates.
+    pub fn vertices(&self) -> &[[f64; 2]] {
+        &self.vertices
+    }
+
+    /// The cells' vertex triples, counter-clockwise, refinement edge opposite local vertex 0.
+    pub fn cells(&self) -> &[[usize; 3]] {
+        &self.cells
+    }
+
+    /// The vertices of cell `c`.
+    #[inline]
+    pub fn cell(&self, c: usize) -> [usize; 3] {
+        self.cells[c]
+    }
+
+    /// The coordinates `x0, y0, x1, y1, x2, y2` of cell `c`, as the element kernels take them.
+    #[inline]
+    pub fn cell_coordinates(&self, c: usize) -> [f64; 6] {
+        let [a, b, d] = self.cells[c];
+        let (p, q, r) = (self.vertices[a], self.vertices[b], self.vertices[d]);
+        [p[0], p[1], q[0], q[1], r[0], r[1]]
+    }
+
+    /// The length of the longest edge of cell `c`.
+    pub fn cell_diameter(&self, c: usize) -> f64 {
+        let [a, b, d] = self.cells[c];
+        let (p, q, r) = (self.vertices[a], self.vertices[b], self.vertices[d]);
+        dist2(p, q).max(dist2(q, r)).max(dist2(r, p)).sqrt()
+    }
+
+    /// The area of cell `c`.
+    pub fn area(&self, c: usize) -> f64 {
+        let [a, b, d] = self.cells[c];
+        0.5 * cross(self.vertices[a], self.vertices[b], self.vertices[d])
+    }
+
+    /// The largest cell diameter.
+    pub fn max_h(&self) -> f64 {
+        (0..self.cells.len())
+            .map(|c| self.cell_diameter(c))
+            .fold(0.0, f64::max)
+    }
+
+    /// The smallest cell diameter.
+    pub fn min_h(&self) -> f64 {
+        (0..self.cells.len())
+            .map(|c| self.cell_diameter(c))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The global edges, each stored as `[a, b]` with `a < b`.
+    pub fn edges(&self) -> &[[usize; 2]] {
+        &self.edges
+    }
+
+    /// The global edges of cell `c`: local edge `k` joins local vertices `k` and `(k + 1) % 3`.
+    #[inline]
+    pub fn cell_edges(&self, c: usize) -> [usize; 3] {
+        self.cell_edges[c]
+    }
+
+    /// The cells of edge `e`: one, or two for an interior edge.
+    pub fn edge_cells(&self, e: usize) -> (usize, Option<usize>) {
+        let [c0, c1] = self.edge_cells[e];
+        (c0, (c1 != NONE).then_some(c1))
+    }
+
+    /// `(global edge, marker)` for every edge with exactly one cell, sorted by edge.
+    pub fn boundary_edges(&self) -> &[(usize, u32)] {
+        &self.boundary_edges
+    }
+
+    /// The vertices on boundary edges, sorted and unique.
+    pub fn boundary_vertices(&self) -> Vec<usize> {
+        let flags = self.is_boundary_vertex();
+        (0..flags.len()).filter(|&v| flags[v]).collect()
+    }
+
+    /// For each vertex, whether it lies on a boundary edge.
+    pub fn is_boundary_vertex(&self) -> Vec<bool> {
+        let mut flags = vec![false; self.vertices.len()];
+        for &(e, _) in &self.boundary_edges {
+            let [a, b] = self.edges[e];
+            flags[a] = true;
+            flags[b] = true;
+        }
+        flags
+    }
+
+    /// Conforming newest-vertex bisection of the marked cells and the closure it needs.
+    ///
+    /// Returns the new mesh and, for each new cell, its parent cell in `self`. Indices may
+    /// repeat; an out-of-range index is an error. Each cell is bisected at most twice in
+    /// depth (into two, three or four children); boundary markers pass to edge halves.
+    pub fn refine(&self, marked: &[usize]) -> Result<(TriangleMesh, Vec<usize>)> {
+        let mut edge_marked = vec![false; self.edges.len()];
+        let mut queue = Vec::new();
+        for &c in marked {
+            if c >= self.cells.len() {
+                return Err(mesh_error(format!(
+                    "cannot refine cell {c}: the mesh has {} cells",
+                    self.cells.len()
+                )));
+            }
+            let r = self.cell_edges[c][1];
+            if !edge_marked[r] {
+                edge_marked[r] = true;
+                queue.push(r);
+            }
+        }
+        // Closure: a cell with any edge to split must first split its refinement edge.
+        // This terminates for any labelling (each edge is marked at most once).
+        while let Some(e) = queue.pop() {
+            for c in self.edge_cells[e] {
+                if c == NONE {
+                    continue;
+                }
+                let r = self.cell_edges[c][1];
+                if !edge_marked[r] {
+                    edge_marked[r] = true;
+                    queue.push(r);
+                }
+            }
+        }
+        self.bisect(&edge_marked)
+    }
+
+    /// Splits every cell into four by two levels of bisection: cell count ×4, `h` halves
+    /// on meshes whose cells' longest edges are their refinement edges.
+    pub fn refine_uniformly(&self) -> TriangleMesh {
+        self.bisect(&vec![true; self.edges.len()])
+            .expect("bisecting every edge of a valid mesh gives a valid mesh")
+            .0
+    }
+
+    /// Bisects the marked edges; every cell with a marked edge has its refinement edge marked.
+    fn bisect(&self, edge_marked: &[bool]) -> Result<(TriangleMesh, Vec<usize>)> {
+        let mut vertices = self.vertices.clone();
+        let mut midpoint = vec![NONE; self.edges.len()];
+        for e in (0..self.edges.len()).filter(|&e| edge_marked[e]) {
+            let [a, b] = self.edges[e];
+            let (p, q) = (self.vertices[a], self.vertices[b]);
+            midpoint[e] = vertices.len();
+            vertices.push([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]);
+        }
+        let mut cells =
+            Vec::with_capacity(self.cells.len() + 3 * (vertices.len() - self.vertices.len()));
+        let mut parents = Vec::with_capacity(cells.capacity());
+        for (c, &[v0, v1, v2]) in self.cells.iter().enumerate() {
+            let [e0, e1, e2] = self.cell_edges[c];
+            let m = midpoint[e1];
+            if m == NONE {
+                cells.push([v0, v1, v2]);
+                parents.push(c);
+                continue;
+            }
+            // children [m, v0, v1] and [m, v2, v0]: the new vertex first, so each child's
+            // refinement edge is one of the parent's other edges
+            match midpoint[e0] {
+                NONE => cells.push([m, v0, v1]),
+                p => cells.extend([[p, m, v0], [p, v1, m]]),
+            }
+            match midpoint[e2] {
+                NONE => cells.push([m, v2, v0]),
+                p => cells.extend([[p, m, v2], [p, v0, m]]),
+            }
+            parents.resize(cells.len(), c);
+        }
+        let mut markers = Vec::new();
+        for &(e, marker) in &self.boundary_edges {
+            if marker == 0 {
+                continue;
+            }
+            let [a, b] = self.edges[e];
+            match midpoint[e] {
+                NONE => markers.push((a, b, marker)),
+                m => markers.extend([(a, m, marker), (m, b, marker)]),
+            }
+        }
+        let mut mesh = Self::from_oriented(vertices, cells)?;
+        mesh.apply_markers(&markers)?;
+        Ok((mesh, parents))
+    }
+}
+
+/// Finds the cell containing a point, through a grid of buckets over the mesh's bounding box.
+#[derive(Clone, Debug)]
+pub struct PointLocator<'a> {
+    mesh: &'a TriangleMesh,
+    origin: [f64; 2],
+    /// Buckets per unit length in x and y.
+    scale: [f64; 2],
+    nx: usize,
+    ny: usize,
+    /// The cells whose (slightly widened) bounding boxes meet bucket `b` are
+    /// `items[start[b]..start[b + 1]]`.
+    start: Vec<usize>,
+    items: Vec<usize>,
+    /// Absolute distance by which a point may lie outside a cell and still be in it.
+    slack: f64,
+    upper: [f64; 2],
+}
+
+impl<'a> PointLocator<'a> {
+    /// Buckets the cells of `mesh` (about one bucket per cell, linear time).
+    pub fn new(mesh: &'a TriangleMesh) -> Self {
+        let mut lower = [f64::INFINITY; 2];
+        let mut upper = [f64::NEG_INFINITY; 2];
+        for v in &mesh.vertices {
+            for d in 0..2 {
+                lower[d] = lower[d].min(v[d]);
+                upper[d] = upper[d].max(v[d]);
+            }
+        }
+        let size = [upper[0] - lower[0], upper[1] - lower[1]];
+        let magnitude = lower
+            .iter()
+            .chain(&upper)
+            .map(|x| x.abs())
+            .fold(size[0].max(size[1]), f64::max);
+        let slack = 1e-12 * magnitude;
+        // about one bucket per cell, square-ish buckets
+        let n = mesh.cells.len().max(1) as f64;
+        let aspect = size[0] / size[1];
+        // capped so that a very elongated mesh does not get more buckets than cells
+        let cap = 4 * mesh.cells.len() + 1;
+        let nx = ((n * aspect).sqrt().ceil() as usize).clamp(1, cap);
+        let ny = ((n / aspect).sqrt().ceil() as usize).clamp(1, cap / nx + 1);
+        let scale = [nx as f64 / size[0], ny as f64 / size[1]];
+        let mut locator = Self {
+            mesh,
+            origin: lower,
+            scale,
+            nx,
+            ny,
+            start: vec![0; nx * ny + 1],
+            items: Vec::new(),
+            slack,
+            upper,
+        };
+        let ranges: Vec<[usize; 4]> = (0..mesh.cells.len())
+            .map(|c| {
+                let [a, b, d] = mesh.cells[c];
+                let p = [mesh.vertices[a], mesh.vertices[b], mesh.vertices[d]];
+                let lo = [0, 1].map(|k| p[0][k].min(p[1][k]).min(p[2][k]) - slack);
+                let hi = [0, 1].map(|k| p[0][k].max(p[1][k]).max(p[2][k]) + slack);
+                let (i0, j0) = locator.bucket(lo);
+                let (i1, j1) = locator.bucket(hi);
+                [i0, i1, j0, j1]
+            })
+            .collect();
+        for &[i0, i1, j0, j1] in &ranges {
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    locator.start[j * nx + i + 1] += 1;
+                }
+            }
+        }
+        for b in 0..nx * ny {
+            locator.start[b + 1] += locator.start[b];
+        }
+        let mut fill = locator.start.clone();
+        locator.items = vec![0; locator.start[nx * ny]];
+        for (c, &[i0, i1, j0, j1]) in ranges.iter().enumerate() {
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    let b = j * nx + i;
+                    locator.items[fill[b]] = c;
+                    fill[b] += 1;
+                }
+            }
+        }
+        locator
+    }
+
+    /// The bucket of a point, clamped to the grid.
+    fn bucket(&self, p: [f64; 2]) -> (usize, usize) {
+        let i = ((p[0] - self.origin[0]) * self.scale[0]).floor();
+        let j = ((p[1] - self.origin[1]) * self.scale[1]).floor();
+        // `as usize` saturates negatives to 0
+        ((i as usize).min(self.nx - 1), (j as usize).min(self.ny - 1))
+    }
+
+    /// A cell containing `p` (up to about 1e-12 of the mesh's extent) and `p`'s barycentric
+    /// coordinates in it; `None` outside the mesh.
+    pub fn locate(&self, p: [f64; 2]) -> Option<(usize, [f64; 3])> {
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            return None;
+        }
+        let s = self.slack;
+        if p[0] < self.origin[0] - s
+            || p[1] < self.origin[1] - s
+            || p[0] > self.upper[0] + s
+            || p[1] > self.upper[1] + s
+        {
+            return None;
+        }
+        let (i, j) = self.bucket(p);
+        let b = j * self.nx + i;
+        let mut best: Option<(f64, usize, [f64; 3])> = None;
+        for &c in &self.items[self.start[b]..self.start[b + 1]] {
+            let [a, b, d] = self.mesh.cells[c];
+            let v = [
+                self.mesh.vertices[a],
+                self.mesh.vertices[b],
+                self.mesh.vertices[d],
+            ];
+            // w[k] = twice the area of the sub-triangle opposite vertex k
+            let w = [
+                cross(p, v[1], v[2]),
+                cross(v[0], p, v[2]),
+                cross(v[0], v[1], p),
+            ];
+            let twice_area = cross(v[0], v[1], v[2]);
+            // distance outside edge k is −w[k] / |edge k|; compare without the division
+            let inside = (0..3)
+                .all(|k| w[k] >= 0.0 || -w[k] <= s * dist2(v[(k + 1) % 3], v[(k + 2) % 3]).sqrt());
+            if !inside {
+                continue;
+            }
+            let lambda = w.map(|x| x / twice_area);
+            let worst = lambda[0].min(lambda[1]).min(lambda[2]);
+            if worst >= 0.0 {
+                return Some((c, lambda));
+            }
+            if best.is_none_or(|(w, _, _)| worst > w) {
+                best = Some((worst, c, lambda));
+            }
+        }
+        best.map(|(_, c, lambda)| (c, lambda))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (xorshift64*), so the tests need no dependencies.
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+        fn uniform(&mut self) -> f64 {
+            (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    fn total_area(m: &TriangleMesh) -> f64 {
+        (0..m.cell_count()).map(|c| m.area(c)).sum()
+    }
+
+    /// V − E + F for the mesh (1 for a simply connected domain).
+    fn euler(m: &TriangleMesh) -> i64 {
+        m.vertex_count() as i64 - m.edge_count() as i64 + m.cell_count() as i64
+    }
+
+    fn angles(m: &TriangleMesh, c: usize) -> [f64; 3] {
+        let [a, b, d] = m.cell(c);
+        let p = [m.vertices()[a], m.vertices()[b], m.vertices()[d]];
+        [0, 1, 2].map(|k| {
+            let (o, u, w) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+            let (ux, uy, wx, wy) = (u[0] - o[0], u[1] - o[1], w[0] - o[0], w[1] - o[1]);
+            (ux * wy - uy * wx).atan2(ux * wx + uy * wy)
+        })
+    }
+
+    fn min_angle(m: &TriangleMesh) -> f64 {
+        (0..m.cell_count())
+            .flat_map(|c| angles(m, c))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    fn boundary_length(m: &TriangleMesh, marker: Option<u32>) -> f64 {
+        m.boundary_edges()
+            .iter()
+            .filter(|&&(_, mk)| marker.is_none_or(|x| x == mk))
+            .map(|&(e, _)| {
+                let [a, b] = m.edges()[e];
+                dist2(m.vertices()[a], m.vertices()[b]).sqrt()
+            })
+            .sum()
+    }
+
+    /// Checks, independently of the edge tables, that no vertex lies inside another
+    /// cell's edge (a hanging node), that all cells are counter-clockwise, and that the
+    /// stored tables agree with the cells.
+    fn assert_conforming(m: &TriangleMesh) {
+        for c in 0..m.cell_count() {
+            assert!(m.area(c) > 0.0, "cell {c} is not counter-clockwise");
+            let cell = m.cell(c);
+            for (k, &e) in m.cell_edges(c).iter().enumerate() {
+                let (a, b) = (cell[k], cell[(k + 1) % 3]);
+                assert_eq!(
+                    m.edges()[e],
+                    [a.min(b), a.max(b)],
+                    "cell {c} local edge {k}"
+                );
+            }
+        }
+        let mut count = vec![0; m.edge_count()];
+        for c in 0..m.cell_count() {
+            for e in m.cell_edges(c) {
+                count[e] += 1;
+            }
+        }
+        assert!(count.iter().all(|&n| n == 1 || n == 2));
+        let boundary: Vec<usize> = (0..count.len()).filter(|&e| count[e] == 1).collect();
+        let listed: Vec<usize> = m.boundary_edges().iter().map(|&(e, _)| e).collect();
+        assert_eq!(boundary, listed);
+        if m.vertex_count() * m.edge_count() <= 20_000_000 {
+            for (e, &[a, b]) in m.edges().iter().enumerate() {
+                let (p, q) = (m.vertices()[a], m.vertices()[b]);
+                let len2 = dist2(p, q);
+                for (v, &x) in m.vertices().iter().enumerate() {
+                    if v == a || v == b {
+                        continue;
+                    }
+                    let t = ((x[0] - p[0]) * (q[0] - p[0]) + (x[1] - p[1]) * (q[1] - p[1])) / len2;
+                    let off = cross(p, q, x).abs() / len2.sqrt();
+                    assert!(
+                        !(t > 1e-9 && t < 1.0 - 1e-9 && off < 1e-9 * len2.sqrt()),
+                        "vertex {v} hangs on edge {e} ({a}, {b})"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rectangle_counts_areas_and_markers() {
+        for diagonal in [
+            Diagonal::Right,
+            Diagonal::Left,
+            Diagonal::Alternating,
+            Diagonal::Crossed,
+        ] {
+            let (nx, ny) = (5, 3);
+            let m = TriangleMesh::rectangle(-1.0, 2.0, 0.5, 1.5, nx, ny, diagonal).unwrap();
+            let per = if diagonal == Diagonal::Crossed { 4 } else { 2 };
+            assert_eq!(m.cell_count(), per * nx * ny, "{diagonal:?}");
+            let extra = if diagonal == Diagonal::Crossed {
+                nx * ny
+            } else {
+                0
+            };
+            assert_eq!(m.vertex_count(), (nx + 1) * (ny + 1) + extra);
+            assert!((total_area(&m) - 3.0).abs() < 1e-13, "{diagonal:?}");
+            assert!((0..m.cell_count()).all(|c| m.area(c) > 0.0));
+            assert_eq!(euler(&m), 1, "{diagonal:?}");
+            assert_eq!(m.boundary_edges().len(), 2 * (nx + ny));
+            assert_conforming(&m);
+            for &(e, marker) in m.boundary_edges() {
+                let [a, b] = m.edges()[e];
+                let (p, q) = (m.vertices()[a], m.vertices()[b]);
+                let expected = if p[1] == 0.5 && q[1] == 0.5 {
+                    1
+                } else if p[0] == 2.0 && q[0] == 2.0 {
+                    2
+                } else if p[1] == 1.5 && q[1] == 1.5 {
+                    3
+                } else if p[0] == -1.0 && q[0] == -1.0 {
+                    4
+                } else {
+                    panic!("edge {e} is not on the rectangle's boundary")
+                };
+                assert_eq!(marker, expected, "edge {e} of {diagonal:?}");
+            }
+            for (marker, length) in [(1, 3.0), (2, 1.0), (3, 3.0), (4, 1.0)] {
+                assert!((boundary_length(&m, Some(marker)) - length).abs() < 1e-13);
+            }
+            assert_eq!(m.boundary_vertices().len(), 2 * (nx + ny));
+        }
+        assert!(TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 0, 2, Diagonal::Right).is_err());
+        assert!(TriangleMesh::rectangle(1.0, 0.0, 0.0, 1.0, 2, 2, Diagonal::Right).is_err());
+        assert!(TriangleMesh::rectangle(0.0, f64::NAN, 0.0, 1.0, 2, 2, Diagonal::Right).is_err());
+    }
+
+    #[test]
+    fn rectangle_diagonal_directions() {
+        // slope sign of the diagonal edges (edges neither horizontal nor vertical)
+        let slopes = |m: &TriangleMesh| -> Vec<([f64; 2], f64)> {
+            m.edges()
+                .iter()
+                .filter_map(|&[a, b]| {
+                    let (p, q) = (m.vertices()[a], m.vertices()[b]);
+                    let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+                    (dx != 0.0 && dy != 0.0)
+                        .then(|| ([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])], dy / dx))
+                })
+                .collect()
+        };
+        let (nx, ny) = (4, 3);
+        let right = TriangleMesh::rectangle(0.0, 4.0, 0.0, 3.0, nx, ny, Diagonal::Right).unwrap();
+        let s = slopes(&right);
+        assert_eq!(s.len(), nx * ny);
+        assert!(s.iter().all(|&(_, k)| (k - 1.0).abs() < 1e-14));
+        let left = TriangleMesh::rectangle(0.0, 4.0, 0.0, 3.0, nx, ny, Diagonal::Left).unwrap();
+        let s = slopes(&left);
+        assert_eq!(s.len(), nx * ny);
+        assert!(s.iter().all(|&(_, k)| (k + 1.0).abs() < 1e-14));
+        let alt =
+            TriangleMesh::rectangle(0.0, 4.0, 0.0, 3.0, nx, ny, Diagonal::Alternating).unwrap();
+        let s = slopes(&alt);
+        assert_eq!(s.len(), nx * ny);
+        for (mid, k) in s {
+            // square (i, j) holds the diagonal through its centre
+            let (i, j) = (mid[0].floor() as usize, mid[1].floor() as usize);
+            let expected = if (i + j) % 2 == 0 { 1.0 } else { -1.0 };
+            assert!((k - expected).abs() < 1e-14, "square ({i}, {j})");
+        }
+        let crossed =
+            TriangleMesh::rectangle(0.0, 4.0, 0.0, 3.0, nx, ny, Diagonal::Crossed).unwrap();
+        let s = slopes(&crossed);
+        assert_eq!(s.len(), 4 * nx * ny);
+        assert_eq!(s.iter().filter(|&&(_, k)| k > 0.0).count(), 2 * nx * ny);
+    }
+
+    #[test]
+    fn refinement_edge_is_the_longest() {
+        let m = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 3, 3, Diagonal::Crossed).unwrap();
+        for c in 0..m.cell_count() {
+            let [a, b, d] = m.cell(c);
+            let v = m.vertices();
+            let refinement = dist2(v[b], v[d]);
+            assert!(refinement >= dist2(v[a], v[b]) && refinement >= dist2(v[d], v[a]));
+        }
+    }
+
+    #[test]
+    fn disk_area_euler_and_markers() {
+        let mut previous_error = f64::INFINITY;
+        for rings in [1, 2, 4, 8, 16] {
+            let r = 2.0;
+            let m = TriangleMesh::disk([1.0, -1.0], r, rings).unwrap();
+            let n = 6 * rings;
+            assert_eq!(m.vertex_count(), 1 + 3 * rings * (rings + 1));
+            assert_eq!(m.cell_count(), 6 * rings * rings);
+            // the mesh is the inscribed regular n-gon
+            let polygon = 0.5 * n as f64 * r * r * (std::f64::consts::TAU / n as f64).sin();
+            let area = total_area(&m);
+            assert!((area - polygon).abs() < 1e-12 * polygon, "{rings} rings");
+            let error = std::f64::consts::PI * r * r - area;
+            assert!(error > 0.0 && error < previous_error);
+            previous_error = error;
+            assert_eq!(euler(&m), 1);
+            assert_eq!(m.boundary_edges().len(), n);
+            assert!(m.boundary_edges().iter().all(|&(_, mk)| mk == 1));
+            for v in m.boundary_vertices() {
+                let p = m.vertices()[v];
+                assert!(((p[0] - 1.0).hypot(p[1] + 1.0) - r).abs() < 1e-13);
+            }
+            assert_conforming(&m);
+            // shape-regular: the smallest angle does not shrink as the rings grow
+            assert!(min_angle(&m) > 25f64.to_radians(), "{rings} rings");
+        }
+        assert!(TriangleMesh::disk([0.0, 0.0], 0.0, 3).is_err());
+        assert!(TriangleMesh::disk([0.0, 0.0], 1.0, 0).is_err());
+    }
+
+    #[test]
+    fn l_shape_area_euler_and_markers() {
+        for n in [1, 2, 5] {
+            let m = TriangleMesh::l_shape(n).unwrap();
+            assert_eq!(m.cell_count(), 6 * n * n);
+            assert_eq!(m.vertex_count(), 3 * n * n + 4 * n + 1);
+            assert!((total_area(&m) - 3.0).abs() < 1e-13);
+            assert_eq!(euler(&m), 1);
+            assert_eq!(m.boundary_edges().len(), 8 * n);
+            assert!((boundary_length(&m, Some(2)) - 2.0).abs() < 1e-13);
+            assert!((boundary_length(&m, Some(1)) - 6.0).abs() < 1e-13);
+            for &(e, marker) in m.boundary_edges() {
+                let [a, b] = m.edges()[e];
+                let (p, q) = (m.vertices()[a], m.vertices()[b]);
+                let reentrant = (p[0] == 0.0 && q[0] == 0.0 && p[1] <= 0.0 && q[1] <= 0.0)
+                    || (p[1] == 0.0 && q[1] == 0.0 && p[0] >= 0.0 && q[0] >= 0.0);
+                assert_eq!(marker, if reentrant { 2 } else { 1 }, "edge {e}");
+            }
+            // no vertex in the removed quadrant's interior
+            assert!(m.vertices().iter().all(|p| !(p[0] > 0.0 && p[1] < 0.0)));
+            assert_conforming(&m);
+        }
+        assert!(TriangleMesh::l_shape(0).is_err());
+    }
+
+    fn message(result: Result<TriangleMesh>) -> String {
+        match result {
+            Ok(_) => panic!("the mesh was accepted"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    fn square() -> Vec<[f64; 2]> {
+        vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+    }
+
+    #[test]
+    fn validation_names_the_element() {
+        let ok = TriangleMesh::new(square(), vec![[0, 1, 2], [0, 2, 3]], &[(0, 1, 7)]).unwrap();
+        assert_eq!(ok.cell_count(), 2);
+
+        let e = message(TriangleMesh::new(square(), vec![], &[]));
+        assert!(e.contains("at least one cell"), "{e}");
+
+        let mut v = square();
+        v[2] = [f64::NAN, 1.0];
+        let e = message(TriangleMesh::new(v, vec![[0, 1, 2], [0, 2, 3]], &[]));
+        assert!(e.contains("vertex 2") && e.contains("non-finite"), "{e}");
+
+        let e = message(TriangleMesh::new(square(), vec![[0, 1, 2], [0, 2, 4]], &[]));
+        assert!(e.contains("cell 1") && e.contains("vertex 4"), "{e}");
+
+        let e = message(TriangleMesh::new(square(), vec![[0, 1, 2], [0, 3, 3]], &[]));
+        assert!(
+            e.contains("cell 1") && e.contains("repeats vertex 3"),
+            "{e}"
+        );
+
+        let mut v = square();
+        v.push([0.5, 0.5]);
+        let e = message(TriangleMesh::new(
+            v.clone(),
+            vec![[0, 1, 2], [0, 2, 3], [0, 4, 2]],
+            &[],
+        ));
+        assert!(e.contains("cell 2") && e.contains("degenerate"), "{e}");
+
+        let e = message(TriangleMesh::new(square(), vec![[0, 1, 2], [0, 3, 2]], &[]));
+        assert!(e.contains("cell 1") && e.contains("inverted"), "{e}");
+
+        let e = message(TriangleMesh::new(
+            square(),
+            vec![[0, 1, 2], [0, 2, 3], [2, 3, 0]],
+            &[],
+        ));
+        assert!(
+            e.contains("cell 1") && e.contains("cell 2") && e.contains("duplicates"),
+            "{e}"
+        );
+
+        // a third cell on the diagonal 0–2 (it overlaps cell 0, but the count is reported)
+        let v3 = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [2.0, 0.5]];
+        let e = message(TriangleMesh::new(
+            v3,
+            vec![[0, 1, 2], [0, 2, 3], [0, 4, 2]],
+            &[],
+        ));
+        assert!(
+            e.contains("vertex 0 and vertex 2")
+                && e.contains("3 cells")
+                && e.contains("cell 0")
+                && e.contains("cell 1")
+                && e.contains("cell 2"),
+            "{e}"
+        );
+
+        let e = message(TriangleMesh::new(
+            vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.5, 2.0]],
+            vec![[0, 1, 2], [0, 1, 3]],
+            &[],
+        ));
+        assert!(
+            e.contains("cell 0") && e.contains("cell 1") && e.contains("overlap"),
+            "{e}"
+        );
+
+        let mut v = square();
+        v.push([5.0, 5.0]);
+        let e = message(TriangleMesh::new(v, vec![[0, 1, 2], [0, 2, 3]], &[]));
+        assert!(e.contains("vertex 4") && e.contains("no cell"), "{e}");
+
+        let e = message(TriangleMesh::new(
+            square(),
+            vec![[0, 1, 2], [0, 2, 3]],
+            &[(0, 2, 1)],
+        ));
+        assert!(e.contains("(0, 2, 1)") && e.contains("interior"), "{e}");
+        let e = message(TriangleMesh::new(
+            square(),
+            vec![[0, 1, 2], [0, 2, 3]],
+            &[(1, 3, 1)],
+        ));
+        assert!(e.contains("(1, 3, 1)") && e.contains("not joined"), "{e}");
+        let e = message(TriangleMesh::new(
+            square(),
+            vec![[0, 1, 2], [0, 2, 3]],
+            &[(0, 1, 1), (1, 0, 2)],
+        ));
+        assert!(e.contains("two markers"), "{e}");
+    }
+
+    #[test]
+    fn new_keeps_markers_and_orientation() {
+        let m = TriangleMesh::new(
+            square(),
+            vec![[1, 2, 0], [2, 3, 0]],
+            &[(1, 0, 5), (2, 3, 6)],
+        )
+        .unwrap();
+        let marker = |a: usize, b: usize| {
+            let e = m.find_edge(a, b).unwrap();
+            m.boundary_edges().iter().find(|&&(x, _)| x == e).unwrap().1
+        };
+        assert_eq!(marker(0, 1), 5);
+        assert_eq!(marker(3, 2), 6);
+        assert_eq!(marker(1, 2), 0);
+        assert_eq!(m.boundary_edges().len(), 4);
+        assert_eq!(m.boundary_vertices(), vec![0, 1, 2, 3]);
+        // the diagonal 0–2 is each cell's refinement edge
+        for c in 0..2 {
+            let [_, b, d] = m.cell(c);
+            assert_eq!([b.min(d), b.max(d)], [0, 2]);
+        }
+        let (c0, c1) = m.edge_cells(m.find_edge(0, 2).unwrap());
+        assert_eq!((c0, c1), (0, Some(1)));
+    }
+
+    /// Conformity, area, parents and markers of `fine = coarse.refine(..)`.
+    fn assert_refinement(coarse: &TriangleMesh, fine: &TriangleMesh, parents: &[usize]) {
+        assert_conforming(fine);
+        assert_eq!(euler(fine), euler(coarse));
+        assert!((total_area(fine) - total_area(coarse)).abs() < 1e-12 * total_area(coarse));
+        assert_eq!(parents.len(), fine.cell_count());
+        let mut child_area = vec![0.0; coarse.cell_count()];
+        for (c, &p) in parents.iter().enumerate() {
+            child_area[p] += fine.area(c);
+            // the child's centroid lies in its parent
+            let x = fine.cell_coordinates(c);
+            let g = [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0];
+            let [a, b, d] = coarse.cell(p);
+            let v = coarse.vertices();
+            assert!(
+                cross(v[a], v[b], g) > 0.0
+                    && cross(v[b], v[d], g) > 0.0
+                    && cross(v[d], v[a], g) > 0.0
+            );
+        }
+        for (p, &area) in child_area.iter().enumerate() {
+            assert!(
+                (area - coarse.area(p)).abs() < 1e-12 * coarse.area(p),
+                "parent {p}"
+            );
+        }
+        // boundary edges only split: same length per marker, at least as many edges
+        assert!(fine.boundary_edges().len() >= coarse.boundary_edges().len());
+        for marker in 0..5 {
+            let (l0, l1) = (
+                boundary_length(coarse, Some(marker)),
+                boundary_length(fine, Some(marker)),
+            );
+            assert!((l0 - l1).abs() < 1e-12 * (1.0 + l0), "marker {marker}");
+        }
+    }
+
+    #[test]
+    fn refining_one_cell_is_conforming() {
+        let m = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap();
+        let (fine, parents) = m.refine(&[5]).unwrap();
+        assert_refinement(&m, &fine, &parents);
+        assert!(fine.cell_count() > m.cell_count());
+        assert_eq!(parents.iter().filter(|&&p| p == 5).count(), 2);
+        // refining again at the same place forces closure across neighbours
+        let children: Vec<usize> = (0..fine.cell_count())
+            .filter(|&c| parents[c] == 5)
+            .collect();
+        let (finer, parents2) = fine.refine(&children).unwrap();
+        assert_refinement(&fine, &finer, &parents2);
+        let (again, parents3) = finer.refine(&[0, 0, 3]).unwrap();
+        assert_refinement(&finer, &again, &parents3);
+        assert!(m.refine(&[32]).unwrap_err().to_string().contains("cell 32"));
+        let (same, identity) = m.refine(&[]).unwrap();
+        assert_eq!(same.cells(), m.cells());
+        assert_eq!(identity, (0..m.cell_count()).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn random_refinement_stays_conforming_and_shape_regular() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let starts = [
+            TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 3, 3, Diagonal::Right).unwrap(),
+            TriangleMesh::rectangle(0.0, 2.0, 0.0, 1.0, 3, 2, Diagonal::Crossed).unwrap(),
+            TriangleMesh::disk([0.0, 0.0], 1.0, 3).unwrap(),
+            TriangleMesh::l_shape(2).unwrap(),
+        ];
+        for (s, start) in starts.iter().enumerate() {
+            let initial = min_angle(start);
+            let mut m = start.clone();
+            for round in 0..10 {
+                let marked: Vec<usize> = (0..m.cell_count())
+                    .filter(|_| rng.uniform() < 0.1)
+                    .collect();
+                let (fine, parents) = m.refine(&marked).unwrap();
+                assert_refinement(&m, &fine, &parents);
+                for &c in &marked {
+                    assert!(
+                        parents.iter().filter(|&&p| p == c).count() >= 2,
+                        "mesh {s} round {round}"
+                    );
+                }
+                m = fine;
+            }
+            assert!(m.cell_count() > 2 * start.cell_count());
+            assert!(min_angle(&m) >= 0.5 * initial - 1e-12, "mesh {s}");
+            if s == 0 {
+                // bisecting right isosceles triangles at the hypotenuse keeps them so
+                for c in 0..m.cell_count() {
+                    let mut a = angles(&m, c);
+                    a.sort_by(f64::total_cmp);
+                    let quarter = std::f64::consts::FRAC_PI_4;
+                    assert!((a[0] - quarter).abs() < 1e-9 && (a[2] - 2.0 * quarter).abs() < 1e-9);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn uniform_refinement_quadruples_and_halves() {
+        let m = TriangleMesh::rectangle(0.0, 1.0, 0.0, 2.0, 3, 5, Diagonal::Right).unwrap();
+        let fine = m.refine_uniformly();
+        assert_eq!(fine.cell_count(), 4 * m.cell_count());
+        assert!((fine.max_h() - 0.5 * m.max_h()).abs() < 1e-14);
+        assert!((fine.min_h() - 0.5 * m.min_h()).abs() < 1e-14);
+        assert_eq!(fine.vertex_count(), m.vertex_count() + m.edge_count());
+        let all: Vec<usize> = (0..m.cell_count()).collect();
+        let (_, parents) = m.refine(&all).unwrap();
+        assert_refinement(&m, &fine, &{
+            // refine_uniformly keeps the parent order of bisect: four children per cell
+            let p: Vec<usize> = (0..m.cell_count()).flat_map(|c| [c; 4]).collect();
+            p
+        });
+        assert_eq!(parents.len(), 2 * m.cell_count());
+        let finer = fine.refine_uniformly();
+        assert!((finer.max_h() - 0.25 * m.max_h()).abs() < 1e-14);
+        for marker in 1..=4 {
+            assert!(
+                (boundary_length(&finer, Some(marker)) - boundary_length(&m, Some(marker))).abs()
+                    < 1e-13
+            );
+        }
+        let d = TriangleMesh::disk([0.0, 0.0], 1.0, 4).unwrap();
+        let fd = d.refine_uniformly();
+        assert_refinement(
+            &d,
+            &fd,
+            &(0..d.cell_count()).flat_map(|c| [c; 4]).collect::<Vec<_>>(),
+        );
+    }
+
+    #[test]
+    fn locator_finds_points_and_rejects_outside() {
+        let mut rng = Rng(12345);
+        let meshes = [
+            TriangleMesh::rectangle(-1.0, 3.0, 0.0, 1.0, 20, 7, Diagonal::Alternating).unwrap(),
+            TriangleMesh::l_shape(4).unwrap(),
+            TriangleMesh::disk([0.5, 0.5], 2.0, 6).unwrap(),
+        ];
+        // refined locally, so cells of very different sizes share buckets
+        let graded = {
+            let mut m = meshes[1].clone();
+            for _ in 0..8 {
+                let near: Vec<usize> = (0..m.cell_count())
+                    .filter(|&c| {
+                        let x = m.cell_coordinates(c);
+                        x[0].abs() + x[1].abs() < 0.3
+                    })
+                    .collect();
+                m = m.refine(&near).unwrap().0;
+            }
+            m
+        };
+        for (k, m) in meshes.iter().chain([&graded]).enumerate() {
+            let locator = PointLocator::new(m);
+            for _ in 0..2000 {
+                // a random point of a random cell, so it is inside the domain
+                let c = (rng.next() % m.cell_count() as u64) as usize;
+                let (mut s, mut t) = (rng.uniform(), rng.uniform());
+                if s + t > 1.0 {
+                    (s, t) = (1.0 - s, 1.0 - t);
+                }
+                let x = m.cell_coordinates(c);
+                let p = [
+                    x[0] + s * (x[2] - x[0]) + t * (x[4] - x[0]),
+                    x[1] + s * (x[3] - x[1]) + t * (x[5] - x[1]),
+                ];
+                let (found, lambda) = locator.locate(p).expect("a point inside the mesh");
+                let y = m.cell_coordinates(found);
+                let q = [
+                    lambda[0] * y[0] + lambda[1] * y[2] + lambda[2] * y[4],
+                    lambda[0] * y[1] + lambda[1] * y[3] + lambda[2] * y[5],
+                ];
+                assert!(dist2(p, q).sqrt() < 1e-12, "mesh {k}");
+                assert!(lambda.iter().all(|&l| l >= -1e-12));
+                assert!((lambda.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            }
+            for v in 0..m.vertex_count() {
+                assert!(
+                    locator.locate(m.vertices()[v]).is_some(),
+                    "mesh {k} vertex {v}"
+                );
+            }
+        }
+        let locator = PointLocator::new(&meshes[1]);
+        for p in [
+            [0.5, -0.5],
+            [0.01, -0.01],
+            [1.5, 0.0],
+            [-1.0 - 1e-6, 0.0],
+            [f64::NAN, 0.0],
+        ] {
+            assert!(locator.locate(p).is_none(), "{p:?}");
+        }
+        assert!(locator.locate([0.0, -1.0]).is_some());
+        let disk = PointLocator::new(&meshes[2]);
+        // just outside the inscribed polygon's edge midpoint at angle 0 + half a step
+        let r = 2.0 * (std::f64::consts::PI / 36.0).cos();
+        let a = std::f64::consts::PI / 36.0;
+        assert!(disk
+            .locate([0.5 + 1.0001 * r * a.cos(), 0.5 + 1.0001 * r * a.sin()])
+            .is_none());
+        assert!(disk
+            .locate([0.5 + 0.9999 * r * a.cos(), 0.5 + 0.9999 * r * a.sin()])
+            .is_some());
+    }
+
+    /// Timing of the spec's large case; run with
+    /// `cargo test --release -p fem-runtime --lib -- --ignored large_rectangle --nocapture`.
+    #[test]
+    #[ignore]
+    fn large_rectangle_timing() {
+        let t = std::time::Instant::now();
+        let m = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 1000, 1000, Diagonal::Right).unwrap();
+        let build = t.elapsed();
+        let t = std::time::Instant::now();
+        let fine = m.refine_uniformly();
+        let refine = t.elapsed();
+        let t = std::time::Instant::now();
+        let locator = PointLocator::new(&fine);
+        let locate = t.elapsed();
+        assert!(locator.locate([0.3, 0.7]).is_some());
+        eprintln!(
+            "rectangle 1000×1000 ({} cells): build {build:?}; refine_uniformly ({} cells) {refine:?}; locator {locate:?}",
+            m.cell_count(),
+            fine.cell_count()
+        );
+    }
+}

@@ -1,0 +1,661 @@
+//! The membrane scenes: element pairs, the stabilization parameter from the computed
+//! inverse-inequality constant `C_I`, the solve with its report (the CLI's `--json`),
+//! errors against the exact radial solution, and VTK output.
+
+use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
+use crate::models::membrane_scenes::{
+    radial_gradient, radial_multiplier, radial_u, Domain, MembraneScene, RADIAL_A, RADIAL_R,
+};
+use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
+use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
+use fem_runtime::obstacle_2d::{
+    dirichlet_constraints, nodal_active_set, solve_obstacle_on_triangles, TriangleObstacleSolution,
+};
+use fem_runtime::triangle_field::{TriangleBasis, TriangleField};
+use fem_runtime::{
+    Coefficients, DataFn, Diagonal, Error, Model, PointLocator, Result, SystemDofs, TriangleMesh,
+};
+use nalgebra::{DMatrix, SymmetricEigen};
+use serde::Serialize;
+use std::time::Instant;
+
+/// The discretizations of the membrane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MembranePair {
+    /// u ∈ P1, λ ∈ P0, stabilized.
+    P1P0,
+    /// u ∈ P2, λ ∈ P0, stabilized.
+    P2P0,
+    /// u ∈ P2, λ ∈ P1 discontinuous, stabilized.
+    P2P1Disc,
+    /// u ∈ P1 with the nodal constraints `u_i ≥ ψ(x_i)` (no multiplier space).
+    P1Nodal,
+}
+
+impl MembranePair {
+    /// Every pair.
+    pub const ALL: [MembranePair; 4] = [
+        MembranePair::P1P0,
+        MembranePair::P2P0,
+        MembranePair::P2P1Disc,
+        MembranePair::P1Nodal,
+    ];
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            MembranePair::P1P0 => "p1-p0",
+            MembranePair::P2P0 => "p2-p0",
+            MembranePair::P2P1Disc => "p2-p1d",
+            MembranePair::P1Nodal => "p1-nodal",
+        }
+    }
+
+    /// The pair called `name`.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name() == name)
+            .ok_or_else(|| {
+                Error::Input(format!(
+                    "unknown membrane pair `{name}`; the pairs are {}",
+                    Self::ALL.map(|p| p.name()).join(", ")
+                ))
+            })
+    }
+
+    /// Polynomial degree of u.
+    pub fn degree(self) -> usize {
+        match self {
+            MembranePair::P1P0 | MembranePair::P1Nodal => 1,
+            _ => 2,
+        }
+    }
+}
+
+/// α for pairs whose `C_I` is 0 (P1: Δ vanishes on each triangle): the stabilization is
+/// then `α Σ h²(λ, μ)`, stable for every α > 0 and limited by accuracy only (see the α study).
+pub const ALPHA_WHEN_CI_VANISHES: f64 = 0.1;
+
+/// What to solve.
+#[derive(Clone, Copy, Debug)]
+pub struct MembraneRequest {
+    /// The scene.
+    pub scene: MembraneScene,
+    /// The pair.
+    pub pair: MembranePair,
+    /// N: an N×N×2 triangle mesh of the scene's square (the L-shape: N×N squares of
+    /// (−1,1)², three quarters of them kept).
+    pub mesh_size: usize,
+    /// The stabilization parameter; `½/C_I` by default. 0 is the plain mixed method.
+    pub alpha: Option<f64>,
+    /// The LCP solver.
+    pub solver: VariationalSolver,
+    /// Nested iteration from coarser meshes (N/2, N/4, … ≥ 4).
+    pub nested: bool,
+    /// Diagonal pattern of the structured mesh.
+    pub diagonal: Diagonal,
+}
+
+impl MembraneRequest {
+    /// The defaults: P2–P0, N = 64, α = ½/C_I, nested semismooth Newton.
+    pub fn new(scene: MembraneScene) -> Self {
+        Self {
+            scene,
+            pair: MembranePair::P2P0,
+            mesh_size: 64,
+            alpha: None,
+            solver: VariationalSolver::SemismoothNewton,
+            nested: true,
+            diagonal: Diagonal::Right,
+        }
+    }
+}
+
+/// What a membrane solve reports (the CLI's `--json` object).
+#[derive(Clone, Debug, Serialize)]
+pub struct MembraneReport {
+    /// Scene name.
+    pub scene: String,
+    /// Element pair.
+    pub pair: String,
+    /// LCP solver.
+    pub solver: String,
+    /// N of the N×N×2 mesh.
+    pub mesh_size: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// Unknowns after eliminating boundary DOFs (primal and multiplier).
+    pub dofs: usize,
+    /// Solver iterations on the final mesh.
+    pub iterations: usize,
+    /// `[triangles, iterations]` of each nested-iteration level.
+    pub levels: Vec<[usize; 2]>,
+    /// Wall time of the solve (assembly and all levels).
+    pub seconds: f64,
+    /// The stabilization parameter used.
+    pub alpha: f64,
+    /// `max_T C_I` of the mesh (0 where Δ vanishes on the elements).
+    pub inverse_constant: f64,
+    /// `‖u − u_h‖_L2` where an exact solution exists.
+    pub error_l2: Option<f64>,
+    /// `|u − u_h|_H1` where an exact solution exists.
+    pub error_h1: Option<f64>,
+    /// `(Σ_T h_T² ‖λ − λ_h‖²_T)^{1/2}` where an exact solution exists (stabilized pairs).
+    pub error_multiplier: Option<f64>,
+    /// `∫ λ_h` (the nodal method: the sum of its nodal contact forces).
+    pub total_contact_force: f64,
+    /// The exact `∫ λ` where known.
+    pub exact_contact_force: Option<f64>,
+    /// Area of the contact set (holes of zero λ_h with zero gap filled).
+    pub contact_area: f64,
+    /// The exact contact area where known.
+    pub exact_contact_area: Option<f64>,
+    /// KKT residual (equilibrium backward error and complementarity).
+    pub complementarity_residual: f64,
+    /// Estimated relative rounding noise of λ_h.
+    pub multiplier_noise: f64,
+    /// What the numbers cannot be trusted for.
+    pub warnings: Vec<String>,
+}
+
+/// The solved fields, for VTK and charts.
+pub struct MembraneFields {
+    /// The mesh.
+    pub mesh: TriangleMesh,
+    /// u at the vertices.
+    pub u: Vec<f64>,
+    /// ψ at the vertices.
+    pub psi: Vec<f64>,
+    /// λ_h at the cell centroids (nodal method: the nodal force over the vertex's area
+    /// share, averaged to the cells).
+    pub lambda: Vec<f64>,
+    /// 1 on contact cells, 0 elsewhere.
+    pub contact: Vec<f64>,
+}
+
+/// The structured mesh of a scene with parameter N.
+pub fn scene_mesh(scene: &MembraneScene, n: usize, diagonal: Diagonal) -> Result<TriangleMesh> {
+    if !(2..=4096).contains(&n) {
+        return Err(Error::Input(format!(
+            "--mesh-size {n} is out of range (2 to 4096)"
+        )));
+    }
+    match scene.domain {
+        Domain::Square(a) => TriangleMesh::rectangle(-a, a, -a, a, n, n, diagonal),
+        Domain::LShape => {
+            if n % 2 != 0 {
+                return Err(Error::Input(format!(
+                    "the L-shape needs an even --mesh-size, got {n}"
+                )));
+            }
+            TriangleMesh::l_shape(n / 2)
+        }
+    }
+}
+
+/// `C_I(T) = max h_T² ‖Δv‖²_T / ‖∇v‖²_T` over the element's functions, from the model's
+/// own kernels: the (u, u) blocks of `S` (which is `h²(Δu, Δv)` there) and of `a`.
+/// 0 when the `S` form has no (u, u) block (Δ vanishes on the element).
+pub fn element_inverse_constant<M: Model>(x: &[f64; 6]) -> Result<f64> {
+    let u = M::field("u")?;
+    let block = |form: &str| -> Result<Option<DMatrix<f64>>> {
+        let f = M::form(form)?;
+        let Some(b) = M::FORMS[f]
+            .blocks
+            .iter()
+            .position(|b| b.test_field == u && b.trial_field == Some(u))
+        else {
+            return Ok(None);
+        };
+        let n = M::FIELDS[u].element.local_dof_count(M::CELL);
+        let mut out = vec![0.0; n * n];
+        let params = vec![0.0; M::PARAMS.len()];
+        let zero = |_: &[f64]| 0.0;
+        let data: Vec<&DataFn> = vec![&zero; M::DATA.len()];
+        M::element_matrix(f, b, x, &params, &data, &mut out);
+        Ok(Some(DMatrix::from_row_slice(n, n, &out)))
+    };
+    let (Some(s), Some(k)) = (block("S")?, block("a")?) else {
+        return Ok(0.0);
+    };
+    let n = k.nrows();
+    // K has the constants as its kernel, and so has S: K + (tr K) 11ᵀ is SPD and has the
+    // same Rayleigh-quotient maximum on the complement of the constants.
+    let shift = k.trace() / n as f64;
+    let k = k + DMatrix::from_element(n, n, shift);
+    let l = k
+        .cholesky()
+        .ok_or_else(|| Error::LinearSolve("element stiffness not positive definite".into()))?;
+    let l_inverse = l
+        .l()
+        .try_inverse()
+        .ok_or_else(|| Error::LinearSolve("singular element stiffness".into()))?;
+    let reduced = &l_inverse * s * l_inverse.transpose();
+    let reduced = (&reduced + reduced.transpose()) * 0.5;
+    Ok(SymmetricEigen::new(reduced)
+        .eigenvalues
+        .iter()
+        .cloned()
+        .fold(0.0, f64::max))
+}
+
+/// `max_T C_I(T)` over a mesh (shapes repeated by translation are computed once).
+pub fn inverse_constant<M: Model>(mesh: &TriangleMesh) -> Result<f64> {
+    let mut seen: Vec<[i64; 4]> = Vec::new();
+    let mut largest: f64 = 0.0;
+    for c in 0..mesh.cell_count() {
+        let x = mesh.cell_coordinates(c);
+        let h = mesh.cell_diameter(c);
+        let key = [
+            ((x[2] - x[0]) / h * 1e9).round() as i64,
+            ((x[3] - x[1]) / h * 1e9).round() as i64,
+            ((x[4] - x[0]) / h * 1e9).round() as i64,
+            ((x[5] - x[1]) / h * 1e9).round() as i64,
+        ];
+        if seen.contains(&key) {
+            continue;
+        }
+        if seen.len() < 64 {
+            seen.push(key);
+        }
+        largest = largest.max(element_inverse_constant::<M>(&x)?);
+    }
+    Ok(largest)
+}
+
+/// Runs `$body` with `M` the model type of a stabilized `$pair`.
+macro_rules! dispatch {
+    ($pair:expr, $m:ident => $body:expr, nodal => $nodal:expr) => {
+        match $pair {
+            MembranePair::P1P0 => {
+                type $m = membrane_p1_p0::Model;
+                $body
+            }
+            MembranePair::P2P0 => {
+                type $m = membrane_p2_p0::Model;
+                $body
+            }
+            MembranePair::P2P1Disc => {
+                type $m = membrane_p2_p1disc::Model;
+                $body
+            }
+            MembranePair::P1Nodal => $nodal,
+        }
+    };
+}
+
+/// The α a request uses and the mesh's `C_I`.
+pub fn alpha_of(request: &MembraneRequest, mesh: &TriangleMesh) -> Result<(f64, f64)> {
+    let c_i = dispatch!(request.pair, M => inverse_constant::<M>(mesh)?, nodal => 0.0);
+    let alpha = match request.alpha {
+        Some(a) => a,
+        None if c_i > 0.0 => 0.5 / c_i,
+        None => ALPHA_WHEN_CI_VANISHES,
+    };
+    if !(alpha >= 0.0 && alpha.is_finite()) {
+        return Err(Error::Input(format!(
+            "α = {alpha} must be finite and ≥ 0 (0 is the plain mixed method)"
+        )));
+    }
+    Ok((alpha, c_i))
+}
+
+/// Checks the scene's data on the mesh: finite values, obstacle not above the boundary data.
+fn validate(scene: &MembraneScene, mesh: &TriangleMesh) -> Result<()> {
+    for (name, f) in [
+        ("load f", scene.load),
+        ("obstacle ψ", scene.obstacle),
+        ("boundary data g", scene.boundary),
+    ] {
+        for x in mesh.vertices() {
+            let v = f(x);
+            if !v.is_finite() {
+                return Err(Error::Input(format!(
+                    "the {name} is {v} at ({}, {})",
+                    x[0], x[1]
+                )));
+            }
+        }
+    }
+    for v in mesh.boundary_vertices() {
+        let x = mesh.vertices()[v];
+        let (psi, g) = ((scene.obstacle)(&x), (scene.boundary)(&x));
+        if psi > g + 1e-12 * (1.0 + g.abs()) {
+            return Err(Error::Input(format!(
+                "infeasible: the obstacle lies above the boundary data at ({}, {}): ψ = {psi} > g = {g}, so no u with u = g on ∂Ω and u ≥ ψ exists",
+                x[0], x[1]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The meshes of a nested solve: N/2^k ≥ 4, …, N (just N without nesting).
+fn level_sizes(n: usize, nested: bool, even: bool) -> Vec<usize> {
+    let mut sizes = vec![n];
+    while nested && sizes[0] % 2 == 0 && sizes[0] / 2 >= 4 && (!even || (sizes[0] / 2) % 2 == 0) {
+        sizes.insert(0, sizes[0] / 2);
+    }
+    sizes
+}
+
+/// Solves a membrane request.
+pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneFields)> {
+    let scene = request.scene;
+    let mesh = scene_mesh(&scene, request.mesh_size, request.diagonal)?;
+    validate(&scene, &mesh)?;
+    let (alpha, c_i) = alpha_of(request, &mesh)?;
+    let even = scene.domain == Domain::LShape;
+    let meshes = level_sizes(request.mesh_size, request.nested, even)
+        .into_iter()
+        .map(|n| scene_mesh(&scene, n, request.diagonal))
+        .collect::<Result<Vec<_>>>()?;
+    dispatch!(request.pair,
+        M => run_stabilized::<M>(request, &meshes, alpha, c_i),
+        nodal => run_nodal(request, &meshes))
+}
+
+fn exact_of(scene: &MembraneScene) -> bool {
+    scene.name == "membrane-radial"
+}
+
+fn exact_u(x: [f64; 2]) -> (f64, [f64; 2]) {
+    (radial_u(&x), radial_gradient(&x))
+}
+
+fn run_stabilized<M: Model>(
+    request: &MembraneRequest,
+    meshes: &[TriangleMesh],
+    alpha: f64,
+    c_i: f64,
+) -> Result<(MembraneReport, MembraneFields)> {
+    let scene = request.scene;
+    let mut warnings = Vec::new();
+    let solver = if alpha == 0.0 && request.solver == VariationalSolver::SemismoothNewton {
+        warnings.push("α = 0 (the plain mixed method): C = 0 leaves nothing to eliminate Λ with, so the QP solver (clarabel) is used".to_string());
+        VariationalSolver::Clarabel
+    } else {
+        request.solver
+    };
+    if c_i > 0.0 && alpha * c_i >= 1.0 {
+        warnings.push(format!(
+            "α·C_I = {:.2} ≥ 1: outside the stability range 0 < α < 1/C_I = {:.3e}; expect a degraded or unstable solution",
+            alpha * c_i,
+            1.0 / c_i
+        ));
+    }
+    let coefficients = Coefficients::new::<M>(
+        &[("α", alpha)],
+        &[
+            ("f", &scene.load),
+            ("ψ", &scene.obstacle),
+            ("g", &scene.boundary),
+        ],
+    )?;
+    let options = ObstacleOptions {
+        solver,
+        ..ObstacleOptions::default()
+    };
+    let meshes = if solver == VariationalSolver::Clarabel {
+        &meshes[meshes.len() - 1..]
+    } else {
+        meshes
+    };
+    let solution = solve_obstacle_on_triangles::<M>(meshes, &coefficients, options)?;
+    let u_field = M::field("u")?;
+    let d = &solution.discretization;
+    let u = solution.view(u_field);
+    let lambda = solution.view(d.multiplier_field);
+    let degree = 2 * M::FIELDS[u_field].element.degree() + 4;
+    let exact = exact_of(&scene);
+    let (error_l2, error_h1, error_multiplier) = if exact {
+        let (l2, h1) = u.errors(&exact_u, degree);
+        (
+            Some(l2),
+            Some(h1),
+            Some(lambda.weighted_error(&|x: [f64; 2]| radial_multiplier(&x), 1, degree)),
+        )
+    } else {
+        (None, None, None)
+    };
+    if solution.multiplier_noise > 1e-6 {
+        warnings.push(format!(
+            "λ_h may carry rounding noise of up to {:.0e} relative",
+            solution.multiplier_noise
+        ));
+    }
+    let contact_area = solution.contact_area();
+    let fields = stabilized_fields(&solution, u_field, &scene);
+    let report = MembraneReport {
+        scene: scene.name.into(),
+        pair: request.pair.name().into(),
+        solver: solver_name(solver).into(),
+        mesh_size: request.mesh_size,
+        triangles: d.mesh.cell_count(),
+        dofs: d.lcp.n() + d.lcp.m(),
+        iterations: solution.iterations,
+        levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
+        seconds: solution.seconds,
+        alpha,
+        inverse_constant: c_i,
+        error_l2,
+        error_h1,
+        error_multiplier,
+        total_contact_force: solution.total_contact_force(),
+        exact_contact_force: exact.then(|| 2.0 * std::f64::consts::PI * RADIAL_A),
+        contact_area,
+        exact_contact_area: exact.then(|| std::f64::consts::PI * RADIAL_R * RADIAL_R),
+        complementarity_residual: solution.kkt_residual,
+        multiplier_noise: solution.multiplier_noise,
+        warnings,
+    };
+    Ok((report, fields))
+}
+
+fn solver_name(solver: VariationalSolver) -> &'static str {
+    match solver {
+        VariationalSolver::SemismoothNewton => "pdas",
+        VariationalSolver::Clarabel => "clarabel",
+    }
+}
+
+fn stabilized_fields(
+    solution: &TriangleObstacleSolution,
+    u_field: usize,
+    scene: &MembraneScene,
+) -> MembraneFields {
+    let d = &solution.discretization;
+    let mesh = d.mesh.clone();
+    let lambda = solution.view(d.multiplier_field).centroid_values();
+    let active = fem_runtime::obstacle_2d::contact_indicator(
+        &d.lcp,
+        &d.primal_part(&solution.values),
+        &d.multiplier_dofs()
+            .iter()
+            .map(|&k| solution.field(d.multiplier_field)[k])
+            .collect::<Vec<_>>(),
+    );
+    let per_cell = d.dofs.map(d.multiplier_field).unwrap().local_count();
+    let mut contact = vec![0.0; mesh.cell_count()];
+    for (k, &dof) in d.multiplier_dofs().iter().enumerate() {
+        if active[k] {
+            contact[dof / per_cell] += 1.0 / per_cell as f64;
+        }
+    }
+    MembraneFields {
+        u: solution.view(u_field).vertex_values(),
+        psi: mesh
+            .vertices()
+            .iter()
+            .map(|x| (scene.obstacle)(x))
+            .collect(),
+        lambda,
+        contact,
+        mesh,
+    }
+}
+
+/// The classical method: P1 with `u_i ≥ ψ(x_i)` at the free nodes.
+fn run_nodal(
+    request: &MembraneRequest,
+    meshes: &[TriangleMesh],
+) -> Result<(MembraneReport, MembraneFields)> {
+    type M = membrane_p1::Model;
+    let clock = Instant::now();
+    let scene = request.scene;
+    let coefficients = Coefficients::new::<M>(&[], &[("f", &scene.load), ("g", &scene.boundary)])?;
+    let mut levels = Vec::new();
+    let mut previous: Option<(TriangleMesh, SystemDofs, Vec<f64>)> = None;
+    let mut last = None;
+    for mesh in meshes {
+        let dofs = SystemDofs::all::<M>(mesh)?;
+        let constraints = dirichlet_constraints::<M>(mesh, &dofs, &coefficients)?;
+        let k = MatrixAssembler::new::<M>("a", mesh, &dofs)?.assemble::<M>(mesh, &coefficients)?;
+        let l = assemble_vector::<M>("ℓ", mesh, &dofs, &coefficients)?;
+        let reduction = constraints.reduction(dofs.dof_count())?;
+        let f = reduction.rhs(&k, &l);
+        let a = reduction.matrix(&k);
+        let nodes = dofs.map(0).unwrap().nodes(mesh);
+        let psi: Vec<f64> = reduction
+            .free()
+            .iter()
+            .map(|&d| (scene.obstacle)(&nodes[d]))
+            .collect();
+        let start = previous.as_ref().map(|(pm, pd, values)| {
+            let locator = PointLocator::new(pm);
+            let view = TriangleField {
+                mesh: pm,
+                map: pd.map(0).unwrap(),
+                coefficients: values,
+            };
+            let basis = TriangleBasis::new(fem_runtime::ElementKind::P1);
+            reduction
+                .free()
+                .iter()
+                .map(|&d| view.at(&basis, &locator, nodes[d]).unwrap_or(0.0))
+                .collect::<Vec<f64>>()
+        });
+        let solution = nodal_active_set(&a, &f, &psi, start.as_deref(), 500)?;
+        levels.push([mesh.cell_count(), solution.iterations]);
+        let values = reduction.expand(&solution.u);
+        previous = Some((mesh.clone(), dofs.clone(), values.clone()));
+        last = Some((mesh.clone(), dofs, values, solution, reduction, a.nrows()));
+    }
+    let (mesh, dofs, values, solution, reduction, n) = last.expect("at least one mesh");
+    let seconds = clock.elapsed().as_secs_f64();
+    let map = dofs.map(0).unwrap();
+    let u = TriangleField {
+        mesh: &mesh,
+        map,
+        coefficients: &values,
+    };
+    let exact = exact_of(&scene);
+    let (error_l2, error_h1) = if exact {
+        let (l2, h1) = u.errors(&exact_u, 6);
+        (Some(l2), Some(h1))
+    } else {
+        (None, None)
+    };
+    // nodal forces: active where λ_i > 0 or the node lies on ψ
+    let mut vertex_active = vec![false; mesh.vertex_count()];
+    let mut vertex_force = vec![0.0; mesh.vertex_count()];
+    let scale = solution.lambda.iter().cloned().fold(0.0, f64::max);
+    for (k, &dof) in reduction.free().iter().enumerate() {
+        let x = mesh.vertices()[dof];
+        let gap = solution.u[k] - (scene.obstacle)(&x);
+        vertex_active[dof] = solution.lambda[k] > 1e-8 * scale.max(1e-300)
+            || gap.abs() <= 1e-10 * (1.0 + solution.u[k].abs());
+        vertex_force[dof] = solution.lambda[k];
+    }
+    let mut vertex_area = vec![0.0; mesh.vertex_count()];
+    for c in 0..mesh.cell_count() {
+        for v in mesh.cell(c) {
+            vertex_area[v] += mesh.area(c) / 3.0;
+        }
+    }
+    let contact: Vec<f64> = (0..mesh.cell_count())
+        .map(|c| mesh.cell(c).iter().filter(|&&v| vertex_active[v]).count() as f64 / 3.0)
+        .collect();
+    let contact_area = contact
+        .iter()
+        .enumerate()
+        .map(|(c, s)| s * mesh.area(c))
+        .sum();
+    let lambda = (0..mesh.cell_count())
+        .map(|c| {
+            mesh.cell(c)
+                .iter()
+                .map(|&v| vertex_force[v] / vertex_area[v])
+                .sum::<f64>()
+                / 3.0
+        })
+        .collect();
+    let report = MembraneReport {
+        scene: scene.name.into(),
+        pair: request.pair.name().into(),
+        solver: "nodal active set".into(),
+        mesh_size: request.mesh_size,
+        triangles: mesh.cell_count(),
+        dofs: n,
+        iterations: solution.iterations,
+        levels,
+        seconds,
+        alpha: 0.0,
+        inverse_constant: 0.0,
+        error_l2,
+        error_h1,
+        error_multiplier: None,
+        total_contact_force: solution.lambda.iter().sum(),
+        exact_contact_force: exact.then(|| 2.0 * std::f64::consts::PI * RADIAL_A),
+        contact_area,
+        exact_contact_area: exact.then(|| std::f64::consts::PI * RADIAL_R * RADIAL_R),
+        complementarity_residual: solution.kkt_residual,
+        multiplier_noise: 0.0,
+        warnings: Vec::new(),
+    };
+    let fields = MembraneFields {
+        u: u.vertex_values(),
+        psi: mesh
+            .vertices()
+            .iter()
+            .map(|x| (scene.obstacle)(x))
+            .collect(),
+        lambda,
+        contact,
+        mesh: mesh.clone(),
+    };
+    Ok((report, fields))
+}
+
+/// Writes the solved fields as a `.vtu` for ParaView: u and ψ at the vertices, λ_h and
+/// the contact set per cell.
+pub fn write_vtk(path: &std::path::Path, fields: &MembraneFields) -> Result<()> {
+    fem_runtime::vtk::write_vtu(
+        path,
+        &fields.mesh,
+        &[("u", &fields.u), ("psi", &fields.psi)],
+        &[("lambda", &fields.lambda), ("contact", &fields.contact)],
+    )
+}
+
+/// Interpolates the P1/P2 field of one solve at the points of another (for reference
+/// errors between meshes): `‖u_a − u_b‖_L2` on `a`'s mesh with a rule of degree `degree`.
+pub fn difference_l2(a: &TriangleField, b: &TriangleField, degree: usize) -> f64 {
+    use fem_runtime::triangle_field::AffineMap;
+    let rule = fem_runtime::reference::triangle::TriangleRule::exact_for_degree(degree);
+    let basis_a = TriangleBasis::new(a.map.element());
+    let basis_b = TriangleBasis::new(b.map.element());
+    let locator = PointLocator::new(b.mesh);
+    let mut sum = 0.0;
+    for c in 0..a.mesh.cell_count() {
+        let map = AffineMap::of(a.mesh, c);
+        for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+            let x = map.point(xi);
+            let vb = b.at(&basis_b, &locator, x).unwrap_or(0.0);
+            let e = a.value(&basis_a, c, xi) - vb;
+            sum += w * map.det * e * e;
+        }
+    }
+    sum.sqrt()
+}

@@ -1,0 +1,286 @@
+//! Generated triangle kernels of the membrane models against hand-coded element
+//! matrices written with barycentric coordinates (an independent basis: `λᵢ(2λᵢ − 1)`,
+//! `4λᵢλⱼ`, their gradients and Laplacians by hand) and an independent 6-point
+//! Dunavant rule, on random triangles and parameters.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use fem_forms::models::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
+use fem_forms::{DataFn, ElementKind, Model};
+use proptest::prelude::*;
+
+fn load(x: &[f64]) -> f64 {
+    1.0 + x[0] - 2.0 * x[1] * x[1]
+}
+
+fn obstacle(x: &[f64]) -> f64 {
+    x[0] * x[1] - 0.3 + 0.5 * x[0] * x[0]
+}
+
+fn boundary(_: &[f64]) -> f64 {
+    0.0
+}
+
+/// Dunavant's degree-4 rule: barycentric points and weights summing to 1.
+fn dunavant4() -> Vec<([f64; 3], f64)> {
+    let (a, wa) = (0.445948490915965, 0.223381589678011);
+    let (b, wb) = (0.091576213509771, 0.109951743655322);
+    let mut rule = Vec::new();
+    for (p, w) in [(a, wa), (b, wb)] {
+        let q = 1.0 - 2.0 * p;
+        for point in [[p, p, q], [p, q, p], [q, p, p]] {
+            rule.push((point, w));
+        }
+    }
+    rule
+}
+
+/// A triangle with its barycentric gradients, area and diameter.
+#[derive(Debug)]
+struct Cell {
+    x: [[f64; 2]; 3],
+    grad: [[f64; 2]; 3],
+    area: f64,
+    h: f64,
+}
+
+impl Cell {
+    fn new(x: [[f64; 2]; 3]) -> Self {
+        let area = 0.5
+            * ((x[1][0] - x[0][0]) * (x[2][1] - x[0][1])
+                - (x[2][0] - x[0][0]) * (x[1][1] - x[0][1]));
+        let grad = std::array::from_fn(|i| {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            [
+                (x[j][1] - x[k][1]) / (2.0 * area),
+                (x[k][0] - x[j][0]) / (2.0 * area),
+            ]
+        });
+        let edge = |i: usize, j: usize| (x[i][0] - x[j][0]).hypot(x[i][1] - x[j][1]);
+        let h = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
+        Self { x, grad, area, h }
+    }
+
+    fn point(&self, b: [f64; 3]) -> [f64; 2] {
+        let mut p = [0.0; 2];
+        for i in 0..3 {
+            p[0] += b[i] * self.x[i][0];
+            p[1] += b[i] * self.x[i][1];
+        }
+        p
+    }
+}
+
+fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+/// Value, gradient and Laplacian of local basis function `i` at barycentric point `b`.
+fn basis(element: ElementKind, cell: &Cell, i: usize, b: [f64; 3]) -> (f64, [f64; 2], f64) {
+    let g = &cell.grad;
+    let edges = [(0, 1), (1, 2), (2, 0)];
+    match element {
+        ElementKind::P0 => (1.0, [0.0; 2], 0.0),
+        ElementKind::P1 | ElementKind::P1Disc => (b[i], g[i], 0.0),
+        ElementKind::P2 if i < 3 => (
+            b[i] * (2.0 * b[i] - 1.0),
+            [(4.0 * b[i] - 1.0) * g[i][0], (4.0 * b[i] - 1.0) * g[i][1]],
+            4.0 * dot(g[i], g[i]),
+        ),
+        ElementKind::P2 => {
+            let (j, k) = edges[i - 3];
+            (
+                4.0 * b[j] * b[k],
+                [
+                    4.0 * (b[k] * g[j][0] + b[j] * g[k][0]),
+                    4.0 * (b[k] * g[j][1] + b[j] * g[k][1]),
+                ],
+                8.0 * dot(g[j], g[k]),
+            )
+        }
+        other => panic!("no hand-coded {other:?}"),
+    }
+}
+
+fn count(element: ElementKind) -> usize {
+    match element {
+        ElementKind::P0 => 1,
+        ElementKind::P1 | ElementKind::P1Disc => 3,
+        _ => 6,
+    }
+}
+
+/// The blocks of `B_h` (test field, trial field) and `L_h` (test field) by hand.
+fn hand_b_h(u: ElementKind, l: ElementKind, cell: &Cell, alpha: f64) -> [Vec<Vec<f64>>; 4] {
+    let h2 = cell.h * cell.h;
+    let integrate = |f: &dyn Fn([f64; 3]) -> f64| -> f64 {
+        dunavant4().iter().map(|&(b, w)| w * f(b)).sum::<f64>() * cell.area
+    };
+    let block =
+        |rows: ElementKind, cols: ElementKind, k: &dyn Fn(usize, usize, [f64; 3]) -> f64| {
+            (0..count(rows))
+                .map(|i| {
+                    (0..count(cols))
+                        .map(|j| integrate(&|b| k(i, j, b)))
+                        .collect()
+                })
+                .collect::<Vec<Vec<f64>>>()
+        };
+    let uu = block(u, u, &|i, j, b| {
+        let (_, gi, li) = basis(u, cell, i, b);
+        let (_, gj, lj) = basis(u, cell, j, b);
+        dot(gi, gj) - alpha * h2 * li * lj
+    });
+    // rows v, columns λ: −(λ, v) − αh²(λ, Δv)
+    let ul = block(u, l, &|i, j, b| {
+        let (vi, _, li) = basis(u, cell, i, b);
+        let (mj, _, _) = basis(l, cell, j, b);
+        -mj * vi - alpha * h2 * mj * li
+    });
+    let lu = block(l, u, &|i, j, b| {
+        let (mi, _, _) = basis(l, cell, i, b);
+        let (vj, _, lj) = basis(u, cell, j, b);
+        -vj * mi - alpha * h2 * lj * mi
+    });
+    let ll = block(l, l, &|i, j, b| {
+        let (mi, _, _) = basis(l, cell, i, b);
+        let (mj, _, _) = basis(l, cell, j, b);
+        -alpha * h2 * mi * mj
+    });
+    [uu, ul, lu, ll]
+}
+
+fn hand_l_h(u: ElementKind, l: ElementKind, cell: &Cell, alpha: f64) -> [Vec<f64>; 2] {
+    let h2 = cell.h * cell.h;
+    let integrate = |f: &dyn Fn([f64; 3]) -> f64| -> f64 {
+        dunavant4().iter().map(|&(b, w)| w * f(b)).sum::<f64>() * cell.area
+    };
+    let v = (0..count(u))
+        .map(|i| {
+            integrate(&|b| {
+                let (vi, _, li) = basis(u, cell, i, b);
+                let f = load(&cell.point(b));
+                f * vi + alpha * h2 * f * li
+            })
+        })
+        .collect();
+    let mu = (0..count(l))
+        .map(|i| {
+            integrate(&|b| {
+                let (mi, _, _) = basis(l, cell, i, b);
+                let x = cell.point(b);
+                -obstacle(&x) * mi + alpha * h2 * load(&x) * mi
+            })
+        })
+        .collect();
+    [v, mu]
+}
+
+fn generated<M: Model>(cell: &Cell, alpha: f64) -> ([Vec<Vec<f64>>; 4], [Vec<f64>; 2]) {
+    let x: Vec<f64> = cell.x.iter().flatten().copied().collect();
+    let data: [&DataFn; 3] = [&load, &obstacle, &boundary];
+    let params = [alpha];
+    let form = M::form("B_h").unwrap();
+    let n = |f: usize| M::FIELDS[f].element.local_dof_count(M::CELL);
+    let pairs = [(0, 0), (0, 1), (1, 0), (1, 1)];
+    let blocks = pairs.map(|(test, trial)| {
+        let (rows, cols) = (n(test), n(trial));
+        let mut flat = vec![0.0; rows * cols];
+        if let Some(b) = M::FORMS[form]
+            .blocks
+            .iter()
+            .position(|b| b.test_field == test && b.trial_field == Some(trial))
+        {
+            M::element_matrix(form, b, &x, &params, &data, &mut flat);
+        }
+        flat.chunks(cols).map(<[f64]>::to_vec).collect::<Vec<_>>()
+    });
+    let form = M::form("L_h").unwrap();
+    let vectors = [0, 1].map(|test| {
+        let mut out = vec![0.0; n(test)];
+        if let Some(b) = M::FORMS[form]
+            .blocks
+            .iter()
+            .position(|b| b.test_field == test)
+        {
+            M::element_vector(form, b, &x, &params, &data, &mut out);
+        }
+        out
+    });
+    (blocks, vectors)
+}
+
+fn largest_difference(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
+    let scale = b.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = a
+        .iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    diff / scale.max(1e-300)
+}
+
+fn check<M: Model>(cell: &Cell, alpha: f64) {
+    let u = M::FIELDS[0].element;
+    let l = M::FIELDS[1].element;
+    let (blocks, vectors) = generated::<M>(cell, alpha);
+    let hand = hand_b_h(u, l, cell, alpha);
+    for (k, (g, h)) in blocks.iter().zip(&hand).enumerate() {
+        let d = largest_difference(g, h);
+        assert!(
+            d < 1e-11,
+            "{} block {k}: relative difference {d:e}",
+            M::NAME
+        );
+    }
+    let hand = hand_l_h(u, l, cell, alpha);
+    for (k, (g, h)) in vectors.iter().zip(&hand).enumerate() {
+        let d = largest_difference(std::slice::from_ref(g), std::slice::from_ref(h));
+        assert!(
+            d < 1e-11,
+            "{} vector {k}: relative difference {d:e}",
+            M::NAME
+        );
+    }
+}
+
+fn triangle() -> impl Strategy<Value = Cell> {
+    (
+        -3.0..3.0f64,
+        -3.0..3.0f64,
+        0.05..2.0f64,
+        0.0..std::f64::consts::TAU,
+        0.2..1.0f64,
+        0.3..2.8f64,
+    )
+        .prop_map(|(x0, y0, size, turn, ratio, angle)| {
+            let (c, s) = (turn.cos(), turn.sin());
+            let a = [x0, y0];
+            let b = [x0 + size * c, y0 + size * s];
+            let r = size * ratio;
+            let d = [
+                x0 + r * (c * angle.cos() - s * angle.sin()),
+                y0 + r * (s * angle.cos() + c * angle.sin()),
+            ];
+            Cell::new([a, b, d])
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn membrane_kernels_match_the_hand_coded_ones(cell in triangle(), alpha in 0.0..2.0f64) {
+        check::<membrane_p1_p0::Model>(&cell, alpha);
+        check::<membrane_p2_p0::Model>(&cell, alpha);
+        check::<membrane_p2_p1disc::Model>(&cell, alpha);
+    }
+}
+
+/// The check catches a wrong sign: flipping α in the hand-coded S must be seen.
+#[test]
+fn a_sign_error_is_caught() {
+    let cell = Cell::new([[0.1, 0.2], [1.3, 0.1], [0.4, 0.9]]);
+    let (blocks, _) = generated::<membrane_p2_p0::Model>(&cell, 0.7);
+    let wrong = hand_b_h(ElementKind::P2, ElementKind::P0, &cell, -0.7);
+    assert!(largest_difference(&blocks[0], &wrong[0]) > 1e-3);
+}
