@@ -402,7 +402,19 @@ fn run_stabilized<M: Model>(
     } else {
         meshes
     };
-    let solution = solve_obstacle_on_triangles::<M>(meshes, &coefficients, options)?;
+    let solution = solve_obstacle_on_triangles::<M>(meshes, &coefficients, options).map_err(
+        |e| {
+            if c_i > 0.0 && alpha * c_i >= 1.0 {
+                Error::Input(format!(
+                    "{e}; α·C_I = {:.2} is outside the stability range 0 < α < 1/C_I = {:.3e}, where A_α = a − αS is indefinite",
+                    alpha * c_i,
+                    1.0 / c_i
+                ))
+            } else {
+                e
+            }
+        },
+    )?;
     let u_field = M::field("u")?;
     let d = &solution.discretization;
     let u = solution.view(u_field);
@@ -443,9 +455,9 @@ fn run_stabilized<M: Model>(
         error_h1,
         error_multiplier,
         total_contact_force: solution.total_contact_force(),
-        exact_contact_force: exact.then(|| 2.0 * std::f64::consts::PI * RADIAL_A),
+        exact_contact_force: exact.then_some(2.0 * std::f64::consts::PI * RADIAL_A),
         contact_area,
-        exact_contact_area: exact.then(|| std::f64::consts::PI * RADIAL_R * RADIAL_R),
+        exact_contact_area: exact.then_some(std::f64::consts::PI * RADIAL_R * RADIAL_R),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: solution.multiplier_noise,
         warnings,
@@ -557,17 +569,19 @@ fn run_nodal(
     } else {
         (None, None)
     };
-    // nodal forces: active where λ_i > 0 or the node lies on ψ
-    let mut vertex_active = vec![false; mesh.vertex_count()];
+    // nodal forces: active where λ_i > 0 or the node lies on ψ (boundary nodes too)
     let mut vertex_force = vec![0.0; mesh.vertex_count()];
     let scale = solution.lambda.iter().cloned().fold(0.0, f64::max);
     for (k, &dof) in reduction.free().iter().enumerate() {
-        let x = mesh.vertices()[dof];
-        let gap = solution.u[k] - (scene.obstacle)(&x);
-        vertex_active[dof] = solution.lambda[k] > 1e-8 * scale.max(1e-300)
-            || gap.abs() <= 1e-10 * (1.0 + solution.u[k].abs());
         vertex_force[dof] = solution.lambda[k];
     }
+    let vertex_active: Vec<bool> = (0..mesh.vertex_count())
+        .map(|v| {
+            let gap = values[v] - (scene.obstacle)(&mesh.vertices()[v]);
+            vertex_force[v] > 1e-8 * scale.max(1e-300)
+                || gap.abs() <= 1e-10 * (1.0 + values[v].abs())
+        })
+        .collect();
     let mut vertex_area = vec![0.0; mesh.vertex_count()];
     for c in 0..mesh.cell_count() {
         for v in mesh.cell(c) {
@@ -607,9 +621,9 @@ fn run_nodal(
         error_h1,
         error_multiplier: None,
         total_contact_force: solution.lambda.iter().sum(),
-        exact_contact_force: exact.then(|| 2.0 * std::f64::consts::PI * RADIAL_A),
+        exact_contact_force: exact.then_some(2.0 * std::f64::consts::PI * RADIAL_A),
         contact_area,
-        exact_contact_area: exact.then(|| std::f64::consts::PI * RADIAL_R * RADIAL_R),
+        exact_contact_area: exact.then_some(std::f64::consts::PI * RADIAL_R * RADIAL_R),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: 0.0,
         warnings: Vec::new(),

@@ -62,9 +62,9 @@ impl Cell {
 
     fn point(&self, b: [f64; 3]) -> [f64; 2] {
         let mut p = [0.0; 2];
-        for i in 0..3 {
-            p[0] += b[i] * self.x[i][0];
-            p[1] += b[i] * self.x[i][1];
+        for (bi, xi) in b.iter().zip(&self.x) {
+            p[0] += bi * xi[0];
+            p[1] += bi * xi[1];
         }
         p
     }

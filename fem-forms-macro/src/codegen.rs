@@ -459,13 +459,9 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
         let f = symbols
             .fields
             .iter()
-            .position(|x| x.name == field.to_string())
+            .position(|x| *field == x.name)
             .unwrap_or(0);
-        let g = symbols
-            .data
-            .iter()
-            .position(|x| x.0 == data.to_string())
-            .unwrap_or(0);
+        let g = symbols.data.iter().position(|x| *data == x.0).unwrap_or(0);
         quote!((#f, #g))
     });
 

@@ -20,14 +20,18 @@ use quote::{format_ident, quote};
 /// A monomial `c · k00^e0 · k01^e1 · k10^e2 · k11^e3` in the entries of `K = J⁻¹`.
 type KMonomial = (f64, [u8; 4]);
 
+/// `T_αβ` of one physical multi-index α: the reference multi-indices β with their
+/// polynomials in K.
+type Transform = Vec<([u8; 2], Vec<KMonomial>)>;
+
 /// `T_αβ` for every reference multi-index β of the same order as α.
-fn transform(alpha: [u8; 2]) -> Vec<([u8; 2], Vec<KMonomial>)> {
+fn transform(alpha: [u8; 2]) -> Transform {
     // Start from the identity operator and apply ∂x = k00 ∂ξ + k10 ∂η, ∂y = k01 ∂ξ + k11 ∂η.
-    let mut terms: Vec<([u8; 2], Vec<KMonomial>)> = vec![([0, 0], vec![(1.0, [0; 4])])];
+    let mut terms: Transform = vec![([0, 0], vec![(1.0, [0; 4])])];
     let factors: [[(usize, usize); 2]; 2] = [[(0, 0), (2, 1)], [(1, 0), (3, 1)]];
     for (axis, &count) in alpha.iter().enumerate() {
         for _ in 0..count {
-            let mut next: Vec<([u8; 2], Vec<KMonomial>)> = Vec::new();
+            let mut next: Transform = Vec::new();
             for (beta, poly) in &terms {
                 for &(k, reference_axis) in &factors[axis] {
                     let mut b = *beta;
@@ -141,8 +145,7 @@ pub fn block_kernel(
         }
     }
     alphas.sort();
-    let transforms: Vec<([u8; 2], Vec<([u8; 2], Vec<KMonomial>)>)> =
-        alphas.iter().map(|&a| (a, transform(a))).collect();
+    let transforms: Vec<([u8; 2], Transform)> = alphas.iter().map(|&a| (a, transform(a))).collect();
     let t_of = |alpha: [u8; 2]| &transforms.iter().find(|(a, _)| *a == alpha).unwrap().1;
     let t_lets: Vec<TokenStream> = transforms
         .iter()

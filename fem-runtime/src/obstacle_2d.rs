@@ -258,7 +258,6 @@ pub fn nodal_active_set(
     let mut active: Vec<bool> = (0..n)
         .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
         .collect();
-    let mut factorizations = 0;
     for iteration in 1..=max_iterations {
         let mut values = vals.to_vec();
         let mut rhs = f.to_vec();
@@ -280,7 +279,6 @@ pub fn nodal_active_set(
         }
         let matrix = SparseColMat::new(pattern.clone(), values);
         u = cholesky.factor(&matrix)?.solve_refined(&matrix, &rhs, 1)?;
-        factorizations += 1;
         let au = multiply(a, &u);
         for i in 0..n {
             lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
@@ -297,7 +295,7 @@ pub fn nodal_active_set(
                 iterations: iteration,
                 kkt_residual,
                 seconds: clock.elapsed().as_secs_f64(),
-                factorizations,
+                factorizations: iteration,
                 multiplier_noise: 0.0,
             });
         }

@@ -1,0 +1,226 @@
+//! The membrane obstacle problem: the inverse-inequality constants of MODELS.md, the
+//! sign test with its exact solution, convergence to the exact radial solution, the
+//! stabilized solve against the QP solver, and bad input.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use fem_forms::membranes::{
+    self, element_inverse_constant, MembranePair, MembraneReport, MembraneRequest,
+};
+use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
+use fem_forms::models::membrane_scenes::{membrane_scene, Domain, MembraneScene};
+use fem_forms::obstacle::VariationalSolver;
+use fem_forms::studies::rates;
+
+fn radial() -> MembraneScene {
+    membrane_scene("membrane-radial").unwrap()
+}
+
+fn solve(scene: MembraneScene, pair: MembranePair, n: usize) -> MembraneReport {
+    let mut request = MembraneRequest::new(scene);
+    request.pair = pair;
+    request.mesh_size = n;
+    membranes::solve(&request).unwrap().0
+}
+
+/// MODELS.md §1 measured `C_I` of the P2 membrane element: 48 on the equilateral
+/// triangle, 96 on the right isosceles one, 240 on the 120° isosceles one; P1 has 0.
+#[test]
+fn inverse_constants_match_the_measured_ones() {
+    let s3 = 3f64.sqrt();
+    let cases = [
+        ([0.0, 0.0, 1.0, 0.0, 0.5, 0.5 * s3], 48.0),
+        ([0.0, 0.0, 1.0, 0.0, 0.0, 1.0], 96.0),
+        ([0.0, 0.0, s3, 0.0, 0.5 * s3, 0.5], 240.0),
+    ];
+    for (x, expected) in cases {
+        let c = element_inverse_constant::<membrane_p2_p0::Model>(&x).unwrap();
+        assert!((c - expected).abs() < 1e-8 * expected, "{c} vs {expected}");
+        // C_I is a property of u's element: the multiplier space does not change it
+        let d = element_inverse_constant::<membrane_p2_p1disc::Model>(&x).unwrap();
+        assert!((c - d).abs() < 1e-9 * c);
+        // scale invariant (h² ‖Δv‖² / ‖∇v‖² has no units)
+        let scaled = x.map(|v| 3.7 * v + 1.0);
+        let e = element_inverse_constant::<membrane_p2_p0::Model>(&scaled).unwrap();
+        assert!((c - e).abs() < 1e-8 * c);
+        assert_eq!(
+            element_inverse_constant::<membrane_p1_p0::Model>(&x).unwrap(),
+            0.0
+        );
+    }
+}
+
+fn pressed_flat(_: &[f64]) -> f64 {
+    -3.0
+}
+
+fn zero(_: &[f64]) -> f64 {
+    0.0
+}
+
+/// The sign test of MODELS.md §1: ψ = 0, g = 0, f = −q pressing everywhere onto the
+/// obstacle: exact u = 0 and λ = q, so ∫λ = 16q on (−2,2)² and the contact is total.
+#[test]
+fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
+    let scene = MembraneScene {
+        name: "sign-test",
+        description: "",
+        domain: Domain::Square(2.0),
+        load: pressed_flat,
+        obstacle: zero,
+        boundary: zero,
+        target_l2: 1e-3,
+    };
+    for pair in [
+        MembranePair::P1P0,
+        MembranePair::P2P0,
+        MembranePair::P1Nodal,
+    ] {
+        let mut request = MembraneRequest::new(scene);
+        request.pair = pair;
+        request.mesh_size = 8;
+        let (report, fields) = membranes::solve(&request).unwrap();
+        let largest_u = fields.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(largest_u < 1e-10, "{pair:?}: u = {largest_u}");
+        // the nodal method has forces at the free nodes only: their area share is
+        // 16·(N−1)²/N²
+        let expected = if pair == MembranePair::P1Nodal {
+            48.0 * 49.0 / 64.0
+        } else {
+            48.0
+        };
+        assert!(
+            (report.total_contact_force - expected).abs() < 1e-8 * expected,
+            "{pair:?}: ∫λ = {}",
+            report.total_contact_force
+        );
+        assert!((report.contact_area - 16.0).abs() < 1e-9, "{pair:?}");
+        if pair != MembranePair::P1Nodal {
+            for l in &fields.lambda {
+                assert!((l - 3.0).abs() < 1e-8, "{pair:?}: λ = {l}");
+            }
+        }
+    }
+}
+
+/// Observed rates against the exact radial solution on N = 8…64 (MODELS.md §2: u ∉ H³,
+/// so P2 saturates near O(h^{3/2}) in H¹; P1 is O(h) in H¹ and O(h²) in L²).
+#[test]
+fn radial_convergence_rates() {
+    let sizes = [8, 16, 32, 64];
+    let expected = [
+        // (pair, H¹ rate range, L² rate at least, multiplier rate at least)
+        (MembranePair::P1P0, (0.85, 1.25), 1.6, Some(0.9)),
+        (MembranePair::P2P0, (1.3, 2.0), 2.0, Some(1.2)),
+        (MembranePair::P1Nodal, (0.85, 1.25), 1.6, None),
+    ];
+    for (pair, (low, high), l2_rate, multiplier_rate) in expected {
+        let reports: Vec<MembraneReport> =
+            sizes.iter().map(|&n| solve(radial(), pair, n)).collect();
+        let h1: Vec<f64> = reports.iter().map(|r| r.error_h1.unwrap()).collect();
+        let l2: Vec<f64> = reports.iter().map(|r| r.error_l2.unwrap()).collect();
+        let r_h1 = rates(&h1);
+        let r_l2 = rates(&l2);
+        let last = |r: &[f64]| r[r.len() - 2..].iter().sum::<f64>() / 2.0;
+        println!("{pair:?}: H1 {h1:?} rates {r_h1:.2?}; L2 {l2:?} rates {r_l2:.2?}");
+        assert!(
+            (low..=high).contains(&last(&r_h1)),
+            "{pair:?}: H¹ rates {r_h1:?}"
+        );
+        assert!(last(&r_l2) >= l2_rate, "{pair:?}: L² rates {r_l2:?}");
+        if let Some(m) = multiplier_rate {
+            let e: Vec<f64> = reports
+                .iter()
+                .map(|r| r.error_multiplier.unwrap())
+                .collect();
+            assert!(last(&rates(&e)) >= m, "{pair:?}: λ rates {:?}", rates(&e));
+        }
+        // the contact force converges to 2πA
+        let force: Vec<f64> = reports
+            .iter()
+            .map(|r| (r.total_contact_force - r.exact_contact_force.unwrap()).abs())
+            .collect();
+        assert!(
+            force[3] < force[0] && force[3] < 2e-2 * 4.27,
+            "{pair:?}: {force:?}"
+        );
+        for r in &reports {
+            assert!(r.complementarity_residual < 1e-10, "{pair:?}");
+        }
+    }
+}
+
+/// The stabilized P2–P0 problem solved by nested semismooth Newton and by clarabel's
+/// interior-point method: the same discrete solution.
+#[test]
+fn newton_and_the_qp_solver_agree() {
+    let mut request = MembraneRequest::new(radial());
+    request.mesh_size = 16;
+    let (newton, a) = membranes::solve(&request).unwrap();
+    request.solver = VariationalSolver::Clarabel;
+    let (qp, b) = membranes::solve(&request).unwrap();
+    let difference =
+        a.u.iter()
+            .zip(&b.u)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(difference < 1e-7, "max |u_newton − u_qp| = {difference}");
+    assert!((newton.total_contact_force - qp.total_contact_force).abs() < 1e-6);
+}
+
+fn above(_: &[f64]) -> f64 {
+    0.5
+}
+
+fn not_a_number(x: &[f64]) -> f64 {
+    if x[0] > 0.9 {
+        f64::NAN
+    } else {
+        0.0
+    }
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let mut scene = radial();
+    scene.obstacle = above;
+    scene.boundary = zero;
+    let error = membranes::solve(&MembraneRequest::new(scene))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        error.contains("obstacle lies above the boundary data"),
+        "{error}"
+    );
+
+    let mut scene = radial();
+    scene.load = not_a_number;
+    let error = membranes::solve(&MembraneRequest::new(scene))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("load f is NaN"), "{error}");
+
+    let mut request = MembraneRequest::new(radial());
+    request.mesh_size = 0;
+    assert!(membranes::solve(&request)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("--mesh-size 0"));
+    request.mesh_size = 8;
+    request.alpha = Some(-1.0);
+    assert!(membranes::solve(&request)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("α = -1"));
+    request.alpha = Some(f64::NAN);
+    assert!(membranes::solve(&request).is_err());
+    // inside 1/C_I = 1/96 it solves; beyond it A_α is indefinite and the error says why
+    request.alpha = Some(0.009);
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    request.alpha = Some(0.02);
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(error.contains("outside the stability range"), "{error}");
+}
