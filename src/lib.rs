@@ -8,6 +8,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod beams;
+pub mod membrane_studies;
 pub mod membranes;
 pub mod plot;
 pub mod studies;

@@ -3,6 +3,7 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
+use fem_forms::membrane_studies::{self, MembraneStudy};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::membrane_scenes::{membrane_scene, MEMBRANE_SCENES};
 use fem_forms::models::scenes::{scene, SCENES};
@@ -81,11 +82,15 @@ enum Command {
         #[arg(long)]
         plot: bool,
     },
-    /// Run a study and write its chart and CSV.
+    /// Run a study and write its chart and CSV: a beam study (convergence, locking,
+    /// stability, alpha, work-precision, iterations), or `membrane-radial` followed by
+    /// convergence, stability or alpha (all three when left out).
     Study {
-        /// Which study.
+        /// Which study, or the membrane scene `membrane-radial`.
+        study: String,
+        /// The membrane study.
         #[arg(value_enum)]
-        study: studies::Study,
+        kind: Option<MembraneStudy>,
         /// Larger meshes (longer).
         #[arg(long)]
         full: bool,
@@ -210,6 +215,77 @@ fn default_job(out: &Path) -> Result<(), String> {
     );
     for study in studies::Study::DEFAULT {
         studies::run(study, false, out).map_err(|e| format!("study {study:?}: {e}"))?;
+    }
+    membrane_job(out)
+}
+
+/// The membrane part of the default job: every pair on the radial scene, each scene at
+/// the cheapest pair and mesh that reach its asked accuracy, VTK files, the studies.
+fn membrane_job(out: &Path) -> Result<(), String> {
+    println!("\nfem-forms: membrane scenes (N×N×2 triangles, nested semismooth Newton)\n");
+    membrane_header();
+    let radial = membrane_scene("membrane-radial").expect("the scene exists");
+    for pair in MembranePair::ALL {
+        let mut request = MembraneRequest::new(radial);
+        request.pair = pair;
+        match membranes::solve(&request) {
+            Ok((report, _)) => membrane_row(&report),
+            Err(e) => println!("{:<16} {:<8} not solved: {e}", radial.name, pair.name()),
+        }
+    }
+    std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
+    for scene in MEMBRANE_SCENES {
+        let (rungs, cheapest) = membranes::cheapest_for_accuracy(&scene, &MembranePair::ALL)
+            .map_err(|e| format!("{}: {e}", scene.name))?;
+        println!(
+            "\n{}: the coarsest mesh of each pair with estimated ‖u − u_h‖_L2 ≤ {:.0e} (Richardson estimate against N×2{})",
+            scene.name,
+            scene.target_l2,
+            if rungs.iter().any(|r| r.exact_l2.is_some()) { "; exact error beside" } else { "" }
+        );
+        for (k, r) in rungs.iter().enumerate() {
+            if let Some(e) = &r.failure {
+                println!("  {:<9} not solved: {e}", r.pair);
+                continue;
+            }
+            println!(
+                "  {:<9} N = {:>3} {:>8} dofs {:>8.3} s  estimated {:.2e}{}{}{}",
+                r.pair,
+                r.mesh_size,
+                r.dofs,
+                r.seconds,
+                r.estimated_l2,
+                r.exact_l2
+                    .map_or(String::new(), |e| format!(", exact {e:.2e}")),
+                if r.reached {
+                    ""
+                } else {
+                    "  (not reached by N = 512)"
+                },
+                if Some(k) == cheapest {
+                    "  ← cheapest"
+                } else {
+                    ""
+                }
+            );
+        }
+        if let Some(k) = cheapest {
+            let mut request = MembraneRequest::new(scene);
+            request.pair = MembranePair::parse(&rungs[k].pair).map_err(|e| e.to_string())?;
+            request.mesh_size = rungs[k].mesh_size;
+            let (_, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
+            let path = out.join(format!("{}.vtu", scene.name));
+            membranes::write_vtk(&path, &fields).map_err(|e| e.to_string())?;
+            println!(
+                "  → {} (u, ψ, λ_h, contact set for ParaView)",
+                path.display()
+            );
+        }
+    }
+    println!();
+    for study in MembraneStudy::ALL {
+        membrane_studies::run(study, false, out)
+            .map_err(|e| format!("membrane study {study:?}: {e}"))?;
     }
     Ok(())
 }
@@ -337,8 +413,30 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             Ok(())
         }
-        Some(Command::Study { study, full }) => {
-            studies::run(study, full, &cli.out).map_err(|e| e.to_string())
+        Some(Command::Study { study, kind, full }) => {
+            if study == "membrane-radial" {
+                let kinds = kind.map_or(MembraneStudy::ALL.to_vec(), |k| vec![k]);
+                for k in kinds {
+                    membrane_studies::run(k, full, &cli.out).map_err(|e| e.to_string())?;
+                }
+                return Ok(());
+            }
+            if kind.is_some() {
+                return Err(format!(
+                    "`{study}` takes no second argument (only membrane-radial does)"
+                ));
+            }
+            let beam_study = <studies::Study as ValueEnum>::from_str(&study, true).map_err(|_| {
+                format!(
+                    "unknown study `{study}`; the studies are {} and membrane-radial convergence|stability|alpha",
+                    studies::Study::DEFAULT
+                        .iter()
+                        .filter_map(|s| s.to_possible_value().map(|v| v.get_name().to_string()))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            })?;
+            studies::run(beam_study, full, &cli.out).map_err(|e| e.to_string())
         }
     }
 }

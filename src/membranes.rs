@@ -13,7 +13,8 @@ use fem_runtime::obstacle_2d::{
 };
 use fem_runtime::triangle_field::{TriangleBasis, TriangleField};
 use fem_runtime::{
-    Coefficients, DataFn, Diagonal, Error, Model, PointLocator, Result, SystemDofs, TriangleMesh,
+    Coefficients, DataFn, Diagonal, DofMap, Error, Model, PointLocator, Result, SystemDofs,
+    TriangleMesh,
 };
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
@@ -172,6 +173,21 @@ pub struct MembraneFields {
     pub lambda: Vec<f64>,
     /// 1 on contact cells, 0 elsewhere.
     pub contact: Vec<f64>,
+    /// The DOFs of u.
+    pub u_dofs: DofMap,
+    /// The coefficients of u on `u_dofs`.
+    pub u_coefficients: Vec<f64>,
+}
+
+impl MembraneFields {
+    /// u_h as a finite element function.
+    pub fn u_field(&self) -> TriangleField<'_> {
+        TriangleField {
+            mesh: &self.mesh,
+            map: &self.u_dofs,
+            coefficients: &self.u_coefficients,
+        }
+    }
 }
 
 /// The structured mesh of a scene with parameter N.
@@ -504,6 +520,8 @@ fn stabilized_fields(
             .collect(),
         lambda,
         contact,
+        u_dofs: d.dofs.map(u_field).unwrap().clone(),
+        u_coefficients: solution.field(u_field).to_vec(),
         mesh,
     }
 }
@@ -637,6 +655,8 @@ fn run_nodal(
             .collect(),
         lambda,
         contact,
+        u_dofs: map.clone(),
+        u_coefficients: values.clone(),
         mesh: mesh.clone(),
     };
     Ok((report, fields))
@@ -672,4 +692,84 @@ pub fn difference_l2(a: &TriangleField, b: &TriangleField, degree: usize) -> f64
         }
     }
     sum.sqrt()
+}
+
+/// One pair's way to a scene's asked accuracy.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyRung {
+    /// The pair.
+    pub pair: String,
+    /// The first N whose estimated L² error of u is within the target (or the last tried).
+    pub mesh_size: usize,
+    /// Unknowns at that N.
+    pub dofs: usize,
+    /// Wall time of the solve at that N.
+    pub seconds: f64,
+    /// Richardson estimate `‖u_N − u_2N‖ / (1 − 2⁻²)` of `‖u − u_N‖_L2`.
+    pub estimated_l2: f64,
+    /// The true error where an exact solution is known.
+    pub exact_l2: Option<f64>,
+    /// Whether the target was reached (N ≤ 512).
+    pub reached: bool,
+    /// Why the pair could not be solved, if it could not.
+    pub failure: Option<String>,
+}
+
+/// For every pair, the coarsest N = 8·2^k whose estimated L² error of u is within the
+/// scene's `target_l2`; and the index of the cheapest (least solve time) that reaches it.
+pub fn cheapest_for_accuracy(
+    scene: &MembraneScene,
+    pairs: &[MembranePair],
+) -> Result<(Vec<AccuracyRung>, Option<usize>)> {
+    let mut rungs = Vec::new();
+    for &pair in pairs {
+        match accuracy_rung(scene, pair) {
+            Ok(rung) => rungs.push(rung),
+            Err(e) => rungs.push(AccuracyRung {
+                pair: pair.name().into(),
+                mesh_size: 0,
+                dofs: 0,
+                seconds: f64::NAN,
+                estimated_l2: f64::NAN,
+                exact_l2: None,
+                reached: false,
+                failure: Some(e.to_string()),
+            }),
+        }
+    }
+    let cheapest = rungs
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.reached)
+        .min_by(|a, b| a.1.seconds.total_cmp(&b.1.seconds))
+        .map(|(k, _)| k);
+    Ok((rungs, cheapest))
+}
+
+fn accuracy_rung(scene: &MembraneScene, pair: MembranePair) -> Result<AccuracyRung> {
+    let mut request = MembraneRequest::new(*scene);
+    request.pair = pair;
+    request.mesh_size = 8;
+    let mut coarse = solve(&request)?;
+    loop {
+        request.mesh_size *= 2;
+        let fine = solve(&request)?;
+        let difference = difference_l2(&coarse.1.u_field(), &fine.1.u_field(), 8);
+        // ‖u − u_N‖ ≈ ‖u_N − u_2N‖ / (1 − 2^−p) with the L² rate p = 2
+        let estimated_l2 = difference / 0.75;
+        let reached = estimated_l2 <= scene.target_l2;
+        if reached || request.mesh_size >= 512 {
+            return Ok(AccuracyRung {
+                pair: pair.name().into(),
+                mesh_size: coarse.0.mesh_size,
+                dofs: coarse.0.dofs,
+                seconds: coarse.0.seconds,
+                estimated_l2,
+                exact_l2: coarse.0.error_l2,
+                reached,
+                failure: None,
+            });
+        }
+        coarse = fine;
+    }
 }

@@ -67,7 +67,7 @@ pub fn rates(errors: &[f64]) -> Vec<f64> {
     errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect()
 }
 
-fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io::Result<()> {
+pub(crate) fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
@@ -83,7 +83,7 @@ fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io::Result<()
     std::fs::rename(tmp, path)
 }
 
-fn io(e: std::io::Error) -> Error {
+pub(crate) fn io(e: std::io::Error) -> Error {
     Error::Input(format!("writing output: {e}"))
 }
 
