@@ -224,3 +224,105 @@ fn bad_input_is_a_clear_error() {
     let error = membranes::solve(&request).err().unwrap().to_string();
     assert!(error.contains("outside the stability range"), "{error}");
 }
+
+/// The stability study's small version: the plain pairs have a multiplier kernel (P1–P0:
+/// many modes; P2–P0: one checkerboard mode, the next value O(h) in the h-weighted
+/// norm), the stabilized ones have γ ≥ α.
+#[test]
+fn plain_pairs_have_a_multiplier_kernel_and_stabilized_ones_do_not() {
+    use fem_forms::membrane_studies::stability;
+    let rows = stability(&[4, 8]).unwrap();
+    for r in &rows {
+        let scale = r.stabilized[1];
+        assert!(r.plain[0].abs() < 1e-10 * scale, "{r:?}");
+        assert!(r.stabilized[0] >= 0.999 * r.alpha, "{r:?}");
+        if r.pair == "p1-p0" {
+            assert!(r.plain[1].abs() < 1e-10 * scale, "{r:?}");
+        } else {
+            assert!(r.plain[1] > 1e-6, "{r:?}");
+        }
+    }
+    let p2: Vec<_> = rows.iter().filter(|r| r.pair == "p2-p0").collect();
+    // the second value decays like h² (inf-sup constant like h)
+    let ratio = p2[0].plain[1] / p2[1].plain[1];
+    assert!((2.5..6.0).contains(&ratio), "γ₂ ratio {ratio}");
+}
+
+/// The plain P2–P0 multiplier oscillates along a line through the contact set; the
+/// stabilized one follows the exact λ.
+#[test]
+fn stabilization_removes_the_multiplier_oscillation() {
+    use fem_forms::membrane_studies::{multiplier_profile, total_variation};
+    let plain = multiplier_profile(MembranePair::P2P0, 32, Some(0.0)).unwrap();
+    let stabilized = multiplier_profile(MembranePair::P2P0, 32, None).unwrap();
+    let exact: Vec<(f64, f64)> = (0..=400)
+        .map(|i| {
+            let x = -2.0 + 4.0 * i as f64 / 400.0;
+            (
+                x,
+                fem_forms::models::membrane_scenes::radial_multiplier(&[x, 0.0]),
+            )
+        })
+        .collect();
+    let (p, s, e) = (
+        total_variation(&plain),
+        total_variation(&stabilized),
+        total_variation(&exact),
+    );
+    // variation beyond the exact one is oscillation
+    assert!(p - e > 10.0 * (s - e).abs(), "plain {p}, stabilized {s}, exact {e}");
+    assert!((s - e).abs() < 0.15 * e, "stabilized {s}, exact {e}");
+}
+
+/// The α sweep's small version: inside 1/C_I every α solves, beyond it the solve
+/// fails with the reason.
+#[test]
+fn the_alpha_sweep_shows_the_breakdown_at_one_over_ci() {
+    use fem_forms::membrane_studies::alpha_sweep;
+    let (rows, c_i) = alpha_sweep(8, &[1e-4, 0.5 / 96.0, 0.9 / 96.0, 2.0 / 96.0]).unwrap();
+    assert!((c_i - 96.0).abs() < 1e-8);
+    for row in &rows[..3] {
+        assert!(row.result.is_ok(), "α = {}: {:?}", row.alpha, row.result);
+    }
+    let error = rows[3].result.as_ref().err().unwrap();
+    assert!(error.contains("outside the stability range"), "{error}");
+}
+
+/// The Richardson estimate that picks a scene's mesh agrees with the exact error.
+#[test]
+fn the_accuracy_estimate_tracks_the_exact_error() {
+    let mut scene = radial();
+    scene.target_l2 = 2e-2;
+    let (rungs, cheapest) =
+        membranes::cheapest_for_accuracy(&scene, &[MembranePair::P1P0, MembranePair::P2P0])
+            .unwrap();
+    assert!(cheapest.is_some());
+    for r in &rungs {
+        assert!(r.reached, "{r:?}");
+        let exact = r.exact_l2.unwrap();
+        assert!(exact <= scene.target_l2, "{r:?}");
+        assert!(
+            (0.5..2.0).contains(&(r.estimated_l2 / exact)),
+            "estimate {} vs exact {exact}",
+            r.estimated_l2
+        );
+    }
+}
+
+#[test]
+fn vtk_output_names_every_field() {
+    let mut request = MembraneRequest::new(radial());
+    request.mesh_size = 4;
+    let (_, fields) = membranes::solve(&request).unwrap();
+    let dir = std::env::temp_dir().join(format!("fem-forms-vtk-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("radial.vtu");
+    membranes::write_vtk(&path, &fields).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    for name in ["\"u\"", "\"psi\"", "\"lambda\"", "\"contact\""] {
+        assert!(text.contains(name), "{name} missing");
+    }
+    // a bad path is an error, and leaves nothing behind
+    assert!(membranes::write_vtk(&dir.join("missing/radial.vtu"), &fields).is_err());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
