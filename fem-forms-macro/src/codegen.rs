@@ -468,6 +468,7 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
     let mut form_modules = Vec::new();
     let mut form_infos = Vec::new();
     let mut matrix_arms = Vec::new();
+    let mut add_arms = Vec::new();
     let mut vector_arms = Vec::new();
     for (form_index, form) in forms.iter().enumerate() {
         let form_ident = Ident::new(&form.name, Span::call_site());
@@ -498,6 +499,9 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
                 }
             });
             if block.trial_field.is_some() {
+                add_arms.push(quote! {
+                    (#form_index, #block_index) => #runtime::kernel::add_matrices(mesh, positions, stride, offset, values, |x| #form_ident::#name(x, p, d)),
+                });
                 matrix_arms.push(quote! {
                     (#form_index, #block_index) => #runtime::kernel::store_matrix(&#form_ident::#name(x, p, d), out),
                 });
@@ -607,6 +611,25 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
                     let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
                     match (form, block) {
                         #(#matrix_arms)*
+                        _ => panic!("{}: form {} has no bilinear block {}", #model_name, form, block),
+                    }
+                }
+
+                fn add_element_matrices<G: #runtime::mesh::Mesh>(
+                    form: usize,
+                    block: usize,
+                    mesh: &G,
+                    params: &[f64],
+                    data: &[&#runtime::DataFn],
+                    positions: &[usize],
+                    stride: usize,
+                    offset: usize,
+                    values: &mut [f64],
+                ) {
+                    let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+                    let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+                    match (form, block) {
+                        #(#add_arms)*
                         _ => panic!("{}: form {} has no bilinear block {}", #model_name, form, block),
                     }
                 }

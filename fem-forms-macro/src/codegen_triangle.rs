@@ -417,6 +417,25 @@ pub fn block_kernel(
         let items = (0..rows).map(|i| quote!(k[#i][0]));
         quote!([#(#items),*])
     };
+    // Only what the terms use: h (a sqrt) and K (a division) are skipped otherwise.
+    let uses_h = block.terms.iter().any(|t| t.h_power != 0);
+    let uses_k = alphas.iter().any(|a| *a != [0, 0]);
+    let h_code = uses_h.then(|| {
+        quote! {
+            let h = {
+                let e0 = j00 * j00 + j10 * j10;
+                let e1 = j01 * j01 + j11 * j11;
+                let (dx, dy) = (x[4] - x[2], x[5] - x[3]);
+                e0.max(e1).max(dx * dx + dy * dy).sqrt()
+            };
+        }
+    });
+    let k_code = uses_k.then(|| {
+        quote! {
+            let inv = 1.0 / det;
+            let (k00, k01, k10, k11) = (j11 * inv, -j01 * inv, -j10 * inv, j00 * inv);
+        }
+    });
     let function = quote! {
         #[doc = #doc_title]
         #[doc = #doc_terms]
@@ -428,14 +447,8 @@ pub fn block_kernel(
             let det = j00 * j11 - j01 * j10;
             // |det J| = 2·area; the reference triangle's weights sum to ½
             let area2 = det.abs();
-            let inv = 1.0 / det;
-            let (k00, k01, k10, k11) = (j11 * inv, -j01 * inv, -j10 * inv, j00 * inv);
-            let h = {
-                let e0 = j00 * j00 + j10 * j10;
-                let e1 = j01 * j01 + j11 * j11;
-                let (dx, dy) = (x[4] - x[2], x[5] - x[3]);
-                e0.max(e1).max(dx * dx + dy * dy).sqrt()
-            };
+            #k_code
+            #h_code
             #(#t_lets)*
             #(#scalar_lets)*
             let mut k = [[0.0f64; #cols]; #rows];

@@ -73,7 +73,6 @@ pub struct MatrixAssembler {
     plans: Vec<BlockPlan>,
     symbolic: SymbolicSparseColMat<usize>,
     positions: Vec<usize>,
-    largest_block: usize,
 }
 
 impl MatrixAssembler {
@@ -133,13 +132,11 @@ impl MatrixAssembler {
             positions.push(col_ptr[col] + k);
         });
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let largest_block = plans.iter().map(|p| p.rows * p.cols).max().unwrap_or(0);
         Ok(Self {
             form,
             plans,
             symbolic,
             positions,
-            largest_block,
         })
     }
 
@@ -162,27 +159,21 @@ impl MatrixAssembler {
     ) -> Result<()> {
         values.clear();
         values.resize(self.nonzero_count(), 0.0);
-        let mut local = vec![0.0; self.largest_block];
-        let mut k = 0;
-        let mut x = [0.0; 6];
-        let x = &mut x[..mesh.cell_kind().vertex_count() * mesh.cell_kind().dimension()];
-        for c in 0..mesh.cell_count() {
-            mesh.cell_coordinates_into(c, x);
-            for plan in &self.plans {
-                let len = plan.rows * plan.cols;
-                M::element_matrix(
-                    self.form,
-                    plan.block,
-                    x,
-                    &coefficients.params,
-                    &coefficients.data,
-                    &mut local[..len],
-                );
-                for &v in &local[..len] {
-                    values[self.positions[k]] += v;
-                    k += 1;
-                }
-            }
+        let stride: usize = self.plans.iter().map(|p| p.rows * p.cols).sum();
+        let mut offset = 0;
+        for plan in &self.plans {
+            M::add_element_matrices(
+                self.form,
+                plan.block,
+                mesh,
+                &coefficients.params,
+                &coefficients.data,
+                &self.positions,
+                stride,
+                offset,
+                values,
+            );
+            offset += plan.rows * plan.cols;
         }
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
             let cell = self.positions.iter().position(|&p| p == bad).unwrap_or(0);

@@ -13,3 +13,28 @@ pub fn store_matrix<const R: usize, const C: usize>(k: &[[f64; C]; R], out: &mut
 pub fn store_vector<const R: usize>(k: &[f64; R], out: &mut [f64]) {
     out[..R].copy_from_slice(k);
 }
+
+/// Adds the element matrices of one block over every cell of `mesh` into `values`: cell
+/// `c`'s entry `(i, j)` goes to `values[positions[c·stride + offset + i·C + j]]`.
+///
+/// Generated per block, so the kernel inlines into the cell loop and the block dispatch
+/// happens once per assembly, not once per cell.
+#[inline(always)]
+pub fn add_matrices<G: crate::mesh::Mesh, const N: usize, const R: usize, const C: usize>(
+    mesh: &G,
+    positions: &[usize],
+    stride: usize,
+    offset: usize,
+    values: &mut [f64],
+    kernel: impl Fn(&[f64; N]) -> [[f64; C]; R],
+) {
+    let mut x = [0.0; N];
+    for c in 0..mesh.cell_count() {
+        mesh.cell_coordinates_into(c, &mut x);
+        let k = kernel(&x);
+        let at = &positions[c * stride + offset..][..R * C];
+        for (&p, &v) in at.iter().zip(k.iter().flatten()) {
+            values[p] += v;
+        }
+    }
+}

@@ -77,6 +77,21 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         out: &mut [f64],
     );
 
+    /// Adds the element matrices of `block` of bilinear `form` over all cells of `mesh`
+    /// into `values`, entry `(i, j)` of cell `c` at `positions[c·stride + offset + i·cols + j]`.
+    #[allow(clippy::too_many_arguments)]
+    fn add_element_matrices<G: crate::mesh::Mesh>(
+        form: usize,
+        block: usize,
+        mesh: &G,
+        params: &[f64],
+        data: &[&DataFn],
+        positions: &[usize],
+        stride: usize,
+        offset: usize,
+        values: &mut [f64],
+    );
+
     /// Element vector of `block` of linear `form` into `out`.
     fn element_vector(
         form: usize,

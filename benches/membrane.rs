@@ -1,0 +1,254 @@
+//! Membrane speed, every ratio measured in this one run:
+//! 1. global stiffness assembly of P1 and P2 on the same mesh (elements per second),
+//!    against a hand-written loop that adds barycentric P1 element matrices into the
+//!    same fixed CSC pattern;
+//! 2. the complete stabilized VI solve (nested iteration, assembly included) against one
+//!    sparse Cholesky factorization + solve of the final mesh's matrix `A_α`, with the
+//!    phases of the solve and the Newton iterations per mesh from 2k to 524k triangles.
+//!
+//! `cargo bench --bench membrane` (add `-- --quick` for smaller meshes).
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use fem_forms::linear_solve::Cholesky;
+use fem_forms::membranes::{self, MembranePair, MembraneRequest};
+use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
+use fem_forms::models::membrane_scenes::membrane_scene;
+use fem_forms::obstacle::{solve_lcp, ObstacleOptions};
+use fem_forms::obstacle_2d::{discretize_on_triangles, prolong_on_triangles};
+use fem_forms::{Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh};
+use std::hint::black_box;
+use std::time::Instant;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn zero(_: &[f64]) -> f64 {
+    0.0
+}
+
+/// The hand-written baseline: P1 stiffness from barycentric gradients, added into the
+/// values of a fixed pattern at precomputed positions.
+fn hand_p1_assembly(mesh: &TriangleMesh, positions: &[usize], values: &mut [f64]) {
+    values.fill(0.0);
+    for c in 0..mesh.cell_count() {
+        let x = mesh.cell_coordinates(c);
+        let det = (x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1]);
+        let g = [
+            [x[3] - x[5], x[4] - x[2]],
+            [x[5] - x[1], x[0] - x[4]],
+            [x[1] - x[3], x[2] - x[0]],
+        ];
+        let scale = 0.5 / det.abs();
+        let p = &positions[9 * c..9 * c + 9];
+        for i in 0..3 {
+            for j in 0..3 {
+                values[p[3 * i + j]] += scale * (g[i][0] * g[j][0] + g[i][1] * g[j][1]);
+            }
+        }
+    }
+}
+
+fn assembly(n: usize, rounds: usize) {
+    let mesh = TriangleMesh::rectangle(-2.0, 2.0, -2.0, 2.0, n, n, Diagonal::Right).unwrap();
+    let cells = mesh.cell_count();
+    println!("assembly of the stiffness ∫∇u·∇v on {n}×{n}×2 = {cells} triangles (median of {rounds} rounds)");
+    // P1: generated, through the generic assembler
+    type P1 = membrane_p1::Model;
+    let coefficients = Coefficients::new::<P1>(&[], &[("f", &zero), ("g", &zero)]).unwrap();
+    let dofs = SystemDofs::all::<P1>(&mesh).unwrap();
+    let clock = Instant::now();
+    let assembler = MatrixAssembler::new::<P1>("a", &mesh, &dofs).unwrap();
+    let pattern_seconds = clock.elapsed().as_secs_f64();
+    let mut values = Vec::new();
+    // hand-written: positions of every local entry in the same pattern (not timed)
+    let map = dofs.map(0).unwrap();
+    let (col_ptr, row_idx) = (
+        assembler.symbolic().col_ptr().to_vec(),
+        assembler.symbolic().row_idx().to_vec(),
+    );
+    let mut positions = Vec::with_capacity(9 * cells);
+    for c in 0..cells {
+        let d = map.cell_dofs(c);
+        for &r in d {
+            for &col in d {
+                let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+                positions.push(col_ptr[col] + column.binary_search(&r).unwrap());
+            }
+        }
+    }
+    let mut hand_values = vec![0.0; assembler.nonzero_count()];
+    let (mut generated, mut hand) = (Vec::new(), Vec::new());
+    for round in 0..rounds {
+        let mut time_generated = || {
+            let t = Instant::now();
+            assembler
+                .assemble_values::<P1>(&mesh, &coefficients, &mut values)
+                .unwrap();
+            black_box(&values);
+            t.elapsed().as_secs_f64()
+        };
+        let mut time_hand = || {
+            let t = Instant::now();
+            hand_p1_assembly(&mesh, &positions, &mut hand_values);
+            black_box(&hand_values);
+            t.elapsed().as_secs_f64()
+        };
+        if round % 2 == 0 {
+            generated.push(time_generated());
+            hand.push(time_hand());
+        } else {
+            hand.push(time_hand());
+            generated.push(time_generated());
+        }
+    }
+    let difference = values
+        .iter()
+        .zip(&hand_values)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        difference < 1e-10,
+        "generated and hand-written P1 assembly differ by {difference}"
+    );
+    let (g, h) = (median(generated), median(hand));
+    println!(
+        "  P1 generated   {:>7.1} M triangles/s  ({:.3} s; pattern built once in {:.3} s)",
+        cells as f64 / g / 1e6,
+        g,
+        pattern_seconds
+    );
+    println!(
+        "  P1 hand-written {:>6.1} M triangles/s  ({:.3} s)   generated/hand time ratio {:.2}",
+        cells as f64 / h / 1e6,
+        h,
+        g / h
+    );
+    // P2: the u block of the P2–P0 membrane's `a`
+    type P2 = membrane_p2_p0::Model;
+    let coefficients =
+        Coefficients::new::<P2>(&[("α", 0.0)], &[("f", &zero), ("ψ", &zero), ("g", &zero)])
+            .unwrap();
+    let dofs = SystemDofs::named::<P2>(&mesh, &["u"]).unwrap();
+    let assembler = MatrixAssembler::new::<P2>("a", &mesh, &dofs).unwrap();
+    let times: Vec<f64> = (0..rounds)
+        .map(|_| {
+            let t = Instant::now();
+            assembler
+                .assemble_values::<P2>(&mesh, &coefficients, &mut values)
+                .unwrap();
+            black_box(&values);
+            t.elapsed().as_secs_f64()
+        })
+        .collect();
+    let p2 = median(times);
+    println!(
+        "  P2 generated   {:>7.1} M triangles/s  ({:.3} s, 36 entries per triangle)",
+        cells as f64 / p2 / 1e6,
+        p2
+    );
+}
+
+/// One stabilized VI solve of the radial scene, phase by phase, against one Cholesky.
+fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
+    let scene = membrane_scene("membrane-radial").unwrap();
+    println!(
+        "\n{} on membrane-radial: complete VI solve (nested from N = 4, assembly included) vs one Cholesky of A_α",
+        pair.name()
+    );
+    println!(
+        "{:>5} {:>9} {:>9} {:>16} {:>9} {:>9} {:>9} {:>9} {:>10} {:>7}",
+        "N",
+        "triangles",
+        "dofs",
+        "iterations/level",
+        "VI s",
+        "assembly",
+        "LCP",
+        "prolong",
+        "Cholesky s",
+        "ratio"
+    );
+    for &n in sizes {
+        let mut request = MembraneRequest::new(scene);
+        request.pair = pair;
+        request.mesh_size = n;
+        let mesh = membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap();
+        let (alpha, _) = membranes::alpha_of(&request, &mesh).unwrap();
+        let coefficients = Coefficients::new::<M>(
+            &[("α", alpha)],
+            &[
+                ("f", &scene.load),
+                ("ψ", &scene.obstacle),
+                ("g", &scene.boundary),
+            ],
+        )
+        .unwrap();
+        let mut sizes = vec![n];
+        while sizes[0] / 2 >= 4 && sizes[0] % 2 == 0 {
+            sizes.insert(0, sizes[0] / 2);
+        }
+        let (mut assembly, mut lcp_time, mut prolong) = (0.0, 0.0, 0.0);
+        let mut iterations = Vec::new();
+        let clock = Instant::now();
+        let mut previous = None;
+        let mut last = None;
+        for &k in &sizes {
+            let t = Instant::now();
+            let level_mesh = membranes::scene_mesh(&scene, k, Diagonal::Right).unwrap();
+            let d = discretize_on_triangles::<M>(&level_mesh, &coefficients, "B_h", "L_h").unwrap();
+            assembly += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let start = previous.as_ref().map(|(pd, values): &(_, Vec<f64>)| {
+                d.primal_part(&prolong_on_triangles(pd, values, &d))
+            });
+            prolong += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let solution = solve_lcp(&d.lcp, start.as_deref(), ObstacleOptions::default()).unwrap();
+            lcp_time += t.elapsed().as_secs_f64();
+            iterations.push(solution.iterations);
+            let values = d.full(&solution);
+            last = Some(d.lcp.a.clone());
+            previous = Some((d, values));
+        }
+        let total = clock.elapsed().as_secs_f64();
+        let a = last.unwrap();
+        let t = Instant::now();
+        let pattern = a.symbolic().to_owned().unwrap();
+        let factor = Cholesky::analyse(&pattern).unwrap().factor(&a).unwrap();
+        let x = factor.solve(&vec![1.0; a.nrows()]).unwrap();
+        black_box(x);
+        let linear = t.elapsed().as_secs_f64();
+        let dofs = previous.as_ref().map_or(0, |(d, _)| d.lcp.n() + d.lcp.m());
+        let levels = iterations
+            .iter()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(",");
+        println!(
+            "{:>5} {:>9} {:>9} {:>16} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>10.3} {:>7.1}",
+            n,
+            2 * n * n,
+            dofs,
+            levels,
+            total,
+            assembly,
+            lcp_time,
+            prolong,
+            linear,
+            total / linear
+        );
+    }
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let (assembly_n, p1_sizes, p2_sizes): (usize, Vec<usize>, Vec<usize>) = if quick {
+        (128, vec![32, 64, 128], vec![32, 64])
+    } else {
+        (512, vec![32, 64, 128, 256, 512], vec![32, 64, 128, 256])
+    };
+    assembly(assembly_n, if quick { 3 } else { 9 });
+    vi_solve::<fem_forms::models::membrane::membrane_p1_p0::Model>(MembranePair::P1P0, &p1_sizes);
+    vi_solve::<membrane_p2_p0::Model>(MembranePair::P2P0, &p2_sizes);
+}
