@@ -48,11 +48,16 @@ enum Command {
         elements: usize,
         /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
         /// three quarters of it).
-        #[arg(long, default_value_t = 64)]
-        mesh_size: usize,
+        /// (default 64; with --msh: 0 refinements)
+        #[arg(long)]
+        mesh_size: Option<usize>,
         /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
         #[arg(long)]
         vtk: bool,
+        /// Solve on this Gmsh mesh (MSH 4.1) instead of the structured one; with it,
+        /// --mesh-size is the number of uniform refinements (membranes).
+        #[arg(long)]
+        msh: Option<PathBuf>,
         /// Load magnitude q (1: no contact; 40 and 100: contact).
         #[arg(long, default_value_t = 1.0)]
         load: f64,
@@ -318,11 +323,13 @@ fn run(cli: Cli) -> Result<(), String> {
             cold,
             json,
             vtk,
+            msh,
             ..
         }) if membrane_scene(&name).is_some() => {
             let scene = membrane_scene(&name).expect("checked");
             let mut request = MembraneRequest::new(scene);
-            request.mesh_size = mesh_size;
+            request.mesh_size = mesh_size.unwrap_or(if msh.is_some() { 0 } else { 64 });
+            request.mesh_file = msh;
             request.alpha = alpha;
             if let Some(p) = pair {
                 request.pair = MembranePair::parse(&p).map_err(|e| e.to_string())?;
@@ -343,9 +350,10 @@ fn run(cli: Cli) -> Result<(), String> {
                 membrane_row(&report);
             }
             if vtk {
-                let path = cli
-                    .out
-                    .join(format!("{}-{}-{}.vtu", scene.name, report.pair, mesh_size));
+                let path = cli.out.join(format!(
+                    "{}-{}-{}.vtu",
+                    scene.name, report.pair, request.mesh_size
+                ));
                 std::fs::create_dir_all(&cli.out).map_err(|e| e.to_string())?;
                 membranes::write_vtk(&path, &fields).map_err(|e| e.to_string())?;
                 eprintln!("→ {}", path.display());

@@ -79,7 +79,7 @@ impl MembranePair {
 pub const ALPHA_WHEN_CI_VANISHES: f64 = 0.1;
 
 /// What to solve.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct MembraneRequest {
     /// The scene.
     pub scene: MembraneScene,
@@ -96,6 +96,9 @@ pub struct MembraneRequest {
     pub nested: bool,
     /// Diagonal pattern of the structured mesh.
     pub diagonal: Diagonal,
+    /// A Gmsh mesh to solve on instead of the structured one, refined uniformly
+    /// `mesh_size` times (each refinement a level of the nested iteration).
+    pub mesh_file: Option<std::path::PathBuf>,
 }
 
 impl MembraneRequest {
@@ -109,6 +112,7 @@ impl MembraneRequest {
             solver: VariationalSolver::SemismoothNewton,
             nested: true,
             diagonal: Diagonal::Right,
+            mesh_file: None,
         }
     }
 }
@@ -359,17 +363,45 @@ fn level_sizes(n: usize, nested: bool, even: bool) -> Vec<usize> {
 /// Solves a membrane request.
 pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneFields)> {
     let scene = request.scene;
-    let mesh = scene_mesh(&scene, request.mesh_size, request.diagonal)?;
-    validate(&scene, &mesh)?;
-    let (alpha, c_i) = alpha_of(request, &mesh)?;
-    let even = scene.domain == Domain::LShape;
-    let meshes = level_sizes(request.mesh_size, request.nested, even)
-        .into_iter()
-        .map(|n| scene_mesh(&scene, n, request.diagonal))
-        .collect::<Result<Vec<_>>>()?;
+    let meshes = match &request.mesh_file {
+        Some(path) => file_levels(path, request.mesh_size, request.nested)?,
+        None => {
+            let even = scene.domain == Domain::LShape;
+            level_sizes(request.mesh_size, request.nested, even)
+                .into_iter()
+                .map(|n| scene_mesh(&scene, n, request.diagonal))
+                .collect::<Result<Vec<_>>>()?
+        }
+    };
+    let mesh = meshes.last().expect("at least one level");
+    validate(&scene, mesh)?;
+    let (alpha, c_i) = alpha_of(request, mesh)?;
     dispatch!(request.pair,
         M => run_stabilized::<M>(request, &meshes, alpha, c_i),
         nodal => run_nodal(request, &meshes))
+}
+
+/// The levels of a Gmsh mesh: the file's mesh and its `refinements` uniform
+/// refinements (all of them for nested iteration, else the finest only).
+fn file_levels(
+    path: &std::path::Path,
+    refinements: usize,
+    nested: bool,
+) -> Result<Vec<TriangleMesh>> {
+    if refinements > 8 {
+        return Err(Error::Input(format!(
+            "--mesh-size {refinements} with --msh means {refinements} uniform refinements (4^{refinements} times the triangles); at most 8"
+        )));
+    }
+    let mut levels = vec![fem_runtime::gmsh::read_msh(path)?];
+    for _ in 0..refinements {
+        let finer = levels.last().expect("a level").refine_uniformly();
+        levels.push(finer);
+    }
+    if !nested {
+        levels.drain(..levels.len() - 1);
+    }
+    Ok(levels)
 }
 
 fn exact_of(scene: &MembraneScene) -> bool {

@@ -270,7 +270,10 @@ fn stabilization_removes_the_multiplier_oscillation() {
         total_variation(&exact),
     );
     // variation beyond the exact one is oscillation
-    assert!(p - e > 10.0 * (s - e).abs(), "plain {p}, stabilized {s}, exact {e}");
+    assert!(
+        p - e > 10.0 * (s - e).abs(),
+        "plain {p}, stabilized {s}, exact {e}"
+    );
     assert!((s - e).abs() < 0.15 * e, "stabilized {s}, exact {e}");
 }
 
@@ -324,5 +327,80 @@ fn vtk_output_names_every_field() {
     }
     // a bad path is an error, and leaves nothing behind
     assert!(membranes::write_vtk(&dir.join("missing/radial.vtu"), &fields).is_err());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+const SQUARE_MSH: &str = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$Entities
+0 4 1 0
+1 -2 -2 0 2 -2 0 0 0
+2 2 -2 0 2 2 0 0 0
+3 -2 2 0 2 2 0 0 0
+4 -2 -2 0 -2 2 0 0 0
+1 -2 -2 0 2 2 0 0 0
+$EndEntities
+$Nodes
+2 5 1 5
+2 1 0 4
+1
+2
+3
+4
+-2 -2 0
+2 -2 0
+2 2 0
+-2 2 0
+2 1 0 1
+5
+0.3 -0.1 0
+$EndNodes
+$Elements
+1 4 1 4
+2 1 2 4
+1 1 2 5
+2 2 3 5
+3 3 4 5
+4 4 1 5
+$EndElements
+";
+
+/// The radial problem on a Gmsh mesh (four triangles around an off-centre point, so
+/// no symmetry), refined by newest-vertex bisection: it converges to the exact solution,
+/// and a broken file is a clear error.
+#[test]
+fn a_gmsh_mesh_refined_uniformly_converges() {
+    let dir = std::env::temp_dir().join(format!("fem-forms-msh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("square.msh");
+    std::fs::write(&path, SQUARE_MSH).unwrap();
+    let errors: Vec<f64> = (3..=5)
+        .map(|refinements| {
+            let mut request = MembraneRequest::new(radial());
+            request.mesh_file = Some(path.clone());
+            request.mesh_size = refinements;
+            let (report, _) = membranes::solve(&request).unwrap();
+            assert_eq!(report.triangles, 4 << (2 * refinements));
+            assert!(report.complementarity_residual < 1e-10);
+            // the shapes are not right isosceles: C_I differs from 96, α follows it
+            assert!((report.alpha * report.inverse_constant - 0.5).abs() < 1e-12);
+            report.error_h1.unwrap()
+        })
+        .collect();
+    let r = rates(&errors);
+    assert!(
+        r.iter().all(|&r| r > 1.2),
+        "H¹ errors {errors:?}, rates {r:?}"
+    );
+    std::fs::write(&path, "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2").unwrap();
+    let mut request = MembraneRequest::new(radial());
+    request.mesh_file = Some(path.clone());
+    request.mesh_size = 1;
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(error.contains("square.msh"), "{error}");
+    request.mesh_size = 9;
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(error.contains("at most 8"), "{error}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
