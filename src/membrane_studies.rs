@@ -58,17 +58,18 @@ pub fn radial_report(pair: MembranePair, n: usize, alpha: Option<f64>) -> Result
     Ok(membranes::solve(&request)?.0)
 }
 
-/// The mesh sizes N of the convergence study for a pair: six meshes by default, up
-/// to 512×512×2 = 524,288 triangles for the P1 pairs with `full`.
+/// The mesh sizes N of the convergence study for a pair: six meshes, up to
+/// 512×512×2 = 524,288 triangles for the P1 pairs and 128×128×2 for P2; `full` adds
+/// one finer mesh (2M triangles for P1).
 pub fn convergence_sizes(pair: MembranePair, full: bool) -> Vec<usize> {
     let top = match (pair.degree(), full) {
-        (1, false) => 256,
-        (1, true) => 512,
+        (1, false) => 512,
+        (1, true) => 1024,
         (_, false) => 128,
         (_, true) => 256,
     };
     let mut sizes = vec![top];
-    while sizes.len() < 6 + usize::from(full && pair.degree() == 1) {
+    while sizes.len() < 6 + usize::from(full) {
         sizes.insert(0, sizes[0] / 2);
     }
     sizes
@@ -115,6 +116,7 @@ fn run_convergence(full: bool, out: &Path) -> Result<()> {
     let mut csv = Vec::new();
     let mut h1_series = Vec::new();
     let mut l2_series = Vec::new();
+    let mut multiplier_series = Vec::new();
     for pair in &pairs {
         let pr = pair_rows(&rows, pair.name());
         let l2: Vec<f64> = pr.iter().map(|r| r.error_l2.unwrap_or(f64::NAN)).collect();
@@ -172,6 +174,12 @@ fn run_convergence(full: bool, out: &Path) -> Result<()> {
             format!("{} L²", pair.name()),
             pr.iter().zip(&l2).map(|(r, &e)| (h(r), e)).collect(),
         ));
+        if lm.iter().all(|e| e.is_finite()) {
+            multiplier_series.push(Series::marked(
+                format!("{} h-weighted λ", pair.name()),
+                pr.iter().zip(&lm).map(|(r, &e)| (h(r), e)).collect(),
+            ));
+        }
     }
     let axes = |y| Axes {
         x: "h",
