@@ -563,6 +563,11 @@ fn run_alpha(full: bool, out: &Path) -> Result<()> {
         .filter(|v| v.is_finite());
     let (low, high) = all.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
     let marker = |a: f64| vec![(a, low.max(1e-12)), (a, high)];
+    let failed: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.result.is_err() && r.alpha > 0.0)
+        .map(|r| (r.alpha, high))
+        .collect();
     plot::chart(
         &out.join("membrane-radial-alpha.svg"),
         &format!("membrane-radial, P2–P0, N = {n}: errors against α (breaks down at α ≥ 1/C_I)"),
@@ -581,6 +586,7 @@ fn run_alpha(full: bool, out: &Path) -> Result<()> {
                 format!("default ½/C_I = {:.2e}", 0.5 / c_i),
                 marker(0.5 / c_i),
             ),
+            Series::marked("failed: A_α indefinite (drawn at the top)", failed),
         ],
     )
     .map_err(io)?;

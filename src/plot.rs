@@ -59,6 +59,17 @@ const COLORS: [RGBColor; 6] = [
     RGBColor(80, 80, 80),
 ];
 
+/// A short axis label: plain for moderate magnitudes, `1e-5` style otherwise.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || (1e-2..1e4).contains(&a) {
+        let text = format!("{v:.3}");
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.0e}")
+    }
+}
+
 fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
@@ -109,6 +120,7 @@ where
                 .x_desc(axes.x)
                 .y_desc(axes.y)
                 .y_label_formatter(&|v| format!("{v:.3e}"))
+                .x_label_formatter(&|v| tick(*v))
                 .draw()?;
             for (k, s) in series.iter().enumerate() {
                 let color = COLORS[k % COLORS.len()];
