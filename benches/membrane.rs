@@ -175,15 +175,7 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         request.mesh_size = n;
         let mesh = membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap();
         let (alpha, _) = membranes::alpha_of(&request, &mesh).unwrap();
-        let coefficients = Coefficients::new::<M>(
-            &[("α", alpha)],
-            &[
-                ("f", &scene.load),
-                ("ψ", &scene.obstacle),
-                ("g", &scene.boundary),
-            ],
-        )
-        .unwrap();
+        let coefficients = membranes::scene_coefficients::<M>(&scene, alpha).unwrap();
         let mut sizes = vec![n];
         while sizes[0] / 2 >= 4 && sizes[0] % 2 == 0 {
             sizes.insert(0, sizes[0] / 2);

@@ -13,7 +13,7 @@ use crate::studies::{io, rates, write_csv};
 use fem_runtime::linear_solve::Cholesky;
 use fem_runtime::obstacle::Discretization;
 use fem_runtime::obstacle_2d::discretize_on_triangles;
-use fem_runtime::{Coefficients, Diagonal, Error, Model, Result, TriangleMesh};
+use fem_runtime::{Diagonal, Error, Model, Result, TriangleMesh};
 use nalgebra::{DMatrix, SymmetricEigen};
 use std::path::Path;
 
@@ -224,14 +224,7 @@ pub fn available_pairs() -> Vec<MembranePair> {
 /// inf-sup constants; the stabilized method has γ ≥ α by construction).
 pub fn inf_sup<M: Model>(mesh: &TriangleMesh, alpha: f64) -> Result<[f64; 2]> {
     let scene = radial();
-    let coefficients = Coefficients::new::<M>(
-        &[("α", alpha)],
-        &[
-            ("f", &scene.load),
-            ("ψ", &scene.obstacle),
-            ("g", &scene.boundary),
-        ],
-    )?;
+    let coefficients = membranes::scene_coefficients::<M>(&scene, alpha)?;
     let d: Discretization<TriangleMesh> =
         discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h")?;
     let lcp = &d.lcp;

@@ -305,6 +305,19 @@ macro_rules! dispatch {
     };
 }
 
+/// The parameters and data of a stabilized membrane model for a scene: α, and the
+/// scene's load f, obstacle ψ and boundary data g.
+pub fn scene_coefficients<M: Model>(scene: &MembraneScene, alpha: f64) -> Result<Coefficients<'_>> {
+    Coefficients::new::<M>(
+        &[("α", alpha)],
+        &[
+            ("f", &scene.load),
+            ("ψ", &scene.obstacle),
+            ("g", &scene.boundary),
+        ],
+    )
+}
+
 /// The α a request uses and the mesh's `C_I`.
 pub fn alpha_of(request: &MembraneRequest, mesh: &TriangleMesh) -> Result<(f64, f64)> {
     let c_i = dispatch!(request.pair, M => inverse_constant::<M>(mesh)?, nodal => 0.0);
@@ -433,14 +446,7 @@ fn run_stabilized<M: Model>(
             1.0 / c_i
         ));
     }
-    let coefficients = Coefficients::new::<M>(
-        &[("α", alpha)],
-        &[
-            ("f", &scene.load),
-            ("ψ", &scene.obstacle),
-            ("g", &scene.boundary),
-        ],
-    )?;
+    let coefficients = scene_coefficients::<M>(&scene, alpha)?;
     let options = ObstacleOptions {
         solver,
         ..ObstacleOptions::default()

@@ -157,6 +157,79 @@ pub(crate) fn describe_term(term: &Term, block: &Block, symbols: &Symbols) -> St
     parts.join("·")
 }
 
+/// The non-negligible `name · literal` products of entry `(i, j)` of reference tables
+/// (relative to each table's largest entry, so rounding residue is not emitted).
+pub(crate) fn literal_products(
+    tables: &[(Ident, &Vec<Vec<f64>>)],
+    i: usize,
+    j: usize,
+) -> Vec<TokenStream> {
+    tables
+        .iter()
+        .filter_map(|(name, table)| {
+            let scale = table.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            let r = table[i][j];
+            (r.abs() > 1e-14 * scale).then(|| {
+                let lit = float(r);
+                quote!(#name * #lit)
+            })
+        })
+        .collect()
+}
+
+/// What every block kernel shares around its body: its doc lines, return type and
+/// return expression.
+pub(crate) struct KernelFrame {
+    /// First doc line.
+    pub doc_title: String,
+    /// Second doc line: the terms.
+    pub doc_terms: String,
+    /// The return type.
+    pub signature_out: TokenStream,
+    /// The return expression.
+    pub ret: TokenStream,
+}
+
+/// The frame of a block kernel; `cell` is added to the doc title (e.g. " on triangles").
+pub(crate) fn kernel_frame(
+    block: &Block,
+    symbols: &Symbols,
+    form: &str,
+    cell: &str,
+    rows: usize,
+    cols: usize,
+) -> KernelFrame {
+    let test_element = symbols.fields[block.test_field].element;
+    let test = &symbols.fields[block.test_field].test_name;
+    let terms: Vec<String> = block
+        .terms
+        .iter()
+        .map(|t| describe_term(t, block, symbols))
+        .collect();
+    let doc_title = match block.trial_field {
+        Some(f) => format!(
+            " Block ({test}, {}) of `{form}`{cell}: rows {test} ({}), columns {} ({}).",
+            symbols.fields[f].name,
+            test_element.name(),
+            symbols.fields[f].name,
+            symbols.fields[f].element.name()
+        ),
+        None => format!(" Block {test} of `{form}`{cell} ({}).", test_element.name()),
+    };
+    let (signature_out, ret) = if block.trial_field.is_some() {
+        (quote!([[f64; #cols]; #rows]), quote!(k))
+    } else {
+        let items = (0..rows).map(|i| quote!(k[#i][0]));
+        (quote!([f64; #rows]), quote!([#(#items),*]))
+    };
+    KernelFrame {
+        doc_title,
+        doc_terms: format!(" Terms: {}.", terms.join(" + ")),
+        signature_out,
+        ret,
+    }
+}
+
 /// Name of a block kernel: `matrix_η_θ` (rows, columns) or `vector_v`.
 pub fn block_ident(block: &Block, symbols: &Symbols) -> Ident {
     let test = &symbols.fields[block.test_field].test_name;
@@ -348,23 +421,15 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
 
     // Entries: (data part + Σ c_g R_g[i][j]) · h^{sᵢ + sⱼ}.
     let has_data = !loops.is_empty();
+    let tables: Vec<(Ident, &Vec<Vec<f64>>)> = groups
+        .iter()
+        .enumerate()
+        .map(|(g, group)| (format_ident!("c{}", g), &group.reference))
+        .collect();
     let mut entries = Vec::new();
     for i in 0..rows {
         for j in 0..cols {
-            let mut sum: Vec<TokenStream> = Vec::new();
-            for (g, group) in groups.iter().enumerate() {
-                let scale = group
-                    .reference
-                    .iter()
-                    .flatten()
-                    .fold(0.0f64, |m, v| m.max(v.abs()));
-                let r = group.reference[i][j];
-                if r.abs() > 1e-14 * scale {
-                    let c = format_ident!("c{}", g);
-                    let lit = float(r);
-                    sum.push(quote!(#c * #lit));
-                }
-            }
+            let sum = literal_products(&tables, i, j);
             let scaling = test_element.dof_scaling_power(i)
                 + trial_element.map_or(0, |e| e.dof_scaling_power(j));
             let scale = power(quote!(h), scaling);
@@ -385,34 +450,12 @@ fn block_kernel(block: &Block, symbols: &Symbols, runtime: &TokenStream, form: &
         }
     }
 
-    let test_name = &symbols.fields[block.test_field].test_name;
-    let description: Vec<String> = block
-        .terms
-        .iter()
-        .map(|t| describe_term(t, block, symbols))
-        .collect();
-    let doc_title = match block.trial_field {
-        Some(f) => format!(
-            " Block ({test_name}, {}) of `{form}`: rows {test_name} ({}), columns {} ({}).",
-            symbols.fields[f].name,
-            test_element.name(),
-            symbols.fields[f].name,
-            trial_element.unwrap().name()
-        ),
-        None => format!(" Block {test_name} of `{form}` ({}).", test_element.name()),
-    };
-    let doc_terms = format!(" Terms: {}.", description.join(" + "));
-    let signature_out = if block.trial_field.is_some() {
-        quote!([[f64; #cols]; #rows])
-    } else {
-        quote!([f64; #rows])
-    };
-    let ret = if block.trial_field.is_some() {
-        quote!(k)
-    } else {
-        let items = (0..rows).map(|i| quote!(k[#i][0]));
-        quote!([#(#items),*])
-    };
+    let KernelFrame {
+        doc_title,
+        doc_terms,
+        signature_out,
+        ret,
+    } = kernel_frame(block, symbols, form, "", rows, cols);
     let function = quote! {
         #[doc = #doc_title]
         #[doc = #doc_terms]

@@ -11,7 +11,9 @@
 //!   reference derivatives, the data evaluated once per point.
 
 use crate::analysis::{Block, Symbols, Term};
-use crate::codegen::{block_ident, coefficient, describe_term, float, BlockCode};
+use crate::codegen::{
+    block_ident, coefficient, float, kernel_frame, literal_products, BlockCode, KernelFrame,
+};
 use fem_reference::triangle::{Polynomial2, TriangleRule};
 use fem_reference::ElementKind;
 use proc_macro2::TokenStream;
@@ -360,23 +362,15 @@ pub fn block_kernel(
 
     // Entries: data part + Σ s_n R_n[i][j] over non-zero literals.
     let has_data = !loops.is_empty();
+    let tables: Vec<(proc_macro2::Ident, &Vec<Vec<f64>>)> = pairs
+        .iter()
+        .enumerate()
+        .map(|(n, pair)| (format_ident!("s{}", n), &pair.reference))
+        .collect();
     let mut entries = Vec::new();
     for i in 0..rows {
         for j in 0..cols {
-            let mut sum: Vec<TokenStream> = Vec::new();
-            for (n, pair) in pairs.iter().enumerate() {
-                let scale = pair
-                    .reference
-                    .iter()
-                    .flatten()
-                    .fold(0.0f64, |m, v| m.max(v.abs()));
-                let r = pair.reference[i][j];
-                if r.abs() > 1e-14 * scale {
-                    let s = format_ident!("s{}", n);
-                    let lit = float(r);
-                    sum.push(quote!(#s * #lit));
-                }
-            }
+            let sum = literal_products(&tables, i, j);
             let value = match (has_data, sum.is_empty()) {
                 (_, true) => continue,
                 (false, false) => quote!(#(#sum)+*),
@@ -386,37 +380,12 @@ pub fn block_kernel(
         }
     }
 
-    let test_name = &symbols.fields[block.test_field].test_name;
-    let description: Vec<String> = block
-        .terms
-        .iter()
-        .map(|t| describe_term(t, block, symbols))
-        .collect();
-    let doc_title = match block.trial_field {
-        Some(f) => format!(
-            " Block ({test_name}, {}) of `{form}` on triangles: rows {test_name} ({}), columns {} ({}).",
-            symbols.fields[f].name,
-            test_element.name(),
-            symbols.fields[f].name,
-            trial_element.unwrap().name()
-        ),
-        None => format!(
-            " Block {test_name} of `{form}` on triangles ({}).",
-            test_element.name()
-        ),
-    };
-    let doc_terms = format!(" Terms: {}.", description.join(" + "));
-    let signature_out = if block.trial_field.is_some() {
-        quote!([[f64; #cols]; #rows])
-    } else {
-        quote!([f64; #rows])
-    };
-    let ret = if block.trial_field.is_some() {
-        quote!(k)
-    } else {
-        let items = (0..rows).map(|i| quote!(k[#i][0]));
-        quote!([#(#items),*])
-    };
+    let KernelFrame {
+        doc_title,
+        doc_terms,
+        signature_out,
+        ret,
+    } = kernel_frame(block, symbols, form, " on triangles", rows, cols);
     // Only what the terms use: h (a sqrt) and K (a division) are skipped otherwise.
     let uses_h = block.terms.iter().any(|t| t.h_power != 0);
     let uses_k = alphas.iter().any(|a| *a != [0, 0]);
