@@ -5,11 +5,16 @@
 //! A U − Bᵀ Λ = F,   Λ ≥ 0,   R := B U + C Λ − G ≥ 0,   Λ·R = 0
 //! ```
 //!
-//! With `C` diagonal and positive (P0 multipliers, α > 0), `Λ = C⁻¹(G − B U)₊`, and `U`
-//! minimizes the convex C¹ function `Φ(U) = ½UᵀAU − FᵀU + ½ Σ_k (G − BU)²₊,k / C_k`.
+//! `C` is block diagonal: small dense SPD blocks of consecutive constraints (size 1 for
+//! P0 multipliers, 3 for P1disc on triangles; [`CouplingBlocks`]). With `C > 0` the
+//! multipliers can be eliminated block by block: with `r = G − BU`,
+//! `Λ_b = argmin_{Λ≥0} ½ΛᵀC_bΛ − Λᵀr_b` (for a block of size 1, `Λ_k = (G − BU)₊,k / C_k`),
+//! and `U` minimizes the convex C¹ function
+//! `Φ(U) = ½UᵀAU − FᵀU + Σ_b φ_b(r_b)`, `φ_b(r) = max_{Λ≥0} Λᵀr − ½ΛᵀC_bΛ`
+//! (for size 1, `½ r₊² / C_k`), whose gradient is `AU − F − BᵀΛ`.
 //! [`semismooth_newton`] is Newton's method on Φ (the primal–dual active set method with
-//! `c_k = 1/C_k` per constraint) with an Armijo line search on Φ, so it cannot cycle;
-//! the Hessian's pattern and symbolic Cholesky factorization are computed once.
+//! `c_k = 1/C_k` per constraint for P0) with an Armijo line search on Φ, so it cannot
+//! cycle; the Hessian's pattern and symbolic Cholesky factorization are computed once.
 //! [`quadratic_program`] solves the same problem with clarabel as an independent check,
 //! and also the plain mixed method (`C = 0`). Every result carries its KKT residual.
 
@@ -17,7 +22,15 @@ use crate::error::{Error, Result};
 use crate::linear_solve::{multiply, Cholesky};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use std::ops::Range;
 use std::time::Instant;
+
+/// The largest block of `C` the solvers accept: eliminating a block's multipliers
+/// enumerates its 2^s faces of the orthant.
+pub const MAX_BLOCK: usize = 8;
+
+/// Room for one dense block.
+const BLOCK_ENTRIES: usize = MAX_BLOCK * MAX_BLOCK;
 
 /// `A U − Bᵀ Λ = F, 0 ≤ Λ ⊥ B U + C Λ − G ≥ 0`.
 #[derive(Clone, Debug)]
@@ -28,10 +41,341 @@ pub struct Lcp {
     pub b_rows: Vec<Vec<(usize, f64)>>,
     /// Diagonal of `C` (m), ≥ 0.
     pub c: Vec<f64>,
+    /// Off-diagonal part of `C` (empty: `C` is diagonal).
+    pub c_blocks: CouplingBlocks,
     /// Primal right-hand side (n).
     pub f: Vec<f64>,
     /// Constraint right-hand side (m).
     pub g: Vec<f64>,
+}
+
+/// The off-diagonal part of a block-diagonal `C`: groups of consecutive constraints whose
+/// multipliers are coupled (P1disc: the three multipliers of a triangle), each with its
+/// dense symmetric block. A constraint in no group is a block of size 1. The default has
+/// no groups: `C` is the diagonal [`Lcp::c`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CouplingBlocks {
+    /// First constraint of each group, ascending, groups disjoint.
+    starts: Vec<usize>,
+    /// Size of each group, 2 to [`MAX_BLOCK`].
+    sizes: Vec<usize>,
+    /// Offset of each group's `s × s` row-major entries in `values`.
+    offsets: Vec<usize>,
+    /// The entries, zero on the diagonal (the diagonal is `Lcp::c`).
+    values: Vec<f64>,
+}
+
+impl CouplingBlocks {
+    /// No coupling: `C` is diagonal.
+    pub fn none() -> Self {
+        Self::default()
+    }
+
+    /// From the off-diagonal entries `(k, l, C_kl)` of an `m × m` matrix `C` (both `(k, l)`
+    /// and `(l, k)`, duplicates summed, diagonal entries ignored): the groups are the
+    /// smallest runs of consecutive constraints that no entry couples across. An error
+    /// when a group is larger than [`MAX_BLOCK`] (the coupling is not block diagonal with
+    /// small blocks), when `C` is not symmetric, or an entry is not finite.
+    pub fn from_entries(m: usize, entries: &[(usize, usize, f64)]) -> Result<Self> {
+        let mut reach: Vec<usize> = (0..m).collect();
+        for &(k, l, v) in entries {
+            if k >= m || l >= m {
+                return Err(Error::Input(format!(
+                    "an entry ({k}, {l}) of C lies outside its {m} constraints"
+                )));
+            }
+            if !v.is_finite() {
+                return Err(Error::Input(format!("C_{k},{l} = {v} is not finite")));
+            }
+            if k != l {
+                let (low, high) = (k.min(l), k.max(l));
+                reach[low] = reach[low].max(high);
+            }
+        }
+        let mut blocks = Self::default();
+        let mut group = vec![usize::MAX; m];
+        let mut k = 0;
+        while k < m {
+            let mut end = reach[k];
+            let mut j = k;
+            while j <= end {
+                end = end.max(reach[j]);
+                j += 1;
+            }
+            let size = end + 1 - k;
+            if size > MAX_BLOCK {
+                return Err(Error::Input(format!(
+                    "C couples constraints {k} to {end}: a block of {size} consecutive multipliers, more than {MAX_BLOCK}; C must be block diagonal with small blocks (the multipliers of one cell)"
+                )));
+            }
+            if size > 1 {
+                group[k..=end].fill(blocks.starts.len());
+                blocks.starts.push(k);
+                blocks.sizes.push(size);
+                blocks.offsets.push(blocks.values.len());
+                blocks.values.resize(blocks.values.len() + size * size, 0.0);
+            }
+            k = end + 1;
+        }
+        for &(k, l, v) in entries {
+            if k != l {
+                let b = group[k];
+                let (s, start) = (blocks.sizes[b], blocks.starts[b]);
+                blocks.values[blocks.offsets[b] + (k - start) * s + (l - start)] += v;
+            }
+        }
+        for b in 0..blocks.starts.len() {
+            let (s, o) = (blocks.sizes[b], blocks.offsets[b]);
+            for i in 0..s {
+                for j in 0..i {
+                    let (x, y) = (blocks.values[o + i * s + j], blocks.values[o + j * s + i]);
+                    if (x - y).abs() > 1e-10 * x.abs().max(y.abs()) {
+                        let k = blocks.starts[b];
+                        return Err(Error::Input(format!(
+                            "C is not symmetric: C_{},{} = {x}, C_{},{} = {y}",
+                            k + i,
+                            k + j,
+                            k + j,
+                            k + i
+                        )));
+                    }
+                    let mean = 0.5 * (x + y);
+                    blocks.values[o + i * s + j] = mean;
+                    blocks.values[o + j * s + i] = mean;
+                }
+            }
+        }
+        Ok(blocks)
+    }
+
+    /// True when `C` is diagonal.
+    pub fn is_empty(&self) -> bool {
+        self.starts.is_empty()
+    }
+
+    /// The coupled groups as `(first constraint, size)`.
+    pub fn groups(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.starts.iter().copied().zip(self.sizes.iter().copied())
+    }
+
+    /// One past the last constraint of any group (0 without groups).
+    fn end(&self) -> usize {
+        self.groups().map(|(k, s)| k + s).max().unwrap_or(0)
+    }
+}
+
+/// One diagonal block of `C`: constraints `start..start + size`.
+#[derive(Clone, Copy, Debug)]
+struct Block<'a> {
+    start: usize,
+    size: usize,
+    /// The group's `size × size` entries (empty for size 1).
+    off: &'a [f64],
+}
+
+impl Block<'_> {
+    fn range(&self) -> Range<usize> {
+        self.start..self.start + self.size
+    }
+
+    /// `C_{start+i, start+j}` with the diagonal `c`.
+    fn entry(&self, c: &[f64], i: usize, j: usize) -> f64 {
+        if i == j {
+            c.get(self.start + i).copied().unwrap_or(0.0)
+        } else {
+            self.off[i * self.size + j]
+        }
+    }
+
+    /// The dense block, row-major, into `out` (`size²` entries).
+    fn dense(&self, c: &[f64], out: &mut [f64]) {
+        for i in 0..self.size {
+            for j in 0..self.size {
+                out[i * self.size + j] = self.entry(c, i, j);
+            }
+        }
+    }
+
+    /// The dense block restricted to the constraints `face` (indices within the block).
+    fn face(&self, c: &[f64], face: &[usize], out: &mut [f64]) {
+        let q = face.len();
+        for (a, &i) in face.iter().enumerate() {
+            for (b, &j) in face.iter().enumerate() {
+                out[a * q + b] = self.entry(c, i, j);
+            }
+        }
+    }
+}
+
+/// The blocks of `C` in order, groups of [`CouplingBlocks`] and singletons between them.
+struct Blocks<'a> {
+    m: usize,
+    coupling: &'a CouplingBlocks,
+    k: usize,
+    group: usize,
+}
+
+impl<'a> Iterator for Blocks<'a> {
+    type Item = Block<'a>;
+
+    fn next(&mut self) -> Option<Block<'a>> {
+        if self.k >= self.m {
+            return None;
+        }
+        let cb = self.coupling;
+        if self.group < cb.starts.len() && cb.starts[self.group] == self.k {
+            let (s, o) = (cb.sizes[self.group], cb.offsets[self.group]);
+            self.group += 1;
+            // a group past the last constraint (rejected by `Lcp::check_shapes`) is
+            // skipped rather than read out of bounds
+            if self.k + s <= self.m {
+                let block = Block {
+                    start: self.k,
+                    size: s,
+                    off: &cb.values[o..o + s * s],
+                };
+                self.k += s;
+                return Some(block);
+            }
+        }
+        let block = Block {
+            start: self.k,
+            size: 1,
+            off: &[],
+        };
+        self.k += 1;
+        Some(block)
+    }
+}
+
+/// In-place Cholesky factorization `a = L Lᵀ` of an `n × n` row-major matrix (L in the
+/// lower triangle); false when a pivot is not positive.
+fn small_cholesky(a: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let mut d = a[j * n + j];
+        for k in 0..j {
+            d -= a[j * n + k] * a[j * n + k];
+        }
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * n + j] = d;
+        for i in j + 1..n {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            a[i * n + j] = s / d;
+        }
+    }
+    true
+}
+
+/// Solves `L Lᵀ x = b` in place (`l` from [`small_cholesky`]).
+fn small_solve(l: &[f64], n: usize, x: &mut [f64]) {
+    for i in 0..n {
+        let mut s = x[i];
+        for k in 0..i {
+            s -= l[i * n + k] * x[k];
+        }
+        x[i] = s / l[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let mut s = x[i];
+        for k in i + 1..n {
+            s -= l[k * n + i] * x[k];
+        }
+        x[i] = s / l[i * n + i];
+    }
+}
+
+/// The inverse of an SPD `n × n` row-major matrix into `out`; false if it is not SPD.
+fn small_inverse(a: &[f64], n: usize, out: &mut [f64]) -> bool {
+    let mut l = [0.0; BLOCK_ENTRIES];
+    l[..n * n].copy_from_slice(&a[..n * n]);
+    if !small_cholesky(&mut l, n) {
+        return false;
+    }
+    let mut x = [0.0; MAX_BLOCK];
+    for j in 0..n {
+        x[..n].fill(0.0);
+        x[j] = 1.0;
+        small_solve(&l, n, &mut x[..n]);
+        for i in 0..n {
+            out[i * n + j] = x[i];
+        }
+    }
+    true
+}
+
+/// On the face `mask` of the orthant (the components in `mask` free, the others zero):
+/// `x` with `C_II x_I = r_I`, and how far it is from the minimizer's KKT conditions
+/// (`x_I ≥ 0` and `(Cx − r)_j ≥ 0` off I) in units of r; `None` if `C_II` is singular.
+fn face_point(c: &[f64], s: usize, r: &[f64], mask: usize, x: &mut [f64]) -> Option<f64> {
+    let mut face = [0usize; MAX_BLOCK];
+    let q = (0..s).filter(|i| mask >> i & 1 == 1).fold(0, |q, i| {
+        face[q] = i;
+        q + 1
+    });
+    let mut l = [0.0; BLOCK_ENTRIES];
+    for a in 0..q {
+        for b in 0..q {
+            l[a * q + b] = c[face[a] * s + face[b]];
+        }
+    }
+    let mut y = [0.0; MAX_BLOCK];
+    for a in 0..q {
+        y[a] = r[face[a]];
+    }
+    if q > 0 {
+        if !small_cholesky(&mut l, q) {
+            return None;
+        }
+        small_solve(&l, q, &mut y[..q]);
+    }
+    x[..s].fill(0.0);
+    let mut violation = 0.0f64;
+    for a in 0..q {
+        x[face[a]] = y[a];
+        violation = violation.max(-y[a] * c[face[a] * s + face[a]]);
+    }
+    for j in (0..s).filter(|j| mask >> j & 1 == 0) {
+        let dual: f64 = (0..q).map(|a| c[j * s + face[a]] * y[a]).sum::<f64>() - r[j];
+        violation = violation.max(-dual);
+    }
+    Some(violation)
+}
+
+/// `Λ = argmin_{Λ≥0} ½ΛᵀCΛ − Λᵀr` for one SPD block `c` (`s × s`, row-major) and the
+/// face it lies on (`active`: the components solved for). The faces are tried from the
+/// smallest: on face I, `C_II Λ_I = r_I`, and the minimizer is the face point with
+/// `Λ_I ≥ 0` and `(CΛ − r)_j ≥ 0` off I (the KKT conditions, which single out the unique
+/// minimizer of a strictly convex QP). Rounding can leave no face exactly feasible at a
+/// kink: then the least violating one, clipped to `Λ ≥ 0`.
+fn block_minimizer(c: &[f64], s: usize, r: &[f64], lambda: &mut [f64], active: &mut [bool]) {
+    let mut x = [0.0; MAX_BLOCK];
+    let mut best = (f64::INFINITY, 0usize);
+    'search: for count in 0..=s {
+        for mask in (0..1usize << s).filter(|m| m.count_ones() as usize == count) {
+            if let Some(violation) = face_point(c, s, r, mask, &mut x) {
+                if violation <= 0.0 {
+                    best = (violation, mask);
+                    break 'search;
+                }
+                if violation < best.0 {
+                    best = (violation, mask);
+                }
+            }
+        }
+    }
+    if face_point(c, s, r, best.1, &mut x).is_none() {
+        x[..s].fill(0.0);
+    }
+    for i in 0..s {
+        lambda[i] = x[i].max(0.0);
+        active[i] = best.1 >> i & 1 == 1;
+    }
 }
 
 /// A solution of the LCP with how it was obtained.
@@ -55,6 +399,24 @@ pub struct LcpSolution {
 }
 
 impl Lcp {
+    /// An LCP with a diagonal `C`.
+    pub fn new(
+        a: SparseMatrix,
+        b_rows: Vec<Vec<(usize, f64)>>,
+        c: Vec<f64>,
+        f: Vec<f64>,
+        g: Vec<f64>,
+    ) -> Self {
+        Self {
+            a,
+            b_rows,
+            c,
+            c_blocks: CouplingBlocks::none(),
+            f,
+            g,
+        }
+    }
+
     /// Number of primal unknowns.
     pub fn n(&self) -> usize {
         self.f.len()
@@ -63,6 +425,47 @@ impl Lcp {
     /// Number of constraints.
     pub fn m(&self) -> usize {
         self.g.len()
+    }
+
+    /// The blocks of `C` in order.
+    fn blocks(&self) -> Blocks<'_> {
+        Blocks {
+            m: self.m(),
+            coupling: &self.c_blocks,
+            k: 0,
+            group: 0,
+        }
+    }
+
+    /// An error unless the sizes of `A`, `B`, `C`, `F`, `G` fit together.
+    fn check_shapes(&self) -> Result<()> {
+        let (n, m) = (self.n(), self.m());
+        if self.a.nrows() != n || self.a.ncols() != n {
+            return Err(Error::Input(format!(
+                "A is {} × {} for {n} primal unknowns",
+                self.a.nrows(),
+                self.a.ncols()
+            )));
+        }
+        if self.b_rows.len() != m || self.c.len() != m {
+            return Err(Error::Input(format!(
+                "{} rows of B and {} diagonal entries of C for {m} constraints",
+                self.b_rows.len(),
+                self.c.len()
+            )));
+        }
+        if self.b_rows.iter().flatten().any(|&(j, _)| j >= n) {
+            return Err(Error::Input(format!(
+                "B has a column beyond the {n} primal unknowns"
+            )));
+        }
+        if self.c_blocks.end() > m {
+            return Err(Error::Input(format!(
+                "a block of C ends at constraint {}, beyond the {m} constraints",
+                self.c_blocks.end()
+            )));
+        }
+        Ok(())
     }
 
     /// `B u`.
@@ -81,6 +484,39 @@ impl Lcp {
                 for &(j, v) in row {
                     out[j] += v * yk;
                 }
+            }
+        }
+        out
+    }
+
+    /// `C λ` (entries of `λ` beyond its length count as 0).
+    pub fn c_times(&self, lambda: &[f64]) -> Vec<f64> {
+        self.c_product(lambda, false)
+    }
+
+    /// `Σ_l |C_kl λ_l|` per constraint: the size of the terms that make up `(Cλ)_k`, for
+    /// judging a constraint residual relative to them.
+    pub fn c_times_abs(&self, lambda: &[f64]) -> Vec<f64> {
+        self.c_product(lambda, true)
+    }
+
+    fn c_product(&self, lambda: &[f64], absolute: bool) -> Vec<f64> {
+        let mut out = vec![0.0; self.m()];
+        let value = |l: usize| lambda.get(l).copied().unwrap_or(0.0);
+        for block in self.blocks() {
+            for (i, k) in block.range().enumerate() {
+                out[k] = block
+                    .range()
+                    .enumerate()
+                    .map(|(j, l)| {
+                        let t = block.entry(&self.c, i, j) * value(l);
+                        if absolute {
+                            t.abs()
+                        } else {
+                            t
+                        }
+                    })
+                    .sum();
             }
         }
         out
@@ -109,7 +545,7 @@ impl Lcp {
     ///   `‖AU − BᵀΛ − F‖∞ / (‖A‖∞‖U‖∞ + ‖Bᵀ‖∞‖Λ‖∞ + ‖F‖∞)`,
     /// - the complementarity `max_k |min(Λ_k/Λ*, r_k)|` (`Λ*` the larger of ‖Λ‖∞ and
     ///   [`Lcp::multiplier_scale`]) with the componentwise relative
-    ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + C_k|Λ_k| + |G_k|)`,
+    ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + Σ_l |C_kl Λ_l| + |G_k|)`,
     /// - the infeasibilities `(−Λ_k)₊/‖Λ‖∞` and `(−r_k)₊`.
     pub fn kkt_residual(&self, u: &[f64], lambda: &[f64]) -> f64 {
         let au = multiply(&self.a, u);
@@ -136,13 +572,15 @@ impl Lcp {
             equilibrium
         };
         let lambda_norm = norm_inf(lambda).max(self.multiplier_scale());
+        let c_lambda = self.c_times(lambda);
+        let c_terms = self.c_times_abs(lambda);
         let mut complementarity = 0.0f64;
         for (k, row) in self.b_rows.iter().enumerate() {
             let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
-                + (self.c[k] * lambda[k]).abs()
+                + c_terms[k]
                 + self.g[k].abs();
             let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
-            let residual = bu + self.c[k] * lambda[k] - self.g[k];
+            let residual = bu + c_lambda[k] - self.g[k];
             let r = if terms > 0.0 {
                 residual / terms
             } else {
@@ -163,18 +601,22 @@ impl Lcp {
     /// `‖d‖∞ / ‖U‖∞` for the Newton step `d = −H⁻¹∇Φ(U)` at `U`: a forward-error
     /// certificate. The backward error alone cannot certify `U` when `A` is as badly
     /// conditioned as a thin beam's (κ ~ 1e13: a backward error of 1e-11 allows an O(1)
-    /// error), and `Λ = C⁻¹(G − BU)₊` loses digits to cancellation when `C ~ αh⁵`; the
-    /// step is damped by the `BᵀC⁻¹B` part of `H` and has neither problem. Needs `C > 0`.
+    /// error), and the eliminated Λ loses digits to cancellation when `C ~ αh⁵`; the
+    /// step is damped by the `BᵀHB` part of the Hessian and has neither problem. Needs
+    /// `C` positive definite.
     pub fn newton_correction(&self, u: &[f64]) -> Result<f64> {
-        if self.c.iter().any(|&c| c.is_nan() || c <= 0.0) {
-            return Err(Error::Input("the Newton correction needs C > 0".into()));
+        self.check_shapes()?;
+        self.require_positive_c("the Newton correction")?;
+        if u.len() != self.n() {
+            return Err(Error::Input(format!(
+                "U has {} entries, the problem {}",
+                u.len(),
+                self.n()
+            )));
         }
         let hessian = Hessian::new(self);
         let bu = self.b_times(u);
-        let active: Vec<bool> = (0..self.m()).map(|k| self.g[k] - bu[k] > 0.0).collect();
-        let lambda: Vec<f64> = (0..self.m())
-            .map(|k| (self.g[k] - bu[k]).max(0.0) / self.c[k])
-            .collect();
+        let (lambda, active) = self.eliminate(&bu);
         let au = multiply(&self.a, u);
         let btl = self.bt_times(&lambda);
         let minus_gradient: Vec<f64> = (0..self.n()).map(|i| self.f[i] + btl[i] - au[i]).collect();
@@ -289,53 +731,103 @@ fn values_of_a(
     values
 }
 
-/// The Hessian `A + Σ_{k active} b_k b_kᵀ / C_k` with a fixed pattern.
+/// The Hessian `A + Bᵀ H B` of Φ, `H = blockdiag(P_I C_II⁻¹ P_Iᵀ)` on each block's face
+/// I, with a fixed pattern: the union over all faces, i.e. the rows of a whole block
+/// coupled.
 struct Hessian {
     symbolic: SymbolicSparseColMat<usize>,
     a_positions: Vec<usize>,
-    /// For row k of B, the value positions of its outer product entries (i-major).
-    row_positions: Vec<Vec<usize>>,
+    /// For each row of B, the index of each of its entries' columns in its block's
+    /// column set J.
+    row_local: Vec<Vec<usize>>,
+    /// For each block of C: `|J|` and the value positions of `J × J` (i-major).
+    block_positions: Vec<(usize, Vec<usize>)>,
 }
 
 impl Hessian {
     fn new(lcp: &Lcp) -> Self {
+        let block_columns: Vec<Vec<usize>> = lcp
+            .blocks()
+            .map(|block| {
+                let mut columns: Vec<usize> = block
+                    .range()
+                    .flat_map(|k| lcp.b_rows[k].iter().map(|&(j, _)| j))
+                    .collect();
+                columns.sort_unstable();
+                columns.dedup();
+                columns
+            })
+            .collect();
         let pattern = Pattern::new(&lcp.a, lcp.n(), |columns| {
-            for row in &lcp.b_rows {
-                for &(i, _) in row {
-                    for &(j, _) in row {
+            for block in &block_columns {
+                for &i in block {
+                    for &j in block {
                         columns[j].push(i);
                     }
                 }
             }
         });
         let a_positions = pattern.positions_of(&lcp.a);
-        let row_positions = lcp
-            .b_rows
-            .iter()
-            .map(|row| {
-                row.iter()
-                    .flat_map(|&(i, _)| row.iter().map(move |&(j, _)| (i, j)))
-                    .map(|(i, j)| pattern.position(i, j))
-                    .collect()
-            })
-            .collect();
+        let mut row_local = vec![Vec::new(); lcp.m()];
+        let mut block_positions = Vec::with_capacity(block_columns.len());
+        for (block, columns) in lcp.blocks().zip(&block_columns) {
+            for k in block.range() {
+                row_local[k] = lcp.b_rows[k]
+                    .iter()
+                    .map(|&(j, _)| {
+                        columns
+                            .binary_search(&j)
+                            .expect("the block's columns hold its rows' columns")
+                    })
+                    .collect();
+            }
+            let positions = columns
+                .iter()
+                .flat_map(|&i| columns.iter().map(move |&j| (i, j)))
+                .map(|(i, j)| pattern.position(i, j))
+                .collect();
+            block_positions.push((columns.len(), positions));
+        }
         Self {
             symbolic: pattern.symbolic(),
             a_positions,
-            row_positions,
+            row_local,
+            block_positions,
         }
     }
 
+    /// The Hessian on the faces `active` (per constraint, from [`Lcp::eliminate`]).
     fn matrix(&self, lcp: &Lcp, active: &[bool]) -> SparseMatrix {
         let mut values = values_of_a(&self.symbolic, &self.a_positions, &lcp.a);
-        for (k, row) in lcp.b_rows.iter().enumerate() {
-            if active[k] {
-                let w = 1.0 / lcp.c[k];
-                let mut q = 0;
-                for &(_, vi) in row {
-                    for &(_, vj) in row {
-                        values[self.row_positions[k][q]] += w * vi * vj;
-                        q += 1;
+        let mut inverse = [0.0; BLOCK_ENTRIES];
+        let mut dense = [0.0; BLOCK_ENTRIES];
+        let mut face = [0usize; MAX_BLOCK];
+        for (block, (width, positions)) in lcp.blocks().zip(&self.block_positions) {
+            let q = block.range().filter(|&k| active[k]).fold(0, |q, k| {
+                face[q] = k - block.start;
+                q + 1
+            });
+            if q == 0 {
+                continue;
+            }
+            if block.size == 1 {
+                inverse[0] = 1.0 / lcp.c[block.start];
+            } else {
+                block.face(&lcp.c, &face[..q], &mut dense[..q * q]);
+                if !small_inverse(&dense, q, &mut inverse) {
+                    // not SPD: the solvers reject such a C before they get here
+                    continue;
+                }
+            }
+            for a in 0..q {
+                let k = block.start + face[a];
+                for b in 0..q {
+                    let l = block.start + face[b];
+                    let w = inverse[a * q + b];
+                    for (&(_, vk), &ik) in lcp.b_rows[k].iter().zip(&self.row_local[k]) {
+                        for (&(_, vl), &il) in lcp.b_rows[l].iter().zip(&self.row_local[l]) {
+                            values[positions[ik * width + il]] += w * vk * vl;
+                        }
                     }
                 }
             }
@@ -345,15 +837,31 @@ impl Hessian {
 }
 
 impl Lcp {
-    /// An error unless every `C_k > 0` (Φ and the elimination of Λ need it).
+    /// An error unless every block of `C` is positive definite (Φ and the elimination of
+    /// Λ need it).
     fn require_positive_c(&self, method: &str) -> Result<()> {
-        match self.c.iter().position(|&c| c.is_nan() || c <= 0.0) {
-            Some(k) => Err(Error::Input(format!(
-                "{method} needs C > 0 (it uses Φ and Λ = C⁻¹(G − BU)₊); C_{k} = {}: α ≤ 0 gives the plain mixed method, solve it with the QP solver",
-                self.c[k]
-            ))),
-            None => Ok(()),
+        let mut dense = [0.0; BLOCK_ENTRIES];
+        for block in self.blocks() {
+            let k = block.start;
+            if block.size == 1 {
+                if self.c[k].is_nan() || self.c[k] <= 0.0 {
+                    return Err(Error::Input(format!(
+                        "{method} needs C > 0 (it uses Φ and Λ = C⁻¹(G − BU)₊); C_{k} = {}: α ≤ 0 gives the plain mixed method, solve it with the QP solver",
+                        self.c[k]
+                    )));
+                }
+                continue;
+            }
+            let s = block.size;
+            block.dense(&self.c, &mut dense[..s * s]);
+            if !small_cholesky(&mut dense, s) {
+                return Err(Error::Input(format!(
+                    "{method} needs C positive definite (it uses Φ and the eliminated Λ); its block of constraints {k} to {} is not: α ≤ 0 gives the plain mixed method, solve it with the QP solver",
+                    k + s - 1
+                )));
+            }
         }
+        Ok(())
     }
 
     /// The start vector, or zero.
@@ -369,14 +877,47 @@ impl Lcp {
         }
     }
 
-    /// `Λ = C⁻¹(G − BU)₊` from `bu = BU`.
+    /// The eliminated multiplier from `bu = BU`: per block of `C`,
+    /// `Λ_b = argmin_{Λ≥0} ½ΛᵀC_bΛ − Λᵀ(G − BU)_b` (for a block of size 1,
+    /// `Λ_k = (G − BU)₊,k / C_k`). Needs `C` positive definite.
     pub fn eliminated_multiplier(&self, bu: &[f64]) -> Vec<f64> {
-        (0..self.m())
-            .map(|k| (self.g[k] - bu[k]).max(0.0) / self.c[k])
-            .collect()
+        self.eliminate(bu).0
     }
 
-    /// The merit function `Φ(U) = ½UᵀAU − FᵀU + ½Σ_k (G − BU)²₊,k / C_k` from `au = AU`, `bu = BU`.
+    /// The eliminated multiplier and, per constraint, whether it is on its block's
+    /// active face (the constraints Newton's Hessian includes).
+    fn eliminate(&self, bu: &[f64]) -> (Vec<f64>, Vec<bool>) {
+        let m = self.m();
+        let mut lambda = vec![0.0; m];
+        let mut active = vec![false; m];
+        let mut dense = [0.0; BLOCK_ENTRIES];
+        let mut r = [0.0; MAX_BLOCK];
+        for block in self.blocks() {
+            let k = block.start;
+            if block.size == 1 {
+                let gap = self.g[k] - bu[k];
+                active[k] = gap > 0.0;
+                lambda[k] = gap.max(0.0) / self.c[k];
+                continue;
+            }
+            let s = block.size;
+            block.dense(&self.c, &mut dense[..s * s]);
+            for (i, r) in r[..s].iter_mut().enumerate() {
+                *r = self.g[k + i] - bu[k + i];
+            }
+            block_minimizer(
+                &dense[..s * s],
+                s,
+                &r[..s],
+                &mut lambda[block.range()],
+                &mut active[block.range()],
+            );
+        }
+        (lambda, active)
+    }
+
+    /// The merit function `Φ(U) = ½UᵀAU − FᵀU + Σ_b max_{Λ≥0}(Λᵀr_b − ½ΛᵀC_bΛ)`,
+    /// `r = G − BU` (for P0: `½Σ_k (G − BU)²₊,k / C_k`), from `au = AU`, `bu = BU`.
     pub fn merit(&self, u: &[f64], au: &[f64], bu: &[f64]) -> f64 {
         let quadratic: f64 = u
             .iter()
@@ -384,10 +925,36 @@ impl Lcp {
             .zip(&self.f)
             .map(|((u, au), f)| 0.5 * u * au - f * u)
             .sum();
-        let penalty: f64 = (0..self.m())
-            .map(|k| {
-                let r = (self.g[k] - bu[k]).max(0.0);
-                0.5 * r * r / self.c[k]
+        let mut dense = [0.0; BLOCK_ENTRIES];
+        let mut r = [0.0; MAX_BLOCK];
+        let mut lambda = [0.0; MAX_BLOCK];
+        let mut active = [false; MAX_BLOCK];
+        let penalty: f64 = self
+            .blocks()
+            .map(|block| {
+                let k = block.start;
+                if block.size == 1 {
+                    let r = (self.g[k] - bu[k]).max(0.0);
+                    return 0.5 * r * r / self.c[k];
+                }
+                let s = block.size;
+                block.dense(&self.c, &mut dense[..s * s]);
+                for (i, r) in r[..s].iter_mut().enumerate() {
+                    *r = self.g[k + i] - bu[k + i];
+                }
+                block_minimizer(
+                    &dense[..s * s],
+                    s,
+                    &r[..s],
+                    &mut lambda[..s],
+                    &mut active[..s],
+                );
+                (0..s)
+                    .map(|i| {
+                        let c_lambda: f64 = (0..s).map(|j| dense[i * s + j] * lambda[j]).sum();
+                        lambda[i] * (r[i] - 0.5 * c_lambda)
+                    })
+                    .sum::<f64>()
             })
             .sum();
         quadratic + penalty
@@ -428,6 +995,7 @@ pub fn semismooth_newton(
     options: NewtonOptions,
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
+    lcp.check_shapes()?;
     lcp.require_positive_c("semismooth Newton")?;
     let n = lcp.n();
     let mut u = lcp.start_vector(start)?;
@@ -446,10 +1014,9 @@ pub fn semismooth_newton(
     for iteration in 1..=options.max_iterations {
         let au = multiply(&lcp.a, &u);
         let bu = lcp.b_times(&u);
-        let active: Vec<bool> = (0..lcp.m()).map(|k| lcp.g[k] - bu[k] > 0.0).collect();
-        let lambda = lcp.eliminated_multiplier(&bu);
-        // Converged: the active set did not change over a full step, so u is the exact
-        // minimizer of the quadratic that Φ is on this active set.
+        let (lambda, active) = lcp.eliminate(&bu);
+        // Converged: the active faces did not change over a full step, so u is the exact
+        // minimizer of the quadratic that Φ is on these faces.
         if previous_active.as_ref() == Some(&active) {
             let residual = lcp.kkt_residual(&u, &lambda);
             if residual <= options.tolerance {
@@ -502,27 +1069,49 @@ pub fn semismooth_newton(
 }
 
 impl Lcp {
-    /// How many digits `Λ = C⁻¹(G − BU)` loses to cancellation: `ε|G_k| / (C_k Λ*)` at its
-    /// worst (Λ* the multiplier scale). Near 1 the eliminated Λ is rounding noise: on fine
-    /// meshes `C = αh⁵` falls below the rounding of `G − BU ≈ CΛ`.
+    /// How many digits the eliminated Λ loses to cancellation: `ε‖G_b‖∞‖C_b⁻¹‖∞ / Λ*`
+    /// at its worst block (`ε|G_k| / (C_k Λ*)` for P0; Λ* the multiplier scale). Near 1 the
+    /// eliminated Λ is rounding noise: on fine meshes `C = αh⁵` falls below the rounding
+    /// of `G − BU ≈ CΛ`.
     pub fn elimination_noise(&self) -> f64 {
         let scale = self.multiplier_scale().max(f64::MIN_POSITIVE);
-        (0..self.m())
-            .filter(|&k| self.c[k] > 0.0)
-            .map(|k| f64::EPSILON * self.g[k].abs() / (self.c[k] * scale))
+        let mut dense = [0.0; BLOCK_ENTRIES];
+        let mut inverse = [0.0; BLOCK_ENTRIES];
+        self.blocks()
+            .filter_map(|block| {
+                let k = block.start;
+                if block.size == 1 {
+                    return (self.c[k] > 0.0)
+                        .then(|| f64::EPSILON * self.g[k].abs() / (self.c[k] * scale));
+                }
+                let s = block.size;
+                block.dense(&self.c, &mut dense[..s * s]);
+                if !small_inverse(&dense, s, &mut inverse) {
+                    return None;
+                }
+                let inverse_norm = (0..s)
+                    .map(|i| (0..s).map(|j| inverse[i * s + j].abs()).sum::<f64>())
+                    .fold(0.0, f64::max);
+                let g = self.g[block.range()]
+                    .iter()
+                    .fold(0.0f64, |m, g| m.max(g.abs()));
+                Some(f64::EPSILON * g * inverse_norm / scale)
+            })
             .fold(0.0, f64::max)
     }
 }
 
 /// The saddle-point system `[[A, −B̃ᵀ], [−B̃, D]]` of the primal–dual active set method with
-/// a fixed pattern: active rows carry `B_k` and `D_kk = −C_k`, inactive rows `Λ_k = 0`
-/// (`B̃_k = 0`, `D_kk = −1`), so one symbolic LU serves every iteration.
+/// a fixed pattern: active rows carry `B_k` and, within their block of `C`, `D_kl = −C_kl`
+/// between active constraints; inactive rows `Λ_k = 0` (`B̃_k = 0`, `D_kk = −1` scaled,
+/// no coupling), so one symbolic LU serves every iteration.
 struct SaddlePoint {
     symbolic: SymbolicSparseColMat<usize>,
     a_positions: Vec<usize>,
-    /// For row k of B: positions of (n+k, j) and (j, n+k) per entry, and of (n+k, n+k).
+    /// For row k of B: positions of (n+k, j) and (j, n+k) per entry.
     b_positions: Vec<Vec<(usize, usize)>>,
-    diagonal: Vec<usize>,
+    /// For each block of C: the positions of (n+k, n+l), k and l in the block (k-major).
+    block_positions: Vec<Vec<usize>>,
 }
 
 impl SaddlePoint {
@@ -534,7 +1123,13 @@ impl SaddlePoint {
                     columns[j].push(n + k);
                     columns[n + k].push(j);
                 }
-                columns[n + k].push(n + k);
+            }
+            for block in lcp.blocks() {
+                for k in block.range() {
+                    for l in block.range() {
+                        columns[n + l].push(n + k);
+                    }
+                }
             }
         });
         let a_positions = pattern.positions_of(&lcp.a);
@@ -548,12 +1143,21 @@ impl SaddlePoint {
                     .collect()
             })
             .collect();
-        let diagonal = (0..m).map(|k| pattern.position(n + k, n + k)).collect();
+        let block_positions = lcp
+            .blocks()
+            .map(|block| {
+                block
+                    .range()
+                    .flat_map(|k| block.range().map(move |l| (k, l)))
+                    .map(|(k, l)| pattern.position(n + k, n + l))
+                    .collect()
+            })
+            .collect();
         Self {
             symbolic: pattern.symbolic(),
             a_positions,
             b_positions,
-            diagonal,
+            block_positions,
         }
     }
 
@@ -565,11 +1169,23 @@ impl SaddlePoint {
                     values[p] = -v;
                     values[q] = -v;
                 }
-                values[self.diagonal[k]] = -lcp.c[k];
-            } else {
-                // Λ_k = 0, scaled like the row so that the matrix stays balanced
-                let scale = row.iter().fold(0.0f64, |m, &(_, v)| m.max(v.abs()));
-                values[self.diagonal[k]] = -scale.max(lcp.c[k]).max(f64::MIN_POSITIVE);
+            }
+        }
+        for (block, positions) in lcp.blocks().zip(&self.block_positions) {
+            let s = block.size;
+            for (i, k) in block.range().enumerate() {
+                for (j, l) in block.range().enumerate() {
+                    let p = positions[i * s + j];
+                    if active[k] && active[l] {
+                        values[p] = -block.entry(&lcp.c, i, j);
+                    } else if k == l {
+                        // Λ_k = 0, scaled like the row so that the matrix stays balanced
+                        let scale = lcp.b_rows[k]
+                            .iter()
+                            .fold(0.0f64, |m, &(_, v)| m.max(v.abs()));
+                        values[p] = -scale.max(lcp.c[k]).max(f64::MIN_POSITIVE);
+                    }
+                }
             }
         }
         SparseColMat::new(self.symbolic.clone(), values)
@@ -587,13 +1203,21 @@ pub fn recover_multiplier(
     refinement_steps: usize,
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
-    let n = lcp.n();
+    lcp.check_shapes()?;
+    let (n, m) = (lcp.n(), lcp.m());
+    if solution.u.len() != n || solution.lambda.len() != m {
+        return Err(Error::Input(format!(
+            "a solution with {} primal values and {} multipliers for a problem with {n} and {m}",
+            solution.u.len(),
+            solution.lambda.len()
+        )));
+    }
     let active: Vec<bool> = solution.lambda.iter().map(|&l| l > 0.0).collect();
     let saddle = SaddlePoint::new(lcp);
     let k_matrix = saddle.matrix(lcp, &active);
     let factor = crate::linear_solve::LuSolver::analyse(&saddle.symbolic)?.factor(&k_matrix)?;
     let mut rhs = lcp.f.clone();
-    rhs.extend((0..lcp.m()).map(|k| if active[k] { -lcp.g[k] } else { 0.0 }));
+    rhs.extend((0..m).map(|k| if active[k] { -lcp.g[k] } else { 0.0 }));
     let x = factor.solve_refined(&k_matrix, &rhs, refinement_steps)?;
     let u = x[..n].to_vec();
     let lambda: Vec<f64> = x[n..]
@@ -621,23 +1245,23 @@ pub fn recover_multiplier(
 }
 
 /// The primal–dual active set method on the saddle-point system, for when eliminating
-/// `Λ = C⁻¹(G − BU)` would lose Λ to cancellation ([`Lcp::elimination_noise`]): Λ is an
-/// unknown of each linear solve, computed from the equilibrium. The step in U is the
-/// Newton step on Φ for the current active set, globalized by the same Armijo search;
-/// after a full step the next active set is `{Λ_k > 0} ∪ {G_k − B_kU > 0}`.
+/// Λ would lose it to cancellation ([`Lcp::elimination_noise`]): Λ is an unknown of each
+/// linear solve, computed from the equilibrium. The step in U is the Newton step on Φ for
+/// the current active set, globalized by the same Armijo search; after a full step the
+/// next active set is `{Λ_k > 0}` on the active constraints and `{R_k < 0}` on the others.
 pub fn primal_dual_active_set(
     lcp: &Lcp,
     start: Option<&[f64]>,
     options: NewtonOptions,
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
+    lcp.check_shapes()?;
     lcp.require_positive_c("the saddle-point active-set method")?;
     let (n, m) = (lcp.n(), lcp.m());
     let mut u = lcp.start_vector(start)?;
     let saddle = SaddlePoint::new(lcp);
     let lu = crate::linear_solve::LuSolver::analyse(&saddle.symbolic)?;
-    let bu0 = lcp.b_times(&u);
-    let mut active: Vec<bool> = (0..m).map(|k| lcp.g[k] - bu0[k] > 0.0).collect();
+    let mut active = lcp.eliminate(&lcp.b_times(&u)).1;
     let mut lambda: Vec<f64> = vec![0.0; m];
     let mut two_ago: Option<Vec<bool>> = None;
     for iteration in 1..=options.max_iterations {
@@ -664,13 +1288,15 @@ pub fn primal_dual_active_set(
                 .zip(&active)
                 .map(|(&l, &a)| if a { l } else { 0.0 })
                 .collect();
+            // R = BU + CΛ − G with Λ = 0 off the active set (for P0: R_k = B_kU − G_k there)
             let bu = lcp.b_times(&u);
+            let c_lambda = lcp.c_times(&lambda);
             let next: Vec<bool> = (0..m)
                 .map(|k| {
                     if active[k] {
                         lambda[k] > 0.0
                     } else {
-                        lcp.g[k] - bu[k] > 0.0
+                        bu[k] + c_lambda[k] - lcp.g[k] < 0.0
                     }
                 })
                 .collect();
@@ -702,8 +1328,7 @@ pub fn primal_dual_active_set(
             two_ago = Some(std::mem::replace(&mut active, next));
         } else {
             u = u.iter().zip(&d).map(|(u, d)| u + step * d).collect();
-            let bu = lcp.b_times(&u);
-            active = (0..m).map(|k| lcp.g[k] - bu[k] > 0.0).collect();
+            active = lcp.eliminate(&lcp.b_times(&u)).1;
         }
     }
     Err(Error::NotConverged {
@@ -718,18 +1343,32 @@ pub fn primal_dual_active_set(
 
 /// The LCP as a convex QP solved by clarabel (an interior-point method independent of
 /// the Newton path): `min ½UᵀAU − FᵀU + ½ΛᵀCΛ` over `BU + CΛ ≥ G`. Its KKT conditions
-/// are the LCP with `Λ` the constraint's multiplier (for `C > 0` also `Λ = C⁻¹CΛ`, the
-/// primal Λ); with `C = 0` it is the plain mixed method `min ½UᵀAU − FᵀU` over `BU ≥ G`.
-/// Unlike a formulation with `C⁻¹`, nothing here grows like `h⁻⁵`.
+/// are the LCP with `Λ` the constraint's multiplier (for `C` positive definite also
+/// `Λ = C⁻¹CΛ`, the primal Λ); with `C = 0` it is the plain mixed method
+/// `min ½UᵀAU − FᵀU` over `BU ≥ G`. Unlike a formulation with `C⁻¹`, nothing here grows
+/// like `h⁻⁵`.
 pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
     use clarabel::algebra::CscMatrix;
     use clarabel::solver::{
         DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
     };
     let clock = Instant::now();
+    lcp.check_shapes()?;
     let (n, m) = (lcp.n(), lcp.m());
     if lcp.c.iter().any(|&c| c.is_nan() || c < 0.0) {
         return Err(Error::Input("C must be non-negative".into()));
+    }
+    let mut dense = [0.0; BLOCK_ENTRIES];
+    for block in lcp.blocks().filter(|b| b.size > 1) {
+        let s = block.size;
+        block.dense(&lcp.c, &mut dense[..s * s]);
+        if !small_cholesky(&mut dense, s) {
+            return Err(Error::Input(format!(
+                "C must be positive semidefinite, and its coupled block of constraints {} to {} is not positive definite",
+                block.start,
+                block.start + s - 1
+            )));
+        }
     }
     let with_lambda = lcp.c.iter().any(|&c| c > 0.0);
     let nx = if with_lambda { n + m } else { n };
@@ -749,12 +1388,28 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
             }
         }
     }
+    // the entries of C by row: (k, l, C_kl) within each block, l ascending
+    let c_entries: Vec<Vec<(usize, f64)>> = {
+        let mut rows_of_c = vec![Vec::new(); m];
+        for block in lcp.blocks() {
+            for (i, k) in block.range().enumerate() {
+                for (j, l) in block.range().enumerate() {
+                    let v = block.entry(&lcp.c, i, j);
+                    if v != 0.0 || k == l {
+                        rows_of_c[k].push((l, v));
+                    }
+                }
+            }
+        }
+        rows_of_c
+    };
     let row_scale: Vec<f64> = (0..m)
         .map(|k| {
             let largest = lcp.b_rows[k]
                 .iter()
                 .map(|&(j, v)| (v * scale[j]).abs())
-                .fold(lcp.c[k], f64::max);
+                .chain(c_entries[k].iter().map(|&(_, v)| v.abs()))
+                .fold(0.0, f64::max);
             if largest > 0.0 {
                 1.0 / largest
             } else {
@@ -776,9 +1431,13 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
         p_ptr.push(p_rows.len());
     }
     if with_lambda {
-        for k in 0..m {
-            p_rows.push(n + k);
-            p_vals.push(lcp.c[k]);
+        // column l of C: its rows k ≤ l (C is symmetric), ascending
+        for entries in &c_entries {
+            let l = p_ptr.len() - 1 - n;
+            for &(k, v) in entries.iter().filter(|&&(k, _)| k <= l) {
+                p_rows.push(n + k);
+                p_vals.push(v);
+            }
             p_ptr.push(p_rows.len());
         }
     }
@@ -794,9 +1453,11 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
             tv.push(-v * scale[j] * row_scale[k]);
         }
         if with_lambda {
-            ti.push(k);
-            tj.push(n + k);
-            tv.push(-lcp.c[k] * row_scale[k]);
+            for &(l, v) in &c_entries[k] {
+                ti.push(k);
+                tj.push(n + l);
+                tv.push(-v * row_scale[k]);
+            }
         }
     }
     let b: Vec<f64> = lcp.g.iter().zip(&row_scale).map(|(g, r)| -g * r).collect();
@@ -873,4 +1534,292 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
         factorizations: solver.solution.iterations as usize,
         multiplier_noise: 0.0,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    /// xorshift64*: reproducible data without a dependency.
+    struct Random(u64);
+
+    impl Random {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        /// Uniform on (−1, 1).
+        fn symmetric(&mut self) -> f64 {
+            2.0 * self.next() - 1.0
+        }
+
+        fn index(&mut self, n: usize) -> usize {
+            ((self.next() * n as f64) as usize).min(n - 1)
+        }
+    }
+
+    /// A random SPD `s × s` block `α(LLᵀ + δI)`, row-major.
+    fn spd_block(random: &mut Random, s: usize, alpha: f64) -> Vec<f64> {
+        let l: Vec<f64> = (0..s * s).map(|_| random.symmetric()).collect();
+        let mut c = vec![0.0; s * s];
+        for i in 0..s {
+            for j in 0..s {
+                let llt: f64 = (0..s).map(|k| l[i * s + k] * l[j * s + k]).sum();
+                c[i * s + j] = alpha * (llt + if i == j { 0.2 } else { 0.0 });
+            }
+        }
+        c
+    }
+
+    fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+    }
+
+    /// A random LCP with blocks of C of sizes 3, 1, 3, 3, 1, 3 and a known solution whose
+    /// blocks are fully active, inactive, and partly active (one or two of three), built
+    /// backwards from `(U*, Λ*, R*)`: `F = AU* − BᵀΛ*`, `G = BU* + CΛ* − R*`. With A and C
+    /// SPD the LCP has exactly this solution.
+    fn blocked_lcp(seed: u64) -> (Lcp, Vec<f64>, Vec<f64>) {
+        let mut random = Random(seed);
+        let n = 40;
+        let mut triplets = Vec::new();
+        for i in 0..n {
+            triplets.push(Triplet::new(i, i, 2.5));
+            if i + 1 < n {
+                triplets.push(Triplet::new(i, i + 1, -1.0));
+                triplets.push(Triplet::new(i + 1, i, -1.0));
+            }
+        }
+        let a = SparseMatrix::try_new_from_triplets(n, n, &triplets).unwrap();
+        let sizes = [3, 1, 3, 3, 1, 3];
+        // which constraints of each block carry Λ > 0
+        let pattern: [&[bool]; 6] = [
+            &[true, true, true],
+            &[false],
+            &[false, true, false],
+            &[true, false, true],
+            &[true],
+            &[false, false, false],
+        ];
+        let m: usize = sizes.iter().sum();
+        let mut c = vec![0.0; m];
+        let mut entries = Vec::new();
+        let mut lambda = vec![0.0; m];
+        let mut gap = vec![0.0; m];
+        let mut start = 0;
+        for (&s, on) in sizes.iter().zip(pattern) {
+            let block = spd_block(&mut random, s, 0.05);
+            for i in 0..s {
+                for j in 0..s {
+                    if i == j {
+                        c[start + i] = block[i * s + j];
+                    } else {
+                        entries.push((start + i, start + j, block[i * s + j]));
+                    }
+                }
+                if on[i] {
+                    lambda[start + i] = 0.5 + random.next();
+                } else {
+                    gap[start + i] = 0.1 + random.next();
+                }
+            }
+            start += s;
+        }
+        let b_rows: Vec<Vec<(usize, f64)>> = (0..m)
+            .map(|_| {
+                let mut row: Vec<(usize, f64)> = Vec::new();
+                while row.len() < 5 {
+                    let j = random.index(n);
+                    if row.iter().all(|&(i, _)| i != j) {
+                        row.push((j, random.symmetric()));
+                    }
+                }
+                row
+            })
+            .collect();
+        let u: Vec<f64> = (0..n).map(|_| random.symmetric()).collect();
+        let mut lcp = Lcp::new(a, b_rows, c, vec![0.0; n], vec![0.0; m]);
+        lcp.c_blocks = CouplingBlocks::from_entries(m, &entries).unwrap();
+        let au = multiply(&lcp.a, &u);
+        let btl = lcp.bt_times(&lambda);
+        lcp.f = (0..n).map(|i| au[i] - btl[i]).collect();
+        let bu = lcp.b_times(&u);
+        let cl = lcp.c_times(&lambda);
+        lcp.g = (0..m).map(|k| bu[k] + cl[k] - gap[k]).collect();
+        (lcp, u, lambda)
+    }
+
+    #[test]
+    fn coupled_groups_are_found_and_bad_coupling_is_an_error() {
+        let (lcp, _, _) = blocked_lcp(7);
+        let groups: Vec<(usize, usize)> = lcp.c_blocks.groups().collect();
+        assert_eq!(groups, vec![(0, 3), (4, 3), (7, 3), (11, 3)]);
+        let sizes: Vec<usize> = lcp.blocks().map(|b| b.size).collect();
+        assert_eq!(sizes, vec![3, 1, 3, 3, 1, 3]);
+        // coupling across more than MAX_BLOCK constraints is not block diagonal
+        let far = CouplingBlocks::from_entries(20, &[(0, 12, 1.0), (12, 0, 1.0)]);
+        assert!(far.unwrap_err().to_string().contains("block diagonal"));
+        let asymmetric = CouplingBlocks::from_entries(3, &[(0, 1, 1.0), (1, 0, 2.0)]);
+        assert!(asymmetric.unwrap_err().to_string().contains("symmetric"));
+        let outside = CouplingBlocks::from_entries(3, &[(0, 3, 1.0)]);
+        assert!(outside.is_err());
+        // a block that is not positive definite is refused by the eliminating solvers
+        let mut bad = lcp.clone();
+        bad.c_blocks = CouplingBlocks::from_entries(
+            bad.m(),
+            &[(0, 1, 10.0), (1, 0, 10.0), (0, 2, 0.0), (2, 0, 0.0)],
+        )
+        .unwrap();
+        let error = semismooth_newton(&bad, None, NewtonOptions::default()).unwrap_err();
+        assert!(error.to_string().contains("positive definite"), "{error}");
+        assert!(quadratic_program(&bad).is_err());
+        // groups beyond the constraints
+        let mut short = lcp.clone();
+        short.c_blocks = CouplingBlocks::from_entries(40, &[(30, 31, 1.0), (31, 30, 1.0)]).unwrap();
+        assert!(semismooth_newton(&short, None, NewtonOptions::default()).is_err());
+        let _ = short.kkt_residual(&vec![0.0; short.n()], &vec![0.0; short.m()]);
+    }
+
+    #[test]
+    fn newton_clarabel_and_the_saddle_point_method_agree_on_a_blocked_lcp() {
+        for seed in [1, 2, 3, 4] {
+            let (lcp, u_exact, lambda_exact) = blocked_lcp(seed);
+            let options = NewtonOptions::default();
+            let newton = semismooth_newton(&lcp, None, options).unwrap();
+            let qp = quadratic_program(&lcp).unwrap();
+            let saddle = primal_dual_active_set(&lcp, None, options).unwrap();
+            let recovered = recover_multiplier(&lcp, newton.clone(), 1).unwrap();
+            let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(
+                max_difference(&newton.u, &u_exact) <= 1e-10 * norm(&u_exact),
+                "seed {seed}: Newton U"
+            );
+            assert!(
+                max_difference(&newton.lambda, &lambda_exact) <= 1e-9 * norm(&lambda_exact),
+                "seed {seed}: Newton Λ"
+            );
+            assert!(newton.kkt_residual < 1e-12, "{}", newton.kkt_residual);
+            // the generalized Hessian is exact on each face: Newton converges fast
+            assert!(
+                newton.iterations <= 10,
+                "seed {seed}: {}",
+                newton.iterations
+            );
+            for (label, other) in [
+                ("clarabel", &qp),
+                ("saddle", &saddle),
+                ("recovered", &recovered),
+            ] {
+                assert!(
+                    max_difference(&newton.u, &other.u) <= 1e-8 * norm(&newton.u),
+                    "seed {seed} {label}: U differs by {}",
+                    max_difference(&newton.u, &other.u)
+                );
+                assert!(
+                    max_difference(&newton.lambda, &other.lambda) <= 1e-6 * norm(&newton.lambda),
+                    "seed {seed} {label}: Λ differs by {}",
+                    max_difference(&newton.lambda, &other.lambda)
+                );
+            }
+            assert!(saddle.kkt_residual < 1e-12, "{}", saddle.kkt_residual);
+            assert!(lcp.kkt_residual(&u_exact, &lambda_exact) < 1e-13);
+            // a wrong multiplier shows in the residual
+            let mut wrong = lambda_exact.clone();
+            wrong[1] *= 1.01;
+            assert!(lcp.kkt_residual(&u_exact, &wrong) > 1e-4);
+            println!(
+                "seed {seed}: Newton {} iterations, saddle point {}, clarabel {}",
+                newton.iterations, saddle.iterations, qp.iterations
+            );
+        }
+    }
+
+    /// The block minimizer against projected gradient descent run to convergence, and
+    /// against the KKT conditions of the small QP, on random SPD 3 × 3 blocks.
+    #[test]
+    fn block_minimizer_is_the_minimizer() {
+        let mut random = Random(11);
+        let s = 3;
+        let objective = |c: &[f64], r: &[f64], x: &[f64]| -> f64 {
+            (0..s)
+                .map(|i| {
+                    let cx: f64 = (0..s).map(|j| c[i * s + j] * x[j]).sum();
+                    0.5 * x[i] * cx - r[i] * x[i]
+                })
+                .sum()
+        };
+        let mut faces_seen = [0usize; 4];
+        for _ in 0..2000 {
+            let c = spd_block(&mut random, s, 1.0);
+            let r: Vec<f64> = (0..s).map(|_| random.symmetric()).collect();
+            let (mut lambda, mut active) = (vec![0.0; s], vec![false; s]);
+            block_minimizer(&c, s, &r, &mut lambda, &mut active);
+            faces_seen[active.iter().filter(|&&a| a).count()] += 1;
+            // KKT: Λ ≥ 0, w = CΛ − r ≥ 0, Λ·w = 0
+            for i in 0..s {
+                let w: f64 = (0..s).map(|j| c[i * s + j] * lambda[j]).sum::<f64>() - r[i];
+                assert!(lambda[i] >= 0.0);
+                assert!(w >= -1e-12, "dual {w}");
+                assert!((lambda[i] * w).abs() < 1e-12, "complementarity");
+                if active[i] {
+                    assert!(w.abs() < 1e-12, "an active component has dual {w}");
+                } else {
+                    assert_eq!(lambda[i], 0.0);
+                }
+            }
+            // projected gradient with step 1/L, L ≤ the trace
+            let step = 1.0 / (0..s).map(|i| c[i * s + i]).sum::<f64>();
+            let mut x = vec![0.0; s];
+            for _ in 0..5000 {
+                let g: Vec<f64> = (0..s)
+                    .map(|i| (0..s).map(|j| c[i * s + j] * x[j]).sum::<f64>() - r[i])
+                    .collect();
+                for i in 0..s {
+                    x[i] = (x[i] - step * g[i]).max(0.0);
+                }
+            }
+            assert!(objective(&c, &r, &lambda) <= objective(&c, &r, &x) + 1e-13);
+            let smallest_eigenvalue_bound = 0.2;
+            // strong convexity: |Λ − x|² ≤ 2(J(x) − J(Λ))/μ, and PG converged
+            assert!(
+                max_difference(&lambda, &x) < 1e-6 / smallest_eigenvalue_bound,
+                "{lambda:?} vs {x:?}"
+            );
+        }
+        // every kind of face occurred
+        assert!(faces_seen.iter().all(|&count| count > 50), "{faces_seen:?}");
+    }
+
+    /// With all blocks of size 1 the general code reduces to the P0 formulas.
+    #[test]
+    fn size_one_blocks_are_the_diagonal_formulas() {
+        let (mut lcp, _, _) = blocked_lcp(5);
+        lcp.c_blocks = CouplingBlocks::none();
+        let u: Vec<f64> = (0..lcp.n()).map(|i| (i as f64 * 0.37).sin()).collect();
+        let bu = lcp.b_times(&u);
+        let au = multiply(&lcp.a, &u);
+        let lambda = lcp.eliminated_multiplier(&bu);
+        let mut penalty = 0.0;
+        for k in 0..lcp.m() {
+            let r = (lcp.g[k] - bu[k]).max(0.0);
+            assert_eq!(lambda[k], r / lcp.c[k]);
+            penalty += 0.5 * r * r / lcp.c[k];
+        }
+        let quadratic: f64 = (0..lcp.n())
+            .map(|i| 0.5 * u[i] * au[i] - lcp.f[i] * u[i])
+            .sum();
+        assert!((lcp.merit(&u, &au, &bu) - (quadratic + penalty)).abs() < 1e-14 * penalty.abs());
+        assert_eq!(
+            lcp.c_times(&lambda),
+            (0..lcp.m())
+                .map(|k| lcp.c[k] * lambda[k])
+                .collect::<Vec<_>>()
+        );
+    }
 }

@@ -6,8 +6,8 @@
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::boundary::{Constraints, Reduction, Side};
 use crate::complementarity::{
-    primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton, Lcp,
-    LcpSolution, NewtonOptions,
+    primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
+    CouplingBlocks, Lcp, LcpSolution, NewtonOptions,
 };
 use crate::dof_map::SystemDofs;
 use crate::element::PhysicalBasis;
@@ -121,6 +121,8 @@ impl<G: Mesh + Clone> Discretization<G> {
         let (n, m) = (primal_reduced.len(), multiplier_reduced.len());
         let mut b_rows = vec![Vec::new(); m];
         let mut c = vec![0.0; m];
+        // off-diagonal entries of C: the multipliers of one cell (P1disc) are coupled
+        let mut coupling = Vec::new();
         let mut a_ptr = vec![0usize];
         let (mut a_rows, mut a_vals) = (Vec::new(), Vec::new());
         let (col_ptr, rows, vals) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
@@ -137,9 +139,7 @@ impl<G: Mesh + Clone> Discretization<G> {
                         if mi == mj {
                             c[mi] = -v;
                         } else if v != 0.0 {
-                            return Err(Error::Input(format!(
-                                "the multiplier block of `{bilinear}` is not diagonal: this LCP form needs P0 multipliers (or a diagonal multiplier mass)"
-                            )));
+                            coupling.push((mi, mj, -v));
                         }
                     }
                     (Role::Primal(_), Role::Multiplier(_)) => {}
@@ -152,6 +152,11 @@ impl<G: Mesh + Clone> Discretization<G> {
         for row in &mut b_rows {
             row.retain(|&(_, v)| v != 0.0);
         }
+        let c_blocks = CouplingBlocks::from_entries(m, &coupling).map_err(|e| {
+            Error::Input(format!(
+                "the multiplier block of `{bilinear}`: {e}; this LCP form needs multipliers coupled only within a cell (P0, P1disc)"
+            ))
+        })?;
         let a: SparseMatrix = SparseColMat::new(
             SymbolicSparseColMat::new_checked(n, n, a_ptr, None, a_rows),
             a_vals,
@@ -162,7 +167,14 @@ impl<G: Mesh + Clone> Discretization<G> {
             mesh: mesh.clone(),
             dofs,
             reduction,
-            lcp: Lcp { a, b_rows, c, f, g },
+            lcp: Lcp {
+                a,
+                b_rows,
+                c,
+                c_blocks,
+                f,
+                g,
+            },
             multiplier_field: multiplier,
             roles,
             primal_reduced,
@@ -449,12 +461,13 @@ impl ObstacleSolution {
         // terms it is made of: holes of touching cells are filled, real gaps are not.
         let lcp = &self.discretization.lcp;
         let u = self.discretization.primal_part(&self.values);
+        let c_lambda = lcp.c_times(lambda);
         let touching = |k: usize| {
             let row = &lcp.b_rows[k];
             let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
             let terms: f64 =
                 row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>() + lcp.g[k].abs();
-            (bu + lcp.c[k] * lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
+            (bu + c_lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
         };
         let mut runs: Vec<(usize, usize)> = Vec::new();
         for (c, &on) in active.iter().enumerate() {

@@ -202,14 +202,15 @@ impl TriangleObstacleSolution {
 pub fn contact_indicator(lcp: &Lcp, u: &[f64], lambda: &[f64]) -> Vec<bool> {
     let largest = lambda.iter().cloned().fold(0.0, f64::max);
     let scale = largest.max(lcp.multiplier_scale());
+    let (c_lambda, c_terms) = (lcp.c_times(lambda), lcp.c_times_abs(lambda));
     (0..lambda.len())
         .map(|k| {
             let row = &lcp.b_rows[k];
             let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
             let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
                 + lcp.g[k].abs()
-                + (lcp.c[k] * lambda[k]).abs();
-            lambda[k] > 1e-8 * scale || (bu + lcp.c[k] * lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
+                + c_terms[k];
+            lambda[k] > 1e-8 * scale || (bu + c_lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
         })
         .collect()
 }
@@ -309,11 +310,11 @@ pub fn nodal_active_set(
 
 /// The LCP of the nodal method (`B = I`, `C = 0`, `G = ψ`), for its KKT residual.
 pub fn nodal_lcp(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
-    Lcp {
-        a: a.clone(),
-        b_rows: (0..f.len()).map(|i| vec![(i, 1.0)]).collect(),
-        c: vec![0.0; f.len()],
-        f: f.to_vec(),
-        g: psi.to_vec(),
-    }
+    Lcp::new(
+        a.clone(),
+        (0..f.len()).map(|i| vec![(i, 1.0)]).collect(),
+        vec![0.0; f.len()],
+        f.to_vec(),
+        psi.to_vec(),
+    )
 }
