@@ -70,17 +70,21 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
         boundary: zero,
         target_l2: 1e-3,
     };
-    for pair in [
-        MembranePair::P1P0,
-        MembranePair::P2P0,
-        MembranePair::P1Nodal,
-    ] {
+    let runs = [
+        (MembranePair::P1P0, VariationalSolver::SemismoothNewton),
+        (MembranePair::P2P0, VariationalSolver::SemismoothNewton),
+        (MembranePair::P1P0, VariationalSolver::Clarabel),
+        (MembranePair::P2P0, VariationalSolver::Clarabel),
+        (MembranePair::P1Nodal, VariationalSolver::SemismoothNewton),
+    ];
+    for (pair, solver) in runs {
         let mut request = MembraneRequest::new(scene);
         request.pair = pair;
+        request.solver = solver;
         request.mesh_size = 8;
         let (report, fields) = membranes::solve(&request).unwrap();
         let largest_u = fields.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        assert!(largest_u < 1e-10, "{pair:?}: u = {largest_u}");
+        assert!(largest_u < 1e-8, "{pair:?} {solver:?}: u = {largest_u}");
         // the nodal method has forces at the free nodes only: their area share is
         // 16·(N−1)²/N²
         let expected = if pair == MembranePair::P1Nodal {
@@ -89,14 +93,14 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
             48.0
         };
         assert!(
-            (report.total_contact_force - expected).abs() < 1e-8 * expected,
+            (report.total_contact_force - expected).abs() < 1e-7 * expected,
             "{pair:?}: ∫λ = {}",
             report.total_contact_force
         );
         assert!((report.contact_area - 16.0).abs() < 1e-9, "{pair:?}");
         if pair != MembranePair::P1Nodal {
             for l in &fields.lambda {
-                assert!((l - 3.0).abs() < 1e-8, "{pair:?}: λ = {l}");
+                assert!((l - 3.0).abs() < 1e-6, "{pair:?} {solver:?}: λ = {l}");
             }
         }
     }

@@ -625,7 +625,14 @@ impl Lcp {
             .factor(&h)?
             .solve_refined(&h, &minus_gradient, 2)?;
         let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        Ok(norm(&d) / norm(u).max(f64::MIN_POSITIVE))
+        // Relative to the size U has or should have: U ≡ 0 is a legitimate solution
+        // (a membrane pressed flat onto ψ = 0), where ‖U‖ alone would make any rounding
+        // of the step look like an O(1) correction.
+        let corrected: Vec<f64> = u.iter().zip(&d).map(|(u, d)| u + d).collect();
+        let scale = norm(u)
+            .max(norm(&corrected))
+            .max(norm(&self.f) / row_sum_norm(&self.a).max(f64::MIN_POSITIVE));
+        Ok(norm(&d) / scale.max(f64::MIN_POSITIVE))
     }
 }
 
