@@ -234,6 +234,7 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
 }
 
 fn main() {
+    fem_forms::linear_solve::factor_sequentially();
     let quick = std::env::args().any(|a| a == "--quick");
     let (assembly_n, p1_sizes, p2_sizes): (usize, Vec<usize>, Vec<usize>) = if quick {
         (128, vec![32, 64, 128], vec![32, 64])

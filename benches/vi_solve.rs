@@ -13,6 +13,7 @@ use fem_forms::models::scenes::scene;
 use std::time::Instant;
 
 fn main() {
+    fem_forms::linear_solve::factor_sequentially();
     let sizes = [1_000usize, 4_000, 16_000, 64_000, 256_000, 1_024_000];
     for (name, thickness) in [
         ("timoshenko-a", 1e-3),
