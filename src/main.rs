@@ -312,6 +312,17 @@ fn run(cli: Cli) -> Result<(), String> {
                     p.default_alpha()
                 );
             }
+            println!("membrane scenes (--mesh-size N, or --msh FILE):");
+            for s in MEMBRANE_SCENES {
+                println!("  {:<17} {}", s.name, s.description);
+            }
+            println!(
+                "membrane pairs (default p2-p0; α = ½/C_I, or {} where C_I = 0):",
+                membranes::ALPHA_WHEN_CI_VANISHES
+            );
+            for p in MembranePair::ALL {
+                println!("  {}", p.name());
+            }
             Ok(())
         }
         Some(Command::Solve {

@@ -408,3 +408,39 @@ fn a_gmsh_mesh_refined_uniformly_converges() {
     assert!(error.contains("at most 8"), "{error}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The L-shaped scene (no exact solution): every pair reaches a loose target, the
+/// solutions of the pairs agree with each other within their estimated errors, and the
+/// membrane touches the obstacle.
+#[test]
+fn the_l_shape_scene_reaches_its_accuracy_with_every_pair() {
+    let mut scene = membrane_scene("membrane-lshape").unwrap();
+    scene.target_l2 = 1e-2;
+    let pairs = [
+        MembranePair::P1P0,
+        MembranePair::P2P0,
+        MembranePair::P1Nodal,
+    ];
+    let (rungs, cheapest) = membranes::cheapest_for_accuracy(&scene, &pairs).unwrap();
+    assert!(cheapest.is_some());
+    let mut solutions = Vec::new();
+    for (pair, rung) in pairs.iter().zip(&rungs) {
+        assert!(rung.reached && rung.estimated_l2 <= 1e-2, "{rung:?}");
+        let mut request = MembraneRequest::new(scene);
+        request.pair = *pair;
+        request.mesh_size = rung.mesh_size;
+        let (report, fields) = membranes::solve(&request).unwrap();
+        assert!(report.contact_area > 0.05, "{report:?}");
+        assert!(report.complementarity_residual < 1e-10);
+        solutions.push((rung.estimated_l2, fields));
+    }
+    for k in 1..solutions.len() {
+        let (ea, a) = &solutions[0];
+        let (eb, b) = &solutions[k];
+        let difference = membranes::difference_l2(&a.u_field(), &b.u_field(), 6);
+        assert!(
+            difference <= 2.0 * (ea + eb),
+            "pairs 0 and {k} differ by {difference}, estimates {ea} and {eb}"
+        );
+    }
+}
