@@ -266,9 +266,9 @@ pub fn prolong<M: Model>(
 }
 
 /// A solved obstacle problem.
-pub struct ObstacleSolution {
+pub struct ObstacleSolution<G = IntervalMesh> {
     /// The discrete problem on the finest mesh.
-    pub discretization: Discretization,
+    pub discretization: Discretization<G>,
     /// Coefficients of all fields (multiplier included).
     pub values: Vec<f64>,
     /// Iterations on the finest mesh.
@@ -362,8 +362,6 @@ pub fn solve_obstacle<M: Model>(
     clamped: &[&str],
     options: ObstacleOptions,
 ) -> Result<ObstacleSolution> {
-    let clock = Instant::now();
-    let solve = |d: &Discretization, start: Option<&[f64]>| solve_lcp(&d.lcp, start, options);
     // Nested iteration over uniform meshes: N/2^k, …, N/2, N.
     let uniform = IntervalMesh::uniform(
         mesh.vertices()[0],
@@ -386,45 +384,66 @@ pub fn solve_obstacle<M: Model>(
         }
     }
     let (a, b) = (mesh.vertices()[0], *mesh.vertices().last().unwrap());
-    let mut levels = Vec::new();
-    let mut previous: Option<(Discretization, Vec<f64>)> = None;
-    for (level, &cells) in sizes.iter().enumerate() {
-        let level_mesh = if level + 1 == sizes.len() {
+    let last = sizes.len() - 1;
+    let levels = sizes.into_iter().enumerate().map(|(level, cells)| {
+        let level_mesh = if level == last {
             mesh.clone()
         } else {
             IntervalMesh::uniform(a, b, cells)?
         };
-        let d = Discretization::new::<M>(&level_mesh, coefficients, clamped, "B_h", "L_h")?;
-        let start = previous.as_ref().map(|(pd, values)| {
-            let fine = prolong::<M>(&pd.mesh, &pd.dofs, values, &d.mesh, &d.dofs);
-            d.primal_part(&fine)
-        });
-        let solution = solve(&d, start.as_deref())?;
-        levels.push((cells, solution.iterations));
-        let values = d.full(&solution);
-        if level + 1 == sizes.len() {
-            return Ok(ObstacleSolution {
-                iterations: solution.iterations,
-                kkt_residual: solution.kkt_residual,
-                solve_seconds: solution.seconds,
-                multiplier_noise: solution.multiplier_noise,
-                discretization: d,
-                values,
-                levels,
-                seconds: clock.elapsed().as_secs_f64(),
-            });
-        }
-        previous = Some((d, values));
-    }
-    unreachable!("the last level returns")
+        Discretization::new::<M>(&level_mesh, coefficients, clamped, "B_h", "L_h")
+    });
+    solve_nested(
+        levels,
+        |coarse, values, fine| {
+            prolong::<M>(&coarse.mesh, &coarse.dofs, values, &fine.mesh, &fine.dofs)
+        },
+        options,
+    )
 }
 
-impl ObstacleSolution {
+/// Solves the LCP of each level in turn, each started from the solution of the level
+/// before, carried over by `prolong` (nested iteration); returns the last level's.
+pub fn solve_nested<G: Mesh>(
+    levels: impl IntoIterator<Item = Result<Discretization<G>>>,
+    prolong: impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
+    options: ObstacleOptions,
+) -> Result<ObstacleSolution<G>> {
+    let clock = Instant::now();
+    let mut counts = Vec::new();
+    let mut last: Option<(Discretization<G>, Vec<f64>, LcpSolution)> = None;
+    for d in levels {
+        let d = d?;
+        let start = last
+            .as_ref()
+            .map(|(coarse, values, _)| d.primal_part(&prolong(coarse, values, &d)));
+        let solution = solve_lcp(&d.lcp, start.as_deref(), options)?;
+        counts.push((d.mesh.cell_count(), solution.iterations));
+        let values = d.full(&solution);
+        last = Some((d, values, solution));
+    }
+    let (discretization, values, solution) =
+        last.ok_or_else(|| Error::Input("no mesh to solve on".into()))?;
+    Ok(ObstacleSolution {
+        iterations: solution.iterations,
+        kkt_residual: solution.kkt_residual,
+        solve_seconds: solution.seconds,
+        multiplier_noise: solution.multiplier_noise,
+        discretization,
+        values,
+        levels: counts,
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+impl<G> ObstacleSolution<G> {
     /// The coefficients of model field `field`.
     pub fn field(&self, field: usize) -> &[f64] {
         &self.values[self.discretization.dofs.range(field).unwrap()]
     }
+}
 
+impl ObstacleSolution<IntervalMesh> {
     /// A view of model field `field` for evaluation and norms.
     pub fn view(&self, field: usize) -> FieldView<'_> {
         FieldView {

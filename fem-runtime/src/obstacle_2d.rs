@@ -9,7 +9,7 @@ use crate::dof_map::SystemDofs;
 use crate::error::{Error, Result};
 use crate::linear_solve::{multiply, Cholesky};
 use crate::model::{Coefficients, Model};
-use crate::obstacle::{solve_lcp, Discretization, ObstacleOptions};
+use crate::obstacle::{solve_nested, Discretization, ObstacleOptions, ObstacleSolution};
 use crate::triangle_field::{TriangleBasis, TriangleField};
 use crate::triangle_mesh::{PointLocator, TriangleMesh};
 use crate::SparseMatrix;
@@ -91,24 +91,7 @@ pub fn prolong_on_triangles(
 }
 
 /// A solved obstacle problem on a triangle mesh.
-pub struct TriangleObstacleSolution {
-    /// The discrete problem on the finest mesh.
-    pub discretization: Discretization<TriangleMesh>,
-    /// Coefficients of all fields (multiplier included).
-    pub values: Vec<f64>,
-    /// Iterations on the finest mesh.
-    pub iterations: usize,
-    /// `(cells, iterations)` of every level of the nested iteration.
-    pub levels: Vec<(usize, usize)>,
-    /// KKT residual of the result.
-    pub kkt_residual: f64,
-    /// Wall time of the whole solve (assembly included).
-    pub seconds: f64,
-    /// Wall time of the LCP solve on the finest mesh alone.
-    pub solve_seconds: f64,
-    /// Estimated relative rounding noise of the multiplier values (0: none).
-    pub multiplier_noise: f64,
-}
+pub type TriangleObstacleSolution = ObstacleSolution<TriangleMesh>;
 
 /// Solves the obstacle problem `B_h`, `L_h` of `M` on the last of `meshes`, each mesh
 /// started from the solution on the one before (nested iteration).
@@ -117,43 +100,16 @@ pub fn solve_obstacle_on_triangles<M: Model>(
     coefficients: &Coefficients,
     options: ObstacleOptions,
 ) -> Result<TriangleObstacleSolution> {
-    let clock = Instant::now();
-    if meshes.is_empty() {
-        return Err(Error::Input("no mesh to solve on".into()));
-    }
-    let mut levels = Vec::new();
-    let mut previous: Option<(Discretization<TriangleMesh>, Vec<f64>)> = None;
-    for (level, mesh) in meshes.iter().enumerate() {
-        let d = discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h")?;
-        let start = previous
-            .as_ref()
-            .map(|(pd, values)| d.primal_part(&prolong_on_triangles(pd, values, &d)));
-        let solution = solve_lcp(&d.lcp, start.as_deref(), options)?;
-        levels.push((mesh.cell_count(), solution.iterations));
-        let values = d.full(&solution);
-        if level + 1 == meshes.len() {
-            return Ok(TriangleObstacleSolution {
-                iterations: solution.iterations,
-                kkt_residual: solution.kkt_residual,
-                solve_seconds: solution.seconds,
-                multiplier_noise: solution.multiplier_noise,
-                discretization: d,
-                values,
-                levels,
-                seconds: clock.elapsed().as_secs_f64(),
-            });
-        }
-        previous = Some((d, values));
-    }
-    unreachable!("the last level returns")
+    solve_nested(
+        meshes
+            .iter()
+            .map(|mesh| discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h")),
+        prolong_on_triangles,
+        options,
+    )
 }
 
-impl TriangleObstacleSolution {
-    /// The coefficients of model field `field`.
-    pub fn field(&self, field: usize) -> &[f64] {
-        &self.values[self.discretization.dofs.range(field).unwrap()]
-    }
-
+impl ObstacleSolution<TriangleMesh> {
     /// A view of model field `field` for evaluation and norms.
     pub fn view(&self, field: usize) -> TriangleField<'_> {
         TriangleField {
