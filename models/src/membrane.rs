@@ -3,70 +3,48 @@
 //!
 //! `S_h = Σ_T h² (−Δu − λ, −Δv − μ)_T`: for P1 the Laplacian vanishes on each triangle
 //! and the term is `α Σ h² (λ, μ)_T`; for P2 it is stable for `0 < α < 1/C_I`, with `C_I`
-//! the inverse-inequality constant of the element (computed at run time). The four
-//! models differ only in their elements.
+//! the inverse-inequality constant of the element (computed at run time). The three
+//! stabilized models differ only in their elements, so one text serves them all.
 
-fem_runtime::model! {
+/// One membrane obstacle model per element pair: the forms are the same text.
+macro_rules! membrane_model {
+    ($(#[$doc:meta])* $name:ident, u: $u:ident, λ: $lambda:ident) => {
+        fem_runtime::model! {
+            $(#[$doc])*
+            pub mod $name on triangle {
+                unknowns: u: $u, λ: $lambda >= 0;
+                tests: v, μ;
+                params: α;
+                data: f, ψ, g;
+                boundary: u = g;
+                forms: "
+                    a(u;v)       = ∫ ∇u·∇v
+                    b(v;μ)       = ∫ v μ
+                    S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
+                    ℓ(v)         = ∫ f v
+                    ℓ_S(v,μ)     = Σ_T h_T² (f, −Δv − μ)_T
+                    G(μ)         = ∫ ψ μ
+                    B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
+                    L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
+                ";
+            }
+        }
+    };
+}
+
+membrane_model! {
     /// Membrane obstacle problem, u ∈ P1, λ ∈ P0 (stabilized; the plain pair, α = 0, is singular).
-    pub mod membrane_p1_p0 on triangle {
-        unknowns: u: P1, λ: P0 >= 0;
-        tests: v, μ;
-        params: α;
-        data: f, ψ, g;
-        boundary: u = g;
-        forms: "
-            a(u;v)       = ∫ ∇u·∇v
-            b(v;μ)       = ∫ v μ
-            S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
-            ℓ(v)         = ∫ f v
-            ℓ_S(v,μ)     = Σ_T h_T² (f, −Δv − μ)_T
-            G(μ)         = ∫ ψ μ
-            B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
-            L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
-        ";
-    }
+    membrane_p1_p0, u: P1, λ: P0
 }
 
-fem_runtime::model! {
+membrane_model! {
     /// Membrane obstacle problem, u ∈ P2, λ ∈ P0 (stabilized; the plain pair has a checkerboard mode).
-    pub mod membrane_p2_p0 on triangle {
-        unknowns: u: P2, λ: P0 >= 0;
-        tests: v, μ;
-        params: α;
-        data: f, ψ, g;
-        boundary: u = g;
-        forms: "
-            a(u;v)       = int grad u dot grad v
-            b(v;μ)       = int v μ
-            S(u,λ;v,μ)   = sum_T h^2 (-lap u - λ, -lap v - μ)_T
-            ℓ(v)         = int f v
-            ℓ_S(v,μ)     = sum_T h^2 (f, -lap v - μ)_T
-            G(μ)         = int ψ μ
-            B_h(u,λ;v,μ) = a(u;v) - b(v;λ) - b(u;μ) - α S(u,λ;v,μ)
-            L_h(v,μ)     = ℓ(v) - G(μ) - α ℓ_S(v,μ)
-        ";
-    }
+    membrane_p2_p0, u: P2, λ: P0
 }
 
-fem_runtime::model! {
+membrane_model! {
     /// Membrane obstacle problem, u ∈ P2, λ ∈ P1 discontinuous (stabilized).
-    pub mod membrane_p2_p1disc on triangle {
-        unknowns: u: P2, λ: P1disc >= 0;
-        tests: v, μ;
-        params: α;
-        data: f, ψ, g;
-        boundary: u = g;
-        forms: "
-            a(u;v)       = ∫ ∇u·∇v
-            b(v;μ)       = ∫ v μ
-            S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
-            ℓ(v)         = ∫ f v
-            ℓ_S(v,μ)     = Σ_T h_T² (f, −Δv − μ)_T
-            G(μ)         = ∫ ψ μ
-            B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
-            L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
-        ";
-    }
+    membrane_p2_p1disc, u: P2, λ: P1disc
 }
 
 fem_runtime::model! {
