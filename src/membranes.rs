@@ -184,6 +184,37 @@ pub struct MembraneFields {
 }
 
 impl MembraneFields {
+    /// The fields of a solve: u from its DOFs and coefficients, ψ from the scene.
+    fn new(
+        mesh: TriangleMesh,
+        scene: &MembraneScene,
+        u_dofs: DofMap,
+        u_coefficients: Vec<f64>,
+        lambda: Vec<f64>,
+        contact: Vec<f64>,
+    ) -> Self {
+        let psi = mesh
+            .vertices()
+            .iter()
+            .map(|x| (scene.obstacle)(x))
+            .collect();
+        let u = TriangleField {
+            mesh: &mesh,
+            map: &u_dofs,
+            coefficients: &u_coefficients,
+        }
+        .vertex_values();
+        Self {
+            mesh,
+            u,
+            psi,
+            lambda,
+            contact,
+            u_dofs,
+            u_coefficients,
+        }
+    }
+
     /// u_h as a finite element function.
     pub fn u_field(&self) -> TriangleField<'_> {
         TriangleField {
@@ -549,19 +580,14 @@ fn stabilized_fields(
             contact[dof / per_cell] += 1.0 / per_cell as f64;
         }
     }
-    MembraneFields {
-        u: solution.view(u_field).vertex_values(),
-        psi: mesh
-            .vertices()
-            .iter()
-            .map(|x| (scene.obstacle)(x))
-            .collect(),
+    MembraneFields::new(
+        mesh,
+        scene,
+        d.dofs.map(u_field).unwrap().clone(),
+        solution.field(u_field).to_vec(),
         lambda,
         contact,
-        u_dofs: d.dofs.map(u_field).unwrap().clone(),
-        u_coefficients: solution.field(u_field).to_vec(),
-        mesh,
-    }
+    )
 }
 
 /// The classical method: P1 with `u_i ≥ ψ(x_i)` at the free nodes.
@@ -684,19 +710,14 @@ fn run_nodal(
         multiplier_noise: 0.0,
         warnings: Vec::new(),
     };
-    let fields = MembraneFields {
-        u: u.vertex_values(),
-        psi: mesh
-            .vertices()
-            .iter()
-            .map(|x| (scene.obstacle)(x))
-            .collect(),
+    let fields = MembraneFields::new(
+        mesh.clone(),
+        &scene,
+        map.clone(),
+        values.clone(),
         lambda,
         contact,
-        u_dofs: map.clone(),
-        u_coefficients: values.clone(),
-        mesh: mesh.clone(),
-    };
+    );
     Ok((report, fields))
 }
 
