@@ -211,6 +211,9 @@ fn bad_input_is_a_clear_error() {
         .unwrap()
         .to_string()
         .contains("--mesh-size 0"));
+    request.mesh_size = 4096;
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(error.contains("GB of memory"), "{error}");
     request.mesh_size = 8;
     request.alpha = Some(-1.0);
     assert!(membranes::solve(&request)
