@@ -13,7 +13,7 @@ use fem_forms::linear_solve::Cholesky;
 use fem_forms::membranes::{self, MembranePair, MembraneRequest};
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::membrane_scene;
-use fem_forms::obstacle::{solve_lcp, ObstacleOptions};
+use fem_forms::obstacle::{solve_lcp, VariationalSolver};
 use fem_forms::obstacle_2d::{discretize_on_triangles, prolong_on_triangles};
 use fem_forms::{Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh};
 use std::hint::black_box;
@@ -196,7 +196,12 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
             });
             prolong += t.elapsed().as_secs_f64();
             let t = Instant::now();
-            let solution = solve_lcp(&d.lcp, start.as_deref(), ObstacleOptions::default()).unwrap();
+            let solution = solve_lcp(
+                &d.lcp,
+                start.as_deref(),
+                membranes::membrane_options(VariationalSolver::SemismoothNewton),
+            )
+            .unwrap();
             lcp_time += t.elapsed().as_secs_f64();
             iterations.push(solution.iterations);
             let values = d.full(&solution);
