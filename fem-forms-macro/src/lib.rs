@@ -4,9 +4,9 @@
 //!
 //! Use it through `fem_forms::model!` (or `fem_runtime::model!`), which passes the
 //! runtime's path to this macro. The pipeline is three pure stages, each unit-tested on
-//! `proc_macro2` types: [`parser`] (text → syntax tree), [`analysis`] with the
-//! [`symbolic`] IR (syntax tree → blocks of expanded monomials), [`codegen`] (blocks →
-//! Rust).
+//! `proc_macro2` types: `parser` (text → syntax tree), `analysis` with the
+//! `symbolic` IR (syntax tree → blocks of expanded monomials), `codegen` and
+//! `codegen_triangle` (blocks → Rust, on intervals and on affine triangles).
 //!
 //! # A model file
 //!
@@ -30,11 +30,15 @@
 //! ```
 //!
 //! ## Declarations (Rust tokens)
-//! - `unknowns: NAME: ELEMENT, …` with elements `P0 P1 P2 P3 Hermite`; `λ: P0 >= 0`
-//!   marks a multiplier constrained to be non-negative.
+//! - `mod NAME on interval` or `on triangle`.
+//! - `unknowns: NAME: ELEMENT, …` with elements `P0 P1 P2 P3 P1disc` (and `Hermite` on
+//!   intervals); `λ: P0 >= 0` (or `P1disc >= 0`) marks a multiplier constrained to be
+//!   non-negative.
 //! - `tests: …` one test function per unknown, in order: `η` goes with `θ`.
 //! - `params: …` runtime scalars; `data: f, ψ: 0` functions of x (the number is the
 //!   polynomial degree assumed for quadrature, default 2).
+//! - `boundary: u = g` (optional) Dirichlet data: unknown `u` equals the data function
+//!   `g` on the whole boundary (the runtime interpolates it at the boundary DOFs).
 //! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may
 //!   want `#![allow(mixed_script_confusables)]`.
 //!
@@ -49,8 +53,11 @@
 //!   integral or form call. `∫[degree=N]` overrides the quadrature (e.g. `∫[degree=1]` for
 //!   one-point reduced integration).
 //! - `Σ_T w (X, Y)_T` (ASCII `sum_T`) is the sum over elements of weighted L² products.
-//! - Derivatives: `w'`, `w''`, …, `w''''` (also `′ ″ ‴ ⁗`), of arguments or of linear
-//!   combinations `(w'−θ)'`; taken element-wise. A derivative above the element's degree
+//! - Derivatives on intervals: `w'`, `w''`, …, `w''''` (also `′ ″ ‴ ⁗`), of arguments
+//!   or of linear combinations `(w'−θ)'`; taken element-wise. On triangles: `∇u`
+//!   (`grad u`), a vector; `Δu` (`lap u`); sums and scalar multiples of vectors are
+//!   vectors, and a product of two vectors (`∇u·∇v`, `grad u dot grad v`, or an L²
+//!   product `(∇u, ∇v)_T`) is their dot product; an integrand must be a scalar. A derivative above the element's degree
 //!   is zero and the term is dropped (`θ'''` of P2); P0 fields have no derivative.
 //! - Products by juxtaposition, `·`, `⋅`, `×` or `*`; `/` by numbers and parameters;
 //!   powers `t⁻²`, `h⁴` or `t^-2`, `h^4`, `t^(-2)`; minus `−` or `-`.
