@@ -64,8 +64,8 @@ enum Command {
         /// Beam thickness t (Timoshenko scenes).
         #[arg(long)]
         thickness: Option<f64>,
-        /// Stabilization parameter α.
-        #[arg(long)]
+        /// Stabilization parameter α (negative values are refused with a reason).
+        #[arg(long, allow_negative_numbers = true)]
         alpha: Option<f64>,
         /// Element pair (beams: p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0;
         /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal).

@@ -1,0 +1,123 @@
+//! The command line as a user runs it: the membrane `solve --json` fields the issue
+//! asks for, the VTK file, the studies' output files, and errors that exit non-zero
+//! with a message instead of a panic.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn fem_forms(args: &[&str], out: &PathBuf) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fem-forms-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn membrane_json_has_every_field_and_agrees_with_the_exact_solution() {
+    let out = scratch("json");
+    let run = fem_forms(
+        &[
+            "solve",
+            "membrane-radial",
+            "--pair",
+            "p2-p0",
+            "--mesh-size",
+            "16",
+            "--json",
+            "--vtk",
+        ],
+        &out,
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    for field in [
+        "dofs",
+        "iterations",
+        "seconds",
+        "error_l2",
+        "error_h1",
+        "total_contact_force",
+        "contact_area",
+        "alpha",
+        "complementarity_residual",
+    ] {
+        assert!(
+            json.get(field).is_some_and(|v| !v.is_null()),
+            "{field} missing"
+        );
+    }
+    let force = json["total_contact_force"].as_f64().unwrap();
+    let exact = json["exact_contact_force"].as_f64().unwrap();
+    assert!(
+        (force - exact).abs() < 0.01 * exact,
+        "∫λ_h = {force}, 2πA = {exact}"
+    );
+    assert!(json["complementarity_residual"].as_f64().unwrap() < 1e-10);
+    assert!((json["alpha"].as_f64().unwrap() - 0.5 / 96.0).abs() < 1e-12);
+    assert!(out.join("membrane-radial-p2-p0-16.vtu").exists());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn bad_input_exits_with_a_message() {
+    let out = scratch("bad");
+    for (args, message) in [
+        (
+            &["solve", "membrane-radial", "--pair", "p9-p9"][..],
+            "unknown membrane pair",
+        ),
+        (
+            &["solve", "membrane-radial", "--msh", "/nonexistent/mesh.msh"][..],
+            "/nonexistent/mesh.msh",
+        ),
+        (
+            &[
+                "solve",
+                "membrane-radial",
+                "--alpha",
+                "-1",
+                "--mesh-size",
+                "8",
+            ][..],
+            "α = -1",
+        ),
+        (&["study", "membrane-radial", "nonsense"][..], "nonsense"),
+        (&["study", "no-such-study"][..], "unknown study"),
+    ] {
+        let run = fem_forms(args, &out);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn the_stability_study_writes_its_chart_and_table() {
+    let out = scratch("study");
+    let run = fem_forms(&["study", "membrane-radial", "stability"], &out);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("membrane-radial-stability.csv")).unwrap();
+    assert!(csv.starts_with("pair_is_p2,N,alpha"));
+    assert!(csv.lines().count() > 6);
+    let svg = std::fs::read_to_string(out.join("membrane-radial-stability.svg")).unwrap();
+    assert!(svg.contains("<svg"));
+    std::fs::remove_dir_all(&out).unwrap();
+}
