@@ -3,18 +3,24 @@
 //!    against a hand-written loop that adds barycentric P1 element matrices into the
 //!    same fixed CSC pattern;
 //! 2. the complete stabilized VI solve (nested iteration, assembly included) against one
-//!    sparse Cholesky factorization + solve of the final mesh's matrix `A_α`, with the
-//!    phases of the solve and the Newton iterations per mesh from 2k to 524k triangles.
+//!    sparse Cholesky factorization + solve of the final mesh's matrix `A_α` (the
+//!    strict baseline: a linear problem of the primal size), and against one sparse LU
+//!    factorization + solve of the saddle-point matrix `[[A_α, −B_αᵀ], [−B_α, −C_α]]`
+//!    of the same discretization, with the phases of the solve and the Newton
+//!    iterations per mesh from 2k to 524k triangles.
 //!
 //! `cargo bench --bench membrane` (add `-- --quick` for smaller meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::linear_solve::Cholesky;
+use faer::sparse::Triplet;
+use fem_forms::complementarity::Lcp;
+use fem_forms::linear_solve::{Cholesky, LuSolver};
 use fem_forms::membranes::{self, MembranePair, MembraneRequest};
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::membrane_scene;
 use fem_forms::obstacle::{solve_lcp, VariationalSolver};
 use fem_forms::obstacle_2d::{discretize_on_triangles, prolong_on_triangles};
+use fem_forms::SparseMatrix;
 use fem_forms::{Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh};
 use std::hint::black_box;
 use std::time::Instant;
@@ -157,7 +163,7 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         pair.name()
     );
     println!(
-        "{:>5} {:>9} {:>9} {:>16} {:>9} {:>9} {:>9} {:>9} {:>10} {:>7}",
+        "{:>5} {:>9} {:>9} {:>16} {:>9} {:>9} {:>9} {:>9} {:>10} {:>7} {:>9} {:>7}",
         "N",
         "triangles",
         "dofs",
@@ -167,6 +173,8 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         "LCP",
         "prolong",
         "Cholesky s",
+        "ratio",
+        "KKT LU s",
         "ratio"
     );
     for &n in sizes {
@@ -185,6 +193,7 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         let clock = Instant::now();
         let mut previous = None;
         let mut last = None;
+        let mut kkt = None;
         for &k in &sizes {
             let t = Instant::now();
             let level_mesh = membranes::scene_mesh(&scene, k, Diagonal::Right).unwrap();
@@ -206,6 +215,7 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
             iterations.push(solution.iterations);
             let values = d.full(&solution);
             last = Some(d.lcp.a.clone());
+            kkt = Some(kkt_matrix(&d.lcp));
             previous = Some((d, values));
         }
         let total = clock.elapsed().as_secs_f64();
@@ -216,6 +226,13 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         let x = factor.solve(&vec![1.0; a.nrows()]).unwrap();
         black_box(x);
         let linear = t.elapsed().as_secs_f64();
+        // the saddle-point matrix of the same discretization, factored by sparse LU
+        let k = kkt.unwrap();
+        let t = Instant::now();
+        let pattern = k.symbolic().to_owned().unwrap();
+        let factor = LuSolver::analyse(&pattern).unwrap().factor(&k).unwrap();
+        black_box(factor.solve(&vec![1.0; k.nrows()]).unwrap());
+        let saddle = t.elapsed().as_secs_f64();
         let dofs = previous.as_ref().map_or(0, |(d, _)| d.lcp.n() + d.lcp.m());
         let levels = iterations
             .iter()
@@ -223,7 +240,7 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
             .collect::<Vec<_>>()
             .join(",");
         println!(
-            "{:>5} {:>9} {:>9} {:>16} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>10.3} {:>7.1}",
+            "{:>5} {:>9} {:>9} {:>16} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>10.3} {:>7.1} {:>9.3} {:>7.1}",
             n,
             2 * n * n,
             dofs,
@@ -233,9 +250,37 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
             lcp_time,
             prolong,
             linear,
-            total / linear
+            total / linear,
+            saddle,
+            total / saddle
         );
     }
+}
+
+// the same allocator as the CLI (see src/main.rs)
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+/// The KKT matrix `[[A, −Bᵀ], [−B, −C]]` of an LCP with a diagonal C.
+fn kkt_matrix(lcp: &Lcp) -> SparseMatrix {
+    let n = lcp.n();
+    let mut triplets = Vec::new();
+    let a = &lcp.a;
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    for j in 0..n {
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            triplets.push(Triplet::new(rows[k], j, vals[k]));
+        }
+    }
+    for (k, row) in lcp.b_rows.iter().enumerate() {
+        for &(j, v) in row {
+            triplets.push(Triplet::new(n + k, j, -v));
+            triplets.push(Triplet::new(j, n + k, -v));
+        }
+        triplets.push(Triplet::new(n + k, n + k, -lcp.c[k]));
+    }
+    let size = n + lcp.m();
+    SparseMatrix::try_new_from_triplets(size, size, &triplets).unwrap()
 }
 
 fn main() {

@@ -12,6 +12,9 @@ use fem_forms::linear_solve::Cholesky;
 use fem_forms::models::scenes::scene;
 use std::time::Instant;
 
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() {
     fem_forms::linear_solve::factor_sequentially();
     let sizes = [1_000usize, 4_000, 16_000, 64_000, 256_000, 1_024_000];

@@ -460,6 +460,12 @@ fn run(cli: Cli) -> Result<(), String> {
     }
 }
 
+// The solvers allocate and drop large vectors at every level and iteration; glibc
+// returns each to the kernel and pays page faults for the next. mimalloc keeps them:
+// the membrane VI solve at 524k triangles takes 2.1–2.3 s instead of 3.0 s.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> ExitCode {
     fem_forms::linear_solve::factor_sequentially();
     match run(Cli::parse()) {
