@@ -697,6 +697,24 @@ impl Pattern {
         Self { ptr, idx }
     }
 
+    /// `A`'s own pattern (`size ≥` A's order; the extra columns are empty).
+    fn of(a: &SparseMatrix, size: usize) -> Self {
+        let (col_ptr, rows) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+        let mut ptr = col_ptr.to_vec();
+        ptr.resize(size + 1, rows.len());
+        Self {
+            ptr,
+            idx: rows.to_vec(),
+        }
+    }
+
+    /// Whether entry `(i, j)` is in the pattern.
+    fn contains(&self, i: usize, j: usize) -> bool {
+        self.idx[self.ptr[j]..self.ptr[j + 1]]
+            .binary_search(&i)
+            .is_ok()
+    }
+
     /// Position of entry `(i, j)` (it must be in the pattern).
     fn position(&self, i: usize, j: usize) -> usize {
         let column = &self.idx[self.ptr[j]..self.ptr[j + 1]];
@@ -765,16 +783,33 @@ impl Hessian {
                 columns
             })
             .collect();
-        let pattern = Pattern::new(&lcp.a, lcp.n(), |columns| {
-            for block in &block_columns {
-                for &i in block {
-                    for &j in block {
-                        columns[j].push(i);
+        // Finite element couplings usually lie inside A's pattern already (a cell's B
+        // row touches the cell's own DOFs): then A's pattern is the Hessian's, and the
+        // union below, the costliest part of the setup, is skipped.
+        let own = Pattern::of(&lcp.a, lcp.n());
+        let inside = block_columns.iter().all(|block| {
+            block
+                .iter()
+                .all(|&i| block.iter().all(|&j| own.contains(i, j)))
+        });
+        let pattern = if inside {
+            own
+        } else {
+            Pattern::new(&lcp.a, lcp.n(), |columns| {
+                for block in &block_columns {
+                    for &i in block {
+                        for &j in block {
+                            columns[j].push(i);
+                        }
                     }
                 }
-            }
-        });
-        let a_positions = pattern.positions_of(&lcp.a);
+            })
+        };
+        let a_positions = if inside {
+            (0..lcp.a.val().len()).collect()
+        } else {
+            pattern.positions_of(&lcp.a)
+        };
         let mut row_local = vec![Vec::new(); lcp.m()];
         let mut block_positions = Vec::with_capacity(block_columns.len());
         for (block, columns) in lcp.blocks().zip(&block_columns) {
