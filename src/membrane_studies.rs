@@ -117,6 +117,7 @@ fn run_convergence(full: bool, out: &Path) -> Result<()> {
     let mut h1_series = Vec::new();
     let mut l2_series = Vec::new();
     let mut multiplier_series = Vec::new();
+    let mut work_series = Vec::new();
     for pair in &pairs {
         let pr = pair_rows(&rows, pair.name());
         let l2: Vec<f64> = pr.iter().map(|r| r.error_l2.unwrap_or(f64::NAN)).collect();
@@ -174,6 +175,13 @@ fn run_convergence(full: bool, out: &Path) -> Result<()> {
             format!("{} L²", pair.name()),
             pr.iter().zip(&l2).map(|(r, &e)| (h(r), e)).collect(),
         ));
+        work_series.push(Series::marked(
+            format!("{} H¹ against seconds", pair.name()),
+            pr.iter()
+                .zip(&h1)
+                .map(|(r, &e)| (r.seconds.max(1e-5), e))
+                .collect(),
+        ));
         if lm.iter().all(|e| e.is_finite()) {
             multiplier_series.push(Series::marked(
                 format!("{} h-weighted λ", pair.name()),
@@ -199,6 +207,21 @@ fn run_convergence(full: bool, out: &Path) -> Result<()> {
                 "membrane-radial: L² error of u".into(),
                 axes("‖u − u_h‖_L2"),
                 l2_series,
+            ),
+            (
+                "membrane-radial: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½".into(),
+                axes("h-weighted error of λ"),
+                multiplier_series,
+            ),
+            (
+                "membrane-radial: work against precision (complete nested solve)".into(),
+                Axes {
+                    x: "seconds",
+                    y: "|u − u_h|_H1",
+                    log_x: true,
+                    log_y: true,
+                },
+                work_series,
             ),
         ],
     )
