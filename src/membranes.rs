@@ -3,9 +3,7 @@
 //! errors against the exact radial solution, and VTK output.
 
 use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
-use crate::models::membrane_scenes::{
-    radial_gradient, radial_multiplier, radial_u, Domain, MembraneScene, RADIAL_A, RADIAL_R,
-};
+use crate::models::membrane_scenes::{Domain, ExactMembrane, MembraneScene};
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
 use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_runtime::obstacle_2d::{
@@ -493,12 +491,9 @@ fn file_levels(
     Ok(levels)
 }
 
-fn exact_of(scene: &MembraneScene) -> bool {
-    scene.name == "membrane-radial"
-}
-
-fn exact_u(x: [f64; 2]) -> (f64, [f64; 2]) {
-    (radial_u(&x), radial_gradient(&x))
+/// `(u, ∇u)` of an exact solution, as the error norms take it.
+fn exact_values(exact: &ExactMembrane) -> impl Fn([f64; 2]) -> (f64, [f64; 2]) + '_ {
+    move |x| ((exact.u)(&x), (exact.gradient)(&x))
 }
 
 fn run_stabilized<M: Model>(
@@ -547,16 +542,17 @@ fn run_stabilized<M: Model>(
     let u = solution.view(u_field);
     let lambda = solution.view(d.multiplier_field);
     let degree = 2 * M::FIELDS[u_field].element.degree() + 4;
-    let exact = exact_of(&scene);
-    let (error_l2, error_h1, error_multiplier) = if exact {
-        let (l2, h1) = u.errors(&exact_u, degree);
-        (
-            Some(l2),
-            Some(h1),
-            Some(lambda.weighted_error(&|x: [f64; 2]| radial_multiplier(&x), 1, degree)),
-        )
-    } else {
-        (None, None, None)
+    let (error_l2, error_h1, error_multiplier) = match &scene.exact {
+        Some(exact) => {
+            let (l2, h1) = u.errors(&exact_values(exact), degree);
+            let multiplier = exact.multiplier;
+            (
+                Some(l2),
+                Some(h1),
+                Some(lambda.weighted_error(&|x: [f64; 2]| multiplier(&x), 1, degree)),
+            )
+        }
+        None => (None, None, None),
     };
     if solution.multiplier_noise > 1e-6 {
         warnings.push(format!(
@@ -582,9 +578,9 @@ fn run_stabilized<M: Model>(
         error_h1,
         error_multiplier,
         total_contact_force: solution.total_contact_force(),
-        exact_contact_force: exact.then_some(2.0 * std::f64::consts::PI * RADIAL_A),
+        exact_contact_force: scene.exact.map(|e| e.total_contact_force),
         contact_area,
-        exact_contact_area: exact.then_some(std::f64::consts::PI * RADIAL_R * RADIAL_R),
+        exact_contact_area: scene.exact.map(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: solution.multiplier_noise,
         warnings,
@@ -686,12 +682,12 @@ fn run_nodal(
         map,
         coefficients: &values,
     };
-    let exact = exact_of(&scene);
-    let (error_l2, error_h1) = if exact {
-        let (l2, h1) = u.errors(&exact_u, 6);
-        (Some(l2), Some(h1))
-    } else {
-        (None, None)
+    let (error_l2, error_h1) = match &scene.exact {
+        Some(exact) => {
+            let (l2, h1) = u.errors(&exact_values(exact), 6);
+            (Some(l2), Some(h1))
+        }
+        None => (None, None),
     };
     // nodal forces: active where λ_i > 0 or the node lies on ψ (boundary nodes too)
     let mut vertex_force = vec![0.0; mesh.vertex_count()];
@@ -745,9 +741,9 @@ fn run_nodal(
         error_h1,
         error_multiplier: None,
         total_contact_force: solution.lambda.iter().sum(),
-        exact_contact_force: exact.then_some(2.0 * std::f64::consts::PI * RADIAL_A),
+        exact_contact_force: scene.exact.map(|e| e.total_contact_force),
         contact_area,
-        exact_contact_area: exact.then_some(std::f64::consts::PI * RADIAL_R * RADIAL_R),
+        exact_contact_area: scene.exact.map(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: 0.0,
         warnings: Vec::new(),

@@ -69,6 +69,7 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
         obstacle: zero,
         boundary: zero,
         target_l2: 1e-3,
+        exact: None,
     };
     let runs = [
         (MembranePair::P1P0, VariationalSolver::SemismoothNewton),

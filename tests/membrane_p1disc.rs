@@ -12,7 +12,7 @@ use fem_forms::models::membrane::membrane_p2_p1disc;
 use fem_forms::models::membrane_scenes::{membrane_scene, Domain, MembraneScene};
 use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_forms::obstacle_2d::{discretize_on_triangles, solve_obstacle_on_triangles};
-use fem_forms::{Coefficients, Model};
+use fem_forms::Model;
 
 fn radial() -> MembraneScene {
     membrane_scene("membrane-radial").unwrap()
@@ -99,15 +99,7 @@ fn newton_and_the_saddle_point_method_agree_on_the_blocked_membrane_lcp() {
     let r = request(scene, MembranePair::P2P1Disc, 16);
     let mesh = scene_mesh(&scene, 16, r.diagonal).unwrap();
     let (alpha, _) = alpha_of(&r, &mesh).unwrap();
-    let coefficients = Coefficients::new::<M>(
-        &[("α", alpha)],
-        &[
-            ("f", &scene.load),
-            ("ψ", &scene.obstacle),
-            ("g", &scene.boundary),
-        ],
-    )
-    .unwrap();
+    let coefficients = membranes::scene_coefficients::<M>(&scene, alpha).unwrap();
     let d = discretize_on_triangles::<M>(&mesh, &coefficients, "B_h", "L_h").unwrap();
     let lcp = &d.lcp;
     assert_eq!(lcp.c_blocks.groups().count(), 2 * 16 * 16);
@@ -165,25 +157,27 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
         obstacle: zero,
         boundary: zero,
         target_l2: 1e-3,
+        exact: None,
     };
     let n = 8;
-    // Newton only: clarabel's certificate (a Newton step relative to ‖U‖) cannot certify
-    // the exact solution U = 0, for P2–P0 as well
-    {
-        let solver = VariationalSolver::SemismoothNewton;
-        let (report, fields) =
-            membranes::solve(&request(scene, MembranePair::P2P1Disc, n)).unwrap();
+    for solver in [
+        VariationalSolver::SemismoothNewton,
+        VariationalSolver::Clarabel,
+    ] {
+        let mut r = request(scene, MembranePair::P2P1Disc, n);
+        r.solver = solver;
+        let (report, fields) = membranes::solve(&r).unwrap();
         let largest_u = fields.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        assert!(largest_u < 1e-10, "{solver:?}: u = {largest_u}");
+        assert!(largest_u < 1e-8, "{solver:?}: u = {largest_u}");
         assert!(
-            (report.total_contact_force - 48.0).abs() < 1e-8 * 48.0,
+            (report.total_contact_force - 48.0).abs() < 1e-7 * 48.0,
             "{solver:?}: ∫λ = {}",
             report.total_contact_force
         );
         assert!((report.contact_area - 16.0).abs() < 1e-9, "{solver:?}");
         assert!(report.complementarity_residual < 1e-10, "{solver:?}");
         for l in &fields.lambda {
-            assert!((l - 3.0).abs() < 1e-8, "{solver:?}: λ = {l}");
+            assert!((l - 3.0).abs() < 1e-6, "{solver:?}: λ = {l}");
         }
     }
 
@@ -192,15 +186,7 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
     let r = request(scene, MembranePair::P2P1Disc, n);
     let mesh = scene_mesh(&scene, n, r.diagonal).unwrap();
     let (alpha, _) = alpha_of(&r, &mesh).unwrap();
-    let coefficients = Coefficients::new::<M>(
-        &[("α", alpha)],
-        &[
-            ("f", &scene.load),
-            ("ψ", &scene.obstacle),
-            ("g", &scene.boundary),
-        ],
-    )
-    .unwrap();
+    let coefficients = membranes::scene_coefficients::<M>(&scene, alpha).unwrap();
     let solution =
         solve_obstacle_on_triangles::<M>(&[mesh], &coefficients, ObstacleOptions::default())
             .unwrap();

@@ -10,6 +10,30 @@ pub enum Domain {
     LShape,
 }
 
+/// A membrane scene's exact solution.
+#[derive(Clone, Copy, Debug)]
+pub struct ExactMembrane {
+    /// `u(x)`.
+    pub u: fn(&[f64]) -> f64,
+    /// `∇u(x)`.
+    pub gradient: fn(&[f64]) -> [f64; 2],
+    /// `λ(x)`.
+    pub multiplier: fn(&[f64]) -> f64,
+    /// `∫ λ`.
+    pub total_contact_force: f64,
+    /// The area of the contact set.
+    pub contact_area: f64,
+}
+
+/// The exact solution of the radial problem.
+pub const RADIAL_EXACT: ExactMembrane = ExactMembrane {
+    u: radial_u,
+    gradient: radial_gradient,
+    multiplier: radial_multiplier,
+    total_contact_force: 2.0 * std::f64::consts::PI * RADIAL_A,
+    contact_area: std::f64::consts::PI * RADIAL_R * RADIAL_R,
+};
+
 /// A membrane scene.
 #[derive(Clone, Copy, Debug)]
 pub struct MembraneScene {
@@ -28,6 +52,8 @@ pub struct MembraneScene {
     /// The accuracy the scene asks for: the L² error of u (estimated where no exact
     /// solution is known).
     pub target_l2: f64,
+    /// The exact solution, where one is known.
+    pub exact: Option<ExactMembrane>,
 }
 
 /// The free-boundary radius `r*` of the radial problem: `r*²(ln 2 − ln r*) = 1 − r*²`.
@@ -107,6 +133,7 @@ pub const MEMBRANE_SCENES: [MembraneScene; 2] = [
         obstacle: radial_obstacle,
         boundary: radial_u,
         target_l2: 1e-3,
+        exact: Some(RADIAL_EXACT),
     },
     MembraneScene {
         name: "membrane-lshape",
@@ -116,6 +143,7 @@ pub const MEMBRANE_SCENES: [MembraneScene; 2] = [
         obstacle: lshape_obstacle,
         boundary: zero,
         target_l2: 1e-3,
+        exact: None,
     },
 ];
 
