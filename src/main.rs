@@ -1,4 +1,4 @@
-//! The fem-forms command line: solve the beam scenes, print tables, write charts.
+//! The fem-forms command line: solve the beam and membrane scenes, print tables, write charts.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -16,8 +16,8 @@ use std::process::ExitCode;
 #[command(
     name = "fem-forms",
     version,
-    about = "Stabilized finite elements for obstacle problems of beams: solve scenes, print tables, write charts",
-    long_about = "Without a command: solves the default scenes at q = 1 (no contact) and q = 100 (contact), prints a table, writes plots of w, θ, λ and ψ and the study charts to out/."
+    about = "Stabilized finite elements for obstacle problems of beams and membranes: solve scenes, print tables, write charts",
+    long_about = "Without a command: solves the beam scenes at q = 1 (no contact) and q = 100 (contact) and the membrane scenes, prints tables, writes plots of w, θ, λ and ψ, .vtu files of the membranes and the study charts to out/."
 )]
 struct Cli {
     #[command(subcommand)]
