@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
 use fem_forms::membrane_studies::{self, MembraneStudy};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
-use fem_forms::models::membrane_scenes::{membrane_scene, MEMBRANE_SCENES};
+use fem_forms::models::membrane_scenes::{membrane_scene, MEMBRANE_FLAT, MEMBRANE_SCENES};
 use fem_forms::models::scenes::{scene, SCENES};
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::{plot, studies};
@@ -313,7 +313,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 );
             }
             println!("membrane scenes (--mesh-size N, or --msh FILE):");
-            for s in MEMBRANE_SCENES {
+            for s in MEMBRANE_SCENES.iter().chain([&MEMBRANE_FLAT]) {
                 println!("  {:<17} {}", s.name, s.description);
             }
             println!(

@@ -7,7 +7,7 @@ use fem_forms::membranes::{
     self, element_inverse_constant, MembranePair, MembraneReport, MembraneRequest,
 };
 use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
-use fem_forms::models::membrane_scenes::{membrane_scene, Domain, MembraneScene};
+use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene, MEMBRANE_FLAT};
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::studies::rates;
 
@@ -49,28 +49,11 @@ fn inverse_constants_match_the_measured_ones() {
     }
 }
 
-fn pressed_flat(_: &[f64]) -> f64 {
-    -3.0
-}
-
-fn zero(_: &[f64]) -> f64 {
-    0.0
-}
-
 /// The sign test of MODELS.md §1: ψ = 0, g = 0, f = −q pressing everywhere onto the
 /// obstacle: exact u = 0 and λ = q, so ∫λ = 16q on (−2,2)² and the contact is total.
 #[test]
 fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
-    let scene = MembraneScene {
-        name: "sign-test",
-        description: "",
-        domain: Domain::Square(2.0),
-        load: pressed_flat,
-        obstacle: zero,
-        boundary: zero,
-        target_l2: 1e-3,
-        exact: None,
-    };
+    let scene = MEMBRANE_FLAT;
     let runs = [
         (MembranePair::P1P0, VariationalSolver::SemismoothNewton),
         (MembranePair::P2P0, VariationalSolver::SemismoothNewton),
@@ -99,6 +82,8 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
             report.total_contact_force
         );
         assert!((report.contact_area - 16.0).abs() < 1e-9, "{pair:?}");
+        // the scene's exact solution gives the errors too
+        assert!(report.error_h1.unwrap() < 1e-8, "{pair:?} {solver:?}");
         if pair != MembranePair::P1Nodal {
             for l in &fields.lambda {
                 assert!((l - 3.0).abs() < 1e-6, "{pair:?} {solver:?}: λ = {l}");
@@ -169,6 +154,10 @@ fn newton_and_the_qp_solver_agree() {
             .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     assert!(difference < 1e-7, "max |u_newton − u_qp| = {difference}");
     assert!((newton.total_contact_force - qp.total_contact_force).abs() < 1e-6);
+}
+
+fn zero(_: &[f64]) -> f64 {
+    0.0
 }
 
 fn above(_: &[f64]) -> f64 {

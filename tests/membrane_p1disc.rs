@@ -9,7 +9,7 @@ use fem_forms::complementarity::{
 };
 use fem_forms::membranes::{self, alpha_of, scene_mesh, MembranePair, MembraneRequest};
 use fem_forms::models::membrane::membrane_p2_p1disc;
-use fem_forms::models::membrane_scenes::{membrane_scene, Domain, MembraneScene};
+use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene, MEMBRANE_FLAT};
 use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_forms::obstacle_2d::{discretize_on_triangles, solve_obstacle_on_triangles};
 use fem_forms::Model;
@@ -136,29 +136,12 @@ fn newton_and_the_saddle_point_method_agree_on_the_blocked_membrane_lcp() {
     assert!(partial > 0);
 }
 
-fn pressed_flat(_: &[f64]) -> f64 {
-    -3.0
-}
-
-fn zero(_: &[f64]) -> f64 {
-    0.0
-}
-
 /// The sign test of MODELS.md §1 for P2–P1disc: ψ = 0, g = 0, f = −3 pressing everywhere
 /// onto the obstacle: exact u = 0 and λ = 3, so every multiplier coefficient (not only
 /// the centroid values) is 3 and ∫λ = 48 on (−2,2)².
 #[test]
 fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
-    let scene = MembraneScene {
-        name: "sign-test",
-        description: "",
-        domain: Domain::Square(2.0),
-        load: pressed_flat,
-        obstacle: zero,
-        boundary: zero,
-        target_l2: 1e-3,
-        exact: None,
-    };
+    let scene = MEMBRANE_FLAT;
     let n = 8;
     for solver in [
         VariationalSolver::SemismoothNewton,

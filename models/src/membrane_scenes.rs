@@ -113,6 +113,38 @@ fn zero(_: &[f64]) -> f64 {
     0.0
 }
 
+fn zero_gradient(_: &[f64]) -> [f64; 2] {
+    [0.0, 0.0]
+}
+
+fn press_down(_: &[f64]) -> f64 {
+    -3.0
+}
+
+fn three(_: &[f64]) -> f64 {
+    3.0
+}
+
+/// The sign test of MODELS.md §1 as a scene: ψ = 0, g = 0 and f = −3 pressing everywhere
+/// onto the obstacle, so u = 0, λ = 3, ∫λ = 48 and the contact is the whole (−2,2)².
+/// Not among the default scenes: it checks signs, not accuracy.
+pub const MEMBRANE_FLAT: MembraneScene = MembraneScene {
+    name: "membrane-flat",
+    description: "membrane on (−2,2)² pressed flat onto ψ = 0 by f = −3 (exact: u = 0, λ = 3)",
+    domain: Domain::Square(2.0),
+    load: press_down,
+    obstacle: zero,
+    boundary: zero,
+    target_l2: 1e-3,
+    exact: Some(ExactMembrane {
+        u: zero,
+        gradient: zero_gradient,
+        multiplier: three,
+        total_contact_force: 48.0,
+        contact_area: 16.0,
+    }),
+};
+
 /// A tilted, off-centre paraboloid below the L-shaped membrane: not symmetric about
 /// any axis of the domain.
 fn lshape_obstacle(x: &[f64]) -> f64 {
@@ -147,9 +179,13 @@ pub const MEMBRANE_SCENES: [MembraneScene; 2] = [
     },
 ];
 
-/// The membrane scene called `name`.
+/// The membrane scene called `name` (the default ones and `membrane-flat`).
 pub fn membrane_scene(name: &str) -> Option<MembraneScene> {
-    MEMBRANE_SCENES.iter().copied().find(|s| s.name == name)
+    MEMBRANE_SCENES
+        .iter()
+        .chain([&MEMBRANE_FLAT])
+        .copied()
+        .find(|s| s.name == name)
 }
 
 #[cfg(test)]
