@@ -528,7 +528,7 @@ fn run_stabilized<M: Model>(
         |e| {
             if c_i > 0.0 && alpha * c_i >= 1.0 {
                 Error::Input(format!(
-                    "{e}; α·C_I = {:.2} is outside the stability range 0 < α < 1/C_I = {:.3e}, where A_α = a − αS is indefinite",
+                    "α·C_I = {:.2} is outside the stability range 0 < α < 1/C_I = {:.3e}, where A_α = a − αS is indefinite, and the solve failed: {e}",
                     alpha * c_i,
                     1.0 / c_i
                 ))
