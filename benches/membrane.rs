@@ -192,8 +192,6 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         let mut iterations = Vec::new();
         let clock = Instant::now();
         let mut previous = None;
-        let mut last = None;
-        let mut kkt = None;
         for &k in &sizes {
             let t = Instant::now();
             let level_mesh = membranes::scene_mesh(&scene, k, Diagonal::Right).unwrap();
@@ -214,12 +212,11 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
             lcp_time += t.elapsed().as_secs_f64();
             iterations.push(solution.iterations);
             let values = d.full(&solution);
-            last = Some(d.lcp.a.clone());
-            kkt = Some(kkt_matrix(&d.lcp));
             previous = Some((d, values));
         }
         let total = clock.elapsed().as_secs_f64();
-        let a = last.unwrap();
+        let lcp = &previous.as_ref().unwrap().0.lcp;
+        let a = lcp.a.clone();
         let t = Instant::now();
         let pattern = a.symbolic().to_owned().unwrap();
         let factor = Cholesky::analyse(&pattern).unwrap().factor(&a).unwrap();
@@ -227,7 +224,7 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         black_box(x);
         let linear = t.elapsed().as_secs_f64();
         // the saddle-point matrix of the same discretization, factored by sparse LU
-        let k = kkt.unwrap();
+        let k = kkt_matrix(lcp);
         let t = Instant::now();
         let pattern = k.symbolic().to_owned().unwrap();
         let factor = LuSolver::analyse(&pattern).unwrap().factor(&k).unwrap();
@@ -285,6 +282,7 @@ fn kkt_matrix(lcp: &Lcp) -> SparseMatrix {
 
 fn main() {
     fem_forms::linear_solve::factor_sequentially();
+    fem_forms::allocator::retain_freed_memory();
     let quick = std::env::args().any(|a| a == "--quick");
     let (assembly_n, p1_sizes, p2_sizes): (usize, Vec<usize>, Vec<usize>) = if quick {
         (128, vec![32, 64, 128], vec![32, 64])

@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+pub mod allocator;
 pub mod beams;
 pub mod membrane_studies;
 pub mod membranes;

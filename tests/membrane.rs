@@ -437,3 +437,46 @@ fn the_l_shape_scene_reaches_its_accuracy_with_every_pair() {
         );
     }
 }
+
+/// The nested solve builds the finest level on a second thread while the coarser levels
+/// are solved: its result must be the one of solving the levels one after the other.
+#[test]
+fn the_pipelined_nested_solve_equals_the_sequential_one() {
+    use fem_forms::obstacle::solve_lcp;
+    use fem_forms::obstacle_2d::{
+        discretize_on_triangles, prolong_on_triangles, solve_obstacle_on_triangles,
+    };
+    type M = membrane_p2_p0::Model;
+    let scene = radial();
+    let meshes: Vec<_> = [4, 8, 16]
+        .iter()
+        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
+        .collect();
+    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 96.0).unwrap();
+    let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let pipelined = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
+    let mut previous: Option<(_, Vec<f64>)> = None;
+    let mut iterations = Vec::new();
+    for mesh in &meshes {
+        let d = discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h").unwrap();
+        let start = previous
+            .as_ref()
+            .map(|(coarse, values)| d.primal_part(&prolong_on_triangles(coarse, values, &d)));
+        let solution = solve_lcp(&d.lcp, start.as_deref(), options).unwrap();
+        iterations.push((mesh.cell_count(), solution.iterations));
+        let values = d.full(&solution);
+        previous = Some((d, values));
+    }
+    let (_, sequential) = previous.unwrap();
+    assert_eq!(pipelined.levels, iterations);
+    assert_eq!(pipelined.values.len(), sequential.len());
+    let difference = pipelined
+        .values
+        .iter()
+        .zip(&sequential)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        difference <= 1e-12,
+        "pipelined and sequential differ by {difference}"
+    );
+}

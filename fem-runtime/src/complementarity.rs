@@ -1029,6 +1029,31 @@ fn max_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
+/// What semismooth Newton needs before its first iteration and that depends only on the
+/// LCP's sparsity: the Hessian's pattern and its symbolic Cholesky factorization (the
+/// ordering). Built apart from the iteration so that it can be prepared on another
+/// thread while a coarser level is solved (see [`crate::obstacle::solve_nested`]).
+pub struct NewtonWorkspace {
+    hessian: Hessian,
+    cholesky: Cholesky,
+    /// `(n, m)` of the LCP it was built for.
+    shape: (usize, usize),
+}
+
+impl NewtonWorkspace {
+    /// The Hessian pattern and symbolic factorization of `lcp`.
+    pub fn new(lcp: &Lcp) -> Result<Self> {
+        lcp.check_shapes()?;
+        let hessian = Hessian::new(lcp);
+        let cholesky = Cholesky::analyse(&hessian.symbolic)?;
+        Ok(Self {
+            hessian,
+            cholesky,
+            shape: (lcp.n(), lcp.m()),
+        })
+    }
+}
+
 /// Semismooth Newton (primal–dual active set) on Φ with an Armijo line search, from
 /// `start` (e.g. the prolonged solution of a coarser mesh) or from zero.
 pub fn semismooth_newton(
@@ -1039,10 +1064,41 @@ pub fn semismooth_newton(
     let clock = Instant::now();
     lcp.check_shapes()?;
     lcp.require_positive_c("semismooth Newton")?;
+    let workspace = NewtonWorkspace::new(lcp)?;
+    newton_iteration(lcp, &workspace, start, options, clock)
+}
+
+/// [`semismooth_newton`] with the pattern work done ahead in `workspace` (built by
+/// [`NewtonWorkspace::new`] for this `lcp`).
+pub fn semismooth_newton_prepared(
+    lcp: &Lcp,
+    workspace: &NewtonWorkspace,
+    start: Option<&[f64]>,
+    options: NewtonOptions,
+) -> Result<LcpSolution> {
+    let clock = Instant::now();
+    lcp.check_shapes()?;
+    lcp.require_positive_c("semismooth Newton")?;
+    if workspace.shape != (lcp.n(), lcp.m()) {
+        return Err(Error::Input(format!(
+            "the Newton workspace was built for an LCP with {:?} (primal, constraint) unknowns, this one has {:?}",
+            workspace.shape,
+            (lcp.n(), lcp.m())
+        )));
+    }
+    newton_iteration(lcp, workspace, start, options, clock)
+}
+
+fn newton_iteration(
+    lcp: &Lcp,
+    workspace: &NewtonWorkspace,
+    start: Option<&[f64]>,
+    options: NewtonOptions,
+    clock: Instant,
+) -> Result<LcpSolution> {
     let n = lcp.n();
     let mut u = lcp.start_vector(start)?;
-    let hessian = Hessian::new(lcp);
-    let cholesky = Cholesky::analyse(&hessian.symbolic)?;
+    let (hessian, cholesky) = (&workspace.hessian, &workspace.cholesky);
     let done = |u: Vec<f64>, lambda: Vec<f64>, iterations: usize, residual: f64| LcpSolution {
         u,
         lambda,

@@ -7,7 +7,7 @@ use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::boundary::{Constraints, Reduction, Side};
 use crate::complementarity::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
-    CouplingBlocks, Lcp, LcpSolution, NewtonOptions,
+    semismooth_newton_prepared, CouplingBlocks, Lcp, LcpSolution, NewtonOptions, NewtonWorkspace,
 };
 use crate::dof_map::SystemDofs;
 use crate::element::PhysicalBasis;
@@ -313,6 +313,17 @@ pub fn solve_lcp(
     start: Option<&[f64]>,
     options: ObstacleOptions,
 ) -> Result<LcpSolution> {
+    solve_lcp_prepared(lcp, None, start, options)
+}
+
+/// [`solve_lcp`] with semismooth Newton's pattern work (Hessian pattern, symbolic
+/// Cholesky) done ahead in `workspace`, if given (other solvers ignore it).
+pub fn solve_lcp_prepared(
+    lcp: &Lcp,
+    workspace: Option<&NewtonWorkspace>,
+    start: Option<&[f64]>,
+    options: ObstacleOptions,
+) -> Result<LcpSolution> {
     match options.solver {
         // Newton with Λ eliminated (SPD Hessian, one symbolic Cholesky); if it fails,
         // the active-set method on the saddle-point system. Where the eliminated Λ
@@ -329,7 +340,11 @@ pub fn solve_lcp(
                 },
                 ..options.newton
             };
-            let solution = match semismooth_newton(lcp, start, newton) {
+            let newton = match workspace {
+                Some(w) => semismooth_newton_prepared(lcp, w, start, newton),
+                None => semismooth_newton(lcp, start, newton),
+            };
+            let solution = match newton {
                 Ok(s) => s,
                 // the fallback factors an LU per iteration: give it fewer
                 Err(newton) => primal_dual_active_set(
@@ -385,14 +400,20 @@ pub fn solve_obstacle<M: Model>(
     }
     let (a, b) = (mesh.vertices()[0], *mesh.vertices().last().unwrap());
     let last = sizes.len() - 1;
-    let levels = sizes.into_iter().enumerate().map(|(level, cells)| {
-        let level_mesh = if level == last {
-            mesh.clone()
-        } else {
-            IntervalMesh::uniform(a, b, cells)?
-        };
-        Discretization::new::<M>(&level_mesh, coefficients, clamped, "B_h", "L_h")
-    });
+    let levels = sizes
+        .into_iter()
+        .enumerate()
+        .map(|(level, cells)| {
+            move || {
+                let level_mesh = if level == last {
+                    mesh.clone()
+                } else {
+                    IntervalMesh::uniform(a, b, cells)?
+                };
+                Discretization::new::<M>(&level_mesh, coefficients, clamped, "B_h", "L_h")
+            }
+        })
+        .collect();
     solve_nested(
         levels,
         |coarse, values, fine| {
@@ -404,26 +425,67 @@ pub fn solve_obstacle<M: Model>(
 
 /// Solves the LCP of each level in turn, each started from the solution of the level
 /// before, carried over by `prolong` (nested iteration); returns the last level's.
-pub fn solve_nested<G: Mesh>(
-    levels: impl IntoIterator<Item = Result<Discretization<G>>>,
+///
+/// `levels` build the discretizations, coarsest first. The last level, the most costly
+/// to build (assembly, and for Newton the Hessian pattern and its symbolic Cholesky
+/// factorization), does not depend on the coarser solutions: it is built on a second
+/// thread while the coarser levels are solved, so that on two cores only the numeric
+/// part of the last level follows the coarse solves.
+pub fn solve_nested<G, B>(
+    levels: Vec<B>,
     prolong: impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
     options: ObstacleOptions,
-) -> Result<ObstacleSolution<G>> {
+) -> Result<ObstacleSolution<G>>
+where
+    G: Mesh + Send,
+    B: FnOnce() -> Result<Discretization<G>> + Send,
+{
     let clock = Instant::now();
-    let mut counts = Vec::new();
-    let mut last: Option<(Discretization<G>, Vec<f64>, LcpSolution)> = None;
-    for d in levels {
-        let d = d?;
-        let start = last
-            .as_ref()
-            .map(|(coarse, values, _)| d.primal_part(&prolong(coarse, values, &d)));
-        let solution = solve_lcp(&d.lcp, start.as_deref(), options)?;
-        counts.push((d.mesh.cell_count(), solution.iterations));
-        let values = d.full(&solution);
-        last = Some((d, values, solution));
-    }
-    let (discretization, values, solution) =
-        last.ok_or_else(|| Error::Input("no mesh to solve on".into()))?;
+    let mut levels = levels;
+    let finest = levels
+        .pop()
+        .ok_or_else(|| Error::Input("no mesh to solve on".into()))?;
+    let newton = options.solver == VariationalSolver::SemismoothNewton;
+    let prepare = move || -> Result<(Discretization<G>, Option<NewtonWorkspace>)> {
+        let d = finest()?;
+        // Newton's own checks (positive C) come with the solve, where their error is
+        // reported; a workspace that cannot be built is simply not used.
+        let workspace = if newton {
+            NewtonWorkspace::new(&d.lcp).ok()
+        } else {
+            None
+        };
+        Ok((d, workspace))
+    };
+    let (coarse, finest) = if levels.is_empty() {
+        (Ok(None), prepare())
+    } else {
+        std::thread::scope(|scope| {
+            let finest = scope.spawn(prepare);
+            let coarse = solve_levels(levels, &prolong, options);
+            let finest = finest
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            (coarse, finest)
+        })
+    };
+    let (coarse, mut counts) = match coarse? {
+        Some((d, values, counts)) => (Some((d, values)), counts),
+        None => (None, Vec::new()),
+    };
+    let (discretization, workspace) = finest?;
+    let start = coarse.as_ref().map(|(coarse, values)| {
+        discretization.primal_part(&prolong(coarse, values, &discretization))
+    });
+    drop(coarse);
+    let solution = solve_lcp_prepared(
+        &discretization.lcp,
+        workspace.as_ref(),
+        start.as_deref(),
+        options,
+    )?;
+    counts.push((discretization.mesh.cell_count(), solution.iterations));
+    let values = discretization.full(&solution);
     Ok(ObstacleSolution {
         iterations: solution.iterations,
         kkt_residual: solution.kkt_residual,
@@ -434,6 +496,32 @@ pub fn solve_nested<G: Mesh>(
         levels: counts,
         seconds: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// A level's discretization, its solution's full coefficients, and the (cells, iterations)
+/// of every level so far.
+type SolvedLevel<G> = (Discretization<G>, Vec<f64>, Vec<(usize, usize)>);
+
+/// Builds and solves `levels` in turn, each from the prolonged solution of the one
+/// before; the last one solved, or `None` for no levels.
+fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
+    levels: Vec<B>,
+    prolong: &impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
+    options: ObstacleOptions,
+) -> Result<Option<SolvedLevel<G>>> {
+    let mut last: Option<SolvedLevel<G>> = None;
+    for build in levels {
+        let d = build()?;
+        let start = last
+            .as_ref()
+            .map(|(coarse, values, _)| d.primal_part(&prolong(coarse, values, &d)));
+        let solution = solve_lcp(&d.lcp, start.as_deref(), options)?;
+        let mut counts = last.map(|(_, _, counts)| counts).unwrap_or_default();
+        counts.push((d.mesh.cell_count(), solution.iterations));
+        let values = d.full(&solution);
+        last = Some((d, values, counts));
+    }
+    Ok(last)
 }
 
 impl<G> ObstacleSolution<G> {

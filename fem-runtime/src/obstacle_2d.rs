@@ -103,7 +103,8 @@ pub fn solve_obstacle_on_triangles<M: Model>(
     solve_nested(
         meshes
             .iter()
-            .map(|mesh| discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h")),
+            .map(|mesh| move || discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h"))
+            .collect(),
         prolong_on_triangles,
         options,
     )
