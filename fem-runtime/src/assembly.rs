@@ -11,18 +11,26 @@ use crate::model::{Coefficients, Model};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
+/// One block of a form on a system of DOFs: which fields, the element-matrix size and
+/// the fields' offsets in the system numbering.
 #[derive(Clone, Debug)]
-struct BlockPlan {
-    block: usize,
-    test_field: usize,
-    trial_field: usize,
-    rows: usize,
-    cols: usize,
-    row_offset: usize,
-    col_offset: usize,
+pub(crate) struct BlockPlan {
+    pub(crate) block: usize,
+    pub(crate) test_field: usize,
+    pub(crate) trial_field: usize,
+    pub(crate) rows: usize,
+    pub(crate) cols: usize,
+    pub(crate) row_offset: usize,
+    pub(crate) col_offset: usize,
 }
 
-fn block_plans<M: Model>(form: usize, dofs: &SystemDofs, bilinear: bool) -> Result<Vec<BlockPlan>> {
+/// The block plans of form `form` of `M` on `dofs` (an error if the form's arity is not
+/// the one asked for, or it couples a field the system leaves out).
+pub(crate) fn block_plans<M: Model>(
+    form: usize,
+    dofs: &SystemDofs,
+    bilinear: bool,
+) -> Result<Vec<BlockPlan>> {
     let info = &M::FORMS[form];
     let expected = if bilinear { 2 } else { 1 };
     if info.arity != expected {

@@ -177,6 +177,11 @@ impl Reduction {
         &self.free
     }
 
+    /// The value of DOF `d` if it is fixed, 0 if it is free.
+    pub fn fixed_value(&self, d: usize) -> f64 {
+        self.value[d]
+    }
+
     /// Index among the free DOFs of full DOF `d`, if it is free.
     pub fn free_index(&self, d: usize) -> Option<usize> {
         (self.free_index[d] != usize::MAX).then_some(self.free_index[d])

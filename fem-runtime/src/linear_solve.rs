@@ -111,6 +111,44 @@ pub fn asymmetry(a: &SparseMatrix) -> f64 {
     }
 }
 
+/// `sweeps` symmetric Gauss–Seidel sweeps (forward, then backward) on `A x = b` from
+/// `x = 0`, for a symmetric `A` stored with both triangles: an SPD approximate inverse
+/// applied to `b`. `None` if a diagonal entry is missing or not positive.
+pub fn symmetric_gauss_seidel(a: &SparseMatrix, b: &[f64], sweeps: usize) -> Option<Vec<f64>> {
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let n = a.ncols();
+    let mut diagonal = vec![0.0; n];
+    for (j, d) in diagonal.iter_mut().enumerate() {
+        let column = &rows[col_ptr[j]..col_ptr[j + 1]];
+        *d = column
+            .binary_search(&j)
+            .map_or(0.0, |k| vals[col_ptr[j] + k]);
+        if d.is_nan() || *d <= 0.0 {
+            return None;
+        }
+    }
+    let mut x = vec![0.0; n];
+    // column j of a symmetric matrix is its row j
+    let relax = |j: usize, x: &mut [f64]| {
+        let mut sum = b[j];
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            if rows[k] != j {
+                sum -= vals[k] * x[rows[k]];
+            }
+        }
+        x[j] = sum / diagonal[j];
+    };
+    for _ in 0..sweeps {
+        for j in 0..n {
+            relax(j, &mut x);
+        }
+        for j in (0..n).rev() {
+            relax(j, &mut x);
+        }
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
 fn solve_in_place(factor: &dyn SolveCore<f64>, x: &mut [f64]) {
     let n = x.len();
     factor.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, n, 1));

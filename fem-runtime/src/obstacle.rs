@@ -3,11 +3,12 @@
 //! `A_α, B_α, C_α, F_α, G_α` of MODELS.md §1 (the KKT matrix is
 //! `[[A_α, −B_αᵀ], [−B_α, −C_α]]`, its right-hand side `[F_α; −G_α]`).
 
-use crate::assembly::{assemble_vector, MatrixAssembler};
+use crate::assembly::{assemble_vector, block_plans, BlockPlan};
 use crate::boundary::{Constraints, Reduction, Side};
 use crate::complementarity::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
-    semismooth_newton_prepared, CouplingBlocks, Lcp, LcpSolution, NewtonOptions, NewtonWorkspace,
+    semismooth_newton_prepared, ConstraintRows, CouplingBlocks, Lcp, LcpSolution, NewtonOptions,
+    NewtonWorkspace,
 };
 use crate::dof_map::SystemDofs;
 use crate::element::PhysicalBasis;
@@ -100,12 +101,9 @@ impl<G: Mesh + Clone> Discretization<G> {
         linear: &str,
     ) -> Result<Self> {
         let multiplier = multiplier_field::<M>()?;
-        let k =
-            MatrixAssembler::new::<M>(bilinear, mesh, &dofs)?.assemble::<M>(mesh, coefficients)?;
-        let rhs = assemble_vector::<M>(linear, mesh, &dofs, coefficients)?;
+        let form = M::form(bilinear)?;
+        let plans = block_plans::<M>(form, &dofs, true)?;
         let reduction = constraints.reduction(dofs.dof_count())?;
-        let rhs = reduction.rhs(&k, &rhs);
-        let k = reduction.matrix(&k);
         let multiplier_range = dofs.range(multiplier).unwrap();
         let mut roles = Vec::with_capacity(reduction.free().len());
         let (mut primal_reduced, mut multiplier_reduced) = (Vec::new(), Vec::new());
@@ -119,57 +117,90 @@ impl<G: Mesh + Clone> Discretization<G> {
             }
         }
         let (n, m) = (primal_reduced.len(), multiplier_reduced.len());
-        let mut b_rows = vec![Vec::new(); m];
-        let mut c = vec![0.0; m];
-        // off-diagonal entries of C: the multipliers of one cell (P1disc) are coupled
-        let mut coupling = Vec::new();
-        let mut a_ptr = vec![0usize];
-        let (mut a_rows, mut a_vals) = (Vec::new(), Vec::new());
-        let (col_ptr, rows, vals) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-        for (j, role_j) in roles.iter().enumerate() {
-            for idx in col_ptr[j]..col_ptr[j + 1] {
-                let (i, v) = (rows[idx], vals[idx]);
-                match (roles[i], *role_j) {
-                    (Role::Primal(p), Role::Primal(_)) => {
-                        a_rows.push(p);
-                        a_vals.push(v);
-                    }
-                    (Role::Multiplier(mk), Role::Primal(p)) => b_rows[mk].push((p, -v)),
-                    (Role::Multiplier(mi), Role::Multiplier(mj)) => {
-                        if mi == mj {
-                            c[mi] = -v;
-                        } else if v != 0.0 {
-                            coupling.push((mi, mj, -v));
-                        }
-                    }
-                    (Role::Primal(_), Role::Multiplier(_)) => {}
+        // Each full DOF's place in the LCP.
+        let mut target: Vec<Target> = (0..dofs.dof_count())
+            .map(|d| Target::Fixed(reduction.fixed_value(d)))
+            .collect();
+        for (&d, role) in reduction.free().iter().zip(&roles) {
+            target[d] = match *role {
+                Role::Primal(p) => Target::Primal(p),
+                Role::Multiplier(k) => Target::Multiplier(k),
+            };
+        }
+        let split = SplitPattern::new(mesh, &dofs, &plans, &target, n, m);
+        let mut values = vec![0.0; split.value_count];
+        let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
+        let mut offset = 0;
+        for plan in &plans {
+            M::add_element_matrices(
+                form,
+                plan.block,
+                mesh,
+                &coefficients.params,
+                &coefficients.data,
+                &split.positions,
+                stride,
+                offset,
+                &mut values,
+            );
+            offset += plan.rows * plan.cols;
+        }
+        if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
+            let entry = split.positions.iter().position(|&p| p == bad).unwrap_or(0);
+            return Err(Error::NonFinite {
+                what: "matrix",
+                cell: entry / stride.max(1),
+            });
+        }
+        // L_h, less the columns of the fixed DOFs
+        let mut rhs = assemble_vector::<M>(linear, mesh, &dofs, coefficients)?;
+        for (&(row, fixed), &v) in split.fixed_terms.iter().zip(&values[split.fixed_start..]) {
+            rhs[row] -= v * fixed;
+        }
+        let (a_len, b_len) = (split.a_rows.len(), split.b_columns.len());
+        let a_vals = values[..a_len].to_vec();
+        // B = −(the multiplier rows of B_h), without its zeros
+        let mut b_ptr = Vec::with_capacity(m + 1);
+        let mut b_entries = Vec::with_capacity(b_len);
+        b_ptr.push(0);
+        for k in 0..m {
+            for e in split.b_ptr[k]..split.b_ptr[k + 1] {
+                let v = values[a_len + e];
+                if v != 0.0 {
+                    b_entries.push((split.b_columns[e], -v));
                 }
             }
-            if let Role::Primal(_) = role_j {
-                a_ptr.push(a_rows.len());
-            }
+            b_ptr.push(b_entries.len());
         }
-        for row in &mut b_rows {
-            row.retain(|&(_, v)| v != 0.0);
-        }
+        let c_start = a_len + b_len;
+        let c: Vec<f64> = values[c_start..c_start + m].iter().map(|v| -v).collect();
+        // off-diagonal entries of C: the multipliers of one cell (P1disc) are coupled
+        let coupling: Vec<(usize, usize, f64)> = split
+            .coupling
+            .iter()
+            .zip(&values[c_start + m..])
+            .filter(|(_, &v)| v != 0.0)
+            .map(|(&(k, l), &v)| (k, l, -v))
+            .collect();
         let c_blocks = CouplingBlocks::from_entries(m, &coupling).map_err(|e| {
             Error::Input(format!(
                 "the multiplier block of `{bilinear}`: {e}; this LCP form needs multipliers coupled only within a cell (P0, P1disc)"
             ))
         })?;
         let a: SparseMatrix = SparseColMat::new(
-            SymbolicSparseColMat::new_checked(n, n, a_ptr, None, a_rows),
+            SymbolicSparseColMat::new_checked(n, n, split.a_ptr, None, split.a_rows),
             a_vals,
         );
-        let f = primal_reduced.iter().map(|&r| rhs[r]).collect();
-        let g = multiplier_reduced.iter().map(|&r| -rhs[r]).collect();
+        let free = reduction.free();
+        let f = primal_reduced.iter().map(|&r| rhs[free[r]]).collect();
+        let g = multiplier_reduced.iter().map(|&r| -rhs[free[r]]).collect();
         Ok(Self {
             mesh: mesh.clone(),
             dofs,
             reduction,
             lcp: Lcp {
                 a,
-                b_rows,
+                b_rows: ConstraintRows::from_flat(b_ptr, b_entries)?,
                 c,
                 c_blocks,
                 f,
@@ -181,6 +212,209 @@ impl<G: Mesh + Clone> Discretization<G> {
             multiplier_reduced,
         })
     }
+}
+
+/// Where a DOF of the full system goes in the LCP.
+#[derive(Clone, Copy, Debug)]
+enum Target {
+    Primal(usize),
+    Multiplier(usize),
+    /// A fixed DOF with its value.
+    Fixed(f64),
+}
+
+/// The patterns of the LCP blocks of a bilinear form, built straight from the element
+/// DOFs (no pattern of the whole saddle-point system, no copies of it: at 524k
+/// triangles those cost more than the assembly itself), and the position of every
+/// element-matrix entry in one value array laid out as
+/// `[A (CSC) | B (rows) | diag C | off-diagonal C entries | fixed-column entries | discard]`.
+struct SplitPattern {
+    a_ptr: Vec<usize>,
+    a_rows: Vec<usize>,
+    b_ptr: Vec<usize>,
+    b_columns: Vec<usize>,
+    /// `(k, l)` of each off-diagonal `C` slot.
+    coupling: Vec<(usize, usize)>,
+    /// Where the fixed-column slots start, and `(full row, fixed value)` of each.
+    fixed_start: usize,
+    fixed_terms: Vec<(usize, f64)>,
+    value_count: usize,
+    positions: Vec<usize>,
+}
+
+impl SplitPattern {
+    fn new<G: Mesh>(
+        mesh: &G,
+        dofs: &SystemDofs,
+        plans: &[BlockPlan],
+        target: &[Target],
+        n: usize,
+        m: usize,
+    ) -> Self {
+        // generic, not `dyn`: the three passes visit every element-matrix entry
+        fn for_each_entry<G: Mesh>(
+            mesh: &G,
+            dofs: &SystemDofs,
+            plans: &[BlockPlan],
+            mut visit: impl FnMut(usize, usize),
+        ) {
+            let maps: Vec<_> = plans
+                .iter()
+                .map(|p| {
+                    (
+                        dofs.map(p.test_field).unwrap(),
+                        dofs.map(p.trial_field).unwrap(),
+                    )
+                })
+                .collect();
+            for c in 0..mesh.cell_count() {
+                for (plan, (test, trial)) in plans.iter().zip(&maps) {
+                    let (rows, cols) = (test.cell_dofs(c), trial.cell_dofs(c));
+                    for &r in rows {
+                        for &col in cols {
+                            visit(r + plan.row_offset, col + plan.col_offset);
+                        }
+                    }
+                }
+            }
+        }
+        // Bucket A's rows by column and B's columns by row (counting sort); each entry
+        // remembers its bucket slot, and the slot learns its place in the pattern when the
+        // buckets are sorted and deduplicated (no search per entry).
+        let mut a_count = vec![0usize; n + 1];
+        let mut b_count = vec![0usize; m + 1];
+        for_each_entry(mesh, dofs, plans, |r, c| match (target[r], target[c]) {
+            (Target::Primal(_), Target::Primal(q)) => a_count[q + 1] += 1,
+            (Target::Multiplier(k), Target::Primal(_)) => b_count[k + 1] += 1,
+            _ => {}
+        });
+        for j in 0..n {
+            a_count[j + 1] += a_count[j];
+        }
+        for k in 0..m {
+            b_count[k + 1] += b_count[k];
+        }
+        // an entry's provisional place, one usize: A's bucket slots, then B's, then the
+        // diagonal of C, then the per-occurrence slots; `usize::MAX` is discarded
+        let a_slots = a_count[n];
+        let b_slots = b_count[m];
+        let occurrence_base = a_slots + b_slots + m;
+        let mut a_bucket = vec![0usize; a_slots];
+        let mut b_bucket = vec![0usize; b_count[m]];
+        let (mut a_fill, mut b_fill) = (a_count.clone(), b_count.clone());
+        // off-diagonal C and fixed-column entries get one slot per occurrence (summed
+        // later); everything else of B_h (the rows of fixed DOFs, the Bᵀ block) is
+        // discarded into the last slot
+        let mut coupling = Vec::new();
+        let mut fixed_terms = Vec::new();
+        let mut slots = Vec::new();
+        let mut positions = Vec::new();
+        for_each_entry(mesh, dofs, plans, |r, c| {
+            let at = match (target[r], target[c]) {
+                (Target::Primal(p), Target::Primal(q)) => {
+                    let slot = a_fill[q];
+                    a_bucket[slot] = p;
+                    a_fill[q] += 1;
+                    slot
+                }
+                (Target::Multiplier(k), Target::Primal(q)) => {
+                    let slot = b_fill[k];
+                    b_bucket[slot] = q;
+                    b_fill[k] += 1;
+                    a_slots + slot
+                }
+                (Target::Multiplier(k), Target::Multiplier(l)) if k == l => a_slots + b_slots + k,
+                (Target::Multiplier(k), Target::Multiplier(l)) => {
+                    coupling.push((k, l));
+                    slots.push(Slot::Coupling);
+                    occurrence_base + slots.len() - 1
+                }
+                (Target::Primal(_) | Target::Multiplier(_), Target::Fixed(v)) if v != 0.0 => {
+                    fixed_terms.push((r, v));
+                    slots.push(Slot::Fixed);
+                    occurrence_base + slots.len() - 1
+                }
+                _ => usize::MAX,
+            };
+            positions.push(at);
+        });
+        drop((a_fill, b_fill));
+        // sorts each bucket, keeps its distinct indices and turns every slot of the
+        // bucket into the position of its index in the pattern
+        let compress = |count: &[usize], bucket: &mut [usize]| {
+            let mut ptr = Vec::with_capacity(count.len());
+            ptr.push(0);
+            let mut idx = Vec::with_capacity(bucket.len());
+            let mut group: Vec<(usize, usize)> = Vec::new();
+            for j in 0..count.len() - 1 {
+                group.clear();
+                group.extend((count[j]..count[j + 1]).map(|slot| (bucket[slot], slot)));
+                group.sort_unstable();
+                let mut last = usize::MAX;
+                for &(i, slot) in &group {
+                    if i != last {
+                        idx.push(i);
+                        last = i;
+                    }
+                    bucket[slot] = idx.len() - 1;
+                }
+                ptr.push(idx.len());
+            }
+            (ptr, idx)
+        };
+        let (a_ptr, a_rows) = compress(&a_count, &mut a_bucket);
+        let (b_ptr, b_columns) = compress(&b_count, &mut b_bucket);
+        let b_start = a_rows.len();
+        let c_start = b_start + b_columns.len();
+        let coupling_start = c_start + m;
+        // Give the per-occurrence slots their places: coupling ones first, then fixed.
+        let fixed_start = coupling_start + coupling.len();
+        let discard = fixed_start + fixed_terms.len();
+        let mut place = Vec::with_capacity(slots.len());
+        let (mut next_coupling, mut next_fixed) = (coupling_start, fixed_start);
+        for slot in &slots {
+            match slot {
+                Slot::Coupling => {
+                    place.push(next_coupling);
+                    next_coupling += 1;
+                }
+                Slot::Fixed => {
+                    place.push(next_fixed);
+                    next_fixed += 1;
+                }
+            }
+        }
+        for at in &mut positions {
+            *at = if *at < a_slots {
+                a_bucket[*at]
+            } else if *at < a_slots + b_slots {
+                b_start + b_bucket[*at - a_slots]
+            } else if *at < occurrence_base {
+                c_start + (*at - a_slots - b_slots)
+            } else if *at != usize::MAX {
+                place[*at - occurrence_base]
+            } else {
+                discard
+            };
+        }
+        Self {
+            a_ptr,
+            a_rows,
+            b_ptr,
+            b_columns,
+            coupling,
+            fixed_start,
+            fixed_terms,
+            value_count: discard + 1,
+            positions,
+        }
+    }
+}
+
+/// A slot of one occurrence of an entry.
+enum Slot {
+    Coupling,
+    Fixed,
 }
 
 impl<G> Discretization<G> {

@@ -269,7 +269,7 @@ pub fn nodal_active_set(
 pub fn nodal_lcp(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
     Lcp::new(
         a.clone(),
-        (0..f.len()).map(|i| vec![(i, 1.0)]).collect(),
+        (0..f.len()).map(|i| vec![(i, 1.0)]).collect::<Vec<_>>(),
         vec![0.0; f.len()],
         f.to_vec(),
         psi.to_vec(),
