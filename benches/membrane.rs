@@ -2,12 +2,15 @@
 //! 1. global stiffness assembly of P1 and P2 on the same mesh (elements per second),
 //!    against a hand-written loop that adds barycentric P1 element matrices into the
 //!    same fixed CSC pattern;
-//! 2. the complete stabilized VI solve (nested iteration, assembly included) against one
-//!    sparse Cholesky factorization + solve of the final mesh's matrix `A_α` (the
-//!    strict baseline: a linear problem of the primal size), and against one sparse LU
+//! 2. the complete stabilized VI solve (coarse meshes, nested iteration, assembly
+//!    included) against one sparse Cholesky analysis + factorization + solve of the
+//!    final mesh's matrix `A_α` (the strict baseline: a linear problem of the primal
+//!    size, on one thread, faer's fastest here), with the finest level built on a second
+//!    thread (the default) and all on one thread; and against one sparse LU
 //!    factorization + solve of the saddle-point matrix `[[A_α, −B_αᵀ], [−B_α, −C_α]]`
-//!    of the same discretization, with the phases of the solve and the Newton
-//!    iterations per mesh from 2k to 524k triangles.
+//!    of the same discretization. Newton iterations per level (the first on each nested
+//!    level is Gauss–Seidel sweeps) and factorizations on the final mesh, from 2k to
+//!    524k triangles.
 //!
 //! `cargo bench --bench membrane` (add `-- --quick` for smaller meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
@@ -17,9 +20,9 @@ use fem_forms::complementarity::Lcp;
 use fem_forms::linear_solve::{Cholesky, LuSolver};
 use fem_forms::membranes::{self, MembranePair, MembraneRequest};
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
-use fem_forms::models::membrane_scenes::membrane_scene;
-use fem_forms::obstacle::{solve_lcp, VariationalSolver};
-use fem_forms::obstacle_2d::{discretize_on_triangles, prolong_on_triangles};
+use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene};
+use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
+use fem_forms::obstacle_2d::{solve_obstacle_on_triangles, TriangleObstacleSolution};
 use fem_forms::SparseMatrix;
 use fem_forms::{Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh};
 use std::hint::black_box;
@@ -155,24 +158,65 @@ fn assembly(n: usize, rounds: usize) {
     );
 }
 
-/// One stabilized VI solve of the radial scene, phase by phase, against one Cholesky.
-fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
+/// One complete stabilized VI solve of the radial scene on the `n × n × 2` mesh: the
+/// coarse meshes, every level's assembly and solve (nested from N = 4), as the CLI runs
+/// it. Returns the solution and its wall time.
+fn vi_solve_once<M: Model>(
+    scene: &MembraneScene,
+    coefficients: &Coefficients,
+    mesh: &TriangleMesh,
+    n: usize,
+    pipelined: bool,
+) -> (TriangleObstacleSolution, f64) {
+    let clock = Instant::now();
+    let mut sizes = vec![n];
+    while sizes[0] / 2 >= 4 && sizes[0] % 2 == 0 {
+        sizes.insert(0, sizes[0] / 2);
+    }
+    // the final mesh is the input, as the matrix is the baseline's; the coarse ones are
+    // the solver's own
+    let mut meshes: Vec<TriangleMesh> = sizes[..sizes.len() - 1]
+        .iter()
+        .map(|&k| membranes::scene_mesh(scene, k, Diagonal::Right).unwrap())
+        .collect();
+    meshes.push(mesh.clone());
+    let options = ObstacleOptions {
+        pipelined,
+        ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+    };
+    let solution = solve_obstacle_on_triangles::<M>(&meshes, coefficients, options).unwrap();
+    (solution, clock.elapsed().as_secs_f64())
+}
+
+/// One Cholesky analysis + factorization + solve of `a`, timed.
+fn cholesky_once(a: &SparseMatrix) -> f64 {
+    let clock = Instant::now();
+    let pattern = a.symbolic().to_owned().unwrap();
+    let factor = Cholesky::analyse(&pattern).unwrap().factor(a).unwrap();
+    black_box(factor.solve(&vec![1.0; a.nrows()]).unwrap());
+    clock.elapsed().as_secs_f64()
+}
+
+/// The complete VI solve against one Cholesky of the final `A_α`, all measured in this
+/// run after one untimed warm-up solve (the allocator then holds the memory, for the
+/// solve as for the baseline), medians of `rounds` interleaved repetitions.
+fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize], rounds: usize, with_lu: bool) {
     let scene = membrane_scene("membrane-radial").unwrap();
     println!(
-        "\n{} on membrane-radial: complete VI solve (nested from N = 4, assembly included) vs one Cholesky of A_α",
+        "\n{} on membrane-radial: complete VI solve (nested from N = 4, assembly included) vs one Cholesky (analysis + factorization + solve) of the final A_α; medians of {rounds}",
         pair.name()
     );
     println!(
-        "{:>5} {:>9} {:>9} {:>16} {:>9} {:>9} {:>9} {:>9} {:>10} {:>7} {:>9} {:>7}",
+        "{:>5} {:>9} {:>9} {:>16} {:>7} {:>10} {:>11} {:>6} {:>11} {:>6} {:>9} {:>6}",
         "N",
         "triangles",
         "dofs",
         "iterations/level",
-        "VI s",
-        "assembly",
-        "LCP",
-        "prolong",
+        "factor.",
         "Cholesky s",
+        "VI s (2 thr)",
+        "ratio",
+        "VI s (1 thr)",
         "ratio",
         "KKT LU s",
         "ratio"
@@ -184,72 +228,49 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize]) {
         let mesh = membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap();
         let (alpha, _) = membranes::alpha_of(&request, &mesh).unwrap();
         let coefficients = membranes::scene_coefficients::<M>(&scene, alpha).unwrap();
-        let mut sizes = vec![n];
-        while sizes[0] / 2 >= 4 && sizes[0] % 2 == 0 {
-            sizes.insert(0, sizes[0] / 2);
+        let (warm, _) = vi_solve_once::<M>(&scene, &coefficients, &mesh, n, true);
+        let a = warm.discretization.lcp.a.clone();
+        let (mut linear, mut pipelined, mut sequential) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..rounds {
+            linear.push(cholesky_once(&a));
+            pipelined.push(vi_solve_once::<M>(&scene, &coefficients, &mesh, n, true).1);
+            sequential.push(vi_solve_once::<M>(&scene, &coefficients, &mesh, n, false).1);
         }
-        let (mut assembly, mut lcp_time, mut prolong) = (0.0, 0.0, 0.0);
-        let mut iterations = Vec::new();
-        let clock = Instant::now();
-        let mut previous = None;
-        for &k in &sizes {
-            let t = Instant::now();
-            let level_mesh = membranes::scene_mesh(&scene, k, Diagonal::Right).unwrap();
-            let d = discretize_on_triangles::<M>(&level_mesh, &coefficients, "B_h", "L_h").unwrap();
-            assembly += t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let start = previous.as_ref().map(|(pd, values): &(_, Vec<f64>)| {
-                d.primal_part(&prolong_on_triangles(pd, values, &d))
-            });
-            prolong += t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let solution = solve_lcp(
-                &d.lcp,
-                start.as_deref(),
-                membranes::membrane_options(VariationalSolver::SemismoothNewton),
-            )
-            .unwrap();
-            lcp_time += t.elapsed().as_secs_f64();
-            iterations.push(solution.iterations);
-            let values = d.full(&solution);
-            previous = Some((d, values));
-        }
-        let total = clock.elapsed().as_secs_f64();
-        let lcp = &previous.as_ref().unwrap().0.lcp;
-        let a = lcp.a.clone();
-        let t = Instant::now();
-        let pattern = a.symbolic().to_owned().unwrap();
-        let factor = Cholesky::analyse(&pattern).unwrap().factor(&a).unwrap();
-        let x = factor.solve(&vec![1.0; a.nrows()]).unwrap();
-        black_box(x);
-        let linear = t.elapsed().as_secs_f64();
+        let (linear, pipelined, sequential) =
+            (median(linear), median(pipelined), median(sequential));
         // the saddle-point matrix of the same discretization, factored by sparse LU
-        let k = kkt_matrix(lcp);
-        let t = Instant::now();
-        let pattern = k.symbolic().to_owned().unwrap();
-        let factor = LuSolver::analyse(&pattern).unwrap().factor(&k).unwrap();
-        black_box(factor.solve(&vec![1.0; k.nrows()]).unwrap());
-        let saddle = t.elapsed().as_secs_f64();
-        let dofs = previous.as_ref().map_or(0, |(d, _)| d.lcp.n() + d.lcp.m());
-        let levels = iterations
+        let saddle = with_lu.then(|| {
+            let k = kkt_matrix(&warm.discretization.lcp);
+            let t = Instant::now();
+            let pattern = k.symbolic().to_owned().unwrap();
+            let factor = LuSolver::analyse(&pattern).unwrap().factor(&k).unwrap();
+            black_box(factor.solve(&vec![1.0; k.nrows()]).unwrap());
+            t.elapsed().as_secs_f64()
+        });
+        let lcp = &warm.discretization.lcp;
+        let levels = warm
+            .levels
             .iter()
-            .map(|i| i.to_string())
+            .map(|(_, i)| i.to_string())
             .collect::<Vec<_>>()
             .join(",");
+        let (lu, lu_ratio) = saddle.map_or(("-".to_string(), "-".to_string()), |s| {
+            (format!("{s:.3}"), format!("{:.2}", pipelined / s))
+        });
         println!(
-            "{:>5} {:>9} {:>9} {:>16} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>10.3} {:>7.1} {:>9.3} {:>7.1}",
+            "{:>5} {:>9} {:>9} {:>16} {:>7} {:>10.3} {:>11.3} {:>6.2} {:>11.3} {:>6.2} {:>9} {:>6}",
             n,
             2 * n * n,
-            dofs,
+            lcp.n() + lcp.m(),
             levels,
-            total,
-            assembly,
-            lcp_time,
-            prolong,
+            warm.factorizations,
             linear,
-            total / linear,
-            saddle,
-            total / saddle
+            pipelined,
+            pipelined / linear,
+            sequential,
+            sequential / linear,
+            lu,
+            lu_ratio
         );
     }
 }
@@ -290,6 +311,12 @@ fn main() {
         (512, vec![32, 64, 128, 256, 512], vec![32, 64, 128, 256])
     };
     assembly(assembly_n, if quick { 3 } else { 9 });
-    vi_solve::<fem_forms::models::membrane::membrane_p1_p0::Model>(MembranePair::P1P0, &p1_sizes);
-    vi_solve::<membrane_p2_p0::Model>(MembranePair::P2P0, &p2_sizes);
+    let rounds = if quick { 3 } else { 5 };
+    vi_solve::<fem_forms::models::membrane::membrane_p1_p0::Model>(
+        MembranePair::P1P0,
+        &p1_sizes,
+        rounds,
+        !quick,
+    );
+    vi_solve::<membrane_p2_p0::Model>(MembranePair::P2P0, &p2_sizes, rounds, !quick);
 }

@@ -360,6 +360,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
             refinement_steps: request.refinement_steps,
             ..NewtonOptions::default()
         },
+        ..ObstacleOptions::default()
     };
     let solution = solve_obstacle::<M>(&mesh, &coefficients, clamped, options)?;
     let w_field = M::field("w")?;

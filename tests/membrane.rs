@@ -480,3 +480,48 @@ fn the_pipelined_nested_solve_equals_the_sequential_one() {
         "pipelined and sequential differ by {difference}"
     );
 }
+
+/// Gauss–Seidel sweeps in place of the first factorization of each nested level change
+/// the path, not the answer: the same solution, and no more factorizations on the final
+/// mesh than Newton with every step exact.
+#[test]
+fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
+    use fem_forms::complementarity::NewtonOptions;
+    use fem_forms::obstacle_2d::solve_obstacle_on_triangles;
+    type M = membrane_p1_p0::Model;
+    let scene = radial();
+    let meshes: Vec<_> = [4, 8, 16, 32, 64]
+        .iter()
+        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
+        .collect();
+    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.1).unwrap();
+    let smoothed = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    assert!(smoothed.newton.smoothing_sweeps > 0);
+    let exact = fem_forms::obstacle::ObstacleOptions {
+        newton: NewtonOptions {
+            smoothing_sweeps: 0,
+            ..smoothed.newton
+        },
+        ..smoothed
+    };
+    let with = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, smoothed).unwrap();
+    let without = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, exact).unwrap();
+    assert!(with.kkt_residual <= 1e-10 && without.kkt_residual <= 1e-10);
+    let scale = without.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let difference = with
+        .values
+        .iter()
+        .zip(&without.values)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        difference <= 1e-9 * scale,
+        "solutions differ by {difference} (scale {scale})"
+    );
+    assert!(
+        with.factorizations <= without.factorizations,
+        "{} factorizations with the sweeps, {} without",
+        with.factorizations,
+        without.factorizations
+    );
+    assert_eq!(without.factorizations, without.iterations);
+}

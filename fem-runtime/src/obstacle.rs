@@ -19,6 +19,7 @@ use crate::norms::FieldView;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use fem_reference::DofLocation;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Which algorithm solves the LCP.
@@ -507,6 +508,8 @@ pub struct ObstacleSolution<G = IntervalMesh> {
     pub values: Vec<f64>,
     /// Iterations on the finest mesh.
     pub iterations: usize,
+    /// Numeric factorizations on the finest mesh.
+    pub factorizations: usize,
     /// `(cells, iterations)` of every level of the nested iteration.
     pub levels: Vec<(usize, usize)>,
     /// KKT residual of the result.
@@ -529,6 +532,9 @@ pub struct ObstacleOptions {
     pub nested_from: Option<usize>,
     /// Newton options.
     pub newton: NewtonOptions,
+    /// Build the finest level on a second thread while the coarser ones are solved
+    /// (see [`solve_nested`]); `false` does everything on the calling thread.
+    pub pipelined: bool,
 }
 
 impl Default for ObstacleOptions {
@@ -537,6 +543,7 @@ impl Default for ObstacleOptions {
             solver: VariationalSolver::SemismoothNewton,
             nested_from: Some(16),
             newton: NewtonOptions::default(),
+            pipelined: true,
         }
     }
 }
@@ -671,7 +678,7 @@ pub fn solve_nested<G, B>(
     options: ObstacleOptions,
 ) -> Result<ObstacleSolution<G>>
 where
-    G: Mesh + Send,
+    G: Mesh + Send + Sync,
     B: FnOnce() -> Result<Discretization<G>> + Send,
 {
     let clock = Instant::now();
@@ -680,38 +687,59 @@ where
         .pop()
         .ok_or_else(|| Error::Input("no mesh to solve on".into()))?;
     let newton = options.solver == VariationalSolver::SemismoothNewton;
-    let prepare = move || -> Result<(Discretization<G>, Option<NewtonWorkspace>)> {
-        let d = finest()?;
-        // Newton's own checks (positive C) come with the solve, where their error is
-        // reported; a workspace that cannot be built is simply not used.
-        let workspace = if newton {
+    // Newton's own checks (positive C) come with the solve, where their error is
+    // reported; a workspace that cannot be built is simply not used.
+    let workspace_of = move |d: &Discretization<G>| {
+        if newton {
             NewtonWorkspace::new(&d.lcp).ok()
         } else {
             None
-        };
-        Ok((d, workspace))
+        }
     };
-    let (coarse, finest) = if levels.is_empty() {
-        (Ok(None), prepare())
+    let start_on = |coarse: &Result<Option<SolvedLevel<G>>>, fine: &Discretization<G>| match coarse
+    {
+        Ok(Some((c, values, _))) => Some(fine.primal_part(&prolong(c, values, fine))),
+        _ => None,
+    };
+    let (coarse, finest, start) = if levels.is_empty() || !options.pipelined {
+        let coarse = solve_levels(levels, &prolong, options);
+        let finest = finest().map(|d| {
+            let workspace = workspace_of(&d);
+            (d, workspace)
+        });
+        let start = finest.as_ref().ok().and_then(|(d, _)| start_on(&coarse, d));
+        (coarse, finest, start)
     } else {
         std::thread::scope(|scope| {
-            let finest = scope.spawn(prepare);
+            // the worker hands the discretization over as soon as it is assembled, so
+            // that the start is prolonged onto it while the worker still builds the
+            // Newton workspace
+            let (sender, receiver) = std::sync::mpsc::channel();
+            let worker = scope.spawn(move || {
+                let d = Arc::new(finest()?);
+                let _ = sender.send(Arc::clone(&d));
+                let workspace = workspace_of(&d);
+                Ok::<_, Error>((d, workspace))
+            });
             let coarse = solve_levels(levels, &prolong, options);
-            let finest = finest
+            let start = receiver.recv().ok().and_then(|d| start_on(&coarse, &d));
+            let finest = worker
                 .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            (coarse, finest)
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                .and_then(|(d, workspace)| {
+                    let d = Arc::try_unwrap(d).map_err(|_| {
+                        Error::Input("the finest discretization is still shared".into())
+                    })?;
+                    Ok((d, workspace))
+                });
+            (coarse, finest, start)
         })
     };
-    let (coarse, mut counts) = match coarse? {
-        Some((d, values, counts)) => (Some((d, values)), counts),
-        None => (None, Vec::new()),
+    let mut counts = match coarse? {
+        Some((_, _, counts)) => counts,
+        None => Vec::new(),
     };
     let (discretization, workspace) = finest?;
-    let start = coarse.as_ref().map(|(coarse, values)| {
-        discretization.primal_part(&prolong(coarse, values, &discretization))
-    });
-    drop(coarse);
     let solution = solve_lcp_prepared(
         &discretization.lcp,
         workspace.as_ref(),
@@ -722,6 +750,7 @@ where
     let values = discretization.full(&solution);
     Ok(ObstacleSolution {
         iterations: solution.iterations,
+        factorizations: solution.factorizations,
         kkt_residual: solution.kkt_residual,
         solve_seconds: solution.seconds,
         multiplier_noise: solution.multiplier_noise,
