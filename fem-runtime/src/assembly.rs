@@ -74,6 +74,36 @@ pub(crate) fn block_plans<M: Model>(
         .collect()
 }
 
+/// Visits `(row, column)` of every element-matrix entry of `plans` on every cell of
+/// `mesh`, in assembly order (the order the generated kernels add them in). Generic,
+/// not `dyn`: pattern builders call it for every entry, several times.
+pub(crate) fn for_each_entry<G: Mesh>(
+    mesh: &G,
+    dofs: &SystemDofs,
+    plans: &[BlockPlan],
+    mut visit: impl FnMut(usize, usize),
+) {
+    let maps: Vec<_> = plans
+        .iter()
+        .map(|p| {
+            (
+                dofs.map(p.test_field).unwrap(),
+                dofs.map(p.trial_field).unwrap(),
+            )
+        })
+        .collect();
+    for c in 0..mesh.cell_count() {
+        for (plan, (test, trial)) in plans.iter().zip(&maps) {
+            let (rows, cols) = (test.cell_dofs(c), trial.cell_dofs(c));
+            for &r in rows {
+                for &col in cols {
+                    visit(r + plan.row_offset, col + plan.col_offset);
+                }
+            }
+        }
+    }
+}
+
 /// Assembles one bilinear form of a model on a mesh, reusing its sparsity pattern.
 #[derive(Clone, Debug)]
 pub struct MatrixAssembler {
@@ -89,30 +119,16 @@ impl MatrixAssembler {
         let form = M::form(form_name)?;
         let plans = block_plans::<M>(form, dofs, true)?;
         let n = dofs.dof_count();
-        // Every (row, col) of every element matrix, in assembly order.
-        let for_each_entry = |visit: &mut dyn FnMut(usize, usize)| {
-            for c in 0..mesh.cell_count() {
-                for plan in &plans {
-                    let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
-                    let cols = dofs.map(plan.trial_field).unwrap().cell_dofs(c);
-                    for &r in rows {
-                        for &col in cols {
-                            visit(r + plan.row_offset, col + plan.col_offset);
-                        }
-                    }
-                }
-            }
-        };
         // Bucket the rows by column (counting sort), then sort and dedup each column:
         // O(entries), where a global sort of the keys was the cost of the whole setup.
         let mut bucket_ptr = vec![0usize; n + 1];
-        for_each_entry(&mut |_, col| bucket_ptr[col + 1] += 1);
+        for_each_entry(mesh, dofs, &plans, |_, col| bucket_ptr[col + 1] += 1);
         for j in 0..n {
             bucket_ptr[j + 1] += bucket_ptr[j];
         }
         let mut fill = bucket_ptr.clone();
         let mut bucket = vec![0usize; bucket_ptr[n]];
-        for_each_entry(&mut |row, col| {
+        for_each_entry(mesh, dofs, &plans, |row, col| {
             bucket[fill[col]] = row;
             fill[col] += 1;
         });
@@ -132,7 +148,7 @@ impl MatrixAssembler {
         }
         drop(bucket);
         let mut positions = Vec::with_capacity(bucket_ptr[n]);
-        for_each_entry(&mut |row, col| {
+        for_each_entry(mesh, dofs, &plans, |row, col| {
             let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
             let k = column
                 .binary_search(&row)

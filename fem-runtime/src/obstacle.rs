@@ -3,7 +3,7 @@
 //! `A_α, B_α, C_α, F_α, G_α` of MODELS.md §1 (the KKT matrix is
 //! `[[A_α, −B_αᵀ], [−B_α, −C_α]]`, its right-hand side `[F_α; −G_α]`).
 
-use crate::assembly::{assemble_vector, block_plans, BlockPlan};
+use crate::assembly::{assemble_vector, block_plans, for_each_entry, BlockPlan};
 use crate::boundary::{Constraints, Reduction, Side};
 use crate::complementarity::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
@@ -252,33 +252,6 @@ impl SplitPattern {
         n: usize,
         m: usize,
     ) -> Self {
-        // generic, not `dyn`: the three passes visit every element-matrix entry
-        fn for_each_entry<G: Mesh>(
-            mesh: &G,
-            dofs: &SystemDofs,
-            plans: &[BlockPlan],
-            mut visit: impl FnMut(usize, usize),
-        ) {
-            let maps: Vec<_> = plans
-                .iter()
-                .map(|p| {
-                    (
-                        dofs.map(p.test_field).unwrap(),
-                        dofs.map(p.trial_field).unwrap(),
-                    )
-                })
-                .collect();
-            for c in 0..mesh.cell_count() {
-                for (plan, (test, trial)) in plans.iter().zip(&maps) {
-                    let (rows, cols) = (test.cell_dofs(c), trial.cell_dofs(c));
-                    for &r in rows {
-                        for &col in cols {
-                            visit(r + plan.row_offset, col + plan.col_offset);
-                        }
-                    }
-                }
-            }
-        }
         // Bucket A's rows by column and B's columns by row (counting sort); each entry
         // remembers its bucket slot, and the slot learns its place in the pattern when the
         // buckets are sorted and deduplicated (no search per entry).
