@@ -1057,27 +1057,49 @@ impl Lcp {
         let mut dense = [0.0; BLOCK_ENTRIES];
         let mut r = [0.0; MAX_BLOCK];
         for block in self.blocks() {
-            let k = block.start;
-            if block.size == 1 {
-                let gap = self.g[k] - bu[k];
-                active[k] = gap > 0.0;
-                lambda[k] = gap.max(0.0) / self.c[k];
-                continue;
-            }
-            let s = block.size;
-            block.dense(&self.c, &mut dense[..s * s]);
-            for (i, r) in r[..s].iter_mut().enumerate() {
-                *r = self.g[k + i] - bu[k + i];
-            }
-            block_minimizer(
-                &dense[..s * s],
-                s,
-                &r[..s],
-                &mut lambda[block.range()],
-                &mut active[block.range()],
+            let range = block.range();
+            self.block_multiplier(
+                &block,
+                bu,
+                &mut dense,
+                &mut r,
+                &mut lambda[range.clone()],
+                &mut active[range],
             );
         }
         (lambda, active)
+    }
+
+    /// One block's eliminated multiplier from `bu = BU`: fills `dense` with `C_b`
+    /// (`s × s`), `r` with `(G − BU)_b`, and `lambda`, `active` with `Λ_b` and its
+    /// active face.
+    fn block_multiplier(
+        &self,
+        block: &Block,
+        bu: &[f64],
+        dense: &mut [f64],
+        r: &mut [f64],
+        lambda: &mut [f64],
+        active: &mut [bool],
+    ) {
+        let (k, s) = (block.start, block.size);
+        for (i, r) in r[..s].iter_mut().enumerate() {
+            *r = self.g[k + i] - bu[k + i];
+        }
+        if s == 1 {
+            dense[0] = self.c[k];
+            active[0] = r[0] > 0.0;
+            lambda[0] = r[0].max(0.0) / self.c[k];
+            return;
+        }
+        block.dense(&self.c, &mut dense[..s * s]);
+        block_minimizer(
+            &dense[..s * s],
+            s,
+            &r[..s],
+            &mut lambda[..s],
+            &mut active[..s],
+        );
     }
 
     /// The merit function `Φ(U) = ½UᵀAU − FᵀU + Σ_b max_{Λ≥0}(Λᵀr_b − ½ΛᵀC_bΛ)`,
@@ -1098,21 +1120,12 @@ impl Lcp {
             .map(|block| {
                 let k = block.start;
                 if block.size == 1 {
+                    // the closed form, cheaper than the general one in the line search
                     let r = (self.g[k] - bu[k]).max(0.0);
                     return 0.5 * r * r / self.c[k];
                 }
                 let s = block.size;
-                block.dense(&self.c, &mut dense[..s * s]);
-                for (i, r) in r[..s].iter_mut().enumerate() {
-                    *r = self.g[k + i] - bu[k + i];
-                }
-                block_minimizer(
-                    &dense[..s * s],
-                    s,
-                    &r[..s],
-                    &mut lambda[..s],
-                    &mut active[..s],
-                );
+                self.block_multiplier(&block, bu, &mut dense, &mut r, &mut lambda, &mut active);
                 (0..s)
                     .map(|i| {
                         let c_lambda: f64 = (0..s).map(|j| dense[i * s + j] * lambda[j]).sum();
