@@ -523,5 +523,56 @@ fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
         with.factorizations,
         without.factorizations
     );
-    assert_eq!(without.factorizations, without.iterations);
+    assert_eq!(
+        without.factorizations + without.low_rank_updates,
+        without.iterations
+    );
+}
+
+/// Newton steps solved through a low-rank update of the last factorization (the cells
+/// that flipped since) change the path's cost, not the answer: the same solution as
+/// factoring every step, fewer factorizations, and every exact step either factored or
+/// updated.
+#[test]
+fn low_rank_updates_keep_the_solution_and_save_factorizations() {
+    use fem_forms::complementarity::NewtonOptions;
+    use fem_forms::obstacle_2d::solve_obstacle_on_triangles;
+    type M = membrane_p1_p0::Model;
+    let scene = radial();
+    let meshes: Vec<_> = [4, 8, 16, 32, 64, 128]
+        .iter()
+        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
+        .collect();
+    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.1).unwrap();
+    let defaults = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let options = |low_rank_updates| fem_forms::obstacle::ObstacleOptions {
+        newton: NewtonOptions {
+            smoothing_sweeps: 0,
+            low_rank_updates,
+            ..defaults.newton
+        },
+        ..defaults
+    };
+    let with = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options(true)).unwrap();
+    let without = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options(false)).unwrap();
+    assert!(with.kkt_residual <= 1e-10 && without.kkt_residual <= 1e-10);
+    let scale = without.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let difference = with
+        .values
+        .iter()
+        .zip(&without.values)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        difference <= 1e-9 * scale,
+        "solutions differ by {difference} (scale {scale})"
+    );
+    assert_eq!(without.low_rank_updates, 0);
+    assert!(with.low_rank_updates > 0, "no step was updated");
+    assert!(
+        with.factorizations < without.factorizations,
+        "{} factorizations with updates, {} without",
+        with.factorizations,
+        without.factorizations
+    );
+    assert_eq!(with.factorizations + with.low_rank_updates, with.iterations);
 }

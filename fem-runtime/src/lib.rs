@@ -23,6 +23,7 @@ pub mod obstacle_2d;
 pub mod triangle_field;
 pub mod triangle_mesh;
 pub mod vtk;
+pub mod woodbury;
 
 pub use assembly::{assemble_vector, MatrixAssembler};
 pub use boundary::{Constraints, Reduction, Side};

@@ -2,11 +2,18 @@
 //! symbolic factorization computed once per pattern and reused.
 
 use crate::error::{Error, Result};
+use crate::woodbury::FactorTree;
 use crate::SparseMatrix;
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::SolveCore;
-use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::SymbolicSparseColMat;
 use faer::{Conj, MatMut, Side};
+use std::sync::Arc;
 
 /// `y = A x` for a sparse matrix.
 pub fn multiply(a: &SparseMatrix, x: &[f64]) -> Vec<f64> {
@@ -149,11 +156,6 @@ pub fn symmetric_gauss_seidel(a: &SparseMatrix, b: &[f64], sweeps: usize) -> Opt
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
-fn solve_in_place(factor: &dyn SolveCore<f64>, x: &mut [f64]) {
-    let n = x.len();
-    factor.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, n, 1));
-}
-
 /// Runs faer's factorizations and solves on one thread from now on (process-wide).
 ///
 /// Measured on the 2-core machines here: the supernodal Cholesky of a 260k-unknown
@@ -165,25 +167,120 @@ pub fn factor_sequentially() {
 }
 
 /// A Cholesky factorization `A = L Lᵀ` whose symbolic part can be reused.
+#[derive(Clone)]
 pub struct Cholesky {
-    symbolic: SymbolicLlt<usize>,
+    structure: Arc<CholeskyStructure>,
+}
+
+/// The symbolic factorization and the elimination tree of its nodes.
+pub(crate) struct CholeskyStructure {
+    pub(crate) symbolic: SymbolicCholesky<usize>,
+    /// `None` when the factor's storage is not the one [`FactorTree`] reads.
+    pub(crate) tree: Option<FactorTree>,
 }
 
 impl Cholesky {
     /// The symbolic factorization of an SPD pattern (the lower triangle is read).
     pub fn analyse(pattern: &SymbolicSparseColMat<usize>) -> Result<Self> {
-        let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Lower)
-            .map_err(|e| Error::LinearSolve(format!("symbolic Cholesky: {e:?}")))?;
-        Ok(Self { symbolic })
+        Self::analyse_with(pattern, CholeskySymbolicParams::default())
+    }
+
+    /// [`Cholesky::analyse`] with a supernodal factor whatever the pattern (faer picks
+    /// a simplicial one for patterns with little fill): both layouts get tested.
+    #[cfg(test)]
+    pub(crate) fn analyse_supernodal(pattern: &SymbolicSparseColMat<usize>) -> Result<Self> {
+        Self::analyse_with(
+            pattern,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold:
+                    faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+    }
+
+    fn analyse_with(
+        pattern: &SymbolicSparseColMat<usize>,
+        params: CholeskySymbolicParams,
+    ) -> Result<Self> {
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            params,
+        )
+        .map_err(|e| Error::LinearSolve(format!("symbolic Cholesky: {e:?}")))?;
+        let tree = FactorTree::new(&symbolic);
+        Ok(Self {
+            structure: Arc::new(CholeskyStructure { symbolic, tree }),
+        })
     }
 
     /// The numeric factorization of `a` (same pattern as analysed).
     pub fn factor(&self, a: &SparseMatrix) -> Result<Factor> {
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), a.as_ref(), Side::Lower)
+        self.factor_cholesky(a).map(Factor::Cholesky)
+    }
+
+    /// [`Cholesky::factor`] without the enum: the factor whose `L` the low-rank updates of
+    /// [`crate::woodbury`] read.
+    pub fn factor_cholesky(&self, a: &SparseMatrix) -> Result<CholeskyFactor> {
+        let symbolic = &self.structure.symbolic;
+        let mut values = Vec::new();
+        values
+            .try_reserve_exact(symbolic.len_val())
+            .map_err(|_| Error::LinearSolve("out of memory for the Cholesky factor".into()))?;
+        values.resize(symbolic.len_val(), 0.0);
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::try_new(
+            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+        )
+        .map_err(|_| Error::LinearSolve("out of memory for the Cholesky workspace".into()))?;
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                a.as_ref(),
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
             .map_err(|e| {
                 Error::LinearSolve(format!("the matrix is not positive definite ({e:?})"))
             })?;
-        Ok(Factor::Cholesky(llt))
+        Ok(CholeskyFactor {
+            structure: self.structure.clone(),
+            values,
+        })
+    }
+}
+
+/// A numeric Cholesky factor `P A Pᵀ = L Lᵀ` (`P` the fill-reducing ordering).
+pub struct CholeskyFactor {
+    pub(crate) structure: Arc<CholeskyStructure>,
+    /// `L`'s values in faer's layout (supernodal blocks or simplicial columns).
+    pub(crate) values: Vec<f64>,
+}
+
+impl CholeskyFactor {
+    fn solve_in_place(&self, x: &mut [f64]) {
+        let symbolic = &self.structure.symbolic;
+        let n = x.len();
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
+        LltRef::new(symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, n, 1),
+            par,
+            MemStack::new(&mut scratch),
+        );
+    }
+
+    /// `A⁻¹ b`; errors when the result is not finite.
+    pub fn solve(&self, b: &[f64]) -> Result<Vec<f64>> {
+        let mut x = b.to_vec();
+        self.solve_in_place(&mut x);
+        finite(x)
     }
 }
 
@@ -211,7 +308,7 @@ impl LuSolver {
 /// A numeric factorization, ready to solve.
 pub enum Factor {
     /// `L Lᵀ`
-    Cholesky(Llt<usize, f64>),
+    Cholesky(CholeskyFactor),
     /// `P L U Q` (boxed: it is much larger than the Cholesky factor)
     Lu(Box<Lu<usize, f64>>),
 }
@@ -219,17 +316,17 @@ pub enum Factor {
 impl Factor {
     /// `A⁻¹ b`; errors when the result is not finite (a numerically singular matrix).
     pub fn solve(&self, b: &[f64]) -> Result<Vec<f64>> {
-        let mut x = b.to_vec();
         match self {
-            Factor::Cholesky(f) => solve_in_place(f, &mut x),
-            Factor::Lu(f) => solve_in_place(f.as_ref(), &mut x),
-        }
-        if x.iter().all(|v| v.is_finite()) {
-            Ok(x)
-        } else {
-            Err(Error::LinearSolve(
-                "the solution is not finite: the matrix is numerically singular".into(),
-            ))
+            Factor::Cholesky(f) => f.solve(b),
+            Factor::Lu(f) => {
+                let mut x = b.to_vec();
+                let n = x.len();
+                f.solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(&mut x, n, 1),
+                );
+                finite(x)
+            }
         }
     }
 
@@ -237,15 +334,37 @@ impl Factor {
     /// the residual in twice the working precision, for the badly conditioned systems of
     /// thin structures (condition ~ t⁻²h⁻²): each round gains a factor ~εκ.
     pub fn solve_refined(&self, a: &SparseMatrix, b: &[f64], steps: usize) -> Result<Vec<f64>> {
-        let mut x = self.solve(b)?;
-        for _ in 0..steps {
-            let r = residual_compensated(a, &x, b);
-            let dx = self.solve(&r)?;
-            for (x, dx) in x.iter_mut().zip(dx) {
-                *x += dx;
-            }
+        refined(a, b, steps, |r| self.solve(r))
+    }
+}
+
+/// `x = solve(b)` improved by `steps` rounds of `x += solve(b − A x)`, the residual in
+/// twice the working precision: iterative refinement for any approximate inverse of `A`.
+pub fn refined(
+    a: &SparseMatrix,
+    b: &[f64],
+    steps: usize,
+    solve: impl Fn(&[f64]) -> Result<Vec<f64>>,
+) -> Result<Vec<f64>> {
+    let mut x = solve(b)?;
+    for _ in 0..steps {
+        let r = residual_compensated(a, &x, b);
+        let dx = solve(&r)?;
+        for (x, dx) in x.iter_mut().zip(dx) {
+            *x += dx;
         }
+    }
+    Ok(x)
+}
+
+/// `x`, or an error when it is not finite (a numerically singular matrix).
+fn finite(x: Vec<f64>) -> Result<Vec<f64>> {
+    if x.iter().all(|v| v.is_finite()) {
         Ok(x)
+    } else {
+        Err(Error::LinearSolve(
+            "the solution is not finite: the matrix is numerically singular".into(),
+        ))
     }
 }
 

@@ -483,6 +483,9 @@ pub struct ObstacleSolution<G = IntervalMesh> {
     pub iterations: usize,
     /// Numeric factorizations on the finest mesh.
     pub factorizations: usize,
+    /// Newton steps on the finest mesh solved through a low-rank update of the last
+    /// factorization instead of a new one.
+    pub low_rank_updates: usize,
     /// `(cells, iterations)` of every level of the nested iteration.
     pub levels: Vec<(usize, usize)>,
     /// KKT residual of the result.
@@ -724,6 +727,7 @@ where
     Ok(ObstacleSolution {
         iterations: solution.iterations,
         factorizations: solution.factorizations,
+        low_rank_updates: solution.low_rank_updates,
         kkt_residual: solution.kkt_residual,
         solve_seconds: solution.seconds,
         multiplier_noise: solution.multiplier_noise,

@@ -254,6 +254,7 @@ pub fn nodal_active_set(
                 kkt_residual,
                 seconds: clock.elapsed().as_secs_f64(),
                 factorizations: iteration,
+                low_rank_updates: 0,
                 multiplier_noise: 0.0,
             });
         }
