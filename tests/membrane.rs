@@ -576,3 +576,63 @@ fn low_rank_updates_keep_the_solution_and_save_factorizations() {
     );
     assert_eq!(with.factorizations + with.low_rank_updates, with.iterations);
 }
+
+/// A level that fails to build or solve stops the nested solve with its own error, on
+/// either thread, the coarser level's first (as in the sequential order); nothing hangs.
+#[test]
+fn the_nested_solve_reports_the_first_failing_level() {
+    use fem_forms::obstacle::solve_nested;
+    use fem_forms::obstacle_2d::{discretize_on_triangles, prolong_on_triangles};
+    use fem_forms::{Error, TriangleMesh};
+    type M = membrane_p1_p0::Model;
+    type Level<'a> = Box<
+        dyn FnOnce() -> fem_forms::Result<fem_forms::obstacle::Discretization<TriangleMesh>>
+            + Send
+            + 'a,
+    >;
+    let scene = radial();
+    let meshes: Vec<_> = [4, 8]
+        .iter()
+        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
+        .collect();
+    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 48.0).unwrap();
+    let level = |k: usize, fails: bool| -> Level<'_> {
+        let (mesh, coefficients) = (&meshes[k], &coefficients);
+        Box::new(move || {
+            if fails {
+                Err(Error::Input(format!("level {k} fails")))
+            } else {
+                discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h")
+            }
+        })
+    };
+    for pipelined in [true, false] {
+        let options = fem_forms::obstacle::ObstacleOptions {
+            pipelined,
+            ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+        };
+        for (coarse_fails, fine_fails, expected) in [
+            (false, true, Some("level 1 fails")),
+            (true, false, Some("level 0 fails")),
+            (true, true, Some("level 0 fails")),
+            (false, false, None),
+        ] {
+            let result = solve_nested(
+                vec![level(0, coarse_fails), level(1, fine_fails)],
+                prolong_on_triangles,
+                options,
+            );
+            match (result, expected) {
+                (Err(e), Some(message)) => assert!(
+                    e.to_string().contains(message),
+                    "pipelined {pipelined}: {e} instead of {message}"
+                ),
+                (Ok(solution), None) => assert!(solution.kkt_residual <= 1e-10),
+                (Ok(_), Some(message)) => {
+                    panic!("pipelined {pipelined}: no error, expected {message}")
+                }
+                (Err(e), None) => panic!("pipelined {pipelined}: {e}"),
+            }
+        }
+    }
+}

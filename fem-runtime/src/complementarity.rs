@@ -26,6 +26,7 @@ use crate::woodbury::{LowRankTerm, WoodburySolver};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use std::ops::Range;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// The largest block of `C` the solvers accept: eliminating a block's multipliers
@@ -1257,10 +1258,14 @@ fn max_norm(v: &[f64]) -> f64 {
 /// What semismooth Newton needs before its first iteration and that depends only on the
 /// LCP's sparsity: the Hessian's pattern and its symbolic Cholesky factorization (the
 /// ordering). Built apart from the iteration so that it can be prepared on another
-/// thread while a coarser level is solved (see [`crate::obstacle::solve_nested`]).
+/// thread while a coarser level is solved (see [`crate::obstacle::solve_nested`]); the
+/// symbolic factorization may even be left to finish there while Newton's first,
+/// smoothed step, which needs only the pattern, runs.
 pub struct NewtonWorkspace {
     hessian: Hessian,
-    cholesky: Cholesky,
+    /// Filled by [`NewtonWorkspace::analyse`], from whichever thread asks first (the
+    /// others wait for it). The error is kept as text: [`Error`] is not `Clone`.
+    cholesky: OnceLock<std::result::Result<Cholesky, String>>,
     /// `(n, m)` of the LCP it was built for.
     shape: (usize, usize),
 }
@@ -1268,14 +1273,35 @@ pub struct NewtonWorkspace {
 impl NewtonWorkspace {
     /// The Hessian pattern and symbolic factorization of `lcp`.
     pub fn new(lcp: &Lcp) -> Result<Self> {
+        let workspace = Self::pattern_of(lcp)?;
+        workspace.analyse()?;
+        Ok(workspace)
+    }
+
+    /// The Hessian pattern of `lcp` only; the symbolic factorization follows from
+    /// [`NewtonWorkspace::analyse`], called ahead (on another thread) or by Newton
+    /// itself when it first factors.
+    pub fn pattern_of(lcp: &Lcp) -> Result<Self> {
         lcp.check_shapes()?;
-        let hessian = Hessian::new(lcp);
-        let cholesky = Cholesky::analyse(&hessian.symbolic)?;
         Ok(Self {
-            hessian,
-            cholesky,
+            hessian: Hessian::new(lcp),
+            cholesky: OnceLock::new(),
             shape: (lcp.n(), lcp.m()),
         })
+    }
+
+    /// The symbolic Cholesky factorization of the Hessian pattern, computed on the first
+    /// call; a call while another thread computes it waits for that one.
+    pub fn analyse(&self) -> Result<&Cholesky> {
+        self.cholesky
+            .get_or_init(|| {
+                Cholesky::analyse(&self.hessian.symbolic).map_err(|e| match e {
+                    Error::LinearSolve(message) => message,
+                    other => other.to_string(),
+                })
+            })
+            .as_ref()
+            .map_err(|e| Error::LinearSolve(e.clone()))
     }
 }
 
@@ -1323,7 +1349,7 @@ fn newton_iteration(
 ) -> Result<LcpSolution> {
     let n = lcp.n();
     let mut u = lcp.start_vector(start)?;
-    let (hessian, cholesky) = (&workspace.hessian, &workspace.cholesky);
+    let hessian = &workspace.hessian;
     let mut factorizations = 0;
     let done = |u: Vec<f64>,
                 lambda: Vec<f64>,
@@ -1396,7 +1422,7 @@ fn newton_iteration(
                     }
                     None => {
                         factorizations += 1;
-                        let factor = cholesky.factor_cholesky(&h)?;
+                        let factor = workspace.analyse()?.factor_cholesky(&h)?;
                         let d = refined(&h, &minus_gradient, options.refinement_steps, |b| {
                             factor.solve(b)
                         })?;

@@ -647,7 +647,8 @@ pub fn solve_obstacle<M: Model>(
 /// to build (assembly, and for Newton the Hessian pattern and its symbolic Cholesky
 /// factorization), does not depend on the coarser solutions: it is built on a second
 /// thread while the coarser levels are solved, so that on two cores only the numeric
-/// part of the last level follows the coarse solves.
+/// part of the last level follows the coarse solves; its symbolic factorization may
+/// still run there during Newton's first, smoothed step, which needs only the pattern.
 pub fn solve_nested<G, B>(
     levels: Vec<B>,
     prolong: impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
@@ -665,64 +666,76 @@ where
     let newton = options.solver == VariationalSolver::SemismoothNewton;
     // Newton's own checks (positive C) come with the solve, where their error is
     // reported; a workspace that cannot be built is simply not used.
-    let workspace_of = move |d: &Discretization<G>| {
+    let pattern_of = move |d: &Discretization<G>| {
         if newton {
-            NewtonWorkspace::new(&d.lcp).ok()
+            NewtonWorkspace::pattern_of(&d.lcp).ok()
         } else {
             None
         }
     };
-    let start_on = |coarse: &Result<Option<SolvedLevel<G>>>, fine: &Discretization<G>| match coarse
-    {
-        Ok(Some((c, values, _))) => Some(fine.primal_part(&prolong(c, values, fine))),
-        _ => None,
+    let solve_finest = |coarse: Option<SolvedLevel<G>>,
+                        d: &Discretization<G>,
+                        workspace: Option<&NewtonWorkspace>| {
+        let start = coarse
+            .as_ref()
+            .map(|(c, values, _)| d.primal_part(&prolong(c, values, d)));
+        let solution = solve_lcp_prepared(&d.lcp, workspace, start.as_deref(), options)?;
+        let mut counts = coarse.map(|(_, _, counts)| counts).unwrap_or_default();
+        counts.push((d.mesh.cell_count(), solution.iterations));
+        Ok::<_, Error>((solution, counts))
     };
-    let (coarse, finest, start) = if levels.is_empty() || !options.pipelined {
-        let coarse = solve_levels(levels, &prolong, options);
-        let finest = finest().map(|d| {
-            let workspace = workspace_of(&d);
-            (d, workspace)
-        });
-        let start = finest.as_ref().ok().and_then(|(d, _)| start_on(&coarse, d));
-        (coarse, finest, start)
+    let (discretization, (solution, counts)) = if levels.is_empty() || !options.pipelined {
+        let coarse = solve_levels(levels, &prolong, options)?;
+        let d = finest()?;
+        let workspace = pattern_of(&d);
+        let solved = solve_finest(coarse, &d, workspace.as_ref())?;
+        (d, solved)
     } else {
         std::thread::scope(|scope| {
-            // the worker hands the discretization over as soon as it is assembled, so
-            // that the start is prolonged onto it while the worker still builds the
-            // Newton workspace
+            // The worker hands the discretization and the Hessian pattern over as soon
+            // as they exist, then computes the symbolic factorization, which Newton's
+            // first, smoothed step does not need: the start is prolonged and that step
+            // taken meanwhile.
             let (sender, receiver) = std::sync::mpsc::channel();
             let worker = scope.spawn(move || {
-                let d = Arc::new(finest()?);
-                let _ = sender.send(Arc::clone(&d));
-                let workspace = workspace_of(&d);
-                Ok::<_, Error>((d, workspace))
+                let d = finest()?;
+                let workspace = pattern_of(&d);
+                let shared = Arc::new((d, workspace));
+                let _ = sender.send(Arc::clone(&shared));
+                if let Some(workspace) = &shared.1 {
+                    // an error here is Newton's to report when it factors
+                    let _ = workspace.analyse();
+                }
+                Ok::<_, Error>(())
             });
             let coarse = solve_levels(levels, &prolong, options);
-            let start = receiver.recv().ok().and_then(|d| start_on(&coarse, &d));
-            let finest = worker
+            let shared = receiver.recv().ok();
+            let solved = match (coarse, &shared) {
+                (Ok(coarse), Some(shared)) => {
+                    Some(solve_finest(coarse, &shared.0, shared.1.as_ref()))
+                }
+                (Err(e), _) => Some(Err(e)),
+                // the worker failed: its error comes from the join
+                (Ok(_), None) => None,
+            };
+            let joined = worker
                 .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-                .and_then(|(d, workspace)| {
-                    let d = Arc::try_unwrap(d).map_err(|_| {
-                        Error::Input("the finest discretization is still shared".into())
-                    })?;
-                    Ok((d, workspace))
-                });
-            (coarse, finest, start)
-        })
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            // the coarse levels' error first, as in the sequential order
+            let (solved, shared) = match (solved, shared) {
+                (Some(solved), Some(shared)) => (solved?, shared),
+                (Some(Err(e)), None) => return Err(e),
+                _ => {
+                    return Err(joined.err().unwrap_or_else(|| {
+                        Error::Input("the finest level was neither built nor failed".into())
+                    }))
+                }
+            };
+            let (d, _) = Arc::try_unwrap(shared)
+                .map_err(|_| Error::Input("the finest discretization is still shared".into()))?;
+            Ok::<_, Error>((d, solved))
+        })?
     };
-    let mut counts = match coarse? {
-        Some((_, _, counts)) => counts,
-        None => Vec::new(),
-    };
-    let (discretization, workspace) = finest?;
-    let solution = solve_lcp_prepared(
-        &discretization.lcp,
-        workspace.as_ref(),
-        start.as_deref(),
-        options,
-    )?;
-    counts.push((discretization.mesh.cell_count(), solution.iterations));
     let values = discretization.full(&solution);
     Ok(ObstacleSolution {
         iterations: solution.iterations,
