@@ -9,8 +9,8 @@
 //!    thread (the default) and all on one thread; and against one sparse LU
 //!    factorization + solve of the saddle-point matrix `[[A_α, −B_αᵀ], [−B_α, −C_α]]`
 //!    of the same discretization. Newton iterations per level (the first on each nested
-//!    level is Gauss–Seidel sweeps) and factorizations on the final mesh, from 2k to
-//!    524k triangles.
+//!    level is Gauss–Seidel sweeps), factorizations and low-rank (Woodbury) updated solves
+//!    on the final mesh, from 2k to 524k triangles.
 //!
 //! `cargo bench --bench membrane` (add `-- --quick` for smaller meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
@@ -207,12 +207,12 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize], rounds: usize, with_l
         pair.name()
     );
     println!(
-        "{:>5} {:>9} {:>9} {:>16} {:>7} {:>10} {:>11} {:>6} {:>11} {:>6} {:>9} {:>6}",
+        "{:>5} {:>9} {:>9} {:>16} {:>8} {:>10} {:>11} {:>6} {:>11} {:>6} {:>9} {:>6}",
         "N",
         "triangles",
         "dofs",
         "iterations/level",
-        "factor.",
+        "fact/upd",
         "Cholesky s",
         "VI s (2 thr)",
         "ratio",
@@ -258,12 +258,12 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize], rounds: usize, with_l
             (format!("{s:.3}"), format!("{:.2}", pipelined / s))
         });
         println!(
-            "{:>5} {:>9} {:>9} {:>16} {:>7} {:>10.3} {:>11.3} {:>6.2} {:>11.3} {:>6.2} {:>9} {:>6}",
+            "{:>5} {:>9} {:>9} {:>16} {:>8} {:>10.3} {:>11.3} {:>6.2} {:>11.3} {:>6.2} {:>9} {:>6}",
             n,
             2 * n * n,
             lcp.n() + lcp.m(),
             levels,
-            warm.factorizations,
+            format!("{}/{}", warm.factorizations, warm.low_rank_updates),
             linear,
             pipelined,
             pipelined / linear,

@@ -636,3 +636,40 @@ fn the_nested_solve_reports_the_first_failing_level() {
         }
     }
 }
+
+/// A level builder that itself runs a nested solve (so the inner solve starts on the
+/// thread that builds the outer finest level) finishes, with the same answer as alone.
+#[test]
+fn a_nested_solve_inside_a_level_builder_finishes() {
+    use fem_forms::obstacle::solve_nested;
+    use fem_forms::obstacle_2d::{
+        discretize_on_triangles, prolong_on_triangles, solve_obstacle_on_triangles,
+    };
+    type M = membrane_p1_p0::Model;
+    let scene = radial();
+    let meshes: Vec<_> = [4, 8]
+        .iter()
+        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
+        .collect();
+    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 48.0).unwrap();
+    let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let alone = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
+    let inner = std::sync::Mutex::new(None);
+    let levels: Vec<Box<dyn FnOnce() -> _ + Send + '_>> = vec![
+        Box::new(|| discretize_on_triangles::<M>(&meshes[0], &coefficients, "B_h", "L_h")),
+        Box::new(|| {
+            let solved = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options)?;
+            *inner.lock().unwrap() = Some(solved.values);
+            discretize_on_triangles::<M>(&meshes[1], &coefficients, "B_h", "L_h")
+        }),
+    ];
+    let outer = solve_nested(levels, prolong_on_triangles, options).unwrap();
+    let inner = inner.into_inner().unwrap().expect("the inner solve ran");
+    for values in [&outer.values, &inner] {
+        let difference = values
+            .iter()
+            .zip(&alone.values)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(difference <= 1e-12, "differs by {difference}");
+    }
+}

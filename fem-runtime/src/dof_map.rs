@@ -16,6 +16,8 @@ pub struct DofMap {
     element: ElementKind,
     cell: CellKind,
     cell_dofs: Vec<usize>,
+    /// DOFs per cell, kept: [`DofMap::cell_dofs`] is on every assembly's hot path.
+    local: usize,
     dof_count: usize,
     per_vertex: usize,
     per_edge: usize,
@@ -41,6 +43,7 @@ impl DofMap {
             element,
             cell: CellKind::Interval,
             cell_dofs,
+            local,
             dof_count: (cells + 1) * per_vertex + cells * interior,
             per_vertex,
             per_edge: 0,
@@ -77,6 +80,7 @@ impl DofMap {
             element,
             cell: CellKind::Triangle,
             cell_dofs,
+            local,
             dof_count: interior_base + cells * interior,
             per_vertex,
             per_edge,
@@ -132,8 +136,9 @@ impl DofMap {
     }
 
     /// Number of DOFs of one cell.
+    #[inline]
     pub fn local_count(&self) -> usize {
-        self.element.local_dof_count(self.cell)
+        self.local
     }
 
     /// Global DOFs of cell `c`, in the element's local order.

@@ -19,7 +19,7 @@ use crate::norms::FieldView;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use fem_reference::DofLocation;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// Which algorithm solves the LCP.
@@ -691,50 +691,45 @@ where
         let solved = solve_finest(coarse, &d, workspace.as_ref())?;
         (d, solved)
     } else {
-        std::thread::scope(|scope| {
-            // The worker hands the discretization and the Hessian pattern over as soon
-            // as they exist, then computes the symbolic factorization, which Newton's
-            // first, smoothed step does not need: the start is prolonged and that step
-            // taken meanwhile.
-            let (sender, receiver) = std::sync::mpsc::channel();
-            let worker = scope.spawn(move || {
-                let d = finest()?;
+        // The worker hands the discretization and the Hessian pattern over as soon as
+        // they exist, then computes the symbolic factorization, which Newton's first,
+        // smoothed step does not need: the start is prolonged and that step taken
+        // meanwhile.
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let worker = move || {
+            let built = finest().map(|d| {
                 let workspace = pattern_of(&d);
-                let shared = Arc::new((d, workspace));
-                let _ = sender.send(Arc::clone(&shared));
-                if let Some(workspace) = &shared.1 {
-                    // an error here is Newton's to report when it factors
-                    let _ = workspace.analyse();
-                }
-                Ok::<_, Error>(())
+                Arc::new((d, workspace))
             });
+            let shared = built.as_ref().ok().map(Arc::clone);
+            let _ = sender.send(built);
+            if let Some(workspace) = shared.as_ref().and_then(|s| s.1.as_ref()) {
+                // an error here is Newton's to report when it factors
+                let _ = workspace.analyse();
+            }
+        };
+        let (solved, shared) = alongside(worker, || {
             let coarse = solve_levels(levels, &prolong, options);
-            let shared = receiver.recv().ok();
-            let solved = match (coarse, &shared) {
-                (Ok(coarse), Some(shared)) => {
-                    Some(solve_finest(coarse, &shared.0, shared.1.as_ref()))
-                }
-                (Err(e), _) => Some(Err(e)),
-                // the worker failed: its error comes from the join
-                (Ok(_), None) => None,
-            };
-            let joined = worker
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
             // the coarse levels' error first, as in the sequential order
-            let (solved, shared) = match (solved, shared) {
-                (Some(solved), Some(shared)) => (solved?, shared),
-                (Some(Err(e)), None) => return Err(e),
-                _ => {
-                    return Err(joined.err().unwrap_or_else(|| {
-                        Error::Input("the finest level was neither built nor failed".into())
-                    }))
+            match (coarse, receiver.recv()) {
+                (Err(e), _) | (Ok(_), Ok(Err(e))) => (Err(e), None),
+                (Ok(coarse), Ok(Ok(shared))) => {
+                    let solved = solve_finest(coarse, &shared.0, shared.1.as_ref());
+                    (solved, Some(shared))
                 }
-            };
-            let (d, _) = Arc::try_unwrap(shared)
-                .map_err(|_| Error::Input("the finest discretization is still shared".into()))?;
-            Ok::<_, Error>((d, solved))
-        })?
+                // the worker panicked: the panic resumes when it is joined
+                (Ok(_), Err(_)) => (
+                    Err(Error::Input("the finest level was not built".into())),
+                    None,
+                ),
+            }
+        });
+        let solved = solved?;
+        let shared = shared.expect("a solved finest level was built");
+        // the worker has finished and dropped its handle
+        let (d, _) = Arc::try_unwrap(shared)
+            .map_err(|_| Error::Input("the finest discretization is still shared".into()))?;
+        (d, solved)
     };
     let values = discretization.full(&solution);
     Ok(ObstacleSolution {
@@ -749,6 +744,35 @@ where
         levels: counts,
         seconds: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// Runs `worker` on another thread while `main` runs on this one; returns `main`'s result
+/// once both have finished (a panic of either resumes here).
+///
+/// The other thread is kept for the process (one, whatever the number of solves):
+/// allocations made on a fresh thread are fresh memory for the allocator, which the
+/// kernel faults in and zeroes page by page — at 524k triangles that cost more than the
+/// finest level's assembly. Called from that thread itself (a level built by a nested
+/// solve), a scoped thread runs `worker` instead, as when the kept one cannot start.
+fn alongside<R>(worker: impl FnOnce() + Send, main: impl FnOnce() -> R) -> R {
+    static KEPT: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
+    let kept = KEPT.get_or_init(|| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .thread_name(|_| "fem-forms finest level".into())
+            .build()
+            .ok()
+    });
+    match kept {
+        Some(pool) if pool.current_thread_index().is_none() => pool.in_place_scope(|scope| {
+            scope.spawn(move |_| worker());
+            main()
+        }),
+        _ => std::thread::scope(|scope| {
+            scope.spawn(worker);
+            main()
+        }),
+    }
 }
 
 /// A level's discretization, its solution's full coefficients, and the (cells, iterations)
