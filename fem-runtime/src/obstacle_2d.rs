@@ -68,9 +68,32 @@ pub fn prolong_on_triangles(
     coarse_values: &[f64],
     fine: &Discretization<TriangleMesh>,
 ) -> Vec<f64> {
+    prolong_fields(coarse, coarse_values, fine, true)
+}
+
+/// [`prolong_on_triangles`] for the primal fields only, the multiplier left 0: all that
+/// nested iteration uses (Newton starts from the primal unknowns; it eliminates Λ), and
+/// for P0 multipliers the larger half of the work.
+pub fn prolong_primal_on_triangles(
+    coarse: &Discretization<TriangleMesh>,
+    coarse_values: &[f64],
+    fine: &Discretization<TriangleMesh>,
+) -> Vec<f64> {
+    prolong_fields(coarse, coarse_values, fine, false)
+}
+
+fn prolong_fields(
+    coarse: &Discretization<TriangleMesh>,
+    coarse_values: &[f64],
+    fine: &Discretization<TriangleMesh>,
+    multiplier: bool,
+) -> Vec<f64> {
     let locator = PointLocator::new(&coarse.mesh);
     let mut out = vec![0.0; fine.dofs.dof_count()];
     for &field in fine.dofs.fields() {
+        if !multiplier && field == fine.multiplier_field {
+            continue;
+        }
         let (Some(map_c), Some(range_c)) = (coarse.dofs.map(field), coarse.dofs.range(field))
         else {
             continue;
@@ -83,8 +106,15 @@ pub fn prolong_on_triangles(
         let basis = TriangleBasis::new(map_c.element());
         let map_f = fine.dofs.map(field).unwrap();
         let offset = fine.dofs.offset(field).unwrap();
+        let mut hint = None;
         for (dof, x) in map_f.nodes(&fine.mesh).into_iter().enumerate() {
-            out[offset + dof] = view.at(&basis, &locator, x).unwrap_or(0.0);
+            out[offset + dof] = match locator.locate_near(x, hint) {
+                Some((c, b)) => {
+                    hint = Some(c);
+                    view.value(&basis, c, [b[1], b[2]])
+                }
+                None => 0.0,
+            };
         }
     }
     out
@@ -105,7 +135,7 @@ pub fn solve_obstacle_on_triangles<M: Model>(
             .iter()
             .map(|mesh| move || discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h"))
             .collect(),
-        prolong_on_triangles,
+        prolong_primal_on_triangles,
         options,
     )
 }

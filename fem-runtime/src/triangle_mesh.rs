@@ -787,6 +787,29 @@ impl<'a> PointLocator<'a> {
         ((i as usize).min(self.nx - 1), (j as usize).min(self.ny - 1))
     }
 
+    /// [`PointLocator::locate`], trying cell `hint` first: points visited in mesh order
+    /// (a finer mesh's nodes) mostly fall in the cell of the point before.
+    pub fn locate_near(&self, p: [f64; 2], hint: Option<usize>) -> Option<(usize, [f64; 3])> {
+        if let Some(c) = hint.filter(|&c| c < self.mesh.cells.len()) {
+            let [a, b, d] = self.mesh.cells[c];
+            let v = [
+                self.mesh.vertices[a],
+                self.mesh.vertices[b],
+                self.mesh.vertices[d],
+            ];
+            let w = [
+                cross(p, v[1], v[2]),
+                cross(v[0], p, v[2]),
+                cross(v[0], v[1], p),
+            ];
+            if w.iter().all(|&w| w >= 0.0) {
+                let twice_area = cross(v[0], v[1], v[2]);
+                return Some((c, w.map(|x| x / twice_area)));
+            }
+        }
+        self.locate(p)
+    }
+
     /// A cell containing `p` (up to about 1e-12 of the mesh's extent) and `p`'s barycentric
     /// coordinates in it; `None` outside the mesh.
     pub fn locate(&self, p: [f64; 2]) -> Option<(usize, [f64; 3])> {
@@ -818,6 +841,10 @@ impl<'a> PointLocator<'a> {
                 cross(v[0], v[1], p),
             ];
             let twice_area = cross(v[0], v[1], v[2]);
+            if w.iter().all(|&w| w >= 0.0) {
+                // inside (the common case, decided before any square root)
+                return Some((c, w.map(|x| x / twice_area)));
+            }
             // distance outside edge k is −w[k] / |edge k|; compare without the division
             let inside = (0..3)
                 .all(|k| w[k] >= 0.0 || -w[k] <= s * dist2(v[(k + 1) % 3], v[(k + 2) % 3]).sqrt());
@@ -826,9 +853,6 @@ impl<'a> PointLocator<'a> {
             }
             let lambda = w.map(|x| x / twice_area);
             let worst = lambda[0].min(lambda[1]).min(lambda[2]);
-            if worst >= 0.0 {
-                return Some((c, lambda));
-            }
             if best.is_none_or(|(w, _, _)| worst > w) {
                 best = Some((worst, c, lambda));
             }
@@ -1392,7 +1416,16 @@ mod tests {
                     x[0] + s * (x[2] - x[0]) + t * (x[4] - x[0]),
                     x[1] + s * (x[3] - x[1]) + t * (x[5] - x[1]),
                 ];
-                let (found, lambda) = locator.locate(p).expect("a point inside the mesh");
+                // with no hint, a hint at the right cell, at a random one, or out of range
+                let hint = match rng.next() % 4 {
+                    0 => None,
+                    1 => Some(c),
+                    2 => Some((rng.next() % m.cell_count() as u64) as usize),
+                    _ => Some(m.cell_count() + 3),
+                };
+                let (found, lambda) = locator
+                    .locate_near(p, hint)
+                    .expect("a point inside the mesh");
                 let y = m.cell_coordinates(found);
                 let q = [
                     lambda[0] * y[0] + lambda[1] * y[2] + lambda[2] * y[4],

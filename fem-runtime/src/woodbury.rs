@@ -263,13 +263,88 @@ impl CholeskyFactor {
             at.binary_search(&j)
                 .expect("a column visits every node of its path")
         };
-        for j in 0..k {
+        if matches!(symbolic.raw(), SymbolicCholeskyRaw::Simplicial(_)) {
+            // Nodes of one column each: the dense kernels would cost more in calls than
+            // in flops, so each column is solved alone along its path.
+            let mut x = vec![0.0; symbolic.nrows()];
+            let mut path = Vec::new();
+            let mut on_path = vec![false; tree.parent.len()];
+            for j in 0..k {
+                path.clear();
+                for &(i, v) in term.column(j) {
+                    let p = row(i);
+                    x[p] += v;
+                    let mut s = tree.node_of_column[p];
+                    while s != usize::MAX && !on_path[s] {
+                        on_path[s] = true;
+                        path.push(s);
+                        s = tree.parent[s];
+                    }
+                }
+                path.sort_unstable();
+                for &s in &path {
+                    on_path[s] = false;
+                    let node = tree.node(symbolic, &self.values, s);
+                    let xs = x[s] / node.block[0];
+                    x[s] = 0.0;
+                    let b = index_of_node[s];
+                    values[value_ptr[b] + position(&columns, b, j)] = xs;
+                    if xs != 0.0 {
+                        for (&r, l) in node.pattern.iter().zip(&node.block[1..]) {
+                            x[r] -= l * xs;
+                        }
+                    }
+                }
+            }
+        } else {
+            self.solve_on_supernodes(
+                &nodes,
+                &column_ptr,
+                &columns,
+                &value_ptr,
+                &index_of_node,
+                term,
+                &mut values,
+            );
+        }
+        PathMatrix {
+            nodes,
+            column_ptr,
+            columns,
+            value_ptr,
+            values,
+        }
+    }
+
+    /// The numeric part of [`CholeskyFactor::path_matrix`] on a supernodal factor: each
+    /// node's block for all its columns at once (dense triangular solve and product).
+    #[allow(clippy::too_many_arguments)]
+    fn solve_on_supernodes(
+        &self,
+        nodes: &[usize],
+        column_ptr: &[usize],
+        columns: &[usize],
+        value_ptr: &[usize],
+        index_of_node: &[usize],
+        term: &LowRankTerm,
+        values: &mut [f64],
+    ) {
+        let tree = self.tree();
+        let symbolic = &self.structure.symbolic;
+        let inverse = symbolic.perm().map(|p| p.arrays().1);
+        let row = |i: usize| inverse.map_or(i, |inv| inv[i]);
+        let position = |i: usize, j: usize| {
+            let at = &columns[column_ptr[i]..column_ptr[i + 1]];
+            at.binary_search(&j)
+                .expect("a column visits every node of its path")
+        };
+        for j in 0..term.rank() {
             for &(i, v) in term.column(j) {
                 let p = row(i);
                 let s = tree.node_of_column[p];
                 let b = index_of_node[s];
                 let width = tree.start[s + 1] - tree.start[s];
-                values[value_ptr[b] + position(&columns, b, j) * width + p - tree.start[s]] += v;
+                values[value_ptr[b] + position(b, j) * width + p - tree.start[s]] += v;
             }
         }
         let mut below = Vec::new();
@@ -306,7 +381,7 @@ impl CholeskyFactor {
                 let a = index_of_node[parent];
                 let parent_width = tree.start[parent + 1] - tree.start[parent];
                 map.clear();
-                map.extend(at.iter().map(|&j| position(&columns, a, j)));
+                map.extend(at.iter().map(|&j| position(a, j)));
                 let offset = value_ptr[a] - value_ptr[b + 1];
                 while t < p && node.pattern[t] < tree.start[parent + 1] {
                     let r = node.pattern[t] - tree.start[parent];
@@ -316,13 +391,6 @@ impl CholeskyFactor {
                     t += 1;
                 }
             }
-        }
-        PathMatrix {
-            nodes,
-            column_ptr,
-            columns,
-            value_ptr,
-            values,
         }
     }
 }
@@ -469,6 +537,15 @@ impl<'f> WoodburySolver<'f> {
             let width = tree.start[s + 1] - tree.start[s];
             let (at, block) = z.block(i);
             let q = at.len();
+            if width == 1 {
+                // a simplicial node: the dense product would cost more in its call
+                for (a, &ja) in at.iter().enumerate() {
+                    for (b, &jb) in at.iter().enumerate() {
+                        w[(ja, jb)] += block[a] * block[b];
+                    }
+                }
+                continue;
+            }
             let x = MatRef::from_column_major_slice(block, width, q);
             gram.clear();
             gram.resize(q * q, 0.0);
