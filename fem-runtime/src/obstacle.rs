@@ -257,10 +257,14 @@ impl SplitPattern {
         // buckets are sorted and deduplicated (no search per entry).
         let mut a_count = vec![0usize; n + 1];
         let mut b_count = vec![0usize; m + 1];
-        for_each_entry(mesh, dofs, plans, |r, c| match (target[r], target[c]) {
-            (Target::Primal(_), Target::Primal(q)) => a_count[q + 1] += 1,
-            (Target::Multiplier(k), Target::Primal(_)) => b_count[k + 1] += 1,
-            _ => {}
+        let mut entries = 0;
+        for_each_entry(mesh, dofs, plans, |r, c| {
+            entries += 1;
+            match (target[r], target[c]) {
+                (Target::Primal(_), Target::Primal(q)) => a_count[q + 1] += 1,
+                (Target::Multiplier(k), Target::Primal(_)) => b_count[k + 1] += 1,
+                _ => {}
+            }
         });
         for j in 0..n {
             a_count[j + 1] += a_count[j];
@@ -282,7 +286,8 @@ impl SplitPattern {
         let mut coupling = Vec::new();
         let mut fixed_terms = Vec::new();
         let mut slots = Vec::new();
-        let mut positions = Vec::new();
+        // sized ahead: one per entry, millions of them
+        let mut positions = Vec::with_capacity(entries);
         for_each_entry(mesh, dofs, plans, |r, c| {
             let at = match (target[r], target[c]) {
                 (Target::Primal(p), Target::Primal(q)) => {
