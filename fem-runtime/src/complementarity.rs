@@ -886,15 +886,11 @@ impl Hessian {
         let mut column_ptr = Vec::with_capacity(lcp.m() + 1);
         column_ptr.push(0);
         let mut columns: Vec<usize> = Vec::with_capacity(lcp.b_rows.entries().len());
-        let diagonal = lcp.c_blocks.is_empty();
-        // a block's rows: one row for a diagonal C, without the block iterator's cost
-        let rows_of = |block: &Block| {
-            let range = block.range();
-            lcp.b_rows.offsets()[range.start]..lcp.b_rows.offsets()[range.end]
-        };
-        let mut add_block = |range: Range<usize>, columns: &mut Vec<usize>| {
+        for block in lcp.blocks() {
             let from = columns.len();
-            columns.extend(lcp.b_rows.entries()[range].iter().map(|&(j, _)| j));
+            for k in block.range() {
+                columns.extend(lcp.b_rows[k].iter().map(|&(j, _)| j));
+            }
             let set = &mut columns[from..];
             set.sort_unstable();
             let mut kept = 0;
@@ -906,16 +902,6 @@ impl Hessian {
             }
             columns.truncate(from + kept);
             column_ptr.push(columns.len());
-        };
-        if diagonal {
-            let offsets = lcp.b_rows.offsets();
-            for k in 0..lcp.m() {
-                add_block(offsets[k]..offsets[k + 1], &mut columns);
-            }
-        } else {
-            for block in lcp.blocks() {
-                add_block(rows_of(&block), &mut columns);
-            }
         }
         let block_count = column_ptr.len() - 1;
         let block_columns = |b: usize| &columns[column_ptr[b]..column_ptr[b + 1]];
@@ -961,21 +947,13 @@ impl Hessian {
             }
         };
         let mut entry_local = Vec::with_capacity(lcp.b_rows.entries().len());
-        let mut add_local = |b: usize, range: Range<usize>| {
+        for (b, block) in lcp.blocks().enumerate() {
             let set = block_columns(b);
-            entry_local.extend(lcp.b_rows.entries()[range].iter().map(|&(j, _)| {
-                set.binary_search(&j)
-                    .expect("the block's columns hold its rows' columns")
-            }));
-        };
-        if diagonal {
-            let offsets = lcp.b_rows.offsets();
-            for k in 0..lcp.m() {
-                add_local(k, offsets[k]..offsets[k + 1]);
-            }
-        } else {
-            for (b, block) in lcp.blocks().enumerate() {
-                add_local(b, rows_of(&block));
+            for k in block.range() {
+                entry_local.extend(lcp.b_rows[k].iter().map(|&(j, _)| {
+                    set.binary_search(&j)
+                        .expect("the block's columns hold its rows' columns")
+                }));
             }
         }
         let widths = (0..block_count)
