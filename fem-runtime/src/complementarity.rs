@@ -1195,8 +1195,9 @@ impl Lcp {
     /// The constraint part of [`Lcp::merit`] from `bu = BU`.
     fn penalty(&self, bu: &[f64]) -> f64 {
         if self.c_blocks.is_empty() {
-            // diagonal C: the closed form, in one pass (the block iterator costs more than
-            // the arithmetic, and the line search evaluates this for every trial)
+            // diagonal C: the closed form in one vectorizable pass; the general per-block
+            // code cost 10 ms per pass at 524k cells, and the line search evaluates this
+            // for every trial
             return self
                 .g
                 .iter()
