@@ -15,6 +15,36 @@ fn radial() -> MembraneScene {
     membrane_scene("membrane-radial").unwrap()
 }
 
+/// The radial scene's meshes of `sizes` (N × N × 2 triangles each).
+fn radial_meshes(sizes: &[usize]) -> Vec<fem_forms::TriangleMesh> {
+    let scene = radial();
+    sizes
+        .iter()
+        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
+        .collect()
+}
+
+/// `max |a − b|`.
+fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+}
+
+/// Both solves converged, to the same coefficients up to 1e-9 of their size.
+fn assert_same_solution(
+    a: &fem_forms::obstacle_2d::TriangleObstacleSolution,
+    b: &fem_forms::obstacle_2d::TriangleObstacleSolution,
+) {
+    assert!(a.kkt_residual <= 1e-10 && b.kkt_residual <= 1e-10);
+    let scale = b.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let difference = max_difference(&a.values, &b.values);
+    assert!(
+        difference <= 1e-9 * scale,
+        "solutions differ by {difference} (scale {scale})"
+    );
+}
+
 fn solve(scene: MembraneScene, pair: MembranePair, n: usize) -> MembraneReport {
     let mut request = MembraneRequest::new(scene);
     request.pair = pair;
@@ -448,10 +478,7 @@ fn the_pipelined_nested_solve_equals_the_sequential_one() {
     };
     type M = membrane_p2_p0::Model;
     let scene = radial();
-    let meshes: Vec<_> = [4, 8, 16]
-        .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
-        .collect();
+    let meshes = radial_meshes(&[4, 8, 16]);
     let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 96.0).unwrap();
     let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     let pipelined = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
@@ -470,11 +497,7 @@ fn the_pipelined_nested_solve_equals_the_sequential_one() {
     let (_, sequential) = previous.unwrap();
     assert_eq!(pipelined.levels, iterations);
     assert_eq!(pipelined.values.len(), sequential.len());
-    let difference = pipelined
-        .values
-        .iter()
-        .zip(&sequential)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let difference = max_difference(&pipelined.values, &sequential);
     assert!(
         difference <= 1e-12,
         "pipelined and sequential differ by {difference}"
@@ -490,10 +513,7 @@ fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
     use fem_forms::obstacle_2d::solve_obstacle_on_triangles;
     type M = membrane_p1_p0::Model;
     let scene = radial();
-    let meshes: Vec<_> = [4, 8, 16, 32, 64]
-        .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
-        .collect();
+    let meshes = radial_meshes(&[4, 8, 16, 32, 64]);
     let coefficients = membranes::scene_coefficients::<M>(&scene, 0.1).unwrap();
     let smoothed = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     assert!(smoothed.newton.smoothing_sweeps > 0);
@@ -506,17 +526,7 @@ fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
     };
     let with = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, smoothed).unwrap();
     let without = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, exact).unwrap();
-    assert!(with.kkt_residual <= 1e-10 && without.kkt_residual <= 1e-10);
-    let scale = without.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let difference = with
-        .values
-        .iter()
-        .zip(&without.values)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-    assert!(
-        difference <= 1e-9 * scale,
-        "solutions differ by {difference} (scale {scale})"
-    );
+    assert_same_solution(&with, &without);
     assert!(
         with.factorizations <= without.factorizations,
         "{} factorizations with the sweeps, {} without",
@@ -539,10 +549,7 @@ fn low_rank_updates_keep_the_solution_and_save_factorizations() {
     use fem_forms::obstacle_2d::solve_obstacle_on_triangles;
     type M = membrane_p1_p0::Model;
     let scene = radial();
-    let meshes: Vec<_> = [4, 8, 16, 32, 64, 128]
-        .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
-        .collect();
+    let meshes = radial_meshes(&[4, 8, 16, 32, 64, 128]);
     let coefficients = membranes::scene_coefficients::<M>(&scene, 0.1).unwrap();
     let defaults = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     let options = |low_rank_updates| fem_forms::obstacle::ObstacleOptions {
@@ -555,17 +562,7 @@ fn low_rank_updates_keep_the_solution_and_save_factorizations() {
     };
     let with = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options(true)).unwrap();
     let without = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options(false)).unwrap();
-    assert!(with.kkt_residual <= 1e-10 && without.kkt_residual <= 1e-10);
-    let scale = without.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let difference = with
-        .values
-        .iter()
-        .zip(&without.values)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-    assert!(
-        difference <= 1e-9 * scale,
-        "solutions differ by {difference} (scale {scale})"
-    );
+    assert_same_solution(&with, &without);
     assert_eq!(without.low_rank_updates, 0);
     assert!(with.low_rank_updates > 0, "no step was updated");
     assert!(
@@ -591,10 +588,7 @@ fn the_nested_solve_reports_the_first_failing_level() {
             + 'a,
     >;
     let scene = radial();
-    let meshes: Vec<_> = [4, 8]
-        .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
-        .collect();
+    let meshes = radial_meshes(&[4, 8]);
     let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 48.0).unwrap();
     let level = |k: usize, fails: bool| -> Level<'_> {
         let (mesh, coefficients) = (&meshes[k], &coefficients);
@@ -647,10 +641,7 @@ fn a_nested_solve_inside_a_level_builder_finishes() {
     };
     type M = membrane_p1_p0::Model;
     let scene = radial();
-    let meshes: Vec<_> = [4, 8]
-        .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
-        .collect();
+    let meshes = radial_meshes(&[4, 8]);
     let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 48.0).unwrap();
     let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     let alone = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
@@ -666,10 +657,7 @@ fn a_nested_solve_inside_a_level_builder_finishes() {
     let outer = solve_nested(levels, prolong_on_triangles, options).unwrap();
     let inner = inner.into_inner().unwrap().expect("the inner solve ran");
     for values in [&outer.values, &inner] {
-        let difference = values
-            .iter()
-            .zip(&alone.values)
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let difference = max_difference(values, &alone.values);
         assert!(difference <= 1e-12, "differs by {difference}");
     }
 }

@@ -791,23 +791,25 @@ impl<'a> PointLocator<'a> {
     /// (a finer mesh's nodes) mostly fall in the cell of the point before.
     pub fn locate_near(&self, p: [f64; 2], hint: Option<usize>) -> Option<(usize, [f64; 3])> {
         if let Some(c) = hint.filter(|&c| c < self.mesh.cells.len()) {
-            let [a, b, d] = self.mesh.cells[c];
-            let v = [
-                self.mesh.vertices[a],
-                self.mesh.vertices[b],
-                self.mesh.vertices[d],
-            ];
-            let w = [
-                cross(p, v[1], v[2]),
-                cross(v[0], p, v[2]),
-                cross(v[0], v[1], p),
-            ];
+            let (v, w) = self.sub_areas(c, p);
             if w.iter().all(|&w| w >= 0.0) {
                 let twice_area = cross(v[0], v[1], v[2]);
                 return Some((c, w.map(|x| x / twice_area)));
             }
         }
         self.locate(p)
+    }
+
+    /// Cell `c`'s vertices and `w[k]`, twice the signed area of the sub-triangle of `p`
+    /// opposite vertex `k` (all ≥ 0 inside).
+    fn sub_areas(&self, c: usize, p: [f64; 2]) -> ([[f64; 2]; 3], [f64; 3]) {
+        let v = self.mesh.cells[c].map(|a| self.mesh.vertices[a]);
+        let w = [
+            cross(p, v[1], v[2]),
+            cross(v[0], p, v[2]),
+            cross(v[0], v[1], p),
+        ];
+        (v, w)
     }
 
     /// A cell containing `p` (up to about 1e-12 of the mesh's extent) and `p`'s barycentric
@@ -828,18 +830,7 @@ impl<'a> PointLocator<'a> {
         let b = j * self.nx + i;
         let mut best: Option<(f64, usize, [f64; 3])> = None;
         for &c in &self.items[self.start[b]..self.start[b + 1]] {
-            let [a, b, d] = self.mesh.cells[c];
-            let v = [
-                self.mesh.vertices[a],
-                self.mesh.vertices[b],
-                self.mesh.vertices[d],
-            ];
-            // w[k] = twice the area of the sub-triangle opposite vertex k
-            let w = [
-                cross(p, v[1], v[2]),
-                cross(v[0], p, v[2]),
-                cross(v[0], v[1], p),
-            ];
+            let (v, w) = self.sub_areas(c, p);
             let twice_area = cross(v[0], v[1], v[2]);
             if w.iter().all(|&w| w >= 0.0) {
                 // inside (the common case, decided before any square root)
