@@ -1317,11 +1317,10 @@ pub fn semismooth_newton(
     start: Option<&[f64]>,
     options: NewtonOptions,
 ) -> Result<LcpSolution> {
-    let clock = Instant::now();
     lcp.check_shapes()?;
     lcp.require_positive_c("semismooth Newton")?;
-    let workspace = NewtonWorkspace::new(lcp)?;
-    newton_iteration(lcp, &workspace, start, options, clock)
+    // the symbolic factorization follows when Newton first factors
+    semismooth_newton_prepared(lcp, &NewtonWorkspace::pattern_of(lcp)?, start, options)
 }
 
 /// [`semismooth_newton`] with the pattern work done ahead in `workspace` (built by
