@@ -93,14 +93,6 @@ impl std::ops::Index<usize> for ConstraintRows {
     }
 }
 
-impl<'a> IntoIterator for &'a ConstraintRows {
-    type Item = &'a [(usize, f64)];
-    type IntoIter = Box<dyn Iterator<Item = &'a [(usize, f64)]> + 'a>;
-    fn into_iter(self) -> Self::IntoIter {
-        Box::new(self.iter())
-    }
-}
-
 impl From<Vec<Vec<(usize, f64)>>> for ConstraintRows {
     fn from(rows: Vec<Vec<(usize, f64)>>) -> Self {
         let mut ptr = Vec::with_capacity(rows.len() + 1);
@@ -607,16 +599,19 @@ impl Lcp {
         out
     }
 
+    /// `‖Bᵀ‖∞`, the largest column sum of `|B|`.
+    fn bt_norm(&self) -> f64 {
+        let mut column_sums = vec![0.0; self.n()];
+        for &(j, v) in self.b_rows.entries() {
+            column_sums[j] += v.abs();
+        }
+        column_sums.iter().fold(0.0f64, |m, x| m.max(*x))
+    }
+
     /// The natural size of a multiplier: `‖F‖∞ / ‖Bᵀ‖∞` (equilibrium `BᵀΛ ~ F`), so that
     /// "λ is zero" is judged against the load, not against λ itself.
     pub fn multiplier_scale(&self) -> f64 {
-        let mut bt_col_sums = vec![0.0; self.n()];
-        for row in &self.b_rows {
-            for &(j, v) in row {
-                bt_col_sums[j] += v.abs();
-            }
-        }
-        let bt = bt_col_sums.iter().fold(0.0f64, |m, x| m.max(*x));
+        let bt = self.bt_norm();
         let f = self.f.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         if bt > 0.0 {
             f / bt
@@ -637,13 +632,7 @@ impl Lcp {
         let btl = self.bt_times(lambda);
         let norm_inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let a_norm = row_sum_norm(&self.a);
-        let mut bt_col_sums = vec![0.0; self.n()];
-        for row in &self.b_rows {
-            for &(j, v) in row {
-                bt_col_sums[j] += v.abs();
-            }
-        }
-        let bt_norm = norm_inf(&bt_col_sums);
+        let bt_norm = self.bt_norm();
         let equilibrium: f64 = au
             .iter()
             .zip(&btl)
@@ -1126,9 +1115,7 @@ impl Lcp {
         if self.c_blocks.is_empty() {
             // diagonal C: the size-1 formulas in one pass, as [`Lcp::penalty`]
             for (k, (lambda, active)) in lambda.iter_mut().zip(&mut active).enumerate() {
-                let r = self.g[k] - bu[k];
-                *active = r > 0.0;
-                *lambda = r.max(0.0) / self.c[k];
+                (*lambda, *active) = single_multiplier(self.g[k] - bu[k], self.c[k]);
             }
             return (lambda, active);
         }
@@ -1166,8 +1153,7 @@ impl Lcp {
         }
         if s == 1 {
             dense[0] = self.c[k];
-            active[0] = r[0] > 0.0;
-            lambda[0] = r[0].max(0.0) / self.c[k];
+            (lambda[0], active[0]) = single_multiplier(r[0], self.c[k]);
             return;
         }
         block.dense(&self.c, &mut dense[..s * s]);
@@ -1203,10 +1189,7 @@ impl Lcp {
                 .iter()
                 .zip(bu)
                 .zip(&self.c)
-                .map(|((g, bu), c)| {
-                    let r = (g - bu).max(0.0);
-                    0.5 * r * r / c
-                })
+                .map(|((g, bu), c)| single_penalty(g - bu, *c))
                 .sum();
         }
         let mut dense = [0.0; BLOCK_ENTRIES];
@@ -1218,8 +1201,7 @@ impl Lcp {
                 let k = block.start;
                 if block.size == 1 {
                     // the closed form, cheaper than the general one in the line search
-                    let r = (self.g[k] - bu[k]).max(0.0);
-                    return 0.5 * r * r / self.c[k];
+                    return single_penalty(self.g[k] - bu[k], self.c[k]);
                 }
                 let s = block.size;
                 self.block_multiplier(&block, bu, &mut dense, &mut r, &mut lambda, &mut active);
@@ -1254,6 +1236,20 @@ impl Lcp {
         }
         None
     }
+}
+
+/// A constraint alone in its block of `C` (`c > 0`) with `r = G − BU`: its eliminated
+/// multiplier `r₊ / c` and whether it is active.
+#[inline]
+fn single_multiplier(r: f64, c: f64) -> (f64, bool) {
+    (r.max(0.0) / c, r > 0.0)
+}
+
+/// Its share of the merit: `max_{λ≥0} (λr − ½cλ²) = ½ r₊² / c`.
+#[inline]
+fn single_penalty(r: f64, c: f64) -> f64 {
+    let r = r.max(0.0);
+    0.5 * r * r / c
 }
 
 fn max_norm(v: &[f64]) -> f64 {
