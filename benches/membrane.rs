@@ -16,13 +16,13 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use faer::sparse::Triplet;
-use fem_forms::complementarity::Lcp;
-use fem_forms::linear_solve::{Cholesky, LuSolver};
+use fem_forms::lcp::cholesky::{Cholesky, LuSolver};
+use fem_forms::lcp::Lcp;
 use fem_forms::membranes::{self, MembranePair, MembraneRequest};
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene};
+use fem_forms::obstacle::triangle::{solve_obstacle_on_triangles, TriangleObstacleSolution};
 use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
-use fem_forms::obstacle_2d::{solve_obstacle_on_triangles, TriangleObstacleSolution};
 use fem_forms::SparseMatrix;
 use fem_forms::{Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh};
 use std::hint::black_box;
@@ -302,7 +302,7 @@ fn kkt_matrix(lcp: &Lcp) -> SparseMatrix {
 }
 
 fn main() {
-    fem_forms::linear_solve::factor_sequentially();
+    fem_forms::lcp::cholesky::factor_sequentially();
     fem_forms::allocator::retain_freed_memory();
     let quick = std::env::args().any(|a| a == "--quick");
     let (assembly_n, p1_sizes, p2_sizes): (usize, Vec<usize>, Vec<usize>) = if quick {

@@ -8,7 +8,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::beams::{discretize, solve, Request};
-use fem_forms::linear_solve::Cholesky;
+use fem_forms::lcp::cholesky::Cholesky;
 use fem_forms::models::scenes::scene;
 use std::time::Instant;
 
@@ -16,7 +16,7 @@ use std::time::Instant;
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
-    fem_forms::linear_solve::factor_sequentially();
+    fem_forms::lcp::cholesky::factor_sequentially();
     let sizes = [1_000usize, 4_000, 16_000, 64_000, 256_000, 1_024_000];
     for (name, thickness) in [
         ("timoshenko-a", 1e-3),

@@ -2,8 +2,8 @@
 
 use crate::models::scenes::{exact_solution, Beam, Scene};
 use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
-use fem_runtime::complementarity::NewtonOptions;
-use fem_runtime::linear_solve::{dot, quadratic_form};
+use fem_runtime::lcp::cholesky::{dot, quadratic_form};
+use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::{
     solve_obstacle, Discretization, ObstacleOptions, ObstacleSolution, VariationalSolver,
 };
@@ -81,7 +81,7 @@ impl Pair {
         }
     }
 
-    /// The default stabilization parameter (MODELS.md: α ≈ 1 for Timoshenko, ≤ 1e-2 for
+    /// The default stabilization parameter (docs/mathematics.md: α ≈ 1 for Timoshenko, ≤ 1e-2 for
     /// Euler–Bernoulli so that the obstacle shift α h⁴|f| stays negligible).
     pub fn default_alpha(self) -> f64 {
         match self {

@@ -467,7 +467,7 @@ fn run(cli: Cli) -> Result<(), String> {
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
-    fem_forms::linear_solve::factor_sequentially();
+    fem_forms::lcp::cholesky::factor_sequentially();
     fem_forms::allocator::retain_freed_memory();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,11 +5,11 @@
 use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use crate::models::membrane_scenes::{Domain, ExactMembrane, MembraneScene};
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
-use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
-use fem_runtime::obstacle_2d::{
+use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
+use fem_runtime::obstacle::triangle::{
     dirichlet_constraints, nodal_active_set, solve_obstacle_on_triangles, TriangleObstacleSolution,
 };
-use fem_runtime::triangle_field::{TriangleBasis, TriangleField};
+use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_runtime::{
     Coefficients, DataFn, Diagonal, DofMap, Error, Model, PointLocator, Result, SystemDofs,
     TriangleMesh,
@@ -348,7 +348,7 @@ pub fn scene_coefficients<M: Model>(scene: &MembraneScene, alpha: f64) -> Result
 }
 
 /// Gauss–Seidel sweeps that replace the first Newton factorization on each nested level
-/// (see [`fem_runtime::complementarity::NewtonOptions::smoothing_sweeps`]).
+/// (see [`fem_runtime::lcp::NewtonOptions::smoothing_sweeps`]).
 pub const MEMBRANE_SMOOTHING_SWEEPS: usize = 8;
 
 /// The LCP options of the membrane solves: no iterative refinement of the Newton
@@ -359,7 +359,7 @@ pub fn membrane_options(solver: VariationalSolver) -> ObstacleOptions {
     let defaults = ObstacleOptions::default();
     ObstacleOptions {
         solver,
-        newton: fem_runtime::complementarity::NewtonOptions {
+        newton: fem_runtime::lcp::NewtonOptions {
             refinement_steps: 0,
             smoothing_sweeps: MEMBRANE_SMOOTHING_SWEEPS,
             ..defaults.newton
@@ -486,7 +486,7 @@ fn file_levels(
             "--mesh-size {refinements} with --msh means {refinements} uniform refinements (4^{refinements} times the triangles); at most 8"
         )));
     }
-    let mut levels = vec![fem_runtime::gmsh::read_msh(path)?];
+    let mut levels = vec![fem_runtime::mesh::gmsh::read_msh(path)?];
     for _ in 0..refinements {
         let finer = levels.last().expect("a level").refine_uniformly();
         levels.push(finer);
@@ -609,7 +609,7 @@ fn stabilized_fields(
     let d = &solution.discretization;
     let mesh = d.mesh.clone();
     let lambda = solution.view(d.multiplier_field).centroid_values();
-    let active = fem_runtime::obstacle_2d::contact_indicator(
+    let active = fem_runtime::obstacle::triangle::contact_indicator(
         &d.lcp,
         &d.primal_part(&solution.values),
         &d.multiplier_dofs()
@@ -768,7 +768,7 @@ fn run_nodal(
 /// Writes the solved fields as a `.vtu` for ParaView: u and ψ at the vertices, λ_h and
 /// the contact set per cell.
 pub fn write_vtk(path: &std::path::Path, fields: &MembraneFields) -> Result<()> {
-    fem_runtime::vtk::write_vtu(
+    fem_runtime::io::vtk::write_vtu(
         path,
         &fields.mesh,
         &[("u", &fields.u), ("psi", &fields.psi)],
@@ -779,7 +779,7 @@ pub fn write_vtk(path: &std::path::Path, fields: &MembraneFields) -> Result<()> 
 /// Interpolates the P1/P2 field of one solve at the points of another (for reference
 /// errors between meshes): `‖u_a − u_b‖_L2` on `a`'s mesh with a rule of degree `degree`.
 pub fn difference_l2(a: &TriangleField, b: &TriangleField, degree: usize) -> f64 {
-    use fem_runtime::triangle_field::AffineMap;
+    use fem_runtime::element::triangle::AffineMap;
     let rule = fem_runtime::reference::triangle::TriangleRule::exact_for_degree(degree);
     let basis_a = TriangleBasis::new(a.map.element());
     let basis_b = TriangleBasis::new(b.map.element());

@@ -1,4 +1,4 @@
-//! The membrane obstacle problem: the inverse-inequality constants of MODELS.md, the
+//! The membrane obstacle problem: the inverse-inequality constants of docs/mathematics.md, the
 //! sign test with its exact solution, convergence to the exact radial solution, the
 //! stabilized solve against the QP solver, and bad input.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
@@ -33,8 +33,8 @@ fn max_difference(a: &[f64], b: &[f64]) -> f64 {
 
 /// Both solves converged, to the same coefficients up to 1e-9 of their size.
 fn assert_same_solution(
-    a: &fem_forms::obstacle_2d::TriangleObstacleSolution,
-    b: &fem_forms::obstacle_2d::TriangleObstacleSolution,
+    a: &fem_forms::obstacle::triangle::TriangleObstacleSolution,
+    b: &fem_forms::obstacle::triangle::TriangleObstacleSolution,
 ) {
     assert!(a.kkt_residual <= 1e-10 && b.kkt_residual <= 1e-10);
     let scale = b.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -52,7 +52,7 @@ fn solve(scene: MembraneScene, pair: MembranePair, n: usize) -> MembraneReport {
     membranes::solve(&request).unwrap().0
 }
 
-/// MODELS.md §1 measured `C_I` of the P2 membrane element: 48 on the equilateral
+/// docs/mathematics.md §1 measured `C_I` of the P2 membrane element: 48 on the equilateral
 /// triangle, 96 on the right isosceles one, 240 on the 120° isosceles one; P1 has 0.
 #[test]
 fn inverse_constants_match_the_measured_ones() {
@@ -79,7 +79,7 @@ fn inverse_constants_match_the_measured_ones() {
     }
 }
 
-/// The sign test of MODELS.md §1: ψ = 0, g = 0, f = −q pressing everywhere onto the
+/// The sign test of docs/mathematics.md §1: ψ = 0, g = 0, f = −q pressing everywhere onto the
 /// obstacle: exact u = 0 and λ = q, so ∫λ = 16q on (−2,2)² and the contact is total.
 #[test]
 fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
@@ -122,7 +122,7 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
     }
 }
 
-/// Observed rates against the exact radial solution on N = 8…64 (MODELS.md §2: u ∉ H³,
+/// Observed rates against the exact radial solution on N = 8…64 (docs/mathematics.md §2: u ∉ H³,
 /// so P2 saturates near O(h^{3/2}) in H¹; P1 is O(h) in H¹ and O(h²) in L²).
 #[test]
 fn radial_convergence_rates() {
@@ -473,7 +473,7 @@ fn the_l_shape_scene_reaches_its_accuracy_with_every_pair() {
 #[test]
 fn the_pipelined_nested_solve_equals_the_sequential_one() {
     use fem_forms::obstacle::solve_lcp;
-    use fem_forms::obstacle_2d::{
+    use fem_forms::obstacle::triangle::{
         discretize_on_triangles, prolong_on_triangles, solve_obstacle_on_triangles,
     };
     type M = membrane_p2_p0::Model;
@@ -509,8 +509,8 @@ fn the_pipelined_nested_solve_equals_the_sequential_one() {
 /// mesh than Newton with every step exact.
 #[test]
 fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
-    use fem_forms::complementarity::NewtonOptions;
-    use fem_forms::obstacle_2d::solve_obstacle_on_triangles;
+    use fem_forms::lcp::NewtonOptions;
+    use fem_forms::obstacle::triangle::solve_obstacle_on_triangles;
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16, 32, 64]);
@@ -545,8 +545,8 @@ fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
 /// updated.
 #[test]
 fn low_rank_updates_keep_the_solution_and_save_factorizations() {
-    use fem_forms::complementarity::NewtonOptions;
-    use fem_forms::obstacle_2d::solve_obstacle_on_triangles;
+    use fem_forms::lcp::NewtonOptions;
+    use fem_forms::obstacle::triangle::solve_obstacle_on_triangles;
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16, 32, 64, 128]);
@@ -579,7 +579,7 @@ fn low_rank_updates_keep_the_solution_and_save_factorizations() {
 #[test]
 fn the_nested_solve_reports_the_first_failing_level() {
     use fem_forms::obstacle::solve_nested;
-    use fem_forms::obstacle_2d::{discretize_on_triangles, prolong_on_triangles};
+    use fem_forms::obstacle::triangle::{discretize_on_triangles, prolong_on_triangles};
     use fem_forms::{Error, TriangleMesh};
     type M = membrane_p1_p0::Model;
     type Level<'a> = Box<
@@ -636,7 +636,7 @@ fn the_nested_solve_reports_the_first_failing_level() {
 #[test]
 fn a_nested_solve_inside_a_level_builder_finishes() {
     use fem_forms::obstacle::solve_nested;
-    use fem_forms::obstacle_2d::{
+    use fem_forms::obstacle::triangle::{
         discretize_on_triangles, prolong_on_triangles, solve_obstacle_on_triangles,
     };
     type M = membrane_p1_p0::Model;

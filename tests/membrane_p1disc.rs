@@ -1,17 +1,17 @@
 //! The membrane with P2–P1disc: its multiplier mass `C_α = α Σ_T h_T² (λ, μ)_T` has one
 //! dense 3 × 3 block per triangle, which the LCP solvers handle block by block. The
 //! radial problem is solved by Newton and by clarabel, compared with P2–P0, and the sign
-//! test of MODELS.md §1 checks every multiplier value.
+//! test of docs/mathematics.md §1 checks every multiplier value.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::complementarity::{
+use fem_forms::lcp::{
     primal_dual_active_set, recover_multiplier, semismooth_newton, NewtonOptions,
 };
 use fem_forms::membranes::{self, alpha_of, scene_mesh, MembranePair, MembraneRequest};
 use fem_forms::models::membrane::membrane_p2_p1disc;
 use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene, MEMBRANE_FLAT};
+use fem_forms::obstacle::triangle::{discretize_on_triangles, solve_obstacle_on_triangles};
 use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
-use fem_forms::obstacle_2d::{discretize_on_triangles, solve_obstacle_on_triangles};
 use fem_forms::Model;
 
 fn radial() -> MembraneScene {
@@ -138,7 +138,7 @@ fn newton_and_the_saddle_point_method_agree_on_the_blocked_membrane_lcp() {
     assert!(partial > 0);
 }
 
-/// The sign test of MODELS.md §1 for P2–P1disc: ψ = 0, g = 0, f = −3 pressing everywhere
+/// The sign test of docs/mathematics.md §1 for P2–P1disc: ψ = 0, g = 0, f = −3 pressing everywhere
 /// onto the obstacle: exact u = 0 and λ = 3, so every multiplier coefficient (not only
 /// the centroid values) is 3 and ∫λ = 48 on (−2,2)².
 #[test]

@@ -5,8 +5,8 @@
 //! and after local newest-vertex refinement.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::linear_solve::Cholesky;
-use fem_forms::obstacle_2d::dirichlet_constraints;
+use fem_forms::lcp::cholesky::Cholesky;
+use fem_forms::obstacle::triangle::dirichlet_constraints;
 use fem_forms::{
     assemble_vector, Coefficients, DataFn, Diagonal, MatrixAssembler, Model, SystemDofs,
     TriangleMesh,

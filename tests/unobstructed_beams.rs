@@ -2,7 +2,7 @@
 //! convergence at the expected rates, symmetric assembled matrices.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::linear_solve::asymmetry;
+use fem_forms::lcp::cholesky::asymmetry;
 use fem_forms::models::{bernoulli, timoshenko_p1_reduced, timoshenko_p2};
 use fem_forms::norms::FieldView;
 use fem_forms::{

@@ -1,5 +1,5 @@
 //! The variational-inequality solvers on the beam scenes: exact solutions and rates,
-//! locking, two independent solvers, iteration counts, the sign test of MODELS.md §1,
+//! locking, two independent solvers, iteration counts, the sign test of docs/mathematics.md §1,
 //! stability where methods fail, and bad input.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
@@ -145,7 +145,7 @@ fn bernoulli_flat_matches_the_exact_contact_set_and_force() {
 
 #[test]
 fn sign_test_both_sides_press_onto_the_obstacle_everywhere() {
-    // MODELS.md §1: ψ = 0, f = −s·q: exact u = 0, λ = q, for both s and both beams.
+    // docs/mathematics.md §1: ψ = 0, f = −s·q: exact u = 0, λ = q, for both s and both beams.
     for (beam, pairs) in [
         (Beam::EulerBernoulli, vec![Pair::BernoulliHermite]),
         (
@@ -353,7 +353,7 @@ fn bad_input_is_a_clear_error() {
 
 #[test]
 fn saddle_point_active_set_and_multiplier_recovery_agree_with_eliminated_newton() {
-    use fem_forms::complementarity::{
+    use fem_forms::lcp::{
         primal_dual_active_set, recover_multiplier, semismooth_newton, NewtonOptions,
     };
     for name in ["timoshenko-a", "bernoulli-flat"] {

@@ -12,7 +12,7 @@
 //!
 //! ```text
 //! fem_forms::model! {
-//!     /// Timoshenko beam over a rigid obstacle (MODELS.md §3), P2–P2–P0.
+//!     /// Timoshenko beam over a rigid obstacle (docs/mathematics.md §3), P2–P2–P0.
 //!     pub mod timoshenko on interval {
 //!         unknowns: θ: P2, w: P2, λ: P0 >= 0;
 //!         tests: η, v, μ;

@@ -1,40 +1,37 @@
 //! The fem-forms runtime: meshes, elements on physical cells, DOF maps, sparse assembly
 //! of generated kernels into faer matrices, boundary conditions and solvers.
 //!
+//! One module per concept, each a folder where it has parts:
+//! [`mesh`] (intervals, triangles, Gmsh files, refinement, point location),
+//! [`element`] (bases on physical cells, finite element functions),
+//! [`assembly`] (DOF maps, the pattern built once, boundary conditions, linear problems),
+//! [`lcp`] (the complementarity problem, semismooth Newton, clarabel, Cholesky with
+//! low-rank updates), [`obstacle`] (a model's VI: the nested solve, the nodal method),
+//! [`norms`] and [`io`]. No module imports one that imports it back.
+//!
 //! Reference elements and quadrature rules come from `fem-reference`, the same crate the
 //! form compiler evaluates at compile time, and are re-exported here.
 #![warn(missing_docs)]
 
 pub mod assembly;
-pub mod boundary;
-pub mod complementarity;
-pub mod dof_map;
 pub mod element;
 pub mod error;
-pub mod gmsh;
-pub mod kernel;
-pub mod linear_problem;
-pub mod linear_solve;
+pub mod io;
+pub mod lcp;
 pub mod mesh;
 pub mod model;
 pub mod norms;
 pub mod obstacle;
-pub mod obstacle_2d;
-pub mod triangle_field;
-pub mod triangle_mesh;
-pub mod vtk;
-pub mod woodbury;
 
-pub use assembly::{assemble_vector, MatrixAssembler};
-pub use boundary::{Constraints, Reduction, Side};
-pub use dof_map::{DofMap, SystemDofs};
+pub use assembly::boundary::{Constraints, Reduction, Side};
+pub use assembly::dof_map::{DofMap, DofNumbering, SystemDofs};
+pub use assembly::linear_problem::{solve_linear, Factorization};
+pub use assembly::{assemble_vector, kernel, MatrixAssembler};
 pub use error::{Error, Result};
 pub use fem_reference as reference;
 pub use fem_reference::{gauss_legendre, CellKind, ElementKind, QuadratureRule};
-pub use linear_problem::{solve_linear, Factorization};
-pub use mesh::IntervalMesh;
+pub use mesh::{Diagonal, IntervalMesh, Mesh, PointLocator, TriangleMesh};
 pub use model::{BlockInfo, Coefficients, DataFn, FieldInfo, FormInfo, Model};
-pub use triangle_mesh::{Diagonal, PointLocator, TriangleMesh};
 
 /// Re-exported sparse matrix type of the assembled systems.
 pub type SparseMatrix = faer::sparse::SparseColMat<usize, f64>;

@@ -1,7 +1,7 @@
 //! Errors of finite element functions against exact solutions, by quadrature.
 
-use crate::dof_map::DofMap;
-use crate::element::PhysicalBasis;
+use crate::assembly::dof_map::DofMap;
+use crate::element::interval::PhysicalBasis;
 use crate::mesh::IntervalMesh;
 use fem_reference::gauss_legendre;
 

@@ -1,4 +1,4 @@
-//! Euler–Bernoulli beam over a rigid obstacle (MODELS.md §4): deflection w in C¹
+//! Euler–Bernoulli beam over a rigid obstacle (docs/mathematics.md §4): deflection w in C¹
 //! Hermite cubics, contact multiplier λ ∈ P0, obstacle side s = ±1.
 //!
 //! `w'''' ≡ 0` for cubics, so `S_h = Σ h⁴ s²(λ, μ)`; α ≤ 1e-2 keeps the obstacle shift

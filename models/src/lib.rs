@@ -1,4 +1,4 @@
-//! fem-forms model files, one DSL file per model (MODELS.md has the mathematics).
+//! fem-forms model files, one DSL file per model (docs/mathematics.md has the mathematics).
 //!
 //! Each model declares its fields, parameters, data and the stabilized forms
 //! `B_h = a − b − bᵀ − α S_h` and `L_h = ℓ − ⟨sψ, μ⟩ − α ℓ_S` of the obstacle problem.

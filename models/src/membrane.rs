@@ -1,4 +1,4 @@
-//! Membrane over a rigid obstacle (MODELS.md §2): deflection u, contact multiplier
+//! Membrane over a rigid obstacle (docs/mathematics.md §2): deflection u, contact multiplier
 //! λ ≥ 0, `u ≥ ψ`, `u = g` on ∂Ω, `−Δu − λ = f`.
 //!
 //! `S_h = Σ_T h² (−Δu − λ, −Δv − μ)_T`: for P1 the Laplacian vanishes on each triangle

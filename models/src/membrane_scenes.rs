@@ -1,4 +1,4 @@
-//! The membrane scenes (MODELS.md §2): domain, load, obstacle and boundary data, and the
+//! The membrane scenes (docs/mathematics.md §2): domain, load, obstacle and boundary data, and the
 //! exact solution where one is known.
 
 /// The domain of a membrane scene.
@@ -125,7 +125,7 @@ fn three(_: &[f64]) -> f64 {
     3.0
 }
 
-/// The sign test of MODELS.md §1 as a scene: ψ = 0, g = 0 and f = −3 pressing everywhere
+/// The sign test of docs/mathematics.md §1 as a scene: ψ = 0, g = 0 and f = −3 pressing everywhere
 /// onto the obstacle, so u = 0, λ = 3, ∫λ = 48 and the contact is the whole (−2,2)².
 /// Not among the default scenes: it checks signs, not accuracy.
 pub const MEMBRANE_FLAT: MembraneScene = MembraneScene {
@@ -159,7 +159,7 @@ fn lshape_load(_: &[f64]) -> f64 {
 pub const MEMBRANE_SCENES: [MembraneScene; 2] = [
     MembraneScene {
         name: "membrane-radial",
-        description: "membrane on (−2,2)² over the hemisphere ψ = √(1−r²), f = 0, exact solution (MODELS.md §2)",
+        description: "membrane on (−2,2)² over the hemisphere ψ = √(1−r²), f = 0, exact solution (docs/mathematics.md §2)",
         domain: Domain::Square(2.0),
         load: zero,
         obstacle: radial_obstacle,

@@ -1,5 +1,5 @@
 //! The beam scenes: data (a name, a beam model, an obstacle, a load, a thickness), not
-//! code paths. MODELS.md §3–§4.
+//! code paths. docs/mathematics.md §3–§4.
 //!
 //! All beams are clamped at both ends of (0, 1). `s = +1` is an obstacle below
 //! (`w ≥ ψ`), `s = −1` one above (`w ≤ ψ`); the load is `f = load_sign · q`.

@@ -1,4 +1,4 @@
-//! Timoshenko beam over a rigid obstacle (MODELS.md §3): rotation θ, deflection w,
+//! Timoshenko beam over a rigid obstacle (docs/mathematics.md §3): rotation θ, deflection w,
 //! contact multiplier λ ≥ 0, thickness t, obstacle side s = ±1.
 //!
 //! The contact equation `θ''' − sλ = f` is free of t, so it is what `S_h` stabilizes,

@@ -1,6 +1,6 @@
 //! Element matrices written by hand, independent of the form compiler and of
 //! `fem-reference`: basis functions typed in from their formulas, a Gauss rule from
-//! the tables, and the forms of MODELS.md written as integrands. Shared by the kernel
+//! the tables, and the forms of docs/mathematics.md written as integrands. Shared by the kernel
 //! tests and the kernel benchmark.
 #![allow(dead_code, clippy::needless_range_loop)]
 
@@ -177,7 +177,7 @@ const LAMBDA: usize = 2;
 const BW: usize = 0;
 const BLAMBDA: usize = 1;
 
-/// The Timoshenko forms of MODELS.md §3 as integrands `(form, U, V, x, setting)`;
+/// The Timoshenko forms of docs/mathematics.md §3 as integrands `(form, U, V, x, setting)`;
 /// `shear_rule` is the rule of the shear term (GAUSS5, or the midpoint for reduced integration).
 pub fn timoshenko_matrix(
     form: &str,
@@ -242,7 +242,7 @@ pub fn timoshenko_vector(
     element_vector(elements, test_field, st, f)
 }
 
-/// The Euler–Bernoulli forms of MODELS.md §4.
+/// The Euler–Bernoulli forms of docs/mathematics.md §4.
 pub fn bernoulli_matrix(
     form: &str,
     test_field: usize,

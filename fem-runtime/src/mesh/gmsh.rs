@@ -8,7 +8,7 @@ use std::path::Path;
 use mshio::{ElementType, MshFile};
 
 use crate::error::{Error, Result};
-use crate::triangle_mesh::TriangleMesh;
+use crate::mesh::triangle::TriangleMesh;
 
 /// Reads a Gmsh `.msh` file (MSH 4.1, ASCII or binary) into a [`TriangleMesh`].
 ///

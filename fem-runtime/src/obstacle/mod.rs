@@ -1,18 +1,21 @@
 //! Obstacle problems of a model: the stabilized saddle-point system `B_h`, `L_h` is
 //! assembled, boundary DOFs are eliminated, and the system is split into the LCP blocks
-//! `A_α, B_α, C_α, F_α, G_α` of MODELS.md §1 (the KKT matrix is
+//! `A_α, B_α, C_α, F_α, G_α` of docs/mathematics.md §1 (the KKT matrix is
 //! `[[A_α, −B_αᵀ], [−B_α, −C_α]]`, its right-hand side `[F_α; −G_α]`).
 
+pub mod triangle;
+
+use crate::assembly::boundary::{Constraints, Reduction, Side};
+use crate::assembly::dof_map::DofNumbering;
+use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::{assemble_vector, block_plans, for_each_entry, BlockPlan};
-use crate::boundary::{Constraints, Reduction, Side};
-use crate::complementarity::{
+use crate::element::interval::PhysicalBasis;
+use crate::error::{Error, Result};
+use crate::lcp::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
     semismooth_newton_prepared, ConstraintRows, CouplingBlocks, Lcp, LcpSolution, NewtonOptions,
     NewtonWorkspace,
 };
-use crate::dof_map::SystemDofs;
-use crate::element::PhysicalBasis;
-use crate::error::{Error, Result};
 use crate::mesh::{IntervalMesh, Mesh};
 use crate::model::{Coefficients, Model};
 use crate::norms::FieldView;
@@ -90,7 +93,7 @@ impl Discretization<IntervalMesh> {
     }
 }
 
-impl<G: Mesh + Clone> Discretization<G> {
+impl<G: DofNumbering + Clone> Discretization<G> {
     /// Assembles `bilinear` and `linear` of `M` on `mesh` with the DOFs `dofs`, eliminates
     /// the fixed DOFs of `constraints` and splits the system into the LCP blocks.
     pub fn with_constraints<M: Model>(
@@ -660,7 +663,7 @@ pub fn solve_nested<G, B>(
     options: ObstacleOptions,
 ) -> Result<ObstacleSolution<G>>
 where
-    G: Mesh + Send + Sync,
+    G: DofNumbering + Send + Sync,
     B: FnOnce() -> Result<Discretization<G>> + Send,
 {
     let clock = Instant::now();

@@ -4,7 +4,12 @@
 //! together with the position in the value array of every element-matrix entry; each
 //! assembly then only zeroes the values and adds the element matrices in place.
 
-use crate::dof_map::SystemDofs;
+pub mod boundary;
+pub mod dof_map;
+pub mod kernel;
+pub mod linear_problem;
+
+use crate::assembly::dof_map::SystemDofs;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::model::{Coefficients, Model};

@@ -2,7 +2,7 @@
 //! symbolic factorization computed once per pattern and reused.
 
 use crate::error::{Error, Result};
-use crate::woodbury::FactorTree;
+use crate::lcp::woodbury::FactorTree;
 use crate::SparseMatrix;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::SolveCore;
@@ -222,7 +222,7 @@ impl Cholesky {
     }
 
     /// [`Cholesky::factor`] without the enum: the factor whose `L` the low-rank updates of
-    /// [`crate::woodbury`] read.
+    /// [`crate::lcp::woodbury`] read.
     pub fn factor_cholesky(&self, a: &SparseMatrix) -> Result<CholeskyFactor> {
         let symbolic = &self.structure.symbolic;
         let mut values = Vec::new();

@@ -5,10 +5,29 @@
 //! triangle mesh: all vertex DOFs, then edge DOFs, then interior DOFs.
 
 use crate::error::{Error, Result};
-use crate::mesh::{IntervalMesh, Mesh};
+use crate::mesh::{IntervalMesh, Mesh, TriangleMesh};
 use crate::model::Model;
-use crate::triangle_mesh::TriangleMesh;
 use fem_reference::{CellKind, ElementKind};
+
+/// Meshes whose DOFs can be numbered: the link from a mesh's topology (vertices, edges,
+/// cells) to the DOF map of an element on it. Kept here rather than on [`Mesh`] so that
+/// meshes know nothing of elements and DOFs.
+pub trait DofNumbering: Mesh {
+    /// Numbers the DOFs of `element` on this mesh.
+    fn dof_map(&self, element: ElementKind) -> DofMap;
+}
+
+impl DofNumbering for IntervalMesh {
+    fn dof_map(&self, element: ElementKind) -> DofMap {
+        DofMap::new(self, element)
+    }
+}
+
+impl DofNumbering for TriangleMesh {
+    fn dof_map(&self, element: ElementKind) -> DofMap {
+        DofMap::on_triangles(self, element)
+    }
+}
 
 /// The DOFs of one field on a mesh.
 #[derive(Clone, Debug, PartialEq)]
@@ -169,7 +188,7 @@ pub struct SystemDofs {
 
 impl SystemDofs {
     /// DOFs of the given fields of model `M` (by index, in the order given).
-    pub fn new<M: Model>(mesh: &impl Mesh, fields: &[usize]) -> Result<Self> {
+    pub fn new<M: Model>(mesh: &impl DofNumbering, fields: &[usize]) -> Result<Self> {
         let mut maps = Vec::new();
         let mut offsets = Vec::new();
         let mut total = 0;
@@ -202,13 +221,13 @@ impl SystemDofs {
     }
 
     /// All fields of the model.
-    pub fn all<M: Model>(mesh: &impl Mesh) -> Result<Self> {
+    pub fn all<M: Model>(mesh: &impl DofNumbering) -> Result<Self> {
         let fields: Vec<usize> = (0..M::FIELDS.len()).collect();
         Self::new::<M>(mesh, &fields)
     }
 
     /// Fields by the names of their unknowns.
-    pub fn named<M: Model>(mesh: &impl Mesh, names: &[&str]) -> Result<Self> {
+    pub fn named<M: Model>(mesh: &impl DofNumbering, names: &[&str]) -> Result<Self> {
         let fields = names
             .iter()
             .map(|n| M::field(n))

@@ -10,7 +10,7 @@
 //! Peierls). A few dozen flipped cells then cost a fraction of a new factorization.
 
 use crate::error::{Error, Result};
-use crate::linear_solve::CholeskyFactor;
+use crate::lcp::cholesky::CholeskyFactor;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
@@ -634,7 +634,7 @@ impl<'f> WoodburySolver<'f> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linear_solve::{multiply, Cholesky};
+    use crate::lcp::cholesky::{multiply, Cholesky};
     use crate::SparseMatrix;
     use faer::sparse::Triplet;
 
@@ -780,7 +780,7 @@ mod tests {
             let solver = WoodburySolver::new(&factor, term).unwrap();
             let b: Vec<f64> = (0..n).map(|_| random.next() - 0.5).collect();
             let x = solver.solve(&b).unwrap();
-            let exact = crate::linear_solve::solve_spd(&h, &b).unwrap();
+            let exact = crate::lcp::cholesky::solve_spd(&h, &b).unwrap();
             let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let error = x
                 .iter()
@@ -815,7 +815,7 @@ mod tests {
             .factor_cholesky(&h0)
             .unwrap();
         // H = H₀ − e₀e₀ᵀ / (H₀⁻¹)₀₀ is singular: H H₀⁻¹e₀ = e₀ − e₀ = 0
-        let e0 = crate::linear_solve::solve_spd(&h0, &{
+        let e0 = crate::lcp::cholesky::solve_spd(&h0, &{
             let mut e = vec![0.0; n];
             e[0] = 1.0;
             e

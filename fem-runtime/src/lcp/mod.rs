@@ -1,5 +1,5 @@
 //! The discrete variational inequality as a linear complementarity problem, and its
-//! solvers (MODELS.md §1):
+//! solvers (docs/mathematics.md §1):
 //!
 //! ```text
 //! A U − Bᵀ Λ = F,   Λ ≥ 0,   R := B U + C Λ − G ≥ 0,   Λ·R = 0
@@ -18,11 +18,14 @@
 //! [`quadratic_program`] solves the same problem with clarabel as an independent check,
 //! and also the plain mixed method (`C = 0`). Every result carries its KKT residual.
 
+pub mod cholesky;
+pub mod woodbury;
+
 use crate::error::{Error, Result};
-use crate::linear_solve::{
+use crate::lcp::cholesky::{
     multiply, refined, residual_compensated, symmetric_gauss_seidel, Cholesky, CholeskyFactor,
 };
-use crate::woodbury::{LowRankTerm, WoodburySolver};
+use crate::lcp::woodbury::{LowRankTerm, WoodburySolver};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use std::ops::Range;
@@ -468,7 +471,7 @@ pub struct LcpSolution {
     /// Number of numeric factorizations.
     pub factorizations: usize,
     /// Newton steps solved through a low-rank update of the last factorization
-    /// ([`crate::woodbury`]) instead of a new one.
+    /// ([`crate::lcp::woodbury`]) instead of a new one.
     pub low_rank_updates: usize,
     /// Estimated relative rounding noise of Λ (see [`Lcp::elimination_noise`]); 0 when Λ
     /// comes from a linear solve or the QP's dual.
@@ -744,7 +747,7 @@ pub struct NewtonOptions {
     /// convergence test stay as they are; convergence is only declared after exact steps.
     pub smoothing_sweeps: usize,
     /// Solve a step through a low-rank update of the last factorization
-    /// ([`crate::woodbury`]) when few constraints changed their face since it and that
+    /// ([`crate::lcp::woodbury`]) when few constraints changed their face since it and that
     /// is estimated cheaper than factoring anew; the step is checked by its residual and
     /// factored anew if that is not at rounding level.
     ///
@@ -1664,7 +1667,7 @@ pub fn recover_multiplier(
     let active: Vec<bool> = solution.lambda.iter().map(|&l| l > 0.0).collect();
     let saddle = SaddlePoint::new(lcp);
     let k_matrix = saddle.matrix(lcp, &active);
-    let factor = crate::linear_solve::LuSolver::analyse(&saddle.symbolic)?.factor(&k_matrix)?;
+    let factor = crate::lcp::cholesky::LuSolver::analyse(&saddle.symbolic)?.factor(&k_matrix)?;
     let mut rhs = lcp.f.clone();
     rhs.extend((0..m).map(|k| if active[k] { -lcp.g[k] } else { 0.0 }));
     let x = factor.solve_refined(&k_matrix, &rhs, refinement_steps)?;
@@ -1710,7 +1713,7 @@ pub fn primal_dual_active_set(
     let (n, m) = (lcp.n(), lcp.m());
     let mut u = lcp.start_vector(start)?;
     let saddle = SaddlePoint::new(lcp);
-    let lu = crate::linear_solve::LuSolver::analyse(&saddle.symbolic)?;
+    let lu = crate::lcp::cholesky::LuSolver::analyse(&saddle.symbolic)?;
     let mut active = lcp.eliminate(&lcp.b_times(&u)).1;
     let mut lambda: Vec<f64> = vec![0.0; m];
     let mut two_ago: Option<Vec<bool>> = None;

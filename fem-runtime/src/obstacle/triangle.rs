@@ -3,15 +3,15 @@
 //! classical nodal-constraint method for comparison, and the solution's contact force
 //! and contact area.
 
-use crate::boundary::Constraints;
-use crate::complementarity::{Lcp, LcpSolution};
-use crate::dof_map::SystemDofs;
+use crate::assembly::boundary::Constraints;
+use crate::assembly::dof_map::SystemDofs;
+use crate::element::triangle::{TriangleBasis, TriangleField};
 use crate::error::{Error, Result};
-use crate::linear_solve::{multiply, Cholesky};
+use crate::lcp::cholesky::{multiply, Cholesky};
+use crate::lcp::{Lcp, LcpSolution};
+use crate::mesh::triangle::{PointLocator, TriangleMesh};
 use crate::model::{Coefficients, Model};
 use crate::obstacle::{solve_nested, Discretization, ObstacleOptions, ObstacleSolution};
-use crate::triangle_field::{TriangleBasis, TriangleField};
-use crate::triangle_mesh::{PointLocator, TriangleMesh};
 use crate::SparseMatrix;
 use faer::sparse::SparseColMat;
 use std::time::Instant;

@@ -1,10 +1,10 @@
 //! A linear variational problem `a(u, v) = ℓ(v)` with fixed DOFs, solved directly.
 
+use crate::assembly::boundary::Constraints;
+use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::{assemble_vector, MatrixAssembler};
-use crate::boundary::Constraints;
-use crate::dof_map::SystemDofs;
 use crate::error::Result;
-use crate::linear_solve::{Cholesky, LuSolver};
+use crate::lcp::cholesky::{Cholesky, LuSolver};
 use crate::mesh::IntervalMesh;
 use crate::model::{Coefficients, Model};
 

@@ -3,7 +3,7 @@
 //! Elimination keeps a symmetric matrix symmetric (and SPD stays SPD), which the
 //! Cholesky solve and the active-set solvers rely on.
 
-use crate::dof_map::SystemDofs;
+use crate::assembly::dof_map::SystemDofs;
 use crate::error::{Error, Result};
 use crate::mesh::IntervalMesh;
 use crate::model::Model;

@@ -10,7 +10,7 @@ use vtkio::model::{
 };
 
 use crate::error::{Error, Result};
-use crate::triangle_mesh::TriangleMesh;
+use crate::mesh::triangle::TriangleMesh;
 
 /// Writes an unstructured-grid `.vtu` (XML with inline base64 data) of the mesh, with
 /// point data (one value per mesh vertex) and cell data (one value per cell).
@@ -110,7 +110,7 @@ fn model(mesh: &TriangleMesh, point_data: &[(&str, &[f64])], cell_data: &[(&str,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::triangle_mesh::Diagonal;
+    use crate::mesh::triangle::Diagonal;
     use vtkio::model::DataArray;
 
     fn scratch(name: &str) -> PathBuf {

@@ -1,8 +1,8 @@
 //! Finite element functions on triangle meshes: values and gradients on cells and at
 //! points, integrals, and errors against exact functions.
 
-use crate::dof_map::DofMap;
-use crate::triangle_mesh::{PointLocator, TriangleMesh};
+use crate::assembly::dof_map::DofMap;
+use crate::mesh::triangle::{PointLocator, TriangleMesh};
 use fem_reference::triangle::{Polynomial2, TriangleRule};
 
 /// A field given by its coefficients on a DOF map of a triangle mesh.

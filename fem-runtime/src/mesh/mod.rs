@@ -1,0 +1,66 @@
+//! Meshes: the abstraction that assembly needs (cells, their coordinates, diameters and
+//! measures: geometry and topology only; DOF numbering lives in [`crate::assembly::dof_map`]),
+//! interval meshes, triangle meshes (generators, validation, newest-vertex bisection,
+//! point location) and Gmsh files.
+
+pub mod gmsh;
+pub mod interval;
+pub mod triangle;
+
+pub use interval::IntervalMesh;
+pub use triangle::{Diagonal, PointLocator, TriangleMesh};
+
+use fem_reference::CellKind;
+
+/// What assembly needs from a mesh: its cells' vertex coordinates as the element kernels
+/// take them, their diameters and measures.
+pub trait Mesh: Sync {
+    /// The reference cell of every cell.
+    const CELL: CellKind;
+    /// Number of cells.
+    fn cell_count(&self) -> usize;
+    /// Writes the vertex coordinates of cell `c` (`x₀ x₁` or `x₀ y₀ x₁ y₁ x₂ y₂`) into `out`.
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]);
+    /// Diameter of cell `c`.
+    fn diameter(&self, c: usize) -> f64;
+    /// Measure (length or area) of cell `c`.
+    fn measure(&self, c: usize) -> f64;
+    /// The reference cell (`Self::CELL`, callable where the mesh type is not named).
+    fn cell_kind(&self) -> CellKind {
+        Self::CELL
+    }
+}
+
+impl Mesh for IntervalMesh {
+    const CELL: CellKind = CellKind::Interval;
+    fn cell_count(&self) -> usize {
+        IntervalMesh::cell_count(self)
+    }
+    #[inline]
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
+        out[..2].copy_from_slice(&self.cell(c));
+    }
+    fn diameter(&self, c: usize) -> f64 {
+        self.h(c)
+    }
+    fn measure(&self, c: usize) -> f64 {
+        self.h(c)
+    }
+}
+
+impl Mesh for TriangleMesh {
+    const CELL: CellKind = CellKind::Triangle;
+    fn cell_count(&self) -> usize {
+        TriangleMesh::cell_count(self)
+    }
+    #[inline]
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
+        out[..6].copy_from_slice(&self.cell_coordinates(c));
+    }
+    fn diameter(&self, c: usize) -> f64 {
+        self.cell_diameter(c)
+    }
+    fn measure(&self, c: usize) -> f64 {
+        self.area(c)
+    }
+}
