@@ -156,6 +156,10 @@ pub fn analyse(
             );
             continue;
         }
+        if let Some(error) = form_name_error(&definition.name) {
+            errors.push(error);
+            continue;
+        }
         if symbols.all_names().contains(&definition.name.text.as_str()) {
             errors.push(Diagnostic::text(
                 definition.name.loc,
@@ -189,6 +193,65 @@ pub fn analyse(
         }
     }
     (forms, errors)
+}
+
+/// Items of the generated module that a form's module must not shadow.
+const GENERATED_ITEMS: [&str; 7] = [
+    "Model", "PARAMS", "DATA", "forms", "fields", "params", "data",
+];
+
+/// Why a form name cannot name the form's generated module and handle, if it cannot.
+fn form_name_error(name: &Name) -> Option<Diagnostic> {
+    let text = name.text.as_str();
+    if GENERATED_ITEMS.contains(&text) {
+        return Some(
+            Diagnostic::text(
+                name.loc,
+                format!("form name `{text}` clashes with the generated item `{text}`"),
+            )
+            .help(format!(
+                "the generated module has {}: pick another name",
+                GENERATED_ITEMS.map(|n| format!("`{n}`")).join(", ")
+            )),
+        );
+    }
+    if syn::parse_str::<syn::Ident>(text).is_ok() {
+        return None;
+    }
+    let keyword = syn::parse_str::<syn::Ident>(&format!("{text}_")).is_ok()
+        && text.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    let (message, help) = if keyword {
+        (
+            format!("form name `{text}` is a Rust keyword or reserved name"),
+            "each form becomes a Rust module and a handle of that name: pick another name"
+                .to_string(),
+        )
+    } else {
+        let suggestion: String = text
+            .chars()
+            .map(|c| match c {
+                '₀'..='₉' => char::from(b'0' + (c as u32 - '₀' as u32) as u8),
+                '⁰' => '0',
+                '¹' => '1',
+                '²' => '2',
+                '³' => '3',
+                '⁴'..='⁹' => char::from(b'4' + (c as u32 - '⁴' as u32) as u8),
+                c => c,
+            })
+            .collect();
+        let hint = if suggestion != text && syn::parse_str::<syn::Ident>(&suggestion).is_ok() {
+            format!(" (e.g. `{suggestion}`)")
+        } else {
+            String::new()
+        };
+        (
+            format!("form name `{text}` is not a Rust identifier"),
+            format!(
+                "each form becomes a Rust module and a handle of that name: use letters, digits and `_`{hint}"
+            ),
+        )
+    };
+    Some(Diagnostic::text(name.loc, message).help(help))
 }
 
 /// Expands a lone integrand-level expression (used by the tests of the symbolic layer).

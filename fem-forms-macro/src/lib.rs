@@ -5,8 +5,9 @@
 //! Use it through `fem_forms::model!` (or `fem_runtime::model!`), which passes the
 //! runtime's path to this macro. The pipeline is three pure stages, each unit-tested on
 //! `proc_macro2` types: `parser` (text → syntax tree), `analysis` with the
-//! `symbolic` IR (syntax tree → blocks of expanded monomials), `codegen` and
-//! `codegen_triangle` (blocks → Rust, on intervals and on affine triangles).
+//! `symbolic` IR (syntax tree → blocks of expanded monomials), `codegen` (blocks →
+//! Rust: a driver, one backend per cell kind — intervals, affine triangles — and one
+//! shared quadrature/data-loop emitter).
 //!
 //! # A model file
 //!
@@ -85,7 +86,6 @@
 
 mod analysis;
 mod codegen;
-mod codegen_triangle;
 mod declaration;
 mod diagnostic;
 mod lexer;

@@ -1,0 +1,374 @@
+//! Kernel IR → the generated Rust module.
+//!
+//! The driver (this file) writes what every model has — the `Model` type and its
+//! `runtime::Model` impl, one module of kernels per form, the typed handles — and asks
+//! the cell's backend for each block kernel:
+//! - `backend.rs`: the interface a cell kind implements ([`backend::CellBackend`]);
+//! - `emit.rs`: the cell-independent parts of a kernel, among them the one quadrature
+//!   and data-loop emitter;
+//! - `interval.rs`, `triangle.rs`: the backends.
+//!
+//! Files depend in one direction only: `backend` ← `emit` ← backends ← driver.
+
+mod backend;
+mod emit;
+mod interval;
+mod triangle;
+
+use crate::analysis::{Block, Form, Symbols};
+use crate::declaration::Declaration;
+use backend::CellBackend;
+use fem_reference::CellKind;
+use proc_macro2::{Ident, Span, TokenStream};
+use quote::quote;
+
+/// The backend of a cell kind.
+fn backend(cell: Option<CellKind>) -> &'static dyn CellBackend {
+    match cell {
+        Some(CellKind::Triangle) => &triangle::Triangle,
+        // An unknown cell is a compile error reported before code generation.
+        _ => &interval::Interval,
+    }
+}
+
+/// The match arms of the `Model` impl's dispatch to the block kernels.
+#[derive(Default)]
+struct Dispatch {
+    matrix: Vec<TokenStream>,
+    add: Vec<TokenStream>,
+    vector: Vec<TokenStream>,
+}
+
+/// What the driver generates for one form.
+struct FormCode {
+    /// The module of its kernels.
+    module: TokenStream,
+    /// Its `FormInfo`.
+    info: TokenStream,
+}
+
+/// The `BlockInfo` of a block.
+fn block_info(
+    block: &Block,
+    symbols: &Symbols,
+    points: usize,
+    runtime: &TokenStream,
+) -> TokenStream {
+    let test_field = block.test_field;
+    let trial_field = match block.trial_field {
+        Some(f) => quote!(::core::option::Option::Some(#f)),
+        None => quote!(::core::option::Option::None),
+    };
+    let description = emit::describe_block(block, symbols);
+    quote! {
+        #runtime::BlockInfo {
+            test_field: #test_field,
+            trial_field: #trial_field,
+            quadrature_points: #points,
+            terms: #description,
+        }
+    }
+}
+
+/// The kernels module and `FormInfo` of form `form_index`, adding its dispatch arms.
+fn form_code(
+    backend: &dyn CellBackend,
+    form_index: usize,
+    form: &Form,
+    symbols: &Symbols,
+    runtime: &TokenStream,
+    dispatch: &mut Dispatch,
+) -> FormCode {
+    let form_ident = Ident::new(&form.name, Span::call_site());
+    let mut functions = Vec::new();
+    let mut block_infos = Vec::new();
+    for (block_index, block) in form.blocks.iter().enumerate() {
+        let code = emit::block_kernel(backend, block, symbols, runtime, &form.name);
+        functions.push(code.function);
+        block_infos.push(block_info(block, symbols, code.quadrature_points, runtime));
+        let name = emit::block_ident(block, symbols);
+        if block.trial_field.is_some() {
+            dispatch.add.push(quote! {
+                (#form_index, #block_index) => #runtime::kernel::add_matrices(mesh, positions, stride, offset, values, |x| #form_ident::#name(x, p, d)),
+            });
+            dispatch.matrix.push(quote! {
+                (#form_index, #block_index) => #runtime::kernel::store_matrix(&#form_ident::#name(x, p, d), out),
+            });
+        } else {
+            dispatch.vector.push(quote! {
+                (#form_index, #block_index) => #runtime::kernel::store_vector(&#form_ident::#name(x, p, d), out),
+            });
+        }
+    }
+    let source = &form.source;
+    let arity = form.arity();
+    let dropped = form.dropped;
+    let doc = format!(" Kernels of `{}`.", form.source);
+    let dropped_doc = format!(
+        " {} term(s) vanish for the chosen elements and were dropped.",
+        form.dropped
+    );
+    let module = quote! {
+        #[doc = #doc]
+        #[doc = #dropped_doc]
+        pub mod #form_ident {
+            use super::*;
+            /// Index of this form in `Model::FORMS`.
+            pub const INDEX: usize = #form_index;
+            /// The definition as written in the model file.
+            pub const SOURCE: &str = #source;
+            #(#functions)*
+        }
+    };
+    let name = &form.name;
+    let info = quote! {
+        #runtime::FormInfo {
+            name: #name,
+            source: #source,
+            arity: #arity,
+            dropped_terms: #dropped,
+            blocks: &[#(#block_infos),*],
+        }
+    };
+    FormCode { module, info }
+}
+
+/// The model's doc comment as one line (`Model::DESCRIPTION`).
+fn description(declaration: &Declaration) -> String {
+    declaration
+        .attrs
+        .iter()
+        .filter_map(|a| match &a.meta {
+            syn::Meta::NameValue(nv) if nv.path.is_ident("doc") => match &nv.value {
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Str(s),
+                    ..
+                }) => Some(s.value().trim().to_string()),
+                _ => None,
+            },
+            _ => None,
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// One typed handle: `pub const name: runtime::Kind<super::Model> = runtime::Kind::new(index);`.
+fn handle(name: &str, kind: &str, index: usize, doc: &str, runtime: &TokenStream) -> TokenStream {
+    let ident = Ident::new(name, Span::call_site());
+    let kind = Ident::new(kind, Span::call_site());
+    quote! {
+        #[doc = #doc]
+        pub const #ident: #runtime::model::#kind<super::Model> = #runtime::model::#kind::new(#index);
+    }
+}
+
+/// The modules `forms`, `fields`, `params` and `data` of typed handles: a misspelled
+/// name is a compile error, and a handle of one model cannot be passed to another.
+fn handles(symbols: &Symbols, forms: &[Form], runtime: &TokenStream) -> TokenStream {
+    let forms = forms
+        .iter()
+        .enumerate()
+        .map(|(i, f)| handle(&f.name, "FormId", i, &format!(" `{}`", f.source), runtime));
+    let fields = symbols.fields.iter().enumerate().flat_map(|(i, f)| {
+        [
+            handle(
+                &f.name,
+                "FieldId",
+                i,
+                &format!(" Unknown `{}` ({}).", f.name, f.element.name()),
+                runtime,
+            ),
+            handle(
+                &f.test_name,
+                "FieldId",
+                i,
+                &format!(
+                    " Test function `{}`: the field of `{}`.",
+                    f.test_name, f.name
+                ),
+                runtime,
+            ),
+        ]
+    });
+    let params = symbols
+        .params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| handle(p, "ParamId", i, &format!(" Parameter `{p}`."), runtime));
+    let data = symbols
+        .data
+        .iter()
+        .enumerate()
+        .map(|(i, (d, _))| handle(d, "DataId", i, &format!(" Data function `{d}`."), runtime));
+    quote! {
+        /// Typed handles of the forms, for `Model::form` and the functions that take a form.
+        pub mod forms {
+            #(#forms)*
+        }
+        /// Typed handles of the fields, by unknown or by test function.
+        pub mod fields {
+            #(#fields)*
+        }
+        /// Typed handles of the parameters, for `Coefficients::from_ids`.
+        pub mod params {
+            #(#params)*
+        }
+        /// Typed handles of the data functions, for `Coefficients::from_ids`.
+        pub mod data {
+            #(#data)*
+        }
+    }
+}
+
+/// The `runtime::Model` impl: names, fields, forms and the dispatch to the kernels.
+fn model_impl(
+    declaration: &Declaration,
+    symbols: &Symbols,
+    backend: &dyn CellBackend,
+    form_infos: &[TokenStream],
+    dispatch: &Dispatch,
+) -> TokenStream {
+    let runtime = &declaration.runtime;
+    let model_name = declaration.name.to_string();
+    let np = symbols.params.len();
+    let nd = symbols.data.len();
+    let cell = Ident::new(backend.cell_variant(), Span::call_site());
+    let coordinates = backend.coordinates();
+    let cell_text = backend.coordinates_message();
+    let dirichlet = declaration.dirichlet.iter().map(|(field, data)| {
+        let f = symbols
+            .fields
+            .iter()
+            .position(|x| *field == x.name)
+            .unwrap_or(0);
+        let g = symbols.data.iter().position(|x| *data == x.0).unwrap_or(0);
+        quote!((#f, #g))
+    });
+    let field_infos = symbols.fields.iter().map(|f| {
+        let (name, test, nonnegative) = (&f.name, &f.test_name, f.nonnegative);
+        let element = Ident::new(&format!("{:?}", f.element), Span::call_site());
+        quote! {
+            #runtime::FieldInfo {
+                name: #name,
+                test_name: #test,
+                element: #runtime::ElementKind::#element,
+                nonnegative: #nonnegative,
+            }
+        }
+    });
+    let params = &symbols.params;
+    let data = symbols.data.iter().map(|d| &d.0);
+    let description = description(declaration);
+    let Dispatch {
+        matrix,
+        add,
+        vector,
+    } = dispatch;
+    quote! {
+        impl #runtime::Model for Model {
+            const NAME: &'static str = #model_name;
+            const DESCRIPTION: &'static str = #description;
+            const CELL: #runtime::CellKind = #runtime::CellKind::#cell;
+            const DIRICHLET: &'static [(usize, usize)] = &[#(#dirichlet),*];
+            const FIELDS: &'static [#runtime::FieldInfo] = &[#(#field_infos),*];
+            const PARAMS: &'static [&'static str] = &[#(#params),*];
+            const DATA: &'static [&'static str] = &[#(#data),*];
+            const FORMS: &'static [#runtime::FormInfo] = &[#(#form_infos),*];
+
+            fn element_matrix(
+                form: usize,
+                block: usize,
+                vertices: &[f64],
+                params: &[f64],
+                data: &[&#runtime::DataFn],
+                out: &mut [f64],
+            ) {
+                let x: &[f64; #coordinates] = vertices.try_into().expect(#cell_text);
+                let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+                let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+                match (form, block) {
+                    #(#matrix)*
+                    _ => panic!("{}: form {} has no bilinear block {}", #model_name, form, block),
+                }
+            }
+
+            fn add_element_matrices<G: #runtime::mesh::Mesh>(
+                form: usize,
+                block: usize,
+                mesh: &G,
+                params: &[f64],
+                data: &[&#runtime::DataFn],
+                positions: &[usize],
+                stride: usize,
+                offset: usize,
+                values: &mut [f64],
+            ) {
+                let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+                let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+                match (form, block) {
+                    #(#add)*
+                    _ => panic!("{}: form {} has no bilinear block {}", #model_name, form, block),
+                }
+            }
+
+            fn element_vector(
+                form: usize,
+                block: usize,
+                vertices: &[f64],
+                params: &[f64],
+                data: &[&#runtime::DataFn],
+                out: &mut [f64],
+            ) {
+                let x: &[f64; #coordinates] = vertices.try_into().expect(#cell_text);
+                let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+                let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+                match (form, block) {
+                    #(#vector)*
+                    _ => panic!("{}: form {} has no linear block {}", #model_name, form, block),
+                }
+            }
+        }
+    }
+}
+
+/// The whole generated module.
+pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) -> TokenStream {
+    let runtime = &declaration.runtime;
+    let backend = backend(declaration.cell);
+    let mut dispatch = Dispatch::default();
+    let (form_modules, form_infos): (Vec<TokenStream>, Vec<TokenStream>) = forms
+        .iter()
+        .enumerate()
+        .map(|(i, form)| {
+            let code = form_code(backend, i, form, symbols, runtime, &mut dispatch);
+            (code.module, code.info)
+        })
+        .unzip();
+    let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch);
+    let handles = handles(symbols, forms, runtime);
+    let module = &declaration.name;
+    let vis = &declaration.vis;
+    let attrs = &declaration.attrs;
+    let np = symbols.params.len();
+    let nd = symbols.data.len();
+    quote! {
+        #(#attrs)*
+        #[allow(non_snake_case, non_upper_case_globals, mixed_script_confusables, confusable_idents, uncommon_codepoints, clippy::all)]
+        #vis mod #module {
+            /// The model: its fields, parameters, data and forms, and the dispatch to its kernels.
+            #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+            pub struct Model;
+
+            /// Number of runtime parameters.
+            pub const PARAMS: usize = #np;
+            /// Number of data functions.
+            pub const DATA: usize = #nd;
+
+            #handles
+
+            #(#form_modules)*
+
+            #model_impl
+        }
+    }
+}
