@@ -4,6 +4,7 @@
 //! the interior DOFs of cell 0, vertex 1, … so that 1D matrices are banded. On a
 //! triangle mesh: all vertex DOFs, then edge DOFs, then interior DOFs.
 
+use crate::element::mapping::Affine;
 use crate::error::{Error, Result};
 use crate::mesh::{IntervalMesh, Mesh, TriangleMesh};
 use crate::model::Model;
@@ -133,12 +134,9 @@ impl DofMap {
         let reference = fem_reference::triangle::lagrange_nodes(self.element.degree());
         let mut nodes = vec![[f64::NAN; 2]; self.dof_count];
         for c in 0..mesh.cell_count() {
-            let x = mesh.cell_coordinates(c);
-            for (&dof, &[s, t]) in self.cell_dofs(c).iter().zip(&reference) {
-                nodes[dof] = [
-                    x[0] + (x[2] - x[0]) * s + (x[4] - x[0]) * t,
-                    x[1] + (x[3] - x[1]) * s + (x[5] - x[1]) * t,
-                ];
+            let map = Affine::of(mesh, c);
+            for (&dof, &xi) in self.cell_dofs(c).iter().zip(&reference) {
+                nodes[dof] = map.point(xi);
             }
         }
         nodes

@@ -1,9 +1,13 @@
-//! Elements on physical cells: basis values and derivatives at points of interval cells
+//! Elements on physical cells: the reference-to-physical map and its chain rule
+//! ([`mapping`]), basis values and derivatives at points of interval cells
 //! ([`interval`]), and finite element functions on triangle meshes with their values,
-//! gradients, integrals and errors ([`triangle`]).
+//! gradients, Hessians, integrals and errors ([`triangle`]).
 
 pub mod interval;
+pub mod mapping;
 pub mod triangle;
+
+pub use mapping::Affine;
 
 pub use interval::PhysicalBasis;
 pub use triangle::{TriangleBasis, TriangleField};

@@ -2,6 +2,7 @@
 //! points, integrals, and errors against exact functions.
 
 use crate::assembly::dof_map::DofMap;
+use crate::element::mapping::Affine;
 use crate::mesh::triangle::{PointLocator, TriangleMesh};
 use fem_reference::triangle::{Polynomial2, TriangleRule};
 
@@ -15,56 +16,16 @@ pub struct TriangleField<'a> {
     pub coefficients: &'a [f64],
 }
 
-/// The affine map of a cell: `x = x₀ + J ξ`, and `K = J⁻¹`.
-#[derive(Clone, Copy, Debug)]
-pub struct AffineMap {
-    origin: [f64; 2],
-    j: [[f64; 2]; 2],
-    k: [[f64; 2]; 2],
-    /// `|det J|` = twice the area.
-    pub det: f64,
-}
+/// The affine map of a triangle (see [`crate::element::mapping`]).
+pub type AffineMap = Affine<2>;
 
-impl AffineMap {
-    /// The map of cell `c`.
-    pub fn of(mesh: &TriangleMesh, c: usize) -> Self {
-        let x = mesh.cell_coordinates(c);
-        let j = [[x[2] - x[0], x[4] - x[0]], [x[3] - x[1], x[5] - x[1]]];
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let k = [
-            [j[1][1] / det, -j[0][1] / det],
-            [-j[1][0] / det, j[0][0] / det],
-        ];
-        Self {
-            origin: [x[0], x[1]],
-            j,
-            k,
-            det: det.abs(),
-        }
-    }
-
-    /// The physical point of reference point `ξ`.
-    pub fn point(&self, xi: [f64; 2]) -> [f64; 2] {
-        [
-            self.origin[0] + self.j[0][0] * xi[0] + self.j[0][1] * xi[1],
-            self.origin[1] + self.j[1][0] * xi[0] + self.j[1][1] * xi[1],
-        ]
-    }
-
-    /// The physical gradient from the reference gradient: `∇φ = Kᵀ ∇̂φ̂`.
-    pub fn gradient(&self, g: [f64; 2]) -> [f64; 2] {
-        [
-            self.k[0][0] * g[0] + self.k[1][0] * g[1],
-            self.k[0][1] * g[0] + self.k[1][1] * g[1],
-        ]
-    }
-}
-
-/// The reference basis of an element with its first derivatives.
+/// The reference basis of an element with its first and second derivatives.
 pub struct TriangleBasis {
     values: Vec<Polynomial2>,
     dx: Vec<Polynomial2>,
     dy: Vec<Polynomial2>,
+    /// `∂²/∂ξ², ∂²/∂ξ∂η, ∂²/∂η²` of each basis function.
+    second: [Vec<Polynomial2>; 3],
 }
 
 impl TriangleBasis {
@@ -73,7 +34,14 @@ impl TriangleBasis {
         let values = element.triangle_basis();
         let dx = values.iter().map(|p| p.derivative(1, 0)).collect();
         let dy = values.iter().map(|p| p.derivative(0, 1)).collect();
-        Self { values, dx, dy }
+        let second = [(2, 0), (1, 1), (0, 2)]
+            .map(|(i, j)| values.iter().map(|p| p.derivative(i, j)).collect());
+        Self {
+            values,
+            dx,
+            dy,
+            second,
+        }
     }
 }
 
@@ -102,6 +70,23 @@ impl TriangleField<'_> {
             g[1] += self.coefficients[d] * py.eval(xi);
         }
         map.gradient(g)
+    }
+
+    /// Hessian (physical second derivatives) at reference point `ξ` of cell `c`.
+    pub fn hessian(
+        &self,
+        basis: &TriangleBasis,
+        map: &AffineMap,
+        c: usize,
+        xi: [f64; 2],
+    ) -> [[f64; 2]; 2] {
+        let mut h = [0.0; 3];
+        for (i, &d) in self.map.cell_dofs(c).iter().enumerate() {
+            for (k, derivative) in basis.second.iter().enumerate() {
+                h[k] += self.coefficients[d] * derivative[i].eval(xi);
+            }
+        }
+        map.hessian([[h[0], h[1]], [h[1], h[2]]])
     }
 
     /// Value at a physical point, `None` outside the mesh.

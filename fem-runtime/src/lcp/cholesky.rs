@@ -2,7 +2,7 @@
 //! symbolic factorization computed once per pattern and reused.
 
 use crate::error::{Error, Result};
-use crate::lcp::woodbury::FactorTree;
+use crate::lcp::factor_tree::FactorTree;
 use crate::SparseMatrix;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::SolveCore;

@@ -19,6 +19,7 @@
 //! and also the plain mixed method (`C = 0`). Every result carries its KKT residual.
 
 pub mod cholesky;
+mod factor_tree;
 pub mod woodbury;
 
 use crate::error::{Error, Result};
