@@ -1035,7 +1035,7 @@ impl Lcp {
 
     /// `H(active) − H(previous)` of the Newton Hessian as `U S Uᵀ`: for each block whose
     /// face changed, its rows of `B` and the change of `P_I C_II⁻¹ P_Iᵀ`.
-    fn hessian_change(&self, previous: &[bool], active: &[bool]) -> LowRankTerm {
+    fn hessian_change(&self, previous: &[bool], active: &[bool]) -> Result<LowRankTerm> {
         let mut term = LowRankTerm::new();
         let mut face = [0usize; MAX_BLOCK];
         let mut inverse = [0.0; BLOCK_ENTRIES];
@@ -1054,9 +1054,9 @@ impl Lcp {
                     }
                 }
             }
-            term.push_block(range.map(|k| &self.b_rows[k]), &change[..s * s]);
+            term.push_block(range.map(|k| &self.b_rows[k]), &change[..s * s])?;
         }
-        term
+        Ok(term)
     }
 
     /// An error unless every block of `C` is positive definite (Φ and the elimination of
@@ -1504,7 +1504,7 @@ fn updated_solve(
     b: &[f64],
     options: NewtonOptions,
 ) -> Option<Vec<f64>> {
-    let term = lcp.hessian_change(factored_active, active);
+    let term = lcp.hessian_change(factored_active, active).ok()?;
     let cost = WoodburySolver::relative_cost(factor, &term, 1 + options.refinement_steps)?;
     if cost > LOW_RANK_COST_LIMIT {
         return None;
@@ -2120,7 +2120,7 @@ mod tests {
             let before: Vec<bool> = (0..m).map(|_| random.next() < 0.5).collect();
             let after: Vec<bool> = (0..m).map(|_| random.next() < 0.5).collect();
             let (h0, h1) = (hessian.matrix(&lcp, &before), hessian.matrix(&lcp, &after));
-            let term = lcp.hessian_change(&before, &after);
+            let term = lcp.hessian_change(&before, &after).unwrap();
             let changed = lcp
                 .blocks()
                 .filter(|b| before[b.range()] != after[b.range()])
