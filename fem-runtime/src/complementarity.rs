@@ -1356,6 +1356,7 @@ fn newton_iteration(
                 iterations: usize,
                 residual: f64,
                 solves: (usize, usize)| {
+        let multiplier_noise = lcp.elimination_noise(&lambda);
         LcpSolution {
             u,
             lambda,
@@ -1364,7 +1365,7 @@ fn newton_iteration(
             seconds: clock.elapsed().as_secs_f64(),
             factorizations: solves.0,
             low_rank_updates: solves.1,
-            multiplier_noise: lcp.elimination_noise(),
+            multiplier_noise,
         }
     };
     let mut smooth_first = start.is_some() && options.smoothing_sweeps > 0;
@@ -1518,16 +1519,35 @@ fn updated_solve(
 }
 
 impl Lcp {
-    /// How many digits the eliminated Λ loses to cancellation: `ε‖G_b‖∞‖C_b⁻¹‖∞ / Λ*`
-    /// at its worst block (`ε|G_k| / (C_k Λ*)` for P0; Λ* the multiplier scale). Near 1 the
-    /// eliminated Λ is rounding noise: on fine meshes `C = αh⁵` falls below the rounding
-    /// of `G − BU ≈ CΛ`.
-    pub fn elimination_noise(&self) -> f64 {
-        let scale = self.multiplier_scale().max(f64::MIN_POSITIVE);
+    /// How many digits the eliminated multiplier `lambda` loses to cancellation: the
+    /// rounding `ε‖G_b‖∞‖C_b⁻¹‖∞` of `Λ_b = C_b⁻¹(G − BU)_b` (`ε|G_k| / C_k` for P0)
+    /// at its worst block among those where `lambda` is nonzero, relative to
+    /// `Λ* = max(‖lambda‖∞, ‖F‖∞/‖Bᵀ‖∞)` (the larger of the multiplier's own size and its
+    /// natural size under the load, [`Lcp::multiplier_scale`]). Near 1 the eliminated Λ
+    /// is rounding noise: on fine meshes `C = αh⁵` falls below the rounding of
+    /// `G − BU ≈ CΛ`.
+    ///
+    /// 0 when `lambda ≡ 0`: the elimination clips every inactive constraint's Λ to an
+    /// exact 0, so there is nothing to be noisy (before, the estimate divided by the load
+    /// scale alone and reported ~1e302 at zero load).
+    pub fn elimination_noise(&self, lambda: &[f64]) -> f64 {
+        let largest = lambda.iter().fold(0.0f64, |m, l| m.max(l.abs()));
+        if largest == 0.0 || !largest.is_finite() {
+            return if largest == 0.0 { 0.0 } else { f64::INFINITY };
+        }
+        let scale = largest.max(self.multiplier_scale());
+        let carries = |range: std::ops::Range<usize>| {
+            lambda
+                .get(range)
+                .is_some_and(|l| l.iter().any(|&l| l != 0.0))
+        };
         let mut dense = [0.0; BLOCK_ENTRIES];
         let mut inverse = [0.0; BLOCK_ENTRIES];
         self.blocks()
             .filter_map(|block| {
+                if !carries(block.range()) {
+                    return None;
+                }
                 let k = block.start;
                 if block.size == 1 {
                     return (self.c[k] > 0.0)
@@ -1678,6 +1698,7 @@ pub fn recover_multiplier(
     // The eliminated Λ's noise is invisible to the (backward-error) residual, so the
     // recovered solution is taken whenever it satisfies the KKT conditions to 1e-8.
     if residual <= 1e-8 {
+        let multiplier_noise = lcp.elimination_noise(&lambda);
         Ok(LcpSolution {
             u,
             lambda,
@@ -1686,7 +1707,7 @@ pub fn recover_multiplier(
             factorizations: solution.factorizations + 1,
             low_rank_updates: solution.low_rank_updates,
             // the recovery helps, but with κ this large it is no guarantee: keep the estimate
-            multiplier_noise: lcp.elimination_noise(),
+            multiplier_noise,
             ..solution
         })
     } else {
