@@ -1521,11 +1521,15 @@ fn updated_solve(
 impl Lcp {
     /// How many digits the eliminated multiplier `lambda` loses to cancellation: the
     /// rounding `ε‖G_b‖∞‖C_b⁻¹‖∞` of `Λ_b = C_b⁻¹(G − BU)_b` (`ε|G_k| / C_k` for P0)
-    /// at its worst block among those where `lambda` is nonzero, relative to
-    /// `Λ* = max(‖lambda‖∞, ‖F‖∞/‖Bᵀ‖∞)` (the larger of the multiplier's own size and its
-    /// natural size under the load, [`Lcp::multiplier_scale`]). Near 1 the eliminated Λ
-    /// is rounding noise: on fine meshes `C = αh⁵` falls below the rounding of
-    /// `G − BU ≈ CΛ`.
+    /// at its worst block among those where `lambda` is nonzero, relative to the
+    /// multiplier's natural size under the load `Λ* = ‖F‖∞/‖Bᵀ‖∞`
+    /// ([`Lcp::multiplier_scale`]), or to `‖lambda‖∞` where `F = 0` (contact driven by
+    /// the obstacle or the boundary data alone). Near 1 the eliminated Λ is rounding
+    /// noise: on fine meshes `C = αh⁵` falls below the rounding of `G − BU ≈ CΛ`.
+    ///
+    /// The load's scale comes first because `‖lambda‖∞` can be far larger than the
+    /// multiplier's typical value (P0 multipliers resolve the point forces at a beam's
+    /// contact edge as ~force/h): relative to it the noise in `∫λ` would be understated.
     ///
     /// 0 when `lambda ≡ 0`: the elimination clips every inactive constraint's Λ to an
     /// exact 0, so there is nothing to be noisy (before, the estimate divided by the load
@@ -1535,7 +1539,12 @@ impl Lcp {
         if largest == 0.0 || !largest.is_finite() {
             return if largest == 0.0 { 0.0 } else { f64::INFINITY };
         }
-        let scale = largest.max(self.multiplier_scale());
+        let load_scale = self.multiplier_scale();
+        let scale = if load_scale > 0.0 {
+            load_scale
+        } else {
+            largest
+        };
         let carries = |range: std::ops::Range<usize>| {
             lambda
                 .get(range)
@@ -2156,7 +2165,7 @@ mod tests {
                 let x: Vec<f64> = (0..lcp.n()).map(|_| random.symmetric()).collect();
                 let expected = multiply(&h1, &x);
                 let h0x = multiply(&h0, &x);
-                let update = term.apply(&x);
+                let update = term.apply(&x).unwrap();
                 let scale = max_norm(&expected);
                 for i in 0..lcp.n() {
                     assert!(
