@@ -244,10 +244,18 @@ pub fn nodal_active_set(
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
     let n = f.len();
-    if psi.len() != n || a.nrows() != n {
+    if psi.len() != n || a.nrows() != n || a.ncols() != n {
         return Err(Error::Input(format!(
-            "nodal obstacle: {} obstacle values for {n} unknowns",
-            psi.len()
+            "nodal obstacle: {} obstacle values and a {} × {} matrix for {n} unknowns",
+            psi.len(),
+            a.nrows(),
+            a.ncols()
+        )));
+    }
+    if let Some(s) = start.filter(|s| s.len() != n) {
+        return Err(Error::Input(format!(
+            "nodal obstacle: a start of {} values for {n} unknowns",
+            s.len()
         )));
     }
     let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());

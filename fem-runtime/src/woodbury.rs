@@ -469,7 +469,11 @@ impl LowRankTerm {
     }
 
     /// `U S Uᵀ x` (`x` of the matrix's order).
-    pub fn apply(&self, x: &[f64]) -> Vec<f64> {
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `U` has a row beyond `x`.
+    pub fn apply(&self, x: &[f64]) -> Result<Vec<f64>> {
+        self.check_rows(x.len())?;
         let t: Vec<f64> = (0..self.rank())
             .map(|j| self.column(j).iter().map(|&(i, v)| v * x[i]).sum())
             .collect();
@@ -480,7 +484,7 @@ impl LowRankTerm {
                 y[i] += v * c;
             }
         }
-        y
+        Ok(y)
     }
 
     /// `y = S x` (block diagonal).
