@@ -158,6 +158,10 @@ pub struct MembraneReport {
     pub complementarity_residual: f64,
     /// Estimated relative rounding noise of λ_h.
     pub multiplier_noise: f64,
+    /// `max(ψ − u_h, 0)` over the vertices and quadrature points: the weak (cell-wise)
+    /// constraint lets u_h dip below ψ by `O(h²)`
+    /// ([`fem_runtime::obstacle_2d::max_penetration`]).
+    pub max_penetration: f64,
     /// What the numbers cannot be trusted for.
     pub warnings: Vec<String>,
 }
@@ -589,6 +593,11 @@ fn run_stabilized<M: Model>(
         exact_contact_area: scene.exact.map(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: solution.multiplier_noise,
+        max_penetration: fem_runtime::obstacle_2d::max_penetration(
+            &u,
+            &scene.obstacle,
+            2 * M::FIELDS[u_field].element.degree(),
+        ),
         warnings,
     };
     Ok((report, fields))
@@ -752,6 +761,7 @@ fn run_nodal(
         exact_contact_area: scene.exact.map(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: 0.0,
+        max_penetration: fem_runtime::obstacle_2d::max_penetration(&u, &scene.obstacle, 2),
         warnings: Vec::new(),
     };
     let fields = MembraneFields::new(

@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::lcp::factor_tree::FactorTree;
 use crate::SparseMatrix;
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::solvers::SolveCore;
+use faer::linalg::solvers::{ShapeCore, SolveCore};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymmetricOrdering,
@@ -225,6 +225,14 @@ impl Cholesky {
     /// [`crate::lcp::woodbury`] read.
     pub fn factor_cholesky(&self, a: &SparseMatrix) -> Result<CholeskyFactor> {
         let symbolic = &self.structure.symbolic;
+        if a.nrows() != symbolic.nrows() || a.ncols() != symbolic.nrows() {
+            return Err(Error::LinearSolve(format!(
+                "a {} × {} matrix for a Cholesky analysis of order {}",
+                a.nrows(),
+                a.ncols(),
+                symbolic.nrows()
+            )));
+        }
         let mut values = Vec::new();
         values
             .try_reserve_exact(symbolic.len_val())
@@ -276,8 +284,9 @@ impl CholeskyFactor {
         );
     }
 
-    /// `A⁻¹ b`; errors when the result is not finite.
+    /// `A⁻¹ b`; errors when `b` is not of `A`'s order or the result is not finite.
     pub fn solve(&self, b: &[f64]) -> Result<Vec<f64>> {
+        check_length(b, self.structure.symbolic.nrows())?;
         let mut x = b.to_vec();
         self.solve_in_place(&mut x);
         finite(x)
@@ -319,6 +328,7 @@ impl Factor {
         match self {
             Factor::Cholesky(f) => f.solve(b),
             Factor::Lu(f) => {
+                check_length(b, f.nrows())?;
                 let mut x = b.to_vec();
                 let n = x.len();
                 f.solve_in_place_with_conj(
@@ -355,6 +365,19 @@ pub fn refined(
         }
     }
     Ok(x)
+}
+
+/// An error unless the right-hand side `b` has the matrix's order `n` (the solvers would
+/// panic on a mismatch).
+fn check_length(b: &[f64], n: usize) -> Result<()> {
+    if b.len() == n {
+        Ok(())
+    } else {
+        Err(Error::Input(format!(
+            "a right-hand side of length {} for a matrix of order {n}",
+            b.len()
+        )))
+    }
 }
 
 /// `x`, or an error when it is not finite (a numerically singular matrix).

@@ -1039,7 +1039,7 @@ impl Lcp {
 
     /// `H(active) − H(previous)` of the Newton Hessian as `U S Uᵀ`: for each block whose
     /// face changed, its rows of `B` and the change of `P_I C_II⁻¹ P_Iᵀ`.
-    fn hessian_change(&self, previous: &[bool], active: &[bool]) -> LowRankTerm {
+    fn hessian_change(&self, previous: &[bool], active: &[bool]) -> Result<LowRankTerm> {
         let mut term = LowRankTerm::new();
         let mut face = [0usize; MAX_BLOCK];
         let mut inverse = [0.0; BLOCK_ENTRIES];
@@ -1058,9 +1058,9 @@ impl Lcp {
                     }
                 }
             }
-            term.push_block(range.map(|k| &self.b_rows[k]), &change[..s * s]);
+            term.push_block(range.map(|k| &self.b_rows[k]), &change[..s * s])?;
         }
-        term
+        Ok(term)
     }
 
     /// An error unless every block of `C` is positive definite (Φ and the elimination of
@@ -1360,6 +1360,7 @@ fn newton_iteration(
                 iterations: usize,
                 residual: f64,
                 solves: (usize, usize)| {
+        let multiplier_noise = lcp.elimination_noise(&lambda);
         LcpSolution {
             u,
             lambda,
@@ -1368,7 +1369,7 @@ fn newton_iteration(
             seconds: clock.elapsed().as_secs_f64(),
             factorizations: solves.0,
             low_rank_updates: solves.1,
-            multiplier_noise: lcp.elimination_noise(),
+            multiplier_noise,
         }
     };
     let mut smooth_first = start.is_some() && options.smoothing_sweeps > 0;
@@ -1508,7 +1509,7 @@ fn updated_solve(
     b: &[f64],
     options: NewtonOptions,
 ) -> Option<Vec<f64>> {
-    let term = lcp.hessian_change(factored_active, active);
+    let term = lcp.hessian_change(factored_active, active).ok()?;
     let cost = WoodburySolver::relative_cost(factor, &term, 1 + options.refinement_steps)?;
     if cost > LOW_RANK_COST_LIMIT {
         return None;
@@ -1522,16 +1523,44 @@ fn updated_solve(
 }
 
 impl Lcp {
-    /// How many digits the eliminated Λ loses to cancellation: `ε‖G_b‖∞‖C_b⁻¹‖∞ / Λ*`
-    /// at its worst block (`ε|G_k| / (C_k Λ*)` for P0; Λ* the multiplier scale). Near 1 the
-    /// eliminated Λ is rounding noise: on fine meshes `C = αh⁵` falls below the rounding
-    /// of `G − BU ≈ CΛ`.
-    pub fn elimination_noise(&self) -> f64 {
-        let scale = self.multiplier_scale().max(f64::MIN_POSITIVE);
+    /// How many digits the eliminated multiplier `lambda` loses to cancellation: the
+    /// rounding `ε‖G_b‖∞‖C_b⁻¹‖∞` of `Λ_b = C_b⁻¹(G − BU)_b` (`ε|G_k| / C_k` for P0)
+    /// at its worst block among those where `lambda` is nonzero, relative to the
+    /// multiplier's natural size under the load `Λ* = ‖F‖∞/‖Bᵀ‖∞`
+    /// ([`Lcp::multiplier_scale`]), or to `‖lambda‖∞` where `F = 0` (contact driven by
+    /// the obstacle or the boundary data alone). Near 1 the eliminated Λ is rounding
+    /// noise: on fine meshes `C = αh⁵` falls below the rounding of `G − BU ≈ CΛ`.
+    ///
+    /// The load's scale comes first because `‖lambda‖∞` can be far larger than the
+    /// multiplier's typical value (P0 multipliers resolve the point forces at a beam's
+    /// contact edge as ~force/h): relative to it the noise in `∫λ` would be understated.
+    ///
+    /// 0 when `lambda ≡ 0`: the elimination clips every inactive constraint's Λ to an
+    /// exact 0, so there is nothing to be noisy (before, the estimate divided by the load
+    /// scale alone and reported ~1e302 at zero load).
+    pub fn elimination_noise(&self, lambda: &[f64]) -> f64 {
+        let largest = lambda.iter().fold(0.0f64, |m, l| m.max(l.abs()));
+        if largest == 0.0 || !largest.is_finite() {
+            return if largest == 0.0 { 0.0 } else { f64::INFINITY };
+        }
+        let load_scale = self.multiplier_scale();
+        let scale = if load_scale > 0.0 {
+            load_scale
+        } else {
+            largest
+        };
+        let carries = |range: std::ops::Range<usize>| {
+            lambda
+                .get(range)
+                .is_some_and(|l| l.iter().any(|&l| l != 0.0))
+        };
         let mut dense = [0.0; BLOCK_ENTRIES];
         let mut inverse = [0.0; BLOCK_ENTRIES];
         self.blocks()
             .filter_map(|block| {
+                if !carries(block.range()) {
+                    return None;
+                }
                 let k = block.start;
                 if block.size == 1 {
                     return (self.c[k] > 0.0)
@@ -1682,6 +1711,7 @@ pub fn recover_multiplier(
     // The eliminated Λ's noise is invisible to the (backward-error) residual, so the
     // recovered solution is taken whenever it satisfies the KKT conditions to 1e-8.
     if residual <= 1e-8 {
+        let multiplier_noise = lcp.elimination_noise(&lambda);
         Ok(LcpSolution {
             u,
             lambda,
@@ -1690,7 +1720,7 @@ pub fn recover_multiplier(
             factorizations: solution.factorizations + 1,
             low_rank_updates: solution.low_rank_updates,
             // the recovery helps, but with κ this large it is no guarantee: keep the estimate
-            multiplier_noise: lcp.elimination_noise(),
+            multiplier_noise,
             ..solution
         })
     } else {
@@ -2124,7 +2154,7 @@ mod tests {
             let before: Vec<bool> = (0..m).map(|_| random.next() < 0.5).collect();
             let after: Vec<bool> = (0..m).map(|_| random.next() < 0.5).collect();
             let (h0, h1) = (hessian.matrix(&lcp, &before), hessian.matrix(&lcp, &after));
-            let term = lcp.hessian_change(&before, &after);
+            let term = lcp.hessian_change(&before, &after).unwrap();
             let changed = lcp
                 .blocks()
                 .filter(|b| before[b.range()] != after[b.range()])
@@ -2139,7 +2169,7 @@ mod tests {
                 let x: Vec<f64> = (0..lcp.n()).map(|_| random.symmetric()).collect();
                 let expected = multiply(&h1, &x);
                 let h0x = multiply(&h0, &x);
-                let update = term.apply(&x);
+                let update = term.apply(&x).unwrap();
                 let scale = max_norm(&expected);
                 for i in 0..lcp.n() {
                     assert!(

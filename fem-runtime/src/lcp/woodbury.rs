@@ -299,23 +299,45 @@ impl LowRankTerm {
 
     /// Appends a block: `columns` of `U` (sparse, `(row, value)`) with their `S` block
     /// (`q × q` row-major, `q` the number of columns).
+    ///
+    /// # Errors
+    /// [`Error::Input`] (and the term unchanged) when `s` does not have `q²` entries.
     pub fn push_block<'a>(
         &mut self,
         columns: impl IntoIterator<Item = &'a [(usize, f64)]>,
         s: &[f64],
-    ) {
+    ) -> Result<()> {
         if self.column_ptr.is_empty() {
             self.column_ptr.push(0);
         }
-        let first = self.rank();
+        let (first, entries) = (self.rank(), self.entries.len());
         for column in columns {
             self.entries.extend_from_slice(column);
             self.column_ptr.push(self.entries.len());
         }
         let q = self.rank() - first;
-        assert_eq!(s.len(), q * q, "S has q² entries for q columns");
+        if s.len() != q * q {
+            self.entries.truncate(entries);
+            self.column_ptr.truncate(first + 1);
+            return Err(Error::Input(format!(
+                "a block of {q} columns of U needs {} entries of S, not {}",
+                q * q,
+                s.len()
+            )));
+        }
         self.blocks.push((first, q));
         self.s.extend_from_slice(s);
+        Ok(())
+    }
+
+    /// An error unless every row of `U` is below `n`, the order of the matrix modified.
+    fn check_rows(&self, n: usize) -> Result<()> {
+        match self.entries.iter().find(|&&(i, _)| i >= n) {
+            Some(&(i, _)) => Err(Error::Input(format!(
+                "the low-rank term has an entry in row {i} of a matrix of order {n}"
+            ))),
+            None => Ok(()),
+        }
     }
 
     /// The number of columns of `U`.
@@ -328,7 +350,11 @@ impl LowRankTerm {
     }
 
     /// `U S Uᵀ x` (`x` of the matrix's order).
-    pub fn apply(&self, x: &[f64]) -> Vec<f64> {
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `U` has a row beyond `x`.
+    pub fn apply(&self, x: &[f64]) -> Result<Vec<f64>> {
+        self.check_rows(x.len())?;
         let t: Vec<f64> = (0..self.rank())
             .map(|j| self.column(j).iter().map(|&(i, v)| v * x[i]).sum())
             .collect();
@@ -339,7 +365,7 @@ impl LowRankTerm {
                 y[i] += v * c;
             }
         }
-        y
+        Ok(y)
     }
 
     /// `y = S x` (block diagonal).
@@ -363,19 +389,26 @@ pub struct WoodburySolver<'f> {
     factor: &'f CholeskyFactor,
     term: LowRankTerm,
     z: PathMatrix,
-    capacitance: nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    /// The LU factors of `I + S W`; `None` for a term of rank 0 (nothing to correct:
+    /// nalgebra's LU of a `0 × 0` matrix cannot solve).
+    capacitance: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
 }
 
 impl<'f> WoodburySolver<'f> {
     /// Estimated flops of `applications` solves through the update, relative to a new
     /// factorization followed by as many solves; `None` when the factor's layout is not
-    /// supported (then factor anew).
+    /// supported, the term has a row beyond the factor's order, or its rank exceeds that
+    /// order (then factor anew: the update cannot be cheaper).
     pub fn relative_cost(
         factor: &CholeskyFactor,
         term: &LowRankTerm,
         applications: usize,
     ) -> Option<f64> {
         let (structure, tree) = (&*factor.structure, factor.structure.tree.as_ref()?);
+        let n = structure.symbolic.nrows();
+        if term.rank() > n || term.check_rows(n).is_err() {
+            return None;
+        }
         let inverse = structure.symbolic.perm().map(|p| p.arrays().1);
         let k = term.rank();
         let (mut paths, mut length) = (0.0, 0.0);
@@ -401,17 +434,37 @@ impl<'f> WoodburySolver<'f> {
         Some(update / refactor)
     }
 
-    /// The solver for `H₀ + U S Uᵀ` with `H₀ = L Lᵀ` in `factor`; an error when the
-    /// capacitance matrix is singular (the modified matrix is, or nearly) or the factor's
-    /// layout is not supported.
+    /// The solver for `H₀ + U S Uᵀ` with `H₀ = L Lᵀ` in `factor`. A term of rank 0
+    /// solves with `H₀` alone.
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `U` has a row beyond the factor's order `n`;
+    /// [`Error::LinearSolve`] when the capacitance matrix is singular (the modified
+    /// matrix is, or nearly), the rank exceeds `n` (factor the modified matrix instead)
+    /// or the factor's layout is not supported.
     pub fn new(factor: &'f CholeskyFactor, term: LowRankTerm) -> Result<Self> {
         let Some(tree) = factor.structure.tree.as_ref() else {
             return Err(Error::LinearSolve(
                 "the factor's layout does not support low-rank updates".into(),
             ));
         };
+        let n = factor.structure.symbolic.nrows();
+        term.check_rows(n)?;
         let k = term.rank();
+        if k > n {
+            return Err(Error::LinearSolve(format!(
+                "a low-rank update of rank {k} to a matrix of order {n}: factor it anew"
+            )));
+        }
         let z = factor.path_matrix(&term);
+        if k == 0 {
+            return Ok(Self {
+                factor,
+                term,
+                z,
+                capacitance: None,
+            });
+        }
         let mut w = DMatrix::<f64>::zeros(k, k);
         let mut gram = Vec::new();
         for (i, &s) in z.nodes.iter().enumerate() {
@@ -468,17 +521,33 @@ impl<'f> WoodburySolver<'f> {
             factor,
             term,
             z,
-            capacitance,
+            capacitance: Some(capacitance),
         })
     }
 
     /// `(H₀ + U S Uᵀ)⁻¹ b = Pᵀ L⁻ᵀ (y − Z (I + S W)⁻¹ S Zᵀ y)`, `y = L⁻¹ P b`: one
     /// solve with `H₀` and products with `Z` on its paths.
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `b` is not of the matrix's order; [`Error::LinearSolve`]
+    /// when the result is not finite.
     pub fn solve(&self, b: &[f64]) -> Result<Vec<f64>> {
+        let n = self.factor.structure.symbolic.nrows();
+        if b.len() != n {
+            return Err(Error::Input(format!(
+                "a right-hand side of length {} for a matrix of order {n}",
+                b.len()
+            )));
+        }
         let tree = self.factor.tree();
         let mut y = self.factor.permute(b);
         self.factor.triangular_solve(&mut y, false);
         let k = self.term.rank();
+        let Some(capacitance) = &self.capacitance else {
+            // rank 0: H = H₀
+            self.factor.triangular_solve(&mut y, true);
+            return finite(self.factor.unpermute(&y));
+        };
         let mut t = vec![0.0; k];
         for (i, &s) in self.z.nodes.iter().enumerate() {
             let (at, block) = self.z.block(i);
@@ -488,7 +557,7 @@ impl<'f> WoodburySolver<'f> {
             }
         }
         let st = DVector::from_vec(self.term.s_times(&t));
-        let c = self.capacitance.solve(&st).ok_or_else(|| {
+        let c = capacitance.solve(&st).ok_or_else(|| {
             Error::LinearSolve("the low-rank update leaves a singular matrix".into())
         })?;
         for (i, &s) in self.z.nodes.iter().enumerate() {
@@ -501,14 +570,18 @@ impl<'f> WoodburySolver<'f> {
             }
         }
         self.factor.triangular_solve(&mut y, true);
-        let x = self.factor.unpermute(&y);
-        if x.iter().all(|v| v.is_finite()) {
-            Ok(x)
-        } else {
-            Err(Error::LinearSolve(
-                "the solution is not finite: the matrix is numerically singular".into(),
-            ))
-        }
+        finite(self.factor.unpermute(&y))
+    }
+}
+
+/// `x`, or an error when it is not finite (a numerically singular matrix).
+fn finite(x: Vec<f64>) -> Result<Vec<f64>> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(Error::LinearSolve(
+            "the solution is not finite: the matrix is numerically singular".into(),
+        ))
     }
 }
 
@@ -638,11 +711,13 @@ mod tests {
             let mut term = LowRankTerm::new();
             for (columns, s) in &added {
                 add_block(&mut h, columns, s, 1.0);
-                term.push_block(columns.iter().map(|c| c.as_slice()), s);
+                term.push_block(columns.iter().map(|c| c.as_slice()), s)
+                    .unwrap();
             }
             for (columns, s) in &removed {
                 let minus: Vec<f64> = s.iter().map(|v| -v).collect();
-                term.push_block(columns.iter().map(|c| c.as_slice()), &minus);
+                term.push_block(columns.iter().map(|c| c.as_slice()), &minus)
+                    .unwrap();
             }
             let h = matrix(n, &h);
             let pattern = h0.symbolic().to_owned().unwrap();
@@ -685,6 +760,69 @@ mod tests {
         );
     }
 
+    /// A term of rank 0 (the Newton step whose contact set did not change since the last
+    /// factorization) solves with `H₀` alone; it panicked in the `0 × 0` capacitance
+    /// solve. Terms that do not fit the factor are errors, not panics.
+    #[test]
+    fn empty_and_misfit_terms_are_solved_or_refused() {
+        for supernodal in [false, true] {
+            let (nx, ny) = (12, 9);
+            let n = nx * ny;
+            let h0 = matrix(n, &grid_laplacian(nx, ny, 0.1));
+            let pattern = h0.symbolic().to_owned().unwrap();
+            let analysis = if supernodal {
+                Cholesky::analyse_supernodal(&pattern)
+            } else {
+                Cholesky::analyse(&pattern)
+            };
+            let factor = analysis.unwrap().factor_cholesky(&h0).unwrap();
+            let b: Vec<f64> = (0..n).map(|i| (i % 7) as f64 - 3.0).collect();
+            let empty = LowRankTerm::new();
+            assert!(WoodburySolver::relative_cost(&factor, &empty, 1).unwrap() < 1.0);
+            let x = WoodburySolver::new(&factor, empty)
+                .unwrap()
+                .solve(&b)
+                .unwrap();
+            let residual = multiply(&h0, &x)
+                .iter()
+                .zip(&b)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(residual <= 1e-12, "rank 0: residual {residual:e}");
+            // the default term (no column pointer yet) is empty too
+            assert!(WoodburySolver::new(&factor, LowRankTerm::default())
+                .unwrap()
+                .solve(&b)
+                .is_ok());
+            // a right-hand side of another order
+            let solver = WoodburySolver::new(&factor, LowRankTerm::new()).unwrap();
+            assert!(solver.solve(&b[1..]).is_err());
+            assert!(factor.solve(&b[1..]).is_err());
+            // a row beyond the matrix
+            let mut outside = LowRankTerm::new();
+            outside.push_block([&[(n, 1.0)][..]], &[1.0]).unwrap();
+            assert!(WoodburySolver::relative_cost(&factor, &outside, 1).is_none());
+            assert!(WoodburySolver::new(&factor, outside).is_err());
+            // more columns than the order: factor anew instead
+            let mut wide = LowRankTerm::new();
+            let column = [(0usize, 1.0)];
+            let columns = vec![&column[..]; n + 1];
+            let mut s = vec![0.0; (n + 1) * (n + 1)];
+            s[0] = 1.0;
+            wide.push_block(columns, &s).unwrap();
+            assert!(WoodburySolver::relative_cost(&factor, &wide, 1).is_none());
+            assert!(WoodburySolver::new(&factor, wide).is_err());
+            // an S block of the wrong size leaves the term as it was
+            let mut term = LowRankTerm::new();
+            assert!(term.push_block([&column[..], &column[..]], &[1.0]).is_err());
+            assert_eq!(term.rank(), 0);
+            // a matrix of another order for the analysis
+            assert!(Cholesky::analyse(&pattern)
+                .unwrap()
+                .factor_cholesky(&matrix(4, &grid_laplacian(2, 2, 0.0)))
+                .is_err());
+        }
+    }
+
     /// An update that makes the matrix singular is refused, not solved into garbage.
     #[test]
     fn a_singular_update_is_refused() {
@@ -703,7 +841,8 @@ mod tests {
         })
         .unwrap();
         let mut term = LowRankTerm::new();
-        term.push_block([&[(0usize, 1.0)][..]], &[-1.0 / e0[0]]);
+        term.push_block([&[(0usize, 1.0)][..]], &[-1.0 / e0[0]])
+            .unwrap();
         assert!(WoodburySolver::new(&factor, term).is_err());
     }
 }

@@ -585,7 +585,7 @@ pub fn solve_lcp_prepared(
                     detail: format!("{newton}; {pdas}"),
                 })?,
             };
-            if lcp.elimination_noise() > 1e-6 {
+            if lcp.elimination_noise(&solution.lambda) > 1e-6 {
                 recover_multiplier(lcp, solution, options.newton.refinement_steps)
             } else {
                 Ok(solution)

@@ -184,6 +184,35 @@ impl ObstacleSolution<TriangleMesh> {
     }
 }
 
+/// The largest penetration `max(ψ − u_h, 0)` of `u` into the obstacle `psi`, over the
+/// mesh vertices (each cell's corners, so discontinuous fields count from every side)
+/// and the points of the symmetric rule exact for degree `degree` on every cell; NaN if
+/// any compared value is.
+///
+/// The stabilized pairs impose `u_h ≥ ψ` weakly, cell by cell against the multiplier
+/// space (P0: on each cell's mean), so `u_h` may dip below ψ inside the contact set and
+/// near its free boundary. For a smooth obstacle the dip is `O(h²)` (the interpolation
+/// error of ψ on the cell: `u_h − ψ` has a nonnegative mean and a second derivative
+/// bounded by ψ's); the nodal method imposes `U_i ≥ ψ_i` at the vertices, where its
+/// penetration is 0 (between them, where ψ is curved, it is `O(h²)` too).
+pub fn max_penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: usize) -> f64 {
+    let basis = TriangleBasis::new(u.map.element());
+    let rule = fem_reference::triangle::TriangleRule::exact_for_degree(degree);
+    let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    let mut largest = 0.0f64;
+    for c in 0..u.mesh.cell_count() {
+        let map = crate::triangle_field::AffineMap::of(u.mesh, c);
+        for &xi in corners.iter().chain(&rule.points) {
+            let depth = psi(&map.point(xi)) - u.value(&basis, c, xi);
+            if depth.is_nan() {
+                return f64::NAN;
+            }
+            largest = largest.max(depth);
+        }
+    }
+    largest
+}
+
 /// Per constraint: active (λ_k above 1e-8 of the multiplier scale) or touching (its
 /// residual `R_k` negligible against the terms it is made of).
 pub fn contact_indicator(lcp: &Lcp, u: &[f64], lambda: &[f64]) -> Vec<bool> {
@@ -215,10 +244,18 @@ pub fn nodal_active_set(
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
     let n = f.len();
-    if psi.len() != n || a.nrows() != n {
+    if psi.len() != n || a.nrows() != n || a.ncols() != n {
         return Err(Error::Input(format!(
-            "nodal obstacle: {} obstacle values for {n} unknowns",
-            psi.len()
+            "nodal obstacle: {} obstacle values and a {} × {} matrix for {n} unknowns",
+            psi.len(),
+            a.nrows(),
+            a.ncols()
+        )));
+    }
+    if let Some(s) = start.filter(|s| s.len() != n) {
+        return Err(Error::Input(format!(
+            "nodal obstacle: a start of {} values for {n} unknowns",
+            s.len()
         )));
     }
     let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
