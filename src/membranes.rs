@@ -160,7 +160,7 @@ pub struct MembraneReport {
     pub multiplier_noise: f64,
     /// `max(ψ − u_h, 0)` over the vertices and quadrature points: the weak (cell-wise)
     /// constraint lets u_h dip below ψ by `O(h²)`
-    /// ([`fem_runtime::obstacle_2d::max_penetration`]).
+    /// ([`fem_runtime::obstacle::triangle::max_penetration`]).
     pub max_penetration: f64,
     /// What the numbers cannot be trusted for.
     pub warnings: Vec<String>,
@@ -593,7 +593,7 @@ fn run_stabilized<M: Model>(
         exact_contact_area: scene.exact.map(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: solution.multiplier_noise,
-        max_penetration: fem_runtime::obstacle_2d::max_penetration(
+        max_penetration: fem_runtime::obstacle::triangle::max_penetration(
             &u,
             &scene.obstacle,
             2 * M::FIELDS[u_field].element.degree(),
@@ -761,7 +761,7 @@ fn run_nodal(
         exact_contact_area: scene.exact.map(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: 0.0,
-        max_penetration: fem_runtime::obstacle_2d::max_penetration(&u, &scene.obstacle, 2),
+        max_penetration: fem_runtime::obstacle::triangle::max_penetration(&u, &scene.obstacle, 2),
         warnings: Vec::new(),
     };
     let fields = MembraneFields::new(

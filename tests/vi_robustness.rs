@@ -6,17 +6,17 @@
 //! is no multiplier, and the `O(h²)` penetration of the weak constraint.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::complementarity::{Lcp, LcpSolution, NewtonOptions};
+use fem_forms::element::triangle::{TriangleBasis, TriangleField};
+use fem_forms::lcp::{Lcp, LcpSolution, NewtonOptions};
 use fem_forms::models::membrane::{
     membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc,
 };
 use fem_forms::models::membrane_scenes::membrane_scene;
-use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
-use fem_forms::obstacle_2d::{
+use fem_forms::obstacle::triangle::{
     dirichlet_constraints, max_penetration, nodal_active_set, nodal_lcp,
     solve_obstacle_on_triangles, TriangleObstacleSolution,
 };
-use fem_forms::triangle_field::{TriangleBasis, TriangleField};
+use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_forms::{
     assemble_vector, Coefficients, DataFn, Diagonal, ElementKind, MatrixAssembler, Model,
     PointLocator, SystemDofs, TriangleMesh,
@@ -278,7 +278,7 @@ fn square(n: usize) -> TriangleMesh {
 /// Issue 10, case 1: pressed flat onto ψ = 0 (f = −3), the contact is total and Newton
 /// ends on a step whose contact set did not change since the last factorization: a
 /// low-rank update of rank 0, on which the capacitance solve panicked ("Matrix slicing
-/// out of bounds"). Every size of the case now gives u = 0 and λ = 3 (MODELS.md §1),
+/// out of bounds"). Every size of the case now gives u = 0 and λ = 3 (docs/mathematics.md §1),
 /// with the updates on as with them off.
 #[test]
 fn full_contact_through_low_rank_updates_is_solved() {
@@ -314,7 +314,7 @@ fn p2_pairs_on_a_small_gmsh_disk_are_certified() {
     let scene = membrane_scene("membrane-lshape").unwrap();
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/disk_r1_order1.msh");
-    let coarse = fem_forms::gmsh::read_msh(&path).unwrap();
+    let coarse = fem_forms::mesh::gmsh::read_msh(&path).unwrap();
     let fine = coarse.refine_uniformly();
     let nested = [coarse, fine];
     let (load, obstacle, boundary) = (&scene.load, &scene.obstacle, &scene.boundary);

@@ -176,3 +176,43 @@ impl TriangleField<'_> {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fem_reference::ElementKind;
+
+    /// A P2 field interpolating `u = x² + 3xy − y²` is `u` itself: its gradient and
+    /// Hessian at any point of any cell of a curved-boundary (disk) mesh are exact.
+    #[test]
+    fn p2_field_reproduces_derivatives_of_a_quadratic() {
+        let mesh = TriangleMesh::disk([0.3, -0.1], 1.5, 3).unwrap();
+        let map = DofMap::on_triangles(&mesh, ElementKind::P2);
+        let coefficients: Vec<f64> = map
+            .nodes(&mesh)
+            .iter()
+            .map(|&[x, y]| x * x + 3.0 * x * y - y * y)
+            .collect();
+        let field = TriangleField {
+            mesh: &mesh,
+            map: &map,
+            coefficients: &coefficients,
+        };
+        let basis = TriangleBasis::new(ElementKind::P2);
+        for c in 0..mesh.cell_count() {
+            let affine = AffineMap::of(&mesh, c);
+            let xi = [0.21, 0.37];
+            let [x, y] = affine.point(xi);
+            let g = field.gradient(&basis, &affine, c, xi);
+            let h = field.hessian(&basis, &affine, c, xi);
+            assert!((g[0] - (2.0 * x + 3.0 * y)).abs() < 1e-11, "{g:?}");
+            assert!((g[1] - (3.0 * x - 2.0 * y)).abs() < 1e-11, "{g:?}");
+            let exact = [[2.0, 3.0], [3.0, -2.0]];
+            for r in 0..2 {
+                for s in 0..2 {
+                    assert!((h[r][s] - exact[r][s]).abs() < 1e-9, "cell {c}: {h:?}");
+                }
+            }
+        }
+    }
+}

@@ -201,7 +201,7 @@ pub fn max_penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: us
     let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
     let mut largest = 0.0f64;
     for c in 0..u.mesh.cell_count() {
-        let map = crate::triangle_field::AffineMap::of(u.mesh, c);
+        let map = crate::element::triangle::AffineMap::of(u.mesh, c);
         for &xi in corners.iter().chain(&rule.points) {
             let depth = psi(&map.point(xi)) - u.value(&basis, c, xi);
             if depth.is_nan() {
