@@ -589,3 +589,87 @@ fn the_penetration_of_the_weak_constraint_is_second_order() {
         }
     }
 }
+
+/// The noise estimate by hand on a one-unknown LCP (`A = 1`, `B = 1`, `C = c`, `G = 1`):
+/// `ε|G|/(C·Λ*)` with `Λ* = |F|/|B|` under a load, `Λ* = Λ` without one, 0 for `Λ = 0`.
+#[test]
+fn the_noise_estimate_follows_its_formula() {
+    let one = faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(
+        1,
+        1,
+        &[faer::sparse::Triplet::new(0, 0, 1.0)],
+    )
+    .unwrap();
+    let c = 1e-6;
+    let lcp = |f: f64| {
+        Lcp::new(
+            one.clone(),
+            vec![vec![(0, 1.0)]],
+            vec![c],
+            vec![f],
+            vec![1.0],
+        )
+    };
+    let epsilon = f64::EPSILON;
+    assert_eq!(lcp(2.0).elimination_noise(&[0.5]), epsilon / (c * 2.0));
+    assert_eq!(lcp(0.0).elimination_noise(&[0.5]), epsilon / (c * 0.5));
+    assert_eq!(lcp(0.0).elimination_noise(&[0.0]), 0.0);
+    assert_eq!(lcp(2.0).elimination_noise(&[0.0]), 0.0);
+}
+
+/// Inputs of the wrong size to the nodal method and the low-rank term are errors.
+#[test]
+fn misfit_inputs_are_errors() {
+    let mesh = square(4);
+    type M = membrane_p1::Model;
+    let coefficients = Coefficients::new::<M>(&[], &[("f", &zero), ("g", &zero)]).unwrap();
+    let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+    let constraints = dirichlet_constraints::<M>(&mesh, &dofs, &coefficients).unwrap();
+    let k = MatrixAssembler::new::<M>("a", &mesh, &dofs)
+        .unwrap()
+        .assemble::<M>(&mesh, &coefficients)
+        .unwrap();
+    let reduction = constraints.reduction(dofs.dof_count()).unwrap();
+    let a = reduction.matrix(&k);
+    let n = a.nrows();
+    let (f, psi) = (vec![-1.0; n], vec![0.0; n]);
+    assert!(nodal_active_set(&a, &f, &psi, None, 50).is_ok());
+    assert!(nodal_active_set(&a, &f, &psi, Some(&vec![0.0; n - 1]), 50).is_err());
+    assert!(nodal_active_set(&a, &f, &psi[1..], None, 50).is_err());
+    let mut term = fem_forms::woodbury::LowRankTerm::new();
+    term.push_block([&[(n, 1.0)][..]], &[1.0]).unwrap();
+    assert!(term.apply(&vec![1.0; n]).is_err());
+    assert!(term.apply(&vec![1.0; n + 1]).is_ok());
+}
+
+/// The sliver mesh of the cases (three triangles, one with an angle near 180°) refined
+/// five times, `membrane-radial`'s data: the P2 pairs panicked; every pair now answers
+/// with an error or a certified solution of its discrete problem (whether that is
+/// accurate on such a mesh is the mesh-quality report's business, not this test's).
+#[test]
+fn the_sliver_mesh_gives_an_error_or_a_certified_solution() {
+    let scene = membrane_scene("membrane-radial").unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sliver.msh");
+    let mut levels = vec![fem_forms::gmsh::read_msh(&path).unwrap()];
+    for _ in 0..5 {
+        let finer = levels.last().unwrap().refine_uniformly();
+        levels.push(finer);
+    }
+    let (load, obstacle, boundary) = (&scene.load, &scene.obstacle, &scene.boundary);
+    let options = options(true, 8);
+    let solutions = [
+        solve_stabilized::<membrane_p1_p0::Model>(&levels, load, obstacle, boundary, options),
+        solve_stabilized::<membrane_p2_p0::Model>(&levels, load, obstacle, boundary, options),
+        solve_stabilized::<membrane_p2_p1disc::Model>(&levels, load, obstacle, boundary, options),
+    ];
+    for (pair, solution) in ["P1–P0", "P2–P0", "P2–P1disc"].iter().zip(solutions) {
+        match solution {
+            Ok(solution) => {
+                let (u, lambda) = lcp_unknowns(&solution);
+                certify(&solution.discretization.lcp, &u, &lambda, 1e-7)
+                    .unwrap_or_else(|e| panic!("{pair}: {e}"));
+            }
+            Err(e) => println!("{pair}: {e}"),
+        }
+    }
+}
