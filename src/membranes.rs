@@ -460,7 +460,14 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     validate(&scene, mesh)?;
     let quality = mesh.quality();
     quality.check(mesh)?;
-    let (alpha, c_i) = alpha_of(request, mesh)?;
+    let (alpha, c_i) = alpha_of(request, mesh).map_err(|e| match e {
+        // C_I's eigenproblem fails only when a cell's stiffness is numerically singular
+        Error::LinearSolve(m) => Error::Input(format!(
+            "cannot compute the stabilization's C_I on this mesh ({m}): its worst triangle, {}, is too thin; remesh with better-shaped triangles",
+            worst_cell(mesh, quality.min_angle_cell)
+        )),
+        other => other,
+    })?;
     check_stabilization_above_rounding(request, mesh, &quality, c_i)?;
     let (mut report, fields) = dispatch!(request.pair,
         M => run_stabilized::<M>(request, &meshes, alpha, c_i),
@@ -476,10 +483,16 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     Ok((report, fields))
 }
 
+/// `α·C_I(equilateral)` below which [`check_stabilization_above_rounding`] refuses: about
+/// 450 rounding units. λ_h's rounding noise grows like `ε / (α·C_I)` (a needle mesh
+/// measured 2e-4 at 4e-12 and 2 at 4e-16), so below this it reaches the percent level.
+const SMALLEST_RELATIVE_STABILIZATION: f64 = 1e-13;
+
 /// Refuses a default α = ½/C_I so small, because of the mesh's worst cell, that the
 /// stabilization of a well-shaped (equilateral) cell, `α·C_I(equilateral)` relative to
-/// its stiffness, is below rounding: the method would then be the unstabilized one
-/// without saying so. An α given by the user is taken as asked.
+/// its stiffness, is below [`SMALLEST_RELATIVE_STABILIZATION`]: the method would run
+/// unstabilized without saying so and λ_h be drowned in rounding. An α given by the
+/// user is taken as asked.
 fn check_stabilization_above_rounding(
     request: &MembraneRequest,
     mesh: &TriangleMesh,
@@ -494,27 +507,37 @@ fn check_stabilization_above_rounding(
         M => element_inverse_constant::<M>(&equilateral)?,
         nodal => 0.0);
     let relative = 0.5 / c_i * regular;
-    if relative >= f64::EPSILON {
+    if relative >= SMALLEST_RELATIVE_STABILIZATION {
         return Ok(());
     }
-    let c = quality.min_angle_cell;
+    Err(Error::Input(format!(
+        "the mesh's worst triangle, {}, has C_I = {c_i:.3e}, which forces α = ½/C_I = {:.3e}: the stabilization of a well-shaped triangle is then {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}, so {} would run practically unstabilized with λ_h lost in rounding; remesh with better-shaped triangles (or give --alpha explicitly)",
+        worst_cell(mesh, quality.min_angle_cell),
+        0.5 / c_i,
+        request.pair.name()
+    )))
+}
+
+/// "cell 3 with corners (…), (…), (…) and angles …°, …°, …°", for messages.
+fn worst_cell(mesh: &TriangleMesh, c: usize) -> String {
     let angles: Vec<String> = mesh
         .cell_angles(c)
         .iter()
-        .map(|a| format!("{:.3e}°", a.to_degrees()))
+        .map(|a| match a.to_degrees() {
+            d if d >= 0.01 => format!("{d:.4}°"),
+            d => format!("{d:.3e}°"),
+        })
         .collect();
     let corners: Vec<String> = mesh
         .cell(c)
         .iter()
         .map(|&v| format!("({}, {})", mesh.vertices()[v][0], mesh.vertices()[v][1]))
         .collect();
-    Err(Error::Input(format!(
-        "the mesh's worst triangle (e.g. cell {c} with corners {} and angles {}) has C_I = {c_i:.3e}, which forces α = ½/C_I = {:.3e}: the stabilization of a well-shaped triangle is then {relative:.1e} of its stiffness, below rounding, so {} would run unstabilized; remesh with better-shaped triangles (or give --alpha explicitly)",
+    format!(
+        "cell {c} with corners {} and angles {}",
         corners.join(", "),
-        angles.join(", "),
-        0.5 / c_i,
-        request.pair.name()
-    )))
+        angles.join(", ")
+    )
 }
 
 /// The most memory a solve may plan to use.

@@ -343,3 +343,73 @@ fn every_mesh_with_every_pair_solves_or_is_refused_without_a_panic() {
         }
     }
 }
+
+/// A mesh of the pentagon (0, ±1), (1, ±1), (0, 0) whose cell 0 is the needle
+/// (0, 0), (1, −t), (1, t): smallest angle about 2t, largest about 90°.
+fn needle_msh(t: f64) -> String {
+    let nodes = [
+        [0.0, 0.0],
+        [1.0, -t],
+        [1.0, t],
+        [1.0, -1.0],
+        [1.0, 1.0],
+        [0.0, -1.0],
+        [0.0, 1.0],
+    ];
+    let cells = [[1, 2, 3], [1, 4, 2], [1, 3, 5], [1, 6, 4], [1, 5, 7]];
+    let mut text = format!("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 7 1 7\n2 1 0 7\n");
+    for i in 1..=7 {
+        text.push_str(&format!("{i}\n"));
+    }
+    for [x, y] in nodes {
+        text.push_str(&format!("{x:e} {y:e} 0\n"));
+    }
+    text.push_str("$EndNodes\n$Elements\n1 5 1 5\n2 1 2 5\n");
+    for (i, [a, b, c]) in cells.iter().enumerate() {
+        text.push_str(&format!("{} {a} {b} {c}\n", i + 1));
+    }
+    text.push_str("$EndElements\n");
+    text
+}
+
+#[test]
+fn needles_warn_and_refuse_where_the_forced_alpha_drowns_in_rounding() {
+    let dir = scratch("needle");
+    for (t, p2_accepted) in [(1e-4, true), (1e-8, false), (1e-10, false)] {
+        let path = dir.join(format!("needle-{t:e}.msh"));
+        std::fs::write(&path, needle_msh(t)).unwrap();
+        let m = read_msh(&path).unwrap();
+        // the apex angle 2·atan(t), and a largest angle of 90° + atan(t)
+        let q = m.quality();
+        let apex = 2.0 * t.atan().to_degrees();
+        assert!((q.min_angle_deg - apex).abs() < 1e-9 * apex, "{q:?}");
+        assert!((q.max_angle_deg - 90.0 - t.atan().to_degrees()).abs() < 1e-9);
+        for pair in PAIRS {
+            let run = solve(&path, pair, &[]);
+            if pair.starts_with("p1") || p2_accepted {
+                let report = json(&run);
+                let warnings = report["warnings"].to_string();
+                assert!(warnings.contains("below 5°"), "{t} {pair}: {warnings}");
+            } else {
+                let stderr = refusal(&run);
+                assert!(
+                    stderr.contains("worst triangle")
+                        && stderr.contains("cell 0 with corners (1, ")
+                        && stderr.contains("remesh"),
+                    "{t} {pair}: {stderr}"
+                );
+            }
+        }
+        // an α given by the user is taken as asked where C_I can be computed (far
+        // outside the stability range here, so the solve itself may fail, cleanly)
+        if t == 1e-8 {
+            let run = solve(&path, "p2-p0", &["--alpha", "1e-3"]);
+            let stderr = String::from_utf8_lossy(&run.stderr);
+            assert!(!stderr.contains("panicked") && !stderr.contains("worst triangle"));
+            if run.status.success() {
+                assert_eq!(json(&run)["alpha"].as_f64(), Some(1e-3));
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
