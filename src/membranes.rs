@@ -164,6 +164,25 @@ pub struct MembraneReport {
     pub max_penetration: f64,
     /// What the numbers cannot be trusted for.
     pub warnings: Vec<String>,
+    /// Shape of the solved (finest) mesh's triangles.
+    pub mesh_quality: MeshQualityReport,
+}
+
+/// The shape of a mesh's triangles and what it forces on the stabilization (the
+/// `mesh_quality` object of the `--json` report).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct MeshQualityReport {
+    /// Smallest angle of any triangle, in degrees.
+    pub min_angle_deg: f64,
+    /// Largest angle of any triangle, in degrees.
+    pub max_angle_deg: f64,
+    /// Largest `h_T / (2√3 r_T)` (1 for the equilateral triangle; see
+    /// [`fem_runtime::mesh::triangle::MeshQuality`]).
+    pub max_aspect_ratio: f64,
+    /// `max_T C_I(T)` of the pair's elements (0 where Δ vanishes on them: P1).
+    pub worst_inverse_constant: f64,
+    /// The α = ½/C_I that constant forces (`None` where C_I = 0).
+    pub forced_alpha: Option<f64>,
 }
 
 /// The solved fields, for VTK and charts.
@@ -432,7 +451,7 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     let scene = request.scene;
     check_memory(request)?;
     let meshes = match &request.mesh_file {
-        Some(path) => file_levels(path, request.mesh_size, request.nested)?,
+        Some(path) => file_levels(path, request.mesh_size, request.nested, request.pair)?,
         None => {
             let even = scene.domain == Domain::LShape;
             level_sizes(request.mesh_size, request.nested, even)
@@ -443,10 +462,86 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     };
     let mesh = meshes.last().expect("at least one level");
     validate(&scene, mesh)?;
-    let (alpha, c_i) = alpha_of(request, mesh)?;
-    dispatch!(request.pair,
+    let quality = mesh.quality();
+    quality.check(mesh)?;
+    let (alpha, c_i) = alpha_of(request, mesh).map_err(|e| match e {
+        // C_I's eigenproblem fails only when a cell's stiffness is numerically singular
+        Error::LinearSolve(m) => Error::Input(format!(
+            "cannot compute the stabilization's C_I on this mesh ({m}): its worst triangle, {}, is too thin; remesh with better-shaped triangles",
+            worst_cell(mesh, quality.min_angle_cell)
+        )),
+        other => other,
+    })?;
+    check_stabilization_above_rounding(request, mesh, &quality, c_i)?;
+    let (mut report, fields) = dispatch!(request.pair,
         M => run_stabilized::<M>(request, &meshes, alpha, c_i),
-        nodal => run_nodal(request, &meshes))
+        nodal => run_nodal(request, &meshes))?;
+    report.warnings.extend(quality.warnings(mesh));
+    report.mesh_quality = MeshQualityReport {
+        min_angle_deg: quality.min_angle_deg,
+        max_angle_deg: quality.max_angle_deg,
+        max_aspect_ratio: quality.max_aspect_ratio,
+        worst_inverse_constant: c_i,
+        forced_alpha: (c_i > 0.0).then(|| 0.5 / c_i),
+    };
+    Ok((report, fields))
+}
+
+/// `α·C_I(equilateral)` below which [`check_stabilization_above_rounding`] refuses: about
+/// 450 rounding units. λ_h's rounding noise grows like `ε / (α·C_I)` (a needle mesh
+/// measured 2e-4 at 4e-12 and 2 at 4e-16), so below this it reaches the percent level.
+const SMALLEST_RELATIVE_STABILIZATION: f64 = 1e-13;
+
+/// Refuses a default α = ½/C_I so small, because of the mesh's worst cell, that the
+/// stabilization of a well-shaped (equilateral) cell, `α·C_I(equilateral)` relative to
+/// its stiffness, is below [`SMALLEST_RELATIVE_STABILIZATION`]: the method would run
+/// unstabilized without saying so and λ_h be drowned in rounding. An α given by the
+/// user is taken as asked.
+fn check_stabilization_above_rounding(
+    request: &MembraneRequest,
+    mesh: &TriangleMesh,
+    quality: &fem_runtime::mesh::triangle::MeshQuality,
+    c_i: f64,
+) -> Result<()> {
+    if request.alpha.is_some() || c_i <= 0.0 {
+        return Ok(());
+    }
+    let equilateral = [0.0, 0.0, 1.0, 0.0, 0.5, 0.75f64.sqrt()];
+    let regular = dispatch!(request.pair,
+        M => element_inverse_constant::<M>(&equilateral)?,
+        nodal => 0.0);
+    let relative = 0.5 / c_i * regular;
+    if relative >= SMALLEST_RELATIVE_STABILIZATION {
+        return Ok(());
+    }
+    Err(Error::Input(format!(
+        "the mesh's worst triangle, {}, has C_I = {c_i:.3e}, which forces α = ½/C_I = {:.3e}: the stabilization of a well-shaped triangle is then {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}, so {} would run practically unstabilized with λ_h lost in rounding; remesh with better-shaped triangles (or give --alpha explicitly)",
+        worst_cell(mesh, quality.min_angle_cell),
+        0.5 / c_i,
+        request.pair.name()
+    )))
+}
+
+/// "cell 3 with corners (…), (…), (…) and angles …°, …°, …°", for messages.
+fn worst_cell(mesh: &TriangleMesh, c: usize) -> String {
+    let angles: Vec<String> = mesh
+        .cell_angles(c)
+        .iter()
+        .map(|a| match a.to_degrees() {
+            d if d >= 0.01 => format!("{d:.4}°"),
+            d => format!("{d:.3e}°"),
+        })
+        .collect();
+    let corners: Vec<String> = mesh
+        .cell(c)
+        .iter()
+        .map(|&v| format!("({}, {})", mesh.vertices()[v][0], mesh.vertices()[v][1]))
+        .collect();
+    format!(
+        "cell {c} with corners {} and angles {}",
+        corners.join(", "),
+        angles.join(", ")
+    )
 }
 
 /// The most memory a solve may plan to use.
@@ -459,11 +554,7 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
     if request.mesh_file.is_some() {
         return Ok(());
     }
-    let per_triangle = match request.pair {
-        MembranePair::P1P0 | MembranePair::P1Nodal => 1.4e3,
-        MembranePair::P2P0 => 2.3e3,
-        MembranePair::P2P1Disc => 3.5e3,
-    };
+    let per_triangle = bytes_per_triangle(request.pair);
     let n = request.mesh_size as f64;
     let bytes = 2.0 * n * n * per_triangle;
     if bytes > MEMORY_LIMIT_BYTES {
@@ -478,19 +569,52 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
     Ok(())
 }
 
+/// Measured peak bytes per triangle of the finest mesh (see [`check_memory`]).
+fn bytes_per_triangle(pair: MembranePair) -> f64 {
+    match pair {
+        MembranePair::P1P0 | MembranePair::P1Nodal => 1.4e3,
+        MembranePair::P2P0 => 2.3e3,
+        MembranePair::P2P1Disc => 3.5e3,
+    }
+}
+
 /// The levels of a Gmsh mesh: the file's mesh and its `refinements` uniform
-/// refinements (all of them for nested iteration, else the finest only).
+/// refinements (all of them for nested iteration, else the finest only). Refused before
+/// refining if the solve would need more than [`MEMORY_LIMIT_BYTES`].
 fn file_levels(
     path: &std::path::Path,
     refinements: usize,
     nested: bool,
+    pair: MembranePair,
 ) -> Result<Vec<TriangleMesh>> {
     if refinements > 8 {
         return Err(Error::Input(format!(
             "--mesh-size {refinements} with --msh means {refinements} uniform refinements (4^{refinements} times the triangles); at most 8"
         )));
     }
-    let mut levels = vec![fem_runtime::mesh::gmsh::read_msh(path)?];
+    let mesh = fem_runtime::mesh::gmsh::read_msh(path)?;
+    // the file's own cells first, so a refusal names corners the user wrote
+    mesh.quality().check(&mesh).map_err(|e| match e {
+        Error::Mesh(m) => Error::Mesh(format!("{}: {m}", path.display())),
+        other => other,
+    })?;
+    let bytes = fem_runtime::mesh::triangle::estimated_bytes(
+        mesh.cell_count(),
+        refinements as u32,
+        bytes_per_triangle(pair),
+    );
+    if bytes > MEMORY_LIMIT_BYTES {
+        return Err(Error::Input(format!(
+            "--mesh-size {refinements} with --msh {} refines its {} triangles {refinements} times, to {:.3e} triangles; with {} that needs about {:.0} GB of memory, more than the {:.0} GB this solver allows itself: use fewer refinements",
+            path.display(),
+            mesh.cell_count(),
+            mesh.cell_count() as f64 * 4f64.powi(refinements as i32),
+            pair.name(),
+            bytes / 1e9,
+            MEMORY_LIMIT_BYTES / 1e9
+        )));
+    }
+    let mut levels = vec![mesh];
     for _ in 0..refinements {
         let finer = levels.last().expect("a level").refine_uniformly();
         levels.push(finer);
@@ -599,6 +723,7 @@ fn run_stabilized<M: Model>(
             2 * M::FIELDS[u_field].element.degree(),
         ),
         warnings,
+        mesh_quality: MeshQualityReport::default(),
     };
     Ok((report, fields))
 }
@@ -763,6 +888,7 @@ fn run_nodal(
         multiplier_noise: 0.0,
         max_penetration: fem_runtime::obstacle::triangle::max_penetration(&u, &scene.obstacle, 2),
         warnings: Vec::new(),
+        mesh_quality: MeshQualityReport::default(),
     };
     let fields = MembraneFields::new(
         mesh.clone(),

@@ -636,7 +636,7 @@ fn misfit_inputs_are_errors() {
     assert!(nodal_active_set(&a, &f, &psi, None, 50).is_ok());
     assert!(nodal_active_set(&a, &f, &psi, Some(&vec![0.0; n - 1]), 50).is_err());
     assert!(nodal_active_set(&a, &f, &psi[1..], None, 50).is_err());
-    let mut term = fem_forms::woodbury::LowRankTerm::new();
+    let mut term = fem_forms::lcp::woodbury::LowRankTerm::new();
     term.push_block([&[(n, 1.0)][..]], &[1.0]).unwrap();
     assert!(term.apply(&vec![1.0; n]).is_err());
     assert!(term.apply(&vec![1.0; n + 1]).is_ok());
@@ -650,7 +650,7 @@ fn misfit_inputs_are_errors() {
 fn the_sliver_mesh_gives_an_error_or_a_certified_solution() {
     let scene = membrane_scene("membrane-radial").unwrap();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sliver.msh");
-    let mut levels = vec![fem_forms::gmsh::read_msh(&path).unwrap()];
+    let mut levels = vec![fem_forms::mesh::gmsh::read_msh(&path).unwrap()];
     for _ in 0..5 {
         let finer = levels.last().unwrap().refine_uniformly();
         levels.push(finer);

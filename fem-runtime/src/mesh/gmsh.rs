@@ -29,10 +29,17 @@ pub fn read_msh(path: &Path) -> Result<TriangleMesh> {
 /// one, else the curve's entity tag. Lines on interior edges (embedded curves) are
 /// ignored, and so are point elements. Nodes no triangle uses are dropped and the rest
 /// numbered compactly in increasing tag order. All nodes must lie in the plane `z = 0`
-/// (up to 1e-12 of the mesh's extent); if every triangle is clockwise (a surface whose
-/// normal is −z) all are flipped.
+/// (up to 1e-12 of the mesh's extent). Each clockwise triangle (of a surface whose
+/// normal is −z) is made counter-clockwise by itself, so surfaces of opposite normals
+/// can be mixed.
 pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
     let binary = check_header(bytes)?;
+    let stripped = if binary {
+        None
+    } else {
+        strip_parametric(bytes)
+    };
+    let bytes = stripped.as_deref().unwrap_or(bytes);
     let file = parse_with_mshio(bytes)?;
     let nodes = node_table(&file, if binary { None } else { ascii_node_tags(bytes) })?;
     let elements = collect_elements(&file)?;
@@ -65,7 +72,7 @@ pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
         .iter()
         .map(|(_, t)| t.map(|tag| index(tag).unwrap_or(usize::MAX)))
         .collect();
-    orient(&vertices, &mut cells, &elements.triangles)?;
+    orient(&vertices, &mut cells);
 
     let element_of_cell: Vec<u64> = elements.triangles.iter().map(|t| t.0).collect();
     let annotate = |e: Error| match e {
@@ -73,6 +80,7 @@ pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
         other => other,
     };
     let mut mesh = TriangleMesh::new(vertices, cells, &[]).map_err(annotate)?;
+    refuse_duplicate_nodes(&mesh).map_err(annotate)?;
 
     let mut markers = Vec::with_capacity(elements.lines.len());
     for &(element, [n0, n1], marker) in &elements.lines {
@@ -154,6 +162,9 @@ fn parse_with_mshio(bytes: &[u8]) -> Result<MshFile<u64, i32, f64>> {
         mshio::parse_msh_bytes(bytes).map_err(|e| describe(bytes, &e))
     }) {
         Ok(Ok(file)) => Ok(file),
+        Ok(Err(message)) if message.contains("arametric") => Err(Error::Mesh(format!(
+            "{message}: the file stores parametric node coordinates, which can be dropped only from ASCII files; re-export it without them (in Gmsh: Mesh.SaveParametric = 0, the default)"
+        ))),
         Ok(Err(message)) => Err(Error::Mesh(message)),
         Err(_) => Err(Error::Mesh(
             "the .msh parser (mshio) failed on this input; the file is probably malformed".into(),
@@ -297,6 +308,67 @@ fn ascii_node_tags(bytes: &[u8]) -> Option<Vec<u64>> {
     Some(tags)
 }
 
+/// The ASCII file with its parametric node coordinates dropped, or `None` if it has
+/// none (or its `$Nodes` section cannot be walked; `mshio` then reports the fault).
+///
+/// In MSH 4.1 a node block with `parametric = 1` on an entity of dimension `d` gives
+/// each node `d` parametric coordinates after `x y z` (Gmsh writes them with
+/// `Mesh.SaveParametric = 1`); `mshio` does not read them. They are not needed for a
+/// planar triangle mesh, so the block is rewritten with `parametric = 0`, one node per
+/// line as Gmsh writes it, keeping the line numbers of a Gmsh-written file.
+fn strip_parametric(bytes: &[u8]) -> Option<Vec<u8>> {
+    let text = std::str::from_utf8(bytes).ok()?;
+    let mut offset = 0;
+    let mut start = None;
+    for line in text.split_inclusive('\n') {
+        offset += line.len();
+        if line.trim() == "$Nodes" {
+            start = Some(offset);
+            break;
+        }
+    }
+    let start = start?;
+    let end = start + text[start..].find("$EndNodes")?;
+    let mut tokens = text[start..end].split_ascii_whitespace();
+    let header: Vec<&str> = (0..4).map(|_| tokens.next()).collect::<Option<_>>()?;
+    let blocks: usize = header[0].parse().ok()?;
+    let mut out = format!("{}\n", header.join(" "));
+    let mut any = false;
+    for _ in 0..blocks {
+        let block: Vec<&str> = (0..4).map(|_| tokens.next()).collect::<Option<_>>()?;
+        let dim: usize = block[0].parse().ok()?;
+        let parametric = match block[2] {
+            "0" => false,
+            "1" => true,
+            _ => return None,
+        };
+        let n: usize = block[3].parse().ok()?;
+        any |= parametric;
+        out.push_str(&format!("{} {} 0 {n}\n", block[0], block[1]));
+        for _ in 0..n {
+            out.push_str(tokens.next()?);
+            out.push('\n');
+        }
+        let extra = if parametric { dim.min(3) } else { 0 };
+        for _ in 0..n {
+            let xyz: Vec<&str> = (0..3).map(|_| tokens.next()).collect::<Option<_>>()?;
+            for _ in 0..extra {
+                tokens.next()?;
+            }
+            out.push_str(&xyz.join(" "));
+            out.push('\n');
+        }
+    }
+    if !any || tokens.next().is_some() {
+        return None;
+    }
+    let mut rewritten = Vec::with_capacity(bytes.len());
+    rewritten.extend_from_slice(&bytes[..start]);
+    rewritten.extend_from_slice(out.as_bytes());
+    rewritten.extend_from_slice(&bytes[end..]);
+    Some(rewritten)
+}
+
 /// The elements the mesh is made of, with their Gmsh element tags.
 struct Elements {
     /// (element tag, node tags)
@@ -421,54 +493,54 @@ fn check_planar(vertices: &[[f64; 2]], zs: &[f64], tags: &[u64]) -> Result<()> {
     Ok(())
 }
 
-/// Flips every triangle if all are clockwise; mixed orientations are an error.
-fn orient(
-    vertices: &[[f64; 2]],
-    cells: &mut [[usize; 3]],
-    triangles: &[(u64, [u64; 3])],
-) -> Result<()> {
-    let sign = |c: &[usize; 3]| {
-        let (p, q, r) = (vertices[c[0]], vertices[c[1]], vertices[c[2]]);
-        let twice_area = (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1]);
-        twice_area.partial_cmp(&0.0)
-    };
-    let ccw = cells
-        .iter()
-        .filter(|c| sign(c) == Some(std::cmp::Ordering::Greater))
-        .count();
-    let cw = cells
-        .iter()
-        .filter(|c| sign(c) == Some(std::cmp::Ordering::Less))
-        .count();
-    if ccw > 0 && cw > 0 {
-        // name an element of the smaller group
-        let minority = if cw <= ccw {
-            std::cmp::Ordering::Less
-        } else {
-            std::cmp::Ordering::Greater
-        };
-        let i = cells
+/// Makes every triangle counter-clockwise by itself, swapping its last two nodes when it
+/// is clockwise, and returns how many were swapped.
+///
+/// Gmsh writes each surface's triangles in the orientation of the surface's normal, so
+/// a valid planar mesh may mix orientations (two surfaces with opposite normals, as
+/// after boolean operations or a reversed curve loop). Orientation is therefore no
+/// evidence of a fault; folded or overlapping cells are caught by
+/// [`TriangleMesh::new`] (two cells on the same side of an edge), and cells of (near)
+/// zero area are refused there too. Boundary lines are matched to edges whatever their
+/// node order, so swapping keeps the markers.
+fn orient(vertices: &[[f64; 2]], cells: &mut [[usize; 3]]) -> usize {
+    let mut swapped = 0;
+    for c in cells.iter_mut() {
+        let Some((p, q, r)) = c
             .iter()
-            .position(|c| sign(c) == Some(minority))
-            .unwrap_or(0);
-        let (odd, other) = if minority == std::cmp::Ordering::Less {
-            ("clockwise", "counter-clockwise")
-        } else {
-            ("counter-clockwise", "clockwise")
+            .map(|&v| vertices.get(v).copied())
+            .collect::<Option<Vec<_>>>()
+            .map(|x| (x[0], x[1], x[2]))
+        else {
+            continue;
         };
-        return Err(Error::Mesh(format!(
-            "element {} is inverted: it is {odd} while {} of the {} triangles are {other}; the surface's orientation is inconsistent",
-            triangles[i].0,
-            ccw.max(cw),
-            cells.len()
-        )));
-    }
-    if cw > 0 {
-        for c in cells.iter_mut() {
+        let twice_area = (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1]);
+        if twice_area < 0.0 {
             c.swap(1, 2);
+            swapped += 1;
         }
     }
-    Ok(())
+    swapped
+}
+
+/// Refuses a mesh with coincident vertices ([`TriangleMesh::coincident_vertices`]),
+/// naming them and their coordinates and saying how to fix the mesh in Gmsh.
+///
+/// Merging them instead would silently change the user's model (the two copies may also
+/// be the lips of an intended slit), so the fix is left to the mesh's author.
+fn refuse_duplicate_nodes(mesh: &TriangleMesh) -> Result<()> {
+    let pairs = mesh.coincident_vertices();
+    let Some(&[a, b]) = pairs.first() else {
+        return Ok(());
+    };
+    let [x, y] = mesh.vertices()[a];
+    let more = match pairs.len() {
+        1 => String::new(),
+        n => format!(" ({n} such pairs in all)"),
+    };
+    Err(Error::Mesh(format!(
+        "vertex {a} and vertex {b} coincide at ({x}, {y}){more}: the mesh has duplicate nodes, as when two surfaces are meshed separately along a common curve, and would be solved with a cut (a boundary where u = g) inside the domain; in Gmsh, make the geometry coherent before meshing (`Coherence;` in a built-in-kernel .geo script, Geometry.AutoCoherence = 1, or BooleanFragments with OpenCASCADE) or merge the mesh's duplicates with `Coherence Mesh;`, then re-export"
+    )))
 }
 
 /// Adds Gmsh's numbers to a mesh message: "cell 3" → "cell 3 (element 17)",
@@ -689,10 +761,74 @@ $EndElements
     }
 
     #[test]
-    fn mixed_orientation_names_the_inverted_element() {
-        let text = SQUARE.replace("6 1 3 4", "6 1 4 3");
+    fn mixed_orientations_are_oriented_cell_by_cell() {
+        // element 6 clockwise, element 5 counter-clockwise: two surfaces of opposite normals
+        let mixed = parse_msh(SQUARE.replace("6 1 3 4", "6 1 4 3").as_bytes()).unwrap();
+        let square = parse_msh(SQUARE.as_bytes()).unwrap();
+        assert!((0..2).all(|c| mixed.area(c) > 0.0));
+        let sets = |m: &TriangleMesh| {
+            let mut cells: Vec<[usize; 3]> = m
+                .cells()
+                .iter()
+                .map(|c| {
+                    let mut c = *c;
+                    c.sort_unstable();
+                    c
+                })
+                .collect();
+            cells.sort_unstable();
+            cells
+        };
+        assert_eq!(sets(&mixed), sets(&square));
+        assert_eq!(mixed.boundary_edges(), square.boundary_edges());
+        // a fold (two cells on the same side of their common edge) is still refused
+        let folded = SQUARE
+            .replace("6 1 3 4", "6 1 3 10")
+            .replace("10\n2 2 0", "10\n2 0.5 0");
+        let e = error(&folded);
+        assert!(e.contains("overlap") && e.contains("element 5"), "{e}");
+        // and so is a flat cell, whatever its orientation
+        let flat = SQUARE.replace("0 4 0 1\n4\n0 1 0", "0 4 0 1\n4\n2 2 0");
+        let e = error(&flat);
+        assert!(e.contains("degenerate") && e.contains("element 6"), "{e}");
+    }
+
+    #[test]
+    fn parametric_coordinates_are_dropped() {
+        // SQUARE with the corner nodes written with parametric coordinates: none on
+        // points (dimension 0), u on a curve, u v on a surface
+        let text = SQUARE
+            .replace("0 1 0 1\n1\n0 0 0", "0 1 1 1\n1\n0 0 0")
+            .replace("0 2 0 1\n2\n1 0 0", "1 1 1 1\n2\n1 0 0 0.5")
+            .replace("0 3 0 1\n3\n1 1 0", "2 1 1 1\n3\n1 1 0 0.25 0.75");
+        let m = parse_msh(text.as_bytes()).unwrap();
+        assert_eq!(m, parse_msh(SQUARE.as_bytes()).unwrap());
+        // a malformed parametric block reaches mshio, whose refusal gets the fix
+        let broken = text.replace("1 1 0 0.25 0.75", "1 1 0 0.25");
+        let e = error(&broken);
+        assert!(e.contains("SaveParametric"), "{e}");
+    }
+
+    #[test]
+    fn duplicate_nodes_are_refused_with_their_place_and_the_fix() {
+        // the square as two triangles that do not share their diagonal: nodes 5 and 6
+        // duplicate nodes 1 and 3
+        let text = SQUARE
+            .replace("5 5 1 10", "6 7 1 10")
+            .replace(
+                "0 5 0 1\n10\n2 2 0",
+                "0 5 0 1\n10\n2 2 0\n2 1 0 2\n5\n6\n0 0 0\n1 1 0",
+            )
+            .replace("6 1 3 4", "6 5 6 4");
         let e = error(&text);
-        assert!(e.contains("element 6") && e.contains("inverted"), "{e}");
+        assert!(
+            e.contains("node 1")
+                && e.contains("node 5")
+                && e.contains("(0, 0)")
+                && e.contains("2 such pairs")
+                && e.contains("Coherence"),
+            "{e}"
+        );
     }
 
     #[test]
