@@ -668,3 +668,15 @@ mod no_panic {
         }
     }
 }
+
+/// Issue 11: on triangles `∫[degree=1]` is one-point (centroid) reduced integration,
+/// as on intervals: the P1 mass matrix becomes `|T|/9` in every entry.
+#[test]
+fn degree_one_on_triangles_is_one_point() {
+    let out = expand(membrane("P1", "a(u;v) = ∫[degree=1] u v")).to_string();
+    assert!(rendered_errors(&out.parse().unwrap()).is_empty(), "{out}");
+    assert!(out.contains("quadrature_points : 1usize"), "{out}");
+    // R[i][j] = ½ · (⅓)² = 1/18 of 2|T| (= area2): |T|/9
+    let literal = format!("{:?}", 1.0f64 / 18.0);
+    assert!(out.contains(&format!("s0 * {literal}f64")), "{out}");
+}
