@@ -296,3 +296,51 @@ fn a_sign_error_is_caught() {
     let wrong = hand_b_h(ElementKind::P2, ElementKind::P0, &cell, -0.7);
     assert!(largest_difference(&blocks[0], &wrong[0]) > 1e-3);
 }
+
+/// The typed handles name the same indices as the strings a scene file uses, and the
+/// two ways of giving coefficients agree.
+#[test]
+fn handles_and_names_agree() {
+    use fem_forms::model::{DataId, FormId};
+    use fem_forms::Coefficients;
+    use membrane_p2_p0::{data, fields, forms, params};
+    type M = membrane_p2_p0::Model;
+    for (name, id) in [
+        ("a", forms::a),
+        ("ℓ_S", forms::ℓ_S),
+        ("B_h", forms::B_h),
+        ("L_h", forms::L_h),
+    ] {
+        assert_eq!(M::form(id).unwrap(), M::form(name).unwrap(), "{name}");
+        assert_eq!(M::FORMS[id.index()].name, name);
+    }
+    assert_eq!(M::field(fields::u).unwrap(), 0);
+    assert_eq!(M::field(fields::v).unwrap(), M::field("u").unwrap());
+    assert_eq!(M::field(fields::μ).unwrap(), M::field("λ").unwrap());
+    assert_eq!(M::param(params::α).unwrap(), M::param("α").unwrap());
+    assert_eq!(M::data_function(data::g).unwrap(), 2);
+    // a hand-made handle out of range is an error, not a panic
+    assert!(M::form(FormId::<M>::new(99)).is_err());
+    assert!(M::data_function(DataId::<M>::new(3)).is_err());
+    assert!(M::form("B").is_err());
+
+    let by_id = Coefficients::from_ids(
+        &[(params::α, 0.25)],
+        &[(data::g, &boundary), (data::f, &load), (data::ψ, &obstacle)],
+    )
+    .unwrap();
+    let by_name = Coefficients::new::<M>(
+        &[("α", 0.25)],
+        &[("f", &load), ("ψ", &obstacle), ("g", &boundary)],
+    )
+    .unwrap();
+    assert_eq!(by_id.params, by_name.params);
+    let x = [0.3, -0.7];
+    for (a, b) in by_id.data.iter().zip(&by_name.data) {
+        assert_eq!(a(&x), b(&x));
+    }
+    // checks still apply: a handle given twice, a missing one, a non-finite value
+    assert!(Coefficients::from_ids(&[(params::α, 0.25), (params::α, 0.5)], &[]).is_err());
+    assert!(Coefficients::from_ids(&[(params::α, 0.25)], &[(data::f, &load)]).is_err());
+    assert!(Coefficients::from_ids::<M>(&[(params::α, f64::NAN)], &[]).is_err());
+}
