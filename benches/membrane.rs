@@ -65,7 +65,11 @@ fn assembly(n: usize, rounds: usize) {
     println!("assembly of the stiffness ∫∇u·∇v on {n}×{n}×2 = {cells} triangles (median of {rounds} rounds)");
     // P1: generated, through the generic assembler
     type P1 = membrane_p1::Model;
-    let coefficients = Coefficients::new::<P1>(&[], &[("f", &zero), ("g", &zero)]).unwrap();
+    let coefficients = Coefficients::from_ids::<P1>(
+        &[],
+        &[(membrane_p1::data::f, &zero), (membrane_p1::data::g, &zero)],
+    )
+    .unwrap();
     let dofs = SystemDofs::all::<P1>(&mesh).unwrap();
     let clock = Instant::now();
     let assembler = MatrixAssembler::new::<P1>("a", &mesh, &dofs).unwrap();
@@ -135,9 +139,15 @@ fn assembly(n: usize, rounds: usize) {
     );
     // P2: the u block of the P2–P0 membrane's `a`
     type P2 = membrane_p2_p0::Model;
-    let coefficients =
-        Coefficients::new::<P2>(&[("α", 0.0)], &[("f", &zero), ("ψ", &zero), ("g", &zero)])
-            .unwrap();
+    let coefficients = Coefficients::from_ids(
+        &[(membrane_p2_p0::params::α, 0.0)],
+        &[
+            (membrane_p2_p0::data::f, &zero),
+            (membrane_p2_p0::data::ψ, &zero),
+            (membrane_p2_p0::data::g, &zero),
+        ],
+    )
+    .unwrap();
     let dofs = SystemDofs::named::<P2>(&mesh, &["u"]).unwrap();
     let assembler = MatrixAssembler::new::<P2>("a", &mesh, &dofs).unwrap();
     let times: Vec<f64> = (0..rounds)

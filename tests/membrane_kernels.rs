@@ -4,6 +4,7 @@
 //! Dunavant rule, on random triangles and parameters.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+use fem_forms::model::FormId;
 use fem_forms::models::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use fem_forms::{DataFn, ElementKind, Model};
 use proptest::prelude::*;
@@ -175,11 +176,18 @@ fn hand_l_h(u: ElementKind, l: ElementKind, cell: &Cell, alpha: f64) -> [Vec<f64
     [v, mu]
 }
 
-fn generated<M: Model>(cell: &Cell, alpha: f64) -> ([Vec<Vec<f64>>; 4], [Vec<f64>; 2]) {
+/// The model's `B_h` and `L_h`, by typed handle.
+type Forms<M> = (FormId<M>, FormId<M>);
+
+fn generated<M: Model>(
+    cell: &Cell,
+    alpha: f64,
+    (bilinear, linear): Forms<M>,
+) -> ([Vec<Vec<f64>>; 4], [Vec<f64>; 2]) {
     let x: Vec<f64> = cell.x.iter().flatten().copied().collect();
     let data: [&DataFn; 3] = [&load, &obstacle, &boundary];
     let params = [alpha];
-    let form = M::form("B_h").unwrap();
+    let form = M::form(bilinear).unwrap();
     let n = |f: usize| M::FIELDS[f].element.local_dof_count(M::CELL);
     let pairs = [(0, 0), (0, 1), (1, 0), (1, 1)];
     let blocks = pairs.map(|(test, trial)| {
@@ -194,7 +202,7 @@ fn generated<M: Model>(cell: &Cell, alpha: f64) -> ([Vec<Vec<f64>>; 4], [Vec<f64
         }
         flat.chunks(cols).map(<[f64]>::to_vec).collect::<Vec<_>>()
     });
-    let form = M::form("L_h").unwrap();
+    let form = M::form(linear).unwrap();
     let vectors = [0, 1].map(|test| {
         let mut out = vec![0.0; n(test)];
         if let Some(b) = M::FORMS[form]
@@ -219,10 +227,10 @@ fn largest_difference(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
     diff / scale.max(1e-300)
 }
 
-fn check<M: Model>(cell: &Cell, alpha: f64) {
+fn check<M: Model>(cell: &Cell, alpha: f64, forms: Forms<M>) {
     let u = M::FIELDS[0].element;
     let l = M::FIELDS[1].element;
-    let (blocks, vectors) = generated::<M>(cell, alpha);
+    let (blocks, vectors) = generated(cell, alpha, forms);
     let hand = hand_b_h(u, l, cell, alpha);
     for (k, (g, h)) in blocks.iter().zip(&hand).enumerate() {
         let d = largest_difference(g, h);
@@ -270,9 +278,9 @@ proptest! {
 
     #[test]
     fn membrane_kernels_match_the_hand_coded_ones(cell in triangle(), alpha in 0.0..2.0f64) {
-        check::<membrane_p1_p0::Model>(&cell, alpha);
-        check::<membrane_p2_p0::Model>(&cell, alpha);
-        check::<membrane_p2_p1disc::Model>(&cell, alpha);
+        check(&cell, alpha, (membrane_p1_p0::forms::B_h, membrane_p1_p0::forms::L_h));
+        check(&cell, alpha, (membrane_p2_p0::forms::B_h, membrane_p2_p0::forms::L_h));
+        check(&cell, alpha, (membrane_p2_p1disc::forms::B_h, membrane_p2_p1disc::forms::L_h));
     }
 }
 
@@ -280,7 +288,59 @@ proptest! {
 #[test]
 fn a_sign_error_is_caught() {
     let cell = Cell::new([[0.1, 0.2], [1.3, 0.1], [0.4, 0.9]]);
-    let (blocks, _) = generated::<membrane_p2_p0::Model>(&cell, 0.7);
+    let (blocks, _) = generated(
+        &cell,
+        0.7,
+        (membrane_p2_p0::forms::B_h, membrane_p2_p0::forms::L_h),
+    );
     let wrong = hand_b_h(ElementKind::P2, ElementKind::P0, &cell, -0.7);
     assert!(largest_difference(&blocks[0], &wrong[0]) > 1e-3);
+}
+
+/// The typed handles name the same indices as the strings a scene file uses, and the
+/// two ways of giving coefficients agree.
+#[test]
+fn handles_and_names_agree() {
+    use fem_forms::model::{DataId, FormId};
+    use fem_forms::Coefficients;
+    use membrane_p2_p0::{data, fields, forms, params};
+    type M = membrane_p2_p0::Model;
+    for (name, id) in [
+        ("a", forms::a),
+        ("ℓ_S", forms::ℓ_S),
+        ("B_h", forms::B_h),
+        ("L_h", forms::L_h),
+    ] {
+        assert_eq!(M::form(id).unwrap(), M::form(name).unwrap(), "{name}");
+        assert_eq!(M::FORMS[id.index()].name, name);
+    }
+    assert_eq!(M::field(fields::u).unwrap(), 0);
+    assert_eq!(M::field(fields::v).unwrap(), M::field("u").unwrap());
+    assert_eq!(M::field(fields::μ).unwrap(), M::field("λ").unwrap());
+    assert_eq!(M::param(params::α).unwrap(), M::param("α").unwrap());
+    assert_eq!(M::data_function(data::g).unwrap(), 2);
+    // a hand-made handle out of range is an error, not a panic
+    assert!(M::form(FormId::<M>::new(99)).is_err());
+    assert!(M::data_function(DataId::<M>::new(3)).is_err());
+    assert!(M::form("B").is_err());
+
+    let by_id = Coefficients::from_ids(
+        &[(params::α, 0.25)],
+        &[(data::g, &boundary), (data::f, &load), (data::ψ, &obstacle)],
+    )
+    .unwrap();
+    let by_name = Coefficients::new::<M>(
+        &[("α", 0.25)],
+        &[("f", &load), ("ψ", &obstacle), ("g", &boundary)],
+    )
+    .unwrap();
+    assert_eq!(by_id.params, by_name.params);
+    let x = [0.3, -0.7];
+    for (a, b) in by_id.data.iter().zip(&by_name.data) {
+        assert_eq!(a(&x), b(&x));
+    }
+    // checks still apply: a handle given twice, a missing one, a non-finite value
+    assert!(Coefficients::from_ids(&[(params::α, 0.25), (params::α, 0.5)], &[]).is_err());
+    assert!(Coefficients::from_ids(&[(params::α, 0.25)], &[(data::f, &load)]).is_err());
+    assert!(Coefficients::from_ids::<M>(&[(params::α, f64::NAN)], &[]).is_err());
 }

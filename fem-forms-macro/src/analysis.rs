@@ -3,7 +3,7 @@
 //! term is checked, terms that vanish for the chosen elements are dropped, and the rest
 //! is grouped into (test field, trial field) blocks.
 
-use crate::diagnostic::{closest, Diagnostic, Loc};
+use crate::diagnostic::{closest, lookalike, Diagnostic, Loc};
 use crate::parser::{Definition, Expr, ExprKind, IntegralKind, Name};
 use crate::symbolic::{self, ArgFactor, DerivativeError, Expansion, Monomial};
 use fem_reference::ElementKind;
@@ -329,6 +329,19 @@ impl Context<'_> {
                 .join("; ")
         );
         for t in terms {
+            if !t.coefficient.is_finite() {
+                self.errors.push(
+                    Diagnostic::text(
+                        t.origin,
+                        format!(
+                            "the coefficient of this term of `{}` overflows ({})",
+                            d.name.text, t.coefficient
+                        ),
+                    )
+                    .help("products and quotients of the constants must stay finite (below about 1.8e308)"),
+                );
+                continue;
+            }
             if !t.integrated {
                 self.errors.push(
                     Diagnostic::text(t.origin, format!("term of `{}` outside an integral", d.name.text))
@@ -545,8 +558,12 @@ impl Context<'_> {
             .iter()
             .flat_map(|f| [f.name.as_str(), f.test_name.as_str()])
             .collect();
-        let hint = closest(&n.text, candidates.iter().copied())
-            .map(|c| format!(" Did you mean `{c}`?"))
+        let hint = lookalike(&n.text, candidates.iter().copied())
+            .map(|h| format!(" {h}."))
+            .or_else(|| {
+                closest(&n.text, candidates.iter().copied())
+                    .map(|c| format!(" Did you mean `{c}`?"))
+            })
             .unwrap_or_default();
         Diagnostic::text(
             n.loc,
@@ -586,8 +603,11 @@ impl Context<'_> {
             );
         }
         let names = self.symbols.all_names();
-        let hint = closest(name, names.iter().copied())
-            .map(|c| format!("did you mean `{c}`? "))
+        let hint = lookalike(name, names.iter().copied())
+            .map(|h| format!("{h}; "))
+            .or_else(|| {
+                closest(name, names.iter().copied()).map(|c| format!("did you mean `{c}`? "))
+            })
             .unwrap_or_default();
         self.fail(
             Diagnostic::text(loc, format!("unknown symbol `{name}`")).help(format!(
@@ -677,33 +697,48 @@ impl Context<'_> {
         None
     }
 
+    /// Expands a sum `t₀ ± t₁ ± … ± tₙ`. The parser builds it as a left-leaning tree as
+    /// deep as it has terms, so it is walked down its left spine in a loop, not by
+    /// recursion: a form of thousands of terms must not overflow the stack.
+    fn sum_value(&mut self, e: &Expr, inside_integral: bool) -> Option<Value> {
+        let mut spine: Vec<(&Expr, bool, Loc)> = Vec::new();
+        let mut left = e;
+        while let ExprKind::Add(a, b) | ExprKind::Sub(a, b) = &left.kind {
+            spine.push((b, matches!(left.kind, ExprKind::Sub(..)), left.loc));
+            left = a;
+        }
+        let mut sum = self.value(left, inside_integral);
+        for (right, subtract, loc) in spine.into_iter().rev() {
+            // Expand every term, also after an error, so that all errors are reported.
+            let y = self.value(right, inside_integral);
+            sum = match (sum, y) {
+                (Some(x), Some(y)) => {
+                    let y = if subtract { y.map(symbolic::neg) } else { y };
+                    match (x, y) {
+                        (Value::Scalar(x), Value::Scalar(y)) => {
+                            Some(Value::Scalar(symbolic::add(x, y)))
+                        }
+                        (Value::Vector(x), Value::Vector(y)) => Some(Value::Vector(
+                            x.into_iter()
+                                .zip(y)
+                                .map(|(x, y)| symbolic::add(x, y))
+                                .collect(),
+                        )),
+                        _ => self.vector_mismatch(loc, "sum"),
+                    }
+                }
+                _ => None,
+            };
+        }
+        sum
+    }
+
     /// Expands an expression to a scalar or a vector (gradients and their combinations).
     fn value(&mut self, e: &Expr, inside_integral: bool) -> Option<Value> {
         let loc = e.loc;
         match &e.kind {
             ExprKind::Neg(a) => Some(self.value(a, inside_integral)?.map(symbolic::neg)),
-            ExprKind::Add(a, b) | ExprKind::Sub(a, b) => {
-                let x = self.value(a, inside_integral);
-                let y = self.value(b, inside_integral);
-                let (x, y) = (x?, y?);
-                let y = if matches!(e.kind, ExprKind::Sub(..)) {
-                    y.map(symbolic::neg)
-                } else {
-                    y
-                };
-                match (x, y) {
-                    (Value::Scalar(x), Value::Scalar(y)) => {
-                        Some(Value::Scalar(symbolic::add(x, y)))
-                    }
-                    (Value::Vector(x), Value::Vector(y)) => Some(Value::Vector(
-                        x.into_iter()
-                            .zip(y)
-                            .map(|(x, y)| symbolic::add(x, y))
-                            .collect(),
-                    )),
-                    _ => self.vector_mismatch(loc, "sum"),
-                }
-            }
+            ExprKind::Add(..) | ExprKind::Sub(..) => self.sum_value(e, inside_integral),
             ExprKind::Mul(a, b) => {
                 let x = self.value(a, inside_integral);
                 let y = self.value(b, inside_integral);

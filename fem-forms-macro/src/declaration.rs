@@ -15,6 +15,7 @@
 //! The cell is `interval` or `triangle`.
 
 use crate::diagnostic::{closest, Diagnostic};
+use crate::parser::MAX_DEGREE;
 use fem_reference::reference_element::ALL_ELEMENTS;
 use fem_reference::{CellKind, ElementKind};
 use proc_macro2::{Span, TokenStream, TokenTree};
@@ -162,6 +163,17 @@ impl Parse for Declaration {
                         let name: Ident = s.parse()?;
                         s.parse::<Token![:]>()?;
                         let element_name: Ident = s.parse()?;
+                        if !s.peek(Token![>=]) && (s.peek(Token![<]) || s.peek(Token![>])) {
+                            let op: TokenTree = s.parse()?;
+                            return Err(syn::Error::new(
+                                op.span(),
+                                format!(
+                                    "only `>= 0` is supported: `{name}: {element_name} >= 0` declares a multiplier {name} ≥ 0. \
+                                     An upper bound u ≤ ψ is the obstacle seen from the other side: keep `>= 0` and flip the \
+                                     constraint's sign with a parameter `s = −1` in the forms (as the beams' `b(η,v;μ) = ∫ s v μ`)"
+                                ),
+                            ));
+                        }
                         let nonnegative = if s.peek(Token![>=]) {
                             s.parse::<Token![>=]>()?;
                             let zero: LitInt = s.parse()?;
@@ -190,7 +202,15 @@ impl Parse for Declaration {
                         let name: Ident = s.parse()?;
                         let degree = if s.peek(Token![:]) {
                             s.parse::<Token![:]>()?;
-                            s.parse::<LitInt>()?.base10_parse::<usize>()?
+                            let literal = s.parse::<LitInt>()?;
+                            let degree = literal.base10_parse::<usize>()?;
+                            if degree > MAX_DEGREE {
+                                return Err(syn::Error::new(
+                                    literal.span(),
+                                    format!("data degree {degree} is above the limit {MAX_DEGREE}: the quadrature of its terms would need too many points"),
+                                ));
+                            }
+                            degree
                         } else {
                             2
                         };

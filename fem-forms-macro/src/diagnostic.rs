@@ -151,6 +151,105 @@ pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) ->
     at_best.next().is_none().then_some(first.1)
 }
 
+/// Letters that look like a Latin letter: Cyrillic and Greek lookalikes, mapped to it.
+const LOOKALIKES: &[(char, char)] = &[
+    ('а', 'a'),
+    ('е', 'e'),
+    ('о', 'o'),
+    ('р', 'p'),
+    ('с', 'c'),
+    ('у', 'y'),
+    ('х', 'x'),
+    ('і', 'i'),
+    ('ј', 'j'),
+    ('ѕ', 's'),
+    ('ԁ', 'd'),
+    ('ԛ', 'q'),
+    ('ԝ', 'w'),
+    ('А', 'A'),
+    ('В', 'B'),
+    ('Е', 'E'),
+    ('К', 'K'),
+    ('М', 'M'),
+    ('Н', 'H'),
+    ('О', 'O'),
+    ('Р', 'P'),
+    ('С', 'C'),
+    ('Т', 'T'),
+    ('Х', 'X'),
+    ('У', 'Y'),
+    ('І', 'I'),
+    ('Ј', 'J'),
+    ('Ѕ', 'S'),
+    ('α', 'a'),
+    ('ο', 'o'),
+    ('ν', 'v'),
+    ('ι', 'i'),
+    ('κ', 'k'),
+    ('ρ', 'p'),
+    ('υ', 'u'),
+    ('χ', 'x'),
+    ('Α', 'A'),
+    ('Β', 'B'),
+    ('Ε', 'E'),
+    ('Ζ', 'Z'),
+    ('Η', 'H'),
+    ('Ι', 'I'),
+    ('Κ', 'K'),
+    ('Μ', 'M'),
+    ('Ν', 'N'),
+    ('Ο', 'O'),
+    ('Ρ', 'P'),
+    ('Τ', 'T'),
+    ('Υ', 'Y'),
+    ('Χ', 'X'),
+];
+
+fn skeleton(c: char) -> char {
+    LOOKALIKES
+        .iter()
+        .find(|(l, _)| *l == c)
+        .map_or(c, |&(_, latin)| latin)
+}
+
+fn script(c: char) -> &'static str {
+    match c as u32 {
+        0x0370..=0x03FF => "Greek",
+        0x0400..=0x052F => "Cyrillic",
+        _ if c.is_ascii() => "Latin",
+        _ => "another script",
+    }
+}
+
+/// A hint when `name` differs from one candidate only by lookalike letters (Cyrillic
+/// `Т` for Latin `T`, Greek `ν` for `v`): such a typo is invisible in the source.
+pub fn lookalike<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
+    let key: Vec<char> = name.chars().map(skeleton).collect();
+    let candidate = candidates.into_iter().find(|c| {
+        *c != name
+            && c.chars().count() == key.len()
+            && c.chars().map(skeleton).eq(key.iter().copied())
+    })?;
+    let differences: Vec<String> = name
+        .chars()
+        .zip(candidate.chars())
+        .filter(|(a, b)| a != b)
+        .map(|(a, b)| {
+            format!(
+                "`{a}` (U+{:04X}, {}) is not `{b}` (U+{:04X}, {})",
+                a as u32,
+                script(a),
+                b as u32,
+                script(b)
+            )
+        })
+        .collect();
+    Some(format!(
+        "`{name}` looks like the declared `{candidate}` but is not the same name: {}",
+        differences.join(", ")
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -180,5 +279,18 @@ mod tests {
         assert_eq!(closest("psi", ["ψ", "psy", "t"]), Some("psy"));
         assert_eq!(closest("x", ["t", "α"]), None);
         assert_eq!(closest("P7", ["P0", "P1", "P2"]), None);
+    }
+
+    #[test]
+    fn lookalike_letters_are_named() {
+        let hint = lookalike("Т", ["T", "v"]).unwrap();
+        assert!(
+            hint.contains("U+0422, Cyrillic") && hint.contains("U+0054, Latin"),
+            "{hint}"
+        );
+        assert!(lookalike("ν", ["u", "v"]).unwrap().contains("Greek"));
+        assert!(lookalike("wа", ["w", "wa"]).unwrap().contains("`wa`"));
+        assert_eq!(lookalike("x", ["T", "v"]), None);
+        assert_eq!(lookalike("v", ["v"]), None);
     }
 }

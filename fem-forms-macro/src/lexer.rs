@@ -191,7 +191,17 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             }
             let raw: String = chars[i..j].iter().collect();
             match raw.parse::<f64>() {
-                Ok(v) => push(Tok::Number(v), j - i, &mut tokens),
+                Ok(v) if v.is_finite() => push(Tok::Number(v), j - i, &mut tokens),
+                Ok(_) => errors.push(
+                    Diagnostic::text(
+                        Loc {
+                            len: j - i,
+                            ..start
+                        },
+                        format!("number `{raw}` is too large: it overflows a 64-bit float"),
+                    )
+                    .help("constants must be finite, below about 1.8e308"),
+                ),
                 Err(_) => errors.push(
                     Diagnostic::text(
                         Loc {

@@ -37,7 +37,7 @@
 //!   non-negative.
 //! - `tests: …` one test function per unknown, in order: `η` goes with `θ`.
 //! - `params: …` runtime scalars; `data: f, ψ: 0` functions of x (the number is the
-//!   polynomial degree assumed for quadrature, default 2).
+//!   polynomial degree assumed for quadrature, default 2, at most 40).
 //! - `boundary: u = g` (optional) Dirichlet data: unknown `u` equals the data function
 //!   `g` on the whole boundary (the runtime interpolates it at the boundary DOFs).
 //! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may
@@ -51,8 +51,9 @@
 //!   function, field of the trial function). `ℓ(η,v) = …` a **linear** form.
 //! - `∫ integrand` (ASCII `int`) integrates over the domain, element by element; its
 //!   integrand runs over the whole sum to its right, up to a `+`/`−` that starts another
-//!   integral or form call. `∫[degree=N]` overrides the quadrature (e.g. `∫[degree=1]` for
-//!   one-point reduced integration).
+//!   integral or form call. `∫[degree=N]` overrides the quadrature with the rule exact
+//!   for degree N, `0 ≤ N ≤ 40` (`∫[degree=1]`: one-point reduced integration, the
+//!   midpoint on intervals and the centroid on triangles).
 //! - `Σ_T w (X, Y)_T` (ASCII `sum_T`) is the sum over elements of weighted L² products.
 //! - Derivatives on intervals: `w'`, `w''`, …, `w''''` (also `′ ″ ‴ ⁗`), of arguments
 //!   or of linear combinations `(w'−θ)'`; taken element-wise. On triangles: `∇u`
@@ -72,8 +73,46 @@
 //! A module `NAME` with `Model` (implementing the runtime's `Model` trait), and per form
 //! a module with one kernel per nonzero block: `a::matrix_η_θ(x, p, d) -> [[f64; 3]; 3]`
 //! (rows η, columns θ) and `ℓ::vector_v(x, p, d) -> [f64; 3]`. Constant-coefficient
-//! terms are integrated exactly at compile time; data terms use Gauss–Legendre rules
-//! exact for the term's degree (data counted with their declared degree).
+//! terms are integrated exactly at compile time; data terms use quadrature rules
+//! exact for the term's degree (data counted with their declared degree):
+//! Gauss–Legendre on intervals, collapsed Gauss rules on triangles.
+//!
+//! ### Typed handles
+//! Beside the kernels, four modules of constants name everything the model declares,
+//! so that Rust code refers to them by a checked name instead of a string:
+//! - `NAME::forms::B_h: FormId<NAME::Model>`, one per form;
+//! - `NAME::fields::θ`, `NAME::fields::η: FieldId<NAME::Model>`, one per unknown and
+//!   one per test function (a test function names its unknown's field);
+//! - `NAME::params::α: ParamId<NAME::Model>` and `NAME::data::f: DataId<NAME::Model>`.
+//!
+//! A misspelled handle is a compile error, and since each handle carries its model's
+//! type, a handle of one model passed where another model is expected does not compile
+//! either. The runtime's name-taking functions accept a handle or a string (scene files
+//! name things by string): `Model::form(NAME::forms::B_h)` and `Model::form("B_h")`
+//! give the same index; `Coefficients::from_ids(&[(NAME::params::α, 0.1)], &[(NAME::data::f,
+//! &f)])` is the handle form of `Coefficients::new::<NAME::Model>(&[("α", 0.1)], &[("f",
+//! &f)])`. (The same design as serde's derives: the generated code exposes plain items
+//! whose types carry the information, and the library's functions are generic over a
+//! small trait — `IntoFormIndex`, `IntoFieldIndex`, `IntoParamIndex`, `IntoDataIndex`.)
+//!
+//! Because of this, a form's name must be a Rust identifier that is not a keyword and
+//! not one of the generated items `Model`, `PARAMS`, `DATA`, `forms`, `fields`,
+//! `params`, `data`; other names (`a₁`, `fn`, `Model`) are compile errors at the name.
+//! Greek and other Unicode letters are fine (`ℓ_S`), subscript digits are not (write
+//! `a1` or `a_1`).
+//!
+//! ### How the code generator is organised
+//! `codegen/mod.rs` is the driver: it writes the module, the `Model` impl, the form
+//! modules and the handles, and asks the backend of the model's cell for each block
+//! kernel. A backend (`codegen/interval.rs`, `codegen/triangle.rs`) implements the
+//! `CellBackend` trait of `codegen/backend.rs`: the cell's geometry (`h`, `J`, `K =
+//! J⁻¹`), its reference basis and quadrature rules, how physical derivatives are written
+//! in reference ones, and the compile-time integration of constant-coefficient terms.
+//! `codegen/emit.rs` holds what all cells share: the kernel's frame, the one emitter of
+//! quadrature loops over data terms (grouped per data set and rule, with compile-time
+//! tables of basis values), and the final entries. A new cell kind is a new
+//! `CellBackend`; facet integrals would add a kernel kind with its own geometry and
+//! rules on top of the same loop emitter.
 //!
 //! To read the generated code, build with `FEM_FORMS_DUMP_DIR=some/dir`: each model is
 //! written there, formatted, as `NAME.rs` (touch the model file first if it is already
@@ -82,7 +121,17 @@
 //! ## Errors
 //! Every mistake is a compile error at the token, or for the forms text at the string
 //! literal with the line, the column and a caret in the message, plus a hint; errors in
-//! several definitions are reported together.
+//! several definitions are reported together. No input makes the macro panic (a
+//! property test feeds it random texts): in particular
+//! - a number or a product of constants that overflows `f64` is an error at the term;
+//! - expressions nest at most 100 levels (parentheses, signs, ∇/Δ, integrals, the
+//!   factors of one product, powers and primes); a sum may have any number of terms;
+//! - a call of an undefined form names it and lists the forms defined above;
+//! - a name that differs from a declared one only by lookalike letters (Cyrillic `Т`,
+//!   Greek `ν` for `v`) gets a hint naming the letters and their scripts.
+//!
+//! The dump (`FEM_FORMS_DUMP_DIR`) names the runtime `::fem_runtime` instead of the
+//! macro-only `$crate`, so the file compiles on its own in a crate depending on it.
 
 mod analysis;
 mod codegen;
@@ -155,11 +204,25 @@ fn expand(input: TokenStream) -> TokenStream {
     code
 }
 
-fn dump(dir: &str, name: &str, code: &TokenStream) {
+/// The generated code as a file that compiles on its own: formatted, and with the
+/// runtime named `::fem_runtime` where the macro was given `$crate` (a path only
+/// meaningful inside a `macro_rules!` expansion).
+fn dump_text(code: &TokenStream) -> String {
     let text = match syn::parse2::<syn::File>(code.clone()) {
         Ok(file) => prettyplease::unparse(&file),
         Err(_) => code.to_string(),
     };
+    standalone(&text)
+}
+
+/// `$crate` (which `fem_runtime::model!` passes, and which only means something inside
+/// a macro expansion) replaced by the runtime's crate name.
+fn standalone(text: &str) -> String {
+    text.replace("$crate", "::fem_runtime")
+}
+
+fn dump(dir: &str, name: &str, code: &TokenStream) {
+    let text = dump_text(code);
     let path = std::path::Path::new(dir).join(format!("{name}.rs"));
     // Dumping is a debugging aid: failing to write must not fail the build.
     let _ = std::fs::create_dir_all(dir).and_then(|_| std::fs::write(path, text));

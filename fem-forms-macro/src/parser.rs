@@ -27,6 +27,10 @@ pub struct Name {
     pub loc: Loc,
 }
 
+/// Highest polynomial degree of a quadrature option `∫[degree=N]` or of a data
+/// function (`data: f: N`): the Gauss rules behind them stay small and accurate.
+pub const MAX_DEGREE: usize = 40;
+
 /// Integral or sum over elements (the same thing for element-wise integrands; only the
 /// L² products `(X, Y)_T` differ in where they may appear).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -132,6 +136,13 @@ pub fn parse_forms(tokens: &[Token]) -> (Vec<Definition>, Vec<Diagnostic>) {
             _ => None,
         })
         .collect();
+    let names_in_order: Vec<String> = starts
+        .iter()
+        .filter_map(|&i| match &tokens[i].tok {
+            Tok::Ident(name) => Some(name.clone()),
+            _ => None,
+        })
+        .collect();
     let mut definitions = Vec::new();
     for (k, &start) in starts.iter().enumerate() {
         let end = starts.get(k + 1).copied().unwrap_or(tokens.len());
@@ -145,6 +156,8 @@ pub fn parse_forms(tokens: &[Token]) -> (Vec<Definition>, Vec<Diagnostic>) {
             tokens: &slice,
             pos: 0,
             form_names: &form_names,
+            earlier_forms: &names_in_order[..k.min(names_in_order.len())],
+            nesting: 0,
         };
         match parser.definition() {
             Ok(mut d) => {
@@ -178,6 +191,8 @@ pub(crate) fn parse_expression(tokens: &[Token]) -> Result<Expr> {
         tokens,
         pos: 0,
         form_names: &names,
+        earlier_forms: &[],
+        nesting: 0,
     };
     let e = parser.sum(false)?;
     match parser.peek() {
@@ -203,10 +218,47 @@ fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
     None
 }
 
+/// Deepest nesting of parentheses, integrals, signs and ∇/Δ: the parser and the
+/// expansion recurse on it, and a deeper text must be an error, not a stack overflow.
+pub const MAX_NESTING: usize = 100;
+
+/// Where `body` is nested deeper than [`MAX_NESTING`], counting every node except the
+/// left spine of a sum (expanded in a loop), if it is. Walks with an explicit stack.
+fn too_deep(body: &Expr) -> Option<Loc> {
+    let mut stack = vec![(body, 0usize)];
+    while let Some((e, depth)) = stack.pop() {
+        if depth > MAX_NESTING {
+            return Some(e.loc);
+        }
+        match &e.kind {
+            ExprKind::Number(_) | ExprKind::Symbol(_) | ExprKind::Call { .. } => {}
+            ExprKind::Add(a, b) | ExprKind::Sub(a, b) => {
+                stack.push((a, depth));
+                stack.push((b, depth + 1));
+            }
+            ExprKind::Mul(a, b) | ExprKind::Div(a, b) | ExprKind::InnerProduct(a, b) => {
+                stack.push((a, depth + 1));
+                stack.push((b, depth + 1));
+            }
+            ExprKind::Neg(a)
+            | ExprKind::Pow(a, _)
+            | ExprKind::Derivative(a, _)
+            | ExprKind::Gradient(a)
+            | ExprKind::Laplacian(a)
+            | ExprKind::Integral { body: a, .. } => stack.push((a, depth + 1)),
+        }
+    }
+    None
+}
+
 struct Parser<'a> {
     tokens: &'a [Token],
     pos: usize,
     form_names: &'a HashSet<String>,
+    /// Names of the definitions above this one, for "unknown form" messages.
+    earlier_forms: &'a [String],
+    /// Current nesting depth (see [`MAX_NESTING`]).
+    nesting: usize,
 }
 
 type Result<T> = std::result::Result<T, Diagnostic>;
@@ -309,6 +361,13 @@ impl<'a> Parser<'a> {
             };
             return Err(d);
         }
+        if let Some(loc) = too_deep(&body) {
+            return Err(Diagnostic::text(
+                loc,
+                format!("expression nested more than {MAX_NESTING} levels deep (products, powers, derivatives and parentheses)"),
+            )
+            .help("split it: define a form for a part and call it"));
+        }
         Ok(Definition {
             name,
             groups,
@@ -409,6 +468,61 @@ impl<'a> Parser<'a> {
         false
     }
 
+    /// Runs `inner` one nesting level deeper, or refuses beyond [`MAX_NESTING`].
+    fn nested<T>(&mut self, loc: Loc, inner: impl FnOnce(&mut Self) -> Result<T>) -> Result<T> {
+        if self.nesting >= MAX_NESTING {
+            return Err(Diagnostic::text(
+                loc,
+                format!("expression nested more than {MAX_NESTING} levels deep"),
+            )
+            .help("split it: define a form for the inner part and call it"));
+        }
+        self.nesting += 1;
+        let out = inner(self);
+        self.nesting -= 1;
+        out
+    }
+
+    /// A call `name(…;…)` of a form that the text does not define.
+    fn unknown_form(&self, name: &str, loc: Loc) -> Diagnostic {
+        let listed = if self.earlier_forms.is_empty() {
+            "no form is defined above this one".to_string()
+        } else {
+            format!(
+                "the forms defined so far are {}",
+                self.earlier_forms
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
+        let hint = crate::diagnostic::closest(name, self.earlier_forms.iter().map(String::as_str))
+            .map(|n| format!("; did you mean `{n}`?"))
+            .unwrap_or_default();
+        Diagnostic::text(loc, format!("unknown form `{name}`")).help(format!("{listed}{hint}"))
+    }
+
+    /// Whether the parenthesis at `open` holds a `;` at its own level (an argument
+    /// list of a bilinear form call, never an expression).
+    fn parenthesis_has_semicolon(&self, open: usize) -> bool {
+        let mut depth = 0usize;
+        for t in &self.tokens[open..] {
+            match t.tok {
+                Tok::LParen => depth += 1,
+                Tok::RParen => {
+                    depth = depth.saturating_sub(1);
+                    if depth == 0 {
+                        return false;
+                    }
+                }
+                Tok::Semicolon if depth == 1 => return true,
+                _ => {}
+            }
+        }
+        false
+    }
+
     fn sum(&mut self, integrand: bool) -> Result<Expr> {
         let mut lhs = self.term()?;
         while let Some(Tok::Plus | Tok::Minus) = self.peek_tok() {
@@ -434,13 +548,13 @@ impl<'a> Parser<'a> {
         match self.peek_tok() {
             Some(Tok::Minus) => {
                 let loc = self.bump().unwrap().loc;
-                let inner = self.term()?;
+                let inner = self.nested(loc, Self::term)?;
                 let loc = loc.to(inner.loc);
                 Ok(Expr::new(ExprKind::Neg(Box::new(inner)), loc))
             }
             Some(Tok::Plus) => {
-                self.pos += 1;
-                self.term()
+                let loc = self.bump().unwrap().loc;
+                self.nested(loc, Self::term)
             }
             _ => self.product(),
         }
@@ -504,7 +618,7 @@ impl<'a> Parser<'a> {
                     "a function after ∇"
                 }));
             }
-            let inner = self.factor()?;
+            let inner = self.nested(loc, Self::factor)?;
             let l = loc.to(inner.loc);
             let kind = if laplacian {
                 ExprKind::Laplacian(Box::new(inner))
@@ -620,14 +734,18 @@ impl<'a> Parser<'a> {
                         l,
                     ));
                 }
+                if self.peek_tok() == Some(&Tok::LParen) && self.parenthesis_has_semicolon(self.pos)
+                {
+                    return Err(self.unknown_form(name, loc));
+                }
                 Ok(Expr::new(ExprKind::Symbol(name.clone()), loc))
             }
             Tok::LParen => {
                 self.pos += 1;
-                let first = self.sum(false)?;
+                let first = self.nested(loc, |p| p.sum(false))?;
                 let second = if self.peek_tok() == Some(&Tok::Comma) {
                     self.pos += 1;
-                    Some(self.sum(false)?)
+                    Some(self.nested(loc, |p| p.sum(false))?)
                 } else {
                     None
                 };
@@ -681,7 +799,7 @@ impl<'a> Parser<'a> {
                 if self.peek().is_none() {
                     return Err(self.unexpected("an integrand"));
                 }
-                let body = self.sum(true)?;
+                let body = self.nested(loc, |p| p.sum(true))?;
                 let l = loc.to(body.loc);
                 Ok(Expr::new(
                     ExprKind::Integral {
@@ -714,7 +832,16 @@ impl<'a> Parser<'a> {
         }
         self.pos += 1;
         let degree = match self.peek_tok() {
-            Some(Tok::Number(v)) if v.fract() == 0.0 && *v >= 0.0 && *v <= 40.0 => *v as usize,
+            Some(Tok::Number(v)) if v.fract() == 0.0 && *v >= 0.0 && *v <= MAX_DEGREE as f64 => {
+                *v as usize
+            }
+            Some(Tok::Number(v)) if v.fract() == 0.0 && *v > MAX_DEGREE as f64 => {
+                return Err(Diagnostic::text(
+                    self.here(),
+                    format!("quadrature degree {v} is above the limit {MAX_DEGREE}"),
+                )
+                .help(format!("write `∫[degree=N]` with N from 0 to {MAX_DEGREE}")))
+            }
             _ => return Err(bad(self.here())),
         };
         self.pos += 1;

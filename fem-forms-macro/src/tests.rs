@@ -446,3 +446,237 @@ fn vector_errors_point_at_the_expression() {
         );
     }
 }
+
+/// Issue 11, depth: a sum of thousands of terms expands in a loop, not by recursion.
+#[test]
+fn a_form_of_five_thousand_terms_compiles() {
+    let terms = vec!["α u v"; 5000].join(" + ");
+    let forms = format!("a(u;v) = ∫ {terms}");
+    let out = expand(membrane("P1", &forms));
+    assert!(
+        rendered_errors(&out).is_empty(),
+        "{:?}",
+        rendered_errors(&out)
+    );
+    // the 5000 equal terms are one term with coefficient 5000
+    assert!(out.to_string().contains("5000"));
+}
+
+#[test]
+fn deep_nesting_is_a_located_error() {
+    let nested = format!("{}u{}", "(".repeat(525), ")".repeat(525));
+    let errors = rendered_errors(&expand(membrane("P1", &format!("a(u;v) = ∫ {nested} v"))));
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("nested more than 100 levels")),
+        "{errors:?}"
+    );
+    let product = vec!["2"; 300].join(" ");
+    let errors = rendered_errors(&expand(membrane(
+        "P1",
+        &format!("a(u;v) = ∫ {product} u v"),
+    )));
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("nested more than 100 levels")),
+        "{errors:?}"
+    );
+}
+
+#[test]
+fn overflowing_constants_are_located_errors() {
+    for (forms, message) in [
+        ("a(u;v) = ∫ 1e999 ∇u·∇v", "number `1e999` is too large"),
+        (
+            "a(u;v) = ∫ (1e999 − 1e999) u v",
+            "number `1e999` is too large",
+        ),
+        ("a(u;v) = ∫ 1e200·1e200 f u v", "overflows (inf)"),
+    ] {
+        let errors = rendered_errors(&expand(membrane("P2", forms)));
+        assert!(
+            errors
+                .iter()
+                .any(|e| e.contains(message) && e.contains("line 1")),
+            "{forms}: {errors:?}"
+        );
+    }
+}
+
+/// The dump names the runtime by its crate name, so the file compiles on its own.
+#[test]
+fn the_dump_has_no_macro_only_paths() {
+    // A real `$crate` is one identifier only the compiler can make: test the rewrite on
+    // text, and that the dump of a model is a whole Rust file.
+    assert_eq!(
+        standalone("impl $crate::Model for Model"),
+        "impl ::fem_runtime::Model for Model"
+    );
+    let code = expand(quote! {
+        pub mod m on interval { unknowns: u: P1; tests: v; forms: "a(u;v) = ∫ u'v'"; }
+    });
+    let text = dump_text(&code);
+    assert!(text.contains("::fem_runtime::Model for Model"), "{text}");
+    syn::parse_file(&text).expect("the dump parses as a Rust file");
+}
+
+/// Issue 11: whatever the text, the macro answers with code or located errors, never
+/// a panic.
+mod no_panic {
+    use super::*;
+    use proptest::prelude::*;
+
+    const PIECES: &[&str] = &[
+        "u",
+        "v",
+        "λ",
+        "μ",
+        "f",
+        "t",
+        "h",
+        "h_T",
+        "w",
+        "a",
+        "b",
+        "B",
+        "ν",
+        "Т",
+        "∫",
+        "int",
+        "Σ_T",
+        "sum_T",
+        "(",
+        ")",
+        ",",
+        ";",
+        "+",
+        "−",
+        "-",
+        "*",
+        "·",
+        "/",
+        "'",
+        "''''",
+        "²",
+        "⁻²",
+        "⁵",
+        "^",
+        "^-2",
+        "[degree=",
+        "[degree=1]",
+        "]",
+        "=",
+        "a(u;v)",
+        "b(v;μ)",
+        "(u;v)",
+        "1e999",
+        "1e200",
+        "0",
+        "2",
+        "0.5",
+        "∇",
+        "Δ",
+        "grad",
+        "lap",
+        "dot",
+        "_T",
+        "\n",
+        " ",
+        "a₁(u;v) =",
+        "fn(u;v) =",
+        "#",
+        "{",
+        "}",
+        "!",
+        "é",
+        "\"",
+    ];
+
+    fn model(cell: &str, forms: &str) -> TokenStream {
+        let cell = proc_macro2::Ident::new(cell, proc_macro2::Span::call_site());
+        quote! {
+            pub mod m on #cell {
+                unknowns: u: P2, λ: P0 >= 0;
+                tests: v, μ;
+                params: t;
+                data: f;
+                forms: #forms;
+            }
+        }
+    }
+
+    /// Code that parses as Rust, or at least one `compile_error!` (with a place: every
+    /// diagnostic of the forms text names a line).
+    fn check(out: &TokenStream) -> Result<(), TestCaseError> {
+        let errors = rendered_errors(out);
+        if errors.is_empty() {
+            prop_assert!(syn::parse2::<syn::File>(out.clone()).is_ok());
+        }
+        Ok(())
+    }
+
+    fn piece_text() -> impl Strategy<Value = String> {
+        prop::collection::vec(prop::sample::select(PIECES), 0..40).prop_map(|v| v.concat())
+    }
+
+    /// Grammar-shaped integrands: sums of products of (derivatives of) arguments,
+    /// numbers and symbols, with parentheses, powers and integrals.
+    fn integrand() -> impl Strategy<Value = String> {
+        let leaf = prop::sample::select(
+            &[
+                "u", "v", "u'", "v''", "∇u", "∇v", "Δu", "λ", "μ", "f", "t", "h", "2", "1e300", "0",
+            ][..],
+        )
+        .prop_map(str::to_string);
+        leaf.prop_recursive(4, 24, 3, |inner| {
+            prop_oneof![
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} + {b}")),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} − {b}")),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a}·{b}")),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} / {b}")),
+                inner.clone().prop_map(|a| format!("({a})")),
+                inner.clone().prop_map(|a| format!("({a})²")),
+                inner.clone().prop_map(|a| format!("∇({a})")),
+                inner.clone().prop_map(|a| format!("({a})'")),
+                (inner.clone(), inner).prop_map(|(a, b)| format!("({a}, {b})_T")),
+            ]
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        #[test]
+        fn random_token_texts(text in piece_text(), triangle in any::<bool>()) {
+            let cell = if triangle { "triangle" } else { "interval" };
+            check(&expand(model(cell, &text)))?;
+            check(&expand(model(cell, &format!("a(u;v) = ∫ {text}"))))?;
+        }
+
+        #[test]
+        fn random_grammar_shaped_forms(
+            body in integrand(),
+            degree in prop::option::of(0usize..45),
+            triangle in any::<bool>(),
+        ) {
+            let cell = if triangle { "triangle" } else { "interval" };
+            let option = degree.map(|d| format!("[degree={d}]")).unwrap_or_default();
+            let forms = format!("a(u,λ;v,μ) = ∫{option} {body}\nℓ(v,μ) = Σ_T {body}\nB(u,λ;v,μ) = a(u,λ;v,μ) − 2 a(u,λ;v,μ)");
+            check(&expand(model(cell, &forms)))?;
+        }
+    }
+}
+
+/// Issue 11: on triangles `∫[degree=1]` is one-point (centroid) reduced integration,
+/// as on intervals: the P1 mass matrix becomes `|T|/9` in every entry.
+#[test]
+fn degree_one_on_triangles_is_one_point() {
+    let out = expand(membrane("P1", "a(u;v) = ∫[degree=1] u v")).to_string();
+    assert!(rendered_errors(&out.parse().unwrap()).is_empty(), "{out}");
+    assert!(out.contains("quadrature_points : 1usize"), "{out}");
+    // R[i][j] = ½ · (⅓)² = 1/18 of 2|T| (= area2): |T|/9
+    let literal = format!("{:?}", 1.0f64 / 18.0);
+    assert!(out.contains(&format!("s0 * {literal}f64")), "{out}");
+}

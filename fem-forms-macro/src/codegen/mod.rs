@@ -220,6 +220,45 @@ fn handles(symbols: &Symbols, forms: &[Form], runtime: &TokenStream) -> TokenStr
     }
 }
 
+/// The entries of `Model::DIRICHLET` and of `Model::FIELDS`.
+fn field_tables(
+    declaration: &Declaration,
+    symbols: &Symbols,
+) -> (Vec<TokenStream>, Vec<TokenStream>) {
+    let runtime = &declaration.runtime;
+    let dirichlet = declaration
+        .dirichlet
+        .iter()
+        .map(|(field, data)| {
+            // Both names were checked against the declaration before code generation.
+            let f = symbols
+                .fields
+                .iter()
+                .position(|x| *field == x.name)
+                .unwrap_or(0);
+            let g = symbols.data.iter().position(|x| *data == x.0).unwrap_or(0);
+            quote!((#f, #g))
+        })
+        .collect();
+    let field_infos = symbols
+        .fields
+        .iter()
+        .map(|f| {
+            let (name, test, nonnegative) = (&f.name, &f.test_name, f.nonnegative);
+            let element = Ident::new(&format!("{:?}", f.element), Span::call_site());
+            quote! {
+                #runtime::FieldInfo {
+                    name: #name,
+                    test_name: #test,
+                    element: #runtime::ElementKind::#element,
+                    nonnegative: #nonnegative,
+                }
+            }
+        })
+        .collect();
+    (dirichlet, field_infos)
+}
+
 /// The `runtime::Model` impl: names, fields, forms and the dispatch to the kernels.
 fn model_impl(
     declaration: &Declaration,
@@ -235,27 +274,7 @@ fn model_impl(
     let cell = Ident::new(backend.cell_variant(), Span::call_site());
     let coordinates = backend.coordinates();
     let cell_text = backend.coordinates_message();
-    let dirichlet = declaration.dirichlet.iter().map(|(field, data)| {
-        let f = symbols
-            .fields
-            .iter()
-            .position(|x| *field == x.name)
-            .unwrap_or(0);
-        let g = symbols.data.iter().position(|x| *data == x.0).unwrap_or(0);
-        quote!((#f, #g))
-    });
-    let field_infos = symbols.fields.iter().map(|f| {
-        let (name, test, nonnegative) = (&f.name, &f.test_name, f.nonnegative);
-        let element = Ident::new(&format!("{:?}", f.element), Span::call_site());
-        quote! {
-            #runtime::FieldInfo {
-                name: #name,
-                test_name: #test,
-                element: #runtime::ElementKind::#element,
-                nonnegative: #nonnegative,
-            }
-        }
-    });
+    let (dirichlet, field_infos) = field_tables(declaration, symbols);
     let params = &symbols.params;
     let data = symbols.data.iter().map(|d| &d.0);
     let description = description(declaration);

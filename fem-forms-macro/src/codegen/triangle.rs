@@ -116,6 +116,20 @@ fn factor_degree(element: ElementKind, derivative: [u8; 2]) -> usize {
         .saturating_sub((derivative[0] + derivative[1]) as usize)
 }
 
+/// The rule of a data loop or of an explicit `∫[degree=N]`: the centroid (one point)
+/// for degree ≤ 1, as reduced integration means, otherwise the collapsed Gauss rule
+/// exact for the degree.
+fn rule_for_degree(degree: usize) -> TriangleRule {
+    if degree <= 1 {
+        TriangleRule {
+            points: vec![[1.0 / 3.0, 1.0 / 3.0]],
+            weights: vec![0.5],
+        }
+    } else {
+        TriangleRule::exact_for_degree(degree)
+    }
+}
+
 /// The physical multi-indices the block's terms use, sorted.
 fn alphas(block: &Block) -> Vec<[u8; 2]> {
     let mut alphas: Vec<[u8; 2]> = Vec::new();
@@ -175,7 +189,11 @@ impl Triangle {
     /// Adds one constant-coefficient term to the pairs: per (β, γ) of its transforms,
     /// the run-time factor `c · T_αβ · T_α'γ`.
     fn add_term(&self, term: &Term, block: &Block, symbols: &Symbols, pairs: &mut Vec<Pair>) {
-        let rule = TriangleRule::exact_for_degree(self.term_degree(term, block, symbols));
+        // Exact terms: any rule exact for the degree gives the same table.
+        let rule = match term.quadrature_degree {
+            Some(degree) => rule_for_degree(degree),
+            None => TriangleRule::exact_for_degree(self.term_degree(term, block, symbols)),
+        };
         let c = coefficient(term.coefficient, &term.params, term.h_power);
         let trial_betas: Vec<[u8; 2]> = match term.trial_derivative {
             Some(d) => transform(d).into_iter().map(|(g, _)| g).collect(),
@@ -250,7 +268,7 @@ impl CellBackend for Triangle {
     }
 
     fn rule(&self, degree: usize) -> Rule {
-        let rule = TriangleRule::exact_for_degree(degree);
+        let rule = rule_for_degree(degree);
         Rule {
             points: rule.points.iter().map(|p| p.to_vec()).collect(),
             weights: rule.weights,
@@ -301,10 +319,8 @@ impl CellBackend for Triangle {
         let mut pairs: Vec<Pair> = Vec::new();
         let mut quadrature_points = 0;
         for &term in terms {
-            if term.quadrature_degree.is_some() {
-                let degree = self.term_degree(term, block, symbols);
-                quadrature_points =
-                    quadrature_points.max(TriangleRule::exact_for_degree(degree).points.len());
+            if let Some(degree) = term.quadrature_degree {
+                quadrature_points = quadrature_points.max(rule_for_degree(degree).points.len());
             }
             self.add_term(term, block, symbols, &mut pairs);
         }
@@ -404,5 +420,20 @@ mod tests {
         assert_eq!(find([1, 1]), &vec![(2.0, [1, 0, 1, 0])]);
         assert_eq!(find([0, 2]), &vec![(1.0, [0, 0, 2, 0])]);
         assert_eq!(transform([0, 1]).len(), 2);
+    }
+
+    #[test]
+    fn degree_one_is_the_centroid_rule() {
+        let rule = Triangle.rule(1);
+        assert_eq!(rule.points, [vec![1.0 / 3.0, 1.0 / 3.0]]);
+        // exact for degree 1: ∫ ξ over the reference triangle is 1/6
+        let integral: f64 = rule
+            .points
+            .iter()
+            .zip(&rule.weights)
+            .map(|(p, w)| w * p[0])
+            .sum();
+        assert!((integral - 1.0 / 6.0).abs() < 1e-16);
+        assert!(Triangle.rule(2).len() > 1);
     }
 }
