@@ -1,0 +1,211 @@
+//! The multiplier on fine meshes: how many digits the eliminated Λ loses to
+//! cancellation when `C ~ αh^p` is tiny, and its recovery from one saddle-point solve on
+//! the converged active set (docs/mathematics.md §5).
+
+use super::*;
+
+impl Lcp {
+    /// How many digits the eliminated multiplier `lambda` loses to cancellation: the
+    /// rounding `ε‖G_b‖∞‖C_b⁻¹‖∞` of `Λ_b = C_b⁻¹(G − BU)_b` (`ε|G_k| / C_k` for P0)
+    /// at its worst block among those where `lambda` is nonzero, relative to the
+    /// multiplier's natural size under the load `Λ* = ‖F‖∞/‖Bᵀ‖∞`
+    /// ([`Lcp::multiplier_scale`]), or to `‖lambda‖∞` where `F = 0` (contact driven by
+    /// the obstacle or the boundary data alone). Near 1 the eliminated Λ is rounding
+    /// noise: on fine meshes `C = αh⁵` falls below the rounding of `G − BU ≈ CΛ`.
+    ///
+    /// The load's scale comes first because `‖lambda‖∞` can be far larger than the
+    /// multiplier's typical value (P0 multipliers resolve the point forces at a beam's
+    /// contact edge as ~force/h): relative to it the noise in `∫λ` would be understated.
+    ///
+    /// 0 when `lambda ≡ 0`: the elimination clips every inactive constraint's Λ to an
+    /// exact 0, so there is nothing to be noisy (before, the estimate divided by the load
+    /// scale alone and reported ~1e302 at zero load).
+    pub fn elimination_noise(&self, lambda: &[f64]) -> f64 {
+        let largest = lambda.iter().fold(0.0f64, |m, l| m.max(l.abs()));
+        if largest == 0.0 || !largest.is_finite() {
+            return if largest == 0.0 { 0.0 } else { f64::INFINITY };
+        }
+        let load_scale = self.multiplier_scale();
+        let scale = if load_scale > 0.0 {
+            load_scale
+        } else {
+            largest
+        };
+        let carries = |range: std::ops::Range<usize>| {
+            lambda
+                .get(range)
+                .is_some_and(|l| l.iter().any(|&l| l != 0.0))
+        };
+        let mut dense = [0.0; BLOCK_ENTRIES];
+        let mut inverse = [0.0; BLOCK_ENTRIES];
+        self.blocks()
+            .filter_map(|block| {
+                if !carries(block.range()) {
+                    return None;
+                }
+                let k = block.start;
+                if block.size == 1 {
+                    return (self.c[k] > 0.0)
+                        .then(|| f64::EPSILON * self.g[k].abs() / (self.c[k] * scale));
+                }
+                let s = block.size;
+                block.dense(&self.c, &mut dense[..s * s]);
+                if !small_inverse(&dense, s, &mut inverse) {
+                    return None;
+                }
+                let inverse_norm = (0..s)
+                    .map(|i| (0..s).map(|j| inverse[i * s + j].abs()).sum::<f64>())
+                    .fold(0.0, f64::max);
+                let g = self.g[block.range()]
+                    .iter()
+                    .fold(0.0f64, |m, g| m.max(g.abs()));
+                Some(f64::EPSILON * g * inverse_norm / scale)
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The saddle-point system `[[A, −B̃ᵀ], [−B̃, D]]` of the primal–dual active set method with
+/// a fixed pattern: active rows carry `B_k` and, within their block of `C`, `D_kl = −C_kl`
+/// between active constraints; inactive rows `Λ_k = 0` (`B̃_k = 0`, `D_kk = −1` scaled,
+/// no coupling), so one symbolic LU serves every iteration.
+pub(super) struct SaddlePoint {
+    pub(super) symbolic: SymbolicSparseColMat<usize>,
+    pub(super) a_positions: Vec<usize>,
+    /// For row k of B: positions of (n+k, j) and (j, n+k) per entry.
+    pub(super) b_positions: Vec<Vec<(usize, usize)>>,
+    /// For each block of C: the positions of (n+k, n+l), k and l in the block (k-major).
+    pub(super) block_positions: Vec<Vec<usize>>,
+}
+
+impl SaddlePoint {
+    pub(super) fn new(lcp: &Lcp) -> Self {
+        let (n, m) = (lcp.n(), lcp.m());
+        let pattern = Pattern::new(&lcp.a, n + m, |columns| {
+            for (k, row) in lcp.b_rows.iter().enumerate() {
+                for &(j, _) in row {
+                    columns[j].push(n + k);
+                    columns[n + k].push(j);
+                }
+            }
+            for block in lcp.blocks() {
+                for k in block.range() {
+                    for l in block.range() {
+                        columns[n + l].push(n + k);
+                    }
+                }
+            }
+        });
+        let a_positions = pattern.positions_of(&lcp.a);
+        let b_positions = lcp
+            .b_rows
+            .iter()
+            .enumerate()
+            .map(|(k, row)| {
+                row.iter()
+                    .map(|&(j, _)| (pattern.position(n + k, j), pattern.position(j, n + k)))
+                    .collect()
+            })
+            .collect();
+        let block_positions = lcp
+            .blocks()
+            .map(|block| {
+                block
+                    .range()
+                    .flat_map(|k| block.range().map(move |l| (k, l)))
+                    .map(|(k, l)| pattern.position(n + k, n + l))
+                    .collect()
+            })
+            .collect();
+        Self {
+            symbolic: pattern.symbolic(),
+            a_positions,
+            b_positions,
+            block_positions,
+        }
+    }
+
+    pub(super) fn matrix(&self, lcp: &Lcp, active: &[bool]) -> SparseMatrix {
+        let mut values = values_of_a(&self.symbolic, &self.a_positions, &lcp.a);
+        for (k, row) in lcp.b_rows.iter().enumerate() {
+            if active[k] {
+                for (&(_, v), &(p, q)) in row.iter().zip(&self.b_positions[k]) {
+                    values[p] = -v;
+                    values[q] = -v;
+                }
+            }
+        }
+        for (block, positions) in lcp.blocks().zip(&self.block_positions) {
+            let s = block.size;
+            for (i, k) in block.range().enumerate() {
+                for (j, l) in block.range().enumerate() {
+                    let p = positions[i * s + j];
+                    if active[k] && active[l] {
+                        values[p] = -block.entry(&lcp.c, i, j);
+                    } else if k == l {
+                        // Λ_k = 0, scaled like the row so that the matrix stays balanced
+                        let scale = lcp.b_rows[k]
+                            .iter()
+                            .fold(0.0f64, |m, &(_, v)| m.max(v.abs()));
+                        values[p] = -scale.max(lcp.c[k]).max(f64::MIN_POSITIVE);
+                    }
+                }
+            }
+        }
+        SparseColMat::new(self.symbolic.clone(), values)
+    }
+}
+
+/// Recovers `(U, Λ)` on the active set `{Λ_k > 0}` of a converged solution from one
+/// saddle-point solve, in which Λ comes from the equilibrium instead of
+/// `C⁻¹(G − BU)`: on fine meshes, where `C = αh⁵` is below the rounding of `G − BU`, this is the
+/// difference between a multiplier and rounding noise. Keeps the solution it was given
+/// when the recovered one does not satisfy the KKT conditions as well.
+pub fn recover_multiplier(
+    lcp: &Lcp,
+    solution: LcpSolution,
+    refinement_steps: usize,
+) -> Result<LcpSolution> {
+    let clock = Instant::now();
+    lcp.check_shapes()?;
+    let (n, m) = (lcp.n(), lcp.m());
+    if solution.u.len() != n || solution.lambda.len() != m {
+        return Err(Error::Input(format!(
+            "a solution with {} primal values and {} multipliers for a problem with {n} and {m}",
+            solution.u.len(),
+            solution.lambda.len()
+        )));
+    }
+    let active: Vec<bool> = solution.lambda.iter().map(|&l| l > 0.0).collect();
+    let saddle = SaddlePoint::new(lcp);
+    let k_matrix = saddle.matrix(lcp, &active);
+    let factor = crate::lcp::cholesky::LuSolver::analyse(&saddle.symbolic)?.factor(&k_matrix)?;
+    let mut rhs = lcp.f.clone();
+    rhs.extend((0..m).map(|k| if active[k] { -lcp.g[k] } else { 0.0 }));
+    let x = factor.solve_refined(&k_matrix, &rhs, refinement_steps)?;
+    let u = x[..n].to_vec();
+    let lambda: Vec<f64> = x[n..]
+        .iter()
+        .zip(&active)
+        .map(|(&l, &a)| if a { l.max(0.0) } else { 0.0 })
+        .collect();
+    let residual = lcp.kkt_residual(&u, &lambda);
+    // The eliminated Λ's noise is invisible to the (backward-error) residual, so the
+    // recovered solution is taken whenever it satisfies the KKT conditions to 1e-8.
+    if residual <= 1e-8 {
+        let multiplier_noise = lcp.elimination_noise(&lambda);
+        Ok(LcpSolution {
+            u,
+            lambda,
+            kkt_residual: residual,
+            seconds: solution.seconds + clock.elapsed().as_secs_f64(),
+            factorizations: solution.factorizations + 1,
+            low_rank_updates: solution.low_rank_updates,
+            // the recovery helps, but with κ this large it is no guarantee: keep the estimate
+            multiplier_noise,
+            ..solution
+        })
+    } else {
+        Ok(solution)
+    }
+}
