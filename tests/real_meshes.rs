@@ -413,3 +413,21 @@ fn needles_warn_and_refuse_where_the_forced_alpha_drowns_in_rounding() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn vertices_hanging_on_boundary_edges_are_found_and_only_they() {
+    // the unit square: the lower-right half one cell, the upper-left half two cells
+    // split at (0.5, 0.5), which hangs on the lower cell's diagonal
+    let vertices = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]];
+    let m = TriangleMesh::new(vertices, vec![[0, 1, 2], [0, 4, 3], [4, 2, 3]], &[]).unwrap();
+    let diagonal = m.edges().iter().position(|&e| e == [0, 2]).unwrap();
+    assert_eq!(m.vertices_on_boundary_edges(), vec![(4, diagonal)]);
+    // none on Gmsh's coherent square, on a disk, or on an L-shape's re-entrant corner
+    for mesh in [
+        read_msh(&data("halves_coherent.msh")).unwrap(),
+        read_msh(&data("disk_r1_order1.msh")).unwrap(),
+        TriangleMesh::l_shape(8).unwrap(),
+    ] {
+        assert!(mesh.vertices_on_boundary_edges().is_empty());
+    }
+}

@@ -1074,6 +1074,85 @@ impl TriangleMesh {
     }
 }
 
+impl TriangleMesh {
+    /// Boundary vertices that lie on a boundary edge they do not end, as
+    /// `(vertex, edge)` pairs sorted by vertex: within `1e-6 ×` the shorter of the
+    /// edge and the vertex's shortest boundary edge of the segment.
+    ///
+    /// On a valid mesh of a domain the boundary edges meet only at their ends, so such a
+    /// vertex is the end of a slit inside the domain: two surfaces meshed separately
+    /// along a common curve, with coincident nodes ([`Self::coincident_vertices`] finds
+    /// those too) or with different nodes on each side (hanging vertices). Boundary
+    /// edges are bucketed on a grid of the longest boundary edge's size, so the search
+    /// is linear for boundaries of comparable edge lengths.
+    pub fn vertices_on_boundary_edges(&self) -> Vec<(usize, usize)> {
+        let segment = |e: usize| {
+            let [a, b] = self.edges[e];
+            (self.vertices[a], self.vertices[b])
+        };
+        let longest = self
+            .boundary_edges
+            .iter()
+            .map(|&(e, _)| {
+                let (p, q) = segment(e);
+                dist2(p, q)
+            })
+            .fold(0.0, f64::max)
+            .sqrt();
+        if !(longest > 0.0 && longest.is_finite()) {
+            return Vec::new();
+        }
+        let key = |x: f64| (x / longest).floor() as i64;
+        let mut buckets: std::collections::HashMap<(i64, i64), Vec<usize>> =
+            std::collections::HashMap::with_capacity(2 * self.boundary_edges.len());
+        for &(e, _) in &self.boundary_edges {
+            let (p, q) = segment(e);
+            let slack = 1e-6 * dist2(p, q).sqrt();
+            for i in key(p[0].min(q[0]) - slack)..=key(p[0].max(q[0]) + slack) {
+                for j in key(p[1].min(q[1]) - slack)..=key(p[1].max(q[1]) + slack) {
+                    buckets.entry((i, j)).or_default().push(e);
+                }
+            }
+        }
+        // each boundary vertex's shortest boundary edge, so that a vertex near a short
+        // edge of its own is not taken for one on a longer edge nearby
+        let mut local = vec![f64::INFINITY; self.vertices.len()];
+        for &(e, _) in &self.boundary_edges {
+            let (p, q) = segment(e);
+            for v in self.edges[e] {
+                local[v] = local[v].min(dist2(p, q));
+            }
+        }
+        let mut found = Vec::new();
+        for (v, &local2) in local.iter().enumerate() {
+            if local2 == f64::INFINITY {
+                continue;
+            }
+            let x = self.vertices[v];
+            let Some(candidates) = buckets.get(&(key(x[0]), key(x[1]))) else {
+                continue;
+            };
+            for &e in candidates {
+                if self.edges[e].contains(&v) {
+                    continue;
+                }
+                let (p, q) = segment(e);
+                let d = [q[0] - p[0], q[1] - p[1]];
+                let length2 = d[0] * d[0] + d[1] * d[1];
+                let s = ((x[0] - p[0]) * d[0] + (x[1] - p[1]) * d[1]) / length2;
+                let s = s.clamp(0.0, 1.0);
+                let nearest = [p[0] + s * d[0], p[1] + s * d[1]];
+                if dist2(x, nearest) <= 1e-12 * length2.min(local2) {
+                    found.push((v, e));
+                }
+            }
+        }
+        found.sort_unstable();
+        found.dedup();
+        found
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
