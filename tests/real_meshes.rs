@@ -357,7 +357,7 @@ fn needle_msh(t: f64) -> String {
         [0.0, 1.0],
     ];
     let cells = [[1, 2, 3], [1, 4, 2], [1, 3, 5], [1, 6, 4], [1, 5, 7]];
-    let mut text = format!("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 7 1 7\n2 1 0 7\n");
+    let mut text = String::from("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 7 1 7\n2 1 0 7\n");
     for i in 1..=7 {
         text.push_str(&format!("{i}\n"));
     }
