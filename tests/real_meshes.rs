@@ -431,3 +431,24 @@ fn vertices_hanging_on_boundary_edges_are_found_and_only_they() {
         assert!(mesh.vertices_on_boundary_edges().is_empty());
     }
 }
+
+#[test]
+fn the_refusal_threshold_lies_between_a_174_and_a_179_4_degree_angle() {
+    let dir = scratch("threshold");
+    for (y, refused) in [("0.9", false), ("0.99", true)] {
+        let text = std::fs::read_to_string(data("sliver.msh"))
+            .unwrap()
+            .replace("1 0.999999 0", &format!("1 {y} 0"));
+        let path = dir.join(format!("sliver-{y}.msh"));
+        std::fs::write(&path, text).unwrap();
+        let m = read_msh(&path).unwrap();
+        assert_eq!(m.quality().check(&m).is_err(), refused, "y = {y}");
+        let run = solve(&path, "p1-p0", &["--mesh-size", "1"]);
+        if refused {
+            assert!(refusal(&run).contains("nearly flat"));
+        } else {
+            assert!(json(&run)["warnings"].to_string().contains("above 160°"));
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
