@@ -31,7 +31,18 @@ pub fn read_msh(path: &Path) -> Result<TriangleMesh> {
 /// numbered compactly in increasing tag order. All nodes must lie in the plane `z = 0`
 /// (up to 1e-12 of the mesh's extent). Each clockwise triangle (of a surface whose
 /// normal is −z) is made counter-clockwise by itself, so surfaces of opposite normals
-/// can be mixed.
+/// can be mixed. Parametric node coordinates (`Mesh.SaveParametric = 1`) are dropped
+/// from ASCII files; binary files with them are refused with that hint.
+///
+/// # Errors
+/// [`Error::Mesh`] naming the Gmsh element or node at fault, for anything
+/// [`TriangleMesh::new`] refuses (degenerate, duplicate or overlapping cells), and for
+/// a mesh with a cut inside its domain: coincident nodes
+/// ([`TriangleMesh::coincident_vertices`]) or a node hanging on another surface's
+/// boundary edge ([`TriangleMesh::vertices_on_boundary_edges`]), as Gmsh writes when two
+/// surfaces are meshed without sharing their common curve. Those are refused, not
+/// merged, with the Gmsh fix (`Coherence`) in the message: merging would silently
+/// change the model, whose author may have meant a slit.
 pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
     let binary = check_header(bytes)?;
     let stripped = if binary {
