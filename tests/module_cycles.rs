@@ -42,29 +42,81 @@ fn resolve<'a>(path: &str, known: &'a BTreeMap<String, PathBuf>) -> Option<&'a s
     })
 }
 
-/// The paths a file names after `crate::`, outside comments and its test module, with
-/// `use crate::{a, b::c}` groups expanded.
-fn crate_paths(source: &str) -> Vec<String> {
+/// The module paths a file names, outside comments and its test module, as absolute
+/// paths: `crate::a::b`, `super::x` and `self::x` (relative to `module`), and `x::…` in
+/// a `use` where `x` is a child module of `module` (how a parent names its children).
+/// `use …::{a, b::c}` groups are expanded.
+fn named_paths(source: &str, module: &str, known: &BTreeMap<String, PathBuf>) -> Vec<String> {
     let code: String = source
-        .split("#[cfg(test)]")
+        .split("#[cfg(test)]\nmod tests")
         .next()
         .unwrap()
         .lines()
         .filter(|l| !l.trim_start().starts_with("//"))
         .collect::<Vec<_>>()
         .join("\n");
-    let mut out = Vec::new();
-    let mut rest = code.as_str();
-    while let Some(at) = rest.find("crate::") {
-        rest = &rest[at + "crate::".len()..];
-        if let Some(group) = rest.strip_prefix('{') {
-            let end = group.find('}').unwrap_or(group.len());
-            out.extend(group[..end].split(',').map(|p| p.trim().to_string()));
+    let parent = match module.rsplit_once("::") {
+        Some((parent, _)) => parent.to_string(),
+        None => "crate".to_string(),
+    };
+    let absolute = |path: &str| -> String {
+        let within = |base: &str, rest: &str| match base {
+            "crate" => rest.to_string(),
+            _ if rest.is_empty() => base.to_string(),
+            _ => format!("{base}::{rest}"),
+        };
+        if let Some(rest) = path.strip_prefix("crate::") {
+            rest.to_string()
+        } else if let Some(rest) = path.strip_prefix("super::") {
+            within(&parent, rest)
+        } else if let Some(rest) = path.strip_prefix("self::") {
+            within(module, rest)
         } else {
-            let end = rest
-                .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
-                .unwrap_or(rest.len());
-            out.push(rest[..end].trim_end_matches(':').to_string());
+            within(module, path)
+        }
+    };
+    let mut out = Vec::new();
+    let word_end = |s: &str| {
+        s.find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+            .unwrap_or(s.len())
+    };
+    for prefix in ["crate::", "super::", "self::"] {
+        let mut rest = code.as_str();
+        while let Some(at) = rest.find(prefix) {
+            let before = rest[..at].chars().last();
+            rest = &rest[at + prefix.len()..];
+            if before.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':') {
+                continue; // `super::` inside `crate::a::super`-like text, or a longer word
+            }
+            if let Some(group) = rest.strip_prefix('{') {
+                let end = group.find('}').unwrap_or(group.len());
+                out.extend(
+                    group[..end]
+                        .split(',')
+                        .map(|p| absolute(&format!("{prefix}{}", p.trim()))),
+                );
+            } else {
+                let end = word_end(rest);
+                out.push(absolute(&format!(
+                    "{prefix}{}",
+                    rest[..end].trim_end_matches(':')
+                )));
+            }
+        }
+    }
+    // `use child::…` in a parent module
+    for line in code.lines() {
+        let line = line.trim_start();
+        let Some(path) = line
+            .strip_prefix("use ")
+            .or_else(|| line.strip_prefix("pub use "))
+        else {
+            continue;
+        };
+        let first = &path[..word_end(path)];
+        let head = first.split("::").next().unwrap_or("");
+        if known.contains_key(&absolute(head)) && !["crate", "super", "self"].contains(&head) {
+            out.push(absolute(first.trim_end_matches(':')));
         }
     }
     out
@@ -78,7 +130,7 @@ fn edges(root: &Path) -> BTreeMap<String, BTreeSet<String>> {
         .iter()
         .map(|(name, file)| {
             let source = std::fs::read_to_string(file).unwrap();
-            let targets = crate_paths(&source)
+            let targets = named_paths(&source, name, &known)
                 .iter()
                 .filter_map(|p| resolve(p, &known))
                 .filter(|t| *t != name && !name.starts_with(&format!("{t}::")) && *t != "crate")
@@ -154,8 +206,25 @@ fn a_cycle_is_found() {
     )
     .unwrap();
     std::fs::write(dir.join("b.rs"), "use crate::{error::E, a::Z};\n").unwrap();
+    std::fs::create_dir_all(dir.join("c")).unwrap();
+    std::fs::write(dir.join("c/mod.rs"), "mod x;\nmod y;\nuse x::Thing;\n").unwrap();
+    std::fs::write(dir.join("c/x.rs"), "use super::*;\nuse super::y::Other;\n").unwrap();
+    std::fs::write(
+        dir.join("c/y.rs"),
+        "fn f() { self::g(); }\n#[cfg(test)]\nmod tests { use super::super::x; }\n",
+    )
+    .unwrap();
     let graph = edges(&dir);
-    std::fs::remove_dir_all(&dir).unwrap();
     assert!(cycle_through(&graph, "b").is_some(), "{graph:?}");
     assert!(cycle_through(&graph, "a::inner").is_none(), "{graph:?}");
+    assert!(
+        graph["c"].contains("c::x") && graph["c::x"].contains("c::y"),
+        "{graph:?}"
+    );
+    assert!(cycle_through(&graph, "c::x").is_none(), "{graph:?}");
+    // a sibling naming the other back through `super::` closes a cycle
+    std::fs::write(dir.join("c/y.rs"), "use super::x::Thing;\n").unwrap();
+    let graph = edges(&dir);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(cycle_through(&graph, "c::x").is_some(), "{graph:?}");
 }

@@ -357,7 +357,7 @@ fn needle_msh(t: f64) -> String {
         [0.0, 1.0],
     ];
     let cells = [[1, 2, 3], [1, 4, 2], [1, 3, 5], [1, 6, 4], [1, 5, 7]];
-    let mut text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 7 1 7\n2 1 0 7\n".to_string();
+    let mut text = String::from("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 7 1 7\n2 1 0 7\n");
     for i in 1..=7 {
         text.push_str(&format!("{i}\n"));
     }
@@ -409,6 +409,45 @@ fn needles_warn_and_refuse_where_the_forced_alpha_drowns_in_rounding() {
             if run.status.success() {
                 assert_eq!(json(&run)["alpha"].as_f64(), Some(1e-3));
             }
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn vertices_hanging_on_boundary_edges_are_found_and_only_they() {
+    // the unit square: the lower-right half one cell, the upper-left half two cells
+    // split at (0.5, 0.5), which hangs on the lower cell's diagonal
+    let vertices = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]];
+    let m = TriangleMesh::new(vertices, vec![[0, 1, 2], [0, 4, 3], [4, 2, 3]], &[]).unwrap();
+    let diagonal = m.edges().iter().position(|&e| e == [0, 2]).unwrap();
+    assert_eq!(m.vertices_on_boundary_edges(), vec![(4, diagonal)]);
+    // none on Gmsh's coherent square, on a disk, or on an L-shape's re-entrant corner
+    for mesh in [
+        read_msh(&data("halves_coherent.msh")).unwrap(),
+        read_msh(&data("disk_r1_order1.msh")).unwrap(),
+        TriangleMesh::l_shape(8).unwrap(),
+    ] {
+        assert!(mesh.vertices_on_boundary_edges().is_empty());
+    }
+}
+
+#[test]
+fn the_refusal_threshold_lies_between_a_174_and_a_179_4_degree_angle() {
+    let dir = scratch("threshold");
+    for (y, refused) in [("0.9", false), ("0.99", true)] {
+        let text = std::fs::read_to_string(data("sliver.msh"))
+            .unwrap()
+            .replace("1 0.999999 0", &format!("1 {y} 0"));
+        let path = dir.join(format!("sliver-{y}.msh"));
+        std::fs::write(&path, text).unwrap();
+        let m = read_msh(&path).unwrap();
+        assert_eq!(m.quality().check(&m).is_err(), refused, "y = {y}");
+        let run = solve(&path, "p1-p0", &["--mesh-size", "1"]);
+        if refused {
+            assert!(refusal(&run).contains("nearly flat"));
+        } else {
+            assert!(json(&run)["warnings"].to_string().contains("above 160°"));
         }
     }
     std::fs::remove_dir_all(&dir).unwrap();

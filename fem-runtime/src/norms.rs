@@ -2,6 +2,7 @@
 
 use crate::assembly::dof_map::DofMap;
 use crate::element::interval::PhysicalBasis;
+use crate::element::mapping::Affine;
 use crate::mesh::IntervalMesh;
 use fem_reference::gauss_legendre;
 
@@ -35,7 +36,7 @@ impl FieldView<'_> {
     pub fn at_with(&self, basis: &PhysicalBasis, x: f64, derivative: usize) -> Option<f64> {
         let c = self.mesh.locate(x)?;
         let cell = self.mesh.cell(c);
-        let xi = (x - cell[0]) / (cell[1] - cell[0]);
+        let [xi] = Affine::interval(cell).reference_point([x]);
         let dofs = self.map.cell_dofs(c);
         Some(
             dofs.iter()
@@ -52,11 +53,12 @@ impl FieldView<'_> {
         let mut sum = 0.0;
         for c in 0..self.mesh.cell_count() {
             let cell = self.mesh.cell(c);
-            let h = cell[1] - cell[0];
+            let map = Affine::interval(cell);
             let local = self.local(c);
             for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
-                let e = exact(cell[0] + h * xi) - basis.evaluate(&local, derivative, cell, xi);
-                sum += w * h * e * e;
+                let [x] = map.point([xi]);
+                let e = exact(x) - basis.evaluate(&local, derivative, cell, xi);
+                sum += w * map.det * e * e;
             }
         }
         sum.sqrt()

@@ -1,7 +1,8 @@
 //! The map from the reference cell to a physical cell, and the chain rule it gives for
-//! derivatives: the one place where points, gradients and Hessians on physical cells are
-//! computed from reference ones (fields, norms, prolongation and boundary data all go
-//! through it; the generated kernels inline the same formulas).
+//! derivatives: points, gradients and Hessians on physical cells from reference ones.
+//! Triangle fields, DOF nodes, the interval basis and the interval norms go through it;
+//! the generated kernels inline the same formulas, and point location inverts the map
+//! through barycentric coordinates of its own.
 //!
 //! Reference cells: the interval `[0, 1]` and the triangle with vertices `(0,0), (1,0),
 //! (0,1)`. For an affine cell `x = x₀ + J ξ`, with `K = J⁻¹`:
@@ -11,6 +12,9 @@ use crate::mesh::TriangleMesh;
 
 /// The affine map `x = x₀ + J ξ` of a cell of dimension `D` (1: an interval, 2: a
 /// triangle), with `K = J⁻¹` kept for the chain rule.
+///
+/// The cell must not be degenerate (`det J ≠ 0`; mesh constructors refuse such cells):
+/// for a degenerate one `K` is not finite, and so are gradients and Hessians.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Affine<const D: usize> {
     origin: [f64; D],
@@ -61,6 +65,11 @@ impl<const D: usize> Affine<D> {
     /// The physical point of reference point `ξ`: `x₀ + J ξ`.
     pub fn point(&self, xi: [f64; D]) -> [f64; D] {
         std::array::from_fn(|r| self.origin[r] + (0..D).map(|c| self.j[r][c] * xi[c]).sum::<f64>())
+    }
+
+    /// The reference point of physical point `x`: `K (x − x₀)`.
+    pub fn reference_point(&self, x: [f64; D]) -> [f64; D] {
+        std::array::from_fn(|r| (0..D).map(|c| self.k[r][c] * (x[c] - self.origin[c])).sum())
     }
 
     /// The physical gradient of a function from its reference gradient: `Kᵀ ∇̂φ̂`.
@@ -134,6 +143,8 @@ mod tests {
         }
         let area = 0.5 * ((x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1])).abs();
         assert!((map.det - 2.0 * area).abs() < 1e-14);
+        let back_xi = map.reference_point(p);
+        assert!((back_xi[0] - xi[0]).abs() < 1e-14 && (back_xi[1] - xi[1]).abs() < 1e-14);
         let vertex = map.point([1.0, 0.0]);
         assert!((vertex[0] - x[2]).abs() < 1e-15 && (vertex[1] - x[3]).abs() < 1e-15);
     }
@@ -142,6 +153,7 @@ mod tests {
     fn interval_map_scales_derivatives_by_the_length() {
         let map = Affine::interval([2.0, 2.5]);
         assert_eq!(map.point([0.5]), [2.25]);
+        assert_eq!(map.reference_point([2.25]), [0.5]);
         assert_eq!(map.gradient([1.0]), [2.0]);
         assert_eq!(map.hessian([[1.0]]), [[4.0]]);
         assert_eq!(map.det, 0.5);

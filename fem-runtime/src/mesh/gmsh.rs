@@ -31,7 +31,18 @@ pub fn read_msh(path: &Path) -> Result<TriangleMesh> {
 /// numbered compactly in increasing tag order. All nodes must lie in the plane `z = 0`
 /// (up to 1e-12 of the mesh's extent). Each clockwise triangle (of a surface whose
 /// normal is −z) is made counter-clockwise by itself, so surfaces of opposite normals
-/// can be mixed.
+/// can be mixed. Parametric node coordinates (`Mesh.SaveParametric = 1`) are dropped
+/// from ASCII files; binary files with them are refused with that hint.
+///
+/// # Errors
+/// [`Error::Mesh`] naming the Gmsh element or node at fault, for anything
+/// [`TriangleMesh::new`] refuses (degenerate, duplicate or overlapping cells), and for
+/// a mesh with a cut inside its domain: coincident nodes
+/// ([`TriangleMesh::coincident_vertices`]) or a node hanging on another surface's
+/// boundary edge ([`TriangleMesh::vertices_on_boundary_edges`]), as Gmsh writes when two
+/// surfaces are meshed without sharing their common curve. Those are refused, not
+/// merged, with the Gmsh fix (`Coherence`) in the message: merging would silently
+/// change the model, whose author may have meant a slit.
 pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
     let binary = check_header(bytes)?;
     let stripped = if binary {
@@ -527,11 +538,12 @@ fn orient(vertices: &[[f64; 2]], cells: &mut [[usize; 3]]) -> usize {
 /// naming them and their coordinates and saying how to fix the mesh in Gmsh.
 ///
 /// Merging them instead would silently change the user's model (the two copies may also
-/// be the lips of an intended slit), so the fix is left to the mesh's author.
+/// be the lips of an intended slit), so the fix is left to the mesh's author. Without
+/// coincident vertices, hanging ones are looked for ([`refuse_hanging_vertices`]).
 fn refuse_duplicate_nodes(mesh: &TriangleMesh) -> Result<()> {
     let pairs = mesh.coincident_vertices();
     let Some(&[a, b]) = pairs.first() else {
-        return Ok(());
+        return refuse_hanging_vertices(mesh);
     };
     let [x, y] = mesh.vertices()[a];
     let more = match pairs.len() {
@@ -540,6 +552,25 @@ fn refuse_duplicate_nodes(mesh: &TriangleMesh) -> Result<()> {
     };
     Err(Error::Mesh(format!(
         "vertex {a} and vertex {b} coincide at ({x}, {y}){more}: the mesh has duplicate nodes, as when two surfaces are meshed separately along a common curve, and would be solved with a cut (a boundary where u = g) inside the domain; in Gmsh, make the geometry coherent before meshing (`Coherence;` in a built-in-kernel .geo script, Geometry.AutoCoherence = 1, or BooleanFragments with OpenCASCADE) or merge the mesh's duplicates with `Coherence Mesh;`, then re-export"
+    )))
+}
+
+/// Refuses a mesh with a boundary vertex inside another boundary edge
+/// ([`TriangleMesh::vertices_on_boundary_edges`]): a curve meshed separately, with
+/// different nodes, by the two surfaces it separates.
+fn refuse_hanging_vertices(mesh: &TriangleMesh) -> Result<()> {
+    let found = mesh.vertices_on_boundary_edges();
+    let Some(&(v, e)) = found.first() else {
+        return Ok(());
+    };
+    let [x, y] = mesh.vertices()[v];
+    let [a, b] = mesh.edges()[e];
+    let more = match found.len() {
+        1 => String::new(),
+        n => format!(" ({n} such vertices in all)"),
+    };
+    Err(Error::Mesh(format!(
+        "vertex {v} at ({x}, {y}) lies on the boundary edge from vertex {a} to vertex {b} without being one of its ends{more}: the mesh has boundary edges inside the domain, as when two surfaces are meshed separately along a common curve, and would be solved with a cut (a boundary where u = g) there; in Gmsh, make the geometry coherent before meshing (`Coherence;` in a built-in-kernel .geo script, Geometry.AutoCoherence = 1, or BooleanFragments with OpenCASCADE), then re-mesh and re-export"
     )))
 }
 
@@ -925,6 +956,27 @@ $EndElements
         let e = error(&text);
         assert!(
             e.contains("element 5") && e.contains("element 9") && e.contains("duplicates"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn hanging_vertices_on_an_inner_boundary_are_refused() {
+        // the upper-left half split at node 10 = (0.5, 0.5), the lower-right half not:
+        // node 10 hangs on the diagonal, a boundary edge inside the square
+        let text = SQUARE
+            .replace("7 8 1 8", "7 9 1 9")
+            .replace(
+                "2 1 2 2\n5 1 2 3\n6 1 3 4",
+                "2 1 2 3\n5 1 2 3\n6 1 10 4\n9 10 3 4",
+            )
+            .replace("10\n2 2 0", "10\n0.5 0.5 0");
+        let e = error(&text);
+        assert!(
+            e.contains("node 10")
+                && e.contains("(0.5, 0.5)")
+                && e.contains("vertex 0 (node 1) to vertex 2 (node 3)")
+                && e.contains("Coherence"),
             "{e}"
         );
     }

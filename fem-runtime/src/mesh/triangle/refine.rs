@@ -1,0 +1,101 @@
+//! Conforming newest-vertex bisection of marked cells (with the closure it needs) and
+//! uniform refinement, with the parent of every new cell for prolongation.
+
+use super::*;
+
+impl TriangleMesh {
+    /// Conforming newest-vertex bisection of the marked cells and the closure it needs.
+    ///
+    /// Returns the new mesh and, for each new cell, its parent cell in `self`. Indices may
+    /// repeat; an out-of-range index is an error. Each cell is bisected at most twice in
+    /// depth (into two, three or four children); boundary markers pass to edge halves.
+    pub fn refine(&self, marked: &[usize]) -> Result<(TriangleMesh, Vec<usize>)> {
+        let mut edge_marked = vec![false; self.edges.len()];
+        let mut queue = Vec::new();
+        for &c in marked {
+            if c >= self.cells.len() {
+                return Err(mesh_error(format!(
+                    "cannot refine cell {c}: the mesh has {} cells",
+                    self.cells.len()
+                )));
+            }
+            let r = self.cell_edges[c][1];
+            if !edge_marked[r] {
+                edge_marked[r] = true;
+                queue.push(r);
+            }
+        }
+        // Closure: a cell with any edge to split must first split its refinement edge.
+        // This terminates for any labelling (each edge is marked at most once).
+        while let Some(e) = queue.pop() {
+            for c in self.edge_cells[e] {
+                if c == NONE {
+                    continue;
+                }
+                let r = self.cell_edges[c][1];
+                if !edge_marked[r] {
+                    edge_marked[r] = true;
+                    queue.push(r);
+                }
+            }
+        }
+        self.bisect(&edge_marked)
+    }
+
+    /// Splits every cell into four by two levels of bisection: cell count ×4, `h` halves
+    /// on meshes whose cells' longest edges are their refinement edges.
+    pub fn refine_uniformly(&self) -> TriangleMesh {
+        self.bisect(&vec![true; self.edges.len()])
+            .expect("bisecting every edge of a valid mesh gives a valid mesh")
+            .0
+    }
+
+    /// Bisects the marked edges; every cell with a marked edge has its refinement edge marked.
+    fn bisect(&self, edge_marked: &[bool]) -> Result<(TriangleMesh, Vec<usize>)> {
+        let mut vertices = self.vertices.clone();
+        let mut midpoint = vec![NONE; self.edges.len()];
+        for e in (0..self.edges.len()).filter(|&e| edge_marked[e]) {
+            let [a, b] = self.edges[e];
+            let (p, q) = (self.vertices[a], self.vertices[b]);
+            midpoint[e] = vertices.len();
+            vertices.push([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]);
+        }
+        let mut cells =
+            Vec::with_capacity(self.cells.len() + 3 * (vertices.len() - self.vertices.len()));
+        let mut parents = Vec::with_capacity(cells.capacity());
+        for (c, &[v0, v1, v2]) in self.cells.iter().enumerate() {
+            let [e0, e1, e2] = self.cell_edges[c];
+            let m = midpoint[e1];
+            if m == NONE {
+                cells.push([v0, v1, v2]);
+                parents.push(c);
+                continue;
+            }
+            // children [m, v0, v1] and [m, v2, v0]: the new vertex first, so each child's
+            // refinement edge is one of the parent's other edges
+            match midpoint[e0] {
+                NONE => cells.push([m, v0, v1]),
+                p => cells.extend([[p, m, v0], [p, v1, m]]),
+            }
+            match midpoint[e2] {
+                NONE => cells.push([m, v2, v0]),
+                p => cells.extend([[p, m, v2], [p, v0, m]]),
+            }
+            parents.resize(cells.len(), c);
+        }
+        let mut markers = Vec::new();
+        for &(e, marker) in &self.boundary_edges {
+            if marker == 0 {
+                continue;
+            }
+            let [a, b] = self.edges[e];
+            match midpoint[e] {
+                NONE => markers.push((a, b, marker)),
+                m => markers.extend([(a, m, marker), (m, b, marker)]),
+            }
+        }
+        let mut mesh = Self::from_oriented(vertices, cells)?;
+        mesh.apply_markers(&markers)?;
+        Ok((mesh, parents))
+    }
+}
