@@ -20,6 +20,7 @@ pub mod model;
 pub mod norms;
 pub mod obstacle;
 pub mod obstacle_2d;
+pub mod stabilization;
 pub mod triangle_field;
 pub mod triangle_mesh;
 pub mod vtk;
