@@ -6,10 +6,12 @@ use fem_forms::beams::{self, Pair, Report, Request};
 use fem_forms::membrane_studies::{self, MembraneStudy};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::membrane_scenes::MembraneScene;
-use fem_forms::models::registry::{find, names, registry, Family, SceneEntry, SceneKind};
+use fem_forms::models::registry::{
+    find, names, registry, Family, SceneEntry, SceneKind, MEMBRANE_PAIRS,
+};
 use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::VariationalSolver;
-use fem_forms::{plot, studies};
+use fem_forms::{plot, scene_file, studies};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -40,10 +42,17 @@ enum SolverName {
 enum Command {
     /// List the scenes (with their family, pairs and studies) and the element pairs.
     List,
-    /// Solve one scene. Options that do not apply to the scene's family are refused.
+    /// Solve one scene: a built-in one by name, or a scene file (`--scene my.toml`).
+    /// Options that do not apply to the scene's family are refused.
     Solve {
         /// Scene name (see `list`).
-        name: String,
+        #[arg(required_unless_present = "scene_file", conflicts_with = "scene_file")]
+        name: Option<String>,
+        /// A scene file (TOML: model, pair, mesh, boundary, parameters, data as
+        /// expressions in x, y; see examples/ and the README). Options given on the
+        /// command line override the file's.
+        #[arg(long = "scene", value_name = "FILE")]
+        scene_file: Option<PathBuf>,
         #[command(flatten)]
         options: SolveOptions,
     },
@@ -260,7 +269,10 @@ fn membrane_row(r: &MembraneReport) {
 fn default_job(out: &Path) -> Result<(), String> {
     println!("fem-forms: default beam scenes (clamped on (0,1), 256 elements, nested semismooth Newton)\n");
     table_header();
-    let entries: Vec<SceneEntry> = registry().into_iter().filter(|e| e.in_default_job).collect();
+    let entries: Vec<SceneEntry> = registry()
+        .into_iter()
+        .filter(|e| e.in_default_job)
+        .collect();
     for e in &entries {
         let SceneKind::Beam(s) = e.kind else {
             continue;
@@ -370,9 +382,9 @@ fn membrane_job(scenes: &[MembraneScene], out: &Path) -> Result<(), String> {
 fn list() {
     println!("scenes (family, pairs with the default first, studies):");
     for e in registry() {
-        let load = e
-            .default_load()
-            .map_or("fixed load".to_string(), |q| format!("--load q = {q} by default"));
+        let load = e.default_load().map_or("fixed load".to_string(), |q| {
+            format!("--load q = {q} by default")
+        });
         println!("  {:<17} {}", e.name(), e.description());
         println!(
             "  {:<17} {} scene; pairs {}; {load}{}",
@@ -416,7 +428,10 @@ fn solve(entry: &SceneEntry, options: &SolveOptions, out: &Path) -> Result<(), S
 fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {
     options.refuse(
         &["--mesh-size", "--msh", "--vtk"],
-        &format!("`{}` is a beam scene on a uniform interval mesh (--elements)", s.name),
+        &format!(
+            "`{}` is a beam scene on a uniform interval mesh (--elements)",
+            s.name
+        ),
     )?;
     if s.beam == Beam::EulerBernoulli {
         options.refuse(
@@ -461,11 +476,7 @@ fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String
     Ok(())
 }
 
-fn solve_membrane(
-    scene: &MembraneScene,
-    options: &SolveOptions,
-    out: &Path,
-) -> Result<(), String> {
+fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> Result<(), String> {
     options.refuse(
         &["--elements", "--thickness", "--refinement", "--plot"],
         &format!(
@@ -572,18 +583,41 @@ fn run(cli: Cli) -> Result<(), String> {
             list();
             Ok(())
         }
-        Some(Command::Solve { name, options }) => {
-            let entry = find(&name).ok_or_else(|| {
-                format!(
-                    "unknown scene `{name}`; the scenes are {}",
-                    names().join(", ")
-                )
-            })?;
+        Some(Command::Solve {
+            name,
+            scene_file,
+            mut options,
+        }) => {
+            let entry = match (name, scene_file) {
+                (_, Some(path)) => {
+                    let file = scene_file::read(&path).map_err(|e| e.to_string())?;
+                    options
+                        .pair
+                        .get_or_insert_with(|| file.pair.name().to_string());
+                    options.mesh_size.get_or_insert(file.mesh_size);
+                    options.alpha = options.alpha.or(file.alpha);
+                    SceneEntry {
+                        kind: SceneKind::Membrane(file.scene),
+                        pairs: MEMBRANE_PAIRS,
+                        studies: &[],
+                        in_default_job: false,
+                    }
+                }
+                (Some(scene), None) => find(&scene).ok_or_else(|| {
+                    format!(
+                        "unknown scene `{scene}`; the scenes are {}",
+                        names().join(", ")
+                    )
+                })?,
+                (None, None) => return Err("give a scene name or --scene FILE".into()),
+            };
             solve(&entry, &options, &cli.out)
         }
-        Some(Command::Study { study: name, kind, full }) => {
-            study(&name, kind.as_deref(), full, &cli.out)
-        }
+        Some(Command::Study {
+            study: name,
+            kind,
+            full,
+        }) => study(&name, kind.as_deref(), full, &cli.out),
     }
 }
 

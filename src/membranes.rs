@@ -2,20 +2,19 @@
 //! inverse-inequality constant `C_I`, the solve with its report (the CLI's `--json`),
 //! errors against the exact radial solution, and VTK output.
 
-use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use crate::models::data::Data;
+use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use crate::models::membrane_scenes::{Domain, ExactMembrane, MembraneScene};
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
 use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_runtime::obstacle_2d::{
     dirichlet_constraints, nodal_active_set, solve_obstacle_on_triangles, TriangleObstacleSolution,
 };
+use fem_runtime::stabilization::{self, Alpha};
 use fem_runtime::triangle_field::{TriangleBasis, TriangleField};
 use fem_runtime::{
-    Coefficients, Diagonal, DofMap, Error, Model, PointLocator, Result, SystemDofs,
-    TriangleMesh,
+    Coefficients, Diagonal, DofMap, Error, Model, PointLocator, Result, SystemDofs, TriangleMesh,
 };
-use fem_runtime::stabilization::{self, Alpha};
 use serde::Serialize;
 use std::time::Instant;
 

@@ -128,17 +128,39 @@ fn the_stability_study_writes_its_chart_and_table() {
 fn options_that_do_not_apply_are_refused_by_name() {
     let out = scratch("options");
     for (args, option) in [
-        (&["solve", "membrane-flat", "--thickness", "0.01"][..], "--thickness"),
-        (&["solve", "membrane-flat", "--elements", "64"][..], "--elements"),
-        (&["solve", "membrane-lshape", "--refinement", "2"][..], "--refinement"),
+        (
+            &["solve", "membrane-flat", "--thickness", "0.01"][..],
+            "--thickness",
+        ),
+        (
+            &["solve", "membrane-flat", "--elements", "64"][..],
+            "--elements",
+        ),
+        (
+            &["solve", "membrane-lshape", "--refinement", "2"][..],
+            "--refinement",
+        ),
         (&["solve", "membrane-lshape", "--plot"][..], "--plot"),
         (&["solve", "bernoulli-a", "--msh", "x.msh"][..], "--msh"),
-        (&["solve", "bernoulli-a", "--mesh-size", "8"][..], "--mesh-size"),
+        (
+            &["solve", "bernoulli-a", "--mesh-size", "8"][..],
+            "--mesh-size",
+        ),
         (&["solve", "timoshenko-a", "--vtk"][..], "--vtk"),
-        (&["solve", "bernoulli-a", "--thickness", "0.01"][..], "--thickness"),
+        (
+            &["solve", "bernoulli-a", "--thickness", "0.01"][..],
+            "--thickness",
+        ),
         (&["solve", "membrane-radial", "--load", "2"][..], "--load"),
         (
-            &["solve", "membrane-flat", "--pair", "p1-nodal", "--alpha", "0.1"][..],
+            &[
+                "solve",
+                "membrane-flat",
+                "--pair",
+                "p1-nodal",
+                "--alpha",
+                "0.1",
+            ][..],
             "--alpha",
         ),
     ] {
@@ -167,19 +189,41 @@ fn json_of(args: &[&str], out: &PathBuf) -> serde_json::Value {
 fn load_scales_the_membrane_load() {
     let out = scratch("load");
     for (q, args) in [
-        (3.0, &["solve", "membrane-flat", "--mesh-size", "8", "--json"][..]),
+        (
+            3.0,
+            &["solve", "membrane-flat", "--mesh-size", "8", "--json"][..],
+        ),
         (
             1.0,
-            &["solve", "membrane-flat", "--mesh-size", "8", "--json", "--load", "1"][..],
+            &[
+                "solve",
+                "membrane-flat",
+                "--mesh-size",
+                "8",
+                "--json",
+                "--load",
+                "1",
+            ][..],
         ),
         (
             5.0,
-            &["solve", "membrane-flat", "--mesh-size", "8", "--json", "--load", "5"][..],
+            &[
+                "solve",
+                "membrane-flat",
+                "--mesh-size",
+                "8",
+                "--json",
+                "--load",
+                "5",
+            ][..],
         ),
     ] {
         let json = json_of(args, &out);
         let force = json["total_contact_force"].as_f64().unwrap();
-        assert!((force - 16.0 * q).abs() < 1e-7 * 16.0 * q, "q = {q}: ∫λ_h = {force}");
+        assert!(
+            (force - 16.0 * q).abs() < 1e-7 * 16.0 * q,
+            "q = {q}: ∫λ_h = {force}"
+        );
         assert_eq!(json["load"].as_f64(), Some(q));
         assert_eq!(json["exact_contact_force"].as_f64(), Some(16.0 * q));
     }
@@ -194,12 +238,23 @@ fn json_is_honest_about_the_domain() {
     let out = scratch("domain");
     let disk = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/disk_r1_order1.msh");
     let json = json_of(
-        &["solve", "membrane-radial", "--msh", disk, "--pair", "p1-p0", "--json"],
+        &[
+            "solve",
+            "membrane-radial",
+            "--msh",
+            disk,
+            "--pair",
+            "p1-p0",
+            "--json",
+        ],
         &out,
     );
     assert!(json["exact_contact_force"].is_null(), "{json}");
     assert!(json["exact_contact_area"].is_null(), "{json}");
-    assert!(json["domain"].as_str().unwrap().contains("disk_r1_order1.msh"));
+    assert!(json["domain"]
+        .as_str()
+        .unwrap()
+        .contains("disk_r1_order1.msh"));
     // the contact disk r* = 0.698 lies inside the unit disk: the error is small
     assert!(json["error_l2"].as_f64().unwrap() < 0.05, "{json}");
     let own = json_of(

@@ -6,8 +6,8 @@
 use fem_forms::membranes::{
     self, element_inverse_constant, MembranePair, MembraneReport, MembraneRequest,
 };
-use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use fem_forms::models::data::Data;
+use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene, MEMBRANE_FLAT};
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::studies::rates;

@@ -294,8 +294,7 @@ mod tests {
             let c = element_inverse_constant::<membrane_p2::Model>(&x, &[], "S", "a").unwrap();
             assert!((c - expected).abs() < 1e-8 * expected, "{c} vs {expected}");
             let moved = x.map(|v| 3.7 * v + 1.0);
-            let d =
-                element_inverse_constant::<membrane_p2::Model>(&moved, &[], "S", "a").unwrap();
+            let d = element_inverse_constant::<membrane_p2::Model>(&moved, &[], "S", "a").unwrap();
             assert!((c - d).abs() < 1e-8 * c, "{c} vs {d}");
             let p1 = element_inverse_constant::<membrane_p1::Model>(&x, &[], "S", "a").unwrap();
             assert_eq!(p1, 0.0);
@@ -318,16 +317,9 @@ mod tests {
     /// The mesh maximum: a structured right-diagonal mesh has only right isosceles cells.
     #[test]
     fn mesh_constant_is_the_largest_cell_constant() {
-        let mesh = crate::TriangleMesh::rectangle(
-            -1.0,
-            1.0,
-            -1.0,
-            1.0,
-            4,
-            4,
-            crate::Diagonal::Right,
-        )
-        .unwrap();
+        let mesh =
+            crate::TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 4, 4, crate::Diagonal::Right)
+                .unwrap();
         let c = inverse_constant::<membrane_p2::Model, _>(&mesh, &[], "S", "a").unwrap();
         assert!((c - 96.0).abs() < 1e-8 * 96.0, "{c}");
     }
