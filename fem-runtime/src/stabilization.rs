@@ -245,7 +245,7 @@ mod tests {
                 a(u;v)       = ∫ ∇u·∇v
                 b(v;μ)       = ∫ v μ
                 S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
-                ℓ(v)         = ∫ f v
+                L(v)         = ∫ f v
             ";
         }
     }
@@ -260,7 +260,7 @@ mod tests {
                 a(u;v)       = ∫ ∇u·∇v
                 b(v;μ)       = ∫ v μ
                 S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
-                ℓ(v)         = ∫ f v
+                L(v)         = ∫ f v
             ";
         }
     }
@@ -275,7 +275,7 @@ mod tests {
                 a(u;v)       = ∫ u'v'
                 b(v;μ)       = ∫ v μ
                 S(u,λ;v,μ)   = Σ_T h_T² (u'' − λ, v'' − μ)_T
-                ℓ(v)         = ∫ f v
+                L(v)         = ∫ f v
             ";
         }
     }

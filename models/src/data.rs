@@ -6,13 +6,16 @@ use fem_runtime::DataFn;
 use std::fmt;
 use std::sync::Arc;
 
+/// A shared function of the point with values of type `T`.
+pub type SharedFn<T> = Arc<dyn Fn(&[f64]) -> T + Send + Sync>;
+
 /// A function of the point `x` (`[x]` on intervals, `[x, y]` on triangles) with values
 /// of type `T`: a plain function (so built-in scenes stay `const`) or a shared closure.
 pub enum Data<T: 'static = f64> {
     /// A plain function.
     Fn(fn(&[f64]) -> T),
     /// A closure, e.g. a compiled expression of a scene file.
-    Shared(Arc<dyn Fn(&[f64]) -> T + Send + Sync>),
+    Shared(SharedFn<T>),
 }
 
 impl<T> Data<T> {
