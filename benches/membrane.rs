@@ -232,12 +232,13 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize], rounds: usize, with_l
         "ratio"
     );
     for &n in sizes {
-        let mut request = MembraneRequest::new(scene);
+        let mut request = MembraneRequest::new(scene.clone());
         request.pair = pair;
         request.mesh_size = n;
         let mesh = membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap();
         let (alpha, _) = membranes::alpha_of(&request, &mesh).unwrap();
-        let coefficients = membranes::scene_coefficients::<M>(&scene, alpha).unwrap();
+        let data = membranes::SceneData::new(&scene, None);
+        let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
         let (warm, _) = vi_solve_once::<M>(&scene, &coefficients, &mesh, n, true);
         let a = warm.discretization.lcp.a.clone();
         let (mut linear, mut pipelined, mut sequential) = (Vec::new(), Vec::new(), Vec::new());

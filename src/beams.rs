@@ -7,6 +7,7 @@ use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::{
     solve_obstacle, Discretization, ObstacleOptions, ObstacleSolution, VariationalSolver,
 };
+use fem_runtime::stabilization;
 use fem_runtime::{
     assemble_vector, Coefficients, DataFn, Error, IntervalMesh, MatrixAssembler, Model, Result,
     SystemDofs,
@@ -150,6 +151,10 @@ pub struct Report {
     pub thickness: Option<f64>,
     /// Stabilization parameter.
     pub alpha: f64,
+    /// `max_T C_I(T)` of the pair's `S_h` against `a` on the mesh
+    /// ([`fem_runtime::stabilization`]): 0 for every beam pair (θ''' and w'''' vanish on
+    /// each element), so every α > 0 is stable.
+    pub inverse_constant: f64,
     /// Elements.
     pub elements: usize,
     /// Unknowns after eliminating boundary DOFs (primal and multiplier).
@@ -353,6 +358,8 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     let coefficients = setup.coefficients::<M>()?;
     let clamped = setup.clamped;
     let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
+    let inverse_constant =
+        stabilization::inverse_constant::<M, _>(&mesh, &coefficients.params, "S", "a")?;
     let options = ObstacleOptions {
         solver: request.solver,
         nested_from: request.nested_from,
@@ -403,6 +410,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         load: q,
         thickness: (scene.beam == Beam::Timoshenko).then_some(thickness),
         alpha,
+        inverse_constant,
         elements: request.elements,
         dofs: d.lcp.n() + d.lcp.m(),
         iterations: solution.iterations,

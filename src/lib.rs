@@ -12,6 +12,7 @@ pub mod beams;
 pub mod membrane_studies;
 pub mod membranes;
 pub mod plot;
+pub mod scene_file;
 pub mod studies;
 
 pub use fem_models as models;

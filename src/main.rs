@@ -5,10 +5,13 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
 use fem_forms::membrane_studies::{self, MembraneStudy};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
-use fem_forms::models::membrane_scenes::{membrane_scene, MEMBRANE_FLAT, MEMBRANE_SCENES};
-use fem_forms::models::scenes::{scene, SCENES};
+use fem_forms::models::membrane_scenes::MembraneScene;
+use fem_forms::models::registry::{
+    find, names, registry, Family, SceneEntry, SceneKind, MEMBRANE_PAIRS,
+};
+use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::VariationalSolver;
-use fem_forms::{plot, studies};
+use fem_forms::{plot, scene_file, studies};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -27,7 +30,7 @@ struct Cli {
     out: PathBuf,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Clone, Copy, Debug, ValueEnum)]
 enum SolverName {
     /// Semismooth Newton / primal–dual active set (nested iteration).
     Pdas,
@@ -37,69 +40,133 @@ enum SolverName {
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the scenes and the element pairs.
+    /// List the scenes (with their family, pairs and studies) and the element pairs.
     List,
-    /// Solve one scene.
+    /// Solve one scene: a built-in one by name, or a scene file (`--scene my.toml`).
+    /// Options that do not apply to the scene's family are refused.
     Solve {
         /// Scene name (see `list`).
-        scene: String,
-        /// Elements of the uniform mesh (beams).
-        #[arg(long, default_value_t = 256)]
-        elements: usize,
-        /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
-        /// three quarters of it).
-        /// (default 64; with --msh: 0 refinements)
-        #[arg(long)]
-        mesh_size: Option<usize>,
-        /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
-        #[arg(long)]
-        vtk: bool,
-        /// Solve on this Gmsh mesh (MSH 4.1) instead of the structured one; with it,
-        /// --mesh-size is the number of uniform refinements (membranes).
-        #[arg(long)]
-        msh: Option<PathBuf>,
-        /// Load magnitude q (1: no contact; 40 and 100: contact).
-        #[arg(long, default_value_t = 1.0)]
-        load: f64,
-        /// Beam thickness t (Timoshenko scenes).
-        #[arg(long)]
-        thickness: Option<f64>,
-        /// Stabilization parameter α (negative values are refused with a reason).
-        #[arg(long, allow_negative_numbers = true)]
-        alpha: Option<f64>,
-        /// Element pair (beams: p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0;
-        /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal).
-        #[arg(long)]
-        pair: Option<String>,
-        /// LCP solver.
-        #[arg(long, value_enum, default_value = "pdas")]
-        solver: SolverName,
-        /// Start Newton from zero on the final mesh instead of nested iteration.
-        #[arg(long)]
-        cold: bool,
-        /// Rounds of iterative refinement per linear solve (t ≤ 1e-5 wants 2 or 3).
-        #[arg(long, default_value_t = 1)]
-        refinement: usize,
-        /// Print one JSON object instead of a table.
-        #[arg(long)]
-        json: bool,
-        /// Also write the plot of w, θ, λ, ψ.
-        #[arg(long)]
-        plot: bool,
+        #[arg(required_unless_present = "scene_file", conflicts_with = "scene_file")]
+        name: Option<String>,
+        /// A scene file (TOML: model, pair, mesh, boundary, parameters, data as
+        /// expressions in x, y; see examples/ and the README). Options given on the
+        /// command line override the file's.
+        #[arg(long = "scene", value_name = "FILE")]
+        scene_file: Option<PathBuf>,
+        #[command(flatten)]
+        options: SolveOptions,
     },
-    /// Run a study and write its chart and CSV: a beam study (convergence, locking,
-    /// stability, alpha, work-precision, iterations), or `membrane-radial` followed by
-    /// convergence, stability or alpha (all three when left out).
+    /// Run a study and write its chart and CSV: `study <scene> [study]` runs one study
+    /// the scene hosts (all of them when left out; see `list`); `study <study>` runs a
+    /// beam study (convergence, locking, stability, alpha, work-precision, iterations).
     Study {
-        /// Which study, or the membrane scene `membrane-radial`.
+        /// A scene name, or a beam study.
         study: String,
-        /// The membrane study.
-        #[arg(value_enum)]
-        kind: Option<MembraneStudy>,
+        /// The study, after a scene name.
+        kind: Option<String>,
         /// Larger meshes (longer).
         #[arg(long)]
         full: bool,
     },
+}
+
+/// The options of `solve`. Each applies to one family (or one kind of scene) only; the
+/// others are `None`/`false` unless given, and a given one that does not apply is an
+/// error naming it.
+#[derive(clap::Args, Debug, Default)]
+struct SolveOptions {
+    /// Elements of the uniform mesh (beams; default 256).
+    #[arg(long)]
+    elements: Option<usize>,
+    /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
+    /// three quarters of it). (default 64; with --msh: 0 refinements)
+    #[arg(long)]
+    mesh_size: Option<usize>,
+    /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
+    #[arg(long)]
+    vtk: bool,
+    /// Solve on this Gmsh mesh (MSH 4.1) instead of the structured one; with it,
+    /// --mesh-size is the number of uniform refinements (membranes).
+    #[arg(long)]
+    msh: Option<PathBuf>,
+    /// Load magnitude q: the load is q times the scene's load field (beams: f = ∓q, q = 1
+    /// no contact, 40 and 100 contact; membrane-flat: f = −q, default 3;
+    /// membrane-lshape: f = −q, default 12). Refused where the load is fixed
+    /// (membrane-radial: f = 0).
+    #[arg(long)]
+    load: Option<f64>,
+    /// Beam thickness t (Timoshenko scenes).
+    #[arg(long)]
+    thickness: Option<f64>,
+    /// Stabilization parameter α (negative values are refused with a reason; not for
+    /// p1-nodal, which has no multiplier).
+    #[arg(long, allow_negative_numbers = true)]
+    alpha: Option<f64>,
+    /// Element pair (beams: p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0;
+    /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal).
+    #[arg(long)]
+    pair: Option<String>,
+    /// LCP solver (default pdas; not for p1-nodal).
+    #[arg(long, value_enum)]
+    solver: Option<SolverName>,
+    /// Start Newton from zero on the final mesh instead of nested iteration.
+    #[arg(long)]
+    cold: bool,
+    /// Rounds of iterative refinement per linear solve (beams; default 1; t ≤ 1e-5
+    /// wants 2 or 3).
+    #[arg(long)]
+    refinement: Option<usize>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Also write the plot of w, θ, λ, ψ (beams).
+    #[arg(long)]
+    plot: bool,
+}
+
+impl SolveOptions {
+    /// The given options among `names` (flag spellings), for the error of options that
+    /// do not apply.
+    fn given(&self) -> Vec<&'static str> {
+        let mut given = Vec::new();
+        let mut note = |set: bool, name: &'static str| {
+            if set {
+                given.push(name);
+            }
+        };
+        note(self.elements.is_some(), "--elements");
+        note(self.mesh_size.is_some(), "--mesh-size");
+        note(self.vtk, "--vtk");
+        note(self.msh.is_some(), "--msh");
+        note(self.load.is_some(), "--load");
+        note(self.thickness.is_some(), "--thickness");
+        note(self.alpha.is_some(), "--alpha");
+        note(self.pair.is_some(), "--pair");
+        note(self.solver.is_some(), "--solver");
+        note(self.cold, "--cold");
+        note(self.refinement.is_some(), "--refinement");
+        note(self.plot, "--plot");
+        given
+    }
+
+    /// An error naming the first given option of `not_applicable`, with `why`.
+    fn refuse(&self, not_applicable: &[&str], why: &str) -> Result<(), String> {
+        match self
+            .given()
+            .into_iter()
+            .find(|o| not_applicable.contains(o))
+        {
+            Some(option) => Err(format!("{option} does not apply: {why}")),
+            None => Ok(()),
+        }
+    }
+
+    fn solver(&self) -> VariationalSolver {
+        match self.solver.unwrap_or(SolverName::Pdas) {
+            SolverName::Pdas => VariationalSolver::SemismoothNewton,
+            SolverName::Clarabel => VariationalSolver::Clarabel,
+        }
+    }
 }
 
 fn table_header() {
@@ -202,7 +269,14 @@ fn membrane_row(r: &MembraneReport) {
 fn default_job(out: &Path) -> Result<(), String> {
     println!("fem-forms: default beam scenes (clamped on (0,1), 256 elements, nested semismooth Newton)\n");
     table_header();
-    for s in SCENES {
+    let entries: Vec<SceneEntry> = registry()
+        .into_iter()
+        .filter(|e| e.in_default_job)
+        .collect();
+    for e in &entries {
+        let SceneKind::Beam(s) = e.kind else {
+            continue;
+        };
         for q in [1.0, 100.0] {
             let mut request = Request::new(s);
             request.load = q;
@@ -221,17 +295,27 @@ fn default_job(out: &Path) -> Result<(), String> {
     for study in studies::Study::DEFAULT {
         studies::run(study, false, out).map_err(|e| format!("study {study:?}: {e}"))?;
     }
-    membrane_job(out)
+    let membranes: Vec<MembraneScene> = entries
+        .into_iter()
+        .filter_map(|e| match e.kind {
+            SceneKind::Membrane(s) => Some(s),
+            SceneKind::Beam(_) => None,
+        })
+        .collect();
+    membrane_job(&membranes, out)
 }
 
 /// The membrane part of the default job: every pair on the radial scene, each scene at
 /// the cheapest pair and mesh that reach its asked accuracy, VTK files, the studies.
-fn membrane_job(out: &Path) -> Result<(), String> {
+fn membrane_job(scenes: &[MembraneScene], out: &Path) -> Result<(), String> {
     println!("\nfem-forms: membrane scenes (N×N×2 triangles, nested semismooth Newton)\n");
     membrane_header();
-    let radial = membrane_scene("membrane-radial").expect("the scene exists");
+    let radial = scenes
+        .iter()
+        .find(|s| s.name == "membrane-radial")
+        .ok_or("the registry has no membrane-radial")?;
     for pair in MembranePair::ALL {
-        let mut request = MembraneRequest::new(radial);
+        let mut request = MembraneRequest::new(radial.clone());
         request.pair = pair;
         match membranes::solve(&request) {
             Ok((report, _)) => membrane_row(&report),
@@ -239,8 +323,8 @@ fn membrane_job(out: &Path) -> Result<(), String> {
         }
     }
     std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
-    for scene in MEMBRANE_SCENES {
-        let (rungs, cheapest) = membranes::cheapest_for_accuracy(&scene, &MembranePair::ALL)
+    for scene in scenes {
+        let (rungs, cheapest) = membranes::cheapest_for_accuracy(scene, &MembranePair::ALL)
             .map_err(|e| format!("{}: {e}", scene.name))?;
         println!(
             "\n{}: the coarsest mesh of each pair with estimated ‖u − u_h‖_L2 ≤ {:.0e} (Richardson estimate against N×2{})",
@@ -275,7 +359,7 @@ fn membrane_job(out: &Path) -> Result<(), String> {
             );
         }
         if let Some(k) = cheapest {
-            let mut request = MembraneRequest::new(scene);
+            let mut request = MembraneRequest::new(scene.clone());
             request.pair = MembranePair::parse(&rungs[k].pair).map_err(|e| e.to_string())?;
             request.mesh_size = rungs[k].mesh_size;
             let (_, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
@@ -295,168 +379,245 @@ fn membrane_job(out: &Path) -> Result<(), String> {
     Ok(())
 }
 
+fn list() {
+    println!("scenes (family, pairs with the default first, studies):");
+    for e in registry() {
+        let load = e.default_load().map_or("fixed load".to_string(), |q| {
+            format!("--load q = {q} by default")
+        });
+        println!("  {:<17} {}", e.name(), e.description());
+        println!(
+            "  {:<17} {} scene; pairs {}; {load}{}",
+            "",
+            e.family().name(),
+            e.pairs.join(", "),
+            if e.studies.is_empty() {
+                String::new()
+            } else {
+                format!("; studies {}", e.studies.join(", "))
+            }
+        );
+    }
+    println!("beam pairs:");
+    for p in Pair::ALL {
+        println!(
+            "  {:<17} {:?} (default α = {})",
+            p.name(),
+            p.beam(),
+            p.default_alpha()
+        );
+    }
+    println!(
+        "membrane pairs (--mesh-size N, or --msh FILE; default p2-p0; α = ½/C_I, or {} where C_I = 0):",
+        membranes::ALPHA_WHEN_CI_VANISHES
+    );
+    for p in MembranePair::ALL {
+        println!("  {}", p.name());
+    }
+}
+
+/// The one family-dispatch point of `solve`: options checked against the scene's family,
+/// then the family's solver.
+fn solve(entry: &SceneEntry, options: &SolveOptions, out: &Path) -> Result<(), String> {
+    match &entry.kind {
+        SceneKind::Beam(scene) => solve_beam(*scene, options, out),
+        SceneKind::Membrane(scene) => solve_membrane(scene, options, out),
+    }
+}
+
+fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {
+    options.refuse(
+        &["--mesh-size", "--msh", "--vtk"],
+        &format!(
+            "`{}` is a beam scene on a uniform interval mesh (--elements)",
+            s.name
+        ),
+    )?;
+    if s.beam == Beam::EulerBernoulli {
+        options.refuse(
+            &["--thickness"],
+            &format!("`{}` is an Euler–Bernoulli beam (no thickness)", s.name),
+        )?;
+    }
+    let pair = options
+        .pair
+        .as_deref()
+        .map(|p| Pair::parse(p, s.beam))
+        .transpose()
+        .map_err(|e| e.to_string())?;
+    let load = options.load.unwrap_or(1.0);
+    let request = Request {
+        scene: s,
+        elements: options.elements.unwrap_or(256),
+        load,
+        thickness: options.thickness,
+        alpha: options.alpha,
+        pair,
+        solver: options.solver(),
+        nested_from: (!options.cold).then_some(16),
+        refinement_steps: options.refinement.unwrap_or(1),
+        plain: false,
+    };
+    let (report, profiles) = beams::solve(&request).map_err(|e| e.to_string())?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        table_header();
+        table_row(&report);
+    }
+    if options.plot {
+        let path = out.join(format!("{}-q{load}.svg", s.name));
+        plot::profiles(&path, &format!("{} q = {load}", s.name), &profiles)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> Result<(), String> {
+    options.refuse(
+        &["--elements", "--thickness", "--refinement", "--plot"],
+        &format!(
+            "`{}` is a membrane scene on a triangle mesh (--mesh-size, --msh; --vtk writes its fields)",
+            scene.name
+        ),
+    )?;
+    let mut request = MembraneRequest::new(scene.clone());
+    if let Some(p) = &options.pair {
+        request.pair = MembranePair::parse(p).map_err(|e| e.to_string())?;
+    }
+    if request.pair == MembranePair::P1Nodal {
+        options.refuse(
+            &["--alpha", "--solver"],
+            "p1-nodal has no multiplier to stabilize and solves its nodal constraints by its own active-set method",
+        )?;
+    }
+    scene.load_magnitude(options.load)?;
+    request.load = options.load;
+    if let Some(n) = options.mesh_size {
+        request.mesh_size = n;
+    } else if options.msh.is_some() {
+        request.mesh_size = 0;
+    }
+    request.mesh_file.clone_from(&options.msh);
+    request.alpha = options.alpha;
+    request.solver = options.solver();
+    request.nested = !options.cold;
+    let (report, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        membrane_header();
+        membrane_row(&report);
+    }
+    if options.vtk {
+        let path = out.join(format!(
+            "{}-{}-{}.vtu",
+            scene.name, report.pair, request.mesh_size
+        ));
+        std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
+        membranes::write_vtk(&path, &fields).map_err(|e| e.to_string())?;
+        eprintln!("→ {}", path.display());
+    }
+    Ok(())
+}
+
+/// `study <scene> [kind]` through the registry, or `study <beam study>`.
+fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
+    let Some(entry) = find(name) else {
+        if let Some(kind) = kind {
+            return Err(format!(
+                "`{name}` is not a scene, so `{kind}` cannot be its study; the scenes are {}",
+                names().join(", ")
+            ));
+        }
+        let beam_study = <studies::Study as ValueEnum>::from_str(name, true).map_err(|_| {
+            format!(
+                "unknown study or scene `{name}`; the beam studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
+                studies::Study::DEFAULT
+                    .iter()
+                    .filter_map(|s| s.to_possible_value().map(|v| v.get_name().to_string()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })?;
+        return studies::run(beam_study, full, out).map_err(|e| e.to_string());
+    };
+    if entry.studies.is_empty() {
+        return Err(format!("scene `{name}` hosts no study"));
+    }
+    let kinds: Vec<&str> = match kind {
+        Some(k) if entry.studies.contains(&k) => vec![k],
+        Some(k) => {
+            return Err(format!(
+                "scene `{name}` hosts no study `{k}`; its studies are {}",
+                entry.studies.join(", ")
+            ))
+        }
+        None => entry.studies.to_vec(),
+    };
+    for k in kinds {
+        match entry.family() {
+            Family::Beam => {
+                let s = <studies::Study as ValueEnum>::from_str(k, true)?;
+                studies::run(s, full, out).map_err(|e| e.to_string())?;
+            }
+            Family::Membrane => {
+                let s = <MembraneStudy as ValueEnum>::from_str(k, true)?;
+                membrane_studies::run(s, full, out).map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
         None => default_job(&cli.out),
         Some(Command::List) => {
-            println!("scenes:");
-            for s in SCENES {
-                println!("  {:<15} {}", s.name, s.description);
-            }
-            println!("pairs:");
-            for p in Pair::ALL {
-                println!(
-                    "  {:<17} {:?} (default α = {})",
-                    p.name(),
-                    p.beam(),
-                    p.default_alpha()
-                );
-            }
-            println!("membrane scenes (--mesh-size N, or --msh FILE):");
-            for s in MEMBRANE_SCENES.iter().chain([&MEMBRANE_FLAT]) {
-                println!("  {:<17} {}", s.name, s.description);
-            }
-            println!(
-                "membrane pairs (default p2-p0; α = ½/C_I, or {} where C_I = 0):",
-                membranes::ALPHA_WHEN_CI_VANISHES
-            );
-            for p in MembranePair::ALL {
-                println!("  {}", p.name());
-            }
+            list();
             Ok(())
         }
         Some(Command::Solve {
-            scene: name,
-            mesh_size,
-            alpha,
-            pair,
-            solver,
-            cold,
-            json,
-            vtk,
-            msh,
-            ..
-        }) if membrane_scene(&name).is_some() => {
-            let scene = membrane_scene(&name).expect("checked");
-            let mut request = MembraneRequest::new(scene);
-            request.mesh_size = mesh_size.unwrap_or(if msh.is_some() { 0 } else { 64 });
-            request.mesh_file = msh;
-            request.alpha = alpha;
-            if let Some(p) = pair {
-                request.pair = MembranePair::parse(&p).map_err(|e| e.to_string())?;
-            }
-            request.solver = match solver {
-                SolverName::Pdas => VariationalSolver::SemismoothNewton,
-                SolverName::Clarabel => VariationalSolver::Clarabel,
-            };
-            request.nested = !cold;
-            let (report, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
-            if json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-                );
-            } else {
-                membrane_header();
-                membrane_row(&report);
-            }
-            if vtk {
-                let path = cli.out.join(format!(
-                    "{}-{}-{}.vtu",
-                    scene.name, report.pair, request.mesh_size
-                ));
-                std::fs::create_dir_all(&cli.out).map_err(|e| e.to_string())?;
-                membranes::write_vtk(&path, &fields).map_err(|e| e.to_string())?;
-                eprintln!("→ {}", path.display());
-            }
-            Ok(())
-        }
-        Some(Command::Solve {
-            scene: name,
-            elements,
-            load,
-            thickness,
-            alpha,
-            pair,
-            solver,
-            cold,
-            refinement,
-            json,
-            plot: write_plot,
-            ..
+            name,
+            scene_file,
+            mut options,
         }) => {
-            let s = scene(&name).ok_or_else(|| {
-                format!(
-                    "unknown scene `{name}`; the scenes are {}",
-                    SCENES
-                        .iter()
-                        .map(|s| s.name)
-                        .chain(MEMBRANE_SCENES.iter().map(|s| s.name))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            })?;
-            let pair = pair
-                .map(|p| Pair::parse(&p, s.beam))
-                .transpose()
-                .map_err(|e| e.to_string())?;
-            let request = Request {
-                scene: s,
-                elements,
-                load,
-                thickness,
-                alpha,
-                pair,
-                solver: match solver {
-                    SolverName::Pdas => VariationalSolver::SemismoothNewton,
-                    SolverName::Clarabel => VariationalSolver::Clarabel,
-                },
-                nested_from: (!cold).then_some(16),
-                refinement_steps: refinement,
-                plain: false,
-            };
-            let (report, profiles) = beams::solve(&request).map_err(|e| e.to_string())?;
-            if json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-                );
-            } else {
-                table_header();
-                table_row(&report);
-            }
-            if write_plot {
-                let path = cli.out.join(format!("{}-q{load}.svg", s.name));
-                plot::profiles(&path, &format!("{} q = {load}", s.name), &profiles)
-                    .map_err(|e| e.to_string())?;
-            }
-            Ok(())
-        }
-        Some(Command::Study { study, kind, full }) => {
-            if study == "membrane-radial" {
-                let kinds = kind.map_or(MembraneStudy::ALL.to_vec(), |k| vec![k]);
-                for k in kinds {
-                    membrane_studies::run(k, full, &cli.out).map_err(|e| e.to_string())?;
+            let entry = match (name, scene_file) {
+                (_, Some(path)) => {
+                    let file = scene_file::read(&path).map_err(|e| e.to_string())?;
+                    options
+                        .pair
+                        .get_or_insert_with(|| file.pair.name().to_string());
+                    options.mesh_size.get_or_insert(file.mesh_size);
+                    options.alpha = options.alpha.or(file.alpha);
+                    SceneEntry {
+                        kind: SceneKind::Membrane(file.scene),
+                        pairs: MEMBRANE_PAIRS,
+                        studies: &[],
+                        in_default_job: false,
+                    }
                 }
-                return Ok(());
-            }
-            if kind.is_some() {
-                return Err(format!(
-                    "`{study}` takes no second argument (only membrane-radial does)"
-                ));
-            }
-            let beam_study = <studies::Study as ValueEnum>::from_str(&study, true).map_err(|_| {
-                format!(
-                    "unknown study `{study}`; the studies are {} and membrane-radial convergence|stability|alpha",
-                    studies::Study::DEFAULT
-                        .iter()
-                        .filter_map(|s| s.to_possible_value().map(|v| v.get_name().to_string()))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            })?;
-            studies::run(beam_study, full, &cli.out).map_err(|e| e.to_string())
+                (Some(scene), None) => find(&scene).ok_or_else(|| {
+                    format!(
+                        "unknown scene `{scene}`; the scenes are {}",
+                        names().join(", ")
+                    )
+                })?,
+                (None, None) => return Err("give a scene name or --scene FILE".into()),
+            };
+            solve(&entry, &options, &cli.out)
         }
+        Some(Command::Study {
+            study: name,
+            kind,
+            full,
+        }) => study(&name, kind.as_deref(), full, &cli.out),
     }
 }
 

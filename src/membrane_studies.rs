@@ -246,8 +246,8 @@ pub fn available_pairs() -> Vec<MembranePair> {
 /// h-weighted norm `‖μ‖²_h = Σ_T h_T² ‖μ‖²_T`, the smallest two (√ of them are the
 /// inf-sup constants; the stabilized method has γ ≥ α by construction).
 pub fn inf_sup<M: Model>(mesh: &TriangleMesh, alpha: f64) -> Result<[f64; 2]> {
-    let scene = radial();
-    let coefficients = membranes::scene_coefficients::<M>(&scene, alpha)?;
+    let data = membranes::SceneData::new(&radial(), None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, alpha)?;
     let d: Discretization<TriangleMesh> =
         discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h")?;
     let lcp = &d.lcp;

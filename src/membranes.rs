@@ -2,6 +2,7 @@
 //! inverse-inequality constant `C_I`, the solve with its report (the CLI's `--json`),
 //! errors against the exact radial solution, and VTK output.
 
+use crate::models::data::Data;
 use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use crate::models::membrane_scenes::{Domain, ExactMembrane, MembraneScene};
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
@@ -10,11 +11,10 @@ use fem_runtime::obstacle::triangle::{
     dirichlet_constraints, nodal_active_set, solve_obstacle_on_triangles, TriangleObstacleSolution,
 };
 use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
+use fem_runtime::stabilization::{self, Alpha};
 use fem_runtime::{
-    Coefficients, DataFn, Diagonal, DofMap, Error, Model, PointLocator, Result, SystemDofs,
-    TriangleMesh,
+    Coefficients, Diagonal, DofMap, Error, Model, PointLocator, Result, SystemDofs, TriangleMesh,
 };
-use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -81,6 +81,9 @@ pub const ALPHA_WHEN_CI_VANISHES: f64 = 0.1;
 pub struct MembraneRequest {
     /// The scene.
     pub scene: MembraneScene,
+    /// The load magnitude q: f is q times the scene's load field (`None`: the scene's
+    /// own q; an error for a scene whose load is fixed).
+    pub load: Option<f64>,
     /// The pair.
     pub pair: MembranePair,
     /// N: an N×N×2 triangle mesh of the scene's square (the L-shape: N×N squares of
@@ -94,18 +97,27 @@ pub struct MembraneRequest {
     pub nested: bool,
     /// Diagonal pattern of the structured mesh.
     pub diagonal: Diagonal,
-    /// A Gmsh mesh to solve on instead of the structured one, refined uniformly
-    /// `mesh_size` times (each refinement a level of the nested iteration).
+    /// A Gmsh mesh to solve on instead of the scene's own domain, refined uniformly
+    /// `mesh_size` times (each refinement a level of the nested iteration). The scene's
+    /// exact constants (∫λ, contact area) are then not reported: they belong to its
+    /// own domain.
     pub mesh_file: Option<std::path::PathBuf>,
 }
 
 impl MembraneRequest {
-    /// The defaults: P2–P0, N = 64, α = ½/C_I, nested semismooth Newton.
+    /// The defaults: P2–P0, N = 64 (a Gmsh domain: no refinement), the scene's load,
+    /// α = ½/C_I, nested semismooth Newton.
     pub fn new(scene: MembraneScene) -> Self {
+        let mesh_size = if matches!(scene.domain, Domain::File(_)) {
+            0
+        } else {
+            64
+        };
         Self {
             scene,
+            load: None,
             pair: MembranePair::P2P0,
-            mesh_size: 64,
+            mesh_size,
             alpha: None,
             solver: VariationalSolver::SemismoothNewton,
             nested: true,
@@ -124,7 +136,12 @@ pub struct MembraneReport {
     pub pair: String,
     /// LCP solver.
     pub solver: String,
-    /// N of the N×N×2 mesh.
+    /// The domain solved on: the scene's own, or the Gmsh file given with `--msh`.
+    pub domain: String,
+    /// The load magnitude q (f = q times the scene's load field); `null` where the
+    /// scene's load is fixed.
+    pub load: Option<f64>,
+    /// N of the N×N×2 mesh (with a Gmsh mesh: its uniform refinements).
     pub mesh_size: usize,
     /// Triangles.
     pub triangles: usize,
@@ -140,19 +157,23 @@ pub struct MembraneReport {
     pub alpha: f64,
     /// `max_T C_I` of the mesh (0 where Δ vanishes on the elements).
     pub inverse_constant: f64,
-    /// `‖u − u_h‖_L2` where an exact solution exists.
+    /// `‖u − u_h‖_L2` where an exact solution exists. On a `--msh` mesh of another
+    /// domain it is still computed from the exact field, which is the solution there
+    /// when the boundary data g equals u_exact on that boundary (as in membrane-radial).
     pub error_l2: Option<f64>,
-    /// `|u − u_h|_H1` where an exact solution exists.
+    /// `|u − u_h|_H1` where an exact solution exists (on other domains: as `error_l2`).
     pub error_h1: Option<f64>,
     /// `(Σ_T h_T² ‖λ − λ_h‖²_T)^{1/2}` where an exact solution exists (stabilized pairs).
     pub error_multiplier: Option<f64>,
     /// `∫ λ_h` (the nodal method: the sum of its nodal contact forces).
     pub total_contact_force: f64,
-    /// The exact `∫ λ` where known.
+    /// The exact `∫ λ` where known for the domain solved (`null` on a `--msh` mesh:
+    /// the scene's constant belongs to its own domain).
     pub exact_contact_force: Option<f64>,
     /// Area of the contact set (holes of zero λ_h with zero gap filled).
     pub contact_area: f64,
-    /// The exact contact area where known.
+    /// The exact contact area where known for the domain solved (as
+    /// `exact_contact_force`).
     pub exact_contact_area: Option<f64>,
     /// KKT residual (equilibrium backward error and complementarity).
     pub complementarity_residual: f64,
@@ -208,7 +229,7 @@ impl MembraneFields {
     /// The fields of a solve: u from its DOFs and coefficients, ψ from the scene.
     fn new(
         mesh: TriangleMesh,
-        scene: &MembraneScene,
+        data: &SceneData,
         u_dofs: DofMap,
         u_coefficients: Vec<f64>,
         lambda: Vec<f64>,
@@ -217,7 +238,7 @@ impl MembraneFields {
         let psi = mesh
             .vertices()
             .iter()
-            .map(|x| (scene.obstacle)(x))
+            .map(|x| data.obstacle.at(x))
             .collect();
         let u = TriangleField {
             mesh: &mesh,
@@ -253,8 +274,8 @@ pub fn scene_mesh(scene: &MembraneScene, n: usize, diagonal: Diagonal) -> Result
             "--mesh-size {n} is out of range (2 to 4096)"
         )));
     }
-    match scene.domain {
-        Domain::Square(a) => TriangleMesh::rectangle(-a, a, -a, a, n, n, diagonal),
+    match &scene.domain {
+        &Domain::Square(a) => TriangleMesh::rectangle(-a, a, -a, a, n, n, diagonal),
         Domain::LShape => {
             if n % 2 != 0 {
                 return Err(Error::Input(format!(
@@ -263,77 +284,25 @@ pub fn scene_mesh(scene: &MembraneScene, n: usize, diagonal: Diagonal) -> Result
             }
             TriangleMesh::l_shape(n / 2)
         }
+        Domain::File(path) => Err(Error::Input(format!(
+            "scene `{}` is posed on the Gmsh mesh {}: it has no structured mesh",
+            scene.name,
+            path.display()
+        ))),
     }
 }
 
 /// `C_I(T) = max h_T² ‖Δv‖²_T / ‖∇v‖²_T` over the element's functions, from the model's
-/// own kernels: the (u, u) blocks of `S` (which is `h²(Δu, Δv)` there) and of `a`.
-/// 0 when the `S` form has no (u, u) block (Δ vanishes on the element).
+/// own kernels (the forms `S` and `a`, by
+/// [`fem_runtime::stabilization::element_inverse_constant`]). 0 when Δ vanishes on the
+/// element.
 pub fn element_inverse_constant<M: Model>(x: &[f64; 6]) -> Result<f64> {
-    let u = M::field("u")?;
-    let block = |form: &str| -> Result<Option<DMatrix<f64>>> {
-        let f = M::form(form)?;
-        let Some(b) = M::FORMS[f]
-            .blocks
-            .iter()
-            .position(|b| b.test_field == u && b.trial_field == Some(u))
-        else {
-            return Ok(None);
-        };
-        let n = M::FIELDS[u].element.local_dof_count(M::CELL);
-        let mut out = vec![0.0; n * n];
-        let params = vec![0.0; M::PARAMS.len()];
-        let zero = |_: &[f64]| 0.0;
-        let data: Vec<&DataFn> = vec![&zero; M::DATA.len()];
-        M::element_matrix(f, b, x, &params, &data, &mut out);
-        Ok(Some(DMatrix::from_row_slice(n, n, &out)))
-    };
-    let (Some(s), Some(k)) = (block("S")?, block("a")?) else {
-        return Ok(0.0);
-    };
-    let n = k.nrows();
-    // K has the constants as its kernel, and so has S: K + (tr K) 11ᵀ is SPD and has the
-    // same Rayleigh-quotient maximum on the complement of the constants.
-    let shift = k.trace() / n as f64;
-    let k = k + DMatrix::from_element(n, n, shift);
-    let l = k
-        .cholesky()
-        .ok_or_else(|| Error::LinearSolve("element stiffness not positive definite".into()))?;
-    let l_inverse = l
-        .l()
-        .try_inverse()
-        .ok_or_else(|| Error::LinearSolve("singular element stiffness".into()))?;
-    let reduced = &l_inverse * s * l_inverse.transpose();
-    let reduced = (&reduced + reduced.transpose()) * 0.5;
-    Ok(SymmetricEigen::new(reduced)
-        .eigenvalues
-        .iter()
-        .cloned()
-        .fold(0.0, f64::max))
+    stabilization::element_inverse_constant::<M>(x, &vec![0.0; M::PARAMS.len()], "S", "a")
 }
 
 /// `max_T C_I(T)` over a mesh (shapes repeated by translation are computed once).
 pub fn inverse_constant<M: Model>(mesh: &TriangleMesh) -> Result<f64> {
-    let mut seen: Vec<[i64; 4]> = Vec::new();
-    let mut largest: f64 = 0.0;
-    for c in 0..mesh.cell_count() {
-        let x = mesh.cell_coordinates(c);
-        let h = mesh.cell_diameter(c);
-        let key = [
-            ((x[2] - x[0]) / h * 1e9).round() as i64,
-            ((x[3] - x[1]) / h * 1e9).round() as i64,
-            ((x[4] - x[0]) / h * 1e9).round() as i64,
-            ((x[5] - x[1]) / h * 1e9).round() as i64,
-        ];
-        if seen.contains(&key) {
-            continue;
-        }
-        if seen.len() < 64 {
-            seen.push(key);
-        }
-        largest = largest.max(element_inverse_constant::<M>(&x)?);
-    }
-    Ok(largest)
+    stabilization::inverse_constant::<M, _>(mesh, &vec![0.0; M::PARAMS.len()], "S", "a")
 }
 
 /// Runs `$body` with `M` the model type of a stabilized `$pair`.
@@ -357,15 +326,47 @@ macro_rules! dispatch {
     };
 }
 
-/// The parameters and data of a stabilized membrane model for a scene: α, and the
-/// scene's load f, obstacle ψ and boundary data g.
-pub fn scene_coefficients<M: Model>(scene: &MembraneScene, alpha: f64) -> Result<Coefficients<'_>> {
+/// The data a solve uses: the load f (the scene's load field times q), the obstacle ψ
+/// and the boundary data g.
+#[derive(Clone, Debug)]
+pub struct SceneData {
+    /// The load f.
+    pub load: Data,
+    /// The obstacle ψ.
+    pub obstacle: Data,
+    /// The boundary data g.
+    pub boundary: Data,
+}
+
+impl SceneData {
+    /// The data of `scene` at load magnitude `q` (`None`: the scene's own q). Where the
+    /// scene's load is fixed (`load_scale` is `None`) f is its load field and q is not
+    /// used ([`MembraneScene::load_magnitude`] refuses one).
+    pub fn new(scene: &MembraneScene, q: Option<f64>) -> Self {
+        let load = match q.or(scene.load_scale) {
+            Some(q) if scene.load_scale.is_some() => {
+                let shape = scene.load.clone();
+                Data::shared(move |x| q * shape.at(x))
+            }
+            _ => scene.load.clone(),
+        };
+        Self {
+            load,
+            obstacle: scene.obstacle.clone(),
+            boundary: scene.boundary.clone(),
+        }
+    }
+}
+
+/// The parameters and data of a stabilized membrane model: α, and the load f, obstacle
+/// ψ and boundary data g.
+pub fn scene_coefficients<M: Model>(data: &SceneData, alpha: f64) -> Result<Coefficients<'_>> {
     Coefficients::new::<M>(
         &[("α", alpha)],
         &[
-            ("f", &scene.load),
-            ("ψ", &scene.obstacle),
-            ("g", &scene.boundary),
+            ("f", data.load.as_data_fn()),
+            ("ψ", data.obstacle.as_data_fn()),
+            ("g", data.boundary.as_data_fn()),
         ],
     )
 }
@@ -394,28 +395,19 @@ pub fn membrane_options(solver: VariationalSolver) -> ObstacleOptions {
 /// The α a request uses and the mesh's `C_I`.
 pub fn alpha_of(request: &MembraneRequest, mesh: &TriangleMesh) -> Result<(f64, f64)> {
     let c_i = dispatch!(request.pair, M => inverse_constant::<M>(mesh)?, nodal => 0.0);
-    let alpha = match request.alpha {
-        Some(a) => a,
-        None if c_i > 0.0 => 0.5 / c_i,
-        None => ALPHA_WHEN_CI_VANISHES,
-    };
-    if !(alpha >= 0.0 && alpha.is_finite()) {
-        return Err(Error::Input(format!(
-            "α = {alpha} must be finite and ≥ 0 (0 is the plain mixed method)"
-        )));
-    }
-    Ok((alpha, c_i))
+    let policy = request.alpha.map_or(Alpha::default(), Alpha::Fixed);
+    Ok((policy.value(c_i, ALPHA_WHEN_CI_VANISHES)?, c_i))
 }
 
 /// Checks the scene's data on the mesh: finite values, obstacle not above the boundary data.
-fn validate(scene: &MembraneScene, mesh: &TriangleMesh) -> Result<()> {
+fn validate(data: &SceneData, mesh: &TriangleMesh) -> Result<()> {
     for (name, f) in [
-        ("load f", scene.load),
-        ("obstacle ψ", scene.obstacle),
-        ("boundary data g", scene.boundary),
+        ("load f", &data.load),
+        ("obstacle ψ", &data.obstacle),
+        ("boundary data g", &data.boundary),
     ] {
         for x in mesh.vertices() {
-            let v = f(x);
+            let v = f.at(x);
             if !v.is_finite() {
                 return Err(Error::Input(format!(
                     "the {name} is {v} at ({}, {})",
@@ -426,7 +418,7 @@ fn validate(scene: &MembraneScene, mesh: &TriangleMesh) -> Result<()> {
     }
     for v in mesh.boundary_vertices() {
         let x = mesh.vertices()[v];
-        let (psi, g) = ((scene.obstacle)(&x), (scene.boundary)(&x));
+        let (psi, g) = (data.obstacle.at(&x), data.boundary.at(&x));
         if psi > g + 1e-12 * (1.0 + g.abs()) {
             return Err(Error::Input(format!(
                 "infeasible: the obstacle lies above the boundary data at ({}, {}): ψ = {psi} > g = {g}, so no u with u = g on ∂Ω and u ≥ ψ exists",
@@ -448,20 +440,46 @@ fn level_sizes(n: usize, nested: bool, even: bool) -> Vec<usize> {
 
 /// Solves a membrane request.
 pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneFields)> {
-    let scene = request.scene;
+    let scene = &request.scene;
+    let load = scene.load_magnitude(request.load).map_err(Error::Input)?;
     check_memory(request)?;
-    let meshes = match &request.mesh_file {
-        Some(path) => file_levels(path, request.mesh_size, request.nested, request.pair)?,
-        None => {
-            let even = scene.domain == Domain::LShape;
-            level_sizes(request.mesh_size, request.nested, even)
+    let (meshes, domain, own_domain) = match (&request.mesh_file, &scene.domain) {
+        (Some(path), _) => (
+            file_levels(path, request.mesh_size, request.nested, request.pair)?,
+            format!("Gmsh file {}", path.display()),
+            false,
+        ),
+        (None, Domain::File(path)) => (
+            file_levels(path, request.mesh_size, request.nested, request.pair)?,
+            scene.domain.describe(),
+            true,
+        ),
+        (None, domain) => {
+            let even = *domain == Domain::LShape;
+            let meshes = level_sizes(request.mesh_size, request.nested, even)
                 .into_iter()
-                .map(|n| scene_mesh(&scene, n, request.diagonal))
-                .collect::<Result<Vec<_>>>()?
+                .map(|n| scene_mesh(scene, n, request.diagonal))
+                .collect::<Result<Vec<_>>>()?;
+            (meshes, domain.describe(), true)
         }
     };
+    let mut exact = scene.exact_at(load);
+    if !own_domain {
+        // ∫λ and the contact area belong to the scene's domain; the exact field stays
+        // (the solution wherever g = u_exact on the boundary solved)
+        if let Some(e) = &mut exact {
+            e.total_contact_force = None;
+            e.contact_area = None;
+        }
+    }
+    let posed = Posed {
+        data: SceneData::new(scene, load),
+        load,
+        exact,
+        domain,
+    };
     let mesh = meshes.last().expect("at least one level");
-    validate(&scene, mesh)?;
+    validate(&posed.data, mesh)?;
     let quality = mesh.quality();
     quality.check(mesh)?;
     let (alpha, c_i) = alpha_of(request, mesh).map_err(|e| match e {
@@ -474,8 +492,8 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     })?;
     check_stabilization_above_rounding(request, mesh, &quality, c_i)?;
     let (mut report, fields) = dispatch!(request.pair,
-        M => run_stabilized::<M>(request, &meshes, alpha, c_i),
-        nodal => run_nodal(request, &meshes))?;
+        M => run_stabilized::<M>(request, &posed, &meshes, alpha, c_i),
+        nodal => run_nodal(request, &posed, &meshes))?;
     report.warnings.extend(quality.warnings(mesh));
     report.mesh_quality = MeshQualityReport {
         min_angle_deg: quality.min_angle_deg,
@@ -544,6 +562,15 @@ fn worst_cell(mesh: &TriangleMesh, c: usize) -> String {
     )
 }
 
+/// What a request poses on the mesh solved: the data at its load, the exact solution
+/// that holds there, the domain's description.
+struct Posed {
+    data: SceneData,
+    load: Option<f64>,
+    exact: Option<ExactMembrane>,
+    domain: String,
+}
+
 /// The most memory a solve may plan to use.
 pub const MEMORY_LIMIT_BYTES: f64 = 16.0 * (1u64 << 30) as f64;
 
@@ -551,7 +578,7 @@ pub const MEMORY_LIMIT_BYTES: f64 = 16.0 * (1u64 << 30) as f64;
 /// [`MEMORY_LIMIT_BYTES`]: measured peaks are about 1.4 kB per triangle for P1 pairs,
 /// 2.3 kB for P2–P0 and 3.5 kB for P2–P1disc (524k P1 triangles: 0.74 GB).
 fn check_memory(request: &MembraneRequest) -> Result<()> {
-    if request.mesh_file.is_some() {
+    if request.mesh_file.is_some() || matches!(request.scene.domain, Domain::File(_)) {
         return Ok(());
     }
     let per_triangle = bytes_per_triangle(request.pair);
@@ -627,16 +654,17 @@ fn file_levels(
 
 /// `(u, ∇u)` of an exact solution, as the error norms take it.
 fn exact_values(exact: &ExactMembrane) -> impl Fn([f64; 2]) -> (f64, [f64; 2]) + '_ {
-    move |x| ((exact.u)(&x), (exact.gradient)(&x))
+    move |x| (exact.u.at(&x), exact.gradient.at(&x))
 }
 
 fn run_stabilized<M: Model>(
     request: &MembraneRequest,
+    posed: &Posed,
     meshes: &[TriangleMesh],
     alpha: f64,
     c_i: f64,
 ) -> Result<(MembraneReport, MembraneFields)> {
-    let scene = request.scene;
+    let scene = &request.scene;
     let mut warnings = Vec::new();
     let solver = if alpha == 0.0 && request.solver == VariationalSolver::SemismoothNewton {
         warnings.push("α = 0 (the plain mixed method): C = 0 leaves nothing to eliminate Λ with, so the QP solver (clarabel) is used".to_string());
@@ -651,7 +679,7 @@ fn run_stabilized<M: Model>(
             1.0 / c_i
         ));
     }
-    let coefficients = scene_coefficients::<M>(&scene, alpha)?;
+    let coefficients = scene_coefficients::<M>(&posed.data, alpha)?;
     let options = membrane_options(solver);
     let meshes = if solver == VariationalSolver::Clarabel {
         &meshes[meshes.len() - 1..]
@@ -676,15 +704,13 @@ fn run_stabilized<M: Model>(
     let u = solution.view(u_field);
     let lambda = solution.view(d.multiplier_field);
     let degree = 2 * M::FIELDS[u_field].element.degree() + 4;
-    let (error_l2, error_h1, error_multiplier) = match &scene.exact {
+    let (error_l2, error_h1, error_multiplier) = match &posed.exact {
         Some(exact) => {
             let (l2, h1) = u.errors(&exact_values(exact), degree);
-            let multiplier = exact.multiplier;
-            (
-                Some(l2),
-                Some(h1),
-                Some(lambda.weighted_error(&|x: [f64; 2]| multiplier(&x), 1, degree)),
-            )
+            let multiplier = exact.multiplier.as_ref().map(|multiplier| {
+                lambda.weighted_error(&|x: [f64; 2]| multiplier.at(&x), 1, degree)
+            });
+            (Some(l2), Some(h1), multiplier)
         }
         None => (None, None, None),
     };
@@ -695,11 +721,13 @@ fn run_stabilized<M: Model>(
         ));
     }
     let contact_area = solution.contact_area();
-    let fields = stabilized_fields(&solution, u_field, &scene);
+    let fields = stabilized_fields(&solution, u_field, &posed.data);
     let report = MembraneReport {
-        scene: scene.name.into(),
+        scene: scene.name.to_string(),
         pair: request.pair.name().into(),
         solver: solver_name(solver).into(),
+        domain: posed.domain.clone(),
+        load: posed.load,
         mesh_size: request.mesh_size,
         triangles: d.mesh.cell_count(),
         dofs: d.lcp.n() + d.lcp.m(),
@@ -712,14 +740,14 @@ fn run_stabilized<M: Model>(
         error_h1,
         error_multiplier,
         total_contact_force: solution.total_contact_force(),
-        exact_contact_force: scene.exact.map(|e| e.total_contact_force),
+        exact_contact_force: posed.exact.as_ref().and_then(|e| e.total_contact_force),
         contact_area,
-        exact_contact_area: scene.exact.map(|e| e.contact_area),
+        exact_contact_area: posed.exact.as_ref().and_then(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: solution.multiplier_noise,
         max_penetration: fem_runtime::obstacle::triangle::max_penetration(
             &u,
-            &scene.obstacle,
+            posed.data.obstacle.as_data_fn(),
             2 * M::FIELDS[u_field].element.degree(),
         ),
         warnings,
@@ -738,7 +766,7 @@ fn solver_name(solver: VariationalSolver) -> &'static str {
 fn stabilized_fields(
     solution: &TriangleObstacleSolution,
     u_field: usize,
-    scene: &MembraneScene,
+    data: &SceneData,
 ) -> MembraneFields {
     let d = &solution.discretization;
     let mesh = d.mesh.clone();
@@ -760,7 +788,7 @@ fn stabilized_fields(
     }
     MembraneFields::new(
         mesh,
-        scene,
+        data,
         d.dofs.map(u_field).unwrap().clone(),
         solution.field(u_field).to_vec(),
         lambda,
@@ -771,12 +799,20 @@ fn stabilized_fields(
 /// The classical method: P1 with `u_i ≥ ψ(x_i)` at the free nodes.
 fn run_nodal(
     request: &MembraneRequest,
+    posed: &Posed,
     meshes: &[TriangleMesh],
 ) -> Result<(MembraneReport, MembraneFields)> {
     type M = membrane_p1::Model;
     let clock = Instant::now();
-    let scene = request.scene;
-    let coefficients = Coefficients::new::<M>(&[], &[("f", &scene.load), ("g", &scene.boundary)])?;
+    let scene = &request.scene;
+    let data = &posed.data;
+    let coefficients = Coefficients::new::<M>(
+        &[],
+        &[
+            ("f", data.load.as_data_fn()),
+            ("g", data.boundary.as_data_fn()),
+        ],
+    )?;
     let mut levels = Vec::new();
     let mut previous: Option<(TriangleMesh, SystemDofs, Vec<f64>)> = None;
     let mut last = None;
@@ -792,7 +828,7 @@ fn run_nodal(
         let psi: Vec<f64> = reduction
             .free()
             .iter()
-            .map(|&d| (scene.obstacle)(&nodes[d]))
+            .map(|&d| data.obstacle.at(&nodes[d]))
             .collect();
         let start = previous.as_ref().map(|(pm, pd, values)| {
             let locator = PointLocator::new(pm);
@@ -822,7 +858,7 @@ fn run_nodal(
         map,
         coefficients: &values,
     };
-    let (error_l2, error_h1) = match &scene.exact {
+    let (error_l2, error_h1) = match &posed.exact {
         Some(exact) => {
             let (l2, h1) = u.errors(&exact_values(exact), 6);
             (Some(l2), Some(h1))
@@ -837,7 +873,7 @@ fn run_nodal(
     }
     let vertex_active: Vec<bool> = (0..mesh.vertex_count())
         .map(|v| {
-            let gap = values[v] - (scene.obstacle)(&mesh.vertices()[v]);
+            let gap = values[v] - data.obstacle.at(&mesh.vertices()[v]);
             vertex_force[v] > 1e-8 * scale.max(1e-300)
                 || gap.abs() <= 1e-10 * (1.0 + values[v].abs())
         })
@@ -866,9 +902,11 @@ fn run_nodal(
         })
         .collect();
     let report = MembraneReport {
-        scene: scene.name.into(),
+        scene: scene.name.to_string(),
         pair: request.pair.name().into(),
         solver: "nodal active set".into(),
+        domain: posed.domain.clone(),
+        load: posed.load,
         mesh_size: request.mesh_size,
         triangles: mesh.cell_count(),
         dofs: n,
@@ -881,18 +919,22 @@ fn run_nodal(
         error_h1,
         error_multiplier: None,
         total_contact_force: solution.lambda.iter().sum(),
-        exact_contact_force: scene.exact.map(|e| e.total_contact_force),
+        exact_contact_force: posed.exact.as_ref().and_then(|e| e.total_contact_force),
         contact_area,
-        exact_contact_area: scene.exact.map(|e| e.contact_area),
+        exact_contact_area: posed.exact.as_ref().and_then(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: 0.0,
-        max_penetration: fem_runtime::obstacle::triangle::max_penetration(&u, &scene.obstacle, 2),
+        max_penetration: fem_runtime::obstacle::triangle::max_penetration(
+            &u,
+            posed.data.obstacle.as_data_fn(),
+            2,
+        ),
         warnings: Vec::new(),
         mesh_quality: MeshQualityReport::default(),
     };
     let fields = MembraneFields::new(
         mesh.clone(),
-        &scene,
+        data,
         map.clone(),
         values.clone(),
         lambda,
@@ -986,7 +1028,7 @@ pub fn cheapest_for_accuracy(
 }
 
 fn accuracy_rung(scene: &MembraneScene, pair: MembranePair) -> Result<AccuracyRung> {
-    let mut request = MembraneRequest::new(*scene);
+    let mut request = MembraneRequest::new(scene.clone());
     request.pair = pair;
     request.mesh_size = 8;
     let mut coarse = solve(&request)?;

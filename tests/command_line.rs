@@ -121,3 +121,146 @@ fn the_stability_study_writes_its_chart_and_table() {
     assert!(svg.contains("<svg"));
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// Options are checked against the scene's family: one that does not apply is an error
+/// naming it, not silently ignored.
+#[test]
+fn options_that_do_not_apply_are_refused_by_name() {
+    let out = scratch("options");
+    for (args, option) in [
+        (
+            &["solve", "membrane-flat", "--thickness", "0.01"][..],
+            "--thickness",
+        ),
+        (
+            &["solve", "membrane-flat", "--elements", "64"][..],
+            "--elements",
+        ),
+        (
+            &["solve", "membrane-lshape", "--refinement", "2"][..],
+            "--refinement",
+        ),
+        (&["solve", "membrane-lshape", "--plot"][..], "--plot"),
+        (&["solve", "bernoulli-a", "--msh", "x.msh"][..], "--msh"),
+        (
+            &["solve", "bernoulli-a", "--mesh-size", "8"][..],
+            "--mesh-size",
+        ),
+        (&["solve", "timoshenko-a", "--vtk"][..], "--vtk"),
+        (
+            &["solve", "bernoulli-a", "--thickness", "0.01"][..],
+            "--thickness",
+        ),
+        (&["solve", "membrane-radial", "--load", "2"][..], "--load"),
+        (
+            &[
+                "solve",
+                "membrane-flat",
+                "--pair",
+                "p1-nodal",
+                "--alpha",
+                "0.1",
+            ][..],
+            "--alpha",
+        ),
+    ] {
+        let run = fem_forms(args, &out);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(option), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+fn json_of(args: &[&str], out: &PathBuf) -> serde_json::Value {
+    let run = fem_forms(args, out);
+    assert!(
+        run.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_slice(&run.stdout).unwrap()
+}
+
+/// `--load q` scales the membrane's load field: membrane-flat is f = −q, so u = 0,
+/// λ = q and ∫λ = 16q on (−2,2)² (48 at the scene's own q = 3).
+#[test]
+fn load_scales_the_membrane_load() {
+    let out = scratch("load");
+    for (q, args) in [
+        (
+            3.0,
+            &["solve", "membrane-flat", "--mesh-size", "8", "--json"][..],
+        ),
+        (
+            1.0,
+            &[
+                "solve",
+                "membrane-flat",
+                "--mesh-size",
+                "8",
+                "--json",
+                "--load",
+                "1",
+            ][..],
+        ),
+        (
+            5.0,
+            &[
+                "solve",
+                "membrane-flat",
+                "--mesh-size",
+                "8",
+                "--json",
+                "--load",
+                "5",
+            ][..],
+        ),
+    ] {
+        let json = json_of(args, &out);
+        let force = json["total_contact_force"].as_f64().unwrap();
+        assert!(
+            (force - 16.0 * q).abs() < 1e-7 * 16.0 * q,
+            "q = {q}: ∫λ_h = {force}"
+        );
+        assert_eq!(json["load"].as_f64(), Some(q));
+        assert_eq!(json["exact_contact_force"].as_f64(), Some(16.0 * q));
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// On a Gmsh mesh of another domain the scene's own constants (∫λ, contact area of
+/// (−2,2)²) are not reported as exact; the errors against the exact field stay (g is
+/// u_exact there, so it is the solution on the disk too).
+#[test]
+fn json_is_honest_about_the_domain() {
+    let out = scratch("domain");
+    let disk = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/disk_r1_order1.msh");
+    let json = json_of(
+        &[
+            "solve",
+            "membrane-radial",
+            "--msh",
+            disk,
+            "--pair",
+            "p1-p0",
+            "--json",
+        ],
+        &out,
+    );
+    assert!(json["exact_contact_force"].is_null(), "{json}");
+    assert!(json["exact_contact_area"].is_null(), "{json}");
+    assert!(json["domain"]
+        .as_str()
+        .unwrap()
+        .contains("disk_r1_order1.msh"));
+    // the contact disk r* = 0.698 lies inside the unit disk: the error is small
+    assert!(json["error_l2"].as_f64().unwrap() < 0.05, "{json}");
+    let own = json_of(
+        &["solve", "membrane-radial", "--mesh-size", "8", "--json"],
+        &out,
+    );
+    assert!(own["exact_contact_force"].as_f64().is_some());
+    std::fs::remove_dir_all(&out).unwrap();
+}

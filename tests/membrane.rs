@@ -6,6 +6,7 @@
 use fem_forms::membranes::{
     self, element_inverse_constant, MembranePair, MembraneReport, MembraneRequest,
 };
+use fem_forms::models::data::Data;
 use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
 use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene, MEMBRANE_FLAT};
 use fem_forms::obstacle::VariationalSolver;
@@ -92,7 +93,7 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
         (MembranePair::P1Nodal, VariationalSolver::SemismoothNewton),
     ];
     for (pair, solver) in runs {
-        let mut request = MembraneRequest::new(scene);
+        let mut request = MembraneRequest::new(scene.clone());
         request.pair = pair;
         request.solver = solver;
         request.mesh_size = 8;
@@ -205,8 +206,8 @@ fn not_a_number(x: &[f64]) -> f64 {
 #[test]
 fn bad_input_is_a_clear_error() {
     let mut scene = radial();
-    scene.obstacle = above;
-    scene.boundary = zero;
+    scene.obstacle = Data::Fn(above);
+    scene.boundary = Data::Fn(zero);
     let error = membranes::solve(&MembraneRequest::new(scene))
         .err()
         .unwrap()
@@ -217,7 +218,7 @@ fn bad_input_is_a_clear_error() {
     );
 
     let mut scene = radial();
-    scene.load = not_a_number;
+    scene.load = Data::Fn(not_a_number);
     let error = membranes::solve(&MembraneRequest::new(scene))
         .err()
         .unwrap()
@@ -449,7 +450,7 @@ fn the_l_shape_scene_reaches_its_accuracy_with_every_pair() {
     let mut solutions = Vec::new();
     for (pair, rung) in pairs.iter().zip(&rungs) {
         assert!(rung.reached && rung.estimated_l2 <= 1e-2, "{rung:?}");
-        let mut request = MembraneRequest::new(scene);
+        let mut request = MembraneRequest::new(scene.clone());
         request.pair = *pair;
         request.mesh_size = rung.mesh_size;
         let (report, fields) = membranes::solve(&request).unwrap();
@@ -479,7 +480,8 @@ fn the_pipelined_nested_solve_equals_the_sequential_one() {
     type M = membrane_p2_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16]);
-    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 96.0).unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, 0.5 / 96.0).unwrap();
     let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     let pipelined = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
     let mut previous: Option<(_, Vec<f64>)> = None;
@@ -514,7 +516,8 @@ fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16, 32, 64]);
-    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.1).unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, 0.1).unwrap();
     let smoothed = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     assert!(smoothed.newton.smoothing_sweeps > 0);
     let exact = fem_forms::obstacle::ObstacleOptions {
@@ -550,7 +553,8 @@ fn low_rank_updates_keep_the_solution_and_save_factorizations() {
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16, 32, 64, 128]);
-    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.1).unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, 0.1).unwrap();
     let defaults = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     let options = |low_rank_updates| fem_forms::obstacle::ObstacleOptions {
         newton: NewtonOptions {
@@ -589,7 +593,8 @@ fn the_nested_solve_reports_the_first_failing_level() {
     >;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8]);
-    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 48.0).unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, 0.5 / 48.0).unwrap();
     let level = |k: usize, fails: bool| -> Level<'_> {
         let (mesh, coefficients) = (&meshes[k], &coefficients);
         Box::new(move || {
@@ -642,7 +647,8 @@ fn a_nested_solve_inside_a_level_builder_finishes() {
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8]);
-    let coefficients = membranes::scene_coefficients::<M>(&scene, 0.5 / 48.0).unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, 0.5 / 48.0).unwrap();
     let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
     let alone = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
     let inner = std::sync::Mutex::new(None);

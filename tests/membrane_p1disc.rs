@@ -98,10 +98,11 @@ fn radial_problem_with_p1disc_multipliers() {
 fn newton_and_the_saddle_point_method_agree_on_the_blocked_membrane_lcp() {
     type M = membrane_p2_p1disc::Model;
     let scene = radial();
-    let r = request(scene, MembranePair::P2P1Disc, 16);
+    let r = request(scene.clone(), MembranePair::P2P1Disc, 16);
     let mesh = scene_mesh(&scene, 16, r.diagonal).unwrap();
     let (alpha, _) = alpha_of(&r, &mesh).unwrap();
-    let coefficients = membranes::scene_coefficients::<M>(&scene, alpha).unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
     let d = discretize_on_triangles::<M>(&mesh, &coefficients, "B_h", "L_h").unwrap();
     let lcp = &d.lcp;
     assert_eq!(lcp.c_blocks.groups().count(), 2 * 16 * 16);
@@ -149,7 +150,7 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
         VariationalSolver::SemismoothNewton,
         VariationalSolver::Clarabel,
     ] {
-        let mut r = request(scene, MembranePair::P2P1Disc, n);
+        let mut r = request(scene.clone(), MembranePair::P2P1Disc, n);
         r.solver = solver;
         let (report, fields) = membranes::solve(&r).unwrap();
         let largest_u = fields.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -168,10 +169,11 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
 
     // every coefficient of λ_h, from the runtime's solve with the same α
     type M = membrane_p2_p1disc::Model;
-    let r = request(scene, MembranePair::P2P1Disc, n);
+    let r = request(scene.clone(), MembranePair::P2P1Disc, n);
     let mesh = scene_mesh(&scene, n, r.diagonal).unwrap();
     let (alpha, _) = alpha_of(&r, &mesh).unwrap();
-    let coefficients = membranes::scene_coefficients::<M>(&scene, alpha).unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
     let solution =
         solve_obstacle_on_triangles::<M>(&[mesh], &coefficients, ObstacleOptions::default())
             .unwrap();

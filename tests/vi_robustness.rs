@@ -317,7 +317,13 @@ fn p2_pairs_on_a_small_gmsh_disk_are_certified() {
     let coarse = fem_forms::mesh::gmsh::read_msh(&path).unwrap();
     let fine = coarse.refine_uniformly();
     let nested = [coarse, fine];
-    let (load, obstacle, boundary) = (&scene.load, &scene.obstacle, &scene.boundary);
+    // the scene's data at its own load (f = q·f̂)
+    let data = fem_forms::membranes::SceneData::new(&scene, None);
+    let (load, obstacle, boundary) = (
+        data.load.as_data_fn(),
+        data.obstacle.as_data_fn(),
+        data.boundary.as_data_fn(),
+    );
     for levels in [&nested[..], &nested[1..]] {
         for (low_rank, sweeps) in [(true, 8), (true, 0), (false, 8)] {
             let options = options(low_rank, sweeps);
@@ -553,7 +559,13 @@ fn the_penetration_is_measured_at_vertices_and_quadrature_points() {
 #[test]
 fn the_penetration_of_the_weak_constraint_is_second_order() {
     let scene = membrane_scene("membrane-radial").unwrap();
-    let (load, obstacle, boundary) = (&scene.load, &scene.obstacle, &scene.boundary);
+    // the scene's data at its own load (f = q·f̂)
+    let data = fem_forms::membranes::SceneData::new(&scene, None);
+    let (load, obstacle, boundary) = (
+        data.load.as_data_fn(),
+        data.obstacle.as_data_fn(),
+        data.boundary.as_data_fn(),
+    );
     fn penetration<M: Model>(n: usize, load: &DataFn, obstacle: &DataFn, boundary: &DataFn) -> f64 {
         let solution =
             solve_stabilized::<M>(&[square(n)], load, obstacle, boundary, options(true, 0))
@@ -655,7 +667,13 @@ fn the_sliver_mesh_gives_an_error_or_a_certified_solution() {
         let finer = levels.last().unwrap().refine_uniformly();
         levels.push(finer);
     }
-    let (load, obstacle, boundary) = (&scene.load, &scene.obstacle, &scene.boundary);
+    // the scene's data at its own load (f = q·f̂)
+    let data = fem_forms::membranes::SceneData::new(&scene, None);
+    let (load, obstacle, boundary) = (
+        data.load.as_data_fn(),
+        data.obstacle.as_data_fn(),
+        data.boundary.as_data_fn(),
+    );
     let options = options(true, 8);
     let solutions = [
         solve_stabilized::<membrane_p1_p0::Model>(&levels, load, obstacle, boundary, options),

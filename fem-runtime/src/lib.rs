@@ -22,6 +22,7 @@ pub mod mesh;
 pub mod model;
 pub mod norms;
 pub mod obstacle;
+pub mod stabilization;
 
 pub use assembly::boundary::{Constraints, Reduction, Side};
 pub use assembly::dof_map::{DofMap, DofNumbering, SystemDofs};

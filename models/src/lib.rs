@@ -5,9 +5,11 @@
 #![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+pub mod data;
 pub mod euler_bernoulli;
 pub mod membrane;
 pub mod membrane_scenes;
+pub mod registry;
 pub mod timoshenko;
 
 pub use euler_bernoulli::bernoulli;

@@ -1,59 +1,120 @@
 //! The membrane scenes (docs/mathematics.md §2): domain, load, obstacle and boundary data, and the
 //! exact solution where one is known.
 
+use crate::data::Data;
+use std::borrow::Cow;
+use std::path::PathBuf;
+
 /// The domain of a membrane scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Domain {
-    /// The square `(−a, a)²`.
+    /// The square `(−a, a)²` (structured N×N×2 meshes).
     Square(f64),
-    /// `(−1, 1)² ∖ [0, 1] × [−1, 0]`.
+    /// `(−1, 1)² ∖ [0, 1] × [−1, 0]` (structured meshes).
     LShape,
+    /// A Gmsh MSH 4.1 file; `--mesh-size` counts its uniform refinements.
+    File(PathBuf),
+}
+
+impl Domain {
+    /// A short description for reports: `(−2,2)²`, `L-shape`, or the file's path.
+    pub fn describe(&self) -> String {
+        match self {
+            Domain::Square(a) => format!("square (−{a},{a})²"),
+            Domain::LShape => "L-shape (−1,1)² ∖ [0,1]×[−1,0]".into(),
+            Domain::File(path) => format!("Gmsh file {}", path.display()),
+        }
+    }
 }
 
 /// A membrane scene's exact solution.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct ExactMembrane {
     /// `u(x)`.
-    pub u: fn(&[f64]) -> f64,
+    pub u: Data,
     /// `∇u(x)`.
-    pub gradient: fn(&[f64]) -> [f64; 2],
-    /// `λ(x)`.
-    pub multiplier: fn(&[f64]) -> f64,
-    /// `∫ λ`.
-    pub total_contact_force: f64,
-    /// The area of the contact set.
-    pub contact_area: f64,
+    pub gradient: Data<[f64; 2]>,
+    /// `λ(x)`, where known.
+    pub multiplier: Option<Data>,
+    /// `∫ λ` over the scene's own domain, where known.
+    pub total_contact_force: Option<f64>,
+    /// The area of the contact set in the scene's own domain, where known.
+    pub contact_area: Option<f64>,
+}
+
+/// Where a scene's exact solution is known.
+#[derive(Clone, Debug)]
+pub enum Exact {
+    /// No exact solution.
+    Unknown,
+    /// Known at the scene's own load (the default `--load`) only.
+    AtDefaultLoad(ExactMembrane),
+    /// Known for every load magnitude q.
+    OfLoad(fn(f64) -> ExactMembrane),
 }
 
 /// The exact solution of the radial problem.
 pub const RADIAL_EXACT: ExactMembrane = ExactMembrane {
-    u: radial_u,
-    gradient: radial_gradient,
-    multiplier: radial_multiplier,
-    total_contact_force: 2.0 * std::f64::consts::PI * RADIAL_A,
-    contact_area: std::f64::consts::PI * RADIAL_R * RADIAL_R,
+    u: Data::Fn(radial_u),
+    gradient: Data::Fn(radial_gradient),
+    multiplier: Some(Data::Fn(radial_multiplier)),
+    total_contact_force: Some(2.0 * std::f64::consts::PI * RADIAL_A),
+    contact_area: Some(std::f64::consts::PI * RADIAL_R * RADIAL_R),
 };
 
 /// A membrane scene.
-#[derive(Clone, Copy, Debug)]
+///
+/// The load is `f = q · load(x)` where the scene's load is a scaled field
+/// (`load_scale = Some(q₀)`, q₀ the default of `--load`); a scene whose f is fixed
+/// (`load_scale = None`, e.g. the radial problem whose exact solution needs f = 0) takes
+/// no `--load`.
+#[derive(Clone, Debug)]
 pub struct MembraneScene {
     /// Its name on the command line.
-    pub name: &'static str,
+    pub name: Cow<'static, str>,
     /// One line of description.
-    pub description: &'static str,
+    pub description: Cow<'static, str>,
     /// The domain.
     pub domain: Domain,
-    /// The load `f(x)`.
-    pub load: fn(&[f64]) -> f64,
+    /// The load field: the shape `f̂` scaled by q (or f itself where `load_scale` is None).
+    pub load: Data,
+    /// The default load magnitude q₀ where the load is a scaled field.
+    pub load_scale: Option<f64>,
     /// The obstacle `ψ(x)` (from below: `u ≥ ψ`).
-    pub obstacle: fn(&[f64]) -> f64,
-    /// The boundary data `g(x)`.
-    pub boundary: fn(&[f64]) -> f64,
+    pub obstacle: Data,
+    /// The boundary data `g(x)` (u = g on the whole boundary).
+    pub boundary: Data,
     /// The accuracy the scene asks for: the L² error of u (estimated where no exact
     /// solution is known).
     pub target_l2: f64,
     /// The exact solution, where one is known.
-    pub exact: Option<ExactMembrane>,
+    pub exact: Exact,
+}
+
+impl MembraneScene {
+    /// The load magnitude q of a request (`None`: the scene's own): an error naming
+    /// `--load` when the scene's load is not a scaled field, or q is not finite.
+    pub fn load_magnitude(&self, requested: Option<f64>) -> Result<Option<f64>, String> {
+        match (self.load_scale, requested) {
+            (_, Some(q)) if !q.is_finite() => Err(format!("--load {q} must be finite")),
+            (None, Some(_)) => Err(format!(
+                "--load does not apply to `{}`: its load f is fixed (not a scaled field)",
+                self.name
+            )),
+            (Some(q0), q) => Ok(Some(q.unwrap_or(q0))),
+            (None, None) => Ok(None),
+        }
+    }
+
+    /// The exact solution at load magnitude `q` (`None` for a scene without scaled
+    /// load), where known.
+    pub fn exact_at(&self, q: Option<f64>) -> Option<ExactMembrane> {
+        match &self.exact {
+            Exact::Unknown => None,
+            Exact::AtDefaultLoad(e) => (q == self.load_scale).then(|| e.clone()),
+            Exact::OfLoad(f) => Some(f(q.or(self.load_scale).unwrap_or(1.0))),
+        }
+    }
 }
 
 /// The free-boundary radius `r*` of the radial problem: `r*²(ln 2 − ln r*) = 1 − r*²`.
@@ -117,32 +178,36 @@ fn zero_gradient(_: &[f64]) -> [f64; 2] {
     [0.0, 0.0]
 }
 
-fn press_down(_: &[f64]) -> f64 {
-    -3.0
+fn minus_one(_: &[f64]) -> f64 {
+    -1.0
 }
 
-fn three(_: &[f64]) -> f64 {
-    3.0
+/// The flat scene's exact solution at load q: u = 0, λ = q on all of (−2,2)².
+fn flat_exact(q: f64) -> ExactMembrane {
+    ExactMembrane {
+        u: Data::Fn(zero),
+        gradient: Data::Fn(zero_gradient),
+        multiplier: Some(Data::shared(move |_| q)),
+        total_contact_force: Some(16.0 * q),
+        contact_area: Some(16.0),
+    }
 }
 
-/// The sign test of docs/mathematics.md §1 as a scene: ψ = 0, g = 0 and f = −3 pressing everywhere
-/// onto the obstacle, so u = 0, λ = 3, ∫λ = 48 and the contact is the whole (−2,2)².
-/// Not among the default scenes: it checks signs, not accuracy.
+/// The sign test of docs/mathematics.md §1 as a scene: ψ = 0, g = 0 and f = −q (q = 3 by default)
+/// pressing everywhere onto the obstacle, so u = 0, λ = q, ∫λ = 16q and the contact is
+/// the whole (−2,2)². Not among the default scenes: it checks signs, not accuracy.
 pub const MEMBRANE_FLAT: MembraneScene = MembraneScene {
-    name: "membrane-flat",
-    description: "membrane on (−2,2)² pressed flat onto ψ = 0 by f = −3 (exact: u = 0, λ = 3)",
+    name: Cow::Borrowed("membrane-flat"),
+    description: Cow::Borrowed(
+        "membrane on (−2,2)² pressed flat onto ψ = 0 by f = −q, q = 3 (exact: u = 0, λ = q)",
+    ),
     domain: Domain::Square(2.0),
-    load: press_down,
-    obstacle: zero,
-    boundary: zero,
+    load: Data::Fn(minus_one),
+    load_scale: Some(3.0),
+    obstacle: Data::Fn(zero),
+    boundary: Data::Fn(zero),
     target_l2: 1e-3,
-    exact: Some(ExactMembrane {
-        u: zero,
-        gradient: zero_gradient,
-        multiplier: three,
-        total_contact_force: 48.0,
-        contact_area: 16.0,
-    }),
+    exact: Exact::OfLoad(flat_exact),
 };
 
 /// A tilted, off-centre paraboloid below the L-shaped membrane: not symmetric about
@@ -151,31 +216,29 @@ fn lshape_obstacle(x: &[f64]) -> f64 {
     -0.05 - 0.6 * ((x[0] + 0.35).powi(2) + 0.5 * (x[1] - 0.4).powi(2)) + 0.1 * x[0]
 }
 
-fn lshape_load(_: &[f64]) -> f64 {
-    -12.0
-}
-
 /// Every membrane scene.
 pub const MEMBRANE_SCENES: [MembraneScene; 2] = [
     MembraneScene {
-        name: "membrane-radial",
-        description: "membrane on (−2,2)² over the hemisphere ψ = √(1−r²), f = 0, exact solution (docs/mathematics.md §2)",
+        name: Cow::Borrowed("membrane-radial"),
+        description: Cow::Borrowed("membrane on (−2,2)² over the hemisphere ψ = √(1−r²), f = 0, exact solution (docs/mathematics.md §2)"),
         domain: Domain::Square(2.0),
-        load: zero,
-        obstacle: radial_obstacle,
-        boundary: radial_u,
+        load: Data::Fn(zero),
+        load_scale: None,
+        obstacle: Data::Fn(radial_obstacle),
+        boundary: Data::Fn(radial_u),
         target_l2: 1e-3,
-        exact: Some(RADIAL_EXACT),
+        exact: Exact::AtDefaultLoad(RADIAL_EXACT),
     },
     MembraneScene {
-        name: "membrane-lshape",
-        description: "L-shaped membrane, u = 0 on ∂Ω, f = −12, pressed onto a tilted off-centre paraboloid",
+        name: Cow::Borrowed("membrane-lshape"),
+        description: Cow::Borrowed("L-shaped membrane, u = 0 on ∂Ω, f = −q, q = 12, pressed onto a tilted off-centre paraboloid"),
         domain: Domain::LShape,
-        load: lshape_load,
-        obstacle: lshape_obstacle,
-        boundary: zero,
+        load: Data::Fn(minus_one),
+        load_scale: Some(12.0),
+        obstacle: Data::Fn(lshape_obstacle),
+        boundary: Data::Fn(zero),
         target_l2: 1e-3,
-        exact: None,
+        exact: Exact::Unknown,
     },
 ];
 
@@ -184,8 +247,8 @@ pub fn membrane_scene(name: &str) -> Option<MembraneScene> {
     MEMBRANE_SCENES
         .iter()
         .chain([&MEMBRANE_FLAT])
-        .copied()
         .find(|s| s.name == name)
+        .cloned()
 }
 
 #[cfg(test)]
@@ -217,10 +280,11 @@ mod tests {
                 let a = match scene.domain {
                     Domain::Square(a) => a,
                     Domain::LShape => 1.0,
+                    Domain::File(_) => unreachable!("the built-in scenes are structured"),
                 };
                 for x in [[a * t, -a], [a * t, a], [-a, a * t], [a, a * t]] {
                     assert!(
-                        (scene.obstacle)(&x) < (scene.boundary)(&x),
+                        scene.obstacle.at(&x) < scene.boundary.at(&x),
                         "{}",
                         scene.name
                     );

@@ -1,0 +1,452 @@
+//! Scene files: a user's own problem as data, `fem-forms solve --scene my.toml`.
+//!
+//! A scene file names the model and element pair, the mesh (a built-in generator and its
+//! size, or a Gmsh file whose path is relative to the scene file), the boundary parts,
+//! the parameters and the data f, ψ, g as expressions in `x` and `y` (and, where known,
+//! the exact solution). Each expression is parsed once (by the `exmex` crate) and then
+//! evaluated at every point the solver asks for. An example, the sign test on
+//! `(−2, 2)²`:
+//!
+//! ```toml
+//! name = "flat"
+//! model = "membrane"
+//! pair = "p2-p0"                  # optional; p2-p0 by default
+//!
+//! [mesh]
+//! generator = "square"            # "square" (half_width a: (−a, a)²) or "l-shape"
+//! half_width = 2.0
+//! size = 16                       # N of the N×N×2 mesh
+//! # file = "disk.msh"             # or a Gmsh MSH 4.1 file, relative to this file,
+//! # refinements = 1               # refined uniformly this many times
+//!
+//! [boundary]
+//! dirichlet = "all"               # u = g on the whole boundary (the only choice today)
+//!
+//! [parameters]
+//! # alpha = 0.005                 # α; ½/C_I by default
+//!
+//! [data]
+//! load = 3.0                      # q: f = q · (the expression f); optional, 1 by default
+//! f = "-1"
+//! psi = "0"
+//! g = "0"
+//!
+//! [exact]                         # optional: the exact solution where known
+//! u = "0"                         # its gradient is derived from the expression
+//! lambda = "3"
+//! contact_force = 48.0            # ∫λ and the contact area on this domain
+//! contact_area = 16.0
+//! ```
+//!
+//! Expressions use `+ − * / ^`, parentheses, numbers, `PI`, `E`, and the functions
+//! `sqrt`, `exp`, `ln`, `sin`, `cos`, `tan`, `abs`, `min`, `max`, … of the `exmex`
+//! crate's `FloatOpsFactory`. A syntax error or a variable other than `x`, `y` is an
+//! error naming the file, the field and the expression.
+
+use crate::membranes::MembranePair;
+use crate::models::data::Data;
+use crate::models::membrane_scenes::{Domain, Exact, ExactMembrane, MembraneScene};
+use exmex::prelude::*;
+use fem_runtime::{Error, Result};
+use serde::Deserialize;
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+
+/// A scene file as written (see the module documentation for the fields).
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct SceneToml {
+    name: Option<String>,
+    description: Option<String>,
+    model: String,
+    pair: Option<String>,
+    mesh: MeshToml,
+    #[serde(default)]
+    boundary: BoundaryToml,
+    #[serde(default)]
+    parameters: ParametersToml,
+    data: DataToml,
+    exact: Option<ExactToml>,
+    /// The asked accuracy (L² error of u).
+    accuracy: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MeshToml {
+    generator: Option<String>,
+    half_width: Option<f64>,
+    size: Option<usize>,
+    file: Option<PathBuf>,
+    refinements: Option<usize>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+struct BoundaryToml {
+    dirichlet: Option<String>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+struct ParametersToml {
+    alpha: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct DataToml {
+    load: Option<f64>,
+    f: String,
+    psi: String,
+    g: String,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct ExactToml {
+    u: String,
+    lambda: Option<String>,
+    contact_force: Option<f64>,
+    contact_area: Option<f64>,
+}
+
+/// A scene read from a file, with the solve settings it asks for (the command line's
+/// options override them).
+#[derive(Clone, Debug)]
+pub struct SceneFile {
+    /// The scene (family: membrane).
+    pub scene: MembraneScene,
+    /// The pair it names (default p2-p0).
+    pub pair: MembranePair,
+    /// N of the structured mesh, or the refinements of the Gmsh file.
+    pub mesh_size: usize,
+    /// α where the file fixes it.
+    pub alpha: Option<f64>,
+}
+
+/// The variables an expression may use, in the order of the point's coordinates.
+const VARIABLES: [&str; 2] = ["x", "y"];
+
+/// Parses `text` (the field `field` of `file`) into a function of the point: checks
+/// that it uses no variable but `x` and `y`.
+pub fn expression(text: &str, field: &str, file: &Path) -> Result<Data> {
+    let parsed = parse_checked(text, field, file)?;
+    Ok(function_of_point(parsed))
+}
+
+fn parse_checked(text: &str, field: &str, file: &Path) -> Result<FlatEx<f64>> {
+    // TOML's multi-line strings let long expressions span lines; exmex wants one line
+    let one_line = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let parsed = exmex::parse::<f64>(&one_line).map_err(|e| {
+        Error::Input(format!(
+            "{}: field `{field}`: cannot parse the expression `{text}`: {e}",
+            file.display()
+        ))
+    })?;
+    if let Some(unknown) = parsed
+        .var_names()
+        .iter()
+        .find(|v| !VARIABLES.contains(&v.as_str()))
+    {
+        return Err(Error::Input(format!(
+            "{}: field `{field}`: unknown variable `{unknown}` in `{text}` (expressions are functions of x and y)",
+            file.display()
+        )));
+    }
+    Ok(parsed)
+}
+
+/// The expression as a function of `[x, y]`: its variables (alphabetical in `exmex`)
+/// mapped to coordinates once, here. An evaluation error (none is known for the float
+/// operators) gives NaN, which the solver's data checks refuse.
+fn function_of_point(parsed: FlatEx<f64>) -> Data {
+    let coordinates: Vec<usize> = parsed
+        .var_names()
+        .iter()
+        .map(|v| VARIABLES.iter().position(|c| c == v).expect("checked"))
+        .collect();
+    Data::shared(move |x: &[f64]| {
+        let mut values = [0.0; 2];
+        for (k, &c) in coordinates.iter().enumerate() {
+            values[k] = x.get(c).copied().unwrap_or(0.0);
+        }
+        parsed
+            .eval(&values[..coordinates.len()])
+            .unwrap_or(f64::NAN)
+    })
+}
+
+/// `∂/∂x` and `∂/∂y` of an expression (0 for a variable it does not use), each
+/// derived once, symbolically, by `exmex`.
+fn gradient(text: &str, field: &str, file: &Path) -> Result<Data<[f64; 2]>> {
+    let parsed = parse_checked(text, field, file)?;
+    let mut parts: Vec<Option<Data>> = Vec::new();
+    for variable in VARIABLES {
+        match parsed.var_names().iter().position(|v| v == variable) {
+            Some(k) => {
+                let derivative = parsed.clone().partial(k).map_err(|e| {
+                    Error::Input(format!(
+                        "{}: field `{field}`: cannot differentiate `{text}` by {variable}: {e}",
+                        file.display()
+                    ))
+                })?;
+                parts.push(Some(function_of_point(derivative)));
+            }
+            None => parts.push(None),
+        }
+    }
+    Ok(Data::shared(move |x: &[f64]| {
+        let mut out = [0.0; 2];
+        for (k, part) in parts.iter().enumerate() {
+            if let Some(d) = part {
+                out[k] = d.at(x);
+            }
+        }
+        out
+    }))
+}
+
+/// Reads and checks a scene file.
+///
+/// # Errors
+/// An unreadable file, TOML errors (with their line and column), unknown fields, a
+/// model other than `membrane`, an unknown pair or mesh generator, a mesh given both
+/// ways or neither, boundary parts other than the whole boundary, and expressions that
+/// do not parse or use variables other than x, y.
+pub fn read(path: &Path) -> Result<SceneFile> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        Error::Input(format!(
+            "cannot read the scene file {}: {e}",
+            path.display()
+        ))
+    })?;
+    parse(&text, path)
+}
+
+/// Parses the text of a scene file; `path` names it in errors and anchors its relative
+/// mesh path.
+///
+/// # Errors
+/// As [`read`].
+pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
+    let file: SceneToml = toml::from_str(text)
+        .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
+    let at = |field: &str, message: String| {
+        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
+    };
+    if file.model != "membrane" {
+        return Err(at(
+            "model",
+            format!(
+                "`{}` is not a model scene files can pose; they support `membrane` (beams: the built-in scenes)",
+                file.model
+            ),
+        ));
+    }
+    let pair = match &file.pair {
+        Some(p) => MembranePair::parse(p).map_err(|e| at("pair", e.to_string()))?,
+        None => MembranePair::P2P0,
+    };
+    let mesh = &file.mesh;
+    let (domain, mesh_size) = match (&mesh.generator, &mesh.file) {
+        (Some(_), Some(_)) => {
+            return Err(at(
+                "mesh",
+                "give either `generator` or `file`, not both".into(),
+            ))
+        }
+        (None, None) => {
+            return Err(at(
+                "mesh",
+                "give a `generator` (square, l-shape) or a Gmsh `file`".into(),
+            ))
+        }
+        (None, Some(msh)) => {
+            if mesh.size.is_some() || mesh.half_width.is_some() {
+                return Err(at(
+                    "mesh",
+                    "a Gmsh `file` takes `refinements`, not `size` or `half_width`".into(),
+                ));
+            }
+            let base = path.parent().unwrap_or(Path::new("."));
+            (Domain::File(base.join(msh)), mesh.refinements.unwrap_or(0))
+        }
+        (Some(generator), None) => {
+            if mesh.refinements.is_some() {
+                return Err(at(
+                    "mesh.refinements",
+                    "applies to a Gmsh `file`; a generator takes `size`".into(),
+                ));
+            }
+            let size = mesh.size.unwrap_or(64);
+            match generator.as_str() {
+                "square" => {
+                    let a = mesh.half_width.unwrap_or(1.0);
+                    if !(a > 0.0 && a.is_finite()) {
+                        return Err(at(
+                            "mesh.half_width",
+                            format!("{a} must be positive and finite"),
+                        ));
+                    }
+                    (Domain::Square(a), size)
+                }
+                "l-shape" => {
+                    if mesh.half_width.is_some() {
+                        return Err(at(
+                            "mesh.half_width",
+                            "the L-shape is (−1,1)² ∖ [0,1]×[−1,0]; it takes no half_width".into(),
+                        ));
+                    }
+                    (Domain::LShape, size)
+                }
+                other => {
+                    return Err(at(
+                        "mesh.generator",
+                        format!("unknown generator `{other}`; the generators are square, l-shape"),
+                    ))
+                }
+            }
+        }
+    };
+    match file.boundary.dirichlet.as_deref() {
+        None | Some("all") => {}
+        Some(other) => {
+            return Err(at(
+                "boundary.dirichlet",
+                format!(
+                    "`{other}`: the membrane model holds u = g on the whole boundary (\"all\"); boundary parts by Gmsh physical name need a model with a natural condition elsewhere, which none has yet"
+                ),
+            ))
+        }
+    }
+    let data = &file.data;
+    if let Some(q) = data.load {
+        if !q.is_finite() {
+            return Err(at("data.load", format!("{q} must be finite")));
+        }
+    }
+    let exact = match &file.exact {
+        None => Exact::Unknown,
+        Some(e) => Exact::AtDefaultLoad(ExactMembrane {
+            u: expression(&e.u, "exact.u", path)?,
+            gradient: gradient(&e.u, "exact.u", path)?,
+            multiplier: e
+                .lambda
+                .as_deref()
+                .map(|l| expression(l, "exact.lambda", path))
+                .transpose()?,
+            total_contact_force: e.contact_force,
+            contact_area: e.contact_area,
+        }),
+    };
+    let target_l2 = file.accuracy.unwrap_or(1e-3);
+    if !(target_l2 > 0.0 && target_l2.is_finite()) {
+        return Err(at("accuracy", format!("{target_l2} must be positive")));
+    }
+    let name = file.name.clone().unwrap_or_else(|| {
+        path.file_stem()
+            .map_or("scene".into(), |s| s.to_string_lossy().into_owned())
+    });
+    let scene = MembraneScene {
+        name: Cow::Owned(name),
+        description: Cow::Owned(
+            file.description
+                .clone()
+                .unwrap_or_else(|| format!("scene file {}", path.display())),
+        ),
+        domain,
+        load: expression(&data.f, "data.f", path)?,
+        load_scale: Some(data.load.unwrap_or(1.0)),
+        obstacle: expression(&data.psi, "data.psi", path)?,
+        boundary: expression(&data.g, "data.g", path)?,
+        target_l2,
+        exact,
+    };
+    Ok(SceneFile {
+        scene,
+        pair,
+        mesh_size,
+        alpha: file.parameters.alpha,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn here() -> &'static Path {
+        Path::new("test.toml")
+    }
+
+    #[test]
+    fn expressions_evaluate_at_points_and_differentiate() {
+        let f = expression("x^2 + 3*y - sqrt(4)", "data.f", here()).unwrap();
+        assert_eq!(f.at(&[2.0, 1.0]), 4.0 + 3.0 - 2.0);
+        // only y: the variable order must still follow the coordinates
+        let g = expression("2*y", "data.g", here()).unwrap();
+        assert_eq!(g.at(&[5.0, 1.5]), 3.0);
+        let grad = gradient("x^2*y + y", "exact.u", here()).unwrap();
+        let [dx, dy] = grad.at(&[3.0, 2.0]);
+        assert!((dx - 12.0).abs() < 1e-12 && (dy - 10.0).abs() < 1e-12);
+        let grad = gradient("x^3", "exact.u", here()).unwrap();
+        assert_eq!(grad.at(&[2.0, 7.0]), [12.0, 0.0]);
+    }
+
+    #[test]
+    fn bad_expressions_name_the_field_and_the_place() {
+        let e = expression("x + * 2", "data.f", here())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("test.toml") && e.contains("data.f") && e.contains("x + * 2"),
+            "{e}"
+        );
+        let e = expression("x + z", "data.psi", here())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("data.psi") && e.contains("unknown variable `z`"),
+            "{e}"
+        );
+    }
+
+    const FLAT: &str = r#"
+        model = "membrane"
+        [mesh]
+        generator = "square"
+        half_width = 2.0
+        size = 8
+        [data]
+        load = 3.0
+        f = "-1"
+        psi = "0"
+        g = "0"
+    "#;
+
+    #[test]
+    fn a_scene_file_is_read_and_checked() {
+        let s = parse(FLAT, here()).unwrap();
+        assert_eq!(s.scene.domain, Domain::Square(2.0));
+        assert_eq!(s.mesh_size, 8);
+        assert_eq!(s.scene.load_scale, Some(3.0));
+        assert_eq!(s.scene.load.at(&[0.3, 0.1]), -1.0);
+        for (broken, field) in [
+            (FLAT.replace("\"membrane\"", "\"plate\""), "model"),
+            (FLAT.replace("\"square\"", "\"circle\""), "mesh.generator"),
+            (FLAT.replace("psi = \"0\"", "psi = \"0 +\""), "data.psi"),
+            (FLAT.replace("g = \"0\"", "g = \"r\""), "data.g"),
+            (
+                FLAT.replace("[data]", "[boundary]\ndirichlet = \"left\"\n[data]"),
+                "boundary.dirichlet",
+            ),
+        ] {
+            let e = parse(&broken, here()).unwrap_err().to_string();
+            assert!(e.contains(field), "{field}: {e}");
+        }
+        let e = parse(&FLAT.replace("size = 8", "size = 8\nsizes = 3"), here())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("sizes"), "{e}");
+    }
+}
