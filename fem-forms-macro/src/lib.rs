@@ -126,6 +126,9 @@
 //! - a number or a product of constants that overflows `f64` is an error at the term;
 //! - expressions nest at most 100 levels (parentheses, signs, ∇/Δ, integrals, the
 //!   factors of one product, powers and primes); a sum may have any number of terms;
+//! - exponents may build powers up to 1000 in all (`f^999999`, `t⁻²¹⁴⁷⁴⁸³⁶⁴⁸` or
+//!   `((f^10)^10)^11` are errors at the power: the expansion multiplies bases out and
+//!   adds exponents in integers);
 //! - a call of an undefined form names it and lists the forms defined above;
 //! - a name that differs from a declared one only by lookalike letters (Cyrillic `Т`,
 //!   Greek `ν` for `v`) gets a hint naming the letters and their scripts.

@@ -251,6 +251,40 @@ fn too_deep(body: &Expr) -> Option<Loc> {
     None
 }
 
+/// Largest total power a form may build from exponents (`h_T⁴`, `t⁻²`, `(…)²`): the
+/// symbolic expansion multiplies a base `n` times and adds exponents in `i32`, so
+/// `t^999999` would take quadratic time and nested powers would overflow.
+pub const MAX_TOTAL_POWER: f64 = 1000.0;
+
+/// Where the exponents of `body` can multiply to more than [`MAX_TOTAL_POWER`], with the
+/// bound reached there. A product adds its factors' bounds, a power multiplies its
+/// base's bound by `|n|`, a sum takes the larger. Recursion is safe: it runs after
+/// [`too_deep`] has bounded the depth.
+fn power_too_large(body: &Expr) -> Option<(Loc, f64)> {
+    fn bound(e: &Expr, worst: &mut Option<(Loc, f64)>) -> f64 {
+        let b = match &e.kind {
+            ExprKind::Number(_) | ExprKind::Symbol(_) | ExprKind::Call { .. } => 1.0,
+            ExprKind::Add(a, b) | ExprKind::Sub(a, b) => bound(a, worst).max(bound(b, worst)),
+            ExprKind::Mul(a, b) | ExprKind::Div(a, b) | ExprKind::InnerProduct(a, b) => {
+                bound(a, worst) + bound(b, worst)
+            }
+            ExprKind::Neg(a)
+            | ExprKind::Derivative(a, _)
+            | ExprKind::Gradient(a)
+            | ExprKind::Laplacian(a)
+            | ExprKind::Integral { body: a, .. } => bound(a, worst),
+            ExprKind::Pow(a, n) => bound(a, worst) * f64::from(*n).abs().max(1.0),
+        };
+        if b > MAX_TOTAL_POWER && worst.is_none() {
+            *worst = Some((e.loc, b));
+        }
+        b
+    }
+    let mut worst = None;
+    bound(body, &mut worst);
+    worst
+}
+
 struct Parser<'a> {
     tokens: &'a [Token],
     pos: usize,
@@ -367,6 +401,13 @@ impl<'a> Parser<'a> {
                 format!("expression nested more than {MAX_NESTING} levels deep (products, powers, derivatives and parentheses)"),
             )
             .help("split it: define a form for a part and call it"));
+        }
+        if let Some((loc, total)) = power_too_large(&body) {
+            return Err(Diagnostic::text(
+                loc,
+                format!("exponents here build a power of up to {total:.3e}, beyond the limit {MAX_TOTAL_POWER}"),
+            )
+            .help("a form is a polynomial of low degree in its fields and data: write the power you mean (h_T⁴, t⁻²)"));
         }
         Ok(Definition {
             name,

@@ -485,6 +485,30 @@ fn deep_nesting_is_a_located_error() {
     );
 }
 
+/// Exponents that would make the expansion overflow its integer powers or take
+/// quadratic time are located errors, whatever the spelling; modest powers compile.
+#[test]
+fn huge_exponents_are_located_errors() {
+    for forms in [
+        "a(u;v) = ∫ f^999999 u v",
+        "a(u;v) = ∫ f⁻²¹⁴⁷⁴⁸³⁶⁴⁸ u v",
+        "a(u;v) = ∫ f²¹⁴⁷⁴⁸³⁶⁴⁷ u v",
+        "a(u;v) = ∫ ((f^10)^10)^11 u v",
+    ] {
+        let errors = rendered_errors(&expand(membrane("P2", forms)));
+        assert!(
+            errors.iter().any(|e| e.contains("beyond the limit 1000")),
+            "{forms}: {errors:?}"
+        );
+    }
+    let out = expand(membrane("P2", "a(u;v) = ∫ ((f^3)^2) u v"));
+    assert!(
+        rendered_errors(&out).is_empty(),
+        "{:?}",
+        rendered_errors(&out)
+    );
+}
+
 #[test]
 fn overflowing_constants_are_located_errors() {
     for (forms, message) in [
