@@ -4,7 +4,7 @@
 //! is grouped into (test field, trial field) blocks.
 
 use crate::diagnostic::{closest, lookalike, Diagnostic, Loc};
-use crate::parser::{Definition, Expr, ExprKind, IntegralKind, Name};
+use crate::parser::{Definition, Expr, ExprKind, IntegralKind, Name, MAX_DEGREE};
 use crate::symbolic::{self, ArgFactor, DerivativeError, Expansion, Monomial};
 use fem_reference::ElementKind;
 
@@ -346,6 +346,19 @@ impl Context<'_> {
                 self.errors.push(
                     Diagnostic::text(t.origin, format!("term of `{}` outside an integral", d.name.text))
                         .help("every term of a form stands under ∫ (or Σ_T), or is a call of another form"),
+                );
+                continue;
+            }
+            // The quadrature of a term is exact for the sum of its data degrees (plus the
+            // basis functions'): the per-declaration limit must bound that sum too.
+            let data_degree: usize = t.data.iter().map(|&i| self.symbols.data[i].1).sum();
+            if data_degree > MAX_DEGREE {
+                self.errors.push(
+                    Diagnostic::text(
+                        t.origin,
+                        format!("the data of this term of `{}` have degrees summing to {data_degree}, above the limit {MAX_DEGREE}: its quadrature would need too many points", d.name.text),
+                    )
+                    .help("lower the declared data degrees (`data: f: 2`), or split the product of data"),
                 );
                 continue;
             }

@@ -37,7 +37,8 @@
 //!   non-negative.
 //! - `tests: …` one test function per unknown, in order: `η` goes with `θ`.
 //! - `params: …` runtime scalars; `data: f, ψ: 0` functions of x (the number is the
-//!   polynomial degree assumed for quadrature, default 2, at most 40).
+//!   polynomial degree assumed for quadrature, default 2, at most 40; the degrees of
+//!   the data in one term may sum to at most 40 too).
 //! - `boundary: u = g` (optional) Dirichlet data: unknown `u` equals the data function
 //!   `g` on the whole boundary (the runtime interpolates it at the boundary DOFs).
 //! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may

@@ -501,6 +501,19 @@ fn huge_exponents_are_located_errors() {
             "{forms}: {errors:?}"
         );
     }
+    // the data degree limit bounds a product of data too (default degree 2: 21 factors
+    // sum to 42)
+    let product = vec!["f"; 21].join(" ");
+    let errors = rendered_errors(&expand(membrane(
+        "P2",
+        &format!("a(u;v) = ∫ {product} u v"),
+    )));
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("degrees summing to 42, above the limit 40")),
+        "{errors:?}"
+    );
     let out = expand(membrane("P2", "a(u;v) = ∫ ((f^3)^2) u v"));
     assert!(
         rendered_errors(&out).is_empty(),
