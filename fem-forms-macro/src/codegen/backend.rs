@@ -59,8 +59,22 @@ pub(crate) trait CellBackend {
     /// intervals, see `ElementKind::dof_scaling_power`); 0 for nodal bases.
     fn dof_scaling(&self, element: ElementKind, index: usize) -> i32;
     /// Quadrature degree that integrates `term` exactly on an affine cell (data counted
-    /// with their declared degree), or the explicit `∫[degree=N]`.
-    fn term_degree(&self, term: &Term, block: &Block, symbols: &Symbols) -> usize;
+    /// with their declared degree), or the explicit `∫[degree=N]`: a derivative of total
+    /// order `k` lowers a basis function's degree by `k` on an affine cell.
+    fn term_degree(&self, term: &Term, block: &Block, symbols: &Symbols) -> usize {
+        if let Some(d) = term.quadrature_degree {
+            return d;
+        }
+        let degree = |field: usize, derivative: [u8; 2]| {
+            let order = derivative.iter().map(|&d| d as usize).sum::<usize>();
+            symbols.fields[field].element.degree().saturating_sub(order)
+        };
+        let mut total = degree(block.test_field, term.test_derivative);
+        if let (Some(f), Some(d)) = (block.trial_field, term.trial_derivative) {
+            total += degree(f, d);
+        }
+        total + term.data.iter().map(|&i| symbols.data[i].1).sum::<usize>()
+    }
     /// The rule used for `degree`.
     fn rule(&self, degree: usize) -> Rule;
     /// Statements computing the cell geometry the block's terms need (`h`, `J`,

@@ -16,11 +16,6 @@ use quote::{format_ident, quote};
 /// Kernels on intervals.
 pub struct Interval;
 
-/// Polynomial degree of `D^k φ` for the element, after differentiation.
-fn factor_degree(element: ElementKind, derivative: u8) -> usize {
-    element.degree().saturating_sub(derivative as usize)
-}
-
 /// The basis of `element` differentiated `derivative` times.
 fn derivatives(element: ElementKind, derivative: u8) -> Vec<Polynomial> {
     element
@@ -124,18 +119,6 @@ impl CellBackend for Interval {
 
     fn dof_scaling(&self, element: ElementKind, index: usize) -> i32 {
         element.dof_scaling_power(index)
-    }
-
-    fn term_degree(&self, term: &Term, block: &Block, symbols: &Symbols) -> usize {
-        if let Some(d) = term.quadrature_degree {
-            return d;
-        }
-        let element = |f: usize| symbols.fields[f].element;
-        let mut degree = factor_degree(element(block.test_field), term.test_derivative[0]);
-        if let (Some(f), Some(d)) = (block.trial_field, term.trial_derivative) {
-            degree += factor_degree(element(f), d[0]);
-        }
-        degree + term.data.iter().map(|&i| symbols.data[i].1).sum::<usize>()
     }
 
     fn rule(&self, degree: usize) -> Rule {

@@ -110,12 +110,6 @@ fn derivatives(element: ElementKind, beta: [u8; 2]) -> Vec<Polynomial2> {
         .collect()
 }
 
-fn factor_degree(element: ElementKind, derivative: [u8; 2]) -> usize {
-    element
-        .degree()
-        .saturating_sub((derivative[0] + derivative[1]) as usize)
-}
-
 /// The rule of a data loop or of an explicit `∫[degree=N]`: the centroid (one point)
 /// for degree ≤ 1, as reduced integration means, otherwise the collapsed Gauss rule
 /// exact for the degree.
@@ -253,18 +247,6 @@ impl CellBackend for Triangle {
 
     fn dof_scaling(&self, _element: ElementKind, _index: usize) -> i32 {
         0
-    }
-
-    fn term_degree(&self, term: &Term, block: &Block, symbols: &Symbols) -> usize {
-        if let Some(d) = term.quadrature_degree {
-            return d;
-        }
-        let element = |f: usize| symbols.fields[f].element;
-        let mut degree = factor_degree(element(block.test_field), term.test_derivative);
-        if let (Some(f), Some(d)) = (block.trial_field, term.trial_derivative) {
-            degree += factor_degree(element(f), d);
-        }
-        degree + term.data.iter().map(|&i| symbols.data[i].1).sum::<usize>()
     }
 
     fn rule(&self, degree: usize) -> Rule {
