@@ -7,7 +7,9 @@
 //! [`assembly`] (DOF maps, the pattern built once, boundary conditions, linear problems),
 //! [`lcp`] (the complementarity problem, semismooth Newton, clarabel, Cholesky with
 //! low-rank updates), [`obstacle`] (a model's VI: the nested solve, the nodal method),
-//! [`norms`] and [`io`]. No module imports one that imports it back.
+//! [`stabilization`] (the element constant C_I from the model's own kernels and the α
+//! policy), [`norms`] and [`io`]. No module imports one that imports it back
+//! (`tests/module_cycles.rs` checks it).
 //!
 //! Reference elements and quadrature rules come from `fem-reference`, the same crate the
 //! form compiler evaluates at compile time, and are re-exported here.
@@ -33,6 +35,7 @@ pub use fem_reference as reference;
 pub use fem_reference::{gauss_legendre, CellKind, ElementKind, QuadratureRule};
 pub use mesh::{Diagonal, IntervalMesh, Mesh, PointLocator, TriangleMesh};
 pub use model::{BlockInfo, Coefficients, DataFn, FieldInfo, FormInfo, Model};
+pub use stabilization::Alpha;
 
 /// Re-exported sparse matrix type of the assembled systems.
 pub type SparseMatrix = faer::sparse::SparseColMat<usize, f64>;
