@@ -495,6 +495,12 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
         M => run_stabilized::<M>(request, &posed, &meshes, alpha, c_i),
         nodal => run_nodal(request, &posed, &meshes))?;
     report.warnings.extend(quality.warnings(mesh));
+    if report.max_penetration.is_nan() {
+        // JSON has no NaN: the field prints as null, so the reason must be said here
+        report.warnings.push(
+            "max_penetration is not a number: the obstacle ψ or u_h is not finite at some vertex or quadrature point".into(),
+        );
+    }
     report.mesh_quality = MeshQualityReport {
         min_angle_deg: quality.min_angle_deg,
         max_angle_deg: quality.max_angle_deg,
