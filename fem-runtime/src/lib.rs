@@ -12,6 +12,8 @@
 //! Reference elements and quadrature rules come from `fem-reference`, the same crate the
 //! form compiler evaluates at compile time, and are re-exported here.
 #![warn(missing_docs)]
+// test models use the mathematical names (α, ℓ) next to ASCII ones
+#![cfg_attr(test, allow(confusable_idents, mixed_script_confusables))]
 
 pub mod assembly;
 pub mod element;

@@ -955,3 +955,119 @@ impl ObstacleSolution<IntervalMesh> {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::triangle::solve_obstacle_on_triangles;
+    use super::*;
+    use crate::mesh::{Diagonal, TriangleMesh};
+
+    crate::model! {
+        /// A clamped string over an obstacle, P1 / P0 (for P1 `u'' = 0`, so `S_h` acts on λ).
+        pub mod string_p1 on interval {
+            unknowns: u: P1, λ: P0 >= 0;
+            tests: v, μ;
+            params: alpha;
+            data: f, ψ;
+            forms: "
+                a(u;v)       = ∫ u'v'
+                b(v;μ)       = ∫ v μ
+                S(u,λ;v,μ)   = Σ_T h_T² (−u'' − λ, −v'' − μ)_T
+                ℓ(v)         = ∫ f v
+                ℓ_S(v,μ)     = Σ_T h_T² (f, −v'' − μ)_T
+                G(μ)         = ∫ ψ μ
+                B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − alpha S(u,λ;v,μ)
+                L_h(v,μ)     = ℓ(v) − G(μ) − alpha ℓ_S(v,μ)
+            ";
+        }
+    }
+
+    crate::model! {
+        /// The P1 / P0 membrane with Dirichlet data `u = g`.
+        pub mod membrane_p1 on triangle {
+            unknowns: u: P1, λ: P0 >= 0;
+            tests: v, μ;
+            params: alpha;
+            data: f, ψ, g;
+            boundary: u = g;
+            forms: "
+                a(u;v)       = ∫ ∇u·∇v
+                b(v;μ)       = ∫ v μ
+                S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
+                ℓ(v)         = ∫ f v
+                ℓ_S(v,μ)     = Σ_T h_T² (f, −Δv − μ)_T
+                G(μ)         = ∫ ψ μ
+                B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − alpha S(u,λ;v,μ)
+                L_h(v,μ)     = ℓ(v) − G(μ) − alpha ℓ_S(v,μ)
+            ";
+        }
+    }
+
+    fn string(f: f64, psi: f64, cells: usize) -> (ObstacleSolution, f64) {
+        let (load, obstacle) = (move |_: &[f64]| f, move |_: &[f64]| psi);
+        let c =
+            Coefficients::new::<string_p1::Model>(&[("alpha", 0.1)], &[("f", &load), ("ψ", &obstacle)])
+                .unwrap();
+        let mesh = IntervalMesh::uniform(0.0, 1.0, cells).unwrap();
+        let s = solve_obstacle::<string_p1::Model>(&mesh, &c, &["u"], Default::default()).unwrap();
+        let energy = s.energy::<string_p1::Model>(&c).unwrap();
+        (s, energy)
+    }
+
+    /// `−u'' = 1`, `u(0) = u(1) = 0` far above the obstacle: P1 is nodally exact in 1D
+    /// (and `S_h` has no primal part), so `½a(u_h,u_h) − ℓ(u_h) = −½ℓ(u_h) = −½ ∫ I_h u`
+    /// with `u = x(1−x)/2`: the trapezoid rule, `−(1 − h²)/24`. No contact.
+    #[test]
+    fn string_energy_without_contact_is_the_trapezoid_value() {
+        for cells in [4, 10] {
+            let h = 1.0 / cells as f64;
+            let (s, energy) = string(1.0, -10.0, cells);
+            let expected = -(1.0 - h * h) / 24.0;
+            assert!((energy - expected).abs() < 1e-12, "{energy} vs {expected}");
+            assert!(s.contact_cells().is_empty());
+            assert!(s.total_contact_force().abs() < 1e-12);
+        }
+    }
+
+    /// Pushed down (`f = −1`) onto `ψ = 0`: `u = 0`, `λ = 1` everywhere, so every cell is
+    /// in contact, `∫λ = 1` and the energy is 0.
+    #[test]
+    fn string_pressed_flat_is_in_contact_everywhere() {
+        let (s, energy) = string(-1.0, 0.0, 8);
+        assert_eq!(s.contact_cells(), (0..8).collect::<Vec<_>>());
+        assert!((s.total_contact_force() - 1.0).abs() < 1e-10);
+        assert!(energy.abs() < 1e-12, "{energy}");
+    }
+
+    fn membrane(f: f64, psi: f64, g: fn(&[f64]) -> f64) -> (ObstacleSolution<TriangleMesh>, f64) {
+        let (load, obstacle) = (move |_: &[f64]| f, move |_: &[f64]| psi);
+        let c = Coefficients::new::<membrane_p1::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &load), ("ψ", &obstacle), ("g", &g)],
+        )
+        .unwrap();
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap();
+        let s = solve_obstacle_on_triangles::<membrane_p1::Model>(&[mesh], &c, Default::default())
+            .unwrap();
+        let energy = s.energy::<membrane_p1::Model>(&c).unwrap();
+        (s, energy)
+    }
+
+    /// `u = x` on the boundary, `f = 0`, obstacle far below: `u_h = x` exactly, so the
+    /// energy is `½ ∫ |∇x|² = ½` on the unit square, with the boundary values included.
+    #[test]
+    fn membrane_energy_of_a_linear_solution() {
+        let (s, energy) = membrane(0.0, -10.0, |x| x[0]);
+        assert!((energy - 0.5).abs() < 1e-12, "{energy}");
+        assert!(s.contact_cells().is_empty());
+    }
+
+    /// Pushed down onto `ψ = 0 = g`: every cell is in contact, `∫λ = 1`, energy 0.
+    #[test]
+    fn membrane_pressed_flat_is_in_contact_everywhere() {
+        let (s, energy) = membrane(-1.0, 0.0, |_| 0.0);
+        assert_eq!(s.contact_cells(), (0..32).collect::<Vec<_>>());
+        assert!((s.total_contact_force() - 1.0).abs() < 1e-10);
+        assert!(energy.abs() < 1e-12, "{energy}");
+    }
+}
