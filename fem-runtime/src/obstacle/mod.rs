@@ -74,7 +74,13 @@ pub fn multiplier_field<M: Model>() -> Result<usize> {
 
 impl Discretization<IntervalMesh> {
     /// Assembles `bilinear` and `linear` (normally `B_h`, `L_h`) of `M` on `mesh`, with the
-    /// fields in `clamped` clamped at both ends.
+    /// fields in `clamped` clamped at both ends and the model's `boundary: u = g`
+    /// conditions imposed at both ends (`u = g(x)` at the end points `x`; where a field is
+    /// both, `g` gives its value and the clamp its zero slope).
+    ///
+    /// # Errors
+    /// Unknown field names, boundary data that is not finite at an end (the message
+    /// names the data and the point), and those of [`Discretization::with_constraints`].
     pub fn new<M: Model>(
         mesh: &IntervalMesh,
         coefficients: &Coefficients,
@@ -87,6 +93,30 @@ impl Discretization<IntervalMesh> {
         for field in clamped {
             for side in [Side::Left, Side::Right] {
                 constraints.clamp::<M>(mesh, &dofs, field, side)?;
+            }
+        }
+        let ends = [
+            (Side::Left, mesh.vertices()[0]),
+            (Side::Right, *mesh.vertices().last().unwrap()),
+        ];
+        for &(field, data) in M::DIRICHLET {
+            let g = coefficients.data.get(data).ok_or_else(|| {
+                Error::Input(format!(
+                    "boundary data `{}` of model `{}` is not given",
+                    M::DATA[data],
+                    M::NAME
+                ))
+            })?;
+            for (side, x) in ends {
+                let value = g(&[x]);
+                if !value.is_finite() {
+                    return Err(Error::Input(format!(
+                        "boundary data `{}` of `{}` is {value} at x = {x}",
+                        M::DATA[data],
+                        M::FIELDS[field].name
+                    )));
+                }
+                constraints.dirichlet::<M>(mesh, &dofs, M::FIELDS[field].name, side, value)?;
             }
         }
         Self::with_constraints::<M>(mesh, coefficients, dofs, &constraints, bilinear, linear)
@@ -1003,11 +1033,69 @@ mod tests {
         }
     }
 
+    crate::model! {
+        /// The string with Dirichlet data `u = g` at both ends.
+        pub mod string_dirichlet on interval {
+            unknowns: u: P1, λ: P0 >= 0;
+            tests: v, μ;
+            params: alpha;
+            data: f, ψ, g;
+            boundary: u = g;
+            forms: "
+                a(u;v)       = ∫ u'v'
+                b(v;μ)       = ∫ v μ
+                S(u,λ;v,μ)   = Σ_T h_T² (−u'' − λ, −v'' − μ)_T
+                ℓ(v)         = ∫ f v
+                ℓ_S(v,μ)     = Σ_T h_T² (f, −v'' − μ)_T
+                G(μ)         = ∫ ψ μ
+                B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − alpha S(u,λ;v,μ)
+                L_h(v,μ)     = ℓ(v) − G(μ) − alpha ℓ_S(v,μ)
+            ";
+        }
+    }
+
+    /// `boundary: u = g` on an interval model (issue 11: it used to be ignored): with
+    /// `f = 0` and `g = 1 + x` on (0, 1) the solution is `u = 1 + x`, energy ½, on every
+    /// level of the nested iteration; a `g` that is infinite at an end is an error naming
+    /// it.
+    #[test]
+    fn interval_boundary_data_is_imposed() {
+        let (zero, obstacle) = (|_: &[f64]| 0.0, |_: &[f64]| -10.0);
+        let g = |x: &[f64]| 1.0 + x[0];
+        let c = Coefficients::new::<string_dirichlet::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &zero), ("ψ", &obstacle), ("g", &g)],
+        )
+        .unwrap();
+        let mesh = IntervalMesh::uniform(0.0, 1.0, 32).unwrap();
+        let s =
+            solve_obstacle::<string_dirichlet::Model>(&mesh, &c, &[], Default::default()).unwrap();
+        let u = s.view(0);
+        for x in [0.0, 0.25, 0.6, 1.0] {
+            assert!((u.at(x, 0).unwrap() - (1.0 + x)).abs() < 1e-12, "u({x})");
+        }
+        let energy = s.energy::<string_dirichlet::Model>(&c).unwrap();
+        assert!((energy - 0.5).abs() < 1e-12, "{energy}");
+        let bad = |x: &[f64]| 1.0 / x[0];
+        let c = Coefficients::new::<string_dirichlet::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &zero), ("ψ", &obstacle), ("g", &bad)],
+        )
+        .unwrap();
+        let error = solve_obstacle::<string_dirichlet::Model>(&mesh, &c, &[], Default::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(error.contains("`g` of `u` is inf at x = 0"), "{error}");
+    }
+
     fn string(f: f64, psi: f64, cells: usize) -> (ObstacleSolution, f64) {
         let (load, obstacle) = (move |_: &[f64]| f, move |_: &[f64]| psi);
-        let c =
-            Coefficients::new::<string_p1::Model>(&[("alpha", 0.1)], &[("f", &load), ("ψ", &obstacle)])
-                .unwrap();
+        let c = Coefficients::new::<string_p1::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &load), ("ψ", &obstacle)],
+        )
+        .unwrap();
         let mesh = IntervalMesh::uniform(0.0, 1.0, cells).unwrap();
         let s = solve_obstacle::<string_p1::Model>(&mesh, &c, &["u"], Default::default()).unwrap();
         let energy = s.energy::<string_p1::Model>(&c).unwrap();
