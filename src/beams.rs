@@ -2,16 +2,10 @@
 
 use crate::models::scenes::{exact_solution, Beam, Scene};
 use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
-use fem_runtime::lcp::cholesky::{dot, quadratic_form};
 use fem_runtime::lcp::NewtonOptions;
-use fem_runtime::obstacle::{
-    solve_obstacle, Discretization, ObstacleOptions, ObstacleSolution, VariationalSolver,
-};
+use fem_runtime::obstacle::{solve_obstacle, Discretization, ObstacleOptions, VariationalSolver};
 use fem_runtime::stabilization;
-use fem_runtime::{
-    assemble_vector, Coefficients, DataFn, Error, IntervalMesh, MatrixAssembler, Model, Result,
-    SystemDofs,
-};
+use fem_runtime::{Coefficients, DataFn, Error, IntervalMesh, Model, Result};
 use serde::Serialize;
 
 /// The element pairs a beam scene can be solved with.
@@ -371,7 +365,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     };
     let solution = solve_obstacle::<M>(&mesh, &coefficients, clamped, options)?;
     let w_field = M::field("w")?;
-    let energy = energy::<M>(&solution, &coefficients)?;
+    let energy = solution.energy::<M>(&coefficients)?;
     let w = solution.view(w_field);
     let exact = exact_solution(&scene, q, thickness);
     let (error_l2, error_h1) = match &exact {
@@ -444,21 +438,4 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         x,
     };
     Ok((report, profiles))
-}
-
-/// `½ a(u,u) − ℓ(u)` of the primal fields of a solution.
-pub fn energy<M: Model>(solution: &ObstacleSolution, coefficients: &Coefficients) -> Result<f64> {
-    let d = &solution.discretization;
-    let primal: Vec<usize> = (0..M::FIELDS.len())
-        .filter(|&f| f != d.multiplier_field)
-        .collect();
-    let dofs = SystemDofs::new::<M>(&d.mesh, &primal)?;
-    let mut u = Vec::with_capacity(dofs.dof_count());
-    for &f in &primal {
-        u.extend_from_slice(solution.field(f));
-    }
-    let a = MatrixAssembler::new::<M>("a", &d.mesh, &dofs)?.assemble::<M>(&d.mesh, coefficients)?;
-    let l = assemble_vector::<M>("ℓ", &d.mesh, &dofs, coefficients)?;
-    // compensated: ½uᵀAu of a thin beam is a small difference of huge terms
-    Ok(0.5 * quadratic_form(&a, &u, &u) - dot(&l, &u))
 }

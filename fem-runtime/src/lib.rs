@@ -11,9 +11,18 @@
 //! policy), [`norms`] and [`io`]. No module imports one that imports it back
 //! (`tests/module_cycles.rs` checks it).
 //!
+//! To solve a model of your own from Rust, start from `examples/winkler_string.rs` in
+//! the repository (a model file and a short program: mesh, parameters and data,
+//! [`stabilization::inverse_constant`], [`obstacle::solve_obstacle`], then
+//! [`obstacle::ObstacleSolution::energy`], `contact_set`,
+//! [`obstacle::ObstacleSolution::contact_cells`] and `total_contact_force`), and the
+//! README's section "Solving your own model from Rust".
+//!
 //! Reference elements and quadrature rules come from `fem-reference`, the same crate the
 //! form compiler evaluates at compile time, and are re-exported here.
 #![warn(missing_docs)]
+// test models use the mathematical names (α, ℓ) next to ASCII ones
+#![cfg_attr(test, allow(confusable_idents, mixed_script_confusables))]
 
 pub mod assembly;
 pub mod element;

@@ -74,7 +74,13 @@ pub fn multiplier_field<M: Model>() -> Result<usize> {
 
 impl Discretization<IntervalMesh> {
     /// Assembles `bilinear` and `linear` (normally `B_h`, `L_h`) of `M` on `mesh`, with the
-    /// fields in `clamped` clamped at both ends.
+    /// fields in `clamped` clamped at both ends and the model's `boundary: u = g`
+    /// conditions imposed at both ends (`u = g(x)` at the end points `x`; where a field is
+    /// both, `g` gives its value and the clamp its zero slope).
+    ///
+    /// # Errors
+    /// Unknown field names, boundary data that is not finite at an end (the message
+    /// names the data and the point), and those of [`Discretization::with_constraints`].
     pub fn new<M: Model>(
         mesh: &IntervalMesh,
         coefficients: &Coefficients,
@@ -87,6 +93,30 @@ impl Discretization<IntervalMesh> {
         for field in clamped {
             for side in [Side::Left, Side::Right] {
                 constraints.clamp::<M>(mesh, &dofs, field, side)?;
+            }
+        }
+        let ends = [
+            (Side::Left, mesh.vertices()[0]),
+            (Side::Right, *mesh.vertices().last().unwrap()),
+        ];
+        for &(field, data) in M::DIRICHLET {
+            let g = coefficients.data.get(data).ok_or_else(|| {
+                Error::Input(format!(
+                    "boundary data `{}` of model `{}` is not given",
+                    M::DATA[data],
+                    M::NAME
+                ))
+            })?;
+            for (side, x) in ends {
+                let value = g(&[x]);
+                if !value.is_finite() {
+                    return Err(Error::Input(format!(
+                        "boundary data `{}` of `{}` is {value} at x = {x}",
+                        M::DATA[data],
+                        M::FIELDS[field].name
+                    )));
+                }
+                constraints.dirichlet::<M>(mesh, &dofs, M::FIELDS[field].name, side, value)?;
             }
         }
         Self::with_constraints::<M>(mesh, coefficients, dofs, &constraints, bilinear, linear)
@@ -814,6 +844,73 @@ impl<G> ObstacleSolution<G> {
     pub fn field(&self, field: usize) -> &[f64] {
         &self.values[self.discretization.dofs.range(field).unwrap()]
     }
+
+    /// The contact cells: indices of the cells on which some multiplier coefficient is
+    /// positive, i.e. above 1e-8 of the larger of its maximum and the load's multiplier
+    /// scale ‖F‖∞/‖Bᵀ‖∞ (so that solver noise is not contact), in increasing order.
+    /// Works on any cell kind; cells touching the obstacle with `λ_h = 0` are not
+    /// included (see [`ObstacleSolution::contact_set`] on intervals, which fills them).
+    pub fn contact_cells(&self) -> Vec<usize> {
+        let d = &self.discretization;
+        let lambda = self.field(d.multiplier_field);
+        let largest = lambda.iter().cloned().fold(0.0, f64::max);
+        let scale = largest.max(d.lcp.multiplier_scale());
+        if largest <= 1e-8 * scale {
+            return Vec::new();
+        }
+        let map = d.dofs.map(d.multiplier_field).unwrap();
+        let cells = map.dof_count() / map.local_count().max(1);
+        let mut contact = Vec::new();
+        for c in 0..cells {
+            if map.cell_dofs(c).iter().any(|&k| lambda[k] > 1e-8 * scale) {
+                contact.push(c);
+            }
+        }
+        contact
+    }
+}
+
+impl<G: DofNumbering> ObstacleSolution<G> {
+    /// The energy `½ a(u,u) − ℓ(u)` of the primal fields `u` (all fields but the
+    /// multiplier) of the solution, with the model's forms named `a` (bilinear) and `ℓ`
+    /// (linear) and the parameters and data of `coefficients`; the boundary values of
+    /// the solution are included as they are. For the exact solution of the obstacle
+    /// problem it is the minimum of the energy over the admissible set.
+    ///
+    /// Computed in twice the working precision: `½uᵀAu` of a thin structure is a small
+    /// difference of huge terms.
+    ///
+    /// # Errors
+    /// If `M` has no form `a` or `ℓ`, or if `M` is not the model the solution was
+    /// computed with (its fields do not fit the mesh).
+    pub fn energy<M: Model>(&self, coefficients: &Coefficients) -> Result<f64> {
+        let d = &self.discretization;
+        let primal: Vec<usize> = (0..M::FIELDS.len())
+            .filter(|&f| f != d.multiplier_field)
+            .collect();
+        let dofs = SystemDofs::new::<M>(&d.mesh, &primal)?;
+        let mut u = Vec::with_capacity(dofs.dof_count());
+        for &f in &primal {
+            let range = d.dofs.range(f).ok_or_else(|| {
+                Error::Input(format!(
+                    "the solution has no field {f} of model `{}`: solved with another model?",
+                    M::NAME
+                ))
+            })?;
+            u.extend_from_slice(&self.values[range]);
+        }
+        if u.len() != dofs.dof_count() {
+            return Err(Error::Input(format!(
+                "the solution's fields do not fit model `{}`: solved with another model?",
+                M::NAME
+            )));
+        }
+        let a = crate::assembly::MatrixAssembler::new::<M>("a", &d.mesh, &dofs)?
+            .assemble::<M>(&d.mesh, coefficients)?;
+        let l = assemble_vector::<M>("ℓ", &d.mesh, &dofs, coefficients)?;
+        Ok(0.5 * crate::lcp::cholesky::quadratic_form(&a, &u, &u)
+            - crate::lcp::cholesky::dot(&l, &u))
+    }
 }
 
 impl ObstacleSolution<IntervalMesh> {
@@ -886,5 +983,179 @@ impl ObstacleSolution<IntervalMesh> {
                 }
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::triangle::solve_obstacle_on_triangles;
+    use super::*;
+    use crate::mesh::{Diagonal, TriangleMesh};
+
+    crate::model! {
+        /// A clamped string over an obstacle, P1 / P0 (for P1 `u'' = 0`, so `S_h` acts on λ).
+        pub mod string_p1 on interval {
+            unknowns: u: P1, λ: P0 >= 0;
+            tests: v, μ;
+            params: alpha;
+            data: f, ψ;
+            forms: "
+                a(u;v)       = ∫ u'v'
+                b(v;μ)       = ∫ v μ
+                S(u,λ;v,μ)   = Σ_T h_T² (−u'' − λ, −v'' − μ)_T
+                ℓ(v)         = ∫ f v
+                ℓ_S(v,μ)     = Σ_T h_T² (f, −v'' − μ)_T
+                G(μ)         = ∫ ψ μ
+                B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − alpha S(u,λ;v,μ)
+                L_h(v,μ)     = ℓ(v) − G(μ) − alpha ℓ_S(v,μ)
+            ";
+        }
+    }
+
+    crate::model! {
+        /// The P1 / P0 membrane with Dirichlet data `u = g`.
+        pub mod membrane_p1 on triangle {
+            unknowns: u: P1, λ: P0 >= 0;
+            tests: v, μ;
+            params: alpha;
+            data: f, ψ, g;
+            boundary: u = g;
+            forms: "
+                a(u;v)       = ∫ ∇u·∇v
+                b(v;μ)       = ∫ v μ
+                S(u,λ;v,μ)   = Σ_T h_T² (−Δu − λ, −Δv − μ)_T
+                ℓ(v)         = ∫ f v
+                ℓ_S(v,μ)     = Σ_T h_T² (f, −Δv − μ)_T
+                G(μ)         = ∫ ψ μ
+                B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − alpha S(u,λ;v,μ)
+                L_h(v,μ)     = ℓ(v) − G(μ) − alpha ℓ_S(v,μ)
+            ";
+        }
+    }
+
+    crate::model! {
+        /// The string with Dirichlet data `u = g` at both ends.
+        pub mod string_dirichlet on interval {
+            unknowns: u: P1, λ: P0 >= 0;
+            tests: v, μ;
+            params: alpha;
+            data: f, ψ, g;
+            boundary: u = g;
+            forms: "
+                a(u;v)       = ∫ u'v'
+                b(v;μ)       = ∫ v μ
+                S(u,λ;v,μ)   = Σ_T h_T² (−u'' − λ, −v'' − μ)_T
+                ℓ(v)         = ∫ f v
+                ℓ_S(v,μ)     = Σ_T h_T² (f, −v'' − μ)_T
+                G(μ)         = ∫ ψ μ
+                B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − alpha S(u,λ;v,μ)
+                L_h(v,μ)     = ℓ(v) − G(μ) − alpha ℓ_S(v,μ)
+            ";
+        }
+    }
+
+    /// `boundary: u = g` on an interval model (issue 11: it used to be ignored): with
+    /// `f = 0` and `g = 1 + x` on (0, 1) the solution is `u = 1 + x`, energy ½, on every
+    /// level of the nested iteration; a `g` that is infinite at an end is an error naming
+    /// it.
+    #[test]
+    fn interval_boundary_data_is_imposed() {
+        let (zero, obstacle) = (|_: &[f64]| 0.0, |_: &[f64]| -10.0);
+        let g = |x: &[f64]| 1.0 + x[0];
+        let c = Coefficients::new::<string_dirichlet::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &zero), ("ψ", &obstacle), ("g", &g)],
+        )
+        .unwrap();
+        let mesh = IntervalMesh::uniform(0.0, 1.0, 32).unwrap();
+        let s =
+            solve_obstacle::<string_dirichlet::Model>(&mesh, &c, &[], Default::default()).unwrap();
+        let u = s.view(0);
+        for x in [0.0, 0.25, 0.6, 1.0] {
+            assert!((u.at(x, 0).unwrap() - (1.0 + x)).abs() < 1e-12, "u({x})");
+        }
+        let energy = s.energy::<string_dirichlet::Model>(&c).unwrap();
+        assert!((energy - 0.5).abs() < 1e-12, "{energy}");
+        let bad = |x: &[f64]| 1.0 / x[0];
+        let c = Coefficients::new::<string_dirichlet::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &zero), ("ψ", &obstacle), ("g", &bad)],
+        )
+        .unwrap();
+        let error = solve_obstacle::<string_dirichlet::Model>(&mesh, &c, &[], Default::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(error.contains("`g` of `u` is inf at x = 0"), "{error}");
+    }
+
+    fn string(f: f64, psi: f64, cells: usize) -> (ObstacleSolution, f64) {
+        let (load, obstacle) = (move |_: &[f64]| f, move |_: &[f64]| psi);
+        let c = Coefficients::new::<string_p1::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &load), ("ψ", &obstacle)],
+        )
+        .unwrap();
+        let mesh = IntervalMesh::uniform(0.0, 1.0, cells).unwrap();
+        let s = solve_obstacle::<string_p1::Model>(&mesh, &c, &["u"], Default::default()).unwrap();
+        let energy = s.energy::<string_p1::Model>(&c).unwrap();
+        (s, energy)
+    }
+
+    /// `−u'' = 1`, `u(0) = u(1) = 0` far above the obstacle: P1 is nodally exact in 1D
+    /// (and `S_h` has no primal part), so `½a(u_h,u_h) − ℓ(u_h) = −½ℓ(u_h) = −½ ∫ I_h u`
+    /// with `u = x(1−x)/2`: the trapezoid rule, `−(1 − h²)/24`. No contact.
+    #[test]
+    fn string_energy_without_contact_is_the_trapezoid_value() {
+        for cells in [4, 10] {
+            let h = 1.0 / cells as f64;
+            let (s, energy) = string(1.0, -10.0, cells);
+            let expected = -(1.0 - h * h) / 24.0;
+            assert!((energy - expected).abs() < 1e-12, "{energy} vs {expected}");
+            assert!(s.contact_cells().is_empty());
+            assert!(s.total_contact_force().abs() < 1e-12);
+        }
+    }
+
+    /// Pushed down (`f = −1`) onto `ψ = 0`: `u = 0`, `λ = 1` everywhere, so every cell is
+    /// in contact, `∫λ = 1` and the energy is 0.
+    #[test]
+    fn string_pressed_flat_is_in_contact_everywhere() {
+        let (s, energy) = string(-1.0, 0.0, 8);
+        assert_eq!(s.contact_cells(), (0..8).collect::<Vec<_>>());
+        assert!((s.total_contact_force() - 1.0).abs() < 1e-10);
+        assert!(energy.abs() < 1e-12, "{energy}");
+    }
+
+    fn membrane(f: f64, psi: f64, g: fn(&[f64]) -> f64) -> (ObstacleSolution<TriangleMesh>, f64) {
+        let (load, obstacle) = (move |_: &[f64]| f, move |_: &[f64]| psi);
+        let c = Coefficients::new::<membrane_p1::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &load), ("ψ", &obstacle), ("g", &g)],
+        )
+        .unwrap();
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap();
+        let s = solve_obstacle_on_triangles::<membrane_p1::Model>(&[mesh], &c, Default::default())
+            .unwrap();
+        let energy = s.energy::<membrane_p1::Model>(&c).unwrap();
+        (s, energy)
+    }
+
+    /// `u = x` on the boundary, `f = 0`, obstacle far below: `u_h = x` exactly, so the
+    /// energy is `½ ∫ |∇x|² = ½` on the unit square, with the boundary values included.
+    #[test]
+    fn membrane_energy_of_a_linear_solution() {
+        let (s, energy) = membrane(0.0, -10.0, |x| x[0]);
+        assert!((energy - 0.5).abs() < 1e-12, "{energy}");
+        assert!(s.contact_cells().is_empty());
+    }
+
+    /// Pushed down onto `ψ = 0 = g`: every cell is in contact, `∫λ = 1`, energy 0.
+    #[test]
+    fn membrane_pressed_flat_is_in_contact_everywhere() {
+        let (s, energy) = membrane(-1.0, 0.0, |_| 0.0);
+        assert_eq!(s.contact_cells(), (0..32).collect::<Vec<_>>());
+        assert!((s.total_contact_force() - 1.0).abs() < 1e-10);
+        assert!(energy.abs() < 1e-12, "{energy}");
     }
 }
