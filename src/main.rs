@@ -76,11 +76,11 @@ enum Command {
 #[derive(clap::Args, Debug, Default)]
 struct SolveOptions {
     /// Elements of the uniform mesh (beams; default 256).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     elements: Option<usize>,
     /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
     /// three quarters of it). (default 64; with --msh: 0 refinements)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     mesh_size: Option<usize>,
     /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
     #[arg(long)]
@@ -93,10 +93,10 @@ struct SolveOptions {
     /// no contact, 40 and 100 contact; membrane-flat: f = −q, default 3;
     /// membrane-lshape: f = −q, default 12). Refused where the load is fixed
     /// (membrane-radial: f = 0).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     load: Option<f64>,
     /// Beam thickness t (Timoshenko scenes).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     thickness: Option<f64>,
     /// Stabilization parameter α (negative values are refused with a reason; not for
     /// p1-nodal, which has no multiplier).
@@ -594,7 +594,11 @@ fn run(cli: Cli) -> Result<(), String> {
                     options
                         .pair
                         .get_or_insert_with(|| file.pair.name().to_string());
-                    options.mesh_size.get_or_insert(file.mesh_size);
+                    // the file's size belongs to its own mesh: with --msh replacing it,
+                    // --mesh-size (refinements of that file) defaults to 0 as for built-in scenes
+                    if options.msh.is_none() {
+                        options.mesh_size.get_or_insert(file.mesh_size);
+                    }
                     options.alpha = options.alpha.or(file.alpha);
                     SceneEntry {
                         kind: SceneKind::Membrane(file.scene),

@@ -180,6 +180,38 @@ fn function_of_point(parsed: FlatEx<f64>) -> Data {
 /// `∂/∂x` and `∂/∂y` of an expression (0 for a variable it does not use), each
 /// derived once, symbolically, by `exmex`.
 fn gradient(text: &str, field: &str, file: &Path) -> Result<Data<[f64; 2]>> {
+    // exmex differentiates by recursion over the expression tree, and its simplification
+    // can take long on long expressions: bound the text, and give the work a large stack
+    if text.len() > MAX_DIFFERENTIATED_LENGTH {
+        return Err(Error::Input(format!(
+            "{}: field `{field}`: the expression has {} characters; an exact solution to differentiate may have at most {MAX_DIFFERENTIATED_LENGTH}",
+            file.display(),
+            text.len()
+        )));
+    }
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .stack_size(256 << 20)
+            .spawn_scoped(scope, || gradient_on_this_thread(text, field, file))
+            .map_err(|e| {
+                Error::Input(format!(
+                    "cannot start the differentiation of `{field}`: {e}"
+                ))
+            })?
+            .join()
+            .unwrap_or_else(|_| {
+                Err(Error::Input(format!(
+                    "{}: field `{field}`: differentiating `{text}` failed",
+                    file.display()
+                )))
+            })
+    })
+}
+
+/// Longest `exact.u` text that is differentiated symbolically.
+const MAX_DIFFERENTIATED_LENGTH: usize = 1000;
+
+fn gradient_on_this_thread(text: &str, field: &str, file: &Path) -> Result<Data<[f64; 2]>> {
     let parsed = parse_checked(text, field, file)?;
     let mut parts: Vec<Option<Data>> = Vec::new();
     for variable in VARIABLES {
@@ -348,6 +380,14 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         path.file_stem()
             .map_or("scene".into(), |s| s.to_string_lossy().into_owned())
     });
+    // the name becomes part of output file names (`out/<name>-<pair>-<N>.vtu`)
+    let plain = |c: char| c.is_alphanumeric() || c == '-' || c == '_' || c == '.';
+    if name.is_empty() || name.starts_with('.') || !name.chars().all(plain) {
+        return Err(at(
+            "name",
+            format!("`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first)"),
+        ));
+    }
     let scene = MembraneScene {
         name: Cow::Owned(name),
         description: Cow::Owned(
@@ -391,6 +431,22 @@ mod tests {
         assert!((dx - 12.0).abs() < 1e-12 && (dy - 10.0).abs() < 1e-12);
         let grad = gradient("x^3", "exact.u", here()).unwrap();
         assert_eq!(grad.at(&[2.0, 7.0]), [12.0, 0.0]);
+        // a long sum overflowed the main thread's stack in exmex's differentiation
+        let long = format!("x{}", "+x*y".repeat(150));
+        let grad = gradient(&long, "exact.u", here()).unwrap();
+        let [dx, dy] = grad.at(&[2.0, 3.0]);
+        assert!(
+            (dx - 451.0).abs() < 1e-9 && (dy - 300.0).abs() < 1e-9,
+            "{dx} {dy}"
+        );
+        let too_long = format!("x{}", "+x*y".repeat(300));
+        let message = gradient(&too_long, "exact.u", here())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("exact.u") && message.contains("at most 1000"),
+            "{message}"
+        );
     }
 
     #[test]
@@ -440,6 +496,8 @@ mod tests {
                 FLAT.replace("[data]", "[boundary]\ndirichlet = \"left\"\n[data]"),
                 "boundary.dirichlet",
             ),
+            (format!("name = \"../escape/x\"\n{FLAT}"), "name"),
+            (format!("name = \"\"\n{FLAT}"), "name"),
         ] {
             let e = parse(&broken, here()).unwrap_err().to_string();
             assert!(e.contains(field), "{field}: {e}");

@@ -49,7 +49,8 @@ pub enum Exact {
     Unknown,
     /// Known at the scene's own load (the default `--load`) only.
     AtDefaultLoad(ExactMembrane),
-    /// Known for every load magnitude q.
+    /// Known for every load magnitude q ≥ 0 (a load that presses onto the obstacle; a
+    /// negative q lifts the membrane off and the formula no longer holds).
     OfLoad(fn(f64) -> ExactMembrane),
 }
 
@@ -112,7 +113,10 @@ impl MembraneScene {
         match &self.exact {
             Exact::Unknown => None,
             Exact::AtDefaultLoad(e) => (q == self.load_scale).then(|| e.clone()),
-            Exact::OfLoad(f) => Some(f(q.or(self.load_scale).unwrap_or(1.0))),
+            Exact::OfLoad(f) => {
+                let q = q.or(self.load_scale).unwrap_or(1.0);
+                (q >= 0.0).then(|| f(q))
+            }
         }
     }
 }
