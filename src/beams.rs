@@ -301,6 +301,12 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
             request.elements
         )));
     }
+    if request.refinement_steps > MAX_REFINEMENT_STEPS {
+        return Err(Error::Input(format!(
+            "--refinement {} is out of range (0 to {MAX_REFINEMENT_STEPS}): each round is one more solve, and 2 or 3 already reach rounding for t ≤ 1e-5",
+            request.refinement_steps
+        )));
+    }
     if !request.load.is_finite() || request.load < 0.0 {
         return Err(Error::Input(format!(
             "load q = {} must be finite and ≥ 0 (the scene fixes its direction)",
@@ -344,6 +350,9 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
     }
     Ok(())
 }
+
+/// Most rounds of iterative refinement per linear solve that `--refinement` accepts.
+pub const MAX_REFINEMENT_STEPS: usize = 10;
 
 fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     let scene = request.scene;

@@ -94,6 +94,14 @@ fn bad_input_exits_with_a_message() {
             "α = -1",
         ),
         (&["study", "membrane-radial", "nonsense"][..], "nonsense"),
+        (
+            &["solve", "bernoulli-flat", "--refinement", "1000000"][..],
+            "--refinement 1000000 is out of range",
+        ),
+        (
+            &["solve", "bernoulli-flat", "--load", "-5"][..],
+            "must be finite and ≥ 0",
+        ),
         (&["study", "no-such-study"][..], "unknown study"),
     ] {
         let run = fem_forms(args, &out);
