@@ -302,7 +302,15 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
                 ));
             }
             let base = path.parent().unwrap_or(Path::new("."));
-            (Domain::File(base.join(msh)), mesh.refinements.unwrap_or(0))
+            let refinements = mesh.refinements.unwrap_or(0);
+            // the solver's own limit, named here by the file's field
+            if refinements > 8 {
+                return Err(at(
+                    "mesh.refinements",
+                    format!("{refinements} uniform refinements (4^{refinements} times the triangles): at most 8"),
+                ));
+            }
+            (Domain::File(base.join(msh)), refinements)
         }
         (Some(generator), None) => {
             if mesh.refinements.is_some() {
@@ -312,6 +320,13 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
                 ));
             }
             let size = mesh.size.unwrap_or(64);
+            // the structured meshes' range, named here by the file's field
+            if !(2..=4096).contains(&size) {
+                return Err(at(
+                    "mesh.size",
+                    format!("{size} is out of range (2 to 4096)"),
+                ));
+            }
             match generator.as_str() {
                 "square" => {
                     let a = mesh.half_width.unwrap_or(1.0);
@@ -497,6 +512,7 @@ mod tests {
                 "boundary.dirichlet",
             ),
             (format!("name = \"../escape/x\"\n{FLAT}"), "name"),
+            (FLAT.replace("size = 8", "size = 0"), "mesh.size"),
             (format!("name = \"\"\n{FLAT}"), "name"),
         ] {
             let e = parse(&broken, here()).unwrap_err().to_string();
