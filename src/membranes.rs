@@ -877,13 +877,34 @@ fn run_nodal(
     for (k, &dof) in reduction.free().iter().enumerate() {
         vertex_force[dof] = solution.lambda[k];
     }
-    let vertex_active: Vec<bool> = (0..mesh.vertex_count())
-        .map(|v| {
-            let gap = values[v] - data.obstacle.at(&mesh.vertices()[v]);
-            vertex_force[v] > 1e-8 * scale.max(1e-300)
-                || gap.abs() <= 1e-10 * (1.0 + values[v].abs())
-        })
+    let mut free = vec![false; mesh.vertex_count()];
+    for &dof in reduction.free() {
+        free[dof] = true;
+    }
+    let on_obstacle = |v: usize| {
+        let gap = values[v] - data.obstacle.at(&mesh.vertices()[v]);
+        gap.abs() <= 1e-10 * (1.0 + values[v].abs())
+    };
+    let interior_active: Vec<bool> = (0..mesh.vertex_count())
+        .map(|v| free[v] && (vertex_force[v] > 1e-8 * scale.max(1e-300) || on_obstacle(v)))
         .collect();
+    // A boundary vertex where g = ψ lies on the obstacle whether or not the membrane
+    // touches it: it counts as contact only next to contact, found in two steps (next to
+    // interior contact, then next to those, which reaches a corner cell whose three
+    // vertices are all on the boundary).
+    let spread = |active: &[bool]| -> Vec<bool> {
+        let mut next = active.to_vec();
+        for c in 0..mesh.cell_count() {
+            let cell = mesh.cell(c);
+            if cell.iter().any(|&v| active[v]) {
+                for v in cell {
+                    next[v] |= !free[v] && on_obstacle(v);
+                }
+            }
+        }
+        next
+    };
+    let vertex_active = spread(&spread(&interior_active));
     let mut vertex_area = vec![0.0; mesh.vertex_count()];
     for c in 0..mesh.cell_count() {
         for v in mesh.cell(c) {

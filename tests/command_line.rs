@@ -313,4 +313,25 @@ fn scene_files_with_msh_and_negative_loads() {
         Some(0.0),
         "{lifted}"
     );
+    assert_eq!(lifted["contact_area"].as_f64(), Some(0.0), "{lifted}");
+    // the nodal method's boundary vertices sit on ψ = g = 0 whether or not the membrane
+    // touches: lifted off, no contact; pressed flat, all of (−2,2)²
+    for (load, area) in [("-5", 0.0), ("3", 16.0)] {
+        let nodal = json_of(
+            &[
+                "solve",
+                "membrane-flat",
+                "--pair",
+                "p1-nodal",
+                "--load",
+                load,
+                "--mesh-size",
+                "8",
+                "--json",
+            ],
+            &out,
+        );
+        let measured = nodal["contact_area"].as_f64().unwrap();
+        assert!((measured - area).abs() < 1e-9, "--load {load}: {nodal}");
+    }
 }
