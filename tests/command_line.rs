@@ -103,6 +103,10 @@ fn bad_input_exits_with_a_message() {
             "must be finite and ≥ 0",
         ),
         (&["study", "no-such-study"][..], "unknown study"),
+        (
+            &["solve", "timoshenko-a", "--thickness", "1e-8"][..],
+            "the Euler–Bernoulli model is the limit",
+        ),
     ] {
         let run = fem_forms(args, &out);
         let stderr = String::from_utf8_lossy(&run.stderr);

@@ -1,0 +1,45 @@
+//! Fine Hermite meshes, where the multiplier's stabilization `C = αh⁵` falls below the
+//! rounding of the gap: the answer is either certified and flagged, or a clear error —
+//! never "did not converge" without a cause, and never a silent λ_h of pure noise.
+
+use fem_forms::beams::{solve, Request};
+use fem_forms::models::scenes::{exact_solution, scene};
+
+fn flat(elements: usize) -> Request {
+    let mut r = Request::new(scene("bernoulli-flat").unwrap());
+    r.elements = elements;
+    r.load = 100.0;
+    r
+}
+
+/// Near rounding the active set flips without end, but the KKT residual certifies the
+/// iterates: a certified one is returned with a warning, and it is still close to the
+/// exact solution.
+#[test]
+fn a_cycling_active_set_at_rounding_level_still_gives_a_certified_answer() {
+    let (report, _) = solve(&flat(8000)).expect("a certified solution");
+    assert!(report.complementarity_residual <= 1e-10);
+    assert!(!report.warnings.is_empty(), "the noise must be flagged");
+    // against the exact solution, not against a previous run
+    let error = report.error_l2.unwrap();
+    assert!(error < 1e-4, "L² error {error}");
+    assert!(exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).is_some());
+}
+
+/// Beyond it λ_h has no correct digit: refused, naming the cause and the way out.
+#[test]
+fn a_multiplier_of_pure_rounding_noise_is_refused_with_its_cause() {
+    for elements in [20_000, 100_000] {
+        let message = match solve(&flat(elements)) {
+            Ok((report, _)) => panic!(
+                "{elements} elements: accepted with ∫λ_h = {} and noise {}",
+                report.total_contact_force, report.multiplier_noise
+            ),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            message.contains("fewer elements") && message.contains("αh⁵"),
+            "{elements}: {message}"
+        );
+    }
+}
