@@ -1,5 +1,6 @@
 //! Solving a beam scene with a chosen element pair and solver, and what a solve reports.
 
+use crate::models::membrane_scenes::MAX_LOAD;
 use crate::models::scenes::{exact_solution, Beam, Scene};
 use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
 use fem_runtime::lcp::NewtonOptions;
@@ -315,6 +316,12 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
     if !request.load.is_finite() || request.load < 0.0 {
         return Err(Error::Input(format!(
             "load q = {} must be finite and ≥ 0 (the scene fixes its direction)",
+            request.load
+        )));
+    }
+    if request.load > MAX_LOAD {
+        return Err(Error::Input(format!(
+            "load q = {:e} is beyond {MAX_LOAD:e}: in contact the obstacle's part of the constraint rows would drown in the rounding of the load's terms (ε·q against the size of ψ)",
             request.load
         )));
     }

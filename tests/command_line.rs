@@ -104,6 +104,14 @@ fn bad_input_exits_with_a_message() {
         ),
         (&["study", "no-such-study"][..], "unknown study"),
         (
+            &["solve", "membrane-lshape", "--load", "1e20"][..],
+            "drown in the rounding",
+        ),
+        (
+            &["solve", "timoshenko-a", "--load", "1e25"][..],
+            "drown in the rounding",
+        ),
+        (
             &["solve", "timoshenko-a", "--thickness", "1e-8"][..],
             "the Euler–Bernoulli model is the limit",
         ),

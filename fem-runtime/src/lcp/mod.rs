@@ -430,6 +430,8 @@ impl Lcp {
     ///   [`Lcp::multiplier_scale`]) with the componentwise relative
     ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + Σ_l |C_kl Λ_l| + |G_k|)`,
     /// - the infeasibilities `(−Λ_k)₊/‖Λ‖∞` and `(−r_k)₊`.
+    ///
+    /// `∞` (never certified) when `U` or `Λ` has a non-finite entry or a norm overflows.
     pub fn kkt_residual(&self, u: &[f64], lambda: &[f64]) -> f64 {
         let au = multiply(&self.a, u);
         let btl = self.bt_times(lambda);
@@ -470,7 +472,21 @@ impl Lcp {
             };
             complementarity = complementarity.max(l.min(r).abs()).max(-l).max(-r);
         }
-        backward.max(complementarity)
+        let result = backward.max(complementarity);
+        // An overflow in a norm (loads near f64::MAX) turns the relative residuals into
+        // 0 / ∞ = 0: a point whose certificate overflowed is not certified.
+        // (`f64::max` skips NaN, so a NaN in U or Λ would otherwise vanish from the norms.)
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if [scale, lambda_norm, a_norm, bt_norm]
+            .iter()
+            .all(|v| v.is_finite())
+            && finite(u)
+            && finite(lambda)
+        {
+            result
+        } else {
+            f64::INFINITY
+        }
     }
 }
 
@@ -678,6 +694,20 @@ mod tests {
         short.c_blocks = CouplingBlocks::from_entries(40, &[(30, 31, 1.0), (31, 30, 1.0)]).unwrap();
         assert!(semismooth_newton(&short, None, NewtonOptions::default()).is_err());
         let _ = short.kkt_residual(&vec![0.0; short.n()], &vec![0.0; short.m()]);
+    }
+
+    #[test]
+    fn a_point_whose_certificate_overflows_or_is_nan_is_not_certified() {
+        let (lcp, u, lambda) = blocked_lcp(1);
+        assert!(lcp.kkt_residual(&u, &lambda) < 1e-10);
+        let mut nan = u.clone();
+        nan[0] = f64::NAN;
+        assert_eq!(lcp.kkt_residual(&nan, &lambda), f64::INFINITY);
+        // a load near f64::MAX: ‖F‖ is finite, but ‖A‖‖U‖ + ‖Bᵀ‖‖Λ‖ + ‖F‖ overflows
+        let mut huge = lcp.clone();
+        huge.f.iter_mut().for_each(|f| *f = f64::MAX);
+        let big = vec![f64::MAX / 2.0; u.len()];
+        assert_eq!(huge.kkt_residual(&big, &lambda), f64::INFINITY);
     }
 
     #[test]
