@@ -317,8 +317,13 @@ impl Lcp {
         }
     }
 
-    /// An error unless the sizes of `A`, `B`, `C`, `F`, `G` fit together.
-    fn check_shapes(&self) -> Result<()> {
+    /// An error unless the sizes of `A`, `B`, `C`, `F`, `G` fit together: `A` is `n × n`
+    /// with `n = F.len()`, `B` has `m = G.len()` rows with columns below `n`, `C` has `m`
+    /// diagonal entries and its blocks end by constraint `m`.
+    ///
+    /// # Errors
+    /// [`Error::Input`] naming the sizes that do not fit.
+    pub fn check_shapes(&self) -> Result<()> {
         let (n, m) = (self.n(), self.m());
         if self.a.nrows() != n || self.a.ncols() != n {
             return Err(Error::Input(format!(
@@ -349,6 +354,10 @@ impl Lcp {
     }
 
     /// `B u`.
+    ///
+    /// # Panics
+    /// If `u` is shorter than a column index of `B` (`u.len() < n`); the solvers check
+    /// shapes first ([`Lcp::check_shapes`] is run by each of them).
     pub fn b_times(&self, u: &[f64]) -> Vec<f64> {
         self.b_rows
             .iter()
@@ -356,7 +365,7 @@ impl Lcp {
             .collect()
     }
 
-    /// `Bᵀ y`.
+    /// `Bᵀ y` (entries of `y` beyond its length count as 0; the result has length `n`).
     pub fn bt_times(&self, y: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.n()];
         for (row, &yk) in self.b_rows.iter().zip(y) {
@@ -431,8 +440,19 @@ impl Lcp {
     ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + Σ_l |C_kl Λ_l| + |G_k|)`,
     /// - the infeasibilities `(−Λ_k)₊/‖Λ‖∞` and `(−r_k)₊`.
     ///
+    /// # Panics
+    /// If `u.len() != n` or `lambda.len() != m`.
+    ///
     /// `∞` (never certified) when `U` or `Λ` has a non-finite entry or a norm overflows.
     pub fn kkt_residual(&self, u: &[f64], lambda: &[f64]) -> f64 {
+        assert!(
+            u.len() == self.n() && lambda.len() == self.m(),
+            "kkt_residual of (U, Λ) of lengths ({}, {}) for an LCP of ({}, {}) unknowns",
+            u.len(),
+            lambda.len(),
+            self.n(),
+            self.m()
+        );
         let au = multiply(&self.a, u);
         let btl = self.bt_times(lambda);
         let norm_inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
