@@ -247,16 +247,9 @@ impl StudyScene for BeamStudies {
         })
     }
 
-    fn multiplier_profile(
-        &self,
-        pair: &'static str,
-        size: usize,
-        alpha: Option<f64>,
-    ) -> Result<Vec<(f64, f64)>> {
-        let (_, p) = beams::solve(&self.request(&Run {
-            alpha,
-            ..Run::new(pair, size)
-        })?)?;
+    /// `(x, λ_h)` at the cell midpoints.
+    fn multiplier_profile(&self, run: &Run) -> Result<Vec<(f64, f64)>> {
+        let (_, p) = beams::solve(&self.request(run)?)?;
         Ok(p.cell_x.into_iter().zip(p.lambda).collect())
     }
 

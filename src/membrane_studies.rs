@@ -301,17 +301,9 @@ impl StudyScene for MembraneStudies {
 
     /// `(x, λ_h)` at the centroids of the cells in the band `0 < y < side/N` (the row of
     /// cells just above the x axis).
-    fn multiplier_profile(
-        &self,
-        pair: &'static str,
-        size: usize,
-        alpha: Option<f64>,
-    ) -> Result<Vec<(f64, f64)>> {
-        let (_, fields) = membranes::solve(&self.request(&Run {
-            alpha,
-            ..Run::new(pair, size)
-        })?)?;
-        let band = self.side() / size as f64;
+    fn multiplier_profile(&self, run: &Run) -> Result<Vec<(f64, f64)>> {
+        let (_, fields) = membranes::solve(&self.request(run)?)?;
+        let band = self.side() / run.size as f64;
         let mut points: Vec<(f64, f64)> = (0..fields.mesh.cell_count())
             .filter_map(|c| {
                 let x = fields.mesh.cell_coordinates(c);

@@ -217,13 +217,8 @@ pub trait StudyScene {
     fn measure(&self) -> Measure;
     /// The stability measure of `pair` on the mesh of `size`.
     fn stability(&self, pair: &'static str, size: usize) -> Result<StabilityRow>;
-    /// `(x, λ_h)` along a line through the contact set, sorted by x.
-    fn multiplier_profile(
-        &self,
-        pair: &'static str,
-        size: usize,
-        alpha: Option<f64>,
-    ) -> Result<Vec<(f64, f64)>>;
+    /// `(x, λ_h)` of a run along a line through the contact set, sorted by x.
+    fn multiplier_profile(&self, run: &Run) -> Result<Vec<(f64, f64)>>;
     /// The exact multiplier along that line, where known.
     fn exact_multiplier(&self) -> Option<ExactMultiplier>;
     /// The x range of the profile chart.
@@ -471,6 +466,20 @@ pub fn stability(
     sizes.iter().map(|&n| scene.stability(pair, n)).collect()
 }
 
+/// The multiplier profile ([`StudyScene::multiplier_profile`]) of `pair` on the mesh of
+/// `size` with `alpha` (`None`: the default; `Some(0.0)`: the plain method).
+pub fn multiplier_profile(
+    scene: &dyn StudyScene,
+    pair: &'static str,
+    size: usize,
+    alpha: Option<f64>,
+) -> Result<Vec<(f64, f64)>> {
+    scene.multiplier_profile(&Run {
+        alpha,
+        ..Run::new(pair, size)
+    })
+}
+
 /// Cells with λ = 0 between the first and the last cell with λ > 0 ("holes") of a
 /// profile.
 pub fn zero_holes(profile: &[(f64, f64)]) -> usize {
@@ -570,7 +579,7 @@ fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
     };
     let mut profiles = Vec::new();
     for alpha in profile.alphas {
-        let p = scene.multiplier_profile(pair, n, alpha)?;
+        let p = multiplier_profile(scene, pair, n, alpha)?;
         let label = variant_label(alpha);
         println!(
             "{label:<24} {:>16} {:>16.4e} {:>22}",
@@ -808,7 +817,7 @@ fn run_alpha(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
                 series,
             ),
             (
-                format!("{contact} against α: a too large α shifts the contact set"),
+                format!("{contact} against α (an overlarge α shifts the contact set)"),
                 Axes {
                     x: "α",
                     y: contact,

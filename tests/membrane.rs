@@ -284,10 +284,10 @@ fn plain_pairs_have_a_multiplier_kernel_and_stabilized_ones_do_not() {
 #[test]
 fn stabilization_removes_the_multiplier_oscillation() {
     use fem_forms::membrane_studies::MembraneStudies;
-    use fem_forms::studies::{total_variation, StudyScene};
+    use fem_forms::studies::{multiplier_profile, total_variation};
     let scene = MembraneStudies::new(radial());
-    let plain = scene.multiplier_profile("p2-p0", 32, Some(0.0)).unwrap();
-    let stabilized = scene.multiplier_profile("p2-p0", 32, None).unwrap();
+    let plain = multiplier_profile(&scene, "p2-p0", 32, Some(0.0)).unwrap();
+    let stabilized = multiplier_profile(&scene, "p2-p0", 32, None).unwrap();
     let exact: Vec<(f64, f64)> = (0..=400)
         .map(|i| {
             let x = -2.0 + 4.0 * i as f64 / 400.0;

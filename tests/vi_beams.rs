@@ -7,7 +7,7 @@ use fem_forms::beam_studies::{self, BeamStudies};
 use fem_forms::beams::{solve, Pair, Request};
 use fem_forms::models::scenes::{exact_solution, scene, Beam, Obstacle, Scene, SCENES};
 use fem_forms::obstacle::VariationalSolver;
-use fem_forms::studies::{self, StudyScene};
+use fem_forms::studies;
 use fem_forms::IntervalMesh;
 
 fn request(name: &str, elements: usize, q: f64) -> Request {
@@ -276,7 +276,7 @@ fn euler_bernoulli_iterations_are_flat_until_double_precision_runs_out() {
 fn plain_and_stabilized_multipliers_where_methods_fail() {
     let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
     let flat = BeamStudies::new(scene("bernoulli-flat").unwrap());
-    let profile = |alpha| flat.multiplier_profile("hermite-p0", 256, alpha).unwrap();
+    let profile = |alpha| studies::multiplier_profile(&flat, "hermite-p0", 256, alpha).unwrap();
     let (plain, weak, strong) = (profile(Some(0.0)), profile(Some(1e-2)), profile(Some(1.0)));
     let contact = exact.contact_set[0];
     // hand-coded: λ = q = 100 inside the contact interval of the flat obstacle
