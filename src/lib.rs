@@ -3,11 +3,13 @@
 //!
 //! This crate re-exports the runtime ([`fem_runtime`]), the `model!` macro that compiles
 //! model files, and the model files and scenes of [`fem_models`]; it adds the beam scene
-//! solver ([`beams`]), the studies and charts ([`studies`], [`plot`]) behind the CLI.
+//! solver ([`beams`]), the studies (each kind once in [`studies`], the families' sides in [`beam_studies`] and
+//! [`membrane_studies`]) and charts ([`plot`]) behind the CLI.
 #![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod allocator;
+pub mod beam_studies;
 pub mod beams;
 pub mod membrane_studies;
 pub mod membranes;

@@ -3,15 +3,13 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
-use fem_forms::membrane_studies::{self, MembraneStudy};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::membrane_scenes::MembraneScene;
-use fem_forms::models::registry::{
-    find, names, registry, Family, SceneEntry, SceneKind, MEMBRANE_PAIRS,
-};
+use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind, MEMBRANE_PAIRS};
 use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::VariationalSolver;
-use fem_forms::{plot, scene_file, studies};
+use fem_forms::studies::{self, Study};
+use fem_forms::{plot, scene_file};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -56,11 +54,12 @@ enum Command {
         #[command(flatten)]
         options: SolveOptions,
     },
-    /// Run a study and write its chart and CSV: `study <scene> [study]` runs one study
-    /// the scene hosts (all of them when left out; see `list`); `study <study>` runs a
-    /// beam study (convergence, locking, stability, alpha, work-precision, iterations).
+    /// Run a study and write its chart and CSV (out/<scene>-<study>.svg, .csv):
+    /// `study <scene> [study]` runs one study the scene hosts (all of them when left
+    /// out; see `list`); `study <study>` runs it on every scene that hosts it (convergence,
+    /// locking, stability, alpha, work-precision, iterations).
     Study {
-        /// A scene name, or a beam study.
+        /// A scene name, or a study.
         study: String,
         /// The study, after a scene name.
         kind: Option<String>,
@@ -292,17 +291,36 @@ fn default_job(out: &Path) -> Result<(), String> {
         "\nplots of w, θ, λ, ψ: {}/<scene>-q<q>.svg\n",
         out.display()
     );
-    for study in studies::Study::DEFAULT {
-        studies::run(study, false, out).map_err(|e| format!("study {study:?}: {e}"))?;
-    }
-    let membranes: Vec<MembraneScene> = entries
+    let (beam_entries, membrane_entries): (Vec<SceneEntry>, Vec<SceneEntry>) = entries
         .into_iter()
-        .filter_map(|e| match e.kind {
-            SceneKind::Membrane(s) => Some(s),
+        .partition(|e| matches!(e.kind, SceneKind::Beam(_)));
+    hosted_studies(&beam_entries, out)?;
+    let membranes: Vec<MembraneScene> = membrane_entries
+        .iter()
+        .filter_map(|e| match &e.kind {
+            SceneKind::Membrane(s) => Some(s.clone()),
             SceneKind::Beam(_) => None,
         })
         .collect();
-    membrane_job(&membranes, out)
+    membrane_job(&membranes, out)?;
+    hosted_studies(&membrane_entries, out)
+}
+
+/// Every study each of `entries` hosts, quick versions.
+fn hosted_studies(entries: &[SceneEntry], out: &Path) -> Result<(), String> {
+    for entry in entries {
+        for &kind in entry.studies {
+            run_study(entry, kind, false, out)?;
+        }
+    }
+    Ok(())
+}
+
+/// Runs the study called `kind` on a registry scene.
+fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(), String> {
+    let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
+    studies::run(&*studies::study_scene(entry), study, full, out)
+        .map_err(|e| format!("study {} {kind}: {e}", entry.name()))
 }
 
 /// The membrane part of the default job: every pair on the radial scene, each scene at
@@ -372,10 +390,6 @@ fn membrane_job(scenes: &[MembraneScene], out: &Path) -> Result<(), String> {
         }
     }
     println!();
-    for study in MembraneStudy::ALL {
-        membrane_studies::run(study, false, out)
-            .map_err(|e| format!("membrane study {study:?}: {e}"))?;
-    }
     Ok(())
 }
 
@@ -527,7 +541,8 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
     Ok(())
 }
 
-/// `study <scene> [kind]` through the registry, or `study <beam study>`.
+/// `study <scene> [kind]` through the registry, or `study <kind>` on every scene that
+/// hosts it.
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
     let Some(entry) = find(name) else {
         if let Some(kind) = kind {
@@ -536,17 +551,20 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
                 names().join(", ")
             ));
         }
-        let beam_study = <studies::Study as ValueEnum>::from_str(name, true).map_err(|_| {
-            format!(
-                "unknown study or scene `{name}`; the beam studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
-                studies::Study::DEFAULT
-                    .iter()
-                    .filter_map(|s| s.to_possible_value().map(|v| v.get_name().to_string()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
-        })?;
-        return studies::run(beam_study, full, out).map_err(|e| e.to_string());
+        if Study::parse(name).is_none() {
+            return Err(format!(
+                "unknown study or scene `{name}`; the studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
+                Study::ALL.map(Study::name).join(", ")
+            ));
+        }
+        let hosts: Vec<SceneEntry> = registry()
+            .into_iter()
+            .filter(|e| e.studies.contains(&name))
+            .collect();
+        for entry in &hosts {
+            run_study(entry, name, full, out)?;
+        }
+        return Ok(());
     };
     if entry.studies.is_empty() {
         return Err(format!("scene `{name}` hosts no study"));
@@ -562,16 +580,7 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
         None => entry.studies.to_vec(),
     };
     for k in kinds {
-        match entry.family() {
-            Family::Beam => {
-                let s = <studies::Study as ValueEnum>::from_str(k, true)?;
-                studies::run(s, full, out).map_err(|e| e.to_string())?;
-            }
-            Family::Membrane => {
-                let s = <MembraneStudy as ValueEnum>::from_str(k, true)?;
-                membrane_studies::run(s, full, out).map_err(|e| e.to_string())?;
-            }
-        }
+        run_study(&entry, k, full, out)?;
     }
     Ok(())
 }

@@ -1,26 +1,33 @@
-//! The studies behind the charts: convergence against the exact flat-obstacle solution,
-//! locking as t → 0, stability of plain vs stabilized pairs, the α range, work against
-//! precision, and iteration counts. Each returns its rows (the tests run small
-//! versions), prints a table, and writes `out/<study>.svg` and `out/<study>.csv`.
+//! The studies behind the charts, each kind implemented once and run on any scene whose
+//! family implements [`StudyScene`]: convergence against the exact solution, stability of
+//! the plain against the stabilized pairs (the family's measure of the multiplier
+//! problem, and multiplier profiles), the α sweep, work against precision, and Newton
+//! iterations with nested iteration and from a cold start. `locking` (t → 0) belongs to
+//! the Timoshenko beams ([`crate::beam_studies`]) and uses the same CSV and chart output.
+//!
+//! A study of scene `s` prints a table and writes `out/<s>-<study>.svg` and `.csv`; the
+//! functions behind each (the tests run small versions) return their rows.
 
-use crate::beams::{self, Pair, Profiles, Report, Request};
-use crate::models::scenes::{exact_solution, scene, Scene};
+use crate::beam_studies::BeamStudies;
+use crate::membrane_studies::MembraneStudies;
+use crate::models::registry::{SceneEntry, SceneKind};
 use crate::plot::{self, Axes, Series};
 use fem_runtime::obstacle::VariationalSolver;
 use fem_runtime::{Error, Result};
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// The studies.
+/// The study kinds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Study {
-    /// Errors against the exact flat-obstacle solution and observed rates.
+    /// Errors against the exact solution and observed rates, every pair.
     Convergence,
     /// Timoshenko → Euler–Bernoulli as t → 0; the locking P1–P1 method beside.
     Locking,
-    /// Plain (α = 0) against stabilized pairs: conditioning and multiplier profiles.
+    /// Plain (α = 0) against stabilized pairs: the family's stability measure of the
+    /// multiplier problem, and multiplier profiles.
     Stability,
-    /// Error and contact set against α.
+    /// Errors and contact against α on one mesh, with 1/C_I marked.
     Alpha,
     /// Error against time for every solver.
     WorkPrecision,
@@ -29,8 +36,8 @@ pub enum Study {
 }
 
 impl Study {
-    /// The studies of the default job.
-    pub const DEFAULT: [Study; 6] = [
+    /// Every study kind.
+    pub const ALL: [Study; 6] = [
         Study::Convergence,
         Study::Locking,
         Study::Stability,
@@ -39,7 +46,8 @@ impl Study {
         Study::Iterations,
     ];
 
-    fn name(self) -> &'static str {
+    /// Its name on the command line and in the registry.
+    pub fn name(self) -> &'static str {
         match self {
             Study::Convergence => "convergence",
             Study::Locking => "locking",
@@ -49,17 +57,187 @@ impl Study {
             Study::Iterations => "iterations",
         }
     }
+
+    /// The study called `name`.
+    pub fn parse(name: &str) -> Option<Study> {
+        Self::ALL.into_iter().find(|s| s.name() == name)
+    }
 }
 
-fn flat() -> Scene {
-    scene("bernoulli-flat").expect("the scene exists")
+/// One solve of a study.
+#[derive(Clone, Copy, Debug)]
+pub struct Run {
+    /// Element pair (its command-line name).
+    pub pair: &'static str,
+    /// Mesh size: elements (beams) or N of the N×N×2 mesh (membranes).
+    pub size: usize,
+    /// α; `None`: the family's default; `Some(0.0)`: the plain mixed method.
+    pub alpha: Option<f64>,
+    /// LCP solver.
+    pub solver: VariationalSolver,
+    /// Nested iteration from coarser meshes (else a cold start on the final mesh).
+    pub nested: bool,
 }
 
-fn request(scene: Scene, elements: usize, load: f64) -> Request {
-    let mut r = Request::new(scene);
-    r.elements = elements;
-    r.load = load;
-    r
+impl Run {
+    /// The default solve of `pair` at `size`: default α, nested semismooth Newton.
+    pub fn new(pair: &'static str, size: usize) -> Self {
+        Self {
+            pair,
+            size,
+            alpha: None,
+            solver: VariationalSolver::SemismoothNewton,
+            nested: true,
+        }
+    }
+}
+
+/// What one solve of a study reports, whatever the family.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Element pair.
+    pub pair: &'static str,
+    /// Mesh size (elements, or N).
+    pub size: usize,
+    /// Largest cell diameter.
+    pub h: f64,
+    /// Cells of the mesh (elements, or triangles).
+    pub cells: usize,
+    /// Unknowns after eliminating boundary DOFs (primal and multiplier).
+    pub dofs: usize,
+    /// α used.
+    pub alpha: f64,
+    /// `‖u − u_h‖_L2` where the exact solution is known.
+    pub error_l2: Option<f64>,
+    /// `|u − u_h|_H1` where the exact solution is known.
+    pub error_h1: Option<f64>,
+    /// An error of the multiplier where the family measures one (membranes:
+    /// `(Σ_T h_T² ‖λ − λ_h‖²_T)^½`).
+    pub error_multiplier: Option<f64>,
+    /// `∫λ_h`.
+    pub total_contact_force: f64,
+    /// `|∫λ_h − ∫λ|` where the exact ∫λ is known.
+    pub force_error: Option<f64>,
+    /// The family's measure of the contact set ([`StudyScene::contact_names`]: beams the
+    /// left edge of the contact set, membranes its area).
+    pub contact: f64,
+    /// Its distance from the exact one, where known.
+    pub contact_error: Option<f64>,
+    /// Newton iterations on the final mesh.
+    pub iterations: usize,
+    /// Solve time in seconds.
+    pub seconds: f64,
+    /// KKT residual.
+    pub kkt_residual: f64,
+    /// The solve's warnings.
+    pub warnings: Vec<String>,
+}
+
+/// One mesh and pair of the stability study: the family's measure of the multiplier
+/// problem for the plain (α = 0) and the stabilized method.
+#[derive(Clone, Debug)]
+pub struct StabilityRow {
+    /// Element pair.
+    pub pair: &'static str,
+    /// Mesh size.
+    pub size: usize,
+    /// α of the stabilized method.
+    pub alpha: f64,
+    /// The measure of the plain method ([`Measure::labels`]).
+    pub plain: Vec<f64>,
+    /// The measure of the stabilized method.
+    pub stabilized: Vec<f64>,
+}
+
+/// What a family measures in the stability study.
+#[derive(Clone, Copy, Debug)]
+pub struct Measure {
+    /// The table's title.
+    pub title: &'static str,
+    /// The values of a [`StabilityRow`] side (`κ₂`, or `γ₁, γ₂`).
+    pub labels: &'static [&'static str],
+    /// The chart's y axis.
+    pub axis: &'static str,
+    /// The plotted value of a measured one.
+    pub plotted: fn(f64) -> f64,
+}
+
+/// The exact multiplier along the line of [`StudyScene::multiplier_profile`].
+pub struct ExactMultiplier {
+    /// The contact interval on that line.
+    pub contact: [f64; 2],
+    /// `λ(x)` on that line (point forces at contact edges left out).
+    pub lambda: Box<dyn Fn(f64) -> f64>,
+}
+
+/// The meshes and settings of one study on one scene (quick, or `--full`).
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// The pair (studies over every pair use [`StudyScene::pairs`]).
+    pub pair: &'static str,
+    /// The mesh sizes (one for the α sweep and the profiles).
+    pub sizes: Vec<usize>,
+    /// Largest size solved from a cold start as well (work–precision, iterations).
+    pub cold_max: usize,
+    /// The α values (α sweep), or the α of each multiplier profile (stability; `None`
+    /// the default, 0 the plain method).
+    pub alphas: Vec<Option<f64>>,
+}
+
+/// A scene family as the studies see it: how to solve one (pair, mesh, α) of a scene,
+/// the family's stability measure and multiplier profile, its mesh ladders and pairs.
+pub trait StudyScene {
+    /// The scene's name (for titles and output files).
+    fn name(&self) -> String;
+    /// The problem solved, for titles (`bernoulli-flat q = 100`).
+    fn setting(&self) -> String;
+    /// What a mesh size counts (`elements`, `N`).
+    fn size_name(&self) -> &'static str;
+    /// The largest cell diameter of the mesh of `size`.
+    fn h(&self, size: usize) -> f64;
+    /// `[measure, error]` names of [`Row::contact`] and [`Row::contact_error`].
+    fn contact_names(&self) -> [&'static str; 2];
+    /// The pairs the convergence study compares.
+    fn pairs(&self) -> Vec<&'static str>;
+    /// The meshes and settings of a study. `pair` is the pair of a study over every pair
+    /// (convergence) or of the stability ladder; a study of one pair (α sweep,
+    /// work–precision, iterations) uses the plan's own.
+    fn plan(&self, study: Study, pair: &'static str, full: bool) -> Plan;
+    /// The pair, mesh and α values of the stability study's multiplier profiles.
+    fn profiles(&self, full: bool) -> Plan;
+    /// Solves one run.
+    fn solve(&self, run: &Run) -> Result<Row>;
+    /// `max_T C_I` of `pair` on the mesh of `size` (0 where Δ vanishes on the elements).
+    fn inverse_constant(&self, pair: &'static str, size: usize) -> Result<f64>;
+    /// The exact measure of the contact set, where known.
+    fn exact_contact(&self) -> Option<f64>;
+    /// The pairs of the stability study.
+    fn stability_pairs(&self) -> Vec<&'static str>;
+    /// What the stability study measures.
+    fn measure(&self) -> Measure;
+    /// The stability measure of `pair` on the mesh of `size`.
+    fn stability(&self, pair: &'static str, size: usize) -> Result<StabilityRow>;
+    /// `(x, λ_h)` of a run along a line through the contact set, sorted by x.
+    fn multiplier_profile(&self, run: &Run) -> Result<Vec<(f64, f64)>>;
+    /// The exact multiplier along that line, where known.
+    fn exact_multiplier(&self) -> Option<ExactMultiplier>;
+    /// The x range of the profile chart.
+    fn profile_window(&self) -> [f64; 2];
+    /// The locking study (Timoshenko beams only).
+    fn locking(&self, _full: bool, _out: &Path) -> Result<()> {
+        Err(Error::Input(format!(
+            "scene `{}` has no locking study (t → 0 is a Timoshenko study)",
+            self.name()
+        )))
+    }
+}
+
+/// The study implementation of a registry scene.
+pub fn study_scene(entry: &SceneEntry) -> Box<dyn StudyScene> {
+    match &entry.kind {
+        SceneKind::Beam(s) => Box::new(BeamStudies::new(*s)),
+        SceneKind::Membrane(s) => Box::new(MembraneStudies::new(s.clone())),
+    }
 }
 
 /// Observed rates `log2(e_k / e_{k+1})` of errors on meshes halved each time.
@@ -87,757 +265,805 @@ pub(crate) fn io(e: std::io::Error) -> Error {
     Error::Input(format!("writing output: {e}"))
 }
 
-/// One mesh of the convergence study.
-#[derive(Clone, Debug)]
-pub struct ConvergenceRow {
-    /// Elements.
-    pub elements: usize,
-    /// `‖w − w_h‖_L2`.
-    pub error_l2: f64,
-    /// `‖(w − w_h)'‖_L2`.
-    pub error_h1: f64,
-    /// `|∫λ_h − ∫λ|` (point forces included in ∫λ).
-    pub force_error: f64,
-    /// Distance of the computed contact edge from the exact one.
-    pub edge_error: f64,
-    /// Solve time.
-    pub seconds: f64,
+/// `out/<scene>-<study>.<extension>`.
+pub(crate) fn output(out: &Path, scene: &str, study: Study, extension: &str) -> PathBuf {
+    out.join(format!("{scene}-{}.{extension}", study.name()))
 }
 
-/// `bernoulli-flat` at q = 100 (contact interval) on uniform meshes.
-pub fn convergence(meshes: &[usize]) -> Result<Vec<ConvergenceRow>> {
-    let q = 100.0;
-    let exact = exact_solution(&flat(), q, 0.0).expect("bernoulli-flat has an exact solution");
-    meshes
+fn nan(v: Option<f64>) -> f64 {
+    v.unwrap_or(f64::NAN)
+}
+
+/// A table cell: `-` where there is no value.
+fn cell(v: f64, width: usize) -> String {
+    if v.is_nan() {
+        format!("{:>width$}", "-")
+    } else {
+        format!("{v:>width$.4e}")
+    }
+}
+
+fn log_axes<'a>(x: &'a str, y: &'a str) -> Axes<'a> {
+    Axes {
+        x,
+        y,
+        log_x: true,
+        log_y: true,
+    }
+}
+
+/// The convergence study: `pair` on each mesh of `sizes`.
+pub fn convergence(
+    scene: &dyn StudyScene,
+    pair: &'static str,
+    sizes: &[usize],
+) -> Result<Vec<Row>> {
+    sizes
         .iter()
-        .map(|&n| {
-            let (r, _) = beams::solve(&request(flat(), n, q))?;
-            let edge = r.contact_set.first().map_or(f64::NAN, |c| c[0]);
-            Ok(ConvergenceRow {
-                elements: n,
-                error_l2: r.error_l2.unwrap_or(f64::NAN),
-                error_h1: r.error_h1.unwrap_or(f64::NAN),
-                force_error: (r.total_contact_force - exact.total_contact_force).abs(),
-                edge_error: (edge - exact.contact_set[0][0]).abs(),
-                seconds: r.seconds,
-            })
+        .map(|&n| scene.solve(&Run::new(pair, n)))
+        .collect()
+}
+
+/// The pairs of a scene that solve on its coarsest convergence mesh (the others are
+/// left out of the convergence study).
+pub fn available_pairs(scene: &dyn StudyScene) -> Vec<&'static str> {
+    scene
+        .pairs()
+        .into_iter()
+        .filter(|&p| {
+            let coarsest = scene.plan(Study::Convergence, p, false).sizes[0];
+            scene.solve(&Run::new(p, coarsest)).is_ok()
         })
         .collect()
 }
 
-fn run_convergence(full: bool, out: &Path) -> Result<()> {
-    let meshes: Vec<usize> = if full {
-        (4..=14).map(|k| 1 << k).collect()
-    } else {
-        (4..=10).map(|k| 1 << k).collect()
-    };
-    let rows = convergence(&meshes)?;
-    let r2 = rates(&rows.iter().map(|r| r.error_l2).collect::<Vec<_>>());
-    let r1 = rates(&rows.iter().map(|r| r.error_h1).collect::<Vec<_>>());
-    println!("convergence: bernoulli-flat, q = 100, Hermite–P0, α = 1e-2 (exact solution, contact interval)");
+fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
+    let name = scene.name();
+    let pairs = available_pairs(scene);
+    let [_, contact_error] = scene.contact_names();
     println!(
-        "{:>8} {:>12} {:>6} {:>12} {:>6} {:>12} {:>12}",
-        "elements", "L2 error", "rate", "H1 error", "rate", "∫λ error", "edge error"
-    );
-    for (k, r) in rows.iter().enumerate() {
-        let rate = |v: &[f64]| {
-            if k == 0 {
-                "-".to_string()
-            } else {
-                format!("{:.2}", v[k - 1])
-            }
-        };
-        println!(
-            "{:>8} {:>12.4e} {:>6} {:>12.4e} {:>6} {:>12.4e} {:>12.4e}",
-            r.elements,
-            r.error_l2,
-            rate(&r2),
-            r.error_h1,
-            rate(&r1),
-            r.force_error,
-            r.edge_error
-        );
-    }
-    let h = |r: &ConvergenceRow| 1.0 / r.elements as f64;
-    plot::chart(
-        &out.join("convergence.svg"),
-        "bernoulli-flat q = 100: errors against h (Hermite–P0, stabilized)",
-        Axes {
-            x: "h",
-            y: "error",
-            log_x: true,
-            log_y: true,
-        },
-        &[
-            Series::marked(
-                "‖w − w_h‖_L2",
-                rows.iter().map(|r| (h(r), r.error_l2)).collect(),
-            ),
-            Series::marked(
-                "‖(w − w_h)'‖_L2",
-                rows.iter().map(|r| (h(r), r.error_h1)).collect(),
-            ),
-            Series::marked(
-                "|∫λ_h − ∫λ|",
-                rows.iter().map(|r| (h(r), r.force_error)).collect(),
-            ),
-        ],
-    )
-    .map_err(io)?;
-    write_csv(
-        &out.join("convergence.csv"),
-        "elements,error_l2,error_h1,force_error,edge_error,seconds",
-        &rows
-            .iter()
-            .map(|r| {
-                vec![
-                    r.elements as f64,
-                    r.error_l2,
-                    r.error_h1,
-                    r.force_error,
-                    r.edge_error,
-                    r.seconds,
-                ]
-            })
-            .collect::<Vec<_>>(),
-    )
-    .map_err(io)
-}
-
-/// One thickness of the locking study.
-#[derive(Clone, Debug)]
-pub struct LockingRow {
-    /// Element pair.
-    pub pair: Pair,
-    /// Thickness.
-    pub thickness: f64,
-    /// Largest |w|.
-    pub max_deflection: f64,
-    /// `‖w_h − w_EB‖_L2` against the Euler–Bernoulli reference.
-    pub difference_to_bernoulli: f64,
-    /// Relative energy difference to the Euler–Bernoulli reference.
-    pub energy_difference: f64,
-}
-
-/// Linear interpolation of sampled values at `x`.
-fn sample(p: &Profiles, x: f64) -> f64 {
-    let n = p.x.len() - 1;
-    let i = ((x * n as f64).floor() as usize).min(n - 1);
-    let t = x * n as f64 - i as f64;
-    p.w[i] * (1.0 - t) + p.w[i + 1] * t
-}
-
-fn l2_difference(a: &Profiles, b: &Profiles) -> f64 {
-    let n = 4000;
-    let sum: f64 = (0..n)
-        .map(|i| {
-            let x = (i as f64 + 0.5) / n as f64;
-            (sample(a, x) - sample(b, x)).powi(2)
-        })
-        .sum();
-    (sum / n as f64).sqrt()
-}
-
-/// `timoshenko-a` at q = 100 on `elements` elements for each pair and thickness, against
-/// `bernoulli-a` on a fine mesh.
-pub fn locking(
-    elements: usize,
-    thicknesses: &[f64],
-    pairs: &[Pair],
-) -> Result<(Report, Vec<LockingRow>)> {
-    let q = 100.0;
-    let (reference, reference_profiles) =
-        beams::solve(&request(scene("bernoulli-a").unwrap(), 4096, q))?;
-    let mut rows = Vec::new();
-    for &pair in pairs {
-        for &t in thicknesses {
-            let mut r = request(scene("timoshenko-a").unwrap(), elements, q);
-            r.pair = Some(pair);
-            r.thickness = Some(t);
-            r.refinement_steps = if t < 1e-4 { 3 } else { 1 };
-            let (report, profiles) = beams::solve(&r)?;
-            rows.push(LockingRow {
-                pair,
-                thickness: t,
-                max_deflection: report.max_deflection,
-                difference_to_bernoulli: l2_difference(&profiles, &reference_profiles),
-                energy_difference: ((report.energy - reference.energy) / reference.energy).abs(),
-            });
-        }
-    }
-    Ok((reference, rows))
-}
-
-fn run_locking(full: bool, out: &Path) -> Result<()> {
-    let thicknesses = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5];
-    let pairs = [
-        Pair::TimoshenkoP2,
-        Pair::TimoshenkoP1Reduced,
-        Pair::TimoshenkoP1Full,
-    ];
-    let (reference, rows) = locking(if full { 1024 } else { 256 }, &thicknesses, &pairs)?;
-    println!(
-        "\nlocking: timoshenko-a, q = 100, {} elements; Euler–Bernoulli reference (4096 Hermite elements): max |w| = {:.6e}",
-        if full { 1024 } else { 256 },
-        reference.max_deflection
+        "{}: errors against the exact solution (rates between successive meshes)",
+        scene.setting()
     );
     println!(
-        "{:<18} {:>8} {:>12} {:>14} {:>12}",
-        "pair", "t", "max |w|", "‖w − w_EB‖", "ΔJ/J"
+        "{:<10} {:>8} {:>9} {:>9} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>11} {:>5} {:>8}",
+        "pair",
+        scene.size_name(),
+        "cells",
+        "dofs",
+        "L2",
+        "rate",
+        "H1",
+        "rate",
+        "λ error",
+        "rate",
+        "|∫λ_h − ∫λ|",
+        contact_error,
+        "iter",
+        "seconds"
     );
-    for r in &rows {
-        println!(
-            "{:<18} {:>8.0e} {:>12.6e} {:>14.4e} {:>12.3e}",
-            r.pair.name(),
-            r.thickness,
-            r.max_deflection,
-            r.difference_to_bernoulli,
-            r.energy_difference
-        );
-    }
-    let series = |f: &dyn Fn(&LockingRow) -> f64| -> Vec<Series> {
-        pairs
-            .iter()
-            .map(|p| {
-                Series::marked(
-                    p.name(),
-                    rows.iter()
-                        .filter(|r| r.pair == *p)
-                        .map(|r| (r.thickness, f(r)))
-                        .collect(),
-                )
-            })
-            .collect()
-    };
-    let mut deflection = series(&|r| r.max_deflection);
-    deflection.push(Series::line(
-        "Euler–Bernoulli",
-        vec![
-            (thicknesses[thicknesses.len() - 1], reference.max_deflection),
-            (thicknesses[0], reference.max_deflection),
-        ],
-    ));
-    plot::stacked(
-        &out.join("locking.svg"),
-        &[
-            (
-                "timoshenko-a q = 100: max |w| against t (locking collapses it)".into(),
-                Axes {
-                    x: "t",
-                    y: "max |w|",
-                    log_x: true,
-                    log_y: true,
-                },
-                deflection,
-            ),
-            (
-                "‖w_h(t) − w_EB‖_L2: converges to Euler–Bernoulli as t → 0".into(),
-                Axes {
-                    x: "t",
-                    y: "difference",
-                    log_x: true,
-                    log_y: true,
-                },
-                series(&|r| r.difference_to_bernoulli),
-            ),
-        ],
-    )
-    .map_err(io)?;
-    write_csv(
-        &out.join("locking.csv"),
-        "pair_index,thickness,max_deflection,difference_to_bernoulli,energy_difference",
-        &rows
-            .iter()
-            .map(|r| {
-                vec![
-                    pairs.iter().position(|p| *p == r.pair).unwrap() as f64,
-                    r.thickness,
-                    r.max_deflection,
-                    r.difference_to_bernoulli,
-                    r.energy_difference,
-                ]
-            })
-            .collect::<Vec<_>>(),
-    )
-    .map_err(io)
-}
-
-/// Condition number of the LCP matrix `M = B A⁻¹ Bᵀ + C` of a request: the matrix the
-/// multiplier sees once U is eliminated. Its smallest eigenvalue is the discrete inf-sup
-/// constant squared (in the Euclidean norm of the P0 coefficients); `C = αΣh⁴(λ, μ)`
-/// lifts it for the stabilized method.
-pub fn lcp_condition(request: &Request) -> Result<f64> {
-    let (d, _) = beams::discretize(request)?;
-    let lcp = &d.lcp;
-    let (n, m) = (lcp.n(), lcp.m());
-    let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
-    let (col_ptr, rows, vals) = (
-        lcp.a.symbolic().col_ptr(),
-        lcp.a.symbolic().row_idx(),
-        lcp.a.val(),
-    );
-    for j in 0..n {
-        for idx in col_ptr[j]..col_ptr[j + 1] {
-            a[(rows[idx], j)] = vals[idx];
-        }
-    }
-    let mut bt = nalgebra::DMatrix::<f64>::zeros(n, m);
-    for (k, row) in lcp.b_rows.iter().enumerate() {
-        for &(j, v) in row {
-            bt[(j, k)] = v;
-        }
-    }
-    let cholesky = a
-        .cholesky()
-        .ok_or_else(|| Error::LinearSolve("A is not positive definite".into()))?;
-    let a_inv_bt = cholesky.solve(&bt);
-    let mut schur = bt.transpose() * a_inv_bt;
-    for k in 0..m {
-        schur[(k, k)] += lcp.c[k];
-    }
-    let eigenvalues = nalgebra::SymmetricEigen::new(schur).eigenvalues;
-    let largest = eigenvalues.max();
-    let smallest = eigenvalues.min();
-    Ok(if smallest > 0.0 {
-        largest / smallest
-    } else {
-        f64::INFINITY
-    })
-}
-
-/// The multiplier profile of a scene at q = 100 with stabilization `alpha` (`None`: the
-/// plain mixed method, α = 0, solved as a QP).
-pub fn multiplier_profile(
-    scene_name: &str,
-    elements: usize,
-    alpha: Option<f64>,
-) -> Result<Profiles> {
-    let s = scene(scene_name).ok_or_else(|| Error::Input(format!("no scene {scene_name}")))?;
-    let mut r = request(s, elements, 100.0);
-    match alpha {
-        Some(a) => r.alpha = Some(a),
-        None => {
-            r.alpha = Some(0.0);
-            r.plain = true;
-            r.solver = VariationalSolver::Clarabel;
-        }
-    }
-    Ok(beams::solve(&r)?.1)
-}
-
-/// Largest `|λ_h − q|` over the middle half of the contact interval of `bernoulli-flat`
-/// (where the exact λ is q = 100): the oscillation the stabilization damps.
-pub fn interior_oscillation(p: &Profiles, contact: [f64; 2]) -> f64 {
-    let (a, b) = (contact[0], contact[1]);
-    let (lo, hi) = (a + 0.25 * (b - a), b - 0.25 * (b - a));
-    p.cell_x
-        .iter()
-        .zip(&p.lambda)
-        .filter(|(x, _)| **x >= lo && **x <= hi)
-        .map(|(_, l)| (l - 100.0).abs())
-        .fold(0.0, f64::max)
-}
-
-fn run_stability(full: bool, out: &Path) -> Result<()> {
-    let meshes: Vec<usize> = if full {
-        vec![8, 16, 32, 64, 128, 256]
-    } else {
-        vec![8, 16, 32, 64, 128]
-    };
-    println!("\nstability: condition number of the LCP matrix B A⁻¹ Bᵀ + C at q = 100");
-    println!(
-        "{:<15} {:>8} {:>14} {:>14}",
-        "scene", "elements", "plain α = 0", "stabilized"
-    );
-    let mut charts = Vec::new();
     let mut csv = Vec::new();
-    for (k, name) in ["bernoulli-a", "timoshenko-a"].iter().enumerate() {
-        let mut plain_series = Vec::new();
-        let mut stabilized_series = Vec::new();
-        for &n in &meshes {
-            let mut r = request(scene(name).unwrap(), n, 100.0);
-            let stabilized = lcp_condition(&r)?;
-            r.alpha = Some(0.0);
-            r.plain = true;
-            r.solver = VariationalSolver::Clarabel;
-            let plain = lcp_condition(&r)?;
-            println!("{name:<15} {n:>8} {plain:>14.4e} {stabilized:>14.4e}");
-            plain_series.push((1.0 / n as f64, plain));
-            stabilized_series.push((1.0 / n as f64, stabilized));
-            csv.push(vec![k as f64, n as f64, plain, stabilized]);
+    let (mut l2_series, mut h1_series, mut multiplier_series, mut force_series, mut work) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (index, &pair) in pairs.iter().enumerate() {
+        let rows = convergence(
+            scene,
+            pair,
+            &scene.plan(Study::Convergence, pair, full).sizes,
+        )?;
+        let column = |f: fn(&Row) -> Option<f64>| rows.iter().map(|r| nan(f(r))).collect();
+        let l2: Vec<f64> = column(|r| r.error_l2);
+        let h1: Vec<f64> = column(|r| r.error_h1);
+        let lm: Vec<f64> = column(|r| r.error_multiplier);
+        let force: Vec<f64> = column(|r| r.force_error);
+        let (rl2, rh1, rlm) = (rates(&l2), rates(&h1), rates(&lm));
+        for (k, r) in rows.iter().enumerate() {
+            let rate = |v: &[f64]| {
+                k.checked_sub(1)
+                    .map_or("-".to_string(), |j| format!("{:.2}", v[j]))
+            };
+            println!(
+                "{:<10} {:>8} {:>9} {:>9} {} {:>6} {} {:>6} {} {:>6} {} {} {:>5} {:>8.3}",
+                r.pair,
+                r.size,
+                r.cells,
+                r.dofs,
+                cell(l2[k], 11),
+                rate(&rl2),
+                cell(h1[k], 11),
+                rate(&rh1),
+                cell(lm[k], 11),
+                if lm[k].is_nan() {
+                    "-".into()
+                } else {
+                    rate(&rlm)
+                },
+                cell(force[k], 11),
+                cell(nan(r.contact_error), 11),
+                r.iterations,
+                r.seconds
+            );
+            csv.push(vec![
+                index as f64,
+                r.size as f64,
+                r.h,
+                r.cells as f64,
+                r.dofs as f64,
+                l2[k],
+                h1[k],
+                lm[k],
+                force[k],
+                nan(r.contact_error),
+                r.iterations as f64,
+                r.seconds,
+            ]);
         }
-        charts.push((
-            format!("{name}: condition number of the LCP matrix B A⁻¹ Bᵀ + C against h"),
-            Axes {
-                x: "h",
-                y: "κ₂",
-                log_x: true,
-                log_y: true,
-            },
-            vec![
-                Series::marked("plain (α = 0)", plain_series),
-                Series::marked("stabilized", stabilized_series),
-            ],
-        ));
-    }
-    let elements = if full { 1024 } else { 256 };
-    let exact = exact_solution(&flat(), 100.0, 0.0).unwrap();
-    let variants: [(&str, Option<f64>); 3] = [
-        ("plain (α = 0)", None),
-        ("stabilized α = 1e-2", Some(1e-2)),
-        ("stabilized α = 1", Some(1.0)),
-    ];
-    println!("\nbernoulli-flat q = 100, {elements} elements: multiplier λ_h (exact: q = 100 inside, point forces at the edges)");
-    println!(
-        "{:<22} {:>16} {:>22}",
-        "method", "holes (λ_h = 0)", "max |λ_h − 100| inside"
-    );
-    let mut series = Vec::new();
-    for (label, alpha) in variants {
-        let p = multiplier_profile("bernoulli-flat", elements, alpha)?;
-        println!(
-            "{label:<22} {:>16} {:>22.4e}",
-            zero_holes(&p.lambda),
-            interior_oscillation(&p, exact.contact_set[0])
-        );
-        let half = 0.5 / p.lambda.len() as f64;
-        series.push(Series::line(
-            label,
-            p.cell_x
-                .iter()
-                .zip(&p.lambda)
-                .filter(|(x, _)| (**x - 0.5).abs() < 0.5 - exact.contact_set[0][0] + 0.03)
-                .flat_map(|(&x, &l)| [(x - half, l), (x + half, l)])
+        let against_h =
+            |v: &[f64]| -> Vec<(f64, f64)> { rows.iter().zip(v).map(|(r, &e)| (r.h, e)).collect() };
+        l2_series.push(Series::marked(format!("{pair} L²"), against_h(&l2)));
+        h1_series.push(Series::marked(format!("{pair} H¹"), against_h(&h1)));
+        if lm.iter().all(|e| e.is_finite()) {
+            multiplier_series.push(Series::marked(format!("{pair} λ"), against_h(&lm)));
+        }
+        if force.iter().all(|e| e.is_finite()) {
+            force_series.push(Series::marked(format!("{pair} ∫λ"), against_h(&force)));
+        }
+        work.push(Series::marked(
+            format!("{pair} H¹ against seconds"),
+            rows.iter()
+                .zip(&h1)
+                .map(|(r, &e)| (r.seconds.max(1e-5), e))
                 .collect(),
         ));
     }
-    charts.push((
-        format!("bernoulli-flat q = 100, {elements} elements: λ_h near the contact set (exact 100 inside)"),
-        Axes { x: "x", y: "λ_h", ..Axes::default() },
-        series,
+    let setting = scene.setting();
+    let mut panels = vec![
+        (
+            format!("{setting}: L² error of u"),
+            log_axes("h", "‖u − u_h‖_L2"),
+            l2_series,
+        ),
+        (
+            format!("{setting}: H¹ error of u"),
+            log_axes("h", "|u − u_h|_H1"),
+            h1_series,
+        ),
+    ];
+    if !multiplier_series.is_empty() {
+        panels.push((
+            format!("{setting}: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½"),
+            log_axes("h", "h-weighted error of λ"),
+            multiplier_series,
+        ));
+    }
+    if !force_series.is_empty() {
+        panels.push((
+            format!("{setting}: error of the total contact force"),
+            log_axes("h", "|∫λ_h − ∫λ|"),
+            force_series,
+        ));
+    }
+    panels.push((
+        format!("{setting}: work against precision (complete nested solve)"),
+        log_axes("seconds", "|u − u_h|_H1"),
+        work,
     ));
-    plot::stacked(&out.join("stability.svg"), &charts).map_err(io)?;
+    plot::stacked(&output(out, &name, Study::Convergence, "svg"), &panels).map_err(io)?;
     write_csv(
-        &out.join("stability.csv"),
-        "scene_index,elements,condition_plain,condition_stabilized",
+        &output(out, &name, Study::Convergence, "csv"),
+        "pair_index,size,h,cells,dofs,error_l2,error_h1,error_multiplier,force_error,contact_error,iterations,seconds",
         &csv,
     )
     .map_err(io)
 }
 
-/// Cells with λ = 0 between the first and the last cell with λ > 0 ("holes").
-pub fn zero_holes(lambda: &[f64]) -> usize {
-    let largest = lambda.iter().cloned().fold(0.0, f64::max);
-    let on: Vec<bool> = lambda.iter().map(|&l| l > 1e-8 * largest).collect();
+/// The stability measure of `pair` on each mesh of `sizes`.
+pub fn stability(
+    scene: &dyn StudyScene,
+    pair: &'static str,
+    sizes: &[usize],
+) -> Result<Vec<StabilityRow>> {
+    sizes.iter().map(|&n| scene.stability(pair, n)).collect()
+}
+
+/// The multiplier profile ([`StudyScene::multiplier_profile`]) of `pair` on the mesh of
+/// `size` with `alpha` (`None`: the default; `Some(0.0)`: the plain method).
+pub fn multiplier_profile(
+    scene: &dyn StudyScene,
+    pair: &'static str,
+    size: usize,
+    alpha: Option<f64>,
+) -> Result<Vec<(f64, f64)>> {
+    scene.multiplier_profile(&Run {
+        alpha,
+        ..Run::new(pair, size)
+    })
+}
+
+/// Cells with λ = 0 between the first and the last cell with λ > 0 ("holes") of a
+/// profile.
+pub fn zero_holes(profile: &[(f64, f64)]) -> usize {
+    let largest = profile.iter().map(|p| p.1).fold(0.0, f64::max);
+    let on: Vec<bool> = profile.iter().map(|&(_, l)| l > 1e-8 * largest).collect();
     match (on.iter().position(|&b| b), on.iter().rposition(|&b| b)) {
         (Some(first), Some(last)) => on[first..=last].iter().filter(|&&b| !b).count(),
         _ => 0,
     }
 }
 
-/// One α of the α sweep.
+/// Total variation of a profile's values (an oscillation measure).
+pub fn total_variation(profile: &[(f64, f64)]) -> f64 {
+    profile.windows(2).map(|w| (w[1].1 - w[0].1).abs()).sum()
+}
+
+/// Largest `|λ_h − λ|` over the middle half of the exact contact interval: the
+/// oscillation the stabilization damps.
+pub fn interior_oscillation(profile: &[(f64, f64)], exact: &ExactMultiplier) -> f64 {
+    let [a, b] = exact.contact;
+    let (lo, hi) = (a + 0.25 * (b - a), b - 0.25 * (b - a));
+    profile
+        .iter()
+        .filter(|(x, _)| *x >= lo && *x <= hi)
+        .map(|&(x, l)| (l - (exact.lambda)(x)).abs())
+        .fold(0.0, f64::max)
+}
+
+fn variant_label(alpha: Option<f64>) -> String {
+    match alpha {
+        Some(0.0) => "plain (α = 0)".into(),
+        Some(a) if a >= 0.1 => format!("stabilized α = {a}"),
+        Some(a) => format!("stabilized α = {a:.0e}"),
+        None => "stabilized, default α".into(),
+    }
+}
+
+fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
+    let name = scene.name();
+    let measure = scene.measure();
+    println!("{}: {}", scene.setting(), measure.title);
+    let mut header = format!("{:<16} {:>8} {:>9}", "pair", scene.size_name(), "α");
+    for side in ["plain", "stab."] {
+        for label in measure.labels {
+            header += &format!(" {:>14}", format!("{side} {label}"));
+        }
+    }
+    println!("{header}");
+    let mut csv = Vec::new();
+    let mut series = Vec::new();
+    for (index, &pair) in scene.stability_pairs().iter().enumerate() {
+        let rows = stability(scene, pair, &scene.plan(Study::Stability, pair, full).sizes)?;
+        for r in &rows {
+            let mut line = format!("{:<16} {:>8} {:>9.2e}", r.pair, r.size, r.alpha);
+            for v in r.plain.iter().chain(&r.stabilized) {
+                line += &format!(" {v:>14.4e}");
+            }
+            println!("{line}");
+            let mut values = vec![index as f64, r.size as f64, r.alpha];
+            values.extend(r.plain.iter().chain(&r.stabilized));
+            csv.push(values);
+        }
+        let h = |r: &StabilityRow| scene.h(r.size);
+        for (k, label) in measure.labels.iter().enumerate() {
+            series.push(Series::marked(
+                format!("{pair} plain {label}"),
+                rows.iter()
+                    .map(|r| (h(r), (measure.plotted)(r.plain[k])))
+                    .collect(),
+            ));
+        }
+        series.push(Series::marked(
+            format!("{pair} stabilized {}", measure.labels[0]),
+            rows.iter()
+                .map(|r| (h(r), (measure.plotted)(r.stabilized[0])))
+                .collect(),
+        ));
+    }
+    let profile = scene.profiles(full);
+    let (pair, n) = (profile.pair, profile.sizes[0]);
+    let exact = scene.exact_multiplier();
+    println!(
+        "\n{}, {pair}, {} = {n}: multiplier λ_h along a line through the contact set",
+        scene.setting(),
+        scene.size_name()
+    );
+    println!(
+        "{:<24} {:>16} {:>16} {:>22}",
+        "method", "holes (λ_h = 0)", "total variation", "max |λ_h − λ| inside"
+    );
+    let [lo, hi] = scene.profile_window();
+    let window = |p: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        p.iter()
+            .copied()
+            .filter(|(x, _)| (lo..=hi).contains(x))
+            .collect()
+    };
+    let mut profiles = Vec::new();
+    for alpha in profile.alphas {
+        let p = multiplier_profile(scene, pair, n, alpha)?;
+        let label = variant_label(alpha);
+        println!(
+            "{label:<24} {:>16} {:>16.4e} {:>22}",
+            zero_holes(&p),
+            total_variation(&window(&p)),
+            exact.as_ref().map_or("-".into(), |e| format!(
+                "{:.4e}",
+                interior_oscillation(&p, e)
+            ))
+        );
+        profiles.push(Series::marked(label, window(&p)));
+    }
+    if let Some(e) = &exact {
+        let samples: Vec<(f64, f64)> = (0..=400)
+            .map(|i| {
+                let x = lo + (hi - lo) * i as f64 / 400.0;
+                (x, (e.lambda)(x))
+            })
+            .collect();
+        println!(
+            "{:<24} {:>16} {:>16.4e}",
+            "exact",
+            "",
+            total_variation(&samples)
+        );
+        profiles.push(Series::line("exact λ", samples));
+    }
+    plot::stacked(
+        &output(out, &name, Study::Stability, "svg"),
+        &[
+            (
+                format!("{name}: {}", measure.title),
+                log_axes("h", measure.axis),
+                series,
+            ),
+            (
+                format!(
+                    "{name}, {pair}, {} = {n}: λ_h; plain (α = 0) oscillates, stabilized does not",
+                    scene.size_name()
+                ),
+                Axes {
+                    x: "x",
+                    y: "λ_h",
+                    ..Axes::default()
+                },
+                profiles,
+            ),
+        ],
+    )
+    .map_err(io)?;
+    let mut header = "pair_index,size,alpha".to_string();
+    for side in ["plain", "stabilized"] {
+        for k in 1..=measure.labels.len() {
+            header += &format!(",{side}_{k}");
+        }
+    }
+    write_csv(&output(out, &name, Study::Stability, "csv"), &header, &csv).map_err(io)
+}
+
+/// One α of the α sweep: the solve's row, or why it failed.
 #[derive(Clone, Debug)]
 pub struct AlphaRow {
     /// α.
     pub alpha: f64,
-    /// `‖w − w_h‖_L2`.
-    pub error_l2: f64,
-    /// Left edge of the computed contact set.
-    pub contact_start: f64,
-    /// `∫λ_h`.
-    pub total_contact_force: f64,
+    /// The row, or the failure (a result of the study: where the method breaks down).
+    pub result: std::result::Result<Row, String>,
 }
 
-/// `bernoulli-flat` at q = 100 for each α.
-pub fn alpha_sweep(elements: usize, alphas: &[f64]) -> Result<Vec<AlphaRow>> {
-    alphas
+/// `pair` on the mesh of `size` for every α in `alphas`; also returns the mesh's `C_I`.
+pub fn alpha_sweep(
+    scene: &dyn StudyScene,
+    pair: &'static str,
+    size: usize,
+    alphas: &[f64],
+) -> Result<(Vec<AlphaRow>, f64)> {
+    let c_i = scene.inverse_constant(pair, size)?;
+    let rows = alphas
         .iter()
-        .map(|&alpha| {
-            let mut r = request(flat(), elements, 100.0);
-            r.alpha = Some(alpha);
-            let (report, _) = beams::solve(&r)?;
-            Ok(AlphaRow {
-                alpha,
-                error_l2: report.error_l2.unwrap_or(f64::NAN),
-                contact_start: report.contact_set.first().map_or(f64::NAN, |c| c[0]),
-                total_contact_force: report.total_contact_force,
-            })
+        .map(|&alpha| AlphaRow {
+            alpha,
+            result: scene
+                .solve(&Run {
+                    alpha: Some(alpha),
+                    ..Run::new(pair, size)
+                })
+                .map_err(|e| e.to_string()),
         })
-        .collect()
+        .collect();
+    Ok((rows, c_i))
 }
 
-fn run_alpha(full: bool, out: &Path) -> Result<()> {
-    let elements = if full { 1024 } else { 128 };
-    let alphas: Vec<f64> = (-8..=8).map(|k| 10f64.powi(k)).collect();
-    let rows = alpha_sweep(elements, &alphas)?;
-    let exact = exact_solution(&flat(), 100.0, 0.0).unwrap();
+fn run_alpha(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
+    let name = scene.name();
+    let plan = scene.plan(Study::Alpha, scene.pairs()[0], full);
+    let (pair, n) = (plan.pair, plan.sizes[0]);
+    let alphas: Vec<f64> = plan.alphas.iter().map(|a| a.unwrap_or(0.0)).collect();
+    let (rows, c_i) = alpha_sweep(scene, pair, n, &alphas)?;
+    let [contact, _] = scene.contact_names();
     println!(
-        "\nα sweep: bernoulli-flat q = 100, {elements} elements (C_I = 0 for Hermite–P0: every α > 0 is stable; α ≤ 1e-2 is accurate)"
+        "{}, {pair}, {} = {n}: errors against α ({})",
+        scene.setting(),
+        scene.size_name(),
+        if c_i > 0.0 {
+            format!(
+                "C_I = {c_i:.1}, 1/C_I = {:.3e}, default ½/C_I = {:.3e}",
+                1.0 / c_i,
+                0.5 / c_i
+            )
+        } else {
+            "C_I = 0: every α > 0 is stable, a small one is accurate".into()
+        }
     );
     println!(
-        "{:>8} {:>12} {:>14} {:>10}",
-        "α", "L2 error", "contact start", "∫λ_h"
+        "{:>10} {:>7} {:>11} {:>11} {:>11} {:>11} {:>14} {:>10}  note",
+        "α", "α·C_I", "L2", "H1", "λ error", "|∫λ_h − ∫λ|", contact, "∫λ_h"
     );
-    for r in &rows {
-        println!(
-            "{:>8.0e} {:>12.4e} {:>14.6} {:>10.4}",
-            r.alpha, r.error_l2, r.contact_start, r.total_contact_force
-        );
+    let mut csv = Vec::new();
+    let mut errors = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+    let mut contacts = Vec::new();
+    for row in &rows {
+        match &row.result {
+            Ok(r) => {
+                let values = [r.error_l2, r.error_h1, r.error_multiplier, r.force_error].map(nan);
+                let note = r.warnings.join("; ");
+                println!(
+                    "{:>10.3e} {:>7.3} {} {} {} {} {:>14.6} {:>10.4}  {}{}",
+                    row.alpha,
+                    row.alpha * c_i,
+                    cell(values[0], 11),
+                    cell(values[1], 11),
+                    cell(values[2], 11),
+                    cell(values[3], 11),
+                    r.contact,
+                    r.total_contact_force,
+                    note.chars().take(90).collect::<String>(),
+                    if note.chars().count() > 90 { "…" } else { "" }
+                );
+                let mut line = vec![row.alpha, row.alpha * c_i];
+                line.extend(values);
+                line.extend([r.contact, r.total_contact_force, 1.0]);
+                csv.push(line);
+                if row.alpha > 0.0 {
+                    for (series, v) in errors.iter_mut().zip(values) {
+                        if v.is_finite() {
+                            series.push((row.alpha, v));
+                        }
+                    }
+                    contacts.push((row.alpha, r.contact));
+                }
+            }
+            Err(e) => {
+                println!(
+                    "{:>10.3e} {:>7.3} {:>11} {:>11} {:>11} {:>11} {:>14} {:>10}  failed: {}",
+                    row.alpha,
+                    row.alpha * c_i,
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    e.chars().take(90).collect::<String>()
+                );
+                let mut line = vec![row.alpha, row.alpha * c_i];
+                line.extend([f64::NAN; 6]);
+                line.push(0.0);
+                csv.push(line);
+            }
+        }
     }
-    println!(
-        "exact contact start {:.6}, ∫λ = {:.4}",
-        exact.contact_set[0][0], exact.total_contact_force
+    let exact_contact = scene.exact_contact();
+    if let Some(c) = exact_contact {
+        println!("exact {contact} {c:.6}");
+    }
+    let finite = errors.iter().flatten().map(|p| p.1);
+    let (low, high) = finite.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    let marker = |a: f64| vec![(a, low.max(1e-12)), (a, high)];
+    let labels = [
+        "‖u − u_h‖_L2",
+        "|u − u_h|_H1",
+        "h-weighted ‖λ − λ_h‖",
+        "|∫λ_h − ∫λ|",
+    ];
+    let mut series: Vec<Series> = labels
+        .iter()
+        .zip(errors)
+        .filter(|(_, points)| !points.is_empty())
+        .map(|(label, points)| Series::marked(*label, points))
+        .collect();
+    if c_i > 0.0 {
+        series.push(Series::line(
+            format!("1/C_I = {:.2e}", 1.0 / c_i),
+            marker(1.0 / c_i),
+        ));
+        series.push(Series::line(
+            format!("default ½/C_I = {:.2e}", 0.5 / c_i),
+            marker(0.5 / c_i),
+        ));
+    }
+    let failed: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.result.is_err() && r.alpha > 0.0)
+        .map(|r| (r.alpha, high))
+        .collect();
+    if !failed.is_empty() {
+        series.push(Series::marked("failed (drawn at the top)", failed));
+    }
+    let (first, last) = (
+        alphas
+            .iter()
+            .copied()
+            .filter(|a| *a > 0.0)
+            .fold(f64::MAX, f64::min),
+        alphas.iter().copied().fold(0.0, f64::max),
     );
+    let mut contact_series = vec![Series::marked("computed", contacts)];
+    if let Some(c) = exact_contact {
+        contact_series.push(Series::line("exact", vec![(first, c), (last, c)]));
+    }
     plot::stacked(
-        &out.join("alpha.svg"),
+        &output(out, &name, Study::Alpha, "svg"),
         &[
             (
-                format!("bernoulli-flat q = 100, {elements} elements: L2 error against α (1/C_I = ∞ for Hermite–P0)"),
-                Axes { x: "α", y: "‖w − w_h‖_L2", log_x: true, log_y: true },
-                vec![Series::marked("stabilized Hermite–P0", rows.iter().map(|r| (r.alpha, r.error_l2)).collect())],
+                format!(
+                    "{}, {pair}, {} = {n}: errors against α{}",
+                    scene.setting(),
+                    scene.size_name(),
+                    if c_i > 0.0 {
+                        " (breaks down at α ≥ 1/C_I)"
+                    } else {
+                        " (1/C_I = ∞)"
+                    }
+                ),
+                log_axes("α", "error"),
+                series,
             ),
             (
-                "contact start against α: a too large α shifts the contact set".into(),
-                Axes { x: "α", y: "contact start", log_x: true, log_y: false },
-                vec![
-                    Series::marked("computed", rows.iter().map(|r| (r.alpha, r.contact_start)).collect()),
-                    Series::line(
-                        "exact",
-                        vec![(alphas[0], exact.contact_set[0][0]), (alphas[alphas.len() - 1], exact.contact_set[0][0])],
-                    ),
-                ],
+                format!("{contact} against α (an overlarge α shifts the contact set)"),
+                Axes {
+                    x: "α",
+                    y: contact,
+                    log_x: true,
+                    log_y: false,
+                },
+                contact_series,
             ),
         ],
     )
     .map_err(io)?;
     write_csv(
-        &out.join("alpha.csv"),
-        "alpha,error_l2,contact_start,total_contact_force",
-        &rows
-            .iter()
-            .map(|r| vec![r.alpha, r.error_l2, r.contact_start, r.total_contact_force])
-            .collect::<Vec<_>>(),
-    )
-    .map_err(io)
-}
-
-/// One solve of the work–precision study.
-#[derive(Clone, Debug)]
-pub struct WorkRow {
-    /// "pdas nested", "pdas cold", "clarabel".
-    pub method: &'static str,
-    /// Elements.
-    pub elements: usize,
-    /// Seconds.
-    pub seconds: f64,
-    /// `‖w − w_h‖_L2`.
-    pub error_l2: f64,
-    /// Iterations on the final mesh.
-    pub iterations: usize,
-    /// Why the solve failed, if it did.
-    pub failure: Option<String>,
-}
-
-/// `bernoulli-flat` at q = 100 with each solver on each mesh (cold starts up to `cold_max`).
-pub fn work_precision(meshes: &[usize], cold_max: usize) -> Result<Vec<WorkRow>> {
-    let mut rows = Vec::new();
-    for &n in meshes {
-        let methods: [(&'static str, VariationalSolver, Option<usize>); 3] = [
-            ("pdas nested", VariationalSolver::SemismoothNewton, Some(16)),
-            ("pdas cold", VariationalSolver::SemismoothNewton, None),
-            ("clarabel", VariationalSolver::Clarabel, None),
-        ];
-        for (method, solver, nested) in methods {
-            if nested.is_none() && solver == VariationalSolver::SemismoothNewton && n > cold_max {
-                continue;
-            }
-            let mut r = request(flat(), n, 100.0);
-            r.solver = solver;
-            r.nested_from = nested;
-            // A failure is a result of the study (where a method breaks down), not an abort.
-            match beams::solve(&r) {
-                Ok((report, _)) => rows.push(WorkRow {
-                    method,
-                    elements: n,
-                    seconds: report.seconds,
-                    error_l2: report.error_l2.unwrap_or(f64::NAN),
-                    iterations: report.iterations,
-                    failure: None,
-                }),
-                Err(e) => rows.push(WorkRow {
-                    method,
-                    elements: n,
-                    seconds: f64::NAN,
-                    error_l2: f64::NAN,
-                    iterations: 0,
-                    failure: Some(e.to_string()),
-                }),
-            }
-        }
-    }
-    Ok(rows)
-}
-
-fn run_work_precision(full: bool, out: &Path) -> Result<()> {
-    let meshes: Vec<usize> = (5..=if full { 15 } else { 12 }).map(|k| 1 << k).collect();
-    let rows = work_precision(&meshes, if full { 8192 } else { 2048 })?;
-    println!("\nwork–precision: bernoulli-flat q = 100");
-    println!(
-        "{:<12} {:>8} {:>10} {:>12} {:>6}",
-        "method", "elements", "seconds", "L2 error", "iter"
-    );
-    for r in &rows {
-        match &r.failure {
-            None => println!(
-                "{:<12} {:>8} {:>10.4} {:>12.4e} {:>6}",
-                r.method, r.elements, r.seconds, r.error_l2, r.iterations
-            ),
-            Some(e) => println!("{:<12} {:>8}  failed: {e}", r.method, r.elements),
-        }
-    }
-    let series: Vec<Series> = ["pdas nested", "pdas cold", "clarabel"]
-        .iter()
-        .map(|m| {
-            Series::marked(
-                *m,
-                rows.iter()
-                    .filter(|r| r.method == *m)
-                    .map(|r| (r.seconds, r.error_l2))
-                    .collect(),
-            )
-        })
-        .collect();
-    plot::chart(
-        &out.join("work-precision.svg"),
-        "bernoulli-flat q = 100: L2 error against solve time",
-        Axes {
-            x: "seconds",
-            y: "‖w − w_h‖_L2",
-            log_x: true,
-            log_y: true,
-        },
-        &series,
-    )
-    .map_err(io)?;
-    write_csv(
-        &out.join("work-precision.csv"),
-        "method_index,elements,seconds,error_l2,iterations",
-        &rows
-            .iter()
-            .map(|r| {
-                let m = ["pdas nested", "pdas cold", "clarabel"]
-                    .iter()
-                    .position(|m| *m == r.method)
-                    .unwrap();
-                vec![
-                    m as f64,
-                    r.elements as f64,
-                    r.seconds,
-                    r.error_l2,
-                    r.iterations as f64,
-                ]
-            })
-            .collect::<Vec<_>>(),
-    )
-    .map_err(io)
-}
-
-/// Newton iterations of a scene at q = 100: `(elements, nested final-level iterations,
-/// cold-start iterations where run)`.
-/// `(elements, nested iterations, cold-start iterations)`; `None` where not run or failed.
-pub type IterationRow = (usize, Option<usize>, Option<usize>);
-
-/// A failed solve is recorded as `None`: the study shows where the method breaks down.
-pub fn iteration_counts(
-    scene_name: &str,
-    meshes: &[usize],
-    cold_max: usize,
-) -> Result<Vec<IterationRow>> {
-    let s = scene(scene_name).ok_or_else(|| Error::Input(format!("no scene {scene_name}")))?;
-    Ok(meshes
-        .iter()
-        .map(|&n| {
-            let nested = beams::solve(&request(s, n, 100.0))
-                .ok()
-                .map(|r| r.0.iterations);
-            let cold = (n <= cold_max)
-                .then(|| {
-                    let mut r = request(s, n, 100.0);
-                    r.nested_from = None;
-                    beams::solve(&r).ok().map(|r| r.0.iterations)
-                })
-                .flatten();
-            (n, nested, cold)
-        })
-        .collect())
-}
-
-fn run_iterations(full: bool, out: &Path) -> Result<()> {
-    let meshes: Vec<usize> = (5..=if full { 17 } else { 15 }).map(|k| 1 << k).collect();
-    let cold_max = if full { 8192 } else { 2048 };
-    println!("\niterations: semismooth Newton at q = 100, nested iteration from 16 elements (cold start beside)");
-    println!(
-        "{:<15} {:>8} {:>8} {:>6}",
-        "scene", "elements", "nested", "cold"
-    );
-    let mut charts = Vec::new();
-    let mut csv = Vec::new();
-    for (k, name) in ["bernoulli-flat", "timoshenko-a"].iter().enumerate() {
-        let rows = iteration_counts(name, &meshes, cold_max)?;
-        for &(n, nested, cold) in &rows {
-            let show = |v: Option<usize>| v.map_or("-".to_string(), |c| c.to_string());
-            println!("{name:<15} {n:>8} {:>8} {:>6}", show(nested), show(cold));
-            csv.push(vec![
-                k as f64,
-                n as f64,
-                nested.map_or(f64::NAN, |c| c as f64),
-                cold.map_or(f64::NAN, |c| c as f64),
-            ]);
-        }
-        println!("  ('-' in nested: the solve failed; Hermite bending matrices have κ ~ h⁻⁴, past 1/ε near 10⁴ elements)");
-        charts.push((
-            format!("{name} q = 100: Newton iterations on the final mesh"),
-            Axes {
-                x: "elements",
-                y: "iterations",
-                log_x: true,
-                log_y: true,
-            },
-            vec![
-                Series::marked(
-                    "nested",
-                    rows.iter()
-                        .filter_map(|r| r.1.map(|c| (r.0 as f64, c.max(1) as f64)))
-                        .collect(),
-                ),
-                Series::marked(
-                    "cold start",
-                    rows.iter()
-                        .filter_map(|r| r.2.map(|c| (r.0 as f64, c.max(1) as f64)))
-                        .collect(),
-                ),
-            ],
-        ));
-    }
-    plot::stacked(&out.join("iterations.svg"), &charts).map_err(io)?;
-    write_csv(
-        &out.join("iterations.csv"),
-        "scene_index,elements,nested,cold",
+        &output(out, &name, Study::Alpha, "csv"),
+        "alpha,alpha_times_CI,error_l2,error_h1,error_multiplier,force_error,contact,total_contact_force,solved",
         &csv,
     )
     .map_err(io)
 }
 
-/// Runs a study, prints its table, writes its chart and CSV.
-pub fn run(study: Study, full: bool, out: &Path) -> Result<()> {
+/// The solvers of the work–precision study: name, solver, nested iteration.
+pub const METHODS: [(&str, VariationalSolver, bool); 3] = [
+    ("pdas nested", VariationalSolver::SemismoothNewton, true),
+    ("pdas cold", VariationalSolver::SemismoothNewton, false),
+    ("clarabel", VariationalSolver::Clarabel, false),
+];
+
+/// One solve of the work–precision study.
+#[derive(Clone, Debug)]
+pub struct WorkRow {
+    /// Index into [`METHODS`].
+    pub method: usize,
+    /// Mesh size.
+    pub size: usize,
+    /// The row, or why the solve failed.
+    pub result: std::result::Result<Row, String>,
+}
+
+/// `pair` with each of [`METHODS`] on each mesh (cold starts up to `cold_max`).
+pub fn work_precision(
+    scene: &dyn StudyScene,
+    pair: &'static str,
+    sizes: &[usize],
+    cold_max: usize,
+) -> Vec<WorkRow> {
+    let mut rows = Vec::new();
+    for &n in sizes {
+        for (method, &(_, solver, nested)) in METHODS.iter().enumerate() {
+            if !nested && solver == VariationalSolver::SemismoothNewton && n > cold_max {
+                continue;
+            }
+            let run = Run {
+                solver,
+                nested,
+                ..Run::new(pair, n)
+            };
+            rows.push(WorkRow {
+                method,
+                size: n,
+                result: scene.solve(&run).map_err(|e| e.to_string()),
+            });
+        }
+    }
+    rows
+}
+
+fn run_work_precision(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
+    let name = scene.name();
+    let plan = scene.plan(Study::WorkPrecision, scene.pairs()[0], full);
+    let rows = work_precision(scene, plan.pair, &plan.sizes, plan.cold_max);
+    println!(
+        "{}, {}: error against solve time",
+        scene.setting(),
+        plan.pair
+    );
+    println!(
+        "{:<12} {:>8} {:>10} {:>12} {:>12} {:>6}",
+        "method",
+        scene.size_name(),
+        "seconds",
+        "L2 error",
+        "H1 error",
+        "iter"
+    );
+    let mut csv = Vec::new();
+    for w in &rows {
+        let method = METHODS[w.method].0;
+        match &w.result {
+            Ok(r) => {
+                println!(
+                    "{:<12} {:>8} {:>10.4} {:>12.4e} {:>12.4e} {:>6}",
+                    method,
+                    w.size,
+                    r.seconds,
+                    nan(r.error_l2),
+                    nan(r.error_h1),
+                    r.iterations
+                );
+                csv.push(vec![
+                    w.method as f64,
+                    w.size as f64,
+                    r.seconds,
+                    nan(r.error_l2),
+                    nan(r.error_h1),
+                    r.iterations as f64,
+                ]);
+            }
+            Err(e) => {
+                println!("{method:<12} {:>8}  failed: {e}", w.size);
+                csv.push(vec![
+                    w.method as f64,
+                    w.size as f64,
+                    f64::NAN,
+                    f64::NAN,
+                    f64::NAN,
+                    0.0,
+                ]);
+            }
+        }
+    }
+    let series: Vec<Series> = METHODS
+        .iter()
+        .enumerate()
+        .map(|(m, (method, _, _))| {
+            Series::marked(
+                *method,
+                rows.iter()
+                    .filter(|w| w.method == m)
+                    .filter_map(|w| w.result.as_ref().ok())
+                    .map(|r| (r.seconds, nan(r.error_l2)))
+                    .collect(),
+            )
+        })
+        .collect();
+    plot::chart(
+        &output(out, &name, Study::WorkPrecision, "svg"),
+        &format!(
+            "{}, {}: L2 error against solve time",
+            scene.setting(),
+            plan.pair
+        ),
+        log_axes("seconds", "‖u − u_h‖_L2"),
+        &series,
+    )
+    .map_err(io)?;
+    write_csv(
+        &output(out, &name, Study::WorkPrecision, "csv"),
+        "method_index,size,seconds,error_l2,error_h1,iterations",
+        &csv,
+    )
+    .map_err(io)
+}
+
+/// `(size, nested final-level iterations, cold-start iterations)`; `None` where not run
+/// or failed (a failure is a result of the study: where the method breaks down).
+pub type IterationRow = (usize, Option<usize>, Option<usize>);
+
+/// Newton iterations of `pair` on each mesh, nested and (up to `cold_max`) cold.
+pub fn iteration_counts(
+    scene: &dyn StudyScene,
+    pair: &'static str,
+    sizes: &[usize],
+    cold_max: usize,
+) -> Vec<IterationRow> {
+    sizes
+        .iter()
+        .map(|&n| {
+            let iterations = |nested: bool| {
+                scene
+                    .solve(&Run {
+                        nested,
+                        ..Run::new(pair, n)
+                    })
+                    .ok()
+                    .map(|r| r.iterations)
+            };
+            let nested = iterations(true);
+            let cold = (n <= cold_max).then(|| iterations(false)).flatten();
+            (n, nested, cold)
+        })
+        .collect()
+}
+
+fn run_iterations(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
+    let name = scene.name();
+    let plan = scene.plan(Study::Iterations, scene.pairs()[0], full);
+    println!(
+        "{}, {}: semismooth Newton iterations on the final mesh, nested iteration (cold start beside; '-': failed or not run)",
+        scene.setting(),
+        plan.pair
+    );
+    println!(
+        "{:<16} {:>8} {:>8} {:>6}",
+        "scene",
+        scene.size_name(),
+        "nested",
+        "cold"
+    );
+    let rows = iteration_counts(scene, plan.pair, &plan.sizes, plan.cold_max);
+    let show = |v: Option<usize>| v.map_or("-".to_string(), |c| c.to_string());
+    let count = |v: Option<usize>| v.map_or(f64::NAN, |c| c as f64);
+    for &(n, nested, cold) in &rows {
+        println!("{name:<16} {n:>8} {:>8} {:>6}", show(nested), show(cold));
+    }
+    let points = |pick: fn(&IterationRow) -> Option<usize>| -> Vec<(f64, f64)> {
+        rows.iter()
+            .filter_map(|r| pick(r).map(|c| (r.0 as f64, c.max(1) as f64)))
+            .collect()
+    };
+    plot::chart(
+        &output(out, &name, Study::Iterations, "svg"),
+        &format!(
+            "{}, {}: Newton iterations on the final mesh",
+            scene.setting(),
+            plan.pair
+        ),
+        log_axes(scene.size_name(), "iterations"),
+        &[
+            Series::marked("nested", points(|r| r.1)),
+            Series::marked("cold start", points(|r| r.2)),
+        ],
+    )
+    .map_err(io)?;
+    write_csv(
+        &output(out, &name, Study::Iterations, "csv"),
+        "size,nested,cold",
+        &rows
+            .iter()
+            .map(|&(n, nested, cold)| vec![n as f64, count(nested), count(cold)])
+            .collect::<Vec<_>>(),
+    )
+    .map_err(io)
+}
+
+/// Runs `study` on `scene`, prints its table, writes `out/<scene>-<study>.svg` and `.csv`.
+pub fn run(scene: &dyn StudyScene, study: Study, full: bool, out: &Path) -> Result<()> {
     match study {
-        Study::Convergence => run_convergence(full, out),
-        Study::Locking => run_locking(full, out),
-        Study::Stability => run_stability(full, out),
-        Study::Alpha => run_alpha(full, out),
-        Study::WorkPrecision => run_work_precision(full, out),
-        Study::Iterations => run_iterations(full, out),
+        Study::Convergence => run_convergence(scene, full, out),
+        Study::Locking => scene.locking(full, out),
+        Study::Stability => run_stability(scene, full, out),
+        Study::Alpha => run_alpha(scene, full, out),
+        Study::WorkPrecision => run_work_precision(scene, full, out),
+        Study::Iterations => run_iterations(scene, full, out),
     }?;
-    println!("→ {}/{}.svg, .csv", out.display(), study.name());
+    println!(
+        "→ {}, .csv\n",
+        output(out, &scene.name(), study, "svg").display()
+    );
     Ok(())
 }

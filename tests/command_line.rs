@@ -135,7 +135,7 @@ fn the_stability_study_writes_its_chart_and_table() {
         String::from_utf8_lossy(&run.stderr)
     );
     let csv = std::fs::read_to_string(out.join("membrane-radial-stability.csv")).unwrap();
-    assert!(csv.starts_with("pair_is_p2,N,alpha"));
+    assert!(csv.starts_with("pair_index,size,alpha"));
     assert!(csv.lines().count() > 6);
     let svg = std::fs::read_to_string(out.join("membrane-radial-stability.svg")).unwrap();
     assert!(svg.contains("<svg"));

@@ -258,8 +258,11 @@ fn bad_input_is_a_clear_error() {
 /// norm), the stabilized ones have γ ≥ α.
 #[test]
 fn plain_pairs_have_a_multiplier_kernel_and_stabilized_ones_do_not() {
-    use fem_forms::membrane_studies::stability;
-    let rows = stability(&[4, 8]).unwrap();
+    use fem_forms::membrane_studies::MembraneStudies;
+    use fem_forms::studies::stability;
+    let scene = MembraneStudies::new(radial());
+    let mut rows = stability(&scene, "p1-p0", &[4, 8]).unwrap();
+    rows.extend(stability(&scene, "p2-p0", &[4, 8]).unwrap());
     for r in &rows {
         let scale = r.stabilized[1];
         assert!(r.plain[0].abs() < 1e-10 * scale, "{r:?}");
@@ -280,9 +283,11 @@ fn plain_pairs_have_a_multiplier_kernel_and_stabilized_ones_do_not() {
 /// stabilized one follows the exact λ.
 #[test]
 fn stabilization_removes_the_multiplier_oscillation() {
-    use fem_forms::membrane_studies::{multiplier_profile, total_variation};
-    let plain = multiplier_profile(MembranePair::P2P0, 32, Some(0.0)).unwrap();
-    let stabilized = multiplier_profile(MembranePair::P2P0, 32, None).unwrap();
+    use fem_forms::membrane_studies::MembraneStudies;
+    use fem_forms::studies::{multiplier_profile, total_variation};
+    let scene = MembraneStudies::new(radial());
+    let plain = multiplier_profile(&scene, "p2-p0", 32, Some(0.0)).unwrap();
+    let stabilized = multiplier_profile(&scene, "p2-p0", 32, None).unwrap();
     let exact: Vec<(f64, f64)> = (0..=400)
         .map(|i| {
             let x = -2.0 + 4.0 * i as f64 / 400.0;
@@ -309,14 +314,49 @@ fn stabilization_removes_the_multiplier_oscillation() {
 /// fails with the reason.
 #[test]
 fn the_alpha_sweep_shows_the_breakdown_at_one_over_ci() {
-    use fem_forms::membrane_studies::alpha_sweep;
-    let (rows, c_i) = alpha_sweep(8, &[1e-4, 0.5 / 96.0, 0.9 / 96.0, 2.0 / 96.0]).unwrap();
+    use fem_forms::membrane_studies::MembraneStudies;
+    use fem_forms::studies::alpha_sweep;
+    let scene = MembraneStudies::new(radial());
+    let (rows, c_i) = alpha_sweep(
+        &scene,
+        "p2-p0",
+        8,
+        &[1e-4, 0.5 / 96.0, 0.9 / 96.0, 2.0 / 96.0],
+    )
+    .unwrap();
     assert!((c_i - 96.0).abs() < 1e-8);
     for row in &rows[..3] {
         assert!(row.result.is_ok(), "α = {}: {:?}", row.alpha, row.result);
     }
     let error = rows[3].result.as_ref().err().unwrap();
     assert!(error.contains("outside the stability range"), "{error}");
+}
+
+/// The generic work–precision study on a membrane scene (before, a beam-only study): the
+/// three solvers of each mesh solve one discrete problem, so they must agree (PDAS and
+/// clarabel's interior point are independent), and the error against the exact solution
+/// falls at P2's rate for the radial obstacle problem (about h², u ∈ H^{5/2−ε}).
+#[test]
+fn the_work_precision_study_runs_on_a_membrane_scene() {
+    use fem_forms::membrane_studies::MembraneStudies;
+    use fem_forms::studies::{work_precision, METHODS};
+    let scene = MembraneStudies::new(radial());
+    let rows = work_precision(&scene, "p2-p0", &[8, 16, 32], usize::MAX);
+    assert_eq!(rows.len(), 3 * METHODS.len(), "every method on every mesh");
+    let mut nested = Vec::new();
+    for n in [8, 16, 32] {
+        let errors: Vec<f64> = rows
+            .iter()
+            .filter(|w| w.size == n)
+            .map(|w| w.result.as_ref().unwrap().error_l2.unwrap())
+            .collect();
+        for e in &errors[1..] {
+            assert!((e / errors[0] - 1.0).abs() < 1e-5, "N = {n}: {errors:?}");
+        }
+        nested.push(errors[0]);
+    }
+    let observed = rates(&nested);
+    assert!(observed.iter().all(|&r| r > 1.8), "L2 rates {observed:?}");
 }
 
 /// The Richardson estimate that picks a scene's mesh agrees with the exact error.

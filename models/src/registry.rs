@@ -128,7 +128,7 @@ fn membrane_entry(
     }
 }
 
-/// The studies each built-in beam scene hosts (the beam studies are written for them).
+/// The studies each built-in beam scene hosts.
 fn beam_studies(name: &str) -> &'static [&'static str] {
     match name {
         "bernoulli-flat" => &[
@@ -138,7 +138,7 @@ fn beam_studies(name: &str) -> &'static [&'static str] {
             "work-precision",
             "iterations",
         ],
-        "timoshenko-a" => &["locking", "iterations"],
+        "timoshenko-a" => &["locking", "stability", "iterations"],
         _ => &[],
     }
 }
@@ -150,10 +150,17 @@ pub fn registry() -> Vec<SceneEntry> {
         .map(|&s| beam_entry(s, beam_studies(s.name)))
         .collect();
     for s in MEMBRANE_SCENES {
-        let studies: &'static [&'static str] = if s.name == "membrane-radial" {
-            &["convergence", "stability", "alpha"]
-        } else {
-            &[]
+        // work–precision needs the exact error; iterations need no exact solution
+        let studies: &'static [&'static str] = match s.name.as_ref() {
+            "membrane-radial" => &[
+                "convergence",
+                "stability",
+                "alpha",
+                "work-precision",
+                "iterations",
+            ],
+            "membrane-lshape" => &["iterations"],
+            _ => &[],
         };
         entries.push(membrane_entry(s, studies, true));
     }
