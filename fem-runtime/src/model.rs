@@ -117,6 +117,11 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     const FORMS: &'static [FormInfo];
     /// Dirichlet conditions `(field, data function)` declared under `boundary:`.
     const DIRICHLET: &'static [(usize, usize)] = &[];
+    /// The discrete obstacle system `[B_h, L_h]` as indices in `FORMS`: the bilinear form
+    /// named `B_h` and the linear form named `L_h`, the names the form language gives the
+    /// stabilized system (docs/mathematics.md §1); `None` for a model without them.
+    /// Found at compile time, so the solvers need no name at run time.
+    const SYSTEM: Option<[usize; 2]> = system_forms(Self::FORMS);
 
     /// Element matrix of `block` of bilinear `form`, row-major into `out`.
     fn element_matrix(
@@ -184,6 +189,61 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// [`Error::UnknownName`] for a name the model does not declare.
     fn data_function(data: impl IntoDataIndex<Self>) -> Result<usize> {
         data.data_index()
+    }
+}
+
+/// The indices of the bilinear form `B_h` and the linear form `L_h` in `forms`
+/// ([`Model::SYSTEM`]).
+///
+/// ```
+/// use fem_runtime::Model;
+/// fem_runtime::model! {
+///     pub mod string on interval {
+///         unknowns: u: P1, λ: P0 >= 0;
+///         tests: v, μ;
+///         forms: "
+///             L_h(v, μ) = ∫ v
+///             B_h(u,λ;v,μ) = ∫ u'v' − λ v − u μ
+///             a(u;v) = ∫ u'v'
+///         ";
+///     }
+/// }
+/// assert_eq!(string::Model::SYSTEM, Some([1, 0]));
+/// fem_runtime::model! {
+///     pub mod plain on interval { unknowns: u: P1; tests: v; forms: "B_h(v) = ∫ v"; }
+/// }
+/// // a linear form named B_h is not the system's bilinear form
+/// assert_eq!(plain::Model::SYSTEM, None);
+/// ```
+pub const fn system_forms(forms: &[FormInfo]) -> Option<[usize; 2]> {
+    const fn same(a: &str, b: &str) -> bool {
+        let (a, b) = (a.as_bytes(), b.as_bytes());
+        if a.len() != b.len() {
+            return false;
+        }
+        let mut i = 0;
+        while i < a.len() {
+            if a[i] != b[i] {
+                return false;
+            }
+            i += 1;
+        }
+        true
+    }
+    let (mut bilinear, mut linear) = (None, None);
+    let mut i = 0;
+    while i < forms.len() {
+        if forms[i].arity == 2 && same(forms[i].name, "B_h") {
+            bilinear = Some(i);
+        }
+        if forms[i].arity == 1 && same(forms[i].name, "L_h") {
+            linear = Some(i);
+        }
+        i += 1;
+    }
+    match (bilinear, linear) {
+        (Some(b), Some(l)) => Some([b, l]),
+        _ => None,
     }
 }
 
