@@ -22,6 +22,56 @@ pub enum Pair {
     BernoulliHermite,
 }
 
+/// A pair as data: its name, the beam theory it discretizes, its default α and the
+/// entry points of its model (the solver and the discretization, instantiated for the
+/// model's type). Adding a pair is one row here and its variant of [`Pair`].
+struct PairRow {
+    pair: Pair,
+    name: &'static str,
+    beam: Beam,
+    /// docs/mathematics.md: α ≈ 1 for Timoshenko, ≤ 1e-2 for Euler–Bernoulli so that the
+    /// obstacle shift α h⁴|f| stays negligible.
+    default_alpha: f64,
+    run: fn(&Request, Pair) -> Result<(Report, Profiles)>,
+    discretize: fn(&Request, Pair) -> Result<Discretization>,
+}
+
+/// Every pair, in the order of [`Pair::ALL`]; the first of each beam theory is its default.
+const PAIRS: [PairRow; 4] = [
+    PairRow {
+        pair: Pair::TimoshenkoP2,
+        name: "p2-p2-p0",
+        beam: Beam::Timoshenko,
+        default_alpha: 1.0,
+        run: run::<timoshenko_p2::Model>,
+        discretize: discretize_with::<timoshenko_p2::Model>,
+    },
+    PairRow {
+        pair: Pair::TimoshenkoP1Reduced,
+        name: "p1-p1-p0-reduced",
+        beam: Beam::Timoshenko,
+        default_alpha: 1.0,
+        run: run::<timoshenko_p1_reduced::Model>,
+        discretize: discretize_with::<timoshenko_p1_reduced::Model>,
+    },
+    PairRow {
+        pair: Pair::TimoshenkoP1Full,
+        name: "p1-p1-p0-full",
+        beam: Beam::Timoshenko,
+        default_alpha: 1.0,
+        run: run::<timoshenko_p1_full::Model>,
+        discretize: discretize_with::<timoshenko_p1_full::Model>,
+    },
+    PairRow {
+        pair: Pair::BernoulliHermite,
+        name: "hermite-p0",
+        beam: Beam::EulerBernoulli,
+        default_alpha: 1e-2,
+        run: run::<bernoulli::Model>,
+        discretize: discretize_with::<bernoulli::Model>,
+    },
+];
+
 impl Pair {
     /// Every pair.
     pub const ALL: [Pair; 4] = [
@@ -31,41 +81,40 @@ impl Pair {
         Pair::BernoulliHermite,
     ];
 
+    fn row(self) -> &'static PairRow {
+        let row = &PAIRS[self as usize];
+        debug_assert_eq!(row.pair, self);
+        row
+    }
+
     /// Its name on the command line.
     pub fn name(self) -> &'static str {
-        match self {
-            Pair::TimoshenkoP2 => "p2-p2-p0",
-            Pair::TimoshenkoP1Reduced => "p1-p1-p0-reduced",
-            Pair::TimoshenkoP1Full => "p1-p1-p0-full",
-            Pair::BernoulliHermite => "hermite-p0",
-        }
+        self.row().name
     }
 
     /// The beam theory it discretizes.
     pub fn beam(self) -> Beam {
-        match self {
-            Pair::BernoulliHermite => Beam::EulerBernoulli,
-            _ => Beam::Timoshenko,
-        }
+        self.row().beam
     }
 
-    /// The default pair of a beam theory.
+    /// The default pair of a beam theory: its first pair.
     pub fn default_for(beam: Beam) -> Pair {
-        match beam {
-            Beam::Timoshenko => Pair::TimoshenkoP2,
-            Beam::EulerBernoulli => Pair::BernoulliHermite,
-        }
+        PAIRS
+            .iter()
+            .find(|row| row.beam == beam)
+            .map(|row| row.pair)
+            .expect("every beam theory has a pair")
     }
 
     /// The pair called `name`, which must discretize `beam`.
     pub fn parse(name: &str, beam: Beam) -> Result<Pair> {
-        let pairs: Vec<&str> = Pair::ALL
+        let pairs: Vec<&str> = PAIRS
             .iter()
-            .filter(|p| p.beam() == beam)
-            .map(|p| p.name())
+            .filter(|p| p.beam == beam)
+            .map(|p| p.name)
             .collect();
-        match Pair::ALL.iter().find(|p| p.name() == name) {
-            Some(&p) if p.beam() == beam => Ok(p),
+        match PAIRS.iter().find(|p| p.name == name) {
+            Some(p) if p.beam == beam => Ok(p.pair),
             Some(_) => Err(Error::Input(format!(
                 "pair `{name}` is for the other beam theory; this scene takes {}",
                 pairs.join(", ")
@@ -80,10 +129,7 @@ impl Pair {
     /// The default stabilization parameter (docs/mathematics.md: α ≈ 1 for Timoshenko, ≤ 1e-2 for
     /// Euler–Bernoulli so that the obstacle shift α h⁴|f| stays negligible).
     pub fn default_alpha(self) -> f64 {
-        match self {
-            Pair::BernoulliHermite => 1e-2,
-            _ => 1.0,
-        }
+        self.row().default_alpha
     }
 }
 
@@ -209,45 +255,22 @@ pub fn solve(request: &Request) -> Result<(Report, Profiles)> {
             request.scene.name
         )));
     }
-    dispatch!(pair, M => run::<M>(request, pair))
+    (pair.row().run)(request, pair)
 }
-
-/// Runs `$body` with `M` the model type of `$pair`.
-macro_rules! dispatch {
-    ($pair:expr, $m:ident => $body:expr) => {
-        match $pair {
-            Pair::TimoshenkoP2 => {
-                type $m = timoshenko_p2::Model;
-                $body
-            }
-            Pair::TimoshenkoP1Reduced => {
-                type $m = timoshenko_p1_reduced::Model;
-                $body
-            }
-            Pair::TimoshenkoP1Full => {
-                type $m = timoshenko_p1_full::Model;
-                $body
-            }
-            Pair::BernoulliHermite => {
-                type $m = bernoulli::Model;
-                $body
-            }
-        }
-    };
-}
-use dispatch;
 
 /// The discrete problem of a request (for studies of its matrices), and its pair.
 pub fn discretize(request: &Request) -> Result<(Discretization, Pair)> {
     let pair = request
         .pair
         .unwrap_or(Pair::default_for(request.scene.beam));
-    dispatch!(pair, M => {
-        let setup = Setup::new(request, pair)?;
-        let coefficients = setup.coefficients::<M>()?;
-        let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
-        Ok((Discretization::new::<M>(&mesh, &coefficients, setup.clamped, "B_h", "L_h")?, pair))
-    })
+    Ok(((pair.row().discretize)(request, pair)?, pair))
+}
+
+fn discretize_with<M: Model>(request: &Request, pair: Pair) -> Result<Discretization> {
+    let setup = Setup::new(request, pair)?;
+    let coefficients = setup.coefficients::<M>()?;
+    let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
+    Discretization::new::<M>(&mesh, &coefficients, setup.clamped, "B_h", "L_h")
 }
 
 /// Parameters and data of a request, validated.
@@ -292,13 +315,13 @@ impl Setup {
     }
 }
 
-/// Checks what a model cannot check: obstacle data, feasibility at the clamped ends,
-/// the ranges of q, t, α.
 /// The thinnest Timoshenko beam solved: below it the shear penalty `t⁻²` leaves too few
 /// digits for the bending energy (measured on timoshenko-a: the L² error against the exact
 /// solution grows from 2e-8 at t = 1e-3 to 2e-6 at t = 1e-6, and Newton fails at 1e-7).
 const MIN_THICKNESS: f64 = 1e-6;
 
+/// Checks what a model cannot check: obstacle data, feasibility at the clamped ends,
+/// the ranges of q, t, α.
 fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
     let scene = &request.scene;
     if request.elements == 0 || request.elements > 50_000_000 {
