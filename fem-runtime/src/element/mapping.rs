@@ -1,7 +1,8 @@
 //! The map from the reference cell to a physical cell, and the chain rule it gives for
 //! derivatives: points, gradients and Hessians on physical cells from reference ones.
 //! Triangle fields, DOF nodes, the interval basis and the interval norms go through it;
-//! the generated kernels inline the same formulas, and point location inverts the map
+//! the generated kernels inline the same formulas, the interval prolongation places its
+//! nodes through it, and point location inverts the map
 //! through barycentric coordinates of its own.
 //!
 //! Reference cells: the interval `[0, 1]` and the triangle with vertices `(0,0), (1,0),

@@ -10,6 +10,7 @@ use crate::assembly::dof_map::DofNumbering;
 use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::{assemble_vector, block_plans, for_each_entry, BlockPlan};
 use crate::element::interval::PhysicalBasis;
+use crate::element::mapping::Affine;
 use crate::error::{Error, Result};
 use crate::lcp::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
@@ -487,6 +488,7 @@ pub fn prolong<M: Model>(
         let nodes = element.lagrange_nodes();
         for c in 0..fine_mesh.cell_count() {
             let cell = fine_mesh.cell(c);
+            let map = Affine::interval(cell);
             let mut interior = 0;
             for (i, location) in element.dofs().iter().enumerate() {
                 let (x, derivative) = match *location {
@@ -494,12 +496,12 @@ pub fn prolong<M: Model>(
                     DofLocation::Interior => {
                         let xi = nodes.map_or(0.5, |n| n[2 * element.dofs_per_vertex() + interior]);
                         interior += 1;
-                        (cell[0] + (cell[1] - cell[0]) * xi, 0)
+                        (map.point([xi])[0], 0)
                     }
                 };
                 // P0: its single "interior" node is the midpoint
                 let x = if element.dofs_per_vertex() == 0 {
-                    0.5 * (cell[0] + cell[1])
+                    map.point([0.5])[0]
                 } else {
                     x
                 };
