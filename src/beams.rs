@@ -222,6 +222,10 @@ pub struct Report {
     pub error_h1: Option<f64>,
     /// Estimated relative rounding noise of the multiplier values λ_h (see `warnings`).
     pub multiplier_noise: f64,
+    /// How far w may be off through the rounding of the rows in contact, relative to the
+    /// larger of `max|w_h|`, `max|ψ|` and 1e-6 of the length (fem_runtime
+    /// `Lcp::primal_rounding`).
+    pub primal_rounding: f64,
     /// What the numbers cannot be trusted for.
     pub warnings: Vec<String>,
 }
@@ -344,7 +348,7 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
     }
     if request.load > MAX_LOAD {
         return Err(Error::Input(format!(
-            "load q = {:e} is beyond {MAX_LOAD:e}: in contact the obstacle's part of the constraint rows would drown in the rounding of the load's terms (ε·q against the size of ψ)",
+            "load q = {:e} is beyond {MAX_LOAD:e}: norms in the solve would overflow double precision",
             request.load
         )));
     }
@@ -396,6 +400,10 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
 /// to 10× (timoshenko-a, q = 100, 32768 elements: 0.1 with ∫λ_h still right to 4 digits);
 /// on bernoulli-flat at q = 100 it is 1.8 at 20000 elements, where ∫λ_h is off by 6×.
 const MAX_MULTIPLIER_NOISE: f64 = 1.0;
+
+/// Largest rounding of w through the contact rows, relative to its size, accepted in a
+/// result ([`Report::primal_rounding`]).
+const MAX_PRIMAL_ROUNDING: f64 = 1e-3;
 
 /// Most rounds of iterative refinement per linear solve that `--refinement` accepts.
 pub const MAX_REFINEMENT_STEPS: usize = 10;
@@ -465,6 +473,29 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
             .map(|&x| view.at(x, 0).unwrap_or(f64::NAN))
             .collect()
     });
+    let psi_size = x
+        .iter()
+        .map(|&x| scene.obstacle.at(x).abs())
+        .fold(0.0, f64::max);
+    // 1e-6 of the beam's length: so that a beam at rest on ψ = 0 is judged against something
+    let primal_rounding = solution.primal_rounding() / max_deflection.max(psi_size).max(1e-6);
+    if primal_rounding > MAX_PRIMAL_ROUNDING {
+        return Err(Error::Input(format!(
+            "the load q = {q:e} dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves w by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it)"
+        )));
+    }
+    let mut warnings = Vec::new();
+    if solution.multiplier_noise > 1e-6 {
+        warnings.push(format!(
+            "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁵ approaches the rounding of G − BU at this mesh size, and the saddle-point recovery of λ is no guarantee at this conditioning; w is affected too once the noise passes ~1e-3 (a larger α or a coarser mesh avoids it)",
+            solution.multiplier_noise
+        ));
+    }
+    if primal_rounding > 1e-8 {
+        warnings.push(format!(
+            "w may be off by {primal_rounding:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)"
+        ));
+    }
     let d = &solution.discretization;
     let report = Report {
         scene: scene.name.to_string(),
@@ -490,14 +521,8 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         error_l2,
         error_h1,
         multiplier_noise: solution.multiplier_noise,
-        warnings: if solution.multiplier_noise > 1e-6 {
-            vec![format!(
-                "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁵ approaches the rounding of G − BU at this mesh size, and the saddle-point recovery of λ is no guarantee at this conditioning; w is affected too once the noise passes ~1e-3 (a larger α or a coarser mesh avoids it)",
-                solution.multiplier_noise
-            )]
-        } else {
-            Vec::new()
-        },
+        primal_rounding,
+        warnings,
     };
     let profiles = Profiles {
         psi: x.iter().map(|&x| scene.obstacle.at(x)).collect(),

@@ -179,6 +179,10 @@ pub struct MembraneReport {
     pub complementarity_residual: f64,
     /// Estimated relative rounding noise of λ_h.
     pub multiplier_noise: f64,
+    /// How far u may be off through the rounding of the rows in contact, relative to the
+    /// larger of `max|u_h|`, `max|ψ|` at the vertices and 1e-6 of the mesh's diameter
+    /// (fem_runtime `Lcp::primal_rounding`); 0 for the nodal method.
+    pub primal_rounding: f64,
     /// `max(ψ − u_h, 0)` over the vertices and quadrature points: the weak (cell-wise)
     /// constraint lets u_h dip below ψ by `O(h²)`
     /// ([`fem_runtime::obstacle::triangle::max_penetration`]).
@@ -726,6 +730,17 @@ fn run_stabilized<M: Model>(
             solution.multiplier_noise
         ));
     }
+    let primal_rounding = primal_rounding(&solution, u_field, posed.data.obstacle.as_data_fn());
+    if primal_rounding > MAX_PRIMAL_ROUNDING {
+        return Err(Error::Input(format!(
+            "the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves u by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it)"
+        )));
+    }
+    if primal_rounding > 1e-8 {
+        warnings.push(format!(
+            "u may be off by {primal_rounding:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)"
+        ));
+    }
     let contact_area = solution.contact_area();
     let fields = stabilized_fields(&solution, u_field, &posed.data);
     let report = MembraneReport {
@@ -751,6 +766,7 @@ fn run_stabilized<M: Model>(
         exact_contact_area: posed.exact.as_ref().and_then(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: solution.multiplier_noise,
+        primal_rounding,
         max_penetration: fem_runtime::obstacle::triangle::max_penetration(
             &u,
             posed.data.obstacle.as_data_fn(),
@@ -951,6 +967,7 @@ fn run_nodal(
         exact_contact_area: posed.exact.as_ref().and_then(|e| e.contact_area),
         complementarity_residual: solution.kkt_residual,
         multiplier_noise: 0.0,
+        primal_rounding: 0.0,
         max_penetration: fem_runtime::obstacle::triangle::max_penetration(
             &u,
             posed.data.obstacle.as_data_fn(),
@@ -1080,4 +1097,34 @@ fn accuracy_rung(scene: &MembraneScene, pair: MembranePair) -> Result<AccuracyRu
         }
         coarse = fine;
     }
+}
+
+/// Largest rounding of u through the contact rows, relative to its size, accepted in a
+/// result ([`MembraneReport::primal_rounding`]).
+const MAX_PRIMAL_ROUNDING: f64 = 1e-3;
+
+/// [`fem_runtime::obstacle::ObstacleSolution::primal_rounding`] relative to the size of
+/// the answer: the larger of `max|u_h|`, `max|ψ|` at the vertices and, so that a
+/// membrane pressed flat onto ψ = 0 (u ≡ 0) is judged against something, 1e-6 of the
+/// mesh's diameter.
+fn primal_rounding(
+    solution: &TriangleObstacleSolution,
+    u_field: usize,
+    obstacle: &fem_runtime::DataFn,
+) -> f64 {
+    let mesh = &solution.discretization.mesh;
+    let largest = |values: &mut dyn Iterator<Item = f64>| {
+        values
+            .filter(|v| v.is_finite())
+            .fold(0.0, |m: f64, v| m.max(v.abs()))
+    };
+    let u_size = largest(&mut solution.field(u_field).iter().copied());
+    let psi_size = largest(&mut mesh.vertices().iter().map(|p| obstacle(p)));
+    let corners = |k: usize| {
+        let values = mesh.vertices().iter().map(|p| p[k]);
+        values.clone().fold(f64::INFINITY, f64::min)..=values.fold(f64::NEG_INFINITY, f64::max)
+    };
+    let (x, y) = (corners(0), corners(1));
+    let diameter = (x.end() - x.start()).hypot(y.end() - y.start());
+    solution.primal_rounding() / u_size.max(psi_size).max(1e-6 * diameter)
 }

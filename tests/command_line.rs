@@ -103,13 +103,25 @@ fn bad_input_exits_with_a_message() {
             "must be finite and ≥ 0",
         ),
         (&["study", "no-such-study"][..], "unknown study"),
+        // a load that dwarfs the obstacle: certified to 1e-16, and still rounding
         (
-            &["solve", "membrane-lshape", "--load", "1e20"][..],
-            "drown in the rounding",
+            &[
+                "solve",
+                "membrane-lshape",
+                "--load",
+                "1e20",
+                "--mesh-size",
+                "8",
+            ][..],
+            "the load dwarfs the obstacle",
         ),
         (
             &["solve", "timoshenko-a", "--load", "1e25"][..],
-            "drown in the rounding",
+            "dwarfs the obstacle",
+        ),
+        (
+            &["solve", "bernoulli-a", "--load", "1e200"][..],
+            "would overflow",
         ),
         (
             &["solve", "timoshenko-a", "--thickness", "1e-8"][..],

@@ -717,6 +717,32 @@ mod tests {
     }
 
     #[test]
+    fn primal_rounding_is_the_rounding_of_the_rows_in_contact_over_their_norm() {
+        // u − λ = f, 2u + cλ ≥ g: the stabilized row of a load q = 1e20 pressing onto ψ
+        // with G = 2ψ + c·q, so that in contact 2u = 2ψ exactly in exact arithmetic
+        let (q, psi, c) = (1e20, 0.05, 1e-4);
+        let a = SparseMatrix::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, 1.0)]).unwrap();
+        let lcp = Lcp::new(
+            a,
+            vec![vec![(0, 2.0)]],
+            vec![c],
+            vec![-q],
+            vec![2.0 * psi + c * q],
+        );
+        let (u, lambda) = ([psi], [psi + q]);
+        let expected = f64::EPSILON * (2.0 * psi + c * (psi + q) + (2.0 * psi + c * q)) / 2.0;
+        let r = lcp.primal_rounding(&u, &lambda);
+        assert!(
+            (r - expected).abs() <= 1e-12 * expected,
+            "{r} vs {expected}"
+        );
+        // ~2e4·ε·1e20/2: far beyond ψ, the rows cannot resolve the obstacle
+        assert!(r > psi);
+        // rows out of contact do not count
+        assert_eq!(lcp.primal_rounding(&u, &[0.0]), 0.0);
+    }
+
+    #[test]
     fn a_point_whose_certificate_overflows_or_is_nan_is_not_certified() {
         let (lcp, u, lambda) = blocked_lcp(1);
         assert!(lcp.kkt_residual(&u, &lambda) < 1e-10);

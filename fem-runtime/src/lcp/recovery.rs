@@ -63,6 +63,39 @@ impl Lcp {
             })
             .fold(0.0, f64::max)
     }
+
+    /// How far `u` may be off through the rounding of the contact rows, in the units of
+    /// U: on a constraint in contact, `B_k U = G_k − (CΛ)_k` is known only to
+    /// `ε(Σ_j|B_kj U_j| + Σ_l|C_kl Λ_l| + |G_k|)`, which moves U along the row by that
+    /// over `Σ_j |B_kj|`; the largest such value over the constraints with `Λ_k > 0`.
+    ///
+    /// The stabilized rows subtract terms of the size of the load (`αh^k f`) to leave the
+    /// obstacle's own part: where the load dwarfs the obstacle the answer is rounding,
+    /// while the KKT residual, relative to those same large terms, stays at 1e-16. The
+    /// caller compares the value with the size of U, ψ or the boundary data.
+    ///
+    /// # Panics
+    /// If `u.len() != n` or `lambda.len() != m`.
+    pub fn primal_rounding(&self, u: &[f64], lambda: &[f64]) -> f64 {
+        assert!(u.len() == self.n() && lambda.len() == self.m());
+        let c_terms = self.c_times_abs(lambda);
+        self.b_rows
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| lambda[k] > 0.0)
+            .map(|(k, row)| {
+                let b_norm: f64 = row.iter().map(|&(_, v)| v.abs()).sum();
+                let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
+                    + c_terms[k]
+                    + self.g[k].abs();
+                if b_norm > 0.0 {
+                    f64::EPSILON * terms / b_norm
+                } else {
+                    0.0
+                }
+            })
+            .fold(0.0, f64::max)
+    }
 }
 
 /// The saddle-point system `[[A, −B̃ᵀ], [−B̃, D]]` of the primal–dual active set method with

@@ -453,6 +453,14 @@ impl<G> Discretization<G> {
         self.reduction.expand(&reduced)
     }
 
+    /// The multipliers of a full coefficient vector, in the order of the LCP's constraints.
+    pub fn multiplier_part(&self, full: &[f64]) -> Vec<f64> {
+        self.multiplier_reduced
+            .iter()
+            .map(|&r| full[self.reduction.free()[r]])
+            .collect()
+    }
+
     /// The primal unknowns of a full coefficient vector (a start for Newton).
     pub fn primal_part(&self, full: &[f64]) -> Vec<f64> {
         self.primal_reduced
@@ -536,6 +544,19 @@ pub struct ObstacleSolution<G = IntervalMesh> {
     pub solve_seconds: f64,
     /// Estimated relative rounding noise of the multiplier values (0: none).
     pub multiplier_noise: f64,
+}
+
+impl<G> ObstacleSolution<G> {
+    /// How far the primal coefficients may be off through the rounding of the rows in
+    /// contact ([`Lcp::primal_rounding`]), in the units of the primal field: compare it
+    /// with the size of u, ψ or g. Far below them unless the load dwarfs the obstacle.
+    pub fn primal_rounding(&self) -> f64 {
+        let d = &self.discretization;
+        d.lcp.primal_rounding(
+            &d.primal_part(&self.values),
+            &d.multiplier_part(&self.values),
+        )
+    }
 }
 
 /// Options of [`solve_obstacle`].
