@@ -113,6 +113,7 @@ impl TriangleMesh {
                 let kind = self.groups.iter().find(|g| g.name == name).map(|g| {
                     match g.dimension {
                         0 => "a group of points (a 0-D physical group)",
+                        3 => "a volume (a 3-D physical group)",
                         _ => "a surface (a 2-D physical group)",
                     }
                 });
