@@ -254,13 +254,15 @@ fn gradient_on_this_thread(text: &str, field: &str, file: &Path) -> Result<Data<
 fn dirichlet_parts(value: Option<&toml::Value>) -> std::result::Result<DirichletParts, String> {
     use toml::Value;
     let by_name = "boundary parts are chosen by name (Gmsh physical names of curve groups, or a generator's side names), not by number; a Gmsh group without a name cannot be chosen: name it (Physical Curve(\"outer\") = {…};)";
-    let name = |v: &Value| match v {
+    let name = |v: &Value| {
+        match v {
         Value::String(s) if s.trim().is_empty() => Err("an empty name".to_string()),
         Value::String(s) => Ok(s.clone()),
         Value::Integer(i) => Err(format!("{i} is a number: {by_name}")),
         other => Err(format!(
             "{other} is not a name: write \"all\", a name, or a list of names such as [\"left\", \"right\"]"
         )),
+    }
     };
     match value {
         None => Ok(DirichletParts::All),
@@ -596,7 +598,8 @@ mod tests {
             let e = parse(&broken, here()).unwrap_err().to_string();
             assert!(e.contains(field), "{field}: {e}");
         }
-        let with = |d: &str| FLAT.replace("[data]", &format!("[boundary]\ndirichlet = {d}\n[data]"));
+        let with =
+            |d: &str| FLAT.replace("[data]", &format!("[boundary]\ndirichlet = {d}\n[data]"));
         for (d, expected) in [
             ("\"all\"", DirichletParts::All),
             ("\"left\"", DirichletParts::Named(vec!["left".into()])),
@@ -605,10 +608,17 @@ mod tests {
                 DirichletParts::Named(vec!["right".into(), "left".into()]),
             ),
         ] {
-            assert_eq!(parse(&with(d), here()).unwrap().scene.dirichlet, expected, "{d}");
+            assert_eq!(
+                parse(&with(d), here()).unwrap().scene.dirichlet,
+                expected,
+                "{d}"
+            );
         }
         for (d, words) in [
-            ("\"outer\"", &["`outer`", "`left`", "generator `square`"][..]),
+            (
+                "\"outer\"",
+                &["`outer`", "`left`", "generator `square`"][..],
+            ),
             ("[]", &["empty list", "constant"]),
             ("[4]", &["4 is a number", "by name"]),
             ("[\"left\", 2.5]", &["2.5 is not a name"]),

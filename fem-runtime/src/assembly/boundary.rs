@@ -72,7 +72,10 @@ impl DirichletPart {
             return map.boundary_dofs(mesh);
         };
         let [per_vertex, per_edge, _] = map.element().triangle_layout();
-        if map.local_count() != map.element().local_dof_count(fem_reference::CellKind::Triangle)
+        if map.local_count()
+            != map
+                .element()
+                .local_dof_count(fem_reference::CellKind::Triangle)
             || map.dof_count() == 0
         {
             return Vec::new();

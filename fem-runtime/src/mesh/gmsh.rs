@@ -160,8 +160,7 @@ fn physical_names(bytes: &[u8]) -> Result<Vec<(usize, i32, String)>> {
                 "cannot read the $PhysicalNames section: the file ends before {what}"
             ))
         })?;
-        let l = std::str::from_utf8(l)
-            .map_err(|_| malformed(i, "the line is not UTF-8 text"))?;
+        let l = std::str::from_utf8(l).map_err(|_| malformed(i, "the line is not UTF-8 text"))?;
         Ok((i, l.trim().to_string()))
     };
     let (at, count) = text("the number of names")?;
@@ -171,9 +170,10 @@ fn physical_names(bytes: &[u8]) -> Result<Vec<(usize, i32, String)>> {
     let mut names = Vec::with_capacity(count.min(1 << 16));
     for _ in 0..count {
         let (at, line) = text("its last name")?;
-        let (numbers, quoted) = line.split_at(line.find('"').ok_or_else(|| {
-            malformed(at, &format!("`{line}` is not `dimension tag \"name\"`"))
-        })?);
+        let (numbers, quoted) =
+            line.split_at(line.find('"').ok_or_else(|| {
+                malformed(at, &format!("`{line}` is not `dimension tag \"name\"`"))
+            })?);
         let mut numbers = numbers.split_whitespace();
         let (Some(Ok(dimension)), Some(Ok(tag)), None) = (
             numbers.next().map(str::parse::<usize>),
@@ -190,7 +190,10 @@ fn physical_names(bytes: &[u8]) -> Result<Vec<(usize, i32, String)>> {
             .and_then(|q| q.strip_suffix('"'))
             .ok_or_else(|| malformed(at, &format!("the name in `{line}` is not quoted")))?;
         if dimension > 3 {
-            return Err(malformed(at, &format!("dimension {dimension} is not 0 to 3")));
+            return Err(malformed(
+                at,
+                &format!("dimension {dimension} is not 0 to 3"),
+            ));
         }
         names.push((dimension, tag, name.to_string()));
     }
@@ -1151,10 +1154,7 @@ $EndElements
     #[test]
     fn physical_names_name_boundary_parts() {
         let m = parse_msh(named_square().as_bytes()).unwrap();
-        assert_eq!(
-            m.boundary_part_names(),
-            ["bottom", "right side", "nowhere"]
-        );
+        assert_eq!(m.boundary_part_names(), ["bottom", "right side", "nowhere"]);
         assert_eq!(m.boundary_part_markers(&["bottom"]).unwrap(), [10]);
         assert_eq!(
             m.boundary_part_markers(&["right side", "bottom"]).unwrap(),

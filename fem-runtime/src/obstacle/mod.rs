@@ -1167,16 +1167,19 @@ mod tests {
         .unwrap();
         let coarse = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap();
         let meshes = [coarse.clone(), coarse.refine_uniformly()];
-        let sides = DirichletPart::Markers(coarse.boundary_part_markers(&["left", "right"]).unwrap());
-        let s = solve_obstacle_on_part::<membrane_p1::Model>(&meshes, &c, &sides, Default::default())
-            .unwrap();
+        let sides =
+            DirichletPart::Markers(coarse.boundary_part_markers(&["left", "right"]).unwrap());
+        let s =
+            solve_obstacle_on_part::<membrane_p1::Model>(&meshes, &c, &sides, Default::default())
+                .unwrap();
         let u = s.field(0);
         for (v, x) in s.discretization.mesh.vertices().iter().enumerate() {
             assert!((u[v] - x[0]).abs() < 1e-12, "vertex {v} at {x:?}: {}", u[v]);
         }
         // on the whole boundary the same data give another solution
-        let all = solve_obstacle_on_triangles::<membrane_p1::Model>(&meshes, &c, Default::default())
-            .unwrap();
+        let all =
+            solve_obstacle_on_triangles::<membrane_p1::Model>(&meshes, &c, Default::default())
+                .unwrap();
         assert!(all.field(0).iter().zip(u).any(|(a, b)| (a - b).abs() > 0.1));
         // no Dirichlet edge: refused, not solved
         let none = DirichletPart::Markers(vec![99]);

@@ -110,17 +110,19 @@ impl TriangleMesh {
                 .filter(|g| g.dimension == 1 && g.name == name)
                 .collect();
             if curves.is_empty() {
-                let kind = self.groups.iter().find(|g| g.name == name).map(|g| {
-                    match g.dimension {
+                let kind = self
+                    .groups
+                    .iter()
+                    .find(|g| g.name == name)
+                    .map(|g| match g.dimension {
                         0 => "a group of points (a 0-D physical group)",
                         3 => "a volume (a 3-D physical group)",
                         _ => "a surface (a 2-D physical group)",
-                    }
-                });
+                    });
                 let message = match kind {
-                    Some(kind) => format!(
-                        "`{name}` names {kind}, not a part of the boundary; {listing}"
-                    ),
+                    Some(kind) => {
+                        format!("`{name}` names {kind}, not a part of the boundary; {listing}")
+                    }
                     None => match name.trim().parse::<u32>() {
                         Ok(tag) => {
                             let used = self.boundary_edges.iter().any(|&(_, m)| m == tag);
@@ -230,8 +232,14 @@ mod tests {
             markers: Vec::new(),
             ambiguity: None,
         }]);
-        let e = named.boundary_part_markers(&["domain"]).unwrap_err().to_string();
-        assert!(e.contains("surface") && e.contains("names no boundary parts"), "{e}");
+        let e = named
+            .boundary_part_markers(&["domain"])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("surface") && e.contains("names no boundary parts"),
+            "{e}"
+        );
         for parts in [
             &[("", &[1u32][..])][..],
             &[("a", &[1][..]), ("a", &[2][..])],
