@@ -1,5 +1,6 @@
 //! Obstacle problems on triangle meshes: the model's Dirichlet data (`boundary:`)
-//! interpolated at the boundary DOFs, nested iteration over a sequence of meshes, the
+//! interpolated at the boundary DOFs (of the whole boundary or of a [`DirichletPart`],
+//! the rest natural), nested iteration over a sequence of meshes, the
 //! classical nodal-constraint method for comparison, and the solution's contact force
 //! and contact area.
 
