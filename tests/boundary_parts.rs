@@ -220,6 +220,32 @@ fn the_file_names_its_parts_and_refinement_keeps_them() {
     }
 }
 
+/// A named curve group with no boundary edge (here: no curve at all) is no Dirichlet
+/// part: u = g would hold nowhere, so the solve is refused, not run pure Neumann.
+#[test]
+fn a_part_without_boundary_edges_is_refused() {
+    let dir = std::env::temp_dir().join(format!("fem-forms-slit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(data("square_named.msh")).unwrap();
+    let with_slit = text.replace("$PhysicalNames\n6\n", "$PhysicalNames\n7\n1 15 \"slit\"\n");
+    assert_ne!(with_slit, text);
+    std::fs::write(dir.join("square_named.msh"), with_slit).unwrap();
+    let mut file =
+        scene_file::parse(&strip_scene(GMSH, "\"slit\""), &dir.join("strip.toml")).unwrap();
+    file.scene.exact = Exact::Unknown;
+    let mut request = MembraneRequest::new(file.scene);
+    request.mesh_size = 0;
+    let e = match membranes::solve(&request) {
+        Ok(_) => panic!("solved without a Dirichlet edge"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("boundary.dirichlet") && e.contains("`slit`") && e.contains("no boundary edge"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Bad boundary parts are errors naming `boundary.dirichlet`, never a solve.
 #[test]
 fn bad_boundary_parts_are_refused_with_clear_messages() {
