@@ -613,9 +613,10 @@ pub fn dirichlet_part(
             "no boundary part is chosen: with ∂u/∂n = 0 on the whole boundary the membrane is determined only up to a constant where contact does not hold it; choose at least one part".into(),
         ));
     }
-    let markers = mesh
-        .boundary_part_markers(names)
-        .map_err(|e| at(format!("{e} (domain: {domain})")))?;
+    let markers = mesh.boundary_part_markers(names).map_err(|e| match e {
+        Error::Input(message) => at(format!("{message} (domain: {domain})")),
+        other => other,
+    })?;
     let part = DirichletPart::Markers(markers);
     if part.edge_count(mesh) == 0 {
         return Err(at(format!(

@@ -430,11 +430,12 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
             Domain::File(_) => None,
         };
         if let Some(mesh) = sample {
-            mesh.boundary_part_markers(names).map_err(|e| {
-                at(
+            mesh.boundary_part_markers(names).map_err(|e| match e {
+                Error::Input(message) => at(
                     "boundary.dirichlet",
-                    format!("{e} (generator `{}`)", mesh_generator_name(&domain)),
-                )
+                    format!("{message} (generator `{}`)", mesh_generator_name(&domain)),
+                ),
+                other => other,
             })?;
         }
     }

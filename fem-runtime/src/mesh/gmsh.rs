@@ -1177,7 +1177,15 @@ $EndElements
         );
         // curve 4 has no group: its marker is its entity tag, which has no name
         let e = m.boundary_part_markers(&["4"]).unwrap_err().to_string();
-        assert!(e.contains("not by marker") && e.contains("marker 4"), "{e}");
+        assert!(
+            e.contains("not by tag or marker")
+                && e.contains("marker 4 exist, but no name")
+                && e.contains("Physical Curve"),
+            "{e}"
+        );
+        // a physical tag that has a name: the message names it
+        let e = m.boundary_part_markers(&["20"]).unwrap_err().to_string();
+        assert!(e.contains("marker 20 belong to `right side`"), "{e}");
         // the names stay through refinement
         let fine = m.refine_uniformly();
         assert_eq!(fine.boundary_part_markers(&["bottom"]).unwrap(), [10]);

@@ -125,15 +125,25 @@ impl TriangleMesh {
                     }
                     None => match name.trim().parse::<u32>() {
                         Ok(tag) => {
+                            let holders: Vec<String> = self
+                                .groups
+                                .iter()
+                                .filter(|g| g.dimension == 1 && g.markers.contains(&tag))
+                                .map(|g| format!("`{}`", g.name))
+                                .collect();
                             let used = self.boundary_edges.iter().any(|&(_, m)| m == tag);
+                            let about = if !holders.is_empty() {
+                                format!(
+                                    "; the edges of marker {tag} belong to {}",
+                                    holders.join(", ")
+                                )
+                            } else if used {
+                                format!("; boundary edges with marker {tag} exist, but no name is given to them: give their curves a physical name (in Gmsh: Physical Curve(\"name\") = {{…}})")
+                            } else {
+                                String::new()
+                            };
                             format!(
-                                "no boundary part is named `{name}`: boundary parts are chosen by name, not by {} number{}; give the curves a physical name (in Gmsh: Physical Curve(\"name\") = {{…}}); {listing}",
-                                if used { "marker" } else { "tag or marker" },
-                                if used {
-                                    format!(" (boundary edges with marker {tag} exist, but no name is given to them)")
-                                } else {
-                                    String::new()
-                                }
+                                "no boundary part is named `{name}`: boundary parts are chosen by name, not by tag or marker number{about}; {listing}"
                             )
                         }
                         Err(_) => format!("no boundary part is named `{name}`; {listing}"),
@@ -222,7 +232,10 @@ mod tests {
             "{e}"
         );
         let e = m.boundary_part_markers(&["3"]).unwrap_err().to_string();
-        assert!(e.contains("not by marker") && e.contains("marker 3"), "{e}");
+        assert!(
+            e.contains("not by tag or marker") && e.contains("marker 3 belong to `top`"),
+            "{e}"
+        );
         let none: [&str; 0] = [];
         assert!(m.boundary_part_markers(&none).is_err());
         let mut named = m.clone();
