@@ -220,6 +220,16 @@ fn the_file_names_its_parts_and_refinement_keeps_them() {
     }
 }
 
+/// The binary file of the same mesh (MSH 4.1, `$PhysicalNames` as text in it) reads to
+/// the same mesh, names and markers included.
+#[test]
+fn the_binary_file_names_the_same_parts() {
+    let ascii = read_msh(&data("square_named.msh")).unwrap();
+    let binary = read_msh(&data("square_named_binary.msh")).unwrap();
+    assert_eq!(binary, ascii);
+    assert_eq!(binary.boundary_part_markers(&["sides"]).unwrap(), [11, 12]);
+}
+
 /// A named curve group with no boundary edge (here: no curve at all) is no Dirichlet
 /// part: u = g would hold nowhere, so the solve is refused, not run pure Neumann.
 #[test]

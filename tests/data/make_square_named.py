@@ -1,4 +1,4 @@
-"""Writes square_named.msh: (-1,1)^2 in Gmsh MSH 4.1 (ASCII) with physical names.
+"""Writes square_named.msh (and square_named_binary.msh): (-1,1)^2 in Gmsh MSH 4.1 (ASCII) with physical names.
 
 Laid out as Gmsh writes a built-in-kernel model: points 1-4 (corners), curves 1 bottom,
 2 right, 3 top, 4 left (p1 -> p2 -> p3 -> p4 -> p1), surface 1; node blocks per entity,
@@ -7,7 +7,8 @@ element blocks per entity. Physical groups (tags differ from the entity tags on 
   ("sides") = 14 {4, 2}   (curves 2 and 4 in two groups each),
   Physical Surface("membrane") = 21 {1}.
 The triangles are an N x N grid with perturbed interior nodes and diagonals chosen
-pseudo-randomly, so the mesh is unstructured in effect. Run: python3 make_square_named.py
+pseudo-randomly, so the mesh is unstructured in effect. Also writes the same mesh as
+binary MSH 4.1, square_named_binary.msh. Run: python3 make_square_named.py
 """
 
 N = 6
@@ -111,3 +112,48 @@ for t in triangles:
     e += 1
 w("$EndElements")
 open(__file__.replace("make_square_named.py", "square_named.msh"), "w").write("\n".join(out) + "\n")
+
+# The same mesh as binary MSH 4.1 (little endian, 8-byte size_t): square_named_binary.msh.
+# $PhysicalNames stays text, as Gmsh writes it in binary files.
+import struct
+
+b = bytearray(b"$MeshFormat\n4.1 1 8\n")
+b += struct.pack("<i", 1)
+b += b"\n$EndMeshFormat\n$PhysicalNames\n6\n"
+b += b'1 11 "left"\n1 12 "right"\n1 13 "walls"\n1 14 "sides"\n2 21 "membrane"\n2 22 "unused"\n'
+b += b"$EndPhysicalNames\n$Entities\n"
+size = lambda *xs: b"".join(struct.pack("<Q", x) for x in xs)
+ints = lambda *xs: b"".join(struct.pack("<i", x) for x in xs)
+dbl = lambda *xs: b"".join(struct.pack("<d", x) for x in xs)
+b += size(4, 4, 1, 0)
+for p, (x, y) in enumerate([(-1, -1), (1, -1), (1, 1), (-1, 1)], start=1):
+    b += ints(p) + dbl(x, y, 0) + size(0)
+for c in range(1, 5):
+    xs = [grid[k][0] for k in curves[c]]
+    ys = [grid[k][1] for k in curves[c]]
+    a, e_ = ends[c]
+    b += ints(c) + dbl(min(xs), min(ys), 0, max(xs), max(ys), 0)
+    b += size(len(physical[c])) + ints(*physical[c]) + size(2) + ints(a, -e_)
+b += ints(1) + dbl(-1, -1, 0, 1, 1, 0) + size(1) + ints(21) + size(4) + ints(1, 2, 3, 4)
+b += b"\n$EndEntities\n$Nodes\n"
+b += size(len(blocks), total, 1, total)
+for dim, entity, nodes in blocks:
+    b += ints(dim, entity, 0) + size(len(nodes))
+    b += size(*[t for t, _ in nodes])
+    for _, (x, y) in nodes:
+        b += dbl(x, y, 0.0)
+b += b"\n$EndNodes\n$Elements\n"
+b += size(5, nlines + len(triangles), 1, nlines + len(triangles))
+e = 1
+for c in range(1, 5):
+    b += ints(1, c, 1) + size(N)
+    ks = curves[c]
+    for m in range(N):
+        b += size(e, tags[ks[m]], tags[ks[m + 1]])
+        e += 1
+b += ints(2, 1, 2) + size(len(triangles))
+for t in triangles:
+    b += size(e, *[tags[k] for k in t])
+    e += 1
+b += b"\n$EndElements\n"
+open(__file__.replace("make_square_named.py", "square_named_binary.msh"), "wb").write(bytes(b))
