@@ -528,6 +528,12 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
     } else {
         membrane_header();
         membrane_row(&report);
+        if report.dirichlet_parts != ["all"] {
+            println!(
+                "u = g on the boundary parts {}; ∂u/∂n = 0 on the rest of the boundary",
+                report.dirichlet_parts.join(", ")
+            );
+        }
     }
     if options.vtk {
         let path = out.join(format!(

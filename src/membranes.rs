@@ -4,16 +4,17 @@
 
 use crate::models::data::Data;
 use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
-use crate::models::membrane_scenes::{Domain, ExactMembrane, MembraneScene};
+use crate::models::membrane_scenes::{DirichletParts, Domain, ExactMembrane, MembraneScene};
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
 use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
 use fem_runtime::obstacle::triangle::{
-    dirichlet_constraints, nodal_active_set, solve_obstacle_on_triangles, TriangleObstacleSolution,
+    dirichlet_constraints_on, nodal_active_set, solve_obstacle_on_part, TriangleObstacleSolution,
 };
 use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_runtime::stabilization::{self, Alpha};
 use fem_runtime::{
-    Coefficients, Diagonal, DofMap, Error, Model, PointLocator, Result, SystemDofs, TriangleMesh,
+    Coefficients, Diagonal, DirichletPart, DofMap, Error, Model, PointLocator, Result, SystemDofs,
+    TriangleMesh,
 };
 use serde::Serialize;
 use std::time::Instant;
@@ -138,6 +139,9 @@ pub struct MembraneReport {
     pub solver: String,
     /// The domain solved on: the scene's own, or the Gmsh file given with `--msh`.
     pub domain: String,
+    /// Where u = g holds: `["all"]` (the whole boundary) or the names of the boundary
+    /// parts; the rest of the boundary has `∂u/∂n = 0`.
+    pub dirichlet_parts: Vec<String>,
     /// The load magnitude q (f = q times the scene's load field); `null` where the
     /// scene's load is fixed.
     pub load: Option<f64>,
@@ -403,8 +407,9 @@ pub fn alpha_of(request: &MembraneRequest, mesh: &TriangleMesh) -> Result<(f64, 
     Ok((policy.value(c_i, ALPHA_WHEN_CI_VANISHES)?, c_i))
 }
 
-/// Checks the scene's data on the mesh: finite values, obstacle not above the boundary data.
-fn validate(data: &SceneData, mesh: &TriangleMesh) -> Result<()> {
+/// Checks the scene's data on the mesh: finite values, obstacle not above the boundary
+/// data where u = g is imposed (`part`).
+fn validate(data: &SceneData, mesh: &TriangleMesh, part: &DirichletPart) -> Result<()> {
     for (name, f) in [
         ("load f", &data.load),
         ("obstacle ψ", &data.obstacle),
@@ -420,12 +425,13 @@ fn validate(data: &SceneData, mesh: &TriangleMesh) -> Result<()> {
             }
         }
     }
-    for v in mesh.boundary_vertices() {
+    let on_part = part.vertices(mesh);
+    for v in (0..mesh.vertex_count()).filter(|&v| on_part[v]) {
         let x = mesh.vertices()[v];
         let (psi, g) = (data.obstacle.at(&x), data.boundary.at(&x));
         if psi > g + 1e-12 * (1.0 + g.abs()) {
             return Err(Error::Input(format!(
-                "infeasible: the obstacle lies above the boundary data at ({}, {}): ψ = {psi} > g = {g}, so no u with u = g on ∂Ω and u ≥ ψ exists",
+                "infeasible: the obstacle lies above the boundary data at ({}, {}): ψ = {psi} > g = {g}, so no u with u = g there and u ≥ ψ exists",
                 x[0], x[1]
             )));
         }
@@ -476,14 +482,16 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
             e.contact_area = None;
         }
     }
+    let part = dirichlet_part(scene, meshes.last().expect("at least one level"), &domain)?;
     let posed = Posed {
         data: SceneData::new(scene, load),
         load,
         exact,
         domain,
+        part,
     };
     let mesh = meshes.last().expect("at least one level");
-    validate(&posed.data, mesh)?;
+    validate(&posed.data, mesh, &posed.part)?;
     let quality = mesh.quality();
     quality.check(mesh)?;
     let (alpha, c_i) = alpha_of(request, mesh).map_err(|e| match e {
@@ -573,12 +581,54 @@ fn worst_cell(mesh: &TriangleMesh, c: usize) -> String {
 }
 
 /// What a request poses on the mesh solved: the data at its load, the exact solution
-/// that holds there, the domain's description.
+/// that holds there, the domain's description, where u = g holds.
 struct Posed {
     data: SceneData,
     load: Option<f64>,
     exact: Option<ExactMembrane>,
     domain: String,
+    part: DirichletPart,
+}
+
+/// The scene's Dirichlet part on `mesh` (the finest level; coarser levels have the same
+/// markers and names): its boundary parts' markers.
+///
+/// # Errors
+/// [`Error::Input`] naming the field `boundary.dirichlet` and the scene for a name the
+/// mesh does not have (listing those it has), the name of a surface or of a number, and
+/// for parts holding no boundary edge of the mesh (the natural condition on the whole
+/// boundary leaves the membrane undetermined up to a constant: refused).
+pub fn dirichlet_part(
+    scene: &MembraneScene,
+    mesh: &TriangleMesh,
+    domain: &str,
+) -> Result<DirichletPart> {
+    let DirichletParts::Named(names) = &scene.dirichlet else {
+        return Ok(DirichletPart::All);
+    };
+    let at = |message: String| {
+        Error::Input(format!(
+            "scene `{}`: field `boundary.dirichlet`: {message}",
+            scene.name
+        ))
+    };
+    if names.is_empty() {
+        return Err(at(
+            "no boundary part is chosen: with ∂u/∂n = 0 on the whole boundary the membrane is determined only up to a constant where contact does not hold it; choose at least one part".into(),
+        ));
+    }
+    let markers = mesh.boundary_part_markers(names).map_err(|e| match e {
+        Error::Input(message) => at(format!("{message} (domain: {domain})")),
+        other => other,
+    })?;
+    let part = DirichletPart::Markers(markers);
+    if part.edge_count(mesh) == 0 {
+        return Err(at(format!(
+            "the boundary parts {} hold no boundary edge of the mesh ({domain}): u = g would hold nowhere and ∂u/∂n = 0 on the whole boundary, which determines the membrane only up to a constant; refused",
+            names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    Ok(part)
 }
 
 /// The most memory a solve may plan to use.
@@ -696,7 +746,7 @@ fn run_stabilized<M: Model>(
     } else {
         meshes
     };
-    let solution = solve_obstacle_on_triangles::<M>(meshes, &coefficients, options).map_err(
+    let solution = solve_obstacle_on_part::<M>(meshes, &coefficients, &posed.part, options).map_err(
         |e| {
             if c_i > 0.0 && alpha * c_i >= 1.0 {
                 Error::Input(format!(
@@ -748,6 +798,7 @@ fn run_stabilized<M: Model>(
         pair: request.pair.name().into(),
         solver: solver_name(solver).into(),
         domain: posed.domain.clone(),
+        dirichlet_parts: scene.dirichlet.names(),
         load: posed.load,
         mesh_size: request.mesh_size,
         triangles: d.mesh.cell_count(),
@@ -840,7 +891,7 @@ fn run_nodal(
     let mut last = None;
     for mesh in meshes {
         let dofs = SystemDofs::all::<M>(mesh)?;
-        let constraints = dirichlet_constraints::<M>(mesh, &dofs, &coefficients)?;
+        let constraints = dirichlet_constraints_on::<M>(mesh, &dofs, &coefficients, &posed.part)?;
         let k = MatrixAssembler::new::<M>("a", mesh, &dofs)?.assemble::<M>(mesh, &coefficients)?;
         let l = assemble_vector::<M>("ℓ", mesh, &dofs, &coefficients)?;
         let reduction = constraints.reduction(dofs.dof_count())?;
@@ -949,6 +1000,7 @@ fn run_nodal(
         pair: request.pair.name().into(),
         solver: "nodal active set".into(),
         domain: posed.domain.clone(),
+        dirichlet_parts: scene.dirichlet.names(),
         load: posed.load,
         mesh_size: request.mesh_size,
         triangles: mesh.cell_count(),

@@ -20,7 +20,8 @@
 //! # refinements = 1               # refined uniformly this many times
 //!
 //! [boundary]
-//! dirichlet = "all"               # u = g on the whole boundary (the only choice today)
+//! dirichlet = "all"               # u = g on the whole boundary (the default), or
+//! # dirichlet = ["left", "right"] # u = g on these boundary parts, ∂u/∂n = 0 elsewhere
 //!
 //! [parameters]
 //! # alpha = 0.005                 # α; ½/C_I by default
@@ -38,6 +39,15 @@
 //! contact_area = 16.0
 //! ```
 //!
+//! Boundary parts are named by the mesh: a Gmsh file's physical names of curve groups
+//! (`Physical Curve("outer") = {…};` in a `.geo` script), the square's sides `bottom`,
+//! `right`, `top`, `left`, the L-shape's `outer` and `reentrant` (its two re-entrant
+//! edges). A single name may be written without brackets. On the boundary outside the
+//! named parts the condition is the natural one, `∂u/∂n = 0`. A name the mesh does not
+//! have, a surface's name, a number (a physical tag: parts are chosen by name) and an
+//! empty list (no part where u = g: the membrane would be determined only up to a
+//! constant) are errors naming the field `boundary.dirichlet`.
+//!
 //! Expressions use `+ − * / ^`, parentheses, numbers, `PI`, `E`, and the functions
 //! `sqrt`, `exp`, `ln`, `sin`, `cos`, `tan`, `abs`, `min`, `max`, … of the `exmex`
 //! crate's `FloatOpsFactory`. A syntax error or a variable other than `x`, `y` is an
@@ -45,9 +55,9 @@
 
 use crate::membranes::MembranePair;
 use crate::models::data::Data;
-use crate::models::membrane_scenes::{Domain, Exact, ExactMembrane, MembraneScene};
+use crate::models::membrane_scenes::{DirichletParts, Domain, Exact, ExactMembrane, MembraneScene};
 use exmex::prelude::*;
-use fem_runtime::{Error, Result};
+use fem_runtime::{Error, Result, TriangleMesh};
 use serde::Deserialize;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -84,7 +94,7 @@ struct MeshToml {
 #[derive(Deserialize, Debug, Default)]
 #[serde(deny_unknown_fields)]
 struct BoundaryToml {
-    dirichlet: Option<String>,
+    dirichlet: Option<toml::Value>,
 }
 
 #[derive(Deserialize, Debug, Default)]
@@ -239,13 +249,59 @@ fn gradient_on_this_thread(text: &str, field: &str, file: &Path) -> Result<Data<
     }))
 }
 
+/// The `boundary.dirichlet` field: absent or `"all"`: the whole boundary; a name or a
+/// list of names: those boundary parts. The error is the message for the field.
+fn dirichlet_parts(value: Option<&toml::Value>) -> std::result::Result<DirichletParts, String> {
+    use toml::Value;
+    let by_name = "boundary parts are chosen by name (Gmsh physical names of curve groups, or a generator's side names), not by number; a Gmsh group without a name cannot be chosen: name it (Physical Curve(\"outer\") = {…};)";
+    let name = |v: &Value| {
+        match v {
+        Value::String(s) if s.trim().is_empty() => Err("an empty name".to_string()),
+        Value::String(s) => Ok(s.clone()),
+        Value::Integer(i) => Err(format!("{i} is a number: {by_name}")),
+        other => Err(format!(
+            "{other} is not a name: write \"all\", a name, or a list of names such as [\"left\", \"right\"]"
+        )),
+    }
+    };
+    match value {
+        None => Ok(DirichletParts::All),
+        Some(Value::String(s)) if s == "all" => Ok(DirichletParts::All),
+        Some(Value::Array(list)) if list.is_empty() => Err(
+            "an empty list: u = g would hold nowhere, and with ∂u/∂n = 0 on the whole boundary the membrane is determined only up to a constant where contact does not hold it; name at least one boundary part (or \"all\")".into(),
+        ),
+        Some(Value::Array(list)) => {
+            let mut names = Vec::with_capacity(list.len());
+            for v in list {
+                let n = name(v)?;
+                if !names.contains(&n) {
+                    names.push(n);
+                }
+            }
+            Ok(DirichletParts::Named(names))
+        }
+        Some(v) => Ok(DirichletParts::Named(vec![name(v)?])),
+    }
+}
+
+/// The generator's name in the scene file.
+fn mesh_generator_name(domain: &Domain) -> &'static str {
+    match domain {
+        Domain::Square(_) => "square",
+        Domain::LShape => "l-shape",
+        Domain::File(_) => "file",
+    }
+}
+
 /// Reads and checks a scene file.
 ///
 /// # Errors
 /// An unreadable file, TOML errors (with their line and column), unknown fields, a
 /// model other than `membrane`, an unknown pair or mesh generator, a mesh given both
-/// ways or neither, boundary parts other than the whole boundary, and expressions that
-/// do not parse or use variables other than x, y.
+/// ways or neither, boundary parts that are not names (numbers, an empty list) or not
+/// the generator's, and expressions that do not parse or use variables other than x,
+/// y. The names of a Gmsh file's parts are checked when it is read, by
+/// [`crate::membranes::solve`].
 pub fn read(path: &Path) -> Result<SceneFile> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         Error::Input(format!(
@@ -356,15 +412,31 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
             }
         }
     };
-    match file.boundary.dirichlet.as_deref() {
-        None | Some("all") => {}
-        Some(other) => {
-            return Err(at(
-                "boundary.dirichlet",
-                format!(
-                    "`{other}`: the membrane model holds u = g on the whole boundary (\"all\"); boundary parts by Gmsh physical name need a model with a natural condition elsewhere, which none has yet"
+    let dirichlet = dirichlet_parts(file.boundary.dirichlet.as_ref())
+        .map_err(|m| at("boundary.dirichlet", m))?;
+    if let DirichletParts::Named(names) = &dirichlet {
+        // a generator's names are known now: check them before any solve
+        let sample = match &domain {
+            Domain::Square(a) => Some(TriangleMesh::rectangle(
+                -a,
+                *a,
+                -a,
+                *a,
+                2,
+                2,
+                fem_runtime::Diagonal::Right,
+            )?),
+            Domain::LShape => Some(TriangleMesh::l_shape(1)?),
+            Domain::File(_) => None,
+        };
+        if let Some(mesh) = sample {
+            mesh.boundary_part_markers(names).map_err(|e| match e {
+                Error::Input(message) => at(
+                    "boundary.dirichlet",
+                    format!("{message} (generator `{}`)", mesh_generator_name(&domain)),
                 ),
-            ))
+                other => other,
+            })?;
         }
     }
     let data = &file.data;
@@ -415,6 +487,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         load_scale: Some(data.load.unwrap_or(1.0)),
         obstacle: expression(&data.psi, "data.psi", path)?,
         boundary: expression(&data.g, "data.g", path)?,
+        dirichlet,
         target_l2,
         exact,
     };
@@ -508,7 +581,15 @@ mod tests {
             (FLAT.replace("psi = \"0\"", "psi = \"0 +\""), "data.psi"),
             (FLAT.replace("g = \"0\"", "g = \"r\""), "data.g"),
             (
-                FLAT.replace("[data]", "[boundary]\ndirichlet = \"left\"\n[data]"),
+                FLAT.replace("[data]", "[boundary]\ndirichlet = \"outer\"\n[data]"),
+                "boundary.dirichlet",
+            ),
+            (
+                FLAT.replace("[data]", "[boundary]\ndirichlet = []\n[data]"),
+                "boundary.dirichlet",
+            ),
+            (
+                FLAT.replace("[data]", "[boundary]\ndirichlet = [4]\n[data]"),
                 "boundary.dirichlet",
             ),
             (format!("name = \"../escape/x\"\n{FLAT}"), "name"),
@@ -517,6 +598,38 @@ mod tests {
         ] {
             let e = parse(&broken, here()).unwrap_err().to_string();
             assert!(e.contains(field), "{field}: {e}");
+        }
+        let with =
+            |d: &str| FLAT.replace("[data]", &format!("[boundary]\ndirichlet = {d}\n[data]"));
+        for (d, expected) in [
+            ("\"all\"", DirichletParts::All),
+            ("\"left\"", DirichletParts::Named(vec!["left".into()])),
+            (
+                "[\"right\", \"left\", \"right\"]",
+                DirichletParts::Named(vec!["right".into(), "left".into()]),
+            ),
+        ] {
+            assert_eq!(
+                parse(&with(d), here()).unwrap().scene.dirichlet,
+                expected,
+                "{d}"
+            );
+        }
+        for (d, words) in [
+            (
+                "\"outer\"",
+                &["`outer`", "`left`", "generator `square`"][..],
+            ),
+            ("[]", &["empty list", "constant"]),
+            ("[4]", &["4 is a number", "by name"]),
+            ("[\"left\", 2.5]", &["2.5 is not a name"]),
+            ("\" \"", &["empty name"]),
+        ] {
+            let e = parse(&with(d), here()).unwrap_err().to_string();
+            assert!(
+                e.contains("boundary.dirichlet") && words.iter().all(|w| e.contains(w)),
+                "{d}: {e}"
+            );
         }
         let e = parse(&FLAT.replace("size = 8", "size = 8\nsizes = 3"), here())
             .unwrap_err()

@@ -185,3 +185,60 @@ fn scene_file_errors_name_the_field() {
         .to_string();
     assert!(e.contains("/nonexistent/scene.toml"), "{e}");
 }
+
+/// The strip example names its Dirichlet parts (Gmsh physical names): it solves the
+/// mixed problem whose exact ∫λ = 16 and contact area 2 (tests/boundary_parts.rs), and
+/// choosing the part `sides` (the same curves) gives the same numbers.
+#[test]
+fn the_strip_example_solves_with_named_boundary_parts() {
+    let file = scene_file::read(&example("membrane-strip.toml")).unwrap();
+    let (report, _) = membranes::solve(&request_of(&file)).unwrap();
+    assert_eq!(report.dirichlet_parts, ["left", "right"]);
+    assert!(report.complementarity_residual < 1e-8, "{report:?}");
+    assert!(
+        (report.total_contact_force - 16.0).abs() < 0.01,
+        "{report:?}"
+    );
+    assert!((report.contact_area - 2.0).abs() < 0.1, "{report:?}");
+    let text = std::fs::read_to_string(example("membrane-strip.toml")).unwrap();
+    let sides = text.replace(r#"["left", "right"]"#, r#""sides""#);
+    assert_ne!(sides, text);
+    let file = scene_file::parse(&sides, &example("membrane-strip.toml")).unwrap();
+    let (same, _) = membranes::solve(&request_of(&file)).unwrap();
+    assert_eq!(same.dirichlet_parts, ["sides"]);
+    assert_eq!(same.total_contact_force, report.total_contact_force);
+    assert_eq!(same.dofs, report.dofs);
+}
+
+/// A boundary part the Gmsh file does not name is refused by the command line with
+/// the field, the name and the file's names, not a panic.
+#[test]
+fn an_unknown_boundary_part_is_refused_by_the_command_line() {
+    let dir = std::env::temp_dir().join(format!("fem-forms-parts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(example("membrane-strip.toml")).unwrap();
+    let scene = dir.join("strip.toml");
+    std::fs::write(
+        &scene,
+        text.replace(r#"["left", "right"]"#, r#"["left", "rim"]"#)
+            .replace(
+                "square_named.msh",
+                &example("square_named.msh").display().to_string(),
+            ),
+    )
+    .unwrap();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["solve", "--scene"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+    for word in ["boundary.dirichlet", "`rim`", "`walls`", "`sides`"] {
+        assert!(stderr.contains(word), "{word}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

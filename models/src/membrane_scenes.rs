@@ -27,6 +27,30 @@ impl Domain {
     }
 }
 
+/// Where a membrane scene holds `u = g`; on the rest of the boundary the condition is
+/// the natural one, `∂u/∂n = 0` (the membrane's weak form `∫ ∇u·∇v` has no boundary
+/// term, and its stabilization works cell by cell, so nothing else changes).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum DirichletParts {
+    /// The whole boundary.
+    #[default]
+    All,
+    /// The boundary parts of these names: Gmsh physical names of curve groups, or the
+    /// names the generators give their sides (the square: `bottom`, `right`, `top`,
+    /// `left`; the L-shape: `outer`, `reentrant`).
+    Named(Vec<String>),
+}
+
+impl DirichletParts {
+    /// The part as reports name it: `["all"]` or the names.
+    pub fn names(&self) -> Vec<String> {
+        match self {
+            DirichletParts::All => vec!["all".into()],
+            DirichletParts::Named(names) => names.clone(),
+        }
+    }
+}
+
 /// A membrane scene's exact solution.
 #[derive(Clone, Debug)]
 pub struct ExactMembrane {
@@ -83,8 +107,10 @@ pub struct MembraneScene {
     pub load_scale: Option<f64>,
     /// The obstacle `ψ(x)` (from below: `u ≥ ψ`).
     pub obstacle: Data,
-    /// The boundary data `g(x)` (u = g on the whole boundary).
+    /// The boundary data `g(x)` (u = g on the Dirichlet part).
     pub boundary: Data,
+    /// Where u = g holds (the rest of the boundary: ∂u/∂n = 0).
+    pub dirichlet: DirichletParts,
     /// The accuracy the scene asks for: the L² error of u (estimated where no exact
     /// solution is known).
     pub target_l2: f64,
@@ -219,6 +245,7 @@ pub const MEMBRANE_FLAT: MembraneScene = MembraneScene {
     load_scale: Some(3.0),
     obstacle: Data::Fn(zero),
     boundary: Data::Fn(zero),
+    dirichlet: DirichletParts::All,
     target_l2: 1e-3,
     exact: Exact::OfLoad(flat_exact),
 };
@@ -239,6 +266,7 @@ pub const MEMBRANE_SCENES: [MembraneScene; 2] = [
         load_scale: None,
         obstacle: Data::Fn(radial_obstacle),
         boundary: Data::Fn(radial_u),
+        dirichlet: DirichletParts::All,
         target_l2: 1e-3,
         exact: Exact::AtDefaultLoad(RADIAL_EXACT),
     },
@@ -250,6 +278,7 @@ pub const MEMBRANE_SCENES: [MembraneScene; 2] = [
         load_scale: Some(12.0),
         obstacle: Data::Fn(lshape_obstacle),
         boundary: Data::Fn(zero),
+        dirichlet: DirichletParts::All,
         target_l2: 1e-3,
         exact: Exact::Unknown,
     },

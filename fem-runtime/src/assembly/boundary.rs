@@ -3,9 +3,9 @@
 //! Elimination keeps a symmetric matrix symmetric (and SPD stays SPD), which the
 //! Cholesky solve and the active-set solvers rely on.
 
-use crate::assembly::dof_map::SystemDofs;
+use crate::assembly::dof_map::{DofMap, SystemDofs};
 use crate::error::{Error, Result};
-use crate::mesh::IntervalMesh;
+use crate::mesh::{IntervalMesh, TriangleMesh};
 use crate::model::Model;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -18,6 +18,90 @@ pub enum Side {
     Left,
     /// The right end.
     Right,
+}
+
+/// The part of a triangle mesh's boundary where the Dirichlet condition holds; the rest
+/// of the boundary gets the natural condition of the form (for `∫ ∇u·∇v`: homogeneous
+/// Neumann, `∂u/∂n = 0`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum DirichletPart {
+    /// The whole boundary.
+    #[default]
+    All,
+    /// The boundary edges whose marker is one of these (see
+    /// [`TriangleMesh::boundary_part_markers`] to choose them by name).
+    Markers(Vec<u32>),
+}
+
+impl DirichletPart {
+    /// Whether boundary edges of marker `marker` belong to the part.
+    pub fn contains(&self, marker: u32) -> bool {
+        match self {
+            DirichletPart::All => true,
+            DirichletPart::Markers(m) => m.contains(&marker),
+        }
+    }
+
+    /// The number of `mesh`'s boundary edges in the part.
+    pub fn edge_count(&self, mesh: &TriangleMesh) -> usize {
+        mesh.boundary_edges()
+            .iter()
+            .filter(|&&(_, m)| self.contains(m))
+            .count()
+    }
+
+    /// For each vertex of `mesh`, whether it lies on an edge of the part (a vertex where
+    /// a Dirichlet edge meets a natural one is in the part).
+    pub fn vertices(&self, mesh: &TriangleMesh) -> Vec<bool> {
+        let mut flags = vec![false; mesh.vertex_count()];
+        for &(e, m) in mesh.boundary_edges() {
+            if self.contains(m) {
+                let [a, b] = mesh.edges()[e];
+                flags[a] = true;
+                flags[b] = true;
+            }
+        }
+        flags
+    }
+
+    /// The DOFs of `map` (a field on `mesh`) on the part: the vertex DOFs of its edges'
+    /// end points and the DOFs inside its edges (the P2 edge midpoints), sorted and
+    /// unique. For [`DirichletPart::All`] these are [`DofMap::boundary_dofs`].
+    pub fn dofs(&self, map: &DofMap, mesh: &TriangleMesh) -> Vec<usize> {
+        let DirichletPart::Markers(_) = self else {
+            return map.boundary_dofs(mesh);
+        };
+        let [per_vertex, per_edge, _] = map.element().triangle_layout();
+        if map.local_count()
+            != map
+                .element()
+                .local_dof_count(fem_reference::CellKind::Triangle)
+            || map.dof_count() == 0
+        {
+            return Vec::new();
+        }
+        // a cell lists its DOFs as vertex 0, 1, 2, then edge k (from vertex k to
+        // vertex k + 1) for k = 0, 1, 2, then its interior (DofMap::on_triangles)
+        let mut out = Vec::new();
+        for &(e, m) in mesh.boundary_edges() {
+            if !self.contains(m) {
+                continue;
+            }
+            let (c, _) = mesh.edge_cells(e);
+            let Some(k) = mesh.cell_edges(c).iter().position(|&x| x == e) else {
+                continue;
+            };
+            let local = map.cell_dofs(c);
+            for v in [k, (k + 1) % 3] {
+                out.extend_from_slice(&local[v * per_vertex..(v + 1) * per_vertex]);
+            }
+            let start = 3 * per_vertex + k * per_edge;
+            out.extend_from_slice(&local[start..start + per_edge]);
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
 }
 
 /// Fixed DOFs with their values.
@@ -232,5 +316,57 @@ impl Reduction {
             full[d] = free_values[k];
         }
         full
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Diagonal;
+    use fem_reference::ElementKind;
+
+    /// A mesh with cells of every orientation: alternating diagonals, then one cell
+    /// bisected (hanging-free closure), so the boundary edges sit at every local position.
+    fn mesh() -> TriangleMesh {
+        let m = TriangleMesh::rectangle(0.0, 2.0, 0.0, 1.0, 4, 3, Diagonal::Alternating).unwrap();
+        m.refine(&[0, 7, 20]).unwrap().0
+    }
+
+    #[test]
+    fn every_marker_gives_the_whole_boundary() {
+        let m = mesh();
+        for element in [ElementKind::P1, ElementKind::P2, ElementKind::P3] {
+            let map = DofMap::on_triangles(&m, element);
+            let all = DirichletPart::Markers(vec![1, 2, 3, 4]).dofs(&map, &m);
+            assert_eq!(all, map.boundary_dofs(&m), "{element:?}");
+            assert_eq!(DirichletPart::All.dofs(&map, &m), all);
+        }
+        let p0 = DofMap::on_triangles(&m, ElementKind::P0);
+        assert!(DirichletPart::Markers(vec![1]).dofs(&p0, &m).is_empty());
+    }
+
+    /// The DOFs of the left and right sides are exactly the DOFs whose nodes lie on
+    /// them (corners included: there a Dirichlet side meets a natural one).
+    #[test]
+    fn a_part_holds_the_dofs_on_its_edges() {
+        let m = mesh();
+        let part = DirichletPart::Markers(vec![4, 2]);
+        for element in [ElementKind::P1, ElementKind::P2, ElementKind::P3] {
+            let map = DofMap::on_triangles(&m, element);
+            let on_sides: Vec<usize> = map
+                .nodes(&m)
+                .iter()
+                .enumerate()
+                .filter(|(_, x)| x[0] == 0.0 || x[0] == 2.0)
+                .map(|(d, _)| d)
+                .collect();
+            assert_eq!(part.dofs(&map, &m), on_sides, "{element:?}");
+        }
+        let vertices = part.vertices(&m);
+        for (v, x) in m.vertices().iter().enumerate() {
+            assert_eq!(vertices[v], x[0] == 0.0 || x[0] == 2.0, "vertex {v}");
+        }
+        assert_eq!(part.edge_count(&m), 6);
+        assert_eq!(DirichletPart::Markers(vec![9]).edge_count(&m), 0);
     }
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use mshio::{ElementType, MshFile};
 
 use crate::error::{Error, Result};
-use crate::mesh::triangle::TriangleMesh;
+use crate::mesh::triangle::{NamedGroup, TriangleMesh};
 
 /// Reads a Gmsh `.msh` file (MSH 4.1, ASCII or binary) into a [`TriangleMesh`].
 ///
@@ -29,7 +29,14 @@ pub fn read_msh(path: &Path) -> Result<TriangleMesh> {
 /// one, else the curve's entity tag. Lines on interior edges (embedded curves) are
 /// ignored, and so are point elements. Nodes no triangle uses are dropped and the rest
 /// numbered compactly in increasing tag order. All nodes must lie in the plane `z = 0`
-/// (up to 1e-12 of the mesh's extent). Each clockwise triangle (of a surface whose
+/// (up to 1e-12 of the mesh's extent). The `$PhysicalNames` section (ASCII in ASCII and
+/// binary files alike) names the mesh's groups ([`TriangleMesh::named_groups`]): a named
+/// curve group (dimension 1) is a boundary part, the boundary edges whose marker is the
+/// first physical tag of one of its curves; point and surface names are kept so that
+/// choosing them as boundary parts is a clear error. A group whose curves share a marker
+/// with a curve outside it (a curve in two groups, or a curve without group whose entity
+/// tag equals a physical tag) cannot be chosen by marker: it is kept with the reason,
+/// given when it is chosen. Each clockwise triangle (of a surface whose
 /// normal is −z) is made counter-clockwise by itself, so surfaces of opposite normals
 /// can be mixed. Parametric node coordinates (`Mesh.SaveParametric = 1`) are dropped
 /// from ASCII files; binary files with them are refused with that hint.
@@ -54,6 +61,7 @@ pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
     let file = parse_with_mshio(bytes)?;
     let nodes = node_table(&file, if binary { None } else { ascii_node_tags(bytes) })?;
     let elements = collect_elements(&file)?;
+    let names = physical_names(bytes)?;
 
     // compact numbering of the nodes the triangles use, in increasing tag order
     let mut used: Vec<u64> = elements.triangles.iter().flat_map(|t| t.1).collect();
@@ -94,7 +102,8 @@ pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
     refuse_duplicate_nodes(&mesh).map_err(annotate)?;
 
     let mut markers = Vec::with_capacity(elements.lines.len());
-    for &(element, [n0, n1], marker) in &elements.lines {
+    let mut boundary_curves = Vec::new();
+    for &(element, [n0, n1], marker, curve) in &elements.lines {
         for n in [n0, n1] {
             if nodes.get(n).is_none() {
                 return Err(Error::Mesh(format!(
@@ -115,10 +124,152 @@ pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
         // Lines on interior edges belong to embedded curves, which carry no boundary marker.
         if mesh.edge_cells(edge).1.is_none() {
             markers.push((a, b, marker));
+            if !boundary_curves.contains(&curve) {
+                boundary_curves.push(curve);
+            }
         }
     }
     mesh.apply_markers(&markers).map_err(annotate)?;
+    mesh.set_named_groups(named_groups(&file, &names, &boundary_curves));
     Ok(mesh)
+}
+
+/// `(dimension, physical tag, name)` of each entry of the `$PhysicalNames` section, in
+/// file order; empty without the section. Gmsh writes the section as text in binary
+/// files too, and `mshio` skips it, so it is read here.
+///
+/// # Errors
+/// [`Error::Mesh`] with the line for a malformed section.
+fn physical_names(bytes: &[u8]) -> Result<Vec<(usize, i32, String)>> {
+    let mut lines = bytes.split(|&b| b == b'\n').enumerate();
+    if !lines
+        .by_ref()
+        .any(|(_, l)| l.trim_ascii() == b"$PhysicalNames")
+    {
+        return Ok(Vec::new());
+    }
+    let malformed = |line: usize, why: &str| {
+        Error::Mesh(format!(
+            "cannot read the $PhysicalNames section at line {}: {why}",
+            line + 1
+        ))
+    };
+    let mut text = |what: &str| -> Result<(usize, String)> {
+        let (i, l) = lines.next().ok_or_else(|| {
+            Error::Mesh(format!(
+                "cannot read the $PhysicalNames section: the file ends before {what}"
+            ))
+        })?;
+        let l = std::str::from_utf8(l).map_err(|_| malformed(i, "the line is not UTF-8 text"))?;
+        Ok((i, l.trim().to_string()))
+    };
+    let (at, count) = text("the number of names")?;
+    let count: usize = count
+        .parse()
+        .map_err(|_| malformed(at, &format!("`{count}` is not a number of names")))?;
+    let mut names = Vec::with_capacity(count.min(1 << 16));
+    for _ in 0..count {
+        let (at, line) = text("its last name")?;
+        let (numbers, quoted) =
+            line.split_at(line.find('"').ok_or_else(|| {
+                malformed(at, &format!("`{line}` is not `dimension tag \"name\"`"))
+            })?);
+        let mut numbers = numbers.split_whitespace();
+        let (Some(Ok(dimension)), Some(Ok(tag)), None) = (
+            numbers.next().map(str::parse::<usize>),
+            numbers.next().map(str::parse::<i32>),
+            numbers.next(),
+        ) else {
+            return Err(malformed(
+                at,
+                &format!("`{line}` is not `dimension tag \"name\"`"),
+            ));
+        };
+        let name = quoted
+            .strip_prefix('"')
+            .and_then(|q| q.strip_suffix('"'))
+            .ok_or_else(|| malformed(at, &format!("the name in `{line}` is not quoted")))?;
+        if dimension > 3 {
+            return Err(malformed(
+                at,
+                &format!("dimension {dimension} is not 0 to 3"),
+            ));
+        }
+        names.push((dimension, tag, name.to_string()));
+    }
+    let (at, end) = text("$EndPhysicalNames")?;
+    if end != "$EndPhysicalNames" {
+        return Err(malformed(
+            at,
+            &format!("expected $EndPhysicalNames after {count} names, found `{end}`"),
+        ));
+    }
+    Ok(names)
+}
+
+/// The mesh's named groups from the `$PhysicalNames` entries and the curves' physical
+/// tags; `boundary_curves` are the curves whose lines gave boundary markers.
+fn named_groups(
+    file: &MshFile<u64, i32, f64>,
+    names: &[(usize, i32, String)],
+    boundary_curves: &[i32],
+) -> Vec<NamedGroup> {
+    let curves = file
+        .data
+        .entities
+        .as_ref()
+        .map_or(&[][..], |e| e.curves.as_slice());
+    // the marker of a curve's lines, as collect_elements gives it
+    let marker = |tag: i32| -> i32 {
+        curves
+            .iter()
+            .find(|c| c.tag == tag)
+            .and_then(|c| c.physical_tags.first().copied())
+            .unwrap_or(tag)
+    };
+    names
+        .iter()
+        .map(|(dimension, tag, name)| {
+            let mut group = NamedGroup {
+                name: name.clone(),
+                dimension: *dimension,
+                markers: Vec::new(),
+                ambiguity: None,
+            };
+            if *dimension != 1 {
+                return group;
+            }
+            if file.data.entities.is_none() {
+                group.ambiguity = Some(
+                    "the file has no $Entities section, which links physical groups to their curves".into(),
+                );
+                return group;
+            }
+            let members: Vec<i32> = curves
+                .iter()
+                .filter(|c| c.physical_tags.contains(tag))
+                .map(|c| c.tag)
+                .collect();
+            let mut markers: Vec<i32> = members.iter().map(|&c| marker(c)).collect();
+            markers.sort_unstable();
+            markers.dedup();
+            let intruder = boundary_curves
+                .iter()
+                .find(|c| !members.contains(c) && markers.contains(&marker(**c)));
+            if let Some(&other) = intruder {
+                let m = marker(other);
+                let inside = members.iter().find(|&&c| marker(c) == m).copied().unwrap_or(m);
+                group.ambiguity = Some(format!(
+                    "its curve {inside} has boundary marker {m} (the first physical group of the curve, else the curve's own tag), and so has curve {other}, which is not in the group; in Gmsh, put each boundary curve in one physical group only (or in this one first), and every boundary curve in some physical group"
+                ));
+            }
+            group.markers = markers
+                .into_iter()
+                .filter_map(|m| u32::try_from(m).ok())
+                .collect();
+            group
+        })
+        .collect()
 }
 
 /// Checks the `$MeshFormat` header before `mshio` sees it, for clearer messages (and
@@ -384,8 +535,8 @@ fn strip_parametric(bytes: &[u8]) -> Option<Vec<u8>> {
 struct Elements {
     /// (element tag, node tags)
     triangles: Vec<(u64, [u64; 3])>,
-    /// (element tag, node tags, marker)
-    lines: Vec<(u64, [u64; 2], u32)>,
+    /// (element tag, node tags, marker, curve's entity tag)
+    lines: Vec<(u64, [u64; 2], u32, i32)>,
 }
 
 fn type_name(t: ElementType) -> String {
@@ -433,7 +584,12 @@ fn collect_elements(file: &MshFile<u64, i32, f64>) -> Result<Elements> {
                     ))
                 })?;
                 for e in &block.elements {
-                    lines.push((e.element_tag, [e.nodes[0], e.nodes[1]], marker));
+                    lines.push((
+                        e.element_tag,
+                        [e.nodes[0], e.nodes[1]],
+                        marker,
+                        block.entity_tag,
+                    ));
                 }
             }
             _ => {}
@@ -741,7 +897,7 @@ $EndElements
         // the unit square in binary MSH 4.1 (little endian, 8-byte size_t), no $Entities
         let mut b: Vec<u8> = b"$MeshFormat\n4.1 1 8\n".to_vec();
         b.extend(1i32.to_le_bytes());
-        b.extend(b"\n$EndMeshFormat\n$Nodes\n");
+        b.extend(b"\n$EndMeshFormat\n$PhysicalNames\n1\n1 5 \"base\"\n$EndPhysicalNames\n$Nodes\n");
         let size = |b: &mut Vec<u8>, x: u64| b.extend(x.to_le_bytes());
         let int = |b: &mut Vec<u8>, x: i32| b.extend(x.to_le_bytes());
         for x in [1, 4, 1, 4] {
@@ -785,6 +941,11 @@ $EndElements
         );
         assert_eq!(m.cell_count(), 2);
         assert_eq!(marker_of(&m, [0.0, 0.0], [1.0, 0.0]), 5);
+        // the names are text in binary files too; without $Entities no curve is known
+        // to be in the group
+        assert_eq!(m.boundary_part_names(), ["base"]);
+        let e = m.boundary_part_markers(&["base"]).unwrap_err().to_string();
+        assert!(e.contains("$Entities"), "{e}");
         // a binary header with an integer size mshio cannot read is an error, not a panic
         let mut odd = b.clone();
         odd[18] = b'3';
@@ -979,6 +1140,89 @@ $EndElements
                 && e.contains("Coherence"),
             "{e}"
         );
+    }
+
+    /// SQUARE with a `$PhysicalNames` section: curve groups 10 and 20, the surface
+    /// group 100, and a curve group 30 that no curve is in.
+    fn named_square() -> String {
+        SQUARE.replace(
+            "$EndMeshFormat\n",
+            "$EndMeshFormat\n$PhysicalNames\n4\n1 10 \"bottom\"\n1 20 \"right side\"\n2 100 \"plate\"\n1 30 \"nowhere\"\n$EndPhysicalNames\n",
+        )
+    }
+
+    #[test]
+    fn physical_names_name_boundary_parts() {
+        let m = parse_msh(named_square().as_bytes()).unwrap();
+        assert_eq!(m.boundary_part_names(), ["bottom", "right side", "nowhere"]);
+        assert_eq!(m.boundary_part_markers(&["bottom"]).unwrap(), [10]);
+        assert_eq!(
+            m.boundary_part_markers(&["right side", "bottom"]).unwrap(),
+            [10, 20]
+        );
+        // the bottom edge, marker 10, is the part `bottom`
+        assert_eq!(marker_of(&m, [0.0, 0.0], [1.0, 0.0]), 10);
+        assert_eq!(m.boundary_edges_with_markers(&[10]), 1);
+        // a group without curves has no markers: it selects no edge
+        assert_eq!(
+            m.boundary_part_markers(&["nowhere"]).unwrap(),
+            Vec::<u32>::new()
+        );
+        let e = m.boundary_part_markers(&["plate"]).unwrap_err().to_string();
+        assert!(e.contains("`plate`") && e.contains("surface"), "{e}");
+        let e = m.boundary_part_markers(&["left"]).unwrap_err().to_string();
+        assert!(
+            e.contains("`left`") && e.contains("`bottom`") && e.contains("`right side`"),
+            "{e}"
+        );
+        // curve 4 has no group: its marker is its entity tag, which has no name
+        let e = m.boundary_part_markers(&["4"]).unwrap_err().to_string();
+        assert!(
+            e.contains("not by tag or marker")
+                && e.contains("marker 4 exist, but no name")
+                && e.contains("Physical Curve"),
+            "{e}"
+        );
+        // a physical tag that has a name: the message names it
+        let e = m.boundary_part_markers(&["20"]).unwrap_err().to_string();
+        assert!(e.contains("marker 20 belong to `right side`"), "{e}");
+        // the names stay through refinement
+        let fine = m.refine_uniformly();
+        assert_eq!(fine.boundary_part_markers(&["bottom"]).unwrap(), [10]);
+        assert_eq!(fine.boundary_edges_with_markers(&[10]), 2);
+        // a file without the section names nothing
+        assert!(parse_msh(SQUARE.as_bytes())
+            .unwrap()
+            .named_groups()
+            .is_empty());
+    }
+
+    #[test]
+    fn a_group_sharing_its_marker_with_another_curve_cannot_be_chosen() {
+        // curve 3 in group 4, curve 4 in no group: both lines get marker 4
+        let text = named_square()
+            .replace("3 0 1 0 1 1 0 0 2 3 -4", "3 0 1 0 1 1 0 1 4 2 3 -4")
+            .replace("4\n1 10 \"bottom\"", "5\n1 4 \"top\"\n1 10 \"bottom\"");
+        let m = parse_msh(text.as_bytes()).unwrap();
+        let e = m.boundary_part_markers(&["top"]).unwrap_err().to_string();
+        assert!(
+            e.contains("`top`") && e.contains("curve 3") && e.contains("curve 4"),
+            "{e}"
+        );
+        // the other groups are unaffected
+        assert_eq!(m.boundary_part_markers(&["bottom"]).unwrap(), [10]);
+    }
+
+    #[test]
+    fn malformed_physical_names_are_errors_with_their_line() {
+        let e = error(&named_square().replace("\"bottom\"", "bottom"));
+        assert!(e.contains("$PhysicalNames") && e.contains("line 6"), "{e}");
+        let e = error(&named_square().replace("1 10 \"bottom\"", "x 10 \"bottom\""));
+        assert!(e.contains("line 6") && e.contains("dimension tag"), "{e}");
+        let e = error(&named_square().replace("\n4\n1 10", "\n5\n1 10"));
+        assert!(e.contains("$EndPhysicalNames"), "{e}");
+        let e = error(&named_square().replace("\n4\n1 10", "\nmany\n1 10"));
+        assert!(e.contains("line 5") && e.contains("many"), "{e}");
     }
 
     #[test]

@@ -1173,6 +1173,48 @@ mod tests {
         assert!(s.contact_cells().is_empty());
     }
 
+    /// u = g on the left and right sides only, `∂u/∂n = 0` on top and bottom: with
+    /// g = x + 7x(1 − x) (= x on the sides, not on top and bottom), f = 0 and the
+    /// obstacle far below, the solution is u = x, which P1 reproduces exactly, on every
+    /// level of a nested solve (refinement keeps the sides' markers).
+    #[test]
+    fn membrane_with_natural_condition_on_top_and_bottom() {
+        use crate::assembly::boundary::DirichletPart;
+        use crate::obstacle::triangle::solve_obstacle_on_part;
+        let (load, obstacle) = (|_: &[f64]| 0.0, |_: &[f64]| -10.0);
+        let g = |x: &[f64]| x[0] + 7.0 * x[0] * (1.0 - x[0]);
+        let c = Coefficients::new::<membrane_p1::Model>(
+            &[("alpha", 0.1)],
+            &[("f", &load), ("ψ", &obstacle), ("g", &g)],
+        )
+        .unwrap();
+        let coarse = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap();
+        let meshes = [coarse.clone(), coarse.refine_uniformly()];
+        let sides =
+            DirichletPart::Markers(coarse.boundary_part_markers(&["left", "right"]).unwrap());
+        let s =
+            solve_obstacle_on_part::<membrane_p1::Model>(&meshes, &c, &sides, Default::default())
+                .unwrap();
+        let u = s.field(0);
+        for (v, x) in s.discretization.mesh.vertices().iter().enumerate() {
+            assert!((u[v] - x[0]).abs() < 1e-12, "vertex {v} at {x:?}: {}", u[v]);
+        }
+        // on the whole boundary the same data give another solution
+        let all =
+            solve_obstacle_on_triangles::<membrane_p1::Model>(&meshes, &c, Default::default())
+                .unwrap();
+        assert!(all.field(0).iter().zip(u).any(|(a, b)| (a - b).abs() > 0.1));
+        // no Dirichlet edge: refused, not solved
+        let none = DirichletPart::Markers(vec![99]);
+        let Err(e) =
+            solve_obstacle_on_part::<membrane_p1::Model>(&meshes, &c, &none, Default::default())
+        else {
+            panic!("a problem without Dirichlet edge was solved");
+        };
+        let e = e.to_string();
+        assert!(e.contains("not coercive") && e.contains("u = g"), "{e}");
+    }
+
     /// Pushed down onto `ψ = 0 = g`: every cell is in contact, `∫λ = 1`, energy 0.
     #[test]
     fn membrane_pressed_flat_is_in_contact_everywhere() {

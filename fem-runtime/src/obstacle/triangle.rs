@@ -1,9 +1,10 @@
 //! Obstacle problems on triangle meshes: the model's Dirichlet data (`boundary:`)
-//! interpolated at the boundary DOFs, nested iteration over a sequence of meshes, the
+//! interpolated at the boundary DOFs (of the whole boundary or of a [`DirichletPart`],
+//! the rest natural), nested iteration over a sequence of meshes, the
 //! classical nodal-constraint method for comparison, and the solution's contact force
 //! and contact area.
 
-use crate::assembly::boundary::Constraints;
+use crate::assembly::boundary::{Constraints, DirichletPart};
 use crate::assembly::dof_map::SystemDofs;
 use crate::element::triangle::{TriangleBasis, TriangleField};
 use crate::error::{Error, Result};
@@ -16,21 +17,55 @@ use crate::SparseMatrix;
 use faer::sparse::SparseColMat;
 use std::time::Instant;
 
-/// The fixed DOFs of the model's `boundary:` conditions: each field's boundary DOFs get
-/// its data function's value at their nodes.
+/// The fixed DOFs of the model's `boundary:` conditions on the whole boundary: each
+/// field's boundary DOFs get its data function's value at their nodes.
 pub fn dirichlet_constraints<M: Model>(
     mesh: &TriangleMesh,
     dofs: &SystemDofs,
     coefficients: &Coefficients,
 ) -> Result<Constraints> {
+    dirichlet_constraints_on::<M>(mesh, dofs, coefficients, &DirichletPart::All)
+}
+
+/// The fixed DOFs of the model's `boundary:` conditions on `part` of the boundary
+/// ([`DirichletPart::dofs`]: for P2 the midpoints of its edges, and the vertices where
+/// it meets the rest, are fixed); the rest of the boundary gets the form's natural
+/// condition.
+///
+/// # Errors
+/// [`Error::Input`] when the model has a `boundary:` condition and `part` holds no
+/// boundary edge of the mesh (a problem with natural conditions only, which the
+/// membrane does not determine: u + constant solves it wherever contact does not hold
+/// it), and for boundary data that is not finite at a node.
+pub fn dirichlet_constraints_on<M: Model>(
+    mesh: &TriangleMesh,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+    part: &DirichletPart,
+) -> Result<Constraints> {
     let mut constraints = Constraints::new();
+    if !M::DIRICHLET.is_empty() && part.edge_count(mesh) == 0 {
+        return Err(Error::Input(format!(
+            "the Dirichlet part of the boundary (markers {}) holds none of the mesh's {} boundary edges: with the natural condition on the whole boundary the problem is not coercive (u + constant solves it wherever contact does not hold it); choose at least one boundary part for `{}`",
+            match part {
+                DirichletPart::All => "all".to_string(),
+                DirichletPart::Markers(m) => format!("{m:?}"),
+            },
+            mesh.boundary_edges().len(),
+            M::DIRICHLET
+                .iter()
+                .map(|&(f, d)| format!("{} = {}", M::FIELDS[f].name, M::DATA[d]))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
     for &(field, data) in M::DIRICHLET {
         let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
             continue;
         };
         let nodes = map.nodes(mesh);
         let g = coefficients.data[data];
-        for dof in map.boundary_dofs(mesh) {
+        for dof in part.dofs(map, mesh) {
             let x = nodes[dof];
             let value = g(&x);
             if !value.is_finite() {
@@ -49,15 +84,27 @@ pub fn dirichlet_constraints<M: Model>(
 }
 
 /// Assembles `bilinear`, `linear` (normally `B_h`, `L_h`) of `M` on a triangle mesh with
-/// the model's Dirichlet data, as an LCP.
+/// the model's Dirichlet data on the whole boundary, as an LCP.
 pub fn discretize_on_triangles<M: Model>(
     mesh: &TriangleMesh,
     coefficients: &Coefficients,
     bilinear: &str,
     linear: &str,
 ) -> Result<Discretization<TriangleMesh>> {
+    discretize_on_part::<M>(mesh, coefficients, &DirichletPart::All, bilinear, linear)
+}
+
+/// [`discretize_on_triangles`] with the Dirichlet data on `part` of the boundary only
+/// (errors: as [`dirichlet_constraints_on`]).
+pub fn discretize_on_part<M: Model>(
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    part: &DirichletPart,
+    bilinear: &str,
+    linear: &str,
+) -> Result<Discretization<TriangleMesh>> {
     let dofs = SystemDofs::all::<M>(mesh)?;
-    let constraints = dirichlet_constraints::<M>(mesh, &dofs, coefficients)?;
+    let constraints = dirichlet_constraints_on::<M>(mesh, &dofs, coefficients, part)?;
     Discretization::with_constraints::<M>(mesh, coefficients, dofs, &constraints, bilinear, linear)
 }
 
@@ -124,16 +171,29 @@ fn prolong_fields(
 pub type TriangleObstacleSolution = ObstacleSolution<TriangleMesh>;
 
 /// Solves the obstacle problem `B_h`, `L_h` of `M` on the last of `meshes`, each mesh
-/// started from the solution on the one before (nested iteration).
+/// started from the solution on the one before (nested iteration), with the Dirichlet
+/// data on the whole boundary.
 pub fn solve_obstacle_on_triangles<M: Model>(
     meshes: &[TriangleMesh],
     coefficients: &Coefficients,
     options: ObstacleOptions,
 ) -> Result<TriangleObstacleSolution> {
+    solve_obstacle_on_part::<M>(meshes, coefficients, &DirichletPart::All, options)
+}
+
+/// [`solve_obstacle_on_triangles`] with the Dirichlet data on `part` of the boundary
+/// only. The part is given by markers, which refined meshes inherit from their parent
+/// edges ([`TriangleMesh::refine`]), so it is the same part on every level.
+pub fn solve_obstacle_on_part<M: Model>(
+    meshes: &[TriangleMesh],
+    coefficients: &Coefficients,
+    part: &DirichletPart,
+    options: ObstacleOptions,
+) -> Result<TriangleObstacleSolution> {
     solve_nested(
         meshes
             .iter()
-            .map(|mesh| move || discretize_on_triangles::<M>(mesh, coefficients, "B_h", "L_h"))
+            .map(|mesh| move || discretize_on_part::<M>(mesh, coefficients, part, "B_h", "L_h"))
             .collect(),
         prolong_primal_on_triangles,
         options,

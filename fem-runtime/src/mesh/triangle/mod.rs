@@ -8,10 +8,12 @@
 //! fall into at most four similarity classes per initial cell.
 
 mod locate;
+mod parts;
 mod quality;
 mod refine;
 
 pub use locate::PointLocator;
+pub use parts::NamedGroup;
 pub use quality::{
     estimated_bytes, MeshQuality, REFUSE_MAX_ANGLE_DEG, WARN_MAX_ANGLE_DEG, WARN_MIN_ANGLE_DEG,
 };
@@ -49,6 +51,8 @@ pub struct TriangleMesh {
     edge_cells: Vec<[usize; 2]>,
     /// Sorted by edge.
     boundary_edges: Vec<(usize, u32)>,
+    /// Named groups (boundary parts by marker), kept by refinement.
+    groups: Vec<NamedGroup>,
 }
 
 fn mesh_error(message: String) -> Error {
@@ -233,6 +237,7 @@ impl TriangleMesh {
             cell_edges,
             edge_cells,
             boundary_edges,
+            groups: Vec::new(),
         })
     }
 
@@ -328,7 +333,9 @@ impl TriangleMesh {
 
     /// `nx × ny` squares on `[x0, x1] × [y0, y1]`, each split as `diagonal` says.
     ///
-    /// Boundary markers: 1 bottom (`y = y0`), 2 right, 3 top, 4 left.
+    /// Boundary markers: 1 bottom (`y = y0`), 2 right, 3 top, 4 left; the boundary
+    /// parts (see [`TriangleMesh::boundary_part_markers`]) are named `bottom`,
+    /// `right`, `top` and `left`.
     pub fn rectangle(
         x0: f64,
         x1: f64,
@@ -393,11 +400,17 @@ impl TriangleMesh {
             markers.push((id(nx, j), id(nx, j + 1), 2));
             markers.push((id(0, j), id(0, j + 1), 4));
         }
-        Self::new(vertices, cells, &markers)
+        Self::new(vertices, cells, &markers)?.with_boundary_names(&[
+            ("bottom", &[1]),
+            ("right", &[2]),
+            ("top", &[3]),
+            ("left", &[4]),
+        ])
     }
 
     /// A disk: a centre vertex and `rings` rings, ring `k` with `6k` vertices at radius
-    /// `k/rings · radius`; neighbouring rings are zipped by angle. Boundary marker 1.
+    /// `k/rings · radius`; neighbouring rings are zipped by angle. Boundary marker 1,
+    /// the boundary part named `circle`.
     pub fn disk(centre: [f64; 2], radius: f64, rings: usize) -> Result<Self> {
         if !(centre[0].is_finite() && centre[1].is_finite()) {
             return Err(mesh_error(format!(
@@ -449,13 +462,14 @@ impl TriangleMesh {
         }
         let (s, n) = (ring_start(rings), 6 * rings);
         let markers: Vec<_> = (0..n).map(|i| (s + i, s + (i + 1) % n, 1)).collect();
-        Self::new(vertices, cells, &markers)
+        Self::new(vertices, cells, &markers)?.with_boundary_names(&[("circle", &[1])])
     }
 
     /// The L-shaped domain `(−1, 1)² \ [0, 1] × [−1, 0]`: the `2n × 2n` grid of squares of
     /// side `1/n` on `(−1, 1)²` with `Right` diagonals, less the lower-right quadrant.
     ///
-    /// Marker 2 on the re-entrant edges (`{0} × [−1, 0]` and `[0, 1] × {0}`), 1 elsewhere.
+    /// Marker 2 on the re-entrant edges (`{0} × [−1, 0]` and `[0, 1] × {0}`), 1 elsewhere;
+    /// the boundary parts are named `reentrant` (marker 2) and `outer` (marker 1).
     pub fn l_shape(n: usize) -> Result<Self> {
         if n == 0 {
             return Err(mesh_error(
@@ -495,7 +509,8 @@ impl TriangleMesh {
             markers.push((at(0, k), at(0, k + 1), 1)); // left
             markers.push((at(k, m), at(k + 1, m), 1)); // top
         }
-        Self::new(vertices, cells, &markers)
+        Self::new(vertices, cells, &markers)?
+            .with_boundary_names(&[("outer", &[1]), ("reentrant", &[2])])
     }
 
     /// Number of vertices.

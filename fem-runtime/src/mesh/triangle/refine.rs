@@ -8,7 +8,8 @@ impl TriangleMesh {
     ///
     /// Returns the new mesh and, for each new cell, its parent cell in `self`. Indices may
     /// repeat; an out-of-range index is an error. Each cell is bisected at most twice in
-    /// depth (into two, three or four children); boundary markers pass to edge halves.
+    /// depth (into two, three or four children); boundary markers pass to edge halves and
+    /// the named groups are kept, so every boundary part stays the same part.
     pub fn refine(&self, marked: &[usize]) -> Result<(TriangleMesh, Vec<usize>)> {
         let mut edge_marked = vec![false; self.edges.len()];
         let mut queue = Vec::new();
@@ -96,6 +97,7 @@ impl TriangleMesh {
         }
         let mut mesh = Self::from_oriented(vertices, cells)?;
         mesh.apply_markers(&markers)?;
+        mesh.set_named_groups(self.groups.clone());
         Ok((mesh, parents))
     }
 }

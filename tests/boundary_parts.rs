@@ -1,0 +1,306 @@
+//! Boundary parts by name: u = g on the named parts, ∂u/∂n = 0 on the rest.
+//!
+//! The mixed problem on (−1, 1)²: u = 1 on the left and right sides (x = ±1),
+//! ∂u/∂n = 0 on the top and bottom, f = −8, ψ = 0. Its solution depends on x alone: the
+//! 1-D obstacle problem −u'' = −8, u ≥ 0, u(±1) = 1, whose solution (derived by hand)
+//! is u = 4 (|x| − ½)₊²: on ½ < |x| < 1, u'' = 8 with u = u' = 0 at |x| = ½ (contact
+//! ends smoothly) and u(±1) = 4·¼ = 1. On the contact strip |x| < ½, λ = −Δu − f = 8,
+//! so ∫λ = 8 · (1 × 2) = 16 and the contact area is 2. Imposing g = 1 on the whole
+//! boundary instead gives another solution (u = 1 ≠ 4 (|x| − ½)₊² on top and bottom),
+//! so a wrong Dirichlet part cannot pass.
+
+use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
+use fem_forms::mesh::gmsh::read_msh;
+use fem_forms::models::data::Data;
+use fem_forms::models::membrane_scenes::{Exact, ExactMembrane};
+use fem_forms::scene_file::{self, SceneFile};
+use std::path::{Path, PathBuf};
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn strip_u(x: &[f64]) -> f64 {
+    4.0 * (x[0].abs() - 0.5).max(0.0).powi(2)
+}
+
+fn strip_gradient(x: &[f64]) -> [f64; 2] {
+    [8.0 * (x[0].abs() - 0.5).max(0.0) * x[0].signum(), 0.0]
+}
+
+fn strip_multiplier(x: &[f64]) -> f64 {
+    if x[0].abs() < 0.5 {
+        8.0
+    } else {
+        0.0
+    }
+}
+
+/// The scene file of the strip problem with `mesh` (a `[mesh]` body) and `dirichlet`.
+fn strip_scene(mesh: &str, dirichlet: &str) -> String {
+    format!(
+        r#"
+        name = "strip"
+        model = "membrane"
+        [mesh]
+        {mesh}
+        [boundary]
+        dirichlet = {dirichlet}
+        [data]
+        load = 8.0
+        f = "-1"
+        psi = "0"
+        g = "1"
+        "#
+    )
+}
+
+const GMSH: &str = "file = \"square_named.msh\"";
+
+/// The scene file parsed as if it lay in tests/data, with the exact solution attached.
+fn parse(text: &str) -> fem_forms::Result<SceneFile> {
+    let mut file = scene_file::parse(text, &data("strip.toml"))?;
+    file.scene.exact = Exact::AtDefaultLoad(ExactMembrane {
+        u: Data::Fn(strip_u),
+        gradient: Data::Fn(strip_gradient),
+        multiplier: Some(Data::Fn(strip_multiplier)),
+        total_contact_force: Some(16.0),
+        contact_area: Some(2.0),
+    });
+    Ok(file)
+}
+
+fn solve(file: &SceneFile, pair: MembranePair, mesh_size: usize) -> MembraneReport {
+    let mut request = MembraneRequest::new(file.scene.clone());
+    request.pair = pair;
+    request.mesh_size = mesh_size;
+    membranes::solve(&request)
+        .unwrap_or_else(|e| panic!("{} at {mesh_size}: {e}", pair.name()))
+        .0
+}
+
+/// Errors of a sequence of meshes whose sizes h fall by the factors `h_ratios`: L² and
+/// H¹ fall at least at the rates `l2_rate`, `h1_rate` from one to the next, and the
+/// finest solve is certified and reports its Dirichlet parts.
+fn check_convergence(reports: &[MembraneReport], h_ratios: &[f64], l2_rate: f64, h1_rate: f64) {
+    for (w, &h_ratio) in reports.windows(2).zip(h_ratios) {
+        let (coarse, fine) = (&w[0], &w[1]);
+        let ratio = |f: fn(&MembraneReport) -> Option<f64>| f(coarse).unwrap() / f(fine).unwrap();
+        let (l2, h1) = (ratio(|r| r.error_l2), ratio(|r| r.error_h1));
+        assert!(
+            l2 >= h_ratio.powf(l2_rate) && h1 >= h_ratio.powf(h1_rate),
+            "{} at {} → {}: L² ratio {l2}, H¹ ratio {h1} ({:?} → {:?})",
+            fine.pair,
+            coarse.triangles,
+            fine.triangles,
+            coarse.error_l2,
+            fine.error_l2
+        );
+    }
+    let finest = reports.last().unwrap();
+    assert!(finest.complementarity_residual < 1e-8, "{finest:?}");
+    assert_eq!(finest.dirichlet_parts, ["left", "right"]);
+    assert!(finest.error_l2.unwrap() < 1e-2, "{finest:?}");
+    // ∫λ_h → 16 and the contact area → 2 (the strip |x| < ½)
+    assert!(
+        (finest.total_contact_force - 16.0).abs() < 0.05 * 16.0,
+        "{}: ∫λ_h = {}",
+        finest.pair,
+        finest.total_contact_force
+    );
+    assert!(
+        (finest.contact_area - 2.0).abs() < 0.25,
+        "{}: contact area {}",
+        finest.pair,
+        finest.contact_area
+    );
+}
+
+/// The P1 rates are 2 (L²) and 1 (H¹); P2 is limited by u ∈ H^{5/2−ε} (u'' jumps at
+/// |x| = ½, inside cells) to about 2.5 and 1.5, reached only on fine meshes (H¹ on the
+/// Gmsh square's levels: 0.85–1.0, then 1.5). The bounds leave room for that range.
+fn rates(pair: MembranePair) -> (f64, f64) {
+    match pair.degree() {
+        1 => (1.7, 0.8),
+        _ => (2.0, 0.8),
+    }
+}
+
+#[test]
+fn mixed_problem_on_a_gmsh_file_with_physical_names_converges_to_the_exact_solution() {
+    let file = parse(&strip_scene(GMSH, r#"["left", "right"]"#)).unwrap();
+    for pair in MembranePair::ALL {
+        let reports: Vec<MembraneReport> = (1..=3).map(|r| solve(&file, pair, r)).collect();
+        let (l2, h1) = rates(pair);
+        check_convergence(&reports, &[2.0, 2.0], l2, h1);
+    }
+}
+
+#[test]
+fn mixed_problem_on_the_generator_square_converges_to_the_exact_solution() {
+    let mesh = "generator = \"square\"\nhalf_width = 1.0\nsize = 8";
+    let file = parse(&strip_scene(mesh, r#"["left", "right"]"#)).unwrap();
+    // odd N: the free boundary x = ±½ never lies on grid lines (it would for N = 4k,
+    // where P2 is exact: u is piecewise quadratic in x)
+    for pair in MembranePair::ALL {
+        let reports: Vec<MembraneReport> = [7, 15, 31].map(|n| solve(&file, pair, n)).to_vec();
+        let (l2, h1) = rates(pair);
+        check_convergence(&reports, &[15.0 / 7.0, 31.0 / 15.0], l2, h1);
+    }
+}
+
+/// The same data with u = g on the whole boundary: the Dirichlet part matters (an
+/// error of order 1 against the mixed problem's solution), so the tests above can fail.
+#[test]
+fn the_whole_boundary_gives_another_solution() {
+    for (mesh, size) in [
+        (GMSH, 2),
+        ("generator = \"square\"\nhalf_width = 1.0\nsize = 8", 16),
+    ] {
+        let file = parse(&strip_scene(mesh, "\"all\"")).unwrap();
+        for pair in [
+            MembranePair::P1P0,
+            MembranePair::P2P0,
+            MembranePair::P1Nodal,
+        ] {
+            let report = solve(&file, pair, size);
+            assert_eq!(report.dirichlet_parts, ["all"]);
+            assert!(report.error_l2.unwrap() > 0.1, "{report:?}");
+        }
+    }
+}
+
+/// `sides` holds the same curves as `left` and `right` (each of those curves is in
+/// two physical groups): it is the same problem, solved the same way.
+#[test]
+fn a_group_of_curves_in_two_groups_is_the_same_part() {
+    let named = parse(&strip_scene(GMSH, r#"["right", "left"]"#)).unwrap();
+    let sides = parse(&strip_scene(GMSH, "\"sides\"")).unwrap();
+    for pair in [MembranePair::P2P1Disc, MembranePair::P1Nodal] {
+        let (a, b) = (solve(&named, pair, 1), solve(&sides, pair, 1));
+        assert_eq!((a.dofs, a.iterations), (b.dofs, b.iterations));
+        assert_eq!(a.error_l2, b.error_l2);
+        assert_eq!(b.dirichlet_parts, ["sides"]);
+    }
+}
+
+#[test]
+fn the_file_names_its_parts_and_refinement_keeps_them() {
+    let mesh = read_msh(&data("square_named.msh")).unwrap();
+    assert_eq!(
+        mesh.boundary_part_names(),
+        ["left", "right", "walls", "sides"]
+    );
+    let fine = mesh.refine_uniformly().refine_uniformly();
+    for m in [&mesh, &fine] {
+        let edges_on = |name: &str| {
+            let markers = m.boundary_part_markers(&[name]).unwrap();
+            m.boundary_edges()
+                .iter()
+                .filter(|e| markers.contains(&e.1))
+                .map(|&(e, _)| m.edges()[e])
+                .collect::<Vec<_>>()
+        };
+        for (name, x) in [("left", -1.0), ("right", 1.0)] {
+            let edges = edges_on(name);
+            assert!(!edges.is_empty());
+            assert!(edges.iter().flatten().all(|&v| m.vertices()[v][0] == x));
+        }
+        let walls = edges_on("walls");
+        assert!(walls
+            .iter()
+            .flatten()
+            .all(|&v| m.vertices()[v][1].abs() == 1.0));
+        assert_eq!(
+            walls.len() + edges_on("sides").len(),
+            m.boundary_edges().len()
+        );
+    }
+}
+
+/// The binary file of the same mesh (MSH 4.1, `$PhysicalNames` as text in it) reads to
+/// the same mesh, names and markers included.
+#[test]
+fn the_binary_file_names_the_same_parts() {
+    let ascii = read_msh(&data("square_named.msh")).unwrap();
+    let binary = read_msh(&data("square_named_binary.msh")).unwrap();
+    assert_eq!(binary, ascii);
+    assert_eq!(binary.boundary_part_markers(&["sides"]).unwrap(), [11, 12]);
+}
+
+/// A named curve group with no boundary edge (here: no curve at all) is no Dirichlet
+/// part: u = g would hold nowhere, so the solve is refused, not run pure Neumann.
+#[test]
+fn a_part_without_boundary_edges_is_refused() {
+    let dir = std::env::temp_dir().join(format!("fem-forms-slit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(data("square_named.msh")).unwrap();
+    let with_slit = text.replace("$PhysicalNames\n6\n", "$PhysicalNames\n7\n1 15 \"slit\"\n");
+    assert_ne!(with_slit, text);
+    std::fs::write(dir.join("square_named.msh"), with_slit).unwrap();
+    let mut file =
+        scene_file::parse(&strip_scene(GMSH, "\"slit\""), &dir.join("strip.toml")).unwrap();
+    file.scene.exact = Exact::Unknown;
+    let mut request = MembraneRequest::new(file.scene);
+    request.mesh_size = 0;
+    let e = match membranes::solve(&request) {
+        Ok(_) => panic!("solved without a Dirichlet edge"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("boundary.dirichlet") && e.contains("`slit`") && e.contains("no boundary edge"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Bad boundary parts are errors naming `boundary.dirichlet`, never a solve.
+#[test]
+fn bad_boundary_parts_are_refused_with_clear_messages() {
+    let refused = |dirichlet: &str| -> String {
+        let file = match parse(&strip_scene(GMSH, dirichlet)) {
+            Ok(file) => file,
+            Err(e) => return e.to_string(),
+        };
+        let mut request = MembraneRequest::new(file.scene.clone());
+        request.mesh_size = 0;
+        match membranes::solve(&request) {
+            Ok(_) => panic!("{dirichlet} was solved"),
+            Err(e) => e.to_string(),
+        }
+    };
+    for (dirichlet, words) in [
+        // a name the mesh does not have: the names it has
+        (
+            r#"["left", "outer"]"#,
+            &[
+                "`outer`",
+                "`left`",
+                "`right`",
+                "`walls`",
+                "`sides`",
+                "square_named.msh",
+            ][..],
+        ),
+        // a surface
+        (r#""membrane""#, &["`membrane`", "surface"]),
+        // a physical tag instead of its name, as a number or as text
+        ("[11]", &["11 is a number", "by name"]),
+        (
+            r#"["11"]"#,
+            &["`11`", "by name", "marker 11 belong to `left`"],
+        ),
+        // no part where u = g: pure Neumann
+        ("[]", &["empty list", "constant"]),
+    ] {
+        let e = refused(dirichlet);
+        assert!(
+            e.contains("boundary.dirichlet")
+                && words.iter().all(|w| e.contains(w))
+                && e.matches("invalid input").count() <= 1,
+            "{dirichlet}: {e}"
+        );
+    }
+}
