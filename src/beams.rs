@@ -4,7 +4,9 @@ use crate::models::membrane_scenes::MAX_LOAD;
 use crate::models::scenes::{exact_solution, Beam, Scene};
 use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
 use fem_runtime::lcp::NewtonOptions;
-use fem_runtime::obstacle::{solve_obstacle, Discretization, ObstacleOptions, VariationalSolver};
+use fem_runtime::obstacle::{
+    solve_obstacle, system_forms, Discretization, ObstacleOptions, VariationalSolver,
+};
 use fem_runtime::stabilization;
 use fem_runtime::{Coefficients, DataFn, Error, IntervalMesh, Model, Result};
 use serde::Serialize;
@@ -274,7 +276,8 @@ fn discretize_with<M: Model>(request: &Request, pair: Pair) -> Result<Discretiza
     let setup = Setup::new(request, pair)?;
     let coefficients = setup.coefficients::<M>()?;
     let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
-    Discretization::new::<M>(&mesh, &coefficients, setup.clamped, "B_h", "L_h")
+    let (bilinear, linear) = system_forms::<M>()?;
+    Discretization::new::<M>(&mesh, &coefficients, setup.clamped, bilinear, linear)
 }
 
 /// Parameters and data of a request, validated.

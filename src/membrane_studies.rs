@@ -7,7 +7,8 @@ use crate::models::membrane::{membrane_p1_p0, membrane_p2_p0};
 use crate::models::membrane_scenes::{Domain, MembraneScene};
 use crate::studies::{ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study, StudyScene};
 use fem_runtime::lcp::cholesky::Cholesky;
-use fem_runtime::obstacle::triangle::discretize_on_triangles;
+use fem_runtime::obstacle::system_forms;
+use fem_runtime::obstacle::triangle::discretize_on_part;
 use fem_runtime::obstacle::Discretization;
 use fem_runtime::{Diagonal, Error, Model, Result, TriangleMesh};
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -97,8 +98,10 @@ pub fn inf_sup<M: Model>(
     let load = scene.load_magnitude(None).map_err(Error::Input)?;
     let data = membranes::SceneData::new(scene, load);
     let coefficients = membranes::scene_coefficients::<M>(&data, alpha)?;
+    let part = membranes::dirichlet_part(scene, mesh, "the study's mesh")?;
+    let (bilinear, linear) = system_forms::<M>()?;
     let d: Discretization<TriangleMesh> =
-        discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h")?;
+        discretize_on_part::<M>(mesh, &coefficients, &part, bilinear, linear)?;
     let lcp = &d.lcp;
     let (n, m) = (lcp.n(), lcp.m());
     if m > 4000 {

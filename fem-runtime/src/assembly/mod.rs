@@ -12,7 +12,7 @@ pub mod linear_problem;
 use crate::assembly::dof_map::SystemDofs;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::model::{Coefficients, Model};
+use crate::model::{Coefficients, IntoFormIndex, Model};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
@@ -120,7 +120,11 @@ pub struct MatrixAssembler {
 
 impl MatrixAssembler {
     /// Builds the pattern of bilinear form `form_name` of `M` on the system `dofs`.
-    pub fn new<M: Model>(form_name: &str, mesh: &impl Mesh, dofs: &SystemDofs) -> Result<Self> {
+    pub fn new<M: Model>(
+        form_name: impl IntoFormIndex<M>,
+        mesh: &impl Mesh,
+        dofs: &SystemDofs,
+    ) -> Result<Self> {
         let form = M::form(form_name)?;
         let plans = block_plans::<M>(form, dofs, true)?;
         let n = dofs.dof_count();
@@ -229,7 +233,7 @@ impl MatrixAssembler {
 
 /// Assembles linear form `form_name` of `M` on the system `dofs`.
 pub fn assemble_vector<M: Model>(
-    form_name: &str,
+    form_name: impl IntoFormIndex<M>,
     mesh: &impl Mesh,
     dofs: &SystemDofs,
     coefficients: &Coefficients,

@@ -18,7 +18,7 @@ use crate::lcp::{
     NewtonWorkspace,
 };
 use crate::mesh::{IntervalMesh, Mesh};
-use crate::model::{Coefficients, Model};
+use crate::model::{Coefficients, FormId, IntoFormIndex, Model};
 use crate::norms::FieldView;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -86,8 +86,8 @@ impl Discretization<IntervalMesh> {
         mesh: &IntervalMesh,
         coefficients: &Coefficients,
         clamped: &[&str],
-        bilinear: &str,
-        linear: &str,
+        bilinear: impl IntoFormIndex<M>,
+        linear: impl IntoFormIndex<M>,
     ) -> Result<Self> {
         let dofs = SystemDofs::all::<M>(mesh)?;
         let mut constraints = Constraints::new();
@@ -126,17 +126,19 @@ impl Discretization<IntervalMesh> {
 
 impl<G: DofNumbering + Clone> Discretization<G> {
     /// Assembles `bilinear` and `linear` of `M` on `mesh` with the DOFs `dofs`, eliminates
-    /// the fixed DOFs of `constraints` and splits the system into the LCP blocks.
+    /// the fixed DOFs of `constraints` and splits the system into the LCP blocks. The forms
+    /// are named by handle (`M::SYSTEM`, `model::forms::B_h`) or by name (`"B_h"`).
     pub fn with_constraints<M: Model>(
         mesh: &G,
         coefficients: &Coefficients,
         dofs: SystemDofs,
         constraints: &Constraints,
-        bilinear: &str,
-        linear: &str,
+        bilinear: impl IntoFormIndex<M>,
+        linear: impl IntoFormIndex<M>,
     ) -> Result<Self> {
         let multiplier = multiplier_field::<M>()?;
         let form = M::form(bilinear)?;
+        let bilinear = M::FORMS[form].name;
         let plans = block_plans::<M>(form, &dofs, true)?;
         let reduction = constraints.reduction(dofs.dof_count())?;
         let multiplier_range = dofs.range(multiplier).unwrap();
@@ -521,6 +523,20 @@ pub fn prolong<M: Model>(
     fine
 }
 
+/// The forms `B_h`, `L_h` of `M` that the obstacle solvers assemble ([`Model::SYSTEM`]).
+///
+/// # Errors
+/// [`Error::Input`] for a model without a bilinear form `B_h` and a linear form `L_h`.
+pub fn system_forms<M: Model>() -> Result<(FormId<M>, FormId<M>)> {
+    let [bilinear, linear] = M::SYSTEM.ok_or_else(|| {
+        Error::Input(format!(
+            "model `{}` has no bilinear form `B_h` and linear form `L_h`, the system the obstacle solvers assemble",
+            M::NAME
+        ))
+    })?;
+    Ok((FormId::new(bilinear), FormId::new(linear)))
+}
+
 /// A solved obstacle problem.
 pub struct ObstacleSolution<G = IntervalMesh> {
     /// The discrete problem on the finest mesh.
@@ -668,6 +684,7 @@ pub fn solve_obstacle<M: Model>(
             .all(|(a, b)| (a - b).abs() <= 1e-12 * (1.0 + a.abs()))
     })
     .unwrap_or(false);
+    let (bilinear, linear) = system_forms::<M>()?;
     let mut sizes = vec![mesh.cell_count()];
     if let (Some(min), true, VariationalSolver::SemismoothNewton) =
         (options.nested_from, uniform, options.solver)
@@ -688,7 +705,7 @@ pub fn solve_obstacle<M: Model>(
                 } else {
                     IntervalMesh::uniform(a, b, cells)?
                 };
-                Discretization::new::<M>(&level_mesh, coefficients, clamped, "B_h", "L_h")
+                Discretization::new::<M>(&level_mesh, coefficients, clamped, bilinear, linear)
             }
         })
         .collect();
@@ -1075,6 +1092,50 @@ mod tests {
                 L_h(v,μ)     = ℓ(v) − G(μ) − alpha ℓ_S(v,μ)
             ";
         }
+    }
+
+    crate::model! {
+        /// The string with its system under other names than `B_h`, `L_h`.
+        pub mod string_renamed on interval {
+            unknowns: u: P1, λ: P0 >= 0;
+            tests: v, μ;
+            data: f, ψ;
+            forms: "
+                K(u,λ;v,μ) = ∫ u'v' − λ v − u μ
+                F(v,μ)     = ∫ f v − ψ μ
+            ";
+        }
+    }
+
+    /// The solvers find the system through `Model::SYSTEM`: a model without `B_h`, `L_h`
+    /// is a clear error, and its forms still assemble by handle or name.
+    #[test]
+    fn the_system_is_found_at_compile_time_and_its_absence_is_named() {
+        assert_eq!(
+            string_p1::Model::SYSTEM,
+            Some([
+                string_p1::Model::form("B_h").unwrap(),
+                string_p1::Model::form("L_h").unwrap()
+            ])
+        );
+        assert_eq!(string_renamed::Model::SYSTEM, None);
+        let (one, low) = (|_: &[f64]| 1.0, |_: &[f64]| -1.0);
+        let c =
+            Coefficients::new::<string_renamed::Model>(&[], &[("f", &one), ("ψ", &low)]).unwrap();
+        let mesh = IntervalMesh::uniform(0.0, 1.0, 8).unwrap();
+        let error = solve_obstacle::<string_renamed::Model>(&mesh, &c, &["u"], Default::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(error.contains("no bilinear form `B_h`"), "{error}");
+        let d = Discretization::new::<string_renamed::Model>(
+            &mesh,
+            &c,
+            &["u"],
+            string_renamed::forms::K,
+            string_renamed::forms::F,
+        );
+        assert!(d.is_ok());
     }
 
     /// `boundary: u = g` on an interval model (issue 11: it used to be ignored): with

@@ -11,8 +11,10 @@ use crate::error::{Error, Result};
 use crate::lcp::cholesky::{multiply, Cholesky};
 use crate::lcp::{Lcp, LcpSolution};
 use crate::mesh::triangle::{PointLocator, TriangleMesh};
-use crate::model::{Coefficients, Model};
-use crate::obstacle::{solve_nested, Discretization, ObstacleOptions, ObstacleSolution};
+use crate::model::{Coefficients, IntoFormIndex, Model};
+use crate::obstacle::{
+    solve_nested, system_forms, Discretization, ObstacleOptions, ObstacleSolution,
+};
 use crate::SparseMatrix;
 use faer::sparse::SparseColMat;
 use std::time::Instant;
@@ -88,8 +90,8 @@ pub fn dirichlet_constraints_on<M: Model>(
 pub fn discretize_on_triangles<M: Model>(
     mesh: &TriangleMesh,
     coefficients: &Coefficients,
-    bilinear: &str,
-    linear: &str,
+    bilinear: impl IntoFormIndex<M>,
+    linear: impl IntoFormIndex<M>,
 ) -> Result<Discretization<TriangleMesh>> {
     discretize_on_part::<M>(mesh, coefficients, &DirichletPart::All, bilinear, linear)
 }
@@ -100,8 +102,8 @@ pub fn discretize_on_part<M: Model>(
     mesh: &TriangleMesh,
     coefficients: &Coefficients,
     part: &DirichletPart,
-    bilinear: &str,
-    linear: &str,
+    bilinear: impl IntoFormIndex<M>,
+    linear: impl IntoFormIndex<M>,
 ) -> Result<Discretization<TriangleMesh>> {
     let dofs = SystemDofs::all::<M>(mesh)?;
     let constraints = dirichlet_constraints_on::<M>(mesh, &dofs, coefficients, part)?;
@@ -190,10 +192,11 @@ pub fn solve_obstacle_on_part<M: Model>(
     part: &DirichletPart,
     options: ObstacleOptions,
 ) -> Result<TriangleObstacleSolution> {
+    let (bilinear, linear) = system_forms::<M>()?;
     solve_nested(
         meshes
             .iter()
-            .map(|mesh| move || discretize_on_part::<M>(mesh, coefficients, part, "B_h", "L_h"))
+            .map(|mesh| move || discretize_on_part::<M>(mesh, coefficients, part, bilinear, linear))
             .collect(),
         prolong_primal_on_triangles,
         options,
