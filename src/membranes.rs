@@ -32,6 +32,78 @@ pub enum MembranePair {
     P1Nodal,
 }
 
+/// A pair as data: its name, the degree of u, its measured memory, and for a stabilized
+/// pair the entry points of its model (instantiated for the model's type). Adding a pair
+/// is one row here and its variant of [`MembranePair`].
+struct PairRow {
+    pair: MembranePair,
+    name: &'static str,
+    degree: usize,
+    /// Measured peak bytes per triangle of the finest mesh (see [`check_memory`]).
+    bytes_per_triangle: f64,
+    /// `None` for the nodal method (no multiplier space, no stabilization).
+    stabilized: Option<Stabilized>,
+}
+
+/// A stabilized solve: (request, posed, meshes, α, C_I) → report and fields.
+type StabilizedRun = fn(
+    &MembraneRequest,
+    &Posed,
+    &[TriangleMesh],
+    f64,
+    f64,
+) -> Result<(MembraneReport, MembraneFields)>;
+
+/// The entry points of a stabilized pair's model.
+struct Stabilized {
+    inverse_constant: fn(&TriangleMesh) -> Result<f64>,
+    element_inverse_constant: fn(&[f64; 6]) -> Result<f64>,
+    /// `run_stabilized` of the model: (request, posed, meshes, α, C_I) → report, fields.
+    run: StabilizedRun,
+}
+
+impl Stabilized {
+    const fn of<M: Model>() -> Self {
+        Self {
+            inverse_constant: inverse_constant::<M>,
+            element_inverse_constant: element_inverse_constant::<M>,
+            run: run_stabilized::<M>,
+        }
+    }
+}
+
+/// Every pair, in the order of [`MembranePair::ALL`].
+const PAIRS: [PairRow; 4] = [
+    PairRow {
+        pair: MembranePair::P1P0,
+        name: "p1-p0",
+        degree: 1,
+        bytes_per_triangle: 1.4e3,
+        stabilized: Some(Stabilized::of::<membrane_p1_p0::Model>()),
+    },
+    PairRow {
+        pair: MembranePair::P2P0,
+        name: "p2-p0",
+        degree: 2,
+        bytes_per_triangle: 2.3e3,
+        stabilized: Some(Stabilized::of::<membrane_p2_p0::Model>()),
+    },
+    PairRow {
+        pair: MembranePair::P2P1Disc,
+        name: "p2-p1d",
+        degree: 2,
+        bytes_per_triangle: 3.5e3,
+        stabilized: Some(Stabilized::of::<membrane_p2_p1disc::Model>()),
+    },
+    PairRow {
+        pair: MembranePair::P1Nodal,
+        name: "p1-nodal",
+        degree: 1,
+        bytes_per_triangle: 1.4e3,
+        stabilized: None,
+    },
+];
+
 impl MembranePair {
     /// Every pair.
     pub const ALL: [MembranePair; 4] = [
@@ -41,35 +113,34 @@ impl MembranePair {
         MembranePair::P1Nodal,
     ];
 
+    fn row(self) -> &'static PairRow {
+        let row = &PAIRS[self as usize];
+        debug_assert_eq!(row.pair, self);
+        row
+    }
+
     /// The name on the command line.
     pub fn name(self) -> &'static str {
-        match self {
-            MembranePair::P1P0 => "p1-p0",
-            MembranePair::P2P0 => "p2-p0",
-            MembranePair::P2P1Disc => "p2-p1d",
-            MembranePair::P1Nodal => "p1-nodal",
-        }
+        self.row().name
     }
 
     /// The pair called `name`.
     pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|p| p.name() == name)
+        PAIRS
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.pair)
             .ok_or_else(|| {
                 Error::Input(format!(
                     "unknown membrane pair `{name}`; the pairs are {}",
-                    Self::ALL.map(|p| p.name()).join(", ")
+                    PAIRS.map(|p| p.name).join(", ")
                 ))
             })
     }
 
     /// Polynomial degree of u.
     pub fn degree(self) -> usize {
-        match self {
-            MembranePair::P1P0 | MembranePair::P1Nodal => 1,
-            _ => 2,
-        }
+        self.row().degree
     }
 }
 
@@ -313,27 +384,6 @@ pub fn inverse_constant<M: Model>(mesh: &TriangleMesh) -> Result<f64> {
     stabilization::inverse_constant::<M, _>(mesh, &vec![0.0; M::PARAMS.len()], "S", "a")
 }
 
-/// Runs `$body` with `M` the model type of a stabilized `$pair`.
-macro_rules! dispatch {
-    ($pair:expr, $m:ident => $body:expr, nodal => $nodal:expr) => {
-        match $pair {
-            MembranePair::P1P0 => {
-                type $m = membrane_p1_p0::Model;
-                $body
-            }
-            MembranePair::P2P0 => {
-                type $m = membrane_p2_p0::Model;
-                $body
-            }
-            MembranePair::P2P1Disc => {
-                type $m = membrane_p2_p1disc::Model;
-                $body
-            }
-            MembranePair::P1Nodal => $nodal,
-        }
-    };
-}
-
 /// The data a solve uses: the load f (the scene's load field times q), the obstacle ψ
 /// and the boundary data g.
 #[derive(Clone, Debug)]
@@ -402,7 +452,10 @@ pub fn membrane_options(solver: VariationalSolver) -> ObstacleOptions {
 
 /// The α a request uses and the mesh's `C_I`.
 pub fn alpha_of(request: &MembraneRequest, mesh: &TriangleMesh) -> Result<(f64, f64)> {
-    let c_i = dispatch!(request.pair, M => inverse_constant::<M>(mesh)?, nodal => 0.0);
+    let c_i = match &request.pair.row().stabilized {
+        Some(model) => (model.inverse_constant)(mesh)?,
+        None => 0.0,
+    };
     let policy = request.alpha.map_or(Alpha::default(), Alpha::Fixed);
     Ok((policy.value(c_i, ALPHA_WHEN_CI_VANISHES)?, c_i))
 }
@@ -503,9 +556,10 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
         other => other,
     })?;
     check_stabilization_above_rounding(request, mesh, &quality, c_i)?;
-    let (mut report, fields) = dispatch!(request.pair,
-        M => run_stabilized::<M>(request, &posed, &meshes, alpha, c_i),
-        nodal => run_nodal(request, &posed, &meshes))?;
+    let (mut report, fields) = match &request.pair.row().stabilized {
+        Some(model) => (model.run)(request, &posed, &meshes, alpha, c_i),
+        None => run_nodal(request, &posed, &meshes),
+    }?;
     report.warnings.extend(quality.warnings(mesh));
     if report.max_penetration.is_nan() {
         // JSON has no NaN: the field prints as null, so the reason must be said here
@@ -543,9 +597,10 @@ fn check_stabilization_above_rounding(
         return Ok(());
     }
     let equilateral = [0.0, 0.0, 1.0, 0.0, 0.5, 0.75f64.sqrt()];
-    let regular = dispatch!(request.pair,
-        M => element_inverse_constant::<M>(&equilateral)?,
-        nodal => 0.0);
+    let regular = match &request.pair.row().stabilized {
+        Some(model) => (model.element_inverse_constant)(&equilateral)?,
+        None => 0.0,
+    };
     let relative = 0.5 / c_i * regular;
     if relative >= SMALLEST_RELATIVE_STABILIZATION {
         return Ok(());
@@ -641,7 +696,7 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
     if request.mesh_file.is_some() || matches!(request.scene.domain, Domain::File(_)) {
         return Ok(());
     }
-    let per_triangle = bytes_per_triangle(request.pair);
+    let per_triangle = request.pair.row().bytes_per_triangle;
     let n = request.mesh_size as f64;
     let bytes = 2.0 * n * n * per_triangle;
     if bytes > MEMORY_LIMIT_BYTES {
@@ -654,15 +709,6 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
         )));
     }
     Ok(())
-}
-
-/// Measured peak bytes per triangle of the finest mesh (see [`check_memory`]).
-fn bytes_per_triangle(pair: MembranePair) -> f64 {
-    match pair {
-        MembranePair::P1P0 | MembranePair::P1Nodal => 1.4e3,
-        MembranePair::P2P0 => 2.3e3,
-        MembranePair::P2P1Disc => 3.5e3,
-    }
 }
 
 /// The levels of a Gmsh mesh: the file's mesh and its `refinements` uniform
@@ -688,7 +734,7 @@ fn file_levels(
     let bytes = fem_runtime::mesh::triangle::estimated_bytes(
         mesh.cell_count(),
         refinements as u32,
-        bytes_per_triangle(pair),
+        pair.row().bytes_per_triangle,
     );
     if bytes > MEMORY_LIMIT_BYTES {
         return Err(Error::Input(format!(
