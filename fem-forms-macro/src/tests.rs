@@ -81,23 +81,27 @@ fn unicode_and_ascii_spellings_give_the_same_blocks() {
                     test_name: "η".into(),
                     element: ElementKind::P2,
                     nonnegative: false,
+                    component: None,
                 },
                 Field {
                     name: "w".into(),
                     test_name: "v".into(),
                     element: ElementKind::P2,
                     nonnegative: false,
+                    component: None,
                 },
                 Field {
                     name: "λ".into(),
                     test_name: "μ".into(),
                     element: ElementKind::P0,
                     nonnegative: true,
+                    component: None,
                 },
             ],
             params: vec!["t".into(), "α".into(), "s".into()],
             data: vec![("f".into(), 2), ("ψ".into(), 2)],
             dimension: 1,
+            ..Default::default()
         };
         let (tokens, e1) = lexer::tokenize(text);
         let (defs, e2) = parser::parse_forms(&tokens);
@@ -274,10 +278,12 @@ mod symbolic_properties {
                 test_name: "v".into(),
                 element: ElementKind::P3,
                 nonnegative: false,
+                component: None,
             }],
             params: vec!["t".into(), "α".into()],
             data: vec![("f".into(), 2)],
             dimension: 1,
+            ..Default::default()
         }
     }
 
@@ -381,17 +387,20 @@ fn vector_calculus_ascii_and_unicode_agree_and_expand_componentwise() {
                 test_name: "v".into(),
                 element: ElementKind::P2,
                 nonnegative: false,
+                component: None,
             },
             Field {
                 name: "λ".into(),
                 test_name: "μ".into(),
                 element: ElementKind::P0,
                 nonnegative: true,
+                component: None,
             },
         ],
         params: vec!["α".into()],
         data: vec![("f".into(), 2)],
         dimension: 2,
+        ..Default::default()
     };
     let blocks = |text: &str| {
         let (tokens, errors) = lexer::tokenize(text);
@@ -409,10 +418,12 @@ fn vector_calculus_ascii_and_unicode_agree_and_expand_componentwise() {
             test_name: "v".into(),
             element: ElementKind::P3,
             nonnegative: false,
+            component: None,
         }],
         params: vec![],
         data: vec![],
         dimension: 2,
+        ..Default::default()
     };
     let terms = analysis::expand_expression(&symbols, "∇u·∇v").unwrap();
     let mut multi: Vec<Vec<[u8; 2]>> = terms
@@ -436,7 +447,14 @@ fn vector_errors_point_at_the_expression() {
             "a(u;v) = ∫ u'v'",
             "a prime ′ is the derivative along an interval",
         ),
-        ("a(u;v) = ∫ ∇(∇u)·v", "a vector where a scalar is needed"),
+        ("a(u;v) = ∫ ∇(∇u)·v", "a matrix where a scalar is needed"),
+        ("a(u;v) = ∫ ∇∇∇u : ∇∇v", "∇ of a matrix"),
+        ("a(u;v) = ∫ ε(u) : ε(v)", "ε of a scalar"),
+        ("a(u;v) = ∫ div u v", "div of a scalar"),
+        ("a(u;v) = ∫ tr ∇u v", "tr of a vector"),
+        ("a(u;v) = ∫ ∇∇u : ∇v", "`:` of a matrix and a vector"),
+        ("a(u;v) = ∫ ∇∇u · ∇∇v", "product of two matrices"),
+        ("a(u;v) = ∫ ∇u − u v", "difference of a vector and a scalar"),
     ];
     for (forms, message) in cases {
         let errors = rendered_errors(&expand(membrane("P2", forms)));
