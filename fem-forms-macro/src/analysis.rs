@@ -1203,6 +1203,12 @@ impl Context<'_> {
         let name = |i: usize| self.symbols.params[i].as_str();
         let mut strictly = false;
         for t in x {
+            if !t.coefficient.is_finite() {
+                return Err(format!(
+                    "a term's coefficient overflows ({})",
+                    t.coefficient
+                ));
+            }
             if t.coefficient <= 0.0 {
                 return Err(format!("a term has the coefficient {}", t.coefficient));
             }

@@ -211,6 +211,7 @@ fn expand(input: TokenStream) -> TokenStream {
 fn symbols(declaration: &Declaration) -> Symbols {
     let mut fields = Vec::new();
     let mut vectors = Vec::new();
+    let dimension = declaration.cell.map_or(1, |c| c.dimension());
     for (k, u) in declaration.unknowns.iter().enumerate() {
         let name = u.name.to_string();
         let test_name = declaration
@@ -229,8 +230,10 @@ fn symbols(declaration: &Declaration) -> Symbols {
             });
             continue;
         }
-        // A wrong component count is reported by `check`; the analysis goes on with 2.
-        let n = 2;
+        // A wrong component count (or a vector on an interval) is reported by `check`;
+        // the analysis goes on with one component per coordinate, so that every
+        // vector and matrix it builds has the cell's dimension.
+        let n = dimension;
         let trial = declaration::component_names(&name, n);
         let test = declaration::component_names(&test_name, n);
         for (axis, (name, test_name)) in trial.into_iter().zip(test).enumerate() {
@@ -259,7 +262,7 @@ fn symbols(declaration: &Declaration) -> Symbols {
             .iter()
             .map(|d| (d.name.to_string(), d.degree))
             .collect(),
-        dimension: declaration.cell.map_or(1, |c| c.dimension()),
+        dimension,
     }
 }
 

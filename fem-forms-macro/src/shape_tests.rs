@@ -315,6 +315,7 @@ fn division_by_positive_sums() {
         ("1/(t − t)", "it is zero"),
         ("1/(t + w)", "holds functions, data or integrals"),
         ("(t + ν)⁻¹", "`ν` is not declared positive"),
+        ("1/(1e200·1e200 + t)", "overflows"),
     ];
     for (divisor, message) in refused {
         let text = format!("a(θ;η) = ∫ {divisor} θ·η");

@@ -647,6 +647,22 @@ mod no_panic {
         "!",
         "é",
         "\"",
+        "θ",
+        "η_y",
+        "ε",
+        "eps",
+        "div",
+        "tr",
+        "I",
+        ":",
+        "∂_x",
+        "d_y",
+        "[",
+        "]",
+        "/(t² + h²)",
+        "/(t − 1)",
+        "(1e200 + t)",
+        "a(θ;η) =",
     ];
 
     fn model(cell: &str, forms: &str) -> TokenStream {
@@ -656,6 +672,21 @@ mod no_panic {
                 unknowns: u: P2, λ: P0 >= 0;
                 tests: v, μ;
                 params: t;
+                data: f;
+                forms: #forms;
+            }
+        }
+    }
+
+    /// The same with a vector field θ: [P1]^2 (an error on intervals, after which the
+    /// analysis must still not panic).
+    fn vector_model(cell: &str, forms: &str) -> TokenStream {
+        let cell = proc_macro2::Ident::new(cell, proc_macro2::Span::call_site());
+        quote! {
+            pub mod m on #cell {
+                unknowns: θ: [P1]^2, u: P2, λ: P0 >= 0;
+                tests: η, v, μ;
+                params: t > 0;
                 data: f;
                 forms: #forms;
             }
@@ -681,7 +712,31 @@ mod no_panic {
     fn integrand() -> impl Strategy<Value = String> {
         let leaf = prop::sample::select(
             &[
-                "u", "v", "u'", "v''", "∇u", "∇v", "Δu", "λ", "μ", "f", "t", "h", "2", "1e300", "0",
+                "u",
+                "v",
+                "u'",
+                "v''",
+                "∇u",
+                "∇v",
+                "Δu",
+                "λ",
+                "μ",
+                "f",
+                "t",
+                "h",
+                "2",
+                "1e300",
+                "0",
+                "θ",
+                "η",
+                "ε(θ)",
+                "ε(η)",
+                "div η",
+                "I",
+                "∂_x θ",
+                "∇θ",
+                "θ_x",
+                "(t² + h²)",
             ][..],
         )
         .prop_map(str::to_string);
@@ -691,6 +746,9 @@ mod no_panic {
                 (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} − {b}")),
                 (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a}·{b}")),
                 (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} / {b}")),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} : {b}")),
+                inner.clone().prop_map(|a| format!("div [{a}]")),
+                inner.clone().prop_map(|a| format!("tr({a}) ε({a})")),
                 inner.clone().prop_map(|a| format!("({a})")),
                 inner.clone().prop_map(|a| format!("({a})²")),
                 inner.clone().prop_map(|a| format!("∇({a})")),
@@ -708,6 +766,7 @@ mod no_panic {
             let cell = if triangle { "triangle" } else { "interval" };
             check(&expand(model(cell, &text)))?;
             check(&expand(model(cell, &format!("a(u;v) = ∫ {text}"))))?;
+            check(&expand(vector_model(cell, &format!("a(θ,u;η,v) = ∫ {text}"))))?;
         }
 
         #[test]
@@ -720,6 +779,8 @@ mod no_panic {
             let option = degree.map(|d| format!("[degree={d}]")).unwrap_or_default();
             let forms = format!("a(u,λ;v,μ) = ∫{option} {body}\nℓ(v,μ) = Σ_T {body}\nB(u,λ;v,μ) = a(u,λ;v,μ) − 2 a(u,λ;v,μ)");
             check(&expand(model(cell, &forms)))?;
+            let forms = format!("a(θ,u,λ;η,v,μ) = ∫{option} {body}\nB(θ,u,λ;η,v,μ) = a(θ,u,λ;η,v,μ) − a(η,v,μ;θ,u,λ)");
+            check(&expand(vector_model(cell, &forms)))?;
         }
     }
 }
