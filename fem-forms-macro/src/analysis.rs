@@ -210,6 +210,9 @@ pub struct Form {
     pub dropped: usize,
     /// Nonzero blocks.
     pub blocks: Vec<Block>,
+    /// For a named expression `Cε(θ) := …`: its value in its own symbols (it has no
+    /// terms or blocks and generates no code).
+    pub value: Option<Value>,
 }
 
 impl Form {
@@ -265,7 +268,11 @@ pub fn analyse(
             later_forms: &all_names[k..],
             errors: Vec::new(),
         };
-        let form = context.definition(definition, forms_text);
+        let form = if definition.expression {
+            context.expression(definition, forms_text)
+        } else {
+            context.definition(definition, forms_text)
+        };
         let failed = !context.errors.is_empty();
         errors.append(&mut context.errors);
         match form {
@@ -279,6 +286,7 @@ pub fn analyse(
                 terms: Vec::new(),
                 dropped: 0,
                 blocks: Vec::new(),
+                value: None,
             }),
         }
     }
@@ -366,10 +374,13 @@ pub(crate) fn expand_expression(
 
 /// What an expression expands to: a scalar, a vector (one scalar per axis) or a matrix
 /// (rows of scalars, `dimension × dimension`; `∇θ` has the components in its rows).
-#[derive(Clone)]
-enum Value {
+#[derive(Clone, Debug)]
+pub enum Value {
+    /// One scalar.
     Scalar(Expansion),
+    /// Entries by axis.
     Vector(Vec<Expansion>),
+    /// Rows of entries.
     Matrix(Vec<Vec<Expansion>>),
 }
 
@@ -459,19 +470,41 @@ struct Context<'a> {
     errors: Vec<Diagnostic>,
 }
 
+/// The text of a definition, its lines joined.
+fn source(d: &Definition, forms_text: &str) -> String {
+    forms_text
+        .lines()
+        .skip(d.lines.0 - 1)
+        .take(d.lines.1 + 1 - d.lines.0)
+        .map(str::trim)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 fn scalar(loc: Loc) -> Monomial {
     Monomial::constant(1.0, loc)
 }
 
-impl Context<'_> {
+impl<'a> Context<'a> {
+    /// A named expression `Cε(θ) := …`: its value, for substitution where it is called.
+    fn expression(&mut self, d: &Definition, forms_text: &str) -> Option<Form> {
+        let (groups, arguments) = self.signature(&d.name, &d.groups)?;
+        // Its calls stand inside integrals (`h` is allowed); an integral in it is an error.
+        let value = self.value(&d.body, true)?;
+        Some(Form {
+            name: d.name.text.clone(),
+            source: source(d, forms_text),
+            groups,
+            arguments,
+            terms: Vec::new(),
+            dropped: 0,
+            blocks: Vec::new(),
+            value: Some(value),
+        })
+    }
+
     fn definition(&mut self, d: &Definition, forms_text: &str) -> Option<Form> {
-        let source = forms_text
-            .lines()
-            .skip(d.lines.0 - 1)
-            .take(d.lines.1 + 1 - d.lines.0)
-            .map(str::trim)
-            .collect::<Vec<_>>()
-            .join(" ");
+        let source = source(d, forms_text);
         let (groups, arguments) = self.signature(&d.name, &d.groups)?;
         let terms = self.expand(&d.body, false)?;
         let mut kept = Vec::new();
@@ -647,6 +680,7 @@ impl Context<'_> {
             terms: kept,
             dropped,
             blocks,
+            value: None,
         })
     }
 
@@ -1037,6 +1071,7 @@ impl Context<'_> {
         let loc = e.loc;
         match &e.kind {
             ExprKind::Symbol(name) => self.symbol(name, loc, inside_integral),
+            ExprKind::Call { name, groups } => self.call(name, groups, loc),
             ExprKind::Neg(a) => Some(self.value(a, inside_integral)?.map(symbolic::neg)),
             ExprKind::Add(..) | ExprKind::Sub(..) => self.sum_value(e, inside_integral),
             ExprKind::Mul(a, b) => {
@@ -1348,15 +1383,41 @@ impl Context<'_> {
                 }
                 Some(x)
             }
-            ExprKind::Call { name, groups } => self.call(name, groups, loc),
             // the vector-capable constructs, handled by `value`
             _ => self.expand(e, inside_integral),
         }
     }
 
-    fn call(&mut self, name: &str, groups: &[Vec<Name>], loc: Loc) -> Option<Expansion> {
-        let Some(callee) = self.forms.iter().find(|f| f.name == name) else {
-            return self.fail(
+    /// A call of a form (a scalar) or of a named expression (any shape) with its
+    /// arguments substituted positionally.
+    fn call(&mut self, name: &str, groups: &[Vec<Name>], loc: Loc) -> Option<Value> {
+        let (callee, mapping) = self.call_mapping(name, groups, loc)?;
+        let substitute = |mut terms: Expansion| {
+            for t in &mut terms {
+                for a in &mut t.args {
+                    a.symbol = mapping.iter().find(|(f, _)| *f == a.symbol).unwrap().1;
+                }
+                t.args.sort();
+                t.origin = loc;
+            }
+            terms
+        };
+        Some(match &callee.value {
+            Some(value) => value.clone().map(substitute),
+            None => Value::Scalar(substitute(callee.terms.clone())),
+        })
+    }
+
+    /// The form called and its formal → actual symbols, after the checks of a call.
+    fn call_mapping(
+        &mut self,
+        name: &str,
+        groups: &[Vec<Name>],
+        loc: Loc,
+    ) -> Option<(&'a Form, Vec<(usize, usize)>)> {
+        let forms = self.forms;
+        let Some(callee) = forms.iter().find(|f| f.name == name) else {
+            return self.fail_mapping(
                 Diagnostic::text(loc, format!("form `{name}` is used before its definition"))
                     .help("define a form above the forms that call it"),
             );
@@ -1391,7 +1452,7 @@ impl Context<'_> {
                     .collect::<Vec<_>>()
                     .join(";")
             };
-            return self.fail(
+            return self.fail_mapping(
                 Diagnostic::text(
                     loc,
                     format!(
@@ -1409,7 +1470,7 @@ impl Context<'_> {
                 let formal = &callee.arguments[g][k];
                 let Some(actual) = self.symbols.function_symbols(&n.text) else {
                     let d = self.not_a_function(n, name);
-                    return self.fail(d);
+                    return self.fail_mapping(d);
                 };
                 let same_field = actual.len() == formal.len()
                     && actual
@@ -1418,7 +1479,7 @@ impl Context<'_> {
                         .all(|(&a, &f)| self.symbols.field_of(a) == self.symbols.field_of(f));
                 if !same_field {
                     let (unknown, test) = self.symbols.field_names(formal);
-                    return self.fail(
+                    return self.fail_mapping(
                         Diagnostic::text(
                             n.loc,
                             format!(
@@ -1431,14 +1492,11 @@ impl Context<'_> {
                 mapping.extend(formal.iter().copied().zip(actual));
             }
         }
-        let mut out = callee.terms.clone();
-        for t in &mut out {
-            for a in &mut t.args {
-                a.symbol = mapping.iter().find(|(f, _)| *f == a.symbol).unwrap().1;
-            }
-            t.args.sort();
-            t.origin = loc;
-        }
-        Some(out)
+        Some((callee, mapping))
+    }
+
+    fn fail_mapping<T>(&mut self, d: Diagnostic) -> Option<T> {
+        self.errors.push(d);
+        None
     }
 }

@@ -86,6 +86,9 @@
 //!   `1/(ν + t)` with `ν` not declared positive are errors at the divisor.
 //! - Names: declared symbols, `h` or `h_T` (element size); names written together that
 //!   are declared symbols multiply (`sλ` = `s·λ`).
+//! - `Cε(θ) := D[(1−ν)ε(θ) + ν tr ε(θ) I]` (with `:=`) names an expression of its
+//!   arguments, of any shape, substituted where it is called (`∫ Cε(θ):ε(η)`,
+//!   `div div Cε(η)`); it generates no code of its own.
 //! - A form may call forms defined above it with other arguments:
 //!   `B_h(…) = a(θ,w;η,v) − b(η,v;λ)` substitutes the arguments positionally (each must
 //!   belong to the same field as the formal argument it replaces).
@@ -198,6 +201,8 @@ fn expand(input: TokenStream) -> TokenStream {
             .map(|e| e.to_compile_error(&text, span))
             .collect();
     }
+    // Named expressions (`Cε(θ) := …`) were substituted where called: no code of their own.
+    let forms: Vec<_> = forms.into_iter().filter(|f| f.value.is_none()).collect();
     let code = codegen::generate(&declaration, &symbols, &forms);
     if let Ok(dir) = std::env::var("FEM_FORMS_DUMP_DIR") {
         dump(&dir, &declaration.name.to_string(), &code);

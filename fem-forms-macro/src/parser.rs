@@ -1,7 +1,8 @@
 //! The forms text → a syntax tree of form definitions.
 //!
 //! ```text
-//! definition := NAME '(' args [';' args] ')' '=' sum
+//! definition := NAME '(' args [';' args] ')' '=' sum      a form
+//!             | NAME '(' args ')' ':=' sum                 an expression of its arguments
 //! sum        := term (('+' | '−') term)*
 //! term       := ('+' | '−')* product
 //! product    := factor (('·' | '*' | '/' | ':')? factor)*    juxtaposition multiplies
@@ -116,9 +117,12 @@ impl Expr {
     }
 }
 
-/// `name(groups) = body`
+/// `name(groups) = body`, or `name(args) := body`
 #[derive(Clone, Debug, PartialEq)]
 pub struct Definition {
+    /// `:=`: a named expression of its arguments (`Cε(θ) := D[(1−ν)ε(θ) + ν tr ε(θ) I]`),
+    /// substituted where it is called, of any shape; not a form.
+    pub expression: bool,
     /// The form's name.
     pub name: Name,
     /// Its argument groups: `[trial…]; [test…]` for bilinear forms, `[test…]` for linear ones.
@@ -216,7 +220,7 @@ pub(crate) fn parse_expression(tokens: &[Token]) -> Result<Expr> {
     }
 }
 
-/// If a definition header `NAME ( … ) =` starts at `i`, the index of its `=`.
+/// If a definition header `NAME ( … ) =` (or `:=`) starts at `i`, the index of its `=`.
 fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
     matches!(tokens.get(i)?.tok, Tok::Ident(_)).then_some(())?;
     (tokens.get(i + 1)?.tok == Tok::LParen).then_some(())?;
@@ -225,7 +229,11 @@ fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
         match t.tok {
             Tok::Ident(_) | Tok::Comma | Tok::Semicolon => j += 1,
             Tok::RParen => {
-                return (tokens.get(j + 1)?.tok == Tok::Equals).then_some(j + 1);
+                return match tokens.get(j + 1)?.tok {
+                    Tok::Equals => Some(j + 1),
+                    Tok::Colon => (tokens.get(j + 2)?.tok == Tok::Equals).then_some(j + 2),
+                    _ => None,
+                };
             }
             _ => return None,
         }
@@ -415,6 +423,22 @@ impl<'a> Parser<'a> {
         let name = self.name("a form name")?;
         self.expect(Tok::LParen, "`(`")?;
         let groups = self.argument_groups()?;
+        let expression = self.peek_tok() == Some(&Tok::Colon);
+        if expression {
+            self.pos += 1;
+            if groups.len() != 1 {
+                return Err(Diagnostic::text(
+                    name.loc,
+                    format!(
+                        "`{}(…) :=` names an expression of one argument list",
+                        name.text
+                    ),
+                )
+                .help(
+                    "write `Cε(θ) := …` without `;`; forms of trial and test functions use `=`",
+                ));
+            }
+        }
         self.expect(Tok::Equals, "`=`")?;
         if self.peek().is_none() {
             return Err(self.unexpected("the form's right-hand side"));
@@ -443,6 +467,7 @@ impl<'a> Parser<'a> {
             .help("a form is a polynomial of low degree in its fields and data: write the power you mean (h_T⁴, t⁻²)"));
         }
         Ok(Definition {
+            expression,
             name,
             groups,
             body,
@@ -1090,6 +1115,19 @@ mod tests {
         assert!(errors[0].message.contains("never closed"), "{errors:?}");
         let (_, errors) = parse("a(u;v) = ∫ div + v");
         assert!(errors[0].message.contains("after `div`"), "{errors:?}");
+    }
+
+    #[test]
+    fn named_expressions_use_colon_equals() {
+        let (defs, errors) = parse("Cε(θ) := D[ε(θ)]\na(θ;η) = ∫ Cε(θ):ε(η)");
+        assert!(errors.is_empty(), "{errors:?}");
+        assert!(defs[0].expression && !defs[1].expression);
+        assert_eq!(sexpr(&defs[1].body), "(intNone (: (call Cε θ) (eps η)))");
+        let (_, errors) = parse("C(θ;η) := θ η");
+        assert!(
+            errors[0].message.contains("one argument list"),
+            "{errors:?}"
+        );
     }
 
     #[test]

@@ -326,3 +326,61 @@ fn division_by_positive_sums() {
         );
     }
 }
+
+#[test]
+fn named_expressions_read_as_in_the_mathematics() {
+    // Cε(θ) := D[(1−ν)ε(θ) + ν tr ε(θ) I], called with a trial and a test function
+    let named = "
+        Cε(θ)      := D[(1−ν)ε(θ) + ν tr ε(θ) I]
+        a(θ;η)     = ∫ Cε(θ):ε(η)
+        b(θ;η)     = ∫ D[(1−ν)ε(θ) + ν tr ε(θ) I] : ε(η)
+        S(θ,λ;η,μ) = Σ_T h_T⁴ (div div Cε(θ) − sλ, div div Cε(η) − sμ)_T
+        ℓ(η)       = ∫ f tr Cε(η)
+    ";
+    let out = expand(plate(named));
+    assert!(rendered_errors(&out).is_empty(), "{out}");
+    let file: syn::File = syn::parse2(out).expect("generated code parses");
+    let text = prettyplease::unparse(&file);
+    // no module or handle for the expression; a and b give the same kernels
+    assert!(!text.contains("pub mod Cε") && !text.contains("const Cε"));
+    let module = |name: &str| {
+        let body = text.split(&format!("pub mod {name} {{")).nth(1).unwrap();
+        body.split("pub mod ").next().unwrap().to_string()
+    };
+    let strip = |m: String| {
+        m.replace("`a`", "")
+            .replace("`b`", "")
+            .replace("INDEX: usize = 1", "INDEX: usize = 0")
+    };
+    let (a, b) = (module("a"), module("b"));
+    let kernels = |m: &str| {
+        m.split("pub fn")
+            .skip(1)
+            .map(|k| k.split("\n        }\n").next().unwrap().to_string())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(kernels(&strip(a)), kernels(&strip(b)));
+    let s = module("S");
+    assert!(s.contains("fn matrix_μ_λ") && !s.contains("fn matrix_η"));
+    // errors: a wrong field, a shape, an integral inside
+    for (forms, message) in [
+        (
+            "Cε(θ) := ε(θ)\na(w;v) = ∫ Cε(w):ε(v)",
+            "must be a function of the field `θ`",
+        ),
+        (
+            "Cε(θ) := ε(θ)\na(θ;η) = ∫ Cε(θ)·ε(η)",
+            "product of two matrices",
+        ),
+        (
+            "Cε(θ) := ∫ ε(θ)\na(θ;η) = ∫ Cε(θ):ε(η)",
+            "integral inside an integral",
+        ),
+    ] {
+        let errors = rendered_errors(&expand(plate(forms)));
+        assert!(
+            errors.iter().any(|e| e.contains(message)),
+            "{forms}: {errors:?}"
+        );
+    }
+}

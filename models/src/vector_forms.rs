@@ -13,10 +13,10 @@ fem_runtime::model! {
         params: D, ν, κ, t > 0, β > 0, s;
         data: f;
         forms: "
-            a_b(θ;η)     = ∫ D[(1−ν)ε(θ) + ν tr ε(θ) I] : ε(η)
+            Cε(θ)        := D[(1−ν)ε(θ) + ν tr ε(θ) I]
+            a_b(θ;η)     = ∫ Cε(θ):ε(η)
             a_s(θ,w;η,v) = ∫ 6κ(1−ν)D/(t² + β h_T²) (∇w − θ)·(∇v − η)
-            S(θ,λ;η,μ)   = Σ_T h_T⁴ (D div div [(1−ν)ε(θ) + ν tr ε(θ) I] − sλ,
-                                     D div div [(1−ν)ε(η) + ν tr ε(η) I] − sμ)_T
+            S(θ,λ;η,μ)   = Σ_T h_T⁴ (div div Cε(θ) − sλ, div div Cε(η) − sμ)_T
             ℓ(η,v)       = ∫ f v + f div η
         ";
     }
