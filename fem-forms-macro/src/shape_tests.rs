@@ -362,6 +362,21 @@ fn named_expressions_read_as_in_the_mathematics() {
     assert_eq!(kernels(&strip(a)), kernels(&strip(b)));
     let s = module("S");
     assert!(s.contains("fn matrix_μ_λ") && !s.contains("fn matrix_η"));
+    // an expression of two arguments: the shear strain γ(θ,w) = ∇w − θ
+    let shear = "
+        γ(θ,w)       := ∇w − θ
+        a(θ,w;η,v)   = ∫ t⁻² γ(θ,w)·γ(η,v)
+        b(θ,w;η,v)   = ∫ t⁻² (∇w − θ)·(∇v − η)
+    ";
+    let text = prettyplease::unparse(&syn::parse2(expand(plate(shear))).unwrap());
+    let (a, b) = (
+        text.split("pub mod a {").nth(1).unwrap(),
+        text.split("pub mod b {").nth(1).unwrap(),
+    );
+    let a = kernels(&strip(a.split("pub mod b").next().unwrap().to_string()));
+    // θ_x, θ_y, w against each other but (η_x, θ_y) and (η_y, θ_x): zero, dropped
+    assert_eq!(a.len(), 7);
+    assert_eq!(a, kernels(&strip(b.to_string())));
     // errors: a wrong field, a shape, an integral inside
     for (forms, message) in [
         (
