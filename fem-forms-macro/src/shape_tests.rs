@@ -399,3 +399,45 @@ fn named_expressions_read_as_in_the_mathematics() {
         );
     }
 }
+
+#[test]
+fn ascii_and_unicode_vector_models_give_the_same_blocks() {
+    let blocks = |declaration: TokenStream| {
+        let declaration: Declaration = syn::parse2(declaration).unwrap();
+        assert!(declaration.check().is_empty());
+        let symbols = symbols(&declaration);
+        let text = declaration.forms.value();
+        let (tokens, e1) = lexer::tokenize(&text);
+        let (definitions, e2) = parser::parse_forms(&tokens);
+        let (forms, e3) = analysis::analyse(&symbols, &definitions, &text);
+        assert!(
+            e1.is_empty() && e2.is_empty() && e3.is_empty(),
+            "{e1:?} {e2:?} {e3:?}"
+        );
+        forms.into_iter().map(|f| f.blocks).collect::<Vec<_>>()
+    };
+    let unicode = blocks(quote! {
+        pub mod m on triangle {
+            unknowns: θ: [P1]^2, w: P2;
+            tests: η, v;
+            params: ν, t > 0, β > 0;
+            forms: "
+                Cε(θ)  := [(1−ν)ε(θ) + ν tr ε(θ) I]
+                a(θ,w;η,v) = ∫ Cε(θ):ε(η) + ∂_x θ_x ∂_y η_y + (∇w − θ)·(∇v − η)/(t² + β h_T²)
+            ";
+        }
+    });
+    let ascii = blocks(quote! {
+        pub mod m on triangle {
+            unknowns: theta: [P1]^2, w: P2;
+            tests: eta, v;
+            params: nu, t > 0, beta > 0;
+            forms: "
+                C(theta) := ((1-nu)*eps(theta) + nu*tr(eps(theta))*I)
+                a(theta,w;eta,v) = int C(theta):eps(eta) + d_x theta_x * d_y eta_y + (grad w - theta) dot (grad v - eta) / (t^2 + beta*h^2)
+            ";
+        }
+    });
+    assert_eq!(unicode, ascii);
+    assert_eq!(unicode[1].len(), 9);
+}
