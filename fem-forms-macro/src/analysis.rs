@@ -2,10 +2,15 @@
 //! expanded into monomials (calls of earlier forms are substituted), the arity of every
 //! term is checked, terms that vanish for the chosen elements are dropped, and the rest
 //! is grouped into (test field, trial field) blocks.
+//!
+//! Expressions evaluate to scalars, vectors or matrices whose entries are scalar
+//! expansions (a vector field `θ` is the vector of its component fields `θ_x`, `θ_y`);
+//! every operator checks the shapes it gets, so `∇w − w` or `ε(w)` of a scalar is an
+//! error at the expression, and an integrand must come out a scalar.
 
 use crate::diagnostic::{closest, lookalike, Diagnostic, Loc};
 use crate::parser::{Definition, Expr, ExprKind, IntegralKind, Name, MAX_DEGREE};
-use crate::symbolic::{self, ArgFactor, DerivativeError, Expansion, Monomial};
+use crate::symbolic::{self, ArgFactor, DerivativeError, Divisor, Expansion, Monomial};
 use fem_reference::ElementKind;
 
 /// Highest derivative order of the language.
@@ -22,15 +27,35 @@ pub struct Field {
     pub element: ElementKind,
     /// Whether it is a multiplier constrained `≥ 0`.
     pub nonnegative: bool,
+    /// `Some((vector, axis))` when the field is component `axis` of vector field
+    /// `Symbols::vectors[vector]`.
+    pub component: Option<(usize, usize)>,
+}
+
+/// A vector field, lowered to consecutive scalar fields of its components.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Vector {
+    /// Name of the unknown (`θ`).
+    pub name: String,
+    /// Name of the test function (`η`).
+    pub test_name: String,
+    /// Index in `Symbols::fields` of its first component.
+    pub first_field: usize,
+    /// Number of components (the cell's dimension).
+    pub components: usize,
 }
 
 /// The names a model declares.
 #[derive(Clone, Debug, Default)]
 pub struct Symbols {
-    /// Fields in declaration order.
+    /// Scalar fields in declaration order (a vector field gives one per component).
     pub fields: Vec<Field>,
+    /// The vector fields.
+    pub vectors: Vec<Vector>,
     /// Parameter names.
     pub params: Vec<String>,
+    /// Indices of the parameters declared `> 0` (checked by the runtime).
+    pub positive: Vec<usize>,
     /// Data names with the polynomial degree assumed for quadrature.
     pub data: Vec<(String, usize)>,
     /// Spatial dimension of the cell (1 for intervals, 2 for triangles).
@@ -63,8 +88,68 @@ impl Symbols {
         })
     }
 
+    /// The function symbols a name stands for: one for a scalar field or a component,
+    /// the components for a vector field.
+    fn function_symbols(&self, name: &str) -> Option<Vec<usize>> {
+        if let Some(s) = self.function_symbol(name) {
+            return Some(vec![s]);
+        }
+        let f = self.fields.len();
+        self.vectors.iter().find_map(|v| {
+            let offset = if v.name == name {
+                0
+            } else if v.test_name == name {
+                f
+            } else {
+                return None;
+            };
+            Some(
+                (v.first_field..v.first_field + v.components)
+                    .map(|k| k + offset)
+                    .collect(),
+            )
+        })
+    }
+
+    /// The name of an argument given by its symbols: a vector's name for its
+    /// components, the function's name otherwise.
+    fn argument_name(&self, symbols: &[usize]) -> &str {
+        match symbols {
+            [first, _, ..] => {
+                let test = *first >= self.fields.len();
+                match self.fields[self.field_of(*first)].component {
+                    Some((v, _)) if test => &self.vectors[v].test_name,
+                    Some((v, _)) => &self.vectors[v].name,
+                    None => self.function_name(*first),
+                }
+            }
+            [s] => self.function_name(*s),
+            [] => "",
+        }
+    }
+
+    /// The unknown's and the test function's names of the field (or vector) of an argument.
+    fn field_names(&self, symbols: &[usize]) -> (&str, &str) {
+        let f = self.fields.len();
+        match symbols {
+            [first, _, ..] => (
+                self.argument_name(&[first % f.max(1), first % f.max(1) + 1]),
+                self.argument_name(&[first % f.max(1) + f, first % f.max(1) + f + 1]),
+            ),
+            [s] => {
+                let field = &self.fields[self.field_of(*s)];
+                (&field.name, &field.test_name)
+            }
+            [] => ("", ""),
+        }
+    }
+
     fn all_names(&self) -> Vec<&str> {
         let mut v: Vec<&str> = Vec::new();
+        for vector in &self.vectors {
+            v.push(&vector.name);
+            v.push(&vector.test_name);
+        }
         for f in &self.fields {
             v.push(&f.name);
             v.push(&f.test_name);
@@ -85,6 +170,8 @@ pub struct Term {
     pub params: Vec<(usize, i32)>,
     /// Power of the element size.
     pub h_power: i32,
+    /// Positive sums the term is divided by, with their exponents.
+    pub divisors: Vec<(Divisor, i32)>,
     /// Data factors (indices).
     pub data: Vec<usize>,
     /// Derivative multi-index on the test function.
@@ -113,14 +200,19 @@ pub struct Form {
     pub name: String,
     /// The definition as written (for docs).
     pub source: String,
-    /// Argument groups as function symbols.
+    /// Argument groups as function symbols (a vector argument gives its components).
     pub groups: Vec<Vec<usize>>,
+    /// Argument groups as written: per argument, its function symbols.
+    pub arguments: Vec<Vec<Vec<usize>>>,
     /// The expansion with the form's own symbols (for substitution into later forms).
     pub terms: Expansion,
     /// Terms dropped because they vanish for the chosen elements.
     pub dropped: usize,
     /// Nonzero blocks.
     pub blocks: Vec<Block>,
+    /// For a named expression `Cε(θ) := …`: its value in its own symbols (it has no
+    /// terms or blocks and generates no code).
+    pub value: Option<Value>,
 }
 
 impl Form {
@@ -176,7 +268,11 @@ pub fn analyse(
             later_forms: &all_names[k..],
             errors: Vec::new(),
         };
-        let form = context.definition(definition, forms_text);
+        let form = if definition.expression {
+            context.expression(definition, forms_text)
+        } else {
+            context.definition(definition, forms_text)
+        };
         let failed = !context.errors.is_empty();
         errors.append(&mut context.errors);
         match form {
@@ -186,9 +282,11 @@ pub fn analyse(
                 name: definition.name.text.clone(),
                 source: String::new(),
                 groups: Vec::new(),
+                arguments: Vec::new(),
                 terms: Vec::new(),
                 dropped: 0,
                 blocks: Vec::new(),
+                value: None,
             }),
         }
     }
@@ -274,10 +372,16 @@ pub(crate) fn expand_expression(
     context.expand(&expr, true).ok_or(context.errors)
 }
 
-/// What an expression expands to: a scalar, or a vector of scalars (one per axis).
-enum Value {
+/// What an expression expands to: a scalar, a vector (one scalar per axis) or a matrix
+/// (rows of scalars, `dimension × dimension`; `∇θ` has the components in its rows).
+#[derive(Clone, Debug)]
+pub enum Value {
+    /// One scalar.
     Scalar(Expansion),
+    /// Entries by axis.
     Vector(Vec<Expansion>),
+    /// Rows of entries.
+    Matrix(Vec<Vec<Expansion>>),
 }
 
 impl Value {
@@ -285,6 +389,76 @@ impl Value {
         match self {
             Value::Scalar(x) => Value::Scalar(f(x)),
             Value::Vector(v) => Value::Vector(v.into_iter().map(f).collect()),
+            Value::Matrix(m) => Value::Matrix(
+                m.into_iter()
+                    .map(|row| row.into_iter().map(&f).collect())
+                    .collect(),
+            ),
+        }
+    }
+
+    /// Every entry through `f`, or `None` when `f` fails on one (all are tried, so
+    /// that every error is reported).
+    fn try_map(self, mut f: impl FnMut(Expansion) -> Option<Expansion>) -> Option<Self> {
+        let mut ok = true;
+        let mut g = |x: Expansion| {
+            f(x).unwrap_or_else(|| {
+                ok = false;
+                Vec::new()
+            })
+        };
+        let out = match self {
+            Value::Scalar(x) => Value::Scalar(g(x)),
+            Value::Vector(v) => Value::Vector(v.into_iter().map(&mut g).collect()),
+            Value::Matrix(m) => Value::Matrix(
+                m.into_iter()
+                    .map(|row| row.into_iter().map(&mut g).collect())
+                    .collect(),
+            ),
+        };
+        ok.then_some(out)
+    }
+
+    /// `a scalar`, `a vector`, `a matrix`: for messages.
+    fn shape(&self) -> &'static str {
+        match self {
+            Value::Scalar(_) => "a scalar",
+            Value::Vector(_) => "a vector",
+            Value::Matrix(_) => "a matrix",
+        }
+    }
+
+    /// The entries in order (row-major for matrices).
+    fn entries(self) -> Vec<Expansion> {
+        match self {
+            Value::Scalar(x) => vec![x],
+            Value::Vector(v) => v,
+            Value::Matrix(m) => m.into_iter().flatten().collect(),
+        }
+    }
+
+    /// `x + y` entry by entry, `None` when the shapes differ.
+    fn add(self, y: Value) -> Option<Value> {
+        match (self, y) {
+            (Value::Scalar(x), Value::Scalar(y)) => Some(Value::Scalar(symbolic::add(x, y))),
+            (Value::Vector(x), Value::Vector(y)) => Some(Value::Vector(
+                x.into_iter()
+                    .zip(y)
+                    .map(|(x, y)| symbolic::add(x, y))
+                    .collect(),
+            )),
+            (Value::Matrix(x), Value::Matrix(y)) => Some(Value::Matrix(
+                x.into_iter()
+                    .zip(y)
+                    .map(|(r, s)| {
+                        r.into_iter()
+                            .zip(s)
+                            .map(|(a, b)| symbolic::add(a, b))
+                            .collect()
+                    })
+                    .collect(),
+            )),
+            _ => None,
         }
     }
 }
@@ -296,35 +470,57 @@ struct Context<'a> {
     errors: Vec<Diagnostic>,
 }
 
+/// The text of a definition, its lines joined.
+fn source(d: &Definition, forms_text: &str) -> String {
+    forms_text
+        .lines()
+        .skip(d.lines.0 - 1)
+        .take(d.lines.1 + 1 - d.lines.0)
+        .map(str::trim)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 fn scalar(loc: Loc) -> Monomial {
     Monomial::constant(1.0, loc)
 }
 
-impl Context<'_> {
+impl<'a> Context<'a> {
+    /// A named expression `Cε(θ) := …`: its value, for substitution where it is called.
+    fn expression(&mut self, d: &Definition, forms_text: &str) -> Option<Form> {
+        let (groups, arguments) = self.signature(&d.name, &d.groups)?;
+        // Its calls stand inside integrals (`h` is allowed); an integral in it is an error.
+        let value = self.value(&d.body, true)?;
+        Some(Form {
+            name: d.name.text.clone(),
+            source: source(d, forms_text),
+            groups,
+            arguments,
+            terms: Vec::new(),
+            dropped: 0,
+            blocks: Vec::new(),
+            value: Some(value),
+        })
+    }
+
     fn definition(&mut self, d: &Definition, forms_text: &str) -> Option<Form> {
-        let source = forms_text
-            .lines()
-            .skip(d.lines.0 - 1)
-            .take(d.lines.1 + 1 - d.lines.0)
-            .map(str::trim)
-            .collect::<Vec<_>>()
-            .join(" ");
-        let groups = self.signature(&d.name, &d.groups)?;
+        let source = source(d, forms_text);
+        let (groups, arguments) = self.signature(&d.name, &d.groups)?;
         let terms = self.expand(&d.body, false)?;
         let mut kept = Vec::new();
         let mut dropped = 0;
-        let group_text = |g: &[usize]| {
-            g.iter()
-                .map(|&s| self.symbols.function_name(s).to_string())
+        let group_text = |g: usize| {
+            arguments[g]
+                .iter()
+                .map(|a| self.symbols.argument_name(a).to_string())
                 .collect::<Vec<_>>()
                 .join(", ")
         };
         let signature = format!(
             "{}({})",
             d.name.text,
-            groups
-                .iter()
-                .map(|g| group_text(g))
+            (0..groups.len())
+                .map(group_text)
                 .collect::<Vec<_>>()
                 .join("; ")
         );
@@ -411,7 +607,7 @@ impl Context<'_> {
                             format!(
                                 "nonlinear term in the {kind} form `{}`: {product} is a product of {count} functions of its {which} {})",
                                 d.name.text,
-                                group_text(&groups[g])
+                                group_text(g)
                             ),
                         )
                         .help(format!("a {kind} form is linear in each argument group: every term has exactly one function from each group")),
@@ -424,7 +620,7 @@ impl Context<'_> {
                             format!(
                                 "term of the {kind} form `{}` contains no function of its {which} {})",
                                 d.name.text,
-                                group_text(&groups[g])
+                                group_text(g)
                             ),
                         )
                         .help(format!("a {kind} form is linear in each argument group: every term has exactly one function from each group")),
@@ -480,9 +676,11 @@ impl Context<'_> {
             name: d.name.text.clone(),
             source,
             groups,
+            arguments,
             terms: kept,
             dropped,
             blocks,
+            value: None,
         })
     }
 
@@ -503,6 +701,7 @@ impl Context<'_> {
                 coefficient: t.coefficient,
                 params: t.params.clone(),
                 h_power: t.h_power,
+                divisors: t.divisors.clone(),
                 data: t.data.clone(),
                 test_derivative: test.derivative,
                 trial_derivative: trial.map(|a| a.derivative),
@@ -524,8 +723,15 @@ impl Context<'_> {
         blocks
     }
 
-    fn signature(&mut self, name: &Name, groups: &[Vec<Name>]) -> Option<Vec<Vec<usize>>> {
-        let mut out = Vec::new();
+    /// The argument groups of a definition: flat symbols and, per argument, its symbols.
+    #[allow(clippy::type_complexity)]
+    fn signature(
+        &mut self,
+        name: &Name,
+        groups: &[Vec<Name>],
+    ) -> Option<(Vec<Vec<usize>>, Vec<Vec<Vec<usize>>>)> {
+        let mut flat = Vec::new();
+        let mut arguments = Vec::new();
         let mut ok = true;
         let mut seen: Vec<usize> = Vec::new();
         if groups.iter().all(|g| g.is_empty()) {
@@ -537,9 +743,10 @@ impl Context<'_> {
         }
         for g in groups {
             let mut group = Vec::new();
+            let mut args = Vec::new();
             for n in g {
-                match self.symbols.function_symbol(&n.text) {
-                    Some(s) if seen.contains(&s) => {
+                match self.symbols.function_symbols(&n.text) {
+                    Some(s) if s.iter().any(|x| seen.contains(x)) => {
                         ok = false;
                         self.errors.push(Diagnostic::text(
                             n.loc,
@@ -550,8 +757,9 @@ impl Context<'_> {
                         ));
                     }
                     Some(s) => {
-                        seen.push(s);
-                        group.push(s);
+                        seen.extend(&s);
+                        group.extend(&s);
+                        args.push(s);
                     }
                     None => {
                         ok = false;
@@ -559,17 +767,24 @@ impl Context<'_> {
                     }
                 }
             }
-            out.push(group);
+            flat.push(group);
+            arguments.push(args);
         }
-        ok.then_some(out)
+        ok.then_some((flat, arguments))
     }
 
     fn not_a_function(&self, n: &Name, form: &str) -> Diagnostic {
         let candidates: Vec<&str> = self
             .symbols
-            .fields
+            .vectors
             .iter()
-            .flat_map(|f| [f.name.as_str(), f.test_name.as_str()])
+            .flat_map(|v| [v.name.as_str(), v.test_name.as_str()])
+            .chain(
+                self.symbols
+                    .fields
+                    .iter()
+                    .flat_map(|f| [f.name.as_str(), f.test_name.as_str()]),
+            )
             .collect();
         let hint = lookalike(&n.text, candidates.iter().copied())
             .map(|h| format!(" {h}."))
@@ -596,21 +811,22 @@ impl Context<'_> {
         None
     }
 
-    /// Resolves a name: a declared symbol, `h`, or declared symbols written together (`sλ`).
-    fn symbol(&mut self, name: &str, loc: Loc, inside_integral: bool) -> Option<Expansion> {
+    /// Resolves a name: a declared symbol, `h`, `I`, or declared symbols written
+    /// together (`sλ`).
+    fn symbol(&mut self, name: &str, loc: Loc, inside_integral: bool) -> Option<Value> {
         if let Some(e) = self.single_symbol(name, loc, inside_integral) {
             return e;
         }
         if let Some(parts) = self.split(name) {
-            let mut product = vec![scalar(loc)];
+            let mut product = Value::Scalar(vec![scalar(loc)]);
             for part in parts {
                 let factor = self.single_symbol(&part, loc, inside_integral)??;
-                product = symbolic::mul(&product, &factor, loc);
+                product = self.product(product, factor, loc)?;
             }
             return Some(product);
         }
         if self.later_forms.contains(&name) || self.forms.iter().any(|f| f.name == name) {
-            return self.fail(
+            return self.fail_value(
                 Diagnostic::text(loc, format!("form `{name}` used without its arguments"))
                     .help(format!("call it with arguments, e.g. `{name}(u; v)`")),
             );
@@ -622,7 +838,7 @@ impl Context<'_> {
                 closest(name, names.iter().copied()).map(|c| format!("did you mean `{c}`? "))
             })
             .unwrap_or_default();
-        self.fail(
+        self.fail_value(
             Diagnostic::text(loc, format!("unknown symbol `{name}`")).help(format!(
                 "{hint}declared names are {}; declare new parameters under `params:` and functions of x under `data:`",
                 names.join(", ")
@@ -630,18 +846,18 @@ impl Context<'_> {
         )
     }
 
-    /// `Some(result)` when `name` is one declared symbol.
+    /// `Some(result)` when `name` is one declared symbol (or `I`).
     fn single_symbol(
         &mut self,
         name: &str,
         loc: Loc,
         inside_integral: bool,
-    ) -> Option<Option<Expansion>> {
+    ) -> Option<Option<Value>> {
         let mut m = scalar(loc);
         if name == "h" || name == "h_T" {
             if !inside_integral {
                 return Some(
-                    self.fail(
+                    self.fail_value(
                         Diagnostic::text(
                             loc,
                             "`h` is the size of an element: it has a meaning only inside ∫ or Σ_T",
@@ -651,11 +867,35 @@ impl Context<'_> {
                 );
             }
             m.h_power = 1;
-        } else if let Some(s) = self.symbols.function_symbol(name) {
-            m.args = vec![ArgFactor {
-                symbol: s,
-                derivative: [0, 0],
-            }];
+        } else if name == "I" {
+            let n = self.symbols.dimension;
+            let identity = (0..n)
+                .map(|i| {
+                    (0..n)
+                        .map(|j| {
+                            if i == j {
+                                vec![scalar(loc)]
+                            } else {
+                                Vec::new()
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            return Some(Some(Value::Matrix(identity)));
+        } else if let Some(s) = self.symbols.function_symbols(name) {
+            let component = |s: usize| {
+                let mut m = scalar(loc);
+                m.args = vec![ArgFactor {
+                    symbol: s,
+                    derivative: [0, 0],
+                }];
+                vec![m]
+            };
+            return Some(Some(match s.as_slice() {
+                [s] => Value::Scalar(component(*s)),
+                _ => Value::Vector(s.into_iter().map(component).collect()),
+            }));
         } else if let Some(i) = self.symbols.params.iter().position(|p| p == name) {
             m.params = vec![(i, 1)];
         } else if let Some(i) = self.symbols.data.iter().position(|d| d.0 == name) {
@@ -663,7 +903,7 @@ impl Context<'_> {
         } else {
             return None;
         }
-        Some(Some(vec![m]))
+        Some(Some(Value::Scalar(vec![m])))
     }
 
     /// Splits `sλ` into declared names (longest first), if it can be done.
@@ -691,7 +931,7 @@ impl Context<'_> {
         (go(name, &names, &mut out) && out.len() > 1).then_some(out)
     }
 
-    /// Expands a scalar expression; a vector here is an error.
+    /// Expands a scalar expression; a vector or matrix here is an error.
     fn expand(&mut self, e: &Expr, inside_integral: bool) -> Option<Expansion> {
         match self.value(e, inside_integral)? {
             Value::Scalar(x) => Some(x),
@@ -699,15 +939,23 @@ impl Context<'_> {
                 Diagnostic::text(e.loc, "a vector where a scalar is needed")
                     .help("take a dot product of two vectors (∇u·∇v, grad u dot grad v), or use Δ (lap) for the divergence of a gradient"),
             ),
+            Value::Matrix(_) => self.fail(
+                Diagnostic::text(e.loc, "a matrix where a scalar is needed")
+                    .help("contract two matrices with `:` (ε(θ):ε(η)), or take the trace `tr`"),
+            ),
         }
     }
 
-    fn vector_mismatch(&mut self, loc: Loc, what: &str) -> Option<Value> {
-        self.errors.push(
-            Diagnostic::text(loc, format!("{what} of a vector and a scalar"))
-                .help("both sides must be scalars or both vectors (∇u + ∇v); a product of two vectors is their dot product"),
-        );
+    fn fail_value(&mut self, d: Diagnostic) -> Option<Value> {
+        self.errors.push(d);
         None
+    }
+
+    fn shape_mismatch(&mut self, loc: Loc, what: &str, x: &Value, y: &Value) -> Option<Value> {
+        self.fail_value(
+            Diagnostic::text(loc, format!("{what} of {} and {}", x.shape(), y.shape()))
+                .help("both sides must have the same shape: scalars, vectors (∇w − θ) or matrices (ε(θ) + ε(η)); a product of two vectors is their dot product"),
+        )
     }
 
     /// Expands a sum `t₀ ± t₁ ± … ± tₙ`. The parser builds it as a left-leaning tree as
@@ -727,17 +975,10 @@ impl Context<'_> {
             sum = match (sum, y) {
                 (Some(x), Some(y)) => {
                     let y = if subtract { y.map(symbolic::neg) } else { y };
-                    match (x, y) {
-                        (Value::Scalar(x), Value::Scalar(y)) => {
-                            Some(Value::Scalar(symbolic::add(x, y)))
-                        }
-                        (Value::Vector(x), Value::Vector(y)) => Some(Value::Vector(
-                            x.into_iter()
-                                .zip(y)
-                                .map(|(x, y)| symbolic::add(x, y))
-                                .collect(),
-                        )),
-                        _ => self.vector_mismatch(loc, "sum"),
+                    let what = if subtract { "difference" } else { "sum" };
+                    match x.clone().add(y.clone()) {
+                        Some(v) => Some(v),
+                        None => self.shape_mismatch(loc, what, &x, &y),
                     }
                 }
                 _ => None,
@@ -746,84 +987,288 @@ impl Context<'_> {
         sum
     }
 
-    /// Expands an expression to a scalar or a vector (gradients and their combinations).
+    /// `x·y`: a scalar scales anything, two vectors give their dot product, a matrix
+    /// times a vector is the matrix–vector product (`v·A` is `Aᵀv`); two matrices are
+    /// contracted with `:`, not multiplied.
+    fn product(&mut self, x: Value, y: Value, loc: Loc) -> Option<Value> {
+        match (x, y) {
+            (Value::Scalar(x), Value::Scalar(y)) => {
+                self.scalar_product(&x, &y, loc).map(Value::Scalar)
+            }
+            (Value::Scalar(s), v) | (v, Value::Scalar(s)) => {
+                v.try_map(|c| self.scalar_product(&s, &c, loc))
+            }
+            (Value::Vector(x), Value::Vector(y)) => {
+                self.dot(x.iter().zip(&y), loc).map(Value::Scalar)
+            }
+            (Value::Matrix(a), Value::Vector(v)) => {
+                let mut out = Vec::new();
+                for row in &a {
+                    out.push(self.dot(row.iter().zip(&v), loc)?);
+                }
+                Some(Value::Vector(out))
+            }
+            (Value::Vector(v), Value::Matrix(a)) => {
+                let mut out = Vec::new();
+                for j in 0..v.len() {
+                    let column: Vec<&Expansion> = a.iter().map(|row| &row[j]).collect();
+                    out.push(self.dot(v.iter().zip(column), loc)?);
+                }
+                Some(Value::Vector(out))
+            }
+            (Value::Matrix(_), Value::Matrix(_)) => self.fail_value(
+                Diagnostic::text(loc, "product of two matrices")
+                    .help("write `A:B` for the double contraction Σᵢⱼ AᵢⱼBᵢⱼ (ε(θ):ε(η))"),
+            ),
+        }
+    }
+
+    /// `Σ xᵢ yᵢ` over pairs of scalars.
+    fn dot<'e>(
+        &mut self,
+        pairs: impl Iterator<Item = (&'e Expansion, &'e Expansion)>,
+        loc: Loc,
+    ) -> Option<Expansion> {
+        let mut sum = Vec::new();
+        for (a, b) in pairs {
+            sum = symbolic::add(sum, self.scalar_product(a, b, loc)?);
+        }
+        Some(sum)
+    }
+
+    /// `∇x`: a scalar's gradient is a vector, a vector's a matrix with the components
+    /// in its rows (`(∇θ)ᵢⱼ = ∂ⱼθᵢ`).
+    fn gradient(&mut self, x: Value, loc: Loc) -> Option<Value> {
+        let n = self.symbols.dimension;
+        match x {
+            Value::Scalar(x) => {
+                let mut components = Vec::new();
+                for axis in 0..n {
+                    components.push(self.partial(&x, axis, 1, loc)?);
+                }
+                Some(Value::Vector(components))
+            }
+            Value::Vector(v) => {
+                let mut rows = Vec::new();
+                for c in &v {
+                    let mut row = Vec::new();
+                    for axis in 0..n {
+                        row.push(self.partial(c, axis, 1, loc)?);
+                    }
+                    rows.push(row);
+                }
+                Some(Value::Matrix(rows))
+            }
+            Value::Matrix(_) => self.fail_value(
+                Diagnostic::text(loc, "∇ of a matrix")
+                    .help("∇ takes a scalar (giving a vector) or a vector (giving a matrix); for a matrix take `div` row by row"),
+            ),
+        }
+    }
+
+    /// Expands an expression to a scalar, a vector or a matrix.
     fn value(&mut self, e: &Expr, inside_integral: bool) -> Option<Value> {
         let loc = e.loc;
         match &e.kind {
+            ExprKind::Symbol(name) => self.symbol(name, loc, inside_integral),
+            ExprKind::Call { name, groups } => self.call(name, groups, loc),
             ExprKind::Neg(a) => Some(self.value(a, inside_integral)?.map(symbolic::neg)),
             ExprKind::Add(..) | ExprKind::Sub(..) => self.sum_value(e, inside_integral),
             ExprKind::Mul(a, b) => {
                 let x = self.value(a, inside_integral);
                 let y = self.value(b, inside_integral);
+                self.product(x?, y?, loc)
+            }
+            ExprKind::Contract(a, b) => {
+                let x = self.value(a, inside_integral);
+                let y = self.value(b, inside_integral);
                 match (x?, y?) {
-                    (Value::Scalar(x), Value::Scalar(y)) => {
-                        self.scalar_product(&x, &y, loc).map(Value::Scalar)
-                    }
-                    (Value::Scalar(s), Value::Vector(v)) | (Value::Vector(v), Value::Scalar(s)) => {
-                        let mut out = Vec::new();
-                        for c in &v {
-                            out.push(self.scalar_product(&s, c, loc)?);
-                        }
-                        Some(Value::Vector(out))
-                    }
-                    (Value::Vector(x), Value::Vector(y)) => {
-                        let mut sum = Vec::new();
-                        for (a, b) in x.iter().zip(&y) {
-                            sum = symbolic::add(sum, self.scalar_product(a, b, loc)?);
-                        }
-                        Some(Value::Scalar(sum))
-                    }
+                    (Value::Matrix(x), Value::Matrix(y)) => self
+                        .dot(x.iter().flatten().zip(y.iter().flatten()), loc)
+                        .map(Value::Scalar),
+                    (x, y) => self.fail_value(
+                        Diagnostic::text(loc, format!("`:` of {} and {}", x.shape(), y.shape()))
+                            .help("`A:B` contracts two matrices (ε(θ):ε(η)); two vectors multiply with `·` (their dot product), and a scalar scales anything by juxtaposition or `·`"),
+                    ),
                 }
             }
             ExprKind::Div(a, b) => {
                 let x = self.value(a, inside_integral);
                 let y = self.expand(b, inside_integral);
                 let (x, y) = (x?, y?);
-                match symbolic::pow(&y, -1, loc) {
-                    Some(inverse) => Some(x.map(|c| symbolic::mul(&c, &inverse, loc))),
-                    None => {
-                        self.errors.push(Diagnostic::text(b.loc, "division by an expression that is not a non-zero number, parameter or power of h")
-                            .help("forms are polynomial in the arguments and data; divide only by numbers, parameters and h"));
-                        None
-                    }
-                }
+                let inverse = self.inverse(&y, 1, loc, b.loc)?;
+                x.try_map(|c| Some(symbolic::mul(&c, &inverse, loc)))
             }
             ExprKind::Gradient(a) => {
-                let x = self.expand(a, inside_integral)?;
-                let mut components = Vec::new();
-                for axis in 0..self.symbols.dimension {
-                    components.push(self.partial(&x, axis, 1, loc)?);
-                }
-                Some(Value::Vector(components))
+                let x = self.value(a, inside_integral)?;
+                self.gradient(x, loc)
             }
             ExprKind::Laplacian(a) => {
-                let x = self.expand(a, inside_integral)?;
-                let mut sum = Vec::new();
-                for axis in 0..self.symbols.dimension {
-                    sum = symbolic::add(sum, self.partial(&x, axis, 2, loc)?);
-                }
-                Some(Value::Scalar(sum))
+                let x = self.value(a, inside_integral)?;
+                x.try_map(|c| {
+                    let mut sum = Vec::new();
+                    for axis in 0..self.symbols.dimension {
+                        sum = symbolic::add(sum, self.partial(&c, axis, 2, loc)?);
+                    }
+                    Some(sum)
+                })
             }
+            ExprKind::Partial(a, axis) => {
+                let axis = *axis as usize;
+                if axis >= self.symbols.dimension {
+                    return self.fail_value(
+                        Diagnostic::text(loc, "∂_y on an interval: the cell has one coordinate")
+                            .help("on intervals write primes (w') or ∂_x"),
+                    );
+                }
+                let x = self.value(a, inside_integral)?;
+                x.try_map(|c| self.partial(&c, axis, 1, loc))
+            }
+            ExprKind::SymmetricGradient(a) => match self.value(a, inside_integral)? {
+                v @ Value::Vector(_) => {
+                    let Value::Matrix(g) = self.gradient(v, loc)? else {
+                        return None;
+                    };
+                    let n = g.len();
+                    let half = vec![Monomial::constant(0.5, loc)];
+                    let rows = (0..n)
+                        .map(|i| {
+                            (0..n)
+                                .map(|j| {
+                                    let sum = symbolic::add(g[i][j].clone(), g[j][i].clone());
+                                    symbolic::mul(&half, &sum, loc)
+                                })
+                                .collect()
+                        })
+                        .collect();
+                    Some(Value::Matrix(rows))
+                }
+                x => self.fail_value(
+                    Diagnostic::text(loc, format!("ε of {}", x.shape()))
+                        .help("ε(θ) = ½(∇θ + ∇θᵀ) is the symmetric gradient of a vector field; the gradient of a scalar w is ∇w"),
+                ),
+            },
+            ExprKind::Divergence(a) => match self.value(a, inside_integral)? {
+                Value::Vector(v) => {
+                    let mut sum = Vec::new();
+                    for (axis, c) in v.iter().enumerate() {
+                        sum = symbolic::add(sum, self.partial(c, axis, 1, loc)?);
+                    }
+                    Some(Value::Scalar(sum))
+                }
+                Value::Matrix(m) => {
+                    let mut out = Vec::new();
+                    for row in &m {
+                        let mut sum = Vec::new();
+                        for (axis, c) in row.iter().enumerate() {
+                            sum = symbolic::add(sum, self.partial(c, axis, 1, loc)?);
+                        }
+                        out.push(sum);
+                    }
+                    Some(Value::Vector(out))
+                }
+                Value::Scalar(_) => self.fail_value(
+                    Diagnostic::text(loc, "div of a scalar")
+                        .help("div takes a vector (giving a scalar) or a matrix (row by row, giving a vector); a scalar w has the gradient ∇w and the Laplacian Δw = div ∇w"),
+                ),
+            },
+            ExprKind::Trace(a) => match self.value(a, inside_integral)? {
+                Value::Matrix(m) => {
+                    let mut sum = Vec::new();
+                    for (i, row) in m.into_iter().enumerate() {
+                        sum = symbolic::add(sum, row.into_iter().nth(i).unwrap_or_default());
+                    }
+                    Some(Value::Scalar(sum))
+                }
+                x => self.fail_value(
+                    Diagnostic::text(loc, format!("tr of {}", x.shape()))
+                        .help("tr takes a matrix: tr ε(θ) = div θ, tr I = 2"),
+                ),
+            },
             ExprKind::InnerProduct(a, b) => {
                 let x = self.value(a, inside_integral);
                 let y = self.value(b, inside_integral);
-                let mut p = match (x?, y?) {
-                    (Value::Scalar(x), Value::Scalar(y)) => symbolic::mul(&x, &y, loc),
-                    (Value::Vector(x), Value::Vector(y)) => {
-                        let mut sum = Vec::new();
-                        for (a, b) in x.iter().zip(&y) {
-                            sum = symbolic::add(sum, symbolic::mul(a, b, loc));
-                        }
-                        sum
-                    }
-                    _ => return self.vector_mismatch(loc, "L² product"),
-                };
+                let (x, y) = (x?, y?);
+                if std::mem::discriminant(&x) != std::mem::discriminant(&y) {
+                    return self.shape_mismatch(loc, "L² product", &x, &y);
+                }
+                let mut p = Vec::new();
+                for (a, b) in x.entries().iter().zip(&y.entries()) {
+                    p = symbolic::add(p, symbolic::mul(a, b, loc));
+                }
                 for t in &mut p {
                     t.inner_products += 1;
                 }
                 Some(Value::Scalar(p))
             }
             _ => self.scalar_value(e, inside_integral).map(Value::Scalar),
+        }
+    }
+
+    /// `1/x^k` (`k > 0`) of a scalar: a non-zero number, parameter or power of `h`
+    /// (any sign: the runtime checks what it must), or a sum of parameters and `h`
+    /// that is positive for every allowed parameter value. `at` locates `x`.
+    fn inverse(&mut self, x: &Expansion, k: i32, loc: Loc, at: Loc) -> Option<Expansion> {
+        if let Some(inverse) = symbolic::pow(x, -k, loc) {
+            return Some(inverse);
+        }
+        if x.iter().any(|t| !t.is_scalar()) {
+            return self.fail(
+                Diagnostic::text(at, "division by an expression that holds functions, data or integrals")
+                    .help("forms are polynomial in the arguments and data; divide only by numbers, parameters, h and positive sums of those (t² + β h_T² with `params: β > 0`)"),
+            );
+        }
+        match self.positive_sum(x) {
+            Ok(()) => symbolic::divide_by_sum(x, k, loc).map(|m| vec![m]).or_else(|| {
+                self.fail(Diagnostic::text(at, "division by a sum that holds a division by a sum")
+                    .help("write the quotient over one common denominator"))
+            }),
+            Err(why) => self.fail(
+                Diagnostic::text(at, format!("division by a sum that is not known to be positive: {why}"))
+                    .help("a sum is a divisor when each term is ≥ 0 (a positive number times even powers, parameters declared `> 0` and h) and one term is > 0 (no parameter in it only known ≥ 0): declare parameters positive with `params: β > 0`"),
+            ),
+        }
+    }
+
+    /// Why the scalar sum `x` of parameters and `h` may vanish or be negative, if it may.
+    fn positive_sum(&self, x: &Expansion) -> Result<(), String> {
+        if x.is_empty() {
+            return Err("it is zero".into());
+        }
+        let name = |i: usize| self.symbols.params[i].as_str();
+        let mut strictly = false;
+        for t in x {
+            if !t.coefficient.is_finite() {
+                return Err(format!(
+                    "a term's coefficient overflows ({})",
+                    t.coefficient
+                ));
+            }
+            if t.coefficient <= 0.0 {
+                return Err(format!("a term has the coefficient {}", t.coefficient));
+            }
+            if !t.divisors.is_empty() {
+                continue; // refused by the caller with its own message
+            }
+            let mut positive = true;
+            for &(i, e) in &t.params {
+                if self.symbols.positive.contains(&i) {
+                    continue;
+                }
+                if e % 2 != 0 {
+                    return Err(format!(
+                        "`{}` is not declared positive and appears to an odd power",
+                        name(i)
+                    ));
+                }
+                positive = false; // an even power is ≥ 0, and 0 when the parameter is
+            }
+            strictly |= positive;
+        }
+        if strictly {
+            Ok(())
+        } else {
+            Err("every term vanishes when a parameter not declared positive is 0".into())
         }
     }
 
@@ -869,7 +1314,6 @@ impl Context<'_> {
         let loc = e.loc;
         match &e.kind {
             ExprKind::Number(v) => Some(vec![Monomial::constant(*v, loc)]),
-            ExprKind::Symbol(name) => self.symbol(name, loc, inside_integral),
             ExprKind::Pow(a, n) => {
                 let x = self.expand(a, inside_integral)?;
                 if x.iter().any(|t| t.integrated) {
@@ -877,6 +1321,10 @@ impl Context<'_> {
                 }
                 match symbolic::pow(&x, *n, loc) {
                     Some(p) => Some(p),
+                    // a positive sum of parameters and h: (t² + β h²)⁻¹
+                    None if x.len() > 1 && x.iter().all(Monomial::is_scalar) => {
+                        self.inverse(&x, -*n, loc, a.loc)
+                    }
                     None => self.fail(
                         Diagnostic::text(loc, format!("negative power {n} of an expression that is not a non-zero number, parameter or h"))
                             .help("only numbers, parameters and h may carry negative exponents (t⁻², h⁻¹)"),
@@ -935,15 +1383,41 @@ impl Context<'_> {
                 }
                 Some(x)
             }
-            ExprKind::Call { name, groups } => self.call(name, groups, loc),
             // the vector-capable constructs, handled by `value`
             _ => self.expand(e, inside_integral),
         }
     }
 
-    fn call(&mut self, name: &str, groups: &[Vec<Name>], loc: Loc) -> Option<Expansion> {
-        let Some(callee) = self.forms.iter().find(|f| f.name == name) else {
-            return self.fail(
+    /// A call of a form (a scalar) or of a named expression (any shape) with its
+    /// arguments substituted positionally.
+    fn call(&mut self, name: &str, groups: &[Vec<Name>], loc: Loc) -> Option<Value> {
+        let (callee, mapping) = self.call_mapping(name, groups, loc)?;
+        let substitute = |mut terms: Expansion| {
+            for t in &mut terms {
+                for a in &mut t.args {
+                    a.symbol = mapping.iter().find(|(f, _)| *f == a.symbol).unwrap().1;
+                }
+                t.args.sort();
+                t.origin = loc;
+            }
+            terms
+        };
+        Some(match &callee.value {
+            Some(value) => value.clone().map(substitute),
+            None => Value::Scalar(substitute(callee.terms.clone())),
+        })
+    }
+
+    /// The form called and its formal → actual symbols, after the checks of a call.
+    fn call_mapping(
+        &mut self,
+        name: &str,
+        groups: &[Vec<Name>],
+        loc: Loc,
+    ) -> Option<(&'a Form, Vec<(usize, usize)>)> {
+        let forms = self.forms;
+        let Some(callee) = forms.iter().find(|f| f.name == name) else {
+            return self.fail_mapping(
                 Diagnostic::text(loc, format!("form `{name}` is used before its definition"))
                     .help("define a form above the forms that call it"),
             );
@@ -951,25 +1425,25 @@ impl Context<'_> {
         if callee.groups.is_empty() {
             return None; // its own definition failed and was reported
         }
-        let show = |g: &[usize]| {
+        let show = |g: &[Vec<usize>]| {
             g.iter()
-                .map(|&s| self.symbols.function_name(s))
+                .map(|a| self.symbols.argument_name(a))
                 .collect::<Vec<_>>()
                 .join(", ")
         };
         let callee_signature = format!(
             "{name}({})",
             callee
-                .groups
+                .arguments
                 .iter()
                 .map(|g| show(g))
                 .collect::<Vec<_>>()
                 .join("; ")
         );
-        if groups.len() != callee.groups.len()
+        if groups.len() != callee.arguments.len()
             || groups
                 .iter()
-                .zip(&callee.groups)
+                .zip(&callee.arguments)
                 .any(|(a, b)| a.len() != b.len())
         {
             let counts = |v: Vec<usize>| {
@@ -978,12 +1452,12 @@ impl Context<'_> {
                     .collect::<Vec<_>>()
                     .join(";")
             };
-            return self.fail(
+            return self.fail_mapping(
                 Diagnostic::text(
                     loc,
                     format!(
                         "wrong number of arguments for `{name}`: it is defined as {callee_signature} ({} arguments), called with {}",
-                        counts(callee.groups.iter().map(Vec::len).collect()),
+                        counts(callee.arguments.iter().map(Vec::len).collect()),
                         counts(groups.iter().map(Vec::len).collect()),
                     ),
                 )
@@ -993,34 +1467,36 @@ impl Context<'_> {
         let mut mapping: Vec<(usize, usize)> = Vec::new();
         for (g, group) in groups.iter().enumerate() {
             for (k, n) in group.iter().enumerate() {
-                let formal = callee.groups[g][k];
-                let Some(actual) = self.symbols.function_symbol(&n.text) else {
+                let formal = &callee.arguments[g][k];
+                let Some(actual) = self.symbols.function_symbols(&n.text) else {
                     let d = self.not_a_function(n, name);
-                    return self.fail(d);
+                    return self.fail_mapping(d);
                 };
-                if self.symbols.field_of(actual) != self.symbols.field_of(formal) {
-                    let field = &self.symbols.fields[self.symbols.field_of(formal)];
-                    return self.fail(
+                let same_field = actual.len() == formal.len()
+                    && actual
+                        .iter()
+                        .zip(formal)
+                        .all(|(&a, &f)| self.symbols.field_of(a) == self.symbols.field_of(f));
+                if !same_field {
+                    let (unknown, test) = self.symbols.field_names(formal);
+                    return self.fail_mapping(
                         Diagnostic::text(
                             n.loc,
                             format!(
-                                "argument `{}` of `{name}` must be a function of the field `{}` (`{}` or `{}`), as in {callee_signature}",
-                                n.text, field.name, field.name, field.test_name
+                                "argument `{}` of `{name}` must be a function of the field `{unknown}` (`{unknown}` or `{test}`), as in {callee_signature}",
+                                n.text
                             ),
                         ),
                     );
                 }
-                mapping.push((formal, actual));
+                mapping.extend(formal.iter().copied().zip(actual));
             }
         }
-        let mut out = callee.terms.clone();
-        for t in &mut out {
-            for a in &mut t.args {
-                a.symbol = mapping.iter().find(|(f, _)| *f == a.symbol).unwrap().1;
-            }
-            t.args.sort();
-            t.origin = loc;
-        }
-        Some(out)
+        Some((callee, mapping))
+    }
+
+    fn fail_mapping<T>(&mut self, d: Diagnostic) -> Option<T> {
+        self.errors.push(d);
+        None
     }
 }

@@ -3,9 +3,9 @@
 //! ```text
 //! /// docs
 //! pub mod NAME on interval {
-//!     unknowns: θ: P2, w: P2, λ: P0 >= 0;
+//!     unknowns: θ: P2, w: P2, λ: P0 >= 0;   // `θ: [P1]^2`: a vector field (triangles)
 //!     tests:    η, v, μ;
-//!     params:   t, α, s;
+//!     params:   t, α, s;       // `β > 0` declares a positive parameter (checked at run time)
 //!     data:     f, ψ;          // `f: 0` declares f constant for quadrature (default degree 2)
 //!     boundary: w = g;         // optional: Dirichlet data, a declared data function
 //!     forms:    "…";
@@ -20,9 +20,18 @@ use fem_reference::reference_element::ALL_ELEMENTS;
 use fem_reference::{CellKind, ElementKind};
 use proc_macro2::{Span, TokenStream, TokenTree};
 use syn::parse::{Parse, ParseStream};
-use syn::{Attribute, Ident, LitInt, LitStr, Token, Visibility};
+use syn::{Attribute, Ident, Lit, LitInt, LitStr, Token, Visibility};
 
-/// An unknown field: `θ: P2` or `λ: P0 >= 0`.
+/// Reserved names: the element size, the keywords of the forms text and `I`.
+pub const RESERVED: [&str; 17] = [
+    "h", "h_T", "int", "sum_T", "Σ_T", "degree", "Model", "grad", "lap", "dot", "d_x", "d_y", "ε",
+    "eps", "div", "tr", "I",
+];
+
+/// Suffixes of the components of a vector field (`θ_x`, `θ_y`), by axis.
+pub const COMPONENT_SUFFIXES: [&str; 2] = ["_x", "_y"];
+
+/// An unknown field: `θ: P2`, `λ: P0 >= 0` or the vector field `θ: [P1]^2`.
 #[derive(Clone, Debug)]
 pub struct UnknownDecl {
     /// The unknown's name.
@@ -33,6 +42,24 @@ pub struct UnknownDecl {
     pub element_name: Ident,
     /// `>= 0`: the field is a multiplier constrained to be non-negative.
     pub nonnegative: bool,
+    /// `Some((n, span of n))` for a vector field `[P1]^n`, `None` for a scalar one.
+    pub vector: Option<(usize, Span)>,
+}
+
+impl UnknownDecl {
+    /// Number of scalar components: 1, or `n` of `[P1]^n`.
+    pub fn components(&self) -> usize {
+        self.vector.map_or(1, |(n, _)| n)
+    }
+}
+
+/// The names of the components of vector `name`: `θ_x`, `θ_y`.
+pub fn component_names(name: &str, components: usize) -> Vec<String> {
+    COMPONENT_SUFFIXES
+        .iter()
+        .take(components)
+        .map(|s| format!("{name}{s}"))
+        .collect()
 }
 
 /// A data function: `f` or `f: 0`.
@@ -65,6 +92,8 @@ pub struct Declaration {
     pub tests: Vec<Ident>,
     /// Runtime scalar parameters.
     pub params: Vec<Ident>,
+    /// Indices in `params` of those declared `> 0`.
+    pub positive: Vec<usize>,
     /// Data functions of x.
     pub data: Vec<DataDecl>,
     /// Dirichlet conditions `field = data` on the whole boundary.
@@ -142,6 +171,7 @@ impl Parse for Declaration {
             unknowns: Vec::new(),
             tests: Vec::new(),
             params: Vec::new(),
+            positive: Vec::new(),
             data: Vec::new(),
             dirichlet: Vec::new(),
             forms: LitStr::new("", brace.span.join()),
@@ -162,7 +192,27 @@ impl Parse for Declaration {
                     declaration.unknowns = comma_list(&content, |s| {
                         let name: Ident = s.parse()?;
                         s.parse::<Token![:]>()?;
-                        let element_name: Ident = s.parse()?;
+                        let (element_name, vector) = if s.peek(syn::token::Bracket) {
+                            let inner;
+                            let brackets = syn::bracketed!(inner in s);
+                            let element_name: Ident = inner.parse()?;
+                            if !inner.is_empty() {
+                                return Err(inner.error(format!(
+                                    "a vector field is declared `{name}: [{element_name}]^2`"
+                                )));
+                            }
+                            if !s.peek(Token![^]) {
+                                return Err(syn::Error::new(
+                                    brackets.span.join(),
+                                    format!("a vector field is declared `{name}: [{element_name}]^2` (the number of components after `^`)"),
+                                ));
+                            }
+                            s.parse::<Token![^]>()?;
+                            let n: LitInt = s.parse()?;
+                            (element_name, Some((n.base10_parse::<usize>()?, n.span())))
+                        } else {
+                            (s.parse()?, None)
+                        };
                         if !s.peek(Token![>=]) && (s.peek(Token![<]) || s.peek(Token![>])) {
                             let op: TokenTree = s.parse()?;
                             return Err(syn::Error::new(
@@ -192,11 +242,43 @@ impl Parse for Declaration {
                             name,
                             element_name,
                             nonnegative,
+                            vector,
                         })
                     })?
                 }
                 "tests" => declaration.tests = comma_list(&content, |s| s.parse())?,
-                "params" => declaration.params = comma_list(&content, |s| s.parse())?,
+                "params" => {
+                    let params = comma_list(&content, |s| {
+                        let name: Ident = s.parse()?;
+                        let positive = if s.peek(Token![>]) && !s.peek(Token![>=]) {
+                            s.parse::<Token![>]>()?;
+                            let zero: Lit = s.parse()?;
+                            let is_zero = match &zero {
+                                Lit::Int(i) => i.base10_parse::<u64>().is_ok_and(|v| v == 0),
+                                Lit::Float(f) => f.base10_parse::<f64>().is_ok_and(|v| v == 0.0),
+                                _ => false,
+                            };
+                            if !is_zero {
+                                return Err(syn::Error::new(
+                                    zero.span(),
+                                    format!("a parameter is declared positive with `{name} > 0`; other bounds are not supported"),
+                                ));
+                            }
+                            true
+                        } else if s.peek(Token![>=]) || s.peek(Token![<]) || s.peek(Token![<=]) {
+                            let op: TokenTree = s.parse()?;
+                            return Err(syn::Error::new(
+                                op.span(),
+                                format!("a parameter is declared positive with `{name} > 0`; other bounds are not supported"),
+                            ));
+                        } else {
+                            false
+                        };
+                        Ok((name, positive))
+                    })?;
+                    declaration.positive = (0..params.len()).filter(|&i| params[i].1).collect();
+                    declaration.params = params.into_iter().map(|(n, _)| n).collect();
+                }
                 "data" => {
                     declaration.data = comma_list(&content, |s| {
                         let name: Ident = s.parse()?;
@@ -289,6 +371,27 @@ impl Declaration {
                     );
                 }
                 Some(e) => {
+                    if let Some((n, span)) = u.vector {
+                        if u.nonnegative {
+                            errors.push(Diagnostic::token(
+                                span,
+                                format!("`{}` is a vector field: a multiplier `>= 0` must be a scalar field", u.name),
+                            ));
+                        }
+                        if cell == Some(CellKind::Interval) || n != 2 {
+                            errors.push(
+                                Diagnostic::token(
+                                    span,
+                                    format!(
+                                        "`{}: [{}]^{n}`: a vector field has as many components as the cell's dimension",
+                                        u.name,
+                                        e.name()
+                                    ),
+                                )
+                                .help("vector fields are declared on triangles as `[P1]^2`; on intervals every field is a scalar"),
+                            );
+                        }
+                    }
                     if let Some(c) = cell {
                         if !e.supports(c) {
                             errors.push(Diagnostic::token(
@@ -332,7 +435,32 @@ impl Declaration {
             );
         }
         for (field, data) in &self.dirichlet {
-            match self.unknowns.iter().find(|u| u.name == *field) {
+            // A component `θ_x` of a vector field is prescribed like a scalar field.
+            let component_of = self.unknowns.iter().find(|u| {
+                u.vector.is_some()
+                    && component_names(&u.name.to_string(), u.components())
+                        .contains(&field.to_string())
+            });
+            match self
+                .unknowns
+                .iter()
+                .find(|u| u.name == *field)
+                .or(component_of)
+            {
+                Some(u) if u.vector.is_some() && u.name == *field => errors.push(
+                    Diagnostic::token(
+                        field.span(),
+                        format!("`{field}` is a vector field: prescribe its components"),
+                    )
+                    .help(format!(
+                        "write one condition per component: {}",
+                        component_names(&field.to_string(), u.components())
+                            .iter()
+                            .map(|c| format!("`{c} = {data}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )),
+                ),
                 None => errors.push(
                     Diagnostic::token(field.span(), format!("`{field}` is not an unknown")).help(
                         "boundary data `w = g` prescribes an unknown declared under `unknowns:`",
@@ -359,10 +487,16 @@ impl Declaration {
             }
         }
         // Every name means one thing.
-        let reserved = [
-            "h", "h_T", "int", "sum_T", "Σ_T", "degree", "Model", "grad", "lap", "dot",
-        ];
-        let mut names: Vec<&Ident> = Vec::new();
+        // (name, where declared, the vector it is a component of)
+        let mut names: Vec<(String, &Ident, Option<&Ident>)> = Vec::new();
+        let components = |name: &Ident| -> usize {
+            self.unknowns
+                .iter()
+                .position(|u| u.name == *name)
+                .or_else(|| self.tests.iter().position(|t| t == name))
+                .and_then(|k| self.unknowns.get(k))
+                .map_or(1, UnknownDecl::components)
+        };
         let all = self
             .unknowns
             .iter()
@@ -372,18 +506,42 @@ impl Declaration {
             .chain(self.data.iter().map(|d| &d.name));
         for name in all {
             let text = name.to_string();
-            if reserved.contains(&text.as_str()) {
+            if RESERVED.contains(&text.as_str()) {
                 errors.push(
                     Diagnostic::token(name.span(), format!("`{text}` is reserved"))
-                        .help("`h`/`h_T` is the element size, `int`/`sum_T` are ∫ and Σ_T, `grad`/`lap`/`dot` are ∇, Δ and ·; pick another name"),
+                        .help("`h`/`h_T` is the element size, `int`/`sum_T` are ∫ and Σ_T, `grad`/`lap`/`dot`/`d_x`/`d_y` are ∇, Δ, ·, ∂_x, ∂_y, `ε`/`eps`/`div`/`tr` the symmetric gradient, divergence and trace, `I` the identity; pick another name"),
                 );
-            } else if names.iter().any(|n| **n == *name) {
-                errors.push(Diagnostic::token(
-                    name.span(),
-                    format!("`{text}` is declared twice"),
-                ));
+                continue;
             }
-            names.push(name);
+            // The components of a vector field are names too (`θ_x`, `η_y`).
+            let mut new = vec![(text.clone(), name, None)];
+            let n = components(name);
+            if n > 1 {
+                new.extend(
+                    component_names(&text, n)
+                        .into_iter()
+                        .map(|c| (c, name, Some(name))),
+                );
+            }
+            for entry in new {
+                if let Some(earlier) = names.iter().find(|e| e.0 == entry.0) {
+                    errors.push(match (earlier.2, entry.2) {
+                        (None, None) => Diagnostic::token(
+                            name.span(),
+                            format!("`{}` is declared twice", entry.0),
+                        ),
+                        (Some(v), _) | (None, Some(v)) => Diagnostic::token(
+                            name.span(),
+                            format!(
+                                "`{}` is both a declared name and a component of the vector field `{v}`",
+                                entry.0
+                            ),
+                        )
+                        .help("the components of a vector field θ are named θ_x and θ_y: pick other names"),
+                    });
+                }
+                names.push(entry);
+            }
         }
         errors
     }

@@ -10,8 +10,15 @@
 //! | product            | `·`, `⋅`, `×`, juxtaposition | `*`, `dot` |
 //! | gradient           | `∇`                | `grad`           |
 //! | Laplacian          | `Δ`                | `lap`            |
+//! | partial derivative | `∂_x`, `∂_y`       | `d_x`, `d_y`     |
+//! | symmetric gradient | `ε`                | `eps`            |
+//! | divergence         | `div`              | `div`            |
+//! | trace              | `tr`               | `tr`             |
+//! | double contraction | `:`                | `:`              |
+//! | grouping           | `( … )`, `[ … ]`   | the same         |
 //!
-//! A product of two vectors (`∇u·∇v`, `grad u dot grad v`) is their dot product.
+//! A product of two vectors (`∇u·∇v`, `grad u dot grad v`) is their dot product; `A:B`
+//! contracts two matrices. `I` (the identity matrix) is a name, resolved by the analysis.
 
 use crate::diagnostic::{Diagnostic, Loc};
 
@@ -42,6 +49,16 @@ pub enum Tok {
     Grad,
     /// `Δ` or `lap`
     Laplacian,
+    /// `∂_x` (axis 0) or `∂_y` (axis 1); ASCII `d_x`, `d_y`
+    Partial(u8),
+    /// `ε` or `eps`: the symmetric gradient
+    SymGrad,
+    /// `div`
+    Divergence,
+    /// `tr`
+    Trace,
+    /// `:` the double contraction of two matrices
+    Colon,
     /// `/`
     Slash,
     /// `(`
@@ -237,6 +254,11 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 "grad" => Tok::Grad,
                 "lap" => Tok::Laplacian,
                 "dot" => Tok::Star,
+                "d_x" => Tok::Partial(0),
+                "d_y" => Tok::Partial(1),
+                "ε" | "eps" => Tok::SymGrad,
+                "div" => Tok::Divergence,
+                "tr" => Tok::Trace,
                 _ => Tok::Ident(name),
             };
             push(tok, j - i, &mut tokens);
@@ -245,6 +267,14 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 '∫' => Some(Tok::Integral),
                 '∇' => Some(Tok::Grad),
                 'Δ' => Some(Tok::Laplacian),
+                '∂' if chars.get(i + 1) == Some(&'_')
+                    && matches!(chars.get(i + 2), Some('x' | 'y'))
+                    && !chars.get(i + 3).is_some_and(|&d| is_ident_continue(d)) =>
+                {
+                    j = i + 3;
+                    Some(Tok::Partial(u8::from(chars[i + 2] == 'y')))
+                }
+                ':' => Some(Tok::Colon),
                 '∑' if chars.get(i + 1) == Some(&'_') && chars.get(i + 2) == Some(&'T') => {
                     j = i + 3;
                     Some(Tok::SumT)
@@ -269,7 +299,11 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 Some(tok) => push(tok, j - i, &mut tokens),
                 None => errors.push(
                     Diagnostic::text(start, format!("unexpected character `{c}` (U+{:04X})", c as u32))
-                        .help("the forms use ∫ (or int), Σ_T (or sum_T), + − · /, primes ' for derivatives (1D), ∇ Δ (grad, lap) on triangles, ⁻² or ^-2 for powers, and (X, Y)_T for L² products"),
+                        .help(if c == '∂' {
+                            "a partial derivative is written ∂_x or ∂_y (ASCII d_x, d_y)"
+                        } else {
+                            "the forms use ∫ (or int), Σ_T (or sum_T), + − · : /, primes ' for derivatives (1D), ∇ Δ ∂_x ∂_y ε div tr (grad, lap, d_x, d_y, eps) on triangles, ⁻² or ^-2 for powers, and (X, Y)_T for L² products"
+                        }),
                 ),
             }
         }
@@ -317,6 +351,31 @@ mod tests {
         assert_eq!(kinds("∇u·∇v + Δw"), kinds("grad u dot grad v + lap w"));
         assert_eq!(kinds("Δw")[0], Tok::Laplacian);
         assert_eq!(kinds("∇")[0], Tok::Grad);
+    }
+
+    #[test]
+    fn tensor_spellings_agree() {
+        assert_eq!(
+            kinds("∂_x θ_x + ∂_y w − ε(θ):ε(η) + div θ tr I"),
+            kinds("d_x θ_x + d_y w - eps(θ):eps(η) + div θ tr I")
+        );
+        assert_eq!(kinds("∂_y")[0], Tok::Partial(1));
+        // a name that merely starts like an operator stays a name
+        assert_eq!(
+            kinds("εr divs d_xx"),
+            vec![
+                Tok::Ident("εr".into()),
+                Tok::Ident("divs".into()),
+                Tok::Ident("d_xx".into())
+            ]
+        );
+        let (_, errors) = tokenize("∂_xy w");
+        assert_eq!(errors.len(), 1);
+        assert!(errors[0]
+            .help
+            .as_deref()
+            .unwrap_or("")
+            .contains("∂_x or ∂_y"));
     }
 
     #[test]

@@ -34,13 +34,19 @@
 //! - `mod NAME on interval` or `on triangle`.
 //! - `unknowns: NAME: ELEMENT, …` with elements `P0 P1 P2 P3 P1disc` (and `Hermite` on
 //!   intervals); `λ: P0 >= 0` (or `P1disc >= 0`) marks a multiplier constrained to be
-//!   non-negative.
+//!   non-negative. `θ: [P1]^2` (on triangles) declares a vector field of two P1
+//!   components (`[P1]²` cannot be written: `²` is not a Rust token); it is lowered to
+//!   the scalar fields `θ_x` and `θ_y` (tests `η_x`, `η_y`), which is what the runtime
+//!   sees, so its DOF map, assembly and kernels are those of scalar fields.
 //! - `tests: …` one test function per unknown, in order: `η` goes with `θ`.
-//! - `params: …` runtime scalars; `data: f, ψ: 0` functions of x (the number is the
+//! - `params: …` runtime scalars; `β > 0` declares one positive (the runtime's
+//!   `Coefficients` refuses other values), which lets the forms divide by sums that are
+//!   positive only then. `data: f, ψ: 0` functions of x (the number is the
 //!   polynomial degree assumed for quadrature, default 2, at most 40; the degrees of
 //!   the data in one term may sum to at most 40 too).
 //! - `boundary: u = g` (optional) Dirichlet data: unknown `u` equals the data function
-//!   `g` on the whole boundary (the runtime interpolates it at the boundary DOFs).
+//!   `g` on the whole boundary (the runtime interpolates it at the boundary DOFs); a
+//!   vector field is prescribed by component (`θ_x = g, θ_y = g`).
 //! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may
 //!   want `#![allow(mixed_script_confusables)]`.
 //!
@@ -62,10 +68,27 @@
 //!   vectors, and a product of two vectors (`∇u·∇v`, `grad u dot grad v`, or an L²
 //!   product `(∇u, ∇v)_T`) is their dot product; an integrand must be a scalar. A derivative above the element's degree
 //!   is zero and the term is dropped (`θ'''` of P2); P0 fields have no derivative.
-//! - Products by juxtaposition, `·`, `⋅`, `×` or `*`; `/` by numbers and parameters;
-//!   powers `t⁻²`, `h⁴` or `t^-2`, `h^4`, `t^(-2)`; minus `−` or `-`.
+//! - Shapes (docs/forms.md): expressions are scalars, vectors or matrices. A vector
+//!   field `θ` is a vector, `θ_x`/`θ_y` its components; `∂_x`, `∂_y` (`d_x`, `d_y`) act
+//!   entry by entry; `∇` of a vector is a matrix with the components in its rows;
+//!   `ε(θ)` (`eps`) is ½(∇θ + ∇θᵀ); `div` of a vector is a scalar, of a matrix the
+//!   vector of its rows' divergences; `tr` of a matrix; `I` the identity. A scalar
+//!   scales anything; `u·v` of vectors is the dot product, `A:B` of matrices the double
+//!   contraction, `A·v` the matrix–vector product; `[ … ]` groups like `( … )`. Every
+//!   operator checks its shapes at compile time (`∇w − w`, `ε(w)` of a scalar, `A:v`,
+//!   `div w` are errors at the expression), and an integrand must be a scalar.
+//! - Products by juxtaposition, `·`, `⋅`, `×` or `*`; powers `t⁻²`, `h⁴` or `t^-2`,
+//!   `h^4`, `t^(-2)`; minus `−` or `-`. `/` by a non-zero number, a parameter or a
+//!   power of `h`, or by a sum of those that is positive for all allowed values:
+//!   every term a positive number times even powers of parameters, parameters declared
+//!   `> 0` and powers of `h`, and one term free of parameters only known to be ≥ 0.
+//!   `6κ(1−ν)D/(t² + β h_T²)` with `β > 0` is such a quotient; `1/(t − β)` or
+//!   `1/(ν + t)` with `ν` not declared positive are errors at the divisor.
 //! - Names: declared symbols, `h` or `h_T` (element size); names written together that
 //!   are declared symbols multiply (`sλ` = `s·λ`).
+//! - `Cε(θ) := D[(1−ν)ε(θ) + ν tr ε(θ) I]` (with `:=`) names an expression of its
+//!   arguments, of any shape, substituted where it is called (`∫ Cε(θ):ε(η)`,
+//!   `div div Cε(η)`); it generates no code of its own.
 //! - A form may call forms defined above it with other arguments:
 //!   `B_h(…) = a(θ,w;η,v) − b(η,v;λ)` substitutes the arguments positionally (each must
 //!   belong to the same field as the formal argument it replaces).
@@ -145,7 +168,7 @@ mod lexer;
 mod parser;
 mod symbolic;
 
-use analysis::{Field, Symbols};
+use analysis::{Field, Symbols, Vector};
 use declaration::Declaration;
 use fem_reference::ElementKind;
 use proc_macro2::TokenStream;
@@ -163,30 +186,7 @@ fn expand(input: TokenStream) -> TokenStream {
         Err(e) => return e.to_compile_error(),
     };
     let mut errors = declaration.check();
-    let symbols = Symbols {
-        fields: declaration
-            .unknowns
-            .iter()
-            .enumerate()
-            .map(|(k, u)| Field {
-                name: u.name.to_string(),
-                test_name: declaration
-                    .tests
-                    .get(k)
-                    .map_or_else(|| format!("{}_test", u.name), |t| t.to_string()),
-                // An unknown element is reported above; P1 lets the analysis go on.
-                element: u.element.unwrap_or(ElementKind::P1),
-                nonnegative: u.nonnegative,
-            })
-            .collect(),
-        params: declaration.params.iter().map(|p| p.to_string()).collect(),
-        data: declaration
-            .data
-            .iter()
-            .map(|d| (d.name.to_string(), d.degree))
-            .collect(),
-        dimension: declaration.cell.map_or(1, |c| c.dimension()),
-    };
+    let symbols = symbols(&declaration);
     let text = declaration.forms.value();
     let (tokens, lex_errors) = lexer::tokenize(&text);
     let (definitions, parse_errors) = parser::parse_forms(&tokens);
@@ -201,11 +201,74 @@ fn expand(input: TokenStream) -> TokenStream {
             .map(|e| e.to_compile_error(&text, span))
             .collect();
     }
+    // Named expressions (`Cε(θ) := …`) were substituted where called: no code of their own.
+    let forms: Vec<_> = forms.into_iter().filter(|f| f.value.is_none()).collect();
     let code = codegen::generate(&declaration, &symbols, &forms);
     if let Ok(dir) = std::env::var("FEM_FORMS_DUMP_DIR") {
         dump(&dir, &declaration.name.to_string(), &code);
     }
     code
+}
+
+/// The names the declaration gives, with each vector field lowered to scalar fields
+/// of its components (`θ: [P1]^2` → `θ_x`, `θ_y`, tests `η_x`, `η_y`): the runtime sees
+/// only scalar fields, so its DOF map, assembly and kernels need no change.
+fn symbols(declaration: &Declaration) -> Symbols {
+    let mut fields = Vec::new();
+    let mut vectors = Vec::new();
+    let dimension = declaration.cell.map_or(1, |c| c.dimension());
+    for (k, u) in declaration.unknowns.iter().enumerate() {
+        let name = u.name.to_string();
+        let test_name = declaration
+            .tests
+            .get(k)
+            .map_or_else(|| format!("{name}_test"), |t| t.to_string());
+        // An unknown element is reported by `check`; P1 lets the analysis go on.
+        let element = u.element.unwrap_or(ElementKind::P1);
+        if u.vector.is_none() {
+            fields.push(Field {
+                name,
+                test_name,
+                element,
+                nonnegative: u.nonnegative,
+                component: None,
+            });
+            continue;
+        }
+        // A wrong component count (or a vector on an interval) is reported by `check`;
+        // the analysis goes on with one component per coordinate, so that every
+        // vector and matrix it builds has the cell's dimension.
+        let n = dimension;
+        let trial = declaration::component_names(&name, n);
+        let test = declaration::component_names(&test_name, n);
+        for (axis, (name, test_name)) in trial.into_iter().zip(test).enumerate() {
+            fields.push(Field {
+                name,
+                test_name,
+                element,
+                nonnegative: false,
+                component: Some((vectors.len(), axis)),
+            });
+        }
+        vectors.push(Vector {
+            name,
+            test_name,
+            first_field: fields.len() - n,
+            components: n,
+        });
+    }
+    Symbols {
+        fields,
+        vectors,
+        params: declaration.params.iter().map(|p| p.to_string()).collect(),
+        positive: declaration.positive.clone(),
+        data: declaration
+            .data
+            .iter()
+            .map(|d| (d.name.to_string(), d.degree))
+            .collect(),
+        dimension,
+    }
 }
 
 /// The generated code as a file that compiles on its own: formatted, and with the
@@ -234,3 +297,6 @@ fn dump(dir: &str, name: &str, code: &TokenStream) {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod shape_tests;

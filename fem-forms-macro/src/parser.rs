@@ -1,14 +1,20 @@
 //! The forms text → a syntax tree of form definitions.
 //!
 //! ```text
-//! definition := NAME '(' args [';' args] ')' '=' sum
+//! definition := NAME '(' args [';' args] ')' '=' sum      a form
+//!             | NAME '(' args ')' ':=' sum                 an expression of its arguments
 //! sum        := term (('+' | '−') term)*
 //! term       := ('+' | '−')* product
-//! product    := factor (('·' | '*' | '/')? factor)*        juxtaposition multiplies
-//! factor     := primary (prime | superscript | '^' exponent)*
-//! primary    := number | name | form '(' args ')' | '(' sum ')' | '(' sum ',' sum ')_T'
-//!             | '∫' ['[' 'degree' '=' integer ']'] sum | 'Σ_T' sum
+//! product    := factor (('·' | '*' | '/' | ':')? factor)*    juxtaposition multiplies
+//! factor     := operator factor | primary (prime | superscript | '^' exponent)*
+//! operator   := '∇' | 'Δ' | '∂_x' | '∂_y' | 'ε' | 'div' | 'tr'
+//! primary    := number | name | form '(' args ')' | '(' sum ')' | '[' sum ']'
+//!             | '(' sum ',' sum ')_T' | '∫' ['[' 'degree' '=' integer ']'] sum | 'Σ_T' sum
 //! ```
+//! The operators bind tighter than products and looser than primes and powers: each
+//! applies to the factor right of it, so `tr ε(θ) I` is `tr(ε(θ))·I` and `div θ div η`
+//! a product of two divergences; `div div (D[(1−ν)ε(θ) + ν tr ε(θ) I])` needs its
+//! parentheses (or `D div div […]`, D being constant).
 //! An integral's integrand extends to the right over the whole sum, up to a `+`/`−` that
 //! starts a new integral or form call (`∫ A + ∫[degree=1] B`, `a(…) − α S(…)`).
 //! A definition starts at the beginning of a line with `NAME(args) =`; anything else
@@ -66,6 +72,16 @@ pub enum ExprKind {
     Gradient(Box<Expr>),
     /// `Δx`
     Laplacian(Box<Expr>),
+    /// `∂_x x` (axis 0) or `∂_y x` (axis 1)
+    Partial(Box<Expr>, u8),
+    /// `ε(x)`, the symmetric gradient
+    SymmetricGradient(Box<Expr>),
+    /// `div x`
+    Divergence(Box<Expr>),
+    /// `tr x`
+    Trace(Box<Expr>),
+    /// `x : y`, the double contraction
+    Contract(Box<Expr>, Box<Expr>),
     /// `(x, y)_T`
     InnerProduct(Box<Expr>, Box<Expr>),
     /// `∫ body` or `Σ_T body`
@@ -101,9 +117,12 @@ impl Expr {
     }
 }
 
-/// `name(groups) = body`
+/// `name(groups) = body`, or `name(args) := body`
 #[derive(Clone, Debug, PartialEq)]
 pub struct Definition {
+    /// `:=`: a named expression of its arguments (`Cε(θ) := D[(1−ν)ε(θ) + ν tr ε(θ) I]`),
+    /// substituted where it is called, of any shape; not a form.
+    pub expression: bool,
     /// The form's name.
     pub name: Name,
     /// Its argument groups: `[trial…]; [test…]` for bilinear forms, `[test…]` for linear ones.
@@ -201,7 +220,7 @@ pub(crate) fn parse_expression(tokens: &[Token]) -> Result<Expr> {
     }
 }
 
-/// If a definition header `NAME ( … ) =` starts at `i`, the index of its `=`.
+/// If a definition header `NAME ( … ) =` (or `:=`) starts at `i`, the index of its `=`.
 fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
     matches!(tokens.get(i)?.tok, Tok::Ident(_)).then_some(())?;
     (tokens.get(i + 1)?.tok == Tok::LParen).then_some(())?;
@@ -210,7 +229,11 @@ fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
         match t.tok {
             Tok::Ident(_) | Tok::Comma | Tok::Semicolon => j += 1,
             Tok::RParen => {
-                return (tokens.get(j + 1)?.tok == Tok::Equals).then_some(j + 1);
+                return match tokens.get(j + 1)?.tok {
+                    Tok::Equals => Some(j + 1),
+                    Tok::Colon => (tokens.get(j + 2)?.tok == Tok::Equals).then_some(j + 2),
+                    _ => None,
+                };
             }
             _ => return None,
         }
@@ -236,7 +259,10 @@ fn too_deep(body: &Expr) -> Option<Loc> {
                 stack.push((a, depth));
                 stack.push((b, depth + 1));
             }
-            ExprKind::Mul(a, b) | ExprKind::Div(a, b) | ExprKind::InnerProduct(a, b) => {
+            ExprKind::Mul(a, b)
+            | ExprKind::Div(a, b)
+            | ExprKind::Contract(a, b)
+            | ExprKind::InnerProduct(a, b) => {
                 stack.push((a, depth + 1));
                 stack.push((b, depth + 1));
             }
@@ -245,6 +271,10 @@ fn too_deep(body: &Expr) -> Option<Loc> {
             | ExprKind::Derivative(a, _)
             | ExprKind::Gradient(a)
             | ExprKind::Laplacian(a)
+            | ExprKind::Partial(a, _)
+            | ExprKind::SymmetricGradient(a)
+            | ExprKind::Divergence(a)
+            | ExprKind::Trace(a)
             | ExprKind::Integral { body: a, .. } => stack.push((a, depth + 1)),
         }
     }
@@ -265,13 +295,18 @@ fn power_too_large(body: &Expr) -> Option<(Loc, f64)> {
         let b = match &e.kind {
             ExprKind::Number(_) | ExprKind::Symbol(_) | ExprKind::Call { .. } => 1.0,
             ExprKind::Add(a, b) | ExprKind::Sub(a, b) => bound(a, worst).max(bound(b, worst)),
-            ExprKind::Mul(a, b) | ExprKind::Div(a, b) | ExprKind::InnerProduct(a, b) => {
-                bound(a, worst) + bound(b, worst)
-            }
+            ExprKind::Mul(a, b)
+            | ExprKind::Div(a, b)
+            | ExprKind::Contract(a, b)
+            | ExprKind::InnerProduct(a, b) => bound(a, worst) + bound(b, worst),
             ExprKind::Neg(a)
             | ExprKind::Derivative(a, _)
             | ExprKind::Gradient(a)
             | ExprKind::Laplacian(a)
+            | ExprKind::Partial(a, _)
+            | ExprKind::SymmetricGradient(a)
+            | ExprKind::Divergence(a)
+            | ExprKind::Trace(a)
             | ExprKind::Integral { body: a, .. } => bound(a, worst),
             ExprKind::Pow(a, n) => bound(a, worst) * f64::from(*n).abs().max(1.0),
         };
@@ -311,6 +346,12 @@ fn describe(tok: &Tok) -> String {
         Tok::Star => "`·`".into(),
         Tok::Grad => "`∇`".into(),
         Tok::Laplacian => "`Δ`".into(),
+        Tok::Partial(0) => "`∂_x`".into(),
+        Tok::Partial(_) => "`∂_y`".into(),
+        Tok::SymGrad => "`ε`".into(),
+        Tok::Divergence => "`div`".into(),
+        Tok::Trace => "`tr`".into(),
+        Tok::Colon => "`:`".into(),
         Tok::Slash => "`/`".into(),
         Tok::LParen => "`(`".into(),
         Tok::RParen => "`)`".into(),
@@ -382,6 +423,22 @@ impl<'a> Parser<'a> {
         let name = self.name("a form name")?;
         self.expect(Tok::LParen, "`(`")?;
         let groups = self.argument_groups()?;
+        let expression = self.peek_tok() == Some(&Tok::Colon);
+        if expression {
+            self.pos += 1;
+            if groups.len() != 1 {
+                return Err(Diagnostic::text(
+                    name.loc,
+                    format!(
+                        "`{}(…) :=` names an expression of one argument list",
+                        name.text
+                    ),
+                )
+                .help(
+                    "write `Cε(θ) := …` without `;`; forms of trial and test functions use `=`",
+                ));
+            }
+        }
         self.expect(Tok::Equals, "`=`")?;
         if self.peek().is_none() {
             return Err(self.unexpected("the form's right-hand side"));
@@ -410,6 +467,7 @@ impl<'a> Parser<'a> {
             .help("a form is a polynomial of low degree in its fields and data: write the power you mean (h_T⁴, t⁻²)"));
         }
         Ok(Definition {
+            expression,
             name,
             groups,
             body,
@@ -609,18 +667,24 @@ impl<'a> Parser<'a> {
                 | Tok::LParen
                 | Tok::Integral
                 | Tok::SumT
+                | Tok::LBracket
                 | Tok::Grad
                 | Tok::Laplacian
+                | Tok::Partial(_)
+                | Tok::SymGrad
+                | Tok::Divergence
+                | Tok::Trace
         )
     }
 
     fn product(&mut self) -> Result<Expr> {
         let mut lhs = self.factor()?;
         loop {
-            let (is_div, explicit) = match self.peek_tok() {
-                Some(Tok::Star) => (false, true),
-                Some(Tok::Slash) => (true, true),
-                Some(t) if Self::starts_factor(t) => (false, false),
+            let (op, explicit) = match self.peek_tok() {
+                Some(Tok::Star) => (Tok::Star, true),
+                Some(Tok::Slash) => (Tok::Slash, true),
+                Some(Tok::Colon) => (Tok::Colon, true),
+                Some(t) if Self::starts_factor(t) => (Tok::Star, false),
                 _ => break,
             };
             if explicit {
@@ -636,10 +700,10 @@ impl<'a> Parser<'a> {
             };
             let loc = lhs.loc.to(rhs.loc);
             lhs = Expr::new(
-                if is_div {
-                    ExprKind::Div(Box::new(lhs), Box::new(rhs))
-                } else {
-                    ExprKind::Mul(Box::new(lhs), Box::new(rhs))
+                match op {
+                    Tok::Slash => ExprKind::Div(Box::new(lhs), Box::new(rhs)),
+                    Tok::Colon => ExprKind::Contract(Box::new(lhs), Box::new(rhs)),
+                    _ => ExprKind::Mul(Box::new(lhs), Box::new(rhs)),
                 },
                 loc,
             );
@@ -648,23 +712,30 @@ impl<'a> Parser<'a> {
     }
 
     fn factor(&mut self) -> Result<Expr> {
-        // ∇ and Δ bind tighter than products and looser than primes and powers: ∇u·∇v
-        if let Some(op @ (Tok::Grad | Tok::Laplacian)) = self.peek_tok() {
-            let laplacian = *op == Tok::Laplacian;
+        // The operators bind tighter than products and looser than primes and powers:
+        // ∇u·∇v, ε(θ):ε(η), div div A.
+        if let Some(
+            op @ (Tok::Grad
+            | Tok::Laplacian
+            | Tok::Partial(_)
+            | Tok::SymGrad
+            | Tok::Divergence
+            | Tok::Trace),
+        ) = self.peek_tok()
+        {
             let loc = self.bump().unwrap().loc;
             if !self.peek_tok().is_some_and(Self::starts_factor) {
-                return Err(self.unexpected(if laplacian {
-                    "a function after Δ"
-                } else {
-                    "a function after ∇"
-                }));
+                return Err(self.unexpected(&format!("a function after {}", describe(op))));
             }
-            let inner = self.nested(loc, Self::factor)?;
+            let inner = Box::new(self.nested(loc, Self::factor)?);
             let l = loc.to(inner.loc);
-            let kind = if laplacian {
-                ExprKind::Laplacian(Box::new(inner))
-            } else {
-                ExprKind::Gradient(Box::new(inner))
+            let kind = match op {
+                Tok::Laplacian => ExprKind::Laplacian(inner),
+                Tok::Partial(axis) => ExprKind::Partial(inner, *axis),
+                Tok::SymGrad => ExprKind::SymmetricGradient(inner),
+                Tok::Divergence => ExprKind::Divergence(inner),
+                Tok::Trace => ExprKind::Trace(inner),
+                _ => ExprKind::Gradient(inner),
             };
             return Ok(Expr::new(kind, l));
         }
@@ -825,6 +896,26 @@ impl<'a> Parser<'a> {
                     (None, false) => Ok(Expr::new(first.kind, loc.to(close))),
                 }
             }
+            Tok::LBracket => {
+                // `D[(1−ν)ε + ν tr ε I]`: brackets group like parentheses
+                self.pos += 1;
+                let inner = self.nested(loc, |p| p.sum(false))?;
+                match self.peek_tok() {
+                    Some(Tok::RBracket) => {}
+                    None => {
+                        return Err(Diagnostic::text(loc, "this `[` is never closed")
+                            .help("add the matching `]`"))
+                    }
+                    Some(_) => {
+                        return Err(self.unexpected("`]`").help(format!(
+                            "the `[` at line {}, column {} is still open",
+                            loc.line, loc.column
+                        )))
+                    }
+                }
+                let close = self.bump().unwrap().loc;
+                Ok(Expr::new(inner.kind, loc.to(close)))
+            }
             Tok::Integral | Tok::SumT => {
                 let kind = if token.tok == Tok::Integral {
                     IntegralKind::Integral
@@ -919,6 +1010,11 @@ mod tests {
             Derivative(a, n) => format!("(d{n} {})", sexpr(a)),
             Gradient(a) => format!("(grad {})", sexpr(a)),
             Laplacian(a) => format!("(lap {})", sexpr(a)),
+            Partial(a, axis) => format!("(d_{axis} {})", sexpr(a)),
+            SymmetricGradient(a) => format!("(eps {})", sexpr(a)),
+            Divergence(a) => format!("(div {})", sexpr(a)),
+            Trace(a) => format!("(tr {})", sexpr(a)),
+            Contract(a, b) => format!("(: {} {})", sexpr(a), sexpr(b)),
             InnerProduct(a, b) => format!("(ip {} {})", sexpr(a), sexpr(b)),
             Integral { degree, body, .. } => format!("(int{degree:?} {})", sexpr(body)),
             Call { name, groups } => format!(
@@ -1004,6 +1100,34 @@ mod tests {
         );
         let (_, errors) = parse("a(u;v) = ∫ ∇ + v");
         assert_eq!(errors.len(), 1);
+    }
+
+    #[test]
+    fn tensor_operators_bind_like_gradients() {
+        let (defs, errors) =
+            parse("a(θ;η) = ∫ D[(1−ν)ε(θ) + ν tr ε(θ) I] : ε(η) + div div θ ∂_x η_y");
+        assert!(errors.is_empty(), "{errors:?}");
+        assert_eq!(
+            sexpr(&defs[0].body),
+            "(intNone (+ (: (* D (+ (* (- 1 ν) (eps θ)) (* (* ν (tr (eps θ))) I))) (eps η)) (* (div (div θ)) (d_0 η_y))))"
+        );
+        let (_, errors) = parse("a(u;v) = ∫ u [u v");
+        assert!(errors[0].message.contains("never closed"), "{errors:?}");
+        let (_, errors) = parse("a(u;v) = ∫ div + v");
+        assert!(errors[0].message.contains("after `div`"), "{errors:?}");
+    }
+
+    #[test]
+    fn named_expressions_use_colon_equals() {
+        let (defs, errors) = parse("Cε(θ) := D[ε(θ)]\na(θ;η) = ∫ Cε(θ):ε(η)");
+        assert!(errors.is_empty(), "{errors:?}");
+        assert!(defs[0].expression && !defs[1].expression);
+        assert_eq!(sexpr(&defs[1].body), "(intNone (: (call Cε θ) (eps η)))");
+        let (_, errors) = parse("C(θ;η) := θ η");
+        assert!(
+            errors[0].message.contains("one argument list"),
+            "{errors:?}"
+        );
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! The symbolic IR: an integrand expanded into a sum of monomials.
 //!
-//! A monomial is `c · Π pᵢ^eᵢ · h^k · Π data · Π argument-derivatives`. The IR knows
+//! A monomial is `c · Π pᵢ^eᵢ · h^k · Π Dₘ^-eₘ · Π data · Π argument-derivatives`,
+//! where the `Dₘ` are divisors: sums of parameter monomials that the analysis has
+//! proved positive (`t² + β h²` with `β > 0` declared). The IR knows
 //! nothing about finite elements: parameters, data and arguments are indices, and an
 //! argument factor is "symbol `s` differentiated `d` times". Expansion distributes
 //! products over sums, merges equal monomials and drops those whose coefficient cancels.
@@ -23,7 +25,62 @@ impl ArgFactor {
     }
 }
 
-/// One term `c · Π pᵢ^eᵢ · h^k · Π data · Π args` of an expansion.
+/// One term `c · pᵢ^eᵢ · h^k` of a divisor: a scalar of parameters and the element size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DivisorTerm {
+    /// The numeric coefficient.
+    pub coefficient: f64,
+    /// `(parameter index, exponent)`, sorted by index, no zero exponents.
+    pub params: Vec<(usize, i32)>,
+    /// Power of the element size `h`.
+    pub h_power: i32,
+}
+
+/// A sum of [`DivisorTerm`]s that a term is divided by (positive by construction: the
+/// analysis builds one only for sums it has proved positive). Its terms are sorted, so
+/// equal sums compare equal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Divisor {
+    /// The terms of the sum.
+    pub terms: Vec<DivisorTerm>,
+}
+
+impl Divisor {
+    /// The divisor of a scalar expansion free of arguments, data, integrals and
+    /// divisors; `None` otherwise.
+    pub fn of(e: &Expansion) -> Option<Self> {
+        let mut terms = Vec::new();
+        for m in e {
+            if !m.is_scalar() || !m.divisors.is_empty() {
+                return None;
+            }
+            terms.push(DivisorTerm {
+                coefficient: m.coefficient,
+                params: m.params.clone(),
+                h_power: m.h_power,
+            });
+        }
+        terms.sort_by(|a, b| (&a.params, a.h_power).cmp(&(&b.params, b.h_power)));
+        Some(Self { terms })
+    }
+
+    /// Value for given parameters and `h`.
+    #[cfg(test)]
+    pub fn evaluate(&self, param: &dyn Fn(usize) -> f64, h: f64) -> f64 {
+        self.terms
+            .iter()
+            .map(|t| {
+                t.params
+                    .iter()
+                    .fold(t.coefficient * h.powi(t.h_power), |v, &(i, e)| {
+                        v * param(i).powi(e)
+                    })
+            })
+            .sum()
+    }
+}
+
+/// One term `c · Π pᵢ^eᵢ · h^k · Π Dₘ^-eₘ · Π data · Π args` of an expansion.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Monomial {
     /// The numeric coefficient.
@@ -32,6 +89,9 @@ pub struct Monomial {
     pub params: Vec<(usize, i32)>,
     /// Power of the element size `h`.
     pub h_power: i32,
+    /// `(divisor, e)`: the term is divided by `divisor^e` (multiplied for `e < 0`); no
+    /// zero exponents, each divisor once.
+    pub divisors: Vec<(Divisor, i32)>,
     /// Data function indices (a multiset, sorted).
     pub data: Vec<usize>,
     /// Argument factors (sorted).
@@ -56,6 +116,7 @@ impl Monomial {
             coefficient: c,
             params: Vec::new(),
             h_power: 0,
+            divisors: Vec::new(),
             data: Vec::new(),
             args: Vec::new(),
             integrated: false,
@@ -73,6 +134,7 @@ impl Monomial {
     fn key_eq(&self, other: &Self) -> bool {
         self.params == other.params
             && self.h_power == other.h_power
+            && self.divisors == other.divisors
             && self.data == other.data
             && self.args == other.args
             && self.integrated == other.integrated
@@ -91,6 +153,14 @@ impl Monomial {
         }
         params.retain(|&(_, e)| e != 0);
         params.sort();
+        let mut divisors = self.divisors.clone();
+        for (d, e) in &other.divisors {
+            match divisors.iter_mut().find(|(x, _)| x == d) {
+                Some((_, f)) => *f += e,
+                None => divisors.push((d.clone(), *e)),
+            }
+        }
+        divisors.retain(|&(_, e)| e != 0);
         let mut data = [self.data.as_slice(), other.data.as_slice()].concat();
         data.sort();
         let mut args = [self.args.as_slice(), other.args.as_slice()].concat();
@@ -99,6 +169,7 @@ impl Monomial {
             coefficient: self.coefficient * other.coefficient,
             params,
             h_power: self.h_power + other.h_power,
+            divisors,
             data,
             args,
             integrated: self.integrated || other.integrated,
@@ -120,6 +191,9 @@ impl Monomial {
         let mut v = self.coefficient * h.powi(self.h_power);
         for &(i, e) in &self.params {
             v *= param(i).powi(e);
+        }
+        for (d, e) in &self.divisors {
+            v /= d.evaluate(param, h).powi(*e);
         }
         for &d in &self.data {
             v *= data(d);
@@ -187,12 +261,26 @@ pub fn pow(a: &Expansion, n: i32, origin: Loc) -> Option<Expansion> {
                 coefficient: m.coefficient.powi(-k),
                 params: m.params.iter().map(|&(i, e)| (i, -e * k)).collect(),
                 h_power: -m.h_power * k,
+                divisors: m
+                    .divisors
+                    .iter()
+                    .map(|(d, e)| (d.clone(), -e * k))
+                    .collect(),
                 origin,
                 ..m.clone()
             }])
         }
         _ => None,
     }
+}
+
+/// `1 / a^k` (`k > 0`) of a scalar sum that the caller has proved positive, as one
+/// monomial with a divisor; `None` when `a` holds arguments, data, integrals or divisors.
+pub fn divide_by_sum(a: &Expansion, k: i32, origin: Loc) -> Option<Monomial> {
+    let divisor = Divisor::of(a)?;
+    let mut m = Monomial::constant(1.0, origin);
+    m.divisors = vec![(divisor, k)];
+    Some(m)
 }
 
 /// Why a derivative could not be taken.
@@ -282,6 +370,35 @@ mod tests {
         assert_eq!(t[0].params, vec![(0, -2)]);
         assert!(pow(&arg(0), -1, l).is_none());
         assert!(pow(&add(param(0), param(1)), -1, l).is_none());
+    }
+
+    #[test]
+    fn divisors_merge_and_cancel() {
+        let l = Loc::default();
+        // D = p0² + p1·h²
+        let mut h2 = Monomial::constant(1.0, l);
+        h2.params = vec![(1, 1)];
+        h2.h_power = 2;
+        let sum = add(mul(&param(0), &param(0), l), vec![h2]);
+        let inverse = vec![divide_by_sum(&sum, 1, l).unwrap()];
+        let value = |e: &Expansion| evaluate(e, &|i| [3.0, 0.5][i], 2.0, &|_| 0.0, &|_| 0.0);
+        assert!((value(&inverse) - 1.0 / (9.0 + 0.5 * 4.0)).abs() < 1e-15);
+        // D⁻¹·D⁻¹ is one factor D⁻², and D⁻¹ · (1/D⁻¹) is 1
+        let square = mul(&inverse, &inverse, l);
+        assert_eq!(square.len(), 1);
+        assert_eq!(square[0].divisors[0].1, 2);
+        let back = mul(&inverse, &pow(&inverse, -1, l).unwrap(), l);
+        assert!(back[0].divisors.is_empty() && back[0].coefficient == 1.0);
+        // the sum in the other order is the same divisor
+        let mut h2 = Monomial::constant(1.0, l);
+        h2.params = vec![(1, 1)];
+        h2.h_power = 2;
+        let swapped = add(vec![h2], mul(&param(0), &param(0), l));
+        assert_eq!(
+            divide_by_sum(&swapped, 1, l).unwrap().divisors,
+            inverse[0].divisors
+        );
+        assert!(divide_by_sum(&add(arg(0), param(0)), 1, l).is_none());
     }
 
     #[test]

@@ -81,23 +81,27 @@ fn unicode_and_ascii_spellings_give_the_same_blocks() {
                     test_name: "η".into(),
                     element: ElementKind::P2,
                     nonnegative: false,
+                    component: None,
                 },
                 Field {
                     name: "w".into(),
                     test_name: "v".into(),
                     element: ElementKind::P2,
                     nonnegative: false,
+                    component: None,
                 },
                 Field {
                     name: "λ".into(),
                     test_name: "μ".into(),
                     element: ElementKind::P0,
                     nonnegative: true,
+                    component: None,
                 },
             ],
             params: vec!["t".into(), "α".into(), "s".into()],
             data: vec![("f".into(), 2), ("ψ".into(), 2)],
             dimension: 1,
+            ..Default::default()
         };
         let (tokens, e1) = lexer::tokenize(text);
         let (defs, e2) = parser::parse_forms(&tokens);
@@ -274,10 +278,12 @@ mod symbolic_properties {
                 test_name: "v".into(),
                 element: ElementKind::P3,
                 nonnegative: false,
+                component: None,
             }],
             params: vec!["t".into(), "α".into()],
             data: vec![("f".into(), 2)],
             dimension: 1,
+            ..Default::default()
         }
     }
 
@@ -381,17 +387,20 @@ fn vector_calculus_ascii_and_unicode_agree_and_expand_componentwise() {
                 test_name: "v".into(),
                 element: ElementKind::P2,
                 nonnegative: false,
+                component: None,
             },
             Field {
                 name: "λ".into(),
                 test_name: "μ".into(),
                 element: ElementKind::P0,
                 nonnegative: true,
+                component: None,
             },
         ],
         params: vec!["α".into()],
         data: vec![("f".into(), 2)],
         dimension: 2,
+        ..Default::default()
     };
     let blocks = |text: &str| {
         let (tokens, errors) = lexer::tokenize(text);
@@ -409,10 +418,12 @@ fn vector_calculus_ascii_and_unicode_agree_and_expand_componentwise() {
             test_name: "v".into(),
             element: ElementKind::P3,
             nonnegative: false,
+            component: None,
         }],
         params: vec![],
         data: vec![],
         dimension: 2,
+        ..Default::default()
     };
     let terms = analysis::expand_expression(&symbols, "∇u·∇v").unwrap();
     let mut multi: Vec<Vec<[u8; 2]>> = terms
@@ -436,7 +447,14 @@ fn vector_errors_point_at_the_expression() {
             "a(u;v) = ∫ u'v'",
             "a prime ′ is the derivative along an interval",
         ),
-        ("a(u;v) = ∫ ∇(∇u)·v", "a vector where a scalar is needed"),
+        ("a(u;v) = ∫ ∇(∇u)·v", "a matrix where a scalar is needed"),
+        ("a(u;v) = ∫ ∇∇∇u : ∇∇v", "∇ of a matrix"),
+        ("a(u;v) = ∫ ε(u) : ε(v)", "ε of a scalar"),
+        ("a(u;v) = ∫ div u v", "div of a scalar"),
+        ("a(u;v) = ∫ tr ∇u v", "tr of a vector"),
+        ("a(u;v) = ∫ ∇∇u : ∇v", "`:` of a matrix and a vector"),
+        ("a(u;v) = ∫ ∇∇u · ∇∇v", "product of two matrices"),
+        ("a(u;v) = ∫ ∇u − u v", "difference of a vector and a scalar"),
     ];
     for (forms, message) in cases {
         let errors = rendered_errors(&expand(membrane("P2", forms)));
@@ -629,6 +647,22 @@ mod no_panic {
         "!",
         "é",
         "\"",
+        "θ",
+        "η_y",
+        "ε",
+        "eps",
+        "div",
+        "tr",
+        "I",
+        ":",
+        "∂_x",
+        "d_y",
+        "[",
+        "]",
+        "/(t² + h²)",
+        "/(t − 1)",
+        "(1e200 + t)",
+        "a(θ;η) =",
     ];
 
     fn model(cell: &str, forms: &str) -> TokenStream {
@@ -638,6 +672,21 @@ mod no_panic {
                 unknowns: u: P2, λ: P0 >= 0;
                 tests: v, μ;
                 params: t;
+                data: f;
+                forms: #forms;
+            }
+        }
+    }
+
+    /// The same with a vector field θ: [P1]^2 (an error on intervals, after which the
+    /// analysis must still not panic).
+    fn vector_model(cell: &str, forms: &str) -> TokenStream {
+        let cell = proc_macro2::Ident::new(cell, proc_macro2::Span::call_site());
+        quote! {
+            pub mod m on #cell {
+                unknowns: θ: [P1]^2, u: P2, λ: P0 >= 0;
+                tests: η, v, μ;
+                params: t > 0;
                 data: f;
                 forms: #forms;
             }
@@ -663,7 +712,31 @@ mod no_panic {
     fn integrand() -> impl Strategy<Value = String> {
         let leaf = prop::sample::select(
             &[
-                "u", "v", "u'", "v''", "∇u", "∇v", "Δu", "λ", "μ", "f", "t", "h", "2", "1e300", "0",
+                "u",
+                "v",
+                "u'",
+                "v''",
+                "∇u",
+                "∇v",
+                "Δu",
+                "λ",
+                "μ",
+                "f",
+                "t",
+                "h",
+                "2",
+                "1e300",
+                "0",
+                "θ",
+                "η",
+                "ε(θ)",
+                "ε(η)",
+                "div η",
+                "I",
+                "∂_x θ",
+                "∇θ",
+                "θ_x",
+                "(t² + h²)",
             ][..],
         )
         .prop_map(str::to_string);
@@ -673,6 +746,9 @@ mod no_panic {
                 (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} − {b}")),
                 (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a}·{b}")),
                 (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} / {b}")),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} : {b}")),
+                inner.clone().prop_map(|a| format!("div [{a}]")),
+                inner.clone().prop_map(|a| format!("tr({a}) ε({a})")),
                 inner.clone().prop_map(|a| format!("({a})")),
                 inner.clone().prop_map(|a| format!("({a})²")),
                 inner.clone().prop_map(|a| format!("∇({a})")),
@@ -690,6 +766,7 @@ mod no_panic {
             let cell = if triangle { "triangle" } else { "interval" };
             check(&expand(model(cell, &text)))?;
             check(&expand(model(cell, &format!("a(u;v) = ∫ {text}"))))?;
+            check(&expand(vector_model(cell, &format!("a(θ,u;η,v) = ∫ {text}"))))?;
         }
 
         #[test]
@@ -702,6 +779,8 @@ mod no_panic {
             let option = degree.map(|d| format!("[degree={d}]")).unwrap_or_default();
             let forms = format!("a(u,λ;v,μ) = ∫{option} {body}\nℓ(v,μ) = Σ_T {body}\nB(u,λ;v,μ) = a(u,λ;v,μ) − 2 a(u,λ;v,μ)");
             check(&expand(model(cell, &forms)))?;
+            let forms = format!("a(θ,u,λ;η,v,μ) = ∫{option} {body}\nB(θ,u,λ;η,v,μ) = a(θ,u,λ;η,v,μ) − a(η,v,μ;θ,u,λ)");
+            check(&expand(vector_model(cell, &forms)))?;
         }
     }
 }

@@ -122,6 +122,10 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// stabilized system (docs/mathematics.md §1); `None` for a model without them.
     /// Found at compile time, so the solvers need no name at run time.
     const SYSTEM: Option<[usize; 2]> = system_forms(Self::FORMS);
+    /// Indices in `PARAMS` of the parameters declared `> 0` (`params: β > 0`): the
+    /// forms may divide by sums that are positive only for positive values of them, so
+    /// [`Coefficients`] refuses other values.
+    const POSITIVE_PARAMS: &'static [usize] = &[];
 
     /// Element matrix of `block` of bilinear `form`, row-major into `out`.
     fn element_matrix(
@@ -395,11 +399,13 @@ pub struct Coefficients<'a> {
 
 impl<'a> Coefficients<'a> {
     /// Values by name; every declared parameter and data function must be given once,
-    /// parameters must be finite. Names come from the model's declaration (a scene file
-    /// gives them as strings); in Rust, [`Coefficients::from_ids`] takes typed handles.
+    /// parameters must be finite, and positive where the model declares them `> 0`.
+    /// Names come from the model's declaration (a scene file gives them as strings); in
+    /// Rust, [`Coefficients::from_ids`] takes typed handles.
     ///
     /// # Errors
-    /// An unknown name, a name given twice, a missing one, or a non-finite value.
+    /// An unknown name, a name given twice, a missing one, a non-finite value, or a
+    /// value ≤ 0 of a parameter declared `> 0`.
     pub fn new<M: Model>(params: &[(&str, f64)], data: &[(&str, &'a DataFn)]) -> Result<Self> {
         let params = params
             .iter()
@@ -415,10 +421,11 @@ impl<'a> Coefficients<'a> {
     /// Values by typed handle, e.g. `Coefficients::from_ids(&[(m::params::α, 0.1)],
     /// &[(m::data::f, &f)])`: a misspelled name is a compile error and the model is
     /// inferred from the handles. Every declared parameter and data function must be
-    /// given once, parameters must be finite.
+    /// given once, parameters must be finite, and positive where declared `> 0`.
     ///
     /// # Errors
-    /// A handle given twice, a missing one, or a non-finite value.
+    /// A handle given twice, a missing one, a non-finite value, or a value ≤ 0 of a
+    /// parameter declared `> 0`.
     pub fn from_ids<M: Model>(
         params: &[(ParamId<M>, f64)],
         data: &[(DataId<M>, &'a DataFn)],
@@ -446,6 +453,12 @@ impl<'a> Coefficients<'a> {
             if !v.is_finite() {
                 return Err(Error::Input(format!(
                     "parameter `{name}` = {v} is not finite"
+                )));
+            }
+            if v <= 0.0 && M::POSITIVE_PARAMS.contains(&i) {
+                return Err(Error::Input(format!(
+                    "parameter `{name}` = {v} must be positive (model `{}` declares `{name} > 0`)",
+                    M::NAME
                 )));
             }
             if values[i].replace(v).is_some() {

@@ -11,6 +11,7 @@ pub mod membrane;
 pub mod membrane_scenes;
 pub mod registry;
 pub mod timoshenko;
+pub mod vector_forms;
 
 pub use euler_bernoulli::bernoulli;
 pub use membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};

@@ -17,6 +17,7 @@
 
 use super::backend::{CellBackend, Rule};
 use crate::analysis::{Block, Symbols, Term};
+use crate::symbolic::Divisor;
 use fem_reference::ElementKind;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -61,20 +62,62 @@ pub fn power(base: TokenStream, e: i32) -> Option<TokenStream> {
     }
 }
 
-/// The coefficient `κ · Π pᵢ^eᵢ · h^k` of a term as code.
-pub fn coefficient(coefficient: f64, params: &[(usize, i32)], h_power: i32) -> TokenStream {
+/// The coefficient `κ · Π pᵢ^eᵢ · h^k · Π Dₘ^-eₘ` of a term as code.
+pub fn coefficient(
+    coefficient: f64,
+    params: &[(usize, i32)],
+    h_power: i32,
+    divisors: &[(Divisor, i32)],
+) -> TokenStream {
     let mut factors = Vec::new();
     for &(i, e) in params {
         factors.extend(power(quote!(p[#i]), e));
     }
     factors.extend(power(quote!(h), h_power));
+    for (d, e) in divisors {
+        let terms = d
+            .terms
+            .iter()
+            .map(|t| coefficient_without_divisors(t.coefficient, &t.params, t.h_power));
+        factors.extend(power(quote!((#(#terms)+*)), -e));
+    }
     if coefficient != 1.0 || factors.is_empty() {
         factors.insert(0, float(coefficient));
     }
     product(factors)
 }
 
-/// A readable term: `2·t^-2·h^4·f·w'·v`.
+fn coefficient_without_divisors(c: f64, params: &[(usize, i32)], h_power: i32) -> TokenStream {
+    coefficient(c, params, h_power, &[])
+}
+
+/// A divisor, readable: `(t^2 + β·h^2)`.
+fn describe_divisor(d: &Divisor, symbols: &Symbols) -> String {
+    let terms: Vec<String> = d
+        .terms
+        .iter()
+        .map(|t| {
+            let mut parts = Vec::new();
+            if t.coefficient != 1.0 || (t.params.is_empty() && t.h_power == 0) {
+                parts.push(format!("{}", t.coefficient));
+            }
+            for &(i, e) in &t.params {
+                parts.push(if e == 1 {
+                    symbols.params[i].clone()
+                } else {
+                    format!("{}^{e}", symbols.params[i])
+                });
+            }
+            if t.h_power != 0 {
+                parts.push(format!("h^{}", t.h_power));
+            }
+            parts.join("·")
+        })
+        .collect();
+    format!("({})", terms.join(" + "))
+}
+
+/// A readable term: `2·t^-2·h^4·(t^2 + β·h^2)^-1·f·w'·v`.
 pub fn describe_term(term: &Term, block: &Block, symbols: &Symbols) -> String {
     let mut parts = Vec::new();
     if term.coefficient != 1.0 {
@@ -89,6 +132,9 @@ pub fn describe_term(term: &Term, block: &Block, symbols: &Symbols) -> String {
     }
     if term.h_power != 0 {
         parts.push(format!("h^{}", term.h_power));
+    }
+    for (d, e) in &term.divisors {
+        parts.push(format!("{}^{}", describe_divisor(d, symbols), -e));
     }
     for &i in &term.data {
         parts.push(symbols.data[i].0.clone());

@@ -9,6 +9,7 @@
 use super::backend::{CellBackend, ExactPart, Rule};
 use super::emit::{coefficient, float};
 use crate::analysis::{Block, Symbols, Term};
+use crate::symbolic::Divisor;
 use fem_reference::{ElementKind, Polynomial, QuadratureRule};
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
@@ -55,6 +56,7 @@ fn gauss_rule(rule: QuadratureRule) -> Rule {
 struct Group {
     params: Vec<(usize, i32)>,
     h_power: i32,
+    divisors: Vec<(Divisor, i32)>,
     reference: Vec<Vec<f64>>,
 }
 
@@ -142,15 +144,15 @@ impl CellBackend for Interval {
                     quadrature_points.max(QuadratureRule::exact_for_degree(degree).len());
             }
             let h_power = h_power(term);
-            let index = match groups
-                .iter()
-                .position(|g| g.params == term.params && g.h_power == h_power)
-            {
+            let index = match groups.iter().position(|g| {
+                g.params == term.params && g.h_power == h_power && g.divisors == term.divisors
+            }) {
                 Some(i) => i,
                 None => {
                     groups.push(Group {
                         params: term.params.clone(),
                         h_power,
+                        divisors: term.divisors.clone(),
                         reference: vec![vec![0.0; cols]; rows],
                     });
                     groups.len() - 1
@@ -162,7 +164,7 @@ impl CellBackend for Interval {
         let mut tables = Vec::new();
         for (g, group) in groups.into_iter().enumerate() {
             let c = format_ident!("c{}", g);
-            let value = coefficient(1.0, &group.params, group.h_power);
+            let value = coefficient(1.0, &group.params, group.h_power, &group.divisors);
             lets.push(quote!(let #c: f64 = #value;));
             tables.push((c, group.reference));
         }
@@ -192,7 +194,12 @@ impl CellBackend for Interval {
     }
 
     fn data_term_coefficient(&self, term: &Term) -> TokenStream {
-        coefficient(term.coefficient, &term.params, h_power(term))
+        coefficient(
+            term.coefficient,
+            &term.params,
+            h_power(term),
+            &term.divisors,
+        )
     }
 
     fn table_ident(&self, element: ElementKind, derivative: [u8; 2]) -> Ident {

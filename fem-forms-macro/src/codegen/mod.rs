@@ -170,12 +170,19 @@ fn handles(symbols: &Symbols, forms: &[Form], runtime: &TokenStream) -> TokenStr
         .enumerate()
         .map(|(i, f)| handle(&f.name, "FormId", i, &format!(" `{}`", f.source), runtime));
     let fields = symbols.fields.iter().enumerate().flat_map(|(i, f)| {
+        let component = f.component.map_or(String::new(), |(v, axis)| {
+            format!(
+                " Component {} of the vector field `{}`.",
+                ["x", "y"][axis.min(1)],
+                symbols.vectors[v].name
+            )
+        });
         [
             handle(
                 &f.name,
                 "FieldId",
                 i,
-                &format!(" Unknown `{}` ({}).", f.name, f.element.name()),
+                &format!(" Unknown `{}` ({}).{component}", f.name, f.element.name()),
                 runtime,
             ),
             handle(
@@ -189,6 +196,28 @@ fn handles(symbols: &Symbols, forms: &[Form], runtime: &TokenStream) -> TokenStr
                 runtime,
             ),
         ]
+    });
+    let vectors = symbols.vectors.iter().flat_map(|v| {
+        let indices: Vec<usize> = (v.first_field..v.first_field + v.components).collect();
+        let n = indices.len();
+        let doc = |name: &str, what: &str| {
+            format!(" The fields of the components of {what} `{name}`, by axis.")
+        };
+        [
+            (v.name.clone(), doc(&v.name, "the vector field")),
+            (
+                v.test_name.clone(),
+                doc(&v.test_name, &format!("the test function of `{}`:", v.name)),
+            ),
+        ]
+        .map(|(name, doc)| {
+            let ident = Ident::new(&name, Span::call_site());
+            quote! {
+                #[doc = #doc]
+                pub const #ident: [#runtime::model::FieldId<super::Model>; #n] =
+                    [#(#runtime::model::FieldId::new(#indices)),*];
+            }
+        })
     });
     let params = symbols
         .params
@@ -208,6 +237,7 @@ fn handles(symbols: &Symbols, forms: &[Form], runtime: &TokenStream) -> TokenStr
         /// Typed handles of the fields, by unknown or by test function.
         pub mod fields {
             #(#fields)*
+            #(#vectors)*
         }
         /// Typed handles of the parameters, for `Coefficients::from_ids`.
         pub mod params {
@@ -278,6 +308,11 @@ fn model_impl(
     let params = &symbols.params;
     let data = symbols.data.iter().map(|d| &d.0);
     let description = description(declaration);
+    // Emitted only when there is one, so that models without keep their code.
+    let positive = (!symbols.positive.is_empty()).then(|| {
+        let positive = &symbols.positive;
+        quote!(const POSITIVE_PARAMS: &'static [usize] = &[#(#positive),*];)
+    });
     let Dispatch {
         matrix,
         add,
@@ -293,6 +328,7 @@ fn model_impl(
             const PARAMS: &'static [&'static str] = &[#(#params),*];
             const DATA: &'static [&'static str] = &[#(#data),*];
             const FORMS: &'static [#runtime::FormInfo] = &[#(#form_infos),*];
+            #positive
 
             fn element_matrix(
                 form: usize,

@@ -188,7 +188,7 @@ impl Triangle {
             Some(degree) => rule_for_degree(degree),
             None => TriangleRule::exact_for_degree(self.term_degree(term, block, symbols)),
         };
-        let c = coefficient(term.coefficient, &term.params, term.h_power);
+        let c = coefficient(term.coefficient, &term.params, term.h_power, &term.divisors);
         let trial_betas: Vec<[u8; 2]> = match term.trial_derivative {
             Some(d) => transform(d).into_iter().map(|(g, _)| g).collect(),
             None => vec![[0, 0]],
@@ -259,7 +259,12 @@ impl CellBackend for Triangle {
 
     fn geometry(&self, block: &Block) -> TokenStream {
         // Only what the terms use: h (a sqrt) and K (a division) are skipped otherwise.
-        let uses_h = block.terms.iter().any(|t| t.h_power != 0);
+        let uses_h = block.terms.iter().any(|t| {
+            t.h_power != 0
+                || t.divisors
+                    .iter()
+                    .any(|(d, _)| d.terms.iter().any(|x| x.h_power != 0))
+        });
         let uses_k = alphas(block).iter().any(|a| *a != [0, 0]);
         let h_code = uses_h.then(|| {
             quote! {
@@ -347,7 +352,7 @@ impl CellBackend for Triangle {
     }
 
     fn data_term_coefficient(&self, term: &Term) -> TokenStream {
-        coefficient(term.coefficient, &term.params, term.h_power)
+        coefficient(term.coefficient, &term.params, term.h_power, &term.divisors)
     }
 
     fn table_ident(&self, element: ElementKind, derivative: [u8; 2]) -> Ident {
