@@ -6,6 +6,8 @@
 //! so the generated kernels and the runtime can never disagree about a basis function.
 #![warn(missing_docs)]
 
+pub mod dense;
+pub mod dual_basis;
 pub mod polynomial;
 pub mod quadrature;
 pub mod reference_element;
