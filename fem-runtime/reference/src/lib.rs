@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod dense;
+pub mod dof_transformation;
 pub mod dual_basis;
 pub mod polynomial;
 pub mod quadrature;
