@@ -14,27 +14,51 @@ pub struct Matrix {
     data: Vec<f64>,
 }
 
-/// Gauss–Jordan elimination met a pivot that is zero to rounding: the matrix is
-/// singular (for a Vandermonde matrix: the functionals are not unisolvent on the space).
+/// Why [`Matrix::inverse`] has no answer.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SingularMatrix {
-    /// The column (0-based) in which no usable pivot was left.
-    pub column: usize,
-    /// The largest remaining candidate pivot, in absolute value.
-    pub pivot: f64,
+pub enum InverseError {
+    /// The matrix is not square.
+    NotSquare {
+        /// Number of rows.
+        rows: usize,
+        /// Number of columns.
+        cols: usize,
+    },
+    /// An entry is NaN or infinite.
+    NonFinite {
+        /// Its row.
+        row: usize,
+        /// Its column.
+        col: usize,
+    },
+    /// Gauss–Jordan elimination met a pivot that is zero to rounding: the matrix is
+    /// singular (for a Vandermonde matrix: the functionals are not unisolvent).
+    Singular {
+        /// The column (0-based) in which no usable pivot was left.
+        column: usize,
+        /// The largest remaining candidate pivot, in absolute value.
+        pivot: f64,
+    },
 }
 
-impl fmt::Display for SingularMatrix {
+impl fmt::Display for InverseError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "the matrix is singular: no pivot left in column {} (largest candidate {:e})",
-            self.column, self.pivot
-        )
+        match self {
+            InverseError::NotSquare { rows, cols } => {
+                write!(f, "a {rows} × {cols} matrix is not square, so it has no inverse")
+            }
+            InverseError::NonFinite { row, col } => {
+                write!(f, "the matrix entry ({row}, {col}) is not finite")
+            }
+            InverseError::Singular { column, pivot } => write!(
+                f,
+                "the matrix is singular: no pivot left in column {column} (largest candidate {pivot:e})"
+            ),
+        }
     }
 }
 
-impl std::error::Error for SingularMatrix {}
+impl std::error::Error for InverseError {}
 
 impl Matrix {
     /// The `rows × cols` zero matrix.
@@ -119,14 +143,20 @@ impl Matrix {
     /// The inverse by Gauss–Jordan elimination with partial (row) pivoting.
     ///
     /// # Errors
-    /// [`SingularMatrix`] when the matrix is not square, contains a non-finite entry,
+    /// [`InverseError`] when the matrix is not square, contains a non-finite entry,
     /// or a pivot falls to `n·ε·max|a_ij|` or below (singular to rounding).
-    pub fn inverse(&self) -> Result<Matrix, SingularMatrix> {
+    pub fn inverse(&self) -> Result<Matrix, InverseError> {
         let n = self.rows;
-        if self.cols != n || self.data.iter().any(|x| !x.is_finite()) {
-            return Err(SingularMatrix {
-                column: 0,
-                pivot: f64::NAN,
+        if self.cols != n {
+            return Err(InverseError::NotSquare {
+                rows: self.rows,
+                cols: self.cols,
+            });
+        }
+        if let Some(k) = self.data.iter().position(|x| !x.is_finite()) {
+            return Err(InverseError::NonFinite {
+                row: k / n,
+                col: k % n,
             });
         }
         let tolerance = n as f64 * f64::EPSILON * self.max_abs();
@@ -138,7 +168,7 @@ impl Matrix {
                 .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()))
                 .unwrap_or((col, 0.0));
             if pivot.abs() <= tolerance {
-                return Err(SingularMatrix {
+                return Err(InverseError::Singular {
                     column: col,
                     pivot: pivot.abs(),
                 });
@@ -235,11 +265,21 @@ mod tests {
     #[test]
     fn singular_and_malformed_matrices_are_errors() {
         let rank_one = Matrix::from_fn(3, 3, |i, j| (i + 1) as f64 * (j + 1) as f64);
-        assert_eq!(rank_one.inverse().unwrap_err().column, 1);
-        assert!(Matrix::zeros(2, 3).inverse().is_err());
+        assert!(matches!(
+            rank_one.inverse(),
+            Err(InverseError::Singular { column: 1, .. })
+        ));
+        assert_eq!(
+            Matrix::zeros(2, 3).inverse(),
+            Err(InverseError::NotSquare { rows: 2, cols: 3 })
+        );
         let mut nan = Matrix::identity(2);
         nan[(1, 0)] = f64::NAN;
-        assert!(nan.inverse().is_err());
+        assert_eq!(
+            nan.inverse(),
+            Err(InverseError::NonFinite { row: 1, col: 0 })
+        );
+        assert!(nan.inverse().unwrap_err().to_string().contains("(1, 0)"));
         assert!(Matrix::zeros(2, 3)
             .checked_mul(&Matrix::zeros(2, 3))
             .is_none());

@@ -15,7 +15,7 @@
 
 use std::fmt;
 
-use crate::dense::{Matrix, SingularMatrix};
+use crate::dense::{InverseError, Matrix};
 use crate::triangle::Polynomial2;
 
 /// The vertices of the reference triangle, in local order.
@@ -124,7 +124,7 @@ pub enum DualBasisError {
         /// The element.
         element: &'static str,
         /// What the elimination found.
-        cause: SingularMatrix,
+        cause: InverseError,
     },
 }
 
