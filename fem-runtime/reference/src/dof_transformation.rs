@@ -564,27 +564,33 @@ mod tests {
         (([p5, p2, p9], [5, g2, g9]), ([p9, p2, p7], [g9, g2, 7]))
     }
 
-    /// A global function from one random value per global DOF (six per vertex, one per
-    /// edge), evaluated on one cell of the pair; `orientation` are the global numbers
-    /// handed to the transformation (normally `global` itself).
-    fn global_function(
+    /// A global DOF: `Vertex(g, k)` is DOF `k` at global vertex `g`; `Edge(lo, hi)` the
+    /// normal-derivative DOF of the edge between global vertices `lo < hi`.
+    #[derive(Clone, Copy)]
+    enum GlobalDof {
+        Vertex(usize, usize),
+        Edge(usize, usize),
+    }
+
+    /// The function with global DOF values `values`, evaluated on one cell;
+    /// `orientation` are the global numbers handed to the transformation (normally
+    /// `global` itself).
+    fn cell_function(
         element: &ElementDefinition,
         transformation: Transformation,
-        vertices: [[f64; 2]; 3],
-        global: [usize; 3],
+        (vertices, global): Cell,
         orientation: [usize; 3],
-        seed: u64,
+        values: impl Fn(GlobalDof) -> f64,
     ) -> impl Fn([f64; 2]) -> [f64; 6] {
         let per_vertex = element.dofs.len() / 3 - 1;
-        let dof_value =
-            move |key: u64| Random(seed ^ key.wrapping_mul(0x9e37_79b9)).uniform(-1.0, 1.0);
         let mut local: Vec<f64> = global
             .iter()
-            .flat_map(|&g| (0..per_vertex).map(move |k| dof_value(100 * g as u64 + k as u64 + 1)))
+            .flat_map(|&g| (0..per_vertex).map(move |k| (g, k)))
+            .map(|(g, k)| values(GlobalDof::Vertex(g, k)))
             .collect();
         for [a, b] in EDGES {
             let (lo, hi) = (global[a].min(global[b]), global[a].max(global[b]));
-            local.push(dof_value(100_000 + 1000 * lo as u64 + hi as u64));
+            local.push(values(GlobalDof::Edge(lo, hi)));
         }
         let physical = Physical::new(
             element,
@@ -600,6 +606,36 @@ mod tests {
             }
             out
         }
+    }
+
+    /// Reproducible random values per global DOF.
+    fn random_values(seed: u64) -> impl Fn(GlobalDof) -> f64 {
+        move |dof| {
+            let key = match dof {
+                GlobalDof::Vertex(g, k) => 100 * g as u64 + k as u64 + 1,
+                GlobalDof::Edge(lo, hi) => 100_000 + 1000 * lo as u64 + hi as u64,
+            };
+            Random(seed ^ key.wrapping_mul(0x9e37_79b9)).uniform(-1.0, 1.0)
+        }
+    }
+
+    /// A global function from one random value per global DOF (six per vertex, one per
+    /// edge), evaluated on one cell of the pair.
+    fn global_function(
+        element: &ElementDefinition,
+        transformation: Transformation,
+        vertices: [[f64; 2]; 3],
+        global: [usize; 3],
+        orientation: [usize; 3],
+        seed: u64,
+    ) -> impl Fn([f64; 2]) -> [f64; 6] {
+        cell_function(
+            element,
+            transformation,
+            (vertices, global),
+            orientation,
+            random_values(seed),
+        )
     }
 
     /// (b) Argyris is C¹: value and gradient of a global function agree from both sides
@@ -663,6 +699,119 @@ mod tests {
             let (ma, mb) = (mean(&ua), mean(&ub));
             assert!((ma - mb).abs() < 1e-11, "trial {trial}: {ma} vs {mb}");
         }
+    }
+
+    /// A patch of 18 cells: a perturbed 4 × 4 grid of vertices, squares split along
+    /// alternating diagonals, every other cell listed clockwise, vertices numbered by a
+    /// scrambled permutation.
+    fn patch(random: &mut Random) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
+        let coordinates: Vec<[f64; 2]> = (0..16)
+            .map(|k| {
+                let (i, j) = ((k % 4) as f64, (k / 4) as f64);
+                [i + random.uniform(-0.2, 0.2), j + random.uniform(-0.2, 0.2)]
+            })
+            .collect();
+        let number = |i: usize, j: usize| (7 * (4 * j + i) + 3) % 16;
+        let mut cells = Vec::new();
+        for j in 0..3 {
+            for i in 0..3 {
+                let [a, b, c, d] =
+                    [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(i, j)| number(i, j));
+                let pair = if (i + j) % 2 == 0 {
+                    [[a, b, c], [a, c, d]]
+                } else {
+                    [[a, b, d], [b, c, d]]
+                };
+                for (n, [x, y, z]) in pair.into_iter().enumerate() {
+                    cells.push(if n == 1 { [x, z, y] } else { [x, y, z] });
+                }
+            }
+        }
+        // coordinates are indexed by global number
+        let mut by_number = vec![[0.0; 2]; 16];
+        for (k, &p) in coordinates.iter().enumerate() {
+            by_number[(7 * k + 3) % 16] = p;
+        }
+        (by_number, cells)
+    }
+
+    /// The patch test on a small mesh: a global P5 polynomial's DOFs reproduce
+    /// it on every cell, and a global function of random DOFs is C¹ across every
+    /// interior edge (values and gradients at three points per edge).
+    #[test]
+    fn argyris_patch_reproduces_p5_and_is_c1_across_every_interior_edge() {
+        let mut random = Random(2024);
+        let argyris = ElementDefinition::argyris();
+        let (points, cells) = patch(&mut random);
+        let cell = |c: usize| -> Cell { (cells[c].map(|g| points[g]), cells[c]) };
+        let f = random_polynomial(&mut random, 5);
+        let f_values = |dof: GlobalDof| match dof {
+            GlobalDof::Vertex(g, k) => jet_of(&f)(points[g])[k],
+            GlobalDof::Edge(lo, hi) => {
+                let (p, q) = (points[lo], points[hi]);
+                let t = [q[0] - p[0], q[1] - p[1]];
+                let l = t[0].hypot(t[1]);
+                let j = jet_of(&f)([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]);
+                (t[1] * j[1] - t[0] * j[2]) / l
+            }
+        };
+        let mut interior_edges = 0;
+        for c in 0..cells.len() {
+            let (vertices, global) = cell(c);
+            let u = cell_function(&argyris, argyris_transformation, cell(c), global, f_values);
+            let centroid = [0, 1].map(|k| vertices.iter().map(|v| v[k]).sum::<f64>() / 3.0);
+            let (got, exact) = (u(centroid), jet_of(&f)(centroid));
+            for k in 0..6 {
+                assert!(
+                    (got[k] - exact[k]).abs() < 1e-9 * (1.0 + exact[k].abs()),
+                    "cell {c}, derivative {k}: {} vs {}",
+                    got[k],
+                    exact[k]
+                );
+            }
+            for (d, other) in cells.iter().enumerate().skip(c + 1) {
+                let shared: Vec<usize> = global
+                    .iter()
+                    .copied()
+                    .filter(|g| other.contains(g))
+                    .collect();
+                if shared.len() != 2 {
+                    continue;
+                }
+                interior_edges += 1;
+                let ua = global_function(
+                    &argyris,
+                    argyris_transformation,
+                    vertices,
+                    global,
+                    global,
+                    5,
+                );
+                let ub = global_function(
+                    &argyris,
+                    argyris_transformation,
+                    cell(d).0,
+                    *other,
+                    *other,
+                    5,
+                );
+                let (p, q) = (points[shared[0]], points[shared[1]]);
+                for s in [0.2, 0.5, 0.9] {
+                    let x = [0, 1].map(|k| p[k] + s * (q[k] - p[k]));
+                    let (ja, jb) = (ua(x), ub(x));
+                    for k in 0..3 {
+                        assert!(
+                            (ja[k] - jb[k]).abs() < 1e-10 * (1.0 + ja[k].abs()),
+                            "cells {c} and {d}, s = {s}, component {k}: {} vs {}",
+                            ja[k],
+                            jb[k]
+                        );
+                    }
+                }
+            }
+        }
+        // 3 × 3 squares: 12 inner grid edges and 9 diagonals
+        assert_eq!(interior_edges, 21);
     }
 
     #[test]
