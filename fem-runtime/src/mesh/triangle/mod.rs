@@ -7,11 +7,13 @@
 //! edge; bisection then keeps the newest vertex at local position 0, so descendants
 //! fall into at most four similarity classes per initial cell.
 
+mod curved;
 mod locate;
 mod parts;
 mod quality;
 mod refine;
 
+pub use curved::QuadraticGeometry;
 pub use locate::PointLocator;
 pub use parts::NamedGroup;
 pub use quality::{
