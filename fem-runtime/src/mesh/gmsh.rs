@@ -8,7 +8,7 @@ use std::path::Path;
 use mshio::{ElementType, MshFile};
 
 use crate::error::{Error, Result};
-use crate::mesh::triangle::{NamedGroup, TriangleMesh};
+use crate::mesh::triangle::{NamedGroup, QuadraticGeometry, TriangleMesh};
 
 /// Reads a Gmsh `.msh` file (MSH 4.1, ASCII or binary) into a [`TriangleMesh`].
 ///
@@ -51,6 +51,48 @@ pub fn read_msh(path: &Path) -> Result<TriangleMesh> {
 /// merged, with the Gmsh fix (`Coherence`) in the message: merging would silently
 /// change the model, whose author may have meant a slit.
 pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
+    Ok(parse(bytes, false)?.0)
+}
+
+/// Reads a Gmsh `.msh` file of second-order (6-node, Gmsh type 9) triangles into a
+/// [`TriangleMesh`] of their corners and the [`QuadraticGeometry`] of their edge nodes:
+/// the isoparametric cells Gmsh meshed with `Mesh.ElementOrder = 2` (curved where the
+/// model's boundary is).
+///
+/// # Errors
+/// As [`parse_msh_quadratic`].
+pub fn read_msh_quadratic(path: &Path) -> Result<(TriangleMesh, QuadraticGeometry)> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::Io(format!("cannot read {}: {e}", path.display())))?;
+    parse_msh_quadratic(&bytes).map_err(|e| match e {
+        Error::Mesh(message) => Error::Mesh(format!("{}: {message}", path.display())),
+        other => other,
+    })
+}
+
+/// Parses a `.msh` file of 6-node triangles (with 3-node boundary lines): everything
+/// [`parse_msh`] reads and checks, on the triangles' corners, plus the edge nodes as
+/// [`QuadraticGeometry`] (Gmsh's node order: corners, then the nodes of edges 0–1, 1–2,
+/// 2–0).
+///
+/// # Errors
+/// Those of [`parse_msh`]; a file of 3-node triangles (read it with [`parse_msh`]) or
+/// of both kinds; two triangles that give one edge different nodes; an edge node that
+/// is not defined or not in the plane; a cell whose quadratic map folds
+/// ([`QuadraticGeometry::from_edge_nodes`]).
+pub fn parse_msh_quadratic(bytes: &[u8]) -> Result<(TriangleMesh, QuadraticGeometry)> {
+    let (mesh, geometry) = parse(bytes, true)?;
+    let geometry = geometry.ok_or_else(|| {
+        Error::Mesh(
+            "the file has 3-node triangles: it is a first-order mesh (read it as one), not a quadratic geometry".into(),
+        )
+    })?;
+    Ok((mesh, geometry))
+}
+
+/// The shared reader: with `quadratic`, 6-node triangles are read (and 3-node ones are
+/// not) and their edge nodes returned as the geometry.
+fn parse(bytes: &[u8], quadratic: bool) -> Result<(TriangleMesh, Option<QuadraticGeometry>)> {
     let binary = check_header(bytes)?;
     let stripped = if binary {
         None
@@ -60,7 +102,7 @@ pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
     let bytes = stripped.as_deref().unwrap_or(bytes);
     let file = parse_with_mshio(bytes)?;
     let nodes = node_table(&file, if binary { None } else { ascii_node_tags(bytes) })?;
-    let elements = collect_elements(&file)?;
+    let elements = collect_elements(&file, quadratic)?;
     let names = physical_names(bytes)?;
 
     // compact numbering of the nodes the triangles use, in increasing tag order
@@ -131,7 +173,66 @@ pub fn parse_msh(bytes: &[u8]) -> Result<TriangleMesh> {
     }
     mesh.apply_markers(&markers).map_err(annotate)?;
     mesh.set_named_groups(named_groups(&file, &names, &boundary_curves));
-    Ok(mesh)
+    if elements.edge_nodes.is_empty() {
+        return Ok((mesh, None));
+    }
+    let geometry = quadratic_geometry(&mesh, &elements, &nodes, &used).map_err(annotate)?;
+    Ok((mesh, Some(geometry)))
+}
+
+/// The edge nodes of 6-node triangles as the geometry of `mesh` (whose vertex `i` is the
+/// node tagged `used[i]`): looked up by each edge's pair of corners, so that the cells
+/// `orient` turned keep their nodes, and checked to agree between neighbours.
+fn quadratic_geometry(
+    mesh: &TriangleMesh,
+    elements: &Elements,
+    nodes: &NodeTable,
+    used: &[u64],
+) -> Result<QuadraticGeometry> {
+    let mut edge_nodes = vec![None; mesh.edge_count()];
+    let index = |tag: u64| used.binary_search(&tag).ok();
+    for (&(element, corners), &(_, middles)) in elements.triangles.iter().zip(&elements.edge_nodes)
+    {
+        for k in 0..3 {
+            let (a, b, middle) = (corners[k], corners[(k + 1) % 3], middles[k]);
+            let p = nodes.get(middle).ok_or_else(|| {
+                Error::Mesh(format!(
+                    "element {element} references node {middle}, which the $Nodes section does not define"
+                ))
+            })?;
+            if !(p[2] == 0.0 || p[2].abs() <= 1e-12 * (p[0].abs() + p[1].abs()).max(1.0)) {
+                return Err(Error::Mesh(format!(
+                    "node {middle} has z = {}: only meshes in the plane z = 0 are supported",
+                    p[2]
+                )));
+            }
+            let edge = match (index(a), index(b)) {
+                (Some(a), Some(b)) => mesh.find_edge(a, b),
+                _ => None,
+            }
+            .ok_or_else(|| {
+                Error::Mesh(format!(
+                    "element {element}: nodes {a} and {b} do not form an edge of the mesh"
+                ))
+            })?;
+            let node = [p[0], p[1]];
+            match edge_nodes[edge] {
+                None => edge_nodes[edge] = Some((node, middle)),
+                Some((other, tag)) if other != node => {
+                    return Err(Error::Mesh(format!(
+                        "the edge between nodes {a} and {b} has two different middle nodes, {tag} and {middle} (element {element}): the triangles do not share the edge's geometry"
+                    )))
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    let edge_nodes = edge_nodes
+        .into_iter()
+        .map(|n| n.map(|(p, _)| p))
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(|| Error::Mesh("an edge of the mesh has no middle node".into()))?;
+    QuadraticGeometry::from_edge_nodes(mesh, edge_nodes)
 }
 
 /// `(dimension, physical tag, name)` of each entry of the `$PhysicalNames` section, in
@@ -533,8 +634,11 @@ fn strip_parametric(bytes: &[u8]) -> Option<Vec<u8>> {
 
 /// The elements the mesh is made of, with their Gmsh element tags.
 struct Elements {
-    /// (element tag, node tags)
+    /// (element tag, node tags of the corners)
     triangles: Vec<(u64, [u64; 3])>,
+    /// For 6-node triangles, in the order of `triangles`: (element tag, node tags of the
+    /// middles of edges 0–1, 1–2, 2–0); empty for 3-node triangles.
+    edge_nodes: Vec<(u64, [u64; 3])>,
     /// (element tag, node tags, marker, curve's entity tag)
     lines: Vec<(u64, [u64; 2], u32, i32)>,
 }
@@ -543,7 +647,7 @@ fn type_name(t: ElementType) -> String {
     format!("{t:?} (Gmsh type {})", t as i32)
 }
 
-fn collect_elements(file: &MshFile<u64, i32, f64>) -> Result<Elements> {
+fn collect_elements(file: &MshFile<u64, i32, f64>, quadratic: bool) -> Result<Elements> {
     let Some(elements) = &file.data.elements else {
         return Err(Error::Mesh(
             "the .msh file has no $Elements section, so no triangles".into(),
@@ -563,6 +667,7 @@ fn collect_elements(file: &MshFile<u64, i32, f64>) -> Result<Elements> {
     };
     let mut found: Vec<(ElementType, usize)> = Vec::new();
     let mut triangles = Vec::new();
+    let mut edge_nodes = Vec::new();
     let mut lines = Vec::new();
     for block in &elements.element_blocks {
         match found.iter_mut().find(|(t, _)| *t == block.element_type) {
@@ -570,12 +675,20 @@ fn collect_elements(file: &MshFile<u64, i32, f64>) -> Result<Elements> {
             None => found.push((block.element_type, block.elements.len())),
         }
         match block.element_type {
-            ElementType::Tri3 => {
+            ElementType::Tri3 if !quadratic => {
                 for e in &block.elements {
                     triangles.push((e.element_tag, [e.nodes[0], e.nodes[1], e.nodes[2]]));
                 }
             }
-            ElementType::Lin2 => {
+            ElementType::Tri6 if quadratic => {
+                for e in &block.elements {
+                    triangles.push((e.element_tag, [e.nodes[0], e.nodes[1], e.nodes[2]]));
+                    edge_nodes.push((e.element_tag, [e.nodes[3], e.nodes[4], e.nodes[5]]));
+                }
+            }
+            ElementType::Lin2 | ElementType::Lin3
+                if (block.element_type == ElementType::Lin3) == quadratic =>
+            {
                 let tag = physical(block.entity_tag).unwrap_or(block.entity_tag);
                 let marker = u32::try_from(tag).map_err(|_| {
                     Error::Mesh(format!(
@@ -602,39 +715,61 @@ fn collect_elements(file: &MshFile<u64, i32, f64>) -> Result<Elements> {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let higher_order: Vec<(ElementType, usize)> = found
+    let (triangle, line) = if quadratic {
+        (ElementType::Tri6, ElementType::Lin3)
+    } else {
+        (ElementType::Tri3, ElementType::Lin2)
+    };
+    let of_the_other_order: Vec<(ElementType, usize)> = found
         .iter()
         .copied()
         .filter(|&(t, _)| {
             let name = format!("{t:?}");
-            let nodes = t.nodes().unwrap_or(0);
-            (name.starts_with("Tri") && nodes > 3) || (name.starts_with("Lin") && nodes > 2)
+            (name.starts_with("Tri") || name.starts_with("Lin")) && t != triangle && t != line
         })
         .collect();
-    if !higher_order.is_empty() {
-        return Err(Error::Mesh(format!(
-            "second- or higher-order elements are not supported (found {}); only 3-node triangles can be read: mesh with Mesh.ElementOrder = 1",
-            list(&higher_order)
-        )));
+    if !of_the_other_order.is_empty() {
+        return Err(Error::Mesh(if quadratic {
+            format!(
+                "a quadratic geometry is read from 6-node triangles with 3-node boundary lines only (found {}): mesh with Mesh.ElementOrder = 2",
+                list(&of_the_other_order)
+            )
+        } else {
+            format!(
+                "second- or higher-order elements are not supported here (found {}); only 3-node triangles can be read as a mesh of straight cells: mesh with Mesh.ElementOrder = 1 (6-node triangles are read as a curved geometry by `read_msh_quadratic`)",
+                list(&of_the_other_order)
+            )
+        }));
     }
     if triangles.is_empty() {
+        let kind = if quadratic { "6-node" } else { "3-node" };
+        let found = if found.is_empty() {
+            "none".to_string()
+        } else {
+            list(&found)
+        };
         return Err(Error::Mesh(format!(
-            "the .msh file has no 3-node triangles (element types found: {}); only 3-node triangles (Gmsh type 2) are supported",
-            if found.is_empty() { "none".to_string() } else { list(&found) }
+            "the .msh file has no {kind} triangles (element types found: {found}); only {kind} triangles ({}) are supported",
+            type_name(triangle)
         )));
     }
     let other: Vec<(ElementType, usize)> = found
         .iter()
         .copied()
-        .filter(|&(t, _)| !matches!(t, ElementType::Tri3 | ElementType::Lin2 | ElementType::Pnt))
+        .filter(|&(t, _)| t != triangle && t != line && t != ElementType::Pnt)
         .collect();
     if !other.is_empty() {
         return Err(Error::Mesh(format!(
-            "unsupported element types {}: only 3-node triangles (with 2-node boundary lines and points) can be read",
-            list(&other)
+            "unsupported element types {}: only {} (with boundary lines and points) can be read",
+            list(&other),
+            type_name(triangle)
         )));
     }
-    Ok(Elements { triangles, lines })
+    Ok(Elements {
+        triangles,
+        edge_nodes,
+        lines,
+    })
 }
 
 /// All coordinates must have `z = 0` up to 1e-12 of the extent in the plane.
@@ -1238,5 +1373,100 @@ $EndElements
         let e = read_msh(&path).unwrap_err().to_string();
         assert!(e.contains("square.msh") && e.contains("2.2"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A second-order mesh of the unit disk written the way Gmsh writes one (MSH 4.1,
+    /// 6-node triangles, 3-node boundary lines on curve 1), from the disk generator with
+    /// its boundary edge nodes on the circle; cells listed clockwise when `flip`.
+    /// With `tamper`, cell 0 names the node of its edge 1–2 as that of its edge 0–1.
+    fn quadratic_disk_text(
+        rings: usize,
+        flip: bool,
+        tamper: bool,
+    ) -> (String, TriangleMesh, QuadraticGeometry) {
+        let mesh = TriangleMesh::disk([0.0, 0.0], 1.0, rings).unwrap();
+        let geometry = QuadraticGeometry::circle(&mesh, [0.0, 0.0], 1.0).unwrap();
+        let (nv, ne) = (mesh.vertex_count(), mesh.edge_count());
+        let mut nodes = Vec::new();
+        for v in mesh.vertices() {
+            nodes.push(*v);
+        }
+        for e in 0..ne {
+            let map_node = (0..mesh.cell_count())
+                .find_map(|c| {
+                    let k = mesh.cell_edges(c).iter().position(|&x| x == e)?;
+                    Some(geometry.cell_map(&mesh, c).nodes()[3 + k])
+                })
+                .unwrap();
+            nodes.push(map_node);
+        }
+        let mut text = String::from("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n");
+        text += &format!("1 {} 1 {}\n2 1 0 {}\n", nv + ne, nv + ne, nv + ne);
+        for i in 1..=nv + ne {
+            text += &format!("{i}\n");
+        }
+        for p in &nodes {
+            text += &format!("{:.17e} {:.17e} 0\n", p[0], p[1]);
+        }
+        let boundary: Vec<(usize, u32)> = mesh.boundary_edges().to_vec();
+        let (nc, nb) = (mesh.cell_count(), boundary.len());
+        text += &format!("$EndNodes\n$Elements\n2 {} 1 {}\n", nc + nb, nc + nb);
+        text += &format!("1 1 8 {nb}\n");
+        for (i, &(e, _)) in boundary.iter().enumerate() {
+            let [a, b] = mesh.edges()[e];
+            text += &format!("{} {} {} {}\n", i + 1, a + 1, b + 1, nv + e + 1);
+        }
+        text += &format!("2 1 9 {nc}\n");
+        for c in 0..nc {
+            let [a, b, d] = mesh.cell(c);
+            let [mut e0, e1, e2] = mesh.cell_edges(c);
+            if tamper && c == 0 {
+                e0 = e1;
+            }
+            let line = if flip {
+                // clockwise: a, d, b with the edges a–d, d–b, b–a
+                [a, d, b, e2, e1, e0]
+            } else {
+                [a, b, d, e0, e1, e2]
+            };
+            let tags: Vec<String> = line
+                .iter()
+                .enumerate()
+                .map(|(k, &i)| (if k < 3 { i + 1 } else { nv + i + 1 }).to_string())
+                .collect();
+            text += &format!("{} {}\n", nb + c + 1, tags.join(" "));
+        }
+        text += "$EndElements\n";
+        (text, mesh, geometry)
+    }
+
+    /// A second-order Gmsh disk reads to the disk's corners and the same curved geometry
+    /// (area to rounding, so O(h⁴) from π), whichever way its cells are listed; read as a
+    /// straight mesh it is refused, and a first-order file is not a quadratic geometry.
+    #[test]
+    fn second_order_triangles_give_the_quadratic_geometry() {
+        for flip in [false, true] {
+            let (text, mesh, geometry) = quadratic_disk_text(8, flip, false);
+            let (read, read_geometry) = parse_msh_quadratic(text.as_bytes()).unwrap();
+            assert_eq!(read.vertex_count(), mesh.vertex_count());
+            assert_eq!(read.cell_count(), mesh.cell_count());
+            let (area, expected) = (read_geometry.area(&read), geometry.area(&mesh));
+            assert!((area - expected).abs() < 1e-13, "{area} vs {expected}");
+            assert!((area - std::f64::consts::PI).abs() < 3e-6, "{area}");
+            // the boundary lines gave markers
+            assert_eq!(read.boundary_edges().len(), mesh.boundary_edges().len());
+            let straight = parse_msh(text.as_bytes()).unwrap_err().to_string();
+            assert!(straight.contains("read_msh_quadratic"), "{straight}");
+        }
+        let first_order = parse_msh_quadratic(SQUARE.as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(first_order.contains("6-node"), "{first_order}");
+        // two cells that disagree on an edge's middle node (an interior edge of ring 1)
+        let (tampered, _, _) = quadratic_disk_text(2, false, true);
+        let e = parse_msh_quadratic(tampered.as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("two different middle nodes"), "{e}");
     }
 }

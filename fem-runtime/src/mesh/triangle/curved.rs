@@ -30,6 +30,31 @@ impl QuadraticGeometry {
         Self { edge_nodes }
     }
 
+    /// The geometry with the given edge nodes (shape: one point per edge of `mesh`, in the
+    /// order of [`TriangleMesh::edges`]), e.g. from a second-order Gmsh mesh.
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] for a wrong number of nodes, a node that is not finite, or a cell
+    /// whose map folds (as [`QuadraticGeometry::curved`]).
+    pub fn from_edge_nodes(mesh: &TriangleMesh, edge_nodes: Vec<[f64; 2]>) -> Result<Self> {
+        if edge_nodes.len() != mesh.edge_count() {
+            return Err(Error::Mesh(format!(
+                "{} edge nodes for a mesh of {} edges",
+                edge_nodes.len(),
+                mesh.edge_count()
+            )));
+        }
+        if let Some(e) = edge_nodes
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(Error::Mesh(format!("the node of edge {e} is not finite")));
+        }
+        let geometry = Self { edge_nodes };
+        geometry.check(mesh)?;
+        Ok(geometry)
+    }
+
     /// Curved boundary edges: the midpoint of every boundary edge whose marker is in
     /// `markers` (every boundary edge for `None`) moved onto the exact boundary by
     /// `projection` (a point near the boundary → the nearest point on it); all other
