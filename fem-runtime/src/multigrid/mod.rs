@@ -33,11 +33,17 @@ pub struct MultigridOptions {
     /// Symmetric Gauss–Seidel sweeps (one forward and one backward each) before and
     /// after the coarse correction; at least 1.
     pub sweeps: usize,
+    /// Coarse corrections per level, `γ`: 1 for the V-cycle, 2 for the W-cycle (each a
+    /// symmetric iteration, so either preconditions CG); at least 1.
+    pub coarse_corrections: usize,
 }
 
 impl Default for MultigridOptions {
     fn default() -> Self {
-        Self { sweeps: 1 }
+        Self {
+            sweeps: 1,
+            coarse_corrections: 1,
+        }
     }
 }
 
@@ -90,10 +96,11 @@ impl Multigrid {
         prolongations: Vec<SparseMatrix>,
         options: MultigridOptions,
     ) -> Result<Self> {
-        if options.sweeps == 0 {
-            return Err(Error::Input(
-                "multigrid needs at least one smoothing sweep".into(),
-            ));
+        if options.sweeps == 0 || options.coarse_corrections == 0 {
+            return Err(Error::Input(format!(
+                "multigrid needs at least one smoothing sweep and one coarse correction, given {} and {}",
+                options.sweeps, options.coarse_corrections
+            )));
         }
         if a.nrows() != a.ncols() {
             return Err(Error::Input(format!(
@@ -199,13 +206,15 @@ impl Multigrid {
         };
         here.x.fill(0.0);
         self.smooth(level, here);
-        sparse::multiply_into(&level.a, &here.x, &mut here.r);
-        for (r, b) in here.r.iter_mut().zip(&here.b) {
-            *r = b - *r;
+        for _ in 0..self.options.coarse_corrections {
+            sparse::multiply_into(&level.a, &here.x, &mut here.r);
+            for (r, b) in here.r.iter_mut().zip(&here.b) {
+                *r = b - *r;
+            }
+            sparse::restrict(p, &here.r, &mut below[0].b);
+            self.cycle(l + 1, below)?;
+            sparse::prolong_add(p, &below[0].x, &mut here.x);
         }
-        sparse::restrict(p, &here.r, &mut below[0].b);
-        self.cycle(l + 1, below)?;
-        sparse::prolong_add(p, &below[0].x, &mut here.x);
         self.smooth(level, here);
         Ok(())
     }

@@ -312,7 +312,15 @@ fn pcg_runs<M: Model>(
         // prolongations are stored fine to coarse for the deepest hierarchy
         let skip = levels.len() - depth;
         let ps = prolongations[skip..].to_vec();
-        let mg = Multigrid::new(a.clone(), ps, MultigridOptions { sweeps }).unwrap();
+        let mg = Multigrid::new(
+            a.clone(),
+            ps,
+            MultigridOptions {
+                sweeps,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         let mut seed = 12345u64;
         let b: Vec<f64> = (0..n)
             .map(|_| 1.0 / n as f64 + 0.5 / n as f64 * (random(&mut seed) - 0.5))
@@ -481,8 +489,16 @@ fn bad_inputs_are_errors() {
     let meshes = hierarchy(2, Diagonal::Right);
     let (levels, prolongations) = laplace_hierarchy::<laplace_p1::Model>(&meshes);
     let a = levels[1].a.clone();
-    let zero = MultigridOptions { sweeps: 0 };
+    let zero = MultigridOptions {
+        sweeps: 0,
+        ..Default::default()
+    };
     assert!(Multigrid::new(a.clone(), prolongations.clone(), zero).is_err());
+    let no_correction = MultigridOptions {
+        coarse_corrections: 0,
+        ..Default::default()
+    };
+    assert!(Multigrid::new(a.clone(), prolongations.clone(), no_correction).is_err());
     // a prolongation for another level
     let wrong = vec![prolongations[0].clone(), prolongations[0].clone()];
     let message = Multigrid::new(a.clone(), wrong, MultigridOptions::default())
