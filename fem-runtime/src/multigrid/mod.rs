@@ -2,18 +2,21 @@
 //! gradients for SPD systems such as the Newton systems `H d = −∇Φ` (issue 15).
 //!
 //! Given the fine matrix `A₀` and prolongations `P_l` from level `l + 1` (coarser) to
-//! level `l` ([`prolongation`] builds them from the refinement), the coarse operators are
-//! Galerkin's `A_{l+1} = P_lᵀ A_l P_l` (so an active-set term of `H` is carried to every
-//! level). One V-cycle on level `l` for `A_l x = b`, from `x = 0`:
-//! `ν` symmetric Gauss–Seidel sweeps; `r = b − A_l x`; the V-cycle on `A_{l+1} e = P_lᵀ r`;
-//! `x += P_l e`; `ν` symmetric Gauss–Seidel sweeps; on the coarsest level a sparse
-//! Cholesky solve ([`crate::lcp::cholesky`]). With symmetric smoothing before and after,
-//! the V-cycle is a symmetric positive definite operator (Hackbusch, *Multi-Grid Methods
-//! and Applications*, 1985, §10.7), so it preconditions CG ([`Multigrid::pcg`]).
+//! level `l` ([`prolongation()`] builds them from the refinement), the coarse operators
+//! are Galerkin's `A_{l+1} = P_lᵀ A_l P_l` (so an active-set term of `H` is carried to
+//! every level). One cycle on level `l` for `A_l x = b`, from `x = 0`: `ν` symmetric
+//! Gauss–Seidel sweeps; `γ` times { `r = b − A_l x`; the cycle on `A_{l+1} e = P_lᵀ r`;
+//! `x += P_l e` }; `ν` symmetric Gauss–Seidel sweeps; on the coarsest level a sparse
+//! Cholesky solve ([`crate::lcp::cholesky`]). `γ = 1` is the V-cycle, `γ = 2` the
+//! W-cycle. With symmetric smoothing before and after, the cycle is a symmetric positive
+//! definite operator (Hackbusch, *Multi-Grid Methods and Applications*, 1985, §10.7), so
+//! it preconditions CG ([`Multigrid::pcg`]).
 //!
 //! All vectors of the cycle are allocated once per level when the hierarchy is built;
 //! the cycle allocates only in the coarsest solve (one vector of the coarsest order).
-//! `docs/multigrid.md` has the measured iteration counts.
+//! `docs/multigrid.md` has the formulas and the measured iteration counts: flat on the
+//! Laplacian with the V-cycle; on the membrane's Newton Hessian the V-cycle's count
+//! grows slowly with the levels and the W-cycle's does not.
 
 mod prolongation;
 mod sparse;
@@ -27,7 +30,7 @@ use crate::lcp::cholesky::{Cholesky, CholeskyFactor};
 use crate::SparseMatrix;
 use std::cell::RefCell;
 
-/// Options of the V-cycle.
+/// Options of the cycle.
 #[derive(Clone, Copy, Debug)]
 pub struct MultigridOptions {
     /// Symmetric Gauss–Seidel sweeps (one forward and one backward each) before and
@@ -63,7 +66,7 @@ struct Work {
     r: Vec<f64>,
 }
 
-/// A multigrid hierarchy ready to run V-cycles: the Galerkin operators of every level,
+/// A multigrid hierarchy ready to run cycles: the Galerkin operators of every level,
 /// the Cholesky factor of the coarsest one and preallocated work vectors.
 pub struct Multigrid {
     levels: Vec<Level>,
@@ -77,7 +80,7 @@ pub struct Multigrid {
 pub struct PcgSolution {
     /// The solution.
     pub x: Vec<f64>,
-    /// CG iterations (V-cycles applied).
+    /// CG iterations (cycles applied).
     pub iterations: usize,
     /// `‖b − A x‖ / ‖b‖` at the end (the recurrence's residual).
     pub relative_residual: f64,
@@ -177,14 +180,14 @@ impl Multigrid {
         self.levels.get(l).map(|level| &level.a)
     }
 
-    /// `x = M⁻¹ b`, one V-cycle from `x = 0` on the fine level.
+    /// `x = M⁻¹ b`, one cycle (V or W, as the options say) from `x = 0` on the fine level.
     ///
     /// Errors: `b` or `x` not of the fine order, a coarsest solve that is not finite.
     pub fn v_cycle(&self, b: &[f64], x: &mut [f64]) -> Result<()> {
         let n = self.levels[0].a.nrows();
         if b.len() != n || x.len() != n {
             return Err(Error::Input(format!(
-                "a V-cycle of order {n} given vectors of lengths {} and {}",
+                "a multigrid cycle of order {n} given vectors of lengths {} and {}",
                 b.len(),
                 x.len()
             )));
@@ -196,7 +199,7 @@ impl Multigrid {
         Ok(())
     }
 
-    /// The V-cycle on level `l`, whose vectors are `work[0]` (`work[k]` is level `l + k`).
+    /// The cycle on level `l`, whose vectors are `work[0]` (`work[k]` is level `l + k`).
     fn cycle(&self, l: usize, work: &mut [Work]) -> Result<()> {
         let level = &self.levels[l];
         let (here, below) = work.split_first_mut().expect("a work entry per level");
@@ -227,7 +230,7 @@ impl Multigrid {
     }
 
     /// Solves `A x = b` (`A` the fine matrix) by conjugate gradients preconditioned with
-    /// one V-cycle per iteration, from `x = 0`, until `‖b − A x‖ ≤ tolerance ‖b‖` or
+    /// one cycle per iteration, from `x = 0`, until `‖b − A x‖ ≤ tolerance ‖b‖` or
     /// `max_iterations`.
     ///
     /// Errors: `b` not of the fine order or not finite, a tolerance not in (0, 1), no

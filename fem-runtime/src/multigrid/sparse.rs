@@ -1,4 +1,4 @@
-//! The few sparse kernels the V-cycle runs, all into preallocated vectors: products with
+//! The few sparse kernels the cycle runs, all into preallocated vectors: products with
 //! `A` and `P`, restriction `Pᵀ r` without forming `Pᵀ`, Gauss–Seidel sweeps, and the
 //! Galerkin triple product `PᵀAP` formed once per hierarchy.
 
