@@ -91,7 +91,7 @@ impl Multigrid {
     /// stored) and `prolongations[l]` from level `l + 1` to level `l` (level 0 is `a`'s,
     /// so the list runs from fine to coarse; it may be empty: then one Cholesky solve).
     ///
-    /// Errors: a non-square `a`, a prolongation whose row count is not the order of the
+    /// Errors: a non-square or non-symmetric `a` (beyond 1e-12 relative), a prolongation whose row count is not the order of the
     /// level it maps to, a level whose operator has a diagonal entry missing or not
     /// positive (not SPD), a coarsest operator Cholesky refuses, `sweeps = 0`.
     pub fn new(
@@ -110,6 +110,13 @@ impl Multigrid {
                 "multigrid of a {} × {} matrix (not square)",
                 a.nrows(),
                 a.ncols()
+            )));
+        }
+        // Gauss–Seidel reads column j as row j
+        let asymmetry = crate::lcp::cholesky::asymmetry(&a);
+        if asymmetry.is_nan() || asymmetry > 1e-12 {
+            return Err(Error::Input(format!(
+                "multigrid of a matrix that is not symmetric (largest |A_ij − A_ji| is {asymmetry:e} of its largest entry)"
             )));
         }
         let mut levels = Vec::with_capacity(prolongations.len() + 1);

@@ -100,13 +100,14 @@ pub fn prolongation(
             coarse.mesh.cell_count()
         )));
     }
-    for level in [coarse, fine] {
+    for (name, level) in [("coarse", coarse), ("fine", fine)] {
         if let Some(r) = level.reduction {
+            // the reduction's own system size, through the full vector it expands to
+            let size = r.expand(&vec![0.0; r.free().len()]).len();
             let n = level.dofs.dof_count();
-            if r.free().last().is_some_and(|&d| d >= n) {
+            if size != n {
                 return Err(Error::Input(format!(
-                    "a reduction with free DOF {} for a system of {n} DOFs",
-                    r.free().last().unwrap()
+                    "the {name} level's reduction is for {size} DOFs, its system has {n}"
                 )));
             }
         }

@@ -516,7 +516,25 @@ fn bad_inputs_are_errors() {
     )
     .unwrap();
     assert!(Multigrid::new(negative, Vec::new(), MultigridOptions::default()).is_err());
+    // a non-symmetric matrix
+    let mut entries = Vec::new();
+    for j in 0..a.ncols() {
+        let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            let skew = if rows[k] < j { 0.1 } else { 0.0 };
+            entries.push(Triplet::new(rows[k], j, vals[k] + skew));
+        }
+    }
+    let skewed = SparseColMat::try_new_from_triplets(a.nrows(), a.ncols(), &entries).unwrap();
+    let message = Multigrid::new(skewed, prolongations.clone(), MultigridOptions::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(message.contains("not symmetric"), "{message}");
     let mg = Multigrid::new(a.clone(), prolongations, MultigridOptions::default()).unwrap();
+    let mut x = vec![0.0; a.nrows()];
+    assert!(mg.v_cycle(&[1.0], &mut x).is_err());
+    assert!(mg.v_cycle(&vec![1.0; a.nrows()], &mut [0.0]).is_err());
     assert!(mg.pcg(&[1.0], 1e-10, 10).is_err());
     assert!(mg.pcg(&vec![f64::NAN; a.nrows()], 1e-10, 10).is_err());
     assert!(mg.pcg(&vec![1.0; a.nrows()], 0.0, 10).is_err());
@@ -548,6 +566,18 @@ fn bad_inputs_are_errors() {
     };
     let parents = parents_by_location(&meshes[0], &meshes[1]).unwrap();
     assert!(prolongation(&other, &fine, &parents).is_err());
+    // a reduction of another system
+    let foreign = Constraints::new().reduction(d0.dof_count()).unwrap();
+    let reduced = NestedLevel {
+        mesh: &meshes[1],
+        dofs: &d1,
+        reduction: Some(&foreign),
+    };
+    let message = prolongation(&coarse, &reduced, &parents)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(message.contains("reduction is for"), "{message}");
     let outside = TriangleMesh::rectangle(2.0, 3.0, 0.0, 1.0, 1, 1, Diagonal::Right).unwrap();
     assert!(parents_by_location(&meshes[0], &outside).is_err());
 }
