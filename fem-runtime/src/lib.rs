@@ -31,6 +31,7 @@ pub mod io;
 pub mod lcp;
 pub mod mesh;
 pub mod model;
+pub mod multigrid;
 pub mod norms;
 pub mod obstacle;
 pub mod stabilization;

@@ -1,0 +1,178 @@
+//! Multigrid-preconditioned CG against sparse Cholesky on the Newton Hessian of the
+//! radial membrane at its converged active set (issue 15), every ratio measured in this
+//! one run, on one thread (faer's sequential mode, as the CLI runs).
+//!
+//! For each pair and mesh N × N × 2: Cholesky's symbolic analysis (done once per pattern
+//! in Newton), its numeric factorization + solve (each Newton step), the multigrid setup
+//! (prolongations, Galerkin operators, coarsest factorization; once per Newton step,
+//! since the Hessian changes) and PCG to a relative residual of 1e-6 and of 1e-10 with
+//! the V(1,1) and W(1,1) cycles. Medians of rounds.
+//!
+//! `cargo bench --bench multigrid` (add `-- --quick` for smaller meshes).
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use faer::sparse::{SparseColMat, Triplet};
+use fem_forms::lcp::cholesky::Cholesky;
+use fem_forms::lcp::Lcp;
+use fem_forms::membranes;
+use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0};
+use fem_forms::models::membrane_scenes::membrane_scene;
+use fem_forms::multigrid::{
+    parents_by_location, prolongation, Multigrid, MultigridOptions, NestedLevel,
+};
+use fem_forms::obstacle::triangle::{discretize_on_triangles, solve_obstacle_on_triangles};
+use fem_forms::obstacle::{Discretization, VariationalSolver};
+use fem_forms::{Constraints, Diagonal, Model, Reduction, SparseMatrix, SystemDofs, TriangleMesh};
+use std::hint::black_box;
+use std::time::Instant;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Seconds of `f`, median of `rounds`, and its last result.
+fn timed<T>(rounds: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..rounds {
+        let clock = Instant::now();
+        last = Some(black_box(f()));
+        times.push(clock.elapsed().as_secs_f64());
+    }
+    (median(times), last.unwrap())
+}
+
+/// Newton's Hessian of Φ at `u` for a diagonal `C` (as tests/multigrid.rs).
+fn newton_hessian(lcp: &Lcp, u: &[f64]) -> SparseMatrix {
+    let lambda = lcp.eliminated_multiplier(&lcp.b_times(u));
+    let a = &lcp.a;
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let mut triplets: Vec<Triplet<usize, usize, f64>> = (0..a.ncols())
+        .flat_map(|j| (col_ptr[j]..col_ptr[j + 1]).map(move |k| Triplet::new(rows[k], j, vals[k])))
+        .collect();
+    for (k, row) in lcp.b_rows.iter().enumerate() {
+        if lambda[k] > 0.0 {
+            let w = 1.0 / lcp.c[k];
+            for &(i, vi) in row {
+                for &(j, vj) in row {
+                    triplets.push(Triplet::new(i, j, w * vi * vj));
+                }
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(a.nrows(), a.ncols(), &triplets).unwrap()
+}
+
+/// The primal field with the DOFs the discretization fixes (as tests/multigrid.rs).
+fn primal_level<M: Model>(d: &Discretization<TriangleMesh>) -> (SystemDofs, Reduction) {
+    let dofs = SystemDofs::named::<M>(&d.mesh, &["u"]).unwrap();
+    let u = d.dofs.range(M::field("u").unwrap()).unwrap();
+    let mut constraints = Constraints::new();
+    for dof in u.filter(|&dof| d.reduction.free_index(dof).is_none()) {
+        constraints.fix_dof(dof, 0.0).unwrap();
+    }
+    let reduction = constraints.reduction(dofs.dof_count()).unwrap();
+    assert_eq!(reduction.free().len(), d.lcp.n());
+    (dofs, reduction)
+}
+
+fn run<M: Model>(name: &str, alpha: f64, sizes: &[usize], rounds: usize) {
+    let scene = membrane_scene("membrane-radial").unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+    let solve_options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    println!("{name}, α = {alpha:.4e}: seconds (median of {rounds})");
+    println!(
+        "| N | unknowns | Cholesky analysis | factor + solve | MG setup | V 1e-6 (its) | V 1e-10 (its) | W 1e-6 (its) | W 1e-10 (its) | setup + W 1e-6 / factor + solve |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for &size in sizes {
+        let mut meshes = Vec::new();
+        let mut n = 4;
+        while n <= size {
+            meshes.push(membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap());
+            n *= 2;
+        }
+        let solution =
+            solve_obstacle_on_triangles::<M>(&meshes, &coefficients, solve_options).unwrap();
+        let d = &solution.discretization;
+        let h = newton_hessian(&d.lcp, &d.primal_part(&solution.values));
+        let mut state = 7u64;
+        let b: Vec<f64> = (0..h.nrows())
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect();
+        let pattern = h.symbolic().to_owned().unwrap();
+        let (analysis, cholesky) = timed(rounds, || Cholesky::analyse(&pattern).unwrap());
+        let (direct, _) = timed(rounds, || cholesky.factor(&h).unwrap().solve(&b).unwrap());
+        // the hierarchy's meshes and primal DOFs do not change between Newton steps:
+        // built once, outside the timing
+        let discretizations: Vec<_> = meshes
+            .iter()
+            .map(|mesh| discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h").unwrap())
+            .collect();
+        let primal: Vec<_> = discretizations.iter().map(primal_level::<M>).collect();
+        let parents: Vec<Vec<usize>> = (1..meshes.len())
+            .map(|l| parents_by_location(&meshes[l - 1], &meshes[l]).unwrap())
+            .collect();
+        let prolongations: Vec<SparseMatrix> = (1..meshes.len())
+            .rev()
+            .map(|l| {
+                let level = |k: usize| NestedLevel {
+                    mesh: &meshes[k],
+                    dofs: &primal[k].0,
+                    reduction: Some(&primal[k].1),
+                };
+                prolongation(&level(l - 1), &level(l), &parents[l - 1]).unwrap()
+            })
+            .collect();
+        let build = |coarse_corrections| {
+            Multigrid::new(
+                h.clone(),
+                prolongations.clone(),
+                MultigridOptions {
+                    sweeps: 1,
+                    coarse_corrections,
+                },
+            )
+            .unwrap()
+        };
+        let (setup, v) = timed(rounds, || build(1));
+        let w = build(2);
+        let mut cells = Vec::new();
+        for mg in [&v, &w] {
+            for tolerance in [1e-6, 1e-10] {
+                let (seconds, pcg) = timed(rounds, || mg.pcg(&b, tolerance, 200).unwrap());
+                cells.push((seconds, pcg.iterations));
+            }
+        }
+        let cell = |(s, i): (f64, usize)| format!("{s:.3} ({i})");
+        println!(
+            "| {size} | {} | {analysis:.3} | {direct:.3} | {setup:.3} | {} | {} | {} | {} | {:.2} |",
+            h.nrows(),
+            cell(cells[0]),
+            cell(cells[1]),
+            cell(cells[2]),
+            cell(cells[3]),
+            (setup + cells[2].0) / direct
+        );
+    }
+}
+
+fn main() {
+    fem_forms::lcp::cholesky::factor_sequentially();
+    let quick = std::env::args().any(|a| a == "--quick");
+    let rounds = if quick { 1 } else { 3 };
+    let (p1, p2): (&[usize], &[usize]) = if quick {
+        (&[64, 128], &[32, 64])
+    } else {
+        (&[256, 512], &[128, 256])
+    };
+    run::<membrane_p1_p0::Model>("P1–P0", 0.1, p1, rounds);
+    run::<membrane_p2_p0::Model>("P2–P0", 0.5 / 96.0, p2, rounds);
+}
