@@ -2,13 +2,16 @@
 //! of generated kernels into faer matrices, boundary conditions and solvers.
 //!
 //! One module per concept, each a folder where it has parts:
-//! [`mesh`] (intervals, triangles, Gmsh files, refinement, point location),
-//! [`element`] (bases on physical cells, finite element functions),
+//! [`mesh`] (intervals, triangles, Gmsh files, refinement, point location, boundary
+//! parts, quadratic geometry of curved domains),
+//! [`element`] (the affine and the isoparametric cell maps, bases on physical cells,
+//! finite element functions),
 //! [`assembly`] (DOF maps, the pattern built once, boundary conditions, linear problems),
 //! [`lcp`] (the complementarity problem, semismooth Newton, clarabel, Cholesky with
 //! low-rank updates), [`obstacle`] (a model's VI: the nested solve, the nodal method),
 //! [`stabilization`] (the element constant C_I from the model's own kernels and the α
-//! policy), [`norms`] and [`io`]. No module imports one that imports it back
+//! policy), [`multigrid`] (prolongation on nested meshes, Galerkin cycles, MG-CG),
+//! [`norms`] and [`io`]. No module imports one that imports it back
 //! (`tests/module_cycles.rs` checks it).
 //!
 //! To solve a model of your own from Rust, start from `examples/winkler_string.rs` in
