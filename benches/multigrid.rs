@@ -11,9 +11,7 @@
 //! `cargo bench --bench multigrid` (add `-- --quick` for smaller meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use faer::sparse::{SparseColMat, Triplet};
 use fem_forms::lcp::cholesky::Cholesky;
-use fem_forms::lcp::Lcp;
 use fem_forms::membranes;
 use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::membrane_scene;
@@ -41,27 +39,6 @@ fn timed<T>(rounds: usize, mut f: impl FnMut() -> T) -> (f64, T) {
         times.push(clock.elapsed().as_secs_f64());
     }
     (median(times), last.unwrap())
-}
-
-/// Newton's Hessian of Φ at `u` for a diagonal `C` (as tests/multigrid.rs).
-fn newton_hessian(lcp: &Lcp, u: &[f64]) -> SparseMatrix {
-    let lambda = lcp.eliminated_multiplier(&lcp.b_times(u));
-    let a = &lcp.a;
-    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let mut triplets: Vec<Triplet<usize, usize, f64>> = (0..a.ncols())
-        .flat_map(|j| (col_ptr[j]..col_ptr[j + 1]).map(move |k| Triplet::new(rows[k], j, vals[k])))
-        .collect();
-    for (k, row) in lcp.b_rows.iter().enumerate() {
-        if lambda[k] > 0.0 {
-            let w = 1.0 / lcp.c[k];
-            for &(i, vi) in row {
-                for &(j, vj) in row {
-                    triplets.push(Triplet::new(i, j, w * vi * vj));
-                }
-            }
-        }
-    }
-    SparseColMat::try_new_from_triplets(a.nrows(), a.ncols(), &triplets).unwrap()
 }
 
 /// The primal field with the DOFs the discretization fixes (as tests/multigrid.rs).
@@ -97,7 +74,10 @@ fn run<M: Model>(name: &str, alpha: f64, sizes: &[usize], rounds: usize) {
         let solution =
             solve_obstacle_on_triangles::<M>(&meshes, &coefficients, solve_options).unwrap();
         let d = &solution.discretization;
-        let h = newton_hessian(&d.lcp, &d.primal_part(&solution.values));
+        let (h, _) = d
+            .lcp
+            .newton_hessian(&d.primal_part(&solution.values))
+            .unwrap();
         let mut state = 7u64;
         let b: Vec<f64> = (0..h.nrows())
             .map(|_| {

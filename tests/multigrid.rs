@@ -124,6 +124,22 @@ fn newton_hessian_runs<M: Model>(
         let d = &solution.discretization;
         let u = d.primal_part(&solution.values);
         let (h, active) = newton_hessian(&d.lcp, &u);
+        // the runtime's Hessian, built its own way, is this one
+        let (runtime, runtime_active) = d.lcp.newton_hessian(&u).unwrap();
+        assert_eq!(runtime_active, active);
+        let x: Vec<f64> = (0..h.ncols())
+            .map(|i| ((i * 7919) % 101) as f64 - 50.0)
+            .collect();
+        let (hx, rx) = (multiply(&h, &x), multiply(&runtime, &x));
+        let scale = hx.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let difference = hx
+            .iter()
+            .zip(&rx)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(
+            difference <= 1e-12 * scale,
+            "H x differs by {difference:e} of {scale:e}"
+        );
         assert!(active > 0, "the radial membrane touches its obstacle");
         let ps: Vec<SparseMatrix> = prolongations[..level].iter().rev().cloned().collect();
         let mg = Multigrid::new(h.clone(), ps, options).unwrap();

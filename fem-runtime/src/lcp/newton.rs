@@ -6,6 +6,27 @@
 use super::*;
 
 impl Lcp {
+    /// Newton's Hessian of Φ at `u` (length `n`) and the number of active constraints:
+    /// `A + Bᵀ H B` with `H` the inverse of `C` on each block's active face
+    /// (docs/mathematics.md §5; `A + Σ_{k active} b_k b_kᵀ / c_k` for a diagonal `C`),
+    /// the `n × n` matrix each Newton step solves, e.g. for a multigrid preconditioner.
+    ///
+    /// # Errors
+    /// [`Error::Input`] for shapes that do not fit or a `u` of another length.
+    pub fn newton_hessian(&self, u: &[f64]) -> Result<(SparseMatrix, usize)> {
+        self.check_shapes()?;
+        if u.len() != self.n() {
+            return Err(Error::Input(format!(
+                "U has {} entries for an LCP of {} primal unknowns",
+                u.len(),
+                self.n()
+            )));
+        }
+        let (_, active) = self.eliminate(&self.b_times(u));
+        let count = active.iter().filter(|&&a| a).count();
+        Ok((Hessian::new(self).matrix(self, &active), count))
+    }
+
     /// `‖d‖∞ / ‖U‖∞` for the Newton step `d = −H⁻¹∇Φ(U)` at `U`: a forward-error
     /// certificate. The backward error alone cannot certify `U` when `A` is as badly
     /// conditioned as a thin beam's (κ ~ 1e13: a backward error of 1e-11 allows an O(1)
