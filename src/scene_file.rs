@@ -48,10 +48,12 @@
 //! empty list (no part where u = g: the membrane would be determined only up to a
 //! constant) are errors naming the field `boundary.dirichlet`.
 //!
-//! Expressions use `+ − * / ^`, parentheses, numbers, `PI`, `E`, and the functions
+//! Expressions use `+ − * / ^`, parentheses, numbers (`2.5`, `1e-3`), `PI`, `E`, and the functions
 //! `sqrt`, `exp`, `ln`, `sin`, `cos`, `tan`, `abs`, `min`, `max`, … of the `exmex`
 //! crate's `FloatOpsFactory`. A syntax error or a variable other than `x`, `y` is an
-//! error naming the file, the field and the expression.
+//! error naming the file, the field and the expression. A unary minus before a power
+//! must be bracketed (`-(x^2)` or `0-x^2`): `exmex` reads `-x^2` as `(−x)²`, so it is
+//! refused rather than read against the mathematics.
 
 use crate::membranes::MembranePair;
 use crate::models::data::Data;
@@ -148,6 +150,12 @@ pub fn expression(text: &str, field: &str, file: &Path) -> Result<Data> {
 fn parse_checked(text: &str, field: &str, file: &Path) -> Result<FlatEx<f64>> {
     // TOML's multi-line strings let long expressions span lines; exmex wants one line
     let one_line = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let one_line = normalize(&one_line).map_err(|why| {
+        Error::Input(format!(
+            "{}: field `{field}`: the expression `{text}`: {why}",
+            file.display()
+        ))
+    })?;
     let parsed = exmex::parse::<f64>(&one_line).map_err(|e| {
         Error::Input(format!(
             "{}: field `{field}`: cannot parse the expression `{text}`: {e}",
@@ -165,6 +173,140 @@ fn parse_checked(text: &str, field: &str, file: &Path) -> Result<FlatEx<f64>> {
         )));
     }
     Ok(parsed)
+}
+
+/// What `exmex` reads differently from the mathematics, made right or refused before it
+/// parses: numbers in scientific notation (`1e-3`, which `exmex` cannot parse) become
+/// their decimal expansion, exactly the same `f64`; a unary minus whose operand is
+/// raised to a power (`-x^2`, which `exmex` reads as `(−x)²` where mathematics means
+/// `−(x²)`) is refused with the two unambiguous spellings.
+fn normalize(text: &str) -> std::result::Result<String, String> {
+    let chars: Vec<char> = text.chars().collect();
+    let is_name = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let starts_number = (c.is_ascii_digit() || c == '.')
+            && (i == 0 || !(is_name(chars[i - 1]) || chars[i - 1] == '.'));
+        if starts_number {
+            let start = i;
+            while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
+                i += 1;
+            }
+            // an exponent: e or E, an optional sign, at least one digit
+            let mut j = i;
+            if j < chars.len() && (chars[j] == 'e' || chars[j] == 'E') {
+                j += 1;
+                if j < chars.len() && (chars[j] == '+' || chars[j] == '-') {
+                    j += 1;
+                }
+                let digits = j;
+                while j < chars.len() && chars[j].is_ascii_digit() {
+                    j += 1;
+                }
+                let followed_by_name = j < chars.len() && is_name(chars[j]);
+                if j > digits && !followed_by_name {
+                    let literal: String = chars[start..j].iter().collect();
+                    let value: f64 = literal
+                        .parse()
+                        .map_err(|_| format!("`{literal}` is not a number"))?;
+                    if !value.is_finite() {
+                        return Err(format!("the number `{literal}` is not finite"));
+                    }
+                    // Display never uses an exponent and round-trips the value exactly
+                    out.push_str(&format!("({value})"));
+                    i = j;
+                    continue;
+                }
+            }
+            out.extend(&chars[start..i]);
+            continue;
+        }
+        if c == '-' {
+            let previous = chars[..i].iter().rev().find(|c| !c.is_whitespace());
+            let unary = previous.is_none_or(|p| "(,+-*/^".contains(*p));
+            if unary {
+                let end = operand_end(&chars, i + 1);
+                let next = chars[end..].iter().find(|c| !c.is_whitespace());
+                if end > i + 1 && next == Some(&'^') {
+                    let operand: String = chars[i + 1..end].iter().collect::<String>();
+                    let operand = operand.trim();
+                    return Err(format!(
+                        "`-{operand}^…` is ambiguous here: the expression language reads it as (−{operand})^…, not −({operand}^…); write `-({operand}^…)` or `0-{operand}^…` for the negative power, or `(-{operand})^…` for the power of the negative"
+                    ));
+                }
+            }
+        }
+        out.push(c);
+        i += 1;
+    }
+    Ok(out)
+}
+
+/// The end of the operand that starts at `from` (after spaces): a number, a name with an
+/// optional call `f(…)`, or a bracketed group; `from` itself where there is none.
+fn operand_end(chars: &[char], from: usize) -> usize {
+    let mut i = from;
+    while i < chars.len() && chars[i].is_whitespace() {
+        i += 1;
+    }
+    let group = |mut i: usize| {
+        // i at '(': to just past its matching ')'
+        let mut depth = 0usize;
+        while i < chars.len() {
+            match chars[i] {
+                '(' => depth += 1,
+                ')' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return i + 1;
+                    }
+                }
+                _ => {}
+            }
+            i += 1;
+        }
+        i
+    };
+    match chars.get(i) {
+        Some(c) if c.is_ascii_digit() || *c == '.' => {
+            while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
+                i += 1;
+            }
+            // and its exponent, if any
+            if matches!(chars.get(i), Some('e' | 'E')) {
+                let mut j = i + 1;
+                if matches!(chars.get(j), Some('+' | '-')) {
+                    j += 1;
+                }
+                let digits = j;
+                while j < chars.len() && chars[j].is_ascii_digit() {
+                    j += 1;
+                }
+                if j > digits {
+                    i = j;
+                }
+            }
+            i
+        }
+        Some(c) if c.is_ascii_alphabetic() || *c == '_' => {
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            let mut j = i;
+            while j < chars.len() && chars[j].is_whitespace() {
+                j += 1;
+            }
+            if chars.get(j) == Some(&'(') {
+                group(j)
+            } else {
+                i
+            }
+        }
+        Some('(') => group(i),
+        _ => from,
+    }
 }
 
 /// The expression as a function of `[x, y]`: its variables (alphabetical in `exmex`)
@@ -497,6 +639,67 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         mesh_size,
         alpha: file.parameters.alpha,
     })
+}
+
+#[cfg(test)]
+mod normalize_tests {
+    use super::*;
+
+    fn value(text: &str, x: f64, y: f64) -> f64 {
+        let parsed = parse_checked(text, "f", Path::new("t.toml")).unwrap();
+        let names: Vec<String> = parsed.var_names().to_vec();
+        let args: Vec<f64> = names.iter().map(|n| if n == "x" { x } else { y }).collect();
+        parsed.eval(&args).unwrap()
+    }
+
+    /// Scientific notation gives the same f64 as Rust's parser, wherever it stands.
+    #[test]
+    fn scientific_notation_is_read_exactly() {
+        for (text, expected) in [
+            ("1e20", 1e20),
+            ("-1e20", -1e20),
+            ("2.5e-3", 2.5e-3),
+            ("1E5 + 1", 1e5 + 1.0),
+            ("x*1e-3", 2.0 * 1e-3),
+            ("3e+2", 300.0),
+            ("1e-300", 1e-300),
+            ("exp(0) + 2", 3.0),
+        ] {
+            let v = value(text, 2.0, 0.0);
+            assert_eq!(v, expected, "{text}");
+        }
+        assert!(normalize("1e999").unwrap_err().contains("not finite"));
+    }
+
+    /// `-x^2` would be read as `(−x)²`: refused with the spellings that say what is meant;
+    /// the unambiguous forms keep their meaning.
+    #[test]
+    fn a_unary_minus_before_a_power_is_refused() {
+        for text in [
+            "-x^2",
+            "exp(-x^2-y^2)",
+            "-1^2",
+            "2*-x^2",
+            "-(x)^2",
+            "-sin(x)^2",
+            "- x ^ 2",
+            "-1e2^2",
+        ] {
+            let error = normalize(text).unwrap_err();
+            assert!(error.contains("ambiguous"), "{text}: {error}");
+        }
+        for (text, expected) in [
+            ("0-x^2", -9.0),
+            ("-(x^2)", -9.0),
+            ("(-x)^2", 9.0),
+            ("2^-x", 0.125),
+            ("x-y^2", 3.0 - 4.0),
+            ("-x", -3.0),
+            ("exp(0-(x^2+y^2))", (-13.0f64).exp()),
+        ] {
+            assert_eq!(value(text, 3.0, 2.0), expected, "{text}");
+        }
+    }
 }
 
 #[cfg(test)]
