@@ -9,6 +9,7 @@ pub mod data;
 pub mod euler_bernoulli;
 pub mod membrane;
 pub mod membrane_scenes;
+pub mod mindlin;
 pub mod registry;
 pub mod timoshenko;
 pub mod vector_forms;
