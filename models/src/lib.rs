@@ -10,6 +10,7 @@ pub mod euler_bernoulli;
 pub mod membrane;
 pub mod membrane_scenes;
 pub mod mindlin;
+pub mod plate_scenes;
 pub mod registry;
 pub mod timoshenko;
 pub mod vector_forms;
