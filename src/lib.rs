@@ -13,6 +13,7 @@ pub mod beam_studies;
 pub mod beams;
 pub mod membrane_studies;
 pub mod membranes;
+pub mod plates;
 pub mod plot;
 pub mod scene_file;
 pub mod studies;

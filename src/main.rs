@@ -5,9 +5,11 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::membrane_scenes::MembraneScene;
+use fem_forms::models::plate_scenes::PlateScene;
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind, MEMBRANE_PAIRS};
 use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::VariationalSolver;
+use fem_forms::plates::{self, PlatePair, PlateRequest};
 use fem_forms::studies::{self, Study};
 use fem_forms::{plot, scene_file};
 use std::path::{Path, PathBuf};
@@ -299,7 +301,7 @@ fn default_job(out: &Path) -> Result<(), String> {
         .iter()
         .filter_map(|e| match &e.kind {
             SceneKind::Membrane(s) => Some(s.clone()),
-            SceneKind::Beam(_) => None,
+            _ => None,
         })
         .collect();
     membrane_job(&membranes, out)?;
@@ -428,6 +430,13 @@ fn list() {
     for p in MembranePair::ALL {
         println!("  {}", p.name());
     }
+    println!(
+        "plate pairs (θ, w, λ; --mesh-size N, --thickness t; default p1-p2-p0, α = {}):",
+        plates::PLATE_ALPHA
+    );
+    for p in PlatePair::ALL {
+        println!("  {}", p.name());
+    }
 }
 
 /// The one family-dispatch point of `solve`: options checked against the scene's family,
@@ -436,7 +445,58 @@ fn solve(entry: &SceneEntry, options: &SolveOptions, out: &Path) -> Result<(), S
     match &entry.kind {
         SceneKind::Beam(scene) => solve_beam(*scene, options, out),
         SceneKind::Membrane(scene) => solve_membrane(scene, options, out),
+        SceneKind::Plate(scene) => solve_plate(*scene, options),
     }
+}
+
+fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> {
+    options.refuse(
+        &[
+            "--elements",
+            "--msh",
+            "--vtk",
+            "--solver",
+            "--cold",
+            "--refinement",
+            "--plot",
+        ],
+        &format!(
+            "`{}` is a plate scene on an N×N×2 mesh (--mesh-size, --thickness, --load, --alpha, --pair, --json)",
+            scene.name
+        ),
+    )?;
+    let mut request = PlateRequest::new(scene);
+    if let Some(name) = &options.pair {
+        request.pair = PlatePair::parse(name).map_err(|e| e.to_string())?;
+    }
+    request.thickness = options.thickness.unwrap_or(request.thickness);
+    request.mesh_size = options.mesh_size.unwrap_or(request.mesh_size);
+    request.load = options.load.unwrap_or(request.load);
+    request.alpha = options.alpha.unwrap_or(request.alpha);
+    let report = plates::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!(
+            "{} {} {} t = {:.0e} N = {}: centre deflection {:.8e}, Kirchhoff {:.8e}, relative error {:+.3e}, J_h {:.6e}, {} dofs, {} iterations, {:.3} s",
+            report.scene,
+            report.pair,
+            report.support,
+            report.thickness,
+            report.mesh_size,
+            report.centre_deflection,
+            report.kirchhoff_reference,
+            report.relative_error,
+            report.energy,
+            report.dofs,
+            report.iterations,
+            report.seconds
+        );
+    }
+    Ok(())
 }
 
 fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {

@@ -237,6 +237,9 @@ pub fn study_scene(entry: &SceneEntry) -> Box<dyn StudyScene> {
     match &entry.kind {
         SceneKind::Beam(s) => Box::new(BeamStudies::new(*s)),
         SceneKind::Membrane(s) => Box::new(MembraneStudies::new(s.clone())),
+        // the registry gives plate scenes no study, and every caller runs only the
+        // studies an entry lists
+        SceneKind::Plate(s) => unreachable!("plate scene `{}` hosts no study", s.name),
     }
 }
 

@@ -9,6 +9,8 @@ pub mod data;
 pub mod euler_bernoulli;
 pub mod membrane;
 pub mod membrane_scenes;
+pub mod mindlin;
+pub mod plate_scenes;
 pub mod registry;
 pub mod timoshenko;
 pub mod vector_forms;

@@ -3,11 +3,13 @@
 //! the same description.
 //!
 //! A scene is data: its family's description ([`Scene`] for beams, [`MembraneScene`]
-//! for membranes: domain, parameters, data f, ψ, g, exact solution, asked accuracy) and
+//! for membranes: domain, parameters, data f, ψ, g, exact solution, asked accuracy;
+//! [`PlateScene`] for plates) and
 //! what the registry adds to it: the element pairs it can be solved with (the first is
 //! the default) and the studies it hosts.
 
 use crate::membrane_scenes::{MembraneScene, MEMBRANE_FLAT, MEMBRANE_SCENES};
+use crate::plate_scenes::{PlateScene, PLATE_SCENES};
 use crate::scenes::{Beam, Scene, SCENES};
 use std::borrow::Cow;
 
@@ -18,6 +20,8 @@ pub enum Family {
     Beam,
     /// Membranes on triangle meshes (structured or Gmsh), `u = g` on the boundary.
     Membrane,
+    /// Reissner–Mindlin plates on triangle meshes.
+    Plate,
 }
 
 impl Family {
@@ -26,6 +30,7 @@ impl Family {
         match self {
             Family::Beam => "beam",
             Family::Membrane => "membrane",
+            Family::Plate => "plate",
         }
     }
 }
@@ -37,6 +42,8 @@ pub enum SceneKind {
     Beam(Scene),
     /// A membrane scene.
     Membrane(MembraneScene),
+    /// A plate scene.
+    Plate(PlateScene),
 }
 
 /// One registry entry: the scene and what can be done with it.
@@ -58,6 +65,9 @@ pub const TIMOSHENKO_PAIRS: &[&str] = &["p2-p2-p0", "p1-p1-p0-reduced", "p1-p1-p
 pub const BERNOULLI_PAIRS: &[&str] = &["hermite-p0"];
 /// The membrane pairs, default first.
 pub const MEMBRANE_PAIRS: &[&str] = &["p2-p0", "p1-p0", "p2-p1d", "p1-nodal"];
+/// The plate pairs (θ, w, λ), default first: the locking-free Stenberg pair and the
+/// plain displacement method.
+pub const PLATE_PAIRS: &[&str] = &["p1-p2-p0", "p1-p1-p0-plain"];
 
 impl SceneEntry {
     /// The scene's name.
@@ -65,6 +75,7 @@ impl SceneEntry {
         match &self.kind {
             SceneKind::Beam(s) => Cow::Borrowed(s.name),
             SceneKind::Membrane(s) => s.name.clone(),
+            SceneKind::Plate(s) => Cow::Borrowed(s.name),
         }
     }
 
@@ -73,6 +84,7 @@ impl SceneEntry {
         match &self.kind {
             SceneKind::Beam(s) => Cow::Borrowed(s.description),
             SceneKind::Membrane(s) => s.description.clone(),
+            SceneKind::Plate(s) => Cow::Borrowed(s.description),
         }
     }
 
@@ -81,6 +93,7 @@ impl SceneEntry {
         match self.kind {
             SceneKind::Beam(_) => Family::Beam,
             SceneKind::Membrane(_) => Family::Membrane,
+            SceneKind::Plate(_) => Family::Plate,
         }
     }
 
@@ -90,6 +103,7 @@ impl SceneEntry {
         match &self.kind {
             SceneKind::Beam(_) => Some(1.0),
             SceneKind::Membrane(s) => s.load_scale,
+            SceneKind::Plate(s) => Some(s.load),
         }
     }
 
@@ -97,7 +111,7 @@ impl SceneEntry {
     /// asks for one.
     pub fn target_l2(&self) -> Option<f64> {
         match &self.kind {
-            SceneKind::Beam(_) => None,
+            SceneKind::Beam(_) | SceneKind::Plate(_) => None,
             SceneKind::Membrane(s) => Some(s.target_l2),
         }
     }
@@ -165,6 +179,13 @@ pub fn registry() -> Vec<SceneEntry> {
         entries.push(membrane_entry(s, studies, true));
     }
     entries.push(membrane_entry(MEMBRANE_FLAT, &[], false));
+    // the plates are solved on demand (`solve mindlin-square`), not in the default job
+    entries.extend(PLATE_SCENES.iter().map(|&s| SceneEntry {
+        kind: SceneKind::Plate(s),
+        pairs: PLATE_PAIRS,
+        studies: &[],
+        in_default_job: false,
+    }));
     entries
 }
 
@@ -190,6 +211,9 @@ mod tests {
             assert_eq!(find(n).unwrap().name(), n.as_str());
         }
         assert!(find("no-such-scene").is_none());
-        assert_eq!(names.len(), SCENES.len() + MEMBRANE_SCENES.len() + 1);
+        assert_eq!(
+            names.len(),
+            SCENES.len() + MEMBRANE_SCENES.len() + 1 + PLATE_SCENES.len()
+        );
     }
 }
