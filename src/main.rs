@@ -321,7 +321,8 @@ fn hosted_studies(entries: &[SceneEntry], out: &Path) -> Result<(), String> {
 /// Runs the study called `kind` on a registry scene.
 fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(), String> {
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
-    studies::run(&*studies::study_scene(entry), study, full, out)
+    studies::study_scene(entry)
+        .and_then(|scene| studies::run(&*scene, study, full, out))
         .map_err(|e| format!("study {} {kind}: {e}", entry.name()))
 }
 

@@ -233,13 +233,18 @@ pub trait StudyScene {
 }
 
 /// The study implementation of a registry scene.
-pub fn study_scene(entry: &SceneEntry) -> Box<dyn StudyScene> {
+///
+/// # Errors
+/// [`Error::Input`] for a family without one (plates: their locking chart is written by
+/// `plates::locking_study`).
+pub fn study_scene(entry: &SceneEntry) -> Result<Box<dyn StudyScene>> {
     match &entry.kind {
-        SceneKind::Beam(s) => Box::new(BeamStudies::new(*s)),
-        SceneKind::Membrane(s) => Box::new(MembraneStudies::new(s.clone())),
-        // the registry gives plate scenes no study, and every caller runs only the
-        // studies an entry lists
-        SceneKind::Plate(s) => unreachable!("plate scene `{}` hosts no study", s.name),
+        SceneKind::Beam(s) => Ok(Box::new(BeamStudies::new(*s))),
+        SceneKind::Membrane(s) => Ok(Box::new(MembraneStudies::new(s.clone()))),
+        SceneKind::Plate(s) => Err(Error::Input(format!(
+            "plate scene `{}` hosts no study of this kind",
+            s.name
+        ))),
     }
 }
 
