@@ -676,6 +676,25 @@ pub fn dirichlet_part(
         Error::Input(message) => at(format!("{message} (domain: {domain})")),
         other => other,
     })?;
+    // a part listed beside others must hold boundary edges of its own: an interior
+    // curve or an empty group would otherwise be reported as a Dirichlet part and do
+    // nothing
+    if names.len() > 1 {
+        for name in names {
+            let own =
+                DirichletPart::Markers(mesh.boundary_part_markers(&[name]).map_err(
+                    |e| match e {
+                        Error::Input(message) => at(format!("{message} (domain: {domain})")),
+                        other => other,
+                    },
+                )?);
+            if own.edge_count(mesh) == 0 {
+                return Err(at(format!(
+                    "the boundary part `{name}` holds no boundary edge of the mesh ({domain}): an interior curve or an empty group cannot carry u = g; remove it from the list"
+                )));
+            }
+        }
+    }
     let part = DirichletPart::Markers(markers);
     if part.edge_count(mesh) == 0 {
         return Err(at(format!(

@@ -240,19 +240,24 @@ fn a_part_without_boundary_edges_is_refused() {
     let with_slit = text.replace("$PhysicalNames\n6\n", "$PhysicalNames\n7\n1 15 \"slit\"\n");
     assert_ne!(with_slit, text);
     std::fs::write(dir.join("square_named.msh"), with_slit).unwrap();
-    let mut file =
-        scene_file::parse(&strip_scene(GMSH, "\"slit\""), &dir.join("strip.toml")).unwrap();
-    file.scene.exact = Exact::Unknown;
-    let mut request = MembraneRequest::new(file.scene);
-    request.mesh_size = 0;
-    let e = match membranes::solve(&request) {
-        Ok(_) => panic!("solved without a Dirichlet edge"),
-        Err(e) => e.to_string(),
-    };
-    assert!(
-        e.contains("boundary.dirichlet") && e.contains("`slit`") && e.contains("no boundary edge"),
-        "{e}"
-    );
+    // alone, or listed beside a real part (where it would be reported and do nothing)
+    for dirichlet in ["\"slit\"", "[\"slit\", \"left\"]"] {
+        let mut file =
+            scene_file::parse(&strip_scene(GMSH, dirichlet), &dir.join("strip.toml")).unwrap();
+        file.scene.exact = Exact::Unknown;
+        let mut request = MembraneRequest::new(file.scene);
+        request.mesh_size = 0;
+        let e = match membranes::solve(&request) {
+            Ok(_) => panic!("{dirichlet}: solved with a part that holds no boundary edge"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("boundary.dirichlet")
+                && e.contains("`slit`")
+                && e.contains("no boundary edge"),
+            "{dirichlet}: {e}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
