@@ -360,6 +360,11 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
             "thickness t = {thickness} must be positive and finite"
         )));
     }
+    if scene.beam == Beam::Timoshenko && thickness > 1.0 {
+        return Err(Error::Input(format!(
+            "thickness t = {thickness:e} exceeds the beam's length 1: beam theory describes slender bodies (t well below the length; t = 1e7 made the stiffness numerically singular); a thicker body is a problem of elasticity"
+        )));
+    }
     if scene.beam == Beam::Timoshenko && thickness < MIN_THICKNESS {
         return Err(Error::Input(format!(
             "thickness t = {thickness:e} is below {MIN_THICKNESS:e} (the beam has length 1): the shear term t⁻²(w′−θ) then swamps the bending term in double precision and the discrete system is numerically singular (at t = 1e-6 rounding already dominates the discretization error); the Euler–Bernoulli model is the limit t → 0 (the scenes bernoulli-a and bernoulli-b)"

@@ -90,7 +90,7 @@ impl PlateRequest {
     /// Checks the request.
     ///
     /// # Errors
-    /// [`Error::Input`] naming the value at fault: t ≤ 0, ν outside (−1, ½), a mesh size
+    /// [`Error::Input`] naming the value at fault: t ≤ 0 or t > 1 (the side), ν outside (−1, ½), a mesh size
     /// of 0 or above [`MAX_PLATE_MESH_SIZE`], α ≤ 0, a load or material value that is not
     /// finite (D and κ must be positive).
     pub fn validate(&self) -> Result<()> {
@@ -99,6 +99,12 @@ impl PlateRequest {
         if !(self.thickness.is_finite() && self.thickness > 0.0) {
             return bad(format!(
                 "thickness t = {} must be positive and finite",
+                self.thickness
+            ));
+        }
+        if self.thickness > 1.0 {
+            return bad(format!(
+                "thickness t = {} exceeds the plate's side 1: plate theory describes thin bodies (t well below the side); a thicker body is a problem of elasticity",
                 self.thickness
             ));
         }

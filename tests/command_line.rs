@@ -124,6 +124,14 @@ fn bad_input_exits_with_a_message() {
             "would overflow",
         ),
         (
+            &["solve", "timoshenko-b", "--thickness", "1e7"][..],
+            "exceeds the beam's length",
+        ),
+        (
+            &["solve", "mindlin-square", "--thickness", "2"][..],
+            "exceeds the plate's side",
+        ),
+        (
             &["solve", "timoshenko-a", "--thickness", "1e-8"][..],
             "the Euler–Bernoulli model is the limit",
         ),
