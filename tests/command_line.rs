@@ -70,6 +70,40 @@ fn membrane_json_has_every_field_and_agrees_with_the_exact_solution() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
+/// A load that bends u more sharply than the mesh resolves makes u_h cross ψ visibly:
+/// said in the warnings (at the default load the crossing is 6e-4 of ψ's range and no
+/// warning is given).
+#[test]
+fn a_visible_penetration_is_a_warning() {
+    let out = scratch("penetration");
+    for (load, warned) in [("12", false), ("1e4", true)] {
+        let run = fem_forms(
+            &[
+                "solve",
+                "membrane-lshape",
+                "--load",
+                load,
+                "--mesh-size",
+                "32",
+                "--json",
+            ],
+            &out,
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        let warnings = json["warnings"].as_array().unwrap();
+        let says = warnings
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("dips below ψ"));
+        assert_eq!(says, warned, "q = {load}: {warnings:?}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
 #[test]
 fn bad_input_exits_with_a_message() {
     let out = scratch("bad");
