@@ -4,7 +4,9 @@
 
 use crate::models::data::Data;
 use crate::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
-use crate::models::membrane_scenes::{DirichletParts, Domain, ExactMembrane, MembraneScene};
+use crate::models::membrane_scenes::{
+    DirichletParts, Domain, ExactMembrane, MembraneScene, MAX_LOAD,
+};
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
 use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
 use fem_runtime::obstacle::triangle::{
@@ -473,6 +475,13 @@ fn validate(data: &SceneData, mesh: &TriangleMesh, part: &DirichletPart) -> Resu
             if !v.is_finite() {
                 return Err(Error::Input(format!(
                     "the {name} is {v} at ({}, {})",
+                    x[0], x[1]
+                )));
+            }
+            // as for --load: beyond it the norms that certify the solve may overflow
+            if v.abs() > MAX_LOAD {
+                return Err(Error::Input(format!(
+                    "the {name} is {v:e} at ({}, {}), beyond ±{MAX_LOAD:e}: norms in the solve would overflow double precision",
                     x[0], x[1]
                 )));
             }

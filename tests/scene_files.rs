@@ -186,6 +186,36 @@ fn scene_file_errors_name_the_field() {
     assert!(e.contains("/nonexistent/scene.toml"), "{e}");
 }
 
+/// Data the solver cannot take are refused before solving, naming the field: a load
+/// whose values would overflow the solve's norms, and `-x^2` (read `(−x)²` by the
+/// expression crate). Scientific notation reads as written: `-3e0` is membrane-flat's
+/// own load, so ∫λ_h = 48 (16q, q = 3).
+#[test]
+fn scene_file_loads_are_read_as_meant_or_refused() {
+    let text = std::fs::read_to_string(example("membrane-flat.toml")).unwrap();
+    let without_exact = |t: String| t[..t.find("[exact]").unwrap()].to_string();
+    let huge = without_exact(text.replace("f = \"-1\"", "f = \"0-10^300\""));
+    let file = scene_file::parse(&huge, Path::new("huge.toml")).unwrap();
+    let e = match membranes::solve(&request_of(&file)) {
+        Ok(_) => panic!("a load of 3e300 was solved"),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("load f") && e.contains("overflow"), "{e}");
+    let ambiguous = text.replace("f = \"-1\"", "f = \"-x^2\"");
+    let e = scene_file::parse(&ambiguous, Path::new("minus.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("data.f") && e.contains("ambiguous"), "{e}");
+    let scientific = text.replace("f = \"-1\"", "f = \"-1e0\"");
+    let file = scene_file::parse(&scientific, Path::new("e.toml")).unwrap();
+    let (report, _) = membranes::solve(&request_of(&file)).unwrap();
+    assert!(
+        (report.total_contact_force - 48.0).abs() < 1e-9,
+        "{}",
+        report.total_contact_force
+    );
+}
+
 /// The strip example names its Dirichlet parts (Gmsh physical names): it solves the
 /// mixed problem whose exact ∫λ = 16 and contact area 2 (tests/boundary_parts.rs), and
 /// choosing the part `sides` (the same curves) gives the same numbers.
