@@ -653,6 +653,19 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
 }
 
 fn run(cli: Cli) -> Result<(), String> {
+    // checked before any solve: a study found its --out unusable only after running
+    if cli.out.exists() && !cli.out.is_dir() {
+        return Err(format!(
+            "--out {}: exists and is not a directory",
+            cli.out.display()
+        ));
+    }
+    std::fs::create_dir_all(&cli.out).map_err(|e| {
+        format!(
+            "--out {}: cannot create the directory: {e}",
+            cli.out.display()
+        )
+    })?;
     match cli.command {
         None => default_job(&cli.out),
         Some(Command::List) => {

@@ -611,10 +611,11 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
     });
     // the name becomes part of output file names (`out/<name>-<pair>-<N>.vtu`)
     let plain = |c: char| c.is_alphanumeric() || c == '-' || c == '_' || c == '.';
-    if name.is_empty() || name.starts_with('.') || !name.chars().all(plain) {
+    // a leading `-` would read as an option to a shell command given the file's name
+    if name.is_empty() || name.starts_with(['.', '-']) || !name.chars().all(plain) {
         return Err(at(
             "name",
-            format!("`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first)"),
+            format!("`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first, nor `-`)"),
         ));
     }
     let scene = MembraneScene {

@@ -176,6 +176,17 @@ fn bad_input_exits_with_a_message() {
         assert!(stderr.contains(message), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
+    // an --out that is a file is refused before any work
+    let file = out.join("a-file");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(&file, "not a directory").unwrap();
+    let run = fem_forms(&["study", "bernoulli-flat", "alpha"], &file);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(
+        stderr.contains("exists and is not a directory") && stderr.contains("a-file"),
+        "{stderr}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }
 
