@@ -402,6 +402,15 @@ impl Declaration {
                                     c.name()
                                 ),
                             ));
+                        } else if c == CellKind::Triangle {
+                            // Argyris and Morley invert their Vandermonde matrix here, at
+                            // compile time: a failure is an error at the element's name.
+                            if let Err(error) = e.try_triangle_basis() {
+                                errors.push(Diagnostic::token(
+                                    u.element_name.span(),
+                                    format!("element {}: {error}", e.name()),
+                                ));
+                            }
                         }
                     }
                     if u.nonnegative && e.is_continuous() {

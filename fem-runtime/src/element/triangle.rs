@@ -19,6 +19,80 @@ pub struct TriangleField<'a> {
 /// The affine map of a triangle (see [`crate::element::mapping`]).
 pub type AffineMap = Affine<2>;
 
+/// The per-cell DOF transformation `M` of `element` on the triangle with coordinates
+/// `x = [x₀, y₀, x₁, y₁, x₂, y₂]` and global vertex numbers `global`
+/// (`docs/elements.md` §3): `Ok(None)` for an element that needs none (Lagrange).
+///
+/// # Errors
+/// The reference crate's `TransformationError` (degenerate cell, non-finite coordinate,
+/// repeated global vertex number).
+pub fn cell_transformation(
+    element: fem_reference::ElementKind,
+    x: &[f64; 6],
+    global: &[usize; 3],
+) -> Result<
+    Option<fem_reference::dense::Matrix>,
+    fem_reference::dof_transformation::TransformationError,
+> {
+    let vertices = [[x[0], x[1]], [x[2], x[3]], [x[4], x[5]]];
+    element.triangle_transformation(vertices, *global)
+}
+
+/// The epilogue of a generated kernel with a transformed element: `k ← M_test k M_trialᵀ`
+/// (`K = M K̂ Mᵀ`; for a load vector, `trial = None` and `k` has one column: `F = M F̂`),
+/// where `k` holds the entries of the pulled-back reference basis `ψ = φ̂ ∘ F⁻¹`.
+///
+/// `M` is sparse (Argyris: 81 non-zeros of 441), so the products skip its zeros. A cell
+/// for which `M` does not exist (degenerate, or a repeated global vertex number) gets NaN
+/// entries: kernels cannot return errors, and meshes refuse such cells when built, so
+/// this only marks a caller's misuse visibly instead of giving plausible numbers.
+pub fn transform_element_matrix<const R: usize, const C: usize>(
+    test: fem_reference::ElementKind,
+    trial: Option<fem_reference::ElementKind>,
+    x: &[f64; 6],
+    global: &[usize; 3],
+    k: &mut [[f64; C]; R],
+) {
+    let poisoned = |k: &mut [[f64; C]; R]| k.iter_mut().flatten().for_each(|v| *v = f64::NAN);
+    match cell_transformation(test, x, global) {
+        Err(_) => return poisoned(k),
+        Ok(None) => {}
+        Ok(Some(m)) => {
+            let mut out = [[0.0; C]; R];
+            for (i, row) in out.iter_mut().enumerate() {
+                for (l, &mil) in m.row(i).iter().enumerate() {
+                    if mil != 0.0 {
+                        for (o, &v) in row.iter_mut().zip(&k[l]) {
+                            *o += mil * v;
+                        }
+                    }
+                }
+            }
+            *k = out;
+        }
+    }
+    let Some(trial) = trial else { return };
+    match cell_transformation(trial, x, global) {
+        Err(_) => poisoned(k),
+        Ok(None) => {}
+        Ok(Some(m)) => {
+            for row in k.iter_mut() {
+                let mut out = [0.0; C];
+                for (j, o) in out.iter_mut().enumerate() {
+                    *o = m
+                        .row(j)
+                        .iter()
+                        .zip(row.iter())
+                        .filter(|(&mjl, _)| mjl != 0.0)
+                        .map(|(&mjl, &v)| mjl * v)
+                        .sum();
+                }
+                *row = out;
+            }
+        }
+    }
+}
+
 /// The reference basis of an element with its first and second derivatives.
 pub struct TriangleBasis {
     values: Vec<Polynomial2>,
