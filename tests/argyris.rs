@@ -12,8 +12,10 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::kirchhoff::{kirchhoff_argyris, kirchhoff_morley};
-use fem_forms::DataFn;
+use fem_forms::{assemble_vector, Coefficients, DataFn, Diagonal, MatrixAssembler, SystemDofs};
+use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use fem_runtime::reference::triangle::{Polynomial2, TriangleRule};
+use fem_runtime::{DofMap, ElementKind};
 
 /// xorshift64*: reproducible pseudo-random numbers.
 struct Random(u64);
@@ -248,4 +250,206 @@ fn morley_kernel_reproduces_the_bending_energy_of_quadratics() {
             );
         }
     }
+}
+
+/// A mesh of the square `[−1, 2]²` with alternating diagonals whose vertices are
+/// renumbered by a scramble and half of whose cells are listed from another vertex, so
+/// that edges are traversed both ways by their cells and global and local orders differ.
+fn scrambled_mesh(n: usize) -> fem_runtime::TriangleMesh {
+    let base =
+        fem_runtime::TriangleMesh::rectangle(-1.0, 2.0, -1.0, 2.0, n, n, Diagonal::Alternating)
+            .unwrap();
+    let count = base.vertex_count();
+    // v ↦ (7v + 3) mod count is a permutation when gcd(7, count) = 1.
+    assert_ne!(count % 7, 0);
+    let new = |v: usize| (7 * v + 3) % count;
+    let mut vertices = vec![[0.0; 2]; count];
+    for (v, &p) in base.vertices().iter().enumerate() {
+        vertices[new(v)] = p;
+    }
+    let cells: Vec<[usize; 3]> = base
+        .cells()
+        .iter()
+        .enumerate()
+        .map(|(c, &[a, b, d])| {
+            let cell = [new(a), new(b), new(d)];
+            if c % 2 == 0 {
+                cell
+            } else {
+                [cell[1], cell[2], cell[0]]
+            }
+        })
+        .collect();
+    fem_runtime::TriangleMesh::new(vertices, cells, &[]).unwrap()
+}
+
+/// The global Argyris interpolant of a random quintic, DOFs computed here from the
+/// polynomial (vertex derivatives; edge normal derivatives along globally oriented
+/// normals), evaluated through the DOF map and the field's `Mᵀ U`: the polynomial with its
+/// gradient and Hessian on every cell.
+#[test]
+fn argyris_field_reproduces_a_global_quintic() {
+    let mesh = scrambled_mesh(5);
+    let map = DofMap::on_triangles(&mesh, ElementKind::Argyris);
+    assert_eq!(map.dof_count(), 6 * mesh.vertex_count() + mesh.edge_count());
+    let mut rng = Random(77);
+    let p = random_polynomial(&mut rng, 5, [0.5, 0.5], 1.5);
+    let mut u = vec![f64::NAN; map.dof_count()];
+    for c in 0..mesh.cell_count() {
+        let (x, g) = (mesh.cell_coordinates(c), mesh.cell(c));
+        for (&d, value) in map.cell_dofs(c).iter().zip(argyris_dofs(&p, &x, &g)) {
+            // Shared DOFs get the same value from every cell (the normals are global).
+            assert!(u[d].is_nan() || (u[d] - value).abs() <= 1e-12 * value.abs().max(1.0));
+            u[d] = value;
+        }
+    }
+    assert!(
+        u.iter().all(|v| v.is_finite()),
+        "every DOF belongs to a cell"
+    );
+    let field = TriangleField {
+        mesh: &mesh,
+        map: &map,
+        coefficients: &u,
+    };
+    let basis = TriangleBasis::new(ElementKind::Argyris);
+    for c in 0..mesh.cell_count() {
+        let affine = AffineMap::of(&mesh, c);
+        for xi in [[0.2, 0.3], [0.6, 0.1], [0.05, 0.9]] {
+            let at = affine.point(xi);
+            let value = field.value(&basis, c, xi);
+            let gradient = field.gradient(&basis, &affine, c, xi);
+            let hessian = field.hessian(&basis, &affine, c, xi);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
+            assert!(
+                close(value, p.eval(at)),
+                "cell {c}: {value} vs {}",
+                p.eval(at)
+            );
+            assert!(close(gradient[0], p.derivative(1, 0).eval(at)), "cell {c}");
+            assert!(close(gradient[1], p.derivative(0, 1).eval(at)), "cell {c}");
+            assert!(
+                close(hessian[0][0], p.derivative(2, 0).eval(at)),
+                "cell {c}"
+            );
+            assert!(
+                close(hessian[0][1], p.derivative(1, 1).eval(at)),
+                "cell {c}"
+            );
+            assert!(
+                close(hessian[1][1], p.derivative(0, 2).eval(at)),
+                "cell {c}"
+            );
+        }
+    }
+}
+
+/// Dense Cholesky solve of a symmetric positive definite system (an independent solver
+/// for the plate tests).
+fn cholesky_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
+    let n = b.len();
+    for j in 0..n {
+        let d = (a[j][j] - (0..j).map(|k| a[j][k] * a[j][k]).sum::<f64>()).sqrt();
+        assert!(d > 0.0, "not positive definite at {j}");
+        a[j][j] = d;
+        for i in j + 1..n {
+            let s = a[i][j] - (0..j).map(|k| a[i][k] * a[j][k]).sum::<f64>();
+            a[i][j] = s / d;
+        }
+    }
+    for i in 0..n {
+        b[i] = (b[i] - (0..i).map(|k| a[i][k] * b[k]).sum::<f64>()) / a[i][i];
+    }
+    for i in (0..n).rev() {
+        b[i] = (b[i] - (i + 1..n).map(|k| a[k][i] * b[k]).sum::<f64>()) / a[i][i];
+    }
+    b
+}
+
+fn unit_load(_: &[f64]) -> f64 {
+    1.0
+}
+
+/// Centre deflection of the clamped unit square plate under a unit load, D = 1, ν = 0.3,
+/// on an `n × n × 2` mesh, assembled by the runtime (`MatrixAssembler`,
+/// `assemble_vector`) and solved here. Clamped DOFs (all zero): at boundary vertices the
+/// value, both first derivatives, the mixed second derivative and the second derivative
+/// along the boundary (`u_yy` on `x = 0, 1`, `u_xx` on `y = 0, 1`), all six at corners,
+/// and the normal derivatives of boundary edges.
+fn clamped_centre_deflection(n: usize) -> f64 {
+    type M = kirchhoff_argyris::Model;
+    let mesh =
+        fem_runtime::TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap();
+    let dofs = SystemDofs::new::<M>(&mesh, &[0]).unwrap();
+    let load: &DataFn = &unit_load;
+    let coefficients = Coefficients::new::<M>(&[("D", 1.0), ("ν", 0.3)], &[("f", load)]).unwrap();
+    let k = MatrixAssembler::new::<M>("a", &mesh, &dofs)
+        .unwrap()
+        .assemble::<M>(&mesh, &coefficients)
+        .unwrap();
+    let f = assemble_vector::<M>("ℓ", &mesh, &dofs, &coefficients).unwrap();
+    let map = dofs.map(0).unwrap();
+    let mut fixed = vec![false; dofs.dof_count()];
+    let on = |t: f64| t.abs() < 1e-12 || (t - 1.0).abs() < 1e-12;
+    for (v, &[x, y]) in mesh.vertices().iter().enumerate() {
+        let r = map.vertex_dofs(v);
+        let kinds: &[usize] = match (on(x), on(y)) {
+            (true, true) => &[0, 1, 2, 3, 4, 5],
+            (true, false) => &[0, 1, 2, 4, 5],
+            (false, true) => &[0, 1, 2, 3, 4],
+            (false, false) => &[],
+        };
+        for &k in kinds {
+            fixed[r.start + k] = true;
+        }
+    }
+    let boundary: Vec<usize> = mesh.boundary_edges().iter().map(|&(e, _)| e).collect();
+    for c in 0..mesh.cell_count() {
+        for (k, e) in mesh.cell_edges(c).into_iter().enumerate() {
+            if boundary.contains(&e) {
+                fixed[map.cell_dofs(c)[18 + k]] = true;
+            }
+        }
+    }
+    let free: Vec<usize> = (0..dofs.dof_count()).filter(|&d| !fixed[d]).collect();
+    let mut position = vec![usize::MAX; dofs.dof_count()];
+    for (i, &d) in free.iter().enumerate() {
+        position[d] = i;
+    }
+    let mut a = vec![vec![0.0; free.len()]; free.len()];
+    let (col_ptr, row_idx, values) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
+    for j in 0..k.ncols() {
+        for p in col_ptr[j]..col_ptr[j + 1] {
+            let i = row_idx[p];
+            if position[i] != usize::MAX && position[j] != usize::MAX {
+                a[position[i]][position[j]] += values[p];
+            }
+        }
+    }
+    let b: Vec<f64> = free.iter().map(|&d| f[d]).collect();
+    let w = cholesky_solve(a, b);
+    let centre = mesh
+        .vertices()
+        .iter()
+        .position(|p| (p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12)
+        .expect("n even: the centre is a vertex");
+    w[position[map.vertex_dofs(centre).start]]
+}
+
+/// The clamped square plate: the centre deflection `0.00126532 q a⁴/D` (Timoshenko and
+/// Woinowsky-Krieger, Table 35; MODELS.md §5), to 1e-5 relative at N = 8.
+#[test]
+fn clamped_square_plate_centre_deflection() {
+    let exact = 0.00126532;
+    let coarse = clamped_centre_deflection(4);
+    let fine = clamped_centre_deflection(8);
+    println!("w_c: N = 4 {coarse:.10e}, N = 8 {fine:.10e}, exact {exact}");
+    assert!(
+        ((fine - exact) / exact).abs() < 1e-5,
+        "N = 8: w_c = {fine}, exact {exact}"
+    );
+    assert!(
+        (fine - exact).abs() < (coarse - exact).abs(),
+        "no convergence: N = 4 {coarse}, N = 8 {fine}"
+    );
 }

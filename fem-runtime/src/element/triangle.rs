@@ -120,8 +120,49 @@ impl TriangleBasis {
 }
 
 impl TriangleField<'_> {
+    /// The coefficients of cell `c` in the pulled-back reference basis `ψ_j = φ̂_j ∘ F⁻¹`,
+    /// in local order: the field's own local coefficients `U` for Lagrange elements, and
+    /// `Mᵀ U` for elements with a DOF transformation `M` (Argyris, Morley), since
+    /// `Σ_i U_i φ_i = Σ_j (Mᵀ U)_j ψ_j` (`docs/elements.md` §3). NaN where `M` does not
+    /// exist (a degenerate cell, which a validated mesh does not have).
+    pub fn reference_coefficients(&self, c: usize) -> Vec<f64> {
+        let local: Vec<f64> = self
+            .map
+            .cell_dofs(c)
+            .iter()
+            .map(|&d| self.coefficients[d])
+            .collect();
+        match cell_transformation(
+            self.map.element(),
+            &self.mesh.cell_coordinates(c),
+            &self.mesh.cell(c),
+        ) {
+            Ok(None) => local,
+            Ok(Some(m)) => (0..local.len())
+                .map(|j| (0..local.len()).map(|i| m[(i, j)] * local[i]).sum())
+                .collect(),
+            Err(_) => vec![f64::NAN; local.len()],
+        }
+    }
+
+    /// The reference coefficients of cell `c` when the element needs a transformation;
+    /// `None` on the Lagrange fast path, which reads the coefficients in place.
+    fn transformed(&self, c: usize) -> Option<Vec<f64>> {
+        self.map
+            .element()
+            .needs_transformation()
+            .then(|| self.reference_coefficients(c))
+    }
+
     /// Value at reference point `ξ` of cell `c`.
     pub fn value(&self, basis: &TriangleBasis, c: usize, xi: [f64; 2]) -> f64 {
+        if let Some(u) = self.transformed(c) {
+            return u
+                .iter()
+                .zip(&basis.values)
+                .map(|(u, p)| u * p.eval(xi))
+                .sum();
+        }
         self.map
             .cell_dofs(c)
             .iter()
@@ -139,6 +180,13 @@ impl TriangleField<'_> {
         xi: [f64; 2],
     ) -> [f64; 2] {
         let mut g = [0.0; 2];
+        if let Some(u) = self.transformed(c) {
+            for ((u, px), py) in u.iter().zip(&basis.dx).zip(&basis.dy) {
+                g[0] += u * px.eval(xi);
+                g[1] += u * py.eval(xi);
+            }
+            return map.gradient(g);
+        }
         for ((&d, px), py) in self.map.cell_dofs(c).iter().zip(&basis.dx).zip(&basis.dy) {
             g[0] += self.coefficients[d] * px.eval(xi);
             g[1] += self.coefficients[d] * py.eval(xi);
@@ -155,9 +203,13 @@ impl TriangleField<'_> {
         xi: [f64; 2],
     ) -> [[f64; 2]; 2] {
         let mut h = [0.0; 3];
-        for (i, &d) in self.map.cell_dofs(c).iter().enumerate() {
+        let local = self.transformed(c).unwrap_or_else(|| {
+            let dofs = self.map.cell_dofs(c);
+            dofs.iter().map(|&d| self.coefficients[d]).collect()
+        });
+        for (i, u) in local.iter().enumerate() {
             for (k, derivative) in basis.second.iter().enumerate() {
-                h[k] += self.coefficients[d] * derivative[i].eval(xi);
+                h[k] += u * derivative[i].eval(xi);
             }
         }
         map.hessian([[h[0], h[1]], [h[1], h[2]]])
