@@ -370,13 +370,24 @@ fn unit_load(_: &[f64]) -> f64 {
     1.0
 }
 
-/// Centre deflection of the clamped unit square plate under a unit load, D = 1, ν = 0.3,
-/// on an `n × n × 2` mesh, assembled by the runtime (`MatrixAssembler`,
-/// `assemble_vector`) and solved here. Clamped DOFs (all zero): at boundary vertices the
-/// value, both first derivatives, the mixed second derivative and the second derivative
-/// along the boundary (`u_yy` on `x = 0, 1`, `u_xx` on `y = 0, 1`), all six at corners,
-/// and the normal derivatives of boundary edges.
-fn clamped_centre_deflection(n: usize) -> f64 {
+/// How the plate's edges are held.
+#[derive(Clone, Copy)]
+enum Support {
+    /// Value and normal derivative zero: at boundary vertices the value, both first
+    /// derivatives, the mixed second derivative and the second derivative along the
+    /// boundary (`u_yy` on `x = 0, 1`, `u_xx` on `y = 0, 1`), all six at corners, and the
+    /// normal derivatives of boundary edges.
+    Clamped,
+    /// Value zero: at boundary vertices the value and the first and second derivatives
+    /// along the boundary (at corners along both edges, so all but `u_xy`); the edge
+    /// normal derivatives stay free.
+    SimplySupported,
+}
+
+/// Centre deflection of the unit square plate under a unit load, D = 1, ν = 0.3, on an
+/// `n × n × 2` mesh, assembled by the runtime (`MatrixAssembler`, `assemble_vector`) and
+/// solved here with the fixed DOFs (all zero) of `support` removed.
+fn centre_deflection(n: usize, support: Support) -> f64 {
     type M = kirchhoff_argyris::Model;
     let mesh =
         fem_runtime::TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap();
@@ -393,11 +404,15 @@ fn clamped_centre_deflection(n: usize) -> f64 {
     let on = |t: f64| t.abs() < 1e-12 || (t - 1.0).abs() < 1e-12;
     for (v, &[x, y]) in mesh.vertices().iter().enumerate() {
         let r = map.vertex_dofs(v);
-        let kinds: &[usize] = match (on(x), on(y)) {
-            (true, true) => &[0, 1, 2, 3, 4, 5],
-            (true, false) => &[0, 1, 2, 4, 5],
-            (false, true) => &[0, 1, 2, 3, 4],
-            (false, false) => &[],
+        // Local order at a vertex: u, u_x, u_y, u_xx, u_xy, u_yy.
+        let kinds: &[usize] = match (support, on(x), on(y)) {
+            (_, false, false) => &[],
+            (Support::Clamped, true, true) => &[0, 1, 2, 3, 4, 5],
+            (Support::Clamped, true, false) => &[0, 1, 2, 4, 5],
+            (Support::Clamped, false, true) => &[0, 1, 2, 3, 4],
+            (Support::SimplySupported, true, true) => &[0, 1, 2, 3, 5],
+            (Support::SimplySupported, true, false) => &[0, 2, 5],
+            (Support::SimplySupported, false, true) => &[0, 1, 3],
         };
         for &k in kinds {
             fixed[r.start + k] = true;
@@ -406,7 +421,7 @@ fn clamped_centre_deflection(n: usize) -> f64 {
     let boundary: Vec<usize> = mesh.boundary_edges().iter().map(|&(e, _)| e).collect();
     for c in 0..mesh.cell_count() {
         for (k, e) in mesh.cell_edges(c).into_iter().enumerate() {
-            if boundary.contains(&e) {
+            if matches!(support, Support::Clamped) && boundary.contains(&e) {
                 fixed[map.cell_dofs(c)[18 + k]] = true;
             }
         }
@@ -441,8 +456,27 @@ fn clamped_centre_deflection(n: usize) -> f64 {
 #[test]
 fn clamped_square_plate_centre_deflection() {
     let exact = 0.00126532;
-    let coarse = clamped_centre_deflection(4);
-    let fine = clamped_centre_deflection(8);
+    let coarse = centre_deflection(4, Support::Clamped);
+    let fine = centre_deflection(8, Support::Clamped);
+    println!("w_c: N = 4 {coarse:.10e}, N = 8 {fine:.10e}, exact {exact}");
+    assert!(
+        ((fine - exact) / exact).abs() < 1e-5,
+        "N = 8: w_c = {fine}, exact {exact}"
+    );
+    assert!(
+        (fine - exact).abs() < (coarse - exact).abs(),
+        "no convergence: N = 4 {coarse}, N = 8 {fine}"
+    );
+}
+
+/// The simply supported square plate: the centre deflection `0.00406235 q a⁴/D`
+/// (Timoshenko and Woinowsky-Krieger, Navier series; MODELS.md §5 and issue 13), to 1e-5
+/// relative at N = 8.
+#[test]
+fn simply_supported_square_plate_centre_deflection() {
+    let exact = 0.00406235;
+    let coarse = centre_deflection(4, Support::SimplySupported);
+    let fine = centre_deflection(8, Support::SimplySupported);
     println!("w_c: N = 4 {coarse:.10e}, N = 8 {fine:.10e}, exact {exact}");
     assert!(
         ((fine - exact) / exact).abs() < 1e-5,
