@@ -54,41 +54,48 @@ pub fn transform_element_matrix<const R: usize, const C: usize>(
     k: &mut [[f64; C]; R],
 ) {
     let poisoned = |k: &mut [[f64; C]; R]| k.iter_mut().flatten().for_each(|v| *v = f64::NAN);
-    match cell_transformation(test, x, global) {
-        Err(_) => return poisoned(k),
-        Ok(None) => {}
-        Ok(Some(m)) => {
-            let mut out = [[0.0; C]; R];
-            for (i, row) in out.iter_mut().enumerate() {
-                for (l, &mil) in m.row(i).iter().enumerate() {
-                    if mil != 0.0 {
-                        for (o, &v) in row.iter_mut().zip(&k[l]) {
-                            *o += mil * v;
-                        }
+    let Ok(test_m) = cell_transformation(test, x, global) else {
+        return poisoned(k);
+    };
+    // A block of one field with itself (the usual bilinear form) builds `M` once.
+    let other_m = match trial {
+        Some(e) if e != test => match cell_transformation(e, x, global) {
+            Ok(m) => m,
+            Err(_) => return poisoned(k),
+        },
+        _ => None,
+    };
+    let trial_m = match trial {
+        None => None,
+        Some(e) if e == test => test_m.as_ref(),
+        Some(_) => other_m.as_ref(),
+    };
+    if let Some(m) = &test_m {
+        let mut out = [[0.0; C]; R];
+        for (i, row) in out.iter_mut().enumerate() {
+            for (l, &mil) in m.row(i).iter().enumerate() {
+                if mil != 0.0 {
+                    for (o, &v) in row.iter_mut().zip(&k[l]) {
+                        *o += mil * v;
                     }
                 }
             }
-            *k = out;
         }
+        *k = out;
     }
-    let Some(trial) = trial else { return };
-    match cell_transformation(trial, x, global) {
-        Err(_) => poisoned(k),
-        Ok(None) => {}
-        Ok(Some(m)) => {
-            for row in k.iter_mut() {
-                let mut out = [0.0; C];
-                for (j, o) in out.iter_mut().enumerate() {
-                    *o = m
-                        .row(j)
-                        .iter()
-                        .zip(row.iter())
-                        .filter(|(&mjl, _)| mjl != 0.0)
-                        .map(|(&mjl, &v)| mjl * v)
-                        .sum();
-                }
-                *row = out;
+    if let Some(m) = trial_m {
+        for row in k.iter_mut() {
+            let mut out = [0.0; C];
+            for (j, o) in out.iter_mut().enumerate() {
+                *o = m
+                    .row(j)
+                    .iter()
+                    .zip(row.iter())
+                    .filter(|(&mjl, _)| mjl != 0.0)
+                    .map(|(&mjl, &v)| mjl * v)
+                    .sum();
             }
+            *row = out;
         }
     }
 }
