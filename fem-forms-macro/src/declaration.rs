@@ -402,6 +402,15 @@ impl Declaration {
                                     c.name()
                                 ),
                             ));
+                        } else if c == CellKind::Triangle {
+                            // Argyris and Morley invert their Vandermonde matrix here, at
+                            // compile time: a failure is an error at the element's name.
+                            if let Err(error) = e.try_triangle_basis() {
+                                errors.push(Diagnostic::token(
+                                    u.element_name.span(),
+                                    format!("element {}: {error}", e.name()),
+                                ));
+                            }
                         }
                     }
                     if u.nonnegative && e.is_continuous() {
@@ -474,6 +483,18 @@ impl Declaration {
                         ),
                     ))
                 }
+                // Their DOFs are derivatives too: interpolating `g` at the DOFs' points,
+                // as `boundary:` does, would fix them to values.
+                Some(u) if u.element.is_some_and(|e| e.needs_transformation()) => errors.push(
+                    Diagnostic::token(
+                        field.span(),
+                        format!(
+                            "`{field}` has the {} element: `boundary:` cannot prescribe it yet",
+                            u.element.map_or("", |e| e.name())
+                        ),
+                    )
+                    .help("its DOFs are values and derivatives: fix them by kind at run time (`Constraints::fix_dof`), as the plate tests of tests/argyris.rs choose them"),
+                ),
                 Some(_) => {}
             }
             if !self.data.iter().any(|d| d.name == *data) {

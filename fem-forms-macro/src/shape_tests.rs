@@ -123,6 +123,13 @@ fn tensor_operators_agree_with_components() {
     );
     same("div ∇w v", "Δw v");
     same("div div ∇∇w v", "ΔΔw v");
+    // The Kirchhoff bending integrand (models/src/kirchhoff.rs) in Hessian notation is the
+    // one written with partial derivatives, and ∂_x ∂_x reads as a second derivative.
+    same(
+        "D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]",
+        "D(1−ν)(∂_x ∂_x w ∂_x ∂_x v + 2 ∂_x ∂_y w ∂_y ∂_x v + ∂_y ∂_y w ∂_y ∂_y v) \
+         + Dν(∂_x ∂_x w + ∂_y ∂_y w)(∂_x ∂_x v + ∂_y ∂_y v)",
+    );
     same("div(∇θ)·η", "Δθ_x η_x + Δθ_y η_y");
     same("∂_x θ · ∂_y η", "∂_x θ_x ∂_y η_x + ∂_x θ_y ∂_y η_y");
     same("tr I w v", "2 w v");

@@ -162,6 +162,43 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         out: &mut [f64],
     );
 
+    /// [`Model::element_matrix`] on a cell whose global vertex numbers are `global`.
+    ///
+    /// Elements that need a per-cell DOF transformation (Argyris, Morley) orient their
+    /// edge DOFs by the global vertex numbers, so that neighbouring cells agree
+    /// (`docs/elements.md` §3); `element_matrix` orients them by the local numbers, as on
+    /// a cell numbered increasingly. The default ignores `global`: right for every
+    /// other element, and what models without such elements keep.
+    #[allow(clippy::too_many_arguments)]
+    fn element_matrix_on_cell(
+        form: usize,
+        block: usize,
+        vertices: &[f64],
+        global: &[usize],
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) {
+        let _ = global;
+        Self::element_matrix(form, block, vertices, params, data, out);
+    }
+
+    /// [`Model::element_vector`] on a cell whose global vertex numbers are `global` (see
+    /// [`Model::element_matrix_on_cell`]).
+    #[allow(clippy::too_many_arguments)]
+    fn element_vector_on_cell(
+        form: usize,
+        block: usize,
+        vertices: &[f64],
+        global: &[usize],
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) {
+        let _ = global;
+        Self::element_vector(form, block, vertices, params, data, out);
+    }
+
     /// Index in `FORMS` of a form: its handle (`model::forms::B_h`) or its name (`"B_h"`).
     ///
     /// # Errors

@@ -7,6 +7,7 @@
 
 pub mod data;
 pub mod euler_bernoulli;
+pub mod kirchhoff;
 pub mod membrane;
 pub mod membrane_scenes;
 pub mod mindlin;

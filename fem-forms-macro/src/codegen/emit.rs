@@ -217,24 +217,67 @@ pub fn block_kernel(
     let nd = symbols.data.len();
     let geometry = backend.geometry(block);
     let lets = &exact.lets;
-    let function = quote! {
-        #[doc = #doc_title]
-        #[doc = #doc_terms]
-        #[inline]
-        #[allow(unused_variables, unused_mut, clippy::all)]
-        pub fn #name(x: &[f64; #coordinates], p: &[f64; #np], d: &[&#runtime::DataFn; #nd]) -> #signature_out {
-            #geometry
-            #(#lets)*
-            let mut k = [[0.0f64; #cols]; #rows];
-            #(#loops)*
-            #(#entries)*
-            #ret
+    let function = if is_transformed(block, symbols) {
+        // The entries above are those of the pulled-back reference basis; the epilogue
+        // maps them to the physical basis with the cell's transformation, which needs
+        // the global vertex numbers `g` for the edge orientation (docs/elements.md §3).
+        let element = |e: ElementKind| {
+            let variant = Ident::new(&format!("{e:?}"), proc_macro2::Span::call_site());
+            quote!(#runtime::ElementKind::#variant)
+        };
+        let test = element(symbols.fields[block.test_field].element);
+        let trial = match block.trial_field {
+            Some(f) => {
+                let e = element(symbols.fields[f].element);
+                quote!(::core::option::Option::Some(#e))
+            }
+            None => quote!(::core::option::Option::None),
+        };
+        let doc_transformed = " Takes the cell's global vertex numbers `g` besides its coordinates: the entries are those of the physical basis, `M K̂ Mᵀ` (`M F̂`), with `M` the element's DOF transformation (`docs/elements.md`).";
+        quote! {
+            #[doc = #doc_title]
+            #[doc = #doc_terms]
+            #[doc = #doc_transformed]
+            #[inline]
+            #[allow(unused_variables, unused_mut, clippy::all)]
+            pub fn #name(x: &[f64; #coordinates], g: &[usize; 3], p: &[f64; #np], d: &[&#runtime::DataFn; #nd]) -> #signature_out {
+                #geometry
+                #(#lets)*
+                let mut k = [[0.0f64; #cols]; #rows];
+                #(#loops)*
+                #(#entries)*
+                #runtime::element::triangle::transform_element_matrix(#test, #trial, x, g, &mut k);
+                #ret
+            }
+        }
+    } else {
+        quote! {
+            #[doc = #doc_title]
+            #[doc = #doc_terms]
+            #[inline]
+            #[allow(unused_variables, unused_mut, clippy::all)]
+            pub fn #name(x: &[f64; #coordinates], p: &[f64; #np], d: &[&#runtime::DataFn; #nd]) -> #signature_out {
+                #geometry
+                #(#lets)*
+                let mut k = [[0.0f64; #cols]; #rows];
+                #(#loops)*
+                #(#entries)*
+                #ret
+            }
         }
     };
     BlockCode {
         function,
         quadrature_points: exact.quadrature_points.max(loop_points),
     }
+}
+
+/// Whether a block's test or trial field has an element that needs the per-cell DOF
+/// transformation (Argyris, Morley): its kernel then takes the global vertex numbers.
+pub fn is_transformed(block: &Block, symbols: &Symbols) -> bool {
+    std::iter::once(block.test_field)
+        .chain(block.trial_field)
+        .any(|f| symbols.fields[f].element.needs_transformation())
 }
 
 /// (rows, columns) of a block's element matrix (columns 1 for a vector).

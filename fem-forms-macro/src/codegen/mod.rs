@@ -37,6 +37,12 @@ struct Dispatch {
     matrix: Vec<TokenStream>,
     add: Vec<TokenStream>,
     vector: Vec<TokenStream>,
+    /// The arms of `element_matrix_on_cell` and `element_vector_on_cell`, emitted only
+    /// when a block has a transformed element (`transformed`), so that the code of
+    /// other models stays as it was.
+    matrix_on_cell: Vec<TokenStream>,
+    vector_on_cell: Vec<TokenStream>,
+    transformed: bool,
 }
 
 /// What the driver generates for one form.
@@ -87,7 +93,32 @@ fn form_code(
         functions.push(code.function);
         block_infos.push(block_info(block, symbols, code.quadrature_points, runtime));
         let name = emit::block_ident(block, symbols);
-        if block.trial_field.is_some() {
+        if emit::is_transformed(block, symbols) {
+            // Without global numbers (`element_matrix`), edges are oriented by the local
+            // vertex numbers, as on a cell numbered increasingly.
+            dispatch.transformed = true;
+            if block.trial_field.is_some() {
+                dispatch.add.push(quote! {
+                    (#form_index, #block_index) => #runtime::kernel::add_matrices_on_cells(mesh, positions, stride, offset, values, |x, g| #form_ident::#name(x, g, p, d)),
+                });
+                dispatch.matrix.push(quote! {
+                    (#form_index, #block_index) => #runtime::kernel::store_matrix(&#form_ident::#name(x, &[0, 1, 2], p, d), out),
+                });
+                dispatch.matrix_on_cell.push(quote! {
+                    (#form_index, #block_index) => #runtime::kernel::store_matrix(&#form_ident::#name(x, g, p, d), out),
+                });
+            } else {
+                dispatch.vector.push(quote! {
+                    (#form_index, #block_index) => #runtime::kernel::store_vector(&#form_ident::#name(x, &[0, 1, 2], p, d), out),
+                });
+                dispatch.vector_on_cell.push(quote! {
+                    (#form_index, #block_index) => #runtime::kernel::store_vector(&#form_ident::#name(x, g, p, d), out),
+                });
+            }
+        } else if block.trial_field.is_some() {
+            dispatch.matrix_on_cell.push(quote! {
+                (#form_index, #block_index) => #runtime::kernel::store_matrix(&#form_ident::#name(x, p, d), out),
+            });
             dispatch.add.push(quote! {
                 (#form_index, #block_index) => #runtime::kernel::add_matrices(mesh, positions, stride, offset, values, |x| #form_ident::#name(x, p, d)),
             });
@@ -95,6 +126,9 @@ fn form_code(
                 (#form_index, #block_index) => #runtime::kernel::store_matrix(&#form_ident::#name(x, p, d), out),
             });
         } else {
+            dispatch.vector_on_cell.push(quote! {
+                (#form_index, #block_index) => #runtime::kernel::store_vector(&#form_ident::#name(x, p, d), out),
+            });
             dispatch.vector.push(quote! {
                 (#form_index, #block_index) => #runtime::kernel::store_vector(&#form_ident::#name(x, p, d), out),
             });
@@ -317,7 +351,51 @@ fn model_impl(
         matrix,
         add,
         vector,
+        matrix_on_cell,
+        vector_on_cell,
+        transformed,
     } = dispatch;
+    let on_cell = transformed.then(|| {
+        quote! {
+            fn element_matrix_on_cell(
+                form: usize,
+                block: usize,
+                vertices: &[f64],
+                global: &[usize],
+                params: &[f64],
+                data: &[&#runtime::DataFn],
+                out: &mut [f64],
+            ) {
+                let x: &[f64; #coordinates] = vertices.try_into().expect(#cell_text);
+                let g: &[usize; 3] = global.try_into().expect("a triangle has three vertex numbers");
+                let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+                let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+                match (form, block) {
+                    #(#matrix_on_cell)*
+                    _ => panic!("{}: form {} has no bilinear block {}", #model_name, form, block),
+                }
+            }
+
+            fn element_vector_on_cell(
+                form: usize,
+                block: usize,
+                vertices: &[f64],
+                global: &[usize],
+                params: &[f64],
+                data: &[&#runtime::DataFn],
+                out: &mut [f64],
+            ) {
+                let x: &[f64; #coordinates] = vertices.try_into().expect(#cell_text);
+                let g: &[usize; 3] = global.try_into().expect("a triangle has three vertex numbers");
+                let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+                let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+                match (form, block) {
+                    #(#vector_on_cell)*
+                    _ => panic!("{}: form {} has no linear block {}", #model_name, form, block),
+                }
+            }
+        }
+    });
     quote! {
         impl #runtime::Model for Model {
             const NAME: &'static str = #model_name;
@@ -382,6 +460,8 @@ fn model_impl(
                     _ => panic!("{}: form {} has no linear block {}", #model_name, form, block),
                 }
             }
+
+            #on_cell
         }
     }
 }

@@ -72,16 +72,26 @@ pub enum ElementKind {
     /// Discontinuous piecewise linear Lagrange (multipliers): nodal values at the
     /// cell's vertices, owned by the cell.
     P1Disc,
+    /// The C¹ Argyris quintic on triangles (`docs/elements.md`): at each vertex the
+    /// value, the gradient and the Hessian `(u, u_x, u_y, u_xx, u_xy, u_yy)`, and the
+    /// normal derivative at each edge midpoint (edges oriented by global vertex numbers).
+    /// Not affine-equivalent: kernels apply the per-cell DOF transformation.
+    Argyris,
+    /// The non-conforming Morley quadratic on triangles: vertex values and the normal
+    /// derivative at each edge midpoint. Not affine-equivalent, like Argyris.
+    Morley,
 }
 
 /// Every element, in the order the DSL lists them in error messages.
-pub const ALL_ELEMENTS: [ElementKind; 6] = [
+pub const ALL_ELEMENTS: [ElementKind; 8] = [
     ElementKind::P0,
     ElementKind::P1,
     ElementKind::P2,
     ElementKind::P3,
     ElementKind::Hermite,
     ElementKind::P1Disc,
+    ElementKind::Argyris,
+    ElementKind::Morley,
 ];
 
 impl ElementKind {
@@ -94,10 +104,12 @@ impl ElementKind {
             ElementKind::P3 => "P3",
             ElementKind::Hermite => "Hermite",
             ElementKind::P1Disc => "P1disc",
+            ElementKind::Argyris => "Argyris",
+            ElementKind::Morley => "Morley",
         }
     }
 
-    /// Parses an element name (`P0`…`P3`, `Hermite`, `H3`).
+    /// Parses an element name (`P0`…`P3`, `Hermite`, `H3`, `P1disc`, `Argyris`, `Morley`).
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
             "P0" => Some(ElementKind::P0),
@@ -106,13 +118,48 @@ impl ElementKind {
             "P3" => Some(ElementKind::P3),
             "Hermite" | "H3" => Some(ElementKind::Hermite),
             "P1disc" | "P1d" | "DG1" => Some(ElementKind::P1Disc),
+            "Argyris" => Some(ElementKind::Argyris),
+            "Morley" => Some(ElementKind::Morley),
             _ => None,
         }
     }
 
-    /// Whether the element exists on the given cell (Hermite only on intervals).
+    /// Whether the element exists on the given cell (Hermite only on intervals, Argyris
+    /// and Morley only on triangles).
     pub fn supports(self, cell: CellKind) -> bool {
-        cell == CellKind::Interval || self != ElementKind::Hermite
+        match self {
+            ElementKind::Hermite => cell == CellKind::Interval,
+            ElementKind::Argyris | ElementKind::Morley => cell == CellKind::Triangle,
+            _ => true,
+        }
+    }
+
+    /// Whether the reference basis pulled back to a cell is not yet the physical nodal
+    /// basis, so that kernels need the per-cell DOF transformation `M`
+    /// ([`crate::argyris_transformation`], [`crate::morley_transformation`]) and the
+    /// cell's global vertex numbers. False for Lagrange and Hermite (their identity or
+    /// diagonal fast path).
+    pub fn needs_transformation(self) -> bool {
+        matches!(self, ElementKind::Argyris | ElementKind::Morley)
+    }
+
+    /// The per-cell transformation `M` (`φ = M (φ̂ ∘ F⁻¹)`, `docs/elements.md` §3) of an
+    /// element that [`needs_transformation`](Self::needs_transformation); `Ok(None)` for
+    /// the others.
+    ///
+    /// # Errors
+    /// [`crate::dof_transformation::TransformationError`] for a degenerate cell, a
+    /// non-finite coordinate or a repeated global vertex number.
+    pub fn triangle_transformation(
+        self,
+        vertices: [[f64; 2]; 3],
+        global: [usize; 3],
+    ) -> Result<Option<crate::dense::Matrix>, crate::dof_transformation::TransformationError> {
+        match self {
+            ElementKind::Argyris => crate::argyris_transformation(vertices, global).map(Some),
+            ElementKind::Morley => crate::morley_transformation(vertices, global).map(Some),
+            _ => Ok(None),
+        }
     }
 
     /// Number of local DOFs on `cell`.
@@ -136,18 +183,36 @@ impl ElementKind {
             ElementKind::P2 => [1, 1, 0],
             ElementKind::P3 => [1, 2, 1],
             ElementKind::P1Disc => [0, 0, 3],
+            ElementKind::Argyris => [6, 1, 0],
+            ElementKind::Morley => [1, 1, 0],
             // Not available on triangles (see `supports`).
             ElementKind::Hermite => [0, 0, 0],
         }
     }
 
-    /// The reference basis on the triangle, in local DOF order (empty where unsupported).
+    /// The reference basis on the triangle, in local DOF order (empty where unsupported,
+    /// or if [`try_triangle_basis`](Self::try_triangle_basis) fails).
     pub fn triangle_basis(self) -> Vec<crate::triangle::Polynomial2> {
-        match self {
+        self.try_triangle_basis().unwrap_or_default()
+    }
+
+    /// The reference basis on the triangle, in local DOF order: Lagrange bases in closed
+    /// form, Argyris and Morley by inverting the Vandermonde matrix of their DOF
+    /// functionals ([`crate::ElementDefinition::nodal_basis`]); empty where unsupported.
+    ///
+    /// # Errors
+    /// The [`crate::dual_basis::DualBasisError`] of a definition whose functionals are
+    /// not unisolvent (does not happen for the elements declared here; the tests check).
+    pub fn try_triangle_basis(
+        self,
+    ) -> Result<Vec<crate::triangle::Polynomial2>, crate::dual_basis::DualBasisError> {
+        Ok(match self {
             ElementKind::Hermite => Vec::new(),
             ElementKind::P1Disc => crate::triangle::lagrange_basis(1),
+            ElementKind::Argyris => crate::ElementDefinition::argyris().nodal_basis()?,
+            ElementKind::Morley => crate::ElementDefinition::morley().nodal_basis()?,
             _ => crate::triangle::lagrange_basis(self.degree()),
-        }
+        })
     }
 
     /// Polynomial degree of the basis.
@@ -155,8 +220,9 @@ impl ElementKind {
         match self {
             ElementKind::P0 => 0,
             ElementKind::P1 | ElementKind::P1Disc => 1,
-            ElementKind::P2 => 2,
+            ElementKind::P2 | ElementKind::Morley => 2,
             ElementKind::P3 | ElementKind::Hermite => 3,
+            ElementKind::Argyris => 5,
         }
     }
 
@@ -171,7 +237,7 @@ impl ElementKind {
         }
     }
 
-    /// Whether neighbouring cells share the vertex DOFs.
+    /// Whether neighbouring cells share the vertex DOFs (and edge DOFs on triangles).
     pub fn is_continuous(self) -> bool {
         !matches!(self, ElementKind::P0 | ElementKind::P1Disc)
     }
@@ -193,6 +259,8 @@ impl ElementKind {
             ElementKind::P1Disc => &[Interior, Interior],
             ElementKind::P2 => &[V0, V1, Interior],
             ElementKind::P3 => &[V0, V1, Interior, Interior],
+            // Triangles only: no layout on the interval (see `supports`).
+            ElementKind::Argyris | ElementKind::Morley => &[],
             ElementKind::Hermite => &[
                 V0,
                 Vertex {
@@ -239,12 +307,16 @@ impl ElementKind {
             ElementKind::P1 | ElementKind::P1Disc => Some(&[0.0, 1.0]),
             ElementKind::P2 => Some(&[0.0, 1.0, 0.5]),
             ElementKind::P3 => Some(&[0.0, 1.0, 1.0 / 3.0, 2.0 / 3.0]),
-            ElementKind::Hermite => None,
+            ElementKind::Hermite | ElementKind::Argyris | ElementKind::Morley => None,
         }
     }
 
-    /// The reference basis as polynomials on `[0, 1]`, in local DOF order.
+    /// The reference basis as polynomials on `[0, 1]`, in local DOF order (empty for the
+    /// triangle-only Argyris and Morley).
     pub fn basis(self) -> Vec<Polynomial> {
+        if !self.supports(CellKind::Interval) {
+            return Vec::new();
+        }
         match self.lagrange_nodes() {
             Some(nodes) if nodes.len() == 1 => vec![Polynomial::constant(1.0)],
             Some(nodes) => (0..nodes.len())
@@ -353,6 +425,10 @@ mod tests {
                 assert!(element.triangle_basis().is_empty());
                 continue;
             }
+            if element.needs_transformation() {
+                // Not nodal at points: checked against its functionals below.
+                continue;
+            }
             let basis = element.triangle_basis();
             assert_eq!(basis.len(), element.local_dof_count(CellKind::Triangle));
             let nodes = crate::triangle::lagrange_nodes(element.degree());
@@ -369,6 +445,58 @@ mod tests {
             }
             let sum: f64 = basis.iter().map(|p| p.eval([0.21, 0.37])).sum();
             assert!((sum - 1.0).abs() < 1e-13);
+        }
+    }
+
+    /// Argyris and Morley: the basis is dual to the functionals of their definitions, the
+    /// layout counts the DOFs each vertex and edge owns in that local order, and they
+    /// exist on triangles only.
+    #[test]
+    fn transformed_elements_match_their_definitions() {
+        use crate::dual_basis::Entity;
+        for (element, definition) in [
+            (ElementKind::Argyris, crate::ElementDefinition::argyris()),
+            (ElementKind::Morley, crate::ElementDefinition::morley()),
+        ] {
+            assert!(element.needs_transformation());
+            assert!(element.supports(CellKind::Triangle));
+            assert!(!element.supports(CellKind::Interval));
+            assert!(element.basis().is_empty());
+            assert_eq!(ElementKind::from_name(element.name()), Some(element));
+            let basis = element.try_triangle_basis().unwrap();
+            assert_eq!(basis.len(), element.local_dof_count(CellKind::Triangle));
+            assert_eq!(basis.len(), definition.dofs.len());
+            for (i, dof) in definition.dofs.iter().enumerate() {
+                for (j, phi) in basis.iter().enumerate() {
+                    let expected = f64::from(u8::from(i == j));
+                    let value = dof.functional.apply(phi);
+                    assert!((value - expected).abs() < 1e-10, "{element:?} {i} {j}");
+                }
+            }
+            // Local order: the vertex DOFs vertex by vertex, then the edge DOFs edge by edge.
+            let [v, e, interior] = element.triangle_layout();
+            assert_eq!(interior, 0);
+            for (i, dof) in definition.dofs.iter().enumerate() {
+                let expected = if i < 3 * v {
+                    Entity::Vertex(i / v)
+                } else {
+                    Entity::Edge((i - 3 * v) / e)
+                };
+                assert_eq!(dof.entity, expected, "{element:?} dof {i}");
+            }
+            let top = element.degree() as u32;
+            assert!(basis
+                .iter()
+                .all(|p| p.terms.iter().all(|&(a, b, _)| a + b <= top)));
+        }
+        for element in ALL_ELEMENTS {
+            assert_eq!(
+                element.needs_transformation(),
+                matches!(element, ElementKind::Argyris | ElementKind::Morley)
+            );
+            let cell = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+            let m = element.triangle_transformation(cell, [0, 1, 2]).unwrap();
+            assert_eq!(m.is_some(), element.needs_transformation());
         }
     }
 }

@@ -288,4 +288,34 @@ mod tests {
         assert_eq!(p3.dof_count(), 10);
         assert_eq!(p3.cell_dofs(2), &[6, 9, 7, 8]);
     }
+
+    /// Argyris: six DOFs per vertex, then one per edge; a cell's local DOF `6v + k` is
+    /// DOF `k` of its vertex `v`, and `18 + k` the DOF of its local edge `k`, which both
+    /// cells of an interior edge share whichever way they traverse it.
+    #[test]
+    fn argyris_numbers_vertex_blocks_and_one_dof_per_edge() {
+        let mesh =
+            TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 3, 2, crate::mesh::Diagonal::Alternating)
+                .unwrap();
+        let map = DofMap::on_triangles(&mesh, ElementKind::Argyris);
+        let (vertices, edges) = (mesh.vertex_count(), mesh.edge_count());
+        assert_eq!(map.local_count(), 21);
+        assert_eq!(map.dof_count(), 6 * vertices + edges);
+        let mut owners = vec![Vec::new(); edges];
+        for c in 0..mesh.cell_count() {
+            let dofs = map.cell_dofs(c);
+            for (v, &vertex) in mesh.cell(c).iter().enumerate() {
+                assert_eq!(
+                    &dofs[6 * v..6 * v + 6],
+                    &map.vertex_dofs(vertex).collect::<Vec<_>>()[..]
+                );
+            }
+            for (k, &e) in mesh.cell_edges(c).iter().enumerate() {
+                assert_eq!(dofs[18 + k], 6 * vertices + e);
+                owners[e].push(c);
+            }
+        }
+        let interior = owners.iter().filter(|o| o.len() == 2).count();
+        assert_eq!(interior, edges - mesh.boundary_edges().len());
+    }
 }

@@ -38,3 +38,36 @@ pub fn add_matrices<G: crate::mesh::Mesh, const N: usize, const R: usize, const 
         }
     }
 }
+
+/// [`add_matrices`] for kernels that also take the cell's global vertex numbers (elements
+/// with a per-cell DOF transformation, triangles only). A mesh without vertex numbers
+/// gets NaN entries, which no solver mistakes for a result.
+#[inline(always)]
+pub fn add_matrices_on_cells<
+    G: crate::mesh::Mesh,
+    const N: usize,
+    const R: usize,
+    const C: usize,
+>(
+    mesh: &G,
+    positions: &[usize],
+    stride: usize,
+    offset: usize,
+    values: &mut [f64],
+    kernel: impl Fn(&[f64; N], &[usize; 3]) -> [[f64; C]; R],
+) {
+    let mut x = [0.0; N];
+    let mut g = [0usize; 3];
+    for c in 0..mesh.cell_count() {
+        mesh.cell_coordinates_into(c, &mut x);
+        let k = if mesh.cell_vertex_numbers_into(c, &mut g) {
+            kernel(&x, &g)
+        } else {
+            [[f64::NAN; C]; R]
+        };
+        let at = &positions[c * stride + offset..][..R * C];
+        for (&p, &v) in at.iter().zip(k.iter().flatten()) {
+            values[p] += v;
+        }
+    }
+}

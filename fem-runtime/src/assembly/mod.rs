@@ -244,17 +244,21 @@ pub fn assemble_vector<M: Model>(
     let mut local = vec![0.0; plans.iter().map(|p| p.rows).max().unwrap_or(0)];
     let mut x = [0.0; 6];
     let x = &mut x[..mesh.cell_kind().vertex_count() * mesh.cell_kind().dimension()];
+    // Global vertex numbers orient the edge DOFs of transformed elements (Argyris,
+    // Morley); other models ignore them (`Model::element_vector_on_cell`).
+    let mut g = [0usize; 3];
+    let g = &mut g[..mesh.cell_kind().vertex_count()];
     for c in 0..mesh.cell_count() {
         mesh.cell_coordinates_into(c, x);
+        let numbered = mesh.cell_vertex_numbers_into(c, g);
         for plan in &plans {
-            M::element_vector(
-                form,
-                plan.block,
-                x,
-                &coefficients.params,
-                &coefficients.data,
-                &mut local[..plan.rows],
-            );
+            let (params, data) = (&coefficients.params, &coefficients.data);
+            let element = &mut local[..plan.rows];
+            if numbered {
+                M::element_vector_on_cell(form, plan.block, x, g, params, data, element);
+            } else {
+                M::element_vector(form, plan.block, x, params, data, element);
+            }
             let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
             for (&r, &v) in rows.iter().zip(&local[..plan.rows]) {
                 out[r + plan.row_offset] += v;

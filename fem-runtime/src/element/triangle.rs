@@ -19,6 +19,87 @@ pub struct TriangleField<'a> {
 /// The affine map of a triangle (see [`crate::element::mapping`]).
 pub type AffineMap = Affine<2>;
 
+/// The per-cell DOF transformation `M` of `element` on the triangle with coordinates
+/// `x = [x₀, y₀, x₁, y₁, x₂, y₂]` and global vertex numbers `global`
+/// (`docs/elements.md` §3): `Ok(None)` for an element that needs none (Lagrange).
+///
+/// # Errors
+/// The reference crate's `TransformationError` (degenerate cell, non-finite coordinate,
+/// repeated global vertex number).
+pub fn cell_transformation(
+    element: fem_reference::ElementKind,
+    x: &[f64; 6],
+    global: &[usize; 3],
+) -> Result<
+    Option<fem_reference::dense::Matrix>,
+    fem_reference::dof_transformation::TransformationError,
+> {
+    let vertices = [[x[0], x[1]], [x[2], x[3]], [x[4], x[5]]];
+    element.triangle_transformation(vertices, *global)
+}
+
+/// The epilogue of a generated kernel with a transformed element: `k ← M_test k M_trialᵀ`
+/// (`K = M K̂ Mᵀ`; for a load vector, `trial = None` and `k` has one column: `F = M F̂`),
+/// where `k` holds the entries of the pulled-back reference basis `ψ = φ̂ ∘ F⁻¹`.
+///
+/// `M` is sparse (Argyris: 81 non-zeros of 441), so the products skip its zeros. A cell
+/// for which `M` does not exist (degenerate, or a repeated global vertex number) gets NaN
+/// entries: kernels cannot return errors, and meshes refuse such cells when built, so
+/// this only marks a caller's misuse visibly instead of giving plausible numbers.
+pub fn transform_element_matrix<const R: usize, const C: usize>(
+    test: fem_reference::ElementKind,
+    trial: Option<fem_reference::ElementKind>,
+    x: &[f64; 6],
+    global: &[usize; 3],
+    k: &mut [[f64; C]; R],
+) {
+    let poisoned = |k: &mut [[f64; C]; R]| k.iter_mut().flatten().for_each(|v| *v = f64::NAN);
+    let Ok(test_m) = cell_transformation(test, x, global) else {
+        return poisoned(k);
+    };
+    // A block of one field with itself (the usual bilinear form) builds `M` once.
+    let other_m = match trial {
+        Some(e) if e != test => match cell_transformation(e, x, global) {
+            Ok(m) => m,
+            Err(_) => return poisoned(k),
+        },
+        _ => None,
+    };
+    let trial_m = match trial {
+        None => None,
+        Some(e) if e == test => test_m.as_ref(),
+        Some(_) => other_m.as_ref(),
+    };
+    if let Some(m) = &test_m {
+        let mut out = [[0.0; C]; R];
+        for (i, row) in out.iter_mut().enumerate() {
+            for (l, &mil) in m.row(i).iter().enumerate() {
+                if mil != 0.0 {
+                    for (o, &v) in row.iter_mut().zip(&k[l]) {
+                        *o += mil * v;
+                    }
+                }
+            }
+        }
+        *k = out;
+    }
+    if let Some(m) = trial_m {
+        for row in k.iter_mut() {
+            let mut out = [0.0; C];
+            for (j, o) in out.iter_mut().enumerate() {
+                *o = m
+                    .row(j)
+                    .iter()
+                    .zip(row.iter())
+                    .filter(|(&mjl, _)| mjl != 0.0)
+                    .map(|(&mjl, &v)| mjl * v)
+                    .sum();
+            }
+            *row = out;
+        }
+    }
+}
+
 /// The reference basis of an element with its first and second derivatives.
 pub struct TriangleBasis {
     values: Vec<Polynomial2>,
@@ -46,8 +127,49 @@ impl TriangleBasis {
 }
 
 impl TriangleField<'_> {
+    /// The coefficients of cell `c` in the pulled-back reference basis `ψ_j = φ̂_j ∘ F⁻¹`,
+    /// in local order: the field's own local coefficients `U` for Lagrange elements, and
+    /// `Mᵀ U` for elements with a DOF transformation `M` (Argyris, Morley), since
+    /// `Σ_i U_i φ_i = Σ_j (Mᵀ U)_j ψ_j` (`docs/elements.md` §3). NaN where `M` does not
+    /// exist (a degenerate cell, which a validated mesh does not have).
+    pub fn reference_coefficients(&self, c: usize) -> Vec<f64> {
+        let local: Vec<f64> = self
+            .map
+            .cell_dofs(c)
+            .iter()
+            .map(|&d| self.coefficients[d])
+            .collect();
+        match cell_transformation(
+            self.map.element(),
+            &self.mesh.cell_coordinates(c),
+            &self.mesh.cell(c),
+        ) {
+            Ok(None) => local,
+            Ok(Some(m)) => (0..local.len())
+                .map(|j| (0..local.len()).map(|i| m[(i, j)] * local[i]).sum())
+                .collect(),
+            Err(_) => vec![f64::NAN; local.len()],
+        }
+    }
+
+    /// The reference coefficients of cell `c` when the element needs a transformation;
+    /// `None` on the Lagrange fast path, which reads the coefficients in place.
+    fn transformed(&self, c: usize) -> Option<Vec<f64>> {
+        self.map
+            .element()
+            .needs_transformation()
+            .then(|| self.reference_coefficients(c))
+    }
+
     /// Value at reference point `ξ` of cell `c`.
     pub fn value(&self, basis: &TriangleBasis, c: usize, xi: [f64; 2]) -> f64 {
+        if let Some(u) = self.transformed(c) {
+            return u
+                .iter()
+                .zip(&basis.values)
+                .map(|(u, p)| u * p.eval(xi))
+                .sum();
+        }
         self.map
             .cell_dofs(c)
             .iter()
@@ -65,6 +187,13 @@ impl TriangleField<'_> {
         xi: [f64; 2],
     ) -> [f64; 2] {
         let mut g = [0.0; 2];
+        if let Some(u) = self.transformed(c) {
+            for ((u, px), py) in u.iter().zip(&basis.dx).zip(&basis.dy) {
+                g[0] += u * px.eval(xi);
+                g[1] += u * py.eval(xi);
+            }
+            return map.gradient(g);
+        }
         for ((&d, px), py) in self.map.cell_dofs(c).iter().zip(&basis.dx).zip(&basis.dy) {
             g[0] += self.coefficients[d] * px.eval(xi);
             g[1] += self.coefficients[d] * py.eval(xi);
@@ -81,9 +210,13 @@ impl TriangleField<'_> {
         xi: [f64; 2],
     ) -> [[f64; 2]; 2] {
         let mut h = [0.0; 3];
-        for (i, &d) in self.map.cell_dofs(c).iter().enumerate() {
+        let local = self.transformed(c).unwrap_or_else(|| {
+            let dofs = self.map.cell_dofs(c);
+            dofs.iter().map(|&d| self.coefficients[d]).collect()
+        });
+        for (i, u) in local.iter().enumerate() {
             for (k, derivative) in basis.second.iter().enumerate() {
-                h[k] += self.coefficients[d] * derivative[i].eval(xi);
+                h[k] += u * derivative[i].eval(xi);
             }
         }
         map.hessian([[h[0], h[1]], [h[1], h[2]]])

@@ -25,6 +25,13 @@ pub trait Mesh: Sync {
     fn diameter(&self, c: usize) -> f64;
     /// Measure (length or area) of cell `c`.
     fn measure(&self, c: usize) -> f64;
+    /// Writes the global vertex numbers of cell `c` into `out` and returns `true`, or
+    /// returns `false` for a mesh that has none. Elements with edge DOFs oriented by
+    /// global numbers (Argyris, Morley) need them.
+    fn cell_vertex_numbers_into(&self, c: usize, out: &mut [usize]) -> bool {
+        let _ = (c, out);
+        false
+    }
     /// The reference cell (`Self::CELL`, callable where the mesh type is not named).
     fn cell_kind(&self) -> CellKind {
         Self::CELL
@@ -39,6 +46,11 @@ impl Mesh for IntervalMesh {
     #[inline]
     fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
         out[..2].copy_from_slice(&self.cell(c));
+    }
+    #[inline]
+    fn cell_vertex_numbers_into(&self, c: usize, out: &mut [usize]) -> bool {
+        out[..2].copy_from_slice(&[c, c + 1]);
+        true
     }
     fn diameter(&self, c: usize) -> f64 {
         self.h(c)
@@ -56,6 +68,11 @@ impl Mesh for TriangleMesh {
     #[inline]
     fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
         out[..6].copy_from_slice(&self.cell_coordinates(c));
+    }
+    #[inline]
+    fn cell_vertex_numbers_into(&self, c: usize, out: &mut [usize]) -> bool {
+        out[..3].copy_from_slice(&self.cell(c));
+        true
     }
     fn diameter(&self, c: usize) -> f64 {
         self.cell_diameter(c)
