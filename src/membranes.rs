@@ -578,6 +578,16 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     ) {
         report.warnings.push(warning);
     }
+    let not_a_number = |e: Option<f64>| e.is_some_and(|e| !e.is_finite());
+    if not_a_number(report.error_l2)
+        || not_a_number(report.error_h1)
+        || not_a_number(report.error_multiplier)
+    {
+        // JSON prints them as null: say why
+        report.warnings.push(
+            "an error against the exact solution is not a number: the exact u, its gradient or λ is not finite at some quadrature point (check the scene's [exact] expressions)".into(),
+        );
+    }
     if report.max_penetration.is_nan() {
         // JSON has no NaN: the field prints as null, so the reason must be said here
         report.warnings.push(

@@ -528,15 +528,22 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
             match generator.as_str() {
                 "square" => {
                     let a = mesh.half_width.unwrap_or(1.0);
-                    if !(a > 0.0 && a.is_finite()) {
+                    // beyond this range the cells' areas under- or overflow
+                    if !(1e-100..=1e100).contains(&a) {
                         return Err(at(
                             "mesh.half_width",
-                            format!("{a} must be positive and finite"),
+                            format!("{a} must be positive and within 1e-100 to 1e100"),
                         ));
                     }
                     (Domain::Square(a), size)
                 }
                 "l-shape" => {
+                    if size % 2 != 0 {
+                        return Err(at(
+                            "mesh.size",
+                            format!("the L-shape needs an even size, got {size}"),
+                        ));
+                    }
                     if mesh.half_width.is_some() {
                         return Err(at(
                             "mesh.half_width",

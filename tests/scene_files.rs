@@ -180,6 +180,23 @@ fn scene_file_errors_name_the_field() {
         e.contains("mine.toml") && e.contains("data.f") && e.contains("`t`"),
         "{e}"
     );
+    for (from, to, field) in [
+        ("half_width = 2.0", "half_width = 1e-200", "mesh.half_width"),
+        ("half_width = 2.0", "half_width = 1e200", "mesh.half_width"),
+    ] {
+        let e = scene_file::parse(&text.replace(from, to), Path::new("mine.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field), "{to}: {e}");
+    }
+    let lshape = text
+        .replace("generator = \"square\"", "generator = \"l-shape\"")
+        .replace("half_width = 2.0\n", "")
+        .replace("size = 16", "size = 7");
+    let e = scene_file::parse(&lshape, Path::new("mine.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mesh.size") && e.contains("even"), "{e}");
     let e = scene_file::read(Path::new("/nonexistent/scene.toml"))
         .unwrap_err()
         .to_string();
@@ -206,6 +223,15 @@ fn scene_file_loads_are_read_as_meant_or_refused() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("data.f") && e.contains("ambiguous"), "{e}");
+    // an exact λ that is not finite: its error cannot be reported, and the report says so
+    let broken_exact = text.replace("lambda = \"3\"", "lambda = \"sqrt(0-1)\"");
+    let file = scene_file::parse(&broken_exact, Path::new("exact.toml")).unwrap();
+    let (report, _) = membranes::solve(&request_of(&file)).unwrap();
+    assert!(
+        report.warnings.iter().any(|w| w.contains("not a number")),
+        "{:?}",
+        report.warnings
+    );
     let scientific = text.replace("f = \"-1\"", "f = \"-1e0\"");
     let file = scene_file::parse(&scientific, Path::new("e.toml")).unwrap();
     let (report, _) = membranes::solve(&request_of(&file)).unwrap();
