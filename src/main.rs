@@ -613,8 +613,13 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
     let Some(entry) = find(name) else {
         if let Some(kind) = kind {
+            let swapped = if find(kind).is_some() && Study::parse(name).is_some() {
+                format!(" (did you mean `study {kind} {name}`?)")
+            } else {
+                String::new()
+            };
             return Err(format!(
-                "`{name}` is not a scene, so `{kind}` cannot be its study; the scenes are {}",
+                "`{name}` is not a scene, so `{kind}` cannot be its study{swapped}; the scenes are {}",
                 names().join(", ")
             ));
         }
@@ -634,7 +639,15 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
         return Ok(());
     };
     if entry.studies.is_empty() {
-        return Err(format!("scene `{name}` hosts no study"));
+        let hosts: Vec<String> = registry()
+            .iter()
+            .filter(|e| !e.studies.is_empty())
+            .map(|e| e.name().to_string())
+            .collect();
+        return Err(format!(
+            "scene `{name}` hosts no study; the scenes that do are {}",
+            hosts.join(", ")
+        ));
     }
     let kinds: Vec<&str> = match kind {
         Some(k) if entry.studies.contains(&k) => vec![k],

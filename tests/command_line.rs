@@ -137,6 +137,11 @@ fn bad_input_exits_with_a_message() {
             "must be finite and ≥ 0",
         ),
         (&["study", "no-such-study"][..], "unknown study"),
+        (
+            &["study", "convergence", "membrane-radial"][..],
+            "did you mean `study membrane-radial convergence`?",
+        ),
+        (&["study", "timoshenko-b"][..], "the scenes that do are"),
         // a load that dwarfs the obstacle: certified to 1e-16, and still rounding
         (
             &[
