@@ -319,3 +319,64 @@ pub fn locking_study(
     }
     Ok(reports)
 }
+
+/// The locking study of `scene` as the CLI runs it (`study mindlin-square locking`):
+/// [`locking_study`] on N = 8, 16, 32 (and 64 with `full`) and t = 1e-1 … 1e-4, a table
+/// on stdout, `out/<scene>-locking.csv` and the chart `out/<scene>-locking.svg` of the
+/// relative error of the centre deflection against t, one line per (pair, N): flat for
+/// the Stenberg pair, rising to 1 (a deflection of 0) for the plain pair.
+///
+/// # Errors
+/// [`locking_study`]'s, and [`Error::Input`] when the chart cannot be written.
+pub fn locking_run(scene: PlateScene, full: bool, out: &std::path::Path) -> Result<()> {
+    let meshes: &[usize] = if full { &[8, 16, 32, 64] } else { &[8, 16, 32] };
+    let thicknesses = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4];
+    let csv = out.join(format!("{}-locking.csv", scene.name));
+    let reports = locking_study(scene, meshes, &thicknesses, Some(&csv))?;
+    println!(
+        "\nlocking: {}, centre deflection against the Kirchhoff value {:.6e}",
+        scene.name, reports[0].kirchhoff_reference
+    );
+    println!(
+        "{:<16} {:>4} {:>8} {:>14} {:>12}",
+        "pair", "N", "t", "w(centre)", "rel. error"
+    );
+    for r in &reports {
+        println!(
+            "{:<16} {:>4} {:>8.0e} {:>14.6e} {:>12.3e}",
+            r.pair, r.mesh_size, r.thickness, r.centre_deflection, r.relative_error
+        );
+    }
+    let mut series = Vec::new();
+    for pair in PlatePair::ALL {
+        for &n in meshes {
+            let points: Vec<(f64, f64)> = reports
+                .iter()
+                .filter(|r| r.pair == pair.name() && r.mesh_size == n)
+                .map(|r| (r.thickness, r.relative_error.abs().max(1e-12)))
+                .collect();
+            series.push(crate::plot::Series::marked(
+                format!("{} N = {n}", pair.name()),
+                points,
+            ));
+        }
+    }
+    let svg = out.join(format!("{}-locking.svg", scene.name));
+    crate::plot::chart(
+        &svg,
+        &format!(
+            "{}: |relative error| of the centre deflection against t",
+            scene.name
+        ),
+        crate::plot::Axes {
+            x: "t",
+            y: "|w_h(centre) / w_Kirchhoff − 1|",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )
+    .map_err(|e| Error::Input(format!("cannot write {}: {e}", svg.display())))?;
+    println!("→ {}, .csv", svg.display());
+    Ok(())
+}

@@ -100,7 +100,45 @@ fn bad_plate_input_exits_with_a_message() {
         assert!(stderr.contains(message), "{all:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{all:?}: {stderr}");
     }
-    let run = fem_forms(&["study", "mindlin-square"]);
+    let run = fem_forms(&["study", "mindlin-square", "convergence"]);
     assert!(!run.status.success());
-    assert!(String::from_utf8_lossy(&run.stderr).contains("hosts no study"));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("hosts no study `convergence`"));
+}
+
+/// `study mindlin-square locking` writes the chart and its table: the Stenberg pair's
+/// error at N = 32 stays within 1 % for every t ≤ 1e-2 (no locking), the plain pair's
+/// deflection collapses (relative error below −0.99 at t = 1e-4).
+#[test]
+fn the_locking_study_writes_its_chart_and_table() {
+    let out = std::env::temp_dir().join(format!("fem-forms-plate-study-{}", std::process::id()));
+    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["study", "mindlin-square", "locking", "--out"])
+        .arg(&out)
+        .output()
+        .expect("the binary runs");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("mindlin-square-locking.csv")).unwrap();
+    let svg = std::fs::read_to_string(out.join("mindlin-square-locking.svg")).unwrap();
+    assert!(svg.contains("<svg"));
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let value = |r: &Vec<&str>, i: usize| r[i].parse::<f64>().unwrap();
+    for r in &rows {
+        let (n, t, error) = (value(r, 1), value(r, 2), value(r, 4));
+        if r[0] == "p1-p2-p0" && n == 32.0 && t <= 1e-2 {
+            assert!(error.abs() < 0.01, "{r:?}");
+        }
+        if r[0] != "p1-p2-p0" && t == 1e-4 {
+            assert!(error < -0.99, "{r:?}");
+        }
+    }
+    assert!(rows.iter().any(|r| r[0] != "p1-p2-p0"));
+    std::fs::remove_dir_all(&out).unwrap();
 }

@@ -179,11 +179,12 @@ pub fn registry() -> Vec<SceneEntry> {
         entries.push(membrane_entry(s, studies, true));
     }
     entries.push(membrane_entry(MEMBRANE_FLAT, &[], false));
-    // the plates are solved on demand (`solve mindlin-square`), not in the default job
+    // the plates are solved on demand (`solve mindlin-square`, `study mindlin-square`),
+    // not in the default job
     entries.extend(PLATE_SCENES.iter().map(|&s| SceneEntry {
         kind: SceneKind::Plate(s),
         pairs: PLATE_PAIRS,
-        studies: &[],
+        studies: &["locking"],
         in_default_job: false,
     }));
     entries
