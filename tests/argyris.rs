@@ -12,7 +12,10 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::kirchhoff::{kirchhoff_argyris, kirchhoff_morley};
-use fem_forms::{assemble_vector, Coefficients, DataFn, Diagonal, MatrixAssembler, SystemDofs};
+use fem_forms::{
+    solve_linear, Coefficients, Constraints, DataFn, Diagonal, DirichletPart, Factorization,
+    PlateSupport, SystemDofs,
+};
 use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use fem_runtime::reference::triangle::{Polynomial2, TriangleRule};
 use fem_runtime::{DofMap, ElementKind};
@@ -344,111 +347,41 @@ fn argyris_field_reproduces_a_global_quintic() {
     }
 }
 
-/// Dense Cholesky solve of a symmetric positive definite system (an independent solver
-/// for the plate tests).
-fn cholesky_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
-    let n = b.len();
-    for j in 0..n {
-        let d = (a[j][j] - (0..j).map(|k| a[j][k] * a[j][k]).sum::<f64>()).sqrt();
-        assert!(d > 0.0, "not positive definite at {j}");
-        a[j][j] = d;
-        for i in j + 1..n {
-            let s = a[i][j] - (0..j).map(|k| a[i][k] * a[j][k]).sum::<f64>();
-            a[i][j] = s / d;
-        }
-    }
-    for i in 0..n {
-        b[i] = (b[i] - (0..i).map(|k| a[i][k] * b[k]).sum::<f64>()) / a[i][i];
-    }
-    for i in (0..n).rev() {
-        b[i] = (b[i] - (i + 1..n).map(|k| a[k][i] * b[k]).sum::<f64>()) / a[i][i];
-    }
-    b
-}
-
 fn unit_load(_: &[f64]) -> f64 {
     1.0
 }
 
-/// How the plate's edges are held.
-#[derive(Clone, Copy)]
-enum Support {
-    /// Value and normal derivative zero: at boundary vertices the value, both first
-    /// derivatives, the mixed second derivative and the second derivative along the
-    /// boundary (`u_yy` on `x = 0, 1`, `u_xx` on `y = 0, 1`), all six at corners, and the
-    /// normal derivatives of boundary edges.
-    Clamped,
-    /// Value zero: at boundary vertices the value and the first and second derivatives
-    /// along the boundary (at corners along both edges, so all but `u_xy`); the edge
-    /// normal derivatives stay free.
-    SimplySupported,
-}
-
 /// Centre deflection of the unit square plate under a unit load, D = 1, ν = 0.3, on an
-/// `n × n × 2` mesh, assembled by the runtime (`MatrixAssembler`, `assemble_vector`) and
-/// solved here with the fixed DOFs (all zero) of `support` removed.
-fn centre_deflection(n: usize, support: Support) -> f64 {
+/// `n × n × 2` mesh, held by `support` on the whole boundary (the runtime's
+/// `Constraints::support_plate`) and solved by the runtime's linear path (`solve_linear`:
+/// assembly, elimination of the fixed DOFs, sparse Cholesky).
+fn centre_deflection(n: usize, support: PlateSupport) -> f64 {
     type M = kirchhoff_argyris::Model;
     let mesh =
         fem_runtime::TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap();
     let dofs = SystemDofs::new::<M>(&mesh, &[0]).unwrap();
     let load: &DataFn = &unit_load;
     let coefficients = Coefficients::new::<M>(&[("D", 1.0), ("ν", 0.3)], &[("f", load)]).unwrap();
-    let k = MatrixAssembler::new::<M>("a", &mesh, &dofs)
-        .unwrap()
-        .assemble::<M>(&mesh, &coefficients)
+    let mut constraints = Constraints::new();
+    constraints
+        .support_plate::<M>(&mesh, &dofs, "w", &DirichletPart::All, support)
         .unwrap();
-    let f = assemble_vector::<M>("ℓ", &mesh, &dofs, &coefficients).unwrap();
-    let map = dofs.map(0).unwrap();
-    let mut fixed = vec![false; dofs.dof_count()];
-    let on = |t: f64| t.abs() < 1e-12 || (t - 1.0).abs() < 1e-12;
-    for (v, &[x, y]) in mesh.vertices().iter().enumerate() {
-        let r = map.vertex_dofs(v);
-        // Local order at a vertex: u, u_x, u_y, u_xx, u_xy, u_yy.
-        let kinds: &[usize] = match (support, on(x), on(y)) {
-            (_, false, false) => &[],
-            (Support::Clamped, true, true) => &[0, 1, 2, 3, 4, 5],
-            (Support::Clamped, true, false) => &[0, 1, 2, 4, 5],
-            (Support::Clamped, false, true) => &[0, 1, 2, 3, 4],
-            (Support::SimplySupported, true, true) => &[0, 1, 2, 3, 5],
-            (Support::SimplySupported, true, false) => &[0, 2, 5],
-            (Support::SimplySupported, false, true) => &[0, 1, 3],
-        };
-        for &k in kinds {
-            fixed[r.start + k] = true;
-        }
-    }
-    let boundary: Vec<usize> = mesh.boundary_edges().iter().map(|&(e, _)| e).collect();
-    for c in 0..mesh.cell_count() {
-        for (k, e) in mesh.cell_edges(c).into_iter().enumerate() {
-            if matches!(support, Support::Clamped) && boundary.contains(&e) {
-                fixed[map.cell_dofs(c)[18 + k]] = true;
-            }
-        }
-    }
-    let free: Vec<usize> = (0..dofs.dof_count()).filter(|&d| !fixed[d]).collect();
-    let mut position = vec![usize::MAX; dofs.dof_count()];
-    for (i, &d) in free.iter().enumerate() {
-        position[d] = i;
-    }
-    let mut a = vec![vec![0.0; free.len()]; free.len()];
-    let (col_ptr, row_idx, values) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-    for j in 0..k.ncols() {
-        for p in col_ptr[j]..col_ptr[j + 1] {
-            let i = row_idx[p];
-            if position[i] != usize::MAX && position[j] != usize::MAX {
-                a[position[i]][position[j]] += values[p];
-            }
-        }
-    }
-    let b: Vec<f64> = free.iter().map(|&d| f[d]).collect();
-    let w = cholesky_solve(a, b);
+    let w = solve_linear::<M>(
+        &mesh,
+        &dofs,
+        "a",
+        "ℓ",
+        &constraints,
+        &coefficients,
+        Factorization::Cholesky,
+    )
+    .unwrap();
     let centre = mesh
         .vertices()
         .iter()
         .position(|p| (p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12)
         .expect("n even: the centre is a vertex");
-    w[position[map.vertex_dofs(centre).start]]
+    w[dofs.map(0).unwrap().vertex_dofs(centre).start]
 }
 
 /// The clamped square plate: the centre deflection `0.00126532 q a⁴/D` (Timoshenko and
@@ -456,8 +389,8 @@ fn centre_deflection(n: usize, support: Support) -> f64 {
 #[test]
 fn clamped_square_plate_centre_deflection() {
     let exact = 0.00126532;
-    let coarse = centre_deflection(4, Support::Clamped);
-    let fine = centre_deflection(8, Support::Clamped);
+    let coarse = centre_deflection(4, PlateSupport::Clamped);
+    let fine = centre_deflection(8, PlateSupport::Clamped);
     println!("w_c: N = 4 {coarse:.10e}, N = 8 {fine:.10e}, exact {exact}");
     assert!(
         ((fine - exact) / exact).abs() < 1e-5,
@@ -475,8 +408,8 @@ fn clamped_square_plate_centre_deflection() {
 #[test]
 fn simply_supported_square_plate_centre_deflection() {
     let exact = 0.00406235;
-    let coarse = centre_deflection(4, Support::SimplySupported);
-    let fine = centre_deflection(8, Support::SimplySupported);
+    let coarse = centre_deflection(4, PlateSupport::SimplySupported);
+    let fine = centre_deflection(8, PlateSupport::SimplySupported);
     println!("w_c: N = 4 {coarse:.10e}, N = 8 {fine:.10e}, exact {exact}");
     assert!(
         ((fine - exact) / exact).abs() < 1e-5,
