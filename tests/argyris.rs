@@ -220,6 +220,60 @@ fn argyris_kernel_reproduces_the_bending_energy_of_quintics() {
     }
 }
 
+/// The stabilization block of the Argyris–P0 obstacle model, `S_ww = h_T⁴ (DΔ²w, DΔ²v)_T`
+/// (`h_T` the longest edge), against `Δ²` of random quintics computed here: the fourth
+/// derivatives through the transformation (`Δ²w` is linear on a quintic's cell; the
+/// product is integrated exactly by a rule of degree 2).
+#[test]
+fn argyris_stabilization_kernel_reproduces_the_bilaplacian_of_quintics() {
+    use fem_forms::models::kirchhoff::kirchhoff_argyris_p0;
+    let mut rng = Random(0x51_7cc1_b727_220a);
+    let f: &DataFn = &constant_load;
+    for case in 0..40 {
+        let h = [0.01, 0.1, 1.0, 3.0][case % 4];
+        let (x, g) = random_cell(&mut rng, h, case % 2 == 1);
+        let (d, nu) = (rng.uniform(0.5, 2.0), rng.uniform(0.0, 0.45));
+        let params = [d, nu, 1e-3, 1.0];
+        let centre = [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0];
+        let k = kirchhoff_argyris_p0::S::matrix_v_w(&x, &g, &params, &[f, f, f]);
+        let diameter = (0..3)
+            .map(|a| {
+                let b = (a + 1) % 3;
+                (x[2 * a] - x[2 * b]).hypot(x[2 * a + 1] - x[2 * b + 1])
+            })
+            .fold(0.0, f64::max);
+        let bilaplacian = |p: &Polynomial2| {
+            let terms = [p.derivative(4, 0), p.derivative(2, 2), p.derivative(0, 4)];
+            move |at: [f64; 2]| terms[0].eval(at) + 2.0 * terms[1].eval(at) + terms[2].eval(at)
+        };
+        for _ in 0..3 {
+            let w = random_polynomial(&mut rng, 5, centre, h);
+            let v = random_polynomial(&mut rng, 5, centre, h);
+            let (wd, vd) = (argyris_dofs(&w, &x, &g), argyris_dofs(&v, &x, &g));
+            let (bw, bv) = (bilaplacian(&w), bilaplacian(&v));
+            let h4 = diameter.powi(4);
+            let expected = h4 * integrate(&x, 2, |p| d * bw(p) * d * bv(p));
+            let got = quadratic_form(&k, &vd, &wd);
+            // Δ²w of a quintic is a cancellation of the DOFs' terms (by 1e7 on thin
+            // cells), so the rounding is measured against their sizes, Σ |V_i S_ij W_j|.
+            let terms: f64 = k
+                .iter()
+                .zip(&vd)
+                .map(|(row, vi)| {
+                    row.iter()
+                        .zip(&wd)
+                        .map(|(s, wj)| (vi * s * wj).abs())
+                        .sum::<f64>()
+                })
+                .sum();
+            assert!(
+                (got - expected).abs() <= 1e-12 * terms,
+                "case {case} (h = {h}): Vᵀ S W = {got}, h⁴ ∫ DΔ²w DΔ²v = {expected}"
+            );
+        }
+    }
+}
+
 /// Morley: the same identities for random quadratics.
 #[test]
 fn morley_kernel_reproduces_the_bending_energy_of_quadratics() {
