@@ -85,3 +85,58 @@ fn the_boundary_condition_of_the_plate_is_the_homogeneous_simple_support() {
         "{message}"
     );
 }
+
+/// A clamped plate in the obstacle path: the runtime's `support_plate` constraints into
+/// `Discretization::with_constraints`, solved by `solve_nested` (one level). With the
+/// obstacle far above the unobstructed deflection it is never touched: λ_h = 0 and the
+/// centre deflection is the clamped plate's `0.00126532 q a⁴/D` (to 1e-5 at N = 8, as the
+/// linear solve of tests/argyris.rs; the stabilization, α = 1e-6, shifts it by far less).
+#[test]
+fn a_clamped_plate_below_a_distant_obstacle_bends_as_without_it() {
+    use fem_forms::obstacle::triangle::prolong_primal_on_triangles;
+    use fem_forms::obstacle::{solve_nested, Discretization};
+    use fem_forms::{Constraints, DirichletPart, PlateSupport, SystemDofs};
+    let q = 2.0;
+    let d_bending = 0.5;
+    let up = move |_: &[f64]| q;
+    let far = |_: &[f64]| 1.0;
+    let (f, psi, g): (&DataFn, &DataFn, &DataFn) = (&up, &far, &zero);
+    let c = Coefficients::new::<M>(
+        &[("D", d_bending), ("ν", 0.3), ("α", 1e-6), ("s", -1.0)],
+        &[("f", f), ("ψ", psi), ("g", g)],
+    )
+    .unwrap();
+    let mesh = square(8);
+    let level = || {
+        let dofs = SystemDofs::all::<M>(&mesh)?;
+        let mut constraints = Constraints::new();
+        constraints.support_plate::<M>(
+            &mesh,
+            &dofs,
+            "w",
+            &DirichletPart::All,
+            PlateSupport::Clamped,
+        )?;
+        Discretization::with_constraints::<M>(&mesh, &c, dofs, &constraints, "B_h", "L_h")
+    };
+    let solution = solve_nested(
+        vec![level],
+        prolong_primal_on_triangles,
+        ObstacleOptions::default(),
+    )
+    .unwrap();
+    let d = &solution.discretization;
+    let lambda = solution.field(d.multiplier_field);
+    assert!(lambda.iter().all(|&l| l == 0.0), "contact where none is");
+    let centre = mesh
+        .vertices()
+        .iter()
+        .position(|p| (p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12)
+        .unwrap();
+    let w = solution.field(0)[d.dofs.map(0).unwrap().vertex_dofs(centre).start];
+    let exact = 0.00126532 * q / d_bending;
+    assert!(
+        ((w - exact) / exact).abs() < 1e-5,
+        "w_c = {w}, expected {exact}"
+    );
+}
