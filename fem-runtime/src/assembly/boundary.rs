@@ -313,7 +313,8 @@ impl Constraints {
     /// boundary of `mesh`: the DOFs of [`DirichletPart::plate_dofs`] are fixed to zero.
     ///
     /// # Errors
-    /// [`Error::Input`] for an unknown field, a field not in `dofs`, and as
+    /// [`Error::Input`] for an unknown field, a field not in `dofs`, a part that holds no
+    /// boundary edge of `mesh` (a misspelt or foreign marker), and as
     /// [`DirichletPart::plate_dofs`].
     pub fn support_plate<M: Model>(
         &mut self,
@@ -329,6 +330,12 @@ impl Constraints {
                 "field `{field}` is not part of this system"
             )));
         };
+        if part.edge_count(mesh) == 0 {
+            return Err(Error::Input(format!(
+                "the boundary part {part:?} where `{field}` is {support:?} holds none of the mesh's {} boundary edges",
+                mesh.boundary_edges().len()
+            )));
+        }
         for d in part.plate_dofs(map, mesh, support)? {
             self.fixed.push((offset + d, 0.0));
         }
