@@ -75,9 +75,10 @@ pub fn dirichlet_constraints_on<M: Model>(
             // only, so g must vanish on the part (checked at its vertices).
             let vertices = part.vertices(mesh);
             let g = coefficients.data[data];
-            for (v, x) in mesh.vertices().iter().enumerate() {
+            let on_part = mesh.vertices().iter().zip(&vertices).filter(|(_, &on)| on);
+            for (x, _) in on_part {
                 let value = g(x);
-                if vertices[v] && value != 0.0 {
+                if value != 0.0 {
                     return Err(Error::Input(format!(
                         "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions on {} fields are homogeneous (w = 0) for now",
                         M::DATA[data],
