@@ -12,7 +12,10 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::kirchhoff::{kirchhoff_argyris, kirchhoff_morley};
-use fem_forms::{assemble_vector, Coefficients, DataFn, Diagonal, MatrixAssembler, SystemDofs};
+use fem_forms::{
+    solve_linear, Coefficients, Constraints, DataFn, Diagonal, DirichletPart, Factorization, Model,
+    PlateSupport, SystemDofs,
+};
 use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use fem_runtime::reference::triangle::{Polynomial2, TriangleRule};
 use fem_runtime::{DofMap, ElementKind};
@@ -217,6 +220,60 @@ fn argyris_kernel_reproduces_the_bending_energy_of_quintics() {
     }
 }
 
+/// The stabilization block of the Argyris–P0 obstacle model, `S_ww = h_T⁴ (DΔ²w, DΔ²v)_T`
+/// (`h_T` the longest edge), against `Δ²` of random quintics computed here: the fourth
+/// derivatives through the transformation (`Δ²w` is linear on a quintic's cell; the
+/// product is integrated exactly by a rule of degree 2).
+#[test]
+fn argyris_stabilization_kernel_reproduces_the_bilaplacian_of_quintics() {
+    use fem_forms::models::kirchhoff::kirchhoff_argyris_p0;
+    let mut rng = Random(0x51_7cc1_b727_220a);
+    let f: &DataFn = &constant_load;
+    for case in 0..40 {
+        let h = [0.01, 0.1, 1.0, 3.0][case % 4];
+        let (x, g) = random_cell(&mut rng, h, case % 2 == 1);
+        let (d, nu) = (rng.uniform(0.5, 2.0), rng.uniform(0.0, 0.45));
+        let params = [d, nu, 1e-3, 1.0];
+        let centre = [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0];
+        let k = kirchhoff_argyris_p0::S::matrix_v_w(&x, &g, &params, &[f, f, f]);
+        let diameter = (0..3)
+            .map(|a| {
+                let b = (a + 1) % 3;
+                (x[2 * a] - x[2 * b]).hypot(x[2 * a + 1] - x[2 * b + 1])
+            })
+            .fold(0.0, f64::max);
+        let bilaplacian = |p: &Polynomial2| {
+            let terms = [p.derivative(4, 0), p.derivative(2, 2), p.derivative(0, 4)];
+            move |at: [f64; 2]| terms[0].eval(at) + 2.0 * terms[1].eval(at) + terms[2].eval(at)
+        };
+        for _ in 0..3 {
+            let w = random_polynomial(&mut rng, 5, centre, h);
+            let v = random_polynomial(&mut rng, 5, centre, h);
+            let (wd, vd) = (argyris_dofs(&w, &x, &g), argyris_dofs(&v, &x, &g));
+            let (bw, bv) = (bilaplacian(&w), bilaplacian(&v));
+            let h4 = diameter.powi(4);
+            let expected = h4 * integrate(&x, 2, |p| d * bw(p) * d * bv(p));
+            let got = quadratic_form(&k, &vd, &wd);
+            // Δ²w of a quintic is a cancellation of the DOFs' terms (by 1e7 on thin
+            // cells), so the rounding is measured against their sizes, Σ |V_i S_ij W_j|.
+            let terms: f64 = k
+                .iter()
+                .zip(&vd)
+                .map(|(row, vi)| {
+                    row.iter()
+                        .zip(&wd)
+                        .map(|(s, wj)| (vi * s * wj).abs())
+                        .sum::<f64>()
+                })
+                .sum();
+            assert!(
+                (got - expected).abs() <= 1e-12 * terms,
+                "case {case} (h = {h}): Vᵀ S W = {got}, h⁴ ∫ DΔ²w DΔ²v = {expected}"
+            );
+        }
+    }
+}
+
 /// Morley: the same identities for random quadratics.
 #[test]
 fn morley_kernel_reproduces_the_bending_energy_of_quadratics() {
@@ -344,111 +401,40 @@ fn argyris_field_reproduces_a_global_quintic() {
     }
 }
 
-/// Dense Cholesky solve of a symmetric positive definite system (an independent solver
-/// for the plate tests).
-fn cholesky_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
-    let n = b.len();
-    for j in 0..n {
-        let d = (a[j][j] - (0..j).map(|k| a[j][k] * a[j][k]).sum::<f64>()).sqrt();
-        assert!(d > 0.0, "not positive definite at {j}");
-        a[j][j] = d;
-        for i in j + 1..n {
-            let s = a[i][j] - (0..j).map(|k| a[i][k] * a[j][k]).sum::<f64>();
-            a[i][j] = s / d;
-        }
-    }
-    for i in 0..n {
-        b[i] = (b[i] - (0..i).map(|k| a[i][k] * b[k]).sum::<f64>()) / a[i][i];
-    }
-    for i in (0..n).rev() {
-        b[i] = (b[i] - (i + 1..n).map(|k| a[k][i] * b[k]).sum::<f64>()) / a[i][i];
-    }
-    b
-}
-
 fn unit_load(_: &[f64]) -> f64 {
     1.0
 }
 
-/// How the plate's edges are held.
-#[derive(Clone, Copy)]
-enum Support {
-    /// Value and normal derivative zero: at boundary vertices the value, both first
-    /// derivatives, the mixed second derivative and the second derivative along the
-    /// boundary (`u_yy` on `x = 0, 1`, `u_xx` on `y = 0, 1`), all six at corners, and the
-    /// normal derivatives of boundary edges.
-    Clamped,
-    /// Value zero: at boundary vertices the value and the first and second derivatives
-    /// along the boundary (at corners along both edges, so all but `u_xy`); the edge
-    /// normal derivatives stay free.
-    SimplySupported,
-}
-
 /// Centre deflection of the unit square plate under a unit load, D = 1, ν = 0.3, on an
-/// `n × n × 2` mesh, assembled by the runtime (`MatrixAssembler`, `assemble_vector`) and
-/// solved here with the fixed DOFs (all zero) of `support` removed.
-fn centre_deflection(n: usize, support: Support) -> f64 {
-    type M = kirchhoff_argyris::Model;
+/// `n × n × 2` mesh, held by `support` on the whole boundary (the runtime's
+/// `Constraints::support_plate`) and solved by the runtime's linear path (`solve_linear`:
+/// assembly, elimination of the fixed DOFs, sparse Cholesky).
+fn centre_deflection<M: Model>(n: usize, support: PlateSupport) -> f64 {
     let mesh =
         fem_runtime::TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap();
     let dofs = SystemDofs::new::<M>(&mesh, &[0]).unwrap();
     let load: &DataFn = &unit_load;
     let coefficients = Coefficients::new::<M>(&[("D", 1.0), ("ν", 0.3)], &[("f", load)]).unwrap();
-    let k = MatrixAssembler::new::<M>("a", &mesh, &dofs)
-        .unwrap()
-        .assemble::<M>(&mesh, &coefficients)
+    let mut constraints = Constraints::new();
+    constraints
+        .support_plate::<M>(&mesh, &dofs, "w", &DirichletPart::All, support)
         .unwrap();
-    let f = assemble_vector::<M>("ℓ", &mesh, &dofs, &coefficients).unwrap();
-    let map = dofs.map(0).unwrap();
-    let mut fixed = vec![false; dofs.dof_count()];
-    let on = |t: f64| t.abs() < 1e-12 || (t - 1.0).abs() < 1e-12;
-    for (v, &[x, y]) in mesh.vertices().iter().enumerate() {
-        let r = map.vertex_dofs(v);
-        // Local order at a vertex: u, u_x, u_y, u_xx, u_xy, u_yy.
-        let kinds: &[usize] = match (support, on(x), on(y)) {
-            (_, false, false) => &[],
-            (Support::Clamped, true, true) => &[0, 1, 2, 3, 4, 5],
-            (Support::Clamped, true, false) => &[0, 1, 2, 4, 5],
-            (Support::Clamped, false, true) => &[0, 1, 2, 3, 4],
-            (Support::SimplySupported, true, true) => &[0, 1, 2, 3, 5],
-            (Support::SimplySupported, true, false) => &[0, 2, 5],
-            (Support::SimplySupported, false, true) => &[0, 1, 3],
-        };
-        for &k in kinds {
-            fixed[r.start + k] = true;
-        }
-    }
-    let boundary: Vec<usize> = mesh.boundary_edges().iter().map(|&(e, _)| e).collect();
-    for c in 0..mesh.cell_count() {
-        for (k, e) in mesh.cell_edges(c).into_iter().enumerate() {
-            if matches!(support, Support::Clamped) && boundary.contains(&e) {
-                fixed[map.cell_dofs(c)[18 + k]] = true;
-            }
-        }
-    }
-    let free: Vec<usize> = (0..dofs.dof_count()).filter(|&d| !fixed[d]).collect();
-    let mut position = vec![usize::MAX; dofs.dof_count()];
-    for (i, &d) in free.iter().enumerate() {
-        position[d] = i;
-    }
-    let mut a = vec![vec![0.0; free.len()]; free.len()];
-    let (col_ptr, row_idx, values) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-    for j in 0..k.ncols() {
-        for p in col_ptr[j]..col_ptr[j + 1] {
-            let i = row_idx[p];
-            if position[i] != usize::MAX && position[j] != usize::MAX {
-                a[position[i]][position[j]] += values[p];
-            }
-        }
-    }
-    let b: Vec<f64> = free.iter().map(|&d| f[d]).collect();
-    let w = cholesky_solve(a, b);
+    let w = solve_linear::<M>(
+        &mesh,
+        &dofs,
+        "a",
+        "ℓ",
+        &constraints,
+        &coefficients,
+        Factorization::Cholesky,
+    )
+    .unwrap();
     let centre = mesh
         .vertices()
         .iter()
         .position(|p| (p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12)
         .expect("n even: the centre is a vertex");
-    w[position[map.vertex_dofs(centre).start]]
+    w[dofs.map(0).unwrap().vertex_dofs(centre).start]
 }
 
 /// The clamped square plate: the centre deflection `0.00126532 q a⁴/D` (Timoshenko and
@@ -456,8 +442,8 @@ fn centre_deflection(n: usize, support: Support) -> f64 {
 #[test]
 fn clamped_square_plate_centre_deflection() {
     let exact = 0.00126532;
-    let coarse = centre_deflection(4, Support::Clamped);
-    let fine = centre_deflection(8, Support::Clamped);
+    let coarse = centre_deflection::<kirchhoff_argyris::Model>(4, PlateSupport::Clamped);
+    let fine = centre_deflection::<kirchhoff_argyris::Model>(8, PlateSupport::Clamped);
     println!("w_c: N = 4 {coarse:.10e}, N = 8 {fine:.10e}, exact {exact}");
     assert!(
         ((fine - exact) / exact).abs() < 1e-5,
@@ -475,8 +461,8 @@ fn clamped_square_plate_centre_deflection() {
 #[test]
 fn simply_supported_square_plate_centre_deflection() {
     let exact = 0.00406235;
-    let coarse = centre_deflection(4, Support::SimplySupported);
-    let fine = centre_deflection(8, Support::SimplySupported);
+    let coarse = centre_deflection::<kirchhoff_argyris::Model>(4, PlateSupport::SimplySupported);
+    let fine = centre_deflection::<kirchhoff_argyris::Model>(8, PlateSupport::SimplySupported);
     println!("w_c: N = 4 {coarse:.10e}, N = 8 {fine:.10e}, exact {exact}");
     assert!(
         ((fine - exact) / exact).abs() < 1e-5,
@@ -486,4 +472,97 @@ fn simply_supported_square_plate_centre_deflection() {
         (fine - exact).abs() < (coarse - exact).abs(),
         "no convergence: N = 4 {coarse}, N = 8 {fine}"
     );
+}
+
+/// The Morley plate through the same runtime path: the non-conforming quadratic converges
+/// to the same centre deflections, the error falling by about 4 per halving of h
+/// (O(h²) for this smooth solution), clamped and simply supported.
+#[test]
+fn morley_square_plate_converges_to_the_centre_deflections() {
+    for (support, exact) in [
+        (PlateSupport::Clamped, 0.00126532),
+        (PlateSupport::SimplySupported, 0.00406235),
+    ] {
+        let errors: Vec<f64> = [8, 16, 32]
+            .iter()
+            .map(|&n| {
+                let w = centre_deflection::<kirchhoff_morley::Model>(n, support);
+                eprintln!("Morley {support:?} N = {n}: w_c = {w:.8e}");
+                ((w - exact) / exact).abs()
+            })
+            .collect();
+        assert!(errors[2] < 3e-2, "{support:?}: errors {errors:?}");
+        for k in 0..2 {
+            let ratio = errors[k] / errors[k + 1];
+            assert!(ratio > 3.0 && ratio < 5.0, "{support:?}: errors {errors:?}");
+        }
+    }
+}
+
+/// Supports chosen per boundary part by name: the square clamped on its left and right
+/// sides and simply supported on the top and bottom. Timoshenko and Woinowsky-Krieger
+/// (Table 29, b/a = 1, ν = 0.3) give the centre deflection `0.00192 q a⁴/D` to three
+/// digits; the two supports alone give 0.00127 and 0.00406, so a part read wrongly fails.
+/// A part that names no boundary edge is refused.
+#[test]
+fn square_plate_clamped_on_two_sides_and_simply_supported_on_the_others() {
+    type M = kirchhoff_argyris::Model;
+    let n = 8;
+    let mesh =
+        fem_runtime::TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap();
+    let dofs = SystemDofs::new::<M>(&mesh, &[0]).unwrap();
+    let load: &DataFn = &unit_load;
+    let coefficients = Coefficients::new::<M>(&[("D", 1.0), ("ν", 0.3)], &[("f", load)]).unwrap();
+    let part = |names: &[&str]| DirichletPart::Markers(mesh.boundary_part_markers(names).unwrap());
+    let mut constraints = Constraints::new();
+    constraints
+        .support_plate::<M>(
+            &mesh,
+            &dofs,
+            "w",
+            &part(&["left", "right"]),
+            PlateSupport::Clamped,
+        )
+        .unwrap();
+    constraints
+        .support_plate::<M>(
+            &mesh,
+            &dofs,
+            "w",
+            &part(&["top", "bottom"]),
+            PlateSupport::SimplySupported,
+        )
+        .unwrap();
+    let w = solve_linear::<M>(
+        &mesh,
+        &dofs,
+        "a",
+        "ℓ",
+        &constraints,
+        &coefficients,
+        Factorization::Cholesky,
+    )
+    .unwrap();
+    let centre = mesh
+        .vertices()
+        .iter()
+        .position(|p| (p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12)
+        .unwrap();
+    let w_c = w[dofs.map(0).unwrap().vertex_dofs(centre).start];
+    println!("clamped left/right, simply supported top/bottom: w_c = {w_c:.8e}");
+    assert!(
+        ((w_c - 0.00192) / 0.00192).abs() < 4e-3,
+        "w_c = {w_c}, Timoshenko 0.00192"
+    );
+    let message = constraints
+        .support_plate::<M>(
+            &mesh,
+            &dofs,
+            "w",
+            &DirichletPart::Markers(vec![99]),
+            PlateSupport::Clamped,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("none of the mesh"), "{message}");
 }

@@ -483,18 +483,9 @@ impl Declaration {
                         ),
                     ))
                 }
-                // Their DOFs are derivatives too: interpolating `g` at the DOFs' points,
-                // as `boundary:` does, would fix them to values.
-                Some(u) if u.element.is_some_and(|e| e.needs_transformation()) => errors.push(
-                    Diagnostic::token(
-                        field.span(),
-                        format!(
-                            "`{field}` has the {} element: `boundary:` cannot prescribe it yet",
-                            u.element.map_or("", |e| e.name())
-                        ),
-                    )
-                    .help("its DOFs are values and derivatives: fix them by kind at run time (`Constraints::fix_dof`), as the plate tests of tests/argyris.rs choose them"),
-                ),
+                // Argyris, Morley: the runtime reads `w = g` as the simple support with
+                // g = 0, fixing DOFs by kind (`DirichletPart::plate_dofs`), not by
+                // interpolating g at points.
                 Some(_) => {}
             }
             if !self.data.iter().any(|d| d.name == *data) {

@@ -39,7 +39,7 @@ pub mod norms;
 pub mod obstacle;
 pub mod stabilization;
 
-pub use assembly::boundary::{Constraints, DirichletPart, Reduction, Side};
+pub use assembly::boundary::{Constraints, DirichletPart, PlateSupport, Reduction, Side};
 pub use assembly::dof_map::{DofMap, DofNumbering, SystemDofs};
 pub use assembly::linear_problem::{solve_linear, Factorization};
 pub use assembly::{assemble_vector, kernel, MatrixAssembler};

@@ -5,7 +5,7 @@ use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::error::Result;
 use crate::lcp::cholesky::{Cholesky, LuSolver};
-use crate::mesh::IntervalMesh;
+use crate::mesh::Mesh;
 use crate::model::{Coefficients, Model};
 
 /// Which factorization to use.
@@ -18,9 +18,9 @@ pub enum Factorization {
 }
 
 /// Solves `bilinear(u, v) = linear(v)` on the fields of `dofs` with the fixed DOFs of
-/// `constraints`; returns the full coefficient vector.
+/// `constraints`, on any mesh (intervals, triangles); returns the full coefficient vector.
 pub fn solve_linear<M: Model>(
-    mesh: &IntervalMesh,
+    mesh: &impl Mesh,
     dofs: &SystemDofs,
     bilinear: &str,
     linear: &str,

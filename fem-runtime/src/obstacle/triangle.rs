@@ -4,7 +4,7 @@
 //! classical nodal-constraint method for comparison, and the solution's contact force
 //! and contact area.
 
-use crate::assembly::boundary::{Constraints, DirichletPart};
+use crate::assembly::boundary::{Constraints, DirichletPart, PlateSupport};
 use crate::assembly::dof_map::SystemDofs;
 use crate::element::triangle::{TriangleBasis, TriangleField};
 use crate::error::{Error, Result};
@@ -32,13 +32,17 @@ pub fn dirichlet_constraints<M: Model>(
 /// The fixed DOFs of the model's `boundary:` conditions on `part` of the boundary
 /// ([`DirichletPart::dofs`]: for P2 the midpoints of its edges, and the vertices where
 /// it meets the rest, are fixed); the rest of the boundary gets the form's natural
-/// condition.
+/// condition. For a plate field (Argyris, Morley) `w = g` is the simple support with
+/// `g = 0` ([`DirichletPart::plate_dofs`]); a clamped plate is supported with
+/// [`Constraints::support_plate`].
 ///
 /// # Errors
 /// [`Error::Input`] when the model has a `boundary:` condition and `part` holds no
 /// boundary edge of the mesh (a problem with natural conditions only, which the
 /// membrane does not determine: u + constant solves it wherever contact does not hold
-/// it), and for boundary data that is not finite at a node.
+/// it), for boundary data that is not finite at a node, and for a plate field: data
+/// that is not zero at a vertex of the part, or (Argyris) an edge of the part that is
+/// not along x or y.
 pub fn dirichlet_constraints_on<M: Model>(
     mesh: &TriangleMesh,
     dofs: &SystemDofs,
@@ -65,6 +69,31 @@ pub fn dirichlet_constraints_on<M: Model>(
         let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
             continue;
         };
+        if map.element().needs_transformation() {
+            // A plate (Argyris, Morley): `w = g` on the part is the simple support,
+            // which fixes derivative DOFs too (DirichletPart::plate_dofs); homogeneous
+            // only, so g must vanish on the part (checked at its vertices).
+            let vertices = part.vertices(mesh);
+            let g = coefficients.data[data];
+            let on_part = mesh.vertices().iter().zip(&vertices).filter(|(_, &on)| on);
+            for (x, _) in on_part {
+                let value = g(x);
+                if value != 0.0 {
+                    return Err(Error::Input(format!(
+                        "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions on {} fields are homogeneous (w = 0) for now",
+                        M::DATA[data],
+                        M::FIELDS[field].name,
+                        x[0],
+                        x[1],
+                        map.element().name()
+                    )));
+                }
+            }
+            for dof in part.plate_dofs(map, mesh, PlateSupport::SimplySupported)? {
+                constraints.fix_dof(offset + dof, 0.0)?;
+            }
+            continue;
+        }
         let nodes = map.nodes(mesh);
         let g = coefficients.data[data];
         for dof in part.dofs(map, mesh) {

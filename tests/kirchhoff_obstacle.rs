@@ -1,0 +1,142 @@
+//! The Kirchhoff plate obstacle model on Argyris–P0 (`models/src/kirchhoff.rs`) through
+//! the runtime's obstacle path (`solve_obstacle_on_triangles`), with its `boundary:`
+//! condition read as the simple support `w = 0` (`DirichletPart::plate_dofs`).
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use fem_forms::models::kirchhoff::kirchhoff_argyris_p0;
+use fem_forms::obstacle::triangle::solve_obstacle_on_triangles;
+use fem_forms::obstacle::ObstacleOptions;
+use fem_forms::{Coefficients, DataFn, Diagonal, TriangleMesh};
+
+type M = kirchhoff_argyris_p0::Model;
+
+fn zero(_: &[f64]) -> f64 {
+    0.0
+}
+
+fn square(n: usize) -> TriangleMesh {
+    TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap()
+}
+
+/// The sign test of MODELS.md §1 for both obstacle sides: ψ = 0 and `f = −s·q` press the
+/// plate onto the obstacle everywhere, so exactly `w = 0` and `λ = q` (`DΔ²w − sλ = f`);
+/// a wrong sign of b, G or the stabilization (α well inside `1/C_I`, here it matters:
+/// `ℓ_S` and `S` do not cancel unless their signs agree) gives another λ or none.
+#[test]
+fn a_plate_pressed_onto_the_obstacle_everywhere_has_lambda_equal_to_the_load() {
+    let q = 3.0;
+    for s in [1.0, -1.0] {
+        let f = move |_: &[f64]| -s * q;
+        let (f, psi, g): (&DataFn, &DataFn, &DataFn) = (&f, &zero, &zero);
+        let c = Coefficients::new::<M>(
+            &[("D", 2.0), ("ν", 0.3), ("α", 1e-6), ("s", s)],
+            &[("f", f), ("ψ", psi), ("g", g)],
+        )
+        .unwrap();
+        let solution =
+            solve_obstacle_on_triangles::<M>(&[square(4)], &c, ObstacleOptions::default()).unwrap();
+        let d = &solution.discretization;
+        let lambda = solution.field(d.multiplier_field);
+        assert_eq!(lambda.len(), 32);
+        assert!(
+            lambda.iter().all(|l| (l - q).abs() <= 1e-8 * q),
+            "s = {s}: λ_h from {} to {}, expected {q}",
+            lambda.iter().cloned().fold(f64::INFINITY, f64::min),
+            lambda.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+        );
+        let primal = d.primal_part(&solution.values);
+        let largest = primal.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(largest <= 1e-10, "s = {s}: |W|∞ = {largest}, expected 0");
+    }
+}
+
+/// `boundary: w = g` on the Argyris field is the simple support: the DOFs the obstacle
+/// discretization fixes are exactly `plate_dofs(SimplySupported)` (5 per corner, 3 per
+/// other boundary vertex), and data that is not zero on the boundary is refused with
+/// its name rather than imposed wrongly.
+#[test]
+fn the_boundary_condition_of_the_plate_is_the_homogeneous_simple_support() {
+    use fem_forms::obstacle::triangle::discretize_on_triangles;
+    use fem_forms::{DirichletPart, PlateSupport};
+    let mesh = square(4);
+    let f = |_: &[f64]| -1.0;
+    let (f, psi, g): (&DataFn, &DataFn, &DataFn) = (&f, &zero, &zero);
+    let params = [("D", 1.0), ("ν", 0.3), ("α", 1e-6), ("s", 1.0)];
+    let c = Coefficients::new::<M>(&params, &[("f", f), ("ψ", psi), ("g", g)]).unwrap();
+    let d = discretize_on_triangles::<M>(&mesh, &c, "B_h", "L_h").unwrap();
+    let fixed: Vec<usize> = (0..d.dofs.dof_count())
+        .filter(|&k| d.reduction.free_index(k).is_none())
+        .collect();
+    let expected = DirichletPart::All
+        .plate_dofs(d.dofs.map(0).unwrap(), &mesh, PlateSupport::SimplySupported)
+        .unwrap();
+    assert_eq!(fixed, expected);
+    assert_eq!(fixed.len(), 4 * 5 + 12 * 3);
+
+    let lifted = |x: &[f64]| 1.0 + x[0];
+    let g: &DataFn = &lifted;
+    let c = Coefficients::new::<M>(&params, &[("f", f), ("ψ", psi), ("g", g)]).unwrap();
+    let message = discretize_on_triangles::<M>(&mesh, &c, "B_h", "L_h")
+        .err()
+        .expect("inhomogeneous plate data is refused")
+        .to_string();
+    assert!(
+        message.contains("`g`") && message.contains("homogeneous"),
+        "{message}"
+    );
+}
+
+/// A clamped plate in the obstacle path: the runtime's `support_plate` constraints into
+/// `Discretization::with_constraints`, solved by `solve_nested` (one level). With the
+/// obstacle far above the unobstructed deflection it is never touched: λ_h = 0 and the
+/// centre deflection is the clamped plate's `0.00126532 q a⁴/D` (to 1e-5 at N = 8, as the
+/// linear solve of tests/argyris.rs; the stabilization, α = 1e-6, shifts it by far less).
+#[test]
+fn a_clamped_plate_below_a_distant_obstacle_bends_as_without_it() {
+    use fem_forms::obstacle::triangle::prolong_primal_on_triangles;
+    use fem_forms::obstacle::{solve_nested, Discretization};
+    use fem_forms::{Constraints, DirichletPart, PlateSupport, SystemDofs};
+    let q = 2.0;
+    let d_bending = 0.5;
+    let up = move |_: &[f64]| q;
+    let far = |_: &[f64]| 1.0;
+    let (f, psi, g): (&DataFn, &DataFn, &DataFn) = (&up, &far, &zero);
+    let c = Coefficients::new::<M>(
+        &[("D", d_bending), ("ν", 0.3), ("α", 1e-6), ("s", -1.0)],
+        &[("f", f), ("ψ", psi), ("g", g)],
+    )
+    .unwrap();
+    let mesh = square(8);
+    let level = || {
+        let dofs = SystemDofs::all::<M>(&mesh)?;
+        let mut constraints = Constraints::new();
+        constraints.support_plate::<M>(
+            &mesh,
+            &dofs,
+            "w",
+            &DirichletPart::All,
+            PlateSupport::Clamped,
+        )?;
+        Discretization::with_constraints::<M>(&mesh, &c, dofs, &constraints, "B_h", "L_h")
+    };
+    let solution = solve_nested(
+        vec![level],
+        prolong_primal_on_triangles,
+        ObstacleOptions::default(),
+    )
+    .unwrap();
+    let d = &solution.discretization;
+    let lambda = solution.field(d.multiplier_field);
+    assert!(lambda.iter().all(|&l| l == 0.0), "contact where none is");
+    let centre = mesh
+        .vertices()
+        .iter()
+        .position(|p| (p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12)
+        .unwrap();
+    let w = solution.field(0)[d.dofs.map(0).unwrap().vertex_dofs(centre).start];
+    let exact = 0.00126532 * q / d_bending;
+    assert!(
+        ((w - exact) / exact).abs() < 1e-5,
+        "w_c = {w}, expected {exact}"
+    );
+}
