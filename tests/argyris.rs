@@ -438,7 +438,7 @@ fn centre_deflection<M: Model>(n: usize, support: PlateSupport) -> f64 {
 }
 
 /// The clamped square plate: the centre deflection `0.00126532 q a⁴/D` (Timoshenko and
-/// Woinowsky-Krieger, Table 35; MODELS.md §5), to 1e-5 relative at N = 8.
+/// Woinowsky-Krieger, Table 35; docs/mathematics.md §9), to 1e-5 relative at N = 8.
 #[test]
 fn clamped_square_plate_centre_deflection() {
     let exact = 0.00126532;
@@ -456,7 +456,7 @@ fn clamped_square_plate_centre_deflection() {
 }
 
 /// The simply supported square plate: the centre deflection `0.00406235 q a⁴/D`
-/// (Timoshenko and Woinowsky-Krieger, Navier series; MODELS.md §5 and issue 13), to 1e-5
+/// (Timoshenko and Woinowsky-Krieger, Navier series; docs/mathematics.md §9), to 1e-5
 /// relative at N = 8.
 #[test]
 fn simply_supported_square_plate_centre_deflection() {

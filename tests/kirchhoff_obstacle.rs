@@ -18,7 +18,7 @@ fn square(n: usize) -> TriangleMesh {
     TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap()
 }
 
-/// The sign test of MODELS.md §1 for both obstacle sides: ψ = 0 and `f = −s·q` press the
+/// The sign test of docs/mathematics.md §1 for both obstacle sides: ψ = 0 and `f = −s·q` press the
 /// plate onto the obstacle everywhere, so exactly `w = 0` and `λ = q` (`DΔ²w − sλ = f`);
 /// a wrong sign of b, G or the stabilization (α well inside `1/C_I`, here it matters:
 /// `ℓ_S` and `S` do not cancel unless their signs agree) gives another λ or none.

@@ -1,4 +1,4 @@
-//! Kirchhoff plate bending (docs/mathematics.md and ../shared/MODELS.md §5) on the C¹
+//! Kirchhoff plate bending (docs/mathematics.md §9) on the C¹
 //! Argyris quintic and on the non-conforming Morley quadratic: the bending form
 //! `a(w;v) = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]` (that is `∫ M(w):K(v)` with
 //! `K(w) = −∇∇w`, `M(w) = D[(1−ν)K(w) + ν tr K(w) I]`) and the load `ℓ(v) = ∫ f v`.
@@ -35,7 +35,7 @@ kirchhoff_model! {
 }
 
 fem_runtime::model! {
-    /// Kirchhoff plate obstacle problem on Argyris–P0 (MODELS.md §5, frame §1): deflection
+    /// Kirchhoff plate obstacle problem on Argyris–P0 (docs/mathematics.md §9, frame §1): deflection
     /// w ∈ Argyris, contact multiplier λ ∈ P0, λ ≥ 0, obstacle side `s = ±1`
     /// (`s·w ≥ s·ψ`: +1 an obstacle below, −1 one above), `DΔ²w − sλ = f`, stabilized by
     /// `S_h = Σ_T h_T⁴ (DΔ²w − sλ, DΔ²v − sμ)_T` (`Δ²` written `ΔΔ`). `boundary: w = g`

@@ -3,7 +3,7 @@
 //! so that each cell is the six-node map of [`Isoparametric`] (docs/mathematics.md §8).
 //!
 //! A polygonal approximation of a curved domain errs by O(h²) in area (and in the
-//! energy of a plate: MODELS.md §6 measured 3e-4 relative to J on a disk); quadratic
+//! energy of a plate: 3e-4 relative to J on a disk, docs/mathematics.md §8); quadratic
 //! geometry errs by O(h⁴).
 
 use super::TriangleMesh;
