@@ -128,6 +128,10 @@ impl<G: DofNumbering + Clone> Discretization<G> {
     /// Assembles `bilinear` and `linear` of `M` on `mesh` with the DOFs `dofs`, eliminates
     /// the fixed DOFs of `constraints` and splits the system into the LCP blocks. The forms
     /// are named by handle (`M::SYSTEM`, `model::forms::B_h`) or by name (`"B_h"`).
+    ///
+    /// Only `constraints` are imposed: the model's `boundary:` conditions are the caller's
+    /// to include ([`Discretization::new`] does on intervals,
+    /// [`triangle::dirichlet_constraints_on`] on triangles).
     pub fn with_constraints<M: Model>(
         mesh: &G,
         coefficients: &Coefficients,
