@@ -5,8 +5,8 @@
 //! and contact area.
 
 use crate::assembly::boundary::{Constraints, DirichletPart, PlateSupport};
-use crate::assembly::dof_map::SystemDofs;
-use crate::element::triangle::{TriangleBasis, TriangleField};
+use crate::assembly::dof_map::{DofMap, SystemDofs};
+use crate::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use crate::error::{Error, Result};
 use crate::lcp::cholesky::{multiply, Cholesky};
 use crate::lcp::{Lcp, LcpSolution};
@@ -160,6 +160,60 @@ pub fn prolong_primal_on_triangles(
     prolong_fields(coarse, coarse_values, fine, false)
 }
 
+/// Argyris and Morley: the fine DOFs are the physical functionals of the coarse field
+/// (values, gradients and Hessians at the vertices, normal derivatives at the edge
+/// midpoints along the normal of the edge oriented from its lower to its higher global
+/// vertex, docs/elements.md), not values at nodes. A nested space reproduces the coarse
+/// field exactly.
+fn prolong_c1(
+    view: &TriangleField,
+    basis: &TriangleBasis,
+    locator: &PointLocator,
+    fine: &Discretization<TriangleMesh>,
+    map_f: &DofMap,
+    out: &mut [f64],
+) {
+    let mesh = &fine.mesh;
+    let [per_vertex, _, _] = map_f.element().triangle_layout();
+    let mut hint = None;
+    let mut evaluate = |x: [f64; 2]| {
+        let (c, b) = locator.locate_near(x, hint)?;
+        hint = Some(c);
+        let map = AffineMap::of(view.mesh, c);
+        let xi = [b[1], b[2]];
+        Some((
+            view.value(basis, c, xi),
+            view.gradient(basis, &map, c, xi),
+            view.hessian(basis, &map, c, xi),
+        ))
+    };
+    for c in 0..mesh.cell_count() {
+        let dofs = map_f.cell_dofs(c);
+        let cell = mesh.cell(c);
+        for (i, &v) in cell.iter().enumerate() {
+            let Some((u, g, h)) = evaluate(mesh.vertices()[v]) else {
+                continue;
+            };
+            let functionals = [u, g[0], g[1], h[0][0], h[0][1], h[1][1]];
+            for (k, value) in functionals.iter().take(per_vertex).enumerate() {
+                out[dofs[per_vertex * i + k]] = *value;
+            }
+        }
+        for k in 0..3 {
+            let (a, b) = (cell[k], cell[(k + 1) % 3]);
+            let (a, b) = (a.min(b), a.max(b));
+            let (pa, pb) = (mesh.vertices()[a], mesh.vertices()[b]);
+            let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+            let t = [(pb[0] - pa[0]) / length, (pb[1] - pa[1]) / length];
+            let normal = [t[1], -t[0]];
+            let midpoint = [(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0];
+            if let Some((_, g, _)) = evaluate(midpoint) {
+                out[dofs[3 * per_vertex + k]] = g[0] * normal[0] + g[1] * normal[1];
+            }
+        }
+    }
+}
+
 fn prolong_fields(
     coarse: &Discretization<TriangleMesh>,
     coarse_values: &[f64],
@@ -184,6 +238,10 @@ fn prolong_fields(
         let basis = TriangleBasis::new(map_c.element());
         let map_f = fine.dofs.map(field).unwrap();
         let offset = fine.dofs.offset(field).unwrap();
+        if map_f.element().needs_transformation() {
+            prolong_c1(&view, &basis, &locator, fine, map_f, &mut out[offset..]);
+            continue;
+        }
         let mut hint = None;
         for (dof, x) in map_f.nodes(&fine.mesh).into_iter().enumerate() {
             out[offset + dof] = match locator.locate_near(x, hint) {
