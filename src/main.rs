@@ -8,6 +8,7 @@ use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::plate_scenes::PlateScene;
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind, MEMBRANE_PAIRS};
 use fem_forms::models::scenes::{Beam, Scene};
+use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::plates::{self, PlatePair, PlateRequest};
 use fem_forms::studies::{self, Study};
@@ -113,6 +114,10 @@ struct SolveOptions {
     /// Start Newton from zero on the final mesh instead of nested iteration.
     #[arg(long)]
     cold: bool,
+    /// Solver of the Newton steps: auto (default: multigrid on the nested meshes from
+    /// 150k unknowns, direct Cholesky below), direct, or multigrid (membranes).
+    #[arg(long, value_name = "auto|direct|multigrid")]
+    linear_solver: Option<String>,
     /// Rounds of iterative refinement per linear solve (beams; default 1; t ≤ 1e-5
     /// wants 2 or 3).
     #[arg(long)]
@@ -145,6 +150,7 @@ impl SolveOptions {
         note(self.pair.is_some(), "--pair");
         note(self.solver.is_some(), "--solver");
         note(self.cold, "--cold");
+        note(self.linear_solver.is_some(), "--linear-solver");
         note(self.refinement.is_some(), "--refinement");
         note(self.plot, "--plot");
         given
@@ -160,6 +166,13 @@ impl SolveOptions {
             Some(option) => Err(format!("{option} does not apply: {why}")),
             None => Ok(()),
         }
+    }
+
+    fn linear_solver(&self) -> Result<LinearSolver, String> {
+        self.linear_solver
+            .as_deref()
+            .map_or(Ok(LinearSolver::Auto), LinearSolver::parse)
+            .map_err(|e| format!("--linear-solver: {e}"))
     }
 
     fn solver(&self) -> VariationalSolver {
@@ -464,6 +477,7 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             "--vtk",
             "--solver",
             "--cold",
+            "--linear-solver",
             "--refinement",
             "--plot",
         ],
@@ -527,6 +541,10 @@ fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String
         .transpose()
         .map_err(|e| e.to_string())?;
     let load = options.load.unwrap_or(1.0);
+    options.refuse(
+        &["--linear-solver"],
+        "beams are solved by Cholesky (banded, O(N)); multigrid is for the triangle meshes",
+    )?;
     let request = Request {
         scene: s,
         elements: options.elements.unwrap_or(256),
@@ -571,6 +589,10 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
     }
     if request.pair == MembranePair::P1Nodal {
         options.refuse(
+            &["--linear-solver"],
+            "p1-nodal solves its nodal constraints by its own active-set method with Cholesky steps (multigrid steps are for the stabilized pairs)",
+        )?;
+        options.refuse(
             &["--alpha", "--solver"],
             "p1-nodal has no multiplier to stabilize and solves its nodal constraints by its own active-set method",
         )?;
@@ -586,6 +608,7 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
     request.alpha = options.alpha;
     request.solver = options.solver();
     request.nested = !options.cold;
+    request.linear_solver = options.linear_solver()?;
     let (report, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
     if options.json {
         println!(

@@ -9,6 +9,7 @@ use crate::models::membrane_scenes::{
 };
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
 use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
+use fem_runtime::obstacle::hierarchy::LinearSolver;
 use fem_runtime::obstacle::triangle::{
     dirichlet_constraints_on, nodal_active_set, solve_obstacle_on_part, TriangleObstacleSolution,
 };
@@ -169,6 +170,8 @@ pub struct MembraneRequest {
     pub solver: VariationalSolver,
     /// Nested iteration from coarser meshes (N/2, N/4, … ≥ 4).
     pub nested: bool,
+    /// The solver of the Newton steps (multigrid needs the nested meshes).
+    pub linear_solver: LinearSolver,
     /// Diagonal pattern of the structured mesh.
     pub diagonal: Diagonal,
     /// A Gmsh mesh to solve on instead of the scene's own domain, refined uniformly
@@ -195,6 +198,7 @@ impl MembraneRequest {
             alpha: None,
             solver: VariationalSolver::SemismoothNewton,
             nested: true,
+            linear_solver: LinearSolver::Auto,
             diagonal: Diagonal::Right,
             mesh_file: None,
         }
@@ -210,6 +214,14 @@ pub struct MembraneReport {
     pub pair: String,
     /// LCP solver.
     pub solver: String,
+    /// The solver of the Newton steps on the finest level: `direct` (Cholesky) or
+    /// `multigrid` (CG with a W-cycle on the nested meshes) when it solved any step.
+    pub linear_solver: &'static str,
+    /// CG iterations over the finest level's multigrid-solved Newton steps.
+    pub krylov_iterations: usize,
+    /// Newton steps solved by a Cholesky factorization on the finest level (with
+    /// multigrid: the steps CG did not finish, normally 0).
+    pub factorizations: usize,
     /// The domain solved on: the scene's own, or the Gmsh file given with `--msh`.
     pub domain: String,
     /// Where u = g holds: `["all"]` (the whole boundary) or the names of the boundary
@@ -833,7 +845,10 @@ fn run_stabilized<M: Model>(
         ));
     }
     let coefficients = scene_coefficients::<M>(&posed.data, alpha)?;
-    let options = membrane_options(solver);
+    let options = ObstacleOptions {
+        linear_solver: request.linear_solver,
+        ..membrane_options(solver)
+    };
     let meshes = if solver == VariationalSolver::Clarabel {
         &meshes[meshes.len() - 1..]
     } else {
@@ -890,6 +905,13 @@ fn run_stabilized<M: Model>(
         scene: scene.name.to_string(),
         pair: request.pair.name().into(),
         solver: solver_name(solver).into(),
+        linear_solver: if solution.iterative_steps > 0 {
+            "multigrid"
+        } else {
+            "direct"
+        },
+        krylov_iterations: solution.krylov_iterations,
+        factorizations: solution.factorizations,
         domain: posed.domain.clone(),
         dirichlet_parts: scene.dirichlet.names(),
         load: posed.load,
@@ -1092,6 +1114,9 @@ fn run_nodal(
         scene: scene.name.to_string(),
         pair: request.pair.name().into(),
         solver: "nodal active set".into(),
+        linear_solver: "direct",
+        krylov_iterations: 0,
+        factorizations: solution.iterations,
         domain: posed.domain.clone(),
         dirichlet_parts: scene.dirichlet.names(),
         load: posed.load,

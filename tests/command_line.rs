@@ -243,6 +243,25 @@ fn options_that_do_not_apply_are_refused_by_name() {
         ),
         (&["solve", "membrane-radial", "--load", "2"][..], "--load"),
         (
+            &["solve", "bernoulli-a", "--linear-solver", "multigrid"][..],
+            "--linear-solver",
+        ),
+        (
+            &[
+                "solve",
+                "membrane-flat",
+                "--pair",
+                "p1-nodal",
+                "--linear-solver",
+                "multigrid",
+            ][..],
+            "--linear-solver",
+        ),
+        (
+            &["solve", "membrane-flat", "--linear-solver", "gmres"][..],
+            "--linear-solver",
+        ),
+        (
             &[
                 "solve",
                 "membrane-flat",
@@ -416,4 +435,37 @@ fn scene_files_with_msh_and_negative_loads() {
         let measured = nodal["contact_area"].as_f64().unwrap();
         assert!((measured - area).abs() < 1e-9, "--load {load}: {nodal}");
     }
+}
+
+/// `--linear-solver multigrid` solves the finest level's Newton steps by CG (no
+/// factorization) and gives the direct solver's answer; the default (auto) keeps
+/// Cholesky on a system this small.
+#[test]
+fn the_linear_solver_is_chosen_and_reported() {
+    let out = scratch("linear-solver");
+    let args = [
+        "solve",
+        "membrane-radial",
+        "--pair",
+        "p1-p0",
+        "--mesh-size",
+        "32",
+        "--json",
+    ];
+    let auto = json_of(&args, &out);
+    assert_eq!(auto["linear_solver"], "direct");
+    assert!(auto["factorizations"].as_u64().unwrap() > 0);
+    let multigrid = json_of(
+        &[&args[..], &["--linear-solver", "multigrid"]].concat(),
+        &out,
+    );
+    assert_eq!(multigrid["linear_solver"], "multigrid");
+    assert_eq!(multigrid["factorizations"], 0);
+    assert!(multigrid["krylov_iterations"].as_u64().unwrap() > 0);
+    let (a, b) = (
+        auto["error_l2"].as_f64().unwrap(),
+        multigrid["error_l2"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() <= 1e-9 * a, "{a} against {b}");
+    std::fs::remove_dir_all(&out).unwrap();
 }

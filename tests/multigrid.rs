@@ -16,8 +16,9 @@ use fem_forms::models::membrane_scenes::membrane_scene;
 use fem_forms::multigrid::{
     parents_by_location, prolongation, Multigrid, MultigridOptions, NestedLevel,
 };
+use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::triangle::{discretize_on_triangles, solve_obstacle_on_triangles};
-use fem_forms::obstacle::{Discretization, VariationalSolver};
+use fem_forms::obstacle::{Discretization, ObstacleOptions, VariationalSolver};
 use fem_forms::{Constraints, Diagonal, Model, Reduction, SparseMatrix, SystemDofs, TriangleMesh};
 
 /// Newton's Hessian of Φ at `u` for an LCP with a diagonal `C`: `A` plus `b_k b_kᵀ / c_k`
@@ -251,4 +252,103 @@ fn multigrid_cg_on_the_p2_p0_newton_hessian_is_bounded_in_h() {
     );
     let runs = newton_hessian_runs::<M>(&sizes, 0.5 / 96.0, v(1));
     check("P2–P0 α = 0.5/96, V(1,1)", &runs, 20, 4);
+}
+
+/// Nested semismooth Newton on membrane-radial with the Newton steps solved by
+/// `linear_solver`, meshes N = 4, 8, …, `finest`.
+fn nested_solve<M: Model>(
+    finest: usize,
+    alpha: f64,
+    linear_solver: LinearSolver,
+) -> fem_forms::obstacle::triangle::TriangleObstacleSolution {
+    let scene = membrane_scene("membrane-radial").unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+    let options = ObstacleOptions {
+        linear_solver,
+        ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+    };
+    let mut meshes = Vec::new();
+    let mut n = 4;
+    while n <= finest {
+        meshes.push(membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap());
+        n *= 2;
+    }
+    solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap()
+}
+
+/// Newton with multigrid steps (issue 15) against Newton with Cholesky steps, for P1–P0
+/// and P2–P0 from N = 16 to 64: the same VI solution (both KKT-certified, the values equal
+/// to 1e-9 of their size), every step of the finest level solved by CG (no
+/// factorization), and the CG iterations per Newton step bounded as h halves.
+#[test]
+fn newton_with_multigrid_steps_is_newton_with_cholesky_steps() {
+    fn compare<M: Model>(name: &str, alpha: f64) {
+        let mut per_step = Vec::new();
+        for finest in [16, 32, 64] {
+            let direct = nested_solve::<M>(finest, alpha, LinearSolver::Direct);
+            let multigrid = nested_solve::<M>(finest, alpha, LinearSolver::Multigrid);
+            assert!(direct.kkt_residual <= 1e-10 && multigrid.kkt_residual <= 1e-10);
+            assert_eq!(direct.iterative_steps, 0, "{name} N = {finest}: direct");
+            assert!(direct.factorizations > 0);
+            assert_eq!(
+                multigrid.factorizations, 0,
+                "{name} N = {finest}: a multigrid step fell back to Cholesky"
+            );
+            assert!(multigrid.iterative_steps > 0);
+            let scale = direct.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let difference = direct
+                .values
+                .iter()
+                .zip(&multigrid.values)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                difference <= 1e-9 * scale,
+                "{name} N = {finest}: the solutions differ by {difference:e} of {scale:e}"
+            );
+            per_step.push(multigrid.krylov_iterations as f64 / multigrid.iterative_steps as f64);
+        }
+        eprintln!("{name}: CG iterations per Newton step at N = 16, 32, 64: {per_step:?}");
+        assert!(per_step.iter().all(|&k| k <= 14.0), "{name}: {per_step:?}");
+        assert!(
+            per_step[2] <= per_step[1] + 1.5,
+            "{name}: CG iterations per step grow with 1/h: {per_step:?}"
+        );
+    }
+    compare::<membrane_p1_p0::Model>("P1–P0", 0.1);
+    compare::<membrane_p2_p0::Model>("P2–P0", 0.5 / 96.0);
+}
+
+/// The automatic choice keeps Cholesky on small systems (below
+/// `AUTO_MULTIGRID_UNKNOWNS`), and a hierarchy of one level (no coarser mesh) is solved
+/// directly even when multigrid is asked for.
+#[test]
+fn small_systems_and_single_levels_are_solved_directly() {
+    type M = membrane_p1_p0::Model;
+    let auto = nested_solve::<M>(32, 0.1, LinearSolver::Auto);
+    assert_eq!(auto.iterative_steps, 0);
+    assert!(auto.factorizations > 0);
+    assert!(auto.discretization.lcp.n() < fem_forms::obstacle::hierarchy::AUTO_MULTIGRID_UNKNOWNS);
+    let scene = membrane_scene("membrane-radial").unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, 0.1).unwrap();
+    let options = ObstacleOptions {
+        linear_solver: LinearSolver::Multigrid,
+        ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+    };
+    let mesh = membranes::scene_mesh(&scene, 16, Diagonal::Right).unwrap();
+    let single = solve_obstacle_on_triangles::<M>(&[mesh], &coefficients, options).unwrap();
+    assert_eq!(single.iterative_steps, 0);
+    assert!(single.kkt_residual <= 1e-10);
+}
+
+/// `--linear-solver` names: every solver parses back from its name, others are refused
+/// with the list.
+#[test]
+fn linear_solver_names() {
+    for s in LinearSolver::ALL {
+        assert_eq!(LinearSolver::parse(s.name()).unwrap(), s);
+    }
+    let error = LinearSolver::parse("gmres").unwrap_err().to_string();
+    assert!(error.contains("auto, direct, multigrid"), "{error}");
 }

@@ -82,6 +82,8 @@ pub fn primal_dual_active_set(
                         factorizations: iteration,
                         low_rank_updates: 0,
                         multiplier_noise: 0.0,
+                        iterative_steps: 0,
+                        krylov_iterations: 0,
                     });
                 }
             }

@@ -30,7 +30,10 @@ pub mod woodbury;
 pub use active_set::primal_dual_active_set;
 use blocks::*;
 use newton::*;
-pub use newton::{semismooth_newton, semismooth_newton_prepared, NewtonOptions, NewtonWorkspace};
+pub use newton::{
+    semismooth_newton, semismooth_newton_prepared, semismooth_newton_with, NewtonOptions,
+    NewtonWorkspace, StepSolver,
+};
 pub use qp::quadratic_program;
 pub use recovery::recover_multiplier;
 use recovery::*;
@@ -276,6 +279,11 @@ pub struct LcpSolution {
     /// Estimated relative rounding noise of Λ (see [`Lcp::elimination_noise`]); 0 when Λ
     /// comes from a linear solve or the QP's dual.
     pub multiplier_noise: f64,
+    /// Newton steps solved by an iterative step solver
+    /// ([`semismooth_newton_with`], e.g. multigrid-preconditioned CG).
+    pub iterative_steps: usize,
+    /// Krylov (CG) iterations over those steps.
+    pub krylov_iterations: usize,
 }
 
 impl Lcp {

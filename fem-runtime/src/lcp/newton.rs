@@ -690,12 +690,44 @@ pub fn semismooth_newton_prepared(
             (lcp.n(), lcp.m())
         )));
     }
-    newton_iteration(lcp, workspace, start, options, clock)
+    newton_iteration(lcp, workspace, None, start, options, clock)
+}
+
+/// A solver of the Newton systems `H d = b` other than the factorization (e.g. multigrid
+/// preconditioned CG, [`crate::obstacle`]): `Some(d)` when it solved the system to the
+/// accuracy of a factored step, `None` to have the step factored instead.
+pub type StepSolver<'a> = &'a (dyn Fn(&SparseMatrix, &[f64]) -> Option<Vec<f64>> + Sync);
+
+/// [`semismooth_newton_prepared`] with the exact steps solved by `step` (each step it
+/// declines is factored as usual and counted in [`LcpSolution::factorizations`]).
+/// Newton's convergence test is unchanged: the KKT residual certifies the result.
+///
+/// # Errors
+/// Those of [`semismooth_newton_prepared`].
+pub fn semismooth_newton_with(
+    lcp: &Lcp,
+    workspace: &NewtonWorkspace,
+    step: StepSolver,
+    start: Option<&[f64]>,
+    options: NewtonOptions,
+) -> Result<LcpSolution> {
+    let clock = Instant::now();
+    lcp.check_shapes()?;
+    lcp.require_positive_c("semismooth Newton")?;
+    if workspace.shape != (lcp.n(), lcp.m()) {
+        return Err(Error::Input(format!(
+            "the Newton workspace was built for an LCP with {:?} (primal, constraint) unknowns, this one has {:?}",
+            workspace.shape,
+            (lcp.n(), lcp.m())
+        )));
+    }
+    newton_iteration(lcp, workspace, Some(step), start, options, clock)
 }
 
 pub(super) fn newton_iteration(
     lcp: &Lcp,
     workspace: &NewtonWorkspace,
+    step_solver: Option<StepSolver>,
     start: Option<&[f64]>,
     options: NewtonOptions,
     clock: Instant,
@@ -708,7 +740,7 @@ pub(super) fn newton_iteration(
                 lambda: Vec<f64>,
                 iterations: usize,
                 residual: f64,
-                solves: (usize, usize)| {
+                solves: (usize, usize, usize)| {
         let multiplier_noise = lcp.elimination_noise(&lambda);
         LcpSolution {
             u,
@@ -719,8 +751,11 @@ pub(super) fn newton_iteration(
             factorizations: solves.0,
             low_rank_updates: solves.1,
             multiplier_noise,
+            iterative_steps: solves.2,
+            krylov_iterations: 0,
         }
     };
+    let mut iterative_steps = 0;
     let mut smooth_first = start.is_some() && options.smoothing_sweeps > 0;
     let mut previous_active: Option<Vec<bool>> = None;
     // the last factored Hessian and its faces, for low-rank updates
@@ -743,7 +778,7 @@ pub(super) fn newton_iteration(
                     lambda,
                     iteration - 1,
                     residual,
-                    (factorizations, low_rank_updates),
+                    (factorizations, low_rank_updates, iterative_steps),
                 ));
             }
         }
@@ -761,7 +796,7 @@ pub(super) fn newton_iteration(
                     lambda,
                     iteration - 1,
                     residual,
-                    (factorizations, low_rank_updates),
+                    (factorizations, low_rank_updates, iterative_steps),
                 ));
             }
             if best.as_ref().is_none_or(|b| residual < b.2) {
@@ -778,7 +813,12 @@ pub(super) fn newton_iteration(
             None
         };
         let exact = smoothed.is_none();
-        let d = match smoothed {
+        let solved = match (&smoothed, step_solver) {
+            (None, Some(solve)) => solve(&h, &minus_gradient),
+            _ => None,
+        };
+        iterative_steps += usize::from(solved.is_some());
+        let d = match smoothed.or(solved) {
             Some(d) => d,
             None => {
                 let reusable = factored.as_ref().filter(|_| options.low_rank_updates);
@@ -820,7 +860,7 @@ pub(super) fn newton_iteration(
                     lambda,
                     iteration,
                     residual,
-                    (factorizations, low_rank_updates),
+                    (factorizations, low_rank_updates, iterative_steps),
                 ));
             }
             return Err(Error::NotConverged {
@@ -844,7 +884,7 @@ pub(super) fn newton_iteration(
                     lambda,
                     iteration,
                     residual,
-                    (factorizations, low_rank_updates),
+                    (factorizations, low_rank_updates, iterative_steps),
                 ));
             }
         }
@@ -858,7 +898,7 @@ pub(super) fn newton_iteration(
             lambda,
             options.max_iterations,
             residual,
-            (factorizations, low_rank_updates),
+            (factorizations, low_rank_updates, iterative_steps),
         ));
     }
     let lambda = lcp.eliminated_multiplier(&lcp.b_times(&u));

@@ -197,5 +197,7 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
         factorizations: solver.solution.iterations as usize,
         low_rank_updates: 0,
         multiplier_noise: 0.0,
+        iterative_steps: 0,
+        krylov_iterations: 0,
     })
 }

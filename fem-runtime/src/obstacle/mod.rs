@@ -3,6 +3,7 @@
 //! `A_α, B_α, C_α, F_α, G_α` of docs/mathematics.md §1 (the KKT matrix is
 //! `[[A_α, −B_αᵀ], [−B_α, −C_α]]`, its right-hand side `[F_α; −G_α]`).
 
+pub mod hierarchy;
 pub mod triangle;
 
 use crate::assembly::boundary::{Constraints, Reduction, Side};
@@ -14,15 +15,17 @@ use crate::element::mapping::Affine;
 use crate::error::{Error, Result};
 use crate::lcp::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
-    semismooth_newton_prepared, ConstraintRows, CouplingBlocks, Lcp, LcpSolution, NewtonOptions,
-    NewtonWorkspace,
+    semismooth_newton_prepared, semismooth_newton_with, ConstraintRows, CouplingBlocks, Lcp,
+    LcpSolution, NewtonOptions, NewtonWorkspace,
 };
 use crate::mesh::{IntervalMesh, Mesh};
 use crate::model::{Coefficients, FormId, IntoFormIndex, Model};
+use crate::multigrid::MultigridOptions;
 use crate::norms::FieldView;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use fem_reference::DofLocation;
+use hierarchy::{multigrid_step, LinearSolver};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
@@ -564,6 +567,11 @@ pub struct ObstacleSolution<G = IntervalMesh> {
     pub solve_seconds: f64,
     /// Estimated relative rounding noise of the multiplier values (0: none).
     pub multiplier_noise: f64,
+    /// Newton steps of the finest level solved by multigrid-preconditioned CG
+    /// ([`ObstacleOptions::linear_solver`]).
+    pub iterative_steps: usize,
+    /// CG iterations over those steps.
+    pub krylov_iterations: usize,
 }
 
 impl<G> ObstacleSolution<G> {
@@ -592,6 +600,12 @@ pub struct ObstacleOptions {
     /// Build the finest level on a second thread while the coarser ones are solved
     /// (see [`solve_nested`]); `false` does everything on the calling thread.
     pub pipelined: bool,
+    /// The solver of the Newton steps: direct, or multigrid on the nested meshes where
+    /// the solve has them ([`hierarchy`]).
+    pub linear_solver: LinearSolver,
+    /// The cycle of the multigrid steps (W(1,1): on the Newton Hessians of the membrane
+    /// its CG iterations stay flat across the contact boundary, `docs/multigrid.md`).
+    pub multigrid: MultigridOptions,
 }
 
 impl Default for ObstacleOptions {
@@ -601,6 +615,11 @@ impl Default for ObstacleOptions {
             nested_from: Some(16),
             newton: NewtonOptions::default(),
             pipelined: true,
+            linear_solver: LinearSolver::Auto,
+            multigrid: MultigridOptions {
+                sweeps: 1,
+                coarse_corrections: 2,
+            },
         }
     }
 }
@@ -622,6 +641,23 @@ pub fn solve_lcp_prepared(
     start: Option<&[f64]>,
     options: ObstacleOptions,
 ) -> Result<LcpSolution> {
+    solve_lcp_on_hierarchy(lcp, workspace, &[], start, options)
+}
+
+/// [`solve_lcp_prepared`] with the prolongations of the primal unknowns from the coarser
+/// levels of a nested solve, fine to coarse (`prolongations[0]` maps the next coarser
+/// level's to `lcp`'s), for the multigrid steps of [`ObstacleOptions::linear_solver`].
+pub fn solve_lcp_on_hierarchy(
+    lcp: &Lcp,
+    workspace: Option<&NewtonWorkspace>,
+    prolongations: &[SparseMatrix],
+    start: Option<&[f64]>,
+    options: ObstacleOptions,
+) -> Result<LcpSolution> {
+    let multigrid = prolongations.first().is_some_and(|p| p.nrows() == lcp.n())
+        && options
+            .linear_solver
+            .uses_multigrid(lcp, prolongations.len());
     match options.solver {
         // Newton with Λ eliminated (SPD Hessian, one symbolic Cholesky); if it fails,
         // the active-set method on the saddle-point system. Where the eliminated Λ
@@ -638,10 +674,23 @@ pub fn solve_lcp_prepared(
                 },
                 ..options.newton
             };
-            let newton = match workspace {
-                Some(w) => semismooth_newton_prepared(lcp, w, start, newton),
-                None => semismooth_newton(lcp, start, newton),
+            let krylov = std::sync::atomic::AtomicUsize::new(0);
+            let step = |h: &SparseMatrix, b: &[f64]| {
+                let (d, iterations) = multigrid_step(h, prolongations, b, options.multigrid)?;
+                krylov.fetch_add(iterations, std::sync::atomic::Ordering::Relaxed);
+                Some(d)
             };
+            let newton = match (workspace, multigrid) {
+                (Some(w), true) => semismooth_newton_with(lcp, w, &step, start, newton),
+                (None, true) => NewtonWorkspace::pattern_of(lcp)
+                    .and_then(|w| semismooth_newton_with(lcp, &w, &step, start, newton)),
+                (Some(w), false) => semismooth_newton_prepared(lcp, w, start, newton),
+                (None, false) => semismooth_newton(lcp, start, newton),
+            };
+            let newton = newton.map(|mut s| {
+                s.krylov_iterations = krylov.into_inner();
+                s
+            });
             let solution = match newton {
                 Ok(s) => s,
                 // the fallback factors an LU per iteration: give it fewer
@@ -740,7 +789,33 @@ where
     G: DofNumbering + Send + Sync,
     B: FnOnce() -> Result<Discretization<G>> + Send,
 {
+    solve_nested_on_hierarchy(levels, prolong, None, options)
+}
+
+/// The prolongation of the LCP's primal unknowns from a coarser level to the next finer
+/// one ([`hierarchy::primal_prolongation`] on triangles), for multigrid Newton steps.
+pub type PrimalProlongation<G> =
+    dyn Fn(&Discretization<G>, &Discretization<G>) -> Result<SparseMatrix> + Sync;
+
+/// [`solve_nested`] whose levels also form the multigrid hierarchy of the Newton steps
+/// ([`ObstacleOptions::linear_solver`]): `primal_prolongation` maps each level's primal
+/// unknowns to the next finer level's. Where it fails (elements without a prolongation)
+/// the levels above are solved directly.
+pub fn solve_nested_on_hierarchy<G, B>(
+    levels: Vec<B>,
+    prolong: impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
+    primal_prolongation: Option<&PrimalProlongation<G>>,
+    options: ObstacleOptions,
+) -> Result<ObstacleSolution<G>>
+where
+    G: DofNumbering + Send + Sync,
+    B: FnOnce() -> Result<Discretization<G>> + Send,
+{
     let clock = Instant::now();
+    let primal_prolongation = primal_prolongation.filter(|_| {
+        options.solver == VariationalSolver::SemismoothNewton
+            && options.linear_solver != LinearSolver::Direct
+    });
     let mut levels = levels;
     let finest = levels
         .pop()
@@ -760,14 +835,16 @@ where
                         workspace: Option<&NewtonWorkspace>| {
         let start = coarse
             .as_ref()
-            .map(|(c, values, _)| d.primal_part(&prolong(c, values, d)));
-        let solution = solve_lcp_prepared(&d.lcp, workspace, start.as_deref(), options)?;
-        let mut counts = coarse.map(|(_, _, counts)| counts).unwrap_or_default();
+            .map(|(c, values, _, _)| d.primal_part(&prolong(c, values, d)));
+        let hierarchy = extend_hierarchy(coarse.as_ref(), d, primal_prolongation);
+        let solution =
+            solve_lcp_on_hierarchy(&d.lcp, workspace, &hierarchy, start.as_deref(), options)?;
+        let mut counts = coarse.map(|(_, _, counts, _)| counts).unwrap_or_default();
         counts.push((d.mesh.cell_count(), solution.iterations));
         Ok::<_, Error>((solution, counts))
     };
     let (discretization, (solution, counts)) = if levels.is_empty() || !options.pipelined {
-        let coarse = solve_levels(levels, &prolong, options)?;
+        let coarse = solve_levels(levels, &prolong, primal_prolongation, options)?;
         let d = finest()?;
         let workspace = pattern_of(&d);
         let solved = solve_finest(coarse, &d, workspace.as_ref())?;
@@ -791,7 +868,7 @@ where
             }
         };
         let (solved, shared) = alongside(worker, || {
-            let coarse = solve_levels(levels, &prolong, options);
+            let coarse = solve_levels(levels, &prolong, primal_prolongation, options);
             // the coarse levels' error first, as in the sequential order
             match (coarse, receiver.recv()) {
                 (Err(e), _) | (Ok(_), Ok(Err(e))) => (Err(e), None),
@@ -821,6 +898,8 @@ where
         kkt_residual: solution.kkt_residual,
         solve_seconds: solution.seconds,
         multiplier_noise: solution.multiplier_noise,
+        iterative_steps: solution.iterative_steps,
+        krylov_iterations: solution.krylov_iterations,
         discretization,
         values,
         levels: counts,
@@ -857,15 +936,44 @@ fn alongside<R>(worker: impl FnOnce() + Send, main: impl FnOnce() -> R) -> R {
     }
 }
 
-/// A level's discretization, its solution's full coefficients, and the (cells, iterations)
-/// of every level so far.
-type SolvedLevel<G> = (Discretization<G>, Vec<f64>, Vec<(usize, usize)>);
+/// A level's discretization, its solution's full coefficients, the (cells, iterations)
+/// of every level so far, and the prolongations of the primal unknowns down to the
+/// coarsest level, fine to coarse (empty without a multigrid hierarchy).
+type SolvedLevel<G> = (
+    Discretization<G>,
+    Vec<f64>,
+    Vec<(usize, usize)>,
+    Vec<SparseMatrix>,
+);
+
+/// The multigrid hierarchy of `fine`: the prolongation from `coarse`'s level followed by
+/// `coarse`'s own hierarchy; empty without a coarse level or a `primal_prolongation`, or
+/// where it fails (then the level is solved directly; so is every finer one, whose chain
+/// would have to pass through it).
+fn extend_hierarchy<G>(
+    coarse: Option<&SolvedLevel<G>>,
+    fine: &Discretization<G>,
+    primal_prolongation: Option<&PrimalProlongation<G>>,
+) -> Vec<SparseMatrix> {
+    let (Some((c, _, counts, below)), Some(prolongation)) = (coarse, primal_prolongation) else {
+        return Vec::new();
+    };
+    // a coarse level that is not the coarsest but has no hierarchy broke the chain
+    if below.is_empty() && counts.len() > 1 {
+        return Vec::new();
+    }
+    match prolongation(c, fine) {
+        Ok(p) => std::iter::once(p).chain(below.iter().cloned()).collect(),
+        Err(_) => Vec::new(),
+    }
+}
 
 /// Builds and solves `levels` in turn, each from the prolonged solution of the one
 /// before; the last one solved, or `None` for no levels.
 fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
     levels: Vec<B>,
     prolong: &impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
+    primal_prolongation: Option<&PrimalProlongation<G>>,
     options: ObstacleOptions,
 ) -> Result<Option<SolvedLevel<G>>> {
     let mut last: Option<SolvedLevel<G>> = None;
@@ -873,12 +981,13 @@ fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
         let d = build()?;
         let start = last
             .as_ref()
-            .map(|(coarse, values, _)| d.primal_part(&prolong(coarse, values, &d)));
-        let solution = solve_lcp(&d.lcp, start.as_deref(), options)?;
-        let mut counts = last.map(|(_, _, counts)| counts).unwrap_or_default();
+            .map(|(coarse, values, _, _)| d.primal_part(&prolong(coarse, values, &d)));
+        let hierarchy = extend_hierarchy(last.as_ref(), &d, primal_prolongation);
+        let solution = solve_lcp_on_hierarchy(&d.lcp, None, &hierarchy, start.as_deref(), options)?;
+        let mut counts = last.map(|(_, _, counts, _)| counts).unwrap_or_default();
         counts.push((d.mesh.cell_count(), solution.iterations));
         let values = d.full(&solution);
-        last = Some((d, values, counts));
+        last = Some((d, values, counts, hierarchy));
     }
     Ok(last)
 }

@@ -13,7 +13,7 @@ use crate::lcp::{Lcp, LcpSolution};
 use crate::mesh::triangle::{PointLocator, TriangleMesh};
 use crate::model::{Coefficients, IntoFormIndex, Model};
 use crate::obstacle::{
-    solve_nested, system_forms, Discretization, ObstacleOptions, ObstacleSolution,
+    solve_nested_on_hierarchy, system_forms, Discretization, ObstacleOptions, ObstacleSolution,
 };
 use crate::SparseMatrix;
 use faer::sparse::SparseColMat;
@@ -280,12 +280,13 @@ pub fn solve_obstacle_on_part<M: Model>(
     options: ObstacleOptions,
 ) -> Result<TriangleObstacleSolution> {
     let (bilinear, linear) = system_forms::<M>()?;
-    solve_nested(
+    solve_nested_on_hierarchy(
         meshes
             .iter()
             .map(|mesh| move || discretize_on_part::<M>(mesh, coefficients, part, bilinear, linear))
             .collect(),
         prolong_primal_on_triangles,
+        Some(&super::hierarchy::primal_prolongation),
         options,
     )
 }
@@ -473,6 +474,8 @@ pub fn nodal_active_set(
                 factorizations: iteration,
                 low_rank_updates: 0,
                 multiplier_noise: 0.0,
+                iterative_steps: 0,
+                krylov_iterations: 0,
             });
         }
         active = next;

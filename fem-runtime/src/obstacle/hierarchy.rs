@@ -1,0 +1,184 @@
+//! Multigrid for the Newton steps of a nested solve (issue 15, `docs/multigrid.md` §4):
+//! the meshes of the nested iteration are the multigrid hierarchy, the prolongation of
+//! the LCP's primal unknowns from one level to the next is that of the finite element
+//! fields restricted to the free primal DOFs, and each Newton step `H d = −∇Φ` is solved by
+//! conjugate gradients preconditioned with a cycle on the Galerkin operators `PᵀHP`.
+
+use super::Discretization;
+use crate::error::{Error, Result};
+use crate::lcp::Lcp;
+use crate::mesh::TriangleMesh;
+use crate::multigrid::{
+    parents_by_location, prolongation, Multigrid, MultigridOptions, NestedLevel,
+};
+use crate::SparseMatrix;
+use faer::sparse::{SparseColMat, Triplet};
+
+/// The linear solver of the Newton steps of an obstacle solve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinearSolver {
+    /// A sparse Cholesky factorization per step (or a low-rank update of the last one):
+    /// about `O(N^1.5)` in 2D, the faster one on small systems, and the only one on
+    /// intervals and for elements without a prolongation (Hermite, Argyris, Morley).
+    Direct,
+    /// Conjugate gradients preconditioned by a multigrid cycle on the nested meshes of
+    /// the solve (`O(N)` per step). Levels without a coarser one, and steps whose CG does
+    /// not reach [`MULTIGRID_TOLERANCE`] in [`MULTIGRID_MAX_ITERATIONS`], are factored.
+    Multigrid,
+    /// [`LinearSolver::Multigrid`] on levels of at least [`AUTO_MULTIGRID_UNKNOWNS`]
+    /// primal unknowns, at most [`AUTO_MULTIGRID_ROW_NONZEROS`] nonzeros per row of `A`
+    /// and at least two coarser levels; [`LinearSolver::Direct`] otherwise.
+    Auto,
+}
+
+/// Relative residual `‖b − Hd‖₂/‖b‖₂` at which CG ends a Newton step. Newton's test
+/// certifies the result by the KKT residual anyway; steps this accurate keep the
+/// active-set iteration that of factored steps.
+pub const MULTIGRID_TOLERANCE: f64 = 1e-10;
+
+/// CG iterations after which a Newton step is given to the factorization instead.
+pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
+
+/// From this many primal unknowns on, [`LinearSolver::Auto`] uses multigrid: measured on
+/// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton"), the whole nested
+/// solve ties with the direct path at 1M unknowns (less memory) and loses below, since
+/// the direct path factors once per level and then updates the factor.
+pub const AUTO_MULTIGRID_UNKNOWNS: usize = 1_000_000;
+
+/// The most nonzeros per row of `A` with which [`LinearSolver::Auto`] uses multigrid.
+/// Gauss–Seidel sweeps cost a pass over the matrix each, while the direct path factors
+/// once and then updates the factor (`crate::lcp::woodbury`): on P2–P0 (about 13 per
+/// row) the direct path was 1.4× faster at 1M unknowns, on P1–P0 (7 per row) the two tie
+/// there (`docs/multigrid.md`, "Multigrid in Newton").
+pub const AUTO_MULTIGRID_ROW_NONZEROS: f64 = 10.0;
+
+impl LinearSolver {
+    /// Every solver, by its name on the command line.
+    pub const ALL: [LinearSolver; 3] = [
+        LinearSolver::Auto,
+        LinearSolver::Direct,
+        LinearSolver::Multigrid,
+    ];
+
+    /// The name (`--linear-solver`).
+    pub fn name(self) -> &'static str {
+        match self {
+            LinearSolver::Direct => "direct",
+            LinearSolver::Multigrid => "multigrid",
+            LinearSolver::Auto => "auto",
+        }
+    }
+
+    /// The solver called `name`.
+    ///
+    /// # Errors
+    /// [`Error::Input`] listing the names when there is none of that name.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|s| s.name() == name)
+            .ok_or_else(|| {
+                Error::Input(format!(
+                    "unknown linear solver `{name}`; the linear solvers are {}",
+                    Self::ALL.map(Self::name).join(", ")
+                ))
+            })
+    }
+
+    /// Whether the Newton steps of `lcp`, with `coarser` levels below it, are solved by
+    /// multigrid.
+    pub fn uses_multigrid(self, lcp: &Lcp, coarser: usize) -> bool {
+        match self {
+            LinearSolver::Direct => false,
+            LinearSolver::Multigrid => coarser > 0,
+            LinearSolver::Auto => {
+                let n = lcp.n();
+                let per_row = lcp.a.compute_nnz() as f64 / n.max(1) as f64;
+                n >= AUTO_MULTIGRID_UNKNOWNS
+                    && per_row <= AUTO_MULTIGRID_ROW_NONZEROS
+                    && coarser >= 2
+            }
+        }
+    }
+}
+
+/// The prolongation of the LCP's primal unknowns from `coarse` to `fine` (two
+/// discretizations of one model on nested triangle meshes): the fields' interpolation
+/// ([`prolongation`]) on the free DOFs, restricted to the primal ones. A `fine.lcp.n() ×
+/// coarse.lcp.n()` matrix.
+///
+/// # Errors
+/// Meshes that are not nested (a fine cell outside every coarse one), elements without a
+/// prolongation (Hermite, Argyris, Morley), other fields on the two levels.
+pub fn primal_prolongation(
+    coarse: &Discretization<TriangleMesh>,
+    fine: &Discretization<TriangleMesh>,
+) -> Result<SparseMatrix> {
+    if let Some(field) = fine.dofs.fields().iter().find(|&&f| {
+        f != fine.multiplier_field
+            && fine
+                .dofs
+                .map(f)
+                .is_some_and(|m| m.element().needs_transformation())
+    }) {
+        return Err(Error::Input(format!(
+            "no multigrid prolongation for field {field}: its element has a per-cell DOF transformation"
+        )));
+    }
+    let parents = parents_by_location(&coarse.mesh, &fine.mesh)?;
+    let full = prolongation(&level(coarse), &level(fine), &parents)?;
+    // reduced (free) DOF → primal unknown, on each level
+    let primal_index = |d: &Discretization<TriangleMesh>| {
+        let mut index = vec![usize::MAX; d.reduction.free().len()];
+        for (p, &r) in d.primal_reduced.iter().enumerate() {
+            index[r] = p;
+        }
+        index
+    };
+    let (rows, columns) = (primal_index(fine), primal_index(coarse));
+    let (col_ptr, row_idx, values) = (
+        full.symbolic().col_ptr(),
+        full.symbolic().row_idx(),
+        full.val(),
+    );
+    let mut triplets = Vec::with_capacity(values.len());
+    for j in 0..full.ncols() {
+        let column = columns[j];
+        if column == usize::MAX {
+            continue;
+        }
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            let row = rows[row_idx[k]];
+            if row != usize::MAX {
+                triplets.push(Triplet::new(row, column, values[k]));
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(fine.lcp.n(), coarse.lcp.n(), &triplets)
+        .map_err(|e| Error::Input(format!("primal prolongation: {e:?}")))
+}
+
+fn level(d: &Discretization<TriangleMesh>) -> NestedLevel<'_> {
+    NestedLevel {
+        mesh: &d.mesh,
+        dofs: &d.dofs,
+        reduction: Some(&d.reduction),
+    }
+}
+
+/// The Newton direction `H d = b` by CG preconditioned with the cycle of `options` on
+/// `prolongations` (fine to coarse), and the CG iterations it took; `None` when the
+/// hierarchy cannot be built (a level whose operator is not SPD) or CG does not reach
+/// [`MULTIGRID_TOLERANCE`], so that Newton factors the step instead.
+pub fn multigrid_step(
+    h: &SparseMatrix,
+    prolongations: &[SparseMatrix],
+    b: &[f64],
+    options: MultigridOptions,
+) -> Option<(Vec<f64>, usize)> {
+    let mg = Multigrid::new(h.clone(), prolongations.to_vec(), options).ok()?;
+    let pcg = mg
+        .pcg(b, MULTIGRID_TOLERANCE, MULTIGRID_MAX_ITERATIONS)
+        .ok()?;
+    (pcg.relative_residual <= MULTIGRID_TOLERANCE).then_some((pcg.x, pcg.iterations))
+}
