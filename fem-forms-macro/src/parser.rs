@@ -723,21 +723,27 @@ impl<'a> Parser<'a> {
             | Tok::Trace),
         ) = self.peek_tok()
         {
+            let op = op.clone();
             let loc = self.bump().unwrap().loc;
+            let (power, loc) = self.operator_power(&op, loc)?;
             if !self.peek_tok().is_some_and(Self::starts_factor) {
-                return Err(self.unexpected(&format!("a function after {}", describe(op))));
+                return Err(self.unexpected(&format!("a function after {}", describe(&op))));
             }
-            let inner = Box::new(self.nested(loc, Self::factor)?);
-            let l = loc.to(inner.loc);
-            let kind = match op {
-                Tok::Laplacian => ExprKind::Laplacian(inner),
-                Tok::Partial(axis) => ExprKind::Partial(inner, *axis),
-                Tok::SymGrad => ExprKind::SymmetricGradient(inner),
-                Tok::Divergence => ExprKind::Divergence(inner),
-                Tok::Trace => ExprKind::Trace(inner),
-                _ => ExprKind::Gradient(inner),
-            };
-            return Ok(Expr::new(kind, l));
+            let mut e = self.nested(loc, Self::factor)?;
+            for _ in 0..power {
+                let inner = Box::new(e);
+                let l = loc.to(inner.loc);
+                let kind = match op {
+                    Tok::Laplacian => ExprKind::Laplacian(inner),
+                    Tok::Partial(axis) => ExprKind::Partial(inner, axis),
+                    Tok::SymGrad => ExprKind::SymmetricGradient(inner),
+                    Tok::Divergence => ExprKind::Divergence(inner),
+                    Tok::Trace => ExprKind::Trace(inner),
+                    _ => ExprKind::Gradient(inner),
+                };
+                e = Expr::new(kind, l);
+            }
+            return Ok(e);
         }
         let mut e = self.primary()?;
         loop {
@@ -776,6 +782,60 @@ impl<'a> Parser<'a> {
                 _ => return Ok(e),
             }
         }
+    }
+
+    /// The power of an operator just read at `loc`: `Δ²` (the bilaplacian, ASCII
+    /// `lap^2`) and `∂_x²` (ASCII `d_x^2`) apply it that many times; 1 without an
+    /// exponent. Powers of the other operators are refused: `∇²` means the Laplacian to
+    /// some readers and the Hessian to others, and `div²`, `ε²`, `tr²` nothing standard.
+    /// Returns the power and the location of the operator with its exponent.
+    fn operator_power(&mut self, op: &Tok, loc: Loc) -> Result<(u32, Loc)> {
+        let (n, end) = match self.peek() {
+            Some(Token {
+                tok: Tok::Superscript(value, raw),
+                loc: end,
+            }) => {
+                let (value, raw, end) = (*value, raw.clone(), *end);
+                self.pos += 1;
+                let Some(n) = value else {
+                    return Err(Diagnostic::text(end, format!("malformed exponent `{raw}`"))
+                        .help("write a positive integer power: Δ² w, ∂_x² w"));
+                };
+                (n, end)
+            }
+            Some(Token {
+                tok: Tok::Caret,
+                loc: caret,
+            }) => {
+                let caret = *caret;
+                self.pos += 1;
+                self.ascii_exponent(caret)?
+            }
+            _ => return Ok((1, loc)),
+        };
+        let whole = loc.to(end);
+        if !matches!(op, Tok::Laplacian | Tok::Partial(_)) {
+            let help = match op {
+                Tok::Grad => "write ∇∇ w for the Hessian or Δ w for the Laplacian",
+                _ => "write the operator twice, e.g. div div A",
+            };
+            return Err(Diagnostic::text(
+                whole,
+                format!("{} cannot be raised to a power", describe(op)),
+            )
+            .help(help));
+        }
+        if n < 1 {
+            return Err(Diagnostic::text(
+                whole,
+                format!(
+                    "{} raised to {n}: only positive powers are derivatives",
+                    describe(op)
+                ),
+            )
+            .help("write a positive integer power: Δ² w, ∂_x² w"));
+        }
+        Ok((n as u32, whole))
     }
 
     /// After `^`: `2`, `-2`, `(-2)`, `{-2}`.

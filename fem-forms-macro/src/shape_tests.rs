@@ -448,3 +448,62 @@ fn ascii_and_unicode_vector_models_give_the_same_blocks() {
     assert_eq!(unicode, ascii);
     assert_eq!(unicode[1].len(), 9);
 }
+
+#[test]
+fn powers_of_derivative_operators_read_as_repeated_operators() {
+    same("Δ²w v", "ΔΔw v");
+    same("lap^2 w v", "ΔΔw v");
+    same("Δ³w v", "ΔΔΔw v");
+    same("∂_x² w v", "∂_x ∂_x w v");
+    same("d_y^2 w d_x^2 v", "∂_y ∂_y w ∂_x ∂_x v");
+    same("Δ²w Δ²v", "div div ∇∇w ΔΔv");
+    for (text, message) in [
+        ("a(w;v) = ∫ ∇²w v", "cannot be raised to a power"),
+        ("a(w;v) = ∫ div² ∇w v", "cannot be raised to a power"),
+        ("a(w;v) = ∫ Δ⁻¹w v", "only positive powers"),
+        ("a(w;v) = ∫ Δ^0 w v", "only positive powers"),
+    ] {
+        let errors = rendered_errors(&expand(plate(text)));
+        assert!(
+            errors.iter().any(|e| e.contains(message)),
+            "{text}: {errors:?}"
+        );
+    }
+}
+
+#[test]
+fn the_kirchhoff_moment_and_curvature_read_as_in_the_mathematics() {
+    // MODELS.md §5: K(w) = −∇∇w, M(w) = D[(1−ν)K(w) + ν tr K(w) I], a(w,v) = ∫ M(w):K(v)
+    let forms = "
+        K(w)   := −∇∇w
+        M(w)   := D[(1−ν)K(w) + ν tr K(w) I]
+        a(w;v) = ∫ M(w):K(v)
+        b(w;v) = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]
+        c(w;v) = Σ_T h_T⁴ (D Δ²w, D Δ²v)_T
+        d(w;v) = Σ_T h_T⁴ (D ΔΔw, D ΔΔv)_T
+    ";
+    let out = expand(plate(forms));
+    assert!(rendered_errors(&out).is_empty(), "{out}");
+    // the same kernels up to the order of the terms: compared numerically in
+    // tests/kirchhoff_notation.rs; here, the same blocks and the Δ² spelling's identity
+    let text = prettyplease::unparse(&syn::parse2(out).unwrap());
+    let module = |name: &str| {
+        let body = text.split(&format!("pub mod {name} {{")).nth(1).unwrap();
+        body.split("pub mod ").next().unwrap().to_string()
+    };
+    let kernels = |m: &str| {
+        m.split("pub fn")
+            .skip(1)
+            .map(|k| k.split("\n        }\n").next().unwrap().to_string())
+            .collect::<Vec<_>>()
+    };
+    let names = |m: &str| {
+        kernels(m)
+            .iter()
+            .map(|k| k.split('(').next().unwrap().to_string())
+            .collect::<Vec<_>>()
+    };
+    assert!(names(&module("a")).contains(&" matrix_v_w".to_string()));
+    assert_eq!(names(&module("a")), names(&module("b")));
+    assert_eq!(kernels(&module("c")), kernels(&module("d")));
+}
