@@ -126,6 +126,43 @@ impl TriangleBasis {
     }
 }
 
+/// The reference basis and its gradient at the points of a rule, evaluated once: the
+/// error norms visit every cell at the same reference points, and evaluating the
+/// polynomials there anew was most of their cost.
+struct Tabulation {
+    /// Per point: the basis values, then the ξ- and η-derivatives, `3 × count` numbers.
+    rows: Vec<Vec<f64>>,
+    count: usize,
+}
+
+impl Tabulation {
+    fn new(basis: &TriangleBasis, points: &[[f64; 2]]) -> Self {
+        let count = basis.values.len();
+        let rows = points
+            .iter()
+            .map(|&xi| {
+                let eval = |ps: &[Polynomial2]| ps.iter().map(|p| p.eval(xi)).collect::<Vec<_>>();
+                [eval(&basis.values), eval(&basis.dx), eval(&basis.dy)].concat()
+            })
+            .collect();
+        Self { rows, count }
+    }
+
+    /// The value and reference gradient at point `q` of the function with reference
+    /// coefficients `u`.
+    fn evaluate(&self, q: usize, u: &[f64]) -> (f64, [f64; 2]) {
+        let row = &self.rows[q];
+        let n = self.count;
+        let (mut value, mut gx, mut gy) = (0.0, 0.0, 0.0);
+        for (i, &ui) in u.iter().enumerate().take(n) {
+            value += ui * row[i];
+            gx += ui * row[n + i];
+            gy += ui * row[2 * n + i];
+        }
+        (value, [gx, gy])
+    }
+}
+
 impl TriangleField<'_> {
     /// The coefficients of cell `c` in the pulled-back reference basis `ψ_j = φ̂_j ∘ F⁻¹`,
     /// in local order: the field's own local coefficients `U` for Lagrange elements, and
@@ -245,13 +282,17 @@ impl TriangleField<'_> {
     pub fn errors(&self, exact: &dyn Fn([f64; 2]) -> (f64, [f64; 2]), degree: usize) -> (f64, f64) {
         let basis = TriangleBasis::new(self.map.element());
         let rule = TriangleRule::exact_for_degree(degree);
+        let table = Tabulation::new(&basis, &rule.points);
         let (mut l2, mut h1) = (0.0, 0.0);
+        let mut local = Vec::new();
         for c in 0..self.mesh.cell_count() {
             let map = AffineMap::of(self.mesh, c);
-            for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+            self.local_coefficients(c, &mut local);
+            for (q, (&xi, &w)) in rule.points.iter().zip(&rule.weights).enumerate() {
                 let (u, g) = exact(map.point(xi));
-                let e = u - self.value(&basis, c, xi);
-                let gh = self.gradient(&basis, &map, c, xi);
+                let (value, gradient) = table.evaluate(q, &local);
+                let e = u - value;
+                let gh = map.gradient(gradient);
                 l2 += w * map.det * e * e;
                 h1 += w * map.det * ((g[0] - gh[0]).powi(2) + (g[1] - gh[1]).powi(2));
             }
@@ -268,18 +309,32 @@ impl TriangleField<'_> {
     ) -> f64 {
         let basis = TriangleBasis::new(self.map.element());
         let rule = TriangleRule::exact_for_degree(degree);
+        let table = Tabulation::new(&basis, &rule.points);
         let mut sum = 0.0;
+        let mut local = Vec::new();
         for c in 0..self.mesh.cell_count() {
             let map = AffineMap::of(self.mesh, c);
             let weight = self.mesh.cell_diameter(c).powi(2 * power);
+            self.local_coefficients(c, &mut local);
             let mut cell = 0.0;
-            for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
-                let e = exact(map.point(xi)) - self.value(&basis, c, xi);
+            for (q, (&xi, &w)) in rule.points.iter().zip(&rule.weights).enumerate() {
+                let e = exact(map.point(xi)) - table.evaluate(q, &local).0;
                 cell += w * map.det * e * e;
             }
             sum += weight * cell;
         }
         sum.sqrt()
+    }
+
+    /// The coefficients of cell `c` in the pulled-back reference basis into `out`
+    /// ([`TriangleField::reference_coefficients`] without its allocation on the Lagrange
+    /// path).
+    fn local_coefficients(&self, c: usize, out: &mut Vec<f64>) {
+        out.clear();
+        match self.transformed(c) {
+            Some(u) => out.extend(u),
+            None => out.extend(self.map.cell_dofs(c).iter().map(|&d| self.coefficients[d])),
+        }
     }
 
     /// The value at every mesh vertex (the mean over the cells around it for
