@@ -472,10 +472,11 @@ pub fn solve_obstacle_on_curved_part<M: Model>(
 }
 
 impl ObstacleSolution<CurvedTriangleMesh> {
-    /// A view of model field `field` on the mesh of the vertices: values at reference
-    /// points of a cell are those of the isoparametric field there (at the physical
-    /// point the cell's six-node map gives them; on affine cells the same point as in
-    /// the straight cell).
+    /// A view of model field `field` on the mesh of the vertices. Its value at
+    /// reference point `ξ` of cell `c` (`TriangleField::value`) is the isoparametric
+    /// field's at the physical point `x(ξ)` of the cell's six-node map
+    /// (`discretization.mesh.cell_map(c)`); `TriangleField::at` and the norms locate and
+    /// integrate in the straight cells, which is exact on affine cells only.
     pub fn view(&self, field: usize) -> TriangleField<'_> {
         TriangleField {
             mesh: self.discretization.mesh.mesh(),
