@@ -509,7 +509,7 @@ impl ObstacleSolution<CurvedTriangleMesh> {
 
     /// Area of the contact set over the curved cells: each cell's curved measure times
     /// the share of its multiplier DOFs that are active or touching (as
-    /// [`ObstacleSolution::<TriangleMesh>::contact_area`]).
+    /// `contact_area` on a `TriangleMesh`).
     pub fn contact_area(&self) -> f64 {
         let d = &self.discretization;
         let u = d.primal_part(&self.values);
