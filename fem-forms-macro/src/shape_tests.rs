@@ -381,8 +381,9 @@ fn named_expressions_read_as_in_the_mathematics() {
         text.split("pub mod b {").nth(1).unwrap(),
     );
     let a = kernels(&strip(a.split("pub mod b").next().unwrap().to_string()));
-    // θ_x, θ_y, w against each other but (η_x, θ_y) and (η_y, θ_x): zero, dropped
-    assert_eq!(a.len(), 7);
+    // θ_x, θ_y, w against each other but (η_x, θ_y) and (η_y, θ_x): zero, dropped;
+    // each kernel twice, affine and curved (`_curved`)
+    assert_eq!(a.len(), 14);
     assert_eq!(a, kernels(&strip(b.to_string())));
     // errors: a wrong field, a shape, an integral inside
     for (forms, message) in [

@@ -199,6 +199,60 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         Self::element_vector(form, block, vertices, params, data, out);
     }
 
+    /// Element matrix of `block` of bilinear `form` on a curved (six-node, isoparametric)
+    /// triangle, row-major into `out` (docs/mathematics.md §8).
+    ///
+    /// `nodes` holds the twelve coordinates `x₀ y₀ … x₅ y₅` of the six nodes in the order
+    /// of [`crate::element::Isoparametric`] (vertices 0, 1, 2 counter-clockwise, then the
+    /// nodes of the edges 0–1, 1–2, 2–0; Gmsh's order for its type-9 triangles). The
+    /// Jacobian is evaluated per quadrature point; `h_T` is the diameter of the three
+    /// vertices. With the edge nodes at the edge midpoints the result equals
+    /// [`Model::element_matrix`] up to rounding.
+    ///
+    /// `model!` generates it for every triangle model. The default, which interval models
+    /// keep (no mesh of curved intervals exists, so the runtime never calls it for them),
+    /// is an error, never a panic.
+    ///
+    /// # Errors
+    /// [`Error::Input`] for `nodes` not of length 12, for a block whose element needs a
+    /// per-cell DOF transformation (Argyris, Morley: defined on affine cells only) or
+    /// derivatives of order ≥ 3 (the message names the form and the block), for a
+    /// block the form does not have, and from the default.
+    fn element_matrix_curved(
+        form: usize,
+        block: usize,
+        nodes: &[f64],
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) -> Result<()> {
+        let _ = (form, block, nodes, params, data, out);
+        Err(Error::Input(format!(
+            "model `{}` has no kernels on curved triangles (model! generates them for triangle models only)",
+            Self::NAME
+        )))
+    }
+
+    /// Element vector of `block` of linear `form` on a curved triangle into `out`: as
+    /// [`Model::element_matrix_curved`].
+    ///
+    /// # Errors
+    /// As [`Model::element_matrix_curved`].
+    fn element_vector_curved(
+        form: usize,
+        block: usize,
+        nodes: &[f64],
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) -> Result<()> {
+        let _ = (form, block, nodes, params, data, out);
+        Err(Error::Input(format!(
+            "model `{}` has no kernels on curved triangles (model! generates them for triangle models only)",
+            Self::NAME
+        )))
+    }
+
     /// Index in `FORMS` of a form: its handle (`model::forms::B_h`) or its name (`"B_h"`).
     ///
     /// # Errors

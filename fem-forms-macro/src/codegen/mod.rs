@@ -11,6 +11,7 @@
 //! Files depend in one direction only: `backend` ← `emit` ← backends ← driver.
 
 mod backend;
+mod curved;
 mod emit;
 mod interval;
 mod triangle;
@@ -43,6 +44,9 @@ struct Dispatch {
     matrix_on_cell: Vec<TokenStream>,
     vector_on_cell: Vec<TokenStream>,
     transformed: bool,
+    /// The arms of `element_matrix_curved` and `element_vector_curved` (triangles only).
+    matrix_curved: Vec<TokenStream>,
+    vector_curved: Vec<TokenStream>,
 }
 
 /// What the driver generates for one form.
@@ -134,6 +138,9 @@ fn form_code(
             });
         }
     }
+    if backend.cell_variant() == "Triangle" {
+        curved_code(form_index, form, symbols, runtime, dispatch, &mut functions);
+    }
     let source = &form.source;
     let arity = form.arity();
     let dropped = form.dropped;
@@ -165,6 +172,54 @@ fn form_code(
         }
     };
     FormCode { module, info }
+}
+
+/// The curved kernels of a form's blocks (appended to `functions`) and their dispatch
+/// arms: a kernel, or an error naming the form and block where there is none.
+fn curved_code(
+    form_index: usize,
+    form: &Form,
+    symbols: &Symbols,
+    runtime: &TokenStream,
+    dispatch: &mut Dispatch,
+    functions: &mut Vec<TokenStream>,
+) {
+    let form_ident = Ident::new(&form.name, Span::call_site());
+    for (block_index, block) in form.blocks.iter().enumerate() {
+        let arms = if block.trial_field.is_some() {
+            &mut dispatch.matrix_curved
+        } else {
+            &mut dispatch.vector_curved
+        };
+        if let Some(reason) = curved::refusal(block, symbols) {
+            let test = &symbols.fields[block.test_field].test_name;
+            let what = match block.trial_field {
+                Some(f) => format!("block ({test}, {})", symbols.fields[f].name),
+                None => format!("block {test}"),
+            };
+            let message = format!(
+                "form `{}`, {what}: no kernel on curved cells: {reason}",
+                form.name
+            );
+            arms.push(quote! {
+                (#form_index, #block_index) => ::core::result::Result::Err(#runtime::Error::Input(::std::string::String::from(#message))),
+            });
+            continue;
+        }
+        functions.push(curved::curved_kernel(block, symbols, runtime, &form.name));
+        let name = curved::curved_ident(block, symbols);
+        let store = if block.trial_field.is_some() {
+            quote!(store_matrix)
+        } else {
+            quote!(store_vector)
+        };
+        arms.push(quote! {
+            (#form_index, #block_index) => {
+                #runtime::kernel::#store(&#form_ident::#name(x, p, d), out);
+                ::core::result::Result::Ok(())
+            }
+        });
+    }
 }
 
 /// The model's doc comment as one line (`Model::DESCRIPTION`).
@@ -354,6 +409,8 @@ fn model_impl(
         matrix_on_cell,
         vector_on_cell,
         transformed,
+        matrix_curved,
+        vector_curved,
     } = dispatch;
     let on_cell = transformed.then(|| {
         quote! {
@@ -392,6 +449,54 @@ fn model_impl(
                 match (form, block) {
                     #(#vector_on_cell)*
                     _ => panic!("{}: form {} has no linear block {}", #model_name, form, block),
+                }
+            }
+        }
+    });
+    // Triangle models only: interval models keep the trait's default (an error), and
+    // their generated code stays as it was.
+    let curved = (backend.cell_variant() == "Triangle").then(|| {
+        let nodes_message = "a curved triangle has twelve node coordinates (six nodes), not ";
+        let signature = |name: Ident| {
+            quote! {
+                fn #name(
+                    form: usize,
+                    block: usize,
+                    nodes: &[f64],
+                    params: &[f64],
+                    data: &[&#runtime::DataFn],
+                    out: &mut [f64],
+                ) -> #runtime::Result<()>
+            }
+        };
+        let matrix = signature(Ident::new("element_matrix_curved", Span::call_site()));
+        let vector = signature(Ident::new("element_vector_curved", Span::call_site()));
+        let prelude = quote! {
+            let x: &[f64; 12] = match nodes.try_into() {
+                ::core::result::Result::Ok(x) => x,
+                ::core::result::Result::Err(_) => {
+                    return ::core::result::Result::Err(#runtime::Error::Input(::std::format!("{}{}", #nodes_message, nodes.len())));
+                }
+            };
+            let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+            let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+        };
+        quote! {
+            #[allow(unused_variables)]
+            #matrix {
+                #prelude
+                match (form, block) {
+                    #(#matrix_curved)*
+                    _ => ::core::result::Result::Err(#runtime::Error::Input(::std::format!("{}: form {} has no bilinear block {}", #model_name, form, block))),
+                }
+            }
+
+            #[allow(unused_variables)]
+            #vector {
+                #prelude
+                match (form, block) {
+                    #(#vector_curved)*
+                    _ => ::core::result::Result::Err(#runtime::Error::Input(::std::format!("{}: form {} has no linear block {}", #model_name, form, block))),
                 }
             }
         }
@@ -462,6 +567,8 @@ fn model_impl(
             }
 
             #on_cell
+
+            #curved
         }
     }
 }

@@ -39,7 +39,7 @@ fn add_monomials(poly: &mut Vec<KMonomial>, monomials: Vec<KMonomial>) {
 }
 
 /// `T_αβ` for every reference multi-index β of the same order as α.
-fn transform(alpha: [u8; 2]) -> Transform {
+pub(super) fn transform(alpha: [u8; 2]) -> Transform {
     // Start from the identity operator and apply ∂x = k00 ∂ξ + k10 ∂η, ∂y = k01 ∂ξ + k11 ∂η.
     let mut terms: Transform = vec![([0, 0], vec![(1.0, [0; 4])])];
     let factors: [[(usize, usize); 2]; 2] = [[(0, 0), (2, 1)], [(1, 0), (3, 1)]];
@@ -69,7 +69,7 @@ fn transform(alpha: [u8; 2]) -> Transform {
     terms
 }
 
-fn k_polynomial_code(poly: &[KMonomial]) -> TokenStream {
+pub(super) fn k_polynomial_code(poly: &[KMonomial]) -> TokenStream {
     let names = [quote!(k00), quote!(k01), quote!(k10), quote!(k11)];
     let monomials: Vec<TokenStream> = poly
         .iter()
@@ -89,12 +89,12 @@ fn k_polynomial_code(poly: &[KMonomial]) -> TokenStream {
     quote!((#(#monomials)+*))
 }
 
-fn t_ident(alpha: [u8; 2], beta: [u8; 2]) -> Ident {
+pub(super) fn t_ident(alpha: [u8; 2], beta: [u8; 2]) -> Ident {
     format_ident!("t_{}{}_{}{}", alpha[0], alpha[1], beta[0], beta[1])
 }
 
 /// `T_αβ` as code: the name of its run-time value, `None` for the identity (α = 0).
-fn t_code(alpha: [u8; 2], beta: [u8; 2]) -> Option<TokenStream> {
+pub(super) fn t_code(alpha: [u8; 2], beta: [u8; 2]) -> Option<TokenStream> {
     (alpha != [0, 0]).then(|| {
         let ident = t_ident(alpha, beta);
         quote!(#ident)
@@ -102,7 +102,7 @@ fn t_code(alpha: [u8; 2], beta: [u8; 2]) -> Option<TokenStream> {
 }
 
 /// The reference basis of `element` differentiated by `beta`.
-fn derivatives(element: ElementKind, beta: [u8; 2]) -> Vec<Polynomial2> {
+pub(super) fn derivatives(element: ElementKind, beta: [u8; 2]) -> Vec<Polynomial2> {
     element
         .triangle_basis()
         .iter()
@@ -113,7 +113,7 @@ fn derivatives(element: ElementKind, beta: [u8; 2]) -> Vec<Polynomial2> {
 /// The rule of a data loop or of an explicit `∫[degree=N]`: the centroid (one point)
 /// for degree ≤ 1, as reduced integration means, otherwise the collapsed Gauss rule
 /// exact for the degree.
-fn rule_for_degree(degree: usize) -> TriangleRule {
+pub(super) fn rule_for_degree(degree: usize) -> TriangleRule {
     if degree <= 1 {
         TriangleRule {
             points: vec![[1.0 / 3.0, 1.0 / 3.0]],
@@ -125,7 +125,7 @@ fn rule_for_degree(degree: usize) -> TriangleRule {
 }
 
 /// The physical multi-indices the block's terms use, sorted.
-fn alphas(block: &Block) -> Vec<[u8; 2]> {
+pub(super) fn alphas(block: &Block) -> Vec<[u8; 2]> {
     let mut alphas: Vec<[u8; 2]> = Vec::new();
     for t in &block.terms {
         for a in [Some(t.test_derivative), t.trial_derivative]

@@ -30,6 +30,14 @@ impl DofNumbering for TriangleMesh {
     }
 }
 
+/// A curved mesh numbers its DOFs as the mesh of its vertices: the DOFs belong to the
+/// topology (vertices, edges, cells), not to the geometry.
+impl DofNumbering for crate::mesh::CurvedTriangleMesh {
+    fn dof_map(&self, element: ElementKind) -> DofMap {
+        DofMap::on_triangles(self.mesh(), element)
+    }
+}
+
 /// The DOFs of one field on a mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DofMap {
@@ -135,6 +143,23 @@ impl DofMap {
         let mut nodes = vec![[f64::NAN; 2]; self.dof_count];
         for c in 0..mesh.cell_count() {
             let map = Affine::of(mesh, c);
+            for (&dof, &xi) in self.cell_dofs(c).iter().zip(&reference) {
+                nodes[dof] = map.point(xi);
+            }
+        }
+        nodes
+    }
+
+    /// The physical node of every DOF (Lagrange elements) on a curved mesh: the
+    /// reference node mapped by its cell's six-node map, so that on a curved edge the
+    /// P2 edge DOF sits at the geometry's edge node (on the exact boundary for
+    /// [`crate::mesh::triangle::QuadraticGeometry::circle`]), where the isoparametric
+    /// basis function of that DOF is 1. Affine cells give [`DofMap::nodes`].
+    pub fn curved_nodes(&self, mesh: &crate::mesh::CurvedTriangleMesh) -> Vec<[f64; 2]> {
+        let reference = fem_reference::triangle::lagrange_nodes(self.element.degree());
+        let mut nodes = self.nodes(mesh.mesh());
+        for c in (0..mesh.mesh().cell_count()).filter(|&c| mesh.is_curved(c)) {
+            let map = mesh.cell_map(c);
             for (&dof, &xi) in self.cell_dofs(c).iter().zip(&reference) {
                 nodes[dof] = map.point(xi);
             }

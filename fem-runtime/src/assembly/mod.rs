@@ -109,6 +109,57 @@ pub(crate) fn for_each_entry<G: Mesh>(
     }
 }
 
+/// Adds the element matrices of `plan`'s block of bilinear `form` over all cells of
+/// `mesh` into `values` (entry `(i, j)` of cell `c` at
+/// `positions[c·stride + offset + i·cols + j]`).
+///
+/// A mesh without curved cells takes the generated loop ([`Model::add_element_matrices`]);
+/// on a [`crate::mesh::CurvedTriangleMesh`] each curved cell gets
+/// [`Model::element_matrix_curved`] and each affine cell the affine kernel, one cell at
+/// a time.
+///
+/// # Errors
+/// Those of [`Model::element_matrix_curved`] (a block with no kernel on curved cells).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn add_block_matrices<M: Model, G: Mesh>(
+    form: usize,
+    plan: &BlockPlan,
+    mesh: &G,
+    coefficients: &Coefficients,
+    positions: &[usize],
+    stride: usize,
+    offset: usize,
+    values: &mut [f64],
+) -> Result<()> {
+    let (params, data) = (&coefficients.params, &coefficients.data);
+    if !mesh.has_curved_cells() {
+        M::add_element_matrices(
+            form, plan.block, mesh, params, data, positions, stride, offset, values,
+        );
+        return Ok(());
+    }
+    let size = plan.rows * plan.cols;
+    let mut local = vec![0.0; size];
+    let (mut x, mut nodes, mut g) = ([0.0; 6], [0.0; 12], [0usize; 3]);
+    for c in 0..mesh.cell_count() {
+        if mesh.curved_cell_nodes_into(c, &mut nodes) {
+            M::element_matrix_curved(form, plan.block, &nodes, params, data, &mut local)?;
+        } else {
+            mesh.cell_coordinates_into(c, &mut x);
+            if mesh.cell_vertex_numbers_into(c, &mut g) {
+                M::element_matrix_on_cell(form, plan.block, &x, &g, params, data, &mut local);
+            } else {
+                M::element_matrix(form, plan.block, &x, params, data, &mut local);
+            }
+        }
+        let at = &positions[c * stride + offset..][..size];
+        for (&p, &v) in at.iter().zip(&local) {
+            values[p] += v;
+        }
+    }
+    Ok(())
+}
+
 /// Assembles one bilinear form of a model on a mesh, reusing its sparsity pattern.
 #[derive(Clone, Debug)]
 pub struct MatrixAssembler {
@@ -195,17 +246,16 @@ impl MatrixAssembler {
         let stride: usize = self.plans.iter().map(|p| p.rows * p.cols).sum();
         let mut offset = 0;
         for plan in &self.plans {
-            M::add_element_matrices(
+            add_block_matrices::<M, _>(
                 self.form,
-                plan.block,
+                plan,
                 mesh,
-                &coefficients.params,
-                &coefficients.data,
+                coefficients,
                 &self.positions,
                 stride,
                 offset,
                 values,
-            );
+            )?;
             offset += plan.rows * plan.cols;
         }
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
@@ -248,13 +298,18 @@ pub fn assemble_vector<M: Model>(
     // Morley); other models ignore them (`Model::element_vector_on_cell`).
     let mut g = [0usize; 3];
     let g = &mut g[..mesh.cell_kind().vertex_count()];
+    // Curved cells (a CurvedTriangleMesh) take the curved kernels.
+    let mut nodes = [0.0; 12];
     for c in 0..mesh.cell_count() {
         mesh.cell_coordinates_into(c, x);
         let numbered = mesh.cell_vertex_numbers_into(c, g);
+        let curved = mesh.has_curved_cells() && mesh.curved_cell_nodes_into(c, &mut nodes);
         for plan in &plans {
             let (params, data) = (&coefficients.params, &coefficients.data);
             let element = &mut local[..plan.rows];
-            if numbered {
+            if curved {
+                M::element_vector_curved(form, plan.block, &nodes, params, data, element)?;
+            } else if numbered {
                 M::element_vector_on_cell(form, plan.block, x, g, params, data, element);
             } else {
                 M::element_vector(form, plan.block, x, params, data, element);

@@ -8,7 +8,7 @@ pub mod interval;
 pub mod triangle;
 
 pub use interval::IntervalMesh;
-pub use triangle::{Diagonal, PointLocator, TriangleMesh};
+pub use triangle::{CurvedTriangleMesh, Diagonal, PointLocator, TriangleMesh};
 
 use fem_reference::CellKind;
 
@@ -35,6 +35,18 @@ pub trait Mesh: Sync {
     /// The reference cell (`Self::CELL`, callable where the mesh type is not named).
     fn cell_kind(&self) -> CellKind {
         Self::CELL
+    }
+    /// Whether some cell is curved (a [`triangle::CurvedTriangleMesh`]); `false` by
+    /// default, and assembly then takes the generated loop over all cells.
+    fn has_curved_cells(&self) -> bool {
+        false
+    }
+    /// For a curved cell `c`, writes the twelve coordinates of its six nodes (the order
+    /// of [`crate::element::Isoparametric`]) into `out` and returns `true`; returns
+    /// `false` for an affine cell (by default every cell).
+    fn curved_cell_nodes_into(&self, c: usize, out: &mut [f64]) -> bool {
+        let _ = (c, out);
+        false
     }
 }
 

@@ -176,17 +176,16 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
         let mut offset = 0;
         for plan in &plans {
-            M::add_element_matrices(
+            crate::assembly::add_block_matrices::<M, G>(
                 form,
-                plan.block,
+                plan,
                 mesh,
-                &coefficients.params,
-                &coefficients.data,
+                coefficients,
                 &split.positions,
                 stride,
                 offset,
                 &mut values,
-            );
+            )?;
             offset += plan.rows * plan.cols;
         }
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {

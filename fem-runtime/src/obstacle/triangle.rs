@@ -10,7 +10,7 @@ use crate::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use crate::error::{Error, Result};
 use crate::lcp::cholesky::{multiply, Cholesky};
 use crate::lcp::{Lcp, LcpSolution};
-use crate::mesh::triangle::{PointLocator, TriangleMesh};
+use crate::mesh::triangle::{CurvedTriangleMesh, PointLocator, QuadraticGeometry, TriangleMesh};
 use crate::model::{Coefficients, IntoFormIndex, Model};
 use crate::obstacle::{
     solve_nested_on_hierarchy, system_forms, Discretization, ObstacleOptions, ObstacleSolution,
@@ -48,6 +48,36 @@ pub fn dirichlet_constraints_on<M: Model>(
     dofs: &SystemDofs,
     coefficients: &Coefficients,
     part: &DirichletPart,
+) -> Result<Constraints> {
+    constraints_at_nodes::<M>(mesh, dofs, coefficients, part, &|map| map.nodes(mesh))
+}
+
+/// [`dirichlet_constraints_on`] on a curved mesh: the data are interpolated at the
+/// nodes of the isoparametric DOFs ([`DofMap::curved_nodes`]), so the P2 DOF of a
+/// curved boundary edge gets the data's value at the geometry's edge node (on the exact
+/// boundary for [`QuadraticGeometry::circle`]), not at the straight edge's midpoint.
+///
+/// # Errors
+/// As [`dirichlet_constraints_on`].
+pub fn curved_dirichlet_constraints_on<M: Model>(
+    mesh: &CurvedTriangleMesh,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+    part: &DirichletPart,
+) -> Result<Constraints> {
+    constraints_at_nodes::<M>(mesh.mesh(), dofs, coefficients, part, &|map| {
+        map.curved_nodes(mesh)
+    })
+}
+
+/// The body of [`dirichlet_constraints_on`], with the DOF nodes of each field's map
+/// given by `nodes`.
+fn constraints_at_nodes<M: Model>(
+    mesh: &TriangleMesh,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+    part: &DirichletPart,
+    nodes: &dyn Fn(&DofMap) -> Vec<[f64; 2]>,
 ) -> Result<Constraints> {
     let mut constraints = Constraints::new();
     if !M::DIRICHLET.is_empty() && part.edge_count(mesh) == 0 {
@@ -94,7 +124,7 @@ pub fn dirichlet_constraints_on<M: Model>(
             }
             continue;
         }
-        let nodes = map.nodes(mesh);
+        let nodes = nodes(map);
         let g = coefficients.data[data];
         for dof in part.dofs(map, mesh) {
             let x = nodes[dof];
@@ -289,6 +319,221 @@ pub fn solve_obstacle_on_part<M: Model>(
         Some(&super::hierarchy::primal_prolongation),
         options,
     )
+}
+
+/// A solved obstacle problem on a curved triangle mesh.
+pub type CurvedObstacleSolution = ObstacleSolution<CurvedTriangleMesh>;
+
+/// Refuses a model whose elements need a per-cell DOF transformation (Argyris, Morley):
+/// it is defined on affine cells only.
+fn check_curved_model<M: Model>() -> Result<()> {
+    match M::FIELDS
+        .iter()
+        .find(|f| f.element.needs_transformation())
+    {
+        Some(f) => Err(Error::Input(format!(
+            "model `{}`: field `{}` ({}) needs a per-cell DOF transformation, which is defined on affine cells only; curved (isoparametric) cells take Lagrange elements",
+            M::NAME,
+            f.name,
+            f.element.name()
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Assembles `bilinear`, `linear` (normally `B_h`, `L_h`) of `M` on a curved mesh, with
+/// the Dirichlet data on `part` interpolated at the isoparametric nodes
+/// ([`curved_dirichlet_constraints_on`]), as an LCP. Curved cells take the curved
+/// kernels, the others the affine ones.
+///
+/// # Errors
+/// A model with Argyris or Morley fields, and those of [`dirichlet_constraints_on`] and
+/// [`Discretization::with_constraints`].
+pub fn discretize_on_curved_part<M: Model>(
+    mesh: &CurvedTriangleMesh,
+    coefficients: &Coefficients,
+    part: &DirichletPart,
+    bilinear: impl IntoFormIndex<M>,
+    linear: impl IntoFormIndex<M>,
+) -> Result<Discretization<CurvedTriangleMesh>> {
+    check_curved_model::<M>()?;
+    let dofs = SystemDofs::all::<M>(mesh)?;
+    let constraints = curved_dirichlet_constraints_on::<M>(mesh, &dofs, coefficients, part)?;
+    Discretization::with_constraints::<M>(mesh, coefficients, dofs, &constraints, bilinear, linear)
+}
+
+/// The primal fields of `coarse_values` on the curved mesh `coarse` interpolated at the
+/// isoparametric DOF nodes of `fine`, the multiplier left 0: a start for nested
+/// iteration. The coarse field is evaluated in the straight cell that holds the node
+/// (exact on affine cells, O(h²)-close on curved ones: a start needs no more); nodes
+/// outside the coarse polygon get 0.
+pub fn prolong_primal_on_curved(
+    coarse: &Discretization<CurvedTriangleMesh>,
+    coarse_values: &[f64],
+    fine: &Discretization<CurvedTriangleMesh>,
+) -> Vec<f64> {
+    let locator = PointLocator::new(coarse.mesh.mesh());
+    let mut out = vec![0.0; fine.dofs.dof_count()];
+    for &field in fine.dofs.fields() {
+        if field == fine.multiplier_field {
+            continue;
+        }
+        let (Some(map_c), Some(range_c)) = (coarse.dofs.map(field), coarse.dofs.range(field))
+        else {
+            continue;
+        };
+        let view = TriangleField {
+            mesh: coarse.mesh.mesh(),
+            map: map_c,
+            coefficients: &coarse_values[range_c],
+        };
+        let basis = TriangleBasis::new(map_c.element());
+        let map_f = fine.dofs.map(field).unwrap();
+        let offset = fine.dofs.offset(field).unwrap();
+        let mut hint = None;
+        for (dof, x) in map_f.curved_nodes(&fine.mesh).into_iter().enumerate() {
+            if let Some((c, b)) = locator.locate_near(x, hint) {
+                hint = Some(c);
+                out[offset + dof] = view.value(&basis, c, [b[1], b[2]]);
+            }
+        }
+    }
+    out
+}
+
+/// Solves the obstacle problem `B_h`, `L_h` of `M` on curved triangles: `meshes[k]` with
+/// the quadratic geometry `geometries[k]` (one per mesh, built for it; refined disks get
+/// theirs from [`QuadraticGeometry::circle`]), each level started from the one before
+/// (nested iteration, [`prolong_primal_on_curved`]), the Dirichlet data on the whole
+/// boundary at the isoparametric nodes. Cells whose edge nodes are their edge midpoints
+/// keep the affine kernels; the others take the curved ones (docs/mathematics.md §8).
+///
+/// The solution's [`ObstacleSolution::energy`] is assembled on the curved cells as the
+/// system was; [`ObstacleSolution::total_contact_force`] and
+/// [`ObstacleSolution::contact_area`] of a [`CurvedObstacleSolution`] integrate over them.
+///
+/// # Errors
+/// Meshes and geometries of different counts, a geometry not built for its mesh, a
+/// model with Argyris or Morley fields, and those of [`solve_obstacle_on_triangles`].
+pub fn solve_obstacle_on_curved_triangles<M: Model>(
+    meshes: &[TriangleMesh],
+    geometries: &[QuadraticGeometry],
+    coefficients: &Coefficients,
+    options: ObstacleOptions,
+) -> Result<CurvedObstacleSolution> {
+    solve_obstacle_on_curved_part::<M>(
+        meshes,
+        geometries,
+        coefficients,
+        &DirichletPart::All,
+        options,
+    )
+}
+
+/// [`solve_obstacle_on_curved_triangles`] with the Dirichlet data on `part` of the
+/// boundary only (as [`solve_obstacle_on_part`]).
+///
+/// # Errors
+/// As [`solve_obstacle_on_curved_triangles`].
+pub fn solve_obstacle_on_curved_part<M: Model>(
+    meshes: &[TriangleMesh],
+    geometries: &[QuadraticGeometry],
+    coefficients: &Coefficients,
+    part: &DirichletPart,
+    options: ObstacleOptions,
+) -> Result<CurvedObstacleSolution> {
+    if meshes.len() != geometries.len() {
+        return Err(Error::Input(format!(
+            "{} meshes and {} quadratic geometries: give one geometry per mesh",
+            meshes.len(),
+            geometries.len()
+        )));
+    }
+    check_curved_model::<M>()?;
+    let (bilinear, linear) = system_forms::<M>()?;
+    let curved = meshes
+        .iter()
+        .zip(geometries)
+        .enumerate()
+        .map(|(k, (mesh, geometry))| {
+            CurvedTriangleMesh::new(mesh.clone(), geometry.clone())
+                .map_err(|e| Error::Input(format!("level {k}: {e}")))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    solve_nested(
+        curved
+            .iter()
+            .map(|mesh| {
+                move || discretize_on_curved_part::<M>(mesh, coefficients, part, bilinear, linear)
+            })
+            .collect(),
+        prolong_primal_on_curved,
+        options,
+    )
+}
+
+impl ObstacleSolution<CurvedTriangleMesh> {
+    /// A view of model field `field` on the mesh of the vertices. Its value at
+    /// reference point `ξ` of cell `c` (`TriangleField::value`) is the isoparametric
+    /// field's at the physical point `x(ξ)` of the cell's six-node map
+    /// (`discretization.mesh.cell_map(c)`); `TriangleField::at` and the norms locate and
+    /// integrate in the straight cells, which is exact on affine cells only.
+    pub fn view(&self, field: usize) -> TriangleField<'_> {
+        TriangleField {
+            mesh: self.discretization.mesh.mesh(),
+            map: self.discretization.dofs.map(field).unwrap(),
+            coefficients: self.field(field),
+        }
+    }
+
+    /// `∫ λ_h` over the curved cells: the total contact force (each cell's
+    /// `Σ_q w_q |det J(ξ_q)| λ_h(ξ_q)` with a rule exact for the multiplier's degree + 2,
+    /// which `det J` needs).
+    pub fn total_contact_force(&self) -> f64 {
+        let d = &self.discretization;
+        let view = self.view(d.multiplier_field);
+        let basis = TriangleBasis::new(view.map.element());
+        let rule = fem_reference::triangle::TriangleRule::exact_for_degree(
+            view.map.element().degree() + 2,
+        );
+        (0..d.mesh.mesh().cell_count())
+            .map(|c| {
+                let map = d.mesh.cell_map(c);
+                rule.points
+                    .iter()
+                    .zip(&rule.weights)
+                    .map(|(&xi, &w)| w * map.det(xi).abs() * view.value(&basis, c, xi))
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// Area of the contact set over the curved cells: each cell's curved measure times
+    /// the share of its multiplier DOFs that are active or touching (as
+    /// `contact_area` on a `TriangleMesh`).
+    pub fn contact_area(&self) -> f64 {
+        let d = &self.discretization;
+        let u = d.primal_part(&self.values);
+        let lambda: Vec<f64> = d
+            .multiplier_dofs()
+            .iter()
+            .map(|&k| self.field(d.multiplier_field)[k])
+            .collect();
+        let active = contact_indicator(&d.lcp, &u, &lambda);
+        let map = d.dofs.map(d.multiplier_field).unwrap();
+        let per_cell = map.local_count();
+        let mut share = vec![0.0; d.mesh.mesh().cell_count()];
+        for (k, &dof) in d.multiplier_dofs().iter().enumerate() {
+            if active[k] {
+                share[dof / per_cell] += 1.0 / per_cell as f64;
+            }
+        }
+        share
+            .iter()
+            .enumerate()
+            .map(|(c, s)| s * crate::mesh::Mesh::measure(&d.mesh, c))
+            .sum()
+    }
 }
 
 impl ObstacleSolution<TriangleMesh> {

@@ -181,6 +181,159 @@ impl QuadraticGeometry {
     }
 }
 
+/// A triangle mesh with quadratic geometry: what assembly takes for curved domains.
+///
+/// Implements [`crate::mesh::Mesh`] (and DOF numbering) like the [`TriangleMesh`] of its
+/// vertices, so every assembly and solver path accepts it; cells whose three edge nodes
+/// lie at their edge midpoints (to 1e-12 of the cell diameter) are affine and keep the
+/// generated fast kernels, the others ([`CurvedTriangleMesh::is_curved`]) are assembled
+/// with the curved kernels (`Model::element_matrix_curved`). Measures are those of the
+/// curved cells; diameters (`h_T`) those of the three vertices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurvedTriangleMesh {
+    mesh: TriangleMesh,
+    geometry: QuadraticGeometry,
+    curved: Vec<bool>,
+    curved_count: usize,
+    measures: Vec<f64>,
+}
+
+impl CurvedTriangleMesh {
+    /// The mesh `mesh` with the geometry `geometry` (built for it).
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] if the geometry has not one node per edge of `mesh`.
+    pub fn new(mesh: TriangleMesh, geometry: QuadraticGeometry) -> Result<Self> {
+        if geometry.edge_nodes.len() != mesh.edge_count() {
+            return Err(Error::Mesh(format!(
+                "a quadratic geometry of {} edge nodes for a mesh of {} edges",
+                geometry.edge_nodes.len(),
+                mesh.edge_count()
+            )));
+        }
+        let v = mesh.vertices();
+        let curved: Vec<bool> = (0..mesh.cell_count())
+            .map(|c| {
+                let tolerance = 1e-12 * mesh.cell_diameter(c);
+                mesh.cell_edges(c).iter().any(|&e| {
+                    let [a, b] = mesh.edges()[e];
+                    let mid = [(v[a][0] + v[b][0]) / 2.0, (v[a][1] + v[b][1]) / 2.0];
+                    let node = geometry.edge_nodes[e];
+                    (node[0] - mid[0]).hypot(node[1] - mid[1]) > tolerance
+                })
+            })
+            .collect();
+        // The measure of a curved cell is ∫|det J|, a polynomial of degree 2 in ξ.
+        let rule = TriangleRule::exact_for_degree(2);
+        let measures = (0..mesh.cell_count())
+            .map(|c| {
+                if !curved[c] {
+                    return mesh.area(c);
+                }
+                let map = geometry.cell_map(&mesh, c);
+                rule.points
+                    .iter()
+                    .zip(&rule.weights)
+                    .map(|(&xi, &w)| w * map.det(xi).abs())
+                    .sum()
+            })
+            .collect();
+        let curved_count = curved.iter().filter(|&&c| c).count();
+        Ok(Self {
+            mesh,
+            geometry,
+            curved,
+            curved_count,
+            measures,
+        })
+    }
+
+    /// The disk of `radius` about `centre` with `rings` rings ([`TriangleMesh::disk`]) and
+    /// its boundary edges curved onto the circle ([`QuadraticGeometry::circle`]).
+    ///
+    /// # Errors
+    /// Those of [`TriangleMesh::disk`] and [`QuadraticGeometry::circle`].
+    pub fn disk(centre: [f64; 2], radius: f64, rings: usize) -> Result<Self> {
+        let mesh = TriangleMesh::disk(centre, radius, rings)?;
+        let geometry = QuadraticGeometry::circle(&mesh, centre, radius)?;
+        Self::new(mesh, geometry)
+    }
+
+    /// The mesh of the vertices (the cells as straight triangles).
+    pub fn mesh(&self) -> &TriangleMesh {
+        &self.mesh
+    }
+
+    /// The quadratic geometry.
+    pub fn geometry(&self) -> &QuadraticGeometry {
+        &self.geometry
+    }
+
+    /// Whether cell `c` is curved (an edge node off its edge's midpoint).
+    pub fn is_curved(&self, c: usize) -> bool {
+        self.curved[c]
+    }
+
+    /// Number of curved cells.
+    pub fn curved_cell_count(&self) -> usize {
+        self.curved_count
+    }
+
+    /// The six-node map of cell `c`.
+    pub fn cell_map(&self, c: usize) -> Isoparametric {
+        self.geometry.cell_map(&self.mesh, c)
+    }
+
+    /// The twelve node coordinates `x₀ y₀ … x₅ y₅` of cell `c`, as the curved kernels
+    /// take them.
+    pub fn cell_nodes(&self, c: usize) -> [f64; 12] {
+        let nodes = self.cell_map(c);
+        let mut out = [0.0; 12];
+        for (n, p) in nodes.nodes().iter().enumerate() {
+            out[2 * n] = p[0];
+            out[2 * n + 1] = p[1];
+        }
+        out
+    }
+
+    /// Area of the curved domain: the sum of the cell measures.
+    pub fn total_area(&self) -> f64 {
+        self.measures.iter().sum()
+    }
+}
+
+impl crate::mesh::Mesh for CurvedTriangleMesh {
+    const CELL: fem_reference::CellKind = fem_reference::CellKind::Triangle;
+    fn cell_count(&self) -> usize {
+        self.mesh.cell_count()
+    }
+    #[inline]
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
+        out[..6].copy_from_slice(&self.mesh.cell_coordinates(c));
+    }
+    #[inline]
+    fn cell_vertex_numbers_into(&self, c: usize, out: &mut [usize]) -> bool {
+        out[..3].copy_from_slice(&self.mesh.cell(c));
+        true
+    }
+    fn diameter(&self, c: usize) -> f64 {
+        self.mesh.cell_diameter(c)
+    }
+    fn measure(&self, c: usize) -> f64 {
+        self.measures[c]
+    }
+    fn has_curved_cells(&self) -> bool {
+        self.curved_count > 0
+    }
+    fn curved_cell_nodes_into(&self, c: usize, out: &mut [f64]) -> bool {
+        if !self.curved[c] {
+            return false;
+        }
+        out[..12].copy_from_slice(&self.cell_nodes(c));
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,7 +13,7 @@ mod parts;
 mod quality;
 mod refine;
 
-pub use curved::QuadraticGeometry;
+pub use curved::{CurvedTriangleMesh, QuadraticGeometry};
 pub use locate::PointLocator;
 pub use parts::NamedGroup;
 pub use quality::{
