@@ -13,7 +13,8 @@ use crate::lcp::{Lcp, LcpSolution};
 use crate::mesh::triangle::{CurvedTriangleMesh, PointLocator, QuadraticGeometry, TriangleMesh};
 use crate::model::{Coefficients, IntoFormIndex, Model};
 use crate::obstacle::{
-    solve_nested_on_hierarchy, system_forms, Discretization, ObstacleOptions, ObstacleSolution,
+    solve_nested, solve_nested_on_hierarchy, system_forms, Discretization, ObstacleOptions,
+    ObstacleSolution,
 };
 use crate::SparseMatrix;
 use faer::sparse::SparseColMat;
