@@ -9,7 +9,9 @@
 //!    load q = 1000 against a flat obstacle above (w ≤ 0.05, t = 1e-3; the contact set
 //!    a rounded square of about half the plate), nested from N = 8, assembly included,
 //!    against one sparse Cholesky analysis + factorization + solve of the final mesh's
-//!    primal matrix `A` (the linear problem of the same size), up to 131k triangles.
+//!    primal matrix `A` (the linear problem of the same size), up to 131k triangles;
+//!    "final LCP s" is the semismooth Newton solve on the final mesh alone (the rest of
+//!    the VI time is the coarse levels and the assembly of every level).
 //!
 //! `cargo bench --bench mindlin` (add `-- --quick` for small meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
@@ -269,6 +271,61 @@ fn assembly(n: usize, rounds: usize) {
     );
 }
 
+/// The element kernels alone, without the scatter: per triangle, every block of the
+/// generated `B_h` through `Model::element_matrix` against the one hand-written element
+/// matrix (both summed so that they are kept). Separates the kernels' arithmetic from
+/// the assembler's memory traffic (it adds each block in its own pass over the mesh).
+fn kernels_only(n: usize, rounds: usize) {
+    let mesh = square(n);
+    let c = coefficients();
+    let form = M::form("B_h").unwrap();
+    let blocks = M::FORMS[form].blocks;
+    let fields = M::FIELDS;
+    let size = |f: usize| {
+        fields[f]
+            .element
+            .local_dof_count(fem_forms::CellKind::Triangle)
+    };
+    let mut buffer = vec![0.0; LOCAL * LOCAL];
+    let (mut generated, mut hand) = (Vec::new(), Vec::new());
+    for _ in 0..rounds {
+        let t = Instant::now();
+        let mut sum = 0.0;
+        for cell in 0..mesh.cell_count() {
+            let x = mesh.cell_coordinates(cell);
+            for (b, block) in blocks.iter().enumerate() {
+                let entries = size(block.test_field) * size(block.trial_field.unwrap());
+                M::element_matrix(
+                    form,
+                    b,
+                    black_box(&x),
+                    &c.params,
+                    &c.data,
+                    &mut buffer[..entries],
+                );
+                sum += buffer[0] + buffer[entries - 1];
+            }
+        }
+        black_box(sum);
+        generated.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let mut sum = 0.0;
+        for cell in 0..mesh.cell_count() {
+            let k = hand_element(black_box(&mesh.cell_coordinates(cell)));
+            sum += k[0][0] + k[LOCAL - 1][LOCAL - 1];
+        }
+        black_box(sum);
+        hand.push(t.elapsed().as_secs_f64());
+    }
+    let per = |v: Vec<f64>| median(v) / mesh.cell_count() as f64 * 1e9;
+    let (g, h) = (per(generated), per(hand));
+    println!(
+        "  kernels alone ({} blocks): generated {g:.1} ns/triangle, hand-written {h:.1} ns/triangle, ratio {:.2}",
+        blocks.len(),
+        g / h
+    );
+}
+
 /// One complete VI solve nested from N = 8 to `n`, meshes generated inside the timing
 /// except the final one (the baseline's matrix is built on it too).
 fn vi_solve_once(
@@ -302,7 +359,7 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
         "\nclamped square, q = {Q} up against w ≤ 0.05, t = {T}: complete VI solve (nested from N = 8, assembly included) vs one Cholesky (analysis + factorization + solve) of the final primal A; medians of {rounds}"
     );
     println!(
-        "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10} {:>8} {:>6} {:>9} {:>10}",
+        "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10} {:>8} {:>6} {:>11} {:>9} {:>10}",
         "N",
         "triangles",
         "primal",
@@ -312,6 +369,7 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
         "Cholesky s",
         "VI s",
         "ratio",
+        "final LCP s",
         "∫λ_h",
         "KKT"
     );
@@ -319,12 +377,14 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
         let mesh = square(n);
         let (warm, _) = vi_solve_once(&c, &mesh, n);
         let a = warm.discretization.lcp.a.clone();
-        let (mut linear, mut vi) = (Vec::new(), Vec::new());
+        let (mut linear, mut vi, mut last) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..rounds {
             linear.push(cholesky_once(&a));
-            vi.push(vi_solve_once(&c, &mesh, n).1);
+            let (solution, seconds) = vi_solve_once(&c, &mesh, n);
+            vi.push(seconds);
+            last.push(solution.solve_seconds);
         }
-        let (linear, vi) = (median(linear), median(vi));
+        let (linear, vi, last) = (median(linear), median(vi), median(last));
         let lcp = &warm.discretization.lcp;
         let levels = warm
             .levels
@@ -333,7 +393,7 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
             .collect::<Vec<_>>()
             .join(",");
         println!(
-            "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10.3} {:>8.3} {:>6.2} {:>9.3} {:>10.1e}",
+            "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10.3} {:>8.3} {:>6.2} {:>11.3} {:>9.3} {:>10.1e}",
             n,
             2 * n * n,
             lcp.n(),
@@ -343,6 +403,7 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
             linear,
             vi,
             vi / linear,
+            last,
             warm.total_contact_force(),
             warm.kkt_residual
         );
@@ -359,5 +420,6 @@ fn main() {
         (256, vec![32, 64, 128, 256])
     };
     assembly(assembly_n, if quick { 3 } else { 9 });
+    kernels_only(assembly_n, if quick { 3 } else { 9 });
     vi_solve(&sizes, if quick { 1 } else { 3 });
 }
