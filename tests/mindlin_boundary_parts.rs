@@ -6,7 +6,7 @@
 //! y = 0 and y = 1 (w = 0, θ free: the "soft" support), D = 1, ν = 0.3, κ = 5/6, uniform
 //! load q = 1, t = 1e-3, no contact (ψ far below). As t → 0 its centre deflection tends to
 //! the Kirchhoff value for two opposite clamped and two simply supported edges,
-//! `0.00191714 q a⁴/D` (Timoshenko & Woinowsky-Krieger, table 29 for b/a = 1: 0.00192;
+//! `0.00191714 q a⁴/D` (Timoshenko & Woinowsky-Krieger tabulate 0.00192 for b/a = 1;
 //! 1.91714e-3 with our Argyris elements). It lies between the fully clamped (1.26532e-3)
 //! and the fully simply supported (4.06235e-3) values, so a support on the wrong sides
 //! or on the wrong fields cannot pass.
