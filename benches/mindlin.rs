@@ -11,7 +11,8 @@
 //!    against one sparse Cholesky analysis + factorization + solve of the final mesh's
 //!    primal matrix `A` (the linear problem of the same size), up to 131k triangles;
 //!    "final LCP s" is the semismooth Newton solve on the final mesh alone (the rest of
-//!    the VI time is the coarse levels and the assembly of every level).
+//!    the VI time is the coarse levels and the assembly of every level); the "swept"
+//!    columns start each nested level with Gauss–Seidel sweeps as the membrane does.
 //!
 //! `cargo bench --bench mindlin` (add `-- --quick` for small meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
@@ -332,6 +333,7 @@ fn vi_solve_once(
     c: &Coefficients,
     mesh: &TriangleMesh,
     n: usize,
+    options: ObstacleOptions,
 ) -> (TriangleObstacleSolution, f64) {
     let clock = Instant::now();
     let mut meshes: Vec<TriangleMesh> = std::iter::successors(Some(8), |&m| Some(2 * m))
@@ -339,9 +341,32 @@ fn vi_solve_once(
         .map(square)
         .collect();
     meshes.push(mesh.clone());
-    let solution =
-        solve_obstacle_on_triangles::<M>(&meshes, c, ObstacleOptions::default()).unwrap();
+    let solution = solve_obstacle_on_triangles::<M>(&meshes, c, options).unwrap();
     (solution, clock.elapsed().as_secs_f64())
+}
+
+/// The default options with the membrane's start on nested levels: 8 symmetric
+/// Gauss–Seidel sweeps on the first Newton system instead of its factorization
+/// (`NewtonOptions::smoothing_sweeps`), the "swept" columns.
+fn with_sweeps() -> ObstacleOptions {
+    let defaults = ObstacleOptions::default();
+    ObstacleOptions {
+        newton: fem_forms::lcp::NewtonOptions {
+            smoothing_sweeps: 8,
+            ..defaults.newton
+        },
+        ..defaults
+    }
+}
+
+/// Newton iterations per level, comma-separated.
+fn levels_of(solution: &TriangleObstacleSolution) -> String {
+    solution
+        .levels
+        .iter()
+        .map(|(_, i)| i.to_string())
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// One Cholesky analysis + factorization + solve of `a`, timed.
@@ -359,7 +384,7 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
         "\nclamped square, q = {Q} up against w ≤ 0.05, t = {T}: complete VI solve (nested from N = 8, assembly included) vs one Cholesky (analysis + factorization + solve) of the final primal A; medians of {rounds}"
     );
     println!(
-        "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10} {:>8} {:>6} {:>11} {:>9} {:>10}",
+        "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10} {:>8} {:>6} {:>11} {:>9} {:>10} {:>16} {:>11} {:>6}",
         "N",
         "triangles",
         "primal",
@@ -371,29 +396,32 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
         "ratio",
         "final LCP s",
         "∫λ_h",
-        "KKT"
+        "KKT",
+        "swept it./level",
+        "swept VI s",
+        "ratio"
     );
     for &n in sizes {
         let mesh = square(n);
-        let (warm, _) = vi_solve_once(&c, &mesh, n);
+        let (warm, _) = vi_solve_once(&c, &mesh, n, ObstacleOptions::default());
         let a = warm.discretization.lcp.a.clone();
-        let (mut linear, mut vi, mut last) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut linear, mut vi, mut last, mut swept) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut swept_levels = String::new();
         for _ in 0..rounds {
             linear.push(cholesky_once(&a));
-            let (solution, seconds) = vi_solve_once(&c, &mesh, n);
+            let (solution, seconds) = vi_solve_once(&c, &mesh, n, ObstacleOptions::default());
             vi.push(seconds);
             last.push(solution.solve_seconds);
+            let (solution, seconds) = vi_solve_once(&c, &mesh, n, with_sweeps());
+            swept.push(seconds);
+            swept_levels = levels_of(&solution);
         }
-        let (linear, vi, last) = (median(linear), median(vi), median(last));
+        let (linear, vi, last, swept) = (median(linear), median(vi), median(last), median(swept));
         let lcp = &warm.discretization.lcp;
-        let levels = warm
-            .levels
-            .iter()
-            .map(|(_, i)| i.to_string())
-            .collect::<Vec<_>>()
-            .join(",");
+        let levels = levels_of(&warm);
         println!(
-            "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10.3} {:>8.3} {:>6.2} {:>11.3} {:>9.3} {:>10.1e}",
+            "{:>5} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10.3} {:>8.3} {:>6.2} {:>11.3} {:>9.3} {:>10.1e} {:>16} {:>11.3} {:>6.2}",
             n,
             2 * n * n,
             lcp.n(),
@@ -405,7 +433,10 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
             vi / linear,
             last,
             warm.total_contact_force(),
-            warm.kkt_residual
+            warm.kkt_residual,
+            swept_levels,
+            swept,
+            swept / linear
         );
     }
 }
