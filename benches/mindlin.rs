@@ -327,6 +327,55 @@ fn kernels_only(n: usize, rounds: usize) {
     );
 }
 
+/// The scatter alone (adding 1 at every position, no kernel): one pass over the
+/// triangles adding all 157 entries of each, against one pass per nonzero block (12, in
+/// the local ranges θ_x 0–2, θ_y 3–5, w 6–11, λ 12) as the generic assembler does.
+fn scatter_only(n: usize, rounds: usize) {
+    let mesh = square(n);
+    let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+    let assembler = MatrixAssembler::new::<M>("B_h", &mesh, &dofs).unwrap();
+    let positions = positions(&mesh, &dofs, &assembler);
+    let mut values = vec![0.0; assembler.nonzero_count()];
+    let ranges = [0..3, 3..6, 6..12, 12..13];
+    let blocks: Vec<(usize, usize)> = (0..4)
+        .flat_map(|a| (0..4).map(move |b| (a, b)))
+        .filter(|&(a, b)| !((a < 2 && b == 3) || (a == 3 && b < 2)))
+        .collect();
+    let (mut once, mut per_block) = (Vec::new(), Vec::new());
+    for _ in 0..rounds {
+        values.fill(0.0);
+        let t = Instant::now();
+        for at in positions.chunks_exact(LOCAL * LOCAL) {
+            for &p in at {
+                if p != usize::MAX {
+                    values[p] += 1.0;
+                }
+            }
+        }
+        black_box(&values);
+        once.push(t.elapsed().as_secs_f64());
+        values.fill(0.0);
+        let t = Instant::now();
+        for &(a, b) in &blocks {
+            for at in positions.chunks_exact(LOCAL * LOCAL) {
+                for i in ranges[a].clone() {
+                    for j in ranges[b].clone() {
+                        values[at[LOCAL * i + j]] += 1.0;
+                    }
+                }
+            }
+        }
+        black_box(&values);
+        per_block.push(t.elapsed().as_secs_f64());
+    }
+    let per = |v: Vec<f64>| median(v) / mesh.cell_count() as f64 * 1e9;
+    let (o, b) = (per(once), per(per_block));
+    println!(
+        "  scatter alone: one pass {o:.1} ns/triangle, {} block passes {b:.1} ns/triangle",
+        blocks.len()
+    );
+}
+
 /// One complete VI solve nested from N = 8 to `n`, meshes generated inside the timing
 /// except the final one (the baseline's matrix is built on it too).
 fn vi_solve_once(
@@ -452,5 +501,6 @@ fn main() {
     };
     assembly(assembly_n, if quick { 3 } else { 9 });
     kernels_only(assembly_n, if quick { 3 } else { 9 });
+    scatter_only(assembly_n, if quick { 3 } else { 9 });
     vi_solve(&sizes, if quick { 1 } else { 3 });
 }
