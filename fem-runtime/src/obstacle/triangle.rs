@@ -742,3 +742,125 @@ pub fn nodal_lcp(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
         psi.to_vec(),
     )
 }
+
+/// The fixed DOFs of the model's `boundary:` conditions, each field on its own part of the
+/// boundary: `parts` pairs a field (by name, one of `M::DIRICHLET`'s fields) with the
+/// [`DirichletPart`] where its condition holds, as [`dirichlet_constraints_on`] imposes
+/// it there; a field of `M::DIRICHLET` that is not listed gets the form's natural
+/// condition on the whole boundary. A Reissner–Mindlin plate clamped on some parts and
+/// simply supported ("soft") on others lists `θ_x`, `θ_y` on the clamped parts and `w`
+/// on all of them.
+///
+/// Each part is also checked for the other fields' data (the data functions of a
+/// model are shared, and [`dirichlet_constraints_on`] evaluates all of them on a part);
+/// only the listed field's DOFs are kept.
+///
+/// # Errors
+/// [`Error::Input`] (naming the field) for an empty list when `M` has boundary
+/// conditions, a field the model does not declare or that has no `boundary:` condition,
+/// a field listed twice, and a part that holds no boundary edge of `mesh` (a misspelt or
+/// foreign marker); as [`dirichlet_constraints_on`] for the data on each part.
+pub fn dirichlet_constraints_per_field<M: Model>(
+    mesh: &TriangleMesh,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+    parts: &[(&str, DirichletPart)],
+) -> Result<Constraints> {
+    let conditions = || {
+        M::DIRICHLET
+            .iter()
+            .map(|&(f, d)| format!("`{} = {}`", M::FIELDS[f].name, M::DATA[d]))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if parts.is_empty() && !M::DIRICHLET.is_empty() {
+        return Err(Error::Input(format!(
+            "no field of `{}` is given a boundary part: with the natural condition on the whole boundary the problem is not coercive; give at least one of {} a part",
+            M::NAME,
+            conditions()
+        )));
+    }
+    let mut constraints = Constraints::new();
+    let mut seen = Vec::new();
+    for (name, part) in parts {
+        let field = M::field(*name).map_err(|_| {
+            Error::Input(format!(
+                "boundary part for field `{name}`: `{}` has no such field (its boundary conditions are {})",
+                M::NAME,
+                conditions()
+            ))
+        })?;
+        if !M::DIRICHLET.iter().any(|&(f, _)| f == field) {
+            return Err(Error::Input(format!(
+                "boundary part for field `{name}`: `{}` declares no boundary condition for it (only {})",
+                M::NAME,
+                conditions()
+            )));
+        }
+        if seen.contains(&field) {
+            return Err(Error::Input(format!(
+                "field `{name}` is given a boundary part twice; list all its markers in one part"
+            )));
+        }
+        seen.push(field);
+        if part.edge_count(mesh) == 0 {
+            return Err(Error::Input(format!(
+                "the boundary part {part:?} of field `{name}` holds none of the mesh's {} boundary edges",
+                mesh.boundary_edges().len()
+            )));
+        }
+        let Some(range) = dofs.range(field) else {
+            return Err(Error::Input(format!(
+                "field `{name}` is not part of this system"
+            )));
+        };
+        let on_part = dirichlet_constraints_on::<M>(mesh, dofs, coefficients, part)?;
+        for &(dof, value) in on_part.fixed() {
+            if range.contains(&dof) {
+                constraints.fix_dof(dof, value)?;
+            }
+        }
+    }
+    Ok(constraints)
+}
+
+/// [`discretize_on_part`] with a part per field ([`dirichlet_constraints_per_field`]).
+///
+/// # Errors
+/// As [`dirichlet_constraints_per_field`], and those of assembly.
+pub fn discretize_on_field_parts<M: Model>(
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    parts: &[(&str, DirichletPart)],
+    bilinear: impl IntoFormIndex<M>,
+    linear: impl IntoFormIndex<M>,
+) -> Result<Discretization<TriangleMesh>> {
+    let dofs = SystemDofs::all::<M>(mesh)?;
+    let constraints = dirichlet_constraints_per_field::<M>(mesh, &dofs, coefficients, parts)?;
+    Discretization::with_constraints::<M>(mesh, coefficients, dofs, &constraints, bilinear, linear)
+}
+
+/// [`solve_obstacle_on_part`] with a part per field ([`dirichlet_constraints_per_field`]):
+/// nested over `meshes`, whose markers refinement keeps, so each field has the same
+/// part on every level.
+///
+/// # Errors
+/// As [`dirichlet_constraints_per_field`] on each mesh, and those of the solve.
+pub fn solve_obstacle_on_field_parts<M: Model>(
+    meshes: &[TriangleMesh],
+    coefficients: &Coefficients,
+    parts: &[(&str, DirichletPart)],
+    options: ObstacleOptions,
+) -> Result<TriangleObstacleSolution> {
+    let (bilinear, linear) = system_forms::<M>()?;
+    solve_nested(
+        meshes
+            .iter()
+            .map(|mesh| {
+                move || discretize_on_field_parts::<M>(mesh, coefficients, parts, bilinear, linear)
+            })
+            .collect(),
+        prolong_primal_on_triangles,
+        options,
+    )
+}
