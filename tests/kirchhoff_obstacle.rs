@@ -3,9 +3,12 @@
 //! condition read as the simple support `w = 0` (`DirichletPart::plate_dofs`).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::models::kirchhoff::kirchhoff_argyris_p0;
+use fem_forms::models::kirchhoff::{
+    kirchhoff_argyris_p0, kirchhoff_argyris_p1disc, kirchhoff_morley_p0,
+};
 use fem_forms::obstacle::triangle::solve_obstacle_on_triangles;
 use fem_forms::obstacle::ObstacleOptions;
+use fem_forms::Model;
 use fem_forms::{Coefficients, DataFn, Diagonal, TriangleMesh};
 
 type M = kirchhoff_argyris_p0::Model;
@@ -22,34 +25,95 @@ fn square(n: usize) -> TriangleMesh {
 /// plate onto the obstacle everywhere, so exactly `w = 0` and `λ = q` (`DΔ²w − sλ = f`);
 /// a wrong sign of b, G or the stabilization (α well inside `1/C_I`, here it matters:
 /// `ℓ_S` and `S` do not cancel unless their signs agree) gives another λ or none.
-#[test]
-fn a_plate_pressed_onto_the_obstacle_everywhere_has_lambda_equal_to_the_load() {
+/// `multipliers` is the number of multiplier DOFs on the 4×4×2 mesh (1 or 3 per cell).
+fn sign_test<Model: fem_forms::Model>(alpha: f64, multipliers: usize) {
     let q = 3.0;
     for s in [1.0, -1.0] {
         let f = move |_: &[f64]| -s * q;
         let (f, psi, g): (&DataFn, &DataFn, &DataFn) = (&f, &zero, &zero);
-        let c = Coefficients::new::<M>(
-            &[("D", 2.0), ("ν", 0.3), ("α", 1e-6), ("s", s)],
+        let c = Coefficients::new::<Model>(
+            &[("D", 2.0), ("ν", 0.3), ("α", alpha), ("s", s)],
             &[("f", f), ("ψ", psi), ("g", g)],
         )
         .unwrap();
         let solution =
-            solve_obstacle_on_triangles::<M>(&[square(4)], &c, ObstacleOptions::default()).unwrap();
+            solve_obstacle_on_triangles::<Model>(&[square(4)], &c, ObstacleOptions::default())
+                .unwrap();
         let d = &solution.discretization;
         let lambda = solution.field(d.multiplier_field);
-        assert_eq!(lambda.len(), 32);
+        assert_eq!(lambda.len(), multipliers);
         assert!(
             lambda.iter().all(|l| (l - q).abs() <= 1e-8 * q),
-            "s = {s}: λ_h from {} to {}, expected {q}",
+            "{} s = {s}: λ_h from {} to {}, expected {q}",
+            Model::NAME,
             lambda.iter().cloned().fold(f64::INFINITY, f64::min),
             lambda.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
         );
         let primal = d.primal_part(&solution.values);
         let largest = primal.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        assert!(largest <= 1e-10, "s = {s}: |W|∞ = {largest}, expected 0");
+        assert!(
+            largest <= 1e-10,
+            "{} s = {s}: |W|∞ = {largest}, expected 0",
+            Model::NAME
+        );
     }
 }
 
+#[test]
+fn a_plate_pressed_onto_the_obstacle_everywhere_has_lambda_equal_to_the_load() {
+    sign_test::<M>(1e-6, 32);
+}
+
+#[test]
+fn the_argyris_p1disc_sign_test() {
+    sign_test::<kirchhoff_argyris_p1disc::Model>(1e-6, 96);
+}
+
+/// Morley: `ΔΔ` of a quadratic is 0, so only the multiplier part of `S_h` is left and
+/// any α > 0 is stable; α = 1 makes the `ℓ_S` term as large as the others.
+#[test]
+fn the_morley_p0_sign_test() {
+    sign_test::<kirchhoff_morley_p0::Model>(1.0, 32);
+}
+
+/// The forms compile to what the mathematics says: on a right isosceles cell the
+/// Argyris stabilization is bounded by the bending form with `C_I ≈ 1.9e5` (h the
+/// diameter; docs/mathematics.md §9 and the prototype's value), the same for both
+/// multiplier spaces (the primal part of `S_h` does not see μ), and Morley's primal part
+/// of `S_h` vanishes (`Δ²` of a quadratic), so its `C_I` is 0 and its `S` block between
+/// multipliers is `α`-free `h⁴ s² |T|` (P0: one entry per cell).
+#[test]
+fn the_stabilizations_compile_to_what_the_mathematics_says() {
+    use fem_forms::stabilization::element_inverse_constant;
+    let x = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+    let params = [1.0, 0.3, 1.0, -1.0];
+    let argyris = element_inverse_constant::<M>(&x, &params, "S", "a").unwrap();
+    assert!((1.8e5..2.0e5).contains(&argyris), "Argyris C_I = {argyris}");
+    let p1disc =
+        element_inverse_constant::<kirchhoff_argyris_p1disc::Model>(&x, &params, "S", "a").unwrap();
+    assert!(
+        (p1disc - argyris).abs() <= 1e-8 * argyris,
+        "{p1disc} vs {argyris}"
+    );
+    type Morley = kirchhoff_morley_p0::Model;
+    assert_eq!(
+        element_inverse_constant::<Morley>(&x, &params, "S", "a").unwrap(),
+        0.0
+    );
+    // the λ–μ block of S on the cell: h⁴ s² |T| with h = √2, |T| = ½
+    let form = Morley::form("S").unwrap();
+    let lambda = Morley::field("λ").unwrap();
+    let block = Morley::FORMS[form]
+        .blocks
+        .iter()
+        .position(|b| b.test_field == lambda && b.trial_field == Some(lambda))
+        .expect("S has a λ–μ block");
+    let zero_data = |_: &[f64]| 0.0;
+    let data: Vec<&DataFn> = vec![&zero_data; Morley::DATA.len()];
+    let mut out = [0.0];
+    Morley::element_matrix(form, block, &x, &params, &data, &mut out);
+    assert!((out[0] - 4.0 * 0.5).abs() < 1e-12, "{}", out[0]);
+}
 /// `boundary: w = g` on the Argyris field is the simple support: the DOFs the obstacle
 /// discretization fixes are exactly `plate_dofs(SimplySupported)` (5 per corner, 3 per
 /// other boundary vertex), and data that is not zero on the boundary is refused with
