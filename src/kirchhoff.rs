@@ -31,6 +31,8 @@ pub const MAX_KIRCHHOFF_MESH_SIZE: usize = 256;
 /// least this far from every cell outside the contact set (a fifth of the contact
 /// radius, about 0.25, at q = 20 on the flat obstacle), and two vertex rings in.
 pub const INTERIOR_MARGIN: f64 = 0.05;
+/// The largest |q| a Kirchhoff solve accepts.
+pub const MAX_LOAD: f64 = 1e100;
 /// The coarsest mesh of the nested iteration (N×N×2 with N ≥ this).
 pub const NESTED_FROM: usize = 4;
 /// The default α of the Argyris pairs as a fraction of `1/C_I` (docs/mathematics.md §1:
@@ -38,9 +40,10 @@ pub const NESTED_FROM: usize = 4;
 pub const ALPHA_FRACTION: f64 = 0.5;
 /// The default α of Morley–P0, where `C_I = 0` (every α > 0 is stable): the term adds
 /// `α h⁴ |T|` to the multiplier's diagonal and shifts the obstacle by `α h⁴ f` where
-/// λ = 0, negligible against the gap 0.002 for q ≤ 20 on the meshes used here
-/// (h⁴ ≤ 2.4e-3 from N = 8 on).
-pub const MORLEY_ALPHA: f64 = 1.0;
+/// λ = 0: at q = 20, 0.04 % of the gap 0.002 at N = 32 and 10 % at N = 8 (α = 1 shifted
+/// it by 4 % at N = 32 and grew the contact area from 0.25 to 0.31); below 1e-4 Newton
+/// needs more iterations on the coarse levels (40 at N = 4 for α = 1e-12).
+pub const MORLEY_ALPHA: f64 = 0.01;
 
 /// The discretizations of the Kirchhoff plate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -176,7 +179,8 @@ impl KirchhoffRequest {
     ///
     /// # Errors
     /// [`Error::Input`] naming the value at fault: a mesh size of 0 or above
-    /// [`MAX_KIRCHHOFF_MESH_SIZE`], a load that is not finite, α ≤ 0 or not finite, D ≤ 0
+    /// [`MAX_KIRCHHOFF_MESH_SIZE`], a load that is not finite or above [`MAX_LOAD`] in
+    /// size, α ≤ 0 or not finite, D ≤ 0
     /// or ν outside (−1, ½), an obstacle whose gap or curvature is not finite or whose gap
     /// is not positive (the clamped plate starts at w = 0 below it).
     pub fn validate(&self) -> Result<()> {
@@ -188,8 +192,13 @@ impl KirchhoffRequest {
                 self.mesh_size
             ));
         }
-        if !self.load.is_finite() {
-            return bad(format!("load q = {} must be finite", self.load));
+        // beyond 1e100 the far obstacle of a scene without one (100 |q|/D) and the
+        // energy (q² a⁴/D) leave the range of f64
+        if !(self.load.is_finite() && self.load.abs() <= MAX_LOAD) {
+            return bad(format!(
+                "load q = {:e} must be finite and at most {MAX_LOAD:e} in size",
+                self.load
+            ));
         }
         if let Some(alpha) = self.alpha {
             if !(alpha.is_finite() && alpha > 0.0) {
@@ -302,7 +311,7 @@ pub struct KirchhoffReport {
     /// Without an obstacle: the series' centre deflection `c q a⁴/D` (clamped: the
     /// tabulated 0.00126532, six digits; simply supported: Navier's series summed).
     pub reference_centre_deflection: Option<f64>,
-    /// Without an obstacle: `(w_h(centre) − reference)/reference`.
+    /// Without an obstacle (and q ≠ 0): `(w_h(centre) − reference)/reference`.
     pub relative_error: Option<f64>,
     /// `max |w_h|` over the vertices, edge midpoints and centroids of the cells.
     pub max_deflection: f64,
@@ -455,7 +464,8 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
         energy: solution.energy::<M>(coefficients)?,
         centre_deflection: centre,
         reference_centre_deflection: reference,
-        relative_error: reference.map(|r| (centre - r) / r),
+        // q = 0: w_h = 0 = reference, no relative error to speak of
+        relative_error: reference.filter(|&r| r != 0.0).map(|r| (centre - r) / r),
         max_deflection: max_deflection(&view, &basis),
         total_contact_force: solution.total_contact_force(),
         contact_area: filled_area(&solution.discretization.mesh, &contact),
@@ -779,7 +789,18 @@ pub const DEFAULT_RECOVERY: MultiplierRecovery = MultiplierRecovery::PatchAverag
 pub fn summary(r: &KirchhoffReport) -> String {
     let mut line = format!(
         "{} {} {} obstacle {} q = {} N = {}: J_h {:.8e}, w(centre) {:.8e}",
-        r.scene, r.pair, r.support, r.obstacle, r.load, r.mesh_size, r.energy, r.centre_deflection
+        r.scene,
+        r.pair,
+        r.support,
+        r.obstacle,
+        if r.load == 0.0 || (1e-3..1e6).contains(&r.load.abs()) {
+            r.load.to_string()
+        } else {
+            format!("{:e}", r.load)
+        },
+        r.mesh_size,
+        r.energy,
+        r.centre_deflection
     );
     if let (Some(reference), Some(e)) = (r.reference_centre_deflection, r.relative_error) {
         line += &format!(" (series {reference:.8e}, relative error {e:+.2e})");
@@ -1090,7 +1111,7 @@ pub const SCATTER_METHODS: &[ScatterMethod] = &[
         recovery: MultiplierRecovery::Raw,
     },
     ScatterMethod {
-        label: "morley-p0 α=1",
+        label: "morley-p0 α=0.01",
         pair: KirchhoffPair::MorleyP0,
         alpha: None,
         recovery: MultiplierRecovery::Raw,
