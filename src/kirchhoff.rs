@@ -1419,24 +1419,23 @@ mod tests {
         let distance = frontier_distances(&mesh, &contact);
         let interior = interior_cells(&mesh, &contact);
         assert!(!interior.is_empty());
+        let h = mesh.max_h();
+        let radius = |c: usize| (centre(c)[0] - 0.5).hypot(centre(c)[1] - 0.5);
         for &c in &interior {
-            let [x, y] = centre(c);
-            // the frontier centroids lie outside r = 0.3 − h/2 or so
-            assert!(
-                (x - 0.5).hypot(y - 0.5) < 0.3 - INTERIOR_MARGIN + 0.05,
-                "cell {c}"
-            );
+            // the cells outside the disk next to it surround r = 0.3 within a diameter
+            assert!(radius(c) < 0.3 - INTERIOR_MARGIN + h, "cell {c}");
             assert!(distance[c] >= INTERIOR_MARGIN);
+        }
+        // and every cell well inside is interior: two vertex rings lie within 4 h
+        for c in (0..mesh.cell_count()).filter(|&c| radius(c) < 0.3 - INTERIOR_MARGIN - 4.0 * h) {
+            assert!(interior.contains(&c), "cell {c} at r = {}", radius(c));
         }
         // a cell right at the edge of the disk is not interior
         let edge = (0..mesh.cell_count())
             .filter(|&c| contact[c])
-            .max_by(|&a, &b| {
-                let r = |c: usize| (centre(c)[0] - 0.5).hypot(centre(c)[1] - 0.5);
-                r(a).total_cmp(&r(b))
-            })
+            .max_by(|&a, &b| radius(a).total_cmp(&radius(b)))
             .unwrap();
         assert!(!interior.contains(&edge));
-        assert!(distance[edge] < 2.0 * mesh.max_h());
+        assert!(distance[edge] < 2.0 * h);
     }
 }
