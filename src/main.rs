@@ -3,7 +3,9 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
+use fem_forms::kirchhoff::{self, KirchhoffPair, KirchhoffRequest};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
+use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::plate_scenes::PlateScene;
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind, MEMBRANE_PAIRS};
@@ -122,6 +124,13 @@ struct SolveOptions {
     /// wants 2 or 3).
     #[arg(long)]
     refinement: Option<usize>,
+    /// Plate support (Kirchhoff scenes): clamped or simply-supported.
+    #[arg(long)]
+    support: Option<String>,
+    /// Obstacle above the plate (Kirchhoff scenes): none, flat (w ≤ 0.002) or curved
+    /// (w ≤ 0.002 + 0.01 r²).
+    #[arg(long)]
+    obstacle: Option<String>,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
@@ -153,6 +162,8 @@ impl SolveOptions {
         note(self.linear_solver.is_some(), "--linear-solver");
         note(self.refinement.is_some(), "--refinement");
         note(self.plot, "--plot");
+        note(self.support.is_some(), "--support");
+        note(self.obstacle.is_some(), "--obstacle");
         given
     }
 
@@ -333,6 +344,10 @@ fn hosted_studies(entries: &[SceneEntry], out: &Path) -> Result<(), String> {
 
 /// Runs the study called `kind` on a registry scene.
 fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(), String> {
+    if let SceneKind::Kirchhoff(scene) = &entry.kind {
+        return run_kirchhoff_study(*scene, kind, full, out)
+            .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
+    }
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
     // a plate's one study, t → 0, is its own (the generic kinds need exact solutions of
     // the obstacle problem, which the plate scenes do not have yet)
@@ -457,16 +472,81 @@ fn list() {
     for p in PlatePair::ALL {
         println!("  {}", p.name());
     }
+    println!(
+        "Kirchhoff pairs (w, λ; --mesh-size N, --support, --obstacle; default argyris-p0, α = {}/C_I; morley-p0 α = {}):",
+        kirchhoff::ALPHA_FRACTION,
+        kirchhoff::MORLEY_ALPHA
+    );
+    for p in KirchhoffPair::ALL {
+        println!("  {}", p.name());
+    }
 }
 
 /// The one family-dispatch point of `solve`: options checked against the scene's family,
 /// then the family's solver.
 fn solve(entry: &SceneEntry, options: &SolveOptions, out: &Path) -> Result<(), String> {
+    if !matches!(entry.kind, SceneKind::Kirchhoff(_)) {
+        options.refuse(
+            &["--support", "--obstacle"],
+            &format!("`{}` is not a Kirchhoff plate scene", entry.name()),
+        )?;
+    }
     match &entry.kind {
+        SceneKind::Kirchhoff(scene) => solve_kirchhoff(*scene, options),
         SceneKind::Beam(scene) => solve_beam(*scene, options, out),
         SceneKind::Membrane(scene) => solve_membrane(scene, options, out),
         SceneKind::Plate(scene) => solve_plate(*scene, options),
     }
+}
+
+/// A Kirchhoff study: `convergence` or `lambda-scatter` (fem_forms::kirchhoff).
+fn run_kirchhoff_study(
+    scene: KirchhoffScene,
+    kind: &str,
+    full: bool,
+    out: &Path,
+) -> Result<(), String> {
+    match kind {
+        "convergence" => kirchhoff::convergence_run(scene, full, out),
+        "lambda-scatter" => kirchhoff::scatter_run(scene, full, out),
+        _ => return Err(format!("unknown Kirchhoff study `{kind}`")),
+    }
+    .map_err(|e| e.to_string())
+}
+
+fn solve_kirchhoff(scene: KirchhoffScene, options: &SolveOptions) -> Result<(), String> {
+    options.refuse(
+        &["--elements", "--msh", "--vtk", "--thickness", "--refinement", "--plot"],
+        &format!(
+            "`{}` is a Kirchhoff plate scene on an N×N×2 mesh (--mesh-size, --load, --alpha, --pair, --support, --obstacle, --solver, --cold, --json)",
+            scene.name
+        ),
+    )?;
+    let mut request = KirchhoffRequest::new(scene);
+    if let Some(name) = &options.pair {
+        request.pair = KirchhoffPair::parse(name).map_err(|e| e.to_string())?;
+    }
+    if let Some(name) = &options.support {
+        request.support = kirchhoff::parse_support(name).map_err(|e| e.to_string())?;
+    }
+    if let Some(name) = &options.obstacle {
+        request.obstacle = kirchhoff::parse_obstacle(name).map_err(|e| e.to_string())?;
+    }
+    request.mesh_size = options.mesh_size.unwrap_or(request.mesh_size);
+    request.load = options.load.unwrap_or(request.load);
+    request.alpha = options.alpha.or(request.alpha);
+    request.solver = options.solver();
+    request.nested = !options.cold;
+    let report = kirchhoff::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!("{}", kirchhoff::summary(&report));
+    }
+    Ok(())
 }
 
 fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> {

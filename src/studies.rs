@@ -245,6 +245,10 @@ pub fn study_scene(entry: &SceneEntry) -> Result<Box<dyn StudyScene>> {
             "plate scene `{}` hosts no study of this kind",
             s.name
         ))),
+        SceneKind::Kirchhoff(s) => Err(Error::Input(format!(
+            "Kirchhoff scene `{}` runs its studies in fem_forms::kirchhoff",
+            s.name
+        ))),
     }
 }
 

@@ -2,8 +2,8 @@
 //! Argyris quintic and on the non-conforming Morley quadratic: the bending form
 //! `a(w;v) = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]` (that is `∫ M(w):K(v)` with
 //! `K(w) = −∇∇w`, `M(w) = D[(1−ν)K(w) + ν tr K(w) I]`) and the load `ℓ(v) = ∫ f v`.
-//! The first two exist to test the elements' wiring (issue 13); `kirchhoff_argyris_p0` is
-//! the obstacle problem.
+//! The first two exist to test the elements' wiring (issue 13); `kirchhoff_argyris_p0`,
+//! `kirchhoff_argyris_p1disc` and `kirchhoff_morley_p0` are the obstacle problem.
 
 /// One plate model per element: the forms are the same text.
 macro_rules! kirchhoff_model {
@@ -34,29 +34,57 @@ kirchhoff_model! {
     kirchhoff_morley, w: Morley
 }
 
-fem_runtime::model! {
-    /// Kirchhoff plate obstacle problem on Argyris–P0 (docs/mathematics.md §9, frame §1): deflection
-    /// w ∈ Argyris, contact multiplier λ ∈ P0, λ ≥ 0, obstacle side `s = ±1`
-    /// (`s·w ≥ s·ψ`: +1 an obstacle below, −1 one above), `DΔ²w − sλ = f`, stabilized by
-    /// `S_h = Σ_T h_T⁴ (DΔ²w − sλ, DΔ²v − sμ)_T` (`Δ²` written `ΔΔ`). `boundary: w = g`
-    /// is the simple support with `g = 0` (the runtime fixes the value and the derivatives
-    /// it implies along the edges, `DirichletPart::plate_dofs`); α: stable for
-    /// `0 < α < 1/C_I`.
-    pub mod kirchhoff_argyris_p0 on triangle {
-        unknowns: w: Argyris, λ: P0 >= 0;
-        tests: v, μ;
-        params: D > 0, ν, α, s;
-        data: f, ψ, g;
-        boundary: w = g;
-        forms: "
-            a(w;v)       = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]
-            b(v;μ)       = ∫ s v μ
-            S(w,λ;v,μ)   = Σ_T h_T⁴ (D ΔΔw − sλ, D ΔΔv − sμ)_T
-            ℓ(v)         = ∫ f v
-            ℓ_S(v,μ)     = Σ_T h_T⁴ (f, D ΔΔv − sμ)_T
-            G(μ)         = ∫ s ψ μ
-            B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
-            L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
-        ";
-    }
+/// One Kirchhoff obstacle model per element pair: the forms are the same text
+/// (docs/mathematics.md §9, frame §1): `DΔ²w − sλ = f`, λ ≥ 0, obstacle side `s = ±1`
+/// (`s·w ≥ s·ψ`: +1 an obstacle below, −1 one above), stabilized by
+/// `S_h = Σ_T h_T⁴ (DΔ²w − sλ, DΔ²v − sμ)_T` (`Δ²` written `ΔΔ`). `boundary: w = g` is
+/// the simple support with `g = 0` (the runtime fixes the value and the derivatives it
+/// implies along the edges, `DirichletPart::plate_dofs`); a clamped plate is held by
+/// `Constraints::support_plate` levels instead (the same forms: a support only fixes
+/// DOFs, so no clamped variant of the text is needed).
+macro_rules! kirchhoff_obstacle_model {
+    ($(#[$doc:meta])* $name:ident, w: $w:ident, λ: $lambda:ident) => {
+        fem_runtime::model! {
+            $(#[$doc])*
+            pub mod $name on triangle {
+                unknowns: w: $w, λ: $lambda >= 0;
+                tests: v, μ;
+                params: D > 0, ν, α, s;
+                data: f, ψ, g;
+                boundary: w = g;
+                forms: "
+                    a(w;v)       = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]
+                    b(v;μ)       = ∫ s v μ
+                    S(w,λ;v,μ)   = Σ_T h_T⁴ (D ΔΔw − sλ, D ΔΔv − sμ)_T
+                    ℓ(v)         = ∫ f v
+                    ℓ_S(v,μ)     = Σ_T h_T⁴ (f, D ΔΔv − sμ)_T
+                    G(μ)         = ∫ s ψ μ
+                    B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
+                    L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
+                ";
+            }
+        }
+    };
+}
+
+kirchhoff_obstacle_model! {
+    /// Kirchhoff plate obstacle problem on Argyris–P0: deflection w ∈ Argyris, contact
+    /// multiplier λ ∈ P0 (see `kirchhoff_obstacle_model!` for the forms); α: stable for
+    /// `0 < α < 1/C_I` (C_I ≈ 1.9e5 on right isosceles cells, computed at run time).
+    kirchhoff_argyris_p0, w: Argyris, λ: P0
+}
+
+kirchhoff_obstacle_model! {
+    /// Kirchhoff plate obstacle problem on Argyris–P1disc: w ∈ Argyris, λ piecewise linear
+    /// and discontinuous (coefficient-wise λ ≥ 0 is λ ≥ 0 pointwise); α as for
+    /// Argyris–P0 (the primal part of `S_h`, hence C_I, is the same).
+    kirchhoff_argyris_p1disc, w: Argyris, λ: P1disc
+}
+
+kirchhoff_obstacle_model! {
+    /// Kirchhoff plate obstacle problem on Morley–P0 (non-conforming, 6 DOFs per cell):
+    /// `Δ²w` vanishes on each cell for w ∈ P2, so `S_h = Σ_T h_T⁴ s² (λ, μ)_T` and
+    /// `ℓ_S = −Σ_T h_T⁴ (f, sμ)_T`: C_I = 0, every α > 0 is stable and α is limited by
+    /// accuracy (the obstacle shifts by about `α h⁴ |f − sλ|`, zero where the residual is).
+    kirchhoff_morley_p0, w: Morley, λ: P0
 }

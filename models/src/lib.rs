@@ -8,6 +8,7 @@
 pub mod data;
 pub mod euler_bernoulli;
 pub mod kirchhoff;
+pub mod kirchhoff_scenes;
 pub mod membrane;
 pub mod membrane_scenes;
 pub mod mindlin;

@@ -1,0 +1,174 @@
+//! The Kirchhoff scenes from the command line: `kirchhoff-square` against the plate
+//! series (Navier's for the simple support, summed here), `kirchhoff-obstacle`'s JSON
+//! fields and what they must satisfy whatever the discretization, and bad input refused
+//! with a message naming it, never a panic.
+
+use std::process::Command;
+
+fn fem_forms(args: &[&str]) -> std::process::Output {
+    let out = std::env::temp_dir().join(format!("fem-forms-kirchhoff-cli-{}", std::process::id()));
+    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("the binary runs")
+}
+
+fn solve_json(scene: &str, args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["solve", scene, "--json"];
+    all.extend_from_slice(args);
+    let run = fem_forms(&all);
+    assert!(
+        run.status.success(),
+        "{all:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_slice(&run.stdout).unwrap()
+}
+
+fn number(json: &serde_json::Value, field: &str) -> f64 {
+    json[field]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{field} missing in {json}"))
+}
+
+/// Navier's series for the centre deflection of the simply supported unit square under a
+/// unit load with D = 1: `16/π⁶ Σ_{m,n odd} (−1)^{(m+n)/2−1} / (mn(m²+n²)²)`; its terms
+/// fall like `1/m⁵`, so 400 odd terms each way leave less than 1e-13.
+fn navier_centre_deflection() -> f64 {
+    let mut sum = 0.0;
+    for m in (1..800).step_by(2) {
+        for n in (1..800).step_by(2) {
+            let sign = if ((m + n) / 2 - 1) % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let (m, n) = (m as f64, n as f64);
+            sum += sign / (m * n * (m * m + n * n).powi(2));
+        }
+    }
+    16.0 / std::f64::consts::PI.powi(6) * sum
+}
+
+/// The clamped square at the default mesh (N = 16) reproduces `0.00126532 q a⁴/D` to its
+/// six digits (within half a unit of the last), for q = 1 and q = 3 (linear in q); the
+/// simply supported one Navier's series to 1e-7.
+#[test]
+fn kirchhoff_square_matches_the_series() {
+    let series = navier_centre_deflection();
+    assert!((series - 0.00406235).abs() < 5e-9, "series {series}");
+    for q in [1.0, 3.0] {
+        let load = q.to_string();
+        let json = solve_json("kirchhoff-square", &["--load", &load]);
+        let w = number(&json, "centre_deflection");
+        assert!(
+            (w - 0.00126532 * q).abs() <= 0.5e-8 * q,
+            "clamped q = {q}: {w}"
+        );
+        assert_eq!(number(&json, "total_contact_force"), 0.0);
+        assert_eq!(number(&json, "contact_area"), 0.0);
+        let json = solve_json(
+            "kirchhoff-square",
+            &["--load", &load, "--support", "simply-supported"],
+        );
+        let w = number(&json, "centre_deflection");
+        assert!(
+            ((w - series * q) / (series * q)).abs() < 1e-7,
+            "simply supported q = {q}: {w} vs {}",
+            series * q
+        );
+        assert!(number(&json, "complementarity_residual") < 1e-10);
+    }
+}
+
+/// kirchhoff-obstacle at q = 5 and 20, flat and curved: the JSON has every field of the
+/// issue; the plate stays under the obstacle at the centre and, for the flat one,
+/// everywhere (to 1 % of the gap: the constraint holds cell by cell on the mean), the contact force is positive and below the load (the
+/// supports carry the rest), the contact area lies inside the square, the interior
+/// energy lies between the unobstructed plate's and 0 (the obstacle raises the minimum;
+/// the plate at rest, w = 0, is admissible with J = 0).
+#[test]
+fn kirchhoff_obstacle_reports_what_the_issue_asks() {
+    for (q, obstacle) in [(5.0, "flat"), (20.0, "curved"), (20.0, "flat")] {
+        let load = format!("{q}");
+        let json = solve_json(
+            "kirchhoff-obstacle",
+            &["--load", &load, "--obstacle", obstacle, "--mesh-size", "16"],
+        );
+        for field in [
+            "energy",
+            "max_deflection",
+            "total_contact_force",
+            "contact_area",
+            "dofs",
+            "iterations",
+            "level_iterations",
+            "seconds",
+            "complementarity_residual",
+        ] {
+            assert!(
+                json.get(field).is_some_and(|v| !v.is_null()),
+                "{field} missing"
+            );
+        }
+        let what = format!("q = {q} {obstacle}");
+        // ψ(centre) = 0.002 for both; the flat obstacle bounds w everywhere
+        assert!(number(&json, "centre_deflection") <= 0.002 * 1.01, "{what}");
+        if obstacle == "flat" {
+            assert!(number(&json, "max_deflection") <= 0.002 * 1.01, "{what}");
+        }
+        let force = number(&json, "total_contact_force");
+        assert!(force > 0.0 && force < q, "{what}: ∫λ_h = {force}");
+        let area = number(&json, "contact_area");
+        assert!(area > 0.0 && area < 1.0, "{what}: area {area}");
+        let energy = number(&json, "energy");
+        // the clamped plate without an obstacle: J = −½ ∫ f w = −½ q² ∫ w₁ < 0, and
+        // ∫ w₁ < w₁(centre) = 0.00126532 bounds it from below
+        assert!(
+            energy < 0.0 && energy > -0.5 * q * q * 0.00126532,
+            "{what}: J_h = {energy}"
+        );
+        assert!(number(&json, "complementarity_residual") < 1e-10, "{what}");
+        let levels = json["level_iterations"].as_array().unwrap();
+        assert_eq!(levels.len(), 3, "{what}: N = 4, 8, 16");
+    }
+}
+
+#[test]
+fn bad_kirchhoff_input_is_refused_by_name() {
+    let cases: [(&[&str], &str); 7] = [
+        (
+            &["solve", "kirchhoff-square", "--support", "glued"],
+            "glued",
+        ),
+        (
+            &["solve", "kirchhoff-obstacle", "--obstacle", "round"],
+            "round",
+        ),
+        (&["solve", "kirchhoff-obstacle", "--pair", "p2-p0"], "p2-p0"),
+        (
+            &["solve", "kirchhoff-obstacle", "--mesh-size", "0"],
+            "mesh size",
+        ),
+        (&["solve", "kirchhoff-obstacle", "--alpha", "-1"], "α"),
+        (
+            &["solve", "kirchhoff-obstacle", "--thickness", "0.1"],
+            "--thickness",
+        ),
+        (
+            &["solve", "membrane-flat", "--support", "clamped"],
+            "--support",
+        ),
+    ];
+    for (args, named) in cases {
+        let run = fem_forms(args);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(
+            stderr.starts_with("error:") && stderr.contains(named),
+            "{args:?}: {stderr}"
+        );
+    }
+}
