@@ -1,26 +1,25 @@
-//! The Kirchhoff plate written as in the mathematics (MODELS.md §5, issue 13):
-//! `K(w) = −∇∇w`, `M(w) = D[(1−ν)K(w) + ν tr K(w) I]`, `a(w,v) = ∫ M(w):K(v)` and the
-//! stabilization with `Δ²`, against the models written with `∇∇w:∇∇v`, `Δw Δv` and `ΔΔ`
-//! (`models/src/kirchhoff.rs`, whose kernels tests/argyris.rs checks against exact
-//! integrals): the element matrices agree on random triangles, transformation included.
+//! The Kirchhoff obstacle models are written as in the mathematics (MODELS.md §5, issue
+//! 13): `K(w) = −∇∇w`, `M(w) = D[(1−ν)K(w) + ν tr K(w) I]`, `a(w,v) = ∫ M(w):K(v)` and the
+//! stabilization with `Δ²` (`models/src/kirchhoff.rs`). Against the same forms written
+//! with `∇∇w:∇∇v`, `Δw Δv` and `ΔΔ` (the notation whose kernels tests/argyris.rs checks
+//! against exact integrals): the element matrices agree on random triangles,
+//! transformation included.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::kirchhoff::kirchhoff_argyris_p0;
 use fem_forms::DataFn;
 
 fem_forms::model! {
-    /// Argyris–P0 Kirchhoff obstacle model in moment–curvature notation.
-    pub mod kirchhoff_moments on triangle {
+    /// Argyris–P0 Kirchhoff obstacle model in Hessian notation.
+    pub mod kirchhoff_hessians on triangle {
         unknowns: w: Argyris, λ: P0 >= 0;
         tests: v, μ;
         params: D > 0, ν, α, s;
         data: f, ψ, g;
         forms: "
-            K(w)         := −∇∇w
-            M(w)         := D[(1−ν)K(w) + ν tr K(w) I]
-            a(w;v)       = ∫ M(w):K(v)
-            S(w,λ;v,μ)   = Σ_T h_T⁴ (D Δ²w − sλ, D Δ²v − sμ)_T
-            ℓ_S(v,μ)     = Σ_T h_T⁴ (f, D Δ²v − sμ)_T
+            a(w;v)       = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]
+            S(w,λ;v,μ)   = Σ_T h_T⁴ (D ΔΔw − sλ, D ΔΔv − sμ)_T
+            ℓ_S(v,μ)     = Σ_T h_T⁴ (f, D ΔΔv − sμ)_T
         ";
     }
 }
@@ -61,7 +60,7 @@ fn moments_and_curvatures_give_the_kernels_of_the_hessian_notation() {
         ];
         let data = [f, f, f];
         let (ours, theirs) = (
-            kirchhoff_moments::a::matrix_v_w(&x, &global, &params, &data),
+            kirchhoff_hessians::a::matrix_v_w(&x, &global, &params, &data),
             kirchhoff_argyris_p0::a::matrix_v_w(&x, &global, &params, &data),
         );
         let tolerance = 1e-12 * largest(&theirs);
@@ -69,7 +68,7 @@ fn moments_and_curvatures_give_the_kernels_of_the_hessian_notation() {
             assert!((a - b).abs() <= tolerance, "case {case}: a {a} against {b}");
         }
         let (ours, theirs) = (
-            kirchhoff_moments::S::matrix_v_w(&x, &global, &params, &data),
+            kirchhoff_hessians::S::matrix_v_w(&x, &global, &params, &data),
             kirchhoff_argyris_p0::S::matrix_v_w(&x, &global, &params, &data),
         );
         let tolerance = 1e-12 * largest(&theirs);

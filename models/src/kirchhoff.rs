@@ -37,7 +37,7 @@ kirchhoff_model! {
 /// One Kirchhoff obstacle model per element pair: the forms are the same text
 /// (docs/mathematics.md §9, frame §1): `DΔ²w − sλ = f`, λ ≥ 0, obstacle side `s = ±1`
 /// (`s·w ≥ s·ψ`: +1 an obstacle below, −1 one above), stabilized by
-/// `S_h = Σ_T h_T⁴ (DΔ²w − sλ, DΔ²v − sμ)_T` (`Δ²` written `ΔΔ`). `boundary: w = g` is
+/// `S_h = Σ_T h_T⁴ (DΔ²w − sλ, DΔ²v − sμ)_T` and `a(w;v) = ∫ M(w):K(v)` with `K(w) = −∇∇w`, as written in the model. `boundary: w = g` is
 /// the simple support with `g = 0` (the runtime fixes the value and the derivatives it
 /// implies along the edges, `DirichletPart::plate_dofs`); a clamped plate is held by
 /// `Constraints::support_plate` levels instead (the same forms: a support only fixes
@@ -53,11 +53,13 @@ macro_rules! kirchhoff_obstacle_model {
                 data: f, ψ, g;
                 boundary: w = g;
                 forms: "
-                    a(w;v)       = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]
+                    K(w)         := −∇∇w
+                    M(w)         := D[(1−ν)K(w) + ν tr K(w) I]
+                    a(w;v)       = ∫ M(w):K(v)
                     b(v;μ)       = ∫ s v μ
-                    S(w,λ;v,μ)   = Σ_T h_T⁴ (D ΔΔw − sλ, D ΔΔv − sμ)_T
+                    S(w,λ;v,μ)   = Σ_T h_T⁴ (D Δ²w − sλ, D Δ²v − sμ)_T
                     ℓ(v)         = ∫ f v
-                    ℓ_S(v,μ)     = Σ_T h_T⁴ (f, D ΔΔv − sμ)_T
+                    ℓ_S(v,μ)     = Σ_T h_T⁴ (f, D Δ²v − sμ)_T
                     G(μ)         = ∫ s ψ μ
                     B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
                     L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
