@@ -157,6 +157,14 @@ fn beam_studies(name: &str) -> &'static [&'static str] {
     }
 }
 
+/// The studies each built-in plate scene hosts (the plate's own: `src/plates.rs`).
+fn plate_studies(name: &str) -> &'static [&'static str] {
+    match name {
+        "mindlin-square" => &["locking"],
+        _ => &[],
+    }
+}
+
 /// Every built-in scene, beams first, in the order `list` prints them.
 pub fn registry() -> Vec<SceneEntry> {
     let mut entries: Vec<SceneEntry> = SCENES
@@ -184,7 +192,7 @@ pub fn registry() -> Vec<SceneEntry> {
     entries.extend(PLATE_SCENES.iter().map(|&s| SceneEntry {
         kind: SceneKind::Plate(s),
         pairs: PLATE_PAIRS,
-        studies: &["locking"],
+        studies: plate_studies(s.name),
         in_default_job: false,
     }));
     entries
