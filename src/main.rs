@@ -327,10 +327,10 @@ fn hosted_studies(entries: &[SceneEntry], out: &Path) -> Result<(), String> {
 /// Runs the study called `kind` on a registry scene.
 fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(), String> {
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
-    // a plate's one study, t → 0, is its own (the generic kinds need exact solutions of
-    // the obstacle problem, which the plate scenes do not have yet)
-    if let (SceneKind::Plate(scene), Study::Locking) = (&entry.kind, study) {
-        return plates::locking_run(*scene, full, out)
+    // the plate studies are the plate's own (the generic kinds need exact solutions of
+    // the obstacle problem, which the plate scenes do not have)
+    if let SceneKind::Plate(scene) = &entry.kind {
+        return plates::run_study(*scene, study, full, out)
             .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
     }
     studies::study_scene(entry)

@@ -10,6 +10,7 @@
 
 use crate::models::mindlin::{mindlin_clamped, mindlin_plain_p1, mindlin_simply_supported};
 use crate::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene, PlateSupport};
+use crate::studies::{io, output, write_csv, Study};
 use fem_runtime::element::triangle::TriangleBasis;
 use fem_runtime::obstacle::triangle::{
     contact_indicator, solve_obstacle_on_triangles, TriangleObstacleSolution,
@@ -17,6 +18,7 @@ use fem_runtime::obstacle::triangle::{
 use fem_runtime::obstacle::ObstacleOptions;
 use fem_runtime::{Coefficients, Diagonal, Error, Model, PointLocator, Result, TriangleMesh};
 use serde::Serialize;
+use std::path::Path;
 
 /// The Stenberg parameter β of the shear weight `6κ(1−ν)D/(t² + β h_T²)` (§6: β ≤ 0.01
 /// brings back coarse-mesh locking, β ≥ 0.3 loses accuracy).
@@ -711,6 +713,361 @@ pub fn locking_run(scene: PlateScene, full: bool, out: &std::path::Path) -> Resu
         &series,
     )
     .map_err(|e| Error::Input(format!("cannot write {}: {e}", svg.display())))?;
+    println!("→ {}, .csv", svg.display());
+    Ok(())
+}
+
+/// The plate studies a scene may host: `locking` ([`locking_run`]), `iterations`
+/// ([`iterations_run`]) and `convergence` ([`convergence_run`]). Each writes
+/// `out/<scene>-<study>.svg` and `.csv`.
+///
+/// # Errors
+/// [`Error::Input`] for another study kind, and the study's own.
+pub fn run_study(scene: PlateScene, study: Study, full: bool, out: &Path) -> Result<()> {
+    match study {
+        Study::Locking => locking_run(scene, full, out),
+        Study::Iterations => iterations_run(scene, full, out),
+        Study::Convergence => convergence_run(scene, full, out),
+        other => Err(Error::Input(format!(
+            "plate scene `{}` hosts no study `{}`; the plate studies are locking, iterations and convergence",
+            scene.name,
+            other.name()
+        ))),
+    }
+}
+
+/// One level of the iterations study: the Newton iterations on a mesh, within a nested
+/// solve and from a cold start.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IterationLevel {
+    /// The load q.
+    pub load: f64,
+    /// The level's mesh size (N, or rings).
+    pub mesh_size: usize,
+    /// Its triangles.
+    pub triangles: usize,
+    /// Newton iterations on this level within the nested solve of the finest size
+    /// (started from the level before; the coarsest from zero).
+    pub nested: usize,
+    /// Newton iterations of a cold start (from zero) on this level's mesh; `None` above
+    /// the study's cold limit or where the cold start failed (a result of the study).
+    pub cold: Option<usize>,
+}
+
+/// The iterations study of `scene` at load `q`: one nested solve on the meshes
+/// [`level_sizes`]`(finest)`, its iterations per level, and beside each level a cold
+/// start on that level's mesh (up to size `cold_max`).
+///
+/// # Errors
+/// [`solve`]'s for the nested solve.
+pub fn iteration_levels(
+    scene: PlateScene,
+    q: f64,
+    finest: usize,
+    cold_max: usize,
+) -> Result<Vec<IterationLevel>> {
+    let nested = solve(&PlateRequest {
+        load: q,
+        mesh_size: finest,
+        nested: true,
+        ..PlateRequest::new(scene)
+    })?;
+    let sizes = level_sizes(finest, true);
+    Ok(sizes
+        .iter()
+        .zip(&nested.levels)
+        .map(|(&n, &[triangles, iterations])| IterationLevel {
+            load: q,
+            mesh_size: n,
+            triangles,
+            nested: iterations,
+            cold: (n <= cold_max)
+                .then(|| {
+                    solve(&PlateRequest {
+                        load: q,
+                        mesh_size: n,
+                        nested: false,
+                        ..PlateRequest::new(scene)
+                    })
+                    .ok()
+                    .map(|r| r.iterations)
+                })
+                .flatten(),
+        })
+        .collect())
+}
+
+/// The iterations study as the CLI runs it (`study mindlin-disk iterations`): for every
+/// load of the scene, [`iteration_levels`] up to N = 32 (128 with `full`), a table, the
+/// CSV `load,mesh_size,triangles,nested,cold` and the chart of iterations against N,
+/// nested and cold per load: nested iteration stays flat in h, a cold start grows.
+///
+/// # Errors
+/// [`iteration_levels`]'s, and [`Error::Input`] when the output cannot be written.
+pub fn iterations_run(scene: PlateScene, full: bool, out: &Path) -> Result<()> {
+    let finest = if full { 128 } else { 32 };
+    println!(
+        "\niterations: {}, semismooth Newton iterations per level of a nested solve, a cold start on the same mesh beside ('-': failed)",
+        scene.name
+    );
+    println!(
+        "{:>8} {:>6} {:>10} {:>7} {:>6}",
+        "q", "N", "triangles", "nested", "cold"
+    );
+    let mut rows = Vec::new();
+    for &q in scene.loads {
+        rows.extend(iteration_levels(scene, q, finest, finest)?);
+    }
+    let show = |v: Option<usize>| v.map_or("-".to_string(), |c| c.to_string());
+    for r in &rows {
+        println!(
+            "{:>8} {:>6} {:>10} {:>7} {:>6}",
+            r.load,
+            r.mesh_size,
+            r.triangles,
+            r.nested,
+            show(r.cold)
+        );
+    }
+    let mut series = Vec::new();
+    for &q in scene.loads {
+        let of = |pick: &dyn Fn(&IterationLevel) -> Option<usize>| -> Vec<(f64, f64)> {
+            rows.iter()
+                .filter(|r| r.load == q)
+                .filter_map(|r| pick(r).map(|c| (r.mesh_size as f64, c.max(1) as f64)))
+                .collect()
+        };
+        series.push(crate::plot::Series::marked(
+            format!("nested, q = {q}"),
+            of(&|r| Some(r.nested)),
+        ));
+        series.push(crate::plot::Series::marked(
+            format!("cold start, q = {q}"),
+            of(&|r| r.cold),
+        ));
+    }
+    let svg = output(out, scene.name, Study::Iterations, "svg");
+    crate::plot::chart(
+        &svg,
+        &format!("{}: Newton iterations per mesh", scene.name),
+        crate::plot::Axes {
+            x: size_name(scene.domain),
+            y: "iterations",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )
+    .map_err(|e| Error::Input(format!("cannot write {}: {e}", svg.display())))?;
+    write_csv(
+        &output(out, scene.name, Study::Iterations, "csv"),
+        "load,mesh_size,triangles,nested,cold",
+        &rows
+            .iter()
+            .map(|r| {
+                vec![
+                    r.load,
+                    r.mesh_size as f64,
+                    r.triangles as f64,
+                    r.nested as f64,
+                    r.cold.map_or(f64::NAN, |c| c as f64),
+                ]
+            })
+            .collect::<Vec<_>>(),
+    )
+    .map_err(io)?;
+    println!("→ {}, .csv", svg.display());
+    Ok(())
+}
+
+/// What a mesh size counts on `domain`, for axes.
+fn size_name(domain: PlateDomain) -> &'static str {
+    match domain {
+        PlateDomain::Square { .. } => "N (N×N×2 mesh)",
+        PlateDomain::Disk { .. } => "rings",
+    }
+}
+
+/// One mesh of the convergence study.
+#[derive(Clone, Debug)]
+pub struct ConvergenceRow {
+    /// The load q.
+    pub load: f64,
+    /// The mesh size (N, or rings).
+    pub mesh_size: usize,
+    /// The largest cell diameter.
+    pub h: f64,
+    /// The report of the solve.
+    pub report: PlateReport,
+}
+
+/// The quantities the convergence study follows, by name: `J_h`, `∫λ_h`, the contact
+/// radius.
+pub const CONVERGENCE_QUANTITIES: [&str; 3] = ["J_h", "∫λ_h", "contact radius"];
+
+impl ConvergenceRow {
+    /// `[J_h, ∫λ_h, contact radius]` (the radius 0 without an obstacle).
+    pub fn quantities(&self) -> [f64; 3] {
+        [
+            self.report.energy,
+            self.report.total_contact_force,
+            self.report.contact_radius.unwrap_or(0.0),
+        ]
+    }
+}
+
+/// The convergence study of `scene` at load `q`: [`solve`] on each mesh size (nested),
+/// one row each. No exact solution is known with contact; [`differences`] gives the
+/// changes between meshes and their observed rates.
+///
+/// # Errors
+/// [`solve`]'s.
+pub fn convergence_study(
+    scene: PlateScene,
+    q: f64,
+    sizes: &[usize],
+) -> Result<Vec<ConvergenceRow>> {
+    sizes
+        .iter()
+        .map(|&n| {
+            let report = solve(&PlateRequest {
+                load: q,
+                mesh_size: n,
+                ..PlateRequest::new(scene)
+            })?;
+            Ok(ConvergenceRow {
+                load: q,
+                mesh_size: n,
+                h: plate_mesh(scene.domain, n)?.max_h(),
+                report,
+            })
+        })
+        .collect()
+}
+
+/// For rows on meshes halved each time: per quantity of [`ConvergenceRow::quantities`],
+/// the differences `d_k = Q_{k+1} − Q_k` between consecutive meshes and the observed
+/// rates `log2(|d_k| / |d_{k+1}|)` (for `Q_h = Q + C hᵖ`, `d_k ∝ h_kᵖ` and the rate is p).
+/// Shapes: `differences[q]` has `rows − 1` entries, `rates[q]` `rows − 2`.
+pub fn differences(rows: &[ConvergenceRow]) -> ([Vec<f64>; 3], [Vec<f64>; 3]) {
+    let d: [Vec<f64>; 3] = std::array::from_fn(|q| {
+        rows.windows(2)
+            .map(|w| w[1].quantities()[q] - w[0].quantities()[q])
+            .collect()
+    });
+    let rates = std::array::from_fn(|q| {
+        d[q].windows(2)
+            .map(|w| (w[0].abs() / w[1].abs()).log2())
+            .collect()
+    });
+    (d, rates)
+}
+
+/// The convergence study as the CLI runs it (`study mindlin-disk convergence`): for each
+/// load of the scene, [`convergence_study`] on N = 8, 16, 32 (up to 128 with `full`);
+/// a table of J_h, ∫λ_h and the contact radius with the differences between meshes and
+/// their observed rates, the CSV
+/// `load,mesh_size,h,dofs,energy,total_contact_force,contact_radius,contact_area,lambda_interior_spread,iterations,seconds`
+/// and the chart of |differences| against h (one line per quantity and load).
+///
+/// # Errors
+/// [`convergence_study`]'s, and [`Error::Input`] when the output cannot be written.
+pub fn convergence_run(scene: PlateScene, full: bool, out: &Path) -> Result<()> {
+    let sizes: &[usize] = if full {
+        &[8, 16, 32, 64, 128]
+    } else {
+        &[8, 16, 32]
+    };
+    println!(
+        "\nconvergence: {} ({}, {}, t = {}), J_h, ∫λ_h and contact radius against h; Δ: change from the mesh before, rate: log2 of the ratio of consecutive Δ",
+        scene.name,
+        scene.domain.describe(),
+        scene.obstacle.describe(),
+        scene.thickness
+    );
+    let mut csv = Vec::new();
+    let mut series = Vec::new();
+    for &q in scene.loads {
+        let rows = convergence_study(scene, q, sizes)?;
+        let (d, rates) = differences(&rows);
+        println!(
+            "q = {q}\n{:>5} {:>8} {:>8} {:>16} {:>10} {:>5} {:>14} {:>10} {:>5} {:>12} {:>10} {:>5} {:>10} {:>5}",
+            "N", "h", "dofs", "J_h", "ΔJ", "rate", "∫λ_h", "Δ∫λ", "rate", "radius", "Δradius", "rate", "λ spread", "iter"
+        );
+        let entry = |v: &[f64], k: usize, shift: usize| {
+            k.checked_sub(shift)
+                .and_then(|k| v.get(k).copied())
+                .unwrap_or(f64::NAN)
+        };
+        for (k, r) in rows.iter().enumerate() {
+            let [j, force, radius] = r.quantities();
+            println!(
+                "{:>5} {:>8.4} {:>8} {:>16.9e} {:>10.2e} {:>5.2} {:>14.7e} {:>10.2e} {:>5.2} {:>12.6} {:>10.2e} {:>5.2} {:>10.2e} {:>5}",
+                r.mesh_size,
+                r.h,
+                r.report.dofs,
+                j,
+                entry(&d[0], k, 1),
+                entry(&rates[0], k, 2),
+                force,
+                entry(&d[1], k, 1),
+                entry(&rates[1], k, 2),
+                radius,
+                entry(&d[2], k, 1),
+                entry(&rates[2], k, 2),
+                r.report.lambda_interior_spread.unwrap_or(f64::NAN),
+                r.report.iterations
+            );
+            csv.push(vec![
+                q,
+                r.mesh_size as f64,
+                r.h,
+                r.report.dofs as f64,
+                j,
+                force,
+                radius,
+                r.report.contact_area,
+                r.report.lambda_interior_spread.unwrap_or(f64::NAN),
+                r.report.iterations as f64,
+                r.report.seconds,
+            ]);
+        }
+        for (name, d) in CONVERGENCE_QUANTITIES.iter().zip(&d) {
+            // the change to the next mesh, plotted at the coarser one's h
+            let points = rows
+                .iter()
+                .zip(d)
+                .filter(|(_, d)| d.is_finite() && d.abs() > 0.0)
+                .map(|(r, d)| (r.h, d.abs()))
+                .collect();
+            series.push(crate::plot::Series::marked(
+                format!("|Δ {name}|, q = {q}"),
+                points,
+            ));
+        }
+    }
+    let svg = output(out, scene.name, Study::Convergence, "svg");
+    crate::plot::chart(
+        &svg,
+        &format!(
+            "{}: change of J_h, ∫λ_h and the contact radius to the next mesh",
+            scene.name
+        ),
+        crate::plot::Axes {
+            x: "h (largest cell diameter)",
+            y: "|change to the next mesh|",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )
+    .map_err(|e| Error::Input(format!("cannot write {}: {e}", svg.display())))?;
+    write_csv(
+        &output(out, scene.name, Study::Convergence, "csv"),
+        "load,mesh_size,h,dofs,energy,total_contact_force,contact_radius,contact_area,lambda_interior_spread,iterations,seconds",
+        &csv,
+    )
+    .map_err(io)?;
     println!("→ {}, .csv", svg.display());
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! centre deflection against the Kirchhoff value as t → 0, and the plain pair locking),
 //! `mindlin-square-ss` against Navier's value, `mindlin-disk` with contact (its report
 //! checked by identities and exact values) and without its obstacle (against the closed
-//! form); and bad input exits non-zero with a message naming it, never a
+//! form), its studies; and bad input exits non-zero with a message naming it, never a
 //! panic.
 
 use std::process::Command;
@@ -322,4 +322,48 @@ fn bad_disk_input_exits_with_a_message() {
         assert!(stderr.contains(message), "{all:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{all:?}: {stderr}");
     }
+}
+
+/// `study mindlin-disk` writes both charts and tables: nested iterations flat (at most 6
+/// on every level of every load), and J_h converging (its change to the next mesh
+/// shrinking).
+#[test]
+fn the_disk_studies_write_their_charts_and_tables() {
+    let out = std::env::temp_dir().join(format!("fem-forms-disk-study-{}", std::process::id()));
+    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["study", "mindlin-disk", "--out"])
+        .arg(&out)
+        .output()
+        .expect("the binary runs");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for study in ["iterations", "convergence"] {
+        let svg = std::fs::read_to_string(out.join(format!("mindlin-disk-{study}.svg"))).unwrap();
+        assert!(svg.contains("<svg"));
+    }
+    let rows = |study: &str| -> Vec<Vec<f64>> {
+        std::fs::read_to_string(out.join(format!("mindlin-disk-{study}.csv")))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect()
+    };
+    let iterations = rows("iterations");
+    assert_eq!(iterations.len(), 3 * 4, "3 loads × rings 4, 8, 16, 32");
+    assert!(iterations.iter().all(|r| r[3] <= 6.0), "{iterations:?}");
+    let convergence = rows("convergence");
+    for q in [10.0, 20.0, 50.0] {
+        let j: Vec<f64> = convergence
+            .iter()
+            .filter(|r| r[0] == q)
+            .map(|r| r[4])
+            .collect();
+        assert_eq!(j.len(), 3);
+        assert!((j[2] - j[1]).abs() < (j[1] - j[0]).abs(), "q = {q}: {j:?}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
 }

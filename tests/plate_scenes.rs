@@ -1,10 +1,11 @@
 //! The plate scenes through the library: input that no command-line option reaches (a
-//! scene's material, its obstacle) is refused with a message naming it.
+//! scene's material, its obstacle) is refused with a message naming it, and nested
+//! iteration on the disk keeps Newton's iterations flat in h while a cold start grows.
 
 use fem_forms::models::plate_scenes::{
     PlateObstacle, PlateScene, MINDLIN_DISK, MINDLIN_SQUARE, MINDLIN_SQUARE_SS,
 };
-use fem_forms::plates::{solve, PlateRequest};
+use fem_forms::plates::{iteration_levels, level_sizes, solve, PlateRequest};
 
 fn refused(scene: PlateScene, message: &str) {
     match solve(&PlateRequest::new(scene)) {
@@ -71,4 +72,21 @@ fn bad_scene_data_is_refused_with_a_message() {
         (flat.total_contact_force - 20.0 * area).abs() < 1e-8 * 20.0 * area,
         "{flat:?}"
     );
+}
+
+/// Nested iteration on the disk (rings 4, 8, 16, 32, 64 at q = 50): at most 5 Newton
+/// steps on every level, and on the finest fewer than a cold start there.
+#[test]
+fn nested_iterations_stay_flat_on_the_disk() {
+    assert_eq!(level_sizes(64, true), [4, 8, 16, 32, 64]);
+    assert_eq!(level_sizes(24, true), [6, 12, 24]);
+    assert_eq!(level_sizes(64, false), [64]);
+    let levels = iteration_levels(MINDLIN_DISK, 50.0, 64, 64).unwrap();
+    assert_eq!(levels.len(), 5);
+    for l in &levels {
+        eprintln!("{l:?}");
+        assert!(l.nested <= 5, "{levels:?}");
+    }
+    let finest = levels.last().unwrap();
+    assert!(finest.cold.unwrap() > finest.nested, "{levels:?}");
 }

@@ -161,6 +161,7 @@ fn beam_studies(name: &str) -> &'static [&'static str] {
 fn plate_studies(name: &str) -> &'static [&'static str] {
     match name {
         "mindlin-square" => &["locking"],
+        "mindlin-disk" => &["convergence", "iterations"],
         _ => &[],
     }
 }
