@@ -9,7 +9,7 @@
 //! the default) and the studies it hosts.
 
 use crate::membrane_scenes::{MembraneScene, MEMBRANE_FLAT, MEMBRANE_SCENES};
-use crate::plate_scenes::{PlateScene, PLATE_SCENES};
+use crate::plate_scenes::{PlateScene, PlateSupport, PLATE_SCENES};
 use crate::scenes::{Beam, Scene, SCENES};
 use std::borrow::Cow;
 
@@ -192,7 +192,11 @@ pub fn registry() -> Vec<SceneEntry> {
     // not in the default job
     entries.extend(PLATE_SCENES.iter().map(|&s| SceneEntry {
         kind: SceneKind::Plate(s),
-        pairs: PLATE_PAIRS,
+        // the plain pair's model is clamped only
+        pairs: match s.support {
+            PlateSupport::Clamped => PLATE_PAIRS,
+            PlateSupport::SimplySupported => &PLATE_PAIRS[..1],
+        },
         studies: plate_studies(s.name),
         in_default_job: false,
     }));
