@@ -34,6 +34,10 @@ pub const MAX_DISK_RINGS: usize = 512;
 /// The largest |q| and |ψ| accepted: beyond it the norms that certify a solve (the KKT
 /// residual's `‖A‖∞‖U‖∞`) may overflow double precision.
 pub const MAX_PLATE_DATA: f64 = 1e100;
+/// The largest rounding of the primal unknowns through the contact rows, relative to
+/// the larger of max|w_h|, |ψ| and 1e-6 of the domain's size, accepted in a result
+/// (fem_runtime `Lcp::primal_rounding`; the membranes' bound).
+pub const MAX_PRIMAL_ROUNDING: f64 = 1e-3;
 /// The coarsest level of a nested solve: N/2^k ≥ this (N×N×2 squares, or rings).
 pub const COARSEST_LEVEL: usize = 4;
 
@@ -370,7 +374,9 @@ fn zero(_: &[f64]) -> f64 {
 /// Solves `request`.
 ///
 /// # Errors
-/// [`PlateRequest::validate`]'s, and the solver's if it does not converge.
+/// [`PlateRequest::validate`]'s, the solver's if it does not converge, and
+/// [`Error::Input`] when the load (or α) dwarfs the obstacle so that w_h is rounding (its
+/// rounding through the contact rows above [`MAX_PRIMAL_ROUNDING`]).
 pub fn solve(request: &PlateRequest) -> Result<PlateReport> {
     request.validate()?;
     let run = request
@@ -455,6 +461,21 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
     let solution =
         solve_on_domain::<M>(s.domain, &meshes, &coefficients, ObstacleOptions::default())?;
     let w = M::field("w")?;
+    let max_deflection = solution.field(w).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if request.obstacle() != PlateObstacle::None {
+        // as for membranes: a load (or α) that dwarfs the obstacle leaves w_h to the
+        // rounding of the contact rows (q = 1e100 on the disk: w(0) = −2.7e78 under
+        // ψ = 0.05), which the KKT residual cannot show
+        let size = max_deflection.max(height.abs()).max(1e-6 * s.domain.size());
+        let rounding = solution.primal_rounding() / size;
+        if rounding.is_nan() || rounding > MAX_PRIMAL_ROUNDING {
+            return Err(Error::Input(format!(
+                "w_h is lost to rounding: in contact the constraint rows subtract terms of the size of the load and of α h⁴ q (q = {q:e}, α = {:e}), which dwarf the obstacle ({}), and their rounding moves w_h by {rounding:.0e} of its own size; use a smaller load or α",
+                request.alpha,
+                request.obstacle().describe()
+            )));
+        }
+    }
     let centre = value_at(&solution, w, s.domain.centre())?;
     let kirchhoff = s.kirchhoff_deflection_at(q);
     let in_contact = request.obstacle() != PlateObstacle::None;
@@ -487,7 +508,7 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
             (centre - reference) / reference
         },
         energy,
-        max_deflection: solution.field(w).iter().fold(0.0, |m, v| m.max(v.abs())),
+        max_deflection,
         deflection_integral: solution.view(w).integral(),
         total_contact_force: solution.total_contact_force(),
         contact_area: contact.area,

@@ -304,6 +304,16 @@ fn bad_disk_input_exits_with_a_message() {
             "--msh does not apply",
         ),
         (
+            "mindlin-disk",
+            &["--load", "1e20"][..],
+            "w_h is lost to rounding",
+        ),
+        (
+            "mindlin-disk",
+            &["--alpha", "1e300"][..],
+            "w_h is lost to rounding",
+        ),
+        (
             "mindlin-square",
             &["--no-obstacle"][..],
             "`mindlin-square` has no obstacle",
