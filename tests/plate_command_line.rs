@@ -241,6 +241,24 @@ fn mindlin_disk_reports_contact_that_satisfies_its_identities() {
     }
 }
 
+/// `--cold` solves the same discrete problem from zero on the finest mesh alone: one
+/// level, more Newton steps, the same J_h and ∫λ_h as the nested solve.
+#[test]
+fn a_cold_start_solves_the_same_disk_problem() {
+    let nested = scene_json("mindlin-disk", &["--mesh-size", "16"]);
+    let cold = scene_json("mindlin-disk", &["--mesh-size", "16", "--cold"]);
+    assert_eq!(cold["levels"].as_array().unwrap().len(), 1);
+    assert_eq!(nested["levels"].as_array().unwrap().len(), 3);
+    assert!(cold["iterations"].as_u64() > nested["iterations"].as_u64());
+    for field in ["energy", "total_contact_force", "contact_area"] {
+        let (a, b) = (
+            nested[field].as_f64().unwrap(),
+            cold[field].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() <= 1e-9 * a.abs(), "{field}: {a} and {b}");
+    }
+}
+
 /// Without its obstacle the disk's centre deflection is the closed form
 /// `q/64 + q t²/14` (t = 0.01, q = 20: 0.3126428571); the polygonal ring mesh's error
 /// falls with h and is below 1e-3 on 32 rings.
