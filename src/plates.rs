@@ -416,7 +416,10 @@ pub fn level_sizes(n: usize, nested: bool) -> Vec<usize> {
 /// now; with isoparametric cells this becomes
 /// `solve_obstacle_on_curved_triangles::<M>(meshes, &geometries, coefficients, options)`
 /// with `geometries[k] = QuadraticGeometry::circle(&meshes[k], centre, radius)?`
-/// (docs/mathematics.md §6: the polygon adds ~3e-4 relative to J).
+/// (docs/mathematics.md §6: the polygon adds ~3e-4 relative to J). What the report
+/// integrates over the solution (J_h, ∫λ_h, ∫w_h, the contact area) then wants the
+/// curved cells' versions too; the contact radius and the centre value only locate
+/// points.
 fn solve_on_domain<M: Model>(
     _domain: PlateDomain,
     meshes: &[TriangleMesh],
