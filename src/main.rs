@@ -7,7 +7,7 @@ use fem_forms::kirchhoff::{self, KirchhoffPair, KirchhoffRequest};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
-use fem_forms::models::plate_scenes::PlateScene;
+use fem_forms::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene};
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind, MEMBRANE_PAIRS};
 use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::hierarchy::LinearSolver;
@@ -83,7 +83,8 @@ struct SolveOptions {
     #[arg(long, allow_negative_numbers = true)]
     elements: Option<usize>,
     /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
-    /// three quarters of it). (default 64; with --msh: 0 refinements)
+    /// three quarters of it). (default 64; with --msh: 0 refinements) Plates: N of the
+    /// square's N×N×2 mesh or the disk's rings (default 32).
     #[arg(long, allow_negative_numbers = true)]
     mesh_size: Option<usize>,
     /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
@@ -134,6 +135,10 @@ struct SolveOptions {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// Solve the plate without its obstacle (plates with one: mindlin-disk); the report
+    /// then compares the centre deflection with the closed form where there is one.
+    #[arg(long)]
+    no_obstacle: bool,
     /// Also write the plot of w, θ, λ, ψ (beams).
     #[arg(long)]
     plot: bool,
@@ -164,6 +169,7 @@ impl SolveOptions {
         note(self.plot, "--plot");
         note(self.support.is_some(), "--support");
         note(self.obstacle.is_some(), "--obstacle");
+        note(self.no_obstacle, "--no-obstacle");
         given
     }
 
@@ -349,10 +355,10 @@ fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(
             .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
     }
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
-    // a plate's one study, t → 0, is its own (the generic kinds need exact solutions of
-    // the obstacle problem, which the plate scenes do not have yet)
-    if let (SceneKind::Plate(scene), Study::Locking) = (&entry.kind, study) {
-        return plates::locking_run(*scene, full, out)
+    // the plate studies are the plate's own (the generic kinds need exact solutions of
+    // the obstacle problem, which the plate scenes do not have)
+    if let SceneKind::Plate(scene) = &entry.kind {
+        return plates::run_study(*scene, study, full, out)
             .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
     }
     studies::study_scene(entry)
@@ -550,6 +556,10 @@ fn solve_kirchhoff(scene: KirchhoffScene, options: &SolveOptions) -> Result<(), 
 }
 
 fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> {
+    let mesh = match scene.domain {
+        PlateDomain::Square { .. } => "an N×N×2 mesh",
+        PlateDomain::Disk { .. } => "a disk mesh of N rings",
+    };
     options.refuse(
         &[
             "--elements",
@@ -562,10 +572,16 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             "--plot",
         ],
         &format!(
-            "`{}` is a plate scene on an N×N×2 mesh (--mesh-size, --thickness, --load, --alpha, --pair, --json)",
+            "`{}` is a plate scene on {mesh} (--mesh-size, --thickness, --load, --alpha, --pair, --cold, --no-obstacle, --json)",
             scene.name
         ),
     )?;
+    if scene.obstacle == PlateObstacle::None {
+        options.refuse(
+            &["--no-obstacle"],
+            &format!("`{}` has no obstacle", scene.name),
+        )?;
+    }
     let mut request = PlateRequest::new(scene);
     if let Some(name) = &options.pair {
         request.pair = PlatePair::parse(name).map_err(|e| e.to_string())?;
@@ -574,22 +590,44 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
     request.mesh_size = options.mesh_size.unwrap_or(request.mesh_size);
     request.load = options.load.unwrap_or(request.load);
     request.alpha = options.alpha.unwrap_or(request.alpha);
+    request.obstacle = !options.no_obstacle;
+    request.nested &= !options.cold;
     let report = plates::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
     if options.json {
         println!(
             "{}",
             serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
         );
+    } else if report.relative_error.is_nan() {
+        println!(
+            "{} {} {} t = {:.0e} N = {}: q = {}, obstacle {}: J_h {:.9e}, ∫λ_h {:.7e}, contact area {:.6}, contact radius {:.6}, centre deflection {:.8e}, {} dofs, {} iterations, {:.3} s",
+            report.scene,
+            report.pair,
+            report.support,
+            report.thickness,
+            report.mesh_size,
+            report.load,
+            report.obstacle,
+            report.energy,
+            report.total_contact_force,
+            report.contact_area,
+            report.contact_radius.unwrap_or(f64::NAN),
+            report.centre_deflection,
+            report.dofs,
+            report.iterations,
+            report.seconds
+        );
     } else {
         println!(
-            "{} {} {} t = {:.0e} N = {}: centre deflection {:.8e}, Kirchhoff {:.8e}, relative error {:+.3e}, J_h {:.6e}, {} dofs, {} iterations, {:.3} s",
+            "{} {} {} t = {:.0e} N = {}: centre deflection {:.8e}, {} {:.8e}, relative error {:+.3e}, J_h {:.6e}, {} dofs, {} iterations, {:.3} s",
             report.scene,
             report.pair,
             report.support,
             report.thickness,
             report.mesh_size,
             report.centre_deflection,
-            report.kirchhoff_reference,
+            if report.unobstructed_reference.is_some() { "exact" } else { "Kirchhoff" },
+            report.unobstructed_reference.unwrap_or(report.kirchhoff_reference),
             report.relative_error,
             report.energy,
             report.dofs,
@@ -602,7 +640,7 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
 
 fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {
     options.refuse(
-        &["--mesh-size", "--msh", "--vtk"],
+        &["--mesh-size", "--msh", "--vtk", "--no-obstacle"],
         &format!(
             "`{}` is a beam scene on a uniform interval mesh (--elements)",
             s.name
@@ -657,7 +695,13 @@ fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String
 
 fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> Result<(), String> {
     options.refuse(
-        &["--elements", "--thickness", "--refinement", "--plot"],
+        &[
+            "--elements",
+            "--thickness",
+            "--refinement",
+            "--plot",
+            "--no-obstacle",
+        ],
         &format!(
             "`{}` is a membrane scene on a triangle mesh (--mesh-size, --msh; --vtk writes its fields)",
             scene.name

@@ -1,14 +1,24 @@
-//! The plate scenes (docs/mathematics.md §6): a Reissner–Mindlin plate on the N×N×2
-//! mesh of its square, solved as an obstacle problem (the obstacle out of reach), with the
-//! report of `solve --json`: the centre deflection against the Kirchhoff limit.
+//! The plate scenes (docs/mathematics.md §6): a Reissner–Mindlin plate on the mesh of its
+//! domain (the N×N×2 mesh of a square, the N-ring mesh of a disk), held by its support,
+//! under its load and against its obstacle, solved as an obstacle problem with nested
+//! iteration; the report of `solve --json`; and the plate studies (locking as t → 0,
+//! Newton iterations per level, convergence of J_h, ∫λ_h and the contact radius).
+//!
+//! A scene is data ([`PlateScene`]: domain, support, load, obstacle); the pairs are a
+//! table ([`PlatePair`] with one row each naming the model of each support). Adding a
+//! scene is one constant in `models/src/plate_scenes.rs`, a pair one row here.
 
-use crate::models::mindlin::{mindlin_clamped, mindlin_plain_p1};
-use crate::models::plate_scenes::{PlateScene, PlateSupport};
+use crate::models::mindlin::{mindlin_clamped, mindlin_plain_p1, mindlin_simply_supported};
+use crate::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene, PlateSupport};
+use crate::studies::{io, output, write_csv, Study};
 use fem_runtime::element::triangle::TriangleBasis;
-use fem_runtime::obstacle::triangle::{solve_obstacle_on_triangles, TriangleObstacleSolution};
+use fem_runtime::obstacle::triangle::{
+    contact_indicator, solve_obstacle_on_triangles, TriangleObstacleSolution,
+};
 use fem_runtime::obstacle::ObstacleOptions;
 use fem_runtime::{Coefficients, Diagonal, Error, Model, PointLocator, Result, TriangleMesh};
 use serde::Serialize;
+use std::path::Path;
 
 /// The Stenberg parameter β of the shear weight `6κ(1−ν)D/(t² + β h_T²)` (§6: β ≤ 0.01
 /// brings back coarse-mesh locking, β ≥ 0.3 loses accuracy).
@@ -18,6 +28,18 @@ pub const STENBERG_BETA: f64 = 0.1;
 pub const PLATE_ALPHA: f64 = 0.1;
 /// The largest N of the N×N×2 mesh a plate solve accepts (memory: about 2 GB at 1024).
 pub const MAX_PLATE_MESH_SIZE: usize = 1024;
+/// The most rings of a disk mesh a plate solve accepts (6N² triangles: 1.6M at 512,
+/// as many as the square's N×N×2 at 900; memory about 2 GB).
+pub const MAX_DISK_RINGS: usize = 512;
+/// The largest |q| and |ψ| accepted: beyond it the norms that certify a solve (the KKT
+/// residual's `‖A‖∞‖U‖∞`) may overflow double precision.
+pub const MAX_PLATE_DATA: f64 = 1e100;
+/// The largest rounding of the primal unknowns through the contact rows, relative to
+/// the larger of max|w_h|, |ψ| and 1e-6 of the domain's size, accepted in a result
+/// (fem_runtime `Lcp::primal_rounding`; the membranes' bound).
+pub const MAX_PRIMAL_ROUNDING: f64 = 1e-3;
+/// The coarsest level of a nested solve: N/2^k ≥ this (N×N×2 squares, or rings).
+pub const COARSEST_LEVEL: usize = 4;
 
 /// The discretizations of the plate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -28,15 +50,57 @@ pub enum PlatePair {
     P1P1P0Plain,
 }
 
+/// A plate solve instantiated for one model.
+type PlateRun = fn(&PlateRequest) -> Result<PlateReport>;
+
+/// A pair as data: its name and the model of each support (`None`: not available).
+struct PairRow {
+    pair: PlatePair,
+    name: &'static str,
+    clamped: Option<PlateRun>,
+    simply_supported: Option<PlateRun>,
+}
+
+/// Every pair, in the order of [`PlatePair::ALL`].
+const PAIRS: [PairRow; 2] = [
+    PairRow {
+        pair: PlatePair::P1P2P0,
+        name: "p1-p2-p0",
+        clamped: Some(solve_with::<mindlin_clamped::Model>),
+        simply_supported: Some(solve_with::<mindlin_simply_supported::Model>),
+    },
+    PairRow {
+        pair: PlatePair::P1P1P0Plain,
+        name: "p1-p1-p0-plain",
+        clamped: Some(solve_with::<mindlin_plain_p1::Model>),
+        simply_supported: None,
+    },
+];
+
 impl PlatePair {
     /// Every pair, the default first.
     pub const ALL: [PlatePair; 2] = [PlatePair::P1P2P0, PlatePair::P1P1P0Plain];
 
+    fn row(self) -> &'static PairRow {
+        let row = &PAIRS[self as usize];
+        debug_assert_eq!(row.pair, self);
+        row
+    }
+
     /// The pair's name (`--pair`).
     pub fn name(self) -> &'static str {
-        match self {
-            PlatePair::P1P2P0 => "p1-p2-p0",
-            PlatePair::P1P1P0Plain => "p1-p1-p0-plain",
+        self.row().name
+    }
+
+    /// Whether the pair has a model for `support`.
+    pub fn supports(self, support: PlateSupport) -> bool {
+        self.run(support).is_some()
+    }
+
+    fn run(self, support: PlateSupport) -> Option<PlateRun> {
+        match support {
+            PlateSupport::Clamped => self.row().clamped,
+            PlateSupport::SimplySupported => self.row().simply_supported,
         }
     }
 
@@ -66,16 +130,25 @@ pub struct PlateRequest {
     pub pair: PlatePair,
     /// Thickness t > 0.
     pub thickness: f64,
-    /// N of the N×N×2 mesh, 1 ≤ N ≤ [`MAX_PLATE_MESH_SIZE`].
+    /// The mesh size: N of the square's N×N×2 mesh, 1 ≤ N ≤ [`MAX_PLATE_MESH_SIZE`], or
+    /// the disk's rings, 1 ≤ N ≤ [`MAX_DISK_RINGS`].
     pub mesh_size: usize,
-    /// Uniform load q.
+    /// Uniform load q (along w, per area; w is positive up).
     pub load: f64,
     /// Stabilization parameter α > 0.
     pub alpha: f64,
+    /// Whether the scene's obstacle is in place (`false`: `--no-obstacle`, the
+    /// unobstructed plate, checked against its closed form where there is one).
+    pub obstacle: bool,
+    /// Nested iteration over the meshes N/2^k ≥ [`COARSEST_LEVEL`], …, N (`false`: a
+    /// cold start on mesh N).
+    pub nested: bool,
 }
 
 impl PlateRequest {
-    /// The scene's defaults: the default pair, its thickness, mesh, load and α.
+    /// The scene's defaults: the default pair, its thickness, mesh, load and α, its
+    /// obstacle in place; nested iteration where the scene has an obstacle (without
+    /// contact the problem is linear and one Newton step solves it from any start).
     pub fn new(scene: PlateScene) -> Self {
         Self {
             scene,
@@ -84,15 +157,30 @@ impl PlateRequest {
             mesh_size: scene.mesh_size,
             load: scene.load,
             alpha: PLATE_ALPHA,
+            obstacle: true,
+            nested: scene.obstacle != PlateObstacle::None,
+        }
+    }
+
+    /// The obstacle solved against: the scene's, or none with `obstacle` off.
+    pub fn obstacle(&self) -> PlateObstacle {
+        if self.obstacle {
+            self.scene.obstacle
+        } else {
+            PlateObstacle::None
         }
     }
 
     /// Checks the request.
     ///
     /// # Errors
-    /// [`Error::Input`] naming the value at fault: t ≤ 0 or t > 1 (the side), ν outside (−1, ½), a mesh size
-    /// of 0 or above [`MAX_PLATE_MESH_SIZE`], α ≤ 0, a load or material value that is not
-    /// finite (D and κ must be positive).
+    /// [`Error::Input`] naming the value at fault: t ≤ 0 or t above the domain's size
+    /// (the side of a square, the diameter of a disk), ν outside (−1, ½), a mesh size of
+    /// 0 or above [`MAX_PLATE_MESH_SIZE`] ([`MAX_DISK_RINGS`]), α ≤ 0, a load or obstacle
+    /// height that is not finite or beyond ±[`MAX_PLATE_DATA`], a material or domain
+    /// value that is not positive and finite, a pair without a model for the support,
+    /// and an obstacle that contradicts the support (`s(g − ψ) < 0` on the boundary,
+    /// where w = g = 0).
     pub fn validate(&self) -> Result<()> {
         let s = &self.scene;
         let bad = |what: String| Err(Error::Input(what));
@@ -102,9 +190,18 @@ impl PlateRequest {
                 self.thickness
             ));
         }
-        if self.thickness > 1.0 {
+        let (size, size_name) = match s.domain {
+            PlateDomain::Square { side } => (side, "side"),
+            PlateDomain::Disk { radius } => (2.0 * radius, "diameter"),
+        };
+        if !(size.is_finite() && size > 0.0) {
             return bad(format!(
-                "thickness t = {} exceeds the plate's side 1: plate theory describes thin bodies (t well below the side); a thicker body is a problem of elasticity",
+                "the plate's {size_name} {size} must be positive and finite"
+            ));
+        }
+        if self.thickness > size {
+            return bad(format!(
+                "thickness t = {} exceeds the plate's {size_name} {size}: plate theory describes thin bodies (t well below the {size_name}); a thicker body is a problem of elasticity",
                 self.thickness
             ));
         }
@@ -126,15 +223,22 @@ impl PlateRequest {
                 s.shear_correction
             ));
         }
-        if !(s.side.is_finite() && s.side > 0.0) {
-            return bad(format!("side a = {} must be positive and finite", s.side));
-        }
         if !self.load.is_finite() {
             return bad(format!("load q = {} must be finite", self.load));
         }
-        if self.mesh_size == 0 || self.mesh_size > MAX_PLATE_MESH_SIZE {
+        if self.load.abs() > MAX_PLATE_DATA {
             return bad(format!(
-                "mesh size N = {} must lie in 1..={MAX_PLATE_MESH_SIZE}",
+                "load q = {:e} is beyond ±{MAX_PLATE_DATA:e}: norms in the solve would overflow double precision",
+                self.load
+            ));
+        }
+        let largest = match s.domain {
+            PlateDomain::Square { .. } => MAX_PLATE_MESH_SIZE,
+            PlateDomain::Disk { .. } => MAX_DISK_RINGS,
+        };
+        if self.mesh_size == 0 || self.mesh_size > largest {
+            return bad(format!(
+                "mesh size N = {} must lie in 1..={largest}",
                 self.mesh_size
             ));
         }
@@ -144,48 +248,123 @@ impl PlateRequest {
                 self.alpha
             ));
         }
+        if !self.pair.supports(s.support) {
+            return bad(format!(
+                "pair {} has no {} model; the pairs for it are {}",
+                self.pair.name(),
+                s.support.name(),
+                PlatePair::ALL
+                    .into_iter()
+                    .filter(|p| p.supports(s.support))
+                    .map(PlatePair::name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+        if let Some((side, height)) = self.obstacle().side_and_height() {
+            if !height.is_finite() || height.abs() > MAX_PLATE_DATA {
+                return bad(format!(
+                    "obstacle height ψ = {height} must be finite and within ±{MAX_PLATE_DATA:e}"
+                ));
+            }
+            // the support fixes w = g = 0 on the whole boundary, where w must also obey
+            // s·w ≥ s·ψ: no admissible deflection exists if s(g − ψ) < 0 there
+            if side * (0.0 - height) < 0.0 {
+                return bad(format!(
+                    "the obstacle ({}) contradicts the {} boundary, where w = 0: s(g − ψ) = {} < 0 on the whole boundary, so no admissible deflection exists",
+                    self.obstacle().describe(),
+                    s.support.name(),
+                    side * (0.0 - height)
+                ));
+            }
+        }
         Ok(())
     }
 }
 
-/// The report of a plate solve (`solve --json`).
+/// The report of a plate solve (`solve --json`). Fields marked optional are left out of
+/// the JSON where they do not apply.
 #[derive(Clone, Debug, Serialize)]
 pub struct PlateReport {
     /// Scene name.
     pub scene: String,
     /// Pair name.
     pub pair: &'static str,
-    /// Support (`clamped`).
+    /// Support (`clamped`, `simply-supported`).
     pub support: &'static str,
+    /// The domain (`unit square`, `disk of radius 1`).
+    pub domain: String,
+    /// The obstacle solved against (`none`, `flat above, w ≤ 0.05`).
+    pub obstacle: String,
     /// Thickness t.
     pub thickness: f64,
-    /// N of the N×N×2 mesh.
+    /// N of the N×N×2 mesh, or the disk's rings.
     pub mesh_size: usize,
+    /// Triangles of the (finest) mesh.
+    pub triangles: usize,
     /// Load q.
     pub load: f64,
     /// α.
     pub alpha: f64,
-    /// w_h at the centre of the square.
+    /// w_h at the centre of the domain.
     pub centre_deflection: f64,
-    /// The Kirchhoff centre deflection (the limit as t → 0).
+    /// The Kirchhoff centre deflection without contact (the limit as t → 0).
     pub kirchhoff_reference: f64,
-    /// `(w_h(centre) − w_K)/w_K`: discretization error plus the O(t²) Mindlin–Kirchhoff
-    /// difference (about 20 t² for the clamped square).
+    /// The exact Mindlin centre deflection without contact where it has a closed form
+    /// (the clamped disk: `q R⁴/(64D) + q R²/(4S)`); only without an obstacle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unobstructed_reference: Option<f64>,
+    /// `(w_h(centre) − w_ref)/w_ref` without an obstacle, against
+    /// `unobstructed_reference` where there is one, else against `kirchhoff_reference`
+    /// (then it includes the O(t²) Mindlin–Kirchhoff difference, about 20 t² for the
+    /// clamped square). NaN (left out of the JSON) with an obstacle in place.
+    #[serde(skip_serializing_if = "is_nan")]
     pub relative_error: f64,
     /// `J_h = ½UᵀA_hU − FᵀU` with the Stenberg (or, for the plain pair, physical) weight.
     pub energy: f64,
     /// The largest |w_h| over the DOF values of w.
     pub max_deflection: f64,
+    /// `∫w_h`, the volume swept by the plate: with J_h and ∫λ_h it checks the energy,
+    /// since testing the equilibrium with u_h gives `J_h = −½ q∫w_h + ½ ∫ s w_h λ_h`,
+    /// and `∫ s w_h λ_h = s ψ ∫λ_h` for a flat obstacle up to the O(α h⁴) stabilization.
+    pub deflection_integral: f64,
     /// `∫λ_h` (0: the obstacle is out of reach).
     pub total_contact_force: f64,
+    /// Area of the contact set: the cells whose multiplier is active or whose constraint
+    /// holds with equality (holes of zero λ_h filled).
+    pub contact_area: f64,
+    /// With an obstacle: the mean, over 360 rays from the centre, of the radius at which
+    /// the ray leaves the contact cells of `contact_area` (the outer radius of the active
+    /// cells along rays; O(h), unlike `√(area/π)` it does not count holes or the jagged
+    /// edge twice). 0 without contact.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_radius: Option<f64>,
+    /// With contact: the mean of λ_h over the contact interior (the contact cells whose
+    /// centroid lies within `contact_radius / 2`: the line force at the edge of contact,
+    /// a layer of width O(t) in the plate, is smeared over several cells of λ_h; on the
+    /// disk at q = 20 λ_h departs from q by 1e-3 at 0.45 r_c on 32 rings, at 0.6 r_c on
+    /// 64). A flat
+    /// obstacle there holds w constant and θ = 0, so the contact equation
+    /// `div div Cε(θ) − sλ = f` gives λ = −s q exactly (q for the disk pushed up).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lambda_interior_mean: Option<f64>,
+    /// `(max − min)/|mean|` of λ_h over that contact interior: its smoothness.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lambda_interior_spread: Option<f64>,
     /// KKT residual of the solution.
     pub complementarity_residual: f64,
     /// Number of unknowns (all fields, multiplier included).
     pub dofs: usize,
-    /// Newton iterations.
+    /// Newton iterations on the finest mesh.
     pub iterations: usize,
+    /// `[triangles, iterations]` of each level of the nested iteration.
+    pub levels: Vec<[usize; 2]>,
     /// Wall time of the solve, assembly included.
     pub seconds: f64,
+}
+
+fn is_nan(v: &f64) -> bool {
+    v.is_nan()
 }
 
 fn zero(_: &[f64]) -> f64 {
@@ -195,67 +374,241 @@ fn zero(_: &[f64]) -> f64 {
 /// Solves `request`.
 ///
 /// # Errors
-/// [`PlateRequest::validate`]'s, and the solver's if it does not converge.
+/// [`PlateRequest::validate`]'s, the solver's if it does not converge, and
+/// [`Error::Input`] when the load (or α) dwarfs the obstacle so that w_h is rounding (its
+/// rounding through the contact rows above [`MAX_PRIMAL_ROUNDING`]).
 pub fn solve(request: &PlateRequest) -> Result<PlateReport> {
     request.validate()?;
-    match (request.scene.support, request.pair) {
-        (PlateSupport::Clamped, PlatePair::P1P2P0) => solve_with::<mindlin_clamped::Model>(request),
-        (PlateSupport::Clamped, PlatePair::P1P1P0Plain) => {
-            solve_with::<mindlin_plain_p1::Model>(request)
+    let run = request
+        .pair
+        .run(request.scene.support)
+        .ok_or_else(|| Error::Input("no model for this support".into()))?;
+    run(request)
+}
+
+/// The mesh of `domain` with size `n`: the N×N×2 mesh of the square (diagonals to the
+/// right), the ring mesh of the disk ([`TriangleMesh::disk`], polygonal: its boundary
+/// vertices lie on the circle).
+///
+/// # Errors
+/// The mesh generator's, for a size of 0 or a domain that is not finite.
+pub fn plate_mesh(domain: PlateDomain, n: usize) -> Result<TriangleMesh> {
+    match domain {
+        PlateDomain::Square { side } => {
+            TriangleMesh::rectangle(0.0, side, 0.0, side, n, n, Diagonal::Right)
         }
+        PlateDomain::Disk { radius } => TriangleMesh::disk(domain.centre(), radius, n),
     }
+}
+
+/// The mesh sizes of a solve: N/2^k ≥ [`COARSEST_LEVEL`], …, N with nesting (halving
+/// while even), just N without.
+pub fn level_sizes(n: usize, nested: bool) -> Vec<usize> {
+    let mut sizes = vec![n];
+    while nested && sizes[0] % 2 == 0 && sizes[0] / 2 >= COARSEST_LEVEL {
+        sizes.insert(0, sizes[0] / 2);
+    }
+    sizes
+}
+
+/// The one call that solves the plate on its meshes, coarsest first (each level
+/// started from the one before). The disk is solved on its polygonal ring meshes for
+/// now; with isoparametric cells this becomes
+/// `solve_obstacle_on_curved_triangles::<M>(meshes, &geometries, coefficients, options)`
+/// with `geometries[k] = QuadraticGeometry::circle(&meshes[k], centre, radius)?`
+/// (docs/mathematics.md §6: the polygon adds ~3e-4 relative to J). What the report
+/// integrates over the solution (J_h, ∫λ_h, ∫w_h, the contact area) then wants the
+/// curved cells' versions too; the contact radius and the centre value only locate
+/// points.
+fn solve_on_domain<M: Model>(
+    _domain: PlateDomain,
+    meshes: &[TriangleMesh],
+    coefficients: &Coefficients,
+    options: ObstacleOptions,
+) -> Result<TriangleObstacleSolution> {
+    solve_obstacle_on_triangles::<M>(meshes, coefficients, options)
 }
 
 fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
     let s = &request.scene;
     let q = request.load;
-    // an obstacle below every deflection the load can cause (the clamped and the simply
-    // supported square stay under 0.005 q a⁴/D; the shear adds O(t²) to it), so λ ≡ 0
-    let depth = -100.0
-        * (q.abs() * s.side.powi(4) / s.bending_stiffness).max(1.0)
-        * (1.0 + request.thickness.powi(2));
+    let length = s.domain.length();
+    let (side, height) = request.obstacle().side_and_height().unwrap_or_else(|| {
+        // an obstacle below every deflection the load can cause (the clamped and the
+        // simply supported square stay under 0.005 q a⁴/D, the disk under q R⁴/(64D);
+        // the shear adds O(t²) to it), so λ ≡ 0
+        let depth = -100.0
+            * (q.abs() * length.powi(4) / s.bending_stiffness).max(1.0)
+            * (1.0 + (request.thickness / length).powi(2));
+        (1.0, depth)
+    });
     let load = move |_: &[f64]| q;
-    let obstacle = move |_: &[f64]| depth;
+    let obstacle = move |_: &[f64]| height;
     let mut params = vec![
         ("D", s.bending_stiffness),
         ("ν", s.poisson_ratio),
         ("κ", s.shear_correction),
         ("t", request.thickness),
         ("α", request.alpha),
-        ("s", 1.0),
+        ("s", side),
     ];
     if M::param("β").is_ok() {
         params.push(("β", STENBERG_BETA));
     }
     let coefficients =
         Coefficients::new::<M>(&params, &[("f", &load), ("ψ", &obstacle), ("g", &zero)])?;
-    let n = request.mesh_size;
-    let mesh = TriangleMesh::rectangle(0.0, s.side, 0.0, s.side, n, n, Diagonal::Right)?;
+    let meshes = level_sizes(request.mesh_size, request.nested)
+        .into_iter()
+        .map(|n| plate_mesh(s.domain, n))
+        .collect::<Result<Vec<_>>>()?;
     let solution =
-        solve_obstacle_on_triangles::<M>(&[mesh], &coefficients, ObstacleOptions::default())?;
+        solve_on_domain::<M>(s.domain, &meshes, &coefficients, ObstacleOptions::default())?;
     let w = M::field("w")?;
-    let centre = value_at(&solution, w, [0.5 * s.side, 0.5 * s.side])?;
-    let reference = s.kirchhoff_deflection();
+    let max_deflection = solution.field(w).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if request.obstacle() != PlateObstacle::None {
+        // as for membranes: a load (or α) that dwarfs the obstacle leaves w_h to the
+        // rounding of the contact rows (q = 1e100 on the disk: w(0) = −2.7e78 under
+        // ψ = 0.05), which the KKT residual cannot show
+        let size = max_deflection.max(height.abs()).max(1e-6 * s.domain.size());
+        let rounding = solution.primal_rounding() / size;
+        if rounding.is_nan() || rounding > MAX_PRIMAL_ROUNDING {
+            return Err(Error::Input(format!(
+                "w_h is lost to rounding: in contact the constraint rows subtract terms of the size of the load and of α h⁴ q (q = {q:e}, α = {:e}), which dwarf the obstacle ({}), and their rounding moves w_h by {rounding:.0e} of its own size; use a smaller load or α",
+                request.alpha,
+                request.obstacle().describe()
+            )));
+        }
+    }
+    let centre = value_at(&solution, w, s.domain.centre())?;
+    let kirchhoff = s.kirchhoff_deflection_at(q);
+    let in_contact = request.obstacle() != PlateObstacle::None;
+    let unobstructed = if in_contact {
+        None
+    } else {
+        s.mindlin_deflection_at(q, request.thickness)
+    };
     let energy = solution.energy::<M>(&coefficients)?;
+    let contact = ContactGeometry::of(&solution, s.domain.centre());
+    let mesh = &solution.discretization.mesh;
     Ok(PlateReport {
         scene: s.name.to_string(),
         pair: request.pair.name(),
         support: s.support.name(),
+        domain: s.domain.describe(),
+        obstacle: request.obstacle().describe(),
         thickness: request.thickness,
-        mesh_size: n,
+        mesh_size: request.mesh_size,
+        triangles: mesh.cell_count(),
         load: q,
         alpha: request.alpha,
         centre_deflection: centre,
-        kirchhoff_reference: reference,
-        relative_error: (centre - reference) / reference,
+        kirchhoff_reference: kirchhoff,
+        unobstructed_reference: unobstructed,
+        relative_error: if in_contact {
+            f64::NAN
+        } else {
+            let reference = unobstructed.unwrap_or(kirchhoff);
+            (centre - reference) / reference
+        },
         energy,
-        max_deflection: solution.field(w).iter().fold(0.0, |m, v| m.max(v.abs())),
+        max_deflection,
+        deflection_integral: solution.view(w).integral(),
         total_contact_force: solution.total_contact_force(),
+        contact_area: contact.area,
+        contact_radius: in_contact.then_some(contact.radius),
+        lambda_interior_mean: contact.interior.map(|(mean, _)| mean),
+        lambda_interior_spread: contact.interior.map(|(_, spread)| spread),
         complementarity_residual: solution.kkt_residual,
         dofs: solution.discretization.dofs.dof_count(),
         iterations: solution.iterations,
+        levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
         seconds: solution.seconds,
     })
+}
+
+/// Rays of [`PlateReport::contact_radius`].
+const CONTACT_RAYS: usize = 360;
+
+/// The contact set of a solution seen from a centre: its area, its radius along rays,
+/// and λ_h over its interior.
+struct ContactGeometry {
+    area: f64,
+    radius: f64,
+    /// `(mean, (max − min)/|mean|)` of λ_h over the contact interior, if it has cells.
+    interior: Option<(f64, f64)>,
+}
+
+impl ContactGeometry {
+    fn of(solution: &TriangleObstacleSolution, centre: [f64; 2]) -> Self {
+        let d = &solution.discretization;
+        let mesh = &d.mesh;
+        let multipliers = solution.field(d.multiplier_field);
+        let lambda: Vec<f64> = d
+            .multiplier_dofs()
+            .iter()
+            .map(|&k| multipliers[k])
+            .collect();
+        let active = contact_indicator(&d.lcp, &d.primal_part(&solution.values), &lambda);
+        let per_cell = d
+            .dofs
+            .map(d.multiplier_field)
+            .map_or(1, |m| m.local_count());
+        let mut contact = vec![false; mesh.cell_count()];
+        for (k, &dof) in d.multiplier_dofs().iter().enumerate() {
+            contact[dof / per_cell] |= active[k];
+        }
+        let locator = PointLocator::new(mesh);
+        let h = mesh.max_h();
+        let reach = mesh
+            .vertices()
+            .iter()
+            .map(|p| (p[0] - centre[0]).hypot(p[1] - centre[1]))
+            .fold(0.0, f64::max);
+        let step = h / 8.0;
+        let mut total = 0.0;
+        for k in 0..CONTACT_RAYS {
+            let angle = std::f64::consts::TAU * (k as f64 + 0.5) / CONTACT_RAYS as f64;
+            let (cos, sin) = (angle.cos(), angle.sin());
+            let mut hint = None;
+            let mut r = 0.0;
+            // the first point of the ray outside the contact cells (or the mesh)
+            while r <= reach {
+                let x = [centre[0] + r * cos, centre[1] + r * sin];
+                match locator.locate_near(x, hint) {
+                    Some((c, _)) if contact[c] => hint = Some(c),
+                    _ => break,
+                }
+                r += step;
+            }
+            // the exit lies between the last point inside and this one
+            total += if r == 0.0 { 0.0 } else { r - 0.5 * step };
+        }
+        let radius = total / CONTACT_RAYS as f64;
+        let lambda_cells = solution.view(d.multiplier_field).centroid_values();
+        let interior: Vec<f64> = (0..mesh.cell_count())
+            .filter(|&c| contact[c])
+            .filter(|&c| {
+                let x = mesh.cell(c).map(|v| mesh.vertices()[v]);
+                let centroid = [
+                    (x[0][0] + x[1][0] + x[2][0]) / 3.0,
+                    (x[0][1] + x[1][1] + x[2][1]) / 3.0,
+                ];
+                (centroid[0] - centre[0]).hypot(centroid[1] - centre[1]) <= 0.5 * radius
+            })
+            .map(|c| lambda_cells[c])
+            .collect();
+        let interior = (!interior.is_empty()).then(|| {
+            let mean = interior.iter().sum::<f64>() / interior.len() as f64;
+            let max = interior.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let min = interior.iter().cloned().fold(f64::INFINITY, f64::min);
+            (mean, (max - min) / mean.abs())
+        });
+        Self {
+            area: solution.contact_area(),
+            radius,
+            interior,
+        }
+    }
 }
 
 /// The value of `field` of `solution` at the point `x` of its mesh.
@@ -289,7 +642,10 @@ pub fn locking_study(
     csv: Option<&std::path::Path>,
 ) -> Result<Vec<PlateReport>> {
     let mut reports = Vec::new();
-    for pair in PlatePair::ALL {
+    for pair in PlatePair::ALL
+        .into_iter()
+        .filter(|p| p.supports(scene.support))
+    {
         for &mesh_size in mesh_sizes {
             for &thickness in thicknesses {
                 reports.push(solve(&PlateRequest {
@@ -348,11 +704,15 @@ pub fn locking_run(scene: PlateScene, full: bool, out: &std::path::Path) -> Resu
         );
     }
     let mut series = Vec::new();
-    for pair in PlatePair::ALL {
+    for pair in PlatePair::ALL
+        .into_iter()
+        .filter(|p| p.supports(scene.support))
+    {
         for &n in meshes {
             let points: Vec<(f64, f64)> = reports
                 .iter()
                 .filter(|r| r.pair == pair.name() && r.mesh_size == n)
+                .filter(|r| r.relative_error.is_finite())
                 .map(|r| (r.thickness, r.relative_error.abs().max(1e-12)))
                 .collect();
             series.push(crate::plot::Series::marked(
@@ -377,6 +737,361 @@ pub fn locking_run(scene: PlateScene, full: bool, out: &std::path::Path) -> Resu
         &series,
     )
     .map_err(|e| Error::Input(format!("cannot write {}: {e}", svg.display())))?;
+    println!("→ {}, .csv", svg.display());
+    Ok(())
+}
+
+/// The plate studies a scene may host: `locking` ([`locking_run`]), `iterations`
+/// ([`iterations_run`]) and `convergence` ([`convergence_run`]). Each writes
+/// `out/<scene>-<study>.svg` and `.csv`.
+///
+/// # Errors
+/// [`Error::Input`] for another study kind, and the study's own.
+pub fn run_study(scene: PlateScene, study: Study, full: bool, out: &Path) -> Result<()> {
+    match study {
+        Study::Locking => locking_run(scene, full, out),
+        Study::Iterations => iterations_run(scene, full, out),
+        Study::Convergence => convergence_run(scene, full, out),
+        other => Err(Error::Input(format!(
+            "plate scene `{}` hosts no study `{}`; the plate studies are locking, iterations and convergence",
+            scene.name,
+            other.name()
+        ))),
+    }
+}
+
+/// One level of the iterations study: the Newton iterations on a mesh, within a nested
+/// solve and from a cold start.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IterationLevel {
+    /// The load q.
+    pub load: f64,
+    /// The level's mesh size (N, or rings).
+    pub mesh_size: usize,
+    /// Its triangles.
+    pub triangles: usize,
+    /// Newton iterations on this level within the nested solve of the finest size
+    /// (started from the level before; the coarsest from zero).
+    pub nested: usize,
+    /// Newton iterations of a cold start (from zero) on this level's mesh; `None` above
+    /// the study's cold limit or where the cold start failed (a result of the study).
+    pub cold: Option<usize>,
+}
+
+/// The iterations study of `scene` at load `q`: one nested solve on the meshes
+/// [`level_sizes`]`(finest)`, its iterations per level, and beside each level a cold
+/// start on that level's mesh (up to size `cold_max`).
+///
+/// # Errors
+/// [`solve`]'s for the nested solve.
+pub fn iteration_levels(
+    scene: PlateScene,
+    q: f64,
+    finest: usize,
+    cold_max: usize,
+) -> Result<Vec<IterationLevel>> {
+    let nested = solve(&PlateRequest {
+        load: q,
+        mesh_size: finest,
+        nested: true,
+        ..PlateRequest::new(scene)
+    })?;
+    let sizes = level_sizes(finest, true);
+    Ok(sizes
+        .iter()
+        .zip(&nested.levels)
+        .map(|(&n, &[triangles, iterations])| IterationLevel {
+            load: q,
+            mesh_size: n,
+            triangles,
+            nested: iterations,
+            cold: (n <= cold_max)
+                .then(|| {
+                    solve(&PlateRequest {
+                        load: q,
+                        mesh_size: n,
+                        nested: false,
+                        ..PlateRequest::new(scene)
+                    })
+                    .ok()
+                    .map(|r| r.iterations)
+                })
+                .flatten(),
+        })
+        .collect())
+}
+
+/// The iterations study as the CLI runs it (`study mindlin-disk iterations`): for every
+/// load of the scene, [`iteration_levels`] up to N = 32 (128 with `full`), a table, the
+/// CSV `load,mesh_size,triangles,nested,cold` and the chart of iterations against N,
+/// nested and cold per load: nested iteration stays flat in h, a cold start grows.
+///
+/// # Errors
+/// [`iteration_levels`]'s, and [`Error::Input`] when the output cannot be written.
+pub fn iterations_run(scene: PlateScene, full: bool, out: &Path) -> Result<()> {
+    let finest = if full { 128 } else { 32 };
+    println!(
+        "\niterations: {}, semismooth Newton iterations per level of a nested solve, a cold start on the same mesh beside ('-': failed)",
+        scene.name
+    );
+    println!(
+        "{:>8} {:>6} {:>10} {:>7} {:>6}",
+        "q", "N", "triangles", "nested", "cold"
+    );
+    let mut rows = Vec::new();
+    for &q in scene.loads {
+        rows.extend(iteration_levels(scene, q, finest, finest)?);
+    }
+    let show = |v: Option<usize>| v.map_or("-".to_string(), |c| c.to_string());
+    for r in &rows {
+        println!(
+            "{:>8} {:>6} {:>10} {:>7} {:>6}",
+            r.load,
+            r.mesh_size,
+            r.triangles,
+            r.nested,
+            show(r.cold)
+        );
+    }
+    let mut series = Vec::new();
+    for &q in scene.loads {
+        let of = |pick: &dyn Fn(&IterationLevel) -> Option<usize>| -> Vec<(f64, f64)> {
+            rows.iter()
+                .filter(|r| r.load == q)
+                .filter_map(|r| pick(r).map(|c| (r.mesh_size as f64, c.max(1) as f64)))
+                .collect()
+        };
+        series.push(crate::plot::Series::marked(
+            format!("nested, q = {q}"),
+            of(&|r| Some(r.nested)),
+        ));
+        series.push(crate::plot::Series::marked(
+            format!("cold start, q = {q}"),
+            of(&|r| r.cold),
+        ));
+    }
+    let svg = output(out, scene.name, Study::Iterations, "svg");
+    crate::plot::chart(
+        &svg,
+        &format!("{}: Newton iterations per mesh", scene.name),
+        crate::plot::Axes {
+            x: size_name(scene.domain),
+            y: "iterations",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )
+    .map_err(|e| Error::Input(format!("cannot write {}: {e}", svg.display())))?;
+    write_csv(
+        &output(out, scene.name, Study::Iterations, "csv"),
+        "load,mesh_size,triangles,nested,cold",
+        &rows
+            .iter()
+            .map(|r| {
+                vec![
+                    r.load,
+                    r.mesh_size as f64,
+                    r.triangles as f64,
+                    r.nested as f64,
+                    r.cold.map_or(f64::NAN, |c| c as f64),
+                ]
+            })
+            .collect::<Vec<_>>(),
+    )
+    .map_err(io)?;
+    println!("→ {}, .csv", svg.display());
+    Ok(())
+}
+
+/// What a mesh size counts on `domain`, for axes.
+fn size_name(domain: PlateDomain) -> &'static str {
+    match domain {
+        PlateDomain::Square { .. } => "N (N×N×2 mesh)",
+        PlateDomain::Disk { .. } => "rings",
+    }
+}
+
+/// One mesh of the convergence study.
+#[derive(Clone, Debug)]
+pub struct ConvergenceRow {
+    /// The load q.
+    pub load: f64,
+    /// The mesh size (N, or rings).
+    pub mesh_size: usize,
+    /// The largest cell diameter.
+    pub h: f64,
+    /// The report of the solve.
+    pub report: PlateReport,
+}
+
+/// The quantities the convergence study follows, by name: `J_h`, `∫λ_h`, the contact
+/// radius.
+pub const CONVERGENCE_QUANTITIES: [&str; 3] = ["J_h", "∫λ_h", "contact radius"];
+
+impl ConvergenceRow {
+    /// `[J_h, ∫λ_h, contact radius]` (the radius 0 without an obstacle).
+    pub fn quantities(&self) -> [f64; 3] {
+        [
+            self.report.energy,
+            self.report.total_contact_force,
+            self.report.contact_radius.unwrap_or(0.0),
+        ]
+    }
+}
+
+/// The convergence study of `scene` at load `q`: [`solve`] on each mesh size (nested),
+/// one row each. No exact solution is known with contact; [`differences`] gives the
+/// changes between meshes and their observed rates.
+///
+/// # Errors
+/// [`solve`]'s.
+pub fn convergence_study(
+    scene: PlateScene,
+    q: f64,
+    sizes: &[usize],
+) -> Result<Vec<ConvergenceRow>> {
+    sizes
+        .iter()
+        .map(|&n| {
+            let report = solve(&PlateRequest {
+                load: q,
+                mesh_size: n,
+                ..PlateRequest::new(scene)
+            })?;
+            Ok(ConvergenceRow {
+                load: q,
+                mesh_size: n,
+                h: plate_mesh(scene.domain, n)?.max_h(),
+                report,
+            })
+        })
+        .collect()
+}
+
+/// For rows on meshes halved each time: per quantity of [`ConvergenceRow::quantities`],
+/// the differences `d_k = Q_{k+1} − Q_k` between consecutive meshes and the observed
+/// rates `log2(|d_k| / |d_{k+1}|)` (for `Q_h = Q + C hᵖ`, `d_k ∝ h_kᵖ` and the rate is p).
+/// Shapes: `differences[q]` has `rows − 1` entries, `rates[q]` `rows − 2`.
+pub fn differences(rows: &[ConvergenceRow]) -> ([Vec<f64>; 3], [Vec<f64>; 3]) {
+    let d: [Vec<f64>; 3] = std::array::from_fn(|q| {
+        rows.windows(2)
+            .map(|w| w[1].quantities()[q] - w[0].quantities()[q])
+            .collect()
+    });
+    let rates = std::array::from_fn(|q| {
+        d[q].windows(2)
+            .map(|w| (w[0].abs() / w[1].abs()).log2())
+            .collect()
+    });
+    (d, rates)
+}
+
+/// The convergence study as the CLI runs it (`study mindlin-disk convergence`): for each
+/// load of the scene, [`convergence_study`] on N = 8, 16, 32 (up to 128 with `full`);
+/// a table of J_h, ∫λ_h and the contact radius with the differences between meshes and
+/// their observed rates, the CSV
+/// `load,mesh_size,h,dofs,energy,total_contact_force,contact_radius,contact_area,lambda_interior_spread,iterations,seconds`
+/// and the chart of |differences| against h (one line per quantity and load).
+///
+/// # Errors
+/// [`convergence_study`]'s, and [`Error::Input`] when the output cannot be written.
+pub fn convergence_run(scene: PlateScene, full: bool, out: &Path) -> Result<()> {
+    let sizes: &[usize] = if full {
+        &[8, 16, 32, 64, 128]
+    } else {
+        &[8, 16, 32]
+    };
+    println!(
+        "\nconvergence: {} ({}, {}, t = {}), J_h, ∫λ_h and contact radius against h; Δ: change from the mesh before, rate: log2 of the ratio of consecutive Δ",
+        scene.name,
+        scene.domain.describe(),
+        scene.obstacle.describe(),
+        scene.thickness
+    );
+    let mut csv = Vec::new();
+    let mut series = Vec::new();
+    for &q in scene.loads {
+        let rows = convergence_study(scene, q, sizes)?;
+        let (d, rates) = differences(&rows);
+        println!(
+            "q = {q}\n{:>5} {:>8} {:>8} {:>16} {:>10} {:>5} {:>14} {:>10} {:>5} {:>12} {:>10} {:>5} {:>10} {:>5}",
+            "N", "h", "dofs", "J_h", "ΔJ", "rate", "∫λ_h", "Δ∫λ", "rate", "radius", "Δradius", "rate", "λ spread", "iter"
+        );
+        let entry = |v: &[f64], k: usize, shift: usize| {
+            k.checked_sub(shift)
+                .and_then(|k| v.get(k).copied())
+                .unwrap_or(f64::NAN)
+        };
+        for (k, r) in rows.iter().enumerate() {
+            let [j, force, radius] = r.quantities();
+            println!(
+                "{:>5} {:>8.4} {:>8} {:>16.9e} {:>10.2e} {:>5.2} {:>14.7e} {:>10.2e} {:>5.2} {:>12.6} {:>10.2e} {:>5.2} {:>10.2e} {:>5}",
+                r.mesh_size,
+                r.h,
+                r.report.dofs,
+                j,
+                entry(&d[0], k, 1),
+                entry(&rates[0], k, 2),
+                force,
+                entry(&d[1], k, 1),
+                entry(&rates[1], k, 2),
+                radius,
+                entry(&d[2], k, 1),
+                entry(&rates[2], k, 2),
+                r.report.lambda_interior_spread.unwrap_or(f64::NAN),
+                r.report.iterations
+            );
+            csv.push(vec![
+                q,
+                r.mesh_size as f64,
+                r.h,
+                r.report.dofs as f64,
+                j,
+                force,
+                radius,
+                r.report.contact_area,
+                r.report.lambda_interior_spread.unwrap_or(f64::NAN),
+                r.report.iterations as f64,
+                r.report.seconds,
+            ]);
+        }
+        for (name, d) in CONVERGENCE_QUANTITIES.iter().zip(&d) {
+            // the change to the next mesh, plotted at the coarser one's h
+            let points = rows
+                .iter()
+                .zip(d)
+                .filter(|(_, d)| d.is_finite() && d.abs() > 0.0)
+                .map(|(r, d)| (r.h, d.abs()))
+                .collect();
+            series.push(crate::plot::Series::marked(
+                format!("|Δ {name}|, q = {q}"),
+                points,
+            ));
+        }
+    }
+    let svg = output(out, scene.name, Study::Convergence, "svg");
+    crate::plot::chart(
+        &svg,
+        &format!(
+            "{}: change of J_h, ∫λ_h and the contact radius to the next mesh",
+            scene.name
+        ),
+        crate::plot::Axes {
+            x: "h (largest cell diameter)",
+            y: "|change to the next mesh|",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )
+    .map_err(|e| Error::Input(format!("cannot write {}: {e}", svg.display())))?;
+    write_csv(
+        &output(out, scene.name, Study::Convergence, "csv"),
+        "load,mesh_size,h,dofs,energy,total_contact_force,contact_radius,contact_area,lambda_interior_spread,iterations,seconds",
+        &csv,
+    )
+    .map_err(io)?;
     println!("→ {}, .csv", svg.display());
     Ok(())
 }

@@ -1,6 +1,9 @@
-//! The plate scene `mindlin-square` from the command line: `solve --json` reports the
-//! centre deflection against the Kirchhoff value as t → 0 (and the plain pair locking),
-//! and bad input exits non-zero with a message naming it, never a panic.
+//! The plate scenes from the command line: `mindlin-square` (`solve --json` reports the
+//! centre deflection against the Kirchhoff value as t → 0, and the plain pair locking),
+//! `mindlin-square-ss` against Navier's value, `mindlin-disk` with contact (its report
+//! checked by identities and exact values) and without its obstacle (against the closed
+//! form), its studies; and bad input exits non-zero with a message naming it, never a
+//! panic.
 
 use std::process::Command;
 
@@ -15,7 +18,11 @@ fn fem_forms(args: &[&str]) -> std::process::Output {
 }
 
 fn solve_json(args: &[&str]) -> serde_json::Value {
-    let mut all = vec!["solve", "mindlin-square", "--json"];
+    scene_json("mindlin-square", args)
+}
+
+fn scene_json(scene: &str, args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["solve", scene, "--json"];
     all.extend_from_slice(args);
     let run = fem_forms(&all);
     assert!(
@@ -140,5 +147,251 @@ fn the_locking_study_writes_its_chart_and_table() {
         }
     }
     assert!(rows.iter().any(|r| r[0] != "p1-p2-p0"));
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The simply supported square tends to Navier's 0.00406235 q a⁴/D (Timoshenko &
+/// Woinowsky-Krieger, table 8) as t → 0: at t = 1e-4 the error falls with h (measured
+/// +6.7e-3, +4.3e-3, +2.4e-3 at N = 16, 32, 64: about O(h) with the soft support) and is
+/// within 0.5 % at N = 64.
+#[test]
+fn the_simply_supported_square_tends_to_navier() {
+    let errors: Vec<f64> = [16, 32, 64]
+        .iter()
+        .map(|n| {
+            let json = scene_json(
+                "mindlin-square-ss",
+                &["--thickness", "1e-4", "--mesh-size", &n.to_string()],
+            );
+            assert_eq!(json["support"], "simply-supported");
+            assert_eq!(json["kirchhoff_reference"].as_f64().unwrap(), 0.00406235);
+            let w = json["centre_deflection"].as_f64().unwrap();
+            (w - 0.00406235) / 0.00406235
+        })
+        .collect();
+    assert!(
+        errors[0].abs() > errors[1].abs() && errors[1].abs() > errors[2].abs(),
+        "{errors:?}"
+    );
+    assert!(errors[2].abs() < 5e-3, "{errors:?}");
+}
+
+/// mindlin-disk at q = 20 on 32 rings: the obstacle holds the centre at w = 0.05 (the
+/// unobstructed plate would rise to 0.3126), the multiplier in the contact interior is
+/// q (there w is constant and θ = 0, so `div div Cε(θ) − sλ = f` gives λ = q), the
+/// energy satisfies `J_h = −½ q∫w_h + ½ s ψ ∫λ_h` (equilibrium tested with u_h, s = −1,
+/// ψ = 0.05), and nested iteration takes a few Newton steps on every level.
+#[test]
+fn mindlin_disk_reports_contact_that_satisfies_its_identities() {
+    let json = scene_json("mindlin-disk", &["--mesh-size", "32"]);
+    for field in [
+        "energy",
+        "max_deflection",
+        "total_contact_force",
+        "contact_area",
+        "contact_radius",
+        "lambda_interior_mean",
+        "lambda_interior_spread",
+        "dofs",
+        "iterations",
+        "levels",
+        "seconds",
+        "complementarity_residual",
+    ] {
+        assert!(
+            json.get(field).is_some_and(|v| !v.is_null()),
+            "{field} missing: {json}"
+        );
+    }
+    let value = |f: &str| json[f].as_f64().unwrap();
+    assert_eq!(json["obstacle"], "flat above, w ≤ 0.05");
+    assert_eq!(value("load"), 20.0);
+    assert!(json.get("relative_error").is_none());
+    assert!((value("centre_deflection") - 0.05).abs() < 1e-4);
+    assert!(value("max_deflection") < 0.0501);
+    assert!(value("complementarity_residual") <= 1e-10);
+    let (force, j) = (value("total_contact_force"), value("energy"));
+    assert!(force > 0.0);
+    // the cell-wise constraint adds `−α Σ_T h_T⁴ (λ_h − q) λ_h |T|` to ∫ s w_h λ_h, of
+    // order α h⁴ q² r_c² ≈ 1e-4 here (measured 1.1e-4 relative); a wrong shear weight in
+    // J_h or a wrong sign of λ_h is off by O(1)
+    let identity = -0.5 * 20.0 * value("deflection_integral") - 0.5 * 0.05 * force;
+    assert!(
+        (j - identity).abs() <= 5e-4 * j.abs(),
+        "J_h = {j}, −½q∫w − ½ψ∫λ = {identity}"
+    );
+    assert!((value("lambda_interior_mean") - 20.0).abs() < 0.2);
+    // the contact set is close to a disk: its area and its radius along rays agree
+    let (area, radius) = (value("contact_area"), value("contact_radius"));
+    assert!(
+        (radius - (area / std::f64::consts::PI).sqrt()).abs() < 0.05,
+        "radius {radius}, area {area}"
+    );
+    // 32 rings: DOFs of θ (2 · vertices), w (vertices + edges) and λ (cells)
+    let (vertices, cells) = (1 + 3 * 32 * 33, 6 * 32 * 32);
+    let edges = vertices + cells - 1;
+    assert_eq!(
+        json["dofs"].as_u64().unwrap() as usize,
+        2 * vertices + vertices + edges + cells
+    );
+    let levels = json["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 4, "rings 4, 8, 16, 32");
+    for level in levels {
+        assert!(level[1].as_u64().unwrap() <= 6, "{levels:?}");
+    }
+}
+
+/// `--cold` solves the same discrete problem from zero on the finest mesh alone: one
+/// level, more Newton steps, the same J_h and ∫λ_h as the nested solve.
+#[test]
+fn a_cold_start_solves_the_same_disk_problem() {
+    let nested = scene_json("mindlin-disk", &["--mesh-size", "16"]);
+    let cold = scene_json("mindlin-disk", &["--mesh-size", "16", "--cold"]);
+    assert_eq!(cold["levels"].as_array().unwrap().len(), 1);
+    assert_eq!(nested["levels"].as_array().unwrap().len(), 3);
+    assert!(cold["iterations"].as_u64() > nested["iterations"].as_u64());
+    for field in ["energy", "total_contact_force", "contact_area"] {
+        let (a, b) = (
+            nested[field].as_f64().unwrap(),
+            cold[field].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() <= 1e-9 * a.abs(), "{field}: {a} and {b}");
+    }
+}
+
+/// Without its obstacle the disk's centre deflection is the closed form
+/// `q/64 + q t²/14` (t = 0.01, q = 20: 0.3126428571); the polygonal ring mesh's error
+/// falls with h and is below 1e-3 on 32 rings.
+#[test]
+fn the_unobstructed_disk_meets_its_closed_form() {
+    let errors: Vec<f64> = ["16", "32"]
+        .iter()
+        .map(|n| {
+            let json = scene_json("mindlin-disk", &["--no-obstacle", "--mesh-size", n]);
+            assert_eq!(json["obstacle"], "none");
+            let reference = json["unobstructed_reference"].as_f64().unwrap();
+            assert!((reference - 0.3126428571).abs() < 1e-10, "{reference}");
+            assert_eq!(json["total_contact_force"].as_f64().unwrap(), 0.0);
+            let w = json["centre_deflection"].as_f64().unwrap();
+            assert!(
+                (json["relative_error"].as_f64().unwrap() - (w - reference) / reference).abs()
+                    < 1e-12
+            );
+            (w - reference) / reference
+        })
+        .collect();
+    assert!(errors[1].abs() < errors[0].abs(), "{errors:?}");
+    assert!(errors[1].abs() < 1e-3, "{errors:?}");
+    // q = 10 still touches: the free plate would rise to 0.156 > 0.05
+    let touching = scene_json("mindlin-disk", &["--load", "10", "--mesh-size", "16"]);
+    assert!(touching["total_contact_force"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn bad_disk_input_exits_with_a_message() {
+    for (scene, args, message) in [
+        ("mindlin-disk", &["--thickness", "0"][..], "thickness t = 0"),
+        (
+            "mindlin-disk",
+            &["--thickness", "3"][..],
+            "exceeds the plate's diameter 2",
+        ),
+        (
+            "mindlin-disk",
+            &["--load", "NaN"][..],
+            "load q = NaN must be finite",
+        ),
+        (
+            "mindlin-disk",
+            &["--load", "inf"][..],
+            "load q = inf must be finite",
+        ),
+        (
+            "mindlin-disk",
+            &["--load", "1e300"][..],
+            "load q = 1e300 is beyond",
+        ),
+        (
+            "mindlin-disk",
+            &["--mesh-size", "600"][..],
+            "mesh size N = 600 must lie in 1..=512",
+        ),
+        (
+            "mindlin-disk",
+            &["--msh", "x.msh"][..],
+            "--msh does not apply",
+        ),
+        (
+            "mindlin-disk",
+            &["--load", "1e20"][..],
+            "w_h is lost to rounding",
+        ),
+        (
+            "mindlin-disk",
+            &["--alpha", "1e300"][..],
+            "w_h is lost to rounding",
+        ),
+        (
+            "mindlin-square",
+            &["--no-obstacle"][..],
+            "`mindlin-square` has no obstacle",
+        ),
+        (
+            "mindlin-square-ss",
+            &["--pair", "p1-p1-p0-plain"][..],
+            "pair p1-p1-p0-plain has no simply-supported model",
+        ),
+    ] {
+        let mut all = vec!["solve", scene];
+        all.extend_from_slice(args);
+        let run = fem_forms(&all);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{all:?} succeeded");
+        assert!(stderr.contains(message), "{all:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{all:?}: {stderr}");
+    }
+}
+
+/// `study mindlin-disk` writes both charts and tables: nested iterations flat (at most 6
+/// on every level of every load), and J_h converging (its change to the next mesh
+/// shrinking).
+#[test]
+fn the_disk_studies_write_their_charts_and_tables() {
+    let out = std::env::temp_dir().join(format!("fem-forms-disk-study-{}", std::process::id()));
+    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["study", "mindlin-disk", "--out"])
+        .arg(&out)
+        .output()
+        .expect("the binary runs");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for study in ["iterations", "convergence"] {
+        let svg = std::fs::read_to_string(out.join(format!("mindlin-disk-{study}.svg"))).unwrap();
+        assert!(svg.contains("<svg"));
+    }
+    let rows = |study: &str| -> Vec<Vec<f64>> {
+        std::fs::read_to_string(out.join(format!("mindlin-disk-{study}.csv")))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect()
+    };
+    let iterations = rows("iterations");
+    assert_eq!(iterations.len(), 3 * 4, "3 loads × rings 4, 8, 16, 32");
+    assert!(iterations.iter().all(|r| r[3] <= 6.0), "{iterations:?}");
+    let convergence = rows("convergence");
+    for q in [10.0, 20.0, 50.0] {
+        let j: Vec<f64> = convergence
+            .iter()
+            .filter(|r| r[0] == q)
+            .map(|r| r[4])
+            .collect();
+        assert_eq!(j.len(), 3);
+        assert!((j[2] - j[1]).abs() < (j[1] - j[0]).abs(), "q = {q}: {j:?}");
+    }
     std::fs::remove_dir_all(&out).unwrap();
 }

@@ -10,7 +10,7 @@
 
 use crate::kirchhoff_scenes::{KirchhoffScene, KIRCHHOFF_SCENES};
 use crate::membrane_scenes::{MembraneScene, MEMBRANE_FLAT, MEMBRANE_SCENES};
-use crate::plate_scenes::{PlateScene, PLATE_SCENES};
+use crate::plate_scenes::{PlateScene, PlateSupport, PLATE_SCENES};
 use crate::scenes::{Beam, Scene, SCENES};
 use std::borrow::Cow;
 
@@ -169,6 +169,15 @@ fn beam_studies(name: &str) -> &'static [&'static str] {
     }
 }
 
+/// The studies each built-in plate scene hosts (the plate's own: `src/plates.rs`).
+fn plate_studies(name: &str) -> &'static [&'static str] {
+    match name {
+        "mindlin-square" => &["locking"],
+        "mindlin-disk" => &["convergence", "iterations"],
+        _ => &[],
+    }
+}
+
 /// Every built-in scene, beams first, in the order `list` prints them.
 pub fn registry() -> Vec<SceneEntry> {
     let mut entries: Vec<SceneEntry> = SCENES
@@ -195,8 +204,12 @@ pub fn registry() -> Vec<SceneEntry> {
     // not in the default job
     entries.extend(PLATE_SCENES.iter().map(|&s| SceneEntry {
         kind: SceneKind::Plate(s),
-        pairs: PLATE_PAIRS,
-        studies: &["locking"],
+        // the plain pair's model is clamped only
+        pairs: match s.support {
+            PlateSupport::Clamped => PLATE_PAIRS,
+            PlateSupport::SimplySupported => &PLATE_PAIRS[..1],
+        },
+        studies: plate_studies(s.name),
         in_default_job: false,
     }));
     // the Kirchhoff scenes too: solved and studied on demand
