@@ -160,6 +160,79 @@ pub(crate) fn add_block_matrices<M: Model, G: Mesh>(
     Ok(())
 }
 
+/// The fewest blocks from which [`add_form_matrices`] visits the cells once for all
+/// blocks instead of once per block. Each per-block pass reads the mesh and the
+/// strided positions again and scatters into the whole value array again: for the
+/// Mindlin plate's 12 blocks the passes cost 3.3 µs per triangle against 0.35 µs for
+/// one pass (benches/mindlin.rs, docs/mathematics.md §9), while a block or two keep the
+/// generated loop, whose kernel is inlined into it.
+pub const CELL_MAJOR_MIN_BLOCKS: usize = 3;
+
+/// Adds the element matrices of all `plans` (blocks of bilinear `form`) over all cells
+/// of `mesh` into `values`, entry `(i, j)` of block `b` on cell `c` at
+/// `positions[c·stride + offset_b + i·cols_b + j]` with `stride` the sum of the blocks'
+/// sizes and `offset_b` the sizes of the blocks before `b`.
+///
+/// # Errors
+/// Those of [`add_block_matrices`].
+pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
+    form: usize,
+    plans: &[BlockPlan],
+    mesh: &G,
+    coefficients: &Coefficients,
+    positions: &[usize],
+    values: &mut [f64],
+) -> Result<()> {
+    let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
+    if plans.len() < CELL_MAJOR_MIN_BLOCKS {
+        let mut offset = 0;
+        for plan in plans {
+            add_block_matrices::<M, G>(
+                form,
+                plan,
+                mesh,
+                coefficients,
+                positions,
+                stride,
+                offset,
+                values,
+            )?;
+            offset += plan.rows * plan.cols;
+        }
+        return Ok(());
+    }
+    let (params, data) = (&coefficients.params, &coefficients.data);
+    let curved = mesh.has_curved_cells();
+    let largest = plans.iter().map(|p| p.rows * p.cols).max().unwrap_or(0);
+    let mut local = vec![0.0; largest];
+    let (mut x, mut nodes, mut g) = ([0.0; 6], [0.0; 12], [0usize; 3]);
+    for c in 0..mesh.cell_count() {
+        let on_curved = curved && mesh.curved_cell_nodes_into(c, &mut nodes);
+        let numbered = !on_curved && {
+            mesh.cell_coordinates_into(c, &mut x);
+            mesh.cell_vertex_numbers_into(c, &mut g)
+        };
+        let cell = &positions[c * stride..][..stride];
+        let mut offset = 0;
+        for plan in plans {
+            let size = plan.rows * plan.cols;
+            let out = &mut local[..size];
+            if on_curved {
+                M::element_matrix_curved(form, plan.block, &nodes, params, data, out)?;
+            } else if numbered {
+                M::element_matrix_on_cell(form, plan.block, &x, &g, params, data, out);
+            } else {
+                M::element_matrix(form, plan.block, &x, params, data, out);
+            }
+            for (&p, &v) in cell[offset..offset + size].iter().zip(out.iter()) {
+                values[p] += v;
+            }
+            offset += size;
+        }
+    }
+    Ok(())
+}
+
 /// Assembles one bilinear form of a model on a mesh, reusing its sparsity pattern.
 #[derive(Clone, Debug)]
 pub struct MatrixAssembler {
@@ -243,21 +316,14 @@ impl MatrixAssembler {
     ) -> Result<()> {
         values.clear();
         values.resize(self.nonzero_count(), 0.0);
-        let stride: usize = self.plans.iter().map(|p| p.rows * p.cols).sum();
-        let mut offset = 0;
-        for plan in &self.plans {
-            add_block_matrices::<M, _>(
-                self.form,
-                plan,
-                mesh,
-                coefficients,
-                &self.positions,
-                stride,
-                offset,
-                values,
-            )?;
-            offset += plan.rows * plan.cols;
-        }
+        add_form_matrices::<M, _>(
+            self.form,
+            &self.plans,
+            mesh,
+            coefficients,
+            &self.positions,
+            values,
+        )?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
             let cell = self.positions.iter().position(|&p| p == bad).unwrap_or(0);
             let per_cell: usize = self.plans.iter().map(|p| p.rows * p.cols).sum();

@@ -174,20 +174,14 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         let split = SplitPattern::new(mesh, &dofs, &plans, &target, n, m);
         let mut values = vec![0.0; split.value_count];
         let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
-        let mut offset = 0;
-        for plan in &plans {
-            crate::assembly::add_block_matrices::<M, G>(
-                form,
-                plan,
-                mesh,
-                coefficients,
-                &split.positions,
-                stride,
-                offset,
-                &mut values,
-            )?;
-            offset += plan.rows * plan.cols;
-        }
+        crate::assembly::add_form_matrices::<M, G>(
+            form,
+            &plans,
+            mesh,
+            coefficients,
+            &split.positions,
+            &mut values,
+        )?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
             let entry = split.positions.iter().position(|&p| p == bad).unwrap_or(0);
             return Err(Error::NonFinite {
