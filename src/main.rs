@@ -56,8 +56,9 @@ enum Command {
         /// command line override the file's.
         #[arg(long = "scene", value_name = "FILE")]
         scene_file: Option<PathBuf>,
+        // boxed: the options are most of the enum's size (clippy::large_enum_variant)
         #[command(flatten)]
-        options: SolveOptions,
+        options: Box<SolveOptions>,
     },
     /// Run a study and write its chart and CSV (out/<scene>-<study>.svg, .csv):
     /// `study <scene> [study]` runs one study the scene hosts (all of them when left
