@@ -205,12 +205,17 @@ pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
     let curved = mesh.has_curved_cells();
     let largest = plans.iter().map(|p| p.rows * p.cols).max().unwrap_or(0);
     let mut local = vec![0.0; largest];
-    let (mut x, mut nodes, mut g) = ([0.0; 6], [0.0; 12], [0usize; 3]);
+    // the kernels take exactly the cell's vertex coordinates (and numbers)
+    let dimension = G::CELL.dimension();
+    let (vertices, coordinates) = (dimension + 1, (dimension + 1) * dimension);
+    let (mut x_all, mut nodes, mut g_all) = ([0.0; 6], [0.0; 12], [0usize; 3]);
+    let x = &mut x_all[..coordinates];
+    let g = &mut g_all[..vertices];
     for c in 0..mesh.cell_count() {
         let on_curved = curved && mesh.curved_cell_nodes_into(c, &mut nodes);
         let numbered = !on_curved && {
-            mesh.cell_coordinates_into(c, &mut x);
-            mesh.cell_vertex_numbers_into(c, &mut g)
+            mesh.cell_coordinates_into(c, x);
+            mesh.cell_vertex_numbers_into(c, g)
         };
         let cell = &positions[c * stride..][..stride];
         let mut offset = 0;
@@ -220,9 +225,9 @@ pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
             if on_curved {
                 M::element_matrix_curved(form, plan.block, &nodes, params, data, out)?;
             } else if numbered {
-                M::element_matrix_on_cell(form, plan.block, &x, &g, params, data, out);
+                M::element_matrix_on_cell(form, plan.block, x, g, params, data, out);
             } else {
-                M::element_matrix(form, plan.block, &x, params, data, out);
+                M::element_matrix(form, plan.block, x, params, data, out);
             }
             for (&p, &v) in cell[offset..offset + size].iter().zip(out.iter()) {
                 values[p] += v;
