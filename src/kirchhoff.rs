@@ -237,9 +237,7 @@ impl KirchhoffRequest {
     /// element constant `C_I` (returned beside it).
     ///
     /// `C_I` depends on the cells' shapes, not their size, and every N×N×2 right-diagonal
-    /// mesh has the same two shapes: it is computed on N = 1. On small cells the runtime's
-    /// eigenvalue split of the Argyris `a_T` (kernel: the affine functions) fails, its
-    /// spectrum spanning more than the 1e-10 it allows (h = 1/32 already).
+    /// mesh has the same two shapes: it is computed on N = 1, two cells instead of 2N².
     fn alpha_on<M: Model>(&self) -> Result<(f64, f64)> {
         let s = &self.scene;
         let params = [s.bending_stiffness, s.poisson_ratio, 1.0, SIDE];

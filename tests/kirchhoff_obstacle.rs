@@ -388,3 +388,23 @@ fn the_square_plate_converges_at_the_elements_rates() {
         }
     }
 }
+
+/// `C_I` depends on a cell's shape, not its size: the Argyris constant of the unit right
+/// triangle is that of the same triangle scaled to h = 1/64 and 1/1024, moved off the
+/// origin (the element matrices in physical DOFs then spread their eigenvalues over
+/// powers of h, which once broke the kernel split at h = 1/32).
+#[test]
+fn the_argyris_inverse_constant_does_not_depend_on_the_cell_size() {
+    use fem_forms::stabilization::element_inverse_constant;
+    let params = [1.0, 0.3, 1.0, -1.0];
+    let unit =
+        element_inverse_constant::<M>(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], &params, "S", "a").unwrap();
+    for h in [1.0 / 64.0, 1.0 / 1024.0] {
+        let x = [0.3, 0.7, 0.3 + h, 0.7, 0.3, 0.7 + h];
+        let small = element_inverse_constant::<M>(&x, &params, "S", "a").unwrap();
+        assert!(
+            (small - unit).abs() <= 1e-6 * unit,
+            "h = {h}: C_I = {small} against {unit} at h = 1"
+        );
+    }
+}

@@ -145,6 +145,25 @@ pub fn element_inverse_constant<M: Model>(
     };
     let symmetric = |m: DMatrix<f64>| (&m + m.transpose()) * 0.5;
     let (s, a) = (symmetric(s), symmetric(a));
+    // C_I is a generalized eigenvalue of (S_T, a_T), unchanged by a congruence with a
+    // diagonal D. Scaled to a unit diagonal, a_T of elements with derivative DOFs
+    // (Argyris: values, h-scaled gradients, h²-scaled Hessians) no longer spreads its
+    // eigenvalues over powers of h, so that the kernel cut below separates the kernel of
+    // a_T from small cells' genuine small eigenvalues (at h = 1/32 it did not).
+    let scale: Vec<f64> = (0..a.nrows())
+        .map(|i| {
+            let d = a[(i, i)];
+            if d > 0.0 && d.is_finite() {
+                1.0 / d.sqrt()
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let congruent = |m: &DMatrix<f64>| {
+        DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| scale[i] * m[(i, j)] * scale[j])
+    };
+    let (s, a) = (congruent(&s), congruent(&a));
     let eigen = SymmetricEigen::new(a);
     let largest = eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
     if !(largest > 0.0 && largest.is_finite()) {
