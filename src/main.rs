@@ -567,7 +567,6 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             "--msh",
             "--vtk",
             "--solver",
-            "--cold",
             "--linear-solver",
             "--refinement",
             "--plot",

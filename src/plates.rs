@@ -11,12 +11,17 @@
 use crate::models::mindlin::{mindlin_clamped, mindlin_plain_p1, mindlin_simply_supported};
 use crate::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene, PlateSupport};
 use crate::studies::{io, output, write_csv, Study};
-use fem_runtime::element::triangle::TriangleBasis;
+use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
+use fem_runtime::mesh::triangle::QuadraticGeometry;
+use fem_runtime::mesh::CurvedTriangleMesh;
 use fem_runtime::obstacle::triangle::{
-    contact_indicator, solve_obstacle_on_triangles, TriangleObstacleSolution,
+    contact_indicator, solve_obstacle_on_curved_triangles, solve_obstacle_on_triangles,
 };
-use fem_runtime::obstacle::ObstacleOptions;
-use fem_runtime::{Coefficients, Diagonal, Error, Model, PointLocator, Result, TriangleMesh};
+use fem_runtime::obstacle::{ObstacleOptions, ObstacleSolution};
+use fem_runtime::reference::triangle::TriangleRule;
+use fem_runtime::{
+    Coefficients, Diagonal, DofNumbering, Error, Model, PointLocator, Result, TriangleMesh,
+};
 use serde::Serialize;
 use std::path::Path;
 
@@ -411,25 +416,113 @@ pub fn level_sizes(n: usize, nested: bool) -> Vec<usize> {
     sizes
 }
 
-/// The one call that solves the plate on its meshes, coarsest first (each level
-/// started from the one before). The disk is solved on its polygonal ring meshes for
-/// now; with isoparametric cells this becomes
-/// `solve_obstacle_on_curved_triangles::<M>(meshes, &geometries, coefficients, options)`
-/// with `geometries[k] = QuadraticGeometry::circle(&meshes[k], centre, radius)?`
-/// (docs/mathematics.md §6: the polygon adds ~3e-4 relative to J). What the report
-/// integrates over the solution (J_h, ∫λ_h, ∫w_h, the contact area) then wants the
-/// curved cells' versions too; the contact radius and the centre value only locate
-/// points.
-fn solve_on_domain<M: Model>(
-    _domain: PlateDomain,
-    meshes: &[TriangleMesh],
-    coefficients: &Coefficients,
-    options: ObstacleOptions,
-) -> Result<TriangleObstacleSolution> {
-    solve_obstacle_on_triangles::<M>(meshes, coefficients, options)
+/// What the report reads from a solution on straight (affine) or curved cells: the
+/// straight mesh (point location, cell lists), field views (evaluated in reference
+/// coordinates, exact on either kind of cell), and the integrals over the cells' own
+/// measures.
+trait PlateCells {
+    /// The mesh of straight cells (the curved one's vertices and cells).
+    fn straight(&self) -> &TriangleMesh;
+    /// The view of a field.
+    fn field_view(&self, field: usize) -> TriangleField<'_>;
+    /// `∫λ_h` over the cells.
+    fn contact_force(&self) -> f64;
+    /// The contact area over the cells.
+    fn area_in_contact(&self) -> f64;
+    /// `∫ u_h` of `field` over the cells.
+    fn integral(&self, field: usize) -> f64;
 }
 
+impl PlateCells for ObstacleSolution<TriangleMesh> {
+    fn straight(&self) -> &TriangleMesh {
+        &self.discretization.mesh
+    }
+    fn field_view(&self, field: usize) -> TriangleField<'_> {
+        self.view(field)
+    }
+    fn contact_force(&self) -> f64 {
+        self.total_contact_force()
+    }
+    fn area_in_contact(&self) -> f64 {
+        self.contact_area()
+    }
+    fn integral(&self, field: usize) -> f64 {
+        self.view(field).integral()
+    }
+}
+
+impl PlateCells for ObstacleSolution<CurvedTriangleMesh> {
+    fn straight(&self) -> &TriangleMesh {
+        self.discretization.mesh.mesh()
+    }
+    fn field_view(&self, field: usize) -> TriangleField<'_> {
+        self.view(field)
+    }
+    fn contact_force(&self) -> f64 {
+        self.total_contact_force()
+    }
+    fn area_in_contact(&self) -> f64 {
+        self.contact_area()
+    }
+    /// The isoparametric field is its reference polynomial on each cell, so the integral
+    /// is `Σ_T ∫_T̂ u(ξ) |det J(ξ)| dξ`, with a rule two degrees above the field's for the
+    /// map's Jacobian (a polynomial of degree 2 on quadratic cells).
+    fn integral(&self, field: usize) -> f64 {
+        let view = self.view(field);
+        let basis = TriangleBasis::new(view.map.element());
+        let rule = TriangleRule::exact_for_degree(view.map.element().degree() + 2);
+        let mesh = &self.discretization.mesh;
+        (0..mesh.mesh().cell_count())
+            .map(|c| {
+                let map = mesh.cell_map(c);
+                rule.integrate(|xi| view.value(&basis, c, xi) * map.det(xi).abs())
+            })
+            .sum()
+    }
+}
+
+/// Solves the plate on its meshes, coarsest first (each level started from the one
+/// before), and reports: on straight cells for the square, on isoparametric
+/// (quadratic-geometry) cells for the disk, whose boundary edges follow the circle
+/// (`QuadraticGeometry::circle`; docs/mathematics.md §8: the polygon adds ~3e-4 relative
+/// to J).
 fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
+    let s = &request.scene;
+    let (params, height) = plate_parameters::<M>(request);
+    let q = request.load;
+    let load = move |_: &[f64]| q;
+    let obstacle = move |_: &[f64]| height;
+    let coefficients =
+        Coefficients::new::<M>(&params, &[("f", &load), ("ψ", &obstacle), ("g", &zero)])?;
+    let meshes = level_sizes(request.mesh_size, request.nested)
+        .into_iter()
+        .map(|n| plate_mesh(s.domain, n))
+        .collect::<Result<Vec<_>>>()?;
+    let options = ObstacleOptions::default();
+    match s.domain {
+        PlateDomain::Square { .. } => {
+            let solution = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options)?;
+            report::<M, _>(request, &solution, &coefficients, height)
+        }
+        PlateDomain::Disk { radius } => {
+            let geometries = meshes
+                .iter()
+                .map(|mesh| QuadraticGeometry::circle(mesh, s.domain.centre(), radius))
+                .collect::<Result<Vec<_>>>()?;
+            let solution = solve_obstacle_on_curved_triangles::<M>(
+                &meshes,
+                &geometries,
+                &coefficients,
+                options,
+            )?;
+            report::<M, _>(request, &solution, &coefficients, height)
+        }
+    }
+}
+
+/// The parameters of `request` for model `M` and the obstacle's height (far below the
+/// plate when the scene has none).
+fn plate_parameters<M: Model>(request: &PlateRequest) -> (Vec<(&'static str, f64)>, f64) {
     let s = &request.scene;
     let q = request.load;
     let length = s.domain.length();
@@ -442,8 +535,6 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
             * (1.0 + (request.thickness / length).powi(2));
         (1.0, depth)
     });
-    let load = move |_: &[f64]| q;
-    let obstacle = move |_: &[f64]| height;
     let mut params = vec![
         ("D", s.bending_stiffness),
         ("ν", s.poisson_ratio),
@@ -455,14 +546,21 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
     if M::param("β").is_ok() {
         params.push(("β", STENBERG_BETA));
     }
-    let coefficients =
-        Coefficients::new::<M>(&params, &[("f", &load), ("ψ", &obstacle), ("g", &zero)])?;
-    let meshes = level_sizes(request.mesh_size, request.nested)
-        .into_iter()
-        .map(|n| plate_mesh(s.domain, n))
-        .collect::<Result<Vec<_>>>()?;
-    let solution =
-        solve_on_domain::<M>(s.domain, &meshes, &coefficients, ObstacleOptions::default())?;
+    (params, height)
+}
+
+/// The report of a solved plate.
+fn report<M: Model, G: DofNumbering>(
+    request: &PlateRequest,
+    solution: &ObstacleSolution<G>,
+    coefficients: &Coefficients,
+    height: f64,
+) -> Result<PlateReport>
+where
+    ObstacleSolution<G>: PlateCells,
+{
+    let s = &request.scene;
+    let q = request.load;
     let w = M::field("w")?;
     let max_deflection = solution.field(w).iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if request.obstacle() != PlateObstacle::None {
@@ -479,7 +577,7 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
             )));
         }
     }
-    let centre = value_at(&solution, w, s.domain.centre())?;
+    let centre = value_at(solution, w, s.domain.centre())?;
     let kirchhoff = s.kirchhoff_deflection_at(q);
     let in_contact = request.obstacle() != PlateObstacle::None;
     let unobstructed = if in_contact {
@@ -487,9 +585,9 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
     } else {
         s.mindlin_deflection_at(q, request.thickness)
     };
-    let energy = solution.energy::<M>(&coefficients)?;
-    let contact = ContactGeometry::of(&solution, s.domain.centre());
-    let mesh = &solution.discretization.mesh;
+    let energy = solution.energy::<M>(coefficients)?;
+    let contact = ContactGeometry::of(solution, s.domain.centre());
+    let mesh = solution.straight();
     Ok(PlateReport {
         scene: s.name.to_string(),
         pair: request.pair.name(),
@@ -512,8 +610,8 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
         },
         energy,
         max_deflection,
-        deflection_integral: solution.view(w).integral(),
-        total_contact_force: solution.total_contact_force(),
+        deflection_integral: solution.integral(w),
+        total_contact_force: solution.contact_force(),
         contact_area: contact.area,
         contact_radius: in_contact.then_some(contact.radius),
         lambda_interior_mean: contact.interior.map(|(mean, _)| mean),
@@ -539,9 +637,12 @@ struct ContactGeometry {
 }
 
 impl ContactGeometry {
-    fn of(solution: &TriangleObstacleSolution, centre: [f64; 2]) -> Self {
+    fn of<G>(solution: &ObstacleSolution<G>, centre: [f64; 2]) -> Self
+    where
+        ObstacleSolution<G>: PlateCells,
+    {
         let d = &solution.discretization;
-        let mesh = &d.mesh;
+        let mesh = solution.straight();
         let multipliers = solution.field(d.multiplier_field);
         let lambda: Vec<f64> = d
             .multiplier_dofs()
@@ -584,7 +685,7 @@ impl ContactGeometry {
             total += if r == 0.0 { 0.0 } else { r - 0.5 * step };
         }
         let radius = total / CONTACT_RAYS as f64;
-        let lambda_cells = solution.view(d.multiplier_field).centroid_values();
+        let lambda_cells = solution.field_view(d.multiplier_field).centroid_values();
         let interior: Vec<f64> = (0..mesh.cell_count())
             .filter(|&c| contact[c])
             .filter(|&c| {
@@ -604,7 +705,7 @@ impl ContactGeometry {
             (mean, (max - min) / mean.abs())
         });
         Self {
-            area: solution.contact_area(),
+            area: solution.area_in_contact(),
             radius,
             interior,
         }
@@ -612,8 +713,8 @@ impl ContactGeometry {
 }
 
 /// The value of `field` of `solution` at the point `x` of its mesh.
-fn value_at(solution: &TriangleObstacleSolution, field: usize, x: [f64; 2]) -> Result<f64> {
-    let view = solution.view(field);
+fn value_at(solution: &impl PlateCells, field: usize, x: [f64; 2]) -> Result<f64> {
+    let view = solution.field_view(field);
     let basis = TriangleBasis::new(view.map.element());
     let locator = PointLocator::new(view.mesh);
     view.at(&basis, &locator, x).ok_or_else(|| {
