@@ -392,8 +392,8 @@ pub fn solve(request: &PlateRequest) -> Result<PlateReport> {
 }
 
 /// The mesh of `domain` with size `n`: the N×N×2 mesh of the square (diagonals to the
-/// right), the ring mesh of the disk ([`TriangleMesh::disk`], polygonal: its boundary
-/// vertices lie on the circle).
+/// right), the ring mesh of the disk ([`TriangleMesh::disk`]: its boundary vertices lie
+/// on the circle; the solve curves its boundary edges with `QuadraticGeometry::circle`).
 ///
 /// # Errors
 /// The mesh generator's, for a size of 0 or a domain that is not finite.
