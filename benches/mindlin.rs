@@ -18,8 +18,12 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::lcp::cholesky::Cholesky;
+use fem_forms::mesh::triangle::QuadraticGeometry;
 use fem_forms::models::mindlin::mindlin_clamped;
-use fem_forms::obstacle::triangle::{solve_obstacle_on_triangles, TriangleObstacleSolution};
+use fem_forms::obstacle::triangle::{
+    solve_obstacle_on_curved_triangles, solve_obstacle_on_triangles, CurvedObstacleSolution,
+    TriangleObstacleSolution,
+};
 use fem_forms::obstacle::ObstacleOptions;
 use fem_forms::{
     Coefficients, DataFn, Diagonal, MatrixAssembler, Model, SparseMatrix, SystemDofs, TriangleMesh,
@@ -490,6 +494,103 @@ fn vi_solve(sizes: &[usize], rounds: usize) {
     }
 }
 
+fn disk_load(_: &[f64]) -> f64 {
+    20.0
+}
+
+/// The scene mindlin-disk: the clamped unit disk, t = 0.01, q = 20 up against w ≤ 0.05.
+fn disk_coefficients() -> Coefficients<'static> {
+    let params = [
+        ("D", D),
+        ("ν", NU),
+        ("κ", KAPPA),
+        ("t", 0.01),
+        ("β", BETA),
+        ("α", ALPHA),
+        ("s", S),
+    ];
+    let data: [(&str, &DataFn); 3] = [("f", &disk_load), ("ψ", &flat_obstacle), ("g", &zero)];
+    Coefficients::new::<M>(&params, &data).unwrap()
+}
+
+/// One complete VI solve of the disk on curved cells, nested from `rings` halved while
+/// even and at least 8; meshes and their geometries built inside the timing.
+fn disk_solve_once(c: &Coefficients, rings: usize) -> (CurvedObstacleSolution, f64) {
+    let clock = Instant::now();
+    let mut sizes = vec![rings];
+    while sizes[0] % 2 == 0 && sizes[0] / 2 >= 8 {
+        sizes.insert(0, sizes[0] / 2);
+    }
+    let meshes: Vec<TriangleMesh> = sizes
+        .iter()
+        .map(|&r| TriangleMesh::disk([0.0, 0.0], 1.0, r).unwrap())
+        .collect();
+    let geometries: Vec<QuadraticGeometry> = meshes
+        .iter()
+        .map(|m| QuadraticGeometry::circle(m, [0.0, 0.0], 1.0).unwrap())
+        .collect();
+    let solution = solve_obstacle_on_curved_triangles::<M>(
+        &meshes,
+        &geometries,
+        c,
+        ObstacleOptions::default(),
+    )
+    .unwrap();
+    (solution, clock.elapsed().as_secs_f64())
+}
+
+/// The issue's own plate scene (mindlin-disk) against one Cholesky of its final matrix.
+fn disk_vi_solve(rings: &[usize], rounds: usize) {
+    let c = disk_coefficients();
+    println!(
+        "
+mindlin-disk (curved cells), q = 20 up against w ≤ 0.05, t = 0.01: complete VI solve (nested, meshes and assembly included) vs one Cholesky (analysis + factorization + solve) of the final primal A; medians of {rounds}"
+    );
+    println!(
+        "{:>6} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10} {:>8} {:>6} {:>9}",
+        "rings",
+        "triangles",
+        "primal",
+        "λ",
+        "iterations/level",
+        "fact/upd",
+        "Cholesky s",
+        "VI s",
+        "ratio",
+        "∫λ_h"
+    );
+    for &n in rings {
+        let (warm, _) = disk_solve_once(&c, n);
+        let a = warm.discretization.lcp.a.clone();
+        let (mut linear, mut vi) = (Vec::new(), Vec::new());
+        for _ in 0..rounds {
+            linear.push(cholesky_once(&a));
+            vi.push(disk_solve_once(&c, n).1);
+        }
+        let (linear, vi) = (median(linear), median(vi));
+        let lcp = &warm.discretization.lcp;
+        let levels = warm
+            .levels
+            .iter()
+            .map(|(_, i)| i.to_string())
+            .collect::<Vec<_>>()
+            .join(",");
+        println!(
+            "{:>6} {:>9} {:>9} {:>9} {:>16} {:>8} {:>10.3} {:>8.3} {:>6.2} {:>9.4}",
+            n,
+            6 * n * n,
+            lcp.n(),
+            lcp.m(),
+            levels,
+            format!("{}/{}", warm.factorizations, warm.low_rank_updates),
+            linear,
+            vi,
+            vi / linear,
+            warm.total_contact_force(),
+        );
+    }
+}
+
 fn main() {
     fem_forms::lcp::cholesky::factor_sequentially();
     fem_forms::allocator::retain_freed_memory();
@@ -503,4 +604,6 @@ fn main() {
     kernels_only(assembly_n, if quick { 3 } else { 9 });
     scatter_only(assembly_n, if quick { 3 } else { 9 });
     vi_solve(&sizes, if quick { 1 } else { 3 });
+    let rings: &[usize] = if quick { &[16, 32] } else { &[32, 64, 144] };
+    disk_vi_solve(rings, if quick { 1 } else { 3 });
 }
