@@ -10,7 +10,7 @@ use crate::models::kirchhoff::{
 use crate::models::kirchhoff_scenes::{
     KirchhoffObstacle, KirchhoffScene, KirchhoffSupport, CURVED_OBSTACLE, FLAT_OBSTACLE,
 };
-use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
+use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use fem_runtime::obstacle::triangle::{
     contact_indicator, prolong_primal_on_triangles, TriangleObstacleSolution,
 };
@@ -341,6 +341,11 @@ pub struct KirchhoffReport {
     pub level_iterations: Vec<LevelIterations>,
     /// Wall time of the solve, assembly included.
     pub seconds: f64,
+    /// The largest `w_h − ψ` at the cells' vertices, edge midpoints and centroids (0
+    /// without an obstacle or where the plate stays below it).
+    pub max_penetration: f64,
+    /// Warnings (e.g. a visible penetration of the obstacle).
+    pub warnings: Vec<String>,
 }
 
 fn zero(_: &[f64]) -> f64 {
@@ -385,6 +390,14 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
     let square = |n: usize| TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right);
     let finest = square(n)?;
     let (alpha, c_i) = request.alpha_on::<M>()?;
+    if c_i > 0.0 && alpha * c_i >= 1.0 {
+        return Err(Error::Input(format!(
+            "α = {alpha:e} is outside the stability range 0 < α < 1/C_I = {:.3e} of {} (α·C_I = {:.2}): A_α = a − αS would be indefinite; leave --alpha out for α = {ALPHA_FRACTION}/C_I",
+            1.0 / c_i,
+            request.pair.name(),
+            alpha * c_i
+        )));
+    }
     let coefficients = Coefficients::new::<M>(
         &[
             ("D", s.bending_stiffness),
@@ -432,6 +445,29 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
     let w = M::field("w")?;
     let view = solution.view(w);
     let basis = TriangleBasis::new(view.map.element());
+    let mut warnings = Vec::new();
+    let max_penetration = match obstacle {
+        KirchhoffObstacle::None => 0.0,
+        _ => penetration(&view, &basis, &psi),
+    };
+    if !matches!(obstacle, KirchhoffObstacle::None) {
+        // as for membranes and Mindlin plates: a load (or α) that dwarfs the obstacle
+        // leaves w_h to the rounding of the contact rows, which the KKT residual cannot show
+        let gap = obstacle.height(0.0).unwrap_or(1.0).abs();
+        let size = max_deflection(&view, &basis).max(gap).max(1e-12);
+        let rounding = solution.primal_rounding() / size;
+        if rounding.is_nan() || rounding > crate::plates::MAX_PRIMAL_ROUNDING {
+            return Err(Error::Input(format!(
+                "w_h is lost to rounding: in contact the constraint rows subtract terms of the size of the load and of α h⁴ q (q = {q:e}, α = {alpha:e}), which dwarf the obstacle, and their rounding moves w_h by {rounding:.0e} of its own size; use a smaller load or α"
+            )));
+        }
+        if max_penetration > 1e-2 * gap {
+            warnings.push(format!(
+                "w_h passes the obstacle by up to {max_penetration:.2e} ({:.1} % of the gap {gap}): the constraint holds on each cell's mean (λ_h ∈ P0), so the plate may cross ψ inside a cell by O(h²); refine the mesh",
+                100.0 * max_penetration / gap
+            ));
+        }
+    }
     let locator = PointLocator::new(view.mesh);
     let centre = view
         .at(&basis, &locator, [0.5, 0.5])
@@ -489,7 +525,32 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
             })
             .collect(),
         seconds: solution.seconds,
+        max_penetration,
+        warnings,
     })
+}
+
+/// The largest `w_h − ψ` (the obstacle lies above) at the vertices, edge midpoints and
+/// centroids of the cells, 0 when the plate stays below it there.
+fn penetration(view: &TriangleField, basis: &TriangleBasis, psi: &dyn Fn(&[f64]) -> f64) -> f64 {
+    let points = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [0.0, 1.0],
+        [0.5, 0.0],
+        [0.5, 0.5],
+        [0.0, 0.5],
+        [1.0 / 3.0, 1.0 / 3.0],
+    ];
+    let mut worst = 0.0f64;
+    for c in 0..view.mesh.cell_count() {
+        let map = AffineMap::of(view.mesh, c);
+        for xi in points {
+            let x = map.point(xi);
+            worst = worst.max(view.value(basis, c, xi) - psi(&x));
+        }
+    }
+    worst
 }
 
 /// The centre deflection of the simply supported unit square under a unit load with
@@ -826,6 +887,9 @@ pub fn summary(r: &KirchhoffReport) -> String {
         r.complementarity_residual,
         r.seconds
     );
+    for warning in &r.warnings {
+        line += &format!("\nwarning: {warning}");
+    }
     line
 }
 

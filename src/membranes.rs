@@ -867,6 +867,13 @@ fn run_stabilized<M: Model>(
             }
         },
     )?;
+    if request.linear_solver == LinearSolver::Multigrid && solution.iterative_steps == 0 {
+        warnings.push(if solver == VariationalSolver::SemismoothNewton {
+            "--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level: a cold start, a single level or N below 8 have none; or CG did not converge), so they were factored".to_string()
+        } else {
+            "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string()
+        });
+    }
     let u_field = M::field("u")?;
     let d = &solution.discretization;
     let u = solution.view(u_field);

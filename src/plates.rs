@@ -33,12 +33,14 @@ pub const STENBERG_BETA: f64 = 0.1;
 pub const PLATE_ALPHA: f64 = 0.1;
 /// The largest N of the N×N×2 mesh a plate solve accepts (memory: about 2 GB at 1024).
 pub const MAX_PLATE_MESH_SIZE: usize = 1024;
-/// The most rings of a disk mesh a plate solve accepts (6N² triangles: 1.6M at 512,
-/// as many as the square's N×N×2 at 900; memory about 2 GB).
-pub const MAX_DISK_RINGS: usize = 512;
+/// The most rings of a disk mesh a plate solve accepts (6N² triangles: 393k at 256,
+/// measured 53 s and 8.8 GB on curved cells; 512 rings ran out of 24 GB).
+pub const MAX_DISK_RINGS: usize = 256;
 /// The largest |q| and |ψ| accepted: beyond it the norms that certify a solve (the KKT
 /// residual's `‖A‖∞‖U‖∞`) may overflow double precision.
 pub const MAX_PLATE_DATA: f64 = 1e100;
+/// The thinnest plate a solve accepts.
+pub const MIN_PLATE_THICKNESS: f64 = 1e-8;
 /// The largest rounding of the primal unknowns through the contact rows, relative to
 /// the larger of max|w_h|, |ψ| and 1e-6 of the domain's size, accepted in a result
 /// (fem_runtime `Lcp::primal_rounding`; the membranes' bound).
@@ -192,6 +194,12 @@ impl PlateRequest {
         if !(self.thickness.is_finite() && self.thickness > 0.0) {
             return bad(format!(
                 "thickness t = {} must be positive and finite",
+                self.thickness
+            ));
+        }
+        if self.thickness < MIN_PLATE_THICKNESS {
+            return bad(format!(
+                "thickness t = {:e} is below {MIN_PLATE_THICKNESS:e}: the Mindlin plate is then Kirchhoff's to t² (rounding), and the plain pair's shear weight 6κ(1−ν)D/t² overflows; use t ≥ {MIN_PLATE_THICKNESS:e}",
                 self.thickness
             ));
         }
@@ -366,6 +374,11 @@ pub struct PlateReport {
     pub levels: Vec<[usize; 2]>,
     /// Wall time of the solve, assembly included.
     pub seconds: f64,
+    /// The largest penetration `s(ψ − w_h)` at the nodes of w_h (0 without an obstacle or
+    /// where the plate stays on its side).
+    pub max_penetration: f64,
+    /// Warnings (a visible penetration of the obstacle).
+    pub warnings: Vec<String>,
 }
 
 fn is_nan(v: &f64) -> bool {
@@ -577,6 +590,28 @@ where
             )));
         }
     }
+    let mut warnings = Vec::new();
+    // w_h ∈ P2 is determined by its nodal values; λ_h ∈ P0 holds the constraint on each
+    // cell's mean, so the plate may cross ψ between nodes and at them by O(h²)
+    let max_penetration = match request.obstacle().side_and_height() {
+        Some((side, psi)) => solution
+            .field(w)
+            .iter()
+            .fold(0.0f64, |m, &v| m.max(side * (psi - v))),
+        None => 0.0,
+    };
+    if max_penetration > 1e-2 * height.abs().max(1e-300) {
+        warnings.push(format!(
+            "w_h crosses the obstacle by up to {max_penetration:.2e} ({:.1} % of its height {height}): the constraint holds on each cell's mean, so coarse meshes let the plate pass ψ by O(h²); refine the mesh",
+            100.0 * max_penetration / height.abs()
+        ));
+    }
+    if request.alpha > 1.0 {
+        warnings.push(format!(
+            "α = {} is above 1: the stabilization's term α h⁴ s²(λ, μ) then moves the constraint visibly (docs/mathematics.md §6: α = 1 is already 5–10× less accurate than the default {PLATE_ALPHA})",
+            request.alpha
+        ));
+    }
     let centre = value_at(solution, w, s.domain.centre())?;
     let kirchhoff = s.kirchhoff_deflection_at(q);
     let in_contact = request.obstacle() != PlateObstacle::None;
@@ -621,6 +656,8 @@ where
         iterations: solution.iterations,
         levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
         seconds: solution.seconds,
+        max_penetration,
+        warnings,
     })
 }
 
@@ -684,10 +721,19 @@ impl ContactGeometry {
             // the exit lies between the last point inside and this one
             total += if r == 0.0 { 0.0 } else { r - 0.5 * step };
         }
-        let radius = total / CONTACT_RAYS as f64;
+        let area = solution.area_in_contact();
+        // a contact set that misses the centre's cells (a small one, found only in part)
+        // has no ray length: the radius of a disk of its area instead
+        let mut radius = total / CONTACT_RAYS as f64;
+        if radius == 0.0 && area > 0.0 {
+            radius = (area / std::f64::consts::PI).sqrt();
+        }
+        // the interior must be wider than the layer of the smeared line force at the
+        // edge of contact (a few cells), or its mean is that force's, not λ's
+        let wide_enough = 0.5 * radius >= 3.0 * h;
         let lambda_cells = solution.field_view(d.multiplier_field).centroid_values();
         let interior: Vec<f64> = (0..mesh.cell_count())
-            .filter(|&c| contact[c])
+            .filter(|&c| wide_enough && contact[c])
             .filter(|&c| {
                 let x = mesh.cell(c).map(|v| mesh.vertices()[v]);
                 let centroid = [
@@ -705,7 +751,7 @@ impl ContactGeometry {
             (mean, (max - min) / mean.abs())
         });
         Self {
-            area: solution.area_in_contact(),
+            area,
             radius,
             interior,
         }

@@ -138,7 +138,23 @@ fn kirchhoff_obstacle_reports_what_the_issue_asks() {
 
 #[test]
 fn bad_kirchhoff_input_is_refused_by_name() {
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 11] = [
+        (
+            &["solve", "kirchhoff-obstacle", "--load", "1e100"],
+            "lost to rounding",
+        ),
+        (
+            &["solve", "kirchhoff-obstacle", "--alpha", "1"],
+            "stability range",
+        ),
+        (
+            &["solve", "kirchhoff-obstacle", "--no-obstacle"],
+            "--no-obstacle",
+        ),
+        (
+            &["solve", "kirchhoff-obstacle", "--linear-solver", "bogus"],
+            "--linear-solver",
+        ),
         (
             &["solve", "kirchhoff-square", "--support", "glued"],
             "glued",

@@ -313,8 +313,13 @@ fn bad_disk_input_exits_with_a_message() {
         ),
         (
             "mindlin-disk",
-            &["--mesh-size", "600"][..],
-            "mesh size N = 600 must lie in 1..=512",
+            &["--mesh-size", "300"][..],
+            "mesh size N = 300 must lie in 1..=256",
+        ),
+        (
+            "mindlin-disk",
+            &["--thickness", "1e-9"][..],
+            "thickness t = 1e-9 is below 1e-8",
         ),
         (
             "mindlin-disk",
@@ -394,4 +399,36 @@ fn the_disk_studies_write_their_charts_and_tables() {
         assert!((j[2] - j[1]).abs() < (j[1] - j[0]).abs(), "q = {q}: {j:?}");
     }
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// What a coarse or odd solve must not hide: a plate that crosses its obstacle is
+/// reported (`max_penetration`) and warned about; a small contact set that misses the
+/// centre's cells still has a radius, and its "interior" λ_h (the smeared line force
+/// only) is not reported as λ.
+#[test]
+fn penetration_and_small_contact_sets_are_reported_honestly() {
+    let run = fem_forms(&["solve", "mindlin-disk", "--mesh-size", "4", "--json"]);
+    assert!(run.status.success());
+    let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let penetration = json["max_penetration"].as_f64().unwrap();
+    // the JSON's own max w_h above ψ = 0.05
+    let above = json["max_deflection"].as_f64().unwrap() - 0.05;
+    assert!(
+        penetration > 1e-3 && (penetration - above).abs() < 1e-12,
+        "{json}"
+    );
+    let warnings = json["warnings"].as_array().unwrap();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("crosses the obstacle")),
+        "{json}"
+    );
+    let small = scene_json("mindlin-disk", &["--mesh-size", "32", "--load", "7"]);
+    let area = small["contact_area"].as_f64().unwrap();
+    let radius = small["contact_radius"].as_f64().unwrap();
+    assert!(area > 0.0 && radius > 0.0, "{small}");
+    if let Some(mean) = small["lambda_interior_mean"].as_f64() {
+        assert!((mean - 7.0).abs() < 0.5, "{small}");
+    }
 }
