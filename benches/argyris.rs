@@ -138,9 +138,11 @@ fn hand_element(t: &Tabulation, x: &[f64; 6], global: &[usize; 3]) -> [[f64; LOC
             }
         }
     }
-    for i in 0..LOCAL {
-        for j in 0..i {
-            k[i][j] = k[j][i];
+    // the lower triangle from the upper: row i, columns j < i, from rows j < i
+    for i in 1..LOCAL {
+        let (upper, lower) = k.split_at_mut(i);
+        for (target, row) in lower[0].iter_mut().zip(upper.iter()) {
+            *target = row[i];
         }
     }
     let m = cell_transformation(ElementKind::Argyris, x, global)
@@ -284,6 +286,63 @@ fn assembly(n: usize, rounds: usize) {
     );
 }
 
+/// The element kernels alone, without the scatter, in ns per element: the generated
+/// `matrix_v_w`, the hand-written element, and `cell_transformation` alone (which both
+/// call once per cell); each result summed so that it is kept.
+fn kernels_only(n: usize, rounds: usize) {
+    let mesh = square(n);
+    let tabulation = Tabulation::new();
+    let f: &DataFn = &load;
+    let (mut generated, mut hand, mut transformation) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..rounds {
+        let t = Instant::now();
+        let mut sum = 0.0;
+        for c in 0..mesh.cell_count() {
+            let k = kirchhoff_argyris::a::matrix_v_w(
+                black_box(&mesh.cell_coordinates(c)),
+                &mesh.cell(c),
+                &[D, NU],
+                &[f],
+            );
+            sum += k[0][0] + k[LOCAL - 1][LOCAL - 1];
+        }
+        black_box(sum);
+        generated.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let mut sum = 0.0;
+        for c in 0..mesh.cell_count() {
+            let k = hand_element(
+                &tabulation,
+                black_box(&mesh.cell_coordinates(c)),
+                &mesh.cell(c),
+            );
+            sum += k[0][0] + k[LOCAL - 1][LOCAL - 1];
+        }
+        black_box(sum);
+        hand.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let mut sum = 0.0;
+        for c in 0..mesh.cell_count() {
+            let m = cell_transformation(
+                ElementKind::Argyris,
+                black_box(&mesh.cell_coordinates(c)),
+                &mesh.cell(c),
+            )
+            .unwrap()
+            .expect("Argyris has a DOF transformation");
+            sum += m.row(0)[0];
+        }
+        black_box(sum);
+        transformation.push(t.elapsed().as_secs_f64());
+    }
+    let per = |v: Vec<f64>| median(v) / mesh.cell_count() as f64 * 1e9;
+    let (g, h, m) = (per(generated), per(hand), per(transformation));
+    println!(
+        "  kernels alone: generated {g:.0} ns/element, hand-written {h:.0} ns/element, ratio {:.2}; cell_transformation alone (in both) {m:.0} ns",
+        g / h
+    );
+}
+
 /// The request of kirchhoff-obstacle at q = 20 (flat obstacle, clamped, Argyris–P0) on
 /// N×N×2.
 fn request(n: usize) -> KirchhoffRequest {
@@ -400,5 +459,6 @@ fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let (assembly_n, solve_n) = if quick { (32, 28) } else { (256, 112) };
     assembly(assembly_n, if quick { 3 } else { 9 });
+    kernels_only(assembly_n, 3);
     obstacle_solve(solve_n, if quick { 1 } else { 3 });
 }
