@@ -585,6 +585,17 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             scene.name
         ),
     )?;
+    if scene.obstacle == PlateObstacle::None || options.no_obstacle {
+        // Without an obstacle the plate is one linear solve on the finest mesh: α and the
+        // nested start only act on contact, so accepting them would suggest an effect.
+        options.refuse(
+            &["--alpha", "--cold"],
+            &format!(
+                "`{}` is solved without an obstacle (one linear solve); α and the nested start concern contact",
+                scene.name
+            ),
+        )?;
+    }
     if scene.obstacle == PlateObstacle::None {
         options.refuse(
             &["--no-obstacle"],

@@ -94,7 +94,8 @@ fn bad_plate_input_exits_with_a_message() {
         (&["--thickness=-1e-3"][..], "thickness t = -0.001"),
         (&["--thickness", "NaN"][..], "thickness t = NaN"),
         (&["--mesh-size", "0"][..], "mesh size N = 0"),
-        (&["--alpha", "-0.1"][..], "α = -0.1"),
+        (&["--alpha", "0.1"][..], "--alpha does not apply"),
+        (&["--cold"][..], "--cold does not apply"),
         (&["--pair", "p2-p0"][..], "unknown plate pair `p2-p0`"),
         (&["--vtk"][..], "--vtk does not apply"),
         (&["--elements", "8"][..], "--elements does not apply"),
@@ -335,6 +336,12 @@ fn bad_disk_input_exits_with_a_message() {
             "mindlin-disk",
             &["--alpha", "1e300"][..],
             "w_h is lost to rounding",
+        ),
+        ("mindlin-disk", &["--alpha", "-0.1"][..], "α = -0.1"),
+        (
+            "mindlin-disk",
+            &["--no-obstacle", "--alpha", "0.1"][..],
+            "--alpha does not apply",
         ),
         (
             "mindlin-square",
