@@ -866,11 +866,7 @@ pub fn summary(r: &KirchhoffReport) -> String {
         r.pair,
         r.support,
         r.obstacle,
-        if r.load == 0.0 || (1e-3..1e6).contains(&r.load.abs()) {
-            r.load.to_string()
-        } else {
-            format!("{:e}", r.load)
-        },
+        crate::number(r.load),
         r.mesh_size,
         r.energy,
         r.centre_deflection
@@ -1328,16 +1324,19 @@ pub fn scatter_run(scene: KirchhoffScene, full: bool, out: &Path) -> Result<()> 
         let i = r.interior;
         let cell = |f: fn(&InteriorMultiplier) -> f64| i.as_ref().map_or(f64::NAN, f);
         println!(
-            "{:<34} {:>4} {:>10.3e} {:>6} {:>10.4} {:>10.4} {:>10.4} {:>10.2e} {:>11.6}",
-            r.method,
-            r.mesh_size,
-            r.alpha,
-            i.map_or(0, |i| i.cells),
-            cell(|i| i.min),
-            cell(|i| i.max),
-            cell(|i| i.mean),
-            cell(|i| i.max_relative_error),
-            r.total_contact_force
+            "{}",
+            crate::dash_nan(format!(
+                "{:<34} {:>4} {:>10.3e} {:>6} {:>10.4} {:>10.4} {:>10.4} {:>10.2e} {:>11.6}",
+                r.method,
+                r.mesh_size,
+                r.alpha,
+                i.map_or(0, |i| i.cells),
+                cell(|i| i.min),
+                cell(|i| i.max),
+                cell(|i| i.mean),
+                cell(|i| i.max_relative_error),
+                r.total_contact_force
+            ))
         );
         csv += &format!(
             "{},{},{:e},{},{:e},{:e},{:e},{:e},{:e},{:e}\n",

@@ -21,3 +21,38 @@ pub mod studies;
 
 pub use fem_models as models;
 pub use fem_runtime::*;
+
+/// A user-given number (a load, a parameter) as a report prints it: as written for
+/// magnitudes in [10⁻³, 10⁶) and zero, in scientific notation otherwise, so that
+/// `1e-300` is not printed as three hundred digits.
+pub fn number(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// A table line with every `NaN` cell (a difference or rate not defined on the first
+/// rows, a quantity without a value) shown as `-`, keeping the columns aligned.
+pub fn dash_nan(line: String) -> String {
+    line.replace("NaN", "  -")
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn reports_print_extreme_numbers_in_scientific_notation() {
+        assert_eq!(super::number(1e-300), "1e-300");
+        assert_eq!(super::number(-2.5e7), "-2.5e7");
+        assert_eq!(super::number(20.0), "20");
+        assert_eq!(super::number(0.0), "0");
+        assert_eq!(super::number(0.005), "0.005");
+    }
+
+    #[test]
+    fn undefined_table_cells_are_dashes_of_the_same_width() {
+        let line = format!("{:>6.2} {:>6.2}", f64::NAN, 1.5);
+        assert_eq!(super::dash_nan(line), "     -   1.50");
+    }
+}

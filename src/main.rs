@@ -236,12 +236,16 @@ fn fmt_contact(set: &[[f64; 2]]) -> String {
 
 fn table_row(r: &Report) {
     for w in &r.warnings {
-        eprintln!("warning ({} q = {}): {w}", r.scene, r.load);
+        eprintln!(
+            "warning ({} q = {}): {w}",
+            r.scene,
+            fem_forms::number(r.load)
+        );
     }
     println!(
         "{:<15} {:>5} {:>7} {:>6} {:>6} {:>5} {:>8.4} {:>14.8e} {:<24} {:>9.1e} {:>10}",
         r.scene,
-        r.load,
+        fem_forms::number(r.load),
         r.thickness.map_or("-".into(), |t| format!("{t:.0e}")),
         r.elements,
         r.dofs,
@@ -626,7 +630,7 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             report.support,
             report.thickness,
             report.mesh_size,
-            report.load,
+            fem_forms::number(report.load),
             report.obstacle,
             report.energy,
             report.total_contact_force,

@@ -1172,7 +1172,7 @@ pub fn convergence_run(scene: PlateScene, full: bool, out: &Path) -> Result<()> 
         };
         for (k, r) in rows.iter().enumerate() {
             let [j, force, radius] = r.quantities();
-            println!(
+            println!("{}", crate::dash_nan(format!(
                 "{:>5} {:>8.4} {:>8} {:>16.9e} {:>10.2e} {:>5.2} {:>14.7e} {:>10.2e} {:>5.2} {:>12.6} {:>10.2e} {:>5.2} {:>10.2e} {:>5}",
                 r.mesh_size,
                 r.h,
@@ -1188,7 +1188,7 @@ pub fn convergence_run(scene: PlateScene, full: bool, out: &Path) -> Result<()> 
                 entry(&rates[2], k, 2),
                 r.report.lambda_interior_spread.unwrap_or(f64::NAN),
                 r.report.iterations
-            );
+            )));
             csv.push(vec![
                 q,
                 r.mesh_size as f64,
