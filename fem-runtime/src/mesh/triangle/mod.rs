@@ -8,12 +8,14 @@
 //! fall into at most four similarity classes per initial cell.
 
 mod curved;
+mod graded;
 mod locate;
 mod parts;
 mod quality;
 mod refine;
 
 pub use curved::{CurvedTriangleMesh, QuadraticGeometry};
+pub use graded::distance_to_segment;
 pub use locate::PointLocator;
 pub use parts::NamedGroup;
 pub use quality::{
