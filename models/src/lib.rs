@@ -7,6 +7,7 @@
 
 pub mod data;
 pub mod euler_bernoulli;
+pub mod hertz;
 pub mod kirchhoff;
 pub mod kirchhoff_scenes;
 pub mod membrane;
