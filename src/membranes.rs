@@ -252,6 +252,12 @@ pub struct MembraneReport {
     pub error_l2: Option<f64>,
     /// `|u − u_h|_H1` where an exact solution exists (on other domains: as `error_l2`).
     pub error_h1: Option<f64>,
+    /// `max_v |u_h(v) − u(v)|` over the mesh vertices, where an exact solution exists:
+    /// the finite-difference measure (PETSc's ex9 prints it as `|u-uexact|_inf`; on the
+    /// right-diagonal grid p1-nodal is ex9's 5-point scheme, so the two agree).
+    pub error_vertex_max: Option<f64>,
+    /// The mean of `|u_h(v) − u(v)|` over the mesh vertices (ex9's `av |u-uexact|`).
+    pub error_vertex_mean: Option<f64>,
     /// `(Σ_T h_T² ‖λ − λ_h‖²_T)^{1/2}` where an exact solution exists (stabilized pairs).
     pub error_multiplier: Option<f64>,
     /// `∫ λ_h` (the nodal method: the sum of its nodal contact forces).
@@ -822,6 +828,21 @@ fn exact_values(exact: &ExactMembrane) -> impl Fn([f64; 2]) -> (f64, [f64; 2]) +
     move |x| (exact.u.at(&x), exact.gradient.at(&x))
 }
 
+/// `[max, mean]` of `|u_h − u|` at the vertices of a Lagrange field (its first DOF at a
+/// vertex is the value there); `None` without an exact solution.
+fn vertex_errors(u: &TriangleField, exact: Option<&ExactMembrane>) -> [Option<f64>; 2] {
+    let Some(exact) = exact else {
+        return [None, None];
+    };
+    let (mut max, mut sum) = (0.0f64, 0.0);
+    for (v, x) in u.mesh.vertices().iter().enumerate() {
+        let e = (u.coefficients[u.map.vertex_dofs(v).start] - exact.u.at(x)).abs();
+        max = max.max(e);
+        sum += e;
+    }
+    [Some(max), Some(sum / u.mesh.vertex_count() as f64)]
+}
+
 fn run_stabilized<M: Model>(
     request: &MembraneRequest,
     posed: &Posed,
@@ -889,6 +910,7 @@ fn run_stabilized<M: Model>(
         }
         None => (None, None, None),
     };
+    let [error_vertex_max, error_vertex_mean] = vertex_errors(&u, posed.exact.as_ref());
     if solution.multiplier_noise > 1e-6 {
         warnings.push(format!(
             "λ_h may carry rounding noise of up to {:.0e} relative",
@@ -932,6 +954,8 @@ fn run_stabilized<M: Model>(
         inverse_constant: c_i,
         error_l2,
         error_h1,
+        error_vertex_max,
+        error_vertex_mean,
         error_multiplier,
         total_contact_force: solution.total_contact_force(),
         exact_contact_force: posed.exact.as_ref().and_then(|e| e.total_contact_force),
@@ -1060,6 +1084,7 @@ fn run_nodal(
         }
         None => (None, None),
     };
+    let [error_vertex_max, error_vertex_mean] = vertex_errors(&u, posed.exact.as_ref());
     // nodal forces: active where λ_i > 0 or the node lies on ψ (boundary nodes too)
     let mut vertex_force = vec![0.0; mesh.vertex_count()];
     let scale = solution.lambda.iter().cloned().fold(0.0, f64::max);
@@ -1137,6 +1162,8 @@ fn run_nodal(
         inverse_constant: 0.0,
         error_l2,
         error_h1,
+        error_vertex_max,
+        error_vertex_mean,
         error_multiplier: None,
         total_contact_force: solution.lambda.iter().sum(),
         exact_contact_force: posed.exact.as_ref().and_then(|e| e.total_contact_force),

@@ -714,3 +714,25 @@ fn a_nested_solve_inside_a_level_builder_finishes() {
         assert!(difference <= 1e-12, "differs by {difference}");
     }
 }
+
+/// The nodal P1 method on the right-diagonal grid is the 5-point scheme of PETSc's SNES
+/// tutorial ex9 (Bueler's radial obstacle problem): an independent solver (PETSc 3.18,
+/// `ex9 -snes_type vinewtonrsls -snes_grid_sequence K -pc_type mg`, K = 2, 3, 4) printed
+/// these errors `av |u-uexact|` and `|u-uexact|_inf` on the 17², 33² and 65² grids; the
+/// same discrete problem must give them to the four digits printed.
+#[test]
+fn the_nodal_method_reproduces_petsc_ex9_errors() {
+    for (n, mean, max) in [
+        (16, 2.707e-3, 1.428e-2),
+        (32, 8.182e-4, 5.747e-3),
+        (64, 9.818e-5, 5.991e-4),
+    ] {
+        let r = solve(radial(), MembranePair::P1Nodal, n);
+        let (m, x) = (r.error_vertex_mean.unwrap(), r.error_vertex_max.unwrap());
+        assert_eq!(
+            format!("{m:.3e} {x:.3e}"),
+            format!("{mean:.3e} {max:.3e}"),
+            "N = {n}"
+        );
+    }
+}
