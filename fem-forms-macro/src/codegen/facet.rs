@@ -277,3 +277,103 @@ pub fn facet_kernel(
         }
     }
 }
+
+/// The facet items of the `Model` impl: `FACET_PARTS`, `FACET_BLOCKS` and the dispatch
+/// of `facet_matrix` / `facet_vector` to the kernels (empty without `facets:`, so that
+/// the other models' code stays as it was).
+pub fn model_items(
+    symbols: &Symbols,
+    forms: &[crate::analysis::Form],
+    runtime: &TokenStream,
+    model_name: &str,
+) -> TokenStream {
+    if symbols.facets.is_empty() {
+        return TokenStream::new();
+    }
+    let parts = &symbols.facets;
+    let mut infos = Vec::new();
+    let (mut matrix, mut vector) = (Vec::new(), Vec::new());
+    let mut index = 0usize;
+    for (form_index, form) in forms.iter().enumerate() {
+        let form_ident = Ident::new(&form.name, proc_macro2::Span::call_site());
+        // the order of the kernels' modules: by part, then by block
+        for (part, part_name) in parts.iter().enumerate() {
+            for (_, block) in form.facet_blocks.iter().filter(|(p, _)| *p == part) {
+                let test = block.test_field;
+                let trial = match block.trial_field {
+                    Some(f) => quote!(::core::option::Option::Some(#f)),
+                    None => quote!(::core::option::Option::None),
+                };
+                infos.push(quote! {
+                    #runtime::FacetBlockInfo { form: #form_index, part: #part, test_field: #test, trial_field: #trial }
+                });
+                let module = part_ident(part_name);
+                let name = super::emit::block_ident(block, symbols);
+                let arm = if block.trial_field.is_some() {
+                    quote!(#index => #runtime::kernel::store_matrix(&#form_ident::#module::#name(x, edge, p, d), out),)
+                } else {
+                    quote!(#index => #runtime::kernel::store_vector(&#form_ident::#module::#name(x, edge, p, d), out),)
+                };
+                if block.trial_field.is_some() {
+                    matrix.push(arm);
+                } else {
+                    vector.push(arm);
+                }
+                index += 1;
+            }
+        }
+    }
+    let np = symbols.params.len();
+    let nd = symbols.data.len();
+    let body = |arms: &[TokenStream], what: &str| {
+        let message = format!("{model_name}: facet block {{}} is not a {what} facet block");
+        quote! {
+            let x: &[f64; 6] = match vertices.try_into() {
+                ::core::result::Result::Ok(x) => x,
+                ::core::result::Result::Err(_) => {
+                    return ::core::result::Result::Err(#runtime::Error::Input(::std::format!("a triangle has six vertex coordinates, not {}", vertices.len())));
+                }
+            };
+            if edge > 2 {
+                return ::core::result::Result::Err(#runtime::Error::Input(::std::format!("a triangle has local edges 0, 1 and 2, not {}", edge)));
+            }
+            let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+            let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+            match block {
+                #(#arms)*
+                _ => return ::core::result::Result::Err(#runtime::Error::Input(::std::format!(#message, block))),
+            }
+            ::core::result::Result::Ok(())
+        }
+    };
+    let matrix_body = body(&matrix, "bilinear");
+    let vector_body = body(&vector, "linear");
+    quote! {
+        const FACET_PARTS: &'static [&'static str] = &[#(#parts),*];
+        const FACET_BLOCKS: &'static [#runtime::FacetBlockInfo] = &[#(#infos),*];
+
+        #[allow(unreachable_code)]
+        fn facet_matrix(
+            block: usize,
+            vertices: &[f64],
+            edge: usize,
+            params: &[f64],
+            data: &[&#runtime::DataFn],
+            out: &mut [f64],
+        ) -> #runtime::Result<()> {
+            #matrix_body
+        }
+
+        #[allow(unreachable_code)]
+        fn facet_vector(
+            block: usize,
+            vertices: &[f64],
+            edge: usize,
+            params: &[f64],
+            data: &[&#runtime::DataFn],
+            out: &mut [f64],
+        ) -> #runtime::Result<()> {
+            #vector_body
+        }
+    }
+}

@@ -48,6 +48,9 @@ struct Dispatch {
     /// The arms of `element_matrix_curved` and `element_vector_curved` (triangles only).
     matrix_curved: Vec<TokenStream>,
     vector_curved: Vec<TokenStream>,
+    /// `FACET_PARTS`, `FACET_BLOCKS` and the facet dispatch (`facet.rs`; empty without
+    /// `facets:`).
+    facet_items: TokenStream,
 }
 
 /// What the driver generates for one form.
@@ -445,6 +448,7 @@ fn model_impl(
         transformed,
         matrix_curved,
         vector_curved,
+        facet_items,
     } = dispatch;
     let on_cell = transformed.then(|| {
         quote! {
@@ -603,6 +607,8 @@ fn model_impl(
             #on_cell
 
             #curved
+
+            #facet_items
         }
     }
 }
@@ -620,6 +626,8 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
             (code.module, code.info)
         })
         .unzip();
+    dispatch.facet_items =
+        facet::model_items(symbols, forms, runtime, &declaration.name.to_string());
     let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch);
     let handles = handles(symbols, forms, runtime);
     let module = &declaration.name;
