@@ -60,6 +60,8 @@ pub struct Symbols {
     pub data: Vec<(String, usize)>,
     /// Spatial dimension of the cell (1 for intervals, 2 for triangles).
     pub dimension: usize,
+    /// Boundary parts declared under `facets:`, integrated over by `∫_Γ … ds`.
+    pub facets: Vec<String>,
 }
 
 impl Symbols {
@@ -180,6 +182,8 @@ pub struct Term {
     pub trial_derivative: Option<[u8; 2]>,
     /// Explicit quadrature degree.
     pub quadrature_degree: Option<usize>,
+    /// Powers of the outward normal's components `n_x`, `n_y` (facet terms only).
+    pub normal: [u8; 2],
 }
 
 /// The nonzero part of a form for one (test field, trial field) pair.
@@ -208,8 +212,11 @@ pub struct Form {
     pub terms: Expansion,
     /// Terms dropped because they vanish for the chosen elements.
     pub dropped: usize,
-    /// Nonzero blocks.
+    /// Nonzero blocks of the cell integrals.
     pub blocks: Vec<Block>,
+    /// Nonzero blocks of the boundary integrals `∫_Γ … ds`: `(facet part, block)`,
+    /// sorted by part, then by block.
+    pub facet_blocks: Vec<(usize, Block)>,
     /// For a named expression `Cε(θ) := …`: its value in its own symbols (it has no
     /// terms or blocks and generates no code).
     pub value: Option<Value>,
@@ -267,6 +274,8 @@ pub fn analyse(
             forms: &forms,
             later_forms: &all_names[k..],
             errors: Vec::new(),
+            facet: None,
+            in_expression: false,
         };
         let form = if definition.expression {
             context.expression(definition, forms_text)
@@ -286,6 +295,7 @@ pub fn analyse(
                 terms: Vec::new(),
                 dropped: 0,
                 blocks: Vec::new(),
+                facet_blocks: Vec::new(),
                 value: None,
             }),
         }
@@ -368,6 +378,8 @@ pub(crate) fn expand_expression(
         forms: &[],
         later_forms: &[],
         errors: Vec::new(),
+        facet: None,
+        in_expression: false,
     };
     context.expand(&expr, true).ok_or(context.errors)
 }
@@ -468,6 +480,11 @@ struct Context<'a> {
     forms: &'a [Form],
     later_forms: &'a [&'a str],
     errors: Vec<Diagnostic>,
+    /// The boundary part of the integral being expanded (`∫_Γ … ds`).
+    facet: Option<usize>,
+    /// Expanding a named expression `X(u) := …`: `n` and `h_E` are allowed there and
+    /// checked where the expression is used.
+    in_expression: bool,
 }
 
 /// The text of a definition, its lines joined.
@@ -490,7 +507,10 @@ impl<'a> Context<'a> {
     fn expression(&mut self, d: &Definition, forms_text: &str) -> Option<Form> {
         let (groups, arguments) = self.signature(&d.name, &d.groups)?;
         // Its calls stand inside integrals (`h` is allowed); an integral in it is an error.
-        let value = self.value(&d.body, true)?;
+        self.in_expression = true;
+        let value = self.value(&d.body, true);
+        self.in_expression = false;
+        let value = value?;
         Some(Form {
             name: d.name.text.clone(),
             source: source(d, forms_text),
@@ -499,6 +519,7 @@ impl<'a> Context<'a> {
             terms: Vec::new(),
             dropped: 0,
             blocks: Vec::new(),
+            facet_blocks: Vec::new(),
             value: Some(value),
         })
     }
@@ -535,6 +556,13 @@ impl<'a> Context<'a> {
                         ),
                     )
                     .help("products and quotients of the constants must stay finite (below about 1.8e308)"),
+                );
+                continue;
+            }
+            if t.normal != [0, 0] && t.facet.is_none() {
+                self.errors.push(
+                    Diagnostic::text(t.origin, format!("the normal `n` in a term of `{}` that is not a boundary integral", d.name.text))
+                        .help("the outward normal n exists on the boundary only: use it inside `∫_Γ … ds`, Γ a part declared under `facets:`"),
                 );
                 continue;
             }
@@ -671,7 +699,22 @@ impl<'a> Context<'a> {
                 kept.push(t);
             }
         }
-        let blocks = self.blocks(&groups, &kept);
+        let (cell_terms, facet_terms): (Vec<Monomial>, Vec<Monomial>) =
+            kept.iter().cloned().partition(|t| t.facet.is_none());
+        let blocks = self.blocks(&groups, &cell_terms);
+        let mut facet_blocks = Vec::new();
+        for part in 0..self.symbols.facets.len() {
+            let on_part: Vec<Monomial> = facet_terms
+                .iter()
+                .filter(|t| t.facet == Some(part))
+                .cloned()
+                .collect();
+            facet_blocks.extend(
+                self.blocks(&groups, &on_part)
+                    .into_iter()
+                    .map(|b| (part, b)),
+            );
+        }
         Some(Form {
             name: d.name.text.clone(),
             source,
@@ -680,6 +723,7 @@ impl<'a> Context<'a> {
             terms: kept,
             dropped,
             blocks,
+            facet_blocks,
             value: None,
         })
     }
@@ -706,6 +750,7 @@ impl<'a> Context<'a> {
                 test_derivative: test.derivative,
                 trial_derivative: trial.map(|a| a.derivative),
                 quadrature_degree: t.quadrature_degree,
+                normal: t.normal,
             };
             match blocks
                 .iter_mut()
@@ -854,7 +899,22 @@ impl<'a> Context<'a> {
         inside_integral: bool,
     ) -> Option<Option<Value>> {
         let mut m = scalar(loc);
-        if name == "h" || name == "h_T" {
+        if name == "h_T" && self.facet.is_some() {
+            return Some(
+                self.fail_value(
+                    Diagnostic::text(loc, "`h_T` in a boundary integral").help(
+                        "on an edge E the size is `h_E` (its length; `h` means the same there)",
+                    ),
+                ),
+            );
+        }
+        if name == "h_E" && !self.in_expression && self.facet.is_none() {
+            return Some(self.fail_value(
+                Diagnostic::text(loc, "`h_E` is the length of an edge: it has a meaning only inside a boundary integral `∫_Γ … ds`")
+                    .help("in a cell integral the element size is `h_T` (or `h`)"),
+            ));
+        }
+        if name == "h" || name == "h_T" || name == "h_E" {
             if !inside_integral {
                 return Some(
                     self.fail_value(
@@ -900,6 +960,20 @@ impl<'a> Context<'a> {
             m.params = vec![(i, 1)];
         } else if let Some(i) = self.symbols.data.iter().position(|d| d.0 == name) {
             m.data = vec![i];
+        } else if name == "n" && self.symbols.dimension == 2 {
+            // The outward normal: a vector, constant on each (straight) edge.
+            if self.facet.is_none() && !self.in_expression {
+                return Some(self.fail_value(
+                    Diagnostic::text(loc, "the outward normal `n` exists only on the boundary")
+                        .help("use `n` inside a boundary integral `∫_Γ … ds`, Γ a part declared under `facets:`"),
+                ));
+            }
+            let component = |axis: usize| {
+                let mut m = scalar(loc);
+                m.normal[axis] = 1;
+                vec![m]
+            };
+            return Some(Some(Value::Vector(vec![component(0), component(1)])));
         } else {
             return None;
         }
@@ -1341,14 +1415,55 @@ impl<'a> Context<'a> {
                 let x = self.expand(a, inside_integral)?;
                 self.partial(&x, 0, *k, loc)
             }
-            ExprKind::Integral { kind, degree, body } => {
+            ExprKind::Integral {
+                kind,
+                facet,
+                degree,
+                body,
+            } => {
                 if inside_integral {
                     return self.fail(
                         Diagnostic::text(loc, "integral inside an integral")
                             .help("a form is a sum of single integrals: `∫ A + ∫ B`"),
                     );
                 }
-                let mut x = self.expand(body, true)?;
+                let part = match facet {
+                    None => None,
+                    Some(name) => match self.symbols.facets.iter().position(|f| *f == name.text) {
+                        Some(k) if self.symbols.dimension == 2 => Some(k),
+                        Some(_) => {
+                            return self.fail(Diagnostic::text(
+                                name.loc,
+                                "boundary integrals `∫_Γ … ds` are available on triangles only",
+                            ))
+                        }
+                        None => {
+                            let declared = &self.symbols.facets;
+                            let hint = closest(&name.text, declared.iter().map(String::as_str))
+                                .map(|c| format!("did you mean `{c}`? "))
+                                .unwrap_or_default();
+                            let list = if declared.is_empty() {
+                                "the model declares none".to_string()
+                            } else {
+                                format!("declared parts: {}", declared.join(", "))
+                            };
+                            return self.fail(
+                                Diagnostic::text(
+                                    name.loc,
+                                    format!(
+                                        "unknown boundary part `{}` in `∫_{} … ds`",
+                                        name.text, name.text
+                                    ),
+                                )
+                                .help(format!("{hint}declare the part under `facets:` ({list})")),
+                            );
+                        }
+                    },
+                };
+                self.facet = part;
+                let x = self.expand(body, true);
+                self.facet = None;
+                let mut x = x?;
                 for t in &mut x {
                     match (kind, t.inner_products) {
                         (IntegralKind::Integral, 0) | (IntegralKind::SumOverElements, 1) => {}
@@ -1378,6 +1493,7 @@ impl<'a> Context<'a> {
                         }
                     }
                     t.integrated = true;
+                    t.facet = part;
                     t.inner_products = 0;
                     t.quadrature_degree = *degree;
                 }

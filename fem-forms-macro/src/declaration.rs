@@ -8,6 +8,7 @@
 //!     params:   t, α, s;       // `β > 0` declares a positive parameter (checked at run time)
 //!     data:     f, ψ;          // `f: 0` declares f constant for quadrature (default degree 2)
 //!     boundary: w = g;         // optional: Dirichlet data, a declared data function
+//!     facets:   Γ_C;           // optional (triangles): boundary parts for `∫_Γ_C … ds`
 //!     forms:    "…";
 //! }
 //! ```
@@ -23,9 +24,9 @@ use syn::parse::{Parse, ParseStream};
 use syn::{Attribute, Ident, Lit, LitInt, LitStr, Token, Visibility};
 
 /// Reserved names: the element size, the keywords of the forms text and `I`.
-pub const RESERVED: [&str; 17] = [
+pub const RESERVED: [&str; 19] = [
     "h", "h_T", "int", "sum_T", "Σ_T", "degree", "Model", "grad", "lap", "dot", "d_x", "d_y", "ε",
-    "eps", "div", "tr", "I",
+    "eps", "div", "tr", "I", "ds", "h_E",
 ];
 
 /// Suffixes of the components of a vector field (`θ_x`, `θ_y`), by axis.
@@ -98,6 +99,8 @@ pub struct Declaration {
     pub data: Vec<DataDecl>,
     /// Dirichlet conditions `field = data` on the whole boundary.
     pub dirichlet: Vec<(Ident, Ident)>,
+    /// Boundary parts named under `facets:` (integrated over by `∫_Γ … ds`).
+    pub facets: Vec<Ident>,
     /// The forms text.
     pub forms: LitStr,
     /// Span of the section list, for "missing section" errors.
@@ -174,6 +177,7 @@ impl Parse for Declaration {
             positive: Vec::new(),
             data: Vec::new(),
             dirichlet: Vec::new(),
+            facets: Vec::new(),
             forms: LitStr::new("", brace.span.join()),
             body_span: brace.span.join(),
         };
@@ -307,18 +311,21 @@ impl Parse for Declaration {
                         Ok((field, data))
                     })?
                 }
+                "facets" => declaration.facets = comma_list(&content, |s| s.parse())?,
                 "forms" => {
                     declaration.forms = content.parse()?;
                     have_forms = true;
                 }
                 other => {
-                    let sections = ["unknowns", "tests", "params", "data", "boundary", "forms"];
+                    let sections = [
+                        "unknowns", "tests", "params", "data", "boundary", "facets", "forms",
+                    ];
                     let hint = closest(other, sections)
                         .map(|s| format!("; did you mean `{s}`?"))
                         .unwrap_or_default();
                     return Err(syn::Error::new(
                         key.span(),
-                        format!("unknown section `{other}`: expected one of unknowns, tests, params, data, boundary, forms{hint}"),
+                        format!("unknown section `{other}`: expected one of unknowns, tests, params, data, boundary, facets, forms{hint}"),
                     ));
                 }
             }
@@ -498,6 +505,42 @@ impl Declaration {
                 );
             }
         }
+        if !self.facets.is_empty() && cell != Some(CellKind::Triangle) {
+            errors.push(
+                Diagnostic::token(
+                    self.facets[0].span(),
+                    "boundary parts (`facets:`) are supported on triangles only",
+                )
+                .help("declare the model `on triangle`, or drop the `facets:` section"),
+            );
+        }
+        for (k, part) in self.facets.iter().enumerate() {
+            if self.facets[..k].contains(part) {
+                errors.push(Diagnostic::token(
+                    part.span(),
+                    format!("boundary part `{part}` is declared twice"),
+                ));
+            }
+        }
+        if !self.facets.is_empty() {
+            // `n` is the outward normal in boundary integrals: no declared name may hide it.
+            let declared = self
+                .unknowns
+                .iter()
+                .map(|u| &u.name)
+                .chain(&self.tests)
+                .chain(&self.params)
+                .chain(self.data.iter().map(|d| &d.name));
+            for name in declared.filter(|n| *n == "n") {
+                errors.push(
+                    Diagnostic::token(
+                        name.span(),
+                        "`n` is the outward normal in a model with boundary parts",
+                    )
+                    .help("pick another name"),
+                );
+            }
+        }
         // Every name means one thing.
         // (name, where declared, the vector it is a component of)
         let mut names: Vec<(String, &Ident, Option<&Ident>)> = Vec::new();
@@ -521,7 +564,7 @@ impl Declaration {
             if RESERVED.contains(&text.as_str()) {
                 errors.push(
                     Diagnostic::token(name.span(), format!("`{text}` is reserved"))
-                        .help("`h`/`h_T` is the element size, `int`/`sum_T` are ∫ and Σ_T, `grad`/`lap`/`dot`/`d_x`/`d_y` are ∇, Δ, ·, ∂_x, ∂_y, `ε`/`eps`/`div`/`tr` the symmetric gradient, divergence and trace, `I` the identity; pick another name"),
+                        .help("`h`/`h_T` is the element size, `int`/`sum_T` are ∫ and Σ_T, `grad`/`lap`/`dot`/`d_x`/`d_y` are ∇, Δ, ·, ∂_x, ∂_y, `ε`/`eps`/`div`/`tr` the symmetric gradient, divergence and trace, `I` the identity, `ds` closes a boundary integral and `h_E` is an edge's length; pick another name"),
                 );
                 continue;
             }

@@ -3,6 +3,7 @@
 //! | meaning            | Unicode            | ASCII            |
 //! |--------------------|--------------------|------------------|
 //! | integral           | `∫`                | `int`            |
+//! | boundary integral  | `∫_Γ … ds`         | `int_Γ … ds`     |
 //! | sum over elements  | `Σ_T`, `∑_T`       | `sum_T`          |
 //! | derivative         | `′ ″ ‴ ⁗`, `'`     | `'`, `''`, …     |
 //! | power              | `⁻² ³ ⁴`           | `^-2`, `^(-2)`   |
@@ -33,6 +34,10 @@ pub enum Tok {
     Integral,
     /// `Σ_T`, `∑_T` or `sum_T`.
     SumT,
+    /// `∫_Γ` or `int_Γ`: an integral over the boundary part named `Γ` (the name as written).
+    FacetIntegral(String),
+    /// `ds`: closes a boundary integral `∫_Γ … ds`.
+    Ds,
     /// A run of primes: the derivative order.
     Prime(u8),
     /// A run of superscript characters, e.g. `⁻²`; `None` when malformed.
@@ -250,6 +255,10 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             let name: String = chars[i..j].iter().collect();
             let tok = match name.as_str() {
                 "int" => Tok::Integral,
+                "ds" => Tok::Ds,
+                _ if name.len() > 4 && name.starts_with("int_") => {
+                    Tok::FacetIntegral(name["int_".len()..].to_string())
+                }
                 "Σ_T" | "sum_T" => Tok::SumT,
                 "grad" => Tok::Grad,
                 "lap" => Tok::Laplacian,
@@ -264,6 +273,16 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             push(tok, j - i, &mut tokens);
         } else {
             let tok = match c {
+                // `∫_Γ_C`: the boundary part's name follows the underscore.
+                '∫' if chars.get(i + 1) == Some(&'_')
+                    && chars.get(i + 2).is_some_and(|&d| is_ident_start(d)) =>
+                {
+                    j = i + 2;
+                    while j < chars.len() && is_ident_continue(chars[j]) {
+                        j += 1;
+                    }
+                    Some(Tok::FacetIntegral(chars[i + 2..j].iter().collect()))
+                }
                 '∫' => Some(Tok::Integral),
                 '∇' => Some(Tok::Grad),
                 'Δ' => Some(Tok::Laplacian),

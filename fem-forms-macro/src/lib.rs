@@ -48,6 +48,9 @@
 //! - `boundary: u = g` (optional) Dirichlet data: unknown `u` equals the data function
 //!   `g` on the whole boundary (the runtime interpolates it at the boundary DOFs); a
 //!   vector field is prescribed by component (`θ_x = g, θ_y = g`).
+//! - `facets: Γ_C, Γ_N;` (optional, triangles) names boundary parts that the forms
+//!   integrate over with `∫_Γ_C … ds`; the runtime says which edges a part holds (a
+//!   Gmsh physical name or a generator's marker).
 //! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may
 //!   want `#![allow(mixed_script_confusables)]`.
 //!
@@ -62,6 +65,17 @@
 //!   integral or form call. `∫[degree=N]` overrides the quadrature with the rule exact
 //!   for degree N, `0 ≤ N ≤ 40` (`∫[degree=1]`: one-point reduced integration, the
 //!   midpoint on intervals and the centroid on triangles).
+//! - `∫_Γ integrand ds` (ASCII `int_Γ … ds`) integrates over the edges of the boundary
+//!   part `Γ` declared under `facets:`, with the traces of the cell's functions (and
+//!   their derivatives, from the cell next to the edge); `ds` closes the integrand.
+//!   There, `n` is the outward unit normal (a vector: `v·n`, `(σ(u)·n)·n`) and `h_E`
+//!   (or `h`) the edge's length; `n` anywhere else, `h_E` in a cell integral, `h_T` on
+//!   an edge, or a missing `ds` are errors at the place. A named expression
+//!   `σ_n(u) := (σ(u)·n)·n` may use `n` and `h_E`: they are checked where it is used.
+//!   Facet terms give facet kernels: `S::on_Γ_C::matrix_v_x_u_x(x, edge, p, d)`
+//!   integrates over local edge `edge` (joining local vertices `edge`, `edge + 1`) of
+//!   the triangle `x` (`codegen/facet.rs`); they are not part of `Model::FORMS`' blocks,
+//!   which hold the cell integrals only.
 //! - `Σ_T w (X, Y)_T` (ASCII `sum_T`) is the sum over elements of weighted L² products.
 //! - Derivatives on intervals: `w'`, `w''`, …, `w''''` (also `′ ″ ‴ ⁗`), of arguments
 //!   or of linear combinations `(w'−θ)'`; taken element-wise. On triangles: `∇u`
@@ -269,6 +283,7 @@ fn symbols(declaration: &Declaration) -> Symbols {
             .map(|d| (d.name.to_string(), d.degree))
             .collect(),
         dimension,
+        facets: declaration.facets.iter().map(|f| f.to_string()).collect(),
     }
 }
 

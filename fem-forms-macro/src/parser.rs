@@ -10,7 +10,10 @@
 //! operator   := '∇' | 'Δ' | '∂_x' | '∂_y' | 'ε' | 'div' | 'tr'
 //! primary    := number | name | form '(' args ')' | '(' sum ')' | '[' sum ']'
 //!             | '(' sum ',' sum ')_T' | '∫' ['[' 'degree' '=' integer ']'] sum | 'Σ_T' sum
+//!             | '∫_' PART ['[' 'degree' '=' integer ']'] sum 'ds'
 //! ```
+//! `∫_Γ_C … ds` (ASCII `int_Γ_C … ds`) integrates over the edges of the boundary part
+//! `Γ_C` declared under `facets:`; `ds` closes its integrand.
 //! The operators bind tighter than products and looser than primes and powers: each
 //! applies to the factor right of it, so `tr ε(θ) I` is `tr(ε(θ))·I` and `div θ div η`
 //! a product of two divergences; `div div (D[(1−ν)ε(θ) + ν tr ε(θ) I])` needs its
@@ -84,10 +87,12 @@ pub enum ExprKind {
     Contract(Box<Expr>, Box<Expr>),
     /// `(x, y)_T`
     InnerProduct(Box<Expr>, Box<Expr>),
-    /// `∫ body` or `Σ_T body`
+    /// `∫ body`, `Σ_T body` or `∫_Γ body ds`
     Integral {
         /// Which notation.
         kind: IntegralKind,
+        /// `∫_Γ … ds`: the boundary part integrated over (`None`: the cells).
+        facet: Option<Name>,
         /// Explicit quadrature degree (`∫[degree=1]`).
         degree: Option<usize>,
         /// The integrand.
@@ -338,6 +343,8 @@ fn describe(tok: &Tok) -> String {
         Tok::Number(v) => format!("the number {v}"),
         Tok::Integral => "`∫`".into(),
         Tok::SumT => "`Σ_T`".into(),
+        Tok::FacetIntegral(part) => format!("`∫_{part}`"),
+        Tok::Ds => "`ds`".into(),
         Tok::Prime(n) => format!("a derivative mark ({n} prime(s))"),
         Tok::Superscript(_, raw) => format!("the exponent `{raw}`"),
         Tok::Caret => "`^`".into(),
@@ -552,7 +559,7 @@ impl<'a> Parser<'a> {
                     }
                 }
                 Tok::Plus | Tok::Minus | Tok::Comma if depth == 0 => return false,
-                Tok::Integral | Tok::SumT if depth == 0 => return true,
+                Tok::Integral | Tok::SumT | Tok::FacetIntegral(_) if depth == 0 => return true,
                 Tok::Ident(name)
                     if depth == 0
                         && self.form_names.contains(name)
@@ -667,6 +674,7 @@ impl<'a> Parser<'a> {
                 | Tok::LParen
                 | Tok::Integral
                 | Tok::SumT
+                | Tok::FacetIntegral(_)
                 | Tok::LBracket
                 | Tok::Grad
                 | Tok::Laplacian
@@ -992,16 +1000,56 @@ impl<'a> Parser<'a> {
                     return Err(self.unexpected("an integrand"));
                 }
                 let body = self.nested(loc, |p| p.sum(true))?;
+                if self.peek_tok() == Some(&Tok::Ds) {
+                    return Err(Diagnostic::text(self.here(), "`ds` closes a boundary integral `∫_Γ … ds`")
+                        .help("integrate over a boundary part declared under `facets:` with `∫_Γ … ds`, or drop `ds`: a cell integral `∫ …` needs none"));
+                }
                 let l = loc.to(body.loc);
                 Ok(Expr::new(
                     ExprKind::Integral {
                         kind,
+                        facet: None,
                         degree,
                         body: Box::new(body),
                     },
                     l,
                 ))
             }
+            Tok::FacetIntegral(part) => {
+                let facet = Name {
+                    text: part.clone(),
+                    loc,
+                };
+                self.pos += 1;
+                let degree = if self.peek_tok() == Some(&Tok::LBracket) {
+                    Some(self.quadrature_option()?)
+                } else {
+                    None
+                };
+                if self.peek().is_none() || self.peek_tok() == Some(&Tok::Ds) {
+                    return Err(self.unexpected("an integrand"));
+                }
+                let body = self.nested(loc, |p| p.sum(true))?;
+                if self.peek_tok() != Some(&Tok::Ds) {
+                    return Err(Diagnostic::text(
+                        loc.to(body.loc),
+                        format!("the boundary integral `∫_{part}` is not closed by `ds`"),
+                    )
+                    .help(format!("write `∫_{part} … ds`: `ds` ends the integrand")));
+                }
+                let close = self.bump().unwrap().loc;
+                Ok(Expr::new(
+                    ExprKind::Integral {
+                        kind: IntegralKind::Integral,
+                        facet: Some(facet),
+                        degree,
+                        body: Box::new(body),
+                    },
+                    loc.to(close),
+                ))
+            }
+            Tok::Ds => Err(Diagnostic::text(loc, "`ds` without a boundary integral")
+                .help("`ds` closes a boundary integral `∫_Γ … ds`")),
             Tok::RParen => Err(Diagnostic::text(loc, "unmatched `)`")
                 .help("remove it, or add the `(` it was meant to close")),
             _ => Err(self.unexpected("an expression")),

@@ -102,6 +102,11 @@ pub struct Monomial {
     pub quadrature_degree: Option<usize>,
     /// How many L² products `(X, Y)_T` the term came from.
     pub inner_products: u8,
+    /// `Some(k)`: the term stands under a boundary integral `∫_Γ … ds` over facet
+    /// part `k` (`Symbols::facets`); `None`: under a cell integral (or none).
+    pub facet: Option<usize>,
+    /// Powers of the components of the outward normal `n` (constant on a straight edge).
+    pub normal: [u8; 2],
     /// Where in the forms text the term comes from.
     pub origin: Loc,
 }
@@ -122,13 +127,16 @@ impl Monomial {
             integrated: false,
             quadrature_degree: None,
             inner_products: 0,
+            facet: None,
+            normal: [0, 0],
             origin,
         }
     }
 
-    /// True when the term has no argument, data or integral: a scalar of parameters and `h`.
+    /// True when the term has no argument, data, normal or integral: a scalar of
+    /// parameters and `h`.
     pub fn is_scalar(&self) -> bool {
-        self.args.is_empty() && self.data.is_empty() && !self.integrated
+        self.args.is_empty() && self.data.is_empty() && !self.integrated && self.normal == [0, 0]
     }
 
     fn key_eq(&self, other: &Self) -> bool {
@@ -140,6 +148,8 @@ impl Monomial {
             && self.integrated == other.integrated
             && self.quadrature_degree == other.quadrature_degree
             && self.inner_products == other.inner_products
+            && self.facet == other.facet
+            && self.normal == other.normal
     }
 
     /// The product of two monomials (integral flags and quadrature options combine).
@@ -175,6 +185,11 @@ impl Monomial {
             integrated: self.integrated || other.integrated,
             quadrature_degree: self.quadrature_degree.or(other.quadrature_degree),
             inner_products: self.inner_products + other.inner_products,
+            facet: self.facet.or(other.facet),
+            normal: [
+                self.normal[0].saturating_add(other.normal[0]),
+                self.normal[1].saturating_add(other.normal[1]),
+            ],
             origin,
         }
     }

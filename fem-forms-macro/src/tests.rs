@@ -796,3 +796,57 @@ fn degree_one_on_triangles_is_one_point() {
     let literal = format!("{:?}", 1.0f64 / 18.0);
     assert!(out.contains(&format!("s0 * {literal}f64")), "{out}");
 }
+
+/// `∫_Γ … ds` and `int_Γ … ds` give the same facet blocks; the cell blocks stay apart,
+/// and the normal's powers are kept per term.
+#[test]
+fn facet_integrals_ascii_and_unicode_agree() {
+    let forms = |text: &str| {
+        let declaration: Declaration = syn::parse2(quote! {
+            pub mod contact on triangle {
+                unknowns: u: [P1]^2, λ: P0 >= 0;
+                tests: v, μ;
+                params: α;
+                data: g;
+                facets: Γ_C;
+                forms: #text;
+            }
+        })
+        .unwrap();
+        assert!(declaration.check().is_empty());
+        let symbols = crate::symbols(&declaration);
+        let (tokens, errors) = lexer::tokenize(text);
+        assert!(errors.is_empty(), "{errors:?}");
+        let (definitions, errors) = parser::parse_forms(&tokens);
+        assert!(errors.is_empty(), "{errors:?}");
+        let (forms, errors) = analysis::analyse(&symbols, &definitions, text);
+        assert!(errors.is_empty(), "{errors:?}");
+        forms
+            .into_iter()
+            .map(|f| (f.blocks, f.facet_blocks))
+            .collect::<Vec<_>>()
+    };
+    let unicode = forms(
+        "
+        a(u;v) = ∫ ε(u):ε(v) + ∫_Γ_C h_E (u·n)(v·n) ds
+        b(v;μ) = −∫_Γ_C μ v·n ds
+    ",
+    );
+    let ascii = forms(
+        "
+        a(u;v) = int eps(u):eps(v) + int_Γ_C h_E (u dot n)(v dot n) ds
+        b(v;μ) = -int_Γ_C μ v dot n ds
+    ",
+    );
+    assert_eq!(unicode, ascii);
+    let (cell, facet) = &unicode[0];
+    assert_eq!(cell.len(), 4);
+    assert_eq!(facet.len(), 4);
+    // (v_x, u_x) on Γ_C: h n_x²
+    let (part, block) = &facet[0];
+    assert_eq!(*part, 0);
+    assert_eq!(block.terms.len(), 1);
+    assert_eq!(block.terms[0].normal, [2, 0]);
+    assert_eq!(block.terms[0].h_power, 1);
+    assert!(unicode[1].0.is_empty());
+}

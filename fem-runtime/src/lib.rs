@@ -28,6 +28,7 @@
 #![cfg_attr(test, allow(confusable_idents, mixed_script_confusables))]
 
 pub mod assembly;
+pub mod contact;
 pub mod element;
 pub mod error;
 pub mod io;
@@ -47,7 +48,7 @@ pub use error::{Error, Result};
 pub use fem_reference as reference;
 pub use fem_reference::{gauss_legendre, CellKind, ElementKind, QuadratureRule};
 pub use mesh::{Diagonal, IntervalMesh, Mesh, PointLocator, TriangleMesh};
-pub use model::{BlockInfo, Coefficients, DataFn, FieldInfo, FormInfo, Model};
+pub use model::{BlockInfo, Coefficients, DataFn, FacetBlockInfo, FieldInfo, FormInfo, Model};
 pub use stabilization::Alpha;
 
 /// Re-exported sparse matrix type of the assembled systems.

@@ -84,6 +84,20 @@ pub struct BlockInfo {
     pub terms: &'static str,
 }
 
+/// One nonzero block of a boundary integral `∫_Γ … ds` (a model's `facets:`): its
+/// kernel integrates over one edge of a cell ([`Model::facet_matrix`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FacetBlockInfo {
+    /// Index of the form in `FORMS`.
+    pub form: usize,
+    /// Index of the boundary part in `FACET_PARTS`.
+    pub part: usize,
+    /// Field of the test function (rows).
+    pub test_field: usize,
+    /// Field of the trial function (columns); `None` for linear forms.
+    pub trial_field: Option<usize>,
+}
+
 /// A form of a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FormInfo {
@@ -249,6 +263,57 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         let _ = (form, block, nodes, params, data, out);
         Err(Error::Input(format!(
             "model `{}` has no kernels on curved triangles (model! generates them for triangle models only)",
+            Self::NAME
+        )))
+    }
+
+    /// The boundary parts the model's forms integrate over (`facets:`), by name; the
+    /// mesh says which edges a name holds. Empty by default (no boundary integrals).
+    const FACET_PARTS: &'static [&'static str] = &[];
+
+    /// The blocks of the boundary integrals of every form, in the order of
+    /// [`Model::facet_matrix`] and [`Model::facet_vector`]'s `block`. Empty by default.
+    const FACET_BLOCKS: &'static [FacetBlockInfo] = &[];
+
+    /// Facet matrix of `FACET_BLOCKS[block]` (a bilinear form's) on local edge `edge`
+    /// (joining local vertices `edge` and `(edge + 1) % 3`) of the affine triangle with
+    /// vertex coordinates `vertices` (`[x0, y0, x1, y1, x2, y2]`), row-major into `out`
+    /// (rows: the test field's local DOFs, columns: the trial field's).
+    ///
+    /// # Errors
+    /// [`Error::Input`] for a block that is not a bilinear facet block, an edge above 2 or
+    /// `vertices` not of length 6; the default (no facets) always.
+    fn facet_matrix(
+        block: usize,
+        vertices: &[f64],
+        edge: usize,
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) -> Result<()> {
+        let _ = (block, vertices, edge, params, data, out);
+        Err(Error::Input(format!(
+            "model `{}` has no boundary integrals (`facets:`)",
+            Self::NAME
+        )))
+    }
+
+    /// Facet vector of `FACET_BLOCKS[block]` (a linear form's): as
+    /// [`Model::facet_matrix`].
+    ///
+    /// # Errors
+    /// As [`Model::facet_matrix`].
+    fn facet_vector(
+        block: usize,
+        vertices: &[f64],
+        edge: usize,
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) -> Result<()> {
+        let _ = (block, vertices, edge, params, data, out);
+        Err(Error::Input(format!(
+            "model `{}` has no boundary integrals (`facets:`)",
             Self::NAME
         )))
     }

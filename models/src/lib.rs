@@ -15,6 +15,7 @@ pub mod membrane_scenes;
 pub mod mindlin;
 pub mod plate_scenes;
 pub mod registry;
+pub mod signorini;
 pub mod timoshenko;
 pub mod vector_forms;
 

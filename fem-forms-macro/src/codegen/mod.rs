@@ -13,6 +13,7 @@
 mod backend;
 mod curved;
 mod emit;
+mod facet;
 mod interval;
 mod triangle;
 
@@ -47,6 +48,9 @@ struct Dispatch {
     /// The arms of `element_matrix_curved` and `element_vector_curved` (triangles only).
     matrix_curved: Vec<TokenStream>,
     vector_curved: Vec<TokenStream>,
+    /// `FACET_PARTS`, `FACET_BLOCKS` and the facet dispatch (`facet.rs`; empty without
+    /// `facets:`).
+    facet_items: TokenStream,
 }
 
 /// What the driver generates for one form.
@@ -141,6 +145,7 @@ fn form_code(
     if backend.cell_variant() == "Triangle" {
         curved_code(form_index, form, symbols, runtime, dispatch, &mut functions);
     }
+    functions.extend(facet_modules(form, symbols, runtime));
     let source = &form.source;
     let arity = form.arity();
     let dropped = form.dropped;
@@ -172,6 +177,38 @@ fn form_code(
         }
     };
     FormCode { module, info }
+}
+
+/// One module per boundary part a form integrates over (`on_Γ_C`), holding the facet
+/// kernels of its blocks (`codegen/facet.rs`).
+fn facet_modules(form: &Form, symbols: &Symbols, runtime: &TokenStream) -> Vec<TokenStream> {
+    (0..symbols.facets.len())
+        .filter_map(|part| {
+            let kernels: Vec<TokenStream> = form
+                .facet_blocks
+                .iter()
+                .filter(|(p, _)| *p == part)
+                .map(|(_, block)| {
+                    facet::facet_kernel(block, symbols, runtime, &form.name, &symbols.facets[part])
+                })
+                .collect();
+            if kernels.is_empty() {
+                return None;
+            }
+            let module = facet::part_ident(&symbols.facets[part]);
+            let doc = format!(
+                " Facet kernels of `{}` on the edges of the boundary part `{}`.",
+                form.name, symbols.facets[part]
+            );
+            Some(quote! {
+                #[doc = #doc]
+                pub mod #module {
+                    use super::*;
+                    #(#kernels)*
+                }
+            })
+        })
+        .collect()
 }
 
 /// The curved kernels of a form's blocks (appended to `functions`) and their dispatch
@@ -411,6 +448,7 @@ fn model_impl(
         transformed,
         matrix_curved,
         vector_curved,
+        facet_items,
     } = dispatch;
     let on_cell = transformed.then(|| {
         quote! {
@@ -569,6 +607,8 @@ fn model_impl(
             #on_cell
 
             #curved
+
+            #facet_items
         }
     }
 }
@@ -586,6 +626,8 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
             (code.module, code.info)
         })
         .unzip();
+    dispatch.facet_items =
+        facet::model_items(symbols, forms, runtime, &declaration.name.to_string());
     let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch);
     let handles = handles(symbols, forms, runtime);
     let module = &declaration.name;

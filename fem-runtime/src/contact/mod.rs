@@ -1,0 +1,437 @@
+//! Obstacle problems whose multiplier lives on a boundary part only: Signorini contact
+//! (docs/mathematics.md §7, MODELS.md §7), the boundary-multiplier variant of
+//! [`crate::obstacle::triangle::solve_obstacle_on_triangles`].
+//!
+//! The model declares its multiplier as a P0 field (`λ: P0 >= 0`) and integrates it
+//! only in boundary integrals `∫_Γ_C … ds` (`facets:`); here it gets one DOF per edge
+//! of `Γ_C` (the edge's P0 function), not one per cell. The system is the one of §1:
+//! from `B_h` and `L_h` (cell and facet blocks),
+//!
+//! ```text
+//! A = (v, u) blocks,  B = −(μ, u) blocks,  C = −(μ, λ) blocks,  F = ℓ part,  G = −(μ part of L_h)
+//! ```
+//!
+//! an LCP `A U − Bᵀ Λ = F, 0 ≤ Λ ⊥ B U + C Λ − G ≥ 0` for [`crate::lcp`]'s solvers
+//! (semismooth Newton needs `C > 0`, i.e. α > 0; the plain method `α = 0` goes to the QP).
+
+use crate::assembly::boundary::{Constraints, DirichletPart, Reduction};
+use crate::assembly::dof_map::SystemDofs;
+use crate::assembly::{assemble_vector, MatrixAssembler};
+use crate::error::{Error, Result};
+use crate::lcp::{ConstraintRows, Lcp};
+use crate::mesh::TriangleMesh;
+use crate::model::{Coefficients, Model};
+use crate::obstacle::{multiplier_field, system_forms};
+use crate::SparseMatrix;
+use faer::sparse::{SparseColMat, Triplet};
+use fem_reference::ElementKind;
+
+/// One edge of the multiplier's boundary part: where its DOF lives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactEdge {
+    /// Global edge number in the mesh.
+    pub edge: usize,
+    /// The cell next to it.
+    pub cell: usize,
+    /// Its local number in that cell (joining local vertices `local`, `local + 1`).
+    pub local: usize,
+    /// Its end points.
+    pub ends: [[f64; 2]; 2],
+}
+
+impl ContactEdge {
+    /// The edge's length `|E|` (= `h_E`).
+    pub fn length(&self) -> f64 {
+        let [a, b] = self.ends;
+        (b[0] - a[0]).hypot(b[1] - a[1])
+    }
+
+    /// The edge's midpoint.
+    pub fn midpoint(&self) -> [f64; 2] {
+        let [a, b] = self.ends;
+        [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
+    }
+}
+
+/// The discrete problem: primal DOFs, their elimination, the LCP and the multiplier's
+/// edges (constraint `k` is the P0 multiplier of `contact_edges[k]`).
+#[derive(Clone, Debug)]
+pub struct BoundaryMultiplierProblem {
+    /// DOFs of the primal fields (every field but the multiplier).
+    pub dofs: SystemDofs,
+    /// Elimination of the fixed primal DOFs.
+    pub reduction: Reduction,
+    /// The LCP in the free primal DOFs and the edge multipliers.
+    pub lcp: Lcp,
+    /// The edges of the multiplier's part, in constraint order.
+    pub contact_edges: Vec<ContactEdge>,
+    /// The model's multiplier field.
+    pub multiplier_field: usize,
+    /// The boundary part (index in `M::FACET_PARTS`) the multiplier lives on.
+    pub multiplier_part: usize,
+}
+
+/// The boundary edges of `mesh` with one of `markers`, with their cell and local number.
+fn part_edges(mesh: &TriangleMesh, markers: &[u32]) -> Vec<ContactEdge> {
+    let vertices = mesh.vertices();
+    mesh.boundary_edges()
+        .iter()
+        .filter(|(_, m)| markers.contains(m))
+        .map(|&(e, _)| {
+            let (cell, _) = mesh.edge_cells(e);
+            let local = mesh
+                .cell_edges(cell)
+                .iter()
+                .position(|&x| x == e)
+                .expect("an edge is an edge of its cell");
+            let c = mesh.cell(cell);
+            ContactEdge {
+                edge: e,
+                cell,
+                local,
+                ends: [vertices[c[local]], vertices[c[(local + 1) % 3]]],
+            }
+        })
+        .collect()
+}
+
+/// Assembles `B_h`, `L_h` of `M` (cell and facet blocks) on `mesh` with the multiplier
+/// on the edges of its boundary part, and eliminates the homogeneous Dirichlet
+/// conditions `fixed` (`(field, boundary markers)`: that field is 0 on those edges).
+///
+/// `parts` names the boundary edges of each of the model's `FACET_PARTS` by marker
+/// (`("Γ_C", &[1])`, e.g. from [`TriangleMesh::boundary_part_markers`]).
+///
+/// # Errors
+/// [`Error::Input`] when the model has no `B_h`/`L_h`, no single multiplier, a
+/// multiplier that is not P0 or that appears in no boundary integral or on two parts; a
+/// model part `parts` does not name, or one that holds no boundary edge of the mesh (a
+/// contact part that is not on the boundary); a field index out of range in `fixed`;
+/// the errors of the kernels ([`Error::NonFinite`] for a non-finite entry).
+pub fn discretize_boundary_multiplier<M: Model>(
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    parts: &[(&str, &[u32])],
+    fixed: &[(usize, &[u32])],
+) -> Result<BoundaryMultiplierProblem> {
+    let (bilinear_id, linear_id) = system_forms::<M>()?;
+    let (bilinear, linear) = (M::form(bilinear_id)?, M::form(linear_id)?);
+    let multiplier = multiplier_field::<M>()?;
+    if M::FIELDS[multiplier].element != ElementKind::P0 {
+        return Err(Error::Input(format!(
+            "the boundary multiplier `{}` of `{}` must be P0 (one value per edge), not {}",
+            M::FIELDS[multiplier].name,
+            M::NAME,
+            M::FIELDS[multiplier].element.name()
+        )));
+    }
+    let mut multiplier_parts: Vec<usize> = M::FACET_BLOCKS
+        .iter()
+        .filter(|b| {
+            b.form == bilinear && (b.test_field == multiplier || b.trial_field == Some(multiplier))
+        })
+        .map(|b| b.part)
+        .collect();
+    multiplier_parts.dedup();
+    let multiplier_part = match multiplier_parts.as_slice() {
+        [p] => *p,
+        [] => {
+            return Err(Error::Input(format!(
+                "the multiplier `{}` of `{}` appears in no boundary integral of `{}`: it has no boundary part to live on",
+                M::FIELDS[multiplier].name,
+                M::NAME,
+                M::FORMS[bilinear].name
+            )))
+        }
+        _ => {
+            return Err(Error::Input(format!(
+                "the multiplier `{}` of `{}` appears in boundary integrals over several parts; it must live on one",
+                M::FIELDS[multiplier].name,
+                M::NAME
+            )))
+        }
+    };
+    // The edges of every part of the model.
+    let mut edges_of_part = Vec::with_capacity(M::FACET_PARTS.len());
+    for &name in M::FACET_PARTS {
+        let markers = parts
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, m)| *m)
+            .ok_or_else(|| {
+                Error::Input(format!(
+                    "the boundary part `{name}` of `{}` is not given markers (given: {})",
+                    M::NAME,
+                    parts.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                ))
+            })?;
+        let edges = part_edges(mesh, markers);
+        if edges.is_empty() {
+            return Err(Error::Input(format!(
+                "the boundary part `{name}` (markers {markers:?}) holds no boundary edge of the mesh: it is not on the boundary"
+            )));
+        }
+        edges_of_part.push(edges);
+    }
+    let contact_edges = edges_of_part[multiplier_part].clone();
+    let primal: Vec<usize> = (0..M::FIELDS.len()).filter(|&f| f != multiplier).collect();
+    let dofs = SystemDofs::new::<M>(mesh, &primal)?;
+    let (n_full, m) = (dofs.dof_count(), contact_edges.len());
+
+    // A: the cell part, then the facet blocks.
+    let cell_part =
+        MatrixAssembler::new::<M>(bilinear_id, mesh, &dofs)?.assemble::<M>(mesh, coefficients)?;
+    let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
+    {
+        let (ptr, rows, vals) = (
+            cell_part.symbolic().col_ptr(),
+            cell_part.symbolic().row_idx(),
+            cell_part.val(),
+        );
+        for j in 0..n_full {
+            for k in ptr[j]..ptr[j + 1] {
+                triplets.push(Triplet::new(rows[k], j, vals[k]));
+            }
+        }
+    }
+    let mut b_full: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
+    let mut c = vec![0.0; m];
+    let mut f_full = assemble_vector::<M>(linear_id, mesh, &dofs, coefficients)?;
+    let mut g = vec![0.0; m];
+    let (params, data) = (&coefficients.params, &coefficients.data);
+    let mut out = [0.0; 64];
+    // The global rows of a field's local DOFs on an edge's cell; for the multiplier, its
+    // constraint (the edge's position in the part).
+    let place = |field: usize, cell: usize| -> Option<Vec<usize>> {
+        let map = dofs.map(field)?;
+        let offset = dofs.offset(field)?;
+        Some(map.cell_dofs(cell).iter().map(|d| d + offset).collect())
+    };
+    for (index, block) in M::FACET_BLOCKS.iter().enumerate() {
+        if block.form != bilinear && block.form != linear {
+            continue;
+        }
+        for (k, edge) in edges_of_part[block.part].iter().enumerate() {
+            let x = mesh.cell_coordinates(edge.cell);
+            let test_is_multiplier = block.test_field == multiplier;
+            let rows = M::FIELDS[block.test_field].element.local_dof_count(M::CELL);
+            if block.form == bilinear {
+                let Some(trial) = block.trial_field else {
+                    continue;
+                };
+                let cols = M::FIELDS[trial].element.local_dof_count(M::CELL);
+                let local = &mut out[..rows * cols];
+                M::facet_matrix(index, &x, edge.local, params, data, local)?;
+                if local.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::NonFinite {
+                        what: "facet matrix",
+                        cell: edge.cell,
+                    });
+                }
+                match (test_is_multiplier, trial == multiplier) {
+                    (true, true) => c[k] -= local[0],
+                    (true, false) => {
+                        let columns = place(trial, edge.cell).expect("a primal field");
+                        for (j, &col) in columns.iter().enumerate() {
+                            if local[j] != 0.0 {
+                                b_full[k].push((col, -local[j]));
+                            }
+                        }
+                    }
+                    // the (v, λ) block is the transpose of (μ, v): B_h is symmetric
+                    (false, true) => {}
+                    (false, false) => {
+                        let r = place(block.test_field, edge.cell).expect("a primal field");
+                        let s = place(trial, edge.cell).expect("a primal field");
+                        for (i, &row) in r.iter().enumerate() {
+                            for (j, &col) in s.iter().enumerate() {
+                                triplets.push(Triplet::new(row, col, local[i * cols + j]));
+                            }
+                        }
+                    }
+                }
+            } else {
+                let local = &mut out[..rows];
+                M::facet_vector(index, &x, edge.local, params, data, local)?;
+                if local.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::NonFinite {
+                        what: "facet vector",
+                        cell: edge.cell,
+                    });
+                }
+                if test_is_multiplier {
+                    g[k] -= local[0];
+                } else {
+                    let r = place(block.test_field, edge.cell).expect("a primal field");
+                    for (i, &row) in r.iter().enumerate() {
+                        f_full[row] += local[i];
+                    }
+                }
+            }
+        }
+    }
+    let a_full: SparseMatrix = SparseColMat::try_new_from_triplets(n_full, n_full, &triplets)
+        .map_err(|e| Error::Input(format!("assembling the contact system: {e:?}")))?;
+    // Homogeneous Dirichlet conditions, eliminated.
+    let mut constraints = Constraints::new();
+    for &(field, markers) in fixed {
+        let map = dofs.map(field).ok_or_else(|| {
+            Error::Input(format!(
+                "field {field} is not a primal field of `{}`",
+                M::NAME
+            ))
+        })?;
+        let offset = dofs.offset(field).unwrap_or(0);
+        for d in DirichletPart::Markers(markers.to_vec()).dofs(map, mesh) {
+            constraints.fix_dof(offset + d, 0.0)?;
+        }
+    }
+    let reduction = constraints.reduction(n_full)?;
+    let a = reduction.matrix(&a_full);
+    let f = reduction.rhs(&a_full, &f_full);
+    let b_rows: Vec<Vec<(usize, f64)>> = b_full
+        .into_iter()
+        .map(|row| {
+            let mut out: Vec<(usize, f64)> = Vec::with_capacity(row.len());
+            for (col, v) in row {
+                if let Some(j) = reduction.free_index(col) {
+                    match out.iter_mut().find(|(c, _)| *c == j) {
+                        Some(e) => e.1 += v,
+                        None => out.push((j, v)),
+                    }
+                }
+            }
+            out.sort_by_key(|e| e.0);
+            out
+        })
+        .collect();
+    Ok(BoundaryMultiplierProblem {
+        dofs,
+        reduction,
+        lcp: Lcp::new(a, ConstraintRows::from(b_rows), c, f, g),
+        contact_edges,
+        multiplier_field: multiplier,
+        multiplier_part,
+    })
+}
+
+/// The per-edge inverse-inequality constants `C_I,E` of the stabilization (MODELS.md
+/// §7): the smallest `C` with `h_E ‖σ_n(v)‖²_E ≤ C a_{T_E}(v, v)` for every `v` of the
+/// primal space on the cell `T_E` next to edge `E`, computed from the model's own
+/// kernels: the largest generalized eigenvalue of `S_E v = C K_T v` on the complement
+/// of the kernel of `K_T` (the rigid motions, where `S_E` vanishes too).
+///
+/// `energy` names the bilinear cell form `a(u;v)` (its blocks give `K_T`), `stabilization`
+/// the form whose facet blocks on the multiplier's part, restricted to the primal
+/// fields, give `S_E` (`S(u,λ;v,μ) = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds`). One value
+/// per edge of `problem.contact_edges`; `α = 1/(2 max_E C_I,E)` is the rule of §1.
+///
+/// # Errors
+/// [`Error::Input`] for unknown forms, a form of the wrong arity; the kernels' errors;
+/// [`Error::NonFinite`] when a local matrix is not finite.
+pub fn inverse_constants<M: Model>(
+    mesh: &TriangleMesh,
+    problem: &BoundaryMultiplierProblem,
+    coefficients: &Coefficients,
+    energy: impl crate::model::IntoFormIndex<M>,
+    stabilization: impl crate::model::IntoFormIndex<M>,
+) -> Result<Vec<f64>> {
+    let energy = M::form(energy)?;
+    let stabilization = M::form(stabilization)?;
+    for (form, what) in [(energy, "energy"), (stabilization, "stabilization")] {
+        if M::FORMS[form].arity != 2 {
+            return Err(Error::Input(format!(
+                "the {what} form `{}` of `{}` is not bilinear",
+                M::FORMS[form].name,
+                M::NAME
+            )));
+        }
+    }
+    // Local numbering: the primal fields' local DOFs one after the other.
+    let fields = problem.dofs.fields();
+    let counts: Vec<usize> = fields
+        .iter()
+        .map(|&f| M::FIELDS[f].element.local_dof_count(M::CELL))
+        .collect();
+    let start: Vec<usize> = counts
+        .iter()
+        .scan(0, |s, &c| {
+            let x = *s;
+            *s += c;
+            Some(x)
+        })
+        .collect();
+    let size: usize = counts.iter().sum();
+    let local_start = |field: usize| fields.iter().position(|&f| f == field).map(|k| start[k]);
+    let (params, data) = (&coefficients.params, &coefficients.data);
+    let mut out = vec![0.0; 64];
+    let mut constants = Vec::with_capacity(problem.contact_edges.len());
+    for edge in &problem.contact_edges {
+        let x = mesh.cell_coordinates(edge.cell);
+        let mut k = nalgebra::DMatrix::<f64>::zeros(size, size);
+        let mut s = nalgebra::DMatrix::<f64>::zeros(size, size);
+        for (b, block) in M::FORMS[energy].blocks.iter().enumerate() {
+            let trial = block.trial_field.unwrap_or(block.test_field);
+            let (Some(r0), Some(c0)) = (local_start(block.test_field), local_start(trial)) else {
+                continue;
+            };
+            let rows = M::FIELDS[block.test_field].element.local_dof_count(M::CELL);
+            let cols = M::FIELDS[trial].element.local_dof_count(M::CELL);
+            M::element_matrix(energy, b, &x, params, data, &mut out[..rows * cols]);
+            for i in 0..rows {
+                for j in 0..cols {
+                    k[(r0 + i, c0 + j)] += out[i * cols + j];
+                }
+            }
+        }
+        for (index, block) in M::FACET_BLOCKS.iter().enumerate() {
+            if block.form != stabilization || block.part != problem.multiplier_part {
+                continue;
+            }
+            let Some(trial) = block.trial_field else {
+                continue;
+            };
+            let (Some(r0), Some(c0)) = (local_start(block.test_field), local_start(trial)) else {
+                continue;
+            };
+            let rows = M::FIELDS[block.test_field].element.local_dof_count(M::CELL);
+            let cols = M::FIELDS[trial].element.local_dof_count(M::CELL);
+            M::facet_matrix(index, &x, edge.local, params, data, &mut out[..rows * cols])?;
+            for i in 0..rows {
+                for j in 0..cols {
+                    s[(r0 + i, c0 + j)] += out[i * cols + j];
+                }
+            }
+        }
+        if k.iter().chain(s.iter()).any(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "local matrix of the inverse constant",
+                cell: edge.cell,
+            });
+        }
+        let k = 0.5 * (&k + k.transpose());
+        let s = 0.5 * (&s + s.transpose());
+        let eigen = k.symmetric_eigen();
+        let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let kept: Vec<usize> = (0..size)
+            .filter(|&i| eigen.eigenvalues[i] > 1e-10 * largest)
+            .collect();
+        // Q_r Λ_r^{-1/2}: S restricted to the range of K, in its energy-orthonormal basis
+        let mut basis = nalgebra::DMatrix::<f64>::zeros(size, kept.len());
+        for (c, &i) in kept.iter().enumerate() {
+            let scale = 1.0 / eigen.eigenvalues[i].sqrt();
+            for r in 0..size {
+                basis[(r, c)] = eigen.eigenvectors[(r, i)] * scale;
+            }
+        }
+        let reduced = basis.transpose() * &s * &basis;
+        let reduced = 0.5 * (&reduced + reduced.transpose());
+        let value = reduced
+            .symmetric_eigen()
+            .eigenvalues
+            .iter()
+            .fold(0.0f64, |m, &v| m.max(v));
+        constants.push(value);
+    }
+    Ok(constants)
+}
