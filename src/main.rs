@@ -3,8 +3,10 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
+use fem_forms::contact;
 use fem_forms::kirchhoff::{self, KirchhoffPair, KirchhoffRequest};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
+use fem_forms::models::contact_scenes::{ContactBody, ContactScene};
 use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene};
@@ -359,6 +361,14 @@ fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(
         return run_kirchhoff_study(*scene, kind, full, out)
             .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
     }
+    if let SceneKind::Contact(scene) = &entry.kind {
+        let result = match kind {
+            "convergence" => contact::convergence_study(*scene, full, out),
+            "alpha" => contact::alpha_study(*scene, if full { 64 } else { 16 }, out),
+            _ => return Err(format!("unknown contact study `{kind}`")),
+        };
+        return result.map_err(|e| format!("study {} {kind}: {e}", entry.name()));
+    }
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
     // the plate studies are the plate's own (the generic kinds need exact solutions of
     // the obstacle problem, which the plate scenes do not have)
@@ -491,6 +501,12 @@ fn list() {
     for p in KirchhoffPair::ALL {
         println!("  {}", p.name());
     }
+    println!(
+        "contact pairs (u, λ on Γ_C; --mesh-size N of the block, b/h of Hertz's graded mesh; default p1-p0, α = ½/max C_I,E; --alpha 0: the plain method):"
+    );
+    for p in contact::ContactPair::ALL {
+        println!("  {}", p.name());
+    }
 }
 
 /// The one family-dispatch point of `solve`: options checked against the scene's family,
@@ -504,6 +520,7 @@ fn solve(entry: &SceneEntry, options: &SolveOptions, out: &Path) -> Result<(), S
     }
     match &entry.kind {
         SceneKind::Kirchhoff(scene) => solve_kirchhoff(*scene, options),
+        SceneKind::Contact(scene) => solve_contact(*scene, options, out),
         SceneKind::Beam(scene) => solve_beam(*scene, options, out),
         SceneKind::Membrane(scene) => solve_membrane(scene, options, out),
         SceneKind::Plate(scene) => solve_plate(*scene, options),
@@ -523,6 +540,66 @@ fn run_kirchhoff_study(
         _ => return Err(format!("unknown Kirchhoff study `{kind}`")),
     }
     .map_err(|e| e.to_string())
+}
+
+fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Result<(), String> {
+    let mesh = match scene.body {
+        ContactBody::Block { .. } => "an N×N×2 mesh of the block (2N×N×2 on its 2:1 shape)",
+        ContactBody::Cylinder { .. } => "a mesh graded to b/h = N cells per contact half-width",
+    };
+    options.refuse(
+        &[
+            "--elements",
+            "--msh",
+            "--vtk",
+            "--thickness",
+            "--refinement",
+            "--no-obstacle",
+            "--linear-solver",
+            "--solver",
+            "--cold",
+        ],
+        &format!(
+            "`{}` is a contact scene on {mesh} (--mesh-size, --load, --alpha, --pair, --plot, --json)",
+            scene.name
+        ),
+    )?;
+    if options.plot && !matches!(scene.body, ContactBody::Cylinder { .. }) {
+        return Err(format!(
+            "--plot does not apply: `{}` has no reference pressure profile to chart (its pressure is q on every edge: see --json's patch_pressure_error)",
+            scene.name
+        ));
+    }
+    let mut request = contact::ContactRequest::new(scene);
+    if let Some(name) = &options.pair {
+        request.pair = contact::ContactPair::parse(name).map_err(|e| e.to_string())?;
+    }
+    request.mesh_size = options.mesh_size.unwrap_or(request.mesh_size);
+    request.load = options.load.unwrap_or(request.load);
+    if let Some(alpha) = options.alpha {
+        request.alpha = Some(alpha);
+    }
+    let (report, profile) = contact::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!("{}", contact::summary(&report));
+    }
+    if options.plot {
+        let hertz = scene.hertz(request.load).expect("checked: a cylinder");
+        let path = contact::pressure_chart(
+            out,
+            &report,
+            &[(format!("λ_h ({})", report.pair), &profile)],
+            &hertz,
+        )
+        .map_err(|e| e.to_string())?;
+        eprintln!("→ {}", path.display());
+    }
+    Ok(())
 }
 
 fn solve_kirchhoff(scene: KirchhoffScene, options: &SolveOptions) -> Result<(), String> {

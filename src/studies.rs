@@ -249,6 +249,10 @@ pub fn study_scene(entry: &SceneEntry) -> Result<Box<dyn StudyScene>> {
             "Kirchhoff scene `{}` runs its studies in fem_forms::kirchhoff",
             s.name
         ))),
+        SceneKind::Contact(s) => Err(Error::Input(format!(
+            "contact scene `{}` runs its studies in fem_forms::contact",
+            s.name
+        ))),
     }
 }
 

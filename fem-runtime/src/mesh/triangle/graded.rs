@@ -24,6 +24,82 @@ pub fn distance_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     dist2(p, [a[0] + s * d[0], a[1] + s * d[1]]).sqrt()
 }
 
+/// The half (`quarter = false`: angles π…2π) or the right quarter (3π/2…2π) of the
+/// disc of radius `radius` centred at `(0, radius)`, `rings` rings zipped by angle.
+fn lower_sector(radius: f64, rings: usize, quarter: bool) -> Result<TriangleMesh> {
+    if !(radius > 0.0 && radius.is_finite()) {
+        return Err(mesh_error(format!(
+            "half-disc radius {radius} must be positive and finite"
+        )));
+    }
+    if rings == 0 {
+        return Err(mesh_error("a half disc needs at least one ring".into()));
+    }
+    let segments = |k: usize| if quarter { (3 * k).div_ceil(2) } else { 3 * k };
+    let (start, span) = if quarter {
+        (1.5 * std::f64::consts::PI, 0.5 * std::f64::consts::PI)
+    } else {
+        (std::f64::consts::PI, std::f64::consts::PI)
+    };
+    let mut ring_start = vec![0, 1];
+    for k in 1..=rings {
+        ring_start.push(ring_start[k] + segments(k) + 1);
+    }
+    let vertex = |k: usize, i: usize| if k == 0 { 0 } else { ring_start[k] + i };
+    let mut vertices = vec![[0.0, radius]];
+    for k in 1..=rings {
+        let r = lerp(0.0, radius, k, rings);
+        let n = segments(k);
+        for i in 0..=n {
+            // the straight sides exactly on their lines
+            let point = if i == n {
+                [r, radius]
+            } else if i == 0 && !quarter {
+                [-r, radius]
+            } else if i == 0 {
+                [0.0, radius - r]
+            } else {
+                let t = start + span * i as f64 / n as f64;
+                [r * t.cos(), radius + r * t.sin()]
+            };
+            vertices.push(point);
+        }
+    }
+    let mut cells = Vec::new();
+    for i in 0..segments(1) {
+        cells.push([0, vertex(1, i), vertex(1, i + 1)]);
+    }
+    for k in 2..=rings {
+        let (n_in, n_out) = (segments(k - 1), segments(k));
+        let (mut p, mut q) = (0, 0);
+        while p < n_in || q < n_out {
+            let step_outer = p == n_in || (q < n_out && (q + 1) * n_in <= (p + 1) * n_out);
+            if step_outer {
+                cells.push([vertex(k - 1, p), vertex(k, q), vertex(k, q + 1)]);
+                q += 1;
+            } else {
+                cells.push([vertex(k - 1, p), vertex(k, q), vertex(k - 1, p + 1)]);
+                p += 1;
+            }
+        }
+    }
+    let start_marker = if quarter { 3 } else { 2 };
+    let mut markers: Vec<(usize, usize, u32)> = (0..segments(rings))
+        .map(|i| (vertex(rings, i), vertex(rings, i + 1), 1))
+        .collect();
+    for k in 1..=rings {
+        let last_in = if k == 1 { 0 } else { segments(k - 1) };
+        markers.push((vertex(k - 1, 0), vertex(k, 0), start_marker));
+        markers.push((vertex(k - 1, last_in), vertex(k, segments(k)), 2));
+    }
+    let mesh = TriangleMesh::new(vertices, cells, &markers)?;
+    if quarter {
+        mesh.with_boundary_names(&[("arc", &[1]), ("top", &[2]), ("axis", &[3])])
+    } else {
+        mesh.with_boundary_names(&[("arc", &[1]), ("top", &[2])])
+    }
+}
+
 impl TriangleMesh {
     /// The lower half of the disc of radius `radius` centred at `(0, radius)`: the
     /// cylinder of Hertz line contact resting on the plane `y = 0` at the origin.
@@ -37,60 +113,19 @@ impl TriangleMesh {
     /// # Errors
     /// [`Error::Mesh`] for a radius that is not positive and finite, or `rings = 0`.
     pub fn half_disk(radius: f64, rings: usize) -> Result<Self> {
-        if !(radius > 0.0 && radius.is_finite()) {
-            return Err(mesh_error(format!(
-                "half-disc radius {radius} must be positive and finite"
-            )));
-        }
-        if rings == 0 {
-            return Err(mesh_error("a half disc needs at least one ring".into()));
-        }
-        // ring k ≥ 1 has 3k + 1 vertices and starts after 1 + Σ_{j<k} (3j + 1)
-        let ring_start = |k: usize| 1 + 3 * k * (k - 1) / 2 + (k - 1);
-        let centre = [0.0, radius];
-        let mut vertices = vec![centre];
-        for k in 1..=rings {
-            debug_assert_eq!(vertices.len(), ring_start(k));
-            let r = lerp(0.0, radius, k, rings);
-            for i in 0..=3 * k {
-                let t = std::f64::consts::PI * (1.0 + i as f64 / (3 * k) as f64);
-                // exact ends on the flat side, so that it is one straight line
-                let y = if i == 0 || i == 3 * k {
-                    radius
-                } else {
-                    radius + r * t.sin()
-                };
-                vertices.push([r * t.cos(), y]);
-            }
-        }
-        let vertex = |k: usize, i: usize| if k == 0 { 0 } else { ring_start(k) + i };
-        let mut cells = Vec::with_capacity(3 * rings * rings);
-        for i in 0..3 {
-            cells.push([0, vertex(1, i), vertex(1, i + 1)]);
-        }
-        for k in 2..=rings {
-            let (n_in, n_out) = (3 * (k - 1), 3 * k);
-            let (mut p, mut q) = (0, 0);
-            while p < n_in || q < n_out {
-                let step_outer = p == n_in || (q < n_out && (q + 1) * n_in <= (p + 1) * n_out);
-                if step_outer {
-                    cells.push([vertex(k - 1, p), vertex(k, q), vertex(k, q + 1)]);
-                    q += 1;
-                } else {
-                    cells.push([vertex(k - 1, p), vertex(k, q), vertex(k - 1, p + 1)]);
-                    p += 1;
-                }
-            }
-        }
-        let mut markers: Vec<(usize, usize, u32)> = (0..3 * rings)
-            .map(|i| (vertex(rings, i), vertex(rings, i + 1), 1))
-            .collect();
-        for k in 1..=rings {
-            markers.push((vertex(k - 1, 0), vertex(k, 0), 2));
-            let last_in = if k == 1 { 0 } else { 3 * (k - 1) };
-            markers.push((vertex(k - 1, last_in), vertex(k, 3 * k), 2));
-        }
-        Self::new(vertices, cells, &markers)?.with_boundary_names(&[("arc", &[1]), ("top", &[2])])
+        lower_sector(radius, rings, false)
+    }
+
+    /// The lower right quarter `x ≥ 0` of [`TriangleMesh::half_disk`]: the symmetric
+    /// half of the Hertz cylinder, whose rigid motions the symmetry line removes
+    /// (`u_x = 0` on it). Ring `k` has `⌈3k/2⌉` segments from angle 3π/2 to 2π.
+    /// Boundary parts: `arc` (marker 1), `top` (marker 2, `y = radius`) and `axis`
+    /// (marker 3, the symmetry line `x = 0`).
+    ///
+    /// # Errors
+    /// As [`TriangleMesh::half_disk`].
+    pub fn quarter_disk(radius: f64, rings: usize) -> Result<Self> {
+        lower_sector(radius, rings, true)
     }
 
     /// Refines by newest-vertex bisection until every cell's diameter is at most the
@@ -241,6 +276,29 @@ mod tests {
         }
         assert!(TriangleMesh::half_disk(0.0, 4).is_err());
         assert!(TriangleMesh::half_disk(1.0, 0).is_err());
+    }
+
+    #[test]
+    fn the_quarter_disk_is_half_the_half_disk_with_its_axis() {
+        for rings in [1, 2, 3, 8] {
+            let m = TriangleMesh::quarter_disk(1.0, rings).unwrap();
+            let area: f64 = (0..m.cell_count()).map(|c| m.area(c)).sum();
+            let n = (3 * rings).div_ceil(2);
+            let polygon = 0.5 * n as f64 * (std::f64::consts::FRAC_PI_2 / n as f64).sin();
+            assert!((area - polygon).abs() < 1e-12, "{rings}: {area} {polygon}");
+            assert_eq!(m.boundary_part_names(), ["arc", "top", "axis"]);
+            for &(e, marker) in m.boundary_edges() {
+                for v in m.edges()[e] {
+                    let [x, y] = m.vertices()[v];
+                    match marker {
+                        1 => assert!((x.hypot(y - 1.0) - 1.0).abs() < 1e-14),
+                        2 => assert_eq!(y, 1.0),
+                        _ => assert_eq!(x, 0.0),
+                    }
+                }
+            }
+            assert!(m.boundary_edges().iter().all(|e| e.1 != 0));
+        }
     }
 
     #[test]

@@ -1,0 +1,557 @@
+//! The Signorini contact scenes (MODELS.md §7, issue 14; docs/contact.md): an elastic
+//! body on a rigid foundation, frictionless, the contact pressure a P0 multiplier on the
+//! edges of the potential contact boundary, stabilized (`α = 1/(2 max_E C_I,E)` by
+//! default). `signorini-patch` checks λ_h = q; `hertz` compares the pressure with
+//! Hertz's (half-width, peak, relative L² error against the best P0 fit) and hosts
+//! the `convergence` and `alpha` studies.
+
+use crate::models::contact_scenes::{ContactBody, ContactScene};
+use crate::models::hertz::HertzLineContact;
+use crate::models::signorini::{solve_signorini, Displacement, SignoriniInput};
+use crate::plot::{self, Axes, Series};
+use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
+use serde::Serialize;
+use std::path::Path;
+
+/// The largest `--mesh-size`: N of the block's N×N×2 mesh (2N×N on the scene's 2:1
+/// block), `b/h` of Hertz's graded mesh.
+pub const MAX_CONTACT_MESH_SIZE: usize = 512;
+
+/// An element pair of the contact scenes: displacement, multiplier.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactPair {
+    /// `u ∈ [P1]²`, λ P0 on the edges of Γ_C.
+    P1P0,
+    /// `u ∈ [P2]²`, λ P0 on the edges of Γ_C.
+    P2P0,
+}
+
+impl ContactPair {
+    /// Both pairs, the default first.
+    pub const ALL: [ContactPair; 2] = [ContactPair::P1P0, ContactPair::P2P0];
+
+    /// The pair's name (`--pair`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactPair::P1P0 => "p1-p0",
+            ContactPair::P2P0 => "p2-p0",
+        }
+    }
+
+    /// The pair called `name`.
+    ///
+    /// # Errors
+    /// [`Error::Input`] listing the pairs for another name.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name() == name)
+            .ok_or_else(|| Error::Input(format!("unknown contact pair `{name}` (p1-p0, p2-p0)")))
+    }
+
+    fn displacement(self) -> Displacement {
+        match self {
+            ContactPair::P1P0 => Displacement::P1,
+            ContactPair::P2P0 => Displacement::P2,
+        }
+    }
+}
+
+/// One contact solve: the scene and what the command line may change.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactRequest {
+    /// The scene.
+    pub scene: ContactScene,
+    /// The pair.
+    pub pair: ContactPair,
+    /// N of the block's mesh, or the cylinder's `b/h`.
+    pub mesh_size: usize,
+    /// The block's top pressure q, or the cylinder's resultant P.
+    pub load: f64,
+    /// α; `None`: `1/(2 max_E C_I,E)`; `Some(0)`: the plain mixed method (a QP).
+    pub alpha: Option<f64>,
+}
+
+impl ContactRequest {
+    /// The scene's defaults with P1–P0.
+    pub fn new(scene: ContactScene) -> Self {
+        Self {
+            scene,
+            pair: ContactPair::P1P0,
+            mesh_size: scene.mesh_size,
+            load: scene.load,
+            alpha: None,
+        }
+    }
+
+    /// Checks the request.
+    ///
+    /// # Errors
+    /// [`Error::Input`] naming the value at fault: a mesh size outside
+    /// `1..=`[`MAX_CONTACT_MESH_SIZE`], a load that is not positive and finite (a
+    /// negative one pulls the body off the foundation, where nothing holds it).
+    pub fn validate(&self) -> Result<()> {
+        if self.mesh_size == 0 || self.mesh_size > MAX_CONTACT_MESH_SIZE {
+            return Err(Error::Input(format!(
+                "mesh size {} must lie in 1..={MAX_CONTACT_MESH_SIZE}",
+                self.mesh_size
+            )));
+        }
+        if !(self.load.is_finite() && self.load > 0.0 && self.load <= 1e100) {
+            return Err(Error::Input(format!(
+                "load {} must be positive and finite (≤ 1e100): the body only rests on the foundation, a pull lifts it off and nothing holds it then",
+                crate::number(self.load)
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// What a contact solve reports (`--json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ContactReport {
+    /// Scene name.
+    pub scene: String,
+    /// Pair name.
+    pub pair: &'static str,
+    /// N (block) or b/h (cylinder).
+    pub mesh_size: usize,
+    /// Cells of the mesh (the cylinder: its symmetric half).
+    pub cells: usize,
+    /// q (block) or P (cylinder).
+    pub load: f64,
+    /// The stabilization parameter used.
+    pub alpha: f64,
+    /// `max_E C_I,E` over the contact edges, from the model's kernels.
+    pub inverse_constant: f64,
+    /// Unknowns of the LCP (free displacements and contact pressures).
+    pub dofs: usize,
+    /// Edges of Γ_C (one pressure each).
+    pub contact_edges: usize,
+    /// Solver iterations (semismooth Newton; the QP's for α = 0).
+    pub iterations: usize,
+    /// Wall time of the solve, seconds.
+    pub seconds: f64,
+    /// The vertical force of the foundation on the body (the whole cylinder: twice the
+    /// symmetric half's), force per unit length.
+    pub total_contact_force: f64,
+    /// The applied vertical load, likewise.
+    pub applied_load: f64,
+    /// `|total_contact_force − applied_load| / applied_load`: 0 to solver precision (a
+    /// rigid translation lies in V_h, so equilibrium is exact).
+    pub equilibrium_residual: f64,
+    /// Half the extent along x of the edges carrying pressure (their far ends; the
+    /// cylinder from its axis).
+    pub contact_half_width: f64,
+    /// The largest contact pressure λ_E.
+    pub max_contact_pressure: f64,
+    /// Hertz's half-width b (cylinder).
+    pub exact_half_width: Option<f64>,
+    /// Hertz's peak pressure p_max (cylinder).
+    pub exact_max_pressure: Option<f64>,
+    /// `‖p − λ_h‖ / ‖p‖` against Hertz's pressure (cylinder; the edges projected on x).
+    pub pressure_l2_error: Option<f64>,
+    /// The same error of the best P0 fit on the same edges (the L² projection of p):
+    /// the floor of any P0 multiplier.
+    pub best_p0_l2_error: Option<f64>,
+    /// `max_E |λ_E − q| / q` (the block: 0 exactly for a correct method).
+    pub patch_pressure_error: Option<f64>,
+    /// The complementarity part of the KKT residual (relative).
+    pub complementarity_residual: f64,
+    /// The solver's KKT residual.
+    pub kkt_residual: f64,
+}
+
+/// The contact pressure per edge along x: `(x0, x1, λ_E)` sorted by x0.
+pub type PressureProfile = Vec<(f64, f64, f64)>;
+
+/// Solves `request`.
+///
+/// # Errors
+/// [`Error::Input`] for an invalid request or scene (E ≤ 0, ν outside (−1, ½), α < 0);
+/// the mesh generator's and the solver's errors.
+pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile)> {
+    request.validate()?;
+    let s = &request.scene;
+    let q = request.load;
+    let n = request.mesh_size;
+    let no_gap = |_: &[f64]| 0.0;
+    let (mesh, hertz, symmetric) = match s.body {
+        ContactBody::Block { width, height } => {
+            let nx = ((width / height).round() as usize).max(1) * n;
+            let mesh = TriangleMesh::rectangle(0.0, width, 0.0, height, nx, n, Diagonal::Right)?;
+            (mesh, None, false)
+        }
+        ContactBody::Cylinder { .. } => {
+            let hertz = s.hertz(q).expect("a cylinder has a Hertz reference");
+            (hertz.graded_mesh(n as f64)?, Some(hertz), true)
+        }
+    };
+    // the block: contact bottom (1), load top (3), roller left (4); the quarter disc:
+    // contact arc (1), load top (2), symmetry axis (3)
+    let (contact, load, fixed_x): (&[u32], &[u32], &[u32]) = match s.body {
+        ContactBody::Block { .. } => (&[1], &[3], &[4]),
+        ContactBody::Cylinder { .. } => (&[1], &[2], &[3]),
+    };
+    let top_pressure = match s.body {
+        ContactBody::Block { .. } => q,
+        // the half model carries P/2 on its top of length R
+        ContactBody::Cylinder { radius } => q / (2.0 * radius),
+    };
+    let pressure = move |_: &[f64]| top_pressure;
+    let radius = match s.body {
+        ContactBody::Cylinder { radius } => radius,
+        ContactBody::Block { .. } => 1.0,
+    };
+    // the distance from the arc to the plane y = 0 along the body's outward normal
+    // n = (x, y − R)/R: y R/(R − y); beyond R it cannot close, so it is capped there
+    let cylinder_gap = move |x: &[f64]| {
+        let y = x[1].max(0.0);
+        if radius - y <= y {
+            radius
+        } else {
+            (y * radius / (radius - y)).min(radius)
+        }
+    };
+    let gap: &fem_runtime::DataFn = if symmetric { &cylinder_gap } else { &no_gap };
+    let input = SignoriniInput {
+        young: s.young,
+        poisson: s.poisson,
+        plane: s.plane,
+        element: request.pair.displacement(),
+        contact,
+        load,
+        pressure: &pressure,
+        gap,
+        fixed_x,
+        fixed_y: &[],
+        alpha: request.alpha,
+    };
+    let solution = solve_signorini(&mesh, &input)?;
+    let factor = if symmetric { 2.0 } else { 1.0 };
+    let largest = solution.max_contact_pressure;
+    let mut profile: PressureProfile = solution
+        .contact_edges
+        .iter()
+        .zip(&solution.pressure)
+        .map(|(e, &p)| {
+            let (a, b) = (e.ends[0][0], e.ends[1][0]);
+            (a.min(b), a.max(b), p)
+        })
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let pressed = profile.iter().filter(|e| e.2 > 1e-10 * largest);
+    let (lo, hi) = pressed.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| {
+        (lo.min(e.0), hi.max(e.1))
+    });
+    let contact_half_width = match (hi >= lo, symmetric) {
+        (false, _) => 0.0,
+        (true, true) => hi,
+        (true, false) => 0.5 * (hi - lo),
+    };
+    let (pressure_l2_error, best_p0_l2_error) = match &hertz {
+        Some(h) => {
+            // mirror the half model's edges to the whole contact zone
+            let mut intervals = Vec::with_capacity(2 * profile.len());
+            let mut values = Vec::with_capacity(2 * profile.len());
+            for &(x0, x1, p) in &profile {
+                intervals.extend([[x0, x1], [-x1, -x0]]);
+                values.extend([p, p]);
+            }
+            (
+                Some(h.relative_l2_error_p0(&intervals, &values)),
+                Some(h.best_p0_relative_l2_error(&intervals)),
+            )
+        }
+        None => (None, None),
+    };
+    let total = factor * solution.total_contact_force[1];
+    let applied = -factor * solution.applied_load[1];
+    let report = ContactReport {
+        scene: s.name.to_string(),
+        pair: request.pair.name(),
+        mesh_size: n,
+        cells: mesh.cell_count(),
+        load: q,
+        alpha: solution.alpha,
+        inverse_constant: solution
+            .inverse_constants
+            .iter()
+            .fold(0.0f64, |m, &c| m.max(c)),
+        dofs: solution.dofs,
+        contact_edges: solution.contact_edges.len(),
+        iterations: solution.iterations,
+        seconds: solution.seconds,
+        total_contact_force: total,
+        applied_load: applied,
+        equilibrium_residual: (total - applied).abs() / applied.abs(),
+        contact_half_width,
+        max_contact_pressure: largest,
+        exact_half_width: hertz.map(|h| h.half_width()),
+        exact_max_pressure: hertz.map(|h| h.max_pressure()),
+        pressure_l2_error,
+        best_p0_l2_error,
+        patch_pressure_error: (!symmetric).then(|| {
+            solution
+                .pressure
+                .iter()
+                .fold(0.0f64, |m, &p| m.max((p - q).abs() / q))
+        }),
+        complementarity_residual: solution.complementarity_residual,
+        kkt_residual: solution.kkt_residual,
+    };
+    Ok((report, profile))
+}
+
+/// One line for a report (`solve` without `--json`).
+pub fn summary(r: &ContactReport) -> String {
+    let mut line = format!(
+        "{} {} mesh size {} ({} cells): α {:.3e}, {} dofs, {} contact edges, total contact force {:.9e} (load {:.9e}, equilibrium residual {:.1e}), contact half-width {:.6e}, max pressure {:.6e}",
+        r.scene,
+        r.pair,
+        r.mesh_size,
+        r.cells,
+        r.alpha,
+        r.dofs,
+        r.contact_edges,
+        r.total_contact_force,
+        r.applied_load,
+        r.equilibrium_residual,
+        r.contact_half_width,
+        r.max_contact_pressure
+    );
+    if let (Some(b), Some(p), Some(e), Some(best)) = (
+        r.exact_half_width,
+        r.exact_max_pressure,
+        r.pressure_l2_error,
+        r.best_p0_l2_error,
+    ) {
+        line += &format!(
+            " (Hertz b {b:.6e}, p_max {p:.6e}); pressure L² error {e:.3e} (best P0 fit {best:.3e}, ratio {:.2})",
+            e / best
+        );
+    }
+    if let Some(e) = r.patch_pressure_error {
+        line += &format!("; max |λ_h − q|/q {e:.1e}");
+    }
+    line += &format!(
+        ", {} iterations, complementarity {:.1e}, {:.3} s",
+        r.iterations, r.complementarity_residual, r.seconds
+    );
+    line
+}
+
+/// The pressure profile as a step curve for a chart.
+fn steps(profile: &PressureProfile) -> Vec<(f64, f64)> {
+    profile
+        .iter()
+        .flat_map(|&(x0, x1, p)| [(x0, p), (x1, p)])
+        .collect()
+}
+
+/// Writes `out/<scene>-pressure.svg`: λ_h against Hertz's p(x) over `0 ≤ x ≤ 1.5 b`.
+///
+/// # Errors
+/// [`Error::Input`] for a scene without a Hertz reference; I/O errors.
+pub fn pressure_chart(
+    out: &Path,
+    report: &ContactReport,
+    curves: &[(String, &PressureProfile)],
+    hertz: &HertzLineContact,
+) -> Result<std::path::PathBuf> {
+    std::fs::create_dir_all(out).map_err(crate::studies::io)?;
+    let b = hertz.half_width();
+    let path = out.join(format!("{}-pressure.svg", report.scene));
+    let exact: Vec<(f64, f64)> = (0..=300)
+        .map(|i| {
+            let x = 1.5 * b * i as f64 / 300.0;
+            (x, hertz.pressure(x))
+        })
+        .collect();
+    let mut series = vec![Series::line("Hertz p(x)", exact)];
+    for (name, profile) in curves {
+        let clipped: PressureProfile = profile.iter().copied().filter(|e| e.0 <= 1.5 * b).collect();
+        series.push(Series::line(name.clone(), steps(&clipped)));
+    }
+    plot::chart(
+        &path,
+        &format!(
+            "{}: contact pressure, b/h = {}",
+            report.scene, report.mesh_size
+        ),
+        Axes {
+            x: "x",
+            y: "pressure",
+            ..Axes::default()
+        },
+        &series,
+    )
+    .map_err(crate::studies::io)?;
+    Ok(path)
+}
+
+/// The `alpha` study of a Hertz scene: α·max C_I from 0 (the plain method) to 2.5 at
+/// one b/h, the pressure error and its oscillation (the largest jump between
+/// neighbouring edges' pressures relative to p_max, inside the contact zone), and the
+/// chart of the plain, the automatic and a too-large α against Hertz.
+///
+/// # Errors
+/// As [`solve`]; I/O errors.
+pub fn alpha_study(scene: ContactScene, b_over_h: usize, out: &Path) -> Result<()> {
+    let mut request = ContactRequest::new(scene);
+    request.mesh_size = b_over_h;
+    let (auto, auto_profile) = solve(&request)?;
+    let hertz = scene
+        .hertz(request.load)
+        .ok_or_else(|| Error::Input(format!("`{}` has no Hertz reference", scene.name)))?;
+    let c_i = auto.inverse_constant;
+    println!(
+        "\nalpha: {}, b/h = {b_over_h}, α·max C_I (automatic: 0.5), relative L² error of the pressure and its oscillation",
+        scene.name
+    );
+    println!(
+        "{:>8} {:>11} {:>10} {:>10} {:>11} {:>6}",
+        "α·C_I", "α", "L² error", "best P0", "oscillation", "iter"
+    );
+    let mut csv = String::from("alpha_c_i,alpha,l2_error,best_p0,oscillation,iterations\n");
+    let mut profiles = Vec::new();
+    for fraction in [0.0, 0.01, 0.1, 0.25, 0.5, 1.0, 1.5, 1.9, 2.5] {
+        request.alpha = Some(fraction / c_i);
+        match solve(&request) {
+            Ok((r, profile)) => {
+                let oscillation = oscillation(&profile, hertz.half_width()) / hertz.max_pressure();
+                let e = r.pressure_l2_error.unwrap_or(f64::NAN);
+                let best = r.best_p0_l2_error.unwrap_or(f64::NAN);
+                println!(
+                    "{fraction:>8} {:>11.3e} {e:>10.3e} {best:>10.3e} {oscillation:>11.3e} {:>6}",
+                    r.alpha, r.iterations
+                );
+                csv += &format!(
+                    "{fraction},{:e},{e:e},{best:e},{oscillation:e},{}\n",
+                    r.alpha, r.iterations
+                );
+                if fraction == 0.0 || fraction == 2.5 {
+                    profiles.push((format!("α·C_I = {fraction}"), profile));
+                }
+            }
+            Err(e) => {
+                println!("{fraction:>8} {:>11.3e} failed: {e}", fraction / c_i);
+                csv += &format!("{fraction},{:e},,,,\n", fraction / c_i);
+            }
+        }
+    }
+    std::fs::create_dir_all(out).map_err(crate::studies::io)?;
+    let csv_path = out.join(format!("{}-alpha.csv", scene.name));
+    std::fs::write(&csv_path, csv).map_err(crate::studies::io)?;
+    let mut curves: Vec<(String, &PressureProfile)> =
+        vec![("automatic α·C_I = 0.5".to_string(), &auto_profile)];
+    curves.extend(profiles.iter().map(|(n, p)| (n.clone(), p)));
+    let path = pressure_chart(out, &auto, &curves, &hertz)?;
+    let target = out.join(format!("{}-alpha.svg", scene.name));
+    std::fs::rename(&path, &target).map_err(crate::studies::io)?;
+    println!("→ {}, {}", target.display(), csv_path.display());
+    Ok(())
+}
+
+/// The largest jump between neighbouring edges' pressures with both inside
+/// `[0, 0.8 b]` (where the exact pressure is smooth and varies by less than
+/// p_max·h/b·…): a checkerboard shows as jumps of the size of the pressure itself.
+fn oscillation(profile: &PressureProfile, b: f64) -> f64 {
+    profile
+        .windows(2)
+        .filter(|w| w[1].1 <= 0.8 * b)
+        .map(|w| (w[1].2 - w[0].2).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The `convergence` study of a Hertz scene: b/h = 8, 16, 32, 64 (`full`: to 128),
+/// half-width, peak and the pressure's L² error against the best P0 fit, per pair.
+///
+/// # Errors
+/// As [`solve`]; I/O errors.
+pub fn convergence_study(scene: ContactScene, full: bool, out: &Path) -> Result<()> {
+    let sizes: &[usize] = if full {
+        &[8, 16, 32, 64, 128]
+    } else {
+        &[8, 16, 32, 64]
+    };
+    println!(
+        "\nconvergence: {}, pressure against Hertz per b/h (relative errors)",
+        scene.name
+    );
+    println!(
+        "{:>6} {:>5} {:>7} {:>8} {:>10} {:>10} {:>10} {:>10} {:>6} {:>8}",
+        "pair",
+        "b/h",
+        "cells",
+        "dofs",
+        "b error",
+        "p_max err",
+        "L² error",
+        "best P0",
+        "iter",
+        "seconds"
+    );
+    let mut csv = String::from(
+        "pair,b_over_h,cells,dofs,half_width_error,max_pressure_error,l2_error,best_p0,iterations,seconds\n",
+    );
+    let mut series = Vec::new();
+    let mut best_series = Vec::new();
+    for pair in ContactPair::ALL {
+        let mut points = Vec::new();
+        for &n in sizes {
+            let mut request = ContactRequest::new(scene);
+            request.pair = pair;
+            request.mesh_size = n;
+            let (r, _) = solve(&request)?;
+            let b = r.exact_half_width.unwrap_or(f64::NAN);
+            let p = r.exact_max_pressure.unwrap_or(f64::NAN);
+            let (eb, ep) = (
+                (r.contact_half_width - b) / b,
+                (r.max_contact_pressure - p) / p,
+            );
+            let e = r.pressure_l2_error.unwrap_or(f64::NAN);
+            let best = r.best_p0_l2_error.unwrap_or(f64::NAN);
+            println!(
+                "{:>6} {n:>5} {:>7} {:>8} {eb:>+10.2e} {ep:>+10.2e} {e:>10.3e} {best:>10.3e} {:>6} {:>8.3}",
+                pair.name(),
+                r.cells,
+                r.dofs,
+                r.iterations,
+                r.seconds
+            );
+            csv += &format!(
+                "{},{n},{},{},{eb:e},{ep:e},{e:e},{best:e},{},{}\n",
+                pair.name(),
+                r.cells,
+                r.dofs,
+                r.iterations,
+                r.seconds
+            );
+            points.push((n as f64, e));
+            if pair == ContactPair::P1P0 {
+                best_series.push((n as f64, best));
+            }
+        }
+        series.push(Series::marked(format!("{} λ_h", pair.name()), points));
+    }
+    series.push(Series::marked("best P0 fit", best_series));
+    std::fs::create_dir_all(out).map_err(crate::studies::io)?;
+    let csv_path = out.join(format!("{}-convergence.csv", scene.name));
+    std::fs::write(&csv_path, csv).map_err(crate::studies::io)?;
+    let svg = out.join(format!("{}-convergence.svg", scene.name));
+    plot::chart(
+        &svg,
+        &format!("{}: relative L² error of the contact pressure", scene.name),
+        Axes {
+            x: "b/h",
+            y: "‖p − λ_h‖/‖p‖",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )
+    .map_err(crate::studies::io)?;
+    println!("→ {}, .csv", svg.display());
+    Ok(())
+}
