@@ -593,3 +593,70 @@ fn table_entries(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn term(coefficient: f64, test: [u8; 2], trial: [u8; 2]) -> Term {
+        Term {
+            coefficient,
+            params: vec![],
+            h_power: 0,
+            divisors: vec![],
+            data: vec![],
+            test_derivative: test,
+            trial_derivative: Some(trial),
+            quadrature_degree: None,
+        }
+    }
+
+    fn block(terms: Vec<Term>) -> Block {
+        Block {
+            test_field: 0,
+            trial_field: Some(0),
+            terms,
+        }
+    }
+
+    const X: [u8; 2] = [1, 0];
+    const Y: [u8; 2] = [0, 1];
+    const VALUE: [u8; 2] = [0, 0];
+
+    #[test]
+    fn symmetry_is_decided_on_the_terms() {
+        // ∫ ∇w·∇v, and ∫ ∂x w ∂y v + ∂y w ∂x v: symmetric
+        assert!(is_symmetric(&block(vec![term(1.0, X, X), term(1.0, Y, Y)])));
+        assert!(is_symmetric(&block(vec![term(2.0, X, Y), term(2.0, Y, X)])));
+        // ∫ ∂x w v (trial ∂x, test value) and ∫ ∂x w ∂y v alone: not symmetric
+        assert!(!is_symmetric(&block(vec![term(1.0, VALUE, X)])));
+        assert!(!is_symmetric(&block(vec![term(1.0, Y, X)])));
+        // the swapped term with another coefficient, parameter or datum: not symmetric
+        assert!(!is_symmetric(&block(vec![term(2.0, X, Y), term(1.0, Y, X)])));
+        let mut with_param = term(1.0, Y, X);
+        with_param.params = vec![(0, 1)];
+        assert!(!is_symmetric(&block(vec![term(1.0, X, Y), with_param])));
+        let mut with_data = term(1.0, Y, X);
+        with_data.data = vec![0];
+        assert!(!is_symmetric(&block(vec![term(1.0, X, Y), with_data])));
+        // equal factors are summed first: 1 + 1 against 2 is symmetric
+        assert!(is_symmetric(&block(vec![
+            term(1.0, X, Y),
+            term(1.0, X, Y),
+            term(2.0, Y, X)
+        ])));
+        // a symmetric part does not hide a non-symmetric one
+        assert!(!is_symmetric(&block(vec![
+            term(1.0, X, X),
+            term(1.0, VALUE, X)
+        ])));
+        // blocks of two fields and linear forms are never symmetric
+        let mut two_fields = block(vec![term(1.0, X, X)]);
+        two_fields.trial_field = Some(1);
+        assert!(!is_symmetric(&two_fields));
+        let mut linear = block(vec![term(1.0, X, X)]);
+        linear.trial_field = None;
+        linear.terms[0].trial_derivative = None;
+        assert!(!is_symmetric(&linear));
+    }
+}
