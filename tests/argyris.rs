@@ -719,9 +719,9 @@ fn non_symmetric_diagonal_blocks_are_right() {
         let asymmetry = |k: &[[f64; 21]]| {
             let scale = k.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
             let mut worst = 0.0f64;
-            for i in 0..k.len() {
-                for j in 0..k.len() {
-                    worst = worst.max((k[i][j] - k[j][i]).abs());
+            for (i, row) in k.iter().enumerate() {
+                for (j, &v) in row.iter().enumerate() {
+                    worst = worst.max((v - k[j][i]).abs());
                 }
             }
             worst / scale

@@ -574,8 +574,15 @@ fn table_entries(
         .iter()
         .enumerate()
         .map(|(n, t)| quote!(let #t = &TABLES[#n][o..o + n];));
-    let terms = tables.iter().zip(&names).map(|((s, _), t)| quote!(#s * #t[j]));
-    let start = if has_data { quote!(row[j] + ) } else { quote!() };
+    let terms = tables
+        .iter()
+        .zip(&names)
+        .map(|((s, _), t)| quote!(#s * #t[j]));
+    let start = if has_data {
+        quote!(row[j] + )
+    } else {
+        quote!()
+    };
     let first = if symmetric { quote!(i) } else { quote!(0) };
     quote! {
         {
@@ -632,7 +639,10 @@ mod tests {
         assert!(!is_symmetric(&block(vec![term(1.0, VALUE, X)])));
         assert!(!is_symmetric(&block(vec![term(1.0, Y, X)])));
         // the swapped term with another coefficient, parameter or datum: not symmetric
-        assert!(!is_symmetric(&block(vec![term(2.0, X, Y), term(1.0, Y, X)])));
+        assert!(!is_symmetric(&block(vec![
+            term(2.0, X, Y),
+            term(1.0, Y, X)
+        ])));
         let mut with_param = term(1.0, Y, X);
         with_param.params = vec![(0, 1)];
         assert!(!is_symmetric(&block(vec![term(1.0, X, Y), with_param])));

@@ -123,17 +123,27 @@ pub fn transform_symmetric_element_matrix<const N: usize>(
         return poison(k);
     };
     b.apply_left(k, false);
-    for i in 0..N {
-        for j in i + 1..N {
-            let v = k[i][j];
-            k[i][j] = k[j][i];
-            k[j][i] = v;
+    transpose(k);
+    b.apply_left(k, true);
+    mirror_upper(k);
+}
+
+/// `k ← kᵀ` in place.
+fn transpose<const N: usize>(k: &mut [[f64; N]; N]) {
+    for i in 1..N {
+        let (upper, lower) = k.split_at_mut(i);
+        for (j, row) in upper.iter_mut().enumerate() {
+            std::mem::swap(&mut row[i], &mut lower[0][j]);
         }
     }
-    b.apply_left(k, true);
+}
+
+/// The entries below the diagonal from those above it.
+fn mirror_upper<const N: usize>(k: &mut [[f64; N]; N]) {
     for i in 1..N {
-        for j in 0..i {
-            k[i][j] = k[j][i];
+        let (upper, lower) = k.split_at_mut(i);
+        for (target, row) in lower[0].iter_mut().zip(upper.iter()) {
+            *target = row[i];
         }
     }
 }
@@ -173,7 +183,8 @@ pub struct CompactTransformation {
 const SORTED_EDGES: [[usize; 2]; 3] = [[0, 1], [1, 2], [0, 2]];
 
 /// Per local vertex: its two edges and its end (0: lower, 1: higher local vertex) in each.
-const VERTEX_EDGES: [[(usize, usize); 2]; 3] = [[(0, 0), (2, 0)], [(0, 1), (1, 0)], [(1, 1), (2, 1)]];
+const VERTEX_EDGES: [[(usize, usize); 2]; 3] =
+    [[(0, 0), (2, 0)], [(0, 1), (1, 0)], [(1, 1), (2, 1)]];
 
 impl CompactTransformation {
     /// Whether `element` has a compact form here (Argyris, Morley).
@@ -766,12 +777,8 @@ mod tests {
                 transform_element_matrix(a, Some(a), &x, global, &mut got);
                 transform_element_matrix_dense(a, Some(a), &x, global, &mut want);
                 assert_close(&got, &want, "Argyris × Argyris");
-                let mut symmetric = k0;
-                for i in 0..21 {
-                    for j in 0..i {
-                        symmetric[i][j] = symmetric[j][i];
-                    }
-                }
+                let symmetric: [[f64; 21]; 21] =
+                    std::array::from_fn(|i| std::array::from_fn(|j| k0[i.min(j)][i.max(j)]));
                 let (mut got, mut want) = (symmetric, symmetric);
                 transform_symmetric_element_matrix(a, &x, global, &mut got);
                 transform_element_matrix_dense(a, Some(a), &x, global, &mut want);
@@ -782,12 +789,8 @@ mod tests {
             transform_element_matrix(m, Some(m), &x, global, &mut got);
             transform_element_matrix_dense(m, Some(m), &x, global, &mut want);
             assert_close(&got, &want, "Morley × Morley");
-            let mut symmetric = k0;
-            for i in 0..6 {
-                for j in 0..i {
-                    symmetric[i][j] = symmetric[j][i];
-                }
-            }
+            let symmetric: [[f64; 6]; 6] =
+                std::array::from_fn(|i| std::array::from_fn(|j| k0[i.min(j)][i.max(j)]));
             let (mut got, mut want) = (symmetric, symmetric);
             transform_symmetric_element_matrix(m, &x, global, &mut got);
             transform_element_matrix_dense(m, Some(m), &x, global, &mut want);
@@ -832,7 +835,13 @@ mod tests {
         transform_element_matrix(ElementKind::Morley, None, &nan, &[0, 1, 2], &mut k);
         assert!(k.iter().flatten().all(|v| v.is_nan()));
         let mut k = [[1.0; 3]; 3];
-        transform_element_matrix(ElementKind::P1, Some(ElementKind::P1), &flat, &[0, 1, 2], &mut k);
+        transform_element_matrix(
+            ElementKind::P1,
+            Some(ElementKind::P1),
+            &flat,
+            &[0, 1, 2],
+            &mut k,
+        );
         assert_eq!(k, [[1.0; 3]; 3]);
     }
 
