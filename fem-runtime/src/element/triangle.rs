@@ -282,8 +282,10 @@ impl CompactTransformation {
         }
     }
 
-    /// The entry `M[i][l] = B[l][i]` (dense access, for tests and checks).
-    pub fn entry(&self, i: usize, l: usize) -> f64 {
+    /// The entry `M[i][l] = B[l][i]`, through [`apply_left`](Self::apply_left) on the
+    /// unit vector `e_l` (for the tests against `cell_transformation`).
+    #[cfg(test)]
+    fn entry(&self, i: usize, l: usize) -> f64 {
         let mut e = [0.0; 21];
         e[l] = 1.0;
         let mut rows = [[0.0; 1]; 21];
