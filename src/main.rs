@@ -803,16 +803,23 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
                 names().join(", ")
             ));
         }
-        if Study::parse(name).is_none() {
-            return Err(format!(
-                "unknown study or scene `{name}`; the studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
-                Study::ALL.map(Study::name).join(", ")
-            ));
-        }
+        // every study some scene hosts, the families' own (lambda-scatter, …) included
         let hosts: Vec<SceneEntry> = registry()
             .into_iter()
             .filter(|e| e.studies.contains(&name))
             .collect();
+        if hosts.is_empty() {
+            let mut kinds: Vec<&str> = registry()
+                .iter()
+                .flat_map(|e| e.studies.iter().copied())
+                .collect();
+            kinds.sort_unstable();
+            kinds.dedup();
+            return Err(format!(
+                "unknown study or scene `{name}`; the studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
+                kinds.join(", ")
+            ));
+        }
         for entry in &hosts {
             run_study(entry, name, full, out)?;
         }

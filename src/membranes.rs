@@ -709,14 +709,21 @@ pub fn dirichlet_part(
     mesh: &TriangleMesh,
     domain: &str,
 ) -> Result<DirichletPart> {
-    let DirichletParts::Named(names) = &scene.dirichlet else {
-        return Ok(DirichletPart::All);
-    };
     let at = |message: String| {
         Error::Input(format!(
             "scene `{}`: field `boundary.dirichlet`: {message}",
             scene.name
         ))
+    };
+    // `"all"` is the keyword for the whole boundary: a mesh with a boundary part of that
+    // name would make `"all"` and `["all"]` mean different sets under one printed name
+    if mesh.boundary_part_names().contains(&"all") {
+        return Err(at(format!(
+            "the mesh ({domain}) has a boundary part named `all`, which is also the keyword for the whole boundary: rename the Gmsh physical group (e.g. Physical Curve(\"outer\")) so that the choice is unambiguous"
+        )));
+    }
+    let DirichletParts::Named(names) = &scene.dirichlet else {
+        return Ok(DirichletPart::All);
     };
     if names.is_empty() {
         return Err(at(
