@@ -54,6 +54,36 @@ impl DirichletPart {
             .count()
     }
 
+    /// The vertices of `mesh` where two edges of the part meet at a turning angle above
+    /// 1e-8 rad (not a straight continuation) and at most `max_turn` rad, with their
+    /// turning angles: where a polygon approximates a curve (docs/elements.md §6,
+    /// Babuška's paradox).
+    pub fn kinks(&self, mesh: &TriangleMesh, max_turn: f64) -> Vec<(usize, f64)> {
+        let mut directions: Vec<Vec<[f64; 2]>> = vec![Vec::new(); mesh.vertex_count()];
+        for &(e, m) in mesh.boundary_edges() {
+            if self.contains(m) {
+                let [a, b] = mesh.edges()[e];
+                let (p, q) = (mesh.vertices()[a], mesh.vertices()[b]);
+                directions[a].push([q[0] - p[0], q[1] - p[1]]);
+                directions[b].push([p[0] - q[0], p[1] - q[1]]);
+            }
+        }
+        let mut out = Vec::new();
+        for (v, d) in directions.iter().enumerate() {
+            if let [d1, d2] = d.as_slice() {
+                // the angle between the two edges leaving v; the turn is its supplement
+                let inner = (d1[0] * d2[1] - d1[1] * d2[0])
+                    .abs()
+                    .atan2(d1[0] * d2[0] + d1[1] * d2[1]);
+                let turn = std::f64::consts::PI - inner;
+                if turn > 1e-8 && turn <= max_turn {
+                    out.push((v, turn));
+                }
+            }
+        }
+        out
+    }
+
     /// For each vertex of `mesh`, whether it lies on an edge of the part (a vertex where
     /// a Dirichlet edge meets a natural one is in the part).
     pub fn vertices(&self, mesh: &TriangleMesh) -> Vec<bool> {
@@ -278,7 +308,19 @@ pub struct Constraints {
     fixed: Vec<(usize, f64)>,
     /// `(first global DOF of the vertex, row, value)`: `row · U_v = value`.
     vertex: Vec<(usize, [f64; VERTEX_DOFS], f64)>,
+    warnings: Vec<String>,
 }
+
+/// The largest turning angle between consecutive edges of a simply supported Argyris
+/// part that [`Constraints::support_plate`] takes for a polygon approximating a curve
+/// (and warns about, [`Constraints::warnings`]): 30°. Real polygonal plates have a few
+/// larger angles (90° for a rectangle, 60° for a hexagon).
+pub const CURVE_TURNING_ANGLE: f64 = std::f64::consts::PI / 6.0;
+
+/// The boundary curve a part of a polygonal mesh approximates, at a vertex `x` of the
+/// part: `(outward unit normal, curvature)`, the curvature positive where the domain is
+/// convex (`1/R` on a disk of radius R). See [`Constraints::support_plate_on_curve`].
+pub type BoundaryCurve<'a> = &'a dyn Fn([f64; 2]) -> ([f64; 2], f64);
 
 impl Constraints {
     /// No constraint.
@@ -407,7 +449,127 @@ impl Constraints {
                 mesh.boundary_edges().len()
             )));
         }
-        self.support_plate_field(mesh, map, offset, part, support)
+        self.support_plate_field(mesh, map, offset, part, support)?;
+        if map.element() == ElementKind::Argyris && support == PlateSupport::SimplySupported {
+            let kinks = part.kinks(mesh, CURVE_TURNING_ANGLE);
+            if let Some(&(v, turn)) = kinks.first() {
+                let x = mesh.vertices()[v];
+                self.warnings.push(format!(
+                    "`{field}` is simply supported on a polygon that looks like a curve ({} vertices where its edges turn by at most {:.0}°, e.g. {:.2}° at ({}, {})): at every such corner w = 0 on both edges fixes the whole gradient, so the Argyris plate converges to the clamped plate, not to the simply supported one of the curve (Babuška's paradox, docs/elements.md §6); support a curved boundary with Constraints::support_plate_on_curve",
+                    kinks.len(),
+                    CURVE_TURNING_ANGLE.to_degrees(),
+                    turn.to_degrees(),
+                    x[0],
+                    x[1]
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Warnings about the supports given so far: a simply supported Argyris part that
+    /// looks like a polygonal approximation of a curve (consecutive edges turning by at
+    /// most [`CURVE_TURNING_ANGLE`]) converges to the wrong plate.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Supports the Argyris field `field` of `M` on `part`, a polygonal approximation
+    /// of the smooth curve `curve` (its outward normal `n` and curvature `κ` at each
+    /// vertex of the part; `t = (−n_y, n_x)`): the conditions of the curve, not of the
+    /// polygon, at each vertex of the part. Simply supported (`w = 0` along the curve):
+    /// `u = 0`, `∂_t u = 0` and `tᵀHt − κ ∂_n u = 0` (the second derivative of `w` along
+    /// the curve, whose acceleration is `−κ n`); `∂_n u` and the rest stay free.
+    /// Clamped (also `∂_n w = 0`): `u = 0`, `∇u = 0`, `tᵀHt = 0`, `nᵀHt = 0` and the
+    /// edges' normal-derivative DOFs. The polygon's corners would fix more (the whole
+    /// gradient, resp. the whole Hessian): with them the simply supported plate converges
+    /// to the clamped one and the clamped one at first order only; with the curve's
+    /// conditions both converge to the plate on the curved domain at second order (the
+    /// polygon's distance from the curve; `tests/plate_supports.rs`). Morley fields take
+    /// [`Constraints::support_plate`] (they fix values and edge DOFs only). Where a
+    /// straight part meets the curve, support it with [`Constraints::support_plate`]:
+    /// the vertex gets the union of both conditions.
+    ///
+    /// # Errors
+    /// As [`Constraints::support_plate`], a field that is not Argyris, and a normal that
+    /// is zero or not finite or a curvature that is not finite at a vertex (the message
+    /// names the vertex).
+    pub fn support_plate_on_curve<M: Model>(
+        &mut self,
+        mesh: &TriangleMesh,
+        dofs: &SystemDofs,
+        field: &str,
+        part: &DirichletPart,
+        support: PlateSupport,
+        curve: BoundaryCurve,
+    ) -> Result<()> {
+        let f = M::field(field)?;
+        let (Some(map), Some(offset)) = (dofs.map(f), dofs.offset(f)) else {
+            return Err(Error::Input(format!(
+                "field `{field}` is not part of this system"
+            )));
+        };
+        if map.element() != ElementKind::Argyris {
+            return Err(Error::Input(format!(
+                "supports on a curve are for Argyris fields, `{field}` is {} (use support_plate)",
+                map.element().name()
+            )));
+        }
+        if part.edge_count(mesh) == 0 {
+            return Err(Error::Input(format!(
+                "the boundary part {part:?} where `{field}` is {support:?} holds none of the mesh's {} boundary edges",
+                mesh.boundary_edges().len()
+            )));
+        }
+        for (v, on) in part.vertices(mesh).into_iter().enumerate() {
+            if !on {
+                continue;
+            }
+            let x = mesh.vertices()[v];
+            let (n, kappa) = curve(x);
+            let length = n[0].hypot(n[1]);
+            if !(length > 0.0 && length.is_finite() && kappa.is_finite()) {
+                return Err(Error::Input(format!(
+                    "the boundary curve of `{field}` at vertex {v} ({}, {}) has normal ({}, {}) and curvature {kappa}: the normal must be finite and nonzero, the curvature finite",
+                    x[0], x[1], n[0], n[1]
+                )));
+            }
+            let n = [n[0] / length, n[1] / length];
+            let t = [-n[1], n[0]];
+            let tt = [0.0, 0.0, 0.0, t[0] * t[0], 2.0 * t[0] * t[1], t[1] * t[1]];
+            let rows: Vec<[f64; VERTEX_DOFS]> = match support {
+                PlateSupport::SimplySupported => vec![
+                    [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                    [0.0, t[0], t[1], 0.0, 0.0, 0.0],
+                    [0.0, -kappa * n[0], -kappa * n[1], tt[3], tt[4], tt[5]],
+                ],
+                PlateSupport::Clamped => vec![
+                    [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+                    tt,
+                    [
+                        0.0,
+                        0.0,
+                        0.0,
+                        n[0] * t[0],
+                        n[0] * t[1] + n[1] * t[0],
+                        n[1] * t[1],
+                    ],
+                ],
+            };
+            let start = offset + map.vertex_dofs(v).start;
+            for row in rows {
+                self.fix_vertex_combination(start, row, 0.0)?;
+            }
+        }
+        if support == PlateSupport::Clamped {
+            let conditions = part.plate_conditions(map, mesh, support)?;
+            for &d in &conditions.dofs {
+                self.fix_dof(offset + d, 0.0)?;
+            }
+        }
+        Ok(())
     }
 
     /// [`Constraints::support_plate`] for the plate field `map` whose DOFs start at
