@@ -209,10 +209,61 @@ pub(crate) fn edge_frame(mesh: &TriangleMesh, e: usize) -> ([f64; 2], [f64; 2]) 
 /// conditions on vertex DOF blocks and DOFs fixed as they are.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct PlateConditions {
-    /// `(first DOF of the vertex, row over its six DOFs)`: `row · U_v = 0`.
-    pub(crate) vertex: Vec<(usize, [f64; 6])>,
-    /// DOFs fixed to zero (Morley vertex values, edge normal-derivative DOFs).
-    pub(crate) dofs: Vec<usize>,
+    /// `(first DOF of the vertex, vertex, row over its six DOFs)`: `row · U_v` is fixed.
+    pub(crate) vertex: Vec<(usize, usize, [f64; 6])>,
+    /// DOFs fixed as they are (Morley vertex values, edge normal-derivative DOFs).
+    pub(crate) dofs: Vec<(usize, PlateFunctional)>,
+}
+
+/// The functional a DOF fixed as it is measures.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum PlateFunctional {
+    /// The value at a vertex.
+    Value(usize),
+    /// The derivative at the midpoint of an edge along its normal `(t_y, −t_x)`, `t`
+    /// the unit vector from its lower to its higher global vertex (the Argyris and
+    /// Morley edge DOF, docs/elements.md §3).
+    EdgeNormal(usize),
+}
+
+/// Boundary data of a plate support: a smooth function `G` near the part, given at a
+/// point `x` as its jet `[G, G_x, G_y, G_xx, G_xy, G_yy]` (the order of the Argyris
+/// vertex DOFs). The support then holds `w = G` on the part and, clamped, also
+/// `∂_n w = ∂_n G`: every fixed functional (value, tangential and normal derivatives,
+/// the curve's second derivative, the edge DOFs) gets its value at `G`. With `G` the
+/// exact solution (a manufactured one) the data are exact; for data given on the
+/// boundary only, extend them (e.g. constantly along the normal).
+pub type PlateData<'a> = &'a dyn Fn([f64; 2]) -> [f64; 6];
+
+/// `data`'s jet at `x`, checked finite.
+fn jet(data: PlateData, x: [f64; 2]) -> Result<[f64; 6]> {
+    let j = data(x);
+    if j.iter().all(|v| v.is_finite()) {
+        Ok(j)
+    } else {
+        Err(Error::Input(format!(
+            "plate boundary data at ({}, {}) are not finite: [G, G_x, G_y, G_xx, G_xy, G_yy] = {j:?}",
+            x[0], x[1]
+        )))
+    }
+}
+
+impl PlateFunctional {
+    /// The functional at `data` on `mesh`.
+    fn at(self, mesh: &TriangleMesh, data: PlateData) -> Result<f64> {
+        match self {
+            PlateFunctional::Value(v) => Ok(jet(data, mesh.vertices()[v])?[0]),
+            PlateFunctional::EdgeNormal(e) => {
+                let [a, b] = mesh.edges()[e];
+                let (a, b) = (a.min(b), a.max(b));
+                let (p, q) = (mesh.vertices()[a], mesh.vertices()[b]);
+                let length = (q[0] - p[0]).hypot(q[1] - p[1]);
+                let t = [(q[0] - p[0]) / length, (q[1] - p[1]) / length];
+                let j = jet(data, [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0])?;
+                Ok(t[1] * j[1] - t[0] * j[2])
+            }
+        }
+    }
 }
 
 impl DirichletPart {
@@ -246,10 +297,10 @@ impl DirichletPart {
                 if argyris {
                     let (t, n) = edge_frame(mesh, e);
                     for row in argyris_edge_rows(support, t, n) {
-                        out.vertex.push((start, row));
+                        out.vertex.push((start, v, row));
                     }
                 } else {
-                    out.dofs.push(start);
+                    out.dofs.push((start, PlateFunctional::Value(v)));
                 }
             }
             if support == PlateSupport::Clamped {
@@ -257,7 +308,10 @@ impl DirichletPart {
                 // the edge's direction), found through a cell as in `dofs`
                 let (c, _) = mesh.edge_cells(e);
                 if let Some(k) = mesh.cell_edges(c).iter().position(|&x| x == e) {
-                    out.dofs.push(map.cell_dofs(c)[3 * per_vertex + k]);
+                    out.dofs.push((
+                        map.cell_dofs(c)[3 * per_vertex + k],
+                        PlateFunctional::EdgeNormal(e),
+                    ));
                 }
             }
         }
@@ -292,7 +346,12 @@ impl DirichletPart {
         support: PlateSupport,
     ) -> Result<Vec<usize>> {
         let mut constraints = Constraints::new();
-        constraints.add_plate_conditions(&self.plate_conditions(map, mesh, support)?, 0)?;
+        constraints.add_plate_conditions(
+            mesh,
+            &self.plate_conditions(map, mesh, support)?,
+            0,
+            None,
+        )?;
         let reduction = constraints.reduction(map.dof_count())?;
         Ok((0..map.dof_count())
             .filter(|&d| reduction.free_index(d).is_none())
@@ -309,6 +368,10 @@ pub struct Constraints {
     /// `(first global DOF of the vertex, row, value)`: `row · U_v = value`.
     vertex: Vec<(usize, [f64; VERTEX_DOFS], f64)>,
     warnings: Vec<String>,
+}
+
+fn dot6(a: &[f64; 6], b: &[f64; 6]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// The largest turning angle between consecutive edges of a simply supported Argyris
@@ -437,6 +500,24 @@ impl Constraints {
         part: &DirichletPart,
         support: PlateSupport,
     ) -> Result<()> {
+        self.support_plate_with_data::<M>(mesh, dofs, field, part, support, None)
+    }
+
+    /// [`Constraints::support_plate`] with boundary data: `w = G` on the part and,
+    /// clamped, `∂_n w = ∂_n G` ([`PlateData`]; `None`: `G = 0`).
+    ///
+    /// # Errors
+    /// As [`Constraints::support_plate`], and data that are not finite at a vertex or
+    /// edge midpoint of the part (the message names the point).
+    pub fn support_plate_with_data<M: Model>(
+        &mut self,
+        mesh: &TriangleMesh,
+        dofs: &SystemDofs,
+        field: &str,
+        part: &DirichletPart,
+        support: PlateSupport,
+        data: Option<PlateData>,
+    ) -> Result<()> {
         let f = M::field(field)?;
         let (Some(map), Some(offset)) = (dofs.map(f), dofs.offset(f)) else {
             return Err(Error::Input(format!(
@@ -449,7 +530,12 @@ impl Constraints {
                 mesh.boundary_edges().len()
             )));
         }
-        self.support_plate_field(mesh, map, offset, part, support)?;
+        self.add_plate_conditions(
+            mesh,
+            &part.plate_conditions(map, mesh, support)?,
+            offset,
+            data,
+        )?;
         if map.element() == ElementKind::Argyris && support == PlateSupport::SimplySupported {
             let kinks = part.kinks(mesh, CURVE_TURNING_ANGLE);
             if let Some(&(v, turn)) = kinks.first() {
@@ -490,10 +576,15 @@ impl Constraints {
     /// straight part meets the curve, support it with [`Constraints::support_plate`]:
     /// the vertex gets the union of both conditions.
     ///
+    /// With `data` ([`PlateData`]) the conditions hold `w = G` (clamped also
+    /// `∂_n w = ∂_n G`) along the curve: each fixed functional gets its value at `G`.
+    ///
     /// # Errors
-    /// As [`Constraints::support_plate`], a field that is not Argyris, and a normal that
-    /// is zero or not finite or a curvature that is not finite at a vertex (the message
-    /// names the vertex).
+    /// As [`Constraints::support_plate_with_data`], a field that is not Argyris, and a
+    /// normal that is zero or not finite or a curvature that is not finite at a vertex
+    /// (the message names the vertex).
+    // the arguments of support_plate_with_data and the curve
+    #[allow(clippy::too_many_arguments)]
     pub fn support_plate_on_curve<M: Model>(
         &mut self,
         mesh: &TriangleMesh,
@@ -502,6 +593,7 @@ impl Constraints {
         part: &DirichletPart,
         support: PlateSupport,
         curve: BoundaryCurve,
+        data: Option<PlateData>,
     ) -> Result<()> {
         let f = M::field(field)?;
         let (Some(map), Some(offset)) = (dofs.map(f), dofs.offset(f)) else {
@@ -559,15 +651,19 @@ impl Constraints {
                 ],
             };
             let start = offset + map.vertex_dofs(v).start;
+            let j = match data {
+                Some(g) => jet(g, x)?,
+                None => [0.0; 6],
+            };
             for row in rows {
-                self.fix_vertex_combination(start, row, 0.0)?;
+                self.fix_vertex_combination(start, row, dot6(&row, &j))?;
             }
         }
         if support == PlateSupport::Clamped {
-            let conditions = part.plate_conditions(map, mesh, support)?;
-            for &d in &conditions.dofs {
-                self.fix_dof(offset + d, 0.0)?;
-            }
+            // the edge DOFs; the vertex rows of the polygon are replaced by the curve's
+            let mut conditions = part.plate_conditions(map, mesh, support)?;
+            conditions.vertex.clear();
+            self.add_plate_conditions(mesh, &conditions, offset, data)?;
         }
         Ok(())
     }
@@ -585,15 +681,36 @@ impl Constraints {
         part: &DirichletPart,
         support: PlateSupport,
     ) -> Result<()> {
-        self.add_plate_conditions(&part.plate_conditions(map, mesh, support)?, offset)
+        self.add_plate_conditions(
+            mesh,
+            &part.plate_conditions(map, mesh, support)?,
+            offset,
+            None,
+        )
     }
 
-    fn add_plate_conditions(&mut self, conditions: &PlateConditions, offset: usize) -> Result<()> {
-        for &(start, row) in &conditions.vertex {
-            self.fix_vertex_combination(offset + start, row, 0.0)?;
+    /// Fixes the functionals of `conditions` (on a field from global DOF `offset`) to
+    /// their values at `data`, or to zero.
+    fn add_plate_conditions(
+        &mut self,
+        mesh: &TriangleMesh,
+        conditions: &PlateConditions,
+        offset: usize,
+        data: Option<PlateData>,
+    ) -> Result<()> {
+        for &(start, v, row) in &conditions.vertex {
+            let value = match data {
+                Some(g) => dot6(&row, &jet(g, mesh.vertices()[v])?),
+                None => 0.0,
+            };
+            self.fix_vertex_combination(offset + start, row, value)?;
         }
-        for &d in &conditions.dofs {
-            self.fix_dof(offset + d, 0.0)?;
+        for &(d, functional) in &conditions.dofs {
+            let value = match data {
+                Some(g) => functional.at(mesh, g)?,
+                None => 0.0,
+            };
+            self.fix_dof(offset + d, value)?;
         }
         Ok(())
     }
