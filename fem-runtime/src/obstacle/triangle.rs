@@ -110,7 +110,7 @@ fn constraints_at_nodes<M: Model>(
                 let value = g(x);
                 if value != 0.0 {
                     return Err(Error::Input(format!(
-                        "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions on {} fields are homogeneous (w = 0) for now",
+                        "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions from a model's `boundary:` data on {} fields are homogeneous (w = 0): they fix derivatives of w, which a data function does not give; hold the plate with Constraints::support_plate_with_data, which takes the data's derivatives",
                         M::DATA[data],
                         M::FIELDS[field].name,
                         x[0],
