@@ -758,3 +758,109 @@ fn simply_supported_data_give_the_lifted_navier_plate() {
         "errors {errors:?}"
     );
 }
+
+/// Supports per named part on the rotated square: clamped on left and right, simply
+/// supported on top and bottom, each corner the union of a clamped and a simply
+/// supported edge of different directions (rotated), bends as the unrotated square
+/// (every vertex to 1e-9 of w_c), whose centre deflection is Timoshenko and
+/// Woinowsky-Krieger's `0.00192 q a⁴/D` (Table 29, three digits; `tests/argyris.rs`).
+#[test]
+fn supports_per_part_on_the_rotated_square() {
+    type M = kirchhoff_argyris::Model;
+    let solve = |mesh: &TriangleMesh| {
+        let dofs = SystemDofs::new::<M>(mesh, &[0]).unwrap();
+        let load: &DataFn = &unit_load;
+        let coefficients =
+            Coefficients::new::<M>(&[("D", 1.0), ("ν", 0.3)], &[("f", load)]).unwrap();
+        let mut constraints = Constraints::new();
+        for (names, support) in [
+            (["left", "right"], PlateSupport::Clamped),
+            (["top", "bottom"], PlateSupport::SimplySupported),
+        ] {
+            let part = DirichletPart::Markers(mesh.boundary_part_markers(&names).unwrap());
+            constraints
+                .support_plate::<M>(mesh, &dofs, "w", &part, support)
+                .unwrap();
+        }
+        let w = solve_linear::<M>(
+            mesh,
+            &dofs,
+            "a",
+            "ℓ",
+            &constraints,
+            &coefficients,
+            Factorization::Cholesky,
+        )
+        .unwrap();
+        vertex_values(&w, &dofs, mesh.vertex_count())
+    };
+    let square = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 8, 8, Diagonal::Right).unwrap();
+    // the rotated copy keeps the markers; the names go with them
+    let turned = rotated(&square, 0.7, [0.5, 0.5])
+        .with_boundary_names(&[
+            ("bottom", &[1]),
+            ("right", &[2]),
+            ("top", &[3]),
+            ("left", &[4]),
+        ])
+        .unwrap();
+    let reference = solve(&square);
+    let values = solve(&turned);
+    let centre = square
+        .vertices()
+        .iter()
+        .position(|p| (p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12)
+        .unwrap();
+    let w_c = values[centre];
+    let largest = reference
+        .iter()
+        .zip(&values)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    println!("per part, rotated by 0.7: w_c = {w_c:.8e}, largest vertex difference {largest:.2e}");
+    assert!(largest < 1e-9 * w_c, "{largest}");
+    assert!(((w_c - 0.00192) / 0.00192).abs() < 4e-3, "w_c = {w_c}");
+}
+
+/// Data that two parts ask differently at their shared corner are refused (naming the
+/// vertex DOFs), as are data that are not finite (naming the point).
+#[test]
+fn contradictory_or_non_finite_plate_data_are_refused() {
+    type M = kirchhoff_argyris::Model;
+    let square = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 2, 2, Diagonal::Right).unwrap();
+    let mesh = rotated(&square, 0.3, [0.5, 0.5]);
+    let dofs = SystemDofs::new::<M>(&mesh, &[0]).unwrap();
+    let one = |_: [f64; 2]| [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let two = |_: [f64; 2]| [2.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let mut constraints = Constraints::new();
+    for (marker, data) in [(1, &one as &dyn Fn([f64; 2]) -> [f64; 6]), (2, &two)] {
+        constraints
+            .support_plate_with_data::<M>(
+                &mesh,
+                &dofs,
+                "w",
+                &DirichletPart::Markers(vec![marker]),
+                PlateSupport::SimplySupported,
+                Some(data),
+            )
+            .unwrap();
+    }
+    let message = constraints
+        .reduction(dofs.dof_count())
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("contradict"), "{message}");
+    let bad = |_: [f64; 2]| [0.0, 0.0, 0.0, 0.0, 0.0, f64::NAN];
+    let message = Constraints::new()
+        .support_plate_with_data::<M>(
+            &mesh,
+            &dofs,
+            "w",
+            &DirichletPart::All,
+            PlateSupport::Clamped,
+            Some(&bad),
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("not finite"), "{message}");
+}
