@@ -15,7 +15,7 @@
 
 use crate::error::{Error, Result};
 use crate::SparseMatrix;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
 /// The number of Argyris DOFs at a vertex: `u, u_x, u_y, u_xx, u_xy, u_yy`.
 pub const VERTEX_DOFS: usize = 6;
@@ -263,6 +263,21 @@ impl<'a> BlockRotation<'a> {
         Self { blocks, place }
     }
 
+    /// Row `i` of `T`, appended to `out` as `(index, value)`.
+    pub(crate) fn row(&self, i: usize, out: &mut Vec<(usize, f64)>) {
+        if self.place[i] == usize::MAX {
+            out.push((i, 1.0));
+        } else {
+            let (indices, t) = &self.blocks[self.place[i] / VERTEX_DOFS];
+            let m = self.place[i] % VERTEX_DOFS;
+            for (j, &x) in t[m].iter().enumerate() {
+                if x != 0.0 {
+                    out.push((indices[j], x));
+                }
+            }
+        }
+    }
+
     /// Column `i` of `T` times `v`, appended to `out` as `(index, value)`: the entry
     /// `(i, v)` of a vector `x` becomes its share of `T x`.
     pub(crate) fn spread(&self, i: usize, v: f64, out: &mut Vec<(usize, f64)>) {
@@ -282,6 +297,8 @@ impl<'a> BlockRotation<'a> {
 
 /// `T K Tᵀ` for `T` the identity but on the index sets of `blocks` (`(indices, t)`:
 /// `T[indices[i], indices[j]] = t[i][j]`, disjoint sets); `k` square, full storage.
+/// Column by column with a dense accumulator: memory of the order of `k`'s, and a
+/// column away from the rotated vertices is copied (its rows there rotated).
 pub(crate) fn congruence(
     k: &SparseMatrix,
     blocks: &[([usize; VERTEX_DOFS], [[f64; VERTEX_DOFS]; VERTEX_DOFS])],
@@ -289,29 +306,48 @@ pub(crate) fn congruence(
     let n = k.nrows();
     let rotation = BlockRotation::new(blocks, n);
     let (col_ptr, rows, values) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-    let mut triplets = Vec::with_capacity(values.len());
-    let (mut column, mut spread_cols) = (Vec::new(), Vec::new());
-    for j in 0..n {
-        // column j of T K, then its share of the columns of (T K) Tᵀ
-        column.clear();
-        for e in col_ptr[j]..col_ptr[j + 1] {
-            rotation.spread(rows[e], values[e], &mut column);
-        }
-        spread_cols.clear();
-        rotation.spread(j, 1.0, &mut spread_cols);
-        for &(c, w) in &spread_cols {
-            for &(r, v) in &column {
-                triplets.push(Triplet::new(r, c, w * v));
+    let mut out_ptr = Vec::with_capacity(n + 1);
+    let mut out_rows = Vec::with_capacity(values.len());
+    let mut out_values = Vec::with_capacity(values.len());
+    out_ptr.push(0);
+    let mut work = vec![0.0; n];
+    let mut seen = vec![false; n];
+    let (mut touched, mut sources, mut spread) = (Vec::new(), Vec::new(), Vec::new());
+    for column in 0..n {
+        // column `column` of T K Tᵀ = Σ_j T[column][j] · T (column j of K)
+        sources.clear();
+        rotation.row(column, &mut sources);
+        for &(j, weight) in &sources {
+            for e in col_ptr[j]..col_ptr[j + 1] {
+                spread.clear();
+                rotation.spread(rows[e], weight * values[e], &mut spread);
+                for &(r, v) in &spread {
+                    if !seen[r] {
+                        seen[r] = true;
+                        touched.push(r);
+                    }
+                    work[r] += v;
+                }
             }
         }
+        touched.sort_unstable();
+        for &r in &touched {
+            out_rows.push(r);
+            out_values.push(work[r]);
+            work[r] = 0.0;
+            seen[r] = false;
+        }
+        touched.clear();
+        out_ptr.push(out_rows.len());
     }
-    SparseColMat::try_new_from_triplets(n, n, &triplets)
-        .map_err(|e| Error::Input(format!("the rotated matrix: {e:?}")))
+    let pattern = SymbolicSparseColMat::new_checked(n, n, out_ptr, None, out_rows);
+    Ok(SparseColMat::new(pattern, out_values))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::sparse::Triplet;
 
     fn rotation(conditions: &[([f64; 6], f64)]) -> RotatedVertex {
         match resolve_vertex(conditions).unwrap() {
