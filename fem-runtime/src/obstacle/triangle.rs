@@ -42,8 +42,7 @@ pub fn dirichlet_constraints<M: Model>(
 /// boundary edge of the mesh (a problem with natural conditions only, which the
 /// membrane does not determine: u + constant solves it wherever contact does not hold
 /// it), for boundary data that is not finite at a node, and for a plate field: data
-/// that is not zero at a vertex of the part, or (Argyris) an edge of the part that is
-/// not along x or y.
+/// that is not zero at a vertex of the part.
 pub fn dirichlet_constraints_on<M: Model>(
     mesh: &TriangleMesh,
     dofs: &SystemDofs,
@@ -111,7 +110,7 @@ fn constraints_at_nodes<M: Model>(
                 let value = g(x);
                 if value != 0.0 {
                     return Err(Error::Input(format!(
-                        "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions on {} fields are homogeneous (w = 0) for now",
+                        "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions from a model's `boundary:` data on {} fields are homogeneous (w = 0): they fix derivatives of w, which a data function does not give; hold the plate with Constraints::support_plate_with_data, which takes the data's derivatives",
                         M::DATA[data],
                         M::FIELDS[field].name,
                         x[0],
@@ -120,9 +119,13 @@ fn constraints_at_nodes<M: Model>(
                     )));
                 }
             }
-            for dof in part.plate_dofs(map, mesh, PlateSupport::SimplySupported)? {
-                constraints.fix_dof(offset + dof, 0.0)?;
-            }
+            constraints.support_plate_field(
+                mesh,
+                map,
+                offset,
+                part,
+                PlateSupport::SimplySupported,
+            )?;
             continue;
         }
         let nodes = nodes(map);
@@ -874,6 +877,11 @@ pub fn dirichlet_constraints_per_field<M: Model>(
         for &(dof, value) in on_part.fixed() {
             if range.contains(&dof) {
                 constraints.fix_dof(dof, value)?;
+            }
+        }
+        for &(start, row, value) in on_part.vertex_conditions() {
+            if range.contains(&start) {
+                constraints.fix_vertex_combination(start, row, value)?;
             }
         }
     }
