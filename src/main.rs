@@ -85,7 +85,7 @@ struct SolveOptions {
     elements: Option<usize>,
     /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
     /// three quarters of it). (default 64; with --msh: 0 refinements) Plates: N of the
-    /// square's N×N×2 mesh or the disk's rings (default 32).
+    /// square's N×N×2 mesh or the disk's rings (default 32; kirchhoff-square 16).
     #[arg(long, allow_negative_numbers = true)]
     mesh_size: Option<usize>,
     /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
