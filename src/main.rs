@@ -87,7 +87,7 @@ struct SolveOptions {
     elements: Option<usize>,
     /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
     /// three quarters of it). (default 64; with --msh: 0 refinements) Plates: N of the
-    /// square's N×N×2 mesh or the disk's rings (default 32).
+    /// square's N×N×2 mesh or the disk's rings (default 32; kirchhoff-square 16).
     #[arg(long, allow_negative_numbers = true)]
     mesh_size: Option<usize>,
     /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
@@ -880,16 +880,23 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
                 names().join(", ")
             ));
         }
-        if Study::parse(name).is_none() {
-            return Err(format!(
-                "unknown study or scene `{name}`; the studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
-                Study::ALL.map(Study::name).join(", ")
-            ));
-        }
+        // every study some scene hosts, the families' own (lambda-scatter, …) included
         let hosts: Vec<SceneEntry> = registry()
             .into_iter()
             .filter(|e| e.studies.contains(&name))
             .collect();
+        if hosts.is_empty() {
+            let mut kinds: Vec<&str> = registry()
+                .iter()
+                .flat_map(|e| e.studies.iter().copied())
+                .collect();
+            kinds.sort_unstable();
+            kinds.dedup();
+            return Err(format!(
+                "unknown study or scene `{name}`; the studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
+                kinds.join(", ")
+            ));
+        }
         for entry in &hosts {
             run_study(entry, name, full, out)?;
         }

@@ -282,6 +282,11 @@ pub struct MembraneReport {
     /// constraint lets u_h dip below ψ by `O(h²)`
     /// ([`fem_runtime::obstacle::triangle::max_penetration`]).
     pub max_penetration: f64,
+    /// The largest clearance `side·(u_h − ψ)` of a cell where λ_h pushes
+    /// ([`fem_runtime::obstacle::triangle::max_open_contact_gap`]): 0 for a real contact
+    /// set; a share of the structure's size where `α h^k` overwhelms the gap (a coarse
+    /// mesh, or α too large) and λ_h pushes where nothing touches (then warned).
+    pub max_open_contact_gap: f64,
     /// What the numbers cannot be trusted for.
     pub warnings: Vec<String>,
     /// Shape of the solved (finest) mesh's triangles.
@@ -704,14 +709,21 @@ pub fn dirichlet_part(
     mesh: &TriangleMesh,
     domain: &str,
 ) -> Result<DirichletPart> {
-    let DirichletParts::Named(names) = &scene.dirichlet else {
-        return Ok(DirichletPart::All);
-    };
     let at = |message: String| {
         Error::Input(format!(
             "scene `{}`: field `boundary.dirichlet`: {message}",
             scene.name
         ))
+    };
+    // `"all"` is the keyword for the whole boundary: a mesh with a boundary part of that
+    // name would make `"all"` and `["all"]` mean different sets under one printed name
+    if mesh.boundary_part_names().contains(&"all") {
+        return Err(at(format!(
+            "the mesh ({domain}) has a boundary part named `all`, which is also the keyword for the whole boundary: rename the Gmsh physical group (e.g. Physical Curve(\"outer\")) so that the choice is unambiguous"
+        )));
+    }
+    let DirichletParts::Named(names) = &scene.dirichlet else {
+        return Ok(DirichletPart::All);
     };
     if names.is_empty() {
         return Err(at(
@@ -911,6 +923,20 @@ fn run_stabilized<M: Model>(
         None => (None, None, None),
     };
     let [error_vertex_max, error_vertex_mean] = vertex_errors(&u, posed.exact.as_ref());
+    let max_open_contact_gap = fem_runtime::obstacle::triangle::max_open_contact_gap(
+        &u,
+        &lambda,
+        posed.data.obstacle.as_data_fn(),
+        1.0,
+    );
+    if let Some(w) = open_gap_warning(
+        max_open_contact_gap,
+        &u,
+        posed.data.obstacle.as_data_fn(),
+        alpha,
+    ) {
+        warnings.push(w);
+    }
     if solution.multiplier_noise > 1e-6 {
         warnings.push(format!(
             "λ_h may carry rounding noise of up to {:.0e} relative",
@@ -969,6 +995,7 @@ fn run_stabilized<M: Model>(
             posed.data.obstacle.as_data_fn(),
             2 * M::FIELDS[u_field].element.degree(),
         ),
+        max_open_contact_gap,
         warnings,
         mesh_quality: MeshQualityReport::default(),
     };
@@ -1177,6 +1204,8 @@ fn run_nodal(
             posed.data.obstacle.as_data_fn(),
             2,
         ),
+        // the nodal constraint holds exactly at the nodes: a pushing node touches ψ
+        max_open_contact_gap: 0.0,
         warnings: if (0..mesh.vertex_count()).any(|v| !free[v] && vertex_active[v]) {
             vec![
                 "∫λ_h of the nodal method sums the forces at the free nodes: contact reaches the boundary where u = g = ψ, whose nodes carry a share of order h it leaves out (membrane-flat, N = 16: 14.06 of 16); a stabilized pair or a finer mesh gives it".into(),
@@ -1337,6 +1366,37 @@ fn primal_rounding(
     let (x, y) = (corners(0), corners(1));
     let diameter = (x.end() - x.start()).hypot(y.end() - y.start());
     solution.primal_rounding() / u_size.max(psi_size).max(1e-6 * diameter)
+}
+
+/// Largest open gap under a pushing λ_h, relative to the size of u_h and ψ (the largest
+/// `|u_h|`, `|ψ|` at the vertices), that passes without a warning.
+pub const OPEN_GAP_WARNING: f64 = 1e-2;
+
+/// A warning when λ_h pushes on cells that stay clear of ψ by more than
+/// [`OPEN_GAP_WARNING`] of the solution's size (docs/mathematics.md §1: the stabilized
+/// constraint `u_h − ψ = α h² (…)` on the contact cells lets `α h²` open a gap).
+fn open_gap_warning(
+    gap: f64,
+    u: &TriangleField,
+    obstacle: &fem_runtime::DataFn,
+    alpha: f64,
+) -> Option<String> {
+    let size = u
+        .mesh
+        .vertices()
+        .iter()
+        .zip(0..)
+        .map(|(x, v)| {
+            let value = u.coefficients[u.map.vertex_dofs(v).start];
+            value.abs().max(obstacle(x).abs())
+        })
+        .fold(0.0f64, f64::max);
+    (gap > OPEN_GAP_WARNING * size).then(|| {
+        format!(
+            "λ_h pushes on cells where u_h stays up to {gap:.2e} clear of ψ ({:.1} % of the solution's size {size:.2e}): the stabilized constraint u_h − ψ = α h²(…) on contact cells lets α h² (α = {alpha:e}) open that gap, so this contact set is not real; refine the mesh or lower α",
+            100.0 * gap / size
+        )
+    })
 }
 
 /// Largest `max_penetration`, relative to the obstacle's range over the vertices, that

@@ -377,6 +377,10 @@ pub struct PlateReport {
     /// The largest penetration `s(ψ − w_h)` at the nodes of w_h (0 without an obstacle or
     /// where the plate stays on its side).
     pub max_penetration: f64,
+    /// The largest clearance of a cell where λ_h pushes (0 for a real contact set; see
+    /// `fem_runtime::obstacle::triangle::max_open_contact_gap`), warned above 1 % of
+    /// the obstacle's height.
+    pub max_open_contact_gap: f64,
     /// Warnings (a visible penetration of the obstacle).
     pub warnings: Vec<String>,
 }
@@ -606,6 +610,26 @@ where
             100.0 * max_penetration / height.abs()
         ));
     }
+    let max_open_contact_gap = match request.obstacle().side_and_height() {
+        Some((side, psi)) => {
+            let obstacle = move |_: &[f64]| psi;
+            fem_runtime::obstacle::triangle::max_open_contact_gap(
+                &solution.field_view(w),
+                &solution.field_view(solution.discretization.multiplier_field),
+                &obstacle,
+                side,
+            )
+        }
+        None => 0.0,
+    };
+    let size = max_deflection.max(height.abs());
+    if max_open_contact_gap > crate::membranes::OPEN_GAP_WARNING * size {
+        warnings.push(format!(
+            "λ_h pushes on cells where w_h stays up to {max_open_contact_gap:.2e} clear of the obstacle ({:.1} % of its height {height}): the stabilized constraint w_h − ψ = α h⁴(…) on contact cells lets α h⁴ q (α = {}) open that gap on this mesh, so this contact set is not real; refine the mesh or lower α",
+            100.0 * max_open_contact_gap / size,
+            request.alpha
+        ));
+    }
     if request.alpha > 1.0 {
         warnings.push(format!(
             "α = {} is above 1: the stabilization's term α h⁴ s²(λ, μ) then moves the constraint visibly (docs/mathematics.md §6: α = 1 is already 5–10× less accurate than the default {PLATE_ALPHA})",
@@ -657,6 +681,7 @@ where
         levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
         seconds: solution.seconds,
         max_penetration,
+        max_open_contact_gap,
         warnings,
     })
 }

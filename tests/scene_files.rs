@@ -298,3 +298,38 @@ fn an_unknown_boundary_part_is_refused_by_the_command_line() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `"all"` is the keyword for the whole boundary; a Gmsh file with a boundary group
+/// named `all` (a tester's annulus: outer circle `all`, inner `hole`) made `"all"` and
+/// `["all"]` choose different boundaries under one printed name. Both are refused with
+/// a message that says how to fix the mesh.
+#[test]
+fn a_boundary_group_named_like_the_keyword_is_refused() {
+    let dir = std::env::temp_dir().join(format!("fem-forms-all-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/annulus_group_named_all.msh");
+    for choice in [r#""all""#, r#"["all"]"#, r#"["hole"]"#] {
+        let scene = dir.join("annulus.toml");
+        std::fs::write(
+            &scene,
+            format!(
+                "name = \"annulus\"\nmodel = \"membrane\"\npair = \"p1-p0\"\n[mesh]\nfile = {:?}\n[boundary]\ndirichlet = {choice}\n[data]\nf = \"-1\"\npsi = \"-1\"\ng = \"0\"\n",
+                mesh.display().to_string()
+            ),
+        )
+        .unwrap();
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+            .args(["solve", "--scene"])
+            .arg(&scene)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{choice}: solved");
+        assert!(
+            stderr.contains("boundary part named `all`") && !stderr.contains("panicked"),
+            "{choice}: {stderr}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

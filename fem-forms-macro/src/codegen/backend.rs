@@ -75,6 +75,13 @@ pub(crate) trait CellBackend {
         }
         total + term.data.iter().map(|&i| symbols.data[i].1).sum::<usize>()
     }
+    /// Whether the emitter may use the symmetry of a symmetric block ([`super::emit::is_symmetric`]):
+    /// compute its entries on and above the diagonal only and mirror them, which needs
+    /// the backend's constant-coefficient part to be symmetric whenever the block's terms
+    /// are. Off by default.
+    fn symmetric_entries(&self) -> bool {
+        false
+    }
     /// The rule used for `degree`.
     fn rule(&self, degree: usize) -> Rule;
     /// Statements computing the cell geometry the block's terms need (`h`, `J`,

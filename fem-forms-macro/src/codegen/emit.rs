@@ -201,7 +201,15 @@ pub fn block_kernel(
         block.terms.iter().partition(|t| t.data.is_empty());
     let exact = backend.exact_part(block, symbols, &exact_terms);
     let (loops, loop_points) = data_loops(backend, block, symbols, &data_terms);
-    let entries = entries(backend, block, symbols, &exact.tables, !loops.is_empty());
+    let symmetric = backend.symmetric_entries() && is_symmetric(block);
+    let entries = entries(
+        backend,
+        block,
+        symbols,
+        &exact.tables,
+        !loops.is_empty(),
+        symmetric,
+    );
     let (rows, cols) = shape(backend, block, symbols);
     let name = block_ident(block, symbols);
     let doc_title = doc_title(block, symbols, form, backend.doc_suffix());
@@ -234,6 +242,13 @@ pub fn block_kernel(
             None => quote!(::core::option::Option::None),
         };
         let doc_transformed = " Takes the cell's global vertex numbers `g` besides its coordinates: the entries are those of the physical basis, `M K̂ Mᵀ` (`M F̂`), with `M` the element's DOF transformation (`docs/elements.md`).";
+        // A symmetric block (one field against itself) needs only one `M` and half of
+        // the second product.
+        let epilogue = if symmetric {
+            quote!(#runtime::element::triangle::transform_symmetric_element_matrix(#test, x, g, &mut k);)
+        } else {
+            quote!(#runtime::element::triangle::transform_element_matrix(#test, #trial, x, g, &mut k);)
+        };
         quote! {
             #[doc = #doc_title]
             #[doc = #doc_terms]
@@ -246,7 +261,7 @@ pub fn block_kernel(
                 let mut k = [[0.0f64; #cols]; #rows];
                 #(#loops)*
                 #(#entries)*
-                #runtime::element::triangle::transform_element_matrix(#test, #trial, x, g, &mut k);
+                #epilogue
                 #ret
             }
         }
@@ -278,6 +293,39 @@ pub fn is_transformed(block: &Block, symbols: &Symbols) -> bool {
     std::iter::once(block.test_field)
         .chain(block.trial_field)
         .any(|f| symbols.fields[f].element.needs_transformation())
+}
+
+/// Whether a block is symmetric, decided on its terms: one field against itself, and
+/// the terms (those with equal factors summed) a set that swapping the test and the
+/// trial derivative maps onto itself with equal coefficients, parameters, powers of `h`,
+/// divisors, data and rules. Then `a(φᵢ, φⱼ) = a(φⱼ, φᵢ)` for every pair of basis
+/// functions (up to rounding), whatever the element.
+pub fn is_symmetric(block: &Block) -> bool {
+    if block.trial_field != Some(block.test_field) {
+        return false;
+    }
+    let factors = |t: &Term| Term {
+        coefficient: 0.0,
+        ..t.clone()
+    };
+    let mut merged: Vec<Term> = Vec::new();
+    for t in &block.terms {
+        match merged.iter_mut().find(|m| factors(m) == factors(t)) {
+            Some(m) => m.coefficient += t.coefficient,
+            None => merged.push(t.clone()),
+        }
+    }
+    merged.iter().all(|t| {
+        let Some(trial) = t.trial_derivative else {
+            return false;
+        };
+        let swapped = Term {
+            test_derivative: trial,
+            trial_derivative: Some(t.test_derivative),
+            ..t.clone()
+        };
+        t.coefficient == 0.0 || merged.contains(&swapped)
+    })
 }
 
 /// (rows, columns) of a block's element matrix (columns 1 for a vector).
@@ -430,25 +478,56 @@ fn literal_products(tables: &[(Ident, Vec<Vec<f64>>)], i: usize, j: usize) -> Ve
         .collect()
 }
 
+/// Above this many `scalar · literal` products, the entries are computed by a loop over
+/// literal tables (`table_entries`) instead of one statement per entry: the
+/// straight-line code of the Argyris stiffness (3845 products) is larger than the
+/// instruction cache and was most of the kernel's time (docs/mathematics.md §9).
+const TABLE_LOOP_PRODUCTS: usize = 1024;
+
 /// Assignments of the entries: `(k[i][j] + Σ scalar · literal) · h^{sᵢ + sⱼ}`, skipping
-/// entries that stay as the loops left them.
+/// entries that stay as the loops left them. For a `symmetric` block (see
+/// [`is_symmetric`]; its tables are symmetric) only the entries on and above the
+/// diagonal are computed, then mirrored.
 fn entries(
     backend: &dyn CellBackend,
     block: &Block,
     symbols: &Symbols,
     tables: &[(Ident, Vec<Vec<f64>>)],
     has_data: bool,
+    symmetric: bool,
 ) -> Vec<TokenStream> {
     let (rows, cols) = shape(backend, block, symbols);
     let test_element = symbols.fields[block.test_field].element;
     let trial_element = block.trial_field.map(|f| symbols.fields[f].element);
+    let scaling = |i: usize, j: usize| {
+        backend.dof_scaling(test_element, i)
+            + trial_element.map_or(0, |e| backend.dof_scaling(e, j))
+    };
+    let first_column = |i: usize| if symmetric { i } else { 0 };
+    let products: usize = (0..rows)
+        .flat_map(|i| (first_column(i)..cols).map(move |j| (i, j)))
+        .map(|(i, j)| literal_products(tables, i, j).len())
+        .sum();
+    let unscaled = (0..rows).all(|i| (0..cols).all(|j| scaling(i, j) == 0));
+    let mirror = symmetric.then(|| {
+        quote! {
+            for i in 1..#rows {
+                for j in 0..i {
+                    k[i][j] = k[j][i];
+                }
+            }
+        }
+    });
+    if products > TABLE_LOOP_PRODUCTS && unscaled {
+        let mut entries = vec![table_entries(tables, rows, cols, has_data, symmetric)];
+        entries.extend(mirror);
+        return entries;
+    }
     let mut entries = Vec::new();
     for i in 0..rows {
-        for j in 0..cols {
+        for j in first_column(i)..cols {
             let sum = literal_products(tables, i, j);
-            let scaling = backend.dof_scaling(test_element, i)
-                + trial_element.map_or(0, |e| backend.dof_scaling(e, j));
-            let scale = power(quote!(h), scaling);
+            let scale = power(quote!(h), scaling(i, j));
             let value = match (has_data, sum.is_empty(), &scale) {
                 (false, true, _) | (true, true, None) => continue,
                 (true, true, Some(_)) => quote!(k[#i][#j]),
@@ -462,5 +541,132 @@ fn entries(
             entries.push(quote!(k[#i][#j] = #value;));
         }
     }
+    entries.extend(mirror);
     entries
+}
+
+/// The entries as a loop over the literal tables, each stored as one constant array
+/// (negligible literals as zeros, as `literal_products` skips them): per row, a loop
+/// over its columns adding `Σ scalar · table[i][j]`, which the compiler vectorizes.
+/// A `symmetric` block stores and computes only the entries with `j ≥ i`, row after
+/// row (the caller mirrors them).
+fn table_entries(
+    tables: &[(Ident, Vec<Vec<f64>>)],
+    rows: usize,
+    cols: usize,
+    has_data: bool,
+    symmetric: bool,
+) -> TokenStream {
+    let first_column = |i: usize| if symmetric { i } else { 0 };
+    let stored: usize = (0..rows).map(|i| cols - first_column(i)).sum();
+    let count = tables.len();
+    let packed = tables.iter().map(|(_, table)| {
+        let scale = table.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let values = (0..rows).flat_map(|i| {
+            table[i][first_column(i)..]
+                .iter()
+                .map(move |&r| float(if r.abs() > 1e-14 * scale { r } else { 0.0 }))
+        });
+        quote!([#(#values),*])
+    });
+    let names: Vec<Ident> = (0..count).map(|n| format_ident!("t{}", n)).collect();
+    let slices = names
+        .iter()
+        .enumerate()
+        .map(|(n, t)| quote!(let #t = &TABLES[#n][o..o + n];));
+    let terms = tables
+        .iter()
+        .zip(&names)
+        .map(|((s, _), t)| quote!(#s * #t[j]));
+    let start = if has_data {
+        quote!(row[j] + )
+    } else {
+        quote!()
+    };
+    let first = if symmetric { quote!(i) } else { quote!(0) };
+    quote! {
+        {
+            const TABLES: [[f64; #stored]; #count] = [#(#packed),*];
+            let mut o = 0usize;
+            for i in 0..#rows {
+                let row = &mut k[i][#first..];
+                let n = row.len();
+                #(#slices)*
+                for j in 0..n {
+                    row[j] = #start #(#terms)+*;
+                }
+                o += n;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn term(coefficient: f64, test: [u8; 2], trial: [u8; 2]) -> Term {
+        Term {
+            coefficient,
+            params: vec![],
+            h_power: 0,
+            divisors: vec![],
+            data: vec![],
+            test_derivative: test,
+            trial_derivative: Some(trial),
+            quadrature_degree: None,
+        }
+    }
+
+    fn block(terms: Vec<Term>) -> Block {
+        Block {
+            test_field: 0,
+            trial_field: Some(0),
+            terms,
+        }
+    }
+
+    const X: [u8; 2] = [1, 0];
+    const Y: [u8; 2] = [0, 1];
+    const VALUE: [u8; 2] = [0, 0];
+
+    #[test]
+    fn symmetry_is_decided_on_the_terms() {
+        // ∫ ∇w·∇v, and ∫ ∂x w ∂y v + ∂y w ∂x v: symmetric
+        assert!(is_symmetric(&block(vec![term(1.0, X, X), term(1.0, Y, Y)])));
+        assert!(is_symmetric(&block(vec![term(2.0, X, Y), term(2.0, Y, X)])));
+        // ∫ ∂x w v (trial ∂x, test value) and ∫ ∂x w ∂y v alone: not symmetric
+        assert!(!is_symmetric(&block(vec![term(1.0, VALUE, X)])));
+        assert!(!is_symmetric(&block(vec![term(1.0, Y, X)])));
+        // the swapped term with another coefficient, parameter or datum: not symmetric
+        assert!(!is_symmetric(&block(vec![
+            term(2.0, X, Y),
+            term(1.0, Y, X)
+        ])));
+        let mut with_param = term(1.0, Y, X);
+        with_param.params = vec![(0, 1)];
+        assert!(!is_symmetric(&block(vec![term(1.0, X, Y), with_param])));
+        let mut with_data = term(1.0, Y, X);
+        with_data.data = vec![0];
+        assert!(!is_symmetric(&block(vec![term(1.0, X, Y), with_data])));
+        // equal factors are summed first: 1 + 1 against 2 is symmetric
+        assert!(is_symmetric(&block(vec![
+            term(1.0, X, Y),
+            term(1.0, X, Y),
+            term(2.0, Y, X)
+        ])));
+        // a symmetric part does not hide a non-symmetric one
+        assert!(!is_symmetric(&block(vec![
+            term(1.0, X, X),
+            term(1.0, VALUE, X)
+        ])));
+        // blocks of two fields and linear forms are never symmetric
+        let mut two_fields = block(vec![term(1.0, X, X)]);
+        two_fields.trial_field = Some(1);
+        assert!(!is_symmetric(&two_fields));
+        let mut linear = block(vec![term(1.0, X, X)]);
+        linear.trial_field = None;
+        linear.terms[0].trial_derivative = None;
+        assert!(!is_symmetric(&linear));
+    }
 }

@@ -11,7 +11,7 @@
 //!   reference derivatives, the data evaluated once per point.
 
 use super::backend::{CellBackend, ExactPart, Rule};
-use super::emit::{coefficient, float, product};
+use super::emit::{coefficient, float, is_symmetric, product};
 use crate::analysis::{Block, Symbols, Term};
 use fem_reference::triangle::{Polynomial2, TriangleRule};
 use fem_reference::ElementKind;
@@ -150,6 +150,36 @@ struct Pair {
     scalar: Vec<TokenStream>,
 }
 
+/// The pairs of a symmetric block ([`is_symmetric`]) with each `(β, γ)`, `β ≠ γ`, merged
+/// with its transpose `(γ, β)`: their scalars are equal (`s_βγ = Σ c T_αβ T_α'γ` over a
+/// term set closed under swapping α and α'), so `s_βγ R_βγ + s_γβ R_γβ` is one scalar
+/// times `R_βγ + R_γβ` (Kirchhoff on Argyris: 9 pairs become 6). A pair whose transpose
+/// is missing is kept as it is.
+fn merge_transposed_pairs(pairs: Vec<Pair>) -> Vec<Pair> {
+    let mut pairs: Vec<Option<Pair>> = pairs.into_iter().map(Some).collect();
+    let mut merged = Vec::new();
+    for a in 0..pairs.len() {
+        let Some(mut pair) = pairs[a].take() else {
+            continue;
+        };
+        if let Some(gamma) = pair.gamma.filter(|g| *g != pair.beta) {
+            let partner = pairs.iter().position(|p| {
+                p.as_ref()
+                    .is_some_and(|p| p.beta == gamma && p.gamma == Some(pair.beta))
+            });
+            if let Some(other) = partner.and_then(|b| pairs[b].take()) {
+                for (row, other_row) in pair.reference.iter_mut().zip(&other.reference) {
+                    for (v, w) in row.iter_mut().zip(other_row) {
+                        *v += w;
+                    }
+                }
+            }
+        }
+        merged.push(pair);
+    }
+    merged
+}
+
 impl Triangle {
     /// `R_βγ[i][j] = ∫_T̂ ∂̂^β φ̂ᵢ ∂̂^γ ψ̂ⱼ` with `rule` (`γ = None`: linear form).
     fn reference_table(
@@ -249,6 +279,11 @@ impl CellBackend for Triangle {
         0
     }
 
+    /// Each table `R_ββ` and each merged `R_βγ + R_γβ = R_βγ + R_βγᵀ` is symmetric.
+    fn symmetric_entries(&self) -> bool {
+        true
+    }
+
     fn rule(&self, degree: usize) -> Rule {
         let rule = rule_for_degree(degree);
         Rule {
@@ -310,6 +345,9 @@ impl CellBackend for Triangle {
                 quadrature_points = quadrature_points.max(rule_for_degree(degree).points.len());
             }
             self.add_term(term, block, symbols, &mut pairs);
+        }
+        if is_symmetric(block) {
+            pairs = merge_transposed_pairs(pairs);
         }
         let mut tables = Vec::new();
         for (n, pair) in pairs.into_iter().enumerate() {

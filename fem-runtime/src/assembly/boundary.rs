@@ -4,12 +4,16 @@
 //! Cholesky solve and the active-set solvers rely on.
 
 use crate::assembly::dof_map::{DofMap, SystemDofs};
+use crate::assembly::plate_basis::{
+    resolve_vertex, ChangeOfBasis, RotatedVertex, VertexResolution, VERTEX_DOFS,
+};
 use crate::error::{Error, Result};
 use crate::mesh::{IntervalMesh, TriangleMesh};
 use crate::model::Model;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use fem_reference::{DofLocation, ElementKind};
+use std::collections::BTreeMap;
 
 /// An end of the interval.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,6 +52,36 @@ impl DirichletPart {
             .iter()
             .filter(|&&(_, m)| self.contains(m))
             .count()
+    }
+
+    /// The vertices of `mesh` where two edges of the part meet at a turning angle above
+    /// 1e-8 rad (not a straight continuation) and at most `max_turn` rad, with their
+    /// turning angles: where a polygon approximates a curve (docs/elements.md §6,
+    /// Babuška's paradox).
+    pub fn kinks(&self, mesh: &TriangleMesh, max_turn: f64) -> Vec<(usize, f64)> {
+        let mut directions: Vec<Vec<[f64; 2]>> = vec![Vec::new(); mesh.vertex_count()];
+        for &(e, m) in mesh.boundary_edges() {
+            if self.contains(m) {
+                let [a, b] = mesh.edges()[e];
+                let (p, q) = (mesh.vertices()[a], mesh.vertices()[b]);
+                directions[a].push([q[0] - p[0], q[1] - p[1]]);
+                directions[b].push([p[0] - q[0], p[1] - q[1]]);
+            }
+        }
+        let mut out = Vec::new();
+        for (v, d) in directions.iter().enumerate() {
+            if let [d1, d2] = d.as_slice() {
+                // the angle between the two edges leaving v; the turn is its supplement
+                let inner = (d1[0] * d2[1] - d1[1] * d2[0])
+                    .abs()
+                    .atan2(d1[0] * d2[0] + d1[1] * d2[1]);
+                let turn = std::f64::consts::PI - inner;
+                if turn > 1e-8 && turn <= max_turn {
+                    out.push((v, turn));
+                }
+            }
+        }
+        out
     }
 
     /// For each vertex of `mesh`, whether it lies on an edge of the part (a vertex where
@@ -115,46 +149,132 @@ pub enum PlateSupport {
     Clamped,
 }
 
-/// Argyris vertex DOFs (local order `u, u_x, u_y, u_xx, u_xy, u_yy`) fixed on a straight
-/// boundary edge along x (`horizontal`) or along y: `w = 0` fixes the value and the first
-/// and second tangential derivatives; `∂_n w = 0` the normal derivative and its tangential
-/// derivative, the mixed one. The normal second derivative stays free.
-fn argyris_vertex_kinds(support: PlateSupport, horizontal: bool) -> &'static [usize] {
-    match (support, horizontal) {
-        (PlateSupport::SimplySupported, true) => &[0, 1, 3],
-        (PlateSupport::SimplySupported, false) => &[0, 2, 5],
-        (PlateSupport::Clamped, true) => &[0, 1, 3, 2, 4],
-        (PlateSupport::Clamped, false) => &[0, 2, 5, 1, 4],
+/// The rows, over the Argyris vertex DOFs `u, u_x, u_y, u_xx, u_xy, u_yy`, of the
+/// conditions `support` imposes at both end points of a straight boundary edge of unit
+/// tangent `t` and unit normal `n`: `w = 0` on the edge is `u = ∂_t u = ∂_tt u = 0` there
+/// (the trace is the quintic these fix at the two ends), `∂_n w = 0` adds `∂_n u = 0`
+/// and its tangential derivative `∂_t ∂_n u = nᵀHt = 0` (the normal derivative is the
+/// quartic these and the edge's midpoint DOF fix). The normal second derivative `nᵀHn`
+/// stays free. For `t` along x or y every row is a single DOF (± a unit row).
+pub(crate) fn argyris_edge_rows(support: PlateSupport, t: [f64; 2], n: [f64; 2]) -> Vec<[f64; 6]> {
+    let mut rows = vec![
+        [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [0.0, t[0], t[1], 0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0, t[0] * t[0], 2.0 * t[0] * t[1], t[1] * t[1]],
+    ];
+    if support == PlateSupport::Clamped {
+        rows.push([0.0, n[0], n[1], 0.0, 0.0, 0.0]);
+        rows.push([
+            0.0,
+            0.0,
+            0.0,
+            n[0] * t[0],
+            n[0] * t[1] + n[1] * t[0],
+            n[1] * t[1],
+        ]);
+    }
+    rows
+}
+
+/// The unit tangent (from `a` to `b`) and the outward unit normal of boundary edge `e`
+/// of `mesh`, snapped to the axes when within 1e-10 of one (so that an edge along x or y
+/// gives exact single-DOF conditions, the fast path without a change of basis).
+pub(crate) fn edge_frame(mesh: &TriangleMesh, e: usize) -> ([f64; 2], [f64; 2]) {
+    let [a, b] = mesh.edges()[e];
+    let (p, q) = (mesh.vertices()[a], mesh.vertices()[b]);
+    let length = (q[0] - p[0]).hypot(q[1] - p[1]);
+    let mut t = [(q[0] - p[0]) / length, (q[1] - p[1]) / length];
+    if t[1].abs() <= 1e-10 {
+        t = [t[0].signum(), 0.0];
+    } else if t[0].abs() <= 1e-10 {
+        t = [0.0, t[1].signum()];
+    }
+    // outward: away from the third vertex of the edge's cell
+    let (c, _) = mesh.edge_cells(e);
+    let cell = mesh.cell(c);
+    let third = cell
+        .iter()
+        .copied()
+        .find(|&v| v != a && v != b)
+        .unwrap_or(a);
+    let x = mesh.vertices()[third];
+    let mut n = [t[1], -t[0]];
+    if n[0] * (x[0] - p[0]) + n[1] * (x[1] - p[1]) > 0.0 {
+        n = [-n[0], -n[1]];
+    }
+    (t, n)
+}
+
+/// What a plate support imposes on a field's DOFs (numbered within the field):
+/// conditions on vertex DOF blocks and DOFs fixed as they are.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PlateConditions {
+    /// `(first DOF of the vertex, vertex, row over its six DOFs)`: `row · U_v` is fixed.
+    pub(crate) vertex: Vec<(usize, usize, [f64; 6])>,
+    /// DOFs fixed as they are (Morley vertex values, edge normal-derivative DOFs).
+    pub(crate) dofs: Vec<(usize, PlateFunctional)>,
+}
+
+/// The functional a DOF fixed as it is measures.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum PlateFunctional {
+    /// The value at a vertex.
+    Value(usize),
+    /// The derivative at the midpoint of an edge along its normal `(t_y, −t_x)`, `t`
+    /// the unit vector from its lower to its higher global vertex (the Argyris and
+    /// Morley edge DOF, docs/elements.md §3).
+    EdgeNormal(usize),
+}
+
+/// Boundary data of a plate support: a smooth function `G` near the part, given at a
+/// point `x` as its jet `[G, G_x, G_y, G_xx, G_xy, G_yy]` (the order of the Argyris
+/// vertex DOFs). The support then holds `w = G` on the part and, clamped, also
+/// `∂_n w = ∂_n G`: every fixed functional (value, tangential and normal derivatives,
+/// the curve's second derivative, the edge DOFs) gets its value at `G`. With `G` the
+/// exact solution (a manufactured one) the data are exact; for data given on the
+/// boundary only, extend them (e.g. constantly along the normal).
+pub type PlateData<'a> = &'a dyn Fn([f64; 2]) -> [f64; 6];
+
+/// `data`'s jet at `x`, checked finite.
+fn jet(data: PlateData, x: [f64; 2]) -> Result<[f64; 6]> {
+    let j = data(x);
+    if j.iter().all(|v| v.is_finite()) {
+        Ok(j)
+    } else {
+        Err(Error::Input(format!(
+            "plate boundary data at ({}, {}) are not finite: [G, G_x, G_y, G_xx, G_xy, G_yy] = {j:?}",
+            x[0], x[1]
+        )))
+    }
+}
+
+impl PlateFunctional {
+    /// The functional at `data` on `mesh`.
+    fn at(self, mesh: &TriangleMesh, data: PlateData) -> Result<f64> {
+        match self {
+            PlateFunctional::Value(v) => Ok(jet(data, mesh.vertices()[v])?[0]),
+            PlateFunctional::EdgeNormal(e) => {
+                let [a, b] = mesh.edges()[e];
+                let (a, b) = (a.min(b), a.max(b));
+                let (p, q) = (mesh.vertices()[a], mesh.vertices()[b]);
+                let length = (q[0] - p[0]).hypot(q[1] - p[1]);
+                let t = [(q[0] - p[0]) / length, (q[1] - p[1]) / length];
+                let j = jet(data, [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0])?;
+                Ok(t[1] * j[1] - t[0] * j[2])
+            }
+        }
     }
 }
 
 impl DirichletPart {
-    /// The DOFs of the plate field `map` (Argyris or Morley on `mesh`) fixed to zero by
-    /// `support` on the part's edges, sorted and unique.
-    ///
-    /// Argyris, on every edge of the part and at both its end points: the value `u`,
-    /// the tangential derivative and the tangential second derivative (`u_x`, `u_xx` on
-    /// an edge along x; `u_y`, `u_yy` along y); clamped also the normal derivative
-    /// (`u_y`, resp. `u_x`), the mixed derivative `u_xy` (the tangential derivative of
-    /// `∂_n u`) and the edge's normal-derivative DOF. These are exactly the conditions
-    /// `w = 0` (and `∂_n w = 0`) on the edge imposes on the DOFs: the trace of an
-    /// Argyris function on an edge is the quintic fixed by `u, ∂_t u, ∂_tt u` at its end
-    /// points, and its normal derivative the quartic fixed by `∂_n u, ∂_tn u` there and
-    /// the midpoint DOF. At a corner where two edges of the part meet, the union holds:
-    /// all six DOFs when both are clamped, all but `u_xy` when both are simply supported.
-    /// Morley: the vertex values, clamped also the edge normal DOFs.
-    ///
-    /// # Errors
-    /// [`Error::Input`] for another element, and (Argyris) for an edge of the part that
-    /// is neither along x nor along y: the vertex DOFs are Cartesian, and fixing a
-    /// tangential derivative along another direction would need a rotation of them to
-    /// normal/tangential components, which is not implemented.
-    pub fn plate_dofs(
+    /// The conditions of `support` on the part's edges for the plate field `map`
+    /// (errors as [`DirichletPart::plate_dofs`]).
+    pub(crate) fn plate_conditions(
         &self,
         map: &DofMap,
         mesh: &TriangleMesh,
         support: PlateSupport,
-    ) -> Result<Vec<usize>> {
+    ) -> Result<PlateConditions> {
         let element = map.element();
         if !matches!(element, ElementKind::Argyris | ElementKind::Morley)
             || map.local_count() != element.local_dof_count(fem_reference::CellKind::Triangle)
@@ -166,52 +286,104 @@ impl DirichletPart {
         }
         let argyris = element == ElementKind::Argyris;
         let per_vertex = if argyris { 6 } else { 1 };
-        let mut out = Vec::new();
+        let mut out = PlateConditions::default();
         for &(e, m) in mesh.boundary_edges() {
             if !self.contains(m) {
                 continue;
             }
             let [a, b] = mesh.edges()[e];
-            let kinds: &[usize] = if argyris {
-                let (p, q) = (mesh.vertices()[a], mesh.vertices()[b]);
-                let t = [q[0] - p[0], q[1] - p[1]];
-                let length = t[0].hypot(t[1]);
-                if t[1].abs() <= 1e-10 * length {
-                    argyris_vertex_kinds(support, true)
-                } else if t[0].abs() <= 1e-10 * length {
-                    argyris_vertex_kinds(support, false)
-                } else {
-                    return Err(Error::Input(format!(
-                        "boundary edge {e} (marker {m}) from ({}, {}) to ({}, {}) is neither along x nor along y: plate supports on Argyris fix tangential derivatives, and the vertex DOFs are x/y components (a rotation to the edge's direction is not implemented)",
-                        p[0], p[1], q[0], q[1]
-                    )));
-                }
-            } else {
-                &[0]
-            };
             for v in [a, b] {
                 let start = map.vertex_dofs(v).start;
-                out.extend(kinds.iter().map(|&k| start + k));
+                if argyris {
+                    let (t, n) = edge_frame(mesh, e);
+                    for row in argyris_edge_rows(support, t, n) {
+                        out.vertex.push((start, v, row));
+                    }
+                } else {
+                    out.dofs.push((start, PlateFunctional::Value(v)));
+                }
             }
             if support == PlateSupport::Clamped {
-                // the edge's normal-derivative DOF, found through a cell as in `dofs`
+                // the edge's normal-derivative DOF (a physical normal derivative whatever
+                // the edge's direction), found through a cell as in `dofs`
                 let (c, _) = mesh.edge_cells(e);
                 if let Some(k) = mesh.cell_edges(c).iter().position(|&x| x == e) {
-                    out.push(map.cell_dofs(c)[3 * per_vertex + k]);
+                    out.dofs.push((
+                        map.cell_dofs(c)[3 * per_vertex + k],
+                        PlateFunctional::EdgeNormal(e),
+                    ));
                 }
             }
         }
-        out.sort_unstable();
-        out.dedup();
         Ok(out)
+    }
+
+    /// The DOFs of the plate field `map` (Argyris or Morley on `mesh`) fixed to zero by
+    /// `support` on the part's edges alone, sorted and unique; for Argyris vertices on
+    /// edges that are not along x or y these are DOFs of the rotated basis
+    /// ([`Constraints::change_of_basis`]), the Cartesian ones elsewhere.
+    ///
+    /// Argyris, on every edge of the part and at both its end points: the value `u`,
+    /// the tangential derivative `∂_t u` and the tangential second derivative `∂_tt u`
+    /// (`u_x`, `u_xx` on an edge along x; `u_y`, `u_yy` along y); clamped also the normal
+    /// derivative `∂_n u` (`u_y`, resp. `u_x`), the mixed derivative `∂_t ∂_n u` (`u_xy`)
+    /// and the edge's normal-derivative DOF. These are exactly the conditions `w = 0`
+    /// (and `∂_n w = 0`) on the edge imposes on the DOFs: the trace of an Argyris
+    /// function on an edge is the quintic fixed by `u, ∂_t u, ∂_tt u` at its end points,
+    /// and its normal derivative the quartic fixed by `∂_n u, ∂_tn u` there and the
+    /// midpoint DOF. At a corner where two edges of the part meet, the union holds: on
+    /// an axis-aligned square all six DOFs when both are clamped, all but `u_xy` when
+    /// both are simply supported; at a corner of any other angle the union of both
+    /// edges' functionals (simply supported: the value, the whole gradient and two
+    /// Hessian functionals). Morley: the vertex values, clamped also the edge normal DOFs.
+    ///
+    /// # Errors
+    /// [`Error::Input`] for another element.
+    pub fn plate_dofs(
+        &self,
+        map: &DofMap,
+        mesh: &TriangleMesh,
+        support: PlateSupport,
+    ) -> Result<Vec<usize>> {
+        let mut constraints = Constraints::new();
+        constraints.add_plate_conditions(
+            mesh,
+            &self.plate_conditions(map, mesh, support)?,
+            0,
+            None,
+        )?;
+        let reduction = constraints.reduction(map.dof_count())?;
+        Ok((0..map.dof_count())
+            .filter(|&d| reduction.free_index(d).is_none())
+            .collect())
     }
 }
 
-/// Fixed DOFs with their values.
+/// Fixed DOFs with their values, and linear conditions on the six DOFs of Argyris
+/// vertices (plate supports on edges that are not along x or y), which
+/// [`Constraints::change_of_basis`] turns into fixed DOFs of a rotated basis.
 #[derive(Clone, Debug, Default)]
 pub struct Constraints {
     fixed: Vec<(usize, f64)>,
+    /// `(first global DOF of the vertex, row, value)`: `row · U_v = value`.
+    vertex: Vec<(usize, [f64; VERTEX_DOFS], f64)>,
+    warnings: Vec<String>,
 }
+
+fn dot6(a: &[f64; 6], b: &[f64; 6]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The largest turning angle between consecutive edges of a simply supported Argyris
+/// part that [`Constraints::support_plate`] takes for a polygon approximating a curve
+/// (and warns about, [`Constraints::warnings`]): 30°. Real polygonal plates have a few
+/// larger angles (90° for a rectangle, 60° for a hexagon).
+pub const CURVE_TURNING_ANGLE: f64 = std::f64::consts::PI / 6.0;
+
+/// The boundary curve a part of a polygonal mesh approximates, at a vertex `x` of the
+/// part: `(outward unit normal, curvature)`, the curvature positive where the domain is
+/// convex (`1/R` on a disk of radius R). See [`Constraints::support_plate_on_curve`].
+pub type BoundaryCurve<'a> = &'a dyn Fn([f64; 2]) -> ([f64; 2], f64);
 
 impl Constraints {
     /// No constraint.
@@ -310,7 +482,11 @@ impl Constraints {
     }
 
     /// Supports the plate field `field` of `M` (Argyris or Morley) on `part` of the
-    /// boundary of `mesh`: the DOFs of [`DirichletPart::plate_dofs`] are fixed to zero.
+    /// boundary of `mesh`: the conditions of [`DirichletPart::plate_dofs`] (values and
+    /// derivatives along and, clamped, across each edge) hold with zero data. On edges
+    /// along x or y they fix single Cartesian DOFs; elsewhere they are conditions on the
+    /// vertex DOFs, fixed DOFs of the basis of [`Constraints::change_of_basis`]. Calls on
+    /// several parts add up: a vertex where they meet gets the union of their conditions.
     ///
     /// # Errors
     /// [`Error::Input`] for an unknown field, a field not in `dofs`, a part that holds no
@@ -324,6 +500,24 @@ impl Constraints {
         part: &DirichletPart,
         support: PlateSupport,
     ) -> Result<()> {
+        self.support_plate_with_data::<M>(mesh, dofs, field, part, support, None)
+    }
+
+    /// [`Constraints::support_plate`] with boundary data: `w = G` on the part and,
+    /// clamped, `∂_n w = ∂_n G` ([`PlateData`]; `None`: `G = 0`).
+    ///
+    /// # Errors
+    /// As [`Constraints::support_plate`], and data that are not finite at a vertex or
+    /// edge midpoint of the part (the message names the point).
+    pub fn support_plate_with_data<M: Model>(
+        &mut self,
+        mesh: &TriangleMesh,
+        dofs: &SystemDofs,
+        field: &str,
+        part: &DirichletPart,
+        support: PlateSupport,
+        data: Option<PlateData>,
+    ) -> Result<()> {
         let f = M::field(field)?;
         let (Some(map), Some(offset)) = (dofs.map(f), dofs.offset(f)) else {
             return Err(Error::Input(format!(
@@ -336,10 +530,284 @@ impl Constraints {
                 mesh.boundary_edges().len()
             )));
         }
-        for d in part.plate_dofs(map, mesh, support)? {
-            self.fixed.push((offset + d, 0.0));
+        self.add_plate_conditions(
+            mesh,
+            &part.plate_conditions(map, mesh, support)?,
+            offset,
+            data,
+        )?;
+        if map.element() == ElementKind::Argyris && support == PlateSupport::SimplySupported {
+            let kinks = part.kinks(mesh, CURVE_TURNING_ANGLE);
+            if let Some(&(v, turn)) = kinks.first() {
+                let x = mesh.vertices()[v];
+                self.warnings.push(format!(
+                    "`{field}` is simply supported on a polygon that looks like a curve ({} vertices where its edges turn by at most {:.0}°, e.g. {:.2}° at ({}, {})): at every such corner w = 0 on both edges fixes the whole gradient, so the Argyris plate converges to the clamped plate, not to the simply supported one of the curve (Babuška's paradox, docs/elements.md §6); support a curved boundary with Constraints::support_plate_on_curve",
+                    kinks.len(),
+                    CURVE_TURNING_ANGLE.to_degrees(),
+                    turn.to_degrees(),
+                    x[0],
+                    x[1]
+                ));
+            }
         }
         Ok(())
+    }
+
+    /// Warnings about the supports given so far: a simply supported Argyris part that
+    /// looks like a polygonal approximation of a curve (consecutive edges turning by at
+    /// most [`CURVE_TURNING_ANGLE`]) converges to the wrong plate.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Supports the Argyris field `field` of `M` on `part`, a polygonal approximation
+    /// of the smooth curve `curve` (its outward normal `n` and curvature `κ` at each
+    /// vertex of the part; `t = (−n_y, n_x)`): the conditions of the curve, not of the
+    /// polygon, at each vertex of the part. Simply supported (`w = 0` along the curve):
+    /// `u = 0`, `∂_t u = 0` and `tᵀHt − κ ∂_n u = 0` (the second derivative of `w` along
+    /// the curve, whose acceleration is `−κ n`); `∂_n u` and the rest stay free.
+    /// Clamped (also `∂_n w = 0`): `u = 0`, `∇u = 0`, `tᵀHt = 0`, `nᵀHt = 0` and the
+    /// edges' normal-derivative DOFs. The polygon's corners would fix more (the whole
+    /// gradient, resp. the whole Hessian): with them the simply supported plate converges
+    /// to the clamped one and the clamped one at first order only; with the curve's
+    /// conditions both converge to the plate on the curved domain at second order (the
+    /// polygon's distance from the curve; `tests/plate_supports.rs`). Morley fields take
+    /// [`Constraints::support_plate`] (they fix values and edge DOFs only). Where a
+    /// straight part meets the curve, support it with [`Constraints::support_plate`]:
+    /// the vertex gets the union of both conditions.
+    ///
+    /// With `data` ([`PlateData`]) the conditions hold `w = G` (clamped also
+    /// `∂_n w = ∂_n G`) along the curve: each fixed functional gets its value at `G`.
+    ///
+    /// # Errors
+    /// As [`Constraints::support_plate_with_data`], a field that is not Argyris, and a
+    /// normal that is zero or not finite or a curvature that is not finite at a vertex
+    /// (the message names the vertex).
+    // the arguments of support_plate_with_data and the curve
+    #[allow(clippy::too_many_arguments)]
+    pub fn support_plate_on_curve<M: Model>(
+        &mut self,
+        mesh: &TriangleMesh,
+        dofs: &SystemDofs,
+        field: &str,
+        part: &DirichletPart,
+        support: PlateSupport,
+        curve: BoundaryCurve,
+        data: Option<PlateData>,
+    ) -> Result<()> {
+        let f = M::field(field)?;
+        let (Some(map), Some(offset)) = (dofs.map(f), dofs.offset(f)) else {
+            return Err(Error::Input(format!(
+                "field `{field}` is not part of this system"
+            )));
+        };
+        if map.element() != ElementKind::Argyris {
+            return Err(Error::Input(format!(
+                "supports on a curve are for Argyris fields, `{field}` is {} (use support_plate)",
+                map.element().name()
+            )));
+        }
+        if part.edge_count(mesh) == 0 {
+            return Err(Error::Input(format!(
+                "the boundary part {part:?} where `{field}` is {support:?} holds none of the mesh's {} boundary edges",
+                mesh.boundary_edges().len()
+            )));
+        }
+        for (v, on) in part.vertices(mesh).into_iter().enumerate() {
+            if !on {
+                continue;
+            }
+            let x = mesh.vertices()[v];
+            let (n, kappa) = curve(x);
+            let length = n[0].hypot(n[1]);
+            if !(length > 0.0 && length.is_finite() && kappa.is_finite()) {
+                return Err(Error::Input(format!(
+                    "the boundary curve of `{field}` at vertex {v} ({}, {}) has normal ({}, {}) and curvature {kappa}: the normal must be finite and nonzero, the curvature finite",
+                    x[0], x[1], n[0], n[1]
+                )));
+            }
+            let n = [n[0] / length, n[1] / length];
+            let t = [-n[1], n[0]];
+            let tt = [0.0, 0.0, 0.0, t[0] * t[0], 2.0 * t[0] * t[1], t[1] * t[1]];
+            let rows: Vec<[f64; VERTEX_DOFS]> = match support {
+                PlateSupport::SimplySupported => vec![
+                    [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                    [0.0, t[0], t[1], 0.0, 0.0, 0.0],
+                    [0.0, -kappa * n[0], -kappa * n[1], tt[3], tt[4], tt[5]],
+                ],
+                PlateSupport::Clamped => vec![
+                    [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+                    tt,
+                    [
+                        0.0,
+                        0.0,
+                        0.0,
+                        n[0] * t[0],
+                        n[0] * t[1] + n[1] * t[0],
+                        n[1] * t[1],
+                    ],
+                ],
+            };
+            let start = offset + map.vertex_dofs(v).start;
+            let j = match data {
+                Some(g) => jet(g, x)?,
+                None => [0.0; 6],
+            };
+            for row in rows {
+                self.fix_vertex_combination(start, row, dot6(&row, &j))?;
+            }
+        }
+        if support == PlateSupport::Clamped {
+            // the edge DOFs; the vertex rows of the polygon are replaced by the curve's
+            let mut conditions = part.plate_conditions(map, mesh, support)?;
+            conditions.vertex.clear();
+            self.add_plate_conditions(mesh, &conditions, offset, data)?;
+        }
+        Ok(())
+    }
+
+    /// [`Constraints::support_plate`] for the plate field `map` whose DOFs start at
+    /// global DOF `offset`, without the check that `part` holds an edge.
+    ///
+    /// # Errors
+    /// As [`DirichletPart::plate_dofs`].
+    pub fn support_plate_field(
+        &mut self,
+        mesh: &TriangleMesh,
+        map: &DofMap,
+        offset: usize,
+        part: &DirichletPart,
+        support: PlateSupport,
+    ) -> Result<()> {
+        self.add_plate_conditions(
+            mesh,
+            &part.plate_conditions(map, mesh, support)?,
+            offset,
+            None,
+        )
+    }
+
+    /// Fixes the functionals of `conditions` (on a field from global DOF `offset`) to
+    /// their values at `data`, or to zero.
+    fn add_plate_conditions(
+        &mut self,
+        mesh: &TriangleMesh,
+        conditions: &PlateConditions,
+        offset: usize,
+        data: Option<PlateData>,
+    ) -> Result<()> {
+        for &(start, v, row) in &conditions.vertex {
+            let value = match data {
+                Some(g) => dot6(&row, &jet(g, mesh.vertices()[v])?),
+                None => 0.0,
+            };
+            self.fix_vertex_combination(offset + start, row, value)?;
+        }
+        for &(d, functional) in &conditions.dofs {
+            let value = match data {
+                Some(g) => functional.at(mesh, g)?,
+                None => 0.0,
+            };
+            self.fix_dof(offset + d, value)?;
+        }
+        Ok(())
+    }
+
+    /// Imposes `Σ_k row[k] U[start + k] = value` on the six DOFs of an Argyris vertex
+    /// (`u, u_x, u_y, u_xx, u_xy, u_yy` from global DOF `start`).
+    ///
+    /// # Errors
+    /// [`Error::Input`] for a row or value that is not finite, or a zero row.
+    pub fn fix_vertex_combination(
+        &mut self,
+        start: usize,
+        row: [f64; VERTEX_DOFS],
+        value: f64,
+    ) -> Result<()> {
+        if !value.is_finite() || !row.iter().all(|x| x.is_finite()) || row.iter().all(|&x| x == 0.0)
+        {
+            return Err(Error::Input(format!(
+                "vertex condition {row:?} = {value} at DOF {start} is zero or not finite"
+            )));
+        }
+        self.vertex.push((start, row, value));
+        Ok(())
+    }
+
+    /// The conditions on vertex DOFs (`(first DOF, row, value)`), in the order given.
+    pub fn vertex_conditions(&self) -> &[(usize, [f64; VERTEX_DOFS], f64)] {
+        &self.vertex
+    }
+
+    /// The fixed DOFs in the primed numbering and the change of basis (module
+    /// [`crate::assembly::plate_basis`]).
+    fn resolve(&self, n: usize) -> Result<(Vec<(usize, f64)>, ChangeOfBasis)> {
+        let mut groups: BTreeMap<usize, Vec<([f64; VERTEX_DOFS], f64)>> = BTreeMap::new();
+        for &(start, row, value) in &self.vertex {
+            if start + VERTEX_DOFS > n {
+                return Err(Error::Input(format!(
+                    "vertex DOFs {start}..{} outside a system of {n}",
+                    start + VERTEX_DOFS
+                )));
+            }
+            groups.entry(start).or_default().push((row, value));
+        }
+        let starts: Vec<usize> = groups.keys().copied().collect();
+        if let Some(w) = starts.windows(2).find(|w| w[1] < w[0] + VERTEX_DOFS) {
+            return Err(Error::Input(format!(
+                "vertex conditions from DOF {} and from DOF {} overlap",
+                w[0], w[1]
+            )));
+        }
+        let block_of = |d: usize| {
+            let i = starts.partition_point(|&s| s <= d);
+            (i > 0 && d < starts[i - 1] + VERTEX_DOFS).then(|| starts[i - 1])
+        };
+        // a single DOF fixed inside a conditioned vertex is one more condition there
+        let mut fixed = Vec::with_capacity(self.fixed.len());
+        for &(d, v) in &self.fixed {
+            match block_of(d) {
+                Some(start) => {
+                    let mut row = [0.0; VERTEX_DOFS];
+                    row[d - start] = 1.0;
+                    groups.get_mut(&start).expect("a block").push((row, v));
+                }
+                None => fixed.push((d, v)),
+            }
+        }
+        let mut blocks = Vec::new();
+        for (start, conditions) in groups {
+            match resolve_vertex(&conditions)
+                .map_err(|e| Error::Input(format!("vertex DOFs from {start}: {e}")))?
+            {
+                VertexResolution::Direct(single) => {
+                    fixed.extend(single.into_iter().map(|(k, v)| (start + k, v)));
+                }
+                VertexResolution::Rotated(r) => {
+                    fixed.extend((0..r.fixed).map(|k| (start + k, r.values[k])));
+                    blocks.push(RotatedVertex { start, ..*r });
+                }
+            }
+        }
+        Ok((fixed, ChangeOfBasis::new(blocks)))
+    }
+
+    /// The change of basis of the DOFs of a system of `n` DOFs that turns the vertex
+    /// conditions into fixed DOFs: the identity where every condition of a vertex is a
+    /// single DOF (edges along x or y, fixed as they are), a rotation of the vertex's six
+    /// DOFs elsewhere. [`Constraints::reduction`] is in its primed numbering: a system
+    /// `K U = F` is to be solved as `K' U' = F'` (`K' = Rᵀ K R`,
+    /// [`ChangeOfBasis::transform_matrix`]; `F' = Rᵀ F`, [`ChangeOfBasis::to_primed`])
+    /// and mapped back by [`ChangeOfBasis::to_cartesian`], as `solve_linear` and the
+    /// obstacle discretization do.
+    ///
+    /// # Errors
+    /// [`Error::Input`] for vertex DOFs outside the system, overlapping vertex blocks,
+    /// and conditions at a vertex that contradict each other.
+    pub fn change_of_basis(&self, n: usize) -> Result<ChangeOfBasis> {
+        Ok(self.resolve(n)?.1)
     }
 
     /// Fixes global DOF `dof` to `value` (a later value for the same DOF wins).
@@ -353,15 +821,22 @@ impl Constraints {
         Ok(())
     }
 
-    /// The fixed DOFs and their values.
+    /// The DOFs fixed as they are ([`Constraints::fix_dof`], single-DOF plate conditions
+    /// are in [`Constraints::vertex_conditions`]) and their values.
     pub fn fixed(&self) -> &[(usize, f64)] {
         &self.fixed
     }
 
-    /// The elimination for a system of `n` DOFs.
+    /// The elimination for a system of `n` DOFs, in the numbering of the primed DOFs of
+    /// [`Constraints::change_of_basis`] (the Cartesian one where it is the identity).
+    ///
+    /// # Errors
+    /// [`Error::Input`] for a DOF outside the system, and as
+    /// [`Constraints::change_of_basis`].
     pub fn reduction(&self, n: usize) -> Result<Reduction> {
+        let (fixed, _) = self.resolve(n)?;
         let mut value = vec![None; n];
-        for &(d, v) in &self.fixed {
+        for &(d, v) in &fixed {
             *value
                 .get_mut(d)
                 .ok_or_else(|| Error::Input(format!("fixed DOF {d} outside a system of {n}")))? =
@@ -591,10 +1066,14 @@ mod tests {
         }
     }
 
-    /// Argyris needs edges along x or y (the vertex DOFs are not rotated); Morley takes
-    /// any edge; other elements are refused.
+    /// A slanted edge rotates the Argyris vertex DOFs instead of being refused: on the
+    /// triangle (0,0), (1,0), (0,1) clamped fixes all 21 DOFs (every corner meets two
+    /// clamped edges of different directions: the whole gradient and Hessian), simply
+    /// supported 5 per corner (the value, the gradient and two Hessian functionals: the
+    /// right angle at the origin keeps its Cartesian `u_xy` free without a rotation, the
+    /// other two are rotated). Morley takes any edge; other elements are refused.
     #[test]
-    fn plate_dofs_refuse_slanted_edges_and_other_elements() {
+    fn plate_dofs_of_slanted_edges_and_other_elements() {
         let m = TriangleMesh::new(
             vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
             vec![[0, 1, 2]],
@@ -602,11 +1081,32 @@ mod tests {
         )
         .unwrap();
         let argyris = DofMap::on_triangles(&m, ElementKind::Argyris);
-        let message = DirichletPart::All
+        let clamped = DirichletPart::All
             .plate_dofs(&argyris, &m, PlateSupport::Clamped)
-            .unwrap_err()
-            .to_string();
-        assert!(message.contains("neither along x nor along y"), "{message}");
+            .unwrap();
+        assert_eq!(clamped, (0..21).collect::<Vec<_>>());
+        let simply = DirichletPart::All
+            .plate_dofs(&argyris, &m, PlateSupport::SimplySupported)
+            .unwrap();
+        assert_eq!(simply, [0, 1, 2, 3, 5, 6, 7, 8, 9, 10, 12, 13, 14, 15, 16]);
+        let mut constraints = Constraints::new();
+        constraints
+            .support_plate_field(
+                &m,
+                &argyris,
+                0,
+                &DirichletPart::All,
+                PlateSupport::SimplySupported,
+            )
+            .unwrap();
+        let starts: Vec<usize> = constraints
+            .change_of_basis(21)
+            .unwrap()
+            .blocks()
+            .iter()
+            .map(|b| b.start)
+            .collect();
+        assert_eq!(starts, [6, 12]);
         let morley = DofMap::on_triangles(&m, ElementKind::Morley);
         let fixed = DirichletPart::All
             .plate_dofs(&morley, &m, PlateSupport::Clamped)

@@ -18,7 +18,10 @@ pub enum Factorization {
 }
 
 /// Solves `bilinear(u, v) = linear(v)` on the fields of `dofs` with the fixed DOFs of
-/// `constraints`, on any mesh (intervals, triangles); returns the full coefficient vector.
+/// `constraints`, on any mesh (intervals, triangles); returns the full coefficient vector
+/// (Cartesian DOFs: where `constraints` rotate vertex DOFs,
+/// [`Constraints::change_of_basis`], the system is solved in the rotated ones and the
+/// solution mapped back).
 pub fn solve_linear<M: Model>(
     mesh: &impl Mesh,
     dofs: &SystemDofs,
@@ -29,8 +32,16 @@ pub fn solve_linear<M: Model>(
     factorization: Factorization,
 ) -> Result<Vec<f64>> {
     let a = MatrixAssembler::new::<M>(bilinear, mesh, dofs)?.assemble::<M>(mesh, coefficients)?;
-    let b = assemble_vector::<M>(linear, mesh, dofs, coefficients)?;
+    let mut b = assemble_vector::<M>(linear, mesh, dofs, coefficients)?;
     let reduction = constraints.reduction(dofs.dof_count())?;
+    // plate supports on edges not along x or y: solve in the rotated vertex DOFs
+    let basis = constraints.change_of_basis(dofs.dof_count())?;
+    let a = if basis.is_identity() {
+        a
+    } else {
+        basis.to_primed(&mut b);
+        basis.transform_matrix(&a)?
+    };
     let a_free = reduction.matrix(&a);
     let b_free = reduction.rhs(&a, &b);
     let pattern = a_free.symbolic().to_owned().expect("an owned pattern");
@@ -39,5 +50,7 @@ pub fn solve_linear<M: Model>(
         Factorization::Lu => LuSolver::analyse(&pattern)?.factor(&a_free)?,
     };
     let u = factor.solve_refined(&a_free, &b_free, 1)?;
-    Ok(reduction.expand(&u))
+    let mut u = reduction.expand(&u);
+    basis.to_cartesian(&mut u);
+    Ok(u)
 }

@@ -8,6 +8,7 @@ pub mod boundary;
 pub mod dof_map;
 pub mod kernel;
 pub mod linear_problem;
+pub mod plate_basis;
 
 use crate::assembly::dof_map::SystemDofs;
 use crate::error::{Error, Result};

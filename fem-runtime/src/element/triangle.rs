@@ -42,11 +42,322 @@ pub fn cell_transformation(
 /// (`K = M K̂ Mᵀ`; for a load vector, `trial = None` and `k` has one column: `F = M F̂`),
 /// where `k` holds the entries of the pulled-back reference basis `ψ = φ̂ ∘ F⁻¹`.
 ///
-/// `M` is sparse (Argyris: 81 non-zeros of 441), so the products skip its zeros. A cell
+/// `M` is applied in its compact form ([`CompactTransformation`]: only its non-zeros,
+/// row operations over whole rows of `k`); the other side as the same left product on
+/// the transpose. Agrees with [`transform_element_matrix_dense`] to rounding (tested). A
+/// cell for which `M` does not exist (degenerate, or a repeated global vertex number)
+/// gets NaN entries: kernels cannot return errors, and meshes refuse such cells when
+/// built, so this only marks a caller's misuse visibly instead of giving plausible
+/// numbers.
+pub fn transform_element_matrix<const R: usize, const C: usize>(
+    test: fem_reference::ElementKind,
+    trial: Option<fem_reference::ElementKind>,
+    x: &[f64; 6],
+    global: &[usize; 3],
+    k: &mut [[f64; C]; R],
+) {
+    let compact = |e: fem_reference::ElementKind, dofs: usize| {
+        if !e.needs_transformation() {
+            Some(None)
+        } else {
+            CompactTransformation::new(e, x, global)
+                .filter(|b| b.dofs() == dofs)
+                .map(Some)
+        }
+    };
+    let known = |e: fem_reference::ElementKind| {
+        !e.needs_transformation() || CompactTransformation::knows(e)
+    };
+    if !known(test) || !trial.is_none_or(known) {
+        return transform_element_matrix_dense(test, trial, x, global, k);
+    }
+    let Some(test_b) = compact(test, R) else {
+        return poison(k);
+    };
+    let trial_b = match trial {
+        None => None,
+        Some(e) => match compact(e, C) {
+            Some(b) => b,
+            None => return poison(k),
+        },
+    };
+    if let Some(b) = &test_b {
+        b.apply_left(k, false);
+    }
+    if let Some(b) = &trial_b {
+        // k M_trialᵀ = (M_trial kᵀ)ᵀ
+        let mut t = [[0.0; R]; C];
+        for (i, row) in k.iter().enumerate() {
+            for (j, &v) in row.iter().enumerate() {
+                t[j][i] = v;
+            }
+        }
+        b.apply_left(&mut t, false);
+        for (i, row) in k.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = t[j][i];
+            }
+        }
+    }
+}
+
+/// [`transform_element_matrix`] for a block of one field against itself whose reference
+/// matrix `k = K̂` is symmetric (the code generator decides this from the form's terms):
+/// `K = M K̂ Mᵀ = M (M K̂)ᵀ`, so the second product is the same left product on the
+/// transpose, computed only on and above the diagonal and mirrored. NaN entries for a
+/// cell without `M`, as there; a `k` that is not symmetric gives a wrong result (it is
+/// not checked: the kernel's terms are).
+pub fn transform_symmetric_element_matrix<const N: usize>(
+    element: fem_reference::ElementKind,
+    x: &[f64; 6],
+    global: &[usize; 3],
+    k: &mut [[f64; N]; N],
+) {
+    if !element.needs_transformation() {
+        return;
+    }
+    if !CompactTransformation::knows(element) {
+        return transform_element_matrix_dense(element, Some(element), x, global, k);
+    }
+    let Some(b) = CompactTransformation::new(element, x, global).filter(|b| b.dofs() == N) else {
+        return poison(k);
+    };
+    b.apply_left(k, false);
+    transpose(k);
+    b.apply_left(k, true);
+    mirror_upper(k);
+}
+
+/// `k ← kᵀ` in place.
+fn transpose<const N: usize>(k: &mut [[f64; N]; N]) {
+    for i in 1..N {
+        let (upper, lower) = k.split_at_mut(i);
+        for (j, row) in upper.iter_mut().enumerate() {
+            std::mem::swap(&mut row[i], &mut lower[0][j]);
+        }
+    }
+}
+
+/// The entries below the diagonal from those above it.
+fn mirror_upper<const N: usize>(k: &mut [[f64; N]; N]) {
+    for i in 1..N {
+        let (upper, lower) = k.split_at_mut(i);
+        for (target, row) in lower[0].iter_mut().zip(upper.iter()) {
+            *target = row[i];
+        }
+    }
+}
+
+fn poison<const R: usize, const C: usize>(k: &mut [[f64; C]; R]) {
+    k.iter_mut().flatten().for_each(|v| *v = f64::NAN);
+}
+
+/// The transposed DOF transformation `B = Mᵀ` of an Argyris or Morley cell
+/// (`fem_reference::dof_transformation`, `docs/elements.md` §3) by its non-zeros only:
+/// per vertex the blocks of the value (1), the gradient (`Jᵀ`) and, for Argyris, the
+/// Hessian (`Ĥ_ab = Σ J_ra J_sb H_rs`); per edge the coefficient `α` of its own normal
+/// derivative and the coefficients of the Hermite data at its two vertices (the
+/// tangential part `β ∂_t`).
+///
+/// The edge's global orientation only flips the sign of `α`: reversing an edge flips
+/// its normal and tangent, hence `α` and `β`, and `β` enters the vertex coefficients only
+/// multiplied by the tangent or by the sign of the end (from/to), which flip with it.
+/// So the vertex coefficients are computed for the edge oriented from its lower to its
+/// higher LOCAL vertex and `α` gets the sign of the global orientation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CompactTransformation {
+    argyris: bool,
+    /// `J` (`jacobian[row][col]`): the gradient block of vertex DOFs is `Jᵀ`.
+    jacobian: [[f64; 2]; 2],
+    /// `hessian[r][c]`: reference second derivative `r` (ξξ, ξη, ηη) from physical `c`
+    /// (xx, xy, yy).
+    hessian: [[f64; 3]; 3],
+    /// Per edge: the signed coefficient of its own normal-derivative DOF.
+    alpha: [f64; 3],
+    /// Per edge and end (lower, higher local vertex): the coefficients of that vertex's
+    /// value, gradient and Hessian DOFs (Morley: the value only, index 0).
+    ends: [[[f64; 6]; 2]; 3],
+}
+
+/// Local vertices of edge `e`, lower first (`fem_reference::dual_basis::EDGES` sorted).
+const SORTED_EDGES: [[usize; 2]; 3] = [[0, 1], [1, 2], [0, 2]];
+
+/// Per local vertex: its two edges and its end (0: lower, 1: higher local vertex) in each.
+const VERTEX_EDGES: [[(usize, usize); 2]; 3] =
+    [[(0, 0), (2, 0)], [(0, 1), (1, 0)], [(1, 1), (2, 1)]];
+
+impl CompactTransformation {
+    /// Whether `element` has a compact form here (Argyris, Morley).
+    pub fn knows(element: fem_reference::ElementKind) -> bool {
+        matches!(
+            element,
+            fem_reference::ElementKind::Argyris | fem_reference::ElementKind::Morley
+        )
+    }
+
+    /// `B = Mᵀ` of `element` on the triangle with coordinates
+    /// `x = [x₀, y₀, x₁, y₁, x₂, y₂]` and global vertex numbers `global`; `None` for an
+    /// element without a compact form, a non-finite or degenerate cell
+    /// (`|det J| ≤ 1e-12 · (longest edge)²`, as [`cell_transformation`] refuses) or a
+    /// repeated global vertex number.
+    pub fn new(
+        element: fem_reference::ElementKind,
+        x: &[f64; 6],
+        global: &[usize; 3],
+    ) -> Option<Self> {
+        if !Self::knows(element) {
+            return None;
+        }
+        if global[0] == global[1] || global[1] == global[2] || global[0] == global[2] {
+            return None;
+        }
+        let argyris = element == fem_reference::ElementKind::Argyris;
+        let j = [[x[2] - x[0], x[4] - x[0]], [x[3] - x[1], x[5] - x[1]]];
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        // The reference normals of `fem_reference::dual_basis::reference_edge_normal`.
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        let reference_normals = [[0.0, -1.0], [r, r], [1.0, 0.0]];
+        let mut longest = 0.0f64;
+        let mut alpha = [0.0; 3];
+        let mut ends = [[[0.0; 6]; 2]; 3];
+        for (e, [p, q]) in SORTED_EDGES.into_iter().enumerate() {
+            let d = [x[2 * q] - x[2 * p], x[2 * q + 1] - x[2 * p + 1]];
+            let l2 = d[0] * d[0] + d[1] * d[1];
+            longest = longest.max(l2);
+            let l = l2.sqrt();
+            let t = [d[0] / l, d[1] / l];
+            let n = [t[1], -t[0]];
+            let nh = reference_normals[e];
+            let w = [
+                j[0][0] * nh[0] + j[0][1] * nh[1],
+                j[1][0] * nh[0] + j[1][1] * nh[1],
+            ];
+            let (a, beta) = (w[0] * n[0] + w[1] * n[1], w[0] * t[0] + w[1] * t[1]);
+            alpha[e] = if global[p] < global[q] { a } else { -a };
+            if argyris {
+                // β ∂_t f(m) by the Hermite data of the quintic trace (as in
+                // `argyris_transformation`): from-end sign −1, to-end +1.
+                let tt = [t[0] * t[0], 2.0 * t[0] * t[1], t[1] * t[1]];
+                for (end, sign) in [(0, -1.0), (1, 1.0)] {
+                    let c = &mut ends[e][end];
+                    c[0] = beta * sign * 15.0 / (8.0 * l);
+                    c[1] = beta * (-7.0 / 16.0) * t[0];
+                    c[2] = beta * (-7.0 / 16.0) * t[1];
+                    for (k, &v) in tt.iter().enumerate() {
+                        c[3 + k] = beta * sign * l / 32.0 * v;
+                    }
+                }
+            } else {
+                // the secant slope of the quadratic trace
+                ends[e][0][0] = -beta / l;
+                ends[e][1][0] = beta / l;
+            }
+        }
+        if !det.is_finite() || det.abs() <= 1e-12 * longest || !longest.is_finite() {
+            return None;
+        }
+        let mut hessian = [[0.0; 3]; 3];
+        for (row, (a, b)) in [(0, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+            hessian[row] = [
+                j[0][a] * j[0][b],
+                j[0][a] * j[1][b] + j[1][a] * j[0][b],
+                j[1][a] * j[1][b],
+            ];
+        }
+        Some(Self {
+            argyris,
+            jacobian: j,
+            hessian,
+            alpha,
+            ends,
+        })
+    }
+
+    /// Number of local DOFs (21 Argyris, 6 Morley).
+    pub fn dofs(&self) -> usize {
+        if self.argyris {
+            21
+        } else {
+            6
+        }
+    }
+
+    /// The entry `M[i][l] = B[l][i]`, through [`apply_left`](Self::apply_left) on the
+    /// unit vector `e_l` (for the tests against `cell_transformation`).
+    #[cfg(test)]
+    fn entry(&self, i: usize, l: usize) -> f64 {
+        let mut e = [0.0; 21];
+        e[l] = 1.0;
+        let mut rows = [[0.0; 1]; 21];
+        for (r, v) in rows.iter_mut().zip(e) {
+            r[0] = v;
+        }
+        let n = self.dofs();
+        self.apply_left(&mut rows[..n], false);
+        rows[i][0]
+    }
+
+    /// `rows ← Bᵀ rows = M rows` in place, each row of `rows` a whole vector of the
+    /// other index (`rows.len()` must be [`dofs`](Self::dofs), else nothing is done).
+    /// With `upper`, the rows of vertex `v`'s DOFs are only computed from column `v`'s
+    /// first DOF on and the edge rows from the first edge DOF on: enough for the upper
+    /// triangle of a square result (used by [`transform_symmetric_element_matrix`]).
+    pub fn apply_left<const C: usize>(&self, rows: &mut [[f64; C]], upper: bool) {
+        let n = self.dofs();
+        if rows.len() != n {
+            return;
+        }
+        let per_vertex = if self.argyris { 6 } else { 1 };
+        let (vertex_rows, edge_rows) = rows.split_at_mut(3 * per_vertex);
+        for (v, block) in vertex_rows.chunks_exact_mut(per_vertex).enumerate() {
+            let [(ea, sa), (eb, sb)] = VERTEX_EDGES[v];
+            let (ra, rb) = (&edge_rows[ea], &edge_rows[eb]);
+            let (wa, wb) = (&self.ends[ea][sa], &self.ends[eb][sb]);
+            let lo = if upper { per_vertex * v } else { 0 };
+            if self.argyris {
+                let [[j00, j01], [j10, j11]] = self.jacobian;
+                let h = &self.hessian;
+                let [b0, b1, b2, b3, b4, b5] = block else {
+                    unreachable!("Argyris vertex blocks have six rows")
+                };
+                for c in lo..C {
+                    let (ya, yb) = (ra[c], rb[c]);
+                    let (g0, g1) = (b1[c], b2[c]);
+                    let (h0, h1, h2) = (b3[c], b4[c], b5[c]);
+                    b0[c] += wa[0] * ya + wb[0] * yb;
+                    b1[c] = j00 * g0 + j01 * g1 + wa[1] * ya + wb[1] * yb;
+                    b2[c] = j10 * g0 + j11 * g1 + wa[2] * ya + wb[2] * yb;
+                    b3[c] = h[0][0] * h0 + h[1][0] * h1 + h[2][0] * h2 + wa[3] * ya + wb[3] * yb;
+                    b4[c] = h[0][1] * h0 + h[1][1] * h1 + h[2][1] * h2 + wa[4] * ya + wb[4] * yb;
+                    b5[c] = h[0][2] * h0 + h[1][2] * h1 + h[2][2] * h2 + wa[5] * ya + wb[5] * yb;
+                }
+            } else {
+                let b0 = &mut block[0];
+                for c in lo..C {
+                    b0[c] += wa[0] * ra[c] + wb[0] * rb[c];
+                }
+            }
+        }
+        let lo = if upper { 3 * per_vertex } else { 0 };
+        for (row, &a) in edge_rows.iter_mut().zip(&self.alpha) {
+            for v in &mut row[lo..] {
+                *v *= a;
+            }
+        }
+    }
+}
+
+/// The dense reference of [`transform_element_matrix`]: `k ← M_test k M_trialᵀ` with
+/// `M` built by [`cell_transformation`] (a heap matrix), the products skipping its zeros.
+/// Slower (it builds the 21 × 21 matrix and tests every entry), kept as the independent
+/// check of the compact epilogue and as the fallback for an element that
+/// [`CompactTransformation`] does not know.
+///
+/// `M` is sparse (Argyris: 81 non-zeros of 441). A cell
 /// for which `M` does not exist (degenerate, or a repeated global vertex number) gets NaN
 /// entries: kernels cannot return errors, and meshes refuse such cells when built, so
 /// this only marks a caller's misuse visibly instead of giving plausible numbers.
-pub fn transform_element_matrix<const R: usize, const C: usize>(
+pub fn transform_element_matrix_dense<const R: usize, const C: usize>(
     test: fem_reference::ElementKind,
     trial: Option<fem_reference::ElementKind>,
     x: &[f64; 6],
@@ -369,6 +680,172 @@ impl TriangleField<'_> {
 mod tests {
     use super::*;
     use fem_reference::ElementKind;
+
+    /// xorshift64*: reproducible pseudo-random numbers in `[-1, 1)`.
+    struct Random(u64);
+
+    impl Random {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            let bits = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
+            2.0 * (bits as f64 / (1u64 << 53) as f64) - 1.0
+        }
+
+        /// Vertex coordinates of a non-degenerate triangle of size about `scale`, in
+        /// either orientation.
+        fn triangle(&mut self, scale: f64) -> [f64; 6] {
+            loop {
+                let x: [f64; 6] = std::array::from_fn(|_| scale * self.next());
+                let det = (x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1]);
+                if det.abs() > 0.3 * scale * scale {
+                    return x;
+                }
+            }
+        }
+
+        fn matrix<const R: usize, const C: usize>(&mut self) -> [[f64; C]; R] {
+            std::array::from_fn(|_| std::array::from_fn(|_| self.next()))
+        }
+    }
+
+    /// Global numberings giving every edge orientation pattern.
+    const NUMBERINGS: [[usize; 3]; 6] = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [20, 3, 11],
+    ];
+
+    fn assert_close<const R: usize, const C: usize>(
+        got: &[[f64; C]; R],
+        want: &[[f64; C]; R],
+        what: &str,
+    ) {
+        let scale = want.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (i, (g, w)) in got.iter().zip(want).enumerate() {
+            for (j, (g, w)) in g.iter().zip(w).enumerate() {
+                assert!(
+                    (g - w).abs() <= 1e-13 * scale,
+                    "{what}: entry ({i}, {j}) {g} vs {w} (scale {scale})"
+                );
+            }
+        }
+    }
+
+    /// The compact `M` is the matrix of `cell_transformation`, entry by entry, for every
+    /// edge orientation.
+    #[test]
+    fn compact_transformation_is_the_reference_matrix() {
+        let mut random = Random(99);
+        for element in [ElementKind::Argyris, ElementKind::Morley] {
+            for (n, global) in NUMBERINGS.iter().enumerate() {
+                let x = random.triangle([1.0, 0.01, 30.0][n % 3]);
+                let m = cell_transformation(element, &x, global).unwrap().unwrap();
+                let b = CompactTransformation::new(element, &x, global).unwrap();
+                let size = b.dofs();
+                assert_eq!(size, m.row(0).len());
+                let scale = (0..size)
+                    .flat_map(|i| m.row(i).to_vec())
+                    .fold(0.0f64, |a, v| a.max(v.abs()));
+                for i in 0..size {
+                    for l in 0..size {
+                        let (got, want) = (b.entry(i, l), m[(i, l)]);
+                        assert!(
+                            (got - want).abs() <= 1e-14 * scale,
+                            "{element:?} {global:?}: M[{i}][{l}] = {got}, reference {want}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// The compact epilogue agrees with the dense reference on random reference matrices:
+    /// both sides transformed, one side (a mixed block with P0 or P1disc, a load vector),
+    /// and the symmetric variant on a symmetric `K̂`.
+    #[test]
+    fn compact_epilogue_agrees_with_the_dense_reference() {
+        let mut random = Random(5);
+        let (a, m) = (ElementKind::Argyris, ElementKind::Morley);
+        for (n, global) in NUMBERINGS.iter().enumerate() {
+            let x = random.triangle([1.0, 0.05, 7.0][n % 3]);
+            {
+                let k0: [[f64; 21]; 21] = random.matrix();
+                let (mut got, mut want) = (k0, k0);
+                transform_element_matrix(a, Some(a), &x, global, &mut got);
+                transform_element_matrix_dense(a, Some(a), &x, global, &mut want);
+                assert_close(&got, &want, "Argyris × Argyris");
+                let symmetric: [[f64; 21]; 21] =
+                    std::array::from_fn(|i| std::array::from_fn(|j| k0[i.min(j)][i.max(j)]));
+                let (mut got, mut want) = (symmetric, symmetric);
+                transform_symmetric_element_matrix(a, &x, global, &mut got);
+                transform_element_matrix_dense(a, Some(a), &x, global, &mut want);
+                assert_close(&got, &want, "symmetric Argyris");
+            }
+            let k0: [[f64; 6]; 6] = random.matrix();
+            let (mut got, mut want) = (k0, k0);
+            transform_element_matrix(m, Some(m), &x, global, &mut got);
+            transform_element_matrix_dense(m, Some(m), &x, global, &mut want);
+            assert_close(&got, &want, "Morley × Morley");
+            let symmetric: [[f64; 6]; 6] =
+                std::array::from_fn(|i| std::array::from_fn(|j| k0[i.min(j)][i.max(j)]));
+            let (mut got, mut want) = (symmetric, symmetric);
+            transform_symmetric_element_matrix(m, &x, global, &mut got);
+            transform_element_matrix_dense(m, Some(m), &x, global, &mut want);
+            assert_close(&got, &want, "symmetric Morley");
+            let k0: [[f64; 3]; 21] = random.matrix();
+            let (mut got, mut want) = (k0, k0);
+            transform_element_matrix(a, Some(ElementKind::P1Disc), &x, global, &mut got);
+            transform_element_matrix_dense(a, Some(ElementKind::P1Disc), &x, global, &mut want);
+            assert_close(&got, &want, "Argyris × P1disc");
+            let k0: [[f64; 21]; 1] = random.matrix();
+            let (mut got, mut want) = (k0, k0);
+            transform_element_matrix(ElementKind::P0, Some(a), &x, global, &mut got);
+            transform_element_matrix_dense(ElementKind::P0, Some(a), &x, global, &mut want);
+            assert_close(&got, &want, "P0 × Argyris");
+            let k0: [[f64; 1]; 6] = random.matrix();
+            let (mut got, mut want) = (k0, k0);
+            transform_element_matrix(m, None, &x, global, &mut got);
+            transform_element_matrix_dense(m, None, &x, global, &mut want);
+            assert_close(&got, &want, "Morley load vector");
+            let k0: [[f64; 6]; 21] = random.matrix();
+            let (mut got, mut want) = (k0, k0);
+            transform_element_matrix(a, Some(m), &x, global, &mut got);
+            transform_element_matrix_dense(a, Some(m), &x, global, &mut want);
+            assert_close(&got, &want, "Argyris × Morley");
+        }
+    }
+
+    /// Cells without `M` get NaN from both epilogues, and a Lagrange block is untouched.
+    #[test]
+    fn cells_without_a_transformation_are_poisoned() {
+        let flat = [0.0, 0.0, 1.0, 1.0, 2.0, 2.0];
+        let good = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+        let a = ElementKind::Argyris;
+        let mut k = [[1.0; 21]; 21];
+        transform_symmetric_element_matrix(a, &flat, &[0, 1, 2], &mut k);
+        assert!(k.iter().flatten().all(|v| v.is_nan()));
+        let mut k = [[1.0; 21]; 21];
+        transform_element_matrix(a, Some(a), &good, &[4, 1, 4], &mut k);
+        assert!(k.iter().flatten().all(|v| v.is_nan()));
+        let mut k = [[1.0; 6]; 6];
+        let nan = [0.0, 0.0, f64::NAN, 0.0, 0.0, 1.0];
+        transform_element_matrix(ElementKind::Morley, None, &nan, &[0, 1, 2], &mut k);
+        assert!(k.iter().flatten().all(|v| v.is_nan()));
+        let mut k = [[1.0; 3]; 3];
+        transform_element_matrix(
+            ElementKind::P1,
+            Some(ElementKind::P1),
+            &flat,
+            &[0, 1, 2],
+            &mut k,
+        );
+        assert_eq!(k, [[1.0; 3]; 3]);
+    }
 
     /// A P2 field interpolating `u = x² + 3xy − y²` is `u` itself: its gradient and
     /// Hessian at any point of any cell of a curved-boundary (disk) mesh are exact.

@@ -736,7 +736,7 @@ fn collect_elements(file: &MshFile<u64, i32, f64>, quadratic: bool) -> Result<El
             )
         } else {
             format!(
-                "second- or higher-order elements are not supported here (found {}); only 3-node triangles can be read as a mesh of straight cells: mesh with Mesh.ElementOrder = 1 (6-node triangles are read as a curved geometry by `read_msh_quadratic`)",
+                "second- or higher-order elements are not supported here (found {}); only 3-node triangles can be read as a mesh of straight cells: mesh with Mesh.ElementOrder = 1 (6-node triangles are read as a curved geometry by the library's `read_msh_quadratic`, for the curved-cell solvers; the membrane command line takes straight cells only)",
                 list(&of_the_other_order)
             )
         }));

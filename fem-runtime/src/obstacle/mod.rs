@@ -9,6 +9,7 @@ pub mod triangle;
 use crate::assembly::boundary::{Constraints, Reduction, Side};
 use crate::assembly::dof_map::DofNumbering;
 use crate::assembly::dof_map::SystemDofs;
+use crate::assembly::plate_basis::{congruence, BlockRotation, ChangeOfBasis, VERTEX_DOFS};
 use crate::assembly::{assemble_vector, block_plans, for_each_entry, BlockPlan};
 use crate::element::interval::PhysicalBasis;
 use crate::element::mapping::Affine;
@@ -50,8 +51,13 @@ pub struct Discretization<G = IntervalMesh> {
     pub mesh: G,
     /// DOFs of all fields of the model.
     pub dofs: SystemDofs,
-    /// Elimination of the boundary DOFs.
+    /// Elimination of the boundary DOFs, in the primed numbering of `basis`.
     pub reduction: Reduction,
+    /// The rotation of the Argyris vertex DOFs that turns plate supports on edges not
+    /// along x or y into fixed DOFs ([`Constraints::change_of_basis`]; the identity
+    /// otherwise). The LCP is in the primed DOFs; full coefficient vectors
+    /// ([`Discretization::full`], the solution's values) are Cartesian.
+    pub basis: ChangeOfBasis,
     /// The LCP blocks.
     pub lcp: Lcp,
     /// The model field that holds the multiplier.
@@ -148,6 +154,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         let bilinear = M::FORMS[form].name;
         let plans = block_plans::<M>(form, &dofs, true)?;
         let reduction = constraints.reduction(dofs.dof_count())?;
+        let basis = constraints.change_of_basis(dofs.dof_count())?;
         let multiplier_range = dofs.range(multiplier).unwrap();
         let mut roles = Vec::with_capacity(reduction.free().len());
         let (mut primal_reduced, mut multiplier_reduced) = (Vec::new(), Vec::new());
@@ -171,7 +178,33 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 Role::Multiplier(k) => Target::Multiplier(k),
             };
         }
-        let split = SplitPattern::new(mesh, &dofs, &plans, &target, n, m);
+        // A rotated vertex is assembled in its Cartesian DOFs, all six primal unknowns (its
+        // fixed primed DOFs as extra unknowns n..), then rotated (T A Tᵀ, B Tᵀ, T F) and
+        // its fixed primed DOFs eliminated.
+        let mut extra_values = Vec::new();
+        let mut rotated = Vec::with_capacity(basis.blocks().len());
+        for block in basis.blocks() {
+            let mut indices = [0; VERTEX_DOFS];
+            for (k, index) in indices.iter_mut().enumerate() {
+                let d = block.start + k;
+                *index = match target[d] {
+                    Target::Primal(p) => p,
+                    Target::Fixed(v) => {
+                        target[d] = Target::Primal(n + extra_values.len());
+                        extra_values.push(v);
+                        n + extra_values.len() - 1
+                    }
+                    Target::Multiplier(_) => {
+                        return Err(Error::Input(format!(
+                            "DOF {d} of the multiplier has a vertex condition: plate supports are for the plate field"
+                        )))
+                    }
+                };
+            }
+            rotated.push((indices, block.t));
+        }
+        let n_ext = n + extra_values.len();
+        let split = SplitPattern::new(mesh, &dofs, &plans, &target, n_ext, m);
         let mut values = vec![0.0; split.value_count];
         let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
         crate::assembly::add_form_matrices::<M, G>(
@@ -194,19 +227,44 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         for (&(row, fixed), &v) in split.fixed_terms.iter().zip(&values[split.fixed_start..]) {
             rhs[row] -= v * fixed;
         }
+        basis.to_primed(&mut rhs);
+        let rotation = BlockRotation::new(&rotated, n_ext);
         let (a_len, b_len) = (split.a_rows.len(), split.b_columns.len());
         let a_vals = values[..a_len].to_vec();
-        // B = −(the multiplier rows of B_h), without its zeros
+        // B = −(the multiplier rows of B_h), without its zeros; rotated, B_h Tᵀ less the
+        // columns of the fixed primed DOFs (moved to the multiplier rows' right side)
         let mut b_ptr = Vec::with_capacity(m + 1);
         let mut b_entries = Vec::with_capacity(b_len);
+        let mut multiplier_shift = vec![0.0; m];
+        let mut row = Vec::new();
         b_ptr.push(0);
-        for k in 0..m {
+        for (k, shift) in multiplier_shift.iter_mut().enumerate() {
+            row.clear();
             for e in split.b_ptr[k]..split.b_ptr[k + 1] {
                 let v = values[a_len + e];
                 if v != 0.0 {
-                    b_entries.push((split.b_columns[e], -v));
+                    rotation.spread(split.b_columns[e], v, &mut row);
                 }
             }
+            if !rotated.is_empty() {
+                row.sort_unstable_by_key(|&(q, _)| q);
+                let mut merged: Vec<(usize, f64)> = Vec::with_capacity(row.len());
+                for &(q, v) in &row {
+                    match merged.last_mut() {
+                        Some(last) if last.0 == q => last.1 += v,
+                        _ => merged.push((q, v)),
+                    }
+                }
+                row.clear();
+                for (q, v) in merged {
+                    if q >= n {
+                        *shift += v * extra_values[q - n];
+                    } else if v != 0.0 {
+                        row.push((q, v));
+                    }
+                }
+            }
+            b_entries.extend(row.iter().map(|&(q, v)| (q, -v)));
             b_ptr.push(b_entries.len());
         }
         let c_start = a_len + b_len;
@@ -225,12 +283,30 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             ))
         })?;
         let a: SparseMatrix = SparseColMat::new(
-            SymbolicSparseColMat::new_checked(n, n, split.a_ptr, None, split.a_rows),
+            SymbolicSparseColMat::new_checked(n_ext, n_ext, split.a_ptr, None, split.a_rows),
             a_vals,
         );
         let free = reduction.free();
-        let f = primal_reduced.iter().map(|&r| rhs[free[r]]).collect();
-        let g = multiplier_reduced.iter().map(|&r| -rhs[free[r]]).collect();
+        let mut f: Vec<f64> = primal_reduced.iter().map(|&r| rhs[free[r]]).collect();
+        let g = multiplier_reduced
+            .iter()
+            .zip(&multiplier_shift)
+            .map(|(&r, shift)| shift - rhs[free[r]])
+            .collect();
+        let a = if rotated.is_empty() {
+            a
+        } else {
+            // the extra unknowns' right sides, for `Reduction::rhs` to size the vector
+            let mut extra = Constraints::new();
+            for (j, &v) in extra_values.iter().enumerate() {
+                extra.fix_dof(n + j, v)?;
+            }
+            let elimination = extra.reduction(n_ext)?;
+            let a = congruence(&a, &rotated)?;
+            f.resize(n_ext, 0.0);
+            f = elimination.rhs(&a, &f);
+            elimination.matrix(&a)
+        };
         Ok(Self {
             mesh: mesh.clone(),
             dofs,
@@ -244,6 +320,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 g,
             },
             multiplier_field: multiplier,
+            basis,
             roles,
             primal_reduced,
             multiplier_reduced,
@@ -443,7 +520,9 @@ impl<G> Discretization<G> {
             .collect()
     }
 
-    /// The full coefficient vector (all fields, boundary values included) of an LCP solution.
+    /// The full coefficient vector (all fields, boundary values included, Cartesian
+    /// DOFs: mapped back from the primed ones of [`Discretization::basis`]) of an LCP
+    /// solution.
     pub fn full(&self, solution: &LcpSolution) -> Vec<f64> {
         let mut reduced = vec![0.0; self.roles.len()];
         for (p, &r) in self.primal_reduced.iter().enumerate() {
@@ -452,7 +531,9 @@ impl<G> Discretization<G> {
         for (k, &r) in self.multiplier_reduced.iter().enumerate() {
             reduced[r] = solution.lambda[k];
         }
-        self.reduction.expand(&reduced)
+        let mut full = self.reduction.expand(&reduced);
+        self.basis.to_cartesian(&mut full);
+        full
     }
 
     /// The multipliers of a full coefficient vector, in the order of the LCP's constraints.
@@ -463,8 +544,21 @@ impl<G> Discretization<G> {
             .collect()
     }
 
-    /// The primal unknowns of a full coefficient vector (a start for Newton).
+    /// The primal unknowns of a full coefficient vector (Cartesian DOFs, as
+    /// [`Discretization::full`] gives; a start for Newton): in the primed DOFs of
+    /// [`Discretization::basis`], which the LCP is in.
     pub fn primal_part(&self, full: &[f64]) -> Vec<f64> {
+        let primed;
+        let full = if self.basis.is_identity() {
+            full
+        } else {
+            primed = {
+                let mut x = full.to_vec();
+                self.basis.to_primed(&mut x);
+                x
+            };
+            &primed
+        };
         self.primal_reduced
             .iter()
             .map(|&r| full[self.reduction.free()[r]])

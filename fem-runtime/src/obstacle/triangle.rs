@@ -42,8 +42,7 @@ pub fn dirichlet_constraints<M: Model>(
 /// boundary edge of the mesh (a problem with natural conditions only, which the
 /// membrane does not determine: u + constant solves it wherever contact does not hold
 /// it), for boundary data that is not finite at a node, and for a plate field: data
-/// that is not zero at a vertex of the part, or (Argyris) an edge of the part that is
-/// not along x or y.
+/// that is not zero at a vertex of the part.
 pub fn dirichlet_constraints_on<M: Model>(
     mesh: &TriangleMesh,
     dofs: &SystemDofs,
@@ -111,7 +110,7 @@ fn constraints_at_nodes<M: Model>(
                 let value = g(x);
                 if value != 0.0 {
                     return Err(Error::Input(format!(
-                        "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions on {} fields are homogeneous (w = 0) for now",
+                        "boundary data `{}` of `{}` is {value} at ({}, {}): plate boundary conditions from a model's `boundary:` data on {} fields are homogeneous (w = 0): they fix derivatives of w, which a data function does not give; hold the plate with Constraints::support_plate_with_data, which takes the data's derivatives",
                         M::DATA[data],
                         M::FIELDS[field].name,
                         x[0],
@@ -120,9 +119,13 @@ fn constraints_at_nodes<M: Model>(
                     )));
                 }
             }
-            for dof in part.plate_dofs(map, mesh, PlateSupport::SimplySupported)? {
-                constraints.fix_dof(offset + dof, 0.0)?;
-            }
+            constraints.support_plate_field(
+                mesh,
+                map,
+                offset,
+                part,
+                PlateSupport::SimplySupported,
+            )?;
             continue;
         }
         let nodes = nodes(map);
@@ -610,6 +613,62 @@ pub fn max_penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: us
     largest
 }
 
+/// The largest open gap under a pushing multiplier: over the cells where the multiplier
+/// `multiplier` pushes (one of its coefficients on the cell above 1e-6 of its largest),
+/// the smallest `side·(u_h − ψ)` at the cell's corners, edge midpoints and centroid;
+/// the largest of these over such cells, 0 where every such cell touches ψ (or there
+/// is none). `side` is +1 for `u ≥ ψ` (an obstacle below), −1 for `u ≤ ψ`.
+///
+/// A stabilized method imposes `s(u_h − ψ) = α h^k (…)` on the cells in contact: with
+/// `α h^k` large against the gap (coarse meshes, or α far above `1/C_I` where C_I gives
+/// no bound), λ_h pushes on cells where the structure stays clear of ψ, and the KKT
+/// residual cannot show it (the discrete problem is solved exactly). This measures
+/// that: a few percent of the structure's size means the contact set is not real.
+/// NaN if a compared value is.
+pub fn max_open_contact_gap(
+    u: &TriangleField,
+    multiplier: &TriangleField,
+    psi: &crate::model::DataFn,
+    side: f64,
+) -> f64 {
+    let largest = multiplier.coefficients.iter().cloned().fold(0.0, f64::max);
+    if largest <= 0.0 {
+        return 0.0;
+    }
+    let basis = TriangleBasis::new(u.map.element());
+    let points = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [0.0, 1.0],
+        [0.5, 0.0],
+        [0.5, 0.5],
+        [0.0, 0.5],
+        [1.0 / 3.0, 1.0 / 3.0],
+    ];
+    let mut widest = 0.0f64;
+    for c in 0..u.mesh.cell_count() {
+        let pushing = multiplier
+            .map
+            .cell_dofs(c)
+            .iter()
+            .any(|&k| multiplier.coefficients[k] > 1e-6 * largest);
+        if !pushing {
+            continue;
+        }
+        let map = crate::element::triangle::AffineMap::of(u.mesh, c);
+        let mut narrowest = f64::INFINITY;
+        for &xi in &points {
+            let gap = side * (u.value(&basis, c, xi) - psi(&map.point(xi)));
+            if gap.is_nan() {
+                return f64::NAN;
+            }
+            narrowest = narrowest.min(gap);
+        }
+        widest = widest.max(narrowest);
+    }
+    widest
+}
+
 /// Per constraint: active (λ_k above 1e-8 of the multiplier scale) or touching (its
 /// residual `R_k` negligible against the terms it is made of).
 pub fn contact_indicator(lcp: &Lcp, u: &[f64], lambda: &[f64]) -> Vec<bool> {
@@ -820,6 +879,11 @@ pub fn dirichlet_constraints_per_field<M: Model>(
                 constraints.fix_dof(dof, value)?;
             }
         }
+        for &(start, row, value) in on_part.vertex_conditions() {
+            if range.contains(&start) {
+                constraints.fix_vertex_combination(start, row, value)?;
+            }
+        }
     }
     Ok(constraints)
 }
@@ -863,4 +927,56 @@ pub fn solve_obstacle_on_field_parts<M: Model>(
         prolong_primal_on_triangles,
         options,
     )
+}
+
+#[cfg(test)]
+mod open_gap_tests {
+    use super::*;
+    use crate::assembly::dof_map::DofMap;
+    use crate::mesh::{Diagonal, TriangleMesh};
+    use fem_reference::ElementKind;
+
+    /// u = 1 − x (P1, exact), ψ = 0, λ pushing on chosen cells: the open gap is the
+    /// smallest u over the pushing cells farthest from touching; u ≤ ψ the other way.
+    #[test]
+    fn the_open_gap_is_the_clearance_of_the_worst_pushing_cell() {
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 2, 2, Diagonal::Right).unwrap();
+        let p1 = DofMap::on_triangles(&mesh, ElementKind::P1);
+        let p0 = DofMap::on_triangles(&mesh, ElementKind::P0);
+        let u: Vec<f64> = mesh.vertices().iter().map(|x| 1.0 - x[0]).collect();
+        let field = TriangleField {
+            mesh: &mesh,
+            map: &p1,
+            coefficients: &u,
+        };
+        let zero = |_: &[f64]| 0.0;
+        let gap_with = |pushing: &[usize], side: f64| {
+            let mut lambda = vec![0.0; mesh.cell_count()];
+            for &c in pushing {
+                lambda[c] = 2.0;
+            }
+            let multiplier = TriangleField {
+                mesh: &mesh,
+                map: &p0,
+                coefficients: &lambda,
+            };
+            max_open_contact_gap(&field, &multiplier, &zero, side)
+        };
+        assert_eq!(gap_with(&[], 1.0), 0.0);
+        // every cell: the left column's cells (x ≤ ½) stay at least ½ clear of ψ = 0
+        let all: Vec<usize> = (0..mesh.cell_count()).collect();
+        assert!((gap_with(&all, 1.0) - 0.5).abs() < 1e-14);
+        // only cells touching x = 1, where u = 0 = ψ: no open gap
+        let right: Vec<usize> = (0..mesh.cell_count())
+            .filter(|&c| {
+                mesh.cell_coordinates(c)
+                    .iter()
+                    .step_by(2)
+                    .any(|&x| x == 1.0)
+            })
+            .collect();
+        assert_eq!(gap_with(&right, 1.0), 0.0);
+        // the obstacle above (u ≤ ψ): u − ψ ≥ 0 is a penetration, never an open gap
+        assert!(gap_with(&all, -1.0) <= 0.0);
+    }
 }
