@@ -37,9 +37,11 @@ fn block_input(element: Displacement, alpha: Option<f64>) -> SignoriniInput<'sta
         load: &[3],
         pressure: &pressure,
         gap: &no_gap,
+        contact_direction: [0.0, -1.0],
         fixed_x: &[4],
         fixed_y: &[],
         alpha,
+        contact_centre: None,
     }
 }
 

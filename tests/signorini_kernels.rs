@@ -1,7 +1,8 @@
 //! Generated facet kernels (`∫_Γ … ds`, docs/forms.md) of the Signorini models against
 //! kernels written by hand, for u ∈ [P1]² and u ∈ [P2]², on every local edge of random
-//! triangles (both orientations): the coupling `b(v;μ) = −∫_Γ_C μ v·n ds`, the
-//! stabilization `S = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds`, the facet part of `B_h`, the
+//! triangles (both orientations): the coupling `b(v;μ) = −∫_Γ_C μ v·n_c ds`, the
+//! stabilization `S = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds` with `σ_n(u) = n_c·σ(u)n`, the
+//! facet part of `B_h`, the
 //! load `ℓ(v) = −∫_Γ_N q v·n ds` and `G(μ) = −∫_Γ_C g μ ds`.
 //!
 //! The hand-coded side uses barycentric formulas for the bases, `σ(φ e_a)` written out
@@ -17,6 +18,8 @@ const MU: f64 = 3.7;
 const LAMBDA: f64 = 5.3;
 const ALPHA: f64 = 0.21;
 const Q: f64 = 1.7;
+/// The contact direction, a unit vector not along any edge's normal.
+const NC: [f64; 2] = [0.6, -0.8];
 
 fn pressure(_x: &[f64]) -> f64 {
     Q
@@ -119,7 +122,7 @@ impl Cell {
             * len
     }
 
-    /// `n·σ(φ_i e_a)n` with `σ = 2μ ε + λ tr ε I`.
+    /// `n_c·σ(φ_i e_a)n` with `σ = 2μ ε + λ tr ε I`.
     fn sigma_n(&self, p: usize, i: usize, a: usize, b: [f64; 3], n: [f64; 2]) -> f64 {
         let g = self.basis(p, i, b).1;
         // ε(φ e_a)_kl = ½(δ_ka g_l + δ_la g_k), tr ε = g_a
@@ -130,7 +133,7 @@ impl Cell {
                 let dl = f64::from(u8::from(l == a));
                 let eps = 0.5 * (dk * g[l] + dl * g[k]);
                 let id = f64::from(u8::from(k == l));
-                s += n[k] * (2.0 * MU * eps + LAMBDA * g[a] * id) * n[l];
+                s += NC[k] * (2.0 * MU * eps + LAMBDA * g[a] * id) * n[l];
             }
         }
         s
@@ -155,7 +158,7 @@ fn hand(cell: &Cell, p: usize, e: usize) -> Hand {
     let b = (0..2)
         .map(|a| {
             (0..nb)
-                .map(|j| -cell.integrate_edge(e, &|bc, _| cell.basis(p, j, bc).0 * n[a]))
+                .map(|j| -cell.integrate_edge(e, &|bc, _| cell.basis(p, j, bc).0 * NC[a]))
                 .collect()
         })
         .collect();
@@ -239,11 +242,17 @@ macro_rules! check_model {
     ($model:ident, $p:expr) => {{
         use $model::{b as coupling, data, params, ℓ, B_h, G, S};
         let coefficients = Coefficients::from_ids(
-            &[(params::μ_L, MU), (params::λ_L, LAMBDA), (params::α, ALPHA)],
+            &[
+                (params::μ_L, MU),
+                (params::λ_L, LAMBDA),
+                (params::α, ALPHA),
+                (params::n_c_x, NC[0]),
+                (params::n_c_y, NC[1]),
+            ],
             &[(data::q, &pressure), (data::g, &gap)],
         )
         .expect("valid coefficients");
-        let prm: [f64; 3] = coefficients.params.clone().try_into().unwrap();
+        let prm: [f64; 5] = coefficients.params.clone().try_into().unwrap();
         let dat: [&fem_forms::DataFn; 2] = [&pressure, &gap];
         let nb = if $p == 1 { 3 } else { 6 };
         for (c, cell) in cells().iter().enumerate() {
@@ -346,12 +355,13 @@ fn p2_facet_kernels_match_hand_coded_ones() {
 }
 
 /// The trace of a P1 field on an edge does not see the opposite vertex: the kernels of
-/// `b` vanish in the column of the vertex off the edge, and the two others share |E|·n_a.
+/// `b` vanish in the column of the vertex off the edge, and the two others share
+/// |E|·n_c,a (here n_c = (0, −1)).
 #[test]
 fn coupling_sees_only_the_edge() {
     let cell = Cell::new([[0.0, 0.0], [2.0, 0.0], [0.5, 1.5]]);
     let x = cell.flat();
-    let prm = [MU, LAMBDA, ALPHA];
+    let prm = [MU, LAMBDA, ALPHA, 0.0, -1.0];
     let dat: [&fem_forms::DataFn; 2] = [&pressure, &gap];
     // edge 0 is the bottom [0,0]–[2,0]: n = (0, −1), |E| = 2
     let k = signorini_p1::b::on_Γ_C::matrix_μ_u_y(&x, 0, &prm, &dat);

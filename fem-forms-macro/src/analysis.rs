@@ -974,10 +974,35 @@ impl<'a> Context<'a> {
                 vec![m]
             };
             return Some(Some(Value::Vector(vec![component(0), component(1)])));
+        } else if let Some(components) = self.vector_parameter(name) {
+            // `n_c` of the parameters `n_c_x`, `n_c_y`: a constant vector.
+            let component = |i: usize| {
+                let mut m = scalar(loc);
+                m.params = vec![(i, 1)];
+                vec![m]
+            };
+            return Some(Some(Value::Vector(
+                components.into_iter().map(component).collect(),
+            )));
         } else {
             return None;
         }
         Some(Some(Value::Scalar(vec![m])))
+    }
+
+    /// The parameters `name_x`, `name_y` (on triangles), when both are declared: the
+    /// components of the constant vector `name` (a given direction such as `n_c`).
+    fn vector_parameter(&self, name: &str) -> Option<Vec<usize>> {
+        if self.symbols.dimension != 2 {
+            return None;
+        }
+        crate::declaration::COMPONENT_SUFFIXES
+            .iter()
+            .map(|suffix| {
+                let component = format!("{name}{suffix}");
+                self.symbols.params.iter().position(|p| *p == component)
+            })
+            .collect()
     }
 
     /// Splits `sλ` into declared names (longest first), if it can be done.

@@ -3,10 +3,12 @@
 //! foundation, frictionless, with a multiplier λ ≥ 0 on the potential contact boundary
 //! `Γ_C`, the contact pressure `λ = −σ_n(u)`.
 //!
-//! In the frame of §1: `s = −1`, `Bv = v·n`, `ψ = g` (the initial gap along n, the
-//! contact direction taken as the body's outward normal), `b(v,μ) = −(μ, v·n)_{Γ_C}`, the
-//! residual of the contact equation `λ + σ_n(u)` with `σ_n(v) = n·σ(v)n` traced from the
-//! cell next to the edge, and no data term in the stabilization:
+//! In the frame of §1: `s = −1`, `Bv = v·n_c`, `ψ = g` (the initial gap along the
+//! contact direction `n_c = (n_c_x, n_c_y)`, a unit vector: the rigid plane's normal
+//! pointing away from the body, or n itself), `b(v,μ) = −(μ, v·n_c)_{Γ_C}`, the
+//! residual of the contact equation `λ + σ_n(u)` with `σ_n(v) = n_c·σ(v)n` traced from
+//! the cell next to the edge (n the outward normal), and no data term in the
+//! stabilization:
 //! `S_h = Σ_{E⊂Γ_C} h_E (λ + σ_n(u), μ + σ_n(v))_E`, `B_h = a − b − bᵀ − α S_h`.
 //! The load is a pressure `q` (force per length, positive pushing in) on the boundary
 //! part `Γ_N`: `ℓ(v) = −(q, v·n)_{Γ_N}`.
@@ -23,14 +25,14 @@ macro_rules! signorini_model {
             pub mod $name on triangle {
                 unknowns: u: [$element]^2, λ: P0 >= 0;
                 tests: v, μ;
-                params: μ_L > 0, λ_L, α;
+                params: μ_L > 0, λ_L, α, n_c_x, n_c_y;
                 data: q: 0, g: 1;
                 facets: Γ_C, Γ_N;
                 forms: "
                     σ(u)             := 2μ_L ε(u) + λ_L tr ε(u) I
-                    σ_n(u)           := (σ(u)·n)·n
+                    σ_n(u)           := (σ(u)·n)·n_c
                     a(u;v)           = ∫ σ(u):ε(v)
-                    b(v;μ)           = −∫_Γ_C μ v·n ds
+                    b(v;μ)           = −∫_Γ_C μ v·n_c ds
                     S(u,λ;v,μ)       = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds
                     ℓ(v)             = −∫_Γ_N q v·n ds
                     G(μ)             = −∫_Γ_C g μ ds
@@ -94,8 +96,11 @@ pub struct SignoriniInput<'a> {
     pub load: &'a [u32],
     /// The pressure q on Γ_N (force per length, positive pressing in), a function of x.
     pub pressure: &'a DataFn,
-    /// The initial gap g along the outward normal on Γ_C (length), a function of x.
+    /// The initial gap g along `contact_direction` on Γ_C (length), a function of x.
     pub gap: &'a DataFn,
+    /// The contact direction `n_c`: the foundation's normal pointing away from the body
+    /// (`[0, −1]` for a foundation below); normalized here.
+    pub contact_direction: [f64; 2],
     /// Edges where `u_x = 0` (a symmetry line or a roller).
     pub fixed_x: &'a [u32],
     /// Edges where `u_y = 0`.
@@ -103,6 +108,9 @@ pub struct SignoriniInput<'a> {
     /// The stabilization parameter; `None`: `α = 1/(2 max_E C_I,E)` (MODELS.md §7);
     /// `Some(0.0)`: the plain mixed method, solved as a QP.
     pub alpha: Option<f64>,
+    /// The x of the middle of the contact zone, for the half-width (a symmetry line);
+    /// `None`: the middle of the pressed edges.
+    pub contact_centre: Option<f64>,
 }
 
 /// A solved Signorini problem.
@@ -119,12 +127,12 @@ pub struct SignoriniSolution {
     pub pressure: Vec<f64>,
     /// The edges of Γ_C.
     pub contact_edges: Vec<ContactEdge>,
-    /// Force of the foundation on the body, `Σ_E λ_E |E| (−n_E)`.
+    /// Force of the foundation on the body, `Σ_E λ_E |E| (−n_c)`.
     pub total_contact_force: [f64; 2],
     /// Resultant of the applied pressure, `∫_Γ_N q (−n) ds` (Gauss–Legendre, 4 points per edge).
     pub applied_load: [f64; 2],
     /// Half the extent along x of the edges that carry pressure (λ_E > 0), holes
-    /// between them included.
+    /// between them included (from `contact_centre` when given).
     pub contact_half_width: f64,
     /// The largest λ_E.
     pub max_contact_pressure: f64,
@@ -187,12 +195,26 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
             )));
         }
     }
+    let [cx, cy] = input.contact_direction;
+    let length = cx.hypot(cy);
+    if !(length.is_finite() && length > 0.0) {
+        return Err(Error::Input(format!(
+            "the contact direction ({cx}, {cy}) must be a non-zero finite vector"
+        )));
+    }
+    let direction = [cx / length, cy / length];
     let (ux, uy) = (M::field("u_x")?, M::field("u_y")?);
     let parts: [(&str, &[u32]); 2] = [("Γ_C", input.contact), ("Γ_N", input.load)];
     let fixed: [(usize, &[u32]); 2] = [(ux, input.fixed_x), (uy, input.fixed_y)];
     let coefficients = |alpha: f64| {
         Coefficients::new::<M>(
-            &[("μ_L", mu), ("λ_L", lambda), ("α", alpha)],
+            &[
+                ("μ_L", mu),
+                ("λ_L", lambda),
+                ("α", alpha),
+                ("n_c_x", direction[0]),
+                ("n_c_y", direction[1]),
+            ],
             &[("q", input.pressure), ("g", input.gap)],
         )
     };
@@ -210,7 +232,7 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
     } else {
         discretize_boundary_multiplier::<M>(mesh, &coefficients(alpha)?, &parts, &fixed)?
     };
-    let translation = towards_foundation(&problem);
+    let translation = towards_foundation(&problem, direction);
     let work: f64 = translation
         .iter()
         .zip(&problem.lcp.f)
@@ -235,25 +257,19 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
     } else {
         quadratic_program(&problem.lcp)?
     };
-    Ok(report(mesh, input, &problem, solution, alpha, constants))
+    Ok(report(
+        mesh, input, direction, &problem, solution, alpha, constants,
+    ))
 }
 
-/// The free-DOF vector of a unit translation along the mean inward direction of Γ_C
-/// (minus the mean outward normal): towards the foundation.
-fn towards_foundation(problem: &BoundaryMultiplierProblem) -> Vec<f64> {
-    let mut n = [0.0; 2];
-    for e in &problem.contact_edges {
-        let normal = outward_normal(e);
-        let l = e.length();
-        n[0] += l * normal[0];
-        n[1] += l * normal[1];
-    }
-    let norm = n[0].hypot(n[1]).max(f64::MIN_POSITIVE);
+/// The free-DOF vector of a unit translation along the contact direction: towards the
+/// foundation.
+fn towards_foundation(problem: &BoundaryMultiplierProblem, n: [f64; 2]) -> Vec<f64> {
     let fields = problem.dofs.fields();
     let mut full = vec![0.0; problem.dofs.dof_count()];
     for (axis, &field) in fields.iter().take(2).enumerate() {
         if let Some(range) = problem.dofs.range(field) {
-            full[range].fill(n[axis] / norm);
+            full[range].fill(n[axis]);
         }
     }
     problem.reduction.free().iter().map(|&d| full[d]).collect()
@@ -270,6 +286,7 @@ fn outward_normal(e: &ContactEdge) -> [f64; 2] {
 fn report(
     mesh: &TriangleMesh,
     input: &SignoriniInput,
+    direction: [f64; 2],
     problem: &BoundaryMultiplierProblem,
     solution: LcpSolution,
     alpha: f64,
@@ -279,9 +296,8 @@ fn report(
     let pressure = solution.lambda.clone();
     let mut force = [0.0; 2];
     for (e, &p) in problem.contact_edges.iter().zip(&pressure) {
-        let n = outward_normal(e);
-        force[0] -= p * e.length() * n[0];
-        force[1] -= p * e.length() * n[1];
+        force[0] -= p * e.length() * direction[0];
+        force[1] -= p * e.length() * direction[1];
     }
     let mut load = [0.0; 2];
     let gauss = fem_runtime::gauss_legendre(4);
@@ -329,10 +345,10 @@ fn report(
             }
         }
     }
-    let half_width = if x_max >= x_min {
-        0.5 * (x_max - x_min)
-    } else {
-        0.0
+    let half_width = match (x_max >= x_min, input.contact_centre) {
+        (false, _) => 0.0,
+        (true, None) => 0.5 * (x_max - x_min),
+        (true, Some(c)) => (x_max - c).abs().max((x_min - c).abs()),
     };
     // complementarity, as in Lcp::kkt_residual
     let bu = lcp.b_times(&solution.u);
@@ -365,4 +381,282 @@ fn report(
         iterations: solution.iterations,
         seconds: solution.seconds,
     }
+}
+
+/// Boundary markers of [`hertz_mesh`]: the arc (the potential contact boundary).
+pub const HERTZ_ARC: u32 = 1;
+/// Boundary markers of [`hertz_mesh`]: the flat top `y = 0` (the load).
+pub const HERTZ_TOP: u32 = 2;
+/// Boundary markers of [`hertz_mesh`]: the symmetry line `x = 0`.
+pub const HERTZ_AXIS: u32 = 3;
+
+/// The quarter `x ≥ 0, y ≤ 0` of the disc of radius `radius` centred at the origin (the
+/// right half of a half disc pressed down onto the plane `y = −radius`), graded towards
+/// the contact zone, the segment from `(0, −radius)` to `(zone, −radius)`: cells of
+/// diameter about `contact_h` over it, growing like `grading · distance` from it (at most
+/// `radius / 6`). Markers [`HERTZ_ARC`],
+/// [`HERTZ_TOP`], [`HERTZ_AXIS`]; the arc's vertices lie on the circle.
+///
+/// Built from a polar mesh of the quarter by newest-vertex bisection of the cells larger
+/// than their target, with the new arc vertices moved onto the circle after each round.
+///
+/// # Errors
+/// [`Error::Input`] for a radius, `contact_h` or `grading` not positive and finite, or
+/// `contact_h > radius`; the mesh's errors.
+pub fn hertz_mesh(radius: f64, zone: f64, contact_h: f64, grading: f64) -> Result<TriangleMesh> {
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !(positive(radius) && positive(contact_h) && positive(grading))
+        || contact_h > radius
+        || !(zone.is_finite() && zone >= 0.0)
+    {
+        return Err(Error::Input(format!(
+            "the Hertz mesh needs 0 < contact_h ≤ radius, zone ≥ 0 and grading > 0, got radius {radius}, zone {zone}, contact_h {contact_h}, grading {grading}"
+        )));
+    }
+    // Polar start: the centre, then rings k = 1..=4 of 3k + 1 vertices over [−π/2, 0].
+    let rings = 4;
+    let mut vertices = vec![[0.0, 0.0]];
+    let mut ring_ids: Vec<Vec<usize>> = vec![vec![0]];
+    for k in 1..=rings {
+        let r = radius * k as f64 / rings as f64;
+        let count = 3 * k + 1;
+        let ids = (0..count)
+            .map(|j| {
+                let theta = -std::f64::consts::FRAC_PI_2 * (1.0 - j as f64 / (count - 1) as f64);
+                vertices.push([r * theta.cos(), r * theta.sin()]);
+                vertices.len() - 1
+            })
+            .collect();
+        ring_ids.push(ids);
+    }
+    let angle = |v: [f64; 2]| v[1].atan2(v[0]);
+    let mut cells = Vec::new();
+    let mut push = |a: usize, b: usize, c: usize, vertices: &[[f64; 2]]| {
+        let (p, q, r) = (vertices[a], vertices[b], vertices[c]);
+        let area = (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1]);
+        cells.push(if area > 0.0 { [a, b, c] } else { [a, c, b] });
+    };
+    for k in 1..=rings {
+        let (inner, outer) = (&ring_ids[k - 1], &ring_ids[k]);
+        if inner.len() == 1 {
+            for j in 0..outer.len() - 1 {
+                push(inner[0], outer[j], outer[j + 1], &vertices);
+            }
+            continue;
+        }
+        let (mut i, mut j) = (0, 0);
+        while i + 1 < inner.len() || j + 1 < outer.len() {
+            let advance_outer = j + 1 < outer.len()
+                && (i + 1 >= inner.len()
+                    || angle(vertices[outer[j + 1]]) <= angle(vertices[inner[i + 1]]));
+            if advance_outer {
+                push(inner[i], outer[j], outer[j + 1], &vertices);
+                j += 1;
+            } else {
+                push(inner[i], outer[j], inner[i + 1], &vertices);
+                i += 1;
+            }
+        }
+    }
+    let mut markers = Vec::new();
+    let outer = &ring_ids[rings];
+    for j in 0..outer.len() - 1 {
+        markers.push((outer[j], outer[j + 1], HERTZ_ARC));
+    }
+    for k in 0..rings {
+        let (a, b) = (
+            *ring_ids[k].last().unwrap(),
+            *ring_ids[k + 1].last().unwrap(),
+        );
+        markers.push((a, b, HERTZ_TOP));
+        let (a, b) = (ring_ids[k][0], ring_ids[k + 1][0]);
+        markers.push((a, b, HERTZ_AXIS));
+    }
+    let mut mesh = TriangleMesh::new(vertices, cells, &markers)?;
+    let largest = radius / 6.0;
+    for _ in 0..200 {
+        let marked: Vec<usize> = (0..mesh.cell_count())
+            .filter(|&c| {
+                let x = mesh.cell_coordinates(c);
+                let centroid = [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0];
+                let d = (centroid[0] - zone).max(0.0).hypot(centroid[1] + radius);
+                mesh.cell_diameter(c) > contact_h.max(grading * d).min(largest)
+            })
+            .collect();
+        if marked.is_empty() {
+            return Ok(mesh);
+        }
+        mesh = project_arc(&mesh.refine(&marked)?.0, radius)?;
+    }
+    Err(Error::Input(format!(
+        "the Hertz mesh did not reach cells of {contact_h} at the contact point in 200 rounds"
+    )))
+}
+
+/// The mesh with the vertices of its arc edges moved radially onto the circle.
+fn project_arc(mesh: &TriangleMesh, radius: f64) -> Result<TriangleMesh> {
+    let mut vertices = mesh.vertices().to_vec();
+    let mut markers = Vec::with_capacity(mesh.boundary_edges().len());
+    for &(e, m) in mesh.boundary_edges() {
+        let [a, b] = mesh.edges()[e];
+        markers.push((a, b, m));
+        if m == HERTZ_ARC {
+            for v in [a, b] {
+                let r = vertices[v][0].hypot(vertices[v][1]);
+                vertices[v] = [vertices[v][0] * radius / r, vertices[v][1] * radius / r];
+            }
+        }
+    }
+    TriangleMesh::new(vertices, mesh.cells().to_vec(), &markers)
+}
+
+/// Hertz line contact in plane strain (MODELS.md §7): `E* = E/(1−ν²)`, half-width
+/// `b = √(4PR/(πE*))`, peak `p_max = 2P/(πb)`, `p(x) = p_max √(1 − x²/b²)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hertz {
+    /// Radius R.
+    pub radius: f64,
+    /// Young's modulus E.
+    pub young: f64,
+    /// Poisson's ratio ν.
+    pub poisson: f64,
+    /// Resultant P (force per length).
+    pub load: f64,
+}
+
+impl Hertz {
+    /// The half-width `b`.
+    pub fn half_width(&self) -> f64 {
+        let e_star = self.young / (1.0 - self.poisson * self.poisson);
+        (4.0 * self.load * self.radius / (std::f64::consts::PI * e_star)).sqrt()
+    }
+
+    /// The peak pressure `p_max = 2P/(πb)`.
+    pub fn peak(&self) -> f64 {
+        2.0 * self.load / (std::f64::consts::PI * self.half_width())
+    }
+
+    /// The pressure at x (0 outside the contact zone).
+    pub fn pressure(&self, x: f64) -> f64 {
+        let b = self.half_width();
+        self.peak() * (1.0 - (x / b) * (x / b)).max(0.0).sqrt()
+    }
+}
+
+/// A Hertz computation against the formulas.
+#[derive(Clone, Debug)]
+pub struct HertzResult {
+    /// The reference.
+    pub hertz: Hertz,
+    /// The cell size at the contact point.
+    pub contact_h: f64,
+    /// The computed solution (on the quarter disc).
+    pub solution: SignoriniSolution,
+    /// `‖λ_h − p‖ / ‖p‖` on Γ_C (16-point Gauss–Legendre per edge).
+    pub pressure_l2_error: f64,
+    /// `‖Π₀p − p‖ / ‖p‖`: the error of the best P0 fit on the same edges.
+    pub best_fit_l2_error: f64,
+    /// The checkerboard measure: `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
+    /// consecutive contact edges (ordered by x) inside `x < 0.8 b`, where p is smooth
+    /// (its own second difference there is at most `4.7 (h/b)² p_max`: 0.018 at b/h = 16).
+    pub oscillation: f64,
+}
+
+/// The Hertz problem on [`hertz_mesh`]: the quarter disc with `u_x = 0` on the axis, the
+/// resultant `P/2` as a uniform pressure `P/(2R)` on the top, the gap to the plane
+/// `y = −R` measured vertically, the contact direction the plane's normal `(0, −1)`.
+/// `b_over_h` sets the cell size at the contact point, `h = b / b_over_h`.
+///
+/// # Errors
+/// Those of [`hertz_mesh`] and [`solve_signorini`]; [`Error::Input`] for `b_over_h` not
+/// positive and finite.
+pub fn solve_hertz(
+    hertz: Hertz,
+    b_over_h: f64,
+    element: Displacement,
+    alpha: Option<f64>,
+) -> Result<HertzResult> {
+    if !(b_over_h.is_finite() && b_over_h > 0.0) {
+        return Err(Error::Input(format!("b/h = {b_over_h} must be positive")));
+    }
+    let h = hertz.half_width() / b_over_h;
+    // uniform cells a little beyond b: the square-root edge of the pressure lies at b
+    let mesh = hertz_mesh(hertz.radius, 1.25 * hertz.half_width(), h, 0.25)?;
+    solve_hertz_on(hertz, &mesh, h, element, alpha)
+}
+
+/// [`solve_hertz`] on a given mesh of the quarter disc (markers as [`hertz_mesh`]'s),
+/// `contact_h` its cell size at the contact (reported only).
+///
+/// # Errors
+/// Those of [`solve_signorini`].
+pub fn solve_hertz_on(
+    hertz: Hertz,
+    mesh: &TriangleMesh,
+    contact_h: f64,
+    element: Displacement,
+    alpha: Option<f64>,
+) -> Result<HertzResult> {
+    let h = contact_h;
+    let q = hertz.load / (2.0 * hertz.radius);
+    let radius = hertz.radius;
+    let pressure = move |_: &[f64]| q;
+    let gap = move |x: &[f64]| x[1] + radius;
+    let input = SignoriniInput {
+        young: hertz.young,
+        poisson: hertz.poisson,
+        plane: Plane::Strain,
+        element,
+        contact: &[HERTZ_ARC],
+        load: &[HERTZ_TOP],
+        pressure: &pressure,
+        gap: &gap,
+        contact_direction: [0.0, -1.0],
+        fixed_x: &[HERTZ_AXIS],
+        fixed_y: &[],
+        alpha,
+        contact_centre: Some(0.0),
+    };
+    let solution = solve_signorini(mesh, &input)?;
+    let gauss = fem_runtime::gauss_legendre(16);
+    let (mut error, mut best, mut norm) = (0.0, 0.0, 0.0);
+    for (e, &lambda) in solution.contact_edges.iter().zip(&solution.pressure) {
+        let [a, b] = e.ends;
+        let l = e.length();
+        let at = |s: f64| hertz.pressure(a[0] + s * (b[0] - a[0]));
+        let mean: f64 = gauss
+            .points
+            .iter()
+            .zip(&gauss.weights)
+            .map(|(&s, &w)| w * at(s))
+            .sum();
+        for (&s, &w) in gauss.points.iter().zip(&gauss.weights) {
+            let p = at(s);
+            error += w * l * (lambda - p) * (lambda - p);
+            best += w * l * (mean - p) * (mean - p);
+            norm += w * l * p * p;
+        }
+    }
+    let mut profile: Vec<(f64, f64)> = solution
+        .contact_edges
+        .iter()
+        .zip(&solution.pressure)
+        .map(|(e, &p)| (e.midpoint()[0], p))
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let inside = 0.8 * hertz.half_width();
+    let oscillation = profile
+        .windows(3)
+        .filter(|w| w[2].0 < inside)
+        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
+        .fold(0.0f64, f64::max)
+        / hertz.peak();
+    Ok(HertzResult {
+        hertz,
+        contact_h: h,
+        oscillation,
+        solution,
+        pressure_l2_error: (error / norm).sqrt(),
+        best_fit_l2_error: (best / norm).sqrt(),
+    })
 }

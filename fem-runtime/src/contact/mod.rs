@@ -199,7 +199,12 @@ pub fn discretize_boundary_multiplier<M: Model>(
     let mut f_full = assemble_vector::<M>(linear_id, mesh, &dofs, coefficients)?;
     let mut g = vec![0.0; m];
     let (params, data) = (&coefficients.params, &coefficients.data);
-    let mut out = [0.0; 64];
+    let largest = M::FIELDS
+        .iter()
+        .map(|f| f.element.local_dof_count(M::CELL))
+        .max()
+        .unwrap_or(0);
+    let mut out = vec![0.0; largest * largest];
     // The global rows of a field's local DOFs on an edge's cell; for the multiplier, its
     // constraint (the edge's position in the part).
     let place = |field: usize, cell: usize| -> Option<Vec<usize>> {
@@ -364,7 +369,12 @@ pub fn inverse_constants<M: Model>(
     let size: usize = counts.iter().sum();
     let local_start = |field: usize| fields.iter().position(|&f| f == field).map(|k| start[k]);
     let (params, data) = (&coefficients.params, &coefficients.data);
-    let mut out = vec![0.0; 64];
+    let largest = M::FIELDS
+        .iter()
+        .map(|f| f.element.local_dof_count(M::CELL))
+        .max()
+        .unwrap_or(0);
+    let mut out = vec![0.0; largest * largest];
     let mut constants = Vec::with_capacity(problem.contact_edges.len());
     for edge in &problem.contact_edges {
         let x = mesh.cell_coordinates(edge.cell);
