@@ -178,3 +178,81 @@ fn bad_input_is_an_error_not_a_panic() {
     input.alpha = Some(-1.0);
     assert!(message(&input).contains("α"), "{}", message(&input));
 }
+
+fn parabolic_gap(x: &[f64]) -> f64 {
+    // the foundation curves away from the block's bottom: contact in the middle only
+    0.02 * (x[0] - 0.5) * (x[0] - 0.5)
+}
+
+/// A non-flat initial gap: only part of Γ_C touches. Newton's answer against clarabel's
+/// QP on the same LCP (an independent solver), the contact force against the load, and
+/// a contact zone that is neither empty nor the whole bottom.
+#[test]
+fn non_flat_gap_newton_agrees_with_the_qp() {
+    use fem_forms::contact::discretize_boundary_multiplier;
+    use fem_forms::lcp::{quadratic_program, semismooth_newton, NewtonOptions};
+    use fem_forms::models::signorini::signorini_p1::{self, Model as M};
+    use fem_forms::{Coefficients, Model};
+    let mesh = block(8, Diagonal::Alternating);
+    let mut input = block_input(Displacement::P1, None);
+    input.gap = &parabolic_gap;
+    let s = solve_signorini(&mesh, &input).unwrap();
+    assert!(
+        (s.total_contact_force[1] + s.applied_load[1]).abs() <= 1e-10 * Q,
+        "{:?} {:?}",
+        s.total_contact_force,
+        s.applied_load
+    );
+    let touching = s.pressure.iter().filter(|&&p| p > 0.0).count();
+    assert!(
+        touching > 0 && touching < s.pressure.len(),
+        "{touching} of {}",
+        s.pressure.len()
+    );
+    assert!(s.contact_half_width < 0.5);
+
+    let (mu, lambda) = lame(input.young, input.poisson, input.plane).unwrap();
+    let coefficients = Coefficients::from_ids(
+        &[
+            (signorini_p1::params::μ_L, mu),
+            (signorini_p1::params::λ_L, lambda),
+            (signorini_p1::params::α, s.alpha),
+            (signorini_p1::params::n_c_x, 0.0),
+            (signorini_p1::params::n_c_y, -1.0),
+        ],
+        &[
+            (signorini_p1::data::q, &pressure),
+            (signorini_p1::data::g, &parabolic_gap),
+        ],
+    )
+    .unwrap();
+    let fixed: [(usize, &[u32]); 1] = [(M::field("u_x").unwrap(), &[4])];
+    let problem = discretize_boundary_multiplier::<M>(
+        &mesh,
+        &coefficients,
+        &[("Γ_C", &[1]), ("Γ_N", &[3])],
+        &fixed,
+    )
+    .unwrap();
+    let n = problem.lcp.n();
+    let newton = semismooth_newton(
+        &problem.lcp,
+        Some(&vec![-0.01; n]),
+        NewtonOptions::default(),
+    )
+    .unwrap();
+    let qp = quadratic_program(&problem.lcp).unwrap();
+    let scale = qp.lambda.iter().fold(0.0f64, |m, &l| m.max(l));
+    for (k, (a, b)) in newton.lambda.iter().zip(&qp.lambda).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-6 * scale,
+            "edge {k}: Newton {a}, QP {b}"
+        );
+    }
+    for (k, (a, b)) in newton.lambda.iter().zip(&s.pressure).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-9 * scale,
+            "edge {k}: {a} against solve_signorini's {b}"
+        );
+    }
+}

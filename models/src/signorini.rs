@@ -45,12 +45,12 @@ macro_rules! signorini_model {
 }
 
 signorini_model! {
-    /// Signorini contact, u ∈ [P1]², λ ∈ P0 on the edges of Γ_C, stabilized (§7).
+    /// Signorini contact, u ∈ `[P1]²`, λ ∈ P0 on the edges of Γ_C, stabilized (§7).
     signorini_p1, P1
 }
 
 signorini_model! {
-    /// Signorini contact, u ∈ [P2]², λ ∈ P0 on the edges of Γ_C, stabilized (§7).
+    /// Signorini contact, u ∈ `[P2]²`, λ ∈ P0 on the edges of Γ_C, stabilized (§7).
     signorini_p2, P2
 }
 
@@ -72,9 +72,9 @@ pub enum Plane {
 /// The displacement element.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Displacement {
-    /// u ∈ [P1]² ([`signorini_p1`]).
+    /// u ∈ `[P1]²` ([`signorini_p1`]).
     P1,
-    /// u ∈ [P2]² ([`signorini_p2`]).
+    /// u ∈ `[P2]²` ([`signorini_p2`]).
     P2,
 }
 
