@@ -6,8 +6,7 @@
 //! the `convergence` and `alpha` studies.
 
 use crate::models::contact_scenes::{ContactBody, ContactScene};
-use crate::models::hertz::HertzLineContact;
-use crate::models::signorini::{solve_signorini, Displacement, SignoriniInput};
+use crate::models::signorini::{solve_hertz, solve_signorini, Displacement, Hertz, SignoriniInput};
 use crate::plot::{self, Axes, Series};
 use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
 use serde::Serialize;
@@ -116,8 +115,6 @@ pub struct ContactReport {
     pub pair: &'static str,
     /// N (block) or b/h (cylinder).
     pub mesh_size: usize,
-    /// Cells of the mesh (the cylinder: its symmetric half).
-    pub cells: usize,
     /// q (block) or P (cylinder).
     pub load: f64,
     /// The stabilization parameter used.
@@ -141,7 +138,7 @@ pub struct ContactReport {
     /// rigid translation lies in V_h, so equilibrium is exact).
     pub equilibrium_residual: f64,
     /// Half the extent along x of the edges carrying pressure (their far ends; the
-    /// cylinder from its axis).
+    /// cylinder from its axis, `models::signorini::SignoriniSolution`).
     pub contact_half_width: f64,
     /// The largest contact pressure λ_E.
     pub max_contact_pressure: f64,
@@ -149,11 +146,14 @@ pub struct ContactReport {
     pub exact_half_width: Option<f64>,
     /// Hertz's peak pressure p_max (cylinder).
     pub exact_max_pressure: Option<f64>,
-    /// `‖p − λ_h‖ / ‖p‖` against Hertz's pressure (cylinder; the edges projected on x).
+    /// `‖p − λ_h‖ / ‖p‖` on Γ_C against Hertz's pressure (cylinder).
     pub pressure_l2_error: Option<f64>,
     /// The same error of the best P0 fit on the same edges (the L² projection of p):
     /// the floor of any P0 multiplier.
     pub best_p0_l2_error: Option<f64>,
+    /// The checkerboard measure `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` inside
+    /// `x < 0.8 b` (cylinder; `models::signorini::HertzResult::oscillation`).
+    pub oscillation: Option<f64>,
     /// `max_E |λ_E − q| / q` (the block: 0 exactly for a correct method).
     pub patch_pressure_error: Option<f64>,
     /// The complementarity part of the KKT residual (relative).
@@ -175,60 +175,49 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
     let s = &request.scene;
     let q = request.load;
     let n = request.mesh_size;
-    let no_gap = |_: &[f64]| 0.0;
-    let (mesh, hertz, symmetric) = match s.body {
+    let element = request.pair.displacement();
+    let (solution, hertz, errors) = match s.body {
         ContactBody::Block { width, height } => {
             let nx = ((width / height).round() as usize).max(1) * n;
             let mesh = TriangleMesh::rectangle(0.0, width, 0.0, height, nx, n, Diagonal::Right)?;
-            (mesh, None, false)
+            let pressure = move |_: &[f64]| q;
+            let no_gap = |_: &[f64]| 0.0;
+            // contact at the bottom (marker 1), the load on the top (3), a roller on
+            // the left side (4) against the rigid translation along x
+            let input = SignoriniInput {
+                young: s.young,
+                poisson: s.poisson,
+                plane: s.plane,
+                element,
+                contact: &[1],
+                load: &[3],
+                pressure: &pressure,
+                gap: &no_gap,
+                contact_direction: [0.0, -1.0],
+                fixed_x: &[4],
+                fixed_y: &[],
+                alpha: request.alpha,
+                contact_centre: None,
+            };
+            (solve_signorini(&mesh, &input)?, None, None)
         }
-        ContactBody::Cylinder { .. } => {
-            let hertz = s.hertz(q).expect("a cylinder has a Hertz reference");
-            (hertz.graded_mesh(n as f64)?, Some(hertz), true)
+        ContactBody::Cylinder { radius } => {
+            let hertz = Hertz {
+                radius,
+                young: s.young,
+                poisson: s.poisson,
+                load: q,
+            };
+            let r = solve_hertz(hertz, n as f64, element, request.alpha)?;
+            (
+                r.solution,
+                Some(hertz),
+                Some([r.pressure_l2_error, r.best_fit_l2_error, r.oscillation]),
+            )
         }
     };
-    // the block: contact bottom (1), load top (3), roller left (4); the quarter disc:
-    // contact arc (1), load top (2), symmetry axis (3)
-    let (contact, load, fixed_x): (&[u32], &[u32], &[u32]) = match s.body {
-        ContactBody::Block { .. } => (&[1], &[3], &[4]),
-        ContactBody::Cylinder { .. } => (&[1], &[2], &[3]),
-    };
-    let top_pressure = match s.body {
-        ContactBody::Block { .. } => q,
-        // the half model carries P/2 on its top of length R
-        ContactBody::Cylinder { radius } => q / (2.0 * radius),
-    };
-    let pressure = move |_: &[f64]| top_pressure;
-    let radius = match s.body {
-        ContactBody::Cylinder { radius } => radius,
-        ContactBody::Block { .. } => 1.0,
-    };
-    // the distance from the arc to the plane y = 0 along the body's outward normal
-    // n = (x, y − R)/R: y R/(R − y); beyond R it cannot close, so it is capped there
-    let cylinder_gap = move |x: &[f64]| {
-        let y = x[1].max(0.0);
-        if radius - y <= y {
-            radius
-        } else {
-            (y * radius / (radius - y)).min(radius)
-        }
-    };
-    let gap: &fem_runtime::DataFn = if symmetric { &cylinder_gap } else { &no_gap };
-    let input = SignoriniInput {
-        young: s.young,
-        poisson: s.poisson,
-        plane: s.plane,
-        element: request.pair.displacement(),
-        contact,
-        load,
-        pressure: &pressure,
-        gap,
-        fixed_x,
-        fixed_y: &[],
-        alpha: request.alpha,
-    };
-    let solution = solve_signorini(&mesh, &input)?;
-    let factor = if symmetric { 2.0 } else { 1.0 };
+    // the cylinder is solved on its symmetric half
+    let factor = if hertz.is_some() { 2.0 } else { 1.0 };
     let largest = solution.max_contact_pressure;
     let mut profile: PressureProfile = solution
         .contact_edges
@@ -240,38 +229,12 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         })
         .collect();
     profile.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let pressed = profile.iter().filter(|e| e.2 > 1e-10 * largest);
-    let (lo, hi) = pressed.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| {
-        (lo.min(e.0), hi.max(e.1))
-    });
-    let contact_half_width = match (hi >= lo, symmetric) {
-        (false, _) => 0.0,
-        (true, true) => hi,
-        (true, false) => 0.5 * (hi - lo),
-    };
-    let (pressure_l2_error, best_p0_l2_error) = match &hertz {
-        Some(h) => {
-            // mirror the half model's edges to the whole contact zone
-            let mut intervals = Vec::with_capacity(2 * profile.len());
-            let mut values = Vec::with_capacity(2 * profile.len());
-            for &(x0, x1, p) in &profile {
-                intervals.extend([[x0, x1], [-x1, -x0]]);
-                values.extend([p, p]);
-            }
-            (
-                Some(h.relative_l2_error_p0(&intervals, &values)),
-                Some(h.best_p0_relative_l2_error(&intervals)),
-            )
-        }
-        None => (None, None),
-    };
     let total = factor * solution.total_contact_force[1];
     let applied = -factor * solution.applied_load[1];
     let report = ContactReport {
         scene: s.name.to_string(),
         pair: request.pair.name(),
         mesh_size: n,
-        cells: mesh.cell_count(),
         load: q,
         alpha: solution.alpha,
         inverse_constant: solution
@@ -285,13 +248,14 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         total_contact_force: total,
         applied_load: applied,
         equilibrium_residual: (total - applied).abs() / applied.abs(),
-        contact_half_width,
+        contact_half_width: solution.contact_half_width,
         max_contact_pressure: largest,
         exact_half_width: hertz.map(|h| h.half_width()),
-        exact_max_pressure: hertz.map(|h| h.max_pressure()),
-        pressure_l2_error,
-        best_p0_l2_error,
-        patch_pressure_error: (!symmetric).then(|| {
+        exact_max_pressure: hertz.map(|h| h.peak()),
+        pressure_l2_error: errors.map(|e| e[0]),
+        best_p0_l2_error: errors.map(|e| e[1]),
+        oscillation: errors.map(|e| e[2]),
+        patch_pressure_error: hertz.is_none().then(|| {
             solution
                 .pressure
                 .iter()
@@ -306,11 +270,10 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
 /// One line for a report (`solve` without `--json`).
 pub fn summary(r: &ContactReport) -> String {
     let mut line = format!(
-        "{} {} mesh size {} ({} cells): α {:.3e}, {} dofs, {} contact edges, total contact force {:.9e} (load {:.9e}, equilibrium residual {:.1e}), contact half-width {:.6e}, max pressure {:.6e}",
+        "{} {} mesh size {}: α {:.3e}, {} dofs, {} contact edges, total contact force {:.9e} (load {:.9e}, equilibrium residual {:.1e}), contact half-width {:.6e}, max pressure {:.6e}",
         r.scene,
         r.pair,
         r.mesh_size,
-        r.cells,
         r.alpha,
         r.dofs,
         r.contact_edges,
@@ -357,7 +320,7 @@ pub fn pressure_chart(
     out: &Path,
     report: &ContactReport,
     curves: &[(String, &PressureProfile)],
-    hertz: &HertzLineContact,
+    hertz: &Hertz,
 ) -> Result<std::path::PathBuf> {
     std::fs::create_dir_all(out).map_err(crate::studies::io)?;
     let b = hertz.half_width();
@@ -391,7 +354,7 @@ pub fn pressure_chart(
 }
 
 /// The `alpha` study of a Hertz scene: α·max C_I from 0 (the plain method) to 2.5 at
-/// one b/h, the pressure error and its oscillation (the largest jump between
+/// one b/h, the pressure error and its oscillation (the second difference of
 /// neighbouring edges' pressures relative to p_max, inside the contact zone), and the
 /// chart of the plain, the automatic and a too-large α against Hertz.
 ///
@@ -419,7 +382,7 @@ pub fn alpha_study(scene: ContactScene, b_over_h: usize, out: &Path) -> Result<(
         request.alpha = Some(fraction / c_i);
         match solve(&request) {
             Ok((r, profile)) => {
-                let oscillation = oscillation(&profile, hertz.half_width()) / hertz.max_pressure();
+                let oscillation = r.oscillation.unwrap_or(f64::NAN);
                 let e = r.pressure_l2_error.unwrap_or(f64::NAN);
                 let best = r.best_p0_l2_error.unwrap_or(f64::NAN);
                 println!(
@@ -453,17 +416,6 @@ pub fn alpha_study(scene: ContactScene, b_over_h: usize, out: &Path) -> Result<(
     Ok(())
 }
 
-/// The largest jump between neighbouring edges' pressures with both inside
-/// `[0, 0.8 b]` (where the exact pressure is smooth and varies by less than
-/// p_max·h/b·…): a checkerboard shows as jumps of the size of the pressure itself.
-fn oscillation(profile: &PressureProfile, b: f64) -> f64 {
-    profile
-        .windows(2)
-        .filter(|w| w[1].1 <= 0.8 * b)
-        .map(|w| (w[1].2 - w[0].2).abs())
-        .fold(0.0, f64::max)
-}
-
 /// The `convergence` study of a Hertz scene: b/h = 8, 16, 32, 64 (`full`: to 128),
 /// half-width, peak and the pressure's L² error against the best P0 fit, per pair.
 ///
@@ -493,7 +445,7 @@ pub fn convergence_study(scene: ContactScene, full: bool, out: &Path) -> Result<
         "seconds"
     );
     let mut csv = String::from(
-        "pair,b_over_h,cells,dofs,half_width_error,max_pressure_error,l2_error,best_p0,iterations,seconds\n",
+        "pair,b_over_h,dofs,half_width_error,max_pressure_error,l2_error,best_p0,iterations,seconds\n",
     );
     let mut series = Vec::new();
     let mut best_series = Vec::new();
@@ -513,17 +465,15 @@ pub fn convergence_study(scene: ContactScene, full: bool, out: &Path) -> Result<
             let e = r.pressure_l2_error.unwrap_or(f64::NAN);
             let best = r.best_p0_l2_error.unwrap_or(f64::NAN);
             println!(
-                "{:>6} {n:>5} {:>7} {:>8} {eb:>+10.2e} {ep:>+10.2e} {e:>10.3e} {best:>10.3e} {:>6} {:>8.3}",
+                "{:>6} {n:>5} {:>8} {eb:>+10.2e} {ep:>+10.2e} {e:>10.3e} {best:>10.3e} {:>6} {:>8.3}",
                 pair.name(),
-                r.cells,
                 r.dofs,
                 r.iterations,
                 r.seconds
             );
             csv += &format!(
-                "{},{n},{},{},{eb:e},{ep:e},{e:e},{best:e},{},{}\n",
+                "{},{n},{},{eb:e},{ep:e},{e:e},{best:e},{},{}\n",
                 pair.name(),
-                r.cells,
                 r.dofs,
                 r.iterations,
                 r.seconds

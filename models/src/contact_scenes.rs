@@ -2,8 +2,7 @@
 //! material, the load and the foundation; the solver is the CLI's (`src/contact.rs`)
 //! over [`crate::signorini::solve_signorini`].
 
-use crate::hertz::HertzLineContact;
-use crate::signorini::Plane;
+use crate::signorini::{Hertz, Plane};
 
 /// The elastic body and how it meets the rigid foundation `y = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,9 +52,9 @@ pub struct ContactScene {
 
 impl ContactScene {
     /// The Hertz reference of a cylinder scene at load `load` (`None` for a block).
-    pub fn hertz(&self, load: f64) -> Option<HertzLineContact> {
+    pub fn hertz(&self, load: f64) -> Option<Hertz> {
         match self.body {
-            ContactBody::Cylinder { radius } => Some(HertzLineContact {
+            ContactBody::Cylinder { radius } => Some(Hertz {
                 radius,
                 young: self.young,
                 poisson: self.poisson,

@@ -1,0 +1,177 @@
+//! The Signorini contact scenes from the command line (issue 14): `signorini-patch`'s
+//! exact pressure, `hertz` against Hertz's formulas (computed here, not by the code under
+//! test), equilibrium as an identity, the plain method's oscillation, the studies'
+//! files, and bad input refused with a message naming it, never a panic.
+
+use std::process::Command;
+
+fn fem_forms(args: &[&str], out: &str) -> std::process::Output {
+    let out = std::env::temp_dir().join(format!("fem-forms-contact-{out}-{}", std::process::id()));
+    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("the binary runs")
+}
+
+fn solve_json(scene: &str, args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["solve", scene, "--json"];
+    all.extend_from_slice(args);
+    let run = fem_forms(&all, "solve");
+    assert!(
+        run.status.success(),
+        "{all:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_slice(&run.stdout).unwrap()
+}
+
+fn number(json: &serde_json::Value, field: &str) -> f64 {
+    json[field]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{field} missing in {json}"))
+}
+
+/// The block under a uniform pressure: λ_h = q on every contact edge, for both pairs
+/// and any load; the foundation carries the load exactly.
+#[test]
+fn the_patch_test_gives_the_pressure_exactly() {
+    for (pair, load) in [("p1-p0", "1"), ("p2-p0", "3.5")] {
+        let json = solve_json(
+            "signorini-patch",
+            &["--pair", pair, "--load", load, "--mesh-size", "4"],
+        );
+        let q: f64 = load.parse().unwrap();
+        assert!(number(&json, "patch_pressure_error") <= 1e-9, "{json}");
+        assert!((number(&json, "max_contact_pressure") - q).abs() <= 1e-9 * q);
+        // the block is 2 wide: the foundation carries 2q
+        assert!((number(&json, "total_contact_force") - 2.0 * q).abs() <= 1e-9 * q);
+        assert!(number(&json, "equilibrium_residual") <= 1e-10);
+        assert!(number(&json, "complementarity_residual") <= 1e-9);
+        assert!(json["pressure_l2_error"].is_null());
+    }
+}
+
+/// MODELS.md §7's Hertz problem: b = √(4PR/(πE*)) = 0.0340389, p_max = 2P/(πb) =
+/// 18.7027 (computed here). The stabilized P1–P0 pressure: half-width within two
+/// cells, peak within 1 %, L² error within 1.7× the best P0 fit and falling with b/h;
+/// the foundation carries P.
+#[test]
+fn hertz_matches_the_formulas() {
+    let (r, e, nu, p) = (1.0f64, 1000.0f64, 0.3f64, 1.0f64);
+    let e_star = e / (1.0 - nu * nu);
+    let b = (4.0 * p * r / (std::f64::consts::PI * e_star)).sqrt();
+    let p_max = 2.0 * p / (std::f64::consts::PI * b);
+    let mut previous = f64::INFINITY;
+    for n in [8, 32] {
+        let json = solve_json("hertz", &["--mesh-size", &n.to_string()]);
+        assert!((number(&json, "exact_half_width") - b).abs() < 1e-12 * b);
+        assert!((number(&json, "exact_max_pressure") - p_max).abs() < 1e-12 * p_max);
+        let half_width = number(&json, "contact_half_width");
+        assert!(
+            (half_width - b).abs() <= 2.0 * b / n as f64,
+            "b/h = {n}: {half_width}"
+        );
+        assert!((number(&json, "max_contact_pressure") - p_max).abs() <= 0.01 * p_max);
+        let error = number(&json, "pressure_l2_error");
+        assert!(error <= 1.7 * number(&json, "best_p0_l2_error"), "{json}");
+        assert!(error < previous);
+        previous = error;
+        assert!((number(&json, "total_contact_force") - p).abs() <= 1e-10);
+        assert!(number(&json, "complementarity_residual") <= 1e-9);
+    }
+}
+
+/// The plain mixed method (α = 0, solved as a QP) oscillates where the stabilized one
+/// does not (MODELS.md §7: a checkerboard).
+#[test]
+fn the_plain_method_oscillates_on_hertz() {
+    let stabilized = solve_json("hertz", &["--mesh-size", "16"]);
+    let plain = solve_json("hertz", &["--mesh-size", "16", "--alpha", "0"]);
+    assert_eq!(number(&plain, "alpha"), 0.0);
+    assert!(
+        number(&plain, "oscillation") > 3.0 * number(&stabilized, "oscillation"),
+        "plain {} stabilized {}",
+        plain["oscillation"],
+        stabilized["oscillation"]
+    );
+}
+
+/// The α study writes its chart and table; `--plot` writes the pressure chart.
+#[test]
+fn the_hertz_study_and_chart_are_written() {
+    let out = std::env::temp_dir().join(format!("fem-forms-contact-study-{}", std::process::id()));
+    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["study", "hertz", "alpha", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("hertz-alpha.csv")).unwrap();
+    assert!(csv.lines().count() >= 9, "{csv}");
+    assert!(out.join("hertz-alpha.svg").exists());
+    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["solve", "hertz", "--plot", "--mesh-size", "8", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(out.join("hertz-pressure.svg").exists());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn bad_contact_input_exits_with_a_message() {
+    for (scene, args, message) in [
+        (
+            "signorini-patch",
+            &["--load", "-1"][..],
+            "load -1 must be positive",
+        ),
+        (
+            "signorini-patch",
+            &["--load", "0"][..],
+            "load 0 must be positive",
+        ),
+        (
+            "hertz",
+            &["--mesh-size", "0"][..],
+            "mesh size 0 must lie in",
+        ),
+        ("hertz", &["--mesh-size", "100000"][..], "must lie in"),
+        (
+            "hertz",
+            &["--pair", "p3-p0"][..],
+            "unknown contact pair `p3-p0`",
+        ),
+        ("hertz", &["--alpha", "-1"][..], "α = -1"),
+        (
+            "hertz",
+            &["--thickness", "0.1"][..],
+            "--thickness does not apply",
+        ),
+        ("signorini-patch", &["--plot"][..], "--plot does not apply"),
+        (
+            "signorini-patch",
+            &["--support", "clamped"][..],
+            "--support does not apply",
+        ),
+    ] {
+        let mut all = vec!["solve", scene];
+        all.extend_from_slice(args);
+        let run = fem_forms(&all, "bad");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{all:?} succeeded");
+        assert!(stderr.contains(message), "{all:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{all:?}: {stderr}");
+    }
+}
