@@ -3,7 +3,6 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::beams::{self, Pair, Report, Request};
-use fem_forms::contact;
 use fem_forms::kirchhoff::{self, KirchhoffPair, KirchhoffRequest};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::contact_scenes::{ContactBody, ContactScene};
@@ -15,6 +14,7 @@ use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::plates::{self, PlatePair, PlateRequest};
+use fem_forms::signorini as contact;
 use fem_forms::studies::{self, Study};
 use fem_forms::{plot, scene_file};
 use std::path::{Path, PathBuf};

@@ -250,7 +250,7 @@ pub fn study_scene(entry: &SceneEntry) -> Result<Box<dyn StudyScene>> {
             s.name
         ))),
         SceneKind::Contact(s) => Err(Error::Input(format!(
-            "contact scene `{}` runs its studies in fem_forms::contact",
+            "contact scene `{}` runs its studies in fem_forms::signorini",
             s.name
         ))),
     }

@@ -1,5 +1,5 @@
 //! The Signorini contact scenes (MODELS.md §7, issue 14), as data: the body, its
-//! material, the load and the foundation; the solver is the CLI's (`src/contact.rs`)
+//! material, the load and the foundation; the solver is the CLI's (`src/signorini.rs`)
 //! over [`crate::signorini::solve_signorini`].
 
 use crate::signorini::{Hertz, Plane};

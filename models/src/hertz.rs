@@ -15,9 +15,6 @@
 //! All integrals here are exact (closed forms of `∫p` and `∫p²`), so the reference adds
 //! no quadrature error of its own.
 
-use fem_runtime::mesh::triangle::distance_to_segment;
-use fem_runtime::mesh::TriangleMesh;
-
 /// Hertz line contact of a cylinder on a rigid plane, plane strain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HertzLineContact {
@@ -31,76 +28,7 @@ pub struct HertzLineContact {
     pub load: f64,
 }
 
-/// Rings of the coarse quarter disc [`HertzLineContact::graded_mesh`] refines.
-const COARSE_RINGS: usize = 4;
-
-/// How fast [`HertzLineContact::graded_mesh`]'s cells grow away from the contact zone:
-/// `h ≤ GRADING · distance` (NVB keeps the cells' shapes, so any grading works; 0.3
-/// keeps the cell count near `O((b/h) log(R/h))`).
-pub const GRADING: f64 = 0.3;
-
 impl HertzLineContact {
-    /// The symmetric half `x ≥ 0` of the cylinder's lower half as a mesh graded towards
-    /// the contact zone: the quarter disc of radius `R` centred at `(0, R)`
-    /// (`TriangleMesh::quarter_disk`: boundary parts `arc`, `top` and the symmetry line
-    /// `axis`, where `u_x = 0` removes the rigid motions), refined by newest-vertex
-    /// bisection until the cells within the zone `0 ≤ x ≤ 1.5 b` next to `y = 0` have
-    /// diameter at most `b / b_over_h`, growing as [`GRADING`] times the distance from
-    /// the zone away from it; new vertices on the arc are put on the circle.
-    ///
-    /// # Errors
-    /// `b_over_h` not in `[1, 4096]` or the problem's constants invalid
-    /// (non-positive R, E or P, ν outside (−1, ½)): [`fem_runtime::Error::Input`]; mesh
-    /// errors as `TriangleMesh::refine_to_size`.
-    pub fn graded_mesh(&self, b_over_h: f64) -> fem_runtime::Result<TriangleMesh> {
-        self.check()?;
-        if !(1.0..=4096.0).contains(&b_over_h) {
-            return Err(fem_runtime::Error::Input(format!(
-                "b/h = {b_over_h} must be in [1, 4096] (the contact zone's cells per half-width)"
-            )));
-        }
-        let (radius, b) = (self.radius, self.half_width());
-        let h_zone = b / b_over_h;
-        let size = |p: [f64; 2]| {
-            let d = distance_to_segment(p, [0.0, 0.0], [1.5 * b, 0.0]);
-            h_zone.max(GRADING * d)
-        };
-        let onto_circle = |marker: u32, p: [f64; 2]| {
-            if marker != 1 {
-                return p;
-            }
-            let (dx, dy) = (p[0], p[1] - radius);
-            let r = dx.hypot(dy);
-            [radius * dx / r, radius + radius * dy / r]
-        };
-        let coarse = TriangleMesh::quarter_disk(radius, COARSE_RINGS)?;
-        Ok(coarse.refine_to_size(size, onto_circle, 5_000_000)?.0)
-    }
-
-    /// Checks the constants: R, E, P positive and finite, ν in (−1, ½).
-    ///
-    /// # Errors
-    /// [`fem_runtime::Error::Input`] naming the constant at fault.
-    pub fn check(&self) -> fem_runtime::Result<()> {
-        let bad = |what: String| Err(fem_runtime::Error::Input(what));
-        for (name, v) in [
-            ("radius R", self.radius),
-            ("Young's modulus E", self.young),
-            ("load P", self.load),
-        ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return bad(format!("{name} = {v} must be positive and finite"));
-            }
-        }
-        if !(self.poisson > -1.0 && self.poisson < 0.5) {
-            return bad(format!(
-                "Poisson ratio ν = {} must be in (−1, ½)",
-                self.poisson
-            ));
-        }
-        Ok(())
-    }
-
     /// The plane-strain modulus `E* = E/(1 − ν²)` (rigid foundation).
     pub fn plane_strain_modulus(&self) -> f64 {
         self.young / (1.0 - self.poisson * self.poisson)
@@ -197,39 +125,6 @@ mod tests {
     fn the_prototype_constants_match_the_models_document() {
         assert!((PROTOTYPE.half_width() - 0.0340389).abs() < 5e-8);
         assert!((PROTOTYPE.max_pressure() - 18.7027).abs() < 5e-5);
-    }
-
-    #[test]
-    fn the_graded_mesh_resolves_the_contact_zone_at_the_asked_b_over_h() {
-        let b = PROTOTYPE.half_width();
-        for b_over_h in [8.0, 64.0] {
-            let mesh = PROTOTYPE.graded_mesh(b_over_h).unwrap();
-            let mut zone_edges = 0;
-            for &(e, marker) in mesh.boundary_edges() {
-                let [p, q] = mesh.edges()[e].map(|v| mesh.vertices()[v]);
-                assert!(p[0] >= 0.0 && q[0] >= 0.0);
-                if marker == 1 && p[0].max(q[0]) <= b {
-                    zone_edges += 1;
-                    let length = (q[0] - p[0]).hypot(q[1] - p[1]);
-                    assert!(length <= b / b_over_h * (1.0 + 1e-12), "{length}");
-                    for v in [p, q] {
-                        assert!((v[0].hypot(v[1] - 1.0) - 1.0).abs() < 1e-13);
-                    }
-                }
-            }
-            assert!(zone_edges as f64 >= b_over_h, "{zone_edges}");
-            assert!(mesh.cell_count() < 60_000, "{}", mesh.cell_count());
-        }
-        let bad = HertzLineContact {
-            poisson: 0.5,
-            ..PROTOTYPE
-        };
-        assert!(bad
-            .graded_mesh(8.0)
-            .unwrap_err()
-            .to_string()
-            .contains("ν = 0.5"));
-        assert!(PROTOTYPE.graded_mesh(0.5).is_err());
     }
 
     #[test]

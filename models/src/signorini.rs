@@ -385,20 +385,20 @@ fn report(
 
 /// Boundary markers of [`hertz_mesh`]: the arc (the potential contact boundary).
 pub const HERTZ_ARC: u32 = 1;
-/// Boundary markers of [`hertz_mesh`]: the flat top `y = 0` (the load).
+/// Boundary markers of [`hertz_mesh`]: the flat top `y = radius` (the load).
 pub const HERTZ_TOP: u32 = 2;
 /// Boundary markers of [`hertz_mesh`]: the symmetry line `x = 0`.
 pub const HERTZ_AXIS: u32 = 3;
 
-/// The quarter `x ≥ 0, y ≤ 0` of the disc of radius `radius` centred at the origin (the
-/// right half of a half disc pressed down onto the plane `y = −radius`), graded towards
-/// the contact zone, the segment from `(0, −radius)` to `(zone, −radius)`: cells of
-/// diameter about `contact_h` over it, growing like `grading · distance` from it (at most
-/// `radius / 6`). Markers [`HERTZ_ARC`],
+/// The quarter `x ≥ 0, y ≤ radius` of the disc of radius `radius` centred at
+/// `(0, radius)` (the right half of a half disc resting on the plane `y = 0` at the
+/// origin), graded towards the contact zone, the segment from the origin to
+/// `(zone, 0)`: cells of diameter at most `contact_h` over it, growing like
+/// `grading · distance` from it (at most `radius / 6`). Markers [`HERTZ_ARC`],
 /// [`HERTZ_TOP`], [`HERTZ_AXIS`]; the arc's vertices lie on the circle.
 ///
-/// Built from a polar mesh of the quarter by newest-vertex bisection of the cells larger
-/// than their target, with the new arc vertices moved onto the circle after each round.
+/// `TriangleMesh::quarter_disk` refined by `TriangleMesh::refine_to_size` (newest-vertex
+/// bisection, new arc vertices moved onto the circle).
 ///
 /// # Errors
 /// [`Error::Input`] for a radius, `contact_h` or `grading` not positive and finite, or
@@ -413,135 +413,28 @@ pub fn hertz_mesh(radius: f64, zone: f64, contact_h: f64, grading: f64) -> Resul
             "the Hertz mesh needs 0 < contact_h ≤ radius, zone ≥ 0 and grading > 0, got radius {radius}, zone {zone}, contact_h {contact_h}, grading {grading}"
         )));
     }
-    // Polar start: the centre, then rings k = 1..=4 of 3k + 1 vertices over [−π/2, 0].
-    let rings = 4;
-    let mut vertices = vec![[0.0, 0.0]];
-    let mut ring_ids: Vec<Vec<usize>> = vec![vec![0]];
-    for k in 1..=rings {
-        let r = radius * k as f64 / rings as f64;
-        let count = 3 * k + 1;
-        let ids = (0..count)
-            .map(|j| {
-                let theta = -std::f64::consts::FRAC_PI_2 * (1.0 - j as f64 / (count - 1) as f64);
-                vertices.push([r * theta.cos(), r * theta.sin()]);
-                vertices.len() - 1
-            })
-            .collect();
-        ring_ids.push(ids);
-    }
-    let angle = |v: [f64; 2]| v[1].atan2(v[0]);
-    let mut cells = Vec::new();
-    let mut push = |a: usize, b: usize, c: usize, vertices: &[[f64; 2]]| {
-        let (p, q, r) = (vertices[a], vertices[b], vertices[c]);
-        let area = (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1]);
-        cells.push(if area > 0.0 { [a, b, c] } else { [a, c, b] });
-    };
-    for k in 1..=rings {
-        let (inner, outer) = (&ring_ids[k - 1], &ring_ids[k]);
-        if inner.len() == 1 {
-            for j in 0..outer.len() - 1 {
-                push(inner[0], outer[j], outer[j + 1], &vertices);
-            }
-            continue;
-        }
-        let (mut i, mut j) = (0, 0);
-        while i + 1 < inner.len() || j + 1 < outer.len() {
-            let advance_outer = j + 1 < outer.len()
-                && (i + 1 >= inner.len()
-                    || angle(vertices[outer[j + 1]]) <= angle(vertices[inner[i + 1]]));
-            if advance_outer {
-                push(inner[i], outer[j], outer[j + 1], &vertices);
-                j += 1;
-            } else {
-                push(inner[i], outer[j], inner[i + 1], &vertices);
-                i += 1;
-            }
-        }
-    }
-    let mut markers = Vec::new();
-    let outer = &ring_ids[rings];
-    for j in 0..outer.len() - 1 {
-        markers.push((outer[j], outer[j + 1], HERTZ_ARC));
-    }
-    for k in 0..rings {
-        let (a, b) = (
-            *ring_ids[k].last().unwrap(),
-            *ring_ids[k + 1].last().unwrap(),
-        );
-        markers.push((a, b, HERTZ_TOP));
-        let (a, b) = (ring_ids[k][0], ring_ids[k + 1][0]);
-        markers.push((a, b, HERTZ_AXIS));
-    }
-    let mut mesh = TriangleMesh::new(vertices, cells, &markers)?;
     let largest = radius / 6.0;
-    for _ in 0..200 {
-        let marked: Vec<usize> = (0..mesh.cell_count())
-            .filter(|&c| {
-                let x = mesh.cell_coordinates(c);
-                let centroid = [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0];
-                let d = (centroid[0] - zone).max(0.0).hypot(centroid[1] + radius);
-                mesh.cell_diameter(c) > contact_h.max(grading * d).min(largest)
-            })
-            .collect();
-        if marked.is_empty() {
-            return Ok(mesh);
+    let size = |p: [f64; 2]| {
+        let d = (p[0] - zone).max(0.0).hypot(p[1]);
+        contact_h.max(grading * d).min(largest)
+    };
+    let onto_circle = |marker: u32, p: [f64; 2]| {
+        if marker != HERTZ_ARC {
+            return p;
         }
-        mesh = project_arc(&mesh.refine(&marked)?.0, radius)?;
-    }
-    Err(Error::Input(format!(
-        "the Hertz mesh did not reach cells of {contact_h} at the contact point in 200 rounds"
-    )))
+        let (dx, dy) = (p[0], p[1] - radius);
+        let r = dx.hypot(dy);
+        [radius * dx / r, radius + radius * dy / r]
+    };
+    // 4 rings: cells of R/4 to start, refined to the size field
+    Ok(TriangleMesh::quarter_disk(radius, 4)?
+        .refine_to_size(size, onto_circle, 20_000_000)?
+        .0)
 }
 
-/// The mesh with the vertices of its arc edges moved radially onto the circle.
-fn project_arc(mesh: &TriangleMesh, radius: f64) -> Result<TriangleMesh> {
-    let mut vertices = mesh.vertices().to_vec();
-    let mut markers = Vec::with_capacity(mesh.boundary_edges().len());
-    for &(e, m) in mesh.boundary_edges() {
-        let [a, b] = mesh.edges()[e];
-        markers.push((a, b, m));
-        if m == HERTZ_ARC {
-            for v in [a, b] {
-                let r = vertices[v][0].hypot(vertices[v][1]);
-                vertices[v] = [vertices[v][0] * radius / r, vertices[v][1] * radius / r];
-            }
-        }
-    }
-    TriangleMesh::new(vertices, mesh.cells().to_vec(), &markers)
-}
-
-/// Hertz line contact in plane strain (MODELS.md §7): `E* = E/(1−ν²)`, half-width
-/// `b = √(4PR/(πE*))`, peak `p_max = 2P/(πb)`, `p(x) = p_max √(1 − x²/b²)`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hertz {
-    /// Radius R.
-    pub radius: f64,
-    /// Young's modulus E.
-    pub young: f64,
-    /// Poisson's ratio ν.
-    pub poisson: f64,
-    /// Resultant P (force per length).
-    pub load: f64,
-}
-
-impl Hertz {
-    /// The half-width `b`.
-    pub fn half_width(&self) -> f64 {
-        let e_star = self.young / (1.0 - self.poisson * self.poisson);
-        (4.0 * self.load * self.radius / (std::f64::consts::PI * e_star)).sqrt()
-    }
-
-    /// The peak pressure `p_max = 2P/(πb)`.
-    pub fn peak(&self) -> f64 {
-        2.0 * self.load / (std::f64::consts::PI * self.half_width())
-    }
-
-    /// The pressure at x (0 outside the contact zone).
-    pub fn pressure(&self, x: f64) -> f64 {
-        let b = self.half_width();
-        self.peak() * (1.0 - (x / b) * (x / b)).max(0.0).sqrt()
-    }
-}
+/// Hertz line contact in plane strain (MODELS.md §7): the reference, with its exact
+/// integrals, is [`crate::hertz::HertzLineContact`].
+pub use crate::hertz::HertzLineContact as Hertz;
 
 /// A Hertz computation against the formulas.
 #[derive(Clone, Debug)]
@@ -564,7 +457,7 @@ pub struct HertzResult {
 
 /// The Hertz problem on [`hertz_mesh`]: the quarter disc with `u_x = 0` on the axis, the
 /// resultant `P/2` as a uniform pressure `P/(2R)` on the top, the gap to the plane
-/// `y = −R` measured vertically, the contact direction the plane's normal `(0, −1)`.
+/// `y = 0` measured vertically, the contact direction the plane's normal `(0, −1)`.
 /// `b_over_h` sets the cell size at the contact point, `h = b / b_over_h`.
 ///
 /// # Errors
@@ -599,9 +492,8 @@ pub fn solve_hertz_on(
 ) -> Result<HertzResult> {
     let h = contact_h;
     let q = hertz.load / (2.0 * hertz.radius);
-    let radius = hertz.radius;
     let pressure = move |_: &[f64]| q;
-    let gap = move |x: &[f64]| x[1] + radius;
+    let gap = |x: &[f64]| x[1];
     let input = SignoriniInput {
         young: hertz.young,
         poisson: hertz.poisson,
@@ -650,7 +542,7 @@ pub fn solve_hertz_on(
         .filter(|w| w[2].0 < inside)
         .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
         .fold(0.0f64, f64::max)
-        / hertz.peak();
+        / hertz.max_pressure();
     Ok(HertzResult {
         hertz,
         contact_h: h,

@@ -615,6 +615,7 @@ mod tests {
             test_derivative: test,
             trial_derivative: Some(trial),
             quadrature_degree: None,
+            normal: [0, 0],
         }
     }
 

@@ -251,7 +251,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         contact_half_width: solution.contact_half_width,
         max_contact_pressure: largest,
         exact_half_width: hertz.map(|h| h.half_width()),
-        exact_max_pressure: hertz.map(|h| h.peak()),
+        exact_max_pressure: hertz.map(|h| h.max_pressure()),
         pressure_l2_error: errors.map(|e| e[0]),
         best_p0_l2_error: errors.map(|e| e[1]),
         oscillation: errors.map(|e| e[2]),
