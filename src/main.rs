@@ -342,7 +342,31 @@ fn default_job(out: &Path) -> Result<(), String> {
         })
         .collect();
     membrane_job(&membranes, out)?;
-    hosted_studies(&membrane_entries, out)
+    hosted_studies(&membrane_entries, out)?;
+    contact_job(out)
+}
+
+/// The contact part of the default job: each contact scene at its defaults, one line
+/// each, and Hertz's pressure chart (out/hertz-pressure.svg).
+fn contact_job(out: &Path) -> Result<(), String> {
+    println!("\nfem-forms: Signorini contact scenes (stabilized P1–P0, α = ½/max C_I,E)\n");
+    for scene in fem_forms::models::contact_scenes::CONTACT_SCENES {
+        let request = contact::ContactRequest::new(scene);
+        let (report, profile) =
+            contact::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
+        println!("{}", contact::summary(&report));
+        if let Some(hertz) = scene.hertz(request.load) {
+            let path = contact::pressure_chart(
+                out,
+                &report,
+                &[(format!("λ_h ({})", report.pair), &profile)],
+                &hertz,
+            )
+            .map_err(|e| e.to_string())?;
+            println!("→ {}", path.display());
+        }
+    }
+    Ok(())
 }
 
 /// Every study each of `entries` hosts, quick versions.

@@ -270,7 +270,18 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io
         let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
         writeln!(file, "{header}")?;
         for row in rows {
-            let cells: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
+            // counts (mesh sizes, cells, iterations) as integers, measurements in
+            // scientific notation with every digit
+            let cells: Vec<String> = row
+                .iter()
+                .map(|v| {
+                    if v.fract() == 0.0 && v.abs() < 1e15 {
+                        format!("{v:.0}")
+                    } else {
+                        format!("{v:e}")
+                    }
+                })
+                .collect();
             writeln!(file, "{}", cells.join(","))?;
         }
     }
@@ -1082,4 +1093,28 @@ pub fn run(scene: &dyn StudyScene, study: Study, full: bool, out: &Path) -> Resu
         output(out, &scene.name(), study, "svg").display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// Counts come out as integers (a tester found `8e0` for a mesh size), measurements
+    /// with every digit, missing values as `NaN`, and each reads back exactly.
+    #[test]
+    fn csv_cells_are_integers_or_full_precision() {
+        let path = std::env::temp_dir().join(format!("fem-forms-csv-{}.csv", std::process::id()));
+        let row = vec![8.0, 1635.0, 0.1 + 0.2, 1e-300, f64::NAN, -3.0];
+        super::write_csv(&path, "a,b,c,d,e,f", std::slice::from_ref(&row)).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let line = text.lines().nth(1).unwrap();
+        assert!(line.starts_with("8,1635,"), "{line}");
+        assert!(line.ends_with(",NaN,-3"), "{line}");
+        for (cell, value) in line.split(',').zip(&row) {
+            let back: f64 = cell.parse().unwrap();
+            assert!(
+                back == *value || (back.is_nan() && value.is_nan()),
+                "{cell}"
+            );
+        }
+        std::fs::remove_file(&path).unwrap();
+    }
 }
