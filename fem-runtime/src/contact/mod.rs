@@ -4,7 +4,11 @@
 //!
 //! The model declares its multiplier as a P0 field (`λ: P0 >= 0`) and integrates it
 //! only in boundary integrals `∫_Γ_C … ds` (`facets:`); here it gets one DOF per edge
-//! of `Γ_C` (the edge's P0 function), not one per cell. The system is the one of §1:
+//! of `Γ_C` (the edge's P0 function), not one per cell. Declared P1 (`λ: P1 >= 0`) it
+//! is continuous and piecewise linear on `Γ_C`: one DOF per vertex of the edges of
+//! `Γ_C` (a facet-space DOF map, [`BoundaryMultiplierProblem::contact_vertices`]); its
+//! `C` block is lumped (see [`discretize_boundary_multiplier`]). The system is the one
+//! of §1:
 //! from `B_h` and `L_h` (cell and facet blocks),
 //!
 //! ```text
@@ -53,8 +57,18 @@ impl ContactEdge {
     }
 }
 
+/// The multiplier's space on the contact boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoundaryMultiplier {
+    /// Piecewise constant: one DOF per edge of `Γ_C`.
+    P0,
+    /// Continuous piecewise linear on `Γ_C`: one DOF per vertex of its edges.
+    P1,
+}
+
 /// The discrete problem: primal DOFs, their elimination, the LCP and the multiplier's
-/// edges (constraint `k` is the P0 multiplier of `contact_edges[k]`).
+/// DOFs: for P0 constraint `k` is the multiplier of `contact_edges[k]`; for P1 it is the
+/// nodal value at vertex `contact_vertices[k]`.
 #[derive(Clone, Debug)]
 pub struct BoundaryMultiplierProblem {
     /// DOFs of the primal fields (every field but the multiplier).
@@ -63,12 +77,36 @@ pub struct BoundaryMultiplierProblem {
     pub reduction: Reduction,
     /// The LCP in the free primal DOFs and the edge multipliers.
     pub lcp: Lcp,
-    /// The edges of the multiplier's part, in constraint order.
+    /// The edges of the multiplier's part (in constraint order for P0).
     pub contact_edges: Vec<ContactEdge>,
+    /// The multiplier's space.
+    pub multiplier_space: BoundaryMultiplier,
+    /// P1: the mesh vertices of the edges of `Γ_C`, ascending by vertex number; constraint
+    /// `k` is the multiplier's value at `contact_vertices[k]`. Empty for P0.
+    pub contact_vertices: Vec<usize>,
+    /// Per contact edge (same order as `contact_edges`), the constraints of its two
+    /// ends `ends[0]`, `ends[1]` (P1), or `[k, k]` for the edge's own constraint (P0):
+    /// `λ_h` on edge `e` is `(1−s) Λ[edge_dofs[e][0]] + s Λ[edge_dofs[e][1]]`, s ∈ [0, 1].
+    pub edge_dofs: Vec<[usize; 2]>,
     /// The model's multiplier field.
     pub multiplier_field: usize,
     /// The boundary part (index in `M::FACET_PARTS`) the multiplier lives on.
     pub multiplier_part: usize,
+}
+
+impl BoundaryMultiplierProblem {
+    /// `∫_Γ_C μ_k ds` for each multiplier basis function `μ_k` (length): the edge's
+    /// length for P0, half the lengths of the (one or two) edges at the vertex for P1.
+    /// `Σ_k Λ_k w_k` is the total `∫_Γ_C λ_h ds`.
+    pub fn multiplier_integrals(&self) -> Vec<f64> {
+        let mut w = vec![0.0; self.lcp.m()];
+        for (e, dofs) in self.contact_edges.iter().zip(&self.edge_dofs) {
+            let l = e.length();
+            w[dofs[0]] += 0.5 * l;
+            w[dofs[1]] += 0.5 * l;
+        }
+        w
+    }
 }
 
 /// The boundary edges of `mesh` with one of `markers`, with their cell and local number.
@@ -102,9 +140,20 @@ fn part_edges(mesh: &TriangleMesh, markers: &[u32]) -> Vec<ContactEdge> {
 /// `parts` names the boundary edges of each of the model's `FACET_PARTS` by marker
 /// (`("Γ_C", &[1])`, e.g. from [`TriangleMesh::boundary_part_markers`]).
 ///
+/// A P1 multiplier's facet kernels see its three local DOFs on the cell; on the edge only
+/// the two end vertices' functions are nonzero, so the third vertex's rows and columns
+/// must vanish (checked: an error otherwise, e.g. a derivative of λ in a boundary
+/// integral). Its `(μ, λ)` block, `C = α Σ_E h_E (μ_l, μ_k)_E`, couples neighbouring
+/// vertices along the whole of `Γ_C`: a chain, not the small blocks of consecutive
+/// constraints [`crate::lcp::CouplingBlocks`] holds (at most
+/// [`crate::lcp::MAX_BLOCK`]), so it is lumped by rows: `C_kk = Σ_l C_kl`. That is exact
+/// on constant pressures (the patch test keeps `λ_h = q`), keeps `C` diagonal and
+/// positive for the semismooth Newton solver, and leaves `B`, `A` and `G` consistent.
+///
 /// # Errors
 /// [`Error::Input`] when the model has no `B_h`/`L_h`, no single multiplier, a
-/// multiplier that is not P0 or that appears in no boundary integral or on two parts; a
+/// multiplier that is neither P0 nor P1 or that appears in no boundary integral or on two
+/// parts, a P1 multiplier whose facet terms reach the vertex off the edge; a
 /// model part `parts` does not name, or one that holds no boundary edge of the mesh (a
 /// contact part that is not on the boundary); a field index out of range in `fixed`;
 /// the errors of the kernels ([`Error::NonFinite`] for a non-finite entry).
@@ -117,14 +166,18 @@ pub fn discretize_boundary_multiplier<M: Model>(
     let (bilinear_id, linear_id) = system_forms::<M>()?;
     let (bilinear, linear) = (M::form(bilinear_id)?, M::form(linear_id)?);
     let multiplier = multiplier_field::<M>()?;
-    if M::FIELDS[multiplier].element != ElementKind::P0 {
-        return Err(Error::Input(format!(
-            "the boundary multiplier `{}` of `{}` must be P0 (one value per edge), not {}",
-            M::FIELDS[multiplier].name,
-            M::NAME,
-            M::FIELDS[multiplier].element.name()
-        )));
-    }
+    let space = match M::FIELDS[multiplier].element {
+        ElementKind::P0 => BoundaryMultiplier::P0,
+        ElementKind::P1 => BoundaryMultiplier::P1,
+        other => {
+            return Err(Error::Input(format!(
+                "the boundary multiplier `{}` of `{}` must be P0 (one value per edge) or P1 (one per vertex of Γ_C), not {}",
+                M::FIELDS[multiplier].name,
+                M::NAME,
+                other.name()
+            )))
+        }
+    };
     let mut multiplier_parts: Vec<usize> = M::FACET_BLOCKS
         .iter()
         .filter(|b| {
@@ -174,9 +227,30 @@ pub fn discretize_boundary_multiplier<M: Model>(
         edges_of_part.push(edges);
     }
     let contact_edges = edges_of_part[multiplier_part].clone();
+    let (contact_vertices, edge_dofs) = multiplier_dofs(mesh, &contact_edges, space);
+    if space == BoundaryMultiplier::P1 {
+        if let Some(b) = M::FACET_BLOCKS.iter().find(|b| {
+            (b.form == bilinear || b.form == linear)
+                && b.part != multiplier_part
+                && (b.test_field == multiplier || b.trial_field == Some(multiplier))
+        }) {
+            return Err(Error::Input(format!(
+                "the P1 multiplier `{}` of `{}` appears in a boundary integral of `{}` over `{}`, not its part `{}`",
+                M::FIELDS[multiplier].name,
+                M::NAME,
+                M::FORMS[b.form].name,
+                M::FACET_PARTS[b.part],
+                M::FACET_PARTS[multiplier_part]
+            )));
+        }
+    }
     let primal: Vec<usize> = (0..M::FIELDS.len()).filter(|&f| f != multiplier).collect();
     let dofs = SystemDofs::new::<M>(mesh, &primal)?;
-    let (n_full, m) = (dofs.dof_count(), contact_edges.len());
+    let n_full = dofs.dof_count();
+    let m = match space {
+        BoundaryMultiplier::P0 => contact_edges.len(),
+        BoundaryMultiplier::P1 => contact_vertices.len(),
+    };
 
     // A: the cell part, then the facet blocks.
     let cell_part =
@@ -233,6 +307,40 @@ pub fn discretize_boundary_multiplier<M: Model>(
                         cell: edge.cell,
                     });
                 }
+                if space == BoundaryMultiplier::P1 && (test_is_multiplier || trial == multiplier) {
+                    let (on_edge, off) = edge_vertices(edge.local);
+                    let (mrows, mcols) = (test_is_multiplier, trial == multiplier);
+                    check_off_edge::<M>(
+                        local,
+                        cols,
+                        &|i, j| (mrows && i == off) || (mcols && j == off),
+                        multiplier,
+                        edge,
+                    )?;
+                    match (mrows, mcols) {
+                        // lumped by rows: the chain of Γ_C does not fit CouplingBlocks
+                        (true, true) => {
+                            for (a, &i) in on_edge.iter().enumerate() {
+                                let row: f64 = on_edge.iter().map(|&j| local[i * cols + j]).sum();
+                                c[edge_dofs[k][a]] -= row;
+                            }
+                        }
+                        (true, false) => {
+                            let columns = place(trial, edge.cell).expect("a primal field");
+                            for (a, &i) in on_edge.iter().enumerate() {
+                                for (j, &col) in columns.iter().enumerate() {
+                                    let v = local[i * cols + j];
+                                    if v != 0.0 {
+                                        b_full[edge_dofs[k][a]].push((col, -v));
+                                    }
+                                }
+                            }
+                        }
+                        // the (v, λ) block is the transpose of (μ, v): B_h is symmetric
+                        _ => {}
+                    }
+                    continue;
+                }
                 match (test_is_multiplier, trial == multiplier) {
                     (true, true) => c[k] -= local[0],
                     (true, false) => {
@@ -264,7 +372,13 @@ pub fn discretize_boundary_multiplier<M: Model>(
                         cell: edge.cell,
                     });
                 }
-                if test_is_multiplier {
+                if test_is_multiplier && space == BoundaryMultiplier::P1 {
+                    let (on_edge, off) = edge_vertices(edge.local);
+                    check_off_edge::<M>(local, 1, &|i, _| i == off, multiplier, edge)?;
+                    for (a, &i) in on_edge.iter().enumerate() {
+                        g[edge_dofs[k][a]] -= local[i];
+                    }
+                } else if test_is_multiplier {
                     g[k] -= local[0];
                 } else {
                     let r = place(block.test_field, edge.cell).expect("a primal field");
@@ -315,9 +429,75 @@ pub fn discretize_boundary_multiplier<M: Model>(
         reduction,
         lcp: Lcp::new(a, ConstraintRows::from(b_rows), c, f, g),
         contact_edges,
+        multiplier_space: space,
+        contact_vertices,
+        edge_dofs,
         multiplier_field: multiplier,
         multiplier_part,
     })
+}
+
+/// The multiplier's DOF map on the contact edges: for P1 the vertices of the edges
+/// (ascending) and each edge's two constraints; for P0 no vertices and `[k, k]`.
+fn multiplier_dofs(
+    mesh: &TriangleMesh,
+    edges: &[ContactEdge],
+    space: BoundaryMultiplier,
+) -> (Vec<usize>, Vec<[usize; 2]>) {
+    match space {
+        BoundaryMultiplier::P0 => (Vec::new(), (0..edges.len()).map(|k| [k, k]).collect()),
+        BoundaryMultiplier::P1 => {
+            let ends = |e: &ContactEdge| {
+                let c = mesh.cell(e.cell);
+                [c[e.local], c[(e.local + 1) % 3]]
+            };
+            let mut vertices: Vec<usize> = edges.iter().flat_map(ends).collect();
+            vertices.sort_unstable();
+            vertices.dedup();
+            let index = |v: usize| vertices.binary_search(&v).expect("a vertex of an edge");
+            let edge_dofs = edges
+                .iter()
+                .map(|e| {
+                    let [a, b] = ends(e);
+                    [index(a), index(b)]
+                })
+                .collect();
+            (vertices, edge_dofs)
+        }
+    }
+}
+
+/// The local vertices of a cell's edge `local`: its two ends (the P1 multiplier's
+/// nonzero local DOFs there), in the order of [`ContactEdge::ends`], and the one off it.
+fn edge_vertices(local: usize) -> ([usize; 2], usize) {
+    ([local, (local + 1) % 3], (local + 2) % 3)
+}
+
+/// A P1 multiplier's function at the vertex off the edge vanishes on the edge, so the
+/// facet kernel's entries `(i, j)` selected by `off` (`cols` columns per row) must be
+/// zero up to rounding; a nonzero one means a facet term that is not the trace of λ
+/// (a derivative), which a DOF map on Γ_C's vertices cannot represent.
+fn check_off_edge<M: Model>(
+    local: &[f64],
+    cols: usize,
+    off: &dyn Fn(usize, usize) -> bool,
+    multiplier: usize,
+    edge: &ContactEdge,
+) -> Result<()> {
+    let scale = local.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (index, v) in local.iter().enumerate() {
+        let (i, j) = (index / cols, index % cols);
+        if off(i, j) && v.abs() > 1e-12 * scale {
+            return Err(Error::Input(format!(
+                "the P1 multiplier `{}` of `{}` has a nonzero facet entry {v:e} at the vertex off contact edge {} (cell {}): only its trace on the edge may enter the boundary integrals",
+                M::FIELDS[multiplier].name,
+                M::NAME,
+                edge.edge,
+                edge.cell
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The per-edge inverse-inequality constants `C_I,E` of the stabilization (MODELS.md
