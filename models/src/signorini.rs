@@ -15,15 +15,21 @@
 //!
 //! The multiplier is declared as a P0 field so that the facet kernels see its trace (1
 //! on the edge); it lives on the edges of `Γ_C` only: the solver gives it one DOF per
-//! contact edge (`fem_models::signorini` solver below).
+//! contact edge (`fem_models::signorini` solver below). Declared P1 (the `_p1` models)
+//! it is continuous on `Γ_C`, one DOF per vertex of its edges
+//! ([`fem_runtime::contact::discretize_boundary_multiplier`]).
 
-/// One elasticity–contact model per displacement element: the forms are one text.
+/// One elasticity–contact model per displacement and multiplier element: the forms are
+/// one text.
 macro_rules! signorini_model {
     ($(#[$doc:meta])* $name:ident, $element:ident) => {
+        signorini_model! { $(#[$doc])* $name, $element, P0 }
+    };
+    ($(#[$doc:meta])* $name:ident, $element:ident, $multiplier:ident) => {
         fem_runtime::model! {
             $(#[$doc])*
             pub mod $name on triangle {
-                unknowns: u: [$element]^2, λ: P0 >= 0;
+                unknowns: u: [$element]^2, λ: $multiplier >= 0;
                 tests: v, μ;
                 params: μ_L > 0, λ_L, α, n_c_x, n_c_y;
                 data: q: 0, g: 1;
@@ -54,6 +60,21 @@ signorini_model! {
     signorini_p2, P2
 }
 
+signorini_model! {
+    /// Signorini contact, u ∈ `[P1]²`, λ continuous P1 on Γ_C (one DOF per vertex of its
+    /// edges), stabilized (§7).
+    signorini_p1_p1, P1, P1
+}
+
+signorini_model! {
+    /// Signorini contact, u ∈ `[P2]²`, λ continuous P1 on Γ_C (one DOF per vertex of its
+    /// edges), stabilized (§7).
+    signorini_p2_p1, P2, P1
+}
+
+/// The multiplier's space on Γ_C: P0 (one pressure per edge) or continuous P1 (one per
+/// vertex of the edges of Γ_C), chosen with [`solve_signorini_with`].
+pub use fem_runtime::contact::BoundaryMultiplier as Multiplier;
 use fem_runtime::contact::{
     discretize_boundary_multiplier, inverse_constants, BoundaryMultiplierProblem, ContactEdge,
 };
@@ -123,11 +144,20 @@ pub struct SignoriniSolution {
     /// The displacement: the full primal DOF vector, the `u_x` DOFs then the `u_y` ones
     /// (each numbered by the element's DOF map on the mesh).
     pub displacement: Vec<f64>,
-    /// The contact pressure λ_h per contact edge (force per length, P0).
+    /// The contact pressure λ_h per multiplier DOF (force per length): per contact edge
+    /// (P0, in `contact_edges` order) or per vertex of Γ_C (P1, in `contact_vertices`
+    /// order). Along Γ_C: [`SignoriniSolution::edge_pressures`].
     pub pressure: Vec<f64>,
     /// The edges of Γ_C.
     pub contact_edges: Vec<ContactEdge>,
-    /// Force of the foundation on the body, `Σ_E λ_E |E| (−n_c)`.
+    /// The multiplier's space.
+    pub multiplier: Multiplier,
+    /// P1: the mesh vertices of Γ_C (ascending), where `pressure` lives. Empty for P0.
+    pub contact_vertices: Vec<usize>,
+    /// Per contact edge, the indices into `pressure` of its ends `ends[0]`, `ends[1]`
+    /// (P1) or `[k, k]` (P0).
+    pub edge_dofs: Vec<[usize; 2]>,
+    /// Force of the foundation on the body, `Σ_E ∫_E λ_h ds (−n_c)` (P0: `Σ_E λ_E |E|`).
     pub total_contact_force: [f64; 2],
     /// Resultant of the applied pressure, `∫_Γ_N q (−n) ds` (Gauss–Legendre, 4 points per edge).
     pub applied_load: [f64; 2],
@@ -147,6 +177,49 @@ pub struct SignoriniSolution {
     pub iterations: usize,
     /// Wall time of the LCP solve, seconds.
     pub seconds: f64,
+}
+
+impl SignoriniSolution {
+    /// λ_h at the two ends `ends[0]`, `ends[1]` of each contact edge (`contact_edges`
+    /// order): equal for P0; λ_h is linear in between (P1) or constant (P0).
+    pub fn edge_pressures(&self) -> Vec<[f64; 2]> {
+        self.edge_dofs
+            .iter()
+            .map(|&[a, b]| [self.pressure[a], self.pressure[b]])
+            .collect()
+    }
+
+    /// λ_h at `ends[0] + s (ends[1] − ends[0])` of contact edge `edge`, s ∈ [0, 1]
+    /// (clamped); `None` for an edge index out of range.
+    pub fn pressure_at(&self, edge: usize, s: f64) -> Option<f64> {
+        let [a, b] = *self.edge_dofs.get(edge)?;
+        let s = s.clamp(0.0, 1.0);
+        Some((1.0 - s) * self.pressure[a] + s * self.pressure[b])
+    }
+
+    /// The pressure along Γ_C for a chart, `(x, λ_h)` sorted by x: the edge midpoints
+    /// (P0) or the vertices (P1, where λ_h is linear in between).
+    pub fn pressure_profile(&self) -> Vec<(f64, f64)> {
+        let mut profile: Vec<(f64, f64)> = match self.multiplier {
+            Multiplier::P0 => self
+                .contact_edges
+                .iter()
+                .zip(&self.pressure)
+                .map(|(e, &p)| (e.midpoint()[0], p))
+                .collect(),
+            Multiplier::P1 => {
+                let mut points = vec![(0.0, 0.0); self.pressure.len()];
+                for (e, dofs) in self.contact_edges.iter().zip(&self.edge_dofs) {
+                    for (end, &k) in e.ends.iter().zip(dofs) {
+                        points[k] = (end[0], self.pressure[k]);
+                    }
+                }
+                points
+            }
+        };
+        profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+        profile
+    }
 }
 
 /// The Lamé parameters `(μ_L, λ_L)` of E, ν.
@@ -180,9 +253,25 @@ pub fn lame(young: f64, poisson: f64, plane: Plane) -> Result<(f64, f64)> {
 /// holds no boundary edge, a load that does not press the body onto Γ_C (the rigid
 /// translation towards the foundation is then not prevented); the solver's errors.
 pub fn solve_signorini(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<SignoriniSolution> {
-    match input.element {
-        Displacement::P1 => solve::<signorini_p1::Model>(mesh, input),
-        Displacement::P2 => solve::<signorini_p2::Model>(mesh, input),
+    solve_signorini_with(mesh, input, Multiplier::P0)
+}
+
+/// [`solve_signorini`] with the multiplier's space chosen: P0 (the same) or continuous
+/// P1 on Γ_C ([`signorini_p1_p1`], [`signorini_p2_p1`]; its `C` block lumped, see
+/// [`discretize_boundary_multiplier`]).
+///
+/// # Errors
+/// Those of [`solve_signorini`].
+pub fn solve_signorini_with(
+    mesh: &TriangleMesh,
+    input: &SignoriniInput,
+    multiplier: Multiplier,
+) -> Result<SignoriniSolution> {
+    match (input.element, multiplier) {
+        (Displacement::P1, Multiplier::P0) => solve::<signorini_p1::Model>(mesh, input),
+        (Displacement::P2, Multiplier::P0) => solve::<signorini_p2::Model>(mesh, input),
+        (Displacement::P1, Multiplier::P1) => solve::<signorini_p1_p1::Model>(mesh, input),
+        (Displacement::P2, Multiplier::P1) => solve::<signorini_p2_p1::Model>(mesh, input),
     }
 }
 
@@ -245,12 +334,13 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
     }
     let solution = if alpha > 0.0 {
         // Start pressed into the foundation (every constraint active), beyond the gaps.
+        // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
         let depth = problem
             .lcp
             .g
             .iter()
-            .zip(&problem.contact_edges)
-            .fold(0.0f64, |m, (g, e)| m.max(-g / e.length()));
+            .zip(problem.multiplier_integrals())
+            .fold(0.0f64, |m, (g, w)| m.max(-g / w));
         let scale = 2.0 * depth + 1e-3 * mesh.max_h();
         let start: Vec<f64> = translation.iter().map(|t| scale * t).collect();
         semismooth_newton(&problem.lcp, Some(&start), NewtonOptions::default())?
@@ -295,9 +385,20 @@ fn report(
     let lcp = &problem.lcp;
     let pressure = solution.lambda.clone();
     let mut force = [0.0; 2];
-    for (e, &p) in problem.contact_edges.iter().zip(&pressure) {
-        force[0] -= p * e.length() * direction[0];
-        force[1] -= p * e.length() * direction[1];
+    match problem.multiplier_space {
+        Multiplier::P0 => {
+            for (e, &p) in problem.contact_edges.iter().zip(&pressure) {
+                force[0] -= p * e.length() * direction[0];
+                force[1] -= p * e.length() * direction[1];
+            }
+        }
+        // ∫_E λ_h ds = |E| (λ_a + λ_b)/2 on each edge
+        Multiplier::P1 => {
+            for (&p, w) in pressure.iter().zip(problem.multiplier_integrals()) {
+                force[0] -= p * w * direction[0];
+                force[1] -= p * w * direction[1];
+            }
+        }
     }
     let mut load = [0.0; 2];
     let gauss = fem_runtime::gauss_legendre(4);
@@ -337,8 +438,9 @@ fn report(
     }
     let largest = pressure.iter().fold(0.0f64, |m, &p| m.max(p));
     let (mut x_min, mut x_max) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (e, &p) in problem.contact_edges.iter().zip(&pressure) {
-        if p > 1e-10 * largest {
+    for (e, &[a, b]) in problem.contact_edges.iter().zip(&problem.edge_dofs) {
+        // the edges where λ_h is not identically 0 (for P1: either end positive)
+        if pressure[a].max(pressure[b]) > 1e-10 * largest {
             for end in e.ends {
                 x_min = x_min.min(end[0]);
                 x_max = x_max.max(end[0]);
@@ -371,6 +473,9 @@ fn report(
         displacement: problem.reduction.expand(&solution.u),
         pressure,
         contact_edges: problem.contact_edges.clone(),
+        multiplier: problem.multiplier_space,
+        contact_vertices: problem.contact_vertices.clone(),
+        edge_dofs: problem.edge_dofs.clone(),
         total_contact_force: force,
         applied_load: load,
         contact_half_width: half_width,
@@ -380,6 +485,41 @@ fn report(
         dofs: lcp.n() + lcp.m(),
         iterations: solution.iterations,
         seconds: solution.seconds,
+    }
+}
+
+/// The Hertz comparison of a continuous P1 pressure: exact integrals over the edges'
+/// x-intervals (the contact edges of the quarter disc are ordered along x).
+fn hertz_p1(hertz: Hertz, h: f64, solution: SignoriniSolution) -> HertzResult {
+    let (intervals, values): (Vec<[f64; 2]>, Vec<[f64; 2]>) = solution
+        .contact_edges
+        .iter()
+        .zip(solution.edge_pressures())
+        .map(|(e, [p0, p1])| {
+            let (x0, x1) = (e.ends[0][0], e.ends[1][0]);
+            if x0 <= x1 {
+                ([x0, x1], [p0, p1])
+            } else {
+                ([x1, x0], [p1, p0])
+            }
+        })
+        .unzip();
+    let profile = solution.pressure_profile();
+    let nodes: Vec<f64> = profile.iter().map(|p| p.0).collect();
+    let inside = 0.8 * hertz.half_width();
+    let oscillation = profile
+        .windows(3)
+        .filter(|w| w[2].0 < inside)
+        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
+        .fold(0.0f64, f64::max)
+        / hertz.max_pressure();
+    HertzResult {
+        hertz,
+        contact_h: h,
+        oscillation,
+        pressure_l2_error: hertz.relative_l2_error_p1(&intervals, &values),
+        best_fit_l2_error: hertz.best_p1_relative_l2_error(&nodes),
+        solution,
     }
 }
 
@@ -445,12 +585,17 @@ pub struct HertzResult {
     pub contact_h: f64,
     /// The computed solution (on the quarter disc).
     pub solution: SignoriniSolution,
-    /// `‖λ_h − p‖ / ‖p‖` on Γ_C (16-point Gauss–Legendre per edge).
+    /// `‖λ_h − p‖ / ‖p‖` on Γ_C (P0: 16-point Gauss–Legendre per edge; P1: exact
+    /// integrals over the edges' x-intervals,
+    /// [`crate::hertz::HertzLineContact::relative_l2_error_p1`]).
     pub pressure_l2_error: f64,
-    /// `‖Π₀p − p‖ / ‖p‖`: the error of the best P0 fit on the same edges.
+    /// `‖Πp − p‖ / ‖p‖`: the error of the best fit in the multiplier's space on the same
+    /// edges (P0: the edge means; P1: the continuous L² projection on the vertices' x,
+    /// [`crate::hertz::HertzLineContact::best_p1_fit`]).
     pub best_fit_l2_error: f64,
     /// The checkerboard measure: `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
-    /// consecutive contact edges (ordered by x) inside `x < 0.8 b`, where p is smooth
+    /// consecutive multiplier DOFs (edges for P0, vertices for P1, ordered by x) inside
+    /// `x < 0.8 b`, where p is smooth
     /// (its own second difference there is at most `4.7 (h/b)² p_max`: 0.018 at b/h = 16).
     pub oscillation: f64,
 }
@@ -469,13 +614,27 @@ pub fn solve_hertz(
     element: Displacement,
     alpha: Option<f64>,
 ) -> Result<HertzResult> {
+    solve_hertz_with(hertz, b_over_h, element, Multiplier::P0, alpha)
+}
+
+/// [`solve_hertz`] with the multiplier's space chosen (P0 or continuous P1 on Γ_C).
+///
+/// # Errors
+/// Those of [`solve_hertz`].
+pub fn solve_hertz_with(
+    hertz: Hertz,
+    b_over_h: f64,
+    element: Displacement,
+    multiplier: Multiplier,
+    alpha: Option<f64>,
+) -> Result<HertzResult> {
     if !(b_over_h.is_finite() && b_over_h > 0.0) {
         return Err(Error::Input(format!("b/h = {b_over_h} must be positive")));
     }
     let h = hertz.half_width() / b_over_h;
     // uniform cells a little beyond b: the square-root edge of the pressure lies at b
     let mesh = hertz_mesh(hertz.radius, 1.25 * hertz.half_width(), h, 0.25)?;
-    solve_hertz_on(hertz, &mesh, h, element, alpha)
+    solve_hertz_on_with(hertz, &mesh, h, element, multiplier, alpha)
 }
 
 /// [`solve_hertz`] on a given mesh of the quarter disc (markers as [`hertz_mesh`]'s),
@@ -488,6 +647,21 @@ pub fn solve_hertz_on(
     mesh: &TriangleMesh,
     contact_h: f64,
     element: Displacement,
+    alpha: Option<f64>,
+) -> Result<HertzResult> {
+    solve_hertz_on_with(hertz, mesh, contact_h, element, Multiplier::P0, alpha)
+}
+
+/// [`solve_hertz_on`] with the multiplier's space chosen (P0 or continuous P1 on Γ_C).
+///
+/// # Errors
+/// Those of [`solve_signorini`].
+pub fn solve_hertz_on_with(
+    hertz: Hertz,
+    mesh: &TriangleMesh,
+    contact_h: f64,
+    element: Displacement,
+    multiplier: Multiplier,
     alpha: Option<f64>,
 ) -> Result<HertzResult> {
     let h = contact_h;
@@ -509,7 +683,10 @@ pub fn solve_hertz_on(
         alpha,
         contact_centre: Some(0.0),
     };
-    let solution = solve_signorini(mesh, &input)?;
+    let solution = solve_signorini_with(mesh, &input, multiplier)?;
+    if multiplier == Multiplier::P1 {
+        return Ok(hertz_p1(hertz, h, solution));
+    }
     let gauss = fem_runtime::gauss_legendre(16);
     let (mut error, mut best, mut norm) = (0.0, 0.0, 0.0);
     for (e, &lambda) in solution.contact_edges.iter().zip(&solution.pressure) {
