@@ -3,10 +3,13 @@
 //! edges of the potential contact boundary, stabilized (`α = 1/(2 max_E C_I,E)` by
 //! default). `signorini-patch` checks λ_h = q; `hertz` compares the pressure with
 //! Hertz's (half-width, peak, relative L² error against the best P0 fit) and hosts
-//! the `convergence` and `alpha` studies.
+//! the `convergence` and `alpha` studies. The pairs `p1-p1`, `p2-p1` take a continuous
+//! P1 multiplier on Γ_C instead (one pressure per vertex of its edges).
 
 use crate::models::contact_scenes::{ContactBody, ContactScene};
-use crate::models::signorini::{solve_hertz, solve_signorini, Displacement, Hertz, SignoriniInput};
+use crate::models::signorini::{
+    solve_hertz_with, solve_signorini_with, Displacement, Hertz, Multiplier, SignoriniInput,
+};
 use crate::plot::{self, Axes, Series};
 use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
 use serde::Serialize;
@@ -23,17 +26,28 @@ pub enum ContactPair {
     P1P0,
     /// `u ∈ [P2]²`, λ P0 on the edges of Γ_C.
     P2P0,
+    /// `u ∈ [P1]²`, λ continuous P1 on Γ_C (one value per vertex of its edges).
+    P1P1,
+    /// `u ∈ [P2]²`, λ continuous P1 on Γ_C.
+    P2P1,
 }
 
 impl ContactPair {
-    /// Both pairs, the default first.
-    pub const ALL: [ContactPair; 2] = [ContactPair::P1P0, ContactPair::P2P0];
+    /// Every pair, the default first.
+    pub const ALL: [ContactPair; 4] = [
+        ContactPair::P1P0,
+        ContactPair::P2P0,
+        ContactPair::P1P1,
+        ContactPair::P2P1,
+    ];
 
     /// The pair's name (`--pair`).
     pub fn name(self) -> &'static str {
         match self {
             ContactPair::P1P0 => "p1-p0",
             ContactPair::P2P0 => "p2-p0",
+            ContactPair::P1P1 => "p1-p1",
+            ContactPair::P2P1 => "p2-p1",
         }
     }
 
@@ -45,13 +59,24 @@ impl ContactPair {
         Self::ALL
             .into_iter()
             .find(|p| p.name() == name)
-            .ok_or_else(|| Error::Input(format!("unknown contact pair `{name}` (p1-p0, p2-p0)")))
+            .ok_or_else(|| {
+                Error::Input(format!(
+                    "unknown contact pair `{name}` (p1-p0, p2-p0, p1-p1, p2-p1)"
+                ))
+            })
     }
 
     fn displacement(self) -> Displacement {
         match self {
-            ContactPair::P1P0 => Displacement::P1,
-            ContactPair::P2P0 => Displacement::P2,
+            ContactPair::P1P0 | ContactPair::P1P1 => Displacement::P1,
+            ContactPair::P2P0 | ContactPair::P2P1 => Displacement::P2,
+        }
+    }
+
+    fn multiplier(self) -> Multiplier {
+        match self {
+            ContactPair::P1P0 | ContactPair::P2P0 => Multiplier::P0,
+            ContactPair::P1P1 | ContactPair::P2P1 => Multiplier::P1,
         }
     }
 }
@@ -123,8 +148,10 @@ pub struct ContactReport {
     pub inverse_constant: f64,
     /// Unknowns of the LCP (free displacements and contact pressures).
     pub dofs: usize,
-    /// Edges of Γ_C (one pressure each).
+    /// Edges of Γ_C (one pressure each for P0).
     pub contact_edges: usize,
+    /// Pressure unknowns: one per edge of Γ_C (P0) or per vertex of its edges (P1).
+    pub multiplier_dofs: usize,
     /// Solver iterations (semismooth Newton; the QP's for α = 0).
     pub iterations: usize,
     /// Wall time of the solve, seconds.
@@ -149,12 +176,17 @@ pub struct ContactReport {
     /// `‖p − λ_h‖ / ‖p‖` on Γ_C against Hertz's pressure (cylinder).
     pub pressure_l2_error: Option<f64>,
     /// The same error of the best P0 fit on the same edges (the L² projection of p):
-    /// the floor of any P0 multiplier.
+    /// the floor of any P0 multiplier (P0 pairs).
     pub best_p0_l2_error: Option<f64>,
+    /// The same error of the best fit in the pair's multiplier space (cylinder): the best
+    /// P0 fit, or for P1 pairs the L² projection onto the continuous piecewise linears on
+    /// the vertices of Γ_C.
+    pub best_fit_l2_error: Option<f64>,
     /// The checkerboard measure `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` inside
     /// `x < 0.8 b` (cylinder; `models::signorini::HertzResult::oscillation`).
     pub oscillation: Option<f64>,
-    /// `max_E |λ_E − q| / q` (the block: 0 exactly for a correct method).
+    /// `max_k |λ_k − q| / q` over the pressure unknowns (the block: 0 exactly for a
+    /// correct method).
     pub patch_pressure_error: Option<f64>,
     /// The complementarity part of the KKT residual (relative).
     pub complementarity_residual: f64,
@@ -162,7 +194,9 @@ pub struct ContactReport {
     pub kkt_residual: f64,
 }
 
-/// The contact pressure per edge along x: `(x0, x1, λ_E)` sorted by x0.
+/// The contact pressure along x, sorted by x0: per edge `(x0, x1, λ_E)` (P0 pairs), or
+/// per vertex of Γ_C `(x, x, λ_k)` (P1 pairs: λ_h is linear between consecutive
+/// entries, and the chart joins them so).
 pub type PressureProfile = Vec<(f64, f64, f64)>;
 
 /// Solves `request`.
@@ -176,6 +210,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
     let q = request.load;
     let n = request.mesh_size;
     let element = request.pair.displacement();
+    let multiplier = request.pair.multiplier();
     let (solution, hertz, errors) = match s.body {
         ContactBody::Block { width, height } => {
             let nx = ((width / height).round() as usize).max(1) * n;
@@ -199,7 +234,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
                 alpha: request.alpha,
                 contact_centre: None,
             };
-            (solve_signorini(&mesh, &input)?, None, None)
+            (solve_signorini_with(&mesh, &input, multiplier)?, None, None)
         }
         ContactBody::Cylinder { radius } => {
             let hertz = Hertz {
@@ -208,7 +243,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
                 poisson: s.poisson,
                 load: q,
             };
-            let r = solve_hertz(hertz, n as f64, element, request.alpha)?;
+            let r = solve_hertz_with(hertz, n as f64, element, multiplier, request.alpha)?;
             (
                 r.solution,
                 Some(hertz),
@@ -219,15 +254,22 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
     // the cylinder is solved on its symmetric half
     let factor = if hertz.is_some() { 2.0 } else { 1.0 };
     let largest = solution.max_contact_pressure;
-    let mut profile: PressureProfile = solution
-        .contact_edges
-        .iter()
-        .zip(&solution.pressure)
-        .map(|(e, &p)| {
-            let (a, b) = (e.ends[0][0], e.ends[1][0]);
-            (a.min(b), a.max(b), p)
-        })
-        .collect();
+    let mut profile: PressureProfile = match multiplier {
+        Multiplier::P0 => solution
+            .contact_edges
+            .iter()
+            .zip(&solution.pressure)
+            .map(|(e, &p)| {
+                let (a, b) = (e.ends[0][0], e.ends[1][0]);
+                (a.min(b), a.max(b), p)
+            })
+            .collect(),
+        Multiplier::P1 => solution
+            .pressure_profile()
+            .into_iter()
+            .map(|(x, p)| (x, x, p))
+            .collect(),
+    };
     profile.sort_by(|a, b| a.0.total_cmp(&b.0));
     let total = factor * solution.total_contact_force[1];
     let applied = -factor * solution.applied_load[1];
@@ -243,6 +285,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
             .fold(0.0f64, |m, &c| m.max(c)),
         dofs: solution.dofs,
         contact_edges: solution.contact_edges.len(),
+        multiplier_dofs: solution.pressure.len(),
         iterations: solution.iterations,
         seconds: solution.seconds,
         total_contact_force: total,
@@ -253,7 +296,10 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         exact_half_width: hertz.map(|h| h.half_width()),
         exact_max_pressure: hertz.map(|h| h.max_pressure()),
         pressure_l2_error: errors.map(|e| e[0]),
-        best_p0_l2_error: errors.map(|e| e[1]),
+        best_p0_l2_error: errors
+            .filter(|_| multiplier == Multiplier::P0)
+            .map(|e| e[1]),
+        best_fit_l2_error: errors.map(|e| e[1]),
         oscillation: errors.map(|e| e[2]),
         patch_pressure_error: hertz.is_none().then(|| {
             solution
@@ -287,10 +333,15 @@ pub fn summary(r: &ContactReport) -> String {
         r.exact_half_width,
         r.exact_max_pressure,
         r.pressure_l2_error,
-        r.best_p0_l2_error,
+        r.best_fit_l2_error,
     ) {
+        let space = if r.best_p0_l2_error.is_some() {
+            "P0"
+        } else {
+            "P1"
+        };
         line += &format!(
-            " (Hertz b {b:.6e}, p_max {p:.6e}); pressure L² error {e:.3e} (best P0 fit {best:.3e}, ratio {:.2})",
+            " (Hertz b {b:.6e}, p_max {p:.6e}); pressure L² error {e:.3e} (best {space} fit {best:.3e}, ratio {:.2})",
             e / best
         );
     }
@@ -304,7 +355,8 @@ pub fn summary(r: &ContactReport) -> String {
     line
 }
 
-/// The pressure profile as a step curve for a chart.
+/// The pressure profile as a step curve for a chart (P1 pairs' vertex entries `x0 = x1`
+/// give the piecewise-linear curve through the vertex values).
 fn steps(profile: &PressureProfile) -> Vec<(f64, f64)> {
     profile
         .iter()
@@ -417,7 +469,8 @@ pub fn alpha_study(scene: ContactScene, b_over_h: usize, out: &Path) -> Result<(
 }
 
 /// The `convergence` study of a Hertz scene: b/h = 8, 16, 32, 64 (`full`: to 128),
-/// half-width, peak and the pressure's L² error against the best P0 fit, per pair.
+/// half-width, peak and the pressure's L² error against the best fit in the pair's
+/// multiplier space (P0 or continuous P1), per pair.
 ///
 /// # Errors
 /// As [`solve`]; I/O errors.
@@ -440,15 +493,15 @@ pub fn convergence_study(scene: ContactScene, full: bool, out: &Path) -> Result<
         "b error",
         "p_max err",
         "L² error",
-        "best P0",
+        "best fit",
         "iter",
         "seconds"
     );
     let mut csv = String::from(
-        "pair,b_over_h,dofs,half_width_error,max_pressure_error,l2_error,best_p0,iterations,seconds\n",
+        "pair,b_over_h,dofs,half_width_error,max_pressure_error,l2_error,best_fit,iterations,seconds\n",
     );
     let mut series = Vec::new();
-    let mut best_series = Vec::new();
+    let (mut best_series, mut best_p1_series) = (Vec::new(), Vec::new());
     for pair in ContactPair::ALL {
         let mut points = Vec::new();
         for &n in sizes {
@@ -463,7 +516,7 @@ pub fn convergence_study(scene: ContactScene, full: bool, out: &Path) -> Result<
                 (r.max_contact_pressure - p) / p,
             );
             let e = r.pressure_l2_error.unwrap_or(f64::NAN);
-            let best = r.best_p0_l2_error.unwrap_or(f64::NAN);
+            let best = r.best_fit_l2_error.unwrap_or(f64::NAN);
             println!(
                 "{:>6} {n:>5} {:>8} {eb:>+10.2e} {ep:>+10.2e} {e:>10.3e} {best:>10.3e} {:>6} {:>8.3}",
                 pair.name(),
@@ -482,10 +535,14 @@ pub fn convergence_study(scene: ContactScene, full: bool, out: &Path) -> Result<
             if pair == ContactPair::P1P0 {
                 best_series.push((n as f64, best));
             }
+            if pair == ContactPair::P1P1 {
+                best_p1_series.push((n as f64, best));
+            }
         }
         series.push(Series::marked(format!("{} λ_h", pair.name()), points));
     }
     series.push(Series::marked("best P0 fit", best_series));
+    series.push(Series::marked("best P1 fit", best_p1_series));
     std::fs::create_dir_all(out).map_err(crate::studies::io)?;
     let csv_path = out.join(format!("{}-convergence.csv", scene.name));
     std::fs::write(&csv_path, csv).map_err(crate::studies::io)?;

@@ -327,6 +327,83 @@ fn hertz_p1_multiplier_against_the_best_p1_fit() {
     assert!((1.0..1.3).contains(&ratio), "P2–P1: ratio {ratio}");
 }
 
+/// The command line's `p1-p1`, `p2-p1` pairs: the patch block (2 wide, 2N × N cells:
+/// 2N + 1 pressure unknowns) gives λ_h = q, the foundation carries 2q; Hertz reports
+/// the best P1 fit and no best P0 fit; `--plot` writes the chart.
+#[test]
+fn the_command_line_pairs() {
+    use std::process::Command;
+    let out = std::env::temp_dir().join(format!("fem-forms-p1m-{}", std::process::id()));
+    let run = |args: &[&str]| {
+        let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+            .args(args)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .expect("the binary runs");
+        assert!(
+            run.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        run.stdout
+    };
+    let number = |json: &serde_json::Value, field: &str| {
+        json[field]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{field} missing in {json}"))
+    };
+    for pair in ["p1-p1", "p2-p1"] {
+        let args = [
+            "solve",
+            "signorini-patch",
+            "--json",
+            "--pair",
+            pair,
+            "--load",
+            "3",
+            "--mesh-size",
+            "4",
+        ];
+        let json: serde_json::Value = serde_json::from_slice(&run(&args)).unwrap();
+        assert_eq!(json["pair"], pair);
+        assert_eq!(number(&json, "multiplier_dofs"), 9.0, "{json}");
+        assert_eq!(number(&json, "contact_edges"), 8.0, "{json}");
+        assert!(number(&json, "patch_pressure_error") <= 1e-9, "{json}");
+        assert!(
+            (number(&json, "total_contact_force") - 6.0).abs() <= 1e-9 * 6.0,
+            "{json}"
+        );
+        assert!(number(&json, "equilibrium_residual") <= 1e-10, "{json}");
+    }
+    let args = [
+        "solve",
+        "hertz",
+        "--json",
+        "--pair",
+        "p1-p1",
+        "--mesh-size",
+        "16",
+    ];
+    let json: serde_json::Value = serde_json::from_slice(&run(&args)).unwrap();
+    assert!(json["best_p0_l2_error"].is_null(), "{json}");
+    let ratio = number(&json, "pressure_l2_error") / number(&json, "best_fit_l2_error");
+    assert!((1.0..2.0).contains(&ratio), "{json}");
+    assert!(number(&json, "equilibrium_residual") <= 1e-10, "{json}");
+    run(&[
+        "solve",
+        "hertz",
+        "--plot",
+        "--pair",
+        "p2-p1",
+        "--mesh-size",
+        "8",
+    ]);
+    let chart = std::fs::read_to_string(out.join("hertz-pressure.svg")).unwrap();
+    assert!(chart.contains("λ_h (p2-p1)"), "the chart names the pair");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 #[test]
 #[ignore = "a measurement: prints the Hertz table of docs/contact.md"]
 fn measure_hertz_table() {
