@@ -445,7 +445,10 @@ impl Lcp {
     ///   `‖AU − BᵀΛ − F‖∞ / (‖A‖∞‖U‖∞ + ‖Bᵀ‖∞‖Λ‖∞ + ‖F‖∞)`,
     /// - the complementarity `max_k |min(Λ_k/Λ*, r_k)|` (`Λ*` the larger of ‖Λ‖∞ and
     ///   [`Lcp::multiplier_scale`]) with the componentwise relative
-    ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + Σ_l |C_kl Λ_l| + |G_k|)`,
+    ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + Σ_l |C_kl Λ_l| + |G_k| +
+    ///   U* Σ_j |B_kj|)` with `U* = ‖F‖∞/‖A‖∞` the displacement scale of the load (without
+    ///   that floor a constraint met exactly, `BU = G = 0` with `C = 0`, would be judged
+    ///   against the rounding of its own terms and reported as 1),
     /// - the infeasibilities `(−Λ_k)₊/‖Λ‖∞` and `(−r_k)₊`.
     ///
     /// # Panics
@@ -479,11 +482,19 @@ impl Lcp {
             equilibrium
         };
         let lambda_norm = norm_inf(lambda).max(self.multiplier_scale());
+        let u_star = if a_norm > 0.0 {
+            norm_inf(&self.f) / a_norm
+        } else {
+            0.0
+        };
         let c_lambda = self.c_times(lambda);
         let c_terms = self.c_times_abs(lambda);
         let mut complementarity = 0.0f64;
         for (k, row) in self.b_rows.iter().enumerate() {
-            let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
+            let terms: f64 = row
+                .iter()
+                .map(|&(j, v)| (v * u[j]).abs() + v.abs() * u_star)
+                .sum::<f64>()
                 + c_terms[k]
                 + self.g[k].abs();
             let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
@@ -748,6 +759,19 @@ mod tests {
         assert!(r > psi);
         // rows out of contact do not count
         assert_eq!(lcp.primal_rounding(&u, &[0.0]), 0.0);
+    }
+
+    #[test]
+    fn a_constraint_met_exactly_is_not_judged_against_its_own_rounding() {
+        // u − λ = −1 against the wall u ≥ 0 with C = 0 and G = 0: u = 0, λ = 1. A
+        // solver's u of 1e-17 meets the constraint to rounding (a tester saw the plain
+        // method's exact patch test reported with a residual of 1); u = 1e-3 does not.
+        let a = SparseMatrix::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, 1.0)]).unwrap();
+        let lcp = Lcp::new(a, vec![vec![(0, 1.0)]], vec![0.0], vec![-1.0], vec![0.0]);
+        let exact = lcp.kkt_residual(&[1e-17], &[1.0 + 1e-17]);
+        assert!(exact < 1e-15, "{exact}");
+        let open = lcp.kkt_residual(&[1e-3], &[1.0 + 1e-3]);
+        assert!(open > 1e-4, "{open}");
     }
 
     #[test]
