@@ -842,6 +842,32 @@ mod tests {
         }
     }
 
+    #[test]
+    fn clarabel_solves_tiny_and_huge_data_alike() {
+        // The LCP is linear in (F, G): the data scaled by s scale (U, Λ) by s. Unscaled,
+        // clarabel's absolute tolerances made a load of 1e-12 wrong by 14× and one of
+        // 1e50 "dual infeasible" (a tester's plain-method patch test).
+        let (lcp, u_exact, lambda_exact) = blocked_lcp(2);
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for s in [1e-12, 1e50] {
+            let mut scaled = lcp.clone();
+            scaled.f.iter_mut().for_each(|f| *f *= s);
+            scaled.g.iter_mut().for_each(|g| *g *= s);
+            let qp = quadratic_program(&scaled).unwrap();
+            let expected: Vec<f64> = lambda_exact.iter().map(|l| l * s).collect();
+            assert!(
+                max_difference(&qp.lambda, &expected) <= 1e-6 * norm(&expected),
+                "s = {s}: Λ differs by {}",
+                max_difference(&qp.lambda, &expected)
+            );
+            let expected: Vec<f64> = u_exact.iter().map(|u| u * s).collect();
+            assert!(
+                max_difference(&qp.u, &expected) <= 1e-6 * norm(&expected),
+                "s = {s}"
+            );
+        }
+    }
+
     /// The block minimizer against projected gradient descent run to convergence, and
     /// against the KKT conditions of the small QP, on random SPD 3 × 3 blocks.
     #[test]

@@ -123,7 +123,20 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
             }
         }
     }
-    let b: Vec<f64> = lcp.g.iter().zip(&row_scale).map(|(g, r)| -g * r).collect();
+    let mut b: Vec<f64> = lcp.g.iter().zip(&row_scale).map(|(g, r)| -g * r).collect();
+    // The LCP is linear in the data (F, G): scaled by 1/σ, its solution is (U, Λ)/σ.
+    // Unit data keep clarabel's absolute tolerances meaningful (a load of 1e-12 was
+    // "solved" to a wrong answer at the gap tolerance, one of 1e50 declared dual
+    // infeasible).
+    let data_scale = q.iter().chain(&b).fold(0.0f64, |m, v| m.max(v.abs()));
+    let data_scale = if data_scale > 0.0 && data_scale.is_finite() {
+        data_scale
+    } else {
+        1.0
+    };
+    q.iter_mut()
+        .chain(b.iter_mut())
+        .for_each(|v| *v /= data_scale);
     let a_c = CscMatrix::new_from_triplets(m, nx, ti, tj, tv);
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
@@ -166,13 +179,13 @@ pub fn quadratic_program(lcp: &Lcp) -> Result<LcpSolution> {
     let u: Vec<f64> = solver.solution.x[..n]
         .iter()
         .zip(&scale)
-        .map(|(y, d)| y * d)
+        .map(|(y, d)| y * d * data_scale)
         .collect();
     // the multiplier of the scaled row k is Λ_k / r_k
     let lambda: Vec<f64> = solver.solution.z[..m]
         .iter()
         .zip(&row_scale)
-        .map(|(z, r)| (z * r).max(0.0))
+        .map(|(z, r)| (z * r * data_scale).max(0.0))
         .collect();
     let mut kkt_residual = lcp.kkt_residual(&u, &lambda);
     if with_lambda {
