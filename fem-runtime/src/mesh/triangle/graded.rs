@@ -198,6 +198,24 @@ impl TriangleMesh {
         }
     }
 
+    /// [`TriangleMesh::refine_uniformly`] with each new boundary vertex moved to
+    /// `snap(marker, x)` as in [`TriangleMesh::refine_to_size`], and the parent of every
+    /// cell of the result (the coarse cell it was split from, for prolongation: the
+    /// parents are those of the split, exact even where snapping moved a vertex off the
+    /// coarse cell).
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] where the projection is not finite or would turn a cell inside out.
+    pub fn refine_uniformly_onto(
+        &self,
+        snap: impl Fn(u32, [f64; 2]) -> [f64; 2],
+    ) -> Result<(TriangleMesh, Vec<usize>)> {
+        let old_vertices = self.vertices.len();
+        let (mut fine, parents) = self.bisect(&vec![true; self.edges.len()])?;
+        fine.snap_new_boundary_vertices(old_vertices, &snap)?;
+        Ok((fine, parents))
+    }
+
     /// Moves the boundary vertices numbered from `first_new` to `snap(marker, x)`,
     /// checking that no cell turns inside out.
     fn snap_new_boundary_vertices(
