@@ -95,7 +95,17 @@ fn nested_hertz_ends_at_the_cold_solution_in_a_few_iterations_per_level() {
             assert!((x.hypot(y - 1.0) - 1.0).abs() <= 1e-14, "({x}, {y})");
         }
     }
-    let cold = solve_signorini(&nested.mesh, &input).unwrap();
+    // the nested solve keeps the coarse α while α max C_I stays in [0.45, 0.5]
+    let s = &nested.solution;
+    let largest = s.inverse_constants.iter().fold(0.0f64, |m, &c| m.max(c));
+    assert!(
+        (0.45..=0.5).contains(&(s.alpha * largest)),
+        "{}",
+        s.alpha * largest
+    );
+    let mut same_alpha = input;
+    same_alpha.alpha = Some(s.alpha);
+    let cold = solve_signorini(&nested.mesh, &same_alpha).unwrap();
     same_as_cold(&nested, &cold, "hertz");
     assert!((nested.solution.total_contact_force[1] - 0.5).abs() <= 1e-10);
     assert_eq!(nested.levels[0].start, LevelStart::Pressed);
@@ -119,6 +129,8 @@ fn nested_block_with_partial_contact_ends_at_the_cold_solution() {
     let coarse = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Alternating).unwrap();
     let nested = solve_signorini_nested(&coarse, 3, &straight_boundary, &input).unwrap();
     let cold = solve_signorini(&nested.mesh, &input).unwrap();
+    // the cells keep their shapes exactly: the automatic α is the same on every level
+    assert_eq!(nested.solution.alpha, cold.alpha);
     same_as_cold(&nested, &cold, "parabolic gap");
     let touching = cold.pressure.iter().filter(|&&p| p > 0.0).count();
     assert!(touching > 0 && touching < cold.pressure.len());

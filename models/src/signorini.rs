@@ -614,7 +614,7 @@ pub struct NestedLevelReport {
     pub iterations: usize,
     /// Wall time of that Newton solve, seconds.
     pub newton_seconds: f64,
-    /// Wall time of the whole level (assembly of the LCP twice, the inverse constants,
+    /// Wall time of the whole level (assembly of the LCP, the inverse constants,
     /// the prolongation, Newton and the report), seconds.
     pub seconds: f64,
     /// `‖λ_{l−1} − λ_l‖ / ‖λ_l‖` in `L²(Γ_C)` on this level's edges, the previous level's
@@ -672,6 +672,12 @@ impl Default for AccuracyLimits {
 /// foundation as [`solve_signorini`] does. A level whose prolongated start fails is
 /// solved again from the pressed start ([`LevelStart::FellBack`]).
 ///
+/// With `input.alpha = None` every level computes its `C_I,E` and keeps the previous
+/// level's α while `α max_E C_I,E` stays in `[0.45, 0.5]` (otherwise it takes its own
+/// automatic `1/(2 max C_I,E)`): the finest level's α (reported in the solution) may
+/// then differ by a fraction of a percent from what [`solve_signorini`] would pick on
+/// the finest mesh alone; given `Some(α)` gives the same discrete problem.
+///
 /// # Errors
 /// Those of [`solve_signorini`] on any level, with the level named; the mesh's when
 /// snapping turns a cell inside out.
@@ -691,7 +697,7 @@ pub fn solve_signorini_nested(
 /// The estimate on level `l ≥ 2` is `max(δ_l, δ_{l−1}) / (2^r − 1)` with
 /// `δ_l = ‖λ_{l−1} − λ_l‖ / ‖λ_l‖` and `r` = [`PRESSURE_RATE`] (Richardson: if
 /// `‖λ − λ_h‖ ≈ C h^r`, then `‖λ − λ_{h/2}‖ ≈ ‖λ_h − λ_{h/2}‖ / (2^r − 1)`). Before the
-/// asymptotic range the differences are irregular (on Hertz, one of them was 2.9× below
+/// asymptotic range the differences are irregular (on Hertz, one of them was 3.0× below
 /// the true error of its level), hence the larger of the last two; docs/contact.md §6
 /// has the measurements. At least two refinements are made.
 ///
@@ -790,7 +796,7 @@ fn nested_with<M: Model>(
     while more(&levels, refinements)? {
         refinements += 1;
         let level_clock = Instant::now();
-        let (fine, parents) = current.mesh.refine_uniformly_onto(|m, p| snap(m, p))?;
+        let (fine, parents) = current.mesh.refine_uniformly_onto(snap)?;
         let previous = current;
         let (next, mut report) = solve_level::<M>(fine, input, Some((&previous, &parents)))
             .map_err(|e| named(refinements, e))?;
@@ -852,15 +858,35 @@ fn solve_level<M: Model>(
             &[("q", input.pressure), ("g", input.gap)],
         )
     };
-    let unstabilized =
-        discretize_boundary_multiplier::<M>(&mesh, &coefficients(0.0)?, &parts, &fixed)?;
-    let constants = inverse_constants::<M>(&mesh, &unstabilized, &coefficients(0.0)?, "a", "S")?;
-    let alpha = input
+    // The constants do not depend on α (only on the mesh, the DOFs and the kernels of
+    // `a` and `S`), so the problem is assembled with the previous level's α first. It is
+    // kept where it lies in [0.9, 1] × this level's automatic value (α max C_I ∈
+    // [0.45, 0.5], inside the working range of §7): uniform refinement keeps the cells'
+    // shapes up to the snapping of new boundary vertices, which moved max C_I by
+    // 0.1–0.4 % per level on Hertz, and a second assembly would cost as much as the
+    // finest level's Newton solve.
+    let guess = input
         .alpha
-        .unwrap_or_else(|| 0.5 / constants.iter().fold(0.0f64, |m, &c| m.max(c)));
-    drop(unstabilized);
-    let problem =
-        discretize_boundary_multiplier::<M>(&mesh, &coefficients(alpha)?, &parts, &fixed)?;
+        .or_else(|| coarser.map(|(previous, _)| previous.solution.alpha))
+        .unwrap_or(0.0);
+    let mut problem =
+        discretize_boundary_multiplier::<M>(&mesh, &coefficients(guess)?, &parts, &fixed)?;
+    let constants = inverse_constants::<M>(&mesh, &problem, &coefficients(guess)?, "a", "S")?;
+    let alpha = match input.alpha {
+        Some(a) => a,
+        None => {
+            let automatic = 0.5 / constants.iter().fold(0.0f64, |m, &c| m.max(c));
+            if guess <= automatic && guess >= 0.9 * automatic {
+                guess
+            } else {
+                automatic
+            }
+        }
+    };
+    if alpha != guess {
+        problem =
+            discretize_boundary_multiplier::<M>(&mesh, &coefficients(alpha)?, &parts, &fixed)?;
+    }
     let translation = towards_foundation(&problem, direction);
     let work: f64 = translation
         .iter()
