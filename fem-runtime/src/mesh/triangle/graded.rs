@@ -270,6 +270,33 @@ mod tests {
     }
 
     #[test]
+    fn uniform_refinement_onto_the_arc_keeps_the_split_parents() {
+        let coarse = TriangleMesh::quarter_disk(1.0, 3).unwrap();
+        let (fine, parents) = coarse
+            .refine_uniformly_onto(onto_circle([0.0, 1.0], 1.0))
+            .unwrap();
+        let plain = coarse.refine_uniformly();
+        assert_eq!(fine.cell_count(), 4 * coarse.cell_count());
+        assert_eq!(fine.cells(), plain.cells());
+        // the split's parents are those the unsnapped (exactly nested) mesh locates
+        assert_eq!(
+            parents,
+            crate::multigrid::parents_by_location(&coarse, &plain).unwrap()
+        );
+        for (v, (p, q)) in fine.vertices().iter().zip(plain.vertices()).enumerate() {
+            let on_arc = fine
+                .boundary_edges()
+                .iter()
+                .any(|&(e, m)| m == 1 && fine.edges()[e].contains(&v));
+            if on_arc {
+                assert!((p[0].hypot(p[1] - 1.0) - 1.0).abs() <= 1e-15, "{p:?}");
+            } else {
+                assert_eq!(p, q, "vertex {v} moved off the arc");
+            }
+        }
+    }
+
+    #[test]
     fn the_half_disk_has_half_the_area_and_its_two_named_sides() {
         for rings in [1, 2, 5, 16] {
             let m = TriangleMesh::half_disk(2.0, rings).unwrap();
