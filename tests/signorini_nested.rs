@@ -227,3 +227,19 @@ fn an_unreached_tolerance_is_an_error_naming_it() {
         .to_string();
     assert!(message.contains("α"), "{message}");
 }
+
+#[test]
+fn nested_p2_block_with_partial_contact_ends_at_the_cold_solution() {
+    let mut input = block_input(&parabolic_gap);
+    input.element = Displacement::P2;
+    let coarse = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 3, 3, Diagonal::Alternating).unwrap();
+    let nested = solve_signorini_nested(&coarse, 2, &straight_boundary, &input).unwrap();
+    let mut same_alpha = input;
+    same_alpha.alpha = Some(nested.solution.alpha);
+    let cold = solve_signorini(&nested.mesh, &same_alpha).unwrap();
+    same_as_cold(&nested, &cold, "P2, parabolic gap");
+    for level in &nested.levels[1..] {
+        assert_eq!(level.start, LevelStart::Prolongated);
+        assert!(level.iterations < cold.iterations);
+    }
+}
