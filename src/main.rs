@@ -570,6 +570,9 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
     let mesh = match scene.body {
         ContactBody::Block { .. } => "an N×N×2 mesh of the block (2N×N×2 on its 2:1 shape)",
         ContactBody::Cylinder { .. } => "a mesh graded to b/h = N cells per contact half-width",
+        ContactBody::GapBlock { .. } => {
+            "a half block graded to b/h = N cells per contact half-width"
+        }
     };
     options.refuse(
         &[
@@ -588,7 +591,12 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
             scene.name
         ),
     )?;
-    if options.plot && !matches!(scene.body, ContactBody::Cylinder { .. }) {
+    if options.plot
+        && !matches!(
+            scene.body,
+            ContactBody::Cylinder { .. } | ContactBody::GapBlock { .. }
+        )
+    {
         return Err(format!(
             "--plot does not apply: `{}` has no reference pressure profile to chart (its pressure is q on every edge: see --json's patch_pressure_error)",
             scene.name
