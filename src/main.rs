@@ -634,6 +634,57 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
     Ok(())
 }
 
+/// `solve --scene FILE` for a file with `model = "contact"` (fem_forms::contact_scene_file):
+/// `--mesh-size` refines the file's mesh uniformly, `--load` scales its pressure.
+fn solve_contact_file(path: &Path, options: &SolveOptions) -> Result<(), String> {
+    use fem_forms::contact_scene_file as file;
+    options.refuse(
+        &[
+            "--elements",
+            "--msh",
+            "--vtk",
+            "--thickness",
+            "--refinement",
+            "--no-obstacle",
+            "--linear-solver",
+            "--solver",
+            "--cold",
+            "--plot",
+            "--support",
+            "--obstacle",
+        ],
+        &format!(
+            "{} is a contact scene file (--mesh-size: uniform refinements of its mesh, --load: its pressure's scale, --alpha, --pair, --json)",
+            path.display()
+        ),
+    )?;
+    let scene = file::read(path).map_err(|e| e.to_string())?;
+    let overrides = file::Overrides {
+        pair: options
+            .pair
+            .as_deref()
+            .map(contact::ContactPair::parse)
+            .transpose()
+            .map_err(|e| e.to_string())?,
+        refinements: options.mesh_size,
+        load: options.load,
+        alpha: options.alpha,
+    };
+    let solved = file::solve(&scene, &overrides).map_err(|e| e.to_string())?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&solved.report).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!("{}", contact::summary(&solved.report));
+        if let Some(e) = solved.report.pressure_l2_error {
+            println!("pressure L² error against exact.pressure: {e:.3e}");
+        }
+    }
+    Ok(())
+}
+
 fn solve_kirchhoff(scene: KirchhoffScene, options: &SolveOptions) -> Result<(), String> {
     options.refuse(
         &[
@@ -987,6 +1038,12 @@ fn run(cli: Cli) -> Result<(), String> {
             mut options,
         }) => {
             let entry = match (name, scene_file) {
+                (_, Some(path))
+                    if std::fs::read_to_string(&path)
+                        .is_ok_and(|t| fem_forms::contact_scene_file::names_contact(&t)) =>
+                {
+                    return solve_contact_file(&path, &options);
+                }
                 (_, Some(path)) => {
                     let file = scene_file::read(&path).map_err(|e| e.to_string())?;
                     options
