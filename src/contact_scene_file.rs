@@ -34,6 +34,7 @@
 //! [parameters]
 //! contact_direction = [0.0, -1.0] # n_c: the foundation's normal away from the body
 //! # alpha = 1e-4                  # α; 1/(2 max C_I,E) by default; 0: the plain method
+//! # contact_centre = 0.0          # x of a symmetry line: the half-width is measured from it
 //!
 //! [data]
 //! load = 1.0                      # a scale of the pressure (--load); 1 by default
@@ -115,6 +116,7 @@ struct BoundaryToml {
 struct ParametersToml {
     contact_direction: Option<[f64; 2]>,
     alpha: Option<f64>,
+    contact_centre: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -165,6 +167,9 @@ pub struct ContactSceneFile {
     pub contact_direction: [f64; 2],
     /// α where the file fixes it.
     pub alpha: Option<f64>,
+    /// The x of the middle of the contact zone (a symmetry line), from which the
+    /// half-width is measured; `None`: the middle of the pressed edges.
+    pub contact_centre: Option<f64>,
     /// The pressure's scale (`data.load`, `--load`).
     pub load: f64,
     /// The pressure shape q(x, y) on Γ_N (multiplied by `load`).
@@ -295,6 +300,14 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             ));
         }
     }
+    if let Some(c) = file.parameters.contact_centre {
+        if !c.is_finite() {
+            return Err(at(
+                "parameters.contact_centre",
+                format!("{c} must be finite"),
+            ));
+        }
+    }
     let load = file.data.load.unwrap_or(1.0);
     check_load(load).map_err(|m| at("data.load", m))?;
     let pressure = expression(&file.data.pressure, "data.pressure", path)?;
@@ -342,6 +355,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         part_names,
         contact_direction,
         alpha: file.parameters.alpha,
+        contact_centre: file.parameters.contact_centre,
         load,
         pressure,
         gap,
@@ -639,7 +653,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         fixed_x: &file.fixed_x,
         fixed_y: &file.fixed_y,
         alpha,
-        contact_centre: None,
+        contact_centre: file.contact_centre,
     };
     let solution = solve_signorini(&mesh, &input).map_err(|e| match e {
         Error::Input(m) if m.contains("rigid motion is not prevented") => {
