@@ -517,7 +517,7 @@ fn contact_scene_files_from_the_command_line() {
     assert!(!run.status.success());
     assert!(String::from_utf8_lossy(&run.stderr).contains("--vtk does not apply"));
 
-    std::fs::write(&file, GMSH.replace("poisson = 0.3", "poisson = 0.7")).unwrap();
+    std::fs::write(file, GMSH.replace("poisson = 0.3", "poisson = 0.7")).unwrap();
     let run = fem_forms(&["solve", "--scene", file]);
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);

@@ -182,10 +182,9 @@ pub fn gap_block_mesh(
 ) -> Result<TriangleMesh> {
     let positive = |v: f64| v.is_finite() && v > 0.0;
     let largest = 0.25 * half_width.min(height);
-    if !(positive(half_width) && positive(height) && positive(contact_h) && positive(grading))
-        || !(zone.is_finite() && zone >= 0.0)
-        || contact_h > largest
-    {
+    let zone_ok = zone.is_finite() && zone >= 0.0;
+    let sizes_ok = positive(half_width) && positive(height) && positive(contact_h);
+    if !(sizes_ok && positive(grading) && zone_ok) || contact_h > largest {
         return Err(Error::Input(format!(
             "the gap block's mesh needs positive sizes, zone ≥ 0 and contact_h ≤ min(w, height)/4, got w {half_width}, height {height}, zone {zone}, contact_h {contact_h}, grading {grading}"
         )));
