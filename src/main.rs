@@ -570,6 +570,9 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
     let mesh = match scene.body {
         ContactBody::Block { .. } => "an N×N×2 mesh of the block (2N×N×2 on its 2:1 shape)",
         ContactBody::Cylinder { .. } => "a mesh graded to b/h = N cells per contact half-width",
+        ContactBody::GapBlock { .. } => {
+            "a half block graded to b/h = N cells per contact half-width"
+        }
     };
     options.refuse(
         &[
@@ -588,7 +591,12 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
             scene.name
         ),
     )?;
-    if options.plot && !matches!(scene.body, ContactBody::Cylinder { .. }) {
+    if options.plot
+        && !matches!(
+            scene.body,
+            ContactBody::Cylinder { .. } | ContactBody::GapBlock { .. }
+        )
+    {
         return Err(format!(
             "--plot does not apply: `{}` has no reference pressure profile to chart (its pressure is q on every edge: see --json's patch_pressure_error)",
             scene.name
@@ -622,6 +630,57 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
         )
         .map_err(|e| e.to_string())?;
         eprintln!("→ {}", path.display());
+    }
+    Ok(())
+}
+
+/// `solve --scene FILE` for a file with `model = "contact"` (fem_forms::contact_scene_file):
+/// `--mesh-size` refines the file's mesh uniformly, `--load` scales its pressure.
+fn solve_contact_file(path: &Path, options: &SolveOptions) -> Result<(), String> {
+    use fem_forms::contact_scene_file as file;
+    options.refuse(
+        &[
+            "--elements",
+            "--msh",
+            "--vtk",
+            "--thickness",
+            "--refinement",
+            "--no-obstacle",
+            "--linear-solver",
+            "--solver",
+            "--cold",
+            "--plot",
+            "--support",
+            "--obstacle",
+        ],
+        &format!(
+            "{} is a contact scene file (--mesh-size: uniform refinements of its mesh, --load: its pressure's scale, --alpha, --pair, --json)",
+            path.display()
+        ),
+    )?;
+    let scene = file::read(path).map_err(|e| e.to_string())?;
+    let overrides = file::Overrides {
+        pair: options
+            .pair
+            .as_deref()
+            .map(contact::ContactPair::parse)
+            .transpose()
+            .map_err(|e| e.to_string())?,
+        refinements: options.mesh_size,
+        load: options.load,
+        alpha: options.alpha,
+    };
+    let solved = file::solve(&scene, &overrides).map_err(|e| e.to_string())?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&solved.report).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!("{}", contact::summary(&solved.report));
+        if let Some(e) = solved.report.pressure_l2_error {
+            println!("pressure L² error against exact.pressure: {e:.3e}");
+        }
     }
     Ok(())
 }
@@ -979,6 +1038,12 @@ fn run(cli: Cli) -> Result<(), String> {
             mut options,
         }) => {
             let entry = match (name, scene_file) {
+                (_, Some(path))
+                    if std::fs::read_to_string(&path)
+                        .is_ok_and(|t| fem_forms::contact_scene_file::names_contact(&t)) =>
+                {
+                    return solve_contact_file(&path, &options);
+                }
                 (_, Some(path)) => {
                     let file = scene_file::read(&path).map_err(|e| e.to_string())?;
                     options

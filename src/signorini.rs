@@ -5,7 +5,7 @@
 //! Hertz's (half-width, peak, relative L² error against the best P0 fit) and hosts
 //! the `convergence` and `alpha` studies.
 
-use crate::models::contact_scenes::{ContactBody, ContactScene};
+use crate::models::contact_scenes::{solve_gap_block, ContactBody, ContactScene};
 use crate::models::signorini::{solve_hertz, solve_signorini, Displacement, Hertz, SignoriniInput};
 use crate::plot::{self, Axes, Series};
 use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
@@ -160,6 +160,9 @@ pub struct ContactReport {
     pub complementarity_residual: f64,
     /// The solver's KKT residual.
     pub kkt_residual: f64,
+    /// The accuracy the scene states for `pressure_l2_error` (`signorini-gap`), where
+    /// it states one.
+    pub accuracy: Option<f64>,
 }
 
 /// The contact pressure per edge along x: `(x0, x1, λ_E)` sorted by x0.
@@ -215,6 +218,15 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
                 Some([r.pressure_l2_error, r.best_fit_l2_error, r.oscillation]),
             )
         }
+        ContactBody::GapBlock { .. } => {
+            let r = solve_gap_block(s, q, n as f64, element, request.alpha)?;
+            let oscillation = oscillation(&r.solution, &r.hertz);
+            (
+                r.solution,
+                Some(r.hertz),
+                Some([r.pressure_l2_error, r.best_fit_l2_error, oscillation]),
+            )
+        }
     };
     // the cylinder is solved on its symmetric half
     let factor = if hertz.is_some() { 2.0 } else { 1.0 };
@@ -263,8 +275,29 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         }),
         complementarity_residual: solution.complementarity_residual,
         kkt_residual: solution.kkt_residual,
+        accuracy: s.accuracy(),
     };
     Ok((report, profile))
+}
+
+/// The checkerboard measure of `models::signorini::HertzResult::oscillation` on any
+/// solution symmetric about `x = 0`: `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
+/// consecutive contact edges (by x) inside `x < 0.8 b`.
+fn oscillation(solution: &crate::models::signorini::SignoriniSolution, hertz: &Hertz) -> f64 {
+    let mut profile: Vec<(f64, f64)> = solution
+        .contact_edges
+        .iter()
+        .zip(&solution.pressure)
+        .map(|(e, &p)| (e.midpoint()[0], p))
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let inside = 0.8 * hertz.half_width();
+    profile
+        .windows(3)
+        .filter(|w| w[2].0 < inside)
+        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
+        .fold(0.0f64, f64::max)
+        / hertz.max_pressure()
 }
 
 /// One line for a report (`solve` without `--json`).
@@ -296,6 +329,12 @@ pub fn summary(r: &ContactReport) -> String {
     }
     if let Some(e) = r.patch_pressure_error {
         line += &format!("; max |λ_h − q|/q {e:.1e}");
+    }
+    if let (Some(a), Some(e)) = (r.accuracy, r.pressure_l2_error) {
+        line += &format!(
+            "; stated accuracy {a:.1e}: {}",
+            if e <= a { "reached" } else { "NOT reached" }
+        );
     }
     line += &format!(
         ", {} iterations, complementarity {:.1e}, {:.3} s",
