@@ -556,7 +556,7 @@ pub fn solve_hertz_on(
 }
 
 // ---------------------------------------------------------------------------------------
-// Nested iteration and the accuracy-driven stop (issue 14, "Speed"; docs/contact.md §6).
+// Nested iteration and the accuracy-driven stop (issue 14, "Speed"; docs/contact.md §7).
 // ---------------------------------------------------------------------------------------
 
 use fem_runtime::multigrid::{prolongation, NestedLevel};
@@ -625,7 +625,7 @@ pub struct NestedLevelReport {
     pub pressure_change: Option<f64>,
     /// The estimate of this level's relative `L²(Γ_C)` pressure error: the larger of
     /// this level's and the previous level's `pressure_change`, over `2^r − 1` with `r`
-    /// = [`PRESSURE_RATE`] (docs/contact.md §6); `None` on the two coarsest levels.
+    /// = [`PRESSURE_RATE`] (docs/contact.md §7); `None` on the two coarsest levels.
     pub estimated_error: Option<f64>,
 }
 
@@ -645,7 +645,7 @@ pub struct NestedSignoriniSolution {
 /// The convergence rate `r` in `h` assumed by the error estimate of
 /// [`solve_signorini_to_accuracy`]: the multiplier is P0 and the pressure has a
 /// square-root edge at the end of the contact zone, which caps the `L²(Γ_C)` rate at
-/// O(h) (issue 14; docs/contact.md §6 for the estimate).
+/// O(h) (issue 14; docs/contact.md §7 for the estimate).
 pub const PRESSURE_RATE: f64 = 1.0;
 
 /// Limits of [`solve_signorini_to_accuracy`].
@@ -700,7 +700,7 @@ pub fn solve_signorini_nested(
 /// `δ_l = ‖λ_{l−1} − λ_l‖ / ‖λ_l‖` and `r` = [`PRESSURE_RATE`] (Richardson: if
 /// `‖λ − λ_h‖ ≈ C h^r`, then `‖λ − λ_{h/2}‖ ≈ ‖λ_h − λ_{h/2}‖ / (2^r − 1)`). Before the
 /// asymptotic range the differences are irregular (on Hertz, one of them was 3.0× below
-/// the true error of its level), hence the larger of the last two; docs/contact.md §6
+/// the true error of its level), hence the larger of the last two; docs/contact.md §7
 /// has the measurements. At least two refinements are made.
 ///
 /// # Errors
@@ -804,7 +804,7 @@ fn nested_with<M: Model>(
             .map_err(|e| named(refinements, e))?;
         let change = pressure_change(&previous, &next, &parents);
         report.pressure_change = Some(change);
-        // two differences: one alone can be small by a coincidence (docs/contact.md §6)
+        // two differences: one alone can be small by a coincidence (docs/contact.md §7)
         report.estimated_error = levels
             .last()
             .and_then(|l| l.pressure_change)
