@@ -288,15 +288,6 @@ pub struct InteriorMultiplier {
     pub max_relative_error: f64,
 }
 
-/// The (cells, iterations) of one level of the nested iteration.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct LevelIterations {
-    /// N of the level's N×N×2 mesh.
-    pub mesh_size: usize,
-    /// Newton (or interior-point) iterations on it.
-    pub iterations: usize,
-}
-
 /// The report of a Kirchhoff solve (`solve --json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct KirchhoffReport {
@@ -354,8 +345,9 @@ pub struct KirchhoffReport {
     pub dofs: usize,
     /// Iterations on the finest mesh.
     pub iterations: usize,
-    /// Iterations on every level of the nested iteration, coarsest first.
-    pub level_iterations: Vec<LevelIterations>,
+    /// `[triangles, iterations]` of each level of the nested iteration (as every family
+    /// reports it).
+    pub levels: Vec<[usize; 2]>,
     /// Wall time of the solve, assembly included.
     pub seconds: f64,
     /// The largest `w_h − ψ` at the cells' vertices, edge midpoints and centroids (0
@@ -387,6 +379,11 @@ pub fn solve(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
 }
 
 /// The N of the nested levels ending at `n`: `n/2^k ≥ NESTED_FROM`, …, `n/2`, `n`.
+/// N of the N×N×2 mesh of `triangles` cells.
+fn mesh_size_of(triangles: usize) -> usize {
+    ((triangles / 2) as f64).sqrt().round() as usize
+}
+
 fn level_sizes(n: usize, nested: bool) -> Vec<usize> {
     let mut sizes = vec![n];
     while nested && sizes[0] % 2 == 0 && sizes[0] / 2 >= NESTED_FROM {
@@ -552,15 +549,7 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
         complementarity_residual: solution.kkt_residual,
         dofs: solution.discretization.dofs.dof_count(),
         iterations: solution.iterations,
-        level_iterations: solution
-            .levels
-            .iter()
-            .zip(&sizes)
-            .map(|(&(_, iterations), &mesh_size)| LevelIterations {
-                mesh_size,
-                iterations,
-            })
-            .collect(),
+        levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
         seconds: solution.seconds,
         max_penetration,
         max_open_contact_gap,
@@ -916,9 +905,9 @@ pub fn summary(r: &KirchhoffReport) -> String {
         );
     }
     let levels: Vec<String> = r
-        .level_iterations
+        .levels
         .iter()
-        .map(|l| format!("{}:{}", l.mesh_size, l.iterations))
+        .map(|[triangles, iterations]| format!("{}:{iterations}", mesh_size_of(*triangles)))
         .collect();
     line += &format!(
         "; α {:.3e}, {} dofs, iterations per level (N:it) {}, KKT residual {:.1e}, {:.3} s",
@@ -1094,11 +1083,7 @@ fn obstacle_convergence(scene: KirchhoffScene, full: bool, out: &Path) -> Result
                 "N", "J_h", "∫λ_h", "area", "max w", "iterations", "KKT res", "seconds"
             );
             for r in &reports {
-                let levels: Vec<String> = r
-                    .level_iterations
-                    .iter()
-                    .map(|l| l.iterations.to_string())
-                    .collect();
+                let levels: Vec<String> = r.levels.iter().map(|l| l[1].to_string()).collect();
                 println!(
                     "{:>5} {:>15.9e} {:>13.7e} {:>10.6} {:>13.7e} {:>12} {:>9.1e} {:>8.2}",
                     r.mesh_size,

@@ -11,6 +11,7 @@
 pub mod allocator;
 pub mod beam_studies;
 pub mod beams;
+pub mod contact_scene_file;
 pub mod kirchhoff;
 pub mod membrane_studies;
 pub mod membranes;

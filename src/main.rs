@@ -9,7 +9,9 @@ use fem_forms::models::contact_scenes::{ContactBody, ContactScene};
 use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene};
-use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind, MEMBRANE_PAIRS};
+use fem_forms::models::registry::{
+    find, names, registry, Family, SceneEntry, SceneKind, MEMBRANE_PAIRS,
+};
 use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
@@ -24,8 +26,8 @@ use std::process::ExitCode;
 #[command(
     name = "fem-forms",
     version,
-    about = "Stabilized finite elements for obstacle problems of beams and membranes: solve scenes, print tables, write charts",
-    long_about = "Without a command: solves the beam scenes at q = 1 (no contact) and q = 100 (contact) and the membrane scenes, prints tables, writes plots of w, θ, λ and ψ, .vtu files of the membranes and the study charts to out/."
+    about = "Stabilized finite elements for obstacle and contact problems of beams, membranes, plates and elastic bodies: solve scenes, print tables, write charts",
+    long_about = "Without a command: solves the beam scenes at q = 1 (no contact) and q = 100 (contact), the membrane scenes and the contact scenes (signorini-patch, hertz, signorini-gap), prints tables, writes plots of w, θ, λ and ψ, the contact pressures against Hertz's, .vtu files of the membranes and the study charts to out/."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -88,6 +90,9 @@ struct SolveOptions {
     /// N: an N×N×2 triangle mesh of the scene's square (membranes; the L-shape keeps
     /// three quarters of it). (default 64; with --msh: 0 refinements) Plates: N of the
     /// square's N×N×2 mesh or the disk's rings (default 32; kirchhoff-square 16).
+    /// Contact: N of signorini-patch's 2N×N×2 block mesh (default 8); b/h, cells per
+    /// contact half-width, of hertz's and signorini-gap's graded meshes (default 16, 64);
+    /// with a scene file, uniform refinements of its mesh.
     #[arg(long, allow_negative_numbers = true)]
     mesh_size: Option<usize>,
     /// Also write u, λ, ψ and the contact set as a .vtu for ParaView (membranes).
@@ -100,18 +105,22 @@ struct SolveOptions {
     /// Load magnitude q: the load is q times the scene's load field (beams: f = ∓q, q = 1
     /// no contact, 40 and 100 contact; membrane-flat: f = −q, default 3;
     /// membrane-lshape: f = −q, default 12). Refused where the load is fixed
-    /// (membrane-radial: f = 0).
+    /// (membrane-radial: f = 0). Contact: the pressure q on signorini-patch's top
+    /// (default 1), the resultant P per unit length of hertz and signorini-gap (default
+    /// 1), the scale of a contact scene file's pressure.
     #[arg(long, allow_negative_numbers = true)]
     load: Option<f64>,
     /// Beam thickness t (Timoshenko scenes).
     #[arg(long, allow_negative_numbers = true)]
     thickness: Option<f64>,
     /// Stabilization parameter α (negative values are refused with a reason; not for
-    /// p1-nodal, which has no multiplier).
+    /// p1-nodal, which has no multiplier). 0: the plain mixed method, solved as a QP by
+    /// clarabel. Each family's default is its rule ½/C_I (contact: ½/max C_I,E); values
+    /// well beyond 1/C_I make the stabilized matrix indefinite: an error names α·C_I.
     #[arg(long, allow_negative_numbers = true)]
     alpha: Option<f64>,
     /// Element pair (beams: p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0;
-    /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal).
+    /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal; plates and contact: see `list`).
     #[arg(long)]
     pair: Option<String>,
     /// LCP solver (default pdas; not for p1-nodal).
@@ -142,7 +151,8 @@ struct SolveOptions {
     /// then compares the centre deflection with the closed form where there is one.
     #[arg(long)]
     no_obstacle: bool,
-    /// Also write the plot of w, θ, λ, ψ (beams).
+    /// Also write the plot of w, θ, λ, ψ (beams), or of the contact pressure against the
+    /// reference (hertz, signorini-gap, contact scene files with an exact pressure).
     #[arg(long)]
     plot: bool,
 }
@@ -479,7 +489,12 @@ fn list() {
     println!("scenes (family, pairs with the default first, studies):");
     for e in registry() {
         let load = e.default_load().map_or("fixed load".to_string(), |q| {
-            format!("--load q = {q} by default")
+            // the cylinder and the gap block take a resultant, not a pressure
+            let symbol = match e.family() {
+                Family::Contact if e.name() != "signorini-patch" => "P",
+                _ => "q",
+            };
+            format!("--load {symbol} = {q} by default")
         });
         println!("  {:<17} {}", e.name(), e.description());
         println!(
@@ -570,6 +585,9 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
     let mesh = match scene.body {
         ContactBody::Block { .. } => "an N×N×2 mesh of the block (2N×N×2 on its 2:1 shape)",
         ContactBody::Cylinder { .. } => "a mesh graded to b/h = N cells per contact half-width",
+        ContactBody::GapBlock { .. } => {
+            "a half block graded to b/h = N cells per contact half-width"
+        }
     };
     options.refuse(
         &[
@@ -588,7 +606,12 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
             scene.name
         ),
     )?;
-    if options.plot && !matches!(scene.body, ContactBody::Cylinder { .. }) {
+    if options.plot
+        && !matches!(
+            scene.body,
+            ContactBody::Cylinder { .. } | ContactBody::GapBlock { .. }
+        )
+    {
         return Err(format!(
             "--plot does not apply: `{}` has no reference pressure profile to chart (its pressure is q on every edge: see --json's patch_pressure_error)",
             scene.name
@@ -622,6 +645,57 @@ fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Res
         )
         .map_err(|e| e.to_string())?;
         eprintln!("→ {}", path.display());
+    }
+    Ok(())
+}
+
+/// `solve --scene FILE` for a file with `model = "contact"` (fem_forms::contact_scene_file):
+/// `--mesh-size` refines the file's mesh uniformly, `--load` scales its pressure.
+fn solve_contact_file(path: &Path, options: &SolveOptions) -> Result<(), String> {
+    use fem_forms::contact_scene_file as file;
+    options.refuse(
+        &[
+            "--elements",
+            "--msh",
+            "--vtk",
+            "--thickness",
+            "--refinement",
+            "--no-obstacle",
+            "--linear-solver",
+            "--solver",
+            "--cold",
+            "--plot",
+            "--support",
+            "--obstacle",
+        ],
+        &format!(
+            "{} is a contact scene file (--mesh-size: uniform refinements of its mesh, --load: its pressure's scale, --alpha, --pair, --json)",
+            path.display()
+        ),
+    )?;
+    let scene = file::read(path).map_err(|e| e.to_string())?;
+    let overrides = file::Overrides {
+        pair: options
+            .pair
+            .as_deref()
+            .map(contact::ContactPair::parse)
+            .transpose()
+            .map_err(|e| e.to_string())?,
+        refinements: options.mesh_size,
+        load: options.load,
+        alpha: options.alpha,
+    };
+    let solved = file::solve(&scene, &overrides).map_err(|e| e.to_string())?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&solved.report).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!("{}", contact::summary(&solved.report));
+        if let Some(e) = solved.report.pressure_l2_error {
+            println!("pressure L² error against exact.pressure: {e:.3e}");
+        }
     }
     Ok(())
 }
@@ -979,6 +1053,12 @@ fn run(cli: Cli) -> Result<(), String> {
             mut options,
         }) => {
             let entry = match (name, scene_file) {
+                (_, Some(path))
+                    if std::fs::read_to_string(&path)
+                        .is_ok_and(|t| fem_forms::contact_scene_file::names_contact(&t)) =>
+                {
+                    return solve_contact_file(&path, &options);
+                }
                 (_, Some(path)) => {
                     let file = scene_file::read(&path).map_err(|e| e.to_string())?;
                     options

@@ -327,6 +327,11 @@ pub struct PlateReport {
     /// (the clamped disk: `q R⁴/(64D) + q R²/(4S)`); only without an obstacle.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub unobstructed_reference: Option<f64>,
+    /// Without an obstacle: the centre deflection `relative_error` is measured against
+    /// (`unobstructed_reference` where there is one, else `kirchhoff_reference`); the
+    /// field of the same name in the Kirchhoff plates' report.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_centre_deflection: Option<f64>,
     /// `(w_h(centre) − w_ref)/w_ref` without an obstacle, against
     /// `unobstructed_reference` where there is one, else against `kirchhoff_reference`
     /// (then it includes the O(t²) Mindlin–Kirchhoff difference, about 20 t² for the
@@ -661,6 +666,7 @@ where
         centre_deflection: centre,
         kirchhoff_reference: kirchhoff,
         unobstructed_reference: unobstructed,
+        reference_centre_deflection: (!in_contact).then(|| unobstructed.unwrap_or(kirchhoff)),
         relative_error: if in_contact {
             f64::NAN
         } else {

@@ -469,7 +469,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         return Err(at(
             "model",
             format!(
-                "`{}` is not a model scene files can pose; they support `membrane` (beams: the built-in scenes)",
+                "`{}` is not a model scene files can pose; they support `membrane` and `contact` (beams: the built-in scenes)",
                 file.model
             ),
         ));

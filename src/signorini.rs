@@ -6,7 +6,7 @@
 //! the `convergence` and `alpha` studies. The pairs `p1-p1`, `p2-p1` take a continuous
 //! P1 multiplier on Γ_C instead (one pressure per vertex of its edges).
 
-use crate::models::contact_scenes::{ContactBody, ContactScene};
+use crate::models::contact_scenes::{solve_gap_block, ContactBody, ContactScene};
 use crate::models::signorini::{
     solve_hertz_with, solve_signorini_with, Displacement, Hertz, Multiplier, SignoriniInput,
 };
@@ -33,8 +33,12 @@ pub enum ContactPair {
 }
 
 impl ContactPair {
-    /// Every pair, the default first.
-    pub const ALL: [ContactPair; 4] = [
+    /// The P0-multiplier pairs, which every contact scene takes, the default first.
+    pub const ALL: [ContactPair; 2] = [ContactPair::P1P0, ContactPair::P2P0];
+
+    /// Every pair (`--pair`): [`ContactPair::ALL`] and the continuous-P1-multiplier pairs
+    /// of the block and the cylinder.
+    pub const EVERY: [ContactPair; 4] = [
         ContactPair::P1P0,
         ContactPair::P2P0,
         ContactPair::P1P1,
@@ -56,7 +60,7 @@ impl ContactPair {
     /// # Errors
     /// [`Error::Input`] listing the pairs for another name.
     pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
+        Self::EVERY
             .into_iter()
             .find(|p| p.name() == name)
             .ok_or_else(|| {
@@ -66,14 +70,16 @@ impl ContactPair {
             })
     }
 
-    fn displacement(self) -> Displacement {
+    /// The pair's displacement element.
+    pub fn displacement(self) -> Displacement {
         match self {
             ContactPair::P1P0 | ContactPair::P1P1 => Displacement::P1,
             ContactPair::P2P0 | ContactPair::P2P1 => Displacement::P2,
         }
     }
 
-    fn multiplier(self) -> Multiplier {
+    /// The pair's multiplier space on Γ_C.
+    pub fn multiplier(self) -> Multiplier {
         match self {
             ContactPair::P1P0 | ContactPair::P2P0 => Multiplier::P0,
             ContactPair::P1P1 | ContactPair::P2P1 => Multiplier::P1,
@@ -192,6 +198,9 @@ pub struct ContactReport {
     pub complementarity_residual: f64,
     /// The solver's KKT residual.
     pub kkt_residual: f64,
+    /// The accuracy the scene states for `pressure_l2_error` (`signorini-gap`), where
+    /// it states one.
+    pub accuracy: Option<f64>,
 }
 
 /// The contact pressure along x, sorted by x0: per edge `(x0, x1, λ_E)` (P0 pairs), or
@@ -248,6 +257,22 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
                 r.solution,
                 Some(hertz),
                 Some([r.pressure_l2_error, r.best_fit_l2_error, r.oscillation]),
+            )
+        }
+        ContactBody::GapBlock { .. } => {
+            if multiplier != Multiplier::P0 {
+                return Err(Error::Input(format!(
+                    "pair `{}`: the scene `{}` takes the P0-multiplier pairs p1-p0, p2-p0",
+                    request.pair.name(),
+                    s.name
+                )));
+            }
+            let r = solve_gap_block(s, q, n as f64, element, request.alpha)?;
+            let oscillation = oscillation(&r.solution, &r.hertz);
+            (
+                r.solution,
+                Some(r.hertz),
+                Some([r.pressure_l2_error, r.best_fit_l2_error, oscillation]),
             )
         }
     };
@@ -309,8 +334,29 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         }),
         complementarity_residual: solution.complementarity_residual,
         kkt_residual: solution.kkt_residual,
+        accuracy: s.accuracy(),
     };
     Ok((report, profile))
+}
+
+/// The checkerboard measure of `models::signorini::HertzResult::oscillation` on any
+/// solution symmetric about `x = 0`: `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
+/// consecutive contact edges (by x) inside `x < 0.8 b`.
+fn oscillation(solution: &crate::models::signorini::SignoriniSolution, hertz: &Hertz) -> f64 {
+    let mut profile: Vec<(f64, f64)> = solution
+        .contact_edges
+        .iter()
+        .zip(&solution.pressure)
+        .map(|(e, &p)| (e.midpoint()[0], p))
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let inside = 0.8 * hertz.half_width();
+    profile
+        .windows(3)
+        .filter(|w| w[2].0 < inside)
+        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
+        .fold(0.0f64, f64::max)
+        / hertz.max_pressure()
 }
 
 /// One line for a report (`solve` without `--json`).
@@ -347,6 +393,12 @@ pub fn summary(r: &ContactReport) -> String {
     }
     if let Some(e) = r.patch_pressure_error {
         line += &format!("; max |λ_h − q|/q {e:.1e}");
+    }
+    if let (Some(a), Some(e)) = (r.accuracy, r.pressure_l2_error) {
+        line += &format!(
+            "; stated accuracy {a:.1e}: {}",
+            if e <= a { "reached" } else { "NOT reached" }
+        );
     }
     line += &format!(
         ", {} iterations, complementarity {:.1e}, {:.3} s",
@@ -502,7 +554,13 @@ pub fn convergence_study(scene: ContactScene, full: bool, out: &Path) -> Result<
     );
     let mut series = Vec::new();
     let (mut best_series, mut best_p1_series) = (Vec::new(), Vec::new());
-    for pair in ContactPair::ALL {
+    // the P1-multiplier pairs on the cylinder only (the gap block takes P0 pairs)
+    let pairs: &[ContactPair] = if matches!(scene.body, ContactBody::Cylinder { .. }) {
+        &ContactPair::EVERY
+    } else {
+        &ContactPair::ALL
+    };
+    for &pair in pairs {
         let mut points = Vec::new();
         for &n in sizes {
             let mut request = ContactRequest::new(scene);

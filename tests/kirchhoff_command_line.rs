@@ -104,7 +104,7 @@ fn kirchhoff_obstacle_reports_what_the_issue_asks() {
             "contact_area",
             "dofs",
             "iterations",
-            "level_iterations",
+            "levels",
             "seconds",
             "complementarity_residual",
         ] {
@@ -131,7 +131,7 @@ fn kirchhoff_obstacle_reports_what_the_issue_asks() {
             "{what}: J_h = {energy}"
         );
         assert!(number(&json, "complementarity_residual") < 1e-10, "{what}");
-        let levels = json["level_iterations"].as_array().unwrap();
+        let levels = json["levels"].as_array().unwrap();
         assert_eq!(levels.len(), 3, "{what}: N = 4, 8, 16");
     }
 }

@@ -320,8 +320,8 @@ fn newton_agrees_with_clarabel_on_a_small_mesh() {
         assert!(newton.complementarity_residual < 1e-12, "{obstacle}");
         assert!(clarabel.complementarity_residual < 1e-6, "{obstacle}");
         // nested: N = 4, 8, each level a handful of Newton steps, no cycling
-        assert_eq!(newton.level_iterations.len(), 2);
-        assert!(newton.level_iterations.iter().all(|l| l.iterations <= 20));
+        assert_eq!(newton.levels.len(), 2);
+        assert!(newton.levels.iter().all(|l| l[1] <= 20));
     }
 }
 

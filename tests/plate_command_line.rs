@@ -55,6 +55,11 @@ fn mindlin_square_json_tends_to_kirchhoff_and_the_plain_pair_locks() {
     }
     // Timoshenko & Woinowsky-Krieger, table 35: 0.00126532 q a⁴/D with q = a = D = 1
     assert_eq!(json["kirchhoff_reference"].as_f64().unwrap(), 0.00126532);
+    // the field name the Kirchhoff plates use for the reference of relative_error
+    assert_eq!(
+        json["reference_centre_deflection"].as_f64().unwrap(),
+        0.00126532
+    );
     let w = json["centre_deflection"].as_f64().unwrap();
     assert!(
         ((w - 0.00126532) / 0.00126532).abs() < 1e-2,

@@ -294,9 +294,9 @@ fn check_hertz(r: &HertzResult, what: &str, half_width: bool) {
     );
 }
 
-/// Hertz with P1–P1 at b/h = 16, 32 (measured, docs/contact.md: .0161, .0147 against the
+/// Hertz with P1–P1 at b/h = 16, 32 (measured, docs/contact.md: .0161, .0120 against the
 /// best continuous P1 fit's .0094, .0084): within 2× of the best fit and decreasing; the
-/// plain method (α = 0, QP) for comparison: the same order (.0174, .0173), not better;
+/// plain method (α = 0, QP) for comparison: the same order (.0174, .0143), not better;
 /// P2–P1 within 1.3× of the best fit (measured 1.20 at b/h = 32).
 #[test]
 fn hertz_p1_multiplier_against_the_best_p1_fit() {

@@ -440,12 +440,64 @@ impl Lcp {
         }
     }
 
+    /// The complementarity part of [`Lcp::kkt_residual`]: `max_k |min(Λ_k/Λ*, r_k)|`
+    /// with the infeasibilities `(−Λ_k)₊/Λ*` and `(−r_k)₊` (`Λ*`, `r_k` as there).
+    ///
+    /// # Panics
+    /// If `u.len() != n` or `lambda.len() != m`.
+    pub fn complementarity_residual(&self, u: &[f64], lambda: &[f64]) -> f64 {
+        assert!(
+            u.len() == self.n() && lambda.len() == self.m(),
+            "complementarity_residual of (U, Λ) of lengths ({}, {}) for an LCP of ({}, {}) unknowns",
+            u.len(),
+            lambda.len(),
+            self.n(),
+            self.m()
+        );
+        let norm_inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let a_norm = row_sum_norm(&self.a);
+        let lambda_norm = norm_inf(lambda).max(self.multiplier_scale());
+        let u_star = if a_norm > 0.0 {
+            norm_inf(&self.f) / a_norm
+        } else {
+            0.0
+        };
+        let c_lambda = self.c_times(lambda);
+        let c_terms = self.c_times_abs(lambda);
+        let mut complementarity = 0.0f64;
+        for (k, row) in self.b_rows.iter().enumerate() {
+            let terms: f64 = row
+                .iter()
+                .map(|&(j, v)| (v * u[j]).abs() + v.abs() * u_star)
+                .sum::<f64>()
+                + c_terms[k]
+                + self.g[k].abs();
+            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
+            let residual = bu + c_lambda[k] - self.g[k];
+            let r = if terms > 0.0 {
+                residual / terms
+            } else {
+                residual
+            };
+            let l = if lambda_norm > 0.0 {
+                lambda[k] / lambda_norm
+            } else {
+                lambda[k]
+            };
+            complementarity = complementarity.max(l.min(r).abs()).max(-l).max(-r);
+        }
+        complementarity
+    }
+
     /// The KKT residual of `(u, λ)`, scale-invariant: the largest of
     /// - the normwise backward error of the equilibrium
     ///   `‖AU − BᵀΛ − F‖∞ / (‖A‖∞‖U‖∞ + ‖Bᵀ‖∞‖Λ‖∞ + ‖F‖∞)`,
     /// - the complementarity `max_k |min(Λ_k/Λ*, r_k)|` (`Λ*` the larger of ‖Λ‖∞ and
     ///   [`Lcp::multiplier_scale`]) with the componentwise relative
-    ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + Σ_l |C_kl Λ_l| + |G_k|)`,
+    ///   constraint residual `r_k = R_k / (Σ_j |B_kj U_j| + Σ_l |C_kl Λ_l| + |G_k| +
+    ///   U* Σ_j |B_kj|)` with `U* = ‖F‖∞/‖A‖∞` the displacement scale of the load (without
+    ///   that floor a constraint met exactly, `BU = G = 0` with `C = 0`, would be judged
+    ///   against the rounding of its own terms and reported as 1),
     /// - the infeasibilities `(−Λ_k)₊/‖Λ‖∞` and `(−r_k)₊`.
     ///
     /// # Panics
@@ -479,27 +531,7 @@ impl Lcp {
             equilibrium
         };
         let lambda_norm = norm_inf(lambda).max(self.multiplier_scale());
-        let c_lambda = self.c_times(lambda);
-        let c_terms = self.c_times_abs(lambda);
-        let mut complementarity = 0.0f64;
-        for (k, row) in self.b_rows.iter().enumerate() {
-            let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
-                + c_terms[k]
-                + self.g[k].abs();
-            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
-            let residual = bu + c_lambda[k] - self.g[k];
-            let r = if terms > 0.0 {
-                residual / terms
-            } else {
-                residual
-            };
-            let l = if lambda_norm > 0.0 {
-                lambda[k] / lambda_norm
-            } else {
-                lambda[k]
-            };
-            complementarity = complementarity.max(l.min(r).abs()).max(-l).max(-r);
-        }
+        let complementarity = self.complementarity_residual(u, lambda);
         let result = backward.max(complementarity);
         // An overflow in a norm (loads near f64::MAX) turns the relative residuals into
         // 0 / ∞ = 0: a point whose certificate overflowed is not certified.
@@ -751,6 +783,19 @@ mod tests {
     }
 
     #[test]
+    fn a_constraint_met_exactly_is_not_judged_against_its_own_rounding() {
+        // u − λ = −1 against the wall u ≥ 0 with C = 0 and G = 0: u = 0, λ = 1. A
+        // solver's u of 1e-17 meets the constraint to rounding (a tester saw the plain
+        // method's exact patch test reported with a residual of 1); u = 1e-3 does not.
+        let a = SparseMatrix::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, 1.0)]).unwrap();
+        let lcp = Lcp::new(a, vec![vec![(0, 1.0)]], vec![0.0], vec![-1.0], vec![0.0]);
+        let exact = lcp.kkt_residual(&[1e-17], &[1.0 + 1e-17]);
+        assert!(exact < 1e-15, "{exact}");
+        let open = lcp.kkt_residual(&[1e-3], &[1.0 + 1e-3]);
+        assert!(open > 1e-4, "{open}");
+    }
+
+    #[test]
     fn a_point_whose_certificate_overflows_or_is_nan_is_not_certified() {
         let (lcp, u, lambda) = blocked_lcp(1);
         assert!(lcp.kkt_residual(&u, &lambda) < 1e-10);
@@ -814,6 +859,54 @@ mod tests {
             println!(
                 "seed {seed}: Newton {} iterations, saddle point {}, clarabel {}",
                 newton.iterations, saddle.iterations, qp.iterations
+            );
+        }
+    }
+
+    #[test]
+    fn clarabel_solves_tiny_and_huge_data_alike() {
+        // The plain method (C = 0): a chain of springs pushed onto a wall at every
+        // other node. The LCP is linear in (F, G): the data scaled by s scale (U, Λ) by
+        // s. Unscaled, clarabel's absolute tolerances made a load of 1e-12 wrong by 14×
+        // and one of 1e50 "dual infeasible" (a tester's plain-method patch test).
+        let n = 40;
+        let mut triplets = Vec::new();
+        for i in 0..n {
+            triplets.push(Triplet::new(i, i, 2.0));
+            if i + 1 < n {
+                triplets.push(Triplet::new(i, i + 1, -1.0));
+                triplets.push(Triplet::new(i + 1, i, -1.0));
+            }
+        }
+        let a = SparseMatrix::try_new_from_triplets(n, n, &triplets).unwrap();
+        let rows: Vec<Vec<(usize, f64)>> = (0..n).step_by(2).map(|j| vec![(j, -1.0)]).collect();
+        let m = rows.len();
+        // u_j ≤ ψ_j (−u_j ≥ −ψ_j) under a load pushing up, a curved wall
+        let f: Vec<f64> = (0..n).map(|i| 0.01 * (1.0 + (i % 3) as f64)).collect();
+        let g: Vec<f64> = (0..m)
+            .map(|k| -(0.2 + 0.001 * (k as f64 - 10.0).powi(2)))
+            .collect();
+        let lcp = Lcp::new(a, rows, vec![0.0; m], f, g);
+        let reference = quadratic_program(&lcp).unwrap();
+        assert!(reference.kkt_residual < 1e-12, "{}", reference.kkt_residual);
+        assert!(reference.lambda.iter().filter(|&&l| l > 0.0).count() > 2);
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for s in [1e-12, 1e50] {
+            let mut scaled = lcp.clone();
+            scaled.f.iter_mut().for_each(|f| *f *= s);
+            scaled.g.iter_mut().for_each(|g| *g *= s);
+            let qp = quadratic_program(&scaled).unwrap();
+            assert!(qp.kkt_residual < 1e-12, "s = {s}: {}", qp.kkt_residual);
+            let expected: Vec<f64> = reference.lambda.iter().map(|l| l * s).collect();
+            assert!(
+                max_difference(&qp.lambda, &expected) <= 1e-9 * norm(&expected),
+                "s = {s}: Λ differs by {}",
+                max_difference(&qp.lambda, &expected)
+            );
+            let expected: Vec<f64> = reference.u.iter().map(|u| u * s).collect();
+            assert!(
+                max_difference(&qp.u, &expected) <= 1e-9 * norm(&expected),
+                "s = {s}"
             );
         }
     }

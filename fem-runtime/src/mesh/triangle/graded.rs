@@ -198,6 +198,24 @@ impl TriangleMesh {
         }
     }
 
+    /// [`TriangleMesh::refine_uniformly`] with each new boundary vertex moved to
+    /// `snap(marker, x)` as in [`TriangleMesh::refine_to_size`], and the parent of every
+    /// cell of the result (the coarse cell it was split from, for prolongation: the
+    /// parents are those of the split, exact even where snapping moved a vertex off the
+    /// coarse cell).
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] where the projection is not finite or would turn a cell inside out.
+    pub fn refine_uniformly_onto(
+        &self,
+        snap: impl Fn(u32, [f64; 2]) -> [f64; 2],
+    ) -> Result<(TriangleMesh, Vec<usize>)> {
+        let old_vertices = self.vertices.len();
+        let (mut fine, parents) = self.bisect(&vec![true; self.edges.len()])?;
+        fine.snap_new_boundary_vertices(old_vertices, &snap)?;
+        Ok((fine, parents))
+    }
+
     /// Moves the boundary vertices numbered from `first_new` to `snap(marker, x)`,
     /// checking that no cell turns inside out.
     fn snap_new_boundary_vertices(
@@ -248,6 +266,33 @@ mod tests {
             let (dx, dy) = (p[0] - centre[0], p[1] - centre[1]);
             let r = (dx * dx + dy * dy).sqrt();
             [centre[0] + radius * dx / r, centre[1] + radius * dy / r]
+        }
+    }
+
+    #[test]
+    fn uniform_refinement_onto_the_arc_keeps_the_split_parents() {
+        let coarse = TriangleMesh::quarter_disk(1.0, 3).unwrap();
+        let (fine, parents) = coarse
+            .refine_uniformly_onto(onto_circle([0.0, 1.0], 1.0))
+            .unwrap();
+        let plain = coarse.refine_uniformly();
+        assert_eq!(fine.cell_count(), 4 * coarse.cell_count());
+        assert_eq!(fine.cells(), plain.cells());
+        // the split's parents are those the unsnapped (exactly nested) mesh locates
+        assert_eq!(
+            parents,
+            crate::multigrid::parents_by_location(&coarse, &plain).unwrap()
+        );
+        for (v, (p, q)) in fine.vertices().iter().zip(plain.vertices()).enumerate() {
+            let on_arc = fine
+                .boundary_edges()
+                .iter()
+                .any(|&(e, m)| m == 1 && fine.edges()[e].contains(&v));
+            if on_arc {
+                assert!((p[0].hypot(p[1] - 1.0) - 1.0).abs() <= 1e-15, "{p:?}");
+            } else {
+                assert_eq!(p, q, "vertex {v} moved off the arc");
+            }
         }
     }
 

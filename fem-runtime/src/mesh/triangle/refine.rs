@@ -52,7 +52,7 @@ impl TriangleMesh {
     }
 
     /// Bisects the marked edges; every cell with a marked edge has its refinement edge marked.
-    fn bisect(&self, edge_marked: &[bool]) -> Result<(TriangleMesh, Vec<usize>)> {
+    pub(super) fn bisect(&self, edge_marked: &[bool]) -> Result<(TriangleMesh, Vec<usize>)> {
         let mut vertices = self.vertices.clone();
         let mut midpoint = vec![NONE; self.edges.len()];
         for e in (0..self.edges.len()).filter(|&e| edge_marked[e]) {

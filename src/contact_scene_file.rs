@@ -1,0 +1,745 @@
+//! Contact scene files: a Signorini problem (MODELS.md §7) as data,
+//! `fem-forms solve --scene my.toml` with `model = "contact"`.
+//!
+//! The membrane scene files' conventions hold ([`crate::scene_file`]): data are
+//! expressions in `x` and `y` (parsed once by [`crate::scene_file::expression`]), boundary
+//! parts are chosen by name (Gmsh physical names of curve groups, or the generator's
+//! sides), and every error names the file and the key at fault. An example, the patch
+//! test with a pressure given as an expression:
+//!
+//! ```toml
+//! name = "block"
+//! model = "contact"
+//! pair = "p1-p0"                  # or p2-p0; p1-p0 by default
+//!
+//! [mesh]
+//! generator = "rectangle"         # sides `bottom`, `right`, `top`, `left`
+//! x = [0.0, 2.0]
+//! y = [0.0, 1.0]
+//! cells = [8, 4]                  # nx, ny (each square split by its diagonal)
+//! # file = "block.msh"            # or a Gmsh MSH 4.1 file, relative to this file
+//! # refinements = 1               # uniform refinements (both kinds; --mesh-size)
+//!
+//! [material]
+//! young = 1000.0                  # E > 0
+//! poisson = 0.3                   # ν in (−1, ½)
+//! plane = "strain"                # or "stress"
+//!
+//! [boundary]                      # each a name or a list of names
+//! contact = "bottom"              # Γ_C, the potential contact boundary
+//! load = "top"                    # Γ_N, where the pressure acts
+//! fixed_x = "left"                # u_x = 0 (optional)
+//! # fixed_y = []                  # u_y = 0 (optional)
+//!
+//! [parameters]
+//! contact_direction = [0.0, -1.0] # n_c: the foundation's normal away from the body
+//! # alpha = 1e-4                  # α; 1/(2 max C_I,E) by default; 0: the plain method
+//! # contact_centre = 0.0          # x of a symmetry line: the half-width is measured from it
+//!
+//! [data]
+//! load = 1.0                      # a scale of the pressure (--load); 1 by default
+//! pressure = "2.5"                # q(x, y) on Γ_N, force per length, pressing in
+//! gap = "0"                       # g(x, y) on Γ_C along n_c, length
+//!
+//! [exact]                         # optional: the contact pressure where known
+//! pressure = "2.5"                # λ(x, y) on Γ_C at data.load = 1
+//! # accuracy = 0.02               # (top level) the relative L² error it should reach
+//! ```
+//!
+//! Refused, naming the key: an unknown model, pair, generator or key; a part name the
+//! mesh does not have (`boundary.contact`, …, with the names it has); a part that holds
+//! no boundary edge (an interior Gmsh curve: "not on the boundary"); `material.young`
+//! ≤ 0; `material.poisson` outside (−1, ½); a zero `parameters.contact_direction`; a
+//! negative `parameters.alpha`; an expression that does not parse, uses a variable
+//! other than x, y, or does not evaluate to a finite number on its part (`data.gap` on
+//! Γ_C, `data.pressure` on Γ_N); a pressure whose resultant pulls the body off the
+//! foundation (`data.pressure`: nothing then holds the body).
+
+use crate::models::data::Data;
+use crate::models::signorini::{solve_signorini, Plane, SignoriniInput, SignoriniSolution};
+use crate::scene_file::expression;
+use crate::signorini::{ContactPair, ContactReport, PressureProfile};
+use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// The largest number of uniform refinements of a contact scene file's mesh.
+pub const MAX_REFINEMENTS: usize = 6;
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct ContactToml {
+    name: Option<String>,
+    description: Option<String>,
+    model: String,
+    pair: Option<String>,
+    mesh: MeshToml,
+    material: MaterialToml,
+    boundary: BoundaryToml,
+    #[serde(default)]
+    parameters: ParametersToml,
+    data: DataToml,
+    exact: Option<ExactToml>,
+    accuracy: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MeshToml {
+    generator: Option<String>,
+    x: Option<[f64; 2]>,
+    y: Option<[f64; 2]>,
+    cells: Option<[usize; 2]>,
+    file: Option<PathBuf>,
+    refinements: Option<usize>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MaterialToml {
+    young: f64,
+    poisson: f64,
+    plane: Option<String>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct BoundaryToml {
+    contact: toml::Value,
+    load: toml::Value,
+    fixed_x: Option<toml::Value>,
+    fixed_y: Option<toml::Value>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+struct ParametersToml {
+    contact_direction: Option<[f64; 2]>,
+    alpha: Option<f64>,
+    contact_centre: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct DataToml {
+    load: Option<f64>,
+    pressure: String,
+    gap: String,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct ExactToml {
+    pressure: String,
+}
+
+/// A contact problem read from a scene file: the mesh as read (before refinement), the
+/// markers of its parts, the material and the data (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct ContactSceneFile {
+    /// The scene's name (names output files).
+    pub name: String,
+    /// One line of description.
+    pub description: String,
+    /// The pair (default p1-p0).
+    pub pair: ContactPair,
+    /// The mesh the file gives, before `refinements`.
+    pub mesh: TriangleMesh,
+    /// Uniform refinements of `mesh` (`mesh.refinements`, `--mesh-size`).
+    pub refinements: usize,
+    /// Young's modulus E.
+    pub young: f64,
+    /// Poisson's ratio ν.
+    pub poisson: f64,
+    /// Plane strain or stress.
+    pub plane: Plane,
+    /// Boundary markers of Γ_C.
+    pub contact: Vec<u32>,
+    /// Boundary markers of Γ_N.
+    pub load_part: Vec<u32>,
+    /// Boundary markers where `u_x = 0`.
+    pub fixed_x: Vec<u32>,
+    /// Boundary markers where `u_y = 0`.
+    pub fixed_y: Vec<u32>,
+    /// The boundary part names as written, per key (for the report).
+    pub part_names: Vec<(String, Vec<String>)>,
+    /// The contact direction n_c (unit).
+    pub contact_direction: [f64; 2],
+    /// α where the file fixes it.
+    pub alpha: Option<f64>,
+    /// The x of the middle of the contact zone (a symmetry line), from which the
+    /// half-width is measured; `None`: the middle of the pressed edges.
+    pub contact_centre: Option<f64>,
+    /// The pressure's scale (`data.load`, `--load`).
+    pub load: f64,
+    /// The pressure shape q(x, y) on Γ_N (multiplied by `load`).
+    pub pressure: Data,
+    /// The gap g(x, y) on Γ_C.
+    pub gap: Data,
+    /// The exact contact pressure at `load = 1` (scaled with the load), where known.
+    pub exact_pressure: Option<Data>,
+    /// The accuracy the file asks of the pressure (relative L² error), where given.
+    pub accuracy: Option<f64>,
+}
+
+/// Whether the TOML text names the contact model (`model = "contact"`): the CLI's
+/// choice between this reader and [`crate::scene_file`]'s. Text that is not TOML is
+/// left to the membrane reader, whose error names the line.
+pub fn names_contact(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .ok()
+        .and_then(|t| {
+            t.get("model")
+                .and_then(|m| m.as_str())
+                .map(|m| m == "contact")
+        })
+        .unwrap_or(false)
+}
+
+/// Reads and checks a contact scene file (Gmsh meshes are read and their parts checked
+/// here too).
+///
+/// # Errors
+/// An unreadable file; those of [`parse`].
+pub fn read(path: &Path) -> Result<ContactSceneFile> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        Error::Input(format!(
+            "cannot read the scene file {}: {e}",
+            path.display()
+        ))
+    })?;
+    parse(&text, path)
+}
+
+/// Parses the text of a contact scene file; `path` names it in errors and anchors a
+/// relative mesh path.
+///
+/// # Errors
+/// [`Error::Input`] naming the file and the key, for everything the module
+/// documentation lists; TOML errors with their line and column.
+pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
+    let file: ContactToml = toml::from_str(text)
+        .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
+    let at = |key: &str, message: String| {
+        Error::Input(format!("{}: key `{key}`: {message}", path.display()))
+    };
+    if file.model != "contact" {
+        return Err(at(
+            "model",
+            format!("`{}`: this reader poses `contact` problems", file.model),
+        ));
+    }
+    let pair = match &file.pair {
+        Some(p) => ContactPair::parse(p).map_err(|e| at("pair", e.to_string()))?,
+        None => ContactPair::P1P0,
+    };
+    let mesh = mesh_of(&file.mesh, path, &at)?;
+    let refinements = file.mesh.refinements.unwrap_or(0);
+    if refinements > MAX_REFINEMENTS {
+        return Err(at(
+            "mesh.refinements",
+            format!("{refinements} uniform refinements: at most {MAX_REFINEMENTS}"),
+        ));
+    }
+    let m = &file.material;
+    if !(m.young.is_finite() && m.young > 0.0) {
+        return Err(at(
+            "material.young",
+            format!(
+                "Young's modulus E = {} must be positive and finite",
+                m.young
+            ),
+        ));
+    }
+    if !(m.poisson > -1.0 && m.poisson < 0.5) {
+        return Err(at(
+            "material.poisson",
+            format!("Poisson's ratio ν = {} must lie in (−1, ½)", m.poisson),
+        ));
+    }
+    let plane = match m.plane.as_deref() {
+        None | Some("strain") => Plane::Strain,
+        Some("stress") => Plane::Stress,
+        Some(other) => {
+            return Err(at(
+                "material.plane",
+                format!("`{other}`: write \"strain\" or \"stress\""),
+            ))
+        }
+    };
+    let mut part_names = Vec::new();
+    let mut part = |key: &str, value: Option<&toml::Value>, required: bool| {
+        let names = names_of(value, required).map_err(|m| at(key, m))?;
+        let markers = if names.is_empty() {
+            Vec::new()
+        } else {
+            markers_on_boundary(&mesh, &names).map_err(|m| at(key, m))?
+        };
+        part_names.push((key.to_string(), names));
+        Ok::<_, Error>(markers)
+    };
+    let b = &file.boundary;
+    let contact = part("boundary.contact", Some(&b.contact), true)?;
+    let load_part = part("boundary.load", Some(&b.load), true)?;
+    let fixed_x = part("boundary.fixed_x", b.fixed_x.as_ref(), false)?;
+    let fixed_y = part("boundary.fixed_y", b.fixed_y.as_ref(), false)?;
+    let [cx, cy] = file.parameters.contact_direction.unwrap_or([0.0, -1.0]);
+    let length = cx.hypot(cy);
+    if !(length.is_finite() && length > 0.0) {
+        return Err(at(
+            "parameters.contact_direction",
+            format!("({cx}, {cy}) must be a non-zero finite vector"),
+        ));
+    }
+    let contact_direction = [cx / length, cy / length];
+    if let Some(a) = file.parameters.alpha {
+        if !(a.is_finite() && a >= 0.0) {
+            return Err(at(
+                "parameters.alpha",
+                format!("α = {a} must be ≥ 0 (0: the plain method)"),
+            ));
+        }
+    }
+    if let Some(c) = file.parameters.contact_centre {
+        if !c.is_finite() {
+            return Err(at(
+                "parameters.contact_centre",
+                format!("{c} must be finite"),
+            ));
+        }
+    }
+    let load = file.data.load.unwrap_or(1.0);
+    check_load(load).map_err(|m| at("data.load", m))?;
+    let pressure = expression(&file.data.pressure, "data.pressure", path)?;
+    let gap = expression(&file.data.gap, "data.gap", path)?;
+    finite_on(&mesh, &contact, &gap).map_err(|m| at("data.gap", m))?;
+    finite_on(&mesh, &load_part, &pressure).map_err(|m| at("data.pressure", m))?;
+    presses(&mesh, &load_part, &pressure, contact_direction).map_err(|m| at("data.pressure", m))?;
+    let exact_pressure = file
+        .exact
+        .as_ref()
+        .map(|e| expression(&e.pressure, "exact.pressure", path))
+        .transpose()?;
+    if let Some(a) = file.accuracy {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(at("accuracy", format!("{a} must be positive")));
+        }
+    }
+    let name = file.name.clone().unwrap_or_else(|| {
+        path.file_stem()
+            .map_or("contact".into(), |s| s.to_string_lossy().into_owned())
+    });
+    let plain = |c: char| c.is_alphanumeric() || c == '-' || c == '_' || c == '.';
+    if name.is_empty() || name.starts_with(['.', '-']) || !name.chars().all(plain) {
+        return Err(at(
+            "name",
+            format!("`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first, nor `-`)"),
+        ));
+    }
+    Ok(ContactSceneFile {
+        name,
+        description: file
+            .description
+            .clone()
+            .unwrap_or_else(|| format!("contact scene file {}", path.display())),
+        pair,
+        mesh,
+        refinements,
+        young: m.young,
+        poisson: m.poisson,
+        plane,
+        contact,
+        load_part,
+        fixed_x,
+        fixed_y,
+        part_names,
+        contact_direction,
+        alpha: file.parameters.alpha,
+        contact_centre: file.parameters.contact_centre,
+        load,
+        pressure,
+        gap,
+        exact_pressure,
+        accuracy: file.accuracy,
+    })
+}
+
+/// The load scale's range (as the built-in scenes'): positive, finite, at most 1e100.
+fn check_load(load: f64) -> std::result::Result<(), String> {
+    if load.is_finite() && load > 0.0 && load <= 1e100 {
+        Ok(())
+    } else {
+        Err(format!(
+            "the pressure's scale {load} must be positive and finite (≤ 1e100); turn the pressure's direction in `data.pressure`"
+        ))
+    }
+}
+
+/// The mesh of `[mesh]`.
+fn mesh_of(
+    mesh: &MeshToml,
+    path: &Path,
+    at: &dyn Fn(&str, String) -> Error,
+) -> Result<TriangleMesh> {
+    match (&mesh.generator, &mesh.file) {
+        (Some(_), Some(_)) => Err(at(
+            "mesh",
+            "give either `generator` or `file`, not both".into(),
+        )),
+        (None, None) => Err(at(
+            "mesh",
+            "give a `generator` (rectangle) or a Gmsh `file`".into(),
+        )),
+        (None, Some(msh)) => {
+            if mesh.x.is_some() || mesh.y.is_some() || mesh.cells.is_some() {
+                return Err(at(
+                    "mesh",
+                    "a Gmsh `file` takes `refinements`, not `x`, `y` or `cells`".into(),
+                ));
+            }
+            let full = path.parent().unwrap_or(Path::new(".")).join(msh);
+            fem_runtime::mesh::gmsh::read_msh(&full).map_err(|e| at("mesh.file", e.to_string()))
+        }
+        (Some(generator), None) => {
+            if generator != "rectangle" {
+                return Err(at(
+                    "mesh.generator",
+                    format!(
+                        "unknown generator `{generator}`; contact scene files have `rectangle`"
+                    ),
+                ));
+            }
+            let [x0, x1] = mesh.x.unwrap_or([0.0, 1.0]);
+            let [y0, y1] = mesh.y.unwrap_or([0.0, 1.0]);
+            for (key, [a, b]) in [("mesh.x", [x0, x1]), ("mesh.y", [y0, y1])] {
+                if !(a.is_finite() && b.is_finite() && a < b && (b - a) <= 1e100) {
+                    return Err(at(key, format!("[{a}, {b}] must be finite and increasing")));
+                }
+            }
+            let [nx, ny] = mesh.cells.unwrap_or([8, 8]);
+            if !(1..=4096).contains(&nx) || !(1..=4096).contains(&ny) || nx * ny > 1 << 20 {
+                return Err(at(
+                    "mesh.cells",
+                    format!("[{nx}, {ny}]: each from 1 to 4096, at most 2^20 squares"),
+                ));
+            }
+            TriangleMesh::rectangle(x0, x1, y0, y1, nx, ny, Diagonal::Right)
+                .map_err(|e| at("mesh", e.to_string()))
+        }
+    }
+}
+
+/// A part's names: one name or a list of names; `required`: at least one.
+fn names_of(
+    value: Option<&toml::Value>,
+    required: bool,
+) -> std::result::Result<Vec<String>, String> {
+    use toml::Value;
+    let name = |v: &Value| {
+        match v {
+        Value::String(s) if s.trim().is_empty() => Err("an empty name".to_string()),
+        Value::String(s) => Ok(s.clone()),
+        Value::Integer(i) => Err(format!(
+            "{i} is a number: boundary parts are chosen by name (Gmsh physical names of curve groups, or the generator's sides)"
+        )),
+        other => Err(format!(
+            "{other} is not a name: write a name or a list of names such as [\"bottom\"]"
+        )),
+    }
+    };
+    let mut names = Vec::new();
+    match value {
+        None => {}
+        Some(Value::Array(list)) => {
+            for v in list {
+                let n = name(v)?;
+                if !names.contains(&n) {
+                    names.push(n);
+                }
+            }
+        }
+        Some(v) => names.push(name(v)?),
+    }
+    if required && names.is_empty() {
+        return Err("name at least one boundary part".into());
+    }
+    Ok(names)
+}
+
+/// The markers of the parts `names`, each of which must hold a boundary edge.
+fn markers_on_boundary(
+    mesh: &TriangleMesh,
+    names: &[String],
+) -> std::result::Result<Vec<u32>, String> {
+    let mut all = Vec::new();
+    for name in names {
+        let markers = mesh
+            .boundary_part_markers(std::slice::from_ref(name))
+            .map_err(|e| match e {
+                Error::Input(m) => m,
+                other => other.to_string(),
+            })?;
+        if mesh.boundary_edges_with_markers(&markers) == 0 {
+            return Err(format!(
+                "the part `{name}` is not on the boundary: no boundary edge of the mesh belongs to it (a curve inside the body cannot touch the foundation or carry a pressure)"
+            ));
+        }
+        all.extend(markers);
+    }
+    all.sort_unstable();
+    all.dedup();
+    Ok(all)
+}
+
+/// The boundary edges carrying one of `markers`: their ends, ordered so the body lies to
+/// the left (the outward normal is `(t_y, −t_x)/|t|`).
+fn oriented_edges(mesh: &TriangleMesh, markers: &[u32]) -> Vec<[[f64; 2]; 2]> {
+    let v = mesh.vertices();
+    mesh.boundary_edges()
+        .iter()
+        .filter(|(_, m)| markers.contains(m))
+        .map(|&(e, _)| {
+            let [a, b] = mesh.edges()[e];
+            let (cell, _) = mesh.edge_cells(e);
+            let c = mesh.cell(cell);
+            let third = c.iter().copied().find(|&k| k != a && k != b).unwrap_or(a);
+            let (pa, pb, pc) = (v[a], v[b], v[third]);
+            // the third vertex to the left of a → b: counter-clockwise
+            let cross = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]);
+            if cross > 0.0 {
+                [pa, pb]
+            } else {
+                [pb, pa]
+            }
+        })
+        .collect()
+}
+
+/// The Gauss–Legendre points of the integrals here (exact to degree 7).
+const GAUSS_POINTS: usize = 4;
+
+fn point(ends: &[[f64; 2]; 2], s: f64) -> [f64; 2] {
+    let [a, b] = ends;
+    [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])]
+}
+
+fn length(ends: &[[f64; 2]; 2]) -> f64 {
+    (ends[1][0] - ends[0][0]).hypot(ends[1][1] - ends[0][1])
+}
+
+/// `data` is finite at the ends and the Gauss points of every edge of the part.
+fn finite_on(mesh: &TriangleMesh, markers: &[u32], data: &Data) -> std::result::Result<(), String> {
+    let gauss = fem_runtime::gauss_legendre(GAUSS_POINTS);
+    for ends in oriented_edges(mesh, markers) {
+        for s in [0.0, 1.0].iter().chain(&gauss.points) {
+            let p = point(&ends, *s);
+            let value = data.at(&p);
+            if !value.is_finite() {
+                return Err(format!(
+                    "the expression is {value} at ({}, {}) on its boundary part: it must evaluate to a finite number there",
+                    p[0], p[1]
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The resultant `∫_Γ_N q (−n) ds` pushes along `n_c`, towards the foundation: else
+/// nothing holds the body (the foundation only pushes).
+fn presses(
+    mesh: &TriangleMesh,
+    markers: &[u32],
+    pressure: &Data,
+    direction: [f64; 2],
+) -> std::result::Result<(), String> {
+    let force = resultant(mesh, markers, pressure);
+    let along = force[0] * direction[0] + force[1] * direction[1];
+    if along > 0.0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "the pressure's resultant ({:e}, {:e}) does not push the body towards the foundation (its component along the contact direction is {along:e} ≤ 0): it pulls the body off, and nothing holds it then (a pressure is positive pressing in)",
+            force[0], force[1]
+        ))
+    }
+}
+
+/// `∫_part q (−n) ds` (Gauss–Legendre, exact for q of degree 7).
+fn resultant(mesh: &TriangleMesh, markers: &[u32], pressure: &Data) -> [f64; 2] {
+    let gauss = fem_runtime::gauss_legendre(GAUSS_POINTS);
+    let mut force = [0.0; 2];
+    for ends in oriented_edges(mesh, markers) {
+        let l = length(&ends);
+        let n = [
+            (ends[1][1] - ends[0][1]) / l,
+            -(ends[1][0] - ends[0][0]) / l,
+        ];
+        let q: f64 = gauss
+            .points
+            .iter()
+            .zip(&gauss.weights)
+            .map(|(&s, &w)| w * pressure.at(&point(&ends, s)))
+            .sum::<f64>()
+            * l;
+        force[0] -= q * n[0];
+        force[1] -= q * n[1];
+    }
+    force
+}
+
+/// What the command line may change in a contact scene file.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// `--pair`.
+    pub pair: Option<ContactPair>,
+    /// `--mesh-size`: uniform refinements of the file's mesh.
+    pub refinements: Option<usize>,
+    /// `--load`: the pressure's scale.
+    pub load: Option<f64>,
+    /// `--alpha`.
+    pub alpha: Option<f64>,
+}
+
+/// A solved contact scene file: the report, the pressure per edge, and the solution.
+#[derive(Clone, Debug)]
+pub struct ContactFileSolution {
+    /// The `--json` report (the fields of the built-in scenes'; `pressure_l2_error` and
+    /// `best_p0_l2_error` against `exact.pressure` where given; `mesh_size` is the
+    /// number of refinements).
+    pub report: ContactReport,
+    /// `(x0, x1, λ_E)` per contact edge, sorted by x0.
+    pub profile: PressureProfile,
+    /// The solution on the refined mesh.
+    pub solution: SignoriniSolution,
+}
+
+/// Solves a contact scene file with the command line's overrides.
+///
+/// # Errors
+/// [`Error::Input`] naming the option for an out-of-range `--mesh-size`, `--load` or
+/// `--alpha`, or the key `data.pressure` for a load that does not press the body onto
+/// Γ_C; the solver's errors.
+pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFileSolution> {
+    let pair = overrides.pair.unwrap_or(file.pair);
+    if pair.multiplier() != crate::models::signorini::Multiplier::P0 {
+        return Err(Error::Input(format!(
+            "pair `{}`: contact scene files take the P0-multiplier pairs p1-p0, p2-p0 (their pressure errors are per edge)",
+            pair.name()
+        )));
+    }
+    let refinements = overrides.refinements.unwrap_or(file.refinements);
+    if refinements > MAX_REFINEMENTS {
+        return Err(Error::Input(format!(
+            "--mesh-size {refinements}: the refinements of a contact scene file's mesh are at most {MAX_REFINEMENTS}"
+        )));
+    }
+    let load = overrides.load.unwrap_or(file.load);
+    check_load(load).map_err(|m| Error::Input(format!("--load: {m}")))?;
+    let alpha = overrides.alpha.or(file.alpha);
+    let mut mesh = file.mesh.clone();
+    for _ in 0..refinements {
+        mesh = mesh.refine_uniformly();
+    }
+    let shape = file.pressure.clone();
+    let pressure = move |x: &[f64]| load * shape.at(x);
+    let input = SignoriniInput {
+        young: file.young,
+        poisson: file.poisson,
+        plane: file.plane,
+        element: pair.displacement(),
+        contact: &file.contact,
+        load: &file.load_part,
+        pressure: &pressure,
+        gap: file.gap.as_data_fn(),
+        contact_direction: file.contact_direction,
+        fixed_x: &file.fixed_x,
+        fixed_y: &file.fixed_y,
+        alpha,
+        contact_centre: file.contact_centre,
+    };
+    let solution = solve_signorini(&mesh, &input).map_err(|e| match e {
+        Error::Input(m) if m.contains("rigid motion is not prevented") => {
+            Error::Input(format!("{}: key `data.pressure`: {m}", file.name))
+        }
+        other => other,
+    })?;
+    let n = file.contact_direction;
+    let total = -(solution.total_contact_force[0] * n[0] + solution.total_contact_force[1] * n[1]);
+    let applied = solution.applied_load[0] * n[0] + solution.applied_load[1] * n[1];
+    let mut profile: PressureProfile = solution
+        .contact_edges
+        .iter()
+        .zip(&solution.pressure)
+        .map(|(e, &p)| {
+            let (a, b) = (e.ends[0][0], e.ends[1][0]);
+            (a.min(b), a.max(b), p)
+        })
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let errors = file
+        .exact_pressure
+        .as_ref()
+        .map(|exact| pressure_errors(&solution, exact, load));
+    let report = ContactReport {
+        scene: file.name.clone(),
+        pair: pair.name(),
+        mesh_size: refinements,
+        load,
+        alpha: solution.alpha,
+        inverse_constant: solution
+            .inverse_constants
+            .iter()
+            .fold(0.0f64, |m, &c| m.max(c)),
+        dofs: solution.dofs,
+        contact_edges: solution.contact_edges.len(),
+        multiplier_dofs: solution.pressure.len(),
+        iterations: solution.iterations,
+        seconds: solution.seconds,
+        total_contact_force: total,
+        applied_load: applied,
+        equilibrium_residual: (total - applied).abs() / applied.abs(),
+        contact_half_width: solution.contact_half_width,
+        max_contact_pressure: solution.max_contact_pressure,
+        exact_half_width: None,
+        exact_max_pressure: None,
+        pressure_l2_error: errors.map(|e| e[0]),
+        best_p0_l2_error: errors.map(|e| e[1]),
+        best_fit_l2_error: errors.map(|e| e[1]),
+        oscillation: None,
+        patch_pressure_error: None,
+        complementarity_residual: solution.complementarity_residual,
+        kkt_residual: solution.kkt_residual,
+        accuracy: file.accuracy,
+    };
+    Ok(ContactFileSolution {
+        report,
+        profile,
+        solution,
+    })
+}
+
+/// `‖λ_h − p‖/‖p‖` on Γ_C and the same of p's best P0 fit (the edge means), p the exact
+/// pressure times the load (8-point Gauss–Legendre per edge); an exact pressure of zero
+/// norm gives the absolute errors.
+fn pressure_errors(solution: &SignoriniSolution, exact: &Data, load: f64) -> [f64; 2] {
+    let gauss = fem_runtime::gauss_legendre(8);
+    let (mut error, mut best, mut norm) = (0.0, 0.0, 0.0);
+    for (e, &lambda) in solution.contact_edges.iter().zip(&solution.pressure) {
+        let ends = e.ends;
+        let l = e.length();
+        let values: Vec<f64> = gauss
+            .points
+            .iter()
+            .map(|&s| load * exact.at(&point(&ends, s)))
+            .collect();
+        let mean: f64 = values.iter().zip(&gauss.weights).map(|(p, w)| w * p).sum();
+        for (&p, &w) in values.iter().zip(&gauss.weights) {
+            error += w * l * (lambda - p) * (lambda - p);
+            best += w * l * (mean - p) * (mean - p);
+            norm += w * l * p * p;
+        }
+    }
+    let scale = if norm > 0.0 { norm } else { 1.0 };
+    [(error / scale).sqrt(), (best / scale).sqrt()]
+}
