@@ -543,8 +543,13 @@ fn list() {
     println!(
         "contact pairs (u, λ on Γ_C; --mesh-size N of the block, b/h of Hertz's graded mesh; default p1-p0, α = ½/max C_I,E; --alpha 0: the plain method):"
     );
-    for p in contact::ContactPair::ALL {
-        println!("  {}", p.name());
+    for p in contact::ContactPair::EVERY {
+        let note = if contact::ContactPair::ALL.contains(&p) {
+            ""
+        } else {
+            " (λ continuous P1; signorini-patch and hertz)"
+        };
+        println!("  {}{note}", p.name());
     }
 }
 
