@@ -437,9 +437,11 @@ fn obstacle_solve(n: usize, rounds: usize) {
     }
     let (library, reproduced, linear) = (median(library), median(reproduced), median(linear));
     let levels = report
-        .level_iterations
+        .levels
         .iter()
-        .map(|l| format!("{}:{}", l.mesh_size, l.iterations))
+        .map(|[triangles, iterations]| {
+            format!("{}:{iterations}", ((triangles / 2) as f64).sqrt().round())
+        })
         .collect::<Vec<_>>()
         .join(", ");
     let lcp = &warm.discretization.lcp;
