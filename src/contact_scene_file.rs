@@ -711,6 +711,11 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         complementarity_residual: solution.complementarity_residual,
         kkt_residual: solution.kkt_residual,
         accuracy: file.accuracy,
+        warnings: Vec::new(),
+    };
+    let report = ContactReport {
+        warnings: crate::signorini::warnings(&report),
+        ..report
     };
     Ok(ContactFileSolution {
         report,

@@ -344,13 +344,48 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
             .fold(0.0f64, |m, (g, w)| m.max(-g / w));
         let scale = 2.0 * depth + 1e-3 * mesh.max_h();
         let start: Vec<f64> = translation.iter().map(|t| scale * t).collect();
-        semismooth_newton(&problem.lcp, Some(&start), NewtonOptions::default())?
+        check_alpha(alpha, &constants)?;
+        semismooth_newton(&problem.lcp, Some(&start), NewtonOptions::default())
+            .map_err(|e| alpha_error(alpha, &constants, e))?
     } else {
         quadratic_program(&problem.lcp)?
     };
     Ok(report(
         mesh, input, direction, &problem, solution, alpha, constants,
     ))
+}
+
+/// The smallest `α max_E C_I,E` semismooth Newton is given: below it `C = α h_E (μ, λ)`
+/// is lost against the rounding of `B U − G` and the Hessian turns singular (a tester's
+/// α = 1e-12 on Hertz, α·C_I = 3e-9, ran 200 iterations; 1e-8 still solved).
+pub const MIN_ALPHA_TIMES_C_I: f64 = 1e-6;
+
+/// Refuses an α too small for Newton, naming `α·max C_I,E` and the alternatives.
+fn check_alpha(alpha: f64, constants: &[f64]) -> Result<()> {
+    let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
+    if alpha > 0.0 && alpha * c < MIN_ALPHA_TIMES_C_I {
+        return Err(Error::Input(format!(
+            "α = {alpha:e} gives α·max C_I,E = {:.1e}, below {MIN_ALPHA_TIMES_C_I:e}: the stabilization is lost in rounding and Newton's matrix turns singular; use α = 0 (the plain method, solved as a QP) or α·max C_I,E from 0.1 to 1 (the automatic α is ½/max C_I,E = {:.3e})",
+            alpha * c,
+            0.5 / c
+        )));
+    }
+    Ok(())
+}
+
+/// Newton's failure, explained where α is beyond the working range `α max C_I,E ≲ 1`
+/// (MODELS.md §7: `A_α` turns indefinite near 2; measured 1.35 on the block patch).
+fn alpha_error(alpha: f64, constants: &[f64], error: Error) -> Error {
+    let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
+    if alpha * c > 1.0 {
+        Error::Input(format!(
+            "α = {alpha:e} gives α·max C_I,E = {:.3}, beyond the working range (about ≤ 1; the automatic α is ½/max C_I,E = {:.3e}): B_h = a − α S_h is no longer positive on the displacements ({error})",
+            alpha * c,
+            0.5 / c
+        ))
+    } else {
+        error
+    }
 }
 
 /// The free-DOF vector of a unit translation along the contact direction: towards the
@@ -1088,8 +1123,12 @@ fn solve_level<M: Model>(
         let start: Vec<f64> = translation.iter().map(|t| scale * t).collect();
         semismooth_newton(&problem.lcp, Some(&start), NewtonOptions::default())
     };
+    check_alpha(alpha, &constants)?;
     let (solution, start) = match coarser {
-        None => (pressed()?, LevelStart::Pressed),
+        None => (
+            pressed().map_err(|e| alpha_error(alpha, &constants, e))?,
+            LevelStart::Pressed,
+        ),
         Some((previous, parents)) => {
             let from_coarse = prolongated(previous, &mesh, &problem, parents)
                 .and_then(|u| semismooth_newton(&problem.lcp, Some(&u), NewtonOptions::default()));
