@@ -133,7 +133,7 @@ impl ContactRequest {
                 self.mesh_size
             )));
         }
-        if !(self.load > 0.0) {
+        if self.load.is_nan() || self.load <= 0.0 {
             return Err(Error::Input(format!(
                 "--load {} must be positive: the body only rests on the foundation, a pull lifts it off and nothing holds it then",
                 crate::number(self.load)
@@ -156,8 +156,8 @@ impl ContactRequest {
                     crate::number(self.load),
                     ratio,
                     self.scene.name,
-                    format!("{:.3e}", at(HERTZ_HALF_WIDTH_RANGE.0)),
-                    format!("{:.3e}", at(HERTZ_HALF_WIDTH_RANGE.1)),
+                    format_args!("{:.3e}", at(HERTZ_HALF_WIDTH_RANGE.0)),
+                    format_args!("{:.3e}", at(HERTZ_HALF_WIDTH_RANGE.1)),
                     HERTZ_HALF_WIDTH_RANGE.0,
                     HERTZ_HALF_WIDTH_RANGE.1
                 )));
@@ -243,7 +243,7 @@ pub const EQUILIBRIUM_WARNING: f64 = 1e-8;
 /// The warnings of a contact report: what its own checks say about it.
 pub fn warnings(r: &ContactReport) -> Vec<String> {
     let mut out = Vec::new();
-    if !(r.equilibrium_residual <= EQUILIBRIUM_WARNING) {
+    if r.equilibrium_residual.is_nan() || r.equilibrium_residual > EQUILIBRIUM_WARNING {
         out.push(format!(
             "the contact force misses the applied load by {:.1e} (relative; a rigid translation lies in V_h, so it should be rounding): the solve did not reach solver precision",
             r.equilibrium_residual

@@ -276,8 +276,52 @@ pub fn solve_signorini_with(
     }
 }
 
+/// What every Signorini solve of `M` derives from its input: the unit contact
+/// direction, the model's boundary parts by marker, the fixed displacement components,
+/// and the coefficients for a given α.
+struct Setup<'a> {
+    direction: [f64; 2],
+    parts: [(&'static str, &'a [u32]); 2],
+    fixed: [(usize, &'a [u32]); 2],
+    coefficients: Box<dyn Fn(f64) -> Result<Coefficients<'a>> + 'a>,
+}
+
+impl<'a> Setup<'a> {
+    /// # Errors
+    /// [`Error::Input`] for E, ν out of range ([`lame`]) or a zero contact direction.
+    fn new<M: Model>(input: &'a SignoriniInput<'a>) -> Result<Self> {
+        let (mu, lambda) = lame(input.young, input.poisson, input.plane)?;
+        let [cx, cy] = input.contact_direction;
+        let length = cx.hypot(cy);
+        if !(length.is_finite() && length > 0.0) {
+            return Err(Error::Input(format!(
+                "the contact direction ({cx}, {cy}) must be a non-zero finite vector"
+            )));
+        }
+        let direction = [cx / length, cy / length];
+        let (ux, uy) = (M::field("u_x")?, M::field("u_y")?);
+        let (pressure, gap) = (input.pressure, input.gap);
+        Ok(Self {
+            direction,
+            parts: [("Γ_C", input.contact), ("Γ_N", input.load)],
+            fixed: [(ux, input.fixed_x), (uy, input.fixed_y)],
+            coefficients: Box::new(move |alpha: f64| {
+                Coefficients::new::<M>(
+                    &[
+                        ("μ_L", mu),
+                        ("λ_L", lambda),
+                        ("α", alpha),
+                        ("n_c_x", direction[0]),
+                        ("n_c_y", direction[1]),
+                    ],
+                    &[("q", pressure), ("g", gap)],
+                )
+            }),
+        })
+    }
+}
+
 fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<SignoriniSolution> {
-    let (mu, lambda) = lame(input.young, input.poisson, input.plane)?;
     if let Some(a) = input.alpha {
         if !(a.is_finite() && a >= 0.0) {
             return Err(Error::Input(format!(
@@ -285,29 +329,12 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
             )));
         }
     }
-    let [cx, cy] = input.contact_direction;
-    let length = cx.hypot(cy);
-    if !(length.is_finite() && length > 0.0) {
-        return Err(Error::Input(format!(
-            "the contact direction ({cx}, {cy}) must be a non-zero finite vector"
-        )));
-    }
-    let direction = [cx / length, cy / length];
-    let (ux, uy) = (M::field("u_x")?, M::field("u_y")?);
-    let parts: [(&str, &[u32]); 2] = [("Γ_C", input.contact), ("Γ_N", input.load)];
-    let fixed: [(usize, &[u32]); 2] = [(ux, input.fixed_x), (uy, input.fixed_y)];
-    let coefficients = |alpha: f64| {
-        Coefficients::new::<M>(
-            &[
-                ("μ_L", mu),
-                ("λ_L", lambda),
-                ("α", alpha),
-                ("n_c_x", direction[0]),
-                ("n_c_y", direction[1]),
-            ],
-            &[("q", input.pressure), ("g", input.gap)],
-        )
-    };
+    let Setup {
+        direction,
+        parts,
+        fixed,
+        coefficients,
+    } = Setup::new::<M>(input)?;
     let problem = discretize_boundary_multiplier::<M>(mesh, &coefficients(0.0)?, &parts, &fixed)?;
     let constants = inverse_constants::<M>(mesh, &problem, &coefficients(0.0)?, "a", "S")?;
     let alpha = match input.alpha {
@@ -1041,7 +1068,6 @@ fn solve_level<M: Model>(
     coarser: Option<(&Solved, &[usize])>,
 ) -> Result<(Solved, NestedLevelReport)> {
     let clock = Instant::now();
-    let (mu, lambda) = lame(input.young, input.poisson, input.plane)?;
     if let Some(a) = input.alpha {
         if !(a.is_finite() && a > 0.0) {
             return Err(Error::Input(format!(
@@ -1049,29 +1075,12 @@ fn solve_level<M: Model>(
             )));
         }
     }
-    let [cx, cy] = input.contact_direction;
-    let length = cx.hypot(cy);
-    if !(length.is_finite() && length > 0.0) {
-        return Err(Error::Input(format!(
-            "the contact direction ({cx}, {cy}) must be a non-zero finite vector"
-        )));
-    }
-    let direction = [cx / length, cy / length];
-    let (ux, uy) = (M::field("u_x")?, M::field("u_y")?);
-    let parts: [(&str, &[u32]); 2] = [("Γ_C", input.contact), ("Γ_N", input.load)];
-    let fixed: [(usize, &[u32]); 2] = [(ux, input.fixed_x), (uy, input.fixed_y)];
-    let coefficients = |alpha: f64| {
-        Coefficients::new::<M>(
-            &[
-                ("μ_L", mu),
-                ("λ_L", lambda),
-                ("α", alpha),
-                ("n_c_x", direction[0]),
-                ("n_c_y", direction[1]),
-            ],
-            &[("q", input.pressure), ("g", input.gap)],
-        )
-    };
+    let Setup {
+        direction,
+        parts,
+        fixed,
+        coefficients,
+    } = Setup::new::<M>(input)?;
     // The constants do not depend on α (only on the mesh, the DOFs and the kernels of
     // `a` and `S`), so the problem is assembled with the previous level's α first. It is
     // kept where it lies in [0.9, 1] × this level's automatic value (α max C_I ∈
