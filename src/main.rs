@@ -151,8 +151,8 @@ struct SolveOptions {
     /// then compares the centre deflection with the closed form where there is one.
     #[arg(long)]
     no_obstacle: bool,
-    /// Also write the plot of w, θ, λ, ψ (beams), or of the contact pressure against the
-    /// reference (hertz, signorini-gap, contact scene files with an exact pressure).
+    /// Also write the plot of w, θ, λ, ψ (beams), or of the contact pressure against
+    /// Hertz's (hertz, signorini-gap).
     #[arg(long)]
     plot: bool,
 }

@@ -608,7 +608,7 @@ pub fn alpha_study(scene: ContactScene, b_over_h: usize, out: &Path) -> Result<(
     }
     if let (Some(low), Some(high)) = (worked.first(), worked.last()) {
         println!(
-            "solved for α·C_I from {low} to {high} of these; the automatic α·C_I = ½ keeps A_α positive definite with a margin of 2 to where it turns indefinite (MODELS.md §7), at the price of some accuracy where a larger α is still stable"
+            "solved for α·C_I from {low} to {high} of these; the automatic α·C_I = ½ stays a factor 2–4 below where A_α turns indefinite (MODELS.md §7; 1.0–1.3 on the block patch, 1.5–1.9 here), at the price of some accuracy where a larger α is still stable"
         );
     }
     profiles.extend(largest);

@@ -243,7 +243,8 @@ fn bad_contact_input_exits_with_a_message() {
             &["--alpha", "4e-4"][..],
             "beyond the working range",
         ),
-        ("signorini-patch", &["--alpha", "1e-300"][..], "below 1e-6"),
+        ("signorini-patch", &["--alpha", "1e-300"][..], "below 1e-3"),
+        ("hertz", &["--alpha", "1e-9"][..], "below 1e-3"),
         (
             "hertz",
             &["--thickness", "0.1"][..],

@@ -177,6 +177,25 @@ fn bad_input_is_an_error_not_a_panic() {
     let mut input = block_input(Displacement::P1, None);
     input.alpha = Some(-1.0);
     assert!(message(&input).contains("α"), "{}", message(&input));
+    // the top and the right side pressed, nothing holding the block along x: it slides
+    // (frictionless contact cannot hold it; a tester's file "solved" with a 1 % error)
+    let mut input = block_input(Displacement::P1, None);
+    input.load = &[2, 3];
+    input.fixed_x = &[];
+    assert!(
+        message(&input).contains("pushes it that way"),
+        "{}",
+        message(&input)
+    );
+    // balanced sideways (left and right pressed alike) the translation is still free
+    let mut input = block_input(Displacement::P1, None);
+    input.load = &[2, 3, 4];
+    input.fixed_x = &[];
+    assert!(
+        message(&input).contains("no support fixes"),
+        "{}",
+        message(&input)
+    );
 }
 
 fn parabolic_gap(x: &[f64]) -> f64 {

@@ -349,17 +349,7 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
     } else {
         discretize_boundary_multiplier::<M>(mesh, &coefficients(alpha)?, &parts, &fixed)?
     };
-    let translation = towards_foundation(&problem, direction);
-    let work: f64 = translation
-        .iter()
-        .zip(&problem.lcp.f)
-        .map(|(t, f)| t * f)
-        .sum();
-    if work.is_nan() || work <= 0.0 {
-        return Err(Error::Input(format!(
-            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0): the rigid motion is not prevented"
-        )));
-    }
+    let translation = rigid_motions_held(&problem, direction)?;
     let solution = if alpha > 0.0 {
         // Start pressed into the foundation (every constraint active), beyond the gaps.
         // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
@@ -384,15 +374,18 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
 
 /// The smallest `α max_E C_I,E` semismooth Newton is given: below it `C = α h_E (μ, λ)`
 /// is lost against the rounding of `B U − G` and the Hessian turns singular (a tester's
-/// α = 1e-12 on Hertz, α·C_I = 3e-9, ran 200 iterations; 1e-8 still solved).
-pub const MIN_ALPHA_TIMES_C_I: f64 = 1e-6;
+/// α = 1e-12 on Hertz, α·C_I = 3e-9, ran 200 iterations).
+/// A tester then found Newton failing up to about 3e-4 (200 iterations) and needing 150
+/// at 1e-3, where the error is 3.5× the best fit's: below 1e-3 the plain method (α = 0)
+/// is the one to use.
+pub const MIN_ALPHA_TIMES_C_I: f64 = 1e-3;
 
 /// Refuses an α too small for Newton, naming `α·max C_I,E` and the alternatives.
 fn check_alpha(alpha: f64, constants: &[f64]) -> Result<()> {
     let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
     if alpha > 0.0 && alpha * c < MIN_ALPHA_TIMES_C_I {
         return Err(Error::Input(format!(
-            "α = {alpha:e} gives α·max C_I,E = {:.1e}, below {MIN_ALPHA_TIMES_C_I:e}: the stabilization is lost in rounding and Newton's matrix turns singular; use α = 0 (the plain method, solved as a QP) or α·max C_I,E from 0.1 to 1 (the automatic α is ½/max C_I,E = {:.3e})",
+            "α = {alpha:e} gives α·max C_I,E = {:.1e}, below {MIN_ALPHA_TIMES_C_I:e}: the stabilization is too weak for semismooth Newton (it stalls or needs hundreds of iterations, and the pressure oscillates like the plain method's); use α = 0 (the plain method, solved as a QP) or α·max C_I,E from 0.1 to 1 (the automatic α is ½/max C_I,E = {:.3e})",
             alpha * c,
             0.5 / c
         )));
@@ -406,13 +399,53 @@ fn alpha_error(alpha: f64, constants: &[f64], error: Error) -> Error {
     let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
     if alpha * c > 1.0 {
         Error::Input(format!(
-            "α = {alpha:e} gives α·max C_I,E = {:.3}, beyond the working range (about ≤ 1; the automatic α is ½/max C_I,E = {:.3e}): B_h = a − α S_h is no longer positive on the displacements ({error})",
+            "α = {alpha:e} gives α·max C_I,E = {:.3}, beyond the working range (measured: up to 1.0–1.3 on the block patch, 1.5–1.9 on Hertz; the automatic α is ½/max C_I,E = {:.3e}): B_h = a − α S_h is no longer positive on the displacements ({error})",
             alpha * c,
             0.5 / c
         ))
     } else {
         error
     }
+}
+
+/// Checks that the load holds the body on the foundation, and returns the free-DOF
+/// vector of the unit translation towards it.
+///
+/// Frictionless contact resists only along `n_c`: the load must press the body on
+/// (positive work on the translation towards the foundation), and a support must fix
+/// the translation along the tangent (else `A` vanishes on it: singular, and a load
+/// with a tangential part has no equilibrium at all — a tester's block pushed sideways
+/// "solved" with a 1 % equilibrium error).
+///
+/// # Errors
+/// [`Error::Input`] naming the unbalanced component.
+fn rigid_motions_held(problem: &BoundaryMultiplierProblem, n: [f64; 2]) -> Result<Vec<f64>> {
+    let f = &problem.lcp.f;
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let translation = towards_foundation(problem, n);
+    let work = dot(&translation, f);
+    if work.is_nan() || work <= 0.0 {
+        return Err(Error::Input(format!(
+            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0): the rigid motion is not prevented"
+        )));
+    }
+    let tangent = towards_foundation(problem, [-n[1], n[0]]);
+    let stiffness = fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, &tangent);
+    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let free = norm(&stiffness) <= 1e-10 * norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
+    let sliding = dot(&tangent, f);
+    if free && norm(&tangent) > 0.0 {
+        let load = if sliding.abs() > 1e-10 * work.abs() {
+            format!(" and the load pushes it that way (work {sliding:e} against {work:e} towards the foundation)")
+        } else {
+            String::new()
+        };
+        return Err(Error::Input(format!(
+            "no support fixes the body along the foundation, the direction ({:.3}, {:.3}){load}: frictionless contact leaves that translation free and the system singular; fix that displacement component on a symmetry line or a roller",
+            -n[1], n[0]
+        )));
+    }
+    Ok(translation)
 }
 
 /// The free-DOF vector of a unit translation along the contact direction: towards the
@@ -1110,17 +1143,7 @@ fn solve_level<M: Model>(
         problem =
             discretize_boundary_multiplier::<M>(&mesh, &coefficients(alpha)?, &parts, &fixed)?;
     }
-    let translation = towards_foundation(&problem, direction);
-    let work: f64 = translation
-        .iter()
-        .zip(&problem.lcp.f)
-        .map(|(t, f)| t * f)
-        .sum();
-    if work.is_nan() || work <= 0.0 {
-        return Err(Error::Input(format!(
-            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0): the rigid motion is not prevented"
-        )));
-    }
+    let translation = rigid_motions_held(&problem, direction)?;
     let pressed = || {
         let depth = problem
             .lcp
