@@ -187,6 +187,14 @@ fn bad_input_is_an_error_not_a_panic() {
         "{}",
         message(&input)
     );
+    // a support along n_c on the contact part itself
+    let mut input = block_input(Displacement::P1, None);
+    input.fixed_y = &[1];
+    assert!(
+        message(&input).contains("also has u_y = 0"),
+        "{}",
+        message(&input)
+    );
     // balanced sideways (left and right pressed alike) the translation is still free
     let mut input = block_input(Displacement::P1, None);
     input.load = &[2, 3, 4];

@@ -299,6 +299,16 @@ impl<'a> Setup<'a> {
             )));
         }
         let direction = [cx / length, cy / length];
+        // a support along n_c on Γ_C itself fights the contact constraint for u·n_c (a
+        // tester's fixed_y on the contact side gave a force of 0.001 for a load of 5)
+        for (axis, fixed, name) in [(0, input.fixed_x, "x"), (1, input.fixed_y, "y")] {
+            if direction[axis] != 0.0 && fixed.iter().any(|m| input.contact.contains(m)) {
+                return Err(Error::Input(format!(
+                    "the contact boundary (markers {:?}) also has u_{name} = 0 (markers {fixed:?}), a component of the contact direction ({:.3}, {:.3}): the support and the contact constraint both fix u·n_c there; drop the support on the contact part",
+                    input.contact, direction[0], direction[1]
+                )));
+            }
+        }
         let (ux, uy) = (M::field("u_x")?, M::field("u_y")?);
         let (pressure, gap) = (input.pressure, input.gap);
         Ok(Self {
