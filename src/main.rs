@@ -920,10 +920,6 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
     }
     if request.pair == MembranePair::P1Nodal {
         options.refuse(
-            &["--linear-solver"],
-            "p1-nodal solves its nodal constraints by its own active-set method with Cholesky steps (multigrid steps are for the stabilized pairs)",
-        )?;
-        options.refuse(
             &["--alpha", "--solver"],
             "p1-nodal has no multiplier to stabilize and solves its nodal constraints by its own active-set method",
         )?;
@@ -1109,6 +1105,7 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 fn main() -> ExitCode {
     fem_forms::lcp::cholesky::factor_sequentially();
     fem_forms::allocator::retain_freed_memory();
+    fem_forms::allocator::small_pages();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

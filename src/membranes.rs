@@ -9,15 +9,19 @@ use crate::models::membrane_scenes::{
 };
 use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
 use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
+use fem_runtime::lcp::cholesky::multiply;
+use fem_runtime::lcp::LcpSolution;
+use fem_runtime::multigrid::{parents_by_location, prolongation, NestedLevel};
 use fem_runtime::obstacle::hierarchy::LinearSolver;
+use fem_runtime::obstacle::nodal::{nodal_active_set_with, NODAL_AUTO_MULTIGRID_UNKNOWNS};
 use fem_runtime::obstacle::triangle::{
-    dirichlet_constraints_on, nodal_active_set, solve_obstacle_on_part, TriangleObstacleSolution,
+    dirichlet_constraints_on, solve_obstacle_on_part, TriangleObstacleSolution,
 };
-use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
+use fem_runtime::obstacle::{alongside, ObstacleOptions, VariationalSolver};
 use fem_runtime::stabilization::{self, Alpha};
 use fem_runtime::{
-    Coefficients, Diagonal, DirichletPart, DofMap, Error, Model, PointLocator, Result, SystemDofs,
-    TriangleMesh,
+    Coefficients, Constraints, Diagonal, DirichletPart, DofMap, Error, Model, PointLocator,
+    Reduction, Result, SparseMatrix, SystemDofs, TriangleMesh,
 };
 use serde::Serialize;
 use std::time::Instant;
@@ -1042,6 +1046,34 @@ fn stabilized_fields(
     )
 }
 
+/// From this many triangles on, the nodal method builds its finest level on the second
+/// core while the coarser levels solve (below it a thread's start costs more than it
+/// saves).
+const PIPELINED_CELLS: usize = 32_768;
+
+/// One level of the nodal method before its solve: DOFs, elimination of the boundary
+/// DOFs, stiffness `a`, load `f` and obstacle `ψ` on the free nodes, and the
+/// prolongations from the next coarser level (all DOFs; free DOFs) if there is one.
+struct NodalLevel {
+    dofs: SystemDofs,
+    reduction: Reduction,
+    a: SparseMatrix,
+    f: Vec<f64>,
+    psi: Vec<f64>,
+    prolongations: Option<(SparseMatrix, SparseMatrix)>,
+}
+
+/// The nodal method's nested iteration so far: (DOFs, iterations) per level, the
+/// prolongations of the free DOFs finest first, the last level's full coefficients and
+/// its DOFs, elimination, solution and order.
+#[derive(Default)]
+struct NodalState {
+    levels: Vec<[usize; 2]>,
+    prolongations: Vec<SparseMatrix>,
+    values: Option<Vec<f64>>,
+    finest: Option<(SystemDofs, Reduction, LcpSolution, usize)>,
+}
+
 /// The classical method: P1 with `u_i ≥ ψ(x_i)` at the free nodes.
 fn run_nodal(
     request: &MembraneRequest,
@@ -1059,48 +1091,131 @@ fn run_nodal(
             ("g", data.boundary.as_data_fn()),
         ],
     )?;
-    let mut levels = Vec::new();
-    let mut previous: Option<(TriangleMesh, SystemDofs, Vec<f64>)> = None;
-    let mut last = None;
-    for mesh in meshes {
-        let dofs = SystemDofs::all::<M>(mesh)?;
-        let constraints = dirichlet_constraints_on::<M>(mesh, &dofs, &coefficients, &posed.part)?;
+    // Everything a level needs before its solve; the finest level's is built on the
+    // second core while the coarser levels solve (`alongside`).
+    let setup = |i: usize| -> Result<NodalLevel> {
+        let mesh = &meshes[i];
+        let free_dofs = |mesh: &TriangleMesh| -> Result<(SystemDofs, Reduction, Constraints)> {
+            let dofs = SystemDofs::all::<M>(mesh)?;
+            let constraints =
+                dirichlet_constraints_on::<M>(mesh, &dofs, &coefficients, &posed.part)?;
+            let reduction = constraints.reduction(dofs.dof_count())?;
+            Ok((dofs, reduction, constraints))
+        };
+        let (dofs, reduction, _) = free_dofs(mesh)?;
         let k = MatrixAssembler::new::<M>("a", mesh, &dofs)?.assemble::<M>(mesh, &coefficients)?;
         let l = assemble_vector::<M>("ℓ", mesh, &dofs, &coefficients)?;
-        let reduction = constraints.reduction(dofs.dof_count())?;
         let f = reduction.rhs(&k, &l);
         let a = reduction.matrix(&k);
+        drop(k);
         let nodes = dofs.map(0).unwrap().nodes(mesh);
         let psi: Vec<f64> = reduction
             .free()
             .iter()
             .map(|&d| data.obstacle.at(&nodes[d]))
             .collect();
-        let start = previous.as_ref().map(|(pm, pd, values)| {
-            let locator = PointLocator::new(pm);
-            let view = TriangleField {
-                mesh: pm,
-                map: pd.map(0).unwrap(),
-                coefficients: values,
-            };
-            let basis = TriangleBasis::new(fem_runtime::ElementKind::P1);
-            reduction
-                .free()
-                .iter()
-                .map(|&d| view.at(&basis, &locator, nodes[d]).unwrap_or(0.0))
-                .collect::<Vec<f64>>()
-        });
-        let solution = nodal_active_set(&a, &f, &psi, start.as_deref(), 500)?;
-        levels.push([mesh.cell_count(), solution.iterations]);
-        let values = reduction.expand(&solution.u);
-        previous = Some((mesh.clone(), dofs.clone(), values.clone()));
-        last = Some((mesh.clone(), dofs, values, solution, reduction, a.nrows()));
+        let prolongations = match i.checked_sub(1).map(|c| &meshes[c]) {
+            Some(coarse) => {
+                let (coarse_dofs, coarse_reduction, _) = free_dofs(coarse)?;
+                let parents = parents_by_location(coarse, mesh)?;
+                let level = |mesh, dofs, reduction| NestedLevel {
+                    mesh,
+                    dofs,
+                    reduction,
+                };
+                Some((
+                    prolongation(
+                        &level(coarse, &coarse_dofs, None),
+                        &level(mesh, &dofs, None),
+                        &parents,
+                    )?,
+                    prolongation(
+                        &level(coarse, &coarse_dofs, Some(&coarse_reduction)),
+                        &level(mesh, &dofs, Some(&reduction)),
+                        &parents,
+                    )?,
+                ))
+            }
+            None => None,
+        };
+        Ok(NodalLevel {
+            dofs,
+            reduction,
+            a,
+            f,
+            psi,
+            prolongations,
+        })
+    };
+    let mut state = NodalState::default();
+    let step = |state: &mut NodalState, level: NodalLevel| -> Result<()> {
+        let NodalLevel {
+            dofs,
+            reduction,
+            a,
+            f,
+            psi,
+            prolongations,
+        } = level;
+        // the coarse solution interpolated at the fine nodes, boundary values included
+        let start = match (prolongations, &state.values) {
+            (Some((all, free)), Some(values)) => {
+                let fine = multiply(&all, values);
+                state.prolongations.insert(0, free);
+                Some(
+                    reduction
+                        .free()
+                        .iter()
+                        .map(|&d| fine[d])
+                        .collect::<Vec<f64>>(),
+                )
+            }
+            _ => None,
+        };
+        let multigrid = match request.linear_solver {
+            LinearSolver::Direct => false,
+            LinearSolver::Multigrid => !state.prolongations.is_empty(),
+            LinearSolver::Auto => {
+                a.nrows() >= NODAL_AUTO_MULTIGRID_UNKNOWNS && state.prolongations.len() >= 2
+            }
+        };
+        let hierarchy: &[SparseMatrix] = if multigrid { &state.prolongations } else { &[] };
+        let solution = nodal_active_set_with(&a, &f, &psi, start.as_deref(), 500, hierarchy)?;
+        state.levels.push([dofs.dof_count(), solution.iterations]);
+        state.values = Some(reduction.expand(&solution.u));
+        state.finest = Some((dofs, reduction, solution, a.nrows()));
+        Ok(())
+    };
+    let count = meshes.len();
+    if count >= 3 && meshes[count - 1].cell_count() >= PIPELINED_CELLS {
+        let mut finest = None;
+        alongside(
+            || finest = Some(setup(count - 1)),
+            || -> Result<()> {
+                for i in 0..count - 1 {
+                    step(&mut state, setup(i)?)?;
+                }
+                Ok(())
+            },
+        )?;
+        step(&mut state, finest.expect("the worker has run")?)?;
+    } else {
+        for i in 0..count {
+            step(&mut state, setup(i)?)?;
+        }
     }
-    let (mesh, dofs, values, solution, reduction, n) = last.expect("at least one mesh");
+    let mut levels = state.levels;
+    for (level, mesh) in levels.iter_mut().zip(meshes) {
+        level[0] = mesh.cell_count();
+    }
+    let mesh = meshes.last().expect("at least one mesh");
+    let values = state.values.expect("at least one mesh");
+    let (dofs, reduction, solution, n) = state.finest.expect("at least one mesh");
+    let (krylov_iterations, factorizations) = (solution.krylov_iterations, solution.factorizations);
     let seconds = clock.elapsed().as_secs_f64();
     let map = dofs.map(0).unwrap();
     let u = TriangleField {
-        mesh: &mesh,
+        mesh,
         map,
         coefficients: &values,
     };
@@ -1173,9 +1288,13 @@ fn run_nodal(
         scene: scene.name.to_string(),
         pair: request.pair.name().into(),
         solver: "nodal active set".into(),
-        linear_solver: "direct",
-        krylov_iterations: 0,
-        factorizations: solution.iterations,
+        linear_solver: if krylov_iterations > 0 {
+            "multigrid"
+        } else {
+            "direct"
+        },
+        krylov_iterations,
+        factorizations,
         domain: posed.domain.clone(),
         dirichlet_parts: scene.dirichlet.names(),
         load: posed.load,

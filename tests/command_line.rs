@@ -247,17 +247,6 @@ fn options_that_do_not_apply_are_refused_by_name() {
             "--linear-solver",
         ),
         (
-            &[
-                "solve",
-                "membrane-flat",
-                "--pair",
-                "p1-nodal",
-                "--linear-solver",
-                "multigrid",
-            ][..],
-            "--linear-solver",
-        ),
-        (
             &["solve", "membrane-flat", "--linear-solver", "gmres"][..],
             "--linear-solver",
         ),

@@ -4,6 +4,7 @@
 //! `[[A_α, −B_αᵀ], [−B_α, −C_α]]`, its right-hand side `[F_α; −G_α]`).
 
 pub mod hierarchy;
+pub mod nodal;
 pub mod triangle;
 
 use crate::assembly::boundary::{Constraints, Reduction, Side};
@@ -1002,7 +1003,7 @@ where
 /// kernel faults in and zeroes page by page — at 524k triangles that cost more than the
 /// finest level's assembly. Called from that thread itself (a level built by a nested
 /// solve), a scoped thread runs `worker` instead, as when the kept one cannot start.
-fn alongside<R>(worker: impl FnOnce() + Send, main: impl FnOnce() -> R) -> R {
+pub fn alongside<R>(worker: impl FnOnce() + Send, main: impl FnOnce() -> R) -> R {
     static KEPT: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
     let kept = KEPT.get_or_init(|| {
         rayon::ThreadPoolBuilder::new()

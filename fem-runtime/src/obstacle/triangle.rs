@@ -8,17 +8,14 @@ use crate::assembly::boundary::{Constraints, DirichletPart, PlateSupport};
 use crate::assembly::dof_map::{DofMap, SystemDofs};
 use crate::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use crate::error::{Error, Result};
-use crate::lcp::cholesky::{multiply, Cholesky};
-use crate::lcp::{Lcp, LcpSolution};
+use crate::lcp::Lcp;
 use crate::mesh::triangle::{CurvedTriangleMesh, PointLocator, QuadraticGeometry, TriangleMesh};
 use crate::model::{Coefficients, IntoFormIndex, Model};
+pub use crate::obstacle::nodal::{nodal_active_set, nodal_active_set_with, nodal_lcp};
 use crate::obstacle::{
     solve_nested, solve_nested_on_hierarchy, system_forms, Discretization, ObstacleOptions,
     ObstacleSolution,
 };
-use crate::SparseMatrix;
-use faer::sparse::SparseColMat;
-use std::time::Instant;
 
 /// The fixed DOFs of the model's `boundary:` conditions on the whole boundary: each
 /// field's boundary DOFs get its data function's value at their nodes.
@@ -685,121 +682,6 @@ pub fn contact_indicator(lcp: &Lcp, u: &[f64], lambda: &[f64]) -> Vec<bool> {
             lambda[k] > 1e-8 * scale || (bu + c_lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
         })
         .collect()
-}
-
-/// The classical nodal-constraint method: `A U = F` with `U_i ≥ ψ_i` at every free node,
-/// solved by the primal–dual active-set method of Hintermüller, Ito and Kunisch. The
-/// active DOFs are eliminated by replacing their rows and columns with the diagonal, so
-/// the sparsity pattern is fixed and one symbolic Cholesky serves every iteration.
-pub fn nodal_active_set(
-    a: &SparseMatrix,
-    f: &[f64],
-    psi: &[f64],
-    start: Option<&[f64]>,
-    max_iterations: usize,
-) -> Result<LcpSolution> {
-    let clock = Instant::now();
-    let n = f.len();
-    if psi.len() != n || a.nrows() != n || a.ncols() != n {
-        return Err(Error::Input(format!(
-            "nodal obstacle: {} obstacle values and a {} × {} matrix for {n} unknowns",
-            psi.len(),
-            a.nrows(),
-            a.ncols()
-        )));
-    }
-    if let Some(s) = start.filter(|s| s.len() != n) {
-        return Err(Error::Input(format!(
-            "nodal obstacle: a start of {} values for {n} unknowns",
-            s.len()
-        )));
-    }
-    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let diagonal: Vec<f64> = (0..n)
-        .map(|j| {
-            (col_ptr[j]..col_ptr[j + 1])
-                .find(|&k| rows[k] == j)
-                .map_or(0.0, |k| vals[k])
-        })
-        .collect();
-    let pattern = a
-        .symbolic()
-        .to_owned()
-        .map_err(|e| Error::LinearSolve(format!("{e:?}")))?;
-    let cholesky = Cholesky::analyse(&pattern)?;
-    let mut u: Vec<f64> = match start {
-        Some(s) => s.iter().zip(psi).map(|(&x, &p)| x.max(p)).collect(),
-        None => psi.to_vec(),
-    };
-    let mut lambda: Vec<f64> = multiply(a, &u)
-        .iter()
-        .zip(f)
-        .map(|(au, fi)| au - fi)
-        .collect();
-    let mut active: Vec<bool> = (0..n)
-        .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
-        .collect();
-    for iteration in 1..=max_iterations {
-        let mut values = vals.to_vec();
-        let mut rhs = f.to_vec();
-        for j in 0..n {
-            for k in col_ptr[j]..col_ptr[j + 1] {
-                let i = rows[k];
-                if active[j] && !active[i] {
-                    rhs[i] -= vals[k] * psi[j];
-                }
-                if active[i] || active[j] {
-                    values[k] = if i == j { diagonal[j] } else { 0.0 };
-                }
-            }
-        }
-        for i in 0..n {
-            if active[i] {
-                rhs[i] = diagonal[i] * psi[i];
-            }
-        }
-        let matrix = SparseColMat::new(pattern.clone(), values);
-        u = cholesky.factor(&matrix)?.solve_refined(&matrix, &rhs, 1)?;
-        let au = multiply(a, &u);
-        for i in 0..n {
-            lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
-        }
-        let next: Vec<bool> = (0..n)
-            .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
-            .collect();
-        if next == active {
-            let lcp = nodal_lcp(a, f, psi);
-            let kkt_residual = lcp.kkt_residual(&u, &lambda);
-            return Ok(LcpSolution {
-                u,
-                lambda,
-                iterations: iteration,
-                kkt_residual,
-                seconds: clock.elapsed().as_secs_f64(),
-                factorizations: iteration,
-                low_rank_updates: 0,
-                multiplier_noise: 0.0,
-                iterative_steps: 0,
-                krylov_iterations: 0,
-            });
-        }
-        active = next;
-    }
-    Err(Error::NotConverged {
-        solver: "nodal primal-dual active set",
-        detail: format!("no fixed active set after {max_iterations} iterations"),
-    })
-}
-
-/// The LCP of the nodal method (`B = I`, `C = 0`, `G = ψ`), for its KKT residual.
-pub fn nodal_lcp(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
-    Lcp::new(
-        a.clone(),
-        (0..f.len()).map(|i| vec![(i, 1.0)]).collect::<Vec<_>>(),
-        vec![0.0; f.len()],
-        f.to_vec(),
-        psi.to_vec(),
-    )
 }
 
 /// The fixed DOFs of the model's `boundary:` conditions, each field on its own part of the

@@ -1,0 +1,172 @@
+//! The nodal method (p1-nodal) with its active-set steps solved by truncated multigrid
+//! (issue 15; docs/multigrid.md, "The nodal method"): the same KKT-certified solution as
+//! the Cholesky steps, CG iterations per step bounded independently of h, and the
+//! truncated hierarchy's prolongations equal to the truncated composed ones.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use faer::sparse::{SparseColMat, Triplet};
+use fem_forms::membranes::{self, MembranePair, MembraneRequest};
+use fem_forms::models::membrane_scenes::membrane_scene;
+use fem_forms::obstacle::hierarchy::LinearSolver;
+use fem_forms::obstacle::nodal::{nodal_active_set, nodal_active_set_with, truncated_hierarchy};
+use fem_forms::SparseMatrix;
+
+fn solve(n: usize, linear_solver: LinearSolver) -> (membranes::MembraneReport, Vec<f64>) {
+    let mut request = MembraneRequest::new(membrane_scene("membrane-radial").unwrap());
+    request.pair = MembranePair::P1Nodal;
+    request.mesh_size = n;
+    request.linear_solver = linear_solver;
+    let (report, fields) = membranes::solve(&request).expect("the radial membrane solves");
+    (report, fields.u)
+}
+
+/// Both linear solvers give the solution of the same nodal LCP: the vertex values
+/// agree to the CG tolerance and both are KKT-certified; the multigrid run factors
+/// nothing and its CG iterations per active-set step stay bounded as h halves.
+#[test]
+fn multigrid_steps_give_the_direct_solution_with_iterations_bounded_in_h() {
+    let mut per_step = Vec::new();
+    for n in [16, 32, 64, 128] {
+        let (direct, u_direct) = solve(n, LinearSolver::Direct);
+        let (multigrid, u_multigrid) = solve(n, LinearSolver::Multigrid);
+        assert_eq!(direct.linear_solver, "direct");
+        assert_eq!(multigrid.linear_solver, "multigrid", "N = {n}");
+        assert_eq!(multigrid.factorizations, 0, "N = {n}: a step was factored");
+        let scale = u_direct.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let difference = u_direct
+            .iter()
+            .zip(&u_multigrid)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(
+            difference <= 1e-8 * scale,
+            "N = {n}: the multigrid solution differs by {difference:e}"
+        );
+        for report in [&direct, &multigrid] {
+            assert!(
+                report.complementarity_residual <= 1e-8,
+                "N = {n}: KKT residual {:e}",
+                report.complementarity_residual
+            );
+        }
+        assert_eq!(direct.iterations, multigrid.iterations, "N = {n}");
+        per_step.push(multigrid.krylov_iterations as f64 / multigrid.iterations as f64);
+    }
+    assert!(
+        per_step.iter().all(|&k| k <= 8.0),
+        "CG iterations per step {per_step:?}"
+    );
+}
+
+/// The hierarchy truncated on a set of fine DOFs: its composed prolongation is the
+/// full composed prolongation with the dropped rows zeroed, on the kept coarse columns,
+/// and every removed coarse column of the full one is zero after truncation.
+#[test]
+fn the_truncated_hierarchy_composes_to_the_truncated_prolongation() {
+    // 1D nested linear interpolation, 17 → 9 → 5 → 3 nodes (Dirichlet ends removed)
+    let interpolation = |coarse: usize| -> SparseMatrix {
+        let fine = 2 * coarse + 1;
+        let mut t = Vec::new();
+        for j in 0..coarse {
+            t.push(Triplet::new(2 * j + 1, j, 1.0));
+            t.push(Triplet::new(2 * j, j, 0.5));
+            t.push(Triplet::new(2 * j + 2, j, 0.5));
+        }
+        SparseColMat::try_new_from_triplets(fine, coarse, &t).unwrap()
+    };
+    let chain = vec![interpolation(7), interpolation(3), interpolation(1)];
+    // a contact set: fine nodes 0..=6 and 12
+    let dropped: Vec<bool> = (0..15).map(|i| i <= 6 || i == 12).collect();
+    let truncated = truncated_hierarchy(&chain, &dropped);
+    let dense = |p: &SparseMatrix| -> Vec<Vec<f64>> {
+        let mut m = vec![vec![0.0; p.ncols()]; p.nrows()];
+        let (ptr, rows, vals) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+        for j in 0..p.ncols() {
+            for k in ptr[j]..ptr[j + 1] {
+                m[rows[k]][j] = vals[k];
+            }
+        }
+        m
+    };
+    let compose = |a: &Vec<Vec<f64>>, b: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
+        a.iter()
+            .map(|row| {
+                (0..b[0].len())
+                    .map(|j| row.iter().zip(b).map(|(x, r)| x * r[j]).sum())
+                    .collect()
+            })
+            .collect()
+    };
+    let mut full = dense(&chain[0]);
+    for (i, row) in full.iter_mut().enumerate() {
+        if dropped[i] {
+            row.iter_mut().for_each(|v| *v = 0.0);
+        }
+    }
+    let mut reduced = dense(&truncated[0]);
+    assert_eq!(reduced.len(), 15, "the finest level keeps its numbering");
+    for l in 0..chain.len() {
+        if l > 0 {
+            full = compose(&full, &dense(&chain[l]));
+            reduced = compose(&reduced, &dense(&truncated[l]));
+        }
+        // the kept columns of `full`, in order, are `reduced`'s columns
+        let kept: Vec<usize> = (0..full[0].len())
+            .filter(|&j| full.iter().any(|row| row[j] != 0.0))
+            .collect();
+        assert_eq!(kept.len(), reduced[0].len(), "level {}", l + 1);
+        for (i, row) in full.iter().enumerate() {
+            for (jr, &j) in kept.iter().enumerate() {
+                assert!((row[j] - reduced[i][jr]).abs() < 1e-15, "level {}", l + 1);
+            }
+        }
+        if l + 1 < chain.len() {
+            assert!(truncated.len() > l + 1);
+        }
+    }
+    // every fine DOF dropped: no coarse level remains
+    assert!(truncated_hierarchy(&chain, &[true; 15]).is_empty());
+}
+
+/// On a small obstacle problem the multigrid path and the Cholesky path agree, also
+/// from a start far from the solution, and a malformed hierarchy is refused by name.
+#[test]
+fn the_nodal_multigrid_solve_checks_its_hierarchy() {
+    // 1D Laplacian on 15 interior nodes, load −10, obstacle −0.1 + 0.2 x
+    let n = 15;
+    let h = 1.0 / 16.0;
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push(Triplet::new(i, i, 2.0 / h));
+        if i + 1 < n {
+            t.push(Triplet::new(i, i + 1, -1.0 / h));
+            t.push(Triplet::new(i + 1, i, -1.0 / h));
+        }
+    }
+    let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
+    let f = vec![-10.0 * h; n];
+    let psi: Vec<f64> = (0..n).map(|i| -0.1 + 0.2 * (i + 1) as f64 * h).collect();
+    let interpolation = |coarse: usize| -> SparseMatrix {
+        let fine = 2 * coarse + 1;
+        let mut t = Vec::new();
+        for j in 0..coarse {
+            t.push(Triplet::new(2 * j + 1, j, 1.0));
+            t.push(Triplet::new(2 * j, j, 0.5));
+            t.push(Triplet::new(2 * j + 2, j, 0.5));
+        }
+        SparseColMat::try_new_from_triplets(fine, coarse, &t).unwrap()
+    };
+    let chain = vec![interpolation(7), interpolation(3)];
+    let direct = nodal_active_set(&a, &f, &psi, None, 50).unwrap();
+    let multigrid = nodal_active_set_with(&a, &f, &psi, None, 50, &chain).unwrap();
+    assert!(multigrid.krylov_iterations > 0);
+    for (x, y) in direct.u.iter().zip(&multigrid.u) {
+        assert!((x - y).abs() <= 1e-9, "{x} against {y}");
+    }
+    assert!(
+        direct.u.iter().zip(&psi).any(|(u, p)| u == p),
+        "contact occurs"
+    );
+    let wrong = vec![interpolation(3)];
+    let e = nodal_active_set_with(&a, &f, &psi, None, 50, &wrong).unwrap_err();
+    assert!(e.to_string().contains("prolongation 0 has 7 rows"), "{e}");
+}
