@@ -15,8 +15,12 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use std::time::Instant;
 
 /// From this many free nodes on, the CLI's `--linear-solver auto` solves the nodal
-/// method's steps by multigrid (with at least two coarser nested levels).
-pub const NODAL_AUTO_MULTIGRID_UNKNOWNS: usize = 100_000;
+/// method's steps by multigrid (with at least two coarser nested levels). Measured on
+/// membrane-radial (2026-11-30, best of 3 or 5, machine shared): multigrid / Cholesky
+/// steps 0.89 at 225 free nodes, 0.42 at 961, 0.38 at 3969, 0.68 at 16k, 0.67 at 65k,
+/// 0.52 at 261k, 0.44 at 1M. Unlike the stabilized pairs' direct path, which updates one
+/// factorization by low-rank terms, the nodal one factors anew at every step.
+pub const NODAL_AUTO_MULTIGRID_UNKNOWNS: usize = 200;
 
 /// The nodal method's active-set iteration with a Cholesky factorization per step.
 ///
@@ -115,38 +119,52 @@ pub fn nodal_active_set_with(
         .collect();
     let (mut factorizations, mut krylov_iterations, mut iterative_steps) = (0, 0, 0);
     for iteration in 1..=max_iterations {
-        let mut values = vals.to_vec();
-        let mut rhs = f.to_vec();
-        for j in 0..n {
-            for k in col_ptr[j]..col_ptr[j + 1] {
-                let i = rows[k];
-                if active[j] && !active[i] {
-                    rhs[i] -= vals[k] * psi[j];
-                }
-                if active[i] || active[j] {
-                    values[k] = if i == j { diagonal[j] } else { 0.0 };
+        let reduced = || -> Result<(SparseMatrix, Vec<f64>)> {
+            let mut values = vals.to_vec();
+            let mut rhs = f.to_vec();
+            for j in 0..n {
+                for k in col_ptr[j]..col_ptr[j + 1] {
+                    let i = rows[k];
+                    if active[j] && !active[i] {
+                        rhs[i] -= vals[k] * psi[j];
+                    }
+                    if active[i] || active[j] {
+                        values[k] = if i == j { diagonal[j] } else { 0.0 };
+                    }
                 }
             }
-        }
+            for i in 0..n {
+                if active[i] {
+                    rhs[i] = diagonal[i] * psi[i];
+                }
+            }
+            let matrix = SparseColMat::new(a.symbolic().to_owned().map_err(linear)?, values);
+            Ok((matrix, rhs))
+        };
         for i in 0..n {
             if active[i] {
-                rhs[i] = diagonal[i] * psi[i];
                 u[i] = psi[i];
             }
         }
-        let matrix = SparseColMat::new(a.symbolic().to_owned().map_err(linear)?, values);
+        let (matrix, rhs) = reduced()?;
+        // the multigrid path takes the matrix over (its finest level), so that the
+        // largest matrix is not held twice; a failed one is built again to be factored
         let solved = if prolongations.is_empty() {
-            None
+            Err(Some(matrix))
         } else {
-            multigrid_solve(&matrix, &rhs, &u, prolongations, &active)
+            multigrid_solve(matrix, &rhs, &u, prolongations, &active)
         };
         u = match solved {
-            Some((x, iterations)) => {
+            Ok((x, iterations)) => {
                 krylov_iterations += iterations;
                 iterative_steps += 1;
                 x
             }
-            None => {
+            Err(matrix) => {
+                let matrix = match matrix {
+                    Some(m) => m,
+                    None => reduced()?.0,
+                };
                 if cholesky.is_none() {
                     cholesky = Some(Cholesky::analyse(
                         &matrix.symbolic().to_owned().map_err(linear)?,
@@ -207,30 +225,35 @@ pub fn nodal_lcp(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
 /// truncated on `active`, built anew: one truncated on an earlier iteration's active
 /// set still preconditions (it is SPD), but measured at 1M unknowns it took 8 CG
 /// iterations instead of 2 after 92 nodes changed, more than the 0.25 s of a new
-/// hierarchy (three iterations' time). `None` when the hierarchy cannot be built or CG
-/// does not reach [`MULTIGRID_TOLERANCE`] (relative to `‖rhs‖`), so that the caller
-/// factors instead.
+/// hierarchy (three iterations' time). The hierarchy takes `matrix` over as its finest
+/// level (no second copy). `Err(None)` when the hierarchy cannot be built or CG does
+/// not reach [`MULTIGRID_TOLERANCE`] (relative to `‖rhs‖`), so that the caller builds
+/// the matrix again and factors it.
 fn multigrid_solve(
-    matrix: &SparseMatrix,
+    matrix: SparseMatrix,
     rhs: &[f64],
     x0: &[f64],
     prolongations: &[SparseMatrix],
     active: &[bool],
-) -> Option<(Vec<f64>, usize)> {
-    let mut residual = multiply(matrix, x0);
+) -> std::result::Result<(Vec<f64>, usize), Option<SparseMatrix>> {
+    let mut residual = multiply(&matrix, x0);
     for (r, b) in residual.iter_mut().zip(rhs) {
         *r = b - *r;
     }
     let (norm_b, norm_r) = (norm(rhs), norm(&residual));
     if norm_r <= MULTIGRID_TOLERANCE * norm_b {
-        return Some((x0.to_vec(), 0));
+        return Ok((x0.to_vec(), 0));
     }
     let tolerance = MULTIGRID_TOLERANCE * norm_b / norm_r;
     let hierarchy = truncated_hierarchy(prolongations, active);
-    let mg = Multigrid::new(matrix.clone(), hierarchy, MultigridOptions::default()).ok()?;
-    let (d, iterations) = pcg(matrix, &mg, &residual, tolerance, MULTIGRID_MAX_ITERATIONS).ok()?;
+    let mg = Multigrid::new(matrix, hierarchy, MultigridOptions::default()).map_err(|_| None)?;
+    let fine = mg
+        .operator(0)
+        .expect("a multigrid hierarchy has a finest level");
+    let (d, iterations) =
+        pcg(fine, &mg, &residual, tolerance, MULTIGRID_MAX_ITERATIONS).map_err(|_| None)?;
     let x = x0.iter().zip(&d).map(|(x, d)| x + d).collect();
-    Some((x, iterations))
+    Ok((x, iterations))
 }
 
 /// Conjugate gradients on `a x = b` from `x = 0`, preconditioned by one cycle of

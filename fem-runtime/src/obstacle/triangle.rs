@@ -596,18 +596,25 @@ pub fn max_penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: us
     let basis = TriangleBasis::new(u.map.element());
     let rule = fem_reference::triangle::TriangleRule::exact_for_degree(degree);
     let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-    let mut largest = 0.0f64;
-    for c in 0..u.mesh.cell_count() {
-        let map = crate::element::triangle::AffineMap::of(u.mesh, c);
-        for &xi in corners.iter().chain(&rule.points) {
-            let depth = psi(&map.point(xi)) - u.value(&basis, c, xi);
-            if depth.is_nan() {
-                return f64::NAN;
+    let depths = crate::element::triangle::over_cell_chunks(u.mesh.cell_count(), |cells| {
+        let mut largest = 0.0f64;
+        for c in cells {
+            let map = crate::element::triangle::AffineMap::of(u.mesh, c);
+            for &xi in corners.iter().chain(&rule.points) {
+                let depth = psi(&map.point(xi)) - u.value(&basis, c, xi);
+                if depth.is_nan() {
+                    return f64::NAN;
+                }
+                largest = largest.max(depth);
             }
-            largest = largest.max(depth);
         }
+        largest
+    });
+    // `f64::max` would skip a NaN
+    if depths.iter().any(|d| d.is_nan()) {
+        return f64::NAN;
     }
-    largest
+    depths.into_iter().fold(0.0, f64::max)
 }
 
 /// The largest open gap under a pushing multiplier: over the cells where the multiplier
