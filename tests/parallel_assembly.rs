@@ -3,13 +3,15 @@
 //! (the plain serial cell loop) to 1e-13 relative in every entry, for the P1 stiffness
 //! (the generated one-block loop), P2 (idem, 36 entries per cell), the P2–P0 membrane
 //! system `B_h` (four blocks: the cell-major loop) and the clamped Mindlin plate `B_h`
-//! (many blocks). A dropped, doubled or racing chunk changes whole entries by O(1)
+//! (many blocks); and the same for their load vectors (`assemble_vector`). A dropped, doubled or racing chunk changes whole entries by O(1)
 //! relative, far above the rounding of a reordered sum.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
 use fem_forms::models::mindlin::mindlin_clamped;
-use fem_forms::{Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh};
+use fem_forms::{
+    assemble_vector, Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh,
+};
 
 fn load(x: &[f64]) -> f64 {
     1.0 + x[0] - 2.0 * x[1] * x[1]
@@ -40,6 +42,40 @@ fn assembled<M: Model>(
     pool.install(|| assembler.assemble_values::<M>(mesh, coefficients, &mut values))
         .unwrap();
     values
+}
+
+/// Linear form `form` of `M` assembled on a pool of `threads` threads.
+fn assembled_vector<M: Model>(
+    form: &str,
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    threads: usize,
+) -> Vec<f64> {
+    let dofs = SystemDofs::all::<M>(mesh).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| assemble_vector::<M>(form, mesh, &dofs, coefficients))
+        .unwrap()
+}
+
+/// The same as [`parallel_difference`] for the vector of a linear form.
+fn parallel_vector_difference<M: Model>(form: &str, mesh: &TriangleMesh, c: &Coefficients) -> f64 {
+    let serial = assembled_vector::<M>(form, mesh, c, 1);
+    let scale = serial.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 0.0);
+    [2, 3]
+        .into_iter()
+        .map(|threads| {
+            let parallel = assembled_vector::<M>(form, mesh, c, threads);
+            serial
+                .iter()
+                .zip(&parallel)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+                / scale
+        })
+        .fold(0.0, f64::max)
 }
 
 /// Largest entry difference between the 1-thread and the 2- and 3-thread assemblies,
@@ -93,6 +129,10 @@ fn parallel_p1_and_p2_stiffness_equal_the_serial_assembly() {
         assert!(d1 <= 1e-13, "P1 stiffness: {d1:e}");
         let d2 = parallel_difference::<P2>("B_h", &mesh, &p2);
         assert!(d2 <= 1e-13, "P2–P0 B_h: {d2:e}");
+        let v1 = parallel_vector_difference::<P1>("ℓ", &mesh, &p1);
+        assert!(v1 <= 1e-13, "P1 ℓ: {v1:e}");
+        let v2 = parallel_vector_difference::<P2>("L_h", &mesh, &p2);
+        assert!(v2 <= 1e-13, "P2–P0 L_h: {v2:e}");
     }
 }
 
@@ -114,4 +154,6 @@ fn parallel_mindlin_system_equals_the_serial_assembly() {
     let mesh = TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 48, 48, Diagonal::Right).unwrap();
     let d = parallel_difference::<M>("B_h", &mesh, &c);
     assert!(d <= 1e-13, "Mindlin B_h: {d:e}");
+    let v = parallel_vector_difference::<M>("L_h", &mesh, &c);
+    assert!(v <= 1e-13, "Mindlin L_h: {v:e}");
 }

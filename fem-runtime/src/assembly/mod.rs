@@ -586,16 +586,81 @@ impl MatrixAssembler {
 }
 
 /// Assembles linear form `form_name` of `M` on the system `dofs`.
+///
+/// Meshes of at least [`PARALLEL_MIN_CELLS`] cells are assembled in parallel on the
+/// current rayon pool (the cells coloured per call, `CellColouring`: `O(cells)`, small
+/// against the kernels); the result equals the one-thread one up to rounding. An error
+/// is the one of the serial loop (on an error the vector is assembled again serially, so
+/// the cell named is the first one at fault).
 pub fn assemble_vector<M: Model>(
     form_name: impl IntoFormIndex<M>,
     mesh: &impl Mesh,
     dofs: &SystemDofs,
     coefficients: &Coefficients,
 ) -> Result<Vec<f64>> {
+    use rayon::prelude::*;
     let form = M::form(form_name)?;
     let plans = block_plans::<M>(form, dofs, false)?;
     let mut out = vec![0.0; dofs.dof_count()];
-    let mut local = vec![0.0; plans.iter().map(|p| p.rows).max().unwrap_or(0)];
+    let cells = mesh.cell_count();
+    let colouring = if rayon::current_num_threads() > 1 {
+        CellColouring::new(mesh)
+    } else {
+        None
+    };
+    if let Some(colouring) = colouring {
+        let shared = SharedValues {
+            start: out.as_mut_ptr(),
+            len: out.len(),
+        };
+        let mut failed = false;
+        for colour in 0..colouring.colour_count() {
+            let ranges: Vec<_> = colouring.ranges(colour).collect();
+            // SAFETY: as in `add_form_matrices_coloured`: the chunks of one colour share
+            // no vertex, hence no DOF, hence no entry of `out`; colours run in sequence.
+            let result = ranges.into_par_iter().try_for_each(|range| {
+                add_vectors::<M, _>(form, &plans, mesh, dofs, coefficients, range, unsafe {
+                    shared.values()
+                })
+            });
+            if result.is_err() {
+                failed = true;
+                break;
+            }
+        }
+        if !failed {
+            return Ok(out);
+        }
+        out.fill(0.0);
+    }
+    add_vectors::<M, _>(form, &plans, mesh, dofs, coefficients, 0..cells, &mut out)?;
+    Ok(out)
+}
+
+/// Adds the element vectors of `plans` (blocks of linear `form`) on the cells `cells`
+/// of `mesh` into `out` (the system numbering of `dofs`).
+///
+/// # Errors
+/// A non-finite element vector (the first cell in `cells` with one), those of
+/// [`Model::element_vector_curved`].
+fn add_vectors<M: Model, G: Mesh>(
+    form: usize,
+    plans: &[BlockPlan],
+    mesh: &G,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+    cells: std::ops::Range<usize>,
+    out: &mut [f64],
+) -> Result<()> {
+    let mut local = [0.0; 64];
+    let mut local_vec;
+    let largest = plans.iter().map(|p| p.rows).max().unwrap_or(0);
+    let local: &mut [f64] = if largest <= local.len() {
+        &mut local[..]
+    } else {
+        local_vec = vec![0.0; largest];
+        &mut local_vec[..]
+    };
     let mut x = [0.0; 6];
     let x = &mut x[..mesh.cell_kind().vertex_count() * mesh.cell_kind().dimension()];
     // Global vertex numbers orient the edge DOFs of transformed elements (Argyris,
@@ -604,11 +669,15 @@ pub fn assemble_vector<M: Model>(
     let g = &mut g[..mesh.cell_kind().vertex_count()];
     // Curved cells (a CurvedTriangleMesh) take the curved kernels.
     let mut nodes = [0.0; 12];
-    for c in 0..mesh.cell_count() {
+    let maps: Vec<_> = plans
+        .iter()
+        .map(|p| dofs.map(p.test_field).unwrap())
+        .collect();
+    for c in cells {
         mesh.cell_coordinates_into(c, x);
         let numbered = mesh.cell_vertex_numbers_into(c, g);
         let curved = mesh.has_curved_cells() && mesh.curved_cell_nodes_into(c, &mut nodes);
-        for plan in &plans {
+        for (plan, map) in plans.iter().zip(&maps) {
             let (params, data) = (&coefficients.params, &coefficients.data);
             let element = &mut local[..plan.rows];
             if curved {
@@ -618,7 +687,7 @@ pub fn assemble_vector<M: Model>(
             } else {
                 M::element_vector(form, plan.block, x, params, data, element);
             }
-            let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
+            let rows = map.cell_dofs(c);
             for (&r, &v) in rows.iter().zip(&local[..plan.rows]) {
                 out[r + plan.row_offset] += v;
             }
@@ -630,7 +699,7 @@ pub fn assemble_vector<M: Model>(
             }
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 #[cfg(test)]
