@@ -586,6 +586,8 @@ mod parallel_tests {
     /// P1 interpolation from the `(m − 1)/2`-grid to the `m`-grid on right-diagonal
     /// triangles: a fine node on a coarse node copies it, one on an edge (horizontal,
     /// vertical or the diagonal `(p, q)–(p + 1, q + 1)`) averages its two ends.
+    // `(p + 1) / 2` beside `(p − 1) / 2`: the two ends of an edge
+    #[allow(clippy::manual_div_ceil)]
     fn interpolation(m: usize) -> SparseMatrix {
         let coarse = (m - 1) / 2;
         let mut t = Vec::new();
