@@ -8,19 +8,27 @@
 //! since the Hessian changes) and PCG to a relative residual of 1e-6 and of 1e-10 with
 //! the V(1,1) and W(1,1) cycles. Medians of rounds.
 //!
-//! `cargo bench --bench multigrid` (add `-- --quick` for smaller meshes).
+//! Then the 2-thread speed-up of the parallel kernels (assembly of the stiffness, the
+//! multigrid products and the multicolour symmetric Gauss–Seidel sweep), each timed in a
+//! 1-thread and a 2-thread rayon pool in this run, at 524k triangles P1 and 131k P2.
+//!
+//! `cargo bench --bench multigrid` (add `-- --quick` for smaller meshes, `-- --parallel`
+//! for the parallel kernels only).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::lcp::cholesky::Cholesky;
 use fem_forms::membranes;
-use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0};
+use fem_forms::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::membrane_scene;
 use fem_forms::multigrid::{
     parents_by_location, prolongation, Multigrid, MultigridOptions, NestedLevel,
 };
 use fem_forms::obstacle::triangle::{discretize_on_triangles, solve_obstacle_on_triangles};
 use fem_forms::obstacle::{Discretization, VariationalSolver};
-use fem_forms::{Constraints, Diagonal, Model, Reduction, SparseMatrix, SystemDofs, TriangleMesh};
+use fem_forms::{
+    assemble_vector, Coefficients, Constraints, Diagonal, MatrixAssembler, Model, Reduction,
+    SparseMatrix, SystemDofs, TriangleMesh,
+};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -144,9 +152,166 @@ fn run<M: Model>(name: &str, alpha: f64, sizes: &[usize], rounds: usize) {
     }
 }
 
+/// Seconds per call of `f` (median of 5 rounds of `calls` calls) in a pool of `threads`.
+fn pool_timed(threads: usize, calls: usize, mut f: impl FnMut() + Send) -> f64 {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        f(); // warm: first touch of the output pages
+        let times: Vec<f64> = (0..5)
+            .map(|_| {
+                let clock = Instant::now();
+                for _ in 0..calls {
+                    f();
+                }
+                clock.elapsed().as_secs_f64() / calls as f64
+            })
+            .collect();
+        median(times)
+    })
+}
+
+fn zero(_: &[f64]) -> f64 {
+    0.0
+}
+
+/// One table row: 1-thread and 2-thread times (ms) and their ratio.
+fn speedup_row(what: &str, calls: usize, mut f: impl FnMut() + Send) {
+    let one = pool_timed(1, calls, &mut f);
+    let two = pool_timed(2, calls, &mut f);
+    println!(
+        "| {what} | {:.2} | {:.2} | {:.2} |",
+        one * 1e3,
+        two * 1e3,
+        one / two
+    );
+}
+
+/// The parallel kernels' 2-thread speed-up on the stiffness `a` of field `u` of `M` on an
+/// `n × n × 2` right-diagonal square, with the prolongation from `n/2`.
+fn parallel_kernels<M: Model>(name: &str, n: usize, coefficients: &Coefficients) {
+    use fem_forms::multigrid::sparse;
+    let coarse_mesh =
+        TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n / 2, n / 2, Diagonal::Right).unwrap();
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap();
+    let dofs = SystemDofs::named::<M>(&mesh, &["u"]).unwrap();
+    let coarse_dofs = SystemDofs::named::<M>(&coarse_mesh, &["u"]).unwrap();
+    let assembler = MatrixAssembler::new::<M>("a", &mesh, &dofs).unwrap();
+    let a = assembler.assemble::<M>(&mesh, coefficients).unwrap();
+    let unknowns = a.nrows();
+    println!(
+        "\n{name}: {} triangles, {unknowns} unknowns, {} nonzeros; ms per call (median of 5 rounds)",
+        mesh.cell_count(),
+        a.val().len()
+    );
+    println!("| kernel | 1 thread | 2 threads | speed-up |");
+    println!("|---|---|---|---|");
+    let mut values = Vec::new();
+    speedup_row("matrix assembly", 3, || {
+        assembler
+            .assemble_values::<M>(&mesh, coefficients, &mut values)
+            .unwrap();
+        black_box(&values);
+    });
+    speedup_row("vector assembly ℓ", 3, || {
+        black_box(assemble_vector::<M>("ℓ", &mesh, &dofs, coefficients).unwrap());
+    });
+    let parents = parents_by_location(&coarse_mesh, &mesh).unwrap();
+    let level = |mesh, dofs| NestedLevel {
+        mesh,
+        dofs,
+        reduction: None,
+    };
+    let p = prolongation(
+        &level(&coarse_mesh, &coarse_dofs),
+        &level(&mesh, &dofs),
+        &parents,
+    )
+    .unwrap();
+    let pt = sparse::transpose_of(&p);
+    let mut state = 7u64;
+    let x: Vec<f64> = (0..unknowns)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect();
+    let mut y = vec![0.0; unknowns];
+    let mut coarse = vec![0.0; p.ncols()];
+    speedup_row("y = A x (rows)", 20, || {
+        sparse::multiply_symmetric_into(&a, &x, &mut y)
+    });
+    speedup_row("x += P e (rows of Pᵀ)", 20, || {
+        sparse::prolong_add_transposed(&pt, &x[..p.ncols()], &mut y)
+    });
+    speedup_row("e = Pᵀ r", 20, || {
+        sparse::restrict_parallel(&p, &x, &mut coarse)
+    });
+    let inverse: Vec<f64> = {
+        let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+        (0..unknowns)
+            .map(|j| {
+                let k = (ptr[j]..ptr[j + 1]).find(|&k| rows[k] == j).unwrap();
+                1.0 / vals[k]
+            })
+            .collect()
+    };
+    let clock = Instant::now();
+    let coloured = sparse::Smoother::coloured(&a);
+    let colouring = clock.elapsed().as_secs_f64();
+    let lexicographic = sparse::Smoother::lexicographic();
+    let serial = pool_timed(1, 10, || {
+        lexicographic.symmetric_sweep(&a, &inverse, &x, &mut y)
+    });
+    speedup_row(
+        &format!("symmetric GS, {} colours", coloured.colour_count()),
+        10,
+        || coloured.symmetric_sweep(&a, &inverse, &x, &mut y),
+    );
+    let hybrid = sparse::Smoother::hybrid(unknowns, 8);
+    speedup_row("symmetric GS, hybrid (8 blocks)", 10, || {
+        hybrid.symmetric_sweep(&a, &inverse, &x, &mut y)
+    });
+    println!(
+        "lexicographic symmetric GS (1 thread): {:.2} ms; multicolouring (once per pattern): {:.2} ms",
+        serial * 1e3,
+        colouring * 1e3
+    );
+}
+
+fn parallel(quick: bool) {
+    let (n1, n2) = if quick { (128, 64) } else { (512, 256) };
+    type P1 = membrane_p1::Model;
+    let c1 = Coefficients::from_ids::<P1>(
+        &[],
+        &[(membrane_p1::data::f, &zero), (membrane_p1::data::g, &zero)],
+    )
+    .unwrap();
+    parallel_kernels::<P1>("P1", n1, &c1);
+    type P2 = membrane_p2_p0::Model;
+    let c2 = Coefficients::from_ids::<P2>(
+        &[(membrane_p2_p0::params::α, 0.0)],
+        &[
+            (membrane_p2_p0::data::f, &zero),
+            (membrane_p2_p0::data::ψ, &zero),
+            (membrane_p2_p0::data::g, &zero),
+        ],
+    )
+    .unwrap();
+    parallel_kernels::<P2>("P2", n2, &c2);
+}
+
 fn main() {
     fem_forms::lcp::cholesky::factor_sequentially();
     let quick = std::env::args().any(|a| a == "--quick");
+    if std::env::args().any(|a| a == "--parallel") {
+        parallel(quick);
+        return;
+    }
     let rounds = if quick { 1 } else { 3 };
     let (p1, p2): (&[usize], &[usize]) = if quick {
         (&[64, 128], &[32, 64])
@@ -155,4 +320,5 @@ fn main() {
     };
     run::<membrane_p1_p0::Model>("P1–P0", 0.1, p1, rounds);
     run::<membrane_p2_p0::Model>("P2–P0", 0.5 / 96.0, p2, rounds);
+    parallel(quick);
 }

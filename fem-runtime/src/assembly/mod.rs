@@ -239,13 +239,243 @@ pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
     Ok(())
 }
 
+/// Meshes with fewer cells than this are assembled on the calling thread: below it the
+/// rayon dispatch (a few µs per colour) is a visible share of a P1 assembly.
+pub const PARALLEL_MIN_CELLS: usize = 4096;
+
+/// Cells per chunk at least: a chunk is a run of consecutive cells assembled by one
+/// thread, long enough that the generated loop runs at full speed and that on a mesh
+/// numbered row by row chunk `k` and chunk `k + 2` share no vertex (two colours).
+const MIN_CHUNK_CELLS: usize = 1024;
+
+/// Chunks aimed at (fewer on small meshes): several per thread per colour, so that
+/// threads finishing early take another chunk.
+const TARGET_CHUNKS: usize = 32;
+
+/// The cells of a mesh cut into chunks of consecutive cells, the chunks greedily coloured
+/// so that two chunks of one colour share no mesh vertex.
+///
+/// Every DOF of the elements here sits on a vertex, an edge or a cell interior
+/// (`dof_map`), so two cells that share a DOF share a vertex; chunks of one colour
+/// therefore share no DOF, hence no matrix or vector entry, and can be added in parallel.
+/// Built once per [`MatrixAssembler`]; `O(cells)` time and one `u64` per vertex.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct CellColouring {
+    /// Chunk `k` is the cells `bounds[k]..bounds[k + 1]`.
+    bounds: Vec<usize>,
+    /// The chunks of colour `c` are `chunks[colour_ptr[c]..colour_ptr[c + 1]]`.
+    colour_ptr: Vec<usize>,
+    chunks: Vec<usize>,
+}
+
+impl CellColouring {
+    /// The colouring of `mesh`'s cells, or `None` where the parallel path does not apply:
+    /// fewer than [`PARALLEL_MIN_CELLS`] cells, a mesh without vertex numbers, or more
+    /// than 64 colours (a mesh numbered at random; the serial loop is then as fast).
+    pub(crate) fn new<G: Mesh>(mesh: &G) -> Option<Self> {
+        let cells = mesh.cell_count();
+        if cells < PARALLEL_MIN_CELLS {
+            return None;
+        }
+        let vertices = G::CELL.dimension() + 1;
+        let mut g = [0usize; 3];
+        let g = &mut g[..vertices];
+        let chunk = (cells / TARGET_CHUNKS).max(MIN_CHUNK_CELLS);
+        let count = cells.div_ceil(chunk);
+        let bounds: Vec<usize> = (0..=count).map(|k| (k * chunk).min(cells)).collect();
+        // colours used by the chunks touching each vertex so far, one bit per colour
+        let mut used: Vec<u64> = Vec::new();
+        let mut colour_of = Vec::with_capacity(count);
+        for k in 0..count {
+            let mut forbidden = 0u64;
+            for c in bounds[k]..bounds[k + 1] {
+                if !mesh.cell_vertex_numbers_into(c, g) {
+                    return None;
+                }
+                for &v in g.iter() {
+                    forbidden |= used.get(v).copied().unwrap_or(0);
+                }
+            }
+            if forbidden == u64::MAX {
+                return None;
+            }
+            let colour = forbidden.trailing_ones() as usize;
+            for c in bounds[k]..bounds[k + 1] {
+                mesh.cell_vertex_numbers_into(c, g);
+                for &v in g.iter() {
+                    if v >= used.len() {
+                        used.resize(v + 1, 0);
+                    }
+                    used[v] |= 1 << colour;
+                }
+            }
+            colour_of.push(colour);
+        }
+        let colours = colour_of.iter().max().map_or(0, |&c| c + 1);
+        let mut colour_ptr = vec![0usize; colours + 1];
+        for &c in &colour_of {
+            colour_ptr[c + 1] += 1;
+        }
+        for c in 0..colours {
+            colour_ptr[c + 1] += colour_ptr[c];
+        }
+        let mut fill = colour_ptr.clone();
+        let mut chunks = vec![0; count];
+        for (k, &c) in colour_of.iter().enumerate() {
+            chunks[fill[c]] = k;
+            fill[c] += 1;
+        }
+        Some(Self {
+            bounds,
+            colour_ptr,
+            chunks,
+        })
+    }
+
+    /// Number of colours.
+    pub(crate) fn colour_count(&self) -> usize {
+        self.colour_ptr.len().saturating_sub(1)
+    }
+
+    /// The cell ranges of colour `c`.
+    fn ranges(&self, c: usize) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        self.chunks[self.colour_ptr[c]..self.colour_ptr[c + 1]]
+            .iter()
+            .map(|&k| self.bounds[k]..self.bounds[k + 1])
+    }
+}
+
+/// The consecutive cells `start..start + count` of a mesh, as a mesh: the generated cell
+/// loop ([`Model::add_element_matrices`]) runs on it unchanged, kernel inlined, one chunk
+/// of a [`CellColouring`] at a time.
+struct CellRange<'a, G> {
+    mesh: &'a G,
+    start: usize,
+    count: usize,
+}
+
+impl<G: Mesh> Mesh for CellRange<'_, G> {
+    const CELL: fem_reference::CellKind = G::CELL;
+    #[inline]
+    fn cell_count(&self) -> usize {
+        self.count
+    }
+    #[inline]
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
+        self.mesh.cell_coordinates_into(self.start + c, out)
+    }
+    fn diameter(&self, c: usize) -> f64 {
+        self.mesh.diameter(self.start + c)
+    }
+    fn measure(&self, c: usize) -> f64 {
+        self.mesh.measure(self.start + c)
+    }
+    #[inline]
+    fn cell_vertex_numbers_into(&self, c: usize, out: &mut [usize]) -> bool {
+        self.mesh.cell_vertex_numbers_into(self.start + c, out)
+    }
+    fn has_curved_cells(&self) -> bool {
+        self.mesh.has_curved_cells()
+    }
+    #[inline]
+    fn curved_cell_nodes_into(&self, c: usize, out: &mut [f64]) -> bool {
+        self.mesh.curved_cell_nodes_into(self.start + c, out)
+    }
+}
+
+/// A value array shared by the threads of one colour, each adding into entries no
+/// other thread of that colour touches.
+#[derive(Clone, Copy)]
+struct SharedValues {
+    start: *mut f64,
+    len: usize,
+}
+
+// SAFETY: only used in `add_form_matrices_coloured`, where the threads of one colour
+// write disjoint entries (the colouring's invariant) and the colours run one after the
+// other (each colour's parallel loop joins before the next starts).
+unsafe impl Send for SharedValues {}
+unsafe impl Sync for SharedValues {}
+
+impl SharedValues {
+    /// The whole array.
+    ///
+    /// # Safety
+    /// No two threads may access one element at the same time (see
+    /// `add_form_matrices_coloured`).
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn values(&self) -> &mut [f64] {
+        unsafe { std::slice::from_raw_parts_mut(self.start, self.len) }
+    }
+}
+
+/// [`add_form_matrices`] with the cells split by `colouring` (built from the same mesh):
+/// the colours one after the other, the chunks of a colour in parallel on the current
+/// rayon pool. With one thread in the pool or no colouring, the serial loop.
+///
+/// `positions` must map two cells that share no vertex to disjoint value entries (true of
+/// a pattern built by [`MatrixAssembler::new`]: an entry is a pair of DOFs of the cell).
+/// Each entry then receives the same terms as in the serial loop, possibly in another
+/// order: the result equals the serial one up to rounding (tested to 1e-13 relative).
+///
+/// # Errors
+/// Those of [`add_form_matrices`], from the first failing chunk rayon reports.
+pub(crate) fn add_form_matrices_coloured<M: Model, G: Mesh>(
+    form: usize,
+    plans: &[BlockPlan],
+    mesh: &G,
+    coefficients: &Coefficients,
+    positions: &[usize],
+    values: &mut [f64],
+    colouring: Option<&CellColouring>,
+) -> Result<()> {
+    use rayon::prelude::*;
+    let colouring = match colouring {
+        Some(c)
+            if rayon::current_num_threads() > 1 && c.bounds.last() == Some(&mesh.cell_count()) =>
+        {
+            c
+        }
+        _ => return add_form_matrices::<M, G>(form, plans, mesh, coefficients, positions, values),
+    };
+    let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
+    let shared = SharedValues {
+        start: values.as_mut_ptr(),
+        len: values.len(),
+    };
+    for colour in 0..colouring.colour_count() {
+        let ranges: Vec<_> = colouring.ranges(colour).collect();
+        ranges.into_par_iter().try_for_each(|range| {
+            let part = CellRange {
+                mesh,
+                start: range.start,
+                count: range.len(),
+            };
+            let at = &positions[range.start * stride..range.end * stride];
+            // SAFETY: `shared` is `values`, borrowed mutably for this whole call; the
+            // chunks of this colour share no vertex, hence (see above) no entry of
+            // `values`: no two threads access one element, and the loop joins before
+            // the next colour starts.
+            let out = unsafe { shared.values() };
+            add_form_matrices::<M, _>(form, plans, &part, coefficients, at, out)
+        })?;
+    }
+    Ok(())
+}
+
 /// Assembles one bilinear form of a model on a mesh, reusing its sparsity pattern.
+///
+/// Meshes of at least [`PARALLEL_MIN_CELLS`] cells are assembled in parallel on the
+/// current rayon pool (cells coloured once here, see `CellColouring`); the result
+/// equals the one-thread assembly up to rounding (the terms of an entry may be added in
+/// another order).
 #[derive(Clone, Debug)]
 pub struct MatrixAssembler {
     form: usize,
     plans: Vec<BlockPlan>,
     symbolic: SymbolicSparseColMat<usize>,
     positions: Vec<usize>,
+    colouring: Option<CellColouring>,
 }
 
 impl MatrixAssembler {
@@ -300,6 +530,7 @@ impl MatrixAssembler {
             plans,
             symbolic,
             positions,
+            colouring: CellColouring::new(mesh),
         })
     }
 
@@ -322,13 +553,14 @@ impl MatrixAssembler {
     ) -> Result<()> {
         values.clear();
         values.resize(self.nonzero_count(), 0.0);
-        add_form_matrices::<M, _>(
+        add_form_matrices_coloured::<M, _>(
             self.form,
             &self.plans,
             mesh,
             coefficients,
             &self.positions,
             values,
+            self.colouring.as_ref(),
         )?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
             let cell = self.positions.iter().position(|&p| p == bad).unwrap_or(0);
@@ -354,16 +586,81 @@ impl MatrixAssembler {
 }
 
 /// Assembles linear form `form_name` of `M` on the system `dofs`.
+///
+/// Meshes of at least [`PARALLEL_MIN_CELLS`] cells are assembled in parallel on the
+/// current rayon pool (the cells coloured per call, `CellColouring`: `O(cells)`, small
+/// against the kernels); the result equals the one-thread one up to rounding. An error
+/// is the one of the serial loop (on an error the vector is assembled again serially, so
+/// the cell named is the first one at fault).
 pub fn assemble_vector<M: Model>(
     form_name: impl IntoFormIndex<M>,
     mesh: &impl Mesh,
     dofs: &SystemDofs,
     coefficients: &Coefficients,
 ) -> Result<Vec<f64>> {
+    use rayon::prelude::*;
     let form = M::form(form_name)?;
     let plans = block_plans::<M>(form, dofs, false)?;
     let mut out = vec![0.0; dofs.dof_count()];
-    let mut local = vec![0.0; plans.iter().map(|p| p.rows).max().unwrap_or(0)];
+    let cells = mesh.cell_count();
+    let colouring = if rayon::current_num_threads() > 1 {
+        CellColouring::new(mesh)
+    } else {
+        None
+    };
+    if let Some(colouring) = colouring {
+        let shared = SharedValues {
+            start: out.as_mut_ptr(),
+            len: out.len(),
+        };
+        let mut failed = false;
+        for colour in 0..colouring.colour_count() {
+            let ranges: Vec<_> = colouring.ranges(colour).collect();
+            // SAFETY: as in `add_form_matrices_coloured`: the chunks of one colour share
+            // no vertex, hence no DOF, hence no entry of `out`; colours run in sequence.
+            let result = ranges.into_par_iter().try_for_each(|range| {
+                add_vectors::<M, _>(form, &plans, mesh, dofs, coefficients, range, unsafe {
+                    shared.values()
+                })
+            });
+            if result.is_err() {
+                failed = true;
+                break;
+            }
+        }
+        if !failed {
+            return Ok(out);
+        }
+        out.fill(0.0);
+    }
+    add_vectors::<M, _>(form, &plans, mesh, dofs, coefficients, 0..cells, &mut out)?;
+    Ok(out)
+}
+
+/// Adds the element vectors of `plans` (blocks of linear `form`) on the cells `cells`
+/// of `mesh` into `out` (the system numbering of `dofs`).
+///
+/// # Errors
+/// A non-finite element vector (the first cell in `cells` with one), those of
+/// [`Model::element_vector_curved`].
+fn add_vectors<M: Model, G: Mesh>(
+    form: usize,
+    plans: &[BlockPlan],
+    mesh: &G,
+    dofs: &SystemDofs,
+    coefficients: &Coefficients,
+    cells: std::ops::Range<usize>,
+    out: &mut [f64],
+) -> Result<()> {
+    let mut local = [0.0; 64];
+    let mut local_vec;
+    let largest = plans.iter().map(|p| p.rows).max().unwrap_or(0);
+    let local: &mut [f64] = if largest <= local.len() {
+        &mut local[..]
+    } else {
+        local_vec = vec![0.0; largest];
+        &mut local_vec[..]
+    };
     let mut x = [0.0; 6];
     let x = &mut x[..mesh.cell_kind().vertex_count() * mesh.cell_kind().dimension()];
     // Global vertex numbers orient the edge DOFs of transformed elements (Argyris,
@@ -372,11 +669,15 @@ pub fn assemble_vector<M: Model>(
     let g = &mut g[..mesh.cell_kind().vertex_count()];
     // Curved cells (a CurvedTriangleMesh) take the curved kernels.
     let mut nodes = [0.0; 12];
-    for c in 0..mesh.cell_count() {
+    let maps: Vec<_> = plans
+        .iter()
+        .map(|p| dofs.map(p.test_field).unwrap())
+        .collect();
+    for c in cells {
         mesh.cell_coordinates_into(c, x);
         let numbered = mesh.cell_vertex_numbers_into(c, g);
         let curved = mesh.has_curved_cells() && mesh.curved_cell_nodes_into(c, &mut nodes);
-        for plan in &plans {
+        for (plan, map) in plans.iter().zip(&maps) {
             let (params, data) = (&coefficients.params, &coefficients.data);
             let element = &mut local[..plan.rows];
             if curved {
@@ -386,7 +687,7 @@ pub fn assemble_vector<M: Model>(
             } else {
                 M::element_vector(form, plan.block, x, params, data, element);
             }
-            let rows = dofs.map(plan.test_field).unwrap().cell_dofs(c);
+            let rows = map.cell_dofs(c);
             for (&r, &v) in rows.iter().zip(&local[..plan.rows]) {
                 out[r + plan.row_offset] += v;
             }
@@ -398,5 +699,52 @@ pub fn assemble_vector<M: Model>(
             }
         }
     }
-    Ok(out)
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{Diagonal, TriangleMesh};
+
+    /// The colouring covers every cell once, and two chunks of one colour share no vertex
+    /// (checked directly on the vertex lists, not through the colouring's own masks).
+    fn check_colouring(mesh: &TriangleMesh) -> usize {
+        let colouring = CellColouring::new(mesh).expect("a mesh above the threshold");
+        let mut covered = vec![0u8; mesh.cell_count()];
+        let mut owner = vec![usize::MAX; mesh.vertex_count()];
+        for colour in 0..colouring.colour_count() {
+            owner.fill(usize::MAX);
+            for (k, range) in colouring.ranges(colour).enumerate() {
+                for c in range {
+                    covered[c] += 1;
+                    for v in mesh.cell(c) {
+                        assert!(
+                            owner[v] == usize::MAX || owner[v] == k,
+                            "colour {colour}: chunks {} and {k} share vertex {v}",
+                            owner[v]
+                        );
+                        owner[v] = k;
+                    }
+                }
+            }
+        }
+        assert!(covered.iter().all(|&n| n == 1), "a cell missed or repeated");
+        colouring.colour_count()
+    }
+
+    #[test]
+    fn chunk_colouring_is_a_partition_into_vertex_disjoint_chunks() {
+        // rows of 2·256 cells, chunks of 4096: neighbours conflict, every other one not
+        let square =
+            TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 256, 256, Diagonal::Right).unwrap();
+        assert_eq!(check_colouring(&square), 2);
+        let refined = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 24, 24, Diagonal::Left)
+            .unwrap()
+            .refine_uniformly()
+            .refine_uniformly();
+        assert!(check_colouring(&refined) >= 2);
+        let small = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 32, 32, Diagonal::Right).unwrap();
+        assert!(CellColouring::new(&small).is_none());
+    }
 }

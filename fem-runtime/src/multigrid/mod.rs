@@ -19,7 +19,7 @@
 //! grows slowly with the levels and the W-cycle's does not.
 
 mod prolongation;
-mod sparse;
+pub mod sparse;
 #[cfg(test)]
 mod tests;
 
