@@ -38,12 +38,12 @@ fn multigrid_steps_give_the_direct_solution_with_iterations_bounded_in_h() {
             .zip(&u_multigrid)
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(
-            difference <= 1e-8 * scale,
+            difference <= 1e-10 * scale,
             "N = {n}: the multigrid solution differs by {difference:e}"
         );
         for report in [&direct, &multigrid] {
             assert!(
-                report.complementarity_residual <= 1e-8,
+                report.complementarity_residual <= 1e-11,
                 "N = {n}: KKT residual {:e}",
                 report.complementarity_residual
             );
@@ -51,8 +51,10 @@ fn multigrid_steps_give_the_direct_solution_with_iterations_bounded_in_h() {
         assert_eq!(direct.iterations, multigrid.iterations, "N = {n}");
         per_step.push(multigrid.krylov_iterations as f64 / multigrid.iterations as f64);
     }
+    // with the final polish to 1e-14 included; flat from N = 32 on (9 at N = 16, whose
+    // hierarchy has two levels)
     assert!(
-        per_step.iter().all(|&k| k <= 8.0),
+        per_step.iter().all(|&k| k <= 10.0) && per_step[3] <= per_step[1] + 1.0,
         "CG iterations per step {per_step:?}"
     );
 }

@@ -8,6 +8,7 @@
 use crate::error::{Error, Result};
 use crate::lcp::cholesky::{multiply, Cholesky};
 use crate::lcp::{Lcp, LcpSolution};
+use crate::multigrid::sparse::multiply_symmetric_into;
 use crate::multigrid::{Multigrid, MultigridOptions};
 use crate::obstacle::hierarchy::{MULTIGRID_MAX_ITERATIONS, MULTIGRID_TOLERANCE};
 use crate::SparseMatrix;
@@ -154,10 +155,12 @@ pub fn nodal_active_set_with(
         } else {
             multigrid_solve(matrix, &rhs, &u, prolongations, &active)
         };
+        let mut hierarchy = None;
         u = match solved {
-            Ok((x, iterations)) => {
+            Ok((x, iterations, mg)) => {
                 krylov_iterations += iterations;
                 iterative_steps += 1;
+                hierarchy = mg;
                 x
             }
             Err(matrix) => {
@@ -183,6 +186,16 @@ pub fn nodal_active_set_with(
             .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
             .collect();
         if next == active {
+            if let Some(mg) = &hierarchy {
+                // the settled system solved to rounding, as a factorization would
+                if let Some(iterations) = polish(mg, &rhs, &mut u) {
+                    krylov_iterations += iterations;
+                    let au = multiply(a, &u);
+                    for i in 0..n {
+                        lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
+                    }
+                }
+            }
             let lcp = nodal_lcp(a, f, psi);
             let kkt_residual = lcp.kkt_residual(&u, &lambda);
             return Ok(LcpSolution {
@@ -235,14 +248,14 @@ fn multigrid_solve(
     x0: &[f64],
     prolongations: &[SparseMatrix],
     active: &[bool],
-) -> std::result::Result<(Vec<f64>, usize), Option<SparseMatrix>> {
+) -> std::result::Result<(Vec<f64>, usize, Option<Multigrid>), Option<SparseMatrix>> {
     let mut residual = multiply(&matrix, x0);
     for (r, b) in residual.iter_mut().zip(rhs) {
         *r = b - *r;
     }
     let (norm_b, norm_r) = (norm(rhs), norm(&residual));
     if norm_r <= MULTIGRID_TOLERANCE * norm_b {
-        return Ok((x0.to_vec(), 0));
+        return Ok((x0.to_vec(), 0, None));
     }
     let tolerance = MULTIGRID_TOLERANCE * norm_b / norm_r;
     let hierarchy = truncated_hierarchy(prolongations, active);
@@ -253,7 +266,36 @@ fn multigrid_solve(
     let (d, iterations) =
         pcg(fine, &mg, &residual, tolerance, MULTIGRID_MAX_ITERATIONS).map_err(|_| None)?;
     let x = x0.iter().zip(&d).map(|(x, d)| x + d).collect();
-    Ok((x, iterations))
+    Ok((x, iterations, Some(mg)))
+}
+
+/// The relative residual to which [`polish`] takes the settled system: about what a
+/// Cholesky solve with one step of refinement leaves (at 1M unknowns, 1e-10 left the
+/// mean nodal error 0.3 % off the factored solution's; 1e-14 costs 4 CG iterations
+/// there and matches it to 7 digits, KKT residual 1e-13).
+const POLISH_TOLERANCE: f64 = 1e-14;
+
+/// CG on `mg`'s finest operator from `u` until the residual of `rhs` is
+/// [`POLISH_TOLERANCE`] of `‖rhs‖` (or 30 iterations, when rounding stops it first);
+/// `u` is updated and the iterations returned when CG improved it.
+fn polish(mg: &Multigrid, rhs: &[f64], u: &mut [f64]) -> Option<usize> {
+    let fine = mg.operator(0)?;
+    let mut residual = multiply(fine, u);
+    for (r, b) in residual.iter_mut().zip(rhs) {
+        *r = b - *r;
+    }
+    let (norm_b, norm_r) = (norm(rhs), norm(&residual));
+    if norm_r <= POLISH_TOLERANCE * norm_b {
+        return None;
+    }
+    let (d, iterations) = match pcg(fine, mg, &residual, POLISH_TOLERANCE * norm_b / norm_r, 30) {
+        Ok(solved) => solved,
+        Err(_) => return None,
+    };
+    for (x, d) in u.iter_mut().zip(&d) {
+        *x += d;
+    }
+    Some(iterations)
 }
 
 /// Conjugate gradients on `a x = b` from `x = 0`, preconditioned by one cycle of
@@ -277,7 +319,7 @@ fn pcg(
     let mut p = z.clone();
     let mut rz = dot(&r, &z);
     for iteration in 1..=max_iterations {
-        multiply_into(a, &p, &mut q);
+        multiply_symmetric_into(a, &p, &mut q);
         let pq = dot(&p, &q);
         if !(rz > 0.0 && pq > 0.0) {
             return Err(iteration);
@@ -299,17 +341,6 @@ fn pcg(
         }
     }
     Err(max_iterations)
-}
-
-/// `y = A x` for a symmetric `A` stored with both triangles: column `i` is row `i`, so
-/// each entry is one gather (no scattered writes).
-fn multiply_into(a: &SparseMatrix, x: &[f64], y: &mut [f64]) {
-    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    for (i, yi) in y.iter_mut().enumerate() {
-        *yi = (col_ptr[i]..col_ptr[i + 1])
-            .map(|k| vals[k] * x[rows[k]])
-            .sum();
-    }
 }
 
 fn dot(x: &[f64], y: &[f64]) -> f64 {
