@@ -130,7 +130,8 @@ struct SolveOptions {
     #[arg(long)]
     cold: bool,
     /// Solver of the Newton steps: auto (default: multigrid on the nested meshes from 1M
-    /// unknowns of P1 pairs, direct Cholesky otherwise), direct, or multigrid (membranes).
+    /// unknowns of P1 pairs and for p1-nodal's active-set steps, direct Cholesky
+    /// otherwise), direct, or multigrid (membranes).
     #[arg(long, value_name = "auto|direct|multigrid")]
     linear_solver: Option<String>,
     /// Rounds of iterative refinement per linear solve (beams; default 1; t ≤ 1e-5
