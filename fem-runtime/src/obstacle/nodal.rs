@@ -196,6 +196,8 @@ pub fn nodal_active_set_with(
                     }
                 }
             }
+            // the KKT check copies `a`: the hierarchy (a matrix as large) goes first
+            drop(hierarchy);
             let lcp = nodal_lcp(a, f, psi);
             let kkt_residual = lcp.kkt_residual(&u, &lambda);
             return Ok(LcpSolution {
