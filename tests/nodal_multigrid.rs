@@ -11,6 +11,19 @@ use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::nodal::{nodal_active_set, nodal_active_set_with, truncated_hierarchy};
 use fem_forms::SparseMatrix;
 
+/// Linear interpolation from `coarse` interior nodes of a uniform 1D mesh to the
+/// `2·coarse + 1` interior nodes of its refinement (Dirichlet ends removed).
+fn interpolation(coarse: usize) -> SparseMatrix {
+    let fine = 2 * coarse + 1;
+    let mut t = Vec::new();
+    for j in 0..coarse {
+        t.push(Triplet::new(2 * j + 1, j, 1.0));
+        t.push(Triplet::new(2 * j, j, 0.5));
+        t.push(Triplet::new(2 * j + 2, j, 0.5));
+    }
+    SparseColMat::try_new_from_triplets(fine, coarse, &t).unwrap()
+}
+
 fn solve(n: usize, linear_solver: LinearSolver) -> (membranes::MembraneReport, Vec<f64>) {
     let mut request = MembraneRequest::new(membrane_scene("membrane-radial").unwrap());
     request.pair = MembranePair::P1Nodal;
@@ -64,17 +77,7 @@ fn multigrid_steps_give_the_direct_solution_with_iterations_bounded_in_h() {
 /// and every removed coarse column of the full one is zero after truncation.
 #[test]
 fn the_truncated_hierarchy_composes_to_the_truncated_prolongation() {
-    // 1D nested linear interpolation, 17 → 9 → 5 → 3 nodes (Dirichlet ends removed)
-    let interpolation = |coarse: usize| -> SparseMatrix {
-        let fine = 2 * coarse + 1;
-        let mut t = Vec::new();
-        for j in 0..coarse {
-            t.push(Triplet::new(2 * j + 1, j, 1.0));
-            t.push(Triplet::new(2 * j, j, 0.5));
-            t.push(Triplet::new(2 * j + 2, j, 0.5));
-        }
-        SparseColMat::try_new_from_triplets(fine, coarse, &t).unwrap()
-    };
+    // 15 → 7 → 3 → 1 interior nodes
     let chain = vec![interpolation(7), interpolation(3), interpolation(1)];
     // a contact set: fine nodes 0..=6 and 12
     let dropped: Vec<bool> = (0..15).map(|i| i <= 6 || i == 12).collect();
@@ -147,16 +150,6 @@ fn the_nodal_multigrid_solve_checks_its_hierarchy() {
     let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
     let f = vec![-10.0 * h; n];
     let psi: Vec<f64> = (0..n).map(|i| -0.1 + 0.2 * (i + 1) as f64 * h).collect();
-    let interpolation = |coarse: usize| -> SparseMatrix {
-        let fine = 2 * coarse + 1;
-        let mut t = Vec::new();
-        for j in 0..coarse {
-            t.push(Triplet::new(2 * j + 1, j, 1.0));
-            t.push(Triplet::new(2 * j, j, 0.5));
-            t.push(Triplet::new(2 * j + 2, j, 0.5));
-        }
-        SparseColMat::try_new_from_triplets(fine, coarse, &t).unwrap()
-    };
     let chain = vec![interpolation(7), interpolation(3)];
     let direct = nodal_active_set(&a, &f, &psi, None, 50).unwrap();
     let multigrid = nodal_active_set_with(&a, &f, &psi, None, 50, &chain).unwrap();
