@@ -693,10 +693,81 @@ pub fn semismooth_newton_prepared(
     newton_iteration(lcp, workspace, None, start, options, clock)
 }
 
+/// One Newton system `H d = b` handed to a [`StepSolver`].
+#[derive(Clone, Copy, Debug)]
+pub struct NewtonStep<'a> {
+    /// The Hessian `H` (the pattern is the same at every step of one solve).
+    pub hessian: &'a SparseMatrix,
+    /// `b = −∇Φ`.
+    pub rhs: &'a [f64],
+    /// The active constraints `H` includes (per constraint, as [`Lcp::hessian_change_blocks`]
+    /// takes them), so that a solver can update what it built for an earlier step.
+    pub active: &'a [bool],
+    /// Whether the active set is that of the previous full step: Newton is then in its
+    /// final, locally quadratic phase and a step solved loosely would cost iterations.
+    /// Before that an inexact step (relative residual 1e-1 … 1e-4) is as good as an
+    /// exact one (Newton's KKT test certifies the result either way).
+    pub settled: bool,
+}
+
 /// A solver of the Newton systems `H d = b` other than the factorization (e.g. multigrid
-/// preconditioned CG, [`crate::obstacle`]): `Some(d)` when it solved the system to the
-/// accuracy of a factored step, `None` to have the step factored instead.
-pub type StepSolver<'a> = &'a (dyn Fn(&SparseMatrix, &[f64]) -> Option<Vec<f64>> + Sync);
+/// preconditioned CG, [`crate::obstacle`]): `Some(d)` when it solved the system (a
+/// descent direction, accurate to the solver's own tolerance: see
+/// [`NewtonStep::settled`]), `None` to have the step factored instead. It may keep state
+/// from step to step (a multigrid hierarchy updated by the flipped constraints).
+pub type StepSolver<'a> = &'a mut dyn FnMut(NewtonStep<'_>) -> Option<Vec<f64>>;
+
+impl Lcp {
+    /// The change `H(active) − H(previous)` of Newton's Hessian, block by block: for each
+    /// block of constraints whose active face differs, `visit(rows, change)` with its rows
+    /// of `B` (sparse, `(column, value)`) and the `s × s` change (row-major, `s` the block
+    /// size, symmetric) of `P_I C_II⁻¹ P_Iᵀ`, so that the change is `Σ Bᵦᵀ change Bᵦ`
+    /// over the visited blocks (docs/mathematics.md §5). With `previous` all false it is
+    /// the whole active part `Bᵀ H_I B` of the Hessian.
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `previous` or `active` is not of length `m`; `visit`'s error,
+    /// which ends the visit.
+    pub fn hessian_change_blocks(
+        &self,
+        previous: &[bool],
+        active: &[bool],
+        mut visit: impl FnMut(&[&[(usize, f64)]], &[f64]) -> Result<()>,
+    ) -> Result<()> {
+        if previous.len() != self.m() || active.len() != self.m() {
+            return Err(Error::Input(format!(
+                "active sets of {} and {} constraints for an LCP of {}",
+                previous.len(),
+                active.len(),
+                self.m()
+            )));
+        }
+        let mut face = [0usize; MAX_BLOCK];
+        let mut inverse = [0.0; BLOCK_ENTRIES];
+        let mut rows: [&[(usize, f64)]; MAX_BLOCK] = [&[]; MAX_BLOCK];
+        for block in self.blocks() {
+            let range = block.range();
+            if previous[range.clone()] == active[range.clone()] {
+                continue;
+            }
+            let s = block.size;
+            let mut change = [0.0; BLOCK_ENTRIES];
+            for (sign, flags) in [(1.0, active), (-1.0, previous)] {
+                let q = self.face_inverse(&block, flags, &mut face, &mut inverse);
+                for a in 0..q {
+                    for c in 0..q {
+                        change[face[a] * s + face[c]] += sign * inverse[a * q + c];
+                    }
+                }
+            }
+            for (row, k) in rows.iter_mut().zip(range) {
+                *row = &self.b_rows[k];
+            }
+            visit(&rows[..s], &change[..s * s])?;
+        }
+        Ok(())
+    }
+}
 
 /// [`semismooth_newton_prepared`] with the exact steps solved by `step` (each step it
 /// declines is factored as usual and counted in [`LcpSolution::factorizations`]).
@@ -727,7 +798,7 @@ pub fn semismooth_newton_with(
 pub(super) fn newton_iteration(
     lcp: &Lcp,
     workspace: &NewtonWorkspace,
-    step_solver: Option<StepSolver>,
+    mut step_solver: Option<StepSolver>,
     start: Option<&[f64]>,
     options: NewtonOptions,
     clock: Instant,
@@ -813,8 +884,13 @@ pub(super) fn newton_iteration(
             None
         };
         let exact = smoothed.is_none();
-        let solved = match (&smoothed, step_solver) {
-            (None, Some(solve)) => solve(&h, &minus_gradient),
+        let solved = match (&smoothed, step_solver.as_mut()) {
+            (None, Some(solve)) => solve(NewtonStep {
+                hessian: &h,
+                rhs: &minus_gradient,
+                active: &active,
+                settled: previous_active.as_ref() == Some(&active),
+            }),
             _ => None,
         };
         iterative_steps += usize::from(solved.is_some());

@@ -6,7 +6,7 @@
 
 use super::Discretization;
 use crate::error::{Error, Result};
-use crate::lcp::Lcp;
+use crate::lcp::{Lcp, NewtonStep};
 use crate::mesh::TriangleMesh;
 use crate::multigrid::{
     parents_by_location, prolongation, Multigrid, MultigridOptions, NestedLevel,
@@ -35,6 +35,12 @@ pub enum LinearSolver {
 /// certifies the result by the KKT residual anyway; steps this accurate keep the
 /// active-set iteration that of factored steps.
 pub const MULTIGRID_TOLERANCE: f64 = 1e-10;
+
+/// Relative residual at which CG ends a Newton step while the active set still changes
+/// ([`NewtonStep::settled`] false): an inexact Newton step (Dembo, Eisenstat and
+/// Steihaug 1982) moves the active set as well as an exact one. Measured on
+/// membrane-radial (`docs/multigrid.md`, "Multigrid in Newton").
+pub const MULTIGRID_INEXACT_TOLERANCE: f64 = 1e-2;
 
 /// CG iterations after which a Newton step is given to the factorization instead.
 pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
@@ -166,19 +172,74 @@ fn level(d: &Discretization<TriangleMesh>) -> NestedLevel<'_> {
     }
 }
 
-/// The Newton direction `H d = b` by CG preconditioned with the cycle of `options` on
-/// `prolongations` (fine to coarse), and the CG iterations it took; `None` when the
-/// hierarchy cannot be built (a level whose operator is not SPD) or CG does not reach
-/// [`MULTIGRID_TOLERANCE`], so that Newton factors the step instead.
-pub fn multigrid_step(
-    h: &SparseMatrix,
-    prolongations: &[SparseMatrix],
-    b: &[f64],
+/// The multigrid step solver of one Newton solve (one level of a nested solve): the
+/// hierarchy is built on the first step (Galerkin products of that step's `H`) and kept;
+/// each later step adds to the coarse operators only the terms of the constraints whose
+/// active state flipped ([`Lcp::hessian_change_blocks`], [`Multigrid::add_coarse_term`]),
+/// copies `H` into the fine level and refactors the tiny coarsest one. A step is solved by
+/// CG to [`MULTIGRID_INEXACT_TOLERANCE`] while the active set still changes and to
+/// [`MULTIGRID_TOLERANCE`] once it has settled.
+pub struct MultigridSteps<'a> {
+    lcp: &'a Lcp,
+    prolongations: &'a [SparseMatrix],
     options: MultigridOptions,
-) -> Option<(Vec<f64>, usize)> {
-    let mg = Multigrid::new(h.clone(), prolongations.to_vec(), options).ok()?;
-    let pcg = mg
-        .pcg(b, MULTIGRID_TOLERANCE, MULTIGRID_MAX_ITERATIONS)
-        .ok()?;
-    (pcg.relative_residual <= MULTIGRID_TOLERANCE).then_some((pcg.x, pcg.iterations))
+    /// The hierarchy and the active set its coarse operators include.
+    hierarchy: Option<(Multigrid, Vec<bool>)>,
+    /// CG iterations over the steps solved.
+    pub krylov_iterations: usize,
+    /// Hierarchies built from the Galerkin products (1 when every update succeeded).
+    pub full_setups: usize,
+}
+
+impl<'a> MultigridSteps<'a> {
+    /// The step solver of `lcp`'s Newton solve on `prolongations` (fine to coarse, the
+    /// first one's rows `lcp`'s primal unknowns).
+    pub fn new(lcp: &'a Lcp, prolongations: &'a [SparseMatrix], options: MultigridOptions) -> Self {
+        Self {
+            lcp,
+            prolongations,
+            options,
+            hierarchy: None,
+            krylov_iterations: 0,
+            full_setups: 0,
+        }
+    }
+
+    /// The Newton direction of `step` by CG preconditioned with the cycle of the options
+    /// on the updated hierarchy; `None` when the hierarchy cannot be built (a level whose
+    /// operator is not SPD) or CG does not reach its tolerance in
+    /// [`MULTIGRID_MAX_ITERATIONS`], so that Newton factors the step instead.
+    pub fn solve(&mut self, step: NewtonStep<'_>) -> Option<Vec<f64>> {
+        let updated = self.hierarchy.take().and_then(|(mut mg, previous)| {
+            let lcp = self.lcp;
+            lcp.hessian_change_blocks(&previous, step.active, |rows, change| {
+                mg.add_coarse_term(rows, change)
+            })
+            .and_then(|()| mg.reset_fine(step.hessian))
+            .ok()
+            .map(|()| mg)
+        });
+        let mg = match updated {
+            Some(mg) => mg,
+            None => {
+                self.full_setups += 1;
+                Multigrid::new(
+                    step.hessian.clone(),
+                    self.prolongations.to_vec(),
+                    self.options,
+                )
+                .ok()?
+            }
+        };
+        let tolerance = if step.settled {
+            MULTIGRID_TOLERANCE
+        } else {
+            MULTIGRID_INEXACT_TOLERANCE
+        };
+        let pcg = mg.pcg(step.rhs, tolerance, MULTIGRID_MAX_ITERATIONS);
+        self.hierarchy = Some((mg, step.active.to_vec()));
+        let pcg = pcg.ok()?;
+        self.krylov_iterations += pcg.iterations;
+        (pcg.relative_residual <= tolerance).then_some(pcg.x)
+    }
 }
