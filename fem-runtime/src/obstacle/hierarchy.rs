@@ -38,9 +38,18 @@ pub const MULTIGRID_TOLERANCE: f64 = 1e-10;
 
 /// Relative residual at which CG ends a Newton step while the active set still changes
 /// ([`NewtonStep::settled`] false): an inexact Newton step (Dembo, Eisenstat and
-/// Steihaug 1982) moves the active set as well as an exact one. Measured on
-/// membrane-radial (`docs/multigrid.md`, "Multigrid in Newton").
-pub const MULTIGRID_INEXACT_TOLERANCE: f64 = 1e-2;
+/// Steihaug 1982) moves the active set about as well as an exact one. Measured on
+/// membrane-radial (`docs/multigrid.md`, "Multigrid in Newton"): 1e-2 and 1e-4 cost extra
+/// Newton iterations (1e-4: one P2–P0 level 10 instead of 3, damped steps), 1e-6 at most
+/// one on a few coarse levels and none on the finest, 1e-8 none.
+pub const MULTIGRID_INEXACT_TOLERANCE: f64 = 1e-6;
+
+/// The inexact Newton steps of one solve: later steps are solved to
+/// [`MULTIGRID_TOLERANCE`] whether or not the active set has settled. Inexact directions
+/// can keep a few constraints flipping without end (measured: P1–P0 at 1M unknowns with
+/// V-cycles and a tolerance of 1e-4, 40 Newton iterations without settling), exact ones
+/// settle in finitely many steps.
+pub const MULTIGRID_INEXACT_STEPS: usize = 3;
 
 /// CG iterations after which a Newton step is given to the factorization instead.
 pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
@@ -177,8 +186,8 @@ fn level(d: &Discretization<TriangleMesh>) -> NestedLevel<'_> {
 /// each later step adds to the coarse operators only the terms of the constraints whose
 /// active state flipped ([`Lcp::hessian_change_blocks`], [`Multigrid::add_coarse_term`]),
 /// copies `H` into the fine level and refactors the tiny coarsest one. A step is solved by
-/// CG to [`MULTIGRID_INEXACT_TOLERANCE`] while the active set still changes and to
-/// [`MULTIGRID_TOLERANCE`] once it has settled.
+/// CG to [`MULTIGRID_INEXACT_TOLERANCE`] while the active set still changes (for at most
+/// [`MULTIGRID_INEXACT_STEPS`] steps) and to [`MULTIGRID_TOLERANCE`] once it has settled.
 pub struct MultigridSteps<'a> {
     lcp: &'a Lcp,
     prolongations: &'a [SparseMatrix],
@@ -189,6 +198,8 @@ pub struct MultigridSteps<'a> {
     pub krylov_iterations: usize,
     /// Hierarchies built from the Galerkin products (1 when every update succeeded).
     pub full_setups: usize,
+    /// Steps asked for so far.
+    steps: usize,
 }
 
 impl<'a> MultigridSteps<'a> {
@@ -202,6 +213,7 @@ impl<'a> MultigridSteps<'a> {
             hierarchy: None,
             krylov_iterations: 0,
             full_setups: 0,
+            steps: 0,
         }
     }
 
@@ -231,7 +243,8 @@ impl<'a> MultigridSteps<'a> {
                 .ok()?
             }
         };
-        let tolerance = if step.settled {
+        self.steps += 1;
+        let tolerance = if step.settled || self.steps > MULTIGRID_INEXACT_STEPS {
             MULTIGRID_TOLERANCE
         } else {
             MULTIGRID_INEXACT_TOLERANCE
