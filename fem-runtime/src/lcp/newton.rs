@@ -704,18 +704,20 @@ pub struct NewtonStep<'a> {
     /// takes them), so that a solver can update what it built for an earlier step.
     pub active: &'a [bool],
     /// Whether the active set is that of the previous full step: Newton is then in its
-    /// final, locally quadratic phase and a step solved loosely would cost iterations.
-    /// Before that an inexact step (relative residual 1e-1 … 1e-4) is as good as an
-    /// exact one (Newton's KKT test certifies the result either way).
+    /// final phase, where a step solved loosely costs iterations. Before that a
+    /// moderately inexact step can do (`docs/multigrid.md` measures how inexact);
+    /// Newton's KKT test certifies the result either way.
     pub settled: bool,
 }
 
 /// A solver of the Newton systems `H d = b` other than the factorization (e.g. multigrid
-/// preconditioned CG, [`crate::obstacle`]): `Some(d)` when it solved the system (a
-/// descent direction, accurate to the solver's own tolerance: see
-/// [`NewtonStep::settled`]), `None` to have the step factored instead. It may keep state
-/// from step to step (a multigrid hierarchy updated by the flipped constraints).
-pub type StepSolver<'a> = &'a mut dyn FnMut(NewtonStep<'_>) -> Option<Vec<f64>>;
+/// preconditioned CG, [`crate::obstacle`]): `Some((d, exact))` when it solved the system,
+/// `exact` when to the accuracy of a factored step, otherwise a descent direction solved
+/// loosely (see [`NewtonStep::settled`]); `None` to have the step factored instead. Newton
+/// declares convergence only after an exact step, so that an inexact one never decides
+/// the answer. The solver may keep state from step to step (a multigrid hierarchy
+/// updated by the flipped constraints).
+pub type StepSolver<'a> = &'a mut dyn FnMut(NewtonStep<'_>) -> Option<(Vec<f64>, bool)>;
 
 impl Lcp {
     /// The change `H(active) − H(previous)` of Newton's Hessian, block by block: for each
@@ -828,6 +830,7 @@ pub(super) fn newton_iteration(
     };
     let mut iterative_steps = 0;
     let mut smooth_first = start.is_some() && options.smoothing_sweeps > 0;
+    let mut last_exact = true;
     let mut previous_active: Option<Vec<bool>> = None;
     // the last factored Hessian and its faces, for low-rank updates
     let mut factored: Option<(CholeskyFactor, Vec<bool>)> = None;
@@ -839,9 +842,9 @@ pub(super) fn newton_iteration(
         let au = multiply(&lcp.a, &u);
         let bu = lcp.b_times(&u);
         let (lambda, active) = lcp.eliminate(&bu);
-        // Converged: the active faces did not change over a full step, so u is the exact
-        // minimizer of the quadratic that Φ is on these faces.
-        if previous_active.as_ref() == Some(&active) {
+        // Converged: the active faces did not change over a full exact step, so u is the
+        // exact minimizer of the quadratic that Φ is on these faces.
+        if last_exact && previous_active.as_ref() == Some(&active) {
             let residual = lcp.kkt_residual(&u, &lambda);
             if residual <= options.tolerance {
                 return Ok(done(
@@ -861,7 +864,7 @@ pub(super) fn newton_iteration(
         if previous_active.is_some() {
             let cycling = !seen_faces.insert(faces_fingerprint(&active));
             let residual = lcp.kkt_residual(&u, &lambda);
-            if cycling && residual <= options.tolerance {
+            if cycling && last_exact && residual <= options.tolerance {
                 return Ok(done(
                     u,
                     lambda,
@@ -883,16 +886,20 @@ pub(super) fn newton_iteration(
         } else {
             None
         };
-        let exact = smoothed.is_none();
-        let solved = match (&smoothed, step_solver.as_mut()) {
-            (None, Some(solve)) => solve(NewtonStep {
+        let full = smoothed.is_none();
+        let (solved, solved_exact) = match (&smoothed, step_solver.as_mut()) {
+            (None, Some(solve)) => match solve(NewtonStep {
                 hessian: &h,
                 rhs: &minus_gradient,
                 active: &active,
                 settled: previous_active.as_ref() == Some(&active),
-            }),
-            _ => None,
+            }) {
+                Some((d, exact)) => (Some(d), exact),
+                None => (None, true),
+            },
+            _ => (None, true),
         };
+        let exact = full && solved_exact;
         iterative_steps += usize::from(solved.is_some());
         let d = match smoothed.or(solved) {
             Some(d) => d,
@@ -964,7 +971,9 @@ pub(super) fn newton_iteration(
                 ));
             }
         }
-        previous_active = (exact && step == 1.0).then_some(active);
+        // an inexact full step still tells whether the active set has settled
+        previous_active = (full && step == 1.0).then_some(active);
+        last_exact = exact;
     }
     // The active set never settled (constraints with λ and gap at rounding level flip
     // without end), but an iterate the KKT residual certifies is a solution all the same.

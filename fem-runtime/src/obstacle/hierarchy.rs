@@ -55,16 +55,19 @@ pub const MULTIGRID_INEXACT_STEPS: usize = 3;
 pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
 
 /// From this many primal unknowns on, [`LinearSolver::Auto`] uses multigrid: measured on
-/// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton"), the whole nested
-/// solve ties with the direct path at 1M unknowns (less memory) and loses below, since
-/// the direct path factors once per level and then updates the factor.
+/// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton", 2026-11-30, with
+/// the updated hierarchy and inexact steps), the whole nested solve is even with the
+/// direct path at 261k unknowns (1.4, 2.8 s against 2.9, 1.6 s on a shared machine) and
+/// at 1M (9.3, 11.3 s against 12.6, 9.7 s) with 10 % less memory, slower at 65k (0.45
+/// against 0.34 s): the direct path factors once per level and then updates the factor.
 pub const AUTO_MULTIGRID_UNKNOWNS: usize = 1_000_000;
 
 /// The most nonzeros per row of `A` with which [`LinearSolver::Auto`] uses multigrid.
 /// Gauss–Seidel sweeps cost a pass over the matrix each, while the direct path factors
 /// once and then updates the factor (`crate::lcp::woodbury`): on P2–P0 (about 13 per
-/// row) the direct path was 1.4× faster at 1M unknowns, on P1–P0 (7 per row) the two tie
-/// there (`docs/multigrid.md`, "Multigrid in Newton").
+/// row) the direct path was 2× faster at 261k unknowns (1.5 against 3.2 s) and even at
+/// 1M (11.4, 13.0 s against 14.0, 12.8 s); on P1–P0 (7 per row) the two are even from
+/// 261k on (`docs/multigrid.md`, "Multigrid in Newton").
 pub const AUTO_MULTIGRID_ROW_NONZEROS: f64 = 10.0;
 
 impl LinearSolver {
@@ -218,10 +221,11 @@ impl<'a> MultigridSteps<'a> {
     }
 
     /// The Newton direction of `step` by CG preconditioned with the cycle of the options
-    /// on the updated hierarchy; `None` when the hierarchy cannot be built (a level whose
+    /// on the updated hierarchy, and whether it was solved to [`MULTIGRID_TOLERANCE`]
+    /// (an exact step); `None` when the hierarchy cannot be built (a level whose
     /// operator is not SPD) or CG does not reach its tolerance in
     /// [`MULTIGRID_MAX_ITERATIONS`], so that Newton factors the step instead.
-    pub fn solve(&mut self, step: NewtonStep<'_>) -> Option<Vec<f64>> {
+    pub fn solve(&mut self, step: NewtonStep<'_>) -> Option<(Vec<f64>, bool)> {
         let updated = self.hierarchy.take().and_then(|(mut mg, previous)| {
             let lcp = self.lcp;
             lcp.hessian_change_blocks(&previous, step.active, |rows, change| {
@@ -253,6 +257,6 @@ impl<'a> MultigridSteps<'a> {
         self.hierarchy = Some((mg, step.active.to_vec()));
         let pcg = pcg.ok()?;
         self.krylov_iterations += pcg.iterations;
-        (pcg.relative_residual <= tolerance).then_some(pcg.x)
+        (pcg.relative_residual <= tolerance).then_some((pcg.x, tolerance <= MULTIGRID_TOLERANCE))
     }
 }
