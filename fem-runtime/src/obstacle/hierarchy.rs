@@ -37,12 +37,14 @@ pub enum LinearSolver {
 pub const MULTIGRID_TOLERANCE: f64 = 1e-10;
 
 /// Relative residual at which CG ends a Newton step while the active set still changes
-/// ([`NewtonStep::settled`] false): an inexact Newton step (Dembo, Eisenstat and
-/// Steihaug 1982) moves the active set about as well as an exact one. Measured on
-/// membrane-radial (`docs/multigrid.md`, "Multigrid in Newton"): 1e-2 and 1e-4 cost extra
-/// Newton iterations (1e-4: one P2–P0 level 10 instead of 3, damped steps), 1e-6 at most
-/// one on a few coarse levels and none on the finest, 1e-8 none.
-pub const MULTIGRID_INEXACT_TOLERANCE: f64 = 1e-6;
+/// ([`NewtonStep::settled`] false), for inexact Newton steps (Dembo, Eisenstat and
+/// Steihaug 1982); Newton converges only after an exact step. Measured on membrane-radial
+/// (`docs/multigrid.md`, "Multigrid in Newton"): from nested starts Newton needs 2–4
+/// steps a level, and the last step before the active set settles is usually the last
+/// one, so loose steps add a Newton iteration per level (1e-6: P1–P0 at 261k unknowns 4
+/// iterations and 18 CG iterations against 3 and 16 exact) and save nothing: off (equal
+/// to [`MULTIGRID_TOLERANCE`]) until a cheaper final test exists.
+pub const MULTIGRID_INEXACT_TOLERANCE: f64 = MULTIGRID_TOLERANCE;
 
 /// The inexact Newton steps of one solve: later steps are solved to
 /// [`MULTIGRID_TOLERANCE`] whether or not the active set has settled. Inexact directions
@@ -56,9 +58,9 @@ pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
 
 /// From this many primal unknowns on, [`LinearSolver::Auto`] uses multigrid: measured on
 /// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton", 2026-11-30, with
-/// the updated hierarchy and inexact steps), the whole nested solve is even with the
-/// direct path at 261k unknowns (1.4, 2.8 s against 2.9, 1.6 s on a shared machine) and
-/// at 1M (9.3, 11.3 s against 12.6, 9.7 s) with 10 % less memory, slower at 65k (0.45
+/// the updated hierarchy), the whole nested solve is about even with the direct path at
+/// 261k unknowns (1.7, 2.0 s against 1.5–2.9 s on a shared machine) and at 1M (9.3,
+/// 11.3 s against 12.6, 9.7 s, 1e-6 steps) with 10 % less memory, slower at 65k (0.45
 /// against 0.34 s): the direct path factors once per level and then updates the factor.
 pub const AUTO_MULTIGRID_UNKNOWNS: usize = 1_000_000;
 
