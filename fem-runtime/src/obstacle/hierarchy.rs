@@ -58,18 +58,19 @@ pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
 
 /// From this many primal unknowns on, [`LinearSolver::Auto`] uses multigrid: measured on
 /// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton", 2026-11-30, with
-/// the updated hierarchy), the whole nested solve is about even with the direct path at
-/// 261k unknowns (1.7, 2.0 s against 1.5–2.9 s on a shared machine) and at 1M (9.3,
-/// 11.3 s against 12.6, 9.7 s, 1e-6 steps) with 10 % less memory, slower at 65k (0.45
-/// against 0.34 s): the direct path factors once per level and then updates the factor.
+/// the updated hierarchy), the whole nested solve is not faster than the direct path
+/// anywhere yet: at 1M unknowns runs side by side went either way (14.5 against 8.3 s,
+/// 10.7 against 12.2 s on a shared machine) with 10 % less memory, at 261k it lost (1.9
+/// against 1.35 s): the direct path factors once per level and then updates the factor.
+/// Kept where the two are closest.
 pub const AUTO_MULTIGRID_UNKNOWNS: usize = 1_000_000;
 
 /// The most nonzeros per row of `A` with which [`LinearSolver::Auto`] uses multigrid.
 /// Gauss–Seidel sweeps cost a pass over the matrix each, while the direct path factors
 /// once and then updates the factor (`crate::lcp::woodbury`): on P2–P0 (about 13 per
-/// row) the direct path was 2× faster at 261k unknowns (1.5 against 3.2 s) and even at
-/// 1M (11.4, 13.0 s against 14.0, 12.8 s); on P1–P0 (7 per row) the two are even from
-/// 261k on (`docs/multigrid.md`, "Multigrid in Newton").
+/// row) the direct path was 1.8× faster at 261k unknowns (1.75 against 3.2 s) and 1.6×
+/// at 1M (9.8 against 16.2 s); on P1–P0 (7 per row) the two are closest at 1M
+/// (`docs/multigrid.md`, "Multigrid in Newton").
 pub const AUTO_MULTIGRID_ROW_NONZEROS: f64 = 10.0;
 
 impl LinearSolver {
