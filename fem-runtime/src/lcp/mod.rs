@@ -32,7 +32,7 @@ use blocks::*;
 use newton::*;
 pub use newton::{
     semismooth_newton, semismooth_newton_prepared, semismooth_newton_with, NewtonOptions,
-    NewtonWorkspace, StepSolver,
+    NewtonStep, NewtonWorkspace, StepSolver,
 };
 pub use qp::quadratic_program;
 pub use recovery::recover_multiplier;

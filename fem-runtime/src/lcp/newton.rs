@@ -693,10 +693,83 @@ pub fn semismooth_newton_prepared(
     newton_iteration(lcp, workspace, None, start, options, clock)
 }
 
+/// One Newton system `H d = b` handed to a [`StepSolver`].
+#[derive(Clone, Copy, Debug)]
+pub struct NewtonStep<'a> {
+    /// The Hessian `H` (the pattern is the same at every step of one solve).
+    pub hessian: &'a SparseMatrix,
+    /// `b = −∇Φ`.
+    pub rhs: &'a [f64],
+    /// The active constraints `H` includes (per constraint, as [`Lcp::hessian_change_blocks`]
+    /// takes them), so that a solver can update what it built for an earlier step.
+    pub active: &'a [bool],
+    /// Whether the active set is that of the previous full step: Newton is then in its
+    /// final phase, where a step solved loosely costs iterations. Before that a
+    /// moderately inexact step can do (`docs/multigrid.md` measures how inexact);
+    /// Newton's KKT test certifies the result either way.
+    pub settled: bool,
+}
+
 /// A solver of the Newton systems `H d = b` other than the factorization (e.g. multigrid
-/// preconditioned CG, [`crate::obstacle`]): `Some(d)` when it solved the system to the
-/// accuracy of a factored step, `None` to have the step factored instead.
-pub type StepSolver<'a> = &'a (dyn Fn(&SparseMatrix, &[f64]) -> Option<Vec<f64>> + Sync);
+/// preconditioned CG, [`crate::obstacle`]): `Some((d, exact))` when it solved the system,
+/// `exact` when to the accuracy of a factored step, otherwise a descent direction solved
+/// loosely (see [`NewtonStep::settled`]); `None` to have the step factored instead. Newton
+/// declares convergence only after an exact step, so that an inexact one never decides
+/// the answer. The solver may keep state from step to step (a multigrid hierarchy
+/// updated by the flipped constraints).
+pub type StepSolver<'a> = &'a mut dyn FnMut(NewtonStep<'_>) -> Option<(Vec<f64>, bool)>;
+
+impl Lcp {
+    /// The change `H(active) − H(previous)` of Newton's Hessian, block by block: for each
+    /// block of constraints whose active face differs, `visit(rows, change)` with its rows
+    /// of `B` (sparse, `(column, value)`) and the `s × s` change (row-major, `s` the block
+    /// size, symmetric) of `P_I C_II⁻¹ P_Iᵀ`, so that the change is `Σ Bᵦᵀ change Bᵦ`
+    /// over the visited blocks (docs/mathematics.md §5). With `previous` all false it is
+    /// the whole active part `Bᵀ H_I B` of the Hessian.
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `previous` or `active` is not of length `m`; `visit`'s error,
+    /// which ends the visit.
+    pub fn hessian_change_blocks(
+        &self,
+        previous: &[bool],
+        active: &[bool],
+        mut visit: impl FnMut(&[&[(usize, f64)]], &[f64]) -> Result<()>,
+    ) -> Result<()> {
+        if previous.len() != self.m() || active.len() != self.m() {
+            return Err(Error::Input(format!(
+                "active sets of {} and {} constraints for an LCP of {}",
+                previous.len(),
+                active.len(),
+                self.m()
+            )));
+        }
+        let mut face = [0usize; MAX_BLOCK];
+        let mut inverse = [0.0; BLOCK_ENTRIES];
+        let mut rows: [&[(usize, f64)]; MAX_BLOCK] = [&[]; MAX_BLOCK];
+        for block in self.blocks() {
+            let range = block.range();
+            if previous[range.clone()] == active[range.clone()] {
+                continue;
+            }
+            let s = block.size;
+            let mut change = [0.0; BLOCK_ENTRIES];
+            for (sign, flags) in [(1.0, active), (-1.0, previous)] {
+                let q = self.face_inverse(&block, flags, &mut face, &mut inverse);
+                for a in 0..q {
+                    for c in 0..q {
+                        change[face[a] * s + face[c]] += sign * inverse[a * q + c];
+                    }
+                }
+            }
+            for (row, k) in rows.iter_mut().zip(range) {
+                *row = &self.b_rows[k];
+            }
+            visit(&rows[..s], &change[..s * s])?;
+        }
+        Ok(())
+    }
+}
 
 /// [`semismooth_newton_prepared`] with the exact steps solved by `step` (each step it
 /// declines is factored as usual and counted in [`LcpSolution::factorizations`]).
@@ -727,7 +800,7 @@ pub fn semismooth_newton_with(
 pub(super) fn newton_iteration(
     lcp: &Lcp,
     workspace: &NewtonWorkspace,
-    step_solver: Option<StepSolver>,
+    mut step_solver: Option<StepSolver>,
     start: Option<&[f64]>,
     options: NewtonOptions,
     clock: Instant,
@@ -757,6 +830,7 @@ pub(super) fn newton_iteration(
     };
     let mut iterative_steps = 0;
     let mut smooth_first = start.is_some() && options.smoothing_sweeps > 0;
+    let mut last_exact = true;
     let mut previous_active: Option<Vec<bool>> = None;
     // the last factored Hessian and its faces, for low-rank updates
     let mut factored: Option<(CholeskyFactor, Vec<bool>)> = None;
@@ -768,9 +842,9 @@ pub(super) fn newton_iteration(
         let au = multiply(&lcp.a, &u);
         let bu = lcp.b_times(&u);
         let (lambda, active) = lcp.eliminate(&bu);
-        // Converged: the active faces did not change over a full step, so u is the exact
-        // minimizer of the quadratic that Φ is on these faces.
-        if previous_active.as_ref() == Some(&active) {
+        // Converged: the active faces did not change over a full exact step, so u is the
+        // exact minimizer of the quadratic that Φ is on these faces.
+        if last_exact && previous_active.as_ref() == Some(&active) {
             let residual = lcp.kkt_residual(&u, &lambda);
             if residual <= options.tolerance {
                 return Ok(done(
@@ -790,7 +864,7 @@ pub(super) fn newton_iteration(
         if previous_active.is_some() {
             let cycling = !seen_faces.insert(faces_fingerprint(&active));
             let residual = lcp.kkt_residual(&u, &lambda);
-            if cycling && residual <= options.tolerance {
+            if cycling && last_exact && residual <= options.tolerance {
                 return Ok(done(
                     u,
                     lambda,
@@ -812,11 +886,20 @@ pub(super) fn newton_iteration(
         } else {
             None
         };
-        let exact = smoothed.is_none();
-        let solved = match (&smoothed, step_solver) {
-            (None, Some(solve)) => solve(&h, &minus_gradient),
-            _ => None,
+        let full = smoothed.is_none();
+        let (solved, solved_exact) = match (&smoothed, step_solver.as_mut()) {
+            (None, Some(solve)) => match solve(NewtonStep {
+                hessian: &h,
+                rhs: &minus_gradient,
+                active: &active,
+                settled: previous_active.as_ref() == Some(&active),
+            }) {
+                Some((d, exact)) => (Some(d), exact),
+                None => (None, true),
+            },
+            _ => (None, true),
         };
+        let exact = full && solved_exact;
         iterative_steps += usize::from(solved.is_some());
         let d = match smoothed.or(solved) {
             Some(d) => d,
@@ -888,7 +971,9 @@ pub(super) fn newton_iteration(
                 ));
             }
         }
-        previous_active = (exact && step == 1.0).then_some(active);
+        // an inexact full step still tells whether the active set has settled
+        previous_active = (full && step == 1.0).then_some(active);
+        last_exact = exact;
     }
     // The active set never settled (constraints with λ and gap at rounding level flip
     // without end), but an iterate the KKT residual certifies is a solution all the same.

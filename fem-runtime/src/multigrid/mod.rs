@@ -71,6 +71,13 @@ struct Work {
 pub struct Multigrid {
     levels: Vec<Level>,
     coarsest: CholeskyFactor,
+    /// The coarsest operator's symbolic factorization, for refactoring after updates.
+    coarsest_analysis: Cholesky,
+    /// `P_lᵀ` of every prolongation (row access to `P_l`), built on the first update.
+    restrictions: Vec<SparseMatrix>,
+    /// The sparse restriction's accumulator, marks and index list (see
+    /// [`restrict_sparse`]), sized for level 1 on the first update.
+    scratch: (Vec<f64>, Vec<bool>, Vec<usize>),
     options: MultigridOptions,
     work: RefCell<Vec<Work>>,
 }
@@ -142,11 +149,10 @@ impl Multigrid {
             .symbolic()
             .to_owned()
             .map_err(|e| Error::LinearSolve(format!("the coarsest pattern: {e:?}")))?;
-        let coarsest = Cholesky::analyse(&pattern)?
-            .factor_cholesky(&a)
-            .map_err(|e| {
-                Error::LinearSolve(format!("the coarsest operator (order {}): {e}", a.nrows()))
-            })?;
+        let coarsest_analysis = Cholesky::analyse(&pattern)?;
+        let coarsest = coarsest_analysis.factor_cholesky(&a).map_err(|e| {
+            Error::LinearSolve(format!("the coarsest operator (order {}): {e}", a.nrows()))
+        })?;
         let inverse_diagonal = inverse_diagonal(&a, levels.len())?;
         levels.push(Level {
             a,
@@ -167,6 +173,9 @@ impl Multigrid {
         Ok(Self {
             levels,
             coarsest,
+            coarsest_analysis,
+            restrictions: Vec::new(),
+            scratch: (Vec::new(), Vec::new(), Vec::new()),
             options,
             work: RefCell::new(work),
         })
@@ -185,6 +194,111 @@ impl Multigrid {
     /// The operator of level `l` (0: the fine matrix; then the Galerkin operators).
     pub fn operator(&self, l: usize) -> Option<&SparseMatrix> {
         self.levels.get(l).map(|level| &level.a)
+    }
+
+    /// Adds `Q_l U S Uᵀ Q_lᵀ` to the Galerkin operator of every coarse level `l ≥ 1`
+    /// (`Q_l = P_{l−1}ᵀ ⋯ P_0ᵀ`, the restriction from the fine level), i.e. keeps the
+    /// coarse operators those of `A₀ + U S Uᵀ` without forming a product: `columns` are
+    /// the columns of `U` (sparse, fine indices), `s` the `q × q` matrix `S` (row-major,
+    /// `q` columns; its symmetric part is used). For a Newton Hessian `H = A + Bᵀ H_I B`
+    /// the columns are a block's rows of `B`, a handful of nonzeros each, and so is each
+    /// `Q_l u`. The fine operator is left alone: [`Multigrid::reset_fine`] replaces it
+    /// and refactors the coarsest level once all terms are in.
+    ///
+    /// Errors: `s` not `q × q`, a column entry beyond the fine order, an entry of
+    /// `Q_l u (Q_l v)ᵀ` outside level `l`'s pattern (then some levels are updated and
+    /// others not: rebuild the hierarchy with [`Multigrid::new`]). For nested Lagrange
+    /// spaces a column supported on one fine cell restricts to the DOFs of its ancestor
+    /// cell on each level, which the Galerkin pattern couples, so this does not happen.
+    pub fn add_coarse_term(&mut self, columns: &[&[(usize, f64)]], s: &[f64]) -> Result<()> {
+        let q = columns.len();
+        if s.len() != q * q {
+            return Err(Error::Input(format!(
+                "a term of {q} columns needs {} entries of S, not {}",
+                q * q,
+                s.len()
+            )));
+        }
+        let n = self.levels[0].a.nrows();
+        if let Some(&(i, _)) = columns.iter().flat_map(|c| c.iter()).find(|e| e.0 >= n) {
+            return Err(Error::Input(format!(
+                "a term with an entry in row {i} for a hierarchy of fine order {n}"
+            )));
+        }
+        if self.levels.len() == 1 || q == 0 {
+            return Ok(());
+        }
+        if self.restrictions.is_empty() {
+            self.restrictions = self
+                .levels
+                .iter()
+                .filter_map(|level| level.p.as_ref().map(sparse::transpose))
+                .collect();
+            let order = self.levels[1].a.nrows();
+            self.scratch = (vec![0.0; order], vec![false; order], Vec::new());
+        }
+        let (dense, seen, touched) = &mut self.scratch;
+        // the columns restricted to the level below, in turn
+        let mut vectors: Vec<Vec<(usize, f64)>> = columns.iter().map(|c| c.to_vec()).collect();
+        for l in 1..self.levels.len() {
+            let restriction = &self.restrictions[l - 1];
+            for vector in &mut vectors {
+                restrict_sparse(restriction, vector, dense, seen, touched);
+            }
+            let a = &mut self.levels[l].a;
+            let (symbolic, values) = a.parts_mut();
+            let (col_ptr, rows) = (symbolic.col_ptr(), symbolic.row_idx());
+            for (x, u) in vectors.iter().enumerate() {
+                for (y, v) in vectors.iter().enumerate() {
+                    let w = 0.5 * (s[x * q + y] + s[y * q + x]);
+                    if w == 0.0 {
+                        continue;
+                    }
+                    for &(j, vj) in v {
+                        let column = &rows[col_ptr[j]..col_ptr[j + 1]];
+                        for &(i, ui) in u {
+                            let Ok(k) = column.binary_search(&i) else {
+                                return Err(Error::Input(format!(
+                                    "multigrid level {l}: the update has an entry ({i}, {j}) outside the Galerkin pattern"
+                                )));
+                            };
+                            values[col_ptr[j] + k] += w * ui * vj;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Replaces the fine operator's values by `fine`'s (the same pattern: a Newton
+    /// Hessian of the same LCP), and recomputes what depends on the operators: the
+    /// inverse diagonals of every level and the numeric factorization of the coarsest
+    /// one (which is tiny). Call it after the [`Multigrid::add_coarse_term`]s of a step.
+    ///
+    /// Errors: `fine` of another pattern or not symmetric-positive on its diagonal, a
+    /// level whose diagonal is not positive, a coarsest operator Cholesky refuses.
+    pub fn reset_fine(&mut self, fine: &SparseMatrix) -> Result<()> {
+        let level = &mut self.levels[0];
+        if fine.symbolic().col_ptr() != level.a.symbolic().col_ptr()
+            || fine.symbolic().row_idx() != level.a.symbolic().row_idx()
+        {
+            return Err(Error::Input(
+                "the new fine operator has another sparsity pattern than the hierarchy's".into(),
+            ));
+        }
+        level.a.val_mut().copy_from_slice(fine.val());
+        for (l, level) in self.levels.iter_mut().enumerate() {
+            level.inverse_diagonal = inverse_diagonal(&level.a, l)?;
+        }
+        let last = &self.levels[self.levels.len() - 1].a;
+        self.coarsest = self.coarsest_analysis.factor_cholesky(last).map_err(|e| {
+            Error::LinearSolve(format!(
+                "the coarsest operator (order {}): {e}",
+                last.nrows()
+            ))
+        })?;
+        Ok(())
     }
 
     /// `x = M⁻¹ b`, one cycle (V or W, as the options say) from `x = 0` on the fine level.
@@ -313,6 +427,38 @@ impl Multigrid {
         Err(Error::LinearSolve(format!(
             "multigrid-preconditioned CG did not reach the relative residual {tolerance:e} in {max_iterations} iterations (it reached {relative:e})"
         )))
+    }
+}
+
+/// `v ← Rv` for a sparse `v` (`(index, value)`, indices distinct) and `R = Pᵀ` stored by
+/// columns, through the dense accumulator `dense` (all zero, left so) with its marks
+/// `seen` (all false, left so) and the index list `touched`.
+fn restrict_sparse(
+    restriction: &SparseMatrix,
+    v: &mut Vec<(usize, f64)>,
+    dense: &mut [f64],
+    seen: &mut [bool],
+    touched: &mut Vec<usize>,
+) {
+    let (col_ptr, rows, vals) = (
+        restriction.symbolic().col_ptr(),
+        restriction.symbolic().row_idx(),
+        restriction.val(),
+    );
+    touched.clear();
+    for &(i, vi) in v.iter() {
+        for k in col_ptr[i]..col_ptr[i + 1] {
+            let j = rows[k];
+            if !std::mem::replace(&mut seen[j], true) {
+                touched.push(j);
+            }
+            dense[j] += vals[k] * vi;
+        }
+    }
+    v.clear();
+    for &j in touched.iter() {
+        seen[j] = false;
+        v.push((j, std::mem::take(&mut dense[j])));
     }
 }
 

@@ -581,3 +581,118 @@ fn bad_inputs_are_errors() {
     let outside = TriangleMesh::rectangle(2.0, 3.0, 0.0, 1.0, 1, 1, Diagonal::Right).unwrap();
     assert!(parents_by_location(&meshes[0], &outside).is_err());
 }
+
+/// The coarse operators kept up to date by [`Multigrid::add_coarse_term`] equal the
+/// Galerkin products recomputed from scratch (to 1e-12 of the largest entry) after
+/// several changes of an "active set" of cell terms `u S uᵀ`: rank-one terms (a diagonal
+/// `C`) and rank-two ones with a full symmetric `S` (a block of `C`), supported on one
+/// fine cell's free DOFs, switched on and off at random as a Newton iteration does.
+#[test]
+fn updated_coarse_operators_are_the_recomputed_ones() {
+    fn check<M: Model>(levels: usize) {
+        let meshes = hierarchy(levels, Diagonal::Right);
+        let (data, prolongations) = laplace_hierarchy::<M>(&meshes);
+        let fine = data.last().unwrap();
+        let mesh = meshes.last().unwrap();
+        let map = fine.dofs.map(0).unwrap();
+        let mut state = 7;
+        // one term per fine cell: its columns (free DOFs of the cell, random weights) and S
+        type Term = (Vec<Vec<(usize, f64)>>, Vec<f64>);
+        let terms: Vec<Term> = (0..mesh.cell_count())
+            .map(|c| {
+                let free: Vec<usize> = map
+                    .cell_dofs(c)
+                    .iter()
+                    .filter_map(|&d| fine.reduction.free_index(d))
+                    .collect();
+                let mut column = || -> Vec<(usize, f64)> {
+                    free.iter()
+                        .map(|&i| (i, 0.5 + random(&mut state)))
+                        .collect()
+                };
+                if c % 3 == 0 {
+                    let (u, v) = (column(), column());
+                    // SPD: diagonal dominant
+                    let off = random(&mut state);
+                    (vec![u, v], vec![2.0 + off, off, off, 3.0])
+                } else {
+                    (vec![column()], vec![1.0 + 10.0 * random(&mut state)])
+                }
+            })
+            .collect();
+        let n = fine.a.nrows();
+        let hessian = |active: &[bool]| -> SparseMatrix {
+            let (col_ptr, rows, vals) = (
+                fine.a.symbolic().col_ptr(),
+                fine.a.symbolic().row_idx(),
+                fine.a.val(),
+            );
+            let mut triplets: Vec<Triplet<usize, usize, f64>> = (0..n)
+                .flat_map(|j| {
+                    (col_ptr[j]..col_ptr[j + 1]).map(move |k| Triplet::new(rows[k], j, vals[k]))
+                })
+                .collect();
+            for ((columns, s), _) in terms.iter().zip(active).filter(|(_, &on)| on) {
+                let q = columns.len();
+                for (x, u) in columns.iter().enumerate() {
+                    for (y, v) in columns.iter().enumerate() {
+                        for &(i, ui) in u {
+                            for &(j, vj) in v {
+                                triplets.push(Triplet::new(i, j, s[x * q + y] * ui * vj));
+                            }
+                        }
+                    }
+                }
+            }
+            SparseColMat::try_new_from_triplets(n, n, &triplets).unwrap()
+        };
+        let mut active: Vec<bool> = (0..terms.len()).map(|_| random(&mut state) < 0.3).collect();
+        let options = MultigridOptions::default();
+        let mut mg = Multigrid::new(hessian(&active), prolongations.clone(), options).unwrap();
+        for round in 0..4 {
+            let previous = active.clone();
+            for flag in active.iter_mut() {
+                if random(&mut state) < 0.2 {
+                    *flag = !*flag;
+                }
+            }
+            for ((columns, s), (&was, &is)) in terms.iter().zip(previous.iter().zip(&active)) {
+                if was != is {
+                    let sign = if is { 1.0 } else { -1.0 };
+                    let s: Vec<f64> = s.iter().map(|v| sign * v).collect();
+                    let columns: Vec<&[(usize, f64)]> = columns.iter().map(|c| &c[..]).collect();
+                    mg.add_coarse_term(&columns, &s).unwrap();
+                }
+            }
+            let h = hessian(&active);
+            mg.reset_fine(&h).unwrap();
+            let fresh = Multigrid::new(h, prolongations.clone(), options).unwrap();
+            for l in 0..mg.level_count() {
+                let (updated, expected) = (mg.operator(l).unwrap(), fresh.operator(l).unwrap());
+                assert_eq!(updated.symbolic().col_ptr(), expected.symbolic().col_ptr());
+                assert_eq!(updated.symbolic().row_idx(), expected.symbolic().row_idx());
+                let scale = expected.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let worst = updated
+                    .val()
+                    .iter()
+                    .zip(expected.val())
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                assert!(
+                    worst <= 1e-12 * scale,
+                    "{} round {round} level {l}: updated operator off by {worst:e} of {scale:e}",
+                    M::NAME
+                );
+            }
+            // the updated hierarchy still preconditions: CG reaches the tolerance
+            let b: Vec<f64> = (0..n).map(|_| random(&mut state) - 0.5).collect();
+            let pcg = mg.pcg(&b, 1e-10, 60).unwrap();
+            let reference = fresh.pcg(&b, 1e-10, 60).unwrap();
+            assert!(pcg.iterations.abs_diff(reference.iterations) <= 1);
+        }
+        // terms outside the hierarchy's order are refused
+        assert!(mg.add_coarse_term(&[&[(n, 1.0)]], &[1.0]).is_err());
+        assert!(mg.add_coarse_term(&[&[(0, 1.0)]], &[1.0, 2.0]).is_err());
+    }
+    check::<laplace_p1::Model>(4);
+    check::<laplace_p2::Model>(4);
+}

@@ -6,7 +6,7 @@
 
 use super::Discretization;
 use crate::error::{Error, Result};
-use crate::lcp::Lcp;
+use crate::lcp::{Lcp, NewtonStep};
 use crate::mesh::TriangleMesh;
 use crate::multigrid::{
     parents_by_location, prolongation, Multigrid, MultigridOptions, NestedLevel,
@@ -36,20 +36,41 @@ pub enum LinearSolver {
 /// active-set iteration that of factored steps.
 pub const MULTIGRID_TOLERANCE: f64 = 1e-10;
 
+/// Relative residual at which CG ends a Newton step while the active set still changes
+/// ([`NewtonStep::settled`] false), for inexact Newton steps (Dembo, Eisenstat and
+/// Steihaug 1982); Newton converges only after an exact step. Measured on membrane-radial
+/// (`docs/multigrid.md`, "Multigrid in Newton"): from nested starts Newton needs 2–4
+/// steps a level, and the last step before the active set settles is usually the last
+/// one, so loose steps add a Newton iteration per level (1e-6: P1–P0 at 261k unknowns 4
+/// iterations and 18 CG iterations against 3 and 16 exact) and save nothing: off (equal
+/// to [`MULTIGRID_TOLERANCE`]) until a cheaper final test exists.
+pub const MULTIGRID_INEXACT_TOLERANCE: f64 = MULTIGRID_TOLERANCE;
+
+/// The inexact Newton steps of one solve: later steps are solved to
+/// [`MULTIGRID_TOLERANCE`] whether or not the active set has settled. Inexact directions
+/// can keep a few constraints flipping without end (measured: P1–P0 at 1M unknowns with
+/// V-cycles and a tolerance of 1e-4, 40 Newton iterations without settling), exact ones
+/// settle in finitely many steps.
+pub const MULTIGRID_INEXACT_STEPS: usize = 3;
+
 /// CG iterations after which a Newton step is given to the factorization instead.
 pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
 
 /// From this many primal unknowns on, [`LinearSolver::Auto`] uses multigrid: measured on
-/// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton"), the whole nested
-/// solve ties with the direct path at 1M unknowns (less memory) and loses below, since
-/// the direct path factors once per level and then updates the factor.
+/// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton", 2026-11-30, with
+/// the updated hierarchy), the whole nested solve is not faster than the direct path
+/// anywhere yet: at 1M unknowns runs side by side went either way (14.5 against 8.3 s,
+/// 10.7 against 12.2 s on a shared machine) with 10 % less memory, at 261k it lost (1.9
+/// against 1.35 s): the direct path factors once per level and then updates the factor.
+/// Kept where the two are closest.
 pub const AUTO_MULTIGRID_UNKNOWNS: usize = 1_000_000;
 
 /// The most nonzeros per row of `A` with which [`LinearSolver::Auto`] uses multigrid.
 /// Gauss–Seidel sweeps cost a pass over the matrix each, while the direct path factors
 /// once and then updates the factor (`crate::lcp::woodbury`): on P2–P0 (about 13 per
-/// row) the direct path was 1.4× faster at 1M unknowns, on P1–P0 (7 per row) the two tie
-/// there (`docs/multigrid.md`, "Multigrid in Newton").
+/// row) the direct path was 1.8× faster at 261k unknowns (1.75 against 3.2 s) and 1.6×
+/// at 1M (9.8 against 16.2 s); on P1–P0 (7 per row) the two are closest at 1M
+/// (`docs/multigrid.md`, "Multigrid in Newton").
 pub const AUTO_MULTIGRID_ROW_NONZEROS: f64 = 10.0;
 
 impl LinearSolver {
@@ -166,19 +187,79 @@ fn level(d: &Discretization<TriangleMesh>) -> NestedLevel<'_> {
     }
 }
 
-/// The Newton direction `H d = b` by CG preconditioned with the cycle of `options` on
-/// `prolongations` (fine to coarse), and the CG iterations it took; `None` when the
-/// hierarchy cannot be built (a level whose operator is not SPD) or CG does not reach
-/// [`MULTIGRID_TOLERANCE`], so that Newton factors the step instead.
-pub fn multigrid_step(
-    h: &SparseMatrix,
-    prolongations: &[SparseMatrix],
-    b: &[f64],
+/// The multigrid step solver of one Newton solve (one level of a nested solve): the
+/// hierarchy is built on the first step (Galerkin products of that step's `H`) and kept;
+/// each later step adds to the coarse operators only the terms of the constraints whose
+/// active state flipped ([`Lcp::hessian_change_blocks`], [`Multigrid::add_coarse_term`]),
+/// copies `H` into the fine level and refactors the tiny coarsest one. A step is solved by
+/// CG to [`MULTIGRID_INEXACT_TOLERANCE`] while the active set still changes (for at most
+/// [`MULTIGRID_INEXACT_STEPS`] steps) and to [`MULTIGRID_TOLERANCE`] once it has settled.
+pub struct MultigridSteps<'a> {
+    lcp: &'a Lcp,
+    prolongations: &'a [SparseMatrix],
     options: MultigridOptions,
-) -> Option<(Vec<f64>, usize)> {
-    let mg = Multigrid::new(h.clone(), prolongations.to_vec(), options).ok()?;
-    let pcg = mg
-        .pcg(b, MULTIGRID_TOLERANCE, MULTIGRID_MAX_ITERATIONS)
-        .ok()?;
-    (pcg.relative_residual <= MULTIGRID_TOLERANCE).then_some((pcg.x, pcg.iterations))
+    /// The hierarchy and the active set its coarse operators include.
+    hierarchy: Option<(Multigrid, Vec<bool>)>,
+    /// CG iterations over the steps solved.
+    pub krylov_iterations: usize,
+    /// Hierarchies built from the Galerkin products (1 when every update succeeded).
+    pub full_setups: usize,
+    /// Steps asked for so far.
+    steps: usize,
+}
+
+impl<'a> MultigridSteps<'a> {
+    /// The step solver of `lcp`'s Newton solve on `prolongations` (fine to coarse, the
+    /// first one's rows `lcp`'s primal unknowns).
+    pub fn new(lcp: &'a Lcp, prolongations: &'a [SparseMatrix], options: MultigridOptions) -> Self {
+        Self {
+            lcp,
+            prolongations,
+            options,
+            hierarchy: None,
+            krylov_iterations: 0,
+            full_setups: 0,
+            steps: 0,
+        }
+    }
+
+    /// The Newton direction of `step` by CG preconditioned with the cycle of the options
+    /// on the updated hierarchy, and whether it was solved to [`MULTIGRID_TOLERANCE`]
+    /// (an exact step); `None` when the hierarchy cannot be built (a level whose
+    /// operator is not SPD) or CG does not reach its tolerance in
+    /// [`MULTIGRID_MAX_ITERATIONS`], so that Newton factors the step instead.
+    pub fn solve(&mut self, step: NewtonStep<'_>) -> Option<(Vec<f64>, bool)> {
+        let updated = self.hierarchy.take().and_then(|(mut mg, previous)| {
+            let lcp = self.lcp;
+            lcp.hessian_change_blocks(&previous, step.active, |rows, change| {
+                mg.add_coarse_term(rows, change)
+            })
+            .and_then(|()| mg.reset_fine(step.hessian))
+            .ok()
+            .map(|()| mg)
+        });
+        let mg = match updated {
+            Some(mg) => mg,
+            None => {
+                self.full_setups += 1;
+                Multigrid::new(
+                    step.hessian.clone(),
+                    self.prolongations.to_vec(),
+                    self.options,
+                )
+                .ok()?
+            }
+        };
+        self.steps += 1;
+        let tolerance = if step.settled || self.steps > MULTIGRID_INEXACT_STEPS {
+            MULTIGRID_TOLERANCE
+        } else {
+            MULTIGRID_INEXACT_TOLERANCE
+        };
+        let pcg = mg.pcg(step.rhs, tolerance, MULTIGRID_MAX_ITERATIONS);
+        self.hierarchy = Some((mg, step.active.to_vec()));
+        let pcg = pcg.ok()?;
+        self.krylov_iterations += pcg.iterations;
+        (pcg.relative_residual <= tolerance).then_some((pcg.x, tolerance <= MULTIGRID_TOLERANCE))
+    }
 }

@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::lcp::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
     semismooth_newton_prepared, semismooth_newton_with, ConstraintRows, CouplingBlocks, Lcp,
-    LcpSolution, NewtonOptions, NewtonWorkspace,
+    LcpSolution, NewtonOptions, NewtonStep, NewtonWorkspace,
 };
 use crate::mesh::{IntervalMesh, Mesh};
 use crate::model::{Coefficients, FormId, IntoFormIndex, Model};
@@ -27,7 +27,7 @@ use crate::norms::FieldView;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use fem_reference::DofLocation;
-use hierarchy::{multigrid_step, LinearSolver};
+use hierarchy::{LinearSolver, MultigridSteps};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
@@ -762,21 +762,18 @@ pub fn solve_lcp_on_hierarchy(
                 },
                 ..options.newton
             };
-            let krylov = std::sync::atomic::AtomicUsize::new(0);
-            let step = |h: &SparseMatrix, b: &[f64]| {
-                let (d, iterations) = multigrid_step(h, prolongations, b, options.multigrid)?;
-                krylov.fetch_add(iterations, std::sync::atomic::Ordering::Relaxed);
-                Some(d)
-            };
+            let mut steps = MultigridSteps::new(lcp, prolongations, options.multigrid);
+            let mut step = |s: NewtonStep<'_>| steps.solve(s);
             let newton = match (workspace, multigrid) {
-                (Some(w), true) => semismooth_newton_with(lcp, w, &step, start, newton),
+                (Some(w), true) => semismooth_newton_with(lcp, w, &mut step, start, newton),
                 (None, true) => NewtonWorkspace::pattern_of(lcp)
-                    .and_then(|w| semismooth_newton_with(lcp, &w, &step, start, newton)),
+                    .and_then(|w| semismooth_newton_with(lcp, &w, &mut step, start, newton)),
                 (Some(w), false) => semismooth_newton_prepared(lcp, w, start, newton),
                 (None, false) => semismooth_newton(lcp, start, newton),
             };
+            let krylov_iterations = steps.krylov_iterations;
             let newton = newton.map(|mut s| {
-                s.krylov_iterations = krylov.into_inner();
+                s.krylov_iterations = krylov_iterations;
                 s
             });
             let solution = match newton {
