@@ -55,6 +55,8 @@ impl Default for MultigridOptions {
 struct Level {
     a: SparseMatrix,
     inverse_diagonal: Vec<f64>,
+    /// Gauss–Seidel on `a`'s pattern: hybrid (parallel blocks) on large levels.
+    smoother: sparse::Smoother,
     /// From level `l + 1`; `None` on the coarsest level.
     p: Option<SparseMatrix>,
 }
@@ -139,6 +141,7 @@ impl Multigrid {
             let coarse = sparse::galerkin(&a, &p);
             let inverse_diagonal = inverse_diagonal(&a, l)?;
             levels.push(Level {
+                smoother: sparse::Smoother::new(&a),
                 a,
                 inverse_diagonal,
                 p: Some(p),
@@ -155,6 +158,7 @@ impl Multigrid {
         })?;
         let inverse_diagonal = inverse_diagonal(&a, levels.len())?;
         levels.push(Level {
+            smoother: sparse::Smoother::new(&a),
             a,
             inverse_diagonal,
             p: None,
@@ -345,8 +349,9 @@ impl Multigrid {
 
     fn smooth(&self, level: &Level, w: &mut Work) {
         for _ in 0..self.options.sweeps {
-            sparse::gauss_seidel(&level.a, &level.inverse_diagonal, &w.b, &mut w.x, true);
-            sparse::gauss_seidel(&level.a, &level.inverse_diagonal, &w.b, &mut w.x, false);
+            level
+                .smoother
+                .symmetric_sweep(&level.a, &level.inverse_diagonal, &w.b, &mut w.x);
         }
     }
 
