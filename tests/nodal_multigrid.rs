@@ -72,6 +72,29 @@ fn multigrid_steps_give_the_direct_solution_with_iterations_bounded_in_h() {
     );
 }
 
+/// A cold start has no coarser level: `--linear-solver multigrid` factors and says so.
+#[test]
+fn a_cold_start_without_hierarchy_is_reported() {
+    let mut request = MembraneRequest::new(membrane_scene("membrane-radial").unwrap());
+    request.pair = MembranePair::P1Nodal;
+    request.mesh_size = 16;
+    request.nested = false;
+    request.linear_solver = LinearSolver::Multigrid;
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert_eq!(report.linear_solver, "direct");
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("no active-set step of the finest level was solved by multigrid")),
+        "{:?}",
+        report.warnings
+    );
+    request.nested = true;
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert!(report.warnings.iter().all(|w| !w.contains("multigrid")));
+}
+
 /// The hierarchy truncated on a set of fine DOFs: its composed prolongation is the
 /// full composed prolongation with the dropped rows zeroed, on the kept coarse columns,
 /// and every removed coarse column of the full one is zero after truncation.
