@@ -295,6 +295,25 @@ pub struct MembraneReport {
     pub warnings: Vec<String>,
     /// Shape of the solved (finest) mesh's triangles.
     pub mesh_quality: MeshQualityReport,
+    /// Wall time of each phase of [`solve`], so that the time outside the solve shows.
+    pub phases: PhaseSeconds,
+}
+
+/// Wall time in seconds of the phases of a membrane solve (the `phases` object of the
+/// `--json` report); their sum is the solve's share of the process, the rest being
+/// start-up and output.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct PhaseSeconds {
+    /// Building the meshes of every level (generation, or reading and refining a file).
+    pub meshes: f64,
+    /// Checks of the data and the finest mesh: validation, shape, the inverse constant
+    /// `C_I` that fixes α, the Dirichlet part.
+    pub checks: f64,
+    /// Assembly and the solve of all levels (the report's `seconds`).
+    pub solve: f64,
+    /// What follows the solve: errors against the exact solution, penetration and gap
+    /// checks, the contact set and the fields for output.
+    pub evaluation: f64,
 }
 
 /// The shape of a mesh's triangles and what it forces on the stabilization (the
@@ -542,6 +561,7 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     let scene = &request.scene;
     let load = scene.load_magnitude(request.load).map_err(Error::Input)?;
     check_memory(request)?;
+    let clock = Instant::now();
     let (meshes, domain, own_domain) = match (&request.mesh_file, &scene.domain) {
         (Some(path), _) => (
             file_levels(path, request.mesh_size, request.nested, request.pair)?,
@@ -571,6 +591,7 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
             e.contact_area = None;
         }
     }
+    let meshes_seconds = clock.elapsed().as_secs_f64();
     let part = dirichlet_part(scene, meshes.last().expect("at least one level"), &domain)?;
     let posed = Posed {
         data: SceneData::new(scene, load),
@@ -592,10 +613,12 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
         other => other,
     })?;
     check_stabilization_above_rounding(request, mesh, &quality, c_i)?;
+    let checks_seconds = clock.elapsed().as_secs_f64() - meshes_seconds;
     let (mut report, fields) = match &request.pair.row().stabilized {
         Some(model) => (model.run)(request, &posed, &meshes, alpha, c_i),
         None => run_nodal(request, &posed, meshes),
     }?;
+    let run_seconds = clock.elapsed().as_secs_f64() - meshes_seconds - checks_seconds;
     let finest = &fields.mesh;
     report.warnings.extend(quality.warnings(finest));
     if let Some(warning) = penetration_warning(
@@ -628,6 +651,12 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
         max_aspect_ratio: quality.max_aspect_ratio,
         worst_inverse_constant: c_i,
         forced_alpha: (c_i > 0.0).then(|| 0.5 / c_i),
+    };
+    report.phases = PhaseSeconds {
+        meshes: meshes_seconds,
+        checks: checks_seconds,
+        solve: report.seconds,
+        evaluation: (run_seconds - report.seconds).max(0.0),
     };
     Ok((report, fields))
 }
@@ -1002,6 +1031,7 @@ fn run_stabilized<M: Model>(
         max_open_contact_gap,
         warnings,
         mesh_quality: MeshQualityReport::default(),
+        phases: PhaseSeconds::default(),
     };
     Ok((report, fields))
 }
@@ -1333,6 +1363,7 @@ fn run_nodal(
             Vec::new()
         },
         mesh_quality: MeshQualityReport::default(),
+        phases: PhaseSeconds::default(),
     };
     if request.linear_solver == LinearSolver::Multigrid && krylov_iterations == 0 {
         report.warnings.push(

@@ -23,6 +23,7 @@ fn scratch(name: &str) -> PathBuf {
 #[test]
 fn membrane_json_has_every_field_and_agrees_with_the_exact_solution() {
     let out = scratch("json");
+    let clock = std::time::Instant::now();
     let run = fem_forms(
         &[
             "solve",
@@ -36,6 +37,7 @@ fn membrane_json_has_every_field_and_agrees_with_the_exact_solution() {
         ],
         &out,
     );
+    let elapsed = clock.elapsed().as_secs_f64();
     assert!(
         run.status.success(),
         "{}",
@@ -66,6 +68,18 @@ fn membrane_json_has_every_field_and_agrees_with_the_exact_solution() {
     );
     assert!(json["complementarity_residual"].as_f64().unwrap() < 1e-10);
     assert!((json["alpha"].as_f64().unwrap() - 0.5 / 96.0).abs() < 1e-12);
+    // the phases: non-negative, the solve's is `seconds`, together within the process
+    let phases = &json["phases"];
+    let phase = |name: &str| phases[name].as_f64().unwrap_or_else(|| panic!("{name}"));
+    for name in ["meshes", "checks", "solve", "evaluation"] {
+        assert!(phase(name) >= 0.0, "{name}");
+    }
+    assert_eq!(phase("solve"), json["seconds"].as_f64().unwrap());
+    let total: f64 = ["meshes", "checks", "solve", "evaluation"]
+        .iter()
+        .map(|n| phase(n))
+        .sum();
+    assert!(total <= elapsed, "{total} s of phases in {elapsed} s");
     assert!(out.join("membrane-radial-p2-p0-16.vtu").exists());
     std::fs::remove_dir_all(&out).unwrap();
 }
