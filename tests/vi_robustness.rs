@@ -551,6 +551,34 @@ fn the_penetration_is_measured_at_vertices_and_quadrature_points() {
     assert!(depth > 0.0 && depth <= 0.5, "{depth}");
     let nan = |_: &[f64]| f64::NAN;
     assert!(max_penetration(&u, &nan, 2).is_nan());
+    // a field that is not zero: u_h interpolates u = x² − y exactly on P2 (and
+    // u = 2x − y on P1), so ψ = u + ¼ lies ¼ above it everywhere
+    type P2 = membrane_p2_p0::Model;
+    for (degree, exact) in [
+        (
+            1,
+            &(|x: &[f64]| 2.0 * x[0] - x[1]) as &(dyn Fn(&[f64]) -> f64 + Sync),
+        ),
+        (2, &|x: &[f64]| x[0] * x[0] - x[1]),
+    ] {
+        let dofs = if degree == 1 {
+            SystemDofs::all::<M>(&mesh).unwrap()
+        } else {
+            SystemDofs::all::<P2>(&mesh).unwrap()
+        };
+        let map = dofs.map(0).unwrap();
+        let coefficients: Vec<f64> = map.nodes(&mesh).iter().map(|x| exact(x)).collect();
+        let u = TriangleField {
+            mesh: &mesh,
+            map,
+            coefficients: &coefficients,
+        };
+        let above = |x: &[f64]| exact(x) + 0.25;
+        let depth = max_penetration(&u, &above, 4);
+        assert!((depth - 0.25).abs() < 1e-14, "P{degree}: {depth}");
+        let under = |x: &[f64]| exact(x) - 0.25;
+        assert_eq!(max_penetration(&u, &under, 4), 0.0, "P{degree}");
+    }
 }
 
 /// Issue 10, item 7: the weak constraint lets u_h dip below ψ, by `O(h²)`. On the radial

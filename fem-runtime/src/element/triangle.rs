@@ -440,14 +440,14 @@ impl TriangleBasis {
 /// The reference basis and its gradient at the points of a rule, evaluated once: the
 /// error norms visit every cell at the same reference points, and evaluating the
 /// polynomials there anew was most of their cost.
-struct Tabulation {
+pub(crate) struct Tabulation {
     /// Per point: the basis values, then the ξ- and η-derivatives, `3 × count` numbers.
     rows: Vec<Vec<f64>>,
     count: usize,
 }
 
 impl Tabulation {
-    fn new(basis: &TriangleBasis, points: &[[f64; 2]]) -> Self {
+    pub(crate) fn new(basis: &TriangleBasis, points: &[[f64; 2]]) -> Self {
         let count = basis.values.len();
         let rows = points
             .iter()
@@ -457,6 +457,15 @@ impl Tabulation {
             })
             .collect();
         Self { rows, count }
+    }
+
+    /// The value at point `q` of the function with reference coefficients `u`.
+    pub(crate) fn value(&self, q: usize, u: &[f64]) -> f64 {
+        self.rows[q][..self.count]
+            .iter()
+            .zip(u)
+            .map(|(p, u)| p * u)
+            .sum()
     }
 
     /// The value and reference gradient at point `q` of the function with reference
@@ -650,7 +659,7 @@ impl TriangleField<'_> {
     /// The coefficients of cell `c` in the pulled-back reference basis into `out`
     /// ([`TriangleField::reference_coefficients`] without its allocation on the Lagrange
     /// path).
-    fn local_coefficients(&self, c: usize, out: &mut Vec<f64>) {
+    pub(crate) fn local_coefficients(&self, c: usize, out: &mut Vec<f64>) {
         out.clear();
         match self.transformed(c) {
             Some(u) => out.extend(u),

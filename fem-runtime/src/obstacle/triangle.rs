@@ -593,15 +593,31 @@ impl ObstacleSolution<TriangleMesh> {
 /// bounded by ψ's); the nodal method imposes `U_i ≥ ψ_i` at the vertices, where its
 /// penetration is 0 (between them, where ψ is curved, it is `O(h²)` too).
 pub fn max_penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: usize) -> f64 {
+    use crate::element::triangle::{over_cell_chunks, AffineMap, Tabulation};
+    use rayon::prelude::*;
     let basis = TriangleBasis::new(u.map.element());
     let rule = fem_reference::triangle::TriangleRule::exact_for_degree(degree);
-    let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-    let depths = crate::element::triangle::over_cell_chunks(u.mesh.cell_count(), |cells| {
+    let points: Vec<[f64; 2]> = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
+        .iter()
+        .chain(&rule.points)
+        .copied()
+        .collect();
+    let table = Tabulation::new(&basis, &points);
+    // ψ at each vertex once: about six cells share one, and ψ may be costly data
+    let vertex_psi: Vec<f64> = u.mesh.vertices().par_iter().map(|x| psi(x)).collect();
+    let depths = over_cell_chunks(u.mesh.cell_count(), |cells| {
         let mut largest = 0.0f64;
+        let mut local = Vec::new();
         for c in cells {
-            let map = crate::element::triangle::AffineMap::of(u.mesh, c);
-            for &xi in corners.iter().chain(&rule.points) {
-                let depth = psi(&map.point(xi)) - u.value(&basis, c, xi);
+            u.local_coefficients(c, &mut local);
+            let corners = u.mesh.cell(c);
+            let map = AffineMap::of(u.mesh, c);
+            for (q, xi) in points.iter().enumerate() {
+                let obstacle = match corners.get(q) {
+                    Some(&v) => vertex_psi[v],
+                    None => psi(&map.point(*xi)),
+                };
+                let depth = obstacle - table.value(q, &local);
                 if depth.is_nan() {
                     return f64::NAN;
                 }
