@@ -107,12 +107,47 @@ fn an_exact_pressure_gives_the_error_against_it() {
     let solved = contact_scene_file::solve(&parse(&text).unwrap(), &Overrides::default()).unwrap();
     // ‖2.5 − 2‖/‖2‖ = 0.25 on any interval
     assert!((solved.report.pressure_l2_error.unwrap() - 0.25).abs() < 1e-9);
+    // the exact pressure is the file's load's: under another --load (here the pressure
+    // is 2.5·1.4, which a scaled 2.5 would match) it is not compared, and the report says why
+    let text = format!("{RECTANGLE}\n[exact]\npressure = \"2.5\"\n");
+    let overrides = Overrides {
+        load: Some(1.4),
+        ..Overrides::default()
+    };
+    let solved = contact_scene_file::solve(&parse(&text).unwrap(), &overrides).unwrap();
+    assert_eq!(solved.report.pressure_l2_error, None);
+    assert!(
+        solved
+            .report
+            .warnings
+            .iter()
+            .any(|w| w.contains("exact.pressure") && w.contains("--load 1.4")),
+        "{:?}",
+        solved.report.warnings
+    );
+    // the file's own load given on the command line is its load: compared
+    let overrides = Overrides {
+        load: Some(1.0),
+        ..Overrides::default()
+    };
+    let solved = contact_scene_file::solve(&parse(&text).unwrap(), &overrides).unwrap();
+    assert!(solved.report.pressure_l2_error.unwrap() < 1e-10);
 }
 
 /// Each bad input is an error naming its key (and saying why), never a panic.
 #[test]
 fn bad_contact_scene_files_name_the_key() {
     let cases: Vec<(String, &str, &[&str])> = vec![
+        (
+            format!("accuracy = 0.05\n{RECTANGLE}"),
+            "accuracy",
+            &["[exact] pressure"],
+        ),
+        (
+            format!("{RECTANGLE}\n[exact]\npressure = \"sqrt(x - 100)\"\n"),
+            "exact.pressure",
+            &["finite"],
+        ),
         (
             RECTANGLE.replace("contact = \"bottom\"", "contact = \"floor\""),
             "boundary.contact",
