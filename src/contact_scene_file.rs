@@ -34,7 +34,8 @@
 //! [parameters]
 //! contact_direction = [0.0, -1.0] # n_c: the foundation's normal away from the body
 //! # alpha = 1e-4                  # α; 1/(2 max C_I,E) by default; 0: the plain method
-//! # contact_centre = 0.0          # x of a symmetry line: the half-width is measured from it
+//! # contact_centre = 0.0          # a symmetry line's x (y beside a vertical plane): the
+//!                                 # half-width is measured along the plane from it
 //!
 //! [data]
 //! load = 1.0                      # a scale of the pressure (--load); 1 by default
@@ -679,12 +680,15 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
     let n = file.contact_direction;
     let total = -(solution.total_contact_force[0] * n[0] + solution.total_contact_force[1] * n[1]);
     let applied = solution.applied_load[0] * n[0] + solution.applied_load[1] * n[1];
+    // along the contact plane: x under a horizontal one, y beside a vertical one
+    let along = crate::models::signorini::contact_tangent(n);
+    let coordinate = |x: [f64; 2]| along[0] * x[0] + along[1] * x[1];
     let mut profile: PressureProfile = solution
         .contact_edges
         .iter()
         .zip(&solution.pressure)
         .map(|(e, &p)| {
-            let (a, b) = (e.ends[0][0], e.ends[1][0]);
+            let (a, b) = (coordinate(e.ends[0]), coordinate(e.ends[1]));
             (a.min(b), a.max(b), p)
         })
         .collect();

@@ -279,7 +279,8 @@ pub fn warnings(r: &ContactReport) -> Vec<String> {
     out
 }
 
-/// The contact pressure along x, sorted by x0: per edge `(x0, x1, λ_E)` (P0 pairs), or
+/// The contact pressure along x (scene files: along the contact plane, the coordinate of
+/// `contact_tangent`), sorted by x0: per edge `(x0, x1, λ_E)` (P0 pairs), or
 /// per vertex of Γ_C `(x, x, λ_k)` (P1 pairs: λ_h is linear between consecutive
 /// entries, and the chart joins them so).
 pub type PressureProfile = Vec<(f64, f64, f64)>;

@@ -97,6 +97,50 @@ fn the_patch_test_from_a_scene_file_gives_the_pressure_exactly() {
     }
 }
 
+/// A block (0,1)×(0,2) pressed sideways onto a wall on its left (n_c = (−1, 0)): the
+/// patch test's λ_h = q on every edge, the profile along the wall (y) covering its
+/// length 2, and the half-width measured along the wall: 1 (from `contact_centre` = 0:
+/// 2), where an extent along x would give 0.
+#[test]
+fn the_half_width_is_measured_along_a_vertical_wall() {
+    let turned = r#"
+    model = "contact"
+    [mesh]
+    generator = "rectangle"
+    x = [0.0, 1.0]
+    y = [0.0, 2.0]
+    cells = [3, 6]
+    [material]
+    young = 1000.0
+    poisson = 0.3
+    [boundary]
+    contact = "left"
+    load = "right"
+    fixed_y = "bottom"
+    [parameters]
+    contact_direction = [-1.0, 0.0]
+    [data]
+    pressure = "2.5"
+    gap = "0"
+"#;
+    for (centre, half_width) in [("", 1.0), ("contact_centre = 0.0\n", 2.0)] {
+        let text = turned.replace("[data]", &format!("{centre}[data]"));
+        let solved = contact_scene_file::solve(&parse(&text).unwrap(), &Overrides::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        for &(y0, y1, p) in &solved.profile {
+            assert!((p - 2.5).abs() <= 1e-9 * 2.5, "λ_h = {p} on [{y0}, {y1}]");
+        }
+        let covered: f64 = solved.profile.iter().map(|e| e.1 - e.0).sum();
+        assert!((covered - 2.0).abs() < 1e-12, "{covered}");
+        let r = &solved.report;
+        assert!(
+            (r.contact_half_width - half_width).abs() < 1e-12,
+            "{centre}: {}",
+            r.contact_half_width
+        );
+    }
+}
+
 /// An exact pressure in the file gives the L² error against it (0 here, to rounding).
 #[test]
 fn an_exact_pressure_gives_the_error_against_it() {

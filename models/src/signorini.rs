@@ -129,9 +129,23 @@ pub struct SignoriniInput<'a> {
     /// The stabilization parameter; `None`: `α = 1/(2 max_E C_I,E)` (MODELS.md §7);
     /// `Some(0.0)`: the plain mixed method, solved as a QP.
     pub alpha: Option<f64>,
-    /// The x of the middle of the contact zone, for the half-width (a symmetry line);
-    /// `None`: the middle of the pressed edges.
+    /// The middle of the contact zone, for the half-width (a symmetry line), as a
+    /// coordinate along the contact plane ([`contact_tangent`]: x under a horizontal
+    /// plane, y beside a vertical one); `None`: the middle of the pressed edges.
     pub contact_centre: Option<f64>,
+}
+
+/// The unit tangent of the contact plane whose normal is `direction` (unit): `n_c`
+/// turned by a quarter, oriented so that its first non-zero component is positive, so
+/// that the coordinate `t·x` along the plane is x for `n_c = (0, ±1)` and y for
+/// `n_c = (±1, 0)`. The contact half-width and `contact_centre` are measured in it.
+pub fn contact_tangent(direction: [f64; 2]) -> [f64; 2] {
+    let t = [-direction[1], direction[0]];
+    if t[0] > 0.0 || (t[0] == 0.0 && t[1] > 0.0) {
+        t
+    } else {
+        [-t[0], -t[1]]
+    }
 }
 
 /// A solved Signorini problem.
@@ -161,8 +175,9 @@ pub struct SignoriniSolution {
     pub total_contact_force: [f64; 2],
     /// Resultant of the applied pressure, `∫_Γ_N q (−n) ds` (Gauss–Legendre, 4 points per edge).
     pub applied_load: [f64; 2],
-    /// Half the extent along x of the edges that carry pressure (λ_E > 0), holes
-    /// between them included (from `contact_centre` when given).
+    /// Half the extent of the edges that carry pressure (λ_E > 0), holes between them
+    /// included, along the contact plane (the coordinate of [`contact_tangent`]: x under
+    /// a horizontal plane, y beside a vertical one); from `contact_centre` when given.
     pub contact_half_width: f64,
     /// The largest λ_E.
     pub max_contact_pressure: f64,
@@ -543,13 +558,15 @@ fn report(
         load[1] -= q * n[1];
     }
     let largest = pressure.iter().fold(0.0f64, |m, &p| m.max(p));
+    let along = contact_tangent(direction);
     let (mut x_min, mut x_max) = (f64::INFINITY, f64::NEG_INFINITY);
     for (e, &[a, b]) in problem.contact_edges.iter().zip(&problem.edge_dofs) {
         // the edges where λ_h is not identically 0 (for P1: either end positive)
         if pressure[a].max(pressure[b]) > 1e-10 * largest {
             for end in e.ends {
-                x_min = x_min.min(end[0]);
-                x_max = x_max.max(end[0]);
+                let s = along[0] * end[0] + along[1] * end[1];
+                x_min = x_min.min(s);
+                x_max = x_max.max(s);
             }
         }
     }
