@@ -234,7 +234,13 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         ));
     }
     let pair = match &file.pair {
-        Some(p) => ContactPair::parse(p).map_err(|e| at("pair", e.to_string()))?,
+        Some(p) => {
+            let pair = ContactPair::parse(p).map_err(|e| at("pair", e.to_string()))?;
+            if pair.multiplier() != crate::models::signorini::Multiplier::P0 {
+                return Err(at("pair", p0_pairs_only(pair)));
+            }
+            pair
+        }
         None => ContactPair::P1P0,
     };
     let mesh = mesh_of(&file.mesh, path, &at)?;
@@ -338,17 +344,8 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             ));
         }
     }
-    let name = file.name.clone().unwrap_or_else(|| {
-        path.file_stem()
-            .map_or("contact".into(), |s| s.to_string_lossy().into_owned())
-    });
-    let plain = |c: char| c.is_alphanumeric() || c == '-' || c == '_' || c == '.';
-    if name.is_empty() || name.starts_with(['.', '-']) || !name.chars().all(plain) {
-        return Err(at(
-            "name",
-            format!("`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first, nor `-`)"),
-        ));
-    }
+    let name = crate::scene_file::scene_name(file.name.as_deref(), path, "contact")
+        .map_err(|m| at("name", m))?;
     Ok(ContactSceneFile {
         name,
         description: file
@@ -601,6 +598,14 @@ fn resultant(mesh: &TriangleMesh, markers: &[u32], pressure: &Data) -> [f64; 2] 
     force
 }
 
+/// Why `pair` (a P1-multiplier pair) cannot solve a contact scene file.
+fn p0_pairs_only(pair: ContactPair) -> String {
+    format!(
+        "`{}` has a P1 multiplier; contact scene files take the P0-multiplier pairs p1-p0 and p2-p0 (their pressure errors are per edge; the P1-multiplier pairs solve the built-in contact scenes: `fem-forms list`)",
+        pair.name()
+    )
+}
+
 /// What the command line may change in a contact scene file.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
@@ -636,10 +641,7 @@ pub struct ContactFileSolution {
 pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFileSolution> {
     let pair = overrides.pair.unwrap_or(file.pair);
     if pair.multiplier() != crate::models::signorini::Multiplier::P0 {
-        return Err(Error::Input(format!(
-            "pair `{}`: contact scene files take the P0-multiplier pairs p1-p0, p2-p0 (their pressure errors are per edge)",
-            pair.name()
-        )));
+        return Err(Error::Input(format!("--pair: {}", p0_pairs_only(pair))));
     }
     let refinements = overrides.refinements.unwrap_or(file.refinements);
     if refinements > MAX_REFINEMENTS {

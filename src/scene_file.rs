@@ -454,25 +454,77 @@ pub fn read(path: &Path) -> Result<SceneFile> {
     parse(&text, path)
 }
 
+/// The name of a scene file's scene, which becomes part of output file names
+/// (`out/<name>-<pair>-<N>.vtu`): the file's `name` as given, or else its file name's
+/// stem with every character other than letters, digits, `-`, `_` and `.` turned into
+/// `-` (`my gap.toml` → `my-gap`), `default` if nothing is left.
+///
+/// # Errors
+/// The reason, for a given `name` that is empty, starts with `.` or `-` (a leading `-`
+/// would read as an option to a shell command given the output file) or has other
+/// characters.
+pub fn scene_name(
+    name: Option<&str>,
+    path: &Path,
+    default: &str,
+) -> std::result::Result<String, String> {
+    let plain = |c: char| c.is_alphanumeric() || c == '-' || c == '_' || c == '.';
+    let Some(name) = name else {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy())
+            .unwrap_or_default();
+        let cleaned: String = stem
+            .chars()
+            .map(|c| if plain(c) { c } else { '-' })
+            .collect();
+        let cleaned = cleaned.trim_start_matches(['.', '-']);
+        return Ok(if cleaned.is_empty() {
+            default.to_string()
+        } else {
+            cleaned.to_string()
+        });
+    };
+    if name.is_empty() || name.starts_with(['.', '-']) || !name.chars().all(plain) {
+        return Err(format!(
+            "`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first, nor `-`)"
+        ));
+    }
+    Ok(name.to_string())
+}
+
 /// Parses the text of a scene file; `path` names it in errors and anchors its relative
 /// mesh path.
 ///
 /// # Errors
 /// As [`read`].
 pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
-    let file: SceneToml = toml::from_str(text)
-        .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
     let at = |field: &str, message: String| {
         Error::Input(format!("{}: field `{field}`: {message}", path.display()))
     };
-    if file.model != "membrane" {
-        return Err(at(
+    let unknown_model = |model: &str| {
+        at(
             "model",
             format!(
-                "`{}` is not a model scene files can pose; they support `membrane` and `contact` (beams: the built-in scenes)",
-                file.model
+                "`{model}` is not a model scene files can pose; they support `membrane` and `contact` (beams: the built-in scenes)"
             ),
-        ));
+        )
+    };
+    // The model first: a misspelt one must be named as such, not reported as the
+    // membrane format's complaint about the other model's keys.
+    #[derive(Deserialize)]
+    struct ModelOnly {
+        model: Option<String>,
+    }
+    if let Ok(ModelOnly { model: Some(model) }) = toml::from_str::<ModelOnly>(text) {
+        if model != "membrane" {
+            return Err(unknown_model(&model));
+        }
+    }
+    let file: SceneToml = toml::from_str(text)
+        .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
+    if file.model != "membrane" {
+        return Err(unknown_model(&file.model));
     }
     let pair = match &file.pair {
         Some(p) => MembranePair::parse(p).map_err(|e| at("pair", e.to_string()))?,
@@ -612,19 +664,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
     if !(target_l2 > 0.0 && target_l2.is_finite()) {
         return Err(at("accuracy", format!("{target_l2} must be positive")));
     }
-    let name = file.name.clone().unwrap_or_else(|| {
-        path.file_stem()
-            .map_or("scene".into(), |s| s.to_string_lossy().into_owned())
-    });
-    // the name becomes part of output file names (`out/<name>-<pair>-<N>.vtu`)
-    let plain = |c: char| c.is_alphanumeric() || c == '-' || c == '_' || c == '.';
-    // a leading `-` would read as an option to a shell command given the file's name
-    if name.is_empty() || name.starts_with(['.', '-']) || !name.chars().all(plain) {
-        return Err(at(
-            "name",
-            format!("`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first, nor `-`)"),
-        ));
-    }
+    let name = scene_name(file.name.as_deref(), path, "scene").map_err(|m| at("name", m))?;
     let scene = MembraneScene {
         name: Cow::Owned(name),
         description: Cow::Owned(

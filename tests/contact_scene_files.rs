@@ -183,6 +183,14 @@ fn an_exact_pressure_gives_the_error_against_it() {
 fn bad_contact_scene_files_name_the_key() {
     let cases: Vec<(String, &str, &[&str])> = vec![
         (
+            RECTANGLE.replace(
+                "model = \"contact\"",
+                "model = \"contact\"\npair = \"p2-p1\"",
+            ),
+            "pair",
+            &["`p2-p1`", "P0-multiplier"],
+        ),
+        (
             format!("accuracy = 0.05\n{RECTANGLE}"),
             "accuracy",
             &["[exact] pressure"],

@@ -201,6 +201,23 @@ fn scene_file_errors_name_the_field() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("/nonexistent/scene.toml"), "{e}");
+    // a misspelt model is named as such, also when the file has another model's keys
+    let contact = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/contact-gap.toml"),
+    )
+    .unwrap();
+    for misspelt in [
+        text.replace("model = \"membrane\"", "model = \"membrain\""),
+        contact.replace("model = \"contact\"", "model = \"contakt\""),
+    ] {
+        let e = scene_file::parse(&misspelt, Path::new("mine.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("field `model`") && (e.contains("`membrain`") || e.contains("`contakt`")),
+            "{e}"
+        );
+    }
 }
 
 /// Data the solver cannot take are refused before solving, naming the field: a load
@@ -332,4 +349,41 @@ fn a_boundary_group_named_like_the_keyword_is_refused() {
         );
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A scene's name comes from its file's name when the file gives none, with characters
+/// that cannot be in output file names turned into `-` (a file `flat one.toml` is
+/// `flat-one`); a `name` written in the file is taken as written or refused.
+#[test]
+fn a_scene_without_a_name_is_named_after_its_file() {
+    use fem_forms::scene_file::scene_name;
+    for (path, expected) in [
+        ("dir/flat one.toml", "flat-one"),
+        ("-x y.toml", "x-y"),
+        (".hidden.toml", "hidden"),
+        ("é√.toml", "é-"),
+        ("  .toml", "scene"),
+    ] {
+        assert_eq!(
+            scene_name(None, Path::new(path), "scene").unwrap(),
+            expected,
+            "{path}"
+        );
+    }
+    assert_eq!(
+        scene_name(Some("a.b_c-1"), Path::new("x.toml"), "s").unwrap(),
+        "a.b_c-1"
+    );
+    for bad in ["my gap", "-rf", ".x", "", "a/b"] {
+        let e = scene_name(Some(bad), Path::new("x.toml"), "s").unwrap_err();
+        assert!(e.contains("cannot name output files"), "{bad}: {e}");
+    }
+    let text = std::fs::read_to_string(example("membrane-flat.toml")).unwrap();
+    let unnamed: String = text
+        .lines()
+        .filter(|l| !l.starts_with("name"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let file = scene_file::parse(&unnamed, Path::new("my scenes/flat one.toml")).unwrap();
+    assert_eq!(file.scene.name, "flat-one");
 }
