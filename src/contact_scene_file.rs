@@ -48,13 +48,15 @@
 //! # accuracy = 0.02               # (top level) the relative L² error it should reach
 //! ```
 //!
-//! Refused, naming the key: an unknown model, pair, generator or key; a part name the
+//! Refused, naming the key: an unknown model, pair (or a P1-multiplier one), generator or
+//! key; `mesh.refinements` beyond 6 or beyond the memory the solver allows itself (an
+//! estimate, before refining); an `accuracy` without `[exact]`; a part name the
 //! mesh does not have (`boundary.contact`, …, with the names it has); a part that holds
 //! no boundary edge (an interior Gmsh curve: "not on the boundary"); `material.young`
 //! ≤ 0; `material.poisson` outside (−1, ½); a zero `parameters.contact_direction`; a
 //! negative `parameters.alpha`; an expression that does not parse, uses a variable
 //! other than x, y, or does not evaluate to a finite number on its part (`data.gap` on
-//! Γ_C, `data.pressure` on Γ_N); a pressure whose resultant pulls the body off the
+//! Γ_C, `data.pressure` on Γ_N, `exact.pressure` on Γ_C); a pressure whose resultant pulls the body off the
 //! foundation (`data.pressure`: nothing then holds the body).
 
 use crate::models::data::Data;
@@ -67,6 +69,43 @@ use std::path::{Path, PathBuf};
 
 /// The largest number of uniform refinements of a contact scene file's mesh.
 pub const MAX_REFINEMENTS: usize = 6;
+
+/// Peak memory of a contact solve per triangle of its finest mesh, in bytes, with
+/// some margin: measured on examples/contact-gap.toml (GNU time's maximum resident set,
+/// 2026-12-01) 2.8 kB per triangle for p1-p0 at 131k and 524k triangles, 12.9 and
+/// 16.3 kB for p2-p0.
+fn bytes_per_triangle(pair: ContactPair) -> f64 {
+    match pair.displacement() {
+        crate::models::signorini::Displacement::P1 => 3.5e3,
+        crate::models::signorini::Displacement::P2 => 20e3,
+    }
+}
+
+/// Refuses `refinements` of a mesh of `cells` triangles that would need more memory
+/// than [`crate::membranes::MEMORY_LIMIT_BYTES`] with `pair` (each refinement
+/// quadruples the triangles), before anything is refined.
+fn check_memory(
+    cells: usize,
+    refinements: usize,
+    pair: ContactPair,
+) -> std::result::Result<(), String> {
+    let limit = crate::membranes::MEMORY_LIMIT_BYTES;
+    let bytes = fem_runtime::mesh::triangle::estimated_bytes(
+        cells,
+        refinements as u32,
+        bytes_per_triangle(pair),
+    );
+    if bytes > limit {
+        return Err(format!(
+            "{refinements} uniform refinements of the mesh's {cells} triangles make {:.0} triangles, which with {} need about {:.0} GB of memory, more than the {:.0} GB this solver allows itself",
+            cells as f64 * 4f64.powi(refinements as i32),
+            pair.name(),
+            bytes / 1e9,
+            limit / 1e9
+        ));
+    }
+    Ok(())
+}
 
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
@@ -251,6 +290,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             format!("{refinements} uniform refinements: at most {MAX_REFINEMENTS}"),
         ));
     }
+    check_memory(mesh.cell_count(), refinements, pair).map_err(|m| at("mesh.refinements", m))?;
     let m = &file.material;
     if !(m.young.is_finite() && m.young > 0.0) {
         return Err(at(
@@ -649,6 +689,14 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
             "--mesh-size {refinements}: the refinements of a contact scene file's mesh are at most {MAX_REFINEMENTS}"
         )));
     }
+    check_memory(file.mesh.cell_count(), refinements, pair).map_err(|m| {
+        let what = match (overrides.refinements, overrides.pair) {
+            (Some(r), _) => format!("--mesh-size {r}"),
+            (None, Some(p)) => format!("--pair {}", p.name()),
+            (None, None) => format!("{}: mesh.refinements", file.name),
+        };
+        Error::Input(format!("{what}: {m}"))
+    })?;
     let load = overrides.load.unwrap_or(file.load);
     check_load(load).map_err(|m| Error::Input(format!("--load: {m}")))?;
     let alpha = overrides.alpha.or(file.alpha);

@@ -141,6 +141,26 @@ fn the_half_width_is_measured_along_a_vertical_wall() {
     }
 }
 
+/// Refinements that would need more memory than the solver allows are refused before
+/// the mesh is refined, naming the option: the example's 8192 triangles refined 5 times
+/// are 8.4M, about 29 GB with p1-p0.
+#[test]
+fn refinements_beyond_the_memory_are_refused_before_refining() {
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/contact-gap.toml");
+    let file = contact_scene_file::read(&example).unwrap();
+    let overrides = Overrides {
+        refinements: Some(5),
+        ..Overrides::default()
+    };
+    let e = contact_scene_file::solve(&file, &overrides)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("--mesh-size 5") && e.contains("8388608 triangles") && e.contains("GB"),
+        "{e}"
+    );
+}
+
 /// An exact pressure in the file gives the L² error against it (0 here, to rounding).
 #[test]
 fn an_exact_pressure_gives_the_error_against_it() {
@@ -189,6 +209,11 @@ fn bad_contact_scene_files_name_the_key() {
             ),
             "pair",
             &["`p2-p1`", "P0-multiplier"],
+        ),
+        (
+            RECTANGLE.replace("cells = [6, 3]", "cells = [600, 300]\n    refinements = 4"),
+            "mesh.refinements",
+            &["92160000 triangles", "GB of memory"],
         ),
         (
             format!("accuracy = 0.05\n{RECTANGLE}"),
