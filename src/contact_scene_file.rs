@@ -722,7 +722,9 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         contact_centre: file.contact_centre,
     };
     let solution = solve_signorini(&mesh, &input).map_err(|e| match e {
-        Error::Input(m) if m.contains("rigid motion is not prevented") => {
+        Error::Input(m)
+            if m.contains("rigid motion is not prevented") || m.contains("tips the body") =>
+        {
             Error::Input(format!("{}: key `data.pressure`: {m}", file.name))
         }
         other => other,

@@ -161,6 +161,58 @@ fn refinements_beyond_the_memory_are_refused_before_refining() {
     );
 }
 
+/// A block (0,2)×(0,1) against a wall on its left, held along the wall on that side
+/// only (`fixed_y = "left"`: a rotation about a point of the wall stays free). Pressed
+/// by q = 1 on its right side the resultant meets the wall at its middle: it solves,
+/// with the contact force equal to the load. Pressed on its top too, the moment about
+/// the wall's foot is 2·1 − ½ = 1.5 against a push of 1 (by hand): the resultant meets
+/// the wall's line 1.5 below its foot, outside it, and the body tips: refused, where
+/// Newton's answer missed the load by 39 %.
+#[test]
+fn a_body_the_load_tips_is_refused() {
+    let block = |load: &str| {
+        format!(
+            r#"
+    model = "contact"
+    [mesh]
+    generator = "rectangle"
+    x = [0.0, 2.0]
+    y = [0.0, 1.0]
+    cells = [8, 4]
+    [material]
+    young = 1000.0
+    poisson = 0.3
+    [boundary]
+    contact = "left"
+    load = {load}
+    fixed_y = "left"
+    [parameters]
+    contact_direction = [-1.0, 0.0]
+    [data]
+    pressure = "1"
+    gap = "0"
+"#
+        )
+    };
+    let solved =
+        contact_scene_file::solve(&parse(&block("\"right\"")).unwrap(), &Overrides::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+    let r = &solved.report;
+    assert!((r.total_contact_force - 1.0).abs() < 1e-9, "{r:?}");
+    let e = contact_scene_file::solve(
+        &parse(&block("[\"top\", \"right\"]")).unwrap(),
+        &Overrides::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("tips the body")
+            && e.contains("-1.50 of its extent")
+            && e.contains("data.pressure"),
+        "{e}"
+    );
+}
+
 /// An exact pressure in the file gives the L² error against it (0 here, to rounding).
 #[test]
 fn an_exact_pressure_gives_the_error_against_it() {

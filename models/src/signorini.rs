@@ -374,7 +374,7 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
     } else {
         discretize_boundary_multiplier::<M>(mesh, &coefficients(alpha)?, &parts, &fixed)?
     };
-    let translation = rigid_motions_held(&problem, direction)?;
+    let translation = rigid_motions_held(mesh, &problem, direction)?;
     let solution = if alpha > 0.0 {
         // Start pressed into the foundation (every constraint active), beyond the gaps.
         // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
@@ -444,7 +444,11 @@ fn alpha_error(alpha: f64, constants: &[f64], error: Error) -> Error {
 ///
 /// # Errors
 /// [`Error::Input`] naming the unbalanced component.
-fn rigid_motions_held(problem: &BoundaryMultiplierProblem, n: [f64; 2]) -> Result<Vec<f64>> {
+fn rigid_motions_held(
+    mesh: &TriangleMesh,
+    problem: &BoundaryMultiplierProblem,
+    n: [f64; 2],
+) -> Result<Vec<f64>> {
     let f = &problem.lcp.f;
     let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
     let translation = towards_foundation(problem, n);
@@ -470,7 +474,96 @@ fn rigid_motions_held(problem: &BoundaryMultiplierProblem, n: [f64; 2]) -> Resul
             -n[1], n[0]
         )));
     }
+    rotation_held(mesh, problem, n, &translation, &tangent, work)?;
     Ok(translation)
+}
+
+/// Refuses a body that tips: when the supports leave a rotation free (a rigid motion
+/// `Z = R + aT + bS` with `A Z = 0`: `R` the rotation about the origin, `T` and `S` the
+/// translations along and across `n_c`), only the contact can hold it, and it can only
+/// where the load's resultant passes through Γ_C. With `s(x) = Z(x)·n_c` the motion of
+/// point `x` towards the foundation, the motions `Z − s_max T` and `s_min T − Z` open every
+/// contact; the load must do negative work on both (Fichera's condition for the
+/// rigid motions): `s_min W < f·Z < s_max W`, `W = f·T > 0`, over the vertices of Γ_C.
+/// Otherwise there is no equilibrium and Newton's answer misses the load (a tester's
+/// block against a wall "solved" with the contact force 39 % off the load).
+fn rotation_held(
+    mesh: &TriangleMesh,
+    problem: &BoundaryMultiplierProblem,
+    n: [f64; 2],
+    translation: &[f64],
+    tangent: &[f64],
+    work: f64,
+) -> Result<()> {
+    let fields = problem.dofs.fields();
+    let mut full = vec![0.0; problem.dofs.dof_count()];
+    for (axis, &field) in fields.iter().take(2).enumerate() {
+        let (Some(range), Some(map)) = (problem.dofs.range(field), problem.dofs.map(field)) else {
+            continue;
+        };
+        // (−y, x): the rotation about the origin
+        for (d, x) in range.zip(map.nodes(mesh)) {
+            full[d] = if axis == 0 { -x[1] } else { x[0] };
+        }
+    }
+    let rotation: Vec<f64> = problem.reduction.free().iter().map(|&d| full[d]).collect();
+    let a = &problem.lcp.a;
+    let multiply = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(a, x);
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let (at, as_, ar) = (
+        multiply(translation),
+        multiply(tangent),
+        multiply(&rotation),
+    );
+    // the combination of the translations closest to making R free (least squares)
+    let (tt, ts, ss) = (dot(&at, &at), dot(&at, &as_), dot(&as_, &as_));
+    let (tr, sr) = (dot(&at, &ar), dot(&as_, &ar));
+    let det = tt * ss - ts * ts;
+    let [a_t, b_s] = if det > 1e-12 * tt * ss && det > 0.0 {
+        [(-tr * ss + sr * ts) / det, (-sr * tt + tr * ts) / det]
+    } else if ss > 0.0 {
+        [0.0, -sr / ss]
+    } else {
+        [0.0, 0.0]
+    };
+    let motion: Vec<f64> = (0..rotation.len())
+        .map(|i| rotation[i] + a_t * translation[i] + b_s * tangent[i])
+        .collect();
+    let residual: Vec<f64> = (0..rotation.len())
+        .map(|i| ar[i] + a_t * at[i] + b_s * as_[i])
+        .collect();
+    let scale = norm(a.val()).max(f64::MIN_POSITIVE) * norm(&motion);
+    if norm(&motion) == 0.0 || norm(&residual) > 1e-10 * scale {
+        return Ok(());
+    }
+    // s(x) = Z(x)·n = (−y, x)·n + a_t (S is normal to n)
+    let s_of = |x: [f64; 2]| -x[1] * n[0] + x[0] * n[1] + a_t;
+    let (s_min, s_max) = problem
+        .contact_edges
+        .iter()
+        .flat_map(|e| e.ends)
+        .map(s_of)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        });
+    let moment = dot(&motion, &problem.lcp.f);
+    let slack = 1e-9 * work.abs() * (s_max - s_min).abs().max(1.0);
+    if moment < s_min * work - slack || moment > s_max * work + slack {
+        // where the resultant's line meets Γ_C, as a share of its extent from one end
+        let place = if s_max > s_min {
+            format!(
+                " (its line meets Γ_C at {:.2} of its extent, outside 0…1)",
+                (moment / work - s_min) / (s_max - s_min)
+            )
+        } else {
+            String::new()
+        };
+        return Err(Error::Input(format!(
+            "the load tips the body: the supports leave a rotation free, which only the contact can hold, but the load's resultant passes outside the contact boundary{place}: there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+        )));
+    }
+    Ok(())
 }
 
 /// The free-DOF vector of a unit translation along the contact direction: towards the
@@ -1170,7 +1263,7 @@ fn solve_level<M: Model>(
         problem =
             discretize_boundary_multiplier::<M>(&mesh, &coefficients(alpha)?, &parts, &fixed)?;
     }
-    let translation = rigid_motions_held(&problem, direction)?;
+    let translation = rigid_motions_held(&mesh, &problem, direction)?;
     let pressed = || {
         let depth = problem
             .lcp
