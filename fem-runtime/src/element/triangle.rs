@@ -633,27 +633,30 @@ impl TriangleField<'_> {
     /// `(Σ_T h_T^{2·power} ‖λ − λ_h‖²_T)^{1/2}` against `exact(x)`; `power = 0` is the L² norm.
     pub fn weighted_error(
         &self,
-        exact: &dyn Fn([f64; 2]) -> f64,
+        exact: &(dyn Fn([f64; 2]) -> f64 + Sync),
         power: i32,
         degree: usize,
     ) -> f64 {
         let basis = TriangleBasis::new(self.map.element());
         let rule = TriangleRule::exact_for_degree(degree);
         let table = Tabulation::new(&basis, &rule.points);
-        let mut sum = 0.0;
-        let mut local = Vec::new();
-        for c in 0..self.mesh.cell_count() {
-            let map = AffineMap::of(self.mesh, c);
-            let weight = self.mesh.cell_diameter(c).powi(2 * power);
-            self.local_coefficients(c, &mut local);
-            let mut cell = 0.0;
-            for (q, (&xi, &w)) in rule.points.iter().zip(&rule.weights).enumerate() {
-                let e = exact(map.point(xi)) - table.evaluate(q, &local).0;
-                cell += w * map.det * e * e;
+        let sums = over_cell_chunks(self.mesh.cell_count(), |cells| {
+            let mut sum = 0.0;
+            let mut local = Vec::new();
+            for c in cells {
+                let map = AffineMap::of(self.mesh, c);
+                let weight = self.mesh.cell_diameter(c).powi(2 * power);
+                self.local_coefficients(c, &mut local);
+                let mut cell = 0.0;
+                for (q, (&xi, &w)) in rule.points.iter().zip(&rule.weights).enumerate() {
+                    let e = exact(map.point(xi)) - table.value(q, &local);
+                    cell += w * map.det * e * e;
+                }
+                sum += weight * cell;
             }
-            sum += weight * cell;
-        }
-        sum.sqrt()
+            sum
+        });
+        sums.into_iter().sum::<f64>().sqrt()
     }
 
     /// The coefficients of cell `c` in the pulled-back reference basis into `out`
