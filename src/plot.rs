@@ -59,14 +59,56 @@ const COLORS: [RGBColor; 6] = [
     RGBColor(80, 80, 80),
 ];
 
-/// A short axis label: plain for moderate magnitudes, `1e-5` style otherwise.
+/// A short axis label with four significant digits, trailing zeros dropped: plain for
+/// moderate magnitudes (`0.0125`, `250`), `1.5e-5` style otherwise. Neighbouring ticks
+/// stay distinct: one significant digit made 1.5e-3 and 2e-3 both `2e-3`, and three
+/// decimals made 0.0125 `0.013` (loads below 0.1 had repeated labels).
 fn tick(v: f64) -> String {
+    let trim = |text: &str| -> String {
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text.to_string()
+        }
+    };
     let a = v.abs();
-    if v == 0.0 || (1e-2..1e4).contains(&a) {
-        let text = format!("{v:.3}");
-        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    if v == 0.0 {
+        "0".into()
+    } else if (1e-2..1e4).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        trim(&format!("{v:.decimals$}"))
     } else {
-        format!("{v:.0e}")
+        let text = format!("{v:.3e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        format!("{}e{exponent}", trim(mantissa))
+    }
+}
+
+#[cfg(test)]
+mod tick_tests {
+    use super::tick;
+
+    #[test]
+    fn ticks_keep_four_significant_digits_and_stay_distinct() {
+        for (v, text) in [
+            (0.0, "0"),
+            (1.0, "1"),
+            (250.0, "250"),
+            (0.0125, "0.0125"),
+            (0.5, "0.5"),
+            (1234.5, "1234"),
+            (-3.25, "-3.25"),
+            (1.5e-3, "1.5e-3"),
+            (2e-3, "2e-3"),
+            (1.25e5, "1.25e5"),
+            (-7e-9, "-7e-9"),
+        ] {
+            assert_eq!(tick(v), text, "{v}");
+        }
+        let labels: Vec<String> = (1..=10).map(|k| tick(k as f64 * 5e-4)).collect();
+        for pair in labels.windows(2) {
+            assert_ne!(pair[0], pair[1]);
+        }
     }
 }
 
