@@ -583,6 +583,24 @@ impl MatrixAssembler {
         self.assemble_values::<M>(mesh, coefficients, &mut values)?;
         Ok(SparseColMat::new(self.symbolic.clone(), values))
     }
+
+    /// The assembled matrix, as [`MatrixAssembler::assemble`], for a pattern used once:
+    /// the matrix takes the assembler's pattern over instead of a copy, and the
+    /// assembler's scatter positions (one index per cell entry) are freed first (at 2M
+    /// P1 cells 66 MB and 150 MB less held at once; issue 15, peak memory).
+    ///
+    /// # Errors
+    /// As [`MatrixAssembler::assemble`].
+    pub fn into_matrix<M: Model>(
+        self,
+        mesh: &impl Mesh,
+        coefficients: &Coefficients,
+    ) -> Result<SparseMatrix> {
+        let mut values = Vec::new();
+        self.assemble_values::<M>(mesh, coefficients, &mut values)?;
+        let Self { symbolic, .. } = self;
+        Ok(SparseColMat::new(symbolic, values))
+    }
 }
 
 /// Assembles linear form `form_name` of `M` on the system `dofs`.
