@@ -502,10 +502,18 @@ impl MatrixAssembler {
             fill[col] += 1;
         });
         let mut col_ptr = vec![0usize; n + 1];
-        let mut row_idx = Vec::with_capacity(bucket.len() / 2);
+        // sorted and counted first, so that the pattern (kept with every matrix
+        // assembled from it) has no spare capacity: at 2M P1 cells an estimate of half
+        // the cell entries left 17 MB unused (issue 15, peak memory)
+        let mut distinct = 0;
         for j in 0..n {
             let column = &mut bucket[bucket_ptr[j]..bucket_ptr[j + 1]];
             column.sort_unstable();
+            distinct += column.len() - column.windows(2).filter(|w| w[0] == w[1]).count();
+        }
+        let mut row_idx = Vec::with_capacity(distinct);
+        for j in 0..n {
+            let column = &bucket[bucket_ptr[j]..bucket_ptr[j + 1]];
             let mut last = usize::MAX;
             for &r in column.iter() {
                 if r != last {
