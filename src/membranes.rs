@@ -1081,7 +1081,9 @@ const PIPELINED_CELLS: usize = 32_768;
 /// DOFs, stiffness `a`, load `f` and obstacle `ψ` on the free nodes, and the
 /// prolongations from the next coarser level (all DOFs; free DOFs) if there is one.
 struct NodalLevel {
-    dofs: SystemDofs,
+    /// The level's DOF count; its DOF map is not kept (48 MB at 2M cells, rebuilt for
+    /// the finest level after the solve).
+    dof_count: usize,
     reduction: Reduction,
     a: SparseMatrix,
     f: Vec<f64>,
@@ -1091,13 +1093,13 @@ struct NodalLevel {
 
 /// The nodal method's nested iteration so far: (DOFs, iterations) per level, the
 /// prolongations of the free DOFs finest first, the last level's full coefficients and
-/// its DOFs, elimination, solution and order.
+/// its elimination, solution and order.
 #[derive(Default)]
 struct NodalState {
     levels: Vec<[usize; 2]>,
     prolongations: Vec<SparseMatrix>,
     values: Option<Vec<f64>>,
-    finest: Option<(SystemDofs, Reduction, LcpSolution, usize)>,
+    finest: Option<(Reduction, LcpSolution, usize)>,
 }
 
 /// The classical method: P1 with `u_i ≥ ψ(x_i)` at the free nodes.
@@ -1129,11 +1131,14 @@ fn run_nodal(
             Ok((dofs, reduction, constraints))
         };
         let (dofs, reduction, _) = free_dofs(mesh)?;
-        let k = MatrixAssembler::new::<M>("a", mesh, &dofs)?.assemble::<M>(mesh, &coefficients)?;
+        // the pattern moves into `k` and `k`'s arrays into `a` (no copies: issue 15,
+        // peak memory)
+        let k =
+            MatrixAssembler::new::<M>("a", mesh, &dofs)?.into_matrix::<M>(mesh, &coefficients)?;
         let l = assemble_vector::<M>("ℓ", mesh, &dofs, &coefficients)?;
         let f = reduction.rhs(&k, &l);
-        let a = reduction.matrix(&k);
-        drop(k);
+        drop(l);
+        let a = reduction.into_matrix(k);
         let nodes = dofs.map(0).unwrap().nodes(mesh);
         let psi: Vec<f64> = reduction
             .free()
@@ -1165,7 +1170,7 @@ fn run_nodal(
             None => None,
         };
         Ok(NodalLevel {
-            dofs,
+            dof_count: dofs.dof_count(),
             reduction,
             a,
             f,
@@ -1176,17 +1181,20 @@ fn run_nodal(
     let mut state = NodalState::default();
     let step = |state: &mut NodalState, level: NodalLevel| -> Result<()> {
         let NodalLevel {
-            dofs,
+            dof_count,
             reduction,
             a,
             f,
             psi,
             prolongations,
         } = level;
+        // the coarser level's results go before this level's solve allocates (issue 15:
+        // peak memory); only its values are needed, for the start
+        state.finest = None;
         // the coarse solution interpolated at the fine nodes, boundary values included
-        let start = match (prolongations, &state.values) {
+        let start = match (prolongations, state.values.take()) {
             (Some((all, free)), Some(values)) => {
-                let fine = multiply(&all, values);
+                let fine = multiply(&all, &values);
                 state.prolongations.insert(0, free);
                 Some(
                     reduction
@@ -1207,12 +1215,13 @@ fn run_nodal(
         };
         let hierarchy: &[SparseMatrix] = if multigrid { &state.prolongations } else { &[] };
         let solution = nodal_active_set_with(&a, &f, &psi, start.as_deref(), 500, hierarchy)?;
-        state.levels.push([dofs.dof_count(), solution.iterations]);
+        state.levels.push([dof_count, solution.iterations]);
         state.values = Some(reduction.expand(&solution.u));
-        state.finest = Some((dofs, reduction, solution, a.nrows()));
+        state.finest = Some((reduction, solution, a.nrows()));
         Ok(())
     };
     let count = meshes.len();
+    let cell_counts: Vec<usize> = meshes.iter().map(TriangleMesh::cell_count).collect();
     if count >= 3 && meshes[count - 1].cell_count() >= PIPELINED_CELLS {
         let mut finest = None;
         alongside(
@@ -1224,6 +1233,9 @@ fn run_nodal(
                 Ok(())
             },
         )?;
+        // every level is set up: the coarser meshes (a third of the meshes' memory) are
+        // not needed for the finest solve nor after it
+        meshes.drain(..count - 1);
         step(&mut state, finest.expect("the worker has run")?)?;
     } else {
         for i in 0..count {
@@ -1231,14 +1243,16 @@ fn run_nodal(
         }
     }
     let mut levels = state.levels;
-    for (level, mesh) in levels.iter_mut().zip(&meshes) {
-        level[0] = mesh.cell_count();
+    for (level, cells) in levels.iter_mut().zip(cell_counts) {
+        level[0] = cells;
     }
     let mesh = meshes.last().expect("at least one mesh");
     let values = state.values.expect("at least one mesh");
-    let (dofs, reduction, solution, n) = state.finest.expect("at least one mesh");
+    let (reduction, solution, n) = state.finest.expect("at least one mesh");
     let (krylov_iterations, factorizations) = (solution.krylov_iterations, solution.factorizations);
     let seconds = clock.elapsed().as_secs_f64();
+    // the same numbering as the solve's (a function of the mesh alone)
+    let dofs = SystemDofs::all::<M>(mesh)?;
     let map = dofs.map(0).unwrap();
     let u = TriangleField {
         mesh,

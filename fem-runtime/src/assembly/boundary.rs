@@ -885,11 +885,19 @@ impl Reduction {
     /// The free–free block of `a`.
     pub fn matrix(&self, a: &SparseMatrix) -> SparseMatrix {
         let n = self.free.len();
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
-        let mut values = Vec::new();
-        col_ptr.push(0);
         let (col_ptrs, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+        // the free columns' lengths bound the entries: no growth by doubling, whose
+        // spare capacity (up to 2×) would stay with the matrix and whose copies cost
+        // peak memory (issue 15)
+        let bound: usize = self
+            .free
+            .iter()
+            .map(|&j| col_ptrs[j + 1] - col_ptrs[j])
+            .sum();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::with_capacity(bound);
+        let mut values = Vec::with_capacity(bound);
+        col_ptr.push(0);
         for &j in &self.free {
             for k in col_ptrs[j]..col_ptrs[j + 1] {
                 let fi = self.free_index[rows[k]];
@@ -900,6 +908,46 @@ impl Reduction {
             }
             col_ptr.push(row_idx.len());
         }
+        SparseColMat::new(
+            SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
+            values,
+        )
+    }
+
+    /// The free–free block of `a`, as [`Reduction::matrix`], built in `a`'s own arrays:
+    /// the full matrix and its block are never held together (at 1M unknowns each is
+    /// about 120 MB; issue 15, peak memory).
+    pub fn into_matrix(&self, a: SparseMatrix) -> SparseMatrix {
+        let (symbolic, mut values) = a.into_parts();
+        let (nrows, ncols, col_ptrs, col_nnz, mut row_idx) = symbolic.into_parts();
+        if col_nnz.is_some() {
+            // not compressed: the general copy
+            let a = SparseColMat::new(
+                SymbolicSparseColMat::new_checked(nrows, ncols, col_ptrs, col_nnz, row_idx),
+                values,
+            );
+            return self.matrix(&a);
+        }
+        let n = self.free.len();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0);
+        // entries only move towards the front (the kept ones keep their order), so
+        // writing at `w` never overwrites an entry still to be read at `k ≥ w`
+        let mut w = 0;
+        for &j in &self.free {
+            for k in col_ptrs[j]..col_ptrs[j + 1] {
+                let fi = self.free_index[row_idx[k]];
+                if fi != usize::MAX {
+                    row_idx[w] = fi;
+                    values[w] = values[k];
+                    w += 1;
+                }
+            }
+            col_ptr.push(w);
+        }
+        drop(col_ptrs);
+        row_idx.truncate(w);
+        values.truncate(w);
         SparseColMat::new(
             SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
             values,

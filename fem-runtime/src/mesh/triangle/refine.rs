@@ -20,7 +20,7 @@ impl TriangleMesh {
                     self.cells.len()
                 )));
             }
-            let r = self.cell_edges[c][1];
+            let r = self.cell_edges(c)[1];
             if !edge_marked[r] {
                 edge_marked[r] = true;
                 queue.push(r);
@@ -29,11 +29,9 @@ impl TriangleMesh {
         // Closure: a cell with any edge to split must first split its refinement edge.
         // This terminates for any labelling (each edge is marked at most once).
         while let Some(e) = queue.pop() {
-            for c in self.edge_cells[e] {
-                if c == NONE {
-                    continue;
-                }
-                let r = self.cell_edges[c][1];
+            let (c0, c1) = self.edge_cells(e);
+            for c in std::iter::once(c0).chain(c1) {
+                let r = self.cell_edges(c)[1];
                 if !edge_marked[r] {
                     edge_marked[r] = true;
                     queue.push(r);
@@ -65,7 +63,7 @@ impl TriangleMesh {
             Vec::with_capacity(self.cells.len() + 3 * (vertices.len() - self.vertices.len()));
         let mut parents = Vec::with_capacity(cells.capacity());
         for (c, &[v0, v1, v2]) in self.cells.iter().enumerate() {
-            let [e0, e1, e2] = self.cell_edges[c];
+            let [e0, e1, e2] = self.cell_edges(c);
             let m = midpoint[e1];
             if m == NONE {
                 cells.push([v0, v1, v2]);
