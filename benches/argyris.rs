@@ -37,10 +37,6 @@ use std::time::Instant;
 type A = kirchhoff_argyris::Model;
 type P0 = kirchhoff_argyris_p0::Model;
 
-// the same allocator as the CLI (see src/main.rs)
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 const D: f64 = 1.0;
 const NU: f64 = 0.3;
 /// The obstacle side of kirchhoff-obstacle: above, `s = −1`.
@@ -471,7 +467,7 @@ fn obstacle_solve(n: usize, rounds: usize) {
 
 fn main() {
     fem_forms::lcp::cholesky::factor_sequentially();
-    fem_forms::allocator::retain_freed_memory();
+    fem_forms::allocator::keep_freed_memory();
     let quick = std::env::args().any(|a| a == "--quick");
     let (assembly_n, solve_n) = if quick { (32, 28) } else { (256, 112) };
     assembly(assembly_n, if quick { 3 } else { 9 });

@@ -286,10 +286,6 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize], rounds: usize, with_l
     }
 }
 
-// the same allocator as the CLI (see src/main.rs)
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 /// The KKT matrix `[[A, −Bᵀ], [−B, −C]]` of an LCP with a diagonal C.
 fn kkt_matrix(lcp: &Lcp) -> SparseMatrix {
     let n = lcp.n();
@@ -314,7 +310,7 @@ fn kkt_matrix(lcp: &Lcp) -> SparseMatrix {
 
 fn main() {
     fem_forms::lcp::cholesky::factor_sequentially();
-    fem_forms::allocator::retain_freed_memory();
+    fem_forms::allocator::keep_freed_memory();
     let quick = std::env::args().any(|a| a == "--quick");
     let (assembly_n, p1_sizes, p2_sizes): (usize, Vec<usize>, Vec<usize>) = if quick {
         (128, vec![32, 64, 128], vec![32, 64])

@@ -33,10 +33,6 @@ use std::time::Instant;
 
 type M = mindlin_clamped::Model;
 
-// the same allocator as the CLI (see src/main.rs)
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 const D: f64 = 1.0;
 const NU: f64 = 0.3;
 const KAPPA: f64 = 5.0 / 6.0;
@@ -593,7 +589,7 @@ mindlin-disk (curved cells), q = 20 up against w ≤ 0.05, t = 0.01: complete VI
 
 fn main() {
     fem_forms::lcp::cholesky::factor_sequentially();
-    fem_forms::allocator::retain_freed_memory();
+    fem_forms::allocator::keep_freed_memory();
     let quick = std::env::args().any(|a| a == "--quick");
     let (assembly_n, sizes) = if quick {
         (64, vec![16, 32])

@@ -26,9 +26,6 @@ use fem_forms::models::signorini::{
 use fem_forms::{Coefficients, Diagonal, Model, TriangleMesh};
 use std::time::Instant;
 
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 /// Seconds of one Cholesky (symbolic + numeric) and solve of the elasticity matrix on
 /// `mesh` with `u_y = 0` also on Γ_C, and its order; the best of three.
 fn linear_solve(mesh: &TriangleMesh, input: &SignoriniInput) -> (f64, usize) {
@@ -152,6 +149,7 @@ fn parabolic_gap(x: &[f64]) -> f64 {
 }
 
 fn main() {
+    fem_forms::allocator::keep_freed_memory();
     fem_forms::lcp::cholesky::factor_sequentially();
     let hertz = Hertz {
         radius: 1.0,

@@ -12,10 +12,8 @@ use fem_forms::lcp::cholesky::Cholesky;
 use fem_forms::models::scenes::scene;
 use std::time::Instant;
 
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 fn main() {
+    fem_forms::allocator::keep_freed_memory();
     fem_forms::lcp::cholesky::factor_sequentially();
     let sizes = [1_000usize, 4_000, 16_000, 64_000, 256_000, 1_024_000];
     for (name, thickness) in [

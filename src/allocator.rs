@@ -1,24 +1,36 @@
-//! Settings of the mimalloc allocator that the CLI and the benchmarks install.
+//! Settings of the system allocator (glibc's malloc) that the CLI and the benchmarks apply
+//! at start-up.
 
-/// mimalloc's `mi_option_purge_delay` (its position in `mi_option_e` of the vendored
-/// v2 and v3 headers; the Rust bindings do not name it).
-pub const PURGE_DELAY: libmimalloc_sys::mi_option_t = 15;
-
-/// Keeps freed memory mapped instead of returning it to the kernel after 10 ms.
+/// Keeps freed memory in the process for the next allocation instead of returning it to
+/// the kernel; returns whether the C library accepted the settings (glibc's `mallopt`;
+/// elsewhere it does nothing and returns `false`).
 ///
-/// The nested solves free and reallocate vectors and factors of hundreds of megabytes
-/// per level and Newton iteration; on these machines each return costs a round of page
-/// faults and kernel page zeroing on the next use (measured: 0.8–1.3 s of system time
-/// in a 2 s membrane solve at 524k triangles, 0.1 s with this setting). Only effective
-/// when mimalloc is the global allocator. The option is set only if it holds a delay
-/// (0 to 10⁵ ms), so an option table of another layout is most likely left untouched;
-/// `tests/allocator.rs` checks the position against `MIMALLOC_PURGE_DELAY`.
-pub fn retain_freed_memory() {
-    // SAFETY: mi_option_get/mi_option_set only read and write mimalloc's option table.
-    unsafe {
-        if (0..=100_000).contains(&libmimalloc_sys::mi_option_get(PURGE_DELAY)) {
-            libmimalloc_sys::mi_option_set(PURGE_DELAY, -1);
+/// The nested solves free and reallocate vectors and matrices of hundreds of megabytes
+/// per level and Newton iteration. By default glibc serves each allocation above 32 MiB
+/// (less before its threshold adapts) with a fresh `mmap` and unmaps it on free, so every
+/// reuse costs a round of page faults and kernel page zeroing (measured: 0.8–1.3 s of
+/// system time in a 2 s membrane solve at 524k triangles). Here every allocation comes
+/// from the heap (`M_MMAP_MAX = 0`), the heap is never trimmed (`M_TRIM_THRESHOLD`), and
+/// all threads share one arena (`M_ARENA_MAX = 1`: the finest level is built on a second
+/// thread and freed on the first). Measured against mimalloc with its purging off (the
+/// allocator before, 2026-12-01, `membrane-radial --mesh-size 1024`, runs interleaved):
+/// p1-nodal peak 905–961 MB against 980–984 MB at the same speed; p1-p0 4.86 s and
+/// 2.62 GB against 5.0 s and 3.0 GB; the default job 13.2 s and 710 MB against 13.8 s and
+/// 910 MB. `tests/allocator.rs` checks that a freed block is reused without page faults.
+pub fn keep_freed_memory() -> bool {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        // SAFETY: mallopt only changes glibc's allocation parameters; called before the
+        // program has threads that allocate concurrently.
+        unsafe {
+            libc::mallopt(libc::M_MMAP_MAX, 0) == 1
+                && libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX) == 1
+                && libc::mallopt(libc::M_ARENA_MAX, 1) == 1
         }
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    {
+        false
     }
 }
 

@@ -1097,15 +1097,10 @@ fn run(cli: Cli) -> Result<(), String> {
     }
 }
 
-// The solvers allocate and drop large vectors at every level and iteration; glibc
-// returns each to the kernel and pays page faults for the next. mimalloc keeps them:
-// the membrane VI solve at 524k triangles takes 2.1–2.3 s instead of 3.0 s.
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 fn main() -> ExitCode {
     fem_forms::lcp::cholesky::factor_sequentially();
-    fem_forms::allocator::retain_freed_memory();
+    // before any thread allocates
+    fem_forms::allocator::keep_freed_memory();
     fem_forms::allocator::small_pages();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,

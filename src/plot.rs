@@ -84,34 +84,6 @@ fn tick(v: f64) -> String {
     }
 }
 
-#[cfg(test)]
-mod tick_tests {
-    use super::tick;
-
-    #[test]
-    fn ticks_keep_four_significant_digits_and_stay_distinct() {
-        for (v, text) in [
-            (0.0, "0"),
-            (1.0, "1"),
-            (250.0, "250"),
-            (0.0125, "0.0125"),
-            (0.5, "0.5"),
-            (1234.5, "1234"),
-            (-3.25, "-3.25"),
-            (1.5e-3, "1.5e-3"),
-            (2e-3, "2e-3"),
-            (1.25e5, "1.25e5"),
-            (-7e-9, "-7e-9"),
-        ] {
-            assert_eq!(tick(v), text, "{v}");
-        }
-        let labels: Vec<String> = (1..=10).map(|k| tick(k as f64 * 5e-4)).collect();
-        for pair in labels.windows(2) {
-            assert_ne!(pair[0], pair[1]);
-        }
-    }
-}
-
 fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
@@ -300,4 +272,32 @@ pub fn profiles(path: &Path, title: &str, p: &Profiles) -> std::io::Result<()> {
         vec![Series::line("λ_h (P0)", steps)],
     ));
     stacked(path, &panels)
+}
+
+#[cfg(test)]
+mod tick_tests {
+    use super::tick;
+
+    #[test]
+    fn ticks_keep_four_significant_digits_and_stay_distinct() {
+        for (v, text) in [
+            (0.0, "0"),
+            (1.0, "1"),
+            (250.0, "250"),
+            (0.0125, "0.0125"),
+            (0.5, "0.5"),
+            (1234.5, "1234"),
+            (-3.25, "-3.25"),
+            (1.5e-3, "1.5e-3"),
+            (2e-3, "2e-3"),
+            (1.25e5, "1.25e5"),
+            (-7e-9, "-7e-9"),
+        ] {
+            assert_eq!(tick(v), text, "{v}");
+        }
+        let labels: Vec<String> = (1..=10).map(|k| tick(k as f64 * 5e-4)).collect();
+        for pair in labels.windows(2) {
+            assert_ne!(pair[0], pair[1]);
+        }
+    }
 }

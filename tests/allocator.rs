@@ -1,35 +1,43 @@
-//! The position of mimalloc's purge-delay option that `fem_forms::allocator` sets is
-//! the one mimalloc reads `MIMALLOC_PURGE_DELAY` into.
+//! `fem_forms::allocator::keep_freed_memory`: a large block freed and allocated again
+//! is served from memory the process keeps, without a new round of page faults (glibc's
+//! default unmaps it on free and faults every page in again). Runs without the test
+//! harness, on the main thread, as the CLI does.
 
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
-#[test]
-fn purge_delay_position_is_the_one_the_environment_sets() {
-    const CHILD: &str = "FEM_FORMS_ALLOCATOR_CHILD";
-    if std::env::var_os(CHILD).is_some() {
-        // the child: mimalloc read MIMALLOC_PURGE_DELAY=1234 at start-up
-        let value = unsafe { libmimalloc_sys::mi_option_get(fem_forms::allocator::PURGE_DELAY) };
-        assert_eq!(
-            value,
-            1234,
-            "option {} is not the purge delay",
-            fem_forms::allocator::PURGE_DELAY
-        );
-        fem_forms::allocator::retain_freed_memory();
-        let value = unsafe { libmimalloc_sys::mi_option_get(fem_forms::allocator::PURGE_DELAY) };
-        assert_eq!(value, -1, "retain_freed_memory did not disable purging");
-        return;
+/// Minor page faults of this process so far.
+fn minor_faults() -> i64 {
+    // SAFETY: getrusage writes the struct it is given.
+    unsafe {
+        let mut usage: libc::rusage = std::mem::zeroed();
+        assert_eq!(libc::getrusage(libc::RUSAGE_SELF, &mut usage), 0);
+        usage.ru_minflt
     }
-    let status = std::process::Command::new(std::env::current_exe().unwrap())
-        .args([
-            "purge_delay_position_is_the_one_the_environment_sets",
-            "--exact",
-            "--nocapture",
-        ])
-        .env(CHILD, "1")
-        .env("MIMALLOC_PURGE_DELAY", "1234")
-        .status()
-        .unwrap();
-    assert!(status.success(), "the child test failed: {status}");
+}
+
+fn main() {
+    assert!(
+        fem_forms::allocator::keep_freed_memory(),
+        "glibc refused the settings"
+    );
+    const BYTES: usize = 256 << 20;
+    const PAGES: i64 = (BYTES / 4096) as i64;
+    let touch = || {
+        let mut block = vec![1u8; BYTES];
+        for i in (0..BYTES).step_by(4096) {
+            block[i] = 2;
+        }
+        std::hint::black_box(&block);
+    };
+    let before = minor_faults();
+    touch();
+    let first = minor_faults() - before;
+    let before = minor_faults();
+    touch();
+    let second = minor_faults() - before;
+    // the first touch faults every page in (huge pages: fewer faults, same test)
+    assert!(first > 0, "no page faults on a fresh block");
+    assert!(
+        second * 20 <= first,
+        "the freed block was not kept: {second} page faults on reuse, {first} on first use ({PAGES} pages)"
+    );
+    println!("allocator: {first} page faults on first use, {second} on reuse");
 }
