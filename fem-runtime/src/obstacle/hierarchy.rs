@@ -25,9 +25,9 @@ pub enum LinearSolver {
     /// the solve (`O(N)` per step). Levels without a coarser one, and steps whose CG does
     /// not reach [`MULTIGRID_TOLERANCE`] in [`MULTIGRID_MAX_ITERATIONS`], are factored.
     Multigrid,
-    /// [`LinearSolver::Multigrid`] on levels of at least [`AUTO_MULTIGRID_UNKNOWNS`]
-    /// primal unknowns, at most [`AUTO_MULTIGRID_ROW_NONZEROS`] nonzeros per row of `A`
-    /// and at least two coarser levels; [`LinearSolver::Direct`] otherwise.
+    /// The faster one as measured: [`LinearSolver::Direct`] for the Newton steps of the
+    /// eliminated LCP (the stabilized pairs) at every size, see [`LinearSolver::uses_multigrid`];
+    /// the nodal method takes multigrid from `obstacle::nodal::NODAL_AUTO_MULTIGRID_UNKNOWNS`.
     Auto,
 }
 
@@ -55,23 +55,6 @@ pub const MULTIGRID_INEXACT_STEPS: usize = 3;
 
 /// CG iterations after which a Newton step is given to the factorization instead.
 pub const MULTIGRID_MAX_ITERATIONS: usize = 80;
-
-/// From this many primal unknowns on, [`LinearSolver::Auto`] uses multigrid: measured on
-/// membrane-radial P1–P0 (`docs/multigrid.md`, "Multigrid in Newton", 2026-11-30, with
-/// the updated hierarchy), the whole nested solve is not faster than the direct path
-/// anywhere yet: at 1M unknowns runs side by side went either way (14.5 against 8.3 s,
-/// 10.7 against 12.2 s on a shared machine) with 10 % less memory, at 261k it lost (1.9
-/// against 1.35 s): the direct path factors once per level and then updates the factor.
-/// Kept where the two are closest.
-pub const AUTO_MULTIGRID_UNKNOWNS: usize = 1_000_000;
-
-/// The most nonzeros per row of `A` with which [`LinearSolver::Auto`] uses multigrid.
-/// Gauss–Seidel sweeps cost a pass over the matrix each, while the direct path factors
-/// once and then updates the factor (`crate::lcp::woodbury`): on P2–P0 (about 13 per
-/// row) the direct path was 1.8× faster at 261k unknowns (1.75 against 3.2 s) and 1.6×
-/// at 1M (9.8 against 16.2 s); on P1–P0 (7 per row) the two are closest at 1M
-/// (`docs/multigrid.md`, "Multigrid in Newton").
-pub const AUTO_MULTIGRID_ROW_NONZEROS: f64 = 10.0;
 
 impl LinearSolver {
     /// Every solver, by its name on the command line.
@@ -106,20 +89,18 @@ impl LinearSolver {
             })
     }
 
-    /// Whether the Newton steps of `lcp`, with `coarser` levels below it, are solved by
-    /// multigrid.
-    pub fn uses_multigrid(self, lcp: &Lcp, coarser: usize) -> bool {
-        match self {
-            LinearSolver::Direct => false,
-            LinearSolver::Multigrid => coarser > 0,
-            LinearSolver::Auto => {
-                let n = lcp.n();
-                let per_row = lcp.a.compute_nnz() as f64 / n.max(1) as f64;
-                n >= AUTO_MULTIGRID_UNKNOWNS
-                    && per_row <= AUTO_MULTIGRID_ROW_NONZEROS
-                    && coarser >= 2
-            }
-        }
+    /// Whether the Newton steps of an LCP with `coarser` levels below it are solved by
+    /// multigrid: asked for and a coarser level exists.
+    ///
+    /// [`LinearSolver::Auto`] is direct: the direct path factors once per level and
+    /// solves the later steps by low-rank updates of that factor, as cheap as a few
+    /// W-cycles, and it was faster at every size measured (membrane-radial P1–P0,
+    /// 2026-12-01, `seconds` direct / multigrid: 0.26 / 0.37 s at 65k primal unknowns,
+    /// 0.92 / 1.41 at 261k, 4.7 / 6.9 at 1.05M, 29.8 / 42.3 at 4.2M; P2–P0 1.6–2× slower
+    /// with multigrid before, docs/multigrid.md "Multigrid in Newton"). Multigrid takes
+    /// 10–20 % less memory; `--linear-solver multigrid` asks for it.
+    pub fn uses_multigrid(self, coarser: usize) -> bool {
+        self == LinearSolver::Multigrid && coarser > 0
     }
 }
 

@@ -743,9 +743,7 @@ pub fn solve_lcp_on_hierarchy(
     options: ObstacleOptions,
 ) -> Result<LcpSolution> {
     let multigrid = prolongations.first().is_some_and(|p| p.nrows() == lcp.n())
-        && options
-            .linear_solver
-            .uses_multigrid(lcp, prolongations.len());
+        && options.linear_solver.uses_multigrid(prolongations.len());
     match options.solver {
         // Newton with Λ eliminated (SPD Hessian, one symbolic Cholesky); if it fails,
         // the active-set method on the saddle-point system. Where the eliminated Λ
