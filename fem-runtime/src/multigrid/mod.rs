@@ -23,7 +23,7 @@ pub mod sparse;
 #[cfg(test)]
 mod tests;
 
-pub use prolongation::{parents_by_location, prolongation, NestedLevel};
+pub use prolongation::{parents_by_location, prolongation, reduced_prolongation, NestedLevel};
 
 use crate::error::{Error, Result};
 use crate::lcp::cholesky::{Cholesky, CholeskyFactor};
@@ -126,6 +126,27 @@ impl Multigrid {
         if asymmetry.is_nan() || asymmetry > 1e-12 {
             return Err(Error::Input(format!(
                 "multigrid of a matrix that is not symmetric (largest |A_ij − A_ji| is {asymmetry:e} of its largest entry)"
+            )));
+        }
+        Self::new_symmetric(a, prolongations, options)
+    }
+
+    /// [`Multigrid::new`] without its symmetry check (an `O(nnz log)` pass), for a caller
+    /// whose matrices are symmetric by construction (the nodal method's reduced
+    /// matrices, which are symmetric when its stiffness matrix is, checked once). The
+    /// other checks stay; a non-symmetric `a` gives a non-symmetric cycle.
+    pub(crate) fn new_symmetric(
+        a: SparseMatrix,
+        prolongations: Vec<SparseMatrix>,
+        options: MultigridOptions,
+    ) -> Result<Self> {
+        if options.sweeps == 0 || options.coarse_corrections == 0 || a.nrows() != a.ncols() {
+            return Err(Error::Input(format!(
+                "multigrid of a {} × {} matrix with {} sweeps and {} coarse corrections",
+                a.nrows(),
+                a.ncols(),
+                options.sweeps,
+                options.coarse_corrections
             )));
         }
         let mut levels = Vec::with_capacity(prolongations.len() + 1);
