@@ -356,11 +356,14 @@ impl Multigrid {
         here.x.fill(0.0);
         self.smooth(level, here);
         for _ in 0..self.options.coarse_corrections {
-            sparse::multiply_into(&level.a, &here.x, &mut here.r);
+            // the operators are symmetric (checked by `new`, or by the caller of
+            // `new_symmetric`): the row-gather product,
+            // parallel on large levels, as is the restriction (bitwise the serial one)
+            sparse::multiply_symmetric_into(&level.a, &here.x, &mut here.r);
             for (r, b) in here.r.iter_mut().zip(&here.b) {
                 *r = b - *r;
             }
-            sparse::restrict(p, &here.r, &mut below[0].b);
+            sparse::restrict_parallel(p, &here.r, &mut below[0].b);
             self.cycle(l + 1, below)?;
             sparse::prolong_add(p, &below[0].x, &mut here.x);
         }
@@ -422,7 +425,7 @@ impl Multigrid {
                     "multigrid-preconditioned CG broke down at iteration {iteration} (rᵀz = {rz:e}: the preconditioner is not positive definite)"
                 )));
             }
-            sparse::multiply_into(a, &p, &mut q);
+            sparse::multiply_symmetric_into(a, &p, &mut q);
             let pq = dot(&p, &q);
             if pq.is_nan() || pq <= 0.0 {
                 return Err(Error::LinearSolve(format!(

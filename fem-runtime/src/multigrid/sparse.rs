@@ -10,7 +10,9 @@
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
-/// `y = A x` (column-oriented: exact for any `A`, symmetric or not).
+/// `y = A x` (column-oriented: exact for any `A`, symmetric or not); the reference of
+/// the parallel kernels' tests.
+#[cfg(test)]
 pub(super) fn multiply_into(a: &SparseMatrix, x: &[f64], y: &mut [f64]) {
     let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
     y.fill(0.0);

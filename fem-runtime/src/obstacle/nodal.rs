@@ -138,11 +138,17 @@ pub fn nodal_active_set_level(
         Some(s) => s.iter().zip(psi).map(|(&x, &p)| x.max(p)).collect(),
         None => psi.to_vec(),
     };
-    let mut lambda: Vec<f64> = multiply(a, &u)
-        .iter()
-        .zip(f)
-        .map(|(au, fi)| au - fi)
-        .collect();
+    // `a u` by the parallel row gather once `a` is known to be symmetric
+    let times_a = |u: &[f64]| -> Vec<f64> {
+        if multigrid {
+            let mut y = vec![0.0; n];
+            multiply_symmetric_into(a, u, &mut y);
+            y
+        } else {
+            multiply(a, u)
+        }
+    };
+    let mut lambda: Vec<f64> = times_a(&u).iter().zip(f).map(|(au, fi)| au - fi).collect();
     let mut active: Vec<bool> = (0..n)
         .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
         .collect();
@@ -223,7 +229,7 @@ pub fn nodal_active_set_level(
                 factor.solve_refined(&matrix, &rhs, 1)?
             }
         };
-        let au = multiply(a, &u);
+        let au = times_a(&u);
         for i in 0..n {
             lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
         }
@@ -235,7 +241,7 @@ pub fn nodal_active_set_level(
                 // the settled system solved to rounding, as a factorization would
                 if let Some(iterations) = polish(mg, &rhs, &mut u) {
                     krylov_iterations += iterations;
-                    let au = multiply(a, &u);
+                    let au = times_a(&u);
                     for i in 0..n {
                         lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
                     }
@@ -299,7 +305,8 @@ fn multigrid_solve(
     prolongations: &[SparseMatrix],
     active: &[bool],
 ) -> std::result::Result<(Vec<f64>, usize, Option<Multigrid>), Option<SparseMatrix>> {
-    let mut residual = multiply(&matrix, x0);
+    let mut residual = vec![0.0; rhs.len()];
+    multiply_symmetric_into(&matrix, x0, &mut residual);
     for (r, b) in residual.iter_mut().zip(rhs) {
         *r = b - *r;
     }
@@ -331,7 +338,8 @@ const POLISH_TOLERANCE: f64 = 1e-14;
 /// `u` is updated and the iterations returned when CG improved it.
 fn polish(mg: &Multigrid, rhs: &[f64], u: &mut [f64]) -> Option<usize> {
     let fine = mg.operator(0)?;
-    let mut residual = multiply(fine, u);
+    let mut residual = vec![0.0; rhs.len()];
+    multiply_symmetric_into(fine, u, &mut residual);
     for (r, b) in residual.iter_mut().zip(rhs) {
         *r = b - *r;
     }
