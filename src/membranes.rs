@@ -11,9 +11,11 @@ use fem_runtime::assembly::{assemble_vector, MatrixAssembler};
 use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
 use fem_runtime::lcp::cholesky::multiply;
 use fem_runtime::lcp::LcpSolution;
-use fem_runtime::multigrid::{parents_by_location, prolongation, NestedLevel};
+use fem_runtime::multigrid::{
+    parents_by_location, prolongation, reduced_prolongation, NestedLevel,
+};
 use fem_runtime::obstacle::hierarchy::LinearSolver;
-use fem_runtime::obstacle::nodal::{nodal_active_set_with, NODAL_AUTO_MULTIGRID_UNKNOWNS};
+use fem_runtime::obstacle::nodal::{nodal_active_set_level, NODAL_AUTO_MULTIGRID_UNKNOWNS};
 use fem_runtime::obstacle::triangle::{
     dirichlet_constraints_on, solve_obstacle_on_part, TriangleObstacleSolution,
 };
@@ -1154,18 +1156,13 @@ fn run_nodal(
                     dofs,
                     reduction,
                 };
-                Some((
-                    prolongation(
-                        &level(coarse, &coarse_dofs, None),
-                        &level(mesh, &dofs, None),
-                        &parents,
-                    )?,
-                    prolongation(
-                        &level(coarse, &coarse_dofs, Some(&coarse_reduction)),
-                        &level(mesh, &dofs, Some(&reduction)),
-                        &parents,
-                    )?,
-                ))
+                let all = prolongation(
+                    &level(coarse, &coarse_dofs, None),
+                    &level(mesh, &dofs, None),
+                    &parents,
+                )?;
+                let free = reduced_prolongation(&all, &coarse_reduction, &reduction)?;
+                Some((all, free))
             }
             None => None,
         };
@@ -1179,6 +1176,8 @@ fn run_nodal(
         })
     };
     let mut state = NodalState::default();
+    // the meshes are drained before the finest level's step: count them now
+    let level_count = meshes.len();
     let step = |state: &mut NodalState, level: NodalLevel| -> Result<()> {
         let NodalLevel {
             dof_count,
@@ -1214,7 +1213,9 @@ fn run_nodal(
             }
         };
         let hierarchy: &[SparseMatrix] = if multigrid { &state.prolongations } else { &[] };
-        let solution = nodal_active_set_with(&a, &f, &psi, start.as_deref(), 500, hierarchy)?;
+        let last = state.levels.len() + 1 == level_count;
+        let solution =
+            nodal_active_set_level(&a, &f, &psi, start.as_deref(), 500, hierarchy, last)?;
         state.levels.push([dof_count, solution.iterations]);
         state.values = Some(reduction.expand(&solution.u));
         state.finest = Some((reduction, solution, a.nrows()));

@@ -23,7 +23,7 @@ pub mod sparse;
 #[cfg(test)]
 mod tests;
 
-pub use prolongation::{parents_by_location, prolongation, NestedLevel};
+pub use prolongation::{parents_by_location, prolongation, reduced_prolongation, NestedLevel};
 
 use crate::error::{Error, Result};
 use crate::lcp::cholesky::{Cholesky, CholeskyFactor};
@@ -126,6 +126,27 @@ impl Multigrid {
         if asymmetry.is_nan() || asymmetry > 1e-12 {
             return Err(Error::Input(format!(
                 "multigrid of a matrix that is not symmetric (largest |A_ij − A_ji| is {asymmetry:e} of its largest entry)"
+            )));
+        }
+        Self::new_symmetric(a, prolongations, options)
+    }
+
+    /// [`Multigrid::new`] without its symmetry check (an `O(nnz log)` pass), for a caller
+    /// whose matrices are symmetric by construction (the nodal method's reduced
+    /// matrices, which are symmetric when its stiffness matrix is, checked once). The
+    /// other checks stay; a non-symmetric `a` gives a non-symmetric cycle.
+    pub(crate) fn new_symmetric(
+        a: SparseMatrix,
+        prolongations: Vec<SparseMatrix>,
+        options: MultigridOptions,
+    ) -> Result<Self> {
+        if options.sweeps == 0 || options.coarse_corrections == 0 || a.nrows() != a.ncols() {
+            return Err(Error::Input(format!(
+                "multigrid of a {} × {} matrix with {} sweeps and {} coarse corrections",
+                a.nrows(),
+                a.ncols(),
+                options.sweeps,
+                options.coarse_corrections
             )));
         }
         let mut levels = Vec::with_capacity(prolongations.len() + 1);
@@ -335,11 +356,14 @@ impl Multigrid {
         here.x.fill(0.0);
         self.smooth(level, here);
         for _ in 0..self.options.coarse_corrections {
-            sparse::multiply_into(&level.a, &here.x, &mut here.r);
+            // the operators are symmetric (checked by `new`, or by the caller of
+            // `new_symmetric`): the row-gather product,
+            // parallel on large levels, as is the restriction (bitwise the serial one)
+            sparse::multiply_symmetric_into(&level.a, &here.x, &mut here.r);
             for (r, b) in here.r.iter_mut().zip(&here.b) {
                 *r = b - *r;
             }
-            sparse::restrict(p, &here.r, &mut below[0].b);
+            sparse::restrict_parallel(p, &here.r, &mut below[0].b);
             self.cycle(l + 1, below)?;
             sparse::prolong_add(p, &below[0].x, &mut here.x);
         }
@@ -401,7 +425,7 @@ impl Multigrid {
                     "multigrid-preconditioned CG broke down at iteration {iteration} (rᵀz = {rz:e}: the preconditioner is not positive definite)"
                 )));
             }
-            sparse::multiply_into(a, &p, &mut q);
+            sparse::multiply_symmetric_into(a, &p, &mut q);
             let pq = dot(&p, &q);
             if pq.is_nan() || pq <= 0.0 {
                 return Err(Error::LinearSolve(format!(

@@ -167,3 +167,54 @@ pub fn prolongation(
     SparseColMat::try_new_from_triplets(fine.size(), coarse.size(), &triplets)
         .map_err(|e| Error::Input(format!("prolongation matrix: {e:?}")))
 }
+
+/// The free–free block of a prolongation `all` between two levels with every DOF free
+/// ([`prolongation`] with both reductions `None`), in the reduced numbering of `coarse`
+/// (columns) and `fine` (rows): the same matrix as [`prolongation`] with both
+/// reductions given (the same weights, bitwise), at the cost of one pass over `all`'s
+/// entries instead of the geometry of every fine cell (about 0.1 s at 1M unknowns).
+///
+/// Errors: `all` of another shape than the two reductions' systems.
+pub fn reduced_prolongation(
+    all: &SparseMatrix,
+    coarse: &Reduction,
+    fine: &Reduction,
+) -> Result<SparseMatrix> {
+    let coarse_size = coarse.expand(&vec![0.0; coarse.free().len()]).len();
+    let fine_size = fine.expand(&vec![0.0; fine.free().len()]).len();
+    if all.ncols() != coarse_size || all.nrows() != fine_size {
+        return Err(Error::Input(format!(
+            "a prolongation of {} × {} for reductions of {fine_size} fine and {coarse_size} coarse DOFs",
+            all.nrows(),
+            all.ncols()
+        )));
+    }
+    let (col_ptr, rows, vals) = (
+        all.symbolic().col_ptr(),
+        all.symbolic().row_idx(),
+        all.val(),
+    );
+    let mut new_ptr = Vec::with_capacity(coarse.free().len() + 1);
+    let mut new_rows = Vec::with_capacity(rows.len());
+    let mut new_vals = Vec::with_capacity(rows.len());
+    new_ptr.push(0);
+    // both free lists increase, so the columns come in order and each column's rows stay
+    // sorted
+    for &d in coarse.free() {
+        for k in col_ptr[d]..col_ptr[d + 1] {
+            if let Some(row) = fine.free_index(rows[k]) {
+                new_rows.push(row);
+                new_vals.push(vals[k]);
+            }
+        }
+        new_ptr.push(new_rows.len());
+    }
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(
+        fine.free().len(),
+        coarse.free().len(),
+        new_ptr,
+        None,
+        new_rows,
+    );
+    Ok(SparseColMat::new(symbolic, new_vals))
+}

@@ -10,7 +10,9 @@
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
-/// `y = A x` (column-oriented: exact for any `A`, symmetric or not).
+/// `y = A x` (column-oriented: exact for any `A`, symmetric or not); the reference of
+/// the parallel kernels' tests.
+#[cfg(test)]
 pub(super) fn multiply_into(a: &SparseMatrix, x: &[f64], y: &mut [f64]) {
     let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
     y.fill(0.0);
@@ -83,39 +85,98 @@ pub(super) fn gauss_seidel(
 }
 
 /// `C = A B` (Gustavson's column-by-column product with a dense accumulator), rows of
-/// each column sorted.
+/// each column sorted. From [`PARALLEL_MIN_ROWS`] rows or columns on (and more than one
+/// thread) the columns of `C` are computed in blocks of consecutive columns on the
+/// current rayon pool and concatenated: every column is the same sum in the same order
+/// as in the serial loop, so the result is bitwise the same whatever the threads.
 pub(super) fn product(a: &SparseMatrix, b: &SparseMatrix) -> SparseMatrix {
+    use rayon::prelude::*;
+    let (m, n) = (a.nrows(), b.ncols());
+    // enough blocks that a thread slowed by another job is not waited for long
+    let blocks = if in_parallel(m.max(n)) {
+        (n / MIN_ROWS_PER_TASK).clamp(1, 32)
+    } else {
+        1
+    };
+    let parts: Vec<ProductColumns> = if blocks == 1 {
+        vec![product_columns(a, b, 0..n)]
+    } else {
+        (0..blocks)
+            .into_par_iter()
+            .map(|c| product_columns(a, b, c * n / blocks..(c + 1) * n / blocks))
+            .collect()
+    };
+    let nnz = parts.iter().map(|p| p.rows.len()).sum();
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut rows = Vec::with_capacity(nnz);
+    let mut values = Vec::with_capacity(nnz);
+    col_ptr.push(0);
+    for part in parts {
+        let offset = rows.len();
+        col_ptr.extend(part.col_end.iter().map(|&e| offset + e));
+        rows.extend_from_slice(&part.rows);
+        values.extend_from_slice(&part.values);
+    }
+    SparseColMat::new(
+        SymbolicSparseColMat::new_checked(m, n, col_ptr, None, rows),
+        values,
+    )
+}
+
+/// Columns of a product `A B`: the end of each column in `rows`/`values`.
+struct ProductColumns {
+    col_end: Vec<usize>,
+    rows: Vec<usize>,
+    values: Vec<f64>,
+}
+
+/// The columns `columns` of `A B`, with a dense accumulator over the rows they can
+/// reach (the span of the first and last row of the columns of `A` they read: a narrow
+/// band on a mesh numbered by position).
+fn product_columns(
+    a: &SparseMatrix,
+    b: &SparseMatrix,
+    columns: std::ops::Range<usize>,
+) -> ProductColumns {
     let (a_ptr, a_rows, a_vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
     let (b_ptr, b_rows, b_vals) = (b.symbolic().col_ptr(), b.symbolic().row_idx(), b.val());
-    let m = a.nrows();
-    let mut accumulator = vec![0.0; m];
-    let mut seen = vec![usize::MAX; m];
-    let mut col_ptr = Vec::with_capacity(b.ncols() + 1);
+    let (mut low, mut high) = (usize::MAX, 0);
+    for &k in &b_rows[b_ptr[columns.start]..b_ptr[columns.end]] {
+        if a_ptr[k] < a_ptr[k + 1] {
+            low = low.min(a_rows[a_ptr[k]]);
+            high = high.max(a_rows[a_ptr[k + 1] - 1] + 1);
+        }
+    }
+    let span = high.saturating_sub(low);
+    let mut accumulator = vec![0.0; span];
+    let mut seen = vec![usize::MAX; span];
+    let mut col_end = Vec::with_capacity(columns.len());
     let mut rows = Vec::new();
     let mut values = Vec::new();
-    col_ptr.push(0);
-    for j in 0..b.ncols() {
+    for j in columns {
         let start = rows.len();
         for kb in b_ptr[j]..b_ptr[j + 1] {
             let (k, bkj) = (b_rows[kb], b_vals[kb]);
             for ka in a_ptr[k]..a_ptr[k + 1] {
                 let i = a_rows[ka];
-                if seen[i] != j {
-                    seen[i] = j;
-                    accumulator[i] = 0.0;
+                let local = i - low;
+                if seen[local] != j {
+                    seen[local] = j;
+                    accumulator[local] = 0.0;
                     rows.push(i);
                 }
-                accumulator[i] += a_vals[ka] * bkj;
+                accumulator[local] += a_vals[ka] * bkj;
             }
         }
         rows[start..].sort_unstable();
-        values.extend(rows[start..].iter().map(|&i| accumulator[i]));
-        col_ptr.push(rows.len());
+        values.extend(rows[start..].iter().map(|&i| accumulator[i - low]));
+        col_end.push(rows.len());
     }
-    SparseColMat::new(
-        SymbolicSparseColMat::new_checked(m, b.ncols(), col_ptr, None, rows),
+    ProductColumns {
+        col_end,
+        rows,
         values,
-    )
+    }
 }
 
 /// `Pᵀ`.
@@ -666,6 +727,48 @@ mod parallel_tests {
             restrict_parallel(&p, &x, &mut parallel);
             assert_eq!(serial, parallel, "Pᵀ r");
         });
+    }
+
+    #[test]
+    fn parallel_galerkin_products_equal_the_serial_ones_and_the_composed_products() {
+        let m = 255;
+        let a = laplacian(
+            m,
+            &random_vector(m * m, 4)
+                .iter()
+                .map(|v| v.abs())
+                .collect::<Vec<_>>(),
+        );
+        // a non-nested column order too: the accumulator then spans most rows
+        let p = interpolation(m);
+        let q = transpose(&interpolation(m));
+        let serial = pool(1).install(|| (product(&a, &p), galerkin(&a, &p), product(&q, &a)));
+        let parallel = pool(2).install(|| (product(&a, &p), galerkin(&a, &p), product(&q, &a)));
+        for (s, t) in [
+            (&serial.0, &parallel.0),
+            (&serial.1, &parallel.1),
+            (&serial.2, &parallel.2),
+        ] {
+            assert_eq!(s.symbolic().col_ptr(), t.symbolic().col_ptr());
+            assert_eq!(s.symbolic().row_idx(), t.symbolic().row_idx());
+            assert_eq!(s.val(), t.val());
+        }
+        // (A P) x = A (P x) and (Pᵀ A P) x = Pᵀ (A (P x)), by the serial kernels
+        let xc = random_vector(p.ncols(), 5);
+        let mut px = vec![0.0; m * m];
+        prolong_add(&p, &xc, &mut px);
+        let mut apx = vec![0.0; m * m];
+        multiply_into(&a, &px, &mut apx);
+        let mut composed = vec![0.0; m * m];
+        multiply_into(&parallel.0, &xc, &mut composed);
+        let d = relative_difference(&apx, &composed);
+        assert!(d <= 1e-14, "(A P) x: {d:e}");
+        let mut ptapx = vec![0.0; p.ncols()];
+        restrict(&p, &apx, &mut ptapx);
+        let mut coarse = vec![0.0; p.ncols()];
+        multiply_into(&parallel.1, &xc, &mut coarse);
+        let d = relative_difference(&ptapx, &coarse);
+        assert!(d <= 1e-14, "(Pᵀ A P) x: {d:e}");
     }
 
     #[test]

@@ -696,3 +696,48 @@ fn updated_coarse_operators_are_the_recomputed_ones() {
     check::<laplace_p1::Model>(4);
     check::<laplace_p2::Model>(4);
 }
+
+/// The free–free block taken from the all-DOF prolongation is the prolongation built
+/// with both reductions (pattern and values, bitwise), for P1 and P2 with Dirichlet
+/// boundaries; a prolongation of another shape is refused.
+#[test]
+fn reduced_prolongation_is_the_prolongation_between_reduced_levels() {
+    fn check<M: Model>(meshes: &[TriangleMesh]) {
+        let (coarse_mesh, fine_mesh) = (&meshes[1], &meshes[2]);
+        let (coarse, fine) = (laplace::<M>(coarse_mesh), laplace::<M>(fine_mesh));
+        let parents = parents_by_location(coarse_mesh, fine_mesh).unwrap();
+        fn level<'a>(mesh: &'a TriangleMesh, level: &'a Laplace, reduced: bool) -> NestedLevel<'a> {
+            NestedLevel {
+                mesh,
+                dofs: &level.dofs,
+                reduction: reduced.then_some(&level.reduction),
+            }
+        }
+        let all = prolongation(
+            &level(coarse_mesh, &coarse, false),
+            &level(fine_mesh, &fine, false),
+            &parents,
+        )
+        .unwrap();
+        let direct = prolongation(
+            &level(coarse_mesh, &coarse, true),
+            &level(fine_mesh, &fine, true),
+            &parents,
+        )
+        .unwrap();
+        let filtered = reduced_prolongation(&all, &coarse.reduction, &fine.reduction).unwrap();
+        assert!(direct.val().len() < all.val().len());
+        assert_eq!(
+            (filtered.nrows(), filtered.ncols()),
+            (direct.nrows(), direct.ncols())
+        );
+        assert_eq!(filtered.symbolic().col_ptr(), direct.symbolic().col_ptr());
+        assert_eq!(filtered.symbolic().row_idx(), direct.symbolic().row_idx());
+        assert_eq!(filtered.val(), direct.val());
+        let e = reduced_prolongation(&all, &fine.reduction, &coarse.reduction).unwrap_err();
+        assert!(e.to_string().contains("reductions of"), "{e}");
+    }
+    let meshes = hierarchy(3, Diagonal::Right);
+    check::<laplace_p1::Model>(&meshes);
+    check::<laplace_p2::Model>(&meshes);
+}
