@@ -49,8 +49,9 @@
 //! ```
 //!
 //! Refused, naming the key: an unknown model, pair (or a P1-multiplier one), generator or
-//! key; `mesh.refinements` beyond 6 or beyond the memory the solver allows itself (an
-//! estimate, before refining); an `accuracy` without `[exact]`; a part name the
+//! key; `mesh.refinements` beyond 6 (and, when solved with the command line's
+//! overrides, beyond the memory the solver allows itself: an estimate, before
+//! refining); an `accuracy` without `[exact]`; a part name the
 //! mesh does not have (`boundary.contact`, …, with the names it has); a part that holds
 //! no boundary edge (an interior Gmsh curve: "not on the boundary"); `material.young`
 //! ≤ 0; `material.poisson` outside (−1, ½); a zero `parameters.contact_direction`; a
@@ -290,7 +291,6 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             format!("{refinements} uniform refinements: at most {MAX_REFINEMENTS}"),
         ));
     }
-    check_memory(mesh.cell_count(), refinements, pair).map_err(|m| at("mesh.refinements", m))?;
     let m = &file.material;
     if !(m.young.is_finite() && m.young > 0.0) {
         return Err(at(

@@ -453,15 +453,20 @@ fn rigid_motions_held(
     let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
     let translation = towards_foundation(problem, n);
     let work = dot(&translation, f);
-    if work.is_nan() || work <= 0.0 {
+    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale = norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
+    let product = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, x);
+    // supports along n_c hold the body whatever the load: only a free translation
+    // needs the load to press it on
+    let translation_free =
+        norm(&translation) > 0.0 && norm(&product(&translation)) <= 1e-10 * scale;
+    if translation_free && (work.is_nan() || work <= 0.0) {
         return Err(Error::Input(format!(
             "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0): the rigid motion is not prevented"
         )));
     }
     let tangent = towards_foundation(problem, [-n[1], n[0]]);
-    let stiffness = fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, &tangent);
-    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let free = norm(&stiffness) <= 1e-10 * norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
+    let free = norm(&product(&tangent)) <= 1e-10 * scale;
     let sliding = dot(&tangent, f);
     if free && norm(&tangent) > 0.0 {
         let load = if sliding.abs() > 1e-10 * work.abs() {
@@ -474,26 +479,30 @@ fn rigid_motions_held(
             -n[1], n[0]
         )));
     }
-    rotation_held(mesh, problem, n, &translation, &tangent, work)?;
+    rotation_held(mesh, problem, n, [&translation, &tangent], translation_free)?;
     Ok(translation)
 }
 
 /// Refuses a body that tips: when the supports leave a rotation free (a rigid motion
 /// `Z = R + aT + bS` with `A Z = 0`: `R` the rotation about the origin, `T` and `S` the
-/// translations along and across `n_c`), only the contact can hold it, and it can only
-/// where the load's resultant passes through Γ_C. With `s(x) = Z(x)·n_c` the motion of
-/// point `x` towards the foundation, the motions `Z − s_max T` and `s_min T − Z` open every
-/// contact; the load must do negative work on both (Fichera's condition for the
-/// rigid motions): `s_min W < f·Z < s_max W`, `W = f·T > 0`, over the vertices of Γ_C.
+/// translations along and across `n_c`), only the contact can hold it. With
+/// `s(x) = Z(x)·n_c` the motion of point `x` towards the foundation, the load must do
+/// negative work on every free rigid motion that opens every contact (Fichera's
+/// condition), over the vertices of Γ_C:
+/// - `T` free too: the motions `Z − s_max T` and `s_min T − Z` span those, so
+///   `s_min W < f·Z < s_max W` with `W = f·T > 0`: the resultant meets Γ_C;
+/// - `T` held by supports: only `βZ`, which opens every contact for `β ≥ 0` if
+///   `s ≤ 0` on Γ_C (then `f·Z < 0` is needed), for `β ≤ 0` if `s ≥ 0` (`f·Z > 0`),
+///   for every β if `s ≡ 0` (`f·Z = 0`), and for none if `s` changes sign.
+///
 /// Otherwise there is no equilibrium and Newton's answer misses the load (a tester's
 /// block against a wall "solved" with the contact force 39 % off the load).
 fn rotation_held(
     mesh: &TriangleMesh,
     problem: &BoundaryMultiplierProblem,
     n: [f64; 2],
-    translation: &[f64],
-    tangent: &[f64],
-    work: f64,
+    [translation, tangent]: [&[f64]; 2],
+    translation_free: bool,
 ) -> Result<()> {
     let fields = problem.dofs.fields();
     let mut full = vec![0.0; problem.dofs.dof_count()];
@@ -547,9 +556,35 @@ fn rotation_held(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
             (lo.min(s), hi.max(s))
         });
-    let moment = dot(&motion, &problem.lcp.f);
-    let slack = 1e-9 * work.abs() * (s_max - s_min).abs().max(1.0);
-    if moment < s_min * work - slack || moment > s_max * work + slack {
+    let f = &problem.lcp.f;
+    let moment = dot(&motion, f);
+    let work = dot(translation, f);
+    // rounding of the sums: a load doing (almost) no work on a motion is not refused
+    let terms: f64 = motion.iter().zip(f).map(|(z, f)| (z * f).abs()).sum();
+    let slack = 1e-9 * terms;
+    // s at rounding level of the coordinates counts as 0
+    let size = s_min.abs().max(s_max.abs()).max(f64::MIN_POSITIVE);
+    let (below, above) = (s_min < -1e-12 * size, s_max > 1e-12 * size);
+    let tips = match (translation_free, below, above) {
+        (true, _, _) => {
+            let slack = 1e-9 * work.abs() * (s_max - s_min).abs().max(1.0) + slack;
+            moment < s_min * work - slack || moment > s_max * work + slack
+        }
+        // s ≤ 0 on Γ_C: βZ opens every contact for β ≥ 0
+        (false, true, false) => moment > slack,
+        // s ≥ 0: for β ≤ 0
+        (false, false, true) => moment < -slack,
+        // s ≡ 0: the contact cannot hold Z at all
+        (false, false, false) => moment.abs() > slack,
+        // s changes sign: no βZ opens every contact
+        (false, true, true) => false,
+    };
+    if tips && !translation_free {
+        return Err(Error::Input(format!(
+            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {moment:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+        )));
+    }
+    if tips {
         // where the resultant's line meets Γ_C, as a share of its extent from one end
         let place = if s_max > s_min {
             format!(
