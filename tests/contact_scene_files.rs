@@ -37,6 +37,37 @@ const RECTANGLE: &str = r#"
     gap = "0"
 "#;
 
+/// A contact scene file on the generated rectangle `(0, width) × (0, height)` with
+/// `cells`, E = 1000, ν = 0.3, gap 0, and `boundary` (the `[boundary]` lines,
+/// `contact_direction` too if not downwards) and `pressure` filled in.
+fn rectangle_scene(
+    width: f64,
+    height: f64,
+    cells: [usize; 2],
+    boundary: &str,
+    pressure: &str,
+) -> String {
+    format!(
+        r#"
+    model = "contact"
+    [mesh]
+    generator = "rectangle"
+    x = [0.0, {width:?}]
+    y = [0.0, {height:?}]
+    cells = [{}, {}]
+    [material]
+    young = 1000.0
+    poisson = 0.3
+    [boundary]
+    {boundary}
+    [data]
+    pressure = "{pressure}"
+    gap = "0"
+"#,
+        cells[0], cells[1]
+    )
+}
+
 /// The same block as a hand-written Gmsh file (perturbed interior nodes, an embedded
 /// curve `midline` inside it).
 const GMSH: &str = r#"
@@ -103,26 +134,13 @@ fn the_patch_test_from_a_scene_file_gives_the_pressure_exactly() {
 /// 2), where an extent along x would give 0.
 #[test]
 fn the_half_width_is_measured_along_a_vertical_wall() {
-    let turned = r#"
-    model = "contact"
-    [mesh]
-    generator = "rectangle"
-    x = [0.0, 1.0]
-    y = [0.0, 2.0]
-    cells = [3, 6]
-    [material]
-    young = 1000.0
-    poisson = 0.3
-    [boundary]
-    contact = "left"
-    load = "right"
-    fixed_y = "bottom"
-    [parameters]
-    contact_direction = [-1.0, 0.0]
-    [data]
-    pressure = "2.5"
-    gap = "0"
-"#;
+    let turned = rectangle_scene(
+        1.0,
+        2.0,
+        [3, 6],
+        "contact = \"left\"\n    load = \"right\"\n    fixed_y = \"bottom\"\n    [parameters]\n    contact_direction = [-1.0, 0.0]",
+        "2.5",
+    );
     for (centre, half_width) in [("", 1.0), ("contact_centre = 0.0\n", 2.0)] {
         let text = turned.replace("[data]", &format!("{centre}[data]"));
         let solved = contact_scene_file::solve(&parse(&text).unwrap(), &Overrides::default())
@@ -182,27 +200,12 @@ fn refinements_beyond_the_memory_are_refused_before_refining() {
 #[test]
 fn a_body_the_load_tips_is_refused() {
     let block = |load: &str| {
-        format!(
-            r#"
-    model = "contact"
-    [mesh]
-    generator = "rectangle"
-    x = [0.0, 2.0]
-    y = [0.0, 1.0]
-    cells = [8, 4]
-    [material]
-    young = 1000.0
-    poisson = 0.3
-    [boundary]
-    contact = "left"
-    load = {load}
-    fixed_y = "left"
-    [parameters]
-    contact_direction = [-1.0, 0.0]
-    [data]
-    pressure = "1"
-    gap = "0"
-"#
+        rectangle_scene(
+            2.0,
+            1.0,
+            [8, 4],
+            &format!("contact = \"left\"\n    load = {load}\n    fixed_y = \"left\"\n    [parameters]\n    contact_direction = [-1.0, 0.0]"),
+            "1",
         )
     };
     let solved =
@@ -234,26 +237,12 @@ fn a_body_the_load_tips_is_refused() {
 #[test]
 fn a_held_translation_leaves_a_one_sided_tipping_condition() {
     let block = |load: &str, pressure: &str| {
-        format!(
-            r#"
-    model = "contact"
-    [mesh]
-    generator = "rectangle"
-    x = [0.0, 2.0]
-    y = [0.0, 1.0]
-    cells = [8, 4]
-    [material]
-    young = 1000.0
-    poisson = 0.3
-    [boundary]
-    contact = "bottom"
-    load = {load}
-    fixed_y = "left"
-    fixed_x = "top"
-    [data]
-    pressure = "{pressure}"
-    gap = "0"
-"#
+        rectangle_scene(
+            2.0,
+            1.0,
+            [8, 4],
+            &format!("contact = \"bottom\"\n    load = {load}\n    fixed_y = \"left\"\n    fixed_x = \"top\""),
+            pressure,
         )
     };
     let text = block("[\"top\", \"right\"]", "10 - 9*y");
