@@ -296,6 +296,158 @@ impl Multigrid {
         Ok(())
     }
 
+    /// Removes the fine DOFs `removed` from the coarse spaces of a hierarchy whose
+    /// finest prolongation is truncated (rows of fixed fine DOFs empty, as
+    /// `obstacle::nodal::truncated_hierarchy` makes it), without recomputing the Galerkin
+    /// products: the truncated multigrid of the nodal method when a few more nodes
+    /// become active between two active-set iterations.
+    ///
+    /// `kept[i]` says whether row `i` of the finest prolongation is in use (false for
+    /// the DOFs truncated so far; updated here), and `stiffness` is the matrix whose
+    /// entries among kept DOFs the coarse operators were formed from. Removing DOF `i`
+    /// subtracts from every coarse level what row `i` of `P₀` contributed:
+    /// `Q (e_i a_iᵀ + a_i e_iᵀ − a_ii e_i e_iᵀ) Qᵀ`, `a_i` the column `i` of `stiffness` on
+    /// the DOFs still kept (one rank-two term each, [`Multigrid::add_coarse_term`]), and
+    /// then empties row `i` of `P₀`. Coarse DOFs left without a kept fine DOF under them
+    /// (their Galerkin row is then zero up to rounding) are decoupled with a unit
+    /// diagonal: their right-hand side is exactly zero in every cycle, so they stay 0.
+    /// A DOF that becomes free again may stay truncated: the cycle is then a weaker,
+    /// still symmetric positive definite, preconditioner. Call
+    /// [`Multigrid::replace_fine`] afterwards.
+    ///
+    /// Errors: sizes that do not match the hierarchy; an entry outside a coarse pattern
+    /// (see [`Multigrid::add_coarse_term`]; then the hierarchy is partly updated: build a
+    /// new one).
+    pub(crate) fn truncate_fine(
+        &mut self,
+        stiffness: &SparseMatrix,
+        kept: &mut [bool],
+        removed: &[usize],
+    ) -> Result<()> {
+        let n = self.levels[0].a.nrows();
+        if stiffness.nrows() != n || stiffness.ncols() != n || kept.len() != n {
+            return Err(Error::Input(format!(
+                "truncating a hierarchy of fine order {n} with a {} × {} stiffness and {} flags",
+                stiffness.nrows(),
+                stiffness.ncols(),
+                kept.len()
+            )));
+        }
+        if let Some(&i) = removed.iter().find(|&&i| i >= n) {
+            return Err(Error::Input(format!(
+                "truncating DOF {i} of a hierarchy of fine order {n}"
+            )));
+        }
+        if self.levels.len() == 1 {
+            for &i in removed {
+                kept[i] = false;
+            }
+            return Ok(());
+        }
+        let (col_ptr, rows, vals) = (
+            stiffness.symbolic().col_ptr(),
+            stiffness.symbolic().row_idx(),
+            stiffness.val(),
+        );
+        let mut column = Vec::new();
+        for &i in removed {
+            if !kept[i] {
+                continue;
+            }
+            column.clear();
+            let mut diagonal = 0.0;
+            for k in col_ptr[i]..col_ptr[i + 1] {
+                let j = rows[k];
+                // exact zeros are not in the truncated operators' patterns
+                if kept[j] && vals[k] != 0.0 {
+                    column.push((j, vals[k]));
+                    if j == i {
+                        diagonal = vals[k];
+                    }
+                }
+            }
+            let unit = [(i, 1.0)];
+            self.add_coarse_term(&[&unit, &column], &[diagonal, -1.0, -1.0, 0.0])?;
+            kept[i] = false;
+        }
+        let p0 = self.levels[0].p.as_mut().expect("a coarser level");
+        let (symbolic, values) = p0.parts_mut();
+        for (value, &i) in values.iter_mut().zip(symbolic.row_idx()) {
+            if !kept[i] {
+                *value = 0.0;
+            }
+        }
+        // and in the cached `P₀ᵀ`, whose columns are the rows of `P₀`
+        if let Some(r0) = self.restrictions.first_mut() {
+            let (symbolic, values) = r0.parts_mut();
+            let col_ptr = symbolic.col_ptr();
+            for &i in removed {
+                values[col_ptr[i]..col_ptr[i + 1]].fill(0.0);
+            }
+        }
+        // coarse DOFs with no kept fine DOF under them, level by level
+        let mut alive = kept.to_vec();
+        for l in 0..self.levels.len() - 1 {
+            let p = self.levels[l].p.as_ref().expect("not the coarsest level");
+            let (p_ptr, p_rows, p_vals) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+            let below: Vec<bool> = (0..p.ncols())
+                .map(|d| (p_ptr[d]..p_ptr[d + 1]).any(|k| alive[p_rows[k]] && p_vals[k] != 0.0))
+                .collect();
+            if below.iter().any(|&a| !a) {
+                let (symbolic, values) = self.levels[l + 1].a.parts_mut();
+                let (a_ptr, a_rows) = (symbolic.col_ptr(), symbolic.row_idx());
+                for j in 0..below.len() {
+                    for k in a_ptr[j]..a_ptr[j + 1] {
+                        let i = a_rows[k];
+                        if !below[i] || !below[j] {
+                            values[k] = if i == j { 1.0 } else { 0.0 };
+                        }
+                    }
+                }
+            }
+            alive = below;
+        }
+        Ok(())
+    }
+
+    /// Takes `fine` (same order, any pattern) as the fine operator and recomputes what
+    /// depends on the operators, as [`Multigrid::reset_fine`] does: the smoother of the
+    /// fine level, the inverse diagonals of every level and the coarsest factorization.
+    ///
+    /// Errors: `fine` of another order, a one-level hierarchy (its factorization is of
+    /// the old pattern), a level whose diagonal is not positive, a
+    /// coarsest operator Cholesky refuses. The hierarchy is then unusable; its fine
+    /// operator comes back with [`Multigrid::into_fine`].
+    pub(crate) fn replace_fine(&mut self, fine: SparseMatrix) -> Result<()> {
+        let n = self.levels[0].a.nrows();
+        // one level is a factorization of the old pattern
+        if self.levels.len() == 1 || fine.nrows() != n || fine.ncols() != n {
+            return Err(Error::Input(format!(
+                "a fine operator of {} × {} for a hierarchy of order {n} and {} levels",
+                fine.nrows(),
+                fine.ncols(),
+                self.levels.len()
+            )));
+        }
+        self.levels[0].a = fine;
+        for (l, level) in self.levels.iter_mut().enumerate() {
+            level.inverse_diagonal = inverse_diagonal(&level.a, l)?;
+        }
+        let last = &self.levels[self.levels.len() - 1].a;
+        self.coarsest = self.coarsest_analysis.factor_cholesky(last).map_err(|e| {
+            Error::LinearSolve(format!(
+                "the coarsest operator (order {}): {e}",
+                last.nrows()
+            ))
+        })?;
+        Ok(())
+    }
+
+    /// The fine operator, taken out of the hierarchy.
+    pub(crate) fn into_fine(mut self) -> SparseMatrix {
+        self.levels.swap_remove(0).a
+    }
+
     /// Replaces the fine operator's values by `fine`'s (the same pattern: a Newton
     /// Hessian of the same LCP), and recomputes what depends on the operators: the
     /// inverse diagonals of every level and the numeric factorization of the coarsest

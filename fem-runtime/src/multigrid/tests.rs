@@ -741,3 +741,168 @@ fn reduced_prolongation_is_the_prolongation_between_reduced_levels() {
     check::<laplace_p1::Model>(&meshes);
     check::<laplace_p2::Model>(&meshes);
 }
+
+/// `a` with the rows and columns of the `fixed` DOFs decoupled (their diagonal kept):
+/// the nodal method's reduced matrix.
+fn decoupled(a: &SparseMatrix, fixed: &[bool]) -> SparseMatrix {
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let triplets: Vec<Triplet<usize, usize, f64>> = (0..a.ncols())
+        .flat_map(|j| {
+            (col_ptr[j]..col_ptr[j + 1])
+                .filter(move |&k| rows[k] == j || !(fixed[rows[k]] || fixed[j]))
+                .map(move |k| Triplet::new(rows[k], j, vals[k]))
+        })
+        .collect();
+    SparseColMat::try_new_from_triplets(a.nrows(), a.ncols(), &triplets).unwrap()
+}
+
+/// A hierarchy truncated on one active set and then, by `truncate_fine`, on more
+/// nodes has the Galerkin operators of the finest prolongation with those rows emptied
+/// (computed here by the products, same coarse numbering), to 1e-12; its coarse DOFs
+/// left without a kept fine DOF under them (exactly zero there) are unit rows; nodes
+/// freed again stay truncated; and it still preconditions CG on the new matrix.
+#[test]
+fn truncating_further_gives_the_galerkin_operators_of_the_emptied_prolongation() {
+    use crate::obstacle::nodal::truncated_hierarchy;
+    fn check<M: Model>(levels: usize) {
+        let meshes = hierarchy(levels, Diagonal::Right);
+        let (data, prolongations) = laplace_hierarchy::<M>(&meshes);
+        let a = &data.last().unwrap().a;
+        let n = a.nrows();
+        let mut state = 11;
+        // a contact set in a disc, as an obstacle makes it, and a few more nodes
+        let nodes = data
+            .last()
+            .unwrap()
+            .dofs
+            .map(0)
+            .unwrap()
+            .nodes(meshes.last().unwrap());
+        let free = data.last().unwrap().reduction.free();
+        let first: Vec<bool> = free
+            .iter()
+            .map(|&d| {
+                let [x, y] = nodes[d];
+                (x - 0.4).powi(2) + (y - 0.5).powi(2) < 0.09
+            })
+            .collect();
+        // the disc grown (coarse DOFs inside lose their whole support), a few nodes
+        // more, a few freed again
+        let mut second: Vec<bool> = free
+            .iter()
+            .map(|&d| {
+                let [x, y] = nodes[d];
+                (x - 0.4).powi(2) + (y - 0.5).powi(2) < 0.16
+            })
+            .collect();
+        for flag in second.iter_mut() {
+            let r = random(&mut state);
+            if r < 0.08 {
+                *flag = true;
+            } else if *flag && r < 0.2 {
+                // freed again
+                *flag = false;
+            }
+        }
+        let options = MultigridOptions::default();
+        let truncated = truncated_hierarchy(&prolongations, &first);
+        let mut mg =
+            Multigrid::new_symmetric(decoupled(a, &first), truncated.clone(), options).unwrap();
+        let mut kept: Vec<bool> = first.iter().map(|&f| !f).collect();
+        let removed: Vec<usize> = (0..n).filter(|&i| second[i] && kept[i]).collect();
+        assert!(!removed.is_empty());
+        let fine = decoupled(a, &second);
+        mg.truncate_fine(a, &mut kept, &removed).unwrap();
+        mg.replace_fine(fine.clone()).unwrap();
+        for i in 0..n {
+            assert_eq!(kept[i], !(first[i] || second[i]), "node {i}");
+        }
+        // the reference: the same prolongations with the rows of `removed` emptied
+        let mut emptied = truncated;
+        {
+            let (symbolic, values) = emptied[0].parts_mut();
+            for (v, &i) in values.iter_mut().zip(symbolic.row_idx()) {
+                if !kept[i] {
+                    *v = 0.0;
+                }
+            }
+        }
+        let mut reference = fine.clone();
+        let mut dead_total = 0;
+        for (l, p) in emptied.iter().enumerate() {
+            reference = sparse::galerkin(&reference, p);
+            let updated = mg.operator(l + 1).unwrap();
+            assert_eq!(updated.nrows(), reference.nrows());
+            let (r_ptr, r_rows) = (
+                reference.symbolic().col_ptr(),
+                reference.symbolic().row_idx(),
+            );
+            let (u_ptr, u_rows) = (updated.symbolic().col_ptr(), updated.symbolic().row_idx());
+            let dead: Vec<bool> = sparse::diagonal(&reference)
+                .iter()
+                .map(|d| d.is_none_or(|d| d == 0.0))
+                .collect();
+            dead_total += dead.iter().filter(|&&d| d).count();
+            let scale = reference.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            // the updated pattern holds the reference's (the old fine operator coupled
+            // more), entries outside it are zero
+            for j in 0..reference.ncols() {
+                let column = &r_rows[r_ptr[j]..r_ptr[j + 1]];
+                let range = u_ptr[j]..u_ptr[j + 1];
+                for (&i, &got) in u_rows[range.clone()].iter().zip(&updated.val()[range]) {
+                    let want = if dead[i] || dead[j] {
+                        if i == j {
+                            1.0
+                        } else {
+                            0.0
+                        }
+                    } else {
+                        column
+                            .binary_search(&i)
+                            .map_or(0.0, |at| reference.val()[r_ptr[j] + at])
+                    };
+                    assert!(
+                        (got - want).abs() <= 1e-12 * scale,
+                        "{} level {}: entry ({i}, {j}) is {got}, expected {want}",
+                        M::NAME,
+                        l + 1
+                    );
+                }
+                for &i in column {
+                    assert!(
+                        u_rows[u_ptr[j]..u_ptr[j + 1]].binary_search(&i).is_ok(),
+                        "{} level {}: entry ({i}, {j}) missing",
+                        M::NAME,
+                        l + 1
+                    );
+                }
+            }
+        }
+        assert!(
+            dead_total > 0,
+            "{}: no coarse DOF lost its support",
+            M::NAME
+        );
+        let b: Vec<f64> = (0..n).map(|_| random(&mut state) - 0.5).collect();
+        let fresh = Multigrid::new_symmetric(
+            fine.clone(),
+            truncated_hierarchy(&prolongations, &second),
+            options,
+        )
+        .unwrap();
+        let updated = mg.pcg(&b, 1e-10, 60).unwrap();
+        let rebuilt = fresh.pcg(&b, 1e-10, 60).unwrap();
+        assert!(
+            updated.iterations <= rebuilt.iterations + 3,
+            "{}: {} CG iterations with the updated hierarchy, {} with a new one",
+            M::NAME,
+            updated.iterations,
+            rebuilt.iterations
+        );
+        // sizes that do not fit are refused
+        assert!(mg.truncate_fine(a, &mut vec![true; n + 1], &[]).is_err());
+        assert!(mg.truncate_fine(a, &mut kept, &[n]).is_err());
+    }
+    check::<laplace_p1::Model>(5);
+    check::<laplace_p2::Model>(4);
+}
