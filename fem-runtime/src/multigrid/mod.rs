@@ -411,25 +411,25 @@ impl Multigrid {
     }
 
     /// Takes `fine` (same order, any pattern) as the fine operator and recomputes what
-    /// depends on the operators, as [`Multigrid::reset_fine`] does: the smoother of the
-    /// fine level, the inverse diagonals of every level and the coarsest factorization.
+    /// depends on the operators, as [`Multigrid::reset_fine`] does: the inverse
+    /// diagonals of every level and the coarsest factorization (the smoothers depend on
+    /// the order only).
     ///
     /// Errors: `fine` of another order, a one-level hierarchy (its factorization is of
     /// the old pattern), a level whose diagonal is not positive, a
     /// coarsest operator Cholesky refuses. The hierarchy is then unusable; its fine
     /// operator comes back with [`Multigrid::into_fine`].
     pub(crate) fn replace_fine(&mut self, fine: SparseMatrix) -> Result<()> {
-        let n = self.levels[0].a.nrows();
+        // taken in first, so that `into_fine` gives it back whatever fails below
+        let (rows, columns) = (fine.nrows(), fine.ncols());
+        let n = std::mem::replace(&mut self.levels[0].a, fine).nrows();
         // one level is a factorization of the old pattern
-        if self.levels.len() == 1 || fine.nrows() != n || fine.ncols() != n {
+        if self.levels.len() == 1 || rows != n || columns != n {
             return Err(Error::Input(format!(
-                "a fine operator of {} × {} for a hierarchy of order {n} and {} levels",
-                fine.nrows(),
-                fine.ncols(),
+                "a fine operator of {rows} × {columns} for a hierarchy of order {n} and {} levels",
                 self.levels.len()
             )));
         }
-        self.levels[0].a = fine;
         for (l, level) in self.levels.iter_mut().enumerate() {
             level.inverse_diagonal = inverse_diagonal(&level.a, l)?;
         }
@@ -441,6 +441,17 @@ impl Multigrid {
             ))
         })?;
         Ok(())
+    }
+
+    /// Frees the fine operator's values and pattern (an empty matrix of the same order
+    /// stays), so that the next one can be built before [`Multigrid::replace_fine`]
+    /// without both being held (issue 15, peak memory). No cycle may run until then.
+    pub(crate) fn release_fine(&mut self) {
+        let n = self.levels[0].a.nrows();
+        self.levels[0].a = faer::sparse::SparseColMat::new(
+            faer::sparse::SymbolicSparseColMat::new_checked(n, n, vec![0; n + 1], None, Vec::new()),
+            Vec::new(),
+        );
     }
 
     /// The fine operator, taken out of the hierarchy.

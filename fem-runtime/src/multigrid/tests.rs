@@ -899,10 +899,92 @@ fn truncating_further_gives_the_galerkin_operators_of_the_emptied_prolongation()
             updated.iterations,
             rebuilt.iterations
         );
+        // a second update on the updated hierarchy: the disc grown again
+        let third: Vec<bool> = free
+            .iter()
+            .zip(&second)
+            .map(|(&d, &was)| {
+                let [x, y] = nodes[d];
+                was || (x - 0.4).powi(2) + (y - 0.5).powi(2) < 0.2
+            })
+            .collect();
+        let before = kept.clone();
+        let removed: Vec<usize> = (0..n).filter(|&i| third[i] && kept[i]).collect();
+        assert!(!removed.is_empty());
+        let fine = decoupled(a, &third);
+        mg.truncate_fine(a, &mut kept, &removed).unwrap();
+        mg.replace_fine(fine.clone()).unwrap();
+        let mut reference = fine;
+        let mut emptied = truncated_hierarchy(&prolongations, &first);
+        {
+            let (symbolic, values) = emptied[0].parts_mut();
+            for (v, &i) in values.iter_mut().zip(symbolic.row_idx()) {
+                if !kept[i] {
+                    *v = 0.0;
+                }
+            }
+        }
+        for (l, p) in emptied.iter().enumerate() {
+            reference = sparse::galerkin(&reference, p);
+            let updated = mg.operator(l + 1).unwrap();
+            let dead: Vec<bool> = sparse::diagonal(&reference)
+                .iter()
+                .map(|d| d.is_none_or(|d| d == 0.0))
+                .collect();
+            let scale = reference.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let (r_ptr, r_rows) = (
+                reference.symbolic().col_ptr(),
+                reference.symbolic().row_idx(),
+            );
+            let (u_ptr, u_rows) = (updated.symbolic().col_ptr(), updated.symbolic().row_idx());
+            for j in 0..reference.ncols() {
+                let column = &r_rows[r_ptr[j]..r_ptr[j + 1]];
+                let range = u_ptr[j]..u_ptr[j + 1];
+                for (&i, &got) in u_rows[range.clone()].iter().zip(&updated.val()[range]) {
+                    let want = if dead[i] || dead[j] {
+                        if i == j {
+                            1.0
+                        } else {
+                            0.0
+                        }
+                    } else {
+                        column
+                            .binary_search(&i)
+                            .map_or(0.0, |at| reference.val()[r_ptr[j] + at])
+                    };
+                    assert!(
+                        (got - want).abs() <= 1e-12 * scale,
+                        "{} second update, level {}: entry ({i}, {j}) is {got}, expected {want}",
+                        M::NAME,
+                        l + 1
+                    );
+                }
+            }
+        }
+        assert!(kept.iter().zip(&before).all(|(&k, &b)| !k || b));
         // sizes that do not fit are refused
         assert!(mg.truncate_fine(a, &mut vec![true; n + 1], &[]).is_err());
         assert!(mg.truncate_fine(a, &mut kept, &[n]).is_err());
     }
     check::<laplace_p1::Model>(5);
     check::<laplace_p2::Model>(4);
+}
+
+/// A one-level hierarchy (a factorization of its matrix's pattern) refuses a new fine
+/// operator, and gives that operator back, not the one it was built on.
+#[test]
+fn a_one_level_hierarchy_gives_back_the_refused_fine_operator() {
+    let meshes = hierarchy(3, Diagonal::Right);
+    let (data, _) = laplace_hierarchy::<laplace_p1::Model>(&meshes);
+    let a = data.last().unwrap().a.clone();
+    let n = a.nrows();
+    let fixed: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
+    let mut mg = Multigrid::new(a.clone(), Vec::new(), MultigridOptions::default()).unwrap();
+    let mut kept = vec![true; n];
+    assert!(mg.truncate_fine(&a, &mut kept, &[0]).is_ok());
+    let next = decoupled(&a, &fixed);
+    assert!(mg.replace_fine(next.clone()).is_err());
+    let back = mg.into_fine();
+    assert_eq!(back.symbolic().row_idx(), next.symbolic().row_idx());
+    assert_eq!(back.val(), next.val());
 }

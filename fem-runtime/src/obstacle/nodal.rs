@@ -200,6 +200,11 @@ pub fn nodal_active_set_level(
                 u[i] = psi[i];
             }
         }
+        // the last hierarchy's fine operator is not needed for its update: freed before
+        // the next one is built
+        if let Some(t) = hierarchy.as_mut() {
+            t.mg.release_fine();
+        }
         let (matrix, rhs) = reduced(multigrid)?;
         // the multigrid path takes the matrix over (its finest level), so that the
         // largest matrix is not held twice; a failed one is built again to be factored
@@ -349,7 +354,9 @@ fn multigrid_solve(
     if let Some(mut t) = previous.take() {
         let newly_active: Vec<usize> = (0..n).filter(|&i| active[i] && t.kept[i]).collect();
         let stale = (0..n).filter(|&i| !active[i] && !t.kept[i]).count();
-        if ((newly_active.len() + stale) as f64) <= UPDATE_LIMIT * n as f64
+        // (a one-level hierarchy is a factorization: built anew)
+        if t.mg.level_count() > 1
+            && ((newly_active.len() + stale) as f64) <= UPDATE_LIMIT * n as f64
             && t.mg
                 .truncate_fine(stiffness, &mut t.kept, &newly_active)
                 .is_ok()
