@@ -114,6 +114,13 @@ impl<'a> PointLocator<'a> {
         self.locate(p)
     }
 
+    /// Whether `p` lies in cell `c` (on its boundary included), by the signs of the
+    /// sub-triangle areas: the test [`PointLocator::locate_near`] makes of its hint.
+    #[inline]
+    pub fn contains(&self, c: usize, p: [f64; 2]) -> bool {
+        c < self.mesh.cells.len() && self.sub_areas(c, p).1.iter().all(|&w| w >= 0.0)
+    }
+
     /// Cell `c`'s vertices and `w[k]`, twice the signed area of the sub-triangle of `p`
     /// opposite vertex `k` (all ≥ 0 inside).
     pub(super) fn sub_areas(&self, c: usize, p: [f64; 2]) -> ([[f64; 2]; 3], [f64; 3]) {
