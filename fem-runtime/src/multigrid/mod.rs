@@ -430,17 +430,7 @@ impl Multigrid {
                 self.levels.len()
             )));
         }
-        for (l, level) in self.levels.iter_mut().enumerate() {
-            level.inverse_diagonal = inverse_diagonal(&level.a, l)?;
-        }
-        let last = &self.levels[self.levels.len() - 1].a;
-        self.coarsest = self.coarsest_analysis.factor_cholesky(last).map_err(|e| {
-            Error::LinearSolve(format!(
-                "the coarsest operator (order {}): {e}",
-                last.nrows()
-            ))
-        })?;
-        Ok(())
+        self.refresh()
     }
 
     /// Frees the fine operator's values and pattern (an empty matrix of the same order
@@ -476,6 +466,13 @@ impl Multigrid {
             ));
         }
         level.a.val_mut().copy_from_slice(fine.val());
+        self.refresh()
+    }
+
+    /// Recomputes what depends on the operators' values: the inverse diagonals of every
+    /// level and the numeric factorization of the coarsest one (its pattern analysed
+    /// once, at construction).
+    fn refresh(&mut self) -> Result<()> {
         for (l, level) in self.levels.iter_mut().enumerate() {
             level.inverse_diagonal = inverse_diagonal(&level.a, l)?;
         }

@@ -742,6 +742,78 @@ fn reduced_prolongation_is_the_prolongation_between_reduced_levels() {
     check::<laplace_p2::Model>(&meshes);
 }
 
+/// Checks every coarse operator of `mg` against the Galerkin products of `fine` with
+/// `truncated` (the hierarchy as first built) whose finest rows outside `kept` are
+/// emptied: equal to 1e-12 of the largest entry where both DOFs have a kept fine DOF
+/// under them, unit rows where not (exactly zero in the products), no entry of the
+/// products missing. Returns how many coarse DOFs lost their support.
+fn check_emptied(
+    name: &str,
+    mg: &Multigrid,
+    fine: &SparseMatrix,
+    mut truncated: Vec<SparseMatrix>,
+    kept: &[bool],
+) -> usize {
+    {
+        let (symbolic, values) = truncated[0].parts_mut();
+        for (v, &i) in values.iter_mut().zip(symbolic.row_idx()) {
+            if !kept[i] {
+                *v = 0.0;
+            }
+        }
+    }
+    let mut reference = fine.clone();
+    let mut dead_total = 0;
+    for (l, p) in truncated.iter().enumerate() {
+        reference = sparse::galerkin(&reference, p);
+        let updated = mg.operator(l + 1).unwrap();
+        assert_eq!(updated.nrows(), reference.nrows());
+        let (r_ptr, r_rows) = (
+            reference.symbolic().col_ptr(),
+            reference.symbolic().row_idx(),
+        );
+        let (u_ptr, u_rows) = (updated.symbolic().col_ptr(), updated.symbolic().row_idx());
+        let dead: Vec<bool> = sparse::diagonal(&reference)
+            .iter()
+            .map(|d| d.is_none_or(|d| d == 0.0))
+            .collect();
+        dead_total += dead.iter().filter(|&&d| d).count();
+        let scale = reference.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        // the updated pattern holds the reference's (the old fine operator coupled
+        // more), entries outside it are zero
+        for j in 0..reference.ncols() {
+            let column = &r_rows[r_ptr[j]..r_ptr[j + 1]];
+            let range = u_ptr[j]..u_ptr[j + 1];
+            for (&i, &got) in u_rows[range.clone()].iter().zip(&updated.val()[range]) {
+                let want = if dead[i] || dead[j] {
+                    if i == j {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                } else {
+                    column
+                        .binary_search(&i)
+                        .map_or(0.0, |at| reference.val()[r_ptr[j] + at])
+                };
+                assert!(
+                    (got - want).abs() <= 1e-12 * scale,
+                    "{name} level {}: entry ({i}, {j}) is {got}, expected {want}",
+                    l + 1
+                );
+            }
+            for &i in column {
+                assert!(
+                    u_rows[u_ptr[j]..u_ptr[j + 1]].binary_search(&i).is_ok(),
+                    "{name} level {}: entry ({i}, {j}) missing",
+                    l + 1
+                );
+            }
+        }
+    }
+    dead_total
+}
+
 /// `a` with the rows and columns of the `fixed` DOFs decoupled (their diagonal kept):
 /// the nodal method's reduced matrix.
 fn decoupled(a: &SparseMatrix, fixed: &[bool]) -> SparseMatrix {
@@ -818,66 +890,7 @@ fn truncating_further_gives_the_galerkin_operators_of_the_emptied_prolongation()
             assert_eq!(kept[i], !(first[i] || second[i]), "node {i}");
         }
         // the reference: the same prolongations with the rows of `removed` emptied
-        let mut emptied = truncated;
-        {
-            let (symbolic, values) = emptied[0].parts_mut();
-            for (v, &i) in values.iter_mut().zip(symbolic.row_idx()) {
-                if !kept[i] {
-                    *v = 0.0;
-                }
-            }
-        }
-        let mut reference = fine.clone();
-        let mut dead_total = 0;
-        for (l, p) in emptied.iter().enumerate() {
-            reference = sparse::galerkin(&reference, p);
-            let updated = mg.operator(l + 1).unwrap();
-            assert_eq!(updated.nrows(), reference.nrows());
-            let (r_ptr, r_rows) = (
-                reference.symbolic().col_ptr(),
-                reference.symbolic().row_idx(),
-            );
-            let (u_ptr, u_rows) = (updated.symbolic().col_ptr(), updated.symbolic().row_idx());
-            let dead: Vec<bool> = sparse::diagonal(&reference)
-                .iter()
-                .map(|d| d.is_none_or(|d| d == 0.0))
-                .collect();
-            dead_total += dead.iter().filter(|&&d| d).count();
-            let scale = reference.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            // the updated pattern holds the reference's (the old fine operator coupled
-            // more), entries outside it are zero
-            for j in 0..reference.ncols() {
-                let column = &r_rows[r_ptr[j]..r_ptr[j + 1]];
-                let range = u_ptr[j]..u_ptr[j + 1];
-                for (&i, &got) in u_rows[range.clone()].iter().zip(&updated.val()[range]) {
-                    let want = if dead[i] || dead[j] {
-                        if i == j {
-                            1.0
-                        } else {
-                            0.0
-                        }
-                    } else {
-                        column
-                            .binary_search(&i)
-                            .map_or(0.0, |at| reference.val()[r_ptr[j] + at])
-                    };
-                    assert!(
-                        (got - want).abs() <= 1e-12 * scale,
-                        "{} level {}: entry ({i}, {j}) is {got}, expected {want}",
-                        M::NAME,
-                        l + 1
-                    );
-                }
-                for &i in column {
-                    assert!(
-                        u_rows[u_ptr[j]..u_ptr[j + 1]].binary_search(&i).is_ok(),
-                        "{} level {}: entry ({i}, {j}) missing",
-                        M::NAME,
-                        l + 1
-                    );
-                }
-            }
-        }
+        let dead_total = check_emptied(M::NAME, &mg, &fine, truncated, &kept);
         assert!(
             dead_total > 0,
             "{}: no coarse DOF lost its support",
@@ -914,53 +927,14 @@ fn truncating_further_gives_the_galerkin_operators_of_the_emptied_prolongation()
         let fine = decoupled(a, &third);
         mg.truncate_fine(a, &mut kept, &removed).unwrap();
         mg.replace_fine(fine.clone()).unwrap();
-        let mut reference = fine;
-        let mut emptied = truncated_hierarchy(&prolongations, &first);
-        {
-            let (symbolic, values) = emptied[0].parts_mut();
-            for (v, &i) in values.iter_mut().zip(symbolic.row_idx()) {
-                if !kept[i] {
-                    *v = 0.0;
-                }
-            }
-        }
-        for (l, p) in emptied.iter().enumerate() {
-            reference = sparse::galerkin(&reference, p);
-            let updated = mg.operator(l + 1).unwrap();
-            let dead: Vec<bool> = sparse::diagonal(&reference)
-                .iter()
-                .map(|d| d.is_none_or(|d| d == 0.0))
-                .collect();
-            let scale = reference.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let (r_ptr, r_rows) = (
-                reference.symbolic().col_ptr(),
-                reference.symbolic().row_idx(),
-            );
-            let (u_ptr, u_rows) = (updated.symbolic().col_ptr(), updated.symbolic().row_idx());
-            for j in 0..reference.ncols() {
-                let column = &r_rows[r_ptr[j]..r_ptr[j + 1]];
-                let range = u_ptr[j]..u_ptr[j + 1];
-                for (&i, &got) in u_rows[range.clone()].iter().zip(&updated.val()[range]) {
-                    let want = if dead[i] || dead[j] {
-                        if i == j {
-                            1.0
-                        } else {
-                            0.0
-                        }
-                    } else {
-                        column
-                            .binary_search(&i)
-                            .map_or(0.0, |at| reference.val()[r_ptr[j] + at])
-                    };
-                    assert!(
-                        (got - want).abs() <= 1e-12 * scale,
-                        "{} second update, level {}: entry ({i}, {j}) is {got}, expected {want}",
-                        M::NAME,
-                        l + 1
-                    );
-                }
-            }
-        }
+        let name = format!("{} second update", M::NAME);
+        check_emptied(
+            &name,
+            &mg,
+            &fine,
+            truncated_hierarchy(&prolongations, &first),
+            &kept,
+        );
         assert!(kept.iter().zip(&before).all(|(&k, &b)| !k || b));
         // sizes that do not fit are refused
         assert!(mg.truncate_fine(a, &mut vec![true; n + 1], &[]).is_err());
