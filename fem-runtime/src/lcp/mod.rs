@@ -431,13 +431,12 @@ impl Lcp {
     /// The natural size of a multiplier: `‖F‖∞ / ‖Bᵀ‖∞` (equilibrium `BᵀΛ ~ F`), so that
     /// "λ is zero" is judged against the load, not against λ itself.
     pub fn multiplier_scale(&self) -> f64 {
-        let bt = self.bt_norm();
-        let f = self.f.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        if bt > 0.0 {
-            f / bt
-        } else {
-            0.0
+        KktScales {
+            a_norm: 0.0,
+            bt_norm: self.bt_norm(),
+            f_norm: norm_inf(&self.f),
         }
+        .multiplier_scale()
     }
 
     /// The complementarity part of [`Lcp::kkt_residual`]: `max_k |min(Λ_k/Λ*, r_k)|`
@@ -454,11 +453,14 @@ impl Lcp {
             self.n(),
             self.m()
         );
-        let norm_inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let a_norm = row_sum_norm(&self.a);
-        let lambda_norm = norm_inf(lambda).max(self.multiplier_scale());
-        let u_star = if a_norm > 0.0 {
-            norm_inf(&self.f) / a_norm
+        self.complementarity_scaled(u, lambda, &self.kkt_scales())
+    }
+
+    /// [`Lcp::complementarity_residual`] with the data norms computed before.
+    fn complementarity_scaled(&self, u: &[f64], lambda: &[f64], scales: &KktScales) -> f64 {
+        let lambda_norm = norm_inf(lambda).max(scales.multiplier_scale());
+        let u_star = if scales.a_norm > 0.0 {
+            scales.f_norm / scales.a_norm
         } else {
             0.0
         };
@@ -515,23 +517,47 @@ impl Lcp {
         );
         let au = multiply(&self.a, u);
         let btl = self.bt_times(lambda);
-        let norm_inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let a_norm = row_sum_norm(&self.a);
-        let bt_norm = self.bt_norm();
+        self.kkt_residual_from(u, lambda, &au, &btl, &self.kkt_scales())
+    }
+
+    /// The norms of the data that [`Lcp::kkt_residual`] scales by; they do not change
+    /// during a solve, so an iteration computes them once.
+    pub(crate) fn kkt_scales(&self) -> KktScales {
+        KktScales {
+            a_norm: row_sum_norm(&self.a),
+            bt_norm: self.bt_norm(),
+            f_norm: norm_inf(&self.f),
+        }
+    }
+
+    /// [`Lcp::kkt_residual`] from `AU`, `BᵀΛ` and the data norms that the caller already
+    /// has (Newton computes the first two for its gradient): one pass over `A` fewer, and
+    /// two over `B`.
+    pub(crate) fn kkt_residual_from(
+        &self,
+        u: &[f64],
+        lambda: &[f64],
+        au: &[f64],
+        btl: &[f64],
+        scales: &KktScales,
+    ) -> f64 {
+        let KktScales {
+            a_norm, bt_norm, ..
+        } = *scales;
         let equilibrium: f64 = au
             .iter()
-            .zip(&btl)
+            .zip(btl)
             .zip(&self.f)
             .map(|((a, b), f)| (a - b - f).abs())
             .fold(0.0, f64::max);
-        let scale = a_norm * norm_inf(u) + bt_norm * norm_inf(lambda) + norm_inf(&self.f);
+        let scale = a_norm * norm_inf(u) + bt_norm * norm_inf(lambda) + scales.f_norm;
         let backward = if scale > 0.0 {
             equilibrium / scale
         } else {
             equilibrium
         };
-        let lambda_norm = norm_inf(lambda).max(self.multiplier_scale());
-        let complementarity = self.complementarity_residual(u, lambda);
+        let lambda_norm = norm_inf(lambda).max(scales.multiplier_scale());
+        let complementarity = self.complementarity_scaled(u, lambda, scales);
         let result = backward.max(complementarity);
         // An overflow in a norm (loads near f64::MAX) turns the relative residuals into
         // 0 / ∞ = 0: a point whose certificate overflowed is not certified.
@@ -548,6 +574,29 @@ impl Lcp {
             f64::INFINITY
         }
     }
+}
+
+/// `‖A‖∞`, `‖Bᵀ‖∞` and `‖F‖∞` of an [`Lcp`] ([`Lcp::kkt_scales`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct KktScales {
+    a_norm: f64,
+    bt_norm: f64,
+    f_norm: f64,
+}
+
+impl KktScales {
+    /// [`Lcp::multiplier_scale`]: `‖F‖∞ / ‖Bᵀ‖∞`, 0 without constraints.
+    fn multiplier_scale(&self) -> f64 {
+        if self.bt_norm > 0.0 {
+            self.f_norm / self.bt_norm
+        } else {
+            0.0
+        }
+    }
+}
+
+fn norm_inf(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 fn row_sum_norm(a: &SparseMatrix) -> f64 {

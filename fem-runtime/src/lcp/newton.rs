@@ -838,14 +838,17 @@ pub(super) fn newton_iteration(
     let mut seen_faces = std::collections::HashSet::new();
     // the iterate after a full exact step with the smallest KKT residual
     let mut best: Option<(Vec<f64>, Vec<f64>, f64)> = None;
+    let scales = lcp.kkt_scales();
     for iteration in 1..=options.max_iterations {
         let au = multiply(&lcp.a, &u);
         let bu = lcp.b_times(&u);
         let (lambda, active) = lcp.eliminate(&bu);
+        let btl = lcp.bt_times(&lambda);
+        let residual_here = || lcp.kkt_residual_from(&u, &lambda, &au, &btl, &scales);
         // Converged: the active faces did not change over a full exact step, so u is the
         // exact minimizer of the quadratic that Φ is on these faces.
         if last_exact && previous_active.as_ref() == Some(&active) {
-            let residual = lcp.kkt_residual(&u, &lambda);
+            let residual = residual_here();
             if residual <= options.tolerance {
                 return Ok(done(
                     u,
@@ -863,7 +866,7 @@ pub(super) fn newton_iteration(
         // iteration limit with a point as good as this one.
         if previous_active.is_some() {
             let cycling = !seen_faces.insert(faces_fingerprint(&active));
-            let residual = lcp.kkt_residual(&u, &lambda);
+            let residual = residual_here();
             if cycling && last_exact && residual <= options.tolerance {
                 return Ok(done(
                     u,
@@ -877,7 +880,6 @@ pub(super) fn newton_iteration(
                 best = Some((u.clone(), lambda.clone(), residual));
             }
         }
-        let btl = lcp.bt_times(&lambda);
         let gradient: Vec<f64> = (0..n).map(|i| au[i] - lcp.f[i] - btl[i]).collect();
         let h = hessian.matrix(lcp, &active);
         let minus_gradient: Vec<f64> = gradient.iter().map(|g| -g).collect();
@@ -936,7 +938,7 @@ pub(super) fn newton_iteration(
         let slope: f64 = gradient.iter().zip(&d).map(|(g, d)| g * d).sum();
         let Some(step) = lcp.armijo(&u, &au, &bu, &d, slope) else {
             // No decrease along a Newton direction: at the minimizer up to rounding.
-            let residual = lcp.kkt_residual(&u, &lambda);
+            let residual = residual_here();
             if residual <= options.tolerance.max(1e-8) {
                 return Ok(done(
                     u,
