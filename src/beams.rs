@@ -4,6 +4,7 @@ use crate::models::membrane_scenes::MAX_LOAD;
 use crate::models::scenes::{exact_solution, Beam, Scene};
 use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
 use fem_runtime::lcp::NewtonOptions;
+use fem_runtime::obstacle::hierarchy::LinearSolver;
 use fem_runtime::obstacle::{
     solve_obstacle, system_forms, Discretization, ObstacleOptions, VariationalSolver,
 };
@@ -156,6 +157,12 @@ pub struct Request {
     pub nested_from: Option<usize>,
     /// Iterative refinement rounds per linear solve.
     pub refinement_steps: usize,
+    /// Solver of the Newton steps: `Auto` and `Direct` factor (banded Cholesky, `O(N)` on
+    /// an interval, with low-rank updates); `Multigrid` solves the steps of the levels
+    /// above the coarsest by CG with a W-cycle on the nested uniform meshes
+    /// (`fem_runtime::obstacle::hierarchy::interval_primal_prolongation`, Hermite slopes
+    /// included), for studying multigrid on fourth-order and locking-prone systems.
+    pub linear_solver: LinearSolver,
     /// Allow α = 0: the plain (unstabilized) mixed method, for the stability studies;
     /// only the QP solver handles it.
     pub plain: bool,
@@ -174,6 +181,7 @@ impl Request {
             solver: VariationalSolver::SemismoothNewton,
             nested_from: Some(16),
             refinement_steps: 1,
+            linear_solver: LinearSolver::Auto,
             plain: false,
         }
     }
@@ -204,6 +212,10 @@ pub struct Report {
     pub dofs: usize,
     /// Solver iterations on the final mesh.
     pub iterations: usize,
+    /// What solved the finest level's Newton steps: `direct` or `multigrid`.
+    pub linear_solver: &'static str,
+    /// CG iterations of the finest level's multigrid steps (0 on the direct path).
+    pub krylov_iterations: usize,
     /// `[elements, iterations]` of each nested-iteration level.
     pub levels: Vec<[usize; 2]>,
     /// Wall time of the whole solve (assembly, all levels, post-processing excluded).
@@ -435,6 +447,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
             refinement_steps: request.refinement_steps,
             ..NewtonOptions::default()
         },
+        linear_solver: request.linear_solver,
         ..ObstacleOptions::default()
     };
     let solution = solve_obstacle::<M>(&mesh, &coefficients, clamped, options).map_err(|e| {
@@ -504,6 +517,12 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         )));
     }
     let mut warnings = Vec::new();
+    if request.linear_solver == LinearSolver::Multigrid && solution.iterative_steps == 0 {
+        warnings.push(crate::membranes::multigrid_unused(
+            request.solver,
+            "a cold start and meshes of fewer than 32 elements or an odd number of them",
+        ));
+    }
     // as for membranes: relative to ψ's size (its range, or |ψ| for a flat one)
     let psi_values: Vec<f64> = x.iter().map(|&x| scene.obstacle.at(x)).collect();
     let psi_range = psi_values.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
@@ -541,6 +560,12 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         elements: request.elements,
         dofs: d.lcp.n() + d.lcp.m(),
         iterations: solution.iterations,
+        linear_solver: if solution.iterative_steps > 0 {
+            "multigrid"
+        } else {
+            "direct"
+        },
+        krylov_iterations: solution.krylov_iterations,
         levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
         seconds: solution.seconds,
         energy,

@@ -936,11 +936,10 @@ fn run_stabilized<M: Model>(
         },
     )?;
     if request.linear_solver == LinearSolver::Multigrid && solution.iterative_steps == 0 {
-        warnings.push(if solver == VariationalSolver::SemismoothNewton {
-            "--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level: a cold start, a single level or N below 8 have none; or CG did not converge), so they were factored".to_string()
-        } else {
-            "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string()
-        });
+        warnings.push(multigrid_unused(
+            solver,
+            "a cold start, a single level or N below 8",
+        ));
     }
     let u_field = M::field("u")?;
     let d = &solution.discretization;
@@ -1036,6 +1035,16 @@ fn run_stabilized<M: Model>(
     };
     let fields = stabilized_fields(solution, u_field, &posed.data);
     Ok((report, fields))
+}
+
+/// The warning of a `--linear-solver multigrid` request that no finest Newton step used
+/// (`no_level`: when the family's nested solve has no coarser level).
+pub(crate) fn multigrid_unused(solver: VariationalSolver, no_level: &str) -> String {
+    if solver == VariationalSolver::SemismoothNewton {
+        format!("--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level: {no_level} have none; or CG did not converge), so they were factored")
+    } else {
+        "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string()
+    }
 }
 
 fn solver_name(solver: VariationalSolver) -> &'static str {

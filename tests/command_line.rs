@@ -257,7 +257,7 @@ fn options_that_do_not_apply_are_refused_by_name() {
         ),
         (&["solve", "membrane-radial", "--load", "2"][..], "--load"),
         (
-            &["solve", "bernoulli-a", "--linear-solver", "multigrid"][..],
+            &["solve", "bernoulli-a", "--linear-solver", "banded"][..],
             "--linear-solver",
         ),
         (
@@ -470,5 +470,34 @@ fn the_linear_solver_is_chosen_and_reported() {
         multigrid["error_l2"].as_f64().unwrap(),
     );
     assert!((a - b).abs() <= 1e-9 * a, "{a} against {b}");
+    // beams too: the Hermite prolongation on the nested interval meshes
+    let beam = ["solve", "bernoulli-flat", "--load", "100", "--json"];
+    let direct = json_of(&beam, &out);
+    assert_eq!(direct["linear_solver"], "direct");
+    let multigrid = json_of(
+        &[&beam[..], &["--linear-solver", "multigrid"]].concat(),
+        &out,
+    );
+    assert_eq!(multigrid["linear_solver"], "multigrid");
+    assert!(multigrid["krylov_iterations"].as_u64().unwrap() > 0);
+    // the error (2e-7) is far below w (5e-2): the two solves agree to CG's 1e-10 of w
+    let (a, b) = (
+        direct["error_l2"].as_f64().unwrap(),
+        multigrid["error_l2"].as_f64().unwrap(),
+    );
+    let w = direct["max_deflection"].as_f64().unwrap();
+    assert!((a - b).abs() <= 1e-10 * w, "{a} against {b}");
+    // a cold start has no coarser level: said, not silently factored
+    let cold = json_of(
+        &[&beam[..], &["--linear-solver", "multigrid", "--cold"]].concat(),
+        &out,
+    );
+    assert_eq!(cold["linear_solver"], "direct");
+    assert!(
+        cold["warnings"]
+            .to_string()
+            .contains("--linear-solver multigrid"),
+        "{cold}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }

@@ -5,21 +5,25 @@
 //! conjugate gradients preconditioned with a cycle on the Galerkin operators `PᵀHP`.
 
 use super::Discretization;
+use crate::element::interval::PhysicalBasis;
+use crate::element::mapping::Affine;
 use crate::error::{Error, Result};
 use crate::lcp::{Lcp, NewtonStep};
-use crate::mesh::TriangleMesh;
+use crate::mesh::{IntervalMesh, TriangleMesh};
 use crate::multigrid::{
     parents_by_location, prolongation, Multigrid, MultigridOptions, NestedLevel,
 };
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, Triplet};
+use fem_reference::DofLocation;
 
 /// The linear solver of the Newton steps of an obstacle solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LinearSolver {
     /// A sparse Cholesky factorization per step (or a low-rank update of the last one):
-    /// about `O(N^1.5)` in 2D, the faster one on small systems, and the only one on
-    /// intervals and for elements without a prolongation (Hermite, Argyris, Morley).
+    /// about `O(N^1.5)` in 2D and `O(N)` on intervals, the faster one on small systems,
+    /// and the only one for elements without a triangle prolongation (Hermite triangles,
+    /// Argyris, Morley).
     Direct,
     /// Conjugate gradients preconditioned by a multigrid cycle on the nested meshes of
     /// the solve (`O(N)` per step). Levels without a coarser one, and steps whose CG does
@@ -158,6 +162,101 @@ pub fn primal_prolongation(
     }
     SparseColMat::try_new_from_triplets(fine.lcp.n(), coarse.lcp.n(), &triplets)
         .map_err(|e| Error::Input(format!("primal prolongation: {e:?}")))
+}
+
+/// [`primal_prolongation`] on intervals: each fine DOF functional (value or slope at a
+/// point, [`super::dof_functionals`]) applied to the basis functions of the coarse cell
+/// containing its point. Exact on nested meshes, where every coarse function is a fine
+/// one (cubic Hermite: the slopes at a new midpoint are those of the coarse cubic, not an
+/// average); on meshes that are not nested it is the interpolation, still a valid
+/// prolongation for the cycle. A `fine.lcp.n() × coarse.lcp.n()` matrix.
+///
+/// # Errors
+/// Discretizations in rotated DOFs ([`Discretization::basis`] not the identity), a field
+/// missing or with another element on one level, a fine DOF point outside the coarse
+/// mesh.
+pub fn interval_primal_prolongation(
+    coarse: &Discretization<IntervalMesh>,
+    fine: &Discretization<IntervalMesh>,
+) -> Result<SparseMatrix> {
+    if !coarse.basis.is_identity() || !fine.basis.is_identity() {
+        return Err(Error::Input(
+            "no multigrid prolongation in rotated DOFs".into(),
+        ));
+    }
+    let (rows, columns) = (primal_of_dof(fine), primal_of_dof(coarse));
+    let mut triplets = Vec::new();
+    for &field in fine.dofs.fields() {
+        if field == fine.multiplier_field {
+            continue;
+        }
+        let (Some(map_c), Some(map_f)) = (coarse.dofs.map(field), fine.dofs.map(field)) else {
+            return Err(Error::Input(format!(
+                "no multigrid prolongation: field {field} is missing on the coarser level"
+            )));
+        };
+        let element = map_f.element();
+        if map_c.element() != element {
+            return Err(Error::Input(format!(
+                "no multigrid prolongation: field {field} has another element on the coarser level"
+            )));
+        }
+        let highest = element
+            .dofs()
+            .iter()
+            .map(|location| match *location {
+                DofLocation::Vertex { derivative, .. } => derivative,
+                DofLocation::Interior => 0,
+            })
+            .max()
+            .unwrap_or(0);
+        let basis = PhysicalBasis::new(element, highest);
+        let (offset_c, offset_f) = (
+            coarse.dofs.offset(field).unwrap_or(0),
+            fine.dofs.offset(field).unwrap_or(0),
+        );
+        // a vertex DOF belongs to two cells: its row is written once
+        let mut written = vec![false; map_f.dof_count()];
+        for c in 0..fine.mesh.cell_count() {
+            let functionals = super::dof_functionals(element, fine.mesh.cell(c));
+            for (&d, (x, derivative)) in map_f.cell_dofs(c).iter().zip(functionals) {
+                let row = rows[offset_f + d];
+                if std::mem::replace(&mut written[d], true) || row == usize::MAX {
+                    continue;
+                }
+                let parent = coarse.mesh.locate(x).ok_or_else(|| {
+                    Error::Input(format!(
+                        "no multigrid prolongation: the fine DOF point {x} is outside the coarser mesh"
+                    ))
+                })?;
+                let cell = coarse.mesh.cell(parent);
+                let [xi] = Affine::interval(cell).reference_point([x]);
+                for (j, &dc) in map_c.cell_dofs(parent).iter().enumerate() {
+                    let column = columns[offset_c + dc];
+                    let weight = basis.value(j, derivative, cell, xi);
+                    if column != usize::MAX && weight.abs() > DROP {
+                        triplets.push(Triplet::new(row, column, weight));
+                    }
+                }
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(fine.lcp.n(), coarse.lcp.n(), &triplets)
+        .map_err(|e| Error::Input(format!("primal prolongation: {e:?}")))
+}
+
+/// Weights of [`interval_primal_prolongation`] below this are the rounding of an exact
+/// 0 (the weights of nested cubic Hermite and P1–P3 Lagrange are multiples of 1/32 or
+/// 1/27 times powers of the cell lengths, here of order 1 to 1e-5).
+const DROP: f64 = 1e-14;
+
+/// The primal unknown of every DOF of `d` (`usize::MAX` for multipliers and fixed DOFs).
+fn primal_of_dof<G>(d: &Discretization<G>) -> Vec<usize> {
+    let mut index = vec![usize::MAX; d.dofs.dof_count()];
+    for (p, &r) in d.primal_reduced.iter().enumerate() {
+        index[d.reduction.free()[r]] = p;
+    }
+    index
 }
 
 fn level(d: &Discretization<TriangleMesh>) -> NestedLevel<'_> {

@@ -26,7 +26,7 @@ use crate::multigrid::MultigridOptions;
 use crate::norms::FieldView;
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
-use fem_reference::DofLocation;
+use fem_reference::{DofLocation, ElementKind};
 use hierarchy::{LinearSolver, MultigridSteps};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
@@ -590,32 +590,40 @@ pub fn prolong<M: Model>(
         let element = map_f.element();
         let basis = PhysicalBasis::new(element, 1);
         let offset = fine_dofs.offset(field).unwrap();
-        let nodes = element.lagrange_nodes();
         for c in 0..fine_mesh.cell_count() {
-            let cell = fine_mesh.cell(c);
-            let map = Affine::interval(cell);
-            let mut interior = 0;
-            for (i, location) in element.dofs().iter().enumerate() {
-                let (x, derivative) = match *location {
-                    DofLocation::Vertex { vertex, derivative } => (cell[vertex], derivative),
-                    DofLocation::Interior => {
-                        let xi = nodes.map_or(0.5, |n| n[2 * element.dofs_per_vertex() + interior]);
-                        interior += 1;
-                        (map.point([xi])[0], 0)
-                    }
-                };
-                // P0: its single "interior" node is the midpoint
-                let x = if element.dofs_per_vertex() == 0 {
-                    map.point([0.5])[0]
-                } else {
-                    x
-                };
+            for (i, (x, derivative)) in dof_functionals(element, fine_mesh.cell(c))
+                .into_iter()
+                .enumerate()
+            {
                 fine[offset + map_f.cell_dofs(c)[i]] =
                     view.at_with(&basis, x, derivative).unwrap_or(0.0);
             }
         }
     }
     fine
+}
+
+/// The DOF functionals of `element` on the interval `cell`, in the element's local
+/// order: `(x, k)` for `ℓ_i(v) = v⁽ᵏ⁾(x)`, the values and slopes at the vertices
+/// (Hermite), the Lagrange nodes, and the midpoint for P0.
+pub(crate) fn dof_functionals(element: ElementKind, cell: [f64; 2]) -> Vec<(f64, usize)> {
+    let map = Affine::interval(cell);
+    let nodes = element.lagrange_nodes();
+    let mut interior = 0;
+    element
+        .dofs()
+        .iter()
+        .map(|location| match *location {
+            DofLocation::Vertex { vertex, derivative } => (cell[vertex], derivative),
+            // P0: its single "interior" node is the midpoint
+            DofLocation::Interior if element.dofs_per_vertex() == 0 => (map.point([0.5])[0], 0),
+            DofLocation::Interior => {
+                let xi = nodes.map_or(0.5, |n| n[2 * element.dofs_per_vertex() + interior]);
+                interior += 1;
+                (map.point([xi])[0], 0)
+            }
+        })
+        .collect()
 }
 
 /// The forms `B_h`, `L_h` of `M` that the obstacle solvers assemble ([`Model::SYSTEM`]).
@@ -801,6 +809,11 @@ pub fn solve_lcp_on_hierarchy(
 }
 
 /// Solves the obstacle problem `B_h`, `L_h` of `M` on `mesh`.
+///
+/// With `options.linear_solver` [`LinearSolver::Multigrid`] the Newton steps of every
+/// level above the coarsest of the nested iteration are solved by CG with a multigrid
+/// cycle on the nested uniform meshes ([`hierarchy::interval_primal_prolongation`]:
+/// Lagrange nodes and Hermite slopes); `Auto` factors (banded, `O(N)` on an interval).
 pub fn solve_obstacle<M: Model>(
     mesh: &IntervalMesh,
     coefficients: &Coefficients,
@@ -845,11 +858,12 @@ pub fn solve_obstacle<M: Model>(
             }
         })
         .collect();
-    solve_nested(
+    solve_nested_on_hierarchy(
         levels,
         |coarse, values, fine| {
             prolong::<M>(&coarse.mesh, &coarse.dofs, values, &fine.mesh, &fine.dofs)
         },
+        Some(&hierarchy::interval_primal_prolongation),
         options,
     )
 }
