@@ -520,7 +520,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     if request.linear_solver == LinearSolver::Multigrid && solution.iterative_steps == 0 {
         warnings.push(crate::membranes::multigrid_unused(
             request.solver,
-            "a cold start and meshes of fewer than 32 elements or an odd number of them",
+            "a cold start, and an element count that is odd or below twice the coarsest level's (16 by default)",
         ));
     }
     // as for membranes: relative to ψ's size (its range, or |ψ| for a flat one)

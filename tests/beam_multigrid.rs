@@ -135,3 +135,37 @@ fn newton_with_multigrid_steps_reaches_the_direct_solution_on_beams() {
         }
     }
 }
+
+/// On a large nested Hermite mesh every fine DOF at a coarse vertex is that vertex's
+/// coarse DOF (one entry, 1), and every new one couples to the four DOFs of its parent
+/// cell at most: no rounding couples a row to a farther coarse DOF.
+#[test]
+fn the_hermite_prolongation_of_a_large_mesh_has_the_nested_pattern() {
+    let (coarse, _) =
+        beams::discretize(&request("bernoulli-a", Pair::BernoulliHermite, 3000, 1.0)).unwrap();
+    let (fine, _) =
+        beams::discretize(&request("bernoulli-a", Pair::BernoulliHermite, 6000, 1.0)).unwrap();
+    let p = interval_primal_prolongation(&coarse, &fine).unwrap();
+    let pt = p.to_row_major().unwrap();
+    let (row_ptr, columns, values) = (pt.symbolic().row_ptr(), pt.symbolic().col_idx(), pt.val());
+    let (mut identity_rows, mut new_rows) = (0, 0);
+    for i in 0..p.nrows() {
+        let entries = row_ptr[i]..row_ptr[i + 1];
+        assert!(entries.len() <= 4, "row {i}: {} entries", entries.len());
+        // 1 up to the rounding of a slope's scaling h·(1/h)
+        if entries.len() == 1 && (values[entries.start] - 1.0).abs() <= 1e-12 {
+            identity_rows += 1;
+        } else {
+            new_rows += 1;
+            // the parent's DOFs: two vertices, value and slope each, within 4 columns
+            let cols = &columns[entries];
+            assert!(
+                cols.iter().max().unwrap() - cols.iter().min().unwrap() <= 3,
+                "row {i}: {cols:?}"
+            );
+        }
+    }
+    // the interior coarse vertices (2 DOFs each, 2999 of them) and the 3000 midpoints
+    assert_eq!(identity_rows, 2 * 2999, "{identity_rows} identity rows");
+    assert_eq!(new_rows, 2 * 3000);
+}

@@ -6,7 +6,6 @@
 
 use super::Discretization;
 use crate::element::interval::PhysicalBasis;
-use crate::element::mapping::Affine;
 use crate::error::{Error, Result};
 use crate::lcp::{Lcp, NewtonStep};
 use crate::mesh::{IntervalMesh, TriangleMesh};
@@ -210,6 +209,11 @@ pub fn interval_primal_prolongation(
             })
             .max()
             .unwrap_or(0);
+        if element.dofs_per_vertex() == 0 && element.dofs().len() > 1 {
+            return Err(Error::Input(format!(
+                "no multigrid prolongation for field {field}: its discontinuous element has no point-value DOFs"
+            )));
+        }
         let basis = PhysicalBasis::new(element, highest);
         let (offset_c, offset_f) = (
             coarse.dofs.offset(field).unwrap_or(0),
@@ -217,9 +221,10 @@ pub fn interval_primal_prolongation(
         );
         // a vertex DOF belongs to two cells: its row is written once
         let mut written = vec![false; map_f.dof_count()];
+        let (mut functionals, mut weights) = (Vec::new(), Vec::new());
         for c in 0..fine.mesh.cell_count() {
-            let functionals = super::dof_functionals(element, fine.mesh.cell(c));
-            for (&d, (x, derivative)) in map_f.cell_dofs(c).iter().zip(functionals) {
+            super::dof_functionals(element, fine.mesh.cell(c), &mut functionals);
+            for (&d, &(x, derivative)) in map_f.cell_dofs(c).iter().zip(&functionals) {
                 let row = rows[offset_f + d];
                 if std::mem::replace(&mut written[d], true) || row == usize::MAX {
                     continue;
@@ -230,11 +235,24 @@ pub fn interval_primal_prolongation(
                     ))
                 })?;
                 let cell = coarse.mesh.cell(parent);
-                let [xi] = Affine::interval(cell).reference_point([x]);
-                for (j, &dc) in map_c.cell_dofs(parent).iter().enumerate() {
+                // At a coarse vertex ξ must be exactly 0 or 1: at 1 − ε the slope rows
+                // would pick up couplings of relative size ε/h. Division is exact where
+                // the coordinates coincide (the map's (1/h)(x − x₀) is not); the snap
+                // covers meshes whose coordinates round differently.
+                let xi = match (x - cell[0]) / (cell[1] - cell[0]) {
+                    xi if xi.abs() <= SNAP => 0.0,
+                    xi if (1.0 - xi).abs() <= SNAP => 1.0,
+                    xi => xi,
+                };
+                weights.clear();
+                weights.extend(
+                    (0..map_c.cell_dofs(parent).len())
+                        .map(|j| basis.value(j, derivative, cell, xi)),
+                );
+                let largest = weights.iter().fold(0.0f64, |m, w| m.max(w.abs()));
+                for (&dc, &weight) in map_c.cell_dofs(parent).iter().zip(&weights) {
                     let column = columns[offset_c + dc];
-                    let weight = basis.value(j, derivative, cell, xi);
-                    if column != usize::MAX && weight.abs() > DROP {
+                    if column != usize::MAX && weight.abs() > DROP * largest {
                         triplets.push(Triplet::new(row, column, weight));
                     }
                 }
@@ -245,10 +263,13 @@ pub fn interval_primal_prolongation(
         .map_err(|e| Error::Input(format!("primal prolongation: {e:?}")))
 }
 
-/// Weights of [`interval_primal_prolongation`] below this are the rounding of an exact
-/// 0 (the weights of nested cubic Hermite and P1–P3 Lagrange are multiples of 1/32 or
-/// 1/27 times powers of the cell lengths, here of order 1 to 1e-5).
-const DROP: f64 = 1e-14;
+/// Weights of [`interval_primal_prolongation`] below this fraction of the largest of
+/// their row are the rounding of an exact 0. The weights of one row differ by powers of
+/// the cell length (a slope row holds `3/(2h)` and `1/4`), so the threshold is relative.
+const DROP: f64 = 1e-13;
+
+/// Reference coordinates this close to 0 or 1 are a coarse vertex ([`interval_primal_prolongation`]).
+const SNAP: f64 = 1e-10;
 
 /// The primal unknown of every DOF of `d` (`usize::MAX` for multipliers and fixed DOFs).
 fn primal_of_dof<G>(d: &Discretization<G>) -> Vec<usize> {

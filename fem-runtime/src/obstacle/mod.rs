@@ -590,11 +590,10 @@ pub fn prolong<M: Model>(
         let element = map_f.element();
         let basis = PhysicalBasis::new(element, 1);
         let offset = fine_dofs.offset(field).unwrap();
+        let mut functionals = Vec::new();
         for c in 0..fine_mesh.cell_count() {
-            for (i, (x, derivative)) in dof_functionals(element, fine_mesh.cell(c))
-                .into_iter()
-                .enumerate()
-            {
+            dof_functionals(element, fine_mesh.cell(c), &mut functionals);
+            for (i, &(x, derivative)) in functionals.iter().enumerate() {
                 fine[offset + map_f.cell_dofs(c)[i]] =
                     view.at_with(&basis, x, derivative).unwrap_or(0.0);
             }
@@ -604,26 +603,24 @@ pub fn prolong<M: Model>(
 }
 
 /// The DOF functionals of `element` on the interval `cell`, in the element's local
-/// order: `(x, k)` for `ℓ_i(v) = v⁽ᵏ⁾(x)`, the values and slopes at the vertices
-/// (Hermite), the Lagrange nodes, and the midpoint for P0.
-pub(crate) fn dof_functionals(element: ElementKind, cell: [f64; 2]) -> Vec<(f64, usize)> {
+/// order, into `out`: `(x, k)` for `ℓ_i(v) = v⁽ᵏ⁾(x)`, the values and slopes at the
+/// vertices (Hermite) and the Lagrange nodes. An element without vertex DOFs (P0, and
+/// P1disc, whose DOFs are not point values here) gets the midpoint for each DOF: exact for
+/// P0, a piecewise-constant approximation otherwise.
+pub(crate) fn dof_functionals(element: ElementKind, cell: [f64; 2], out: &mut Vec<(f64, usize)>) {
     let map = Affine::interval(cell);
     let nodes = element.lagrange_nodes();
     let mut interior = 0;
-    element
-        .dofs()
-        .iter()
-        .map(|location| match *location {
-            DofLocation::Vertex { vertex, derivative } => (cell[vertex], derivative),
-            // P0: its single "interior" node is the midpoint
-            DofLocation::Interior if element.dofs_per_vertex() == 0 => (map.point([0.5])[0], 0),
-            DofLocation::Interior => {
-                let xi = nodes.map_or(0.5, |n| n[2 * element.dofs_per_vertex() + interior]);
-                interior += 1;
-                (map.point([xi])[0], 0)
-            }
-        })
-        .collect()
+    out.clear();
+    out.extend(element.dofs().iter().map(|location| match *location {
+        DofLocation::Vertex { vertex, derivative } => (cell[vertex], derivative),
+        DofLocation::Interior if element.dofs_per_vertex() == 0 => (map.point([0.5])[0], 0),
+        DofLocation::Interior => {
+            let xi = nodes.map_or(0.5, |n| n[2 * element.dofs_per_vertex() + interior]);
+            interior += 1;
+            (map.point([xi])[0], 0)
+        }
+    }));
 }
 
 /// The forms `B_h`, `L_h` of `M` that the obstacle solvers assemble ([`Model::SYSTEM`]).
