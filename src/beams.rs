@@ -216,6 +216,9 @@ pub struct Report {
     pub linear_solver: &'static str,
     /// CG iterations of the finest level's multigrid steps (0 on the direct path).
     pub krylov_iterations: usize,
+    /// Cholesky factorizations on the finest level (its steps that multigrid did not
+    /// solve start from one; the others are low-rank updates of it).
+    pub factorizations: usize,
     /// `[elements, iterations]` of each nested-iteration level.
     pub levels: Vec<[usize; 2]>,
     /// Wall time of the whole solve (assembly, all levels, post-processing excluded).
@@ -566,6 +569,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
             "direct"
         },
         krylov_iterations: solution.krylov_iterations,
+        factorizations: solution.factorizations,
         levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
         seconds: solution.seconds,
         energy,

@@ -113,6 +113,7 @@ fn newton_with_multigrid_steps_reaches_the_direct_solution_on_beams() {
             let (m, _) = beams::solve(&multigrid).unwrap();
             assert_eq!(d.linear_solver, "direct");
             assert_eq!(m.linear_solver, "multigrid", "{name} at {elements}");
+            assert!(d.factorizations > 0, "{name}: the direct path factors");
             assert!(m.complementarity_residual <= 1e-10, "{name}: {m:?}");
             assert!(
                 (m.energy - d.energy).abs() <= 1e-9 * d.energy.abs(),

@@ -541,6 +541,11 @@ impl Lcp {
         btl: &[f64],
         scales: &KktScales,
     ) -> f64 {
+        debug_assert!(
+            u.len() == self.n() && au.len() == self.n() && btl.len() == self.n(),
+            "AU and BᵀΛ of U's length"
+        );
+        debug_assert_eq!(lambda.len(), self.m());
         let KktScales {
             a_norm, bt_norm, ..
         } = *scales;
