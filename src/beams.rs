@@ -563,11 +563,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         elements: request.elements,
         dofs: d.lcp.n() + d.lcp.m(),
         iterations: solution.iterations,
-        linear_solver: if solution.iterative_steps > 0 {
-            "multigrid"
-        } else {
-            "direct"
-        },
+        linear_solver: solution.linear_solver_name(),
         krylov_iterations: solution.krylov_iterations,
         factorizations: solution.factorizations,
         levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),

@@ -993,11 +993,7 @@ fn run_stabilized<M: Model>(
         scene: scene.name.to_string(),
         pair: request.pair.name().into(),
         solver: solver_name(solver).into(),
-        linear_solver: if solution.iterative_steps > 0 {
-            "multigrid"
-        } else {
-            "direct"
-        },
+        linear_solver: solution.linear_solver_name(),
         krylov_iterations: solution.krylov_iterations,
         factorizations: solution.factorizations,
         domain: posed.domain.clone(),

@@ -668,6 +668,17 @@ pub struct ObstacleSolution<G = IntervalMesh> {
 }
 
 impl<G> ObstacleSolution<G> {
+    /// What solved the finest level's Newton steps, as the reports name it: `multigrid`
+    /// when any step was solved by CG with a multigrid cycle (`iterative_steps > 0`; the
+    /// count of factorizations tells whether others were factored), else `direct`.
+    pub fn linear_solver_name(&self) -> &'static str {
+        if self.iterative_steps > 0 {
+            "multigrid"
+        } else {
+            "direct"
+        }
+    }
+
     /// How far the primal coefficients may be off through the rounding of the rows in
     /// contact ([`Lcp::primal_rounding`]), in the units of the primal field: compare it
     /// with the size of u, ψ or g. Far below them unless the load dwarfs the obstacle.
