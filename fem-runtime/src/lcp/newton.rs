@@ -708,6 +708,10 @@ pub struct NewtonStep<'a> {
     /// moderately inexact step can do (`docs/multigrid.md` measures how inexact);
     /// Newton's KKT test certifies the result either way.
     pub settled: bool,
+    /// The size of the terms the gradient balances, `max(‖AU‖₂, ‖F‖₂, ‖BᵀΛ‖₂)`: the
+    /// gradient itself is computed to about `1e-16` of it, so a step's residual far
+    /// below that is rounding (an iterative solver may stop at a small multiple of it).
+    pub scale: f64,
 }
 
 /// A solver of the Newton systems `H d = b` other than the factorization (e.g. multigrid
@@ -895,6 +899,11 @@ pub(super) fn newton_iteration(
                 rhs: &minus_gradient,
                 active: &active,
                 settled: previous_active.as_ref() == Some(&active),
+                scale: [au.as_slice(), &lcp.f, &btl]
+                    .into_iter()
+                    .map(|v| v.iter().map(|x| x * x).sum::<f64>())
+                    .fold(0.0, f64::max)
+                    .sqrt(),
             }) {
                 Some((d, exact)) => (Some(d), exact),
                 None => (None, true),
