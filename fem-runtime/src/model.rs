@@ -160,7 +160,7 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         mesh: &G,
         params: &[f64],
         data: &[&DataFn],
-        positions: &[usize],
+        positions: &[crate::kernel::Position],
         stride: usize,
         offset: usize,
         values: &mut [f64],

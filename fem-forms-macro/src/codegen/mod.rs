@@ -574,7 +574,7 @@ fn model_impl(
                 mesh: &G,
                 params: &[f64],
                 data: &[&#runtime::DataFn],
-                positions: &[usize],
+                positions: &[#runtime::kernel::Position],
                 stride: usize,
                 offset: usize,
                 values: &mut [f64],

@@ -8,6 +8,27 @@ pub fn store_matrix<const R: usize, const C: usize>(k: &[[f64; C]; R], out: &mut
     }
 }
 
+/// A scatter position: the index in a matrix's value array that one entry of one cell's
+/// element matrix goes to. 32 bits, half of `usize`: an assembler holds one per cell
+/// entry (32 million for 2 million P1–P0 triangles), and memory first touched costs
+/// time here (`docs/multigrid.md`, "p1-p0 at 1025²"). The patterns refuse value arrays
+/// of more than `u32::MAX` entries ([`position`]).
+pub type Position = u32;
+
+/// `index` as a [`Position`].
+///
+/// # Errors
+/// [`crate::Error::Input`] when `index` does not fit in 32 bits (a matrix of more than
+/// 4.29·10⁹ stored entries, 34 GB of values).
+pub fn position(index: usize) -> crate::Result<Position> {
+    Position::try_from(index).map_err(|_| {
+        crate::Error::Input(format!(
+            "a matrix of more than {} stored entries (entry {index}): too large to assemble",
+            Position::MAX
+        ))
+    })
+}
+
 /// Copies an element vector into `out`.
 #[inline(always)]
 pub fn store_vector<const R: usize>(k: &[f64; R], out: &mut [f64]) {
@@ -22,7 +43,7 @@ pub fn store_vector<const R: usize>(k: &[f64; R], out: &mut [f64]) {
 #[inline(always)]
 pub fn add_matrices<G: crate::mesh::Mesh, const N: usize, const R: usize, const C: usize>(
     mesh: &G,
-    positions: &[usize],
+    positions: &[Position],
     stride: usize,
     offset: usize,
     values: &mut [f64],
@@ -34,7 +55,7 @@ pub fn add_matrices<G: crate::mesh::Mesh, const N: usize, const R: usize, const 
         let k = kernel(&x);
         let at = &positions[c * stride + offset..][..R * C];
         for (&p, &v) in at.iter().zip(k.iter().flatten()) {
-            values[p] += v;
+            values[p as usize] += v;
         }
     }
 }
@@ -50,7 +71,7 @@ pub fn add_matrices_on_cells<
     const C: usize,
 >(
     mesh: &G,
-    positions: &[usize],
+    positions: &[Position],
     stride: usize,
     offset: usize,
     values: &mut [f64],
@@ -67,7 +88,20 @@ pub fn add_matrices_on_cells<
         };
         let at = &positions[c * stride + offset..][..R * C];
         for (&p, &v) in at.iter().zip(k.iter().flatten()) {
-            values[p] += v;
+            values[p as usize] += v;
         }
+    }
+}
+
+#[cfg(test)]
+mod position_tests {
+    use super::*;
+
+    #[test]
+    fn positions_beyond_32_bits_are_refused_by_name() {
+        assert_eq!(position(0).unwrap(), 0);
+        assert_eq!(position(u32::MAX as usize).unwrap(), u32::MAX);
+        let error = position(u32::MAX as usize + 1).unwrap_err().to_string();
+        assert!(error.contains("too large to assemble"), "{error}");
     }
 }

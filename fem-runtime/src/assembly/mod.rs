@@ -16,6 +16,7 @@ use crate::mesh::Mesh;
 use crate::model::{Coefficients, IntoFormIndex, Model};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use kernel::Position;
 
 /// One block of a form on a system of DOFs: which fields, the element-matrix size and
 /// the fields' offsets in the system numbering.
@@ -127,7 +128,7 @@ pub(crate) fn add_block_matrices<M: Model, G: Mesh>(
     plan: &BlockPlan,
     mesh: &G,
     coefficients: &Coefficients,
-    positions: &[usize],
+    positions: &[Position],
     stride: usize,
     offset: usize,
     values: &mut [f64],
@@ -155,7 +156,7 @@ pub(crate) fn add_block_matrices<M: Model, G: Mesh>(
         }
         let at = &positions[c * stride + offset..][..size];
         for (&p, &v) in at.iter().zip(&local) {
-            values[p] += v;
+            values[p as usize] += v;
         }
     }
     Ok(())
@@ -181,7 +182,7 @@ pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
     plans: &[BlockPlan],
     mesh: &G,
     coefficients: &Coefficients,
-    positions: &[usize],
+    positions: &[Position],
     values: &mut [f64],
 ) -> Result<()> {
     let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
@@ -231,7 +232,7 @@ pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
                 M::element_matrix(form, plan.block, x, params, data, out);
             }
             for (&p, &v) in cell[offset..offset + size].iter().zip(out.iter()) {
-                values[p] += v;
+                values[p as usize] += v;
             }
             offset += size;
         }
@@ -425,7 +426,7 @@ pub(crate) fn add_form_matrices_coloured<M: Model, G: Mesh>(
     plans: &[BlockPlan],
     mesh: &G,
     coefficients: &Coefficients,
-    positions: &[usize],
+    positions: &[Position],
     values: &mut [f64],
     colouring: Option<&CellColouring>,
 ) -> Result<()> {
@@ -474,7 +475,7 @@ pub struct MatrixAssembler {
     form: usize,
     plans: Vec<BlockPlan>,
     symbolic: SymbolicSparseColMat<usize>,
-    positions: Vec<usize>,
+    positions: Vec<Position>,
     colouring: Option<CellColouring>,
 }
 
@@ -495,7 +496,7 @@ fn pattern_by_incidence<G: Mesh>(
     mesh: &G,
     dofs: &SystemDofs,
     plans: &[BlockPlan],
-) -> Result<(Vec<usize>, Vec<usize>, Vec<usize>)> {
+) -> Result<(Vec<usize>, Vec<usize>, Vec<Position>)> {
     let n = dofs.dof_count();
     let cells = mesh.cell_count();
     if u32::try_from(cells).is_err() {
@@ -590,13 +591,15 @@ fn pattern_by_incidence<G: Mesh>(
     // them column by column measured slower at 2M cells: a cell's entries are written
     // from columns far apart)
     let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
+    kernel::position(row_idx.len())?;
     let mut positions = Vec::with_capacity(cells * stride);
     for_each_entry(mesh, dofs, plans, |row, col| {
         let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
         let k = column
             .binary_search(&row)
             .expect("every entry is in the pattern");
-        positions.push(col_ptr[col] + k);
+        // below row_idx.len(), checked above
+        positions.push((col_ptr[col] + k) as Position);
     });
     Ok((col_ptr, row_idx, positions))
 }
@@ -651,7 +654,11 @@ impl MatrixAssembler {
             self.colouring.as_ref(),
         )?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
-            let cell = self.positions.iter().position(|&p| p == bad).unwrap_or(0);
+            let cell = self
+                .positions
+                .iter()
+                .position(|&p| p as usize == bad)
+                .unwrap_or(0);
             let per_cell: usize = self.plans.iter().map(|p| p.rows * p.cols).sum();
             return Err(Error::NonFinite {
                 what: "matrix",

@@ -10,6 +10,7 @@ pub mod triangle;
 use crate::assembly::boundary::{Constraints, Reduction, Side};
 use crate::assembly::dof_map::DofNumbering;
 use crate::assembly::dof_map::SystemDofs;
+use crate::assembly::kernel::{self, Position};
 use crate::assembly::plate_basis::{congruence, BlockRotation, ChangeOfBasis, VERTEX_DOFS};
 use crate::assembly::{assemble_vector, block_plans, for_each_entry, BlockPlan};
 use crate::element::interval::PhysicalBasis;
@@ -205,7 +206,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             rotated.push((indices, block.t));
         }
         let n_ext = n + extra_values.len();
-        let split = SplitPattern::new(mesh, &dofs, &plans, &target, n_ext, m);
+        let split = SplitPattern::new(mesh, &dofs, &plans, &target, n_ext, m)?;
         let mut values = vec![0.0; split.value_count];
         let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
         crate::assembly::add_form_matrices::<M, G>(
@@ -217,7 +218,11 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             &mut values,
         )?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
-            let entry = split.positions.iter().position(|&p| p == bad).unwrap_or(0);
+            let entry = split
+                .positions
+                .iter()
+                .position(|&p| p as usize == bad)
+                .unwrap_or(0);
             return Err(Error::NonFinite {
                 what: "matrix",
                 cell: entry / stride.max(1),
@@ -354,7 +359,7 @@ struct SplitPattern {
     fixed_start: usize,
     fixed_terms: Vec<(usize, f64)>,
     value_count: usize,
-    positions: Vec<usize>,
+    positions: Vec<Position>,
 }
 
 impl SplitPattern {
@@ -365,7 +370,7 @@ impl SplitPattern {
         target: &[Target],
         n: usize,
         m: usize,
-    ) -> Self {
+    ) -> Result<Self> {
         // Bucket A's rows by column and B's columns by row (counting sort); each entry
         // remembers its bucket slot, and the slot learns its place in the pattern when the
         // buckets are sorted and deduplicated (no search per entry).
@@ -386,13 +391,19 @@ impl SplitPattern {
         for k in 0..m {
             b_count[k + 1] += b_count[k];
         }
-        // an entry's provisional place, one usize: A's bucket slots, then B's, then the
-        // diagonal of C, then the per-occurrence slots; `usize::MAX` is discarded
+        // an entry's provisional place, one `Position`: A's bucket slots, then B's, then
+        // the diagonal of C, then the per-occurrence slots (at most one per entry);
+        // `DISCARDED` is discarded. Buckets and places are 32-bit: at 2M cells they are
+        // 56M indices, and memory first touched costs time (docs/multigrid.md).
+        const DISCARDED: Position = Position::MAX;
         let a_slots = a_count[n];
         let b_slots = b_count[m];
         let occurrence_base = a_slots + b_slots + m;
-        let mut a_bucket = vec![0usize; a_slots];
-        let mut b_bucket = vec![0usize; b_count[m]];
+        // every provisional place and every bucket entry (a row below n, a column below
+        // the pattern's length) stays below this
+        kernel::position(occurrence_base + entries + n + 1)?;
+        let mut a_bucket: Vec<Position> = vec![0; a_slots];
+        let mut b_bucket: Vec<Position> = vec![0; b_slots];
         let (mut a_fill, mut b_fill) = (a_count.clone(), b_count.clone());
         // off-diagonal C and fixed-column entries get one slot per occurrence (summed
         // later); everything else of B_h (the rows of fixed DOFs, the Bᵀ block) is
@@ -406,13 +417,13 @@ impl SplitPattern {
             let at = match (target[r], target[c]) {
                 (Target::Primal(p), Target::Primal(q)) => {
                     let slot = a_fill[q];
-                    a_bucket[slot] = p;
+                    a_bucket[slot] = p as Position;
                     a_fill[q] += 1;
                     slot
                 }
                 (Target::Multiplier(k), Target::Primal(q)) => {
                     let slot = b_fill[k];
-                    b_bucket[slot] = q;
+                    b_bucket[slot] = q as Position;
                     b_fill[k] += 1;
                     a_slots + slot
                 }
@@ -427,29 +438,30 @@ impl SplitPattern {
                     slots.push(Slot::Fixed);
                     occurrence_base + slots.len() - 1
                 }
-                _ => usize::MAX,
+                _ => DISCARDED as usize,
             };
-            positions.push(at);
+            // checked above: every provisional place fits
+            positions.push(at as Position);
         });
         drop((a_fill, b_fill));
         // sorts each bucket, keeps its distinct indices and turns every slot of the
         // bucket into the position of its index in the pattern
-        let compress = |count: &[usize], bucket: &mut [usize]| {
+        let compress = |count: &[usize], bucket: &mut [Position]| {
             let mut ptr = Vec::with_capacity(count.len());
             ptr.push(0);
             let mut idx = Vec::with_capacity(bucket.len());
-            let mut group: Vec<(usize, usize)> = Vec::new();
+            let mut group: Vec<(Position, usize)> = Vec::new();
             for j in 0..count.len() - 1 {
                 group.clear();
                 group.extend((count[j]..count[j + 1]).map(|slot| (bucket[slot], slot)));
                 group.sort_unstable();
-                let mut last = usize::MAX;
+                let mut last = None;
                 for &(i, slot) in &group {
-                    if i != last {
-                        idx.push(i);
-                        last = i;
+                    if last != Some(i) {
+                        idx.push(i as usize);
+                        last = Some(i);
                     }
-                    bucket[slot] = idx.len() - 1;
+                    bucket[slot] = (idx.len() - 1) as Position;
                 }
                 ptr.push(idx.len());
             }
@@ -477,20 +489,24 @@ impl SplitPattern {
                 }
             }
         }
+        // the final places are below the provisional ones' bound: the pattern has at
+        // most one entry per bucket slot
         for at in &mut positions {
-            *at = if *at < a_slots {
-                a_bucket[*at]
-            } else if *at < a_slots + b_slots {
-                b_start + b_bucket[*at - a_slots]
-            } else if *at < occurrence_base {
-                c_start + (*at - a_slots - b_slots)
-            } else if *at != usize::MAX {
-                place[*at - occurrence_base]
+            let provisional = *at as usize;
+            let final_place = if provisional < a_slots {
+                a_bucket[provisional] as usize
+            } else if provisional < a_slots + b_slots {
+                b_start + b_bucket[provisional - a_slots] as usize
+            } else if provisional < occurrence_base {
+                c_start + (provisional - a_slots - b_slots)
+            } else if *at != DISCARDED {
+                place[provisional - occurrence_base]
             } else {
                 discard
             };
+            *at = final_place as Position;
         }
-        Self {
+        Ok(Self {
             a_ptr,
             a_rows,
             b_ptr,
@@ -500,7 +516,7 @@ impl SplitPattern {
             fixed_terms,
             value_count: discard + 1,
             positions,
-        }
+        })
     }
 }
 
