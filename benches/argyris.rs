@@ -185,7 +185,7 @@ fn hand_element(t: &Tabulation, x: &[f64; 6], global: &[usize; 3]) -> [[f64; LOC
 
 /// For each cell and local entry (row-major, `LOCAL²` per cell) its position in the
 /// pattern of `assembler`.
-fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler) -> Vec<usize> {
+fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler) -> Vec<u32> {
     let w = A::field("w").unwrap();
     let map = dofs.map(w).unwrap();
     let offset = dofs.offset(w).unwrap();
@@ -202,7 +202,7 @@ fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler
                 let k = column
                     .binary_search(&r)
                     .expect("every local pair is in the pattern");
-                out.push(col_ptr[col] + k);
+                out.push((col_ptr[col] + k) as u32);
             }
         }
     }
@@ -210,13 +210,13 @@ fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler
 }
 
 /// The hand-written assembly loop.
-fn hand_assembly(t: &Tabulation, mesh: &TriangleMesh, positions: &[usize], values: &mut [f64]) {
+fn hand_assembly(t: &Tabulation, mesh: &TriangleMesh, positions: &[u32], values: &mut [f64]) {
     values.fill(0.0);
     for c in 0..mesh.cell_count() {
         let k = hand_element(t, &mesh.cell_coordinates(c), &mesh.cell(c));
         let p = &positions[LOCAL * LOCAL * c..LOCAL * LOCAL * (c + 1)];
         for (&at, &v) in p.iter().zip(k.iter().flatten()) {
-            values[at] += v;
+            values[at as usize] += v;
         }
     }
 }

@@ -39,7 +39,7 @@ fn zero(_: &[f64]) -> f64 {
 
 /// The hand-written baseline: P1 stiffness from barycentric gradients, added into the
 /// values of a fixed pattern at precomputed positions.
-fn hand_p1_assembly(mesh: &TriangleMesh, positions: &[usize], values: &mut [f64]) {
+fn hand_p1_assembly(mesh: &TriangleMesh, positions: &[u32], values: &mut [f64]) {
     values.fill(0.0);
     for c in 0..mesh.cell_count() {
         let x = mesh.cell_coordinates(c);
@@ -53,7 +53,7 @@ fn hand_p1_assembly(mesh: &TriangleMesh, positions: &[usize], values: &mut [f64]
         let p = &positions[9 * c..9 * c + 9];
         for i in 0..3 {
             for j in 0..3 {
-                values[p[3 * i + j]] += scale * (g[i][0] * g[j][0] + g[i][1] * g[j][1]);
+                values[p[3 * i + j] as usize] += scale * (g[i][0] * g[j][0] + g[i][1] * g[j][1]);
             }
         }
     }
@@ -87,7 +87,7 @@ fn assembly(n: usize, rounds: usize) {
         for &r in d {
             for &col in d {
                 let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
-                positions.push(col_ptr[col] + column.binary_search(&r).unwrap());
+                positions.push((col_ptr[col] + column.binary_search(&r).unwrap()) as u32);
             }
         }
     }

@@ -161,8 +161,9 @@ fn hand_element(x: &[f64; 6]) -> [[f64; LOCAL]; LOCAL] {
 }
 
 /// For each cell and local entry (row-major, `LOCAL²` per cell) its position in the
-/// pattern of `assembler`, `usize::MAX` for the structurally zero θ–λ entries.
-fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler) -> Vec<usize> {
+/// pattern of `assembler` (32-bit, as the generated assembly's), `u32::MAX` for the
+/// structurally zero θ–λ entries.
+fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler) -> Vec<u32> {
     let fields = ["θ_x", "θ_y", "w", "λ"].map(|f| M::field(f).unwrap());
     let (col_ptr, row_idx) = (
         assembler.symbolic().col_ptr(),
@@ -182,7 +183,7 @@ fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler
                 out.push(
                     column
                         .binary_search(&r)
-                        .map_or(usize::MAX, |k| col_ptr[col] + k),
+                        .map_or(u32::MAX, |k| (col_ptr[col] + k) as u32),
                 );
             }
         }
@@ -191,7 +192,7 @@ fn positions(mesh: &TriangleMesh, dofs: &SystemDofs, assembler: &MatrixAssembler
 }
 
 /// The hand-written assembly loop.
-fn hand_assembly(mesh: &TriangleMesh, positions: &[usize], values: &mut [f64]) {
+fn hand_assembly(mesh: &TriangleMesh, positions: &[u32], values: &mut [f64]) {
     values.fill(0.0);
     for c in 0..mesh.cell_count() {
         let k = hand_element(&mesh.cell_coordinates(c));
@@ -199,8 +200,8 @@ fn hand_assembly(mesh: &TriangleMesh, positions: &[usize], values: &mut [f64]) {
         for (i, row) in k.iter().enumerate() {
             for (j, &v) in row.iter().enumerate() {
                 let at = p[LOCAL * i + j];
-                if at != usize::MAX {
-                    values[at] += v;
+                if at != u32::MAX {
+                    values[at as usize] += v;
                 }
             }
         }
@@ -347,8 +348,8 @@ fn scatter_only(n: usize, rounds: usize) {
         let t = Instant::now();
         for at in positions.chunks_exact(LOCAL * LOCAL) {
             for &p in at {
-                if p != usize::MAX {
-                    values[p] += 1.0;
+                if p != u32::MAX {
+                    values[p as usize] += 1.0;
                 }
             }
         }
@@ -360,7 +361,7 @@ fn scatter_only(n: usize, rounds: usize) {
             for at in positions.chunks_exact(LOCAL * LOCAL) {
                 for i in ranges[a].clone() {
                     for j in ranges[b].clone() {
-                        values[at[LOCAL * i + j]] += 1.0;
+                        values[at[LOCAL * i + j] as usize] += 1.0;
                     }
                 }
             }

@@ -490,6 +490,17 @@ fn late_newton_steps_stop_at_the_rounding_floor() {
         norm(&difference),
         norm(&reference)
     );
+    // no floor without a gradient or a finite scale: the zero step, exact
+    let zero = vec![0.0; h.nrows()];
+    for scale in [1.0, 0.0, f64::INFINITY, f64::NAN] {
+        let (d, exact) = MultigridSteps::new(lcp, &prolongations, w(1))
+            .solve(NewtonStep {
+                rhs: &zero,
+                ..step(scale)
+            })
+            .expect("a zero right-hand side");
+        assert!(exact && d.iter().all(|&x| x == 0.0), "scale {scale}");
+    }
 }
 
 /// The automatic choice is Cholesky for the stabilized pairs (measured faster at every

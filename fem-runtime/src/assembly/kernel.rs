@@ -15,15 +15,16 @@ pub fn store_matrix<const R: usize, const C: usize>(k: &[[f64; C]; R], out: &mut
 /// of more than `u32::MAX` entries ([`position`]).
 pub type Position = u32;
 
-/// `index` as a [`Position`].
+/// `index` as a [`Position`]: a pattern checks the largest index it will store this way
+/// before it stores any.
 ///
 /// # Errors
-/// [`crate::Error::Input`] when `index` does not fit in 32 bits (a matrix of more than
-/// 4.29·10⁹ stored entries, 34 GB of values).
+/// [`crate::Error::Input`] when `index` does not fit in 32 bits (an assembly of more than
+/// 4.29·10⁹ cell entries or stored entries, 34 GB of values).
 pub fn position(index: usize) -> crate::Result<Position> {
     Position::try_from(index).map_err(|_| {
         crate::Error::Input(format!(
-            "a matrix of more than {} stored entries (entry {index}): too large to assemble",
+            "an assembly that needs index {index} in its scatter positions, beyond the {} of 32 bits: too large to assemble (refine less or split the mesh)",
             Position::MAX
         ))
     })

@@ -604,6 +604,20 @@ fn norm_inf(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
+/// The Euclidean norm of `v`, scaled by its largest entry so that entries near
+/// `f64::MAX` (loads the KKT tests accept) do not overflow the sum of squares; NaN if an
+/// entry is NaN.
+pub(crate) fn norm2(v: &[f64]) -> f64 {
+    if v.iter().any(|x| x.is_nan()) {
+        return f64::NAN;
+    }
+    let largest = norm_inf(v);
+    if largest == 0.0 || !largest.is_finite() {
+        return largest;
+    }
+    largest * v.iter().map(|x| (x / largest).powi(2)).sum::<f64>().sqrt()
+}
+
 fn row_sum_norm(a: &SparseMatrix) -> f64 {
     // symmetric: the largest column sum equals the largest row sum
     let (col_ptr, vals) = (a.symbolic().col_ptr(), a.val());
@@ -621,6 +635,16 @@ fn row_sum_norm(a: &SparseMatrix) -> f64 {
 mod tests {
     use super::*;
     use faer::sparse::Triplet;
+
+    #[test]
+    fn the_scaled_euclidean_norm_does_not_overflow() {
+        assert_eq!(norm2(&[3.0, 4.0]), 5.0);
+        assert_eq!(norm2(&[]), 0.0);
+        let big = 1e300;
+        assert!((norm2(&[3.0 * big, -4.0 * big]) / (5.0 * big) - 1.0).abs() < 1e-15);
+        assert_eq!(norm2(&[1.0, f64::INFINITY]), f64::INFINITY);
+        assert!(norm2(&[f64::NAN, f64::INFINITY]).is_nan());
+    }
 
     /// xorshift64*: reproducible data without a dependency.
     struct Random(u64);

@@ -901,9 +901,8 @@ pub(super) fn newton_iteration(
                 settled: previous_active.as_ref() == Some(&active),
                 scale: [au.as_slice(), &lcp.f, &btl]
                     .into_iter()
-                    .map(|v| v.iter().map(|x| x * x).sum::<f64>())
-                    .fold(0.0, f64::max)
-                    .sqrt(),
+                    .map(norm2)
+                    .fold(0.0, f64::max),
             }) {
                 Some((d, exact)) => (Some(d), exact),
                 None => (None, true),

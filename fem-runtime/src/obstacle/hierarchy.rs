@@ -337,8 +337,8 @@ impl<'a> MultigridSteps<'a> {
     }
 
     /// The Newton direction of `step` by CG preconditioned with the cycle of the options
-    /// on the updated hierarchy, and whether it was solved to [`MULTIGRID_TOLERANCE`]
-    /// (an exact step); `None` when the hierarchy cannot be built (a level whose
+    /// on the updated hierarchy, and whether it was solved to [`MULTIGRID_TOLERANCE`] or
+    /// to the rounding floor (an exact step); `None` when the hierarchy cannot be built (a level whose
     /// operator is not SPD) or CG does not reach its tolerance in
     /// [`MULTIGRID_MAX_ITERATIONS`], so that Newton factors the step instead.
     pub fn solve(&mut self, step: NewtonStep<'_>) -> Option<(Vec<f64>, bool)> {
@@ -371,8 +371,10 @@ impl<'a> MultigridSteps<'a> {
         };
         // Late steps correct a few flipped constraints: 1e-10 of their small gradient
         // would ask for a residual far below the rounding of the gradient itself.
-        let norm_rhs = step.rhs.iter().map(|b| b * b).sum::<f64>().sqrt();
+        let norm_rhs = crate::lcp::norm2(step.rhs);
         let floor = MULTIGRID_ROUNDING_FLOOR * step.scale / norm_rhs;
+        // a zero or non-finite gradient or scale gets no floor (CG then decides alone)
+        let floor = if floor.is_finite() { floor } else { 0.0 };
         let tolerance = relative.max(floor.min(MULTIGRID_LOOSEST_FLOOR));
         let pcg = mg.pcg(step.rhs, tolerance, MULTIGRID_MAX_ITERATIONS);
         self.hierarchy = Some((mg, step.active.to_vec()));

@@ -399,9 +399,10 @@ impl SplitPattern {
         let a_slots = a_count[n];
         let b_slots = b_count[m];
         let occurrence_base = a_slots + b_slots + m;
-        // every provisional place and every bucket entry (a row below n, a column below
-        // the pattern's length) stays below this
-        kernel::position(occurrence_base + entries + n + 1)?;
+        // every provisional place (A's and B's slots and the per-occurrence ones, at most
+        // one per entry, then C's diagonal) and every bucket entry (an index below n)
+        // stays below this, and so below `DISCARDED`
+        kernel::position(entries + m + n)?;
         let mut a_bucket: Vec<Position> = vec![0; a_slots];
         let mut b_bucket: Vec<Position> = vec![0; b_slots];
         let (mut a_fill, mut b_fill) = (a_count.clone(), b_count.clone());
@@ -921,7 +922,9 @@ pub type PrimalProlongation<G> =
 /// [`solve_nested`] whose levels also form the multigrid hierarchy of the Newton steps
 /// ([`ObstacleOptions::linear_solver`]): `primal_prolongation` maps each level's primal
 /// unknowns to the next finer level's. Where it fails (elements without a prolongation)
-/// the levels above are solved directly.
+/// the levels above are solved directly. With a `primal_prolongation` (multigrid asked
+/// for) the second thread builds the finest Hessian's pattern but not its symbolic
+/// factorization, which Newton then computes only if a step is factored.
 pub fn solve_nested_on_hierarchy<G, B>(
     levels: Vec<B>,
     prolong: impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
@@ -980,7 +983,9 @@ where
         let (sender, receiver) = std::sync::mpsc::channel();
         // Multigrid steps need no factorization of the finest Hessian (a step whose CG
         // fails analyses it then): AMD and the symbolic factorization would cost the
-        // worker 0.6 s and 0.3 GB at 1M unknowns for nothing.
+        // worker 0.6 s and 0.3 GB at 1M unknowns for nothing. (With multigrid asked for
+        // on elements without a prolongation every step factors, and the analysis then
+        // runs on this thread: that request is warned about as unused.)
         let factors = primal_prolongation.is_none();
         let worker = move || {
             let built = finest().map(|d| {
