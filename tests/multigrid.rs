@@ -255,6 +255,44 @@ fn multigrid_cg_on_the_p2_p0_newton_hessian_is_bounded_in_h() {
     check("P2–P0 α = 0.5/96, V(1,1)", &runs, 20, 4);
 }
 
+/// membrane-radial solved by nested Newton on N = 4, 8, 16, 32, and the prolongations of
+/// its primal unknowns between those levels, fine to coarse (as `Multigrid` and the
+/// Newton step solver take them).
+fn solved_on_hierarchy<M: Model>(
+    alpha: f64,
+) -> (
+    fem_forms::obstacle::triangle::TriangleObstacleSolution,
+    Vec<SparseMatrix>,
+) {
+    let scene = membrane_scene("membrane-radial").unwrap();
+    let data = membranes::SceneData::new(&scene, None);
+    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+    let meshes: Vec<TriangleMesh> = [4, 8, 16, 32]
+        .iter()
+        .map(|&n| membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap())
+        .collect();
+    let discretizations: Vec<_> = meshes
+        .iter()
+        .map(|mesh| discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h").unwrap())
+        .collect();
+    let primal: Vec<_> = discretizations.iter().map(primal_level::<M>).collect();
+    let prolongations = (1..meshes.len())
+        .rev()
+        .map(|l| {
+            let parents = parents_by_location(&meshes[l - 1], &meshes[l]).unwrap();
+            let level = |k: usize| NestedLevel {
+                mesh: &meshes[k],
+                dofs: &primal[k].0,
+                reduction: Some(&primal[k].1),
+            };
+            prolongation(&level(l - 1), &level(l), &parents).unwrap()
+        })
+        .collect();
+    let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let solution = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
+    (solution, prolongations)
+}
+
 /// The coarse operators of a multigrid hierarchy updated across Newton steps (the terms
 /// of the constraints whose active state flipped, `Lcp::hessian_change_blocks` into
 /// `Multigrid::add_coarse_term`) equal the Galerkin products `PᵀHP` recomputed from this
@@ -264,33 +302,7 @@ fn multigrid_cg_on_the_p2_p0_newton_hessian_is_bounded_in_h() {
 #[test]
 fn updated_galerkin_operators_of_the_newton_hessian_are_the_recomputed_ones() {
     fn run<M: Model>(alpha: f64) {
-        let scene = membrane_scene("membrane-radial").unwrap();
-        let data = membranes::SceneData::new(&scene, None);
-        let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
-        let meshes: Vec<TriangleMesh> = [4, 8, 16, 32]
-            .iter()
-            .map(|&n| membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap())
-            .collect();
-        let discretizations: Vec<_> = meshes
-            .iter()
-            .map(|mesh| discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h").unwrap())
-            .collect();
-        let primal: Vec<_> = discretizations.iter().map(primal_level::<M>).collect();
-        // fine to coarse
-        let prolongations: Vec<SparseMatrix> = (1..meshes.len())
-            .rev()
-            .map(|l| {
-                let parents = parents_by_location(&meshes[l - 1], &meshes[l]).unwrap();
-                let level = |k: usize| NestedLevel {
-                    mesh: &meshes[k],
-                    dofs: &primal[k].0,
-                    reduction: Some(&primal[k].1),
-                };
-                prolongation(&level(l - 1), &level(l), &parents).unwrap()
-            })
-            .collect();
-        let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
-        let solution = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
+        let (solution, prolongations) = solved_on_hierarchy::<M>(alpha);
         let d = &solution.discretization;
         let lcp = &d.lcp;
         let u_star = d.primal_part(&solution.values);
@@ -412,34 +424,7 @@ fn newton_with_multigrid_steps_is_newton_with_cholesky_steps() {
 /// to the floor's accuracy.
 #[test]
 fn late_newton_steps_stop_at_the_rounding_floor() {
-    type M = membrane_p1_p0::Model;
-    let scene = membrane_scene("membrane-radial").unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, 0.1).unwrap();
-    let meshes: Vec<_> = [4, 8, 16, 32]
-        .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap())
-        .collect();
-    let discretizations: Vec<_> = meshes
-        .iter()
-        .map(|mesh| discretize_on_triangles::<M>(mesh, &coefficients, "B_h", "L_h").unwrap())
-        .collect();
-    let primal: Vec<_> = discretizations.iter().map(primal_level::<M>).collect();
-    // fine to coarse, as the step solver takes them
-    let prolongations: Vec<SparseMatrix> = (1..meshes.len())
-        .rev()
-        .map(|l| {
-            let parents = parents_by_location(&meshes[l - 1], &meshes[l]).unwrap();
-            let level = |k: usize| NestedLevel {
-                mesh: &meshes[k],
-                dofs: &primal[k].0,
-                reduction: Some(&primal[k].1),
-            };
-            prolongation(&level(l - 1), &level(l), &parents).unwrap()
-        })
-        .collect();
-    let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
-    let solution = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
+    let (solution, prolongations) = solved_on_hierarchy::<membrane_p1_p0::Model>(0.1);
     let lcp = &solution.discretization.lcp;
     let u = solution.discretization.primal_part(&solution.values);
     let (h, count) = newton_hessian(lcp, &u);
