@@ -83,14 +83,14 @@ fn bytes_per_triangle(pair: ContactPair) -> f64 {
 }
 
 /// Refuses `refinements` of a mesh of `cells` triangles that would need more memory
-/// than [`crate::membranes::MEMORY_LIMIT_BYTES`] with `pair` (each refinement
+/// than [`crate::membranes::memory_limit_bytes`] with `pair` (each refinement
 /// quadruples the triangles), before anything is refined.
 fn check_memory(
     cells: usize,
     refinements: usize,
     pair: ContactPair,
 ) -> std::result::Result<(), String> {
-    let limit = crate::membranes::MEMORY_LIMIT_BYTES;
+    let limit = crate::membranes::memory_limit_bytes();
     let bytes = fem_runtime::mesh::triangle::estimated_bytes(
         cells,
         refinements as u32,

@@ -87,21 +87,21 @@ const PAIRS: [PairRow; 4] = [
         pair: MembranePair::P1P0,
         name: "p1-p0",
         degree: 1,
-        bytes_per_triangle: 1.4e3,
+        bytes_per_triangle: 1.6e3,
         stabilized: Some(Stabilized::of::<membrane_p1_p0::Model>()),
     },
     PairRow {
         pair: MembranePair::P2P0,
         name: "p2-p0",
         degree: 2,
-        bytes_per_triangle: 2.3e3,
+        bytes_per_triangle: 6.0e3,
         stabilized: Some(Stabilized::of::<membrane_p2_p0::Model>()),
     },
     PairRow {
         pair: MembranePair::P2P1Disc,
         name: "p2-p1d",
         degree: 2,
-        bytes_per_triangle: 3.5e3,
+        bytes_per_triangle: 7.0e3,
         stabilized: Some(Stabilized::of::<membrane_p2_p1disc::Model>()),
     },
     PairRow {
@@ -617,12 +617,17 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     check_stabilization_above_rounding(request, mesh, &quality, c_i)?;
     let checks_seconds = clock.elapsed().as_secs_f64() - meshes_seconds;
     let (mut report, fields) = match &request.pair.row().stabilized {
-        Some(model) => (model.run)(request, &posed, &meshes, alpha, c_i),
+        Some(model) => (model.run)(request, &posed, &meshes, alpha, c_i)
+            .map_err(|e| small_alpha_hint(e, request.alpha)),
         None => run_nodal(request, &posed, meshes),
     }?;
     let run_seconds = clock.elapsed().as_secs_f64() - meshes_seconds - checks_seconds;
     let finest = &fields.mesh;
-    report.warnings.extend(quality.warnings(finest));
+    // α = ½/C_I only where C_I > 0 and no α was given
+    let alpha_from_inverse_constant = c_i > 0.0 && request.alpha.is_none();
+    report
+        .warnings
+        .extend(quality.warnings(finest, alpha_from_inverse_constant));
     if let Some(warning) = penetration_warning(
         report.max_penetration,
         finest,
@@ -672,21 +677,36 @@ const SMALLEST_RELATIVE_STABILIZATION: f64 = 1e-13;
 /// stabilization of a well-shaped (equilateral) cell, `α·C_I(equilateral)` relative to
 /// its stiffness, is below [`SMALLEST_RELATIVE_STABILIZATION`]: the method would run
 /// unstabilized without saying so and λ_h be drowned in rounding. An α given by the
-/// user is taken as asked.
+/// user is held to the same bound (with `α` itself as the relative size for P1, whose
+/// `C_I` is 0): a tester's `--alpha 1e-16` failed in Newton's Cholesky with a message
+/// that did not name α. `--alpha 0`, the plain method, passes.
 fn check_stabilization_above_rounding(
     request: &MembraneRequest,
     mesh: &TriangleMesh,
     quality: &fem_runtime::mesh::triangle::MeshQuality,
     c_i: f64,
 ) -> Result<()> {
-    if request.alpha.is_some() || c_i <= 0.0 {
+    let Some(model) = &request.pair.row().stabilized else {
+        return Ok(());
+    };
+    let equilateral = [0.0, 0.0, 1.0, 0.0, 0.5, 0.75f64.sqrt()];
+    let regular = (model.element_inverse_constant)(&equilateral)?;
+    if let Some(alpha) = request.alpha {
+        // P1's S_h is α h² (λ, μ) (its C_I is 0): relative to the stiffness it is α itself
+        let per_alpha = if regular > 0.0 { regular } else { 1.0 };
+        let relative = alpha * per_alpha;
+        if alpha == 0.0 || relative >= SMALLEST_RELATIVE_STABILIZATION {
+            return Ok(());
+        }
+        return Err(Error::Input(format!(
+            "--alpha {alpha:e} makes the stabilization of a well-shaped triangle {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}: {} would run practically unstabilized, with λ_h lost in rounding (its Newton Hessian is then not positive definite in floating point); give --alpha 0 for the plain method, or at least {:.0e}",
+            request.pair.name(),
+            SMALLEST_RELATIVE_STABILIZATION / per_alpha
+        )));
+    }
+    if c_i <= 0.0 {
         return Ok(());
     }
-    let equilateral = [0.0, 0.0, 1.0, 0.0, 0.5, 0.75f64.sqrt()];
-    let regular = match &request.pair.row().stabilized {
-        Some(model) => (model.element_inverse_constant)(&equilateral)?,
-        None => 0.0,
-    };
     let relative = 0.5 / c_i * regular;
     if relative >= SMALLEST_RELATIVE_STABILIZATION {
         return Ok(());
@@ -697,6 +717,31 @@ fn check_stabilization_above_rounding(
         0.5 / c_i,
         request.pair.name()
     )))
+}
+
+/// Below this an `--alpha` given by the user is named in a solver's failure.
+const SMALL_ALPHA: f64 = 1e-6;
+
+/// `error` with the user's `alpha` named as the likely cause, when it is positive and
+/// below [`SMALL_ALPHA`] and the solvers failed: the eliminated multipliers are
+/// `(G − BU)/(α h² |T|)`, whose rounding grows like `1/(α h²)`, so a small α that works on
+/// a coarse mesh fails on a fine one (p1-p0 at α = 1e-13: N = 16 solves, N = 128 does
+/// not), and Newton's failure alone does not say why.
+fn small_alpha_hint(error: Error, alpha: Option<f64>) -> Error {
+    let Some(alpha) = alpha.filter(|&a| a > 0.0 && a < SMALL_ALPHA) else {
+        return error;
+    };
+    let hint = format!(
+        "--alpha {alpha:e} is small: with so little stabilization the multipliers, eliminated as (G − BU)/(α h² |T|), drown in rounding on fine meshes; give --alpha 0 for the plain method, or a larger α"
+    );
+    match error {
+        Error::NotConverged { solver, detail } => Error::NotConverged {
+            solver,
+            detail: format!("{detail}; {hint}"),
+        },
+        Error::LinearSolve(detail) => Error::LinearSolve(format!("{detail}; {hint}")),
+        other => other,
+    }
 }
 
 /// "cell 3 with corners (…), (…), (…) and angles …°, …°, …°", for messages.
@@ -798,12 +843,39 @@ pub fn dirichlet_part(
     Ok(part)
 }
 
-/// The most memory a solve may plan to use.
+/// The most memory a solve may plan to use, on any machine.
 pub const MEMORY_LIMIT_BYTES: f64 = 16.0 * (1u64 << 30) as f64;
 
+/// The share of the memory available now (`MemAvailable` of `/proc/meminfo`) a solve
+/// may plan to use: the estimates are within about 20 % of the measured peaks.
+pub const AVAILABLE_MEMORY_SHARE: f64 = 0.8;
+
+/// The most memory a solve may plan to use here: [`MEMORY_LIMIT_BYTES`], or
+/// [`AVAILABLE_MEMORY_SHARE`] of the memory the kernel reports available if that is
+/// less (a tester's 28 GB run on a 23 GB machine passed a fixed 16 GiB check with an
+/// estimate of half its need and was killed by the kernel). Where `/proc/meminfo` cannot
+/// be read, the fixed limit.
+pub fn memory_limit_bytes() -> f64 {
+    let available = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find_map(|line| line.strip_prefix("MemAvailable:"))
+                .and_then(|rest| rest.trim().strip_suffix("kB"))
+                .and_then(|kb| kb.trim().parse::<f64>().ok())
+                .map(|kb| kb * 1024.0)
+        });
+    match available {
+        Some(bytes) if bytes > 0.0 => MEMORY_LIMIT_BYTES.min(AVAILABLE_MEMORY_SHARE * bytes),
+        _ => MEMORY_LIMIT_BYTES,
+    }
+}
+
 /// Refuses, before allocating, a structured mesh whose solve would need more than
-/// [`MEMORY_LIMIT_BYTES`]: measured peaks are about 1.4 kB per triangle for P1 pairs,
-/// 2.3 kB for P2–P0 and 3.5 kB for P2–P1disc (524k P1 triangles: 0.74 GB).
+/// [`memory_limit_bytes`]. Measured peaks per triangle (membrane-radial, 2026-12-01):
+/// p1-p0 1.2 kB at 2.1M and 1.3 kB at 8.4M triangles, p1-nodal 0.4 kB, p2-p0 4.3 kB at
+/// 131k and 4.7 kB at 524k, p2-p1disc 5.6 kB at both, growing with the factor's fill
+/// (`O(N log N)` in 2D); the table's figures leave room for that growth.
 fn check_memory(request: &MembraneRequest) -> Result<()> {
     if request.mesh_file.is_some() || matches!(request.scene.domain, Domain::File(_)) {
         return Ok(());
@@ -811,12 +883,15 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
     let per_triangle = request.pair.row().bytes_per_triangle;
     let n = request.mesh_size as f64;
     let bytes = 2.0 * n * n * per_triangle;
-    if bytes > MEMORY_LIMIT_BYTES {
+    let limit = memory_limit_bytes();
+    if bytes > limit {
         return Err(Error::Input(format!(
-            "--mesh-size {} with {} needs about {:.0} GB of memory, more than the {:.0} GB this solver allows itself",
+            "--mesh-size {} with {} needs about {:.1} GB of memory, more than the {:.1} GB this solver allows itself here ({:.0} % of the memory available now, at most {:.0} GB)",
             request.mesh_size,
             request.pair.name(),
             bytes / 1e9,
+            limit / 1e9,
+            100.0 * AVAILABLE_MEMORY_SHARE,
             MEMORY_LIMIT_BYTES / 1e9
         )));
     }
@@ -825,7 +900,7 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
 
 /// The levels of a Gmsh mesh: the file's mesh and its `refinements` uniform
 /// refinements (all of them for nested iteration, else the finest only). Refused before
-/// refining if the solve would need more than [`MEMORY_LIMIT_BYTES`].
+/// refining if the solve would need more than [`memory_limit_bytes`].
 fn file_levels(
     path: &std::path::Path,
     refinements: usize,
@@ -848,14 +923,17 @@ fn file_levels(
         refinements as u32,
         pair.row().bytes_per_triangle,
     );
-    if bytes > MEMORY_LIMIT_BYTES {
+    let limit = memory_limit_bytes();
+    if bytes > limit {
         return Err(Error::Input(format!(
-            "--mesh-size {refinements} with --msh {} refines its {} triangles {refinements} times, to {:.3e} triangles; with {} that needs about {:.0} GB of memory, more than the {:.0} GB this solver allows itself: use fewer refinements",
+            "--mesh-size {refinements} with --msh {} refines its {} triangles {refinements} times, to {:.3e} triangles; with {} that needs about {:.1} GB of memory, more than the {:.1} GB this solver allows itself here ({:.0} % of the memory available now, at most {:.0} GB): use fewer refinements",
             path.display(),
             mesh.cell_count(),
             mesh.cell_count() as f64 * 4f64.powi(refinements as i32),
             pair.name(),
             bytes / 1e9,
+            limit / 1e9,
+            100.0 * AVAILABLE_MEMORY_SHARE,
             MEMORY_LIMIT_BYTES / 1e9
         )));
     }
@@ -967,6 +1045,7 @@ fn run_stabilized<M: Model>(
         max_open_contact_gap,
         &u,
         posed.data.obstacle.as_data_fn(),
+        posed.data.load.as_data_fn(),
         alpha,
     ) {
         warnings.push(w);
@@ -1381,7 +1460,12 @@ fn run_nodal(
         mesh_quality: MeshQualityReport::default(),
         phases: PhaseSeconds::default(),
     };
-    if request.linear_solver == LinearSolver::Multigrid && krylov_iterations == 0 {
+    // with no factorization either, no step had a system to solve (every free node in
+    // contact, or the start already the solution): nothing to warn about
+    if request.linear_solver == LinearSolver::Multigrid
+        && krylov_iterations == 0
+        && factorizations > 0
+    {
         report.warnings.push(
             "--linear-solver multigrid: no active-set step of the finest level was solved by multigrid (it needs a coarser nested level: a cold start, a single level or N below 8 have none; or CG did not converge), so they were factored".into(),
         );
@@ -1539,6 +1623,12 @@ fn primal_rounding(
 /// `|u_h|`, `|ψ|` at the vertices), that passes without a warning.
 pub const OPEN_GAP_WARNING: f64 = 1e-2;
 
+/// Gaps below this multiple of the machine epsilon times the problem's scale (the
+/// largest of `|u_h|`, `|ψ|` and `|f| d²`, `d` the mesh's diameter: the deflection the
+/// load alone would make) are rounding, whatever the solution's size: on membrane-flat
+/// `u = ψ = 0` exactly, and a gap of 5e-17 was once called "not real".
+const OPEN_GAP_ROUNDING: f64 = 1e3;
+
 /// A warning when λ_h pushes on cells that stay clear of ψ by more than
 /// [`OPEN_GAP_WARNING`] of the solution's size (docs/mathematics.md §1: the stabilized
 /// constraint `u_h − ψ = α h² (…)` on the contact cells lets `α h²` open a gap).
@@ -1546,19 +1636,31 @@ fn open_gap_warning(
     gap: f64,
     u: &TriangleField,
     obstacle: &fem_runtime::DataFn,
+    load: &fem_runtime::DataFn,
     alpha: f64,
 ) -> Option<String> {
-    let size = u
-        .mesh
-        .vertices()
+    let vertices = u.mesh.vertices();
+    let (size, largest_load) = vertices
         .iter()
         .zip(0..)
-        .map(|(x, v)| {
+        .fold((0.0f64, 0.0f64), |(s, l), (x, v)| {
             let value = u.coefficients[u.map.vertex_dofs(v).start];
-            value.abs().max(obstacle(x).abs())
-        })
-        .fold(0.0f64, f64::max);
-    (gap > OPEN_GAP_WARNING * size).then(|| {
+            (
+                s.max(value.abs()).max(obstacle(x).abs()),
+                l.max(load(x).abs()),
+            )
+        });
+    let extent = |k: usize| {
+        let (lo, hi) = vertices
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x[k]), hi.max(x[k]))
+            });
+        hi - lo
+    };
+    let diameter = extent(0).hypot(extent(1));
+    let rounding = OPEN_GAP_ROUNDING * f64::EPSILON * size.max(largest_load * diameter * diameter);
+    (gap > OPEN_GAP_WARNING * size && gap > rounding).then(|| {
         format!(
             "λ_h pushes on cells where u_h stays up to {gap:.2e} clear of ψ ({:.1} % of the solution's size {size:.2e}): the stabilized constraint u_h − ψ = α h²(…) on contact cells lets α h² (α = {alpha:e}) open that gap, so this contact set is not real; refine the mesh or lower α",
             100.0 * gap / size

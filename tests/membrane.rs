@@ -235,6 +235,12 @@ fn bad_input_is_a_clear_error() {
     request.mesh_size = 4096;
     let error = membranes::solve(&request).err().unwrap().to_string();
     assert!(error.contains("GB of memory"), "{error}");
+    // the machine's available memory can only lower the fixed limit
+    let limit = membranes::memory_limit_bytes();
+    assert!(
+        limit > 0.0 && limit <= membranes::MEMORY_LIMIT_BYTES,
+        "{limit}"
+    );
     request.mesh_size = 8;
     request.alpha = Some(-1.0);
     assert!(membranes::solve(&request)
@@ -735,4 +741,62 @@ fn the_nodal_method_reproduces_petsc_ex9_errors() {
             "N = {n}"
         );
     }
+}
+
+/// Findings of a tester (2026-12-01), each a message that misled or a check that let a
+/// run through to the kernel's out-of-memory killer.
+#[test]
+fn tester_findings_on_alpha_memory_and_warnings() {
+    // p2-p0 at N = 1800 was accepted with 2.3 kB a triangle (15 GB planned) and needs
+    // about 4.7 kB: now refused before anything is allocated
+    let mut request = MembraneRequest::new(radial());
+    request.pair = MembranePair::P2P0;
+    request.mesh_size = 1800;
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(error.contains("GB of memory"), "{error}");
+
+    // an α so small that the stabilization is below rounding is refused by name ...
+    let mut request = MembraneRequest::new(radial());
+    request.pair = MembranePair::P1P0;
+    request.mesh_size = 16;
+    request.alpha = Some(1e-14);
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(
+        error.contains("--alpha 1e-14") && error.contains("--alpha 0"),
+        "{error}"
+    );
+    // ... and one that fails only on finer meshes is named in the failure
+    request.mesh_size = 32;
+    request.alpha = Some(1e-13);
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(error.contains("--alpha 1e-13 is small"), "{error}");
+    request.alpha = Some(0.1);
+    assert!(membranes::solve(&request).is_ok());
+
+    // u = ψ = 0 exactly: a gap of rounding size is not an "unreal contact set"
+    let flat = MEMBRANE_FLAT;
+    let mut request = MembraneRequest::new(flat.clone());
+    request.pair = MembranePair::P1P0;
+    request.mesh_size = 16;
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert!(
+        report.warnings.iter().all(|w| !w.contains("not real")),
+        "{:?}",
+        report.warnings
+    );
+
+    // full contact leaves the nodal method no system to solve: no multigrid warning
+    let mut request = MembraneRequest::new(flat);
+    request.pair = MembranePair::P1Nodal;
+    request.mesh_size = 32;
+    request.linear_solver = fem_forms::obstacle::hierarchy::LinearSolver::Multigrid;
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .all(|w| !w.contains("--linear-solver multigrid")),
+        "{:?}",
+        report.warnings
+    );
 }

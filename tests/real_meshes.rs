@@ -398,6 +398,12 @@ fn needles_warn_and_refuse_where_the_forced_alpha_drowns_in_rounding() {
                 let report = json(&run);
                 let warnings = report["warnings"].to_string();
                 assert!(warnings.contains("below 5°"), "{t} {pair}: {warnings}");
+                // α = ½/C_I only for the P2 pairs; P1 has a fixed α or none
+                assert_eq!(
+                    warnings.contains("α = ½/C_I"),
+                    pair.starts_with("p2"),
+                    "{t} {pair}: {warnings}"
+                );
             } else {
                 let stderr = refusal(&run);
                 assert!(

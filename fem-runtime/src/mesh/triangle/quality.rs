@@ -45,10 +45,15 @@ pub const WARN_MIN_ANGLE_DEG: f64 = 5.0;
 pub const REFUSE_MAX_ANGLE_DEG: f64 = 179.0;
 
 impl MeshQuality {
-    /// Warnings for angles beyond [`WARN_MAX_ANGLE_DEG`] or below
+    /// Warnings for angles beyond [`WARN_MAX_ANGLE_DEG`] or, where the stabilization
+    /// parameter is derived from the mesh's inverse constant (`alpha_from_inverse_constant`:
+    /// `α = ½/C_I`, which one thin cell makes small everywhere), below
     /// [`WARN_MIN_ANGLE_DEG`], naming the cell of `mesh` (the mesh `self` was computed
-    /// on) by its corners; empty for a shape-regular mesh.
-    pub fn warnings(&self, mesh: &TriangleMesh) -> Vec<String> {
+    /// on) by its corners; empty for a shape-regular mesh. Without that α a small angle
+    /// is warned about for what it does there: stiffness entries of the size of its
+    /// cotangent, so the linear systems lose digits (small angles alone do not degrade P1
+    /// interpolation; the maximum-angle condition does).
+    pub fn warnings(&self, mesh: &TriangleMesh, alpha_from_inverse_constant: bool) -> Vec<String> {
         let mut out = Vec::new();
         if self.max_angle_deg > WARN_MAX_ANGLE_DEG {
             out.push(format!(
@@ -58,8 +63,13 @@ impl MeshQuality {
             ));
         }
         if self.min_angle_deg < WARN_MIN_ANGLE_DEG {
+            let consequence = if alpha_from_inverse_constant {
+                "its inverse constant C_I is large, which makes the stabilization α = ½/C_I small on the whole mesh"
+            } else {
+                "its stiffness entries grow like the cotangent of that angle, so the linear systems lose digits"
+            };
             out.push(format!(
-                "{} has an angle of {:.5}° (below {WARN_MIN_ANGLE_DEG}°): its inverse constant C_I is large, which makes the stabilization α = ½/C_I small on the whole mesh; remesh",
+                "{} has an angle of {:.5}° (below {WARN_MIN_ANGLE_DEG}°): {consequence}; remesh",
                 describe_cell(mesh, self.min_angle_cell),
                 self.min_angle_deg
             ));
