@@ -155,6 +155,11 @@ pub fn nodal_active_set_level(
     let (mut factorizations, mut krylov_iterations, mut iterative_steps) = (0, 0, 0);
     // the truncated hierarchy of the last multigrid solve, updated by the next one
     let mut hierarchy: Option<Truncated> = None;
+    // Once a step's CG fails (on a new hierarchy too) the level's later steps are
+    // factored at once: on a strip of cells with aspect ratio 90 the point smoother
+    // fails every step, and retrying made the solve 8× slower than the direct path
+    // (a tester's Gmsh mesh: 1227 CG iterations and 39 factorizations).
+    let mut steps_by_multigrid = multigrid;
     for iteration in 1..=max_iterations {
         // `compact`: the exact zeros left out of the pattern (the right-diagonal P1
         // stiffness stores its diagonal couplings as 0, 28 % of the entries, and the
@@ -205,10 +210,11 @@ pub fn nodal_active_set_level(
         if let Some(t) = hierarchy.as_mut() {
             t.mg.release_fine();
         }
-        let (matrix, rhs) = reduced(multigrid)?;
+        // compact only for multigrid: the factorization is analysed on the full pattern
+        let (matrix, rhs) = reduced(steps_by_multigrid)?;
         // the multigrid path takes the matrix over (its finest level), so that the
         // largest matrix is not held twice; a failed one is built again to be factored
-        let solved = if !multigrid {
+        let solved = if !steps_by_multigrid {
             Err(Some(matrix))
         } else {
             multigrid_solve(matrix, &rhs, &u, prolongations, &active, a, &mut hierarchy)
@@ -223,6 +229,10 @@ pub fn nodal_active_set_level(
                 x
             }
             Err(matrix) => {
+                if steps_by_multigrid {
+                    steps_by_multigrid = false;
+                    hierarchy = None;
+                }
                 let matrix = match matrix {
                     Some(m) => m,
                     None => reduced(false)?.0,
@@ -245,14 +255,32 @@ pub fn nodal_active_set_level(
             .map(|i| lambda[i] + diagonal[i] * (psi[i] - u[i]) > 0.0)
             .collect();
         if next == active {
-            if let Some(t) = hierarchy.as_ref().filter(|_| last && current) {
-                // the settled system solved to rounding, as a factorization would
-                if let Some(iterations) = polish(&t.mg, &rhs, &mut u) {
-                    krylov_iterations += iterations;
-                    let au = times_a(&u);
-                    for i in 0..n {
-                        lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
-                    }
+            // the settled system solved to rounding, as a factorization would
+            let polished = match hierarchy.as_ref().filter(|_| last && current) {
+                Some(t) => polish(&t.mg, &rhs, &mut u),
+                None => Polish::Unneeded,
+            };
+            if polished == Polish::Failed {
+                // CG cannot reach rounding here (anisotropic cells): a factorization
+                // does, rather than a solution left at MULTIGRID_TOLERANCE
+                hierarchy = None;
+                let (matrix, rhs) = reduced(false)?;
+                if cholesky.is_none() {
+                    cholesky = Some(Cholesky::analyse(
+                        &matrix.symbolic().to_owned().map_err(linear)?,
+                    )?);
+                }
+                factorizations += 1;
+                let factor = cholesky.as_ref().expect("analysed above").factor(&matrix)?;
+                u = factor.solve_refined(&matrix, &rhs, 1)?;
+            }
+            if let Polish::Done(iterations) = polished {
+                krylov_iterations += iterations;
+            }
+            if polished != Polish::Unneeded {
+                let au = times_a(&u);
+                for i in 0..n {
+                    lambda[i] = if active[i] { au[i] - f[i] } else { 0.0 };
                 }
             }
             // the KKT check copies `a`: the hierarchy (a matrix as large) goes first
@@ -409,11 +437,24 @@ fn multigrid_solve(
 /// there and matches it to 7 digits, KKT residual 1e-13).
 const POLISH_TOLERANCE: f64 = 1e-14;
 
+/// What [`polish`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Polish {
+    /// `u` updated, in this many CG iterations.
+    Done(usize),
+    /// The residual was already at [`POLISH_TOLERANCE`].
+    Unneeded,
+    /// CG did not get there (`u` unchanged): the system must be factored.
+    Failed,
+}
+
 /// CG on `mg`'s finest operator from `u` until the residual of `rhs` is
-/// [`POLISH_TOLERANCE`] of `‖rhs‖` (or 30 iterations, when rounding stops it first);
-/// `u` is updated and the iterations returned when CG improved it.
-fn polish(mg: &Multigrid, rhs: &[f64], u: &mut [f64]) -> Option<usize> {
-    let fine = mg.operator(0)?;
+/// [`POLISH_TOLERANCE`] of `‖rhs‖`, in at most 30 iterations (4 at 1M unknowns on a
+/// shape-regular mesh); `u` is updated when it got there.
+fn polish(mg: &Multigrid, rhs: &[f64], u: &mut [f64]) -> Polish {
+    let Some(fine) = mg.operator(0) else {
+        return Polish::Failed;
+    };
     let mut residual = vec![0.0; rhs.len()];
     multiply_symmetric_into(fine, u, &mut residual);
     for (r, b) in residual.iter_mut().zip(rhs) {
@@ -421,16 +462,16 @@ fn polish(mg: &Multigrid, rhs: &[f64], u: &mut [f64]) -> Option<usize> {
     }
     let (norm_b, norm_r) = (norm(rhs), norm(&residual));
     if norm_r <= POLISH_TOLERANCE * norm_b {
-        return None;
+        return Polish::Unneeded;
     }
     let (d, iterations) = match pcg(fine, mg, &residual, POLISH_TOLERANCE * norm_b / norm_r, 30) {
         Ok(solved) => solved,
-        Err(_) => return None,
+        Err(_) => return Polish::Failed,
     };
     for (x, d) in u.iter_mut().zip(&d) {
         *x += d;
     }
-    Some(iterations)
+    Polish::Done(iterations)
 }
 
 /// Conjugate gradients on `a x = b` from `x = 0`, preconditioned by one cycle of
