@@ -319,6 +319,10 @@ pub struct MultigridSteps<'a> {
     pub full_setups: usize,
     /// Steps asked for so far.
     steps: usize,
+    /// A step failed (no hierarchy, or CG short of its tolerance): the later ones are
+    /// left to the factorization at once (retrying cost a tester's anisotropic mesh
+    /// 80 CG iterations and a hierarchy per step on the nodal path).
+    gave_up: bool,
 }
 
 impl<'a> MultigridSteps<'a> {
@@ -333,6 +337,7 @@ impl<'a> MultigridSteps<'a> {
             krylov_iterations: 0,
             full_setups: 0,
             steps: 0,
+            gave_up: false,
         }
     }
 
@@ -340,8 +345,21 @@ impl<'a> MultigridSteps<'a> {
     /// on the updated hierarchy, and whether it was solved to [`MULTIGRID_TOLERANCE`] or
     /// to the rounding floor (an exact step); `None` when the hierarchy cannot be built (a level whose
     /// operator is not SPD) or CG does not reach its tolerance in
-    /// [`MULTIGRID_MAX_ITERATIONS`], so that Newton factors the step instead.
+    /// [`MULTIGRID_MAX_ITERATIONS`], so that Newton factors the step instead; after one
+    /// such step always `None` (the level's later steps are factored).
     pub fn solve(&mut self, step: NewtonStep<'_>) -> Option<(Vec<f64>, bool)> {
+        if self.gave_up {
+            return None;
+        }
+        let solved = self.solve_by_multigrid(step);
+        if solved.is_none() {
+            self.gave_up = true;
+            self.hierarchy = None;
+        }
+        solved
+    }
+
+    fn solve_by_multigrid(&mut self, step: NewtonStep<'_>) -> Option<(Vec<f64>, bool)> {
         let updated = self.hierarchy.take().and_then(|(mut mg, previous)| {
             let lcp = self.lcp;
             lcp.hessian_change_blocks(&previous, step.active, |rows, change| {
