@@ -635,6 +635,19 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
         request.pair == MembranePair::P1Nodal,
     ) {
         report.warnings.push(warning);
+        // refining or the nodal method is the advice for the default α; a large α of the
+        // user's is the likelier cause (p1-p0 at α = 1e10: ∫λ_h 1e-7 of the exact 4.27)
+        let default = Alpha::default().value(c_i, ALPHA_WHEN_CI_VANISHES).ok();
+        if let (Some(given), Some(default), Some(_)) =
+            (request.alpha, default, &request.pair.row().stabilized)
+        {
+            if given > LARGE_ALPHA_FACTOR * default {
+                report.warnings.push(format!(
+                    "--alpha {given:e} is {:.0e} times the default {default:.3e}: the stabilized constraint lets u_h cross ψ by about α h² λ_h, so lower --alpha before refining",
+                    given / default
+                ));
+            }
+        }
     }
     let not_a_number = |e: Option<f64>| e.is_some_and(|e| !e.is_finite());
     if not_a_number(report.error_l2)
@@ -718,6 +731,9 @@ fn check_stabilization_above_rounding(
         request.pair.name()
     )))
 }
+
+/// An `--alpha` this many times the default is named when u_h crosses ψ.
+const LARGE_ALPHA_FACTOR: f64 = 10.0;
 
 /// Below this an `--alpha` given by the user is named in a solver's failure.
 const SMALL_ALPHA: f64 = 1e-6;

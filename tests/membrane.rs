@@ -772,6 +772,14 @@ fn tester_findings_on_alpha_memory_and_warnings() {
     assert!(error.contains("--alpha 1e-13 is small"), "{error}");
     request.alpha = Some(0.1);
     assert!(membranes::solve(&request).is_ok());
+    // a huge α lets u_h through ψ: the warning names it rather than only "refine"
+    request.alpha = Some(1e10);
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert!(
+        report.warnings.iter().any(|w| w.contains("--alpha 1e10")),
+        "{:?}",
+        report.warnings
+    );
 
     // u = ψ = 0 exactly: a gap of rounding size is not an "unreal contact set"
     let flat = MEMBRANE_FLAT;

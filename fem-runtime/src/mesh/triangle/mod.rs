@@ -30,6 +30,12 @@ const NONE: usize = usize::MAX;
 /// Marks "no cell" in the 32-bit edge table `edge_cells`.
 const NO_CELL: u32 = u32::MAX;
 
+/// The largest vertex coordinate a mesh accepts, in absolute value: beyond it the squared
+/// edge lengths, the areas and the stiffness entries the solvers form overflow (`f64`
+/// holds up to 1.8e308), and a cell of 1e300 was once called degenerate with a longest
+/// edge of `inf`.
+pub const MAX_COORDINATE: f64 = 1e100;
+
 /// `value` as a 32-bit index of the mesh tables: below `u32::MAX`, which marks "none".
 ///
 /// The edge tables store `u32` indices (half the memory of `usize`: at 2M cells the
@@ -126,6 +132,16 @@ impl TriangleMesh {
         {
             return Err(mesh_error(format!(
                 "vertex {i} has non-finite coordinates ({}, {})",
+                vertices[i][0], vertices[i][1]
+            )));
+        }
+        // squared lengths, areas and the stiffness of cells this large overflow
+        if let Some(i) = vertices
+            .iter()
+            .position(|v| v[0].abs() > MAX_COORDINATE || v[1].abs() > MAX_COORDINATE)
+        {
+            return Err(mesh_error(format!(
+                "vertex {i} has coordinates ({:e}, {:e}) beyond ±{MAX_COORDINATE:e}, where squared lengths overflow: rescale the mesh",
                 vertices[i][0], vertices[i][1]
             )));
         }
@@ -921,6 +937,15 @@ mod tests {
             Ok(_) => panic!("the mesh was accepted"),
             Err(e) => e.to_string(),
         }
+    }
+
+    #[test]
+    fn coordinates_whose_squares_overflow_are_refused_by_vertex() {
+        let square = |s: f64| vec![[0.0, 0.0], [s, 0.0], [s, s], [0.0, s]];
+        let cells = vec![[0, 1, 2], [0, 2, 3]];
+        let e = message(TriangleMesh::new(square(1e300), cells.clone(), &[]));
+        assert!(e.contains("vertex 1") && e.contains("rescale"), "{e}");
+        assert!(TriangleMesh::new(square(1e90), cells, &[]).is_ok());
     }
 
     fn square() -> Vec<[f64; 2]> {
