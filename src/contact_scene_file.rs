@@ -98,11 +98,11 @@ fn check_memory(
     );
     if bytes > limit {
         return Err(format!(
-            "{refinements} uniform refinements of the mesh's {cells} triangles make {:.0} triangles, which with {} need about {:.0} GB of memory, more than the {:.0} GB this solver allows itself",
+            "{refinements} uniform refinements of the mesh's {cells} triangles make {:.0} triangles, which with {} need about {:.1} GB of memory, more than {}",
             cells as f64 * 4f64.powi(refinements as i32),
             pair.name(),
             bytes / 1e9,
-            limit / 1e9
+            crate::membranes::memory_limit_text(limit)
         ));
     }
     Ok(())

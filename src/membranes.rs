@@ -108,7 +108,7 @@ const PAIRS: [PairRow; 4] = [
         pair: MembranePair::P1Nodal,
         name: "p1-nodal",
         degree: 1,
-        bytes_per_triangle: 1.4e3,
+        bytes_per_triangle: 0.6e3,
         stabilized: None,
     },
 ];
@@ -226,7 +226,8 @@ pub struct MembraneReport {
     /// CG iterations over the finest level's multigrid-solved Newton steps.
     pub krylov_iterations: usize,
     /// Newton steps solved by a Cholesky factorization on the finest level (with
-    /// multigrid: the steps CG did not finish, normally 0).
+    /// multigrid: the steps CG did not finish, and the level's steps after them, plus a
+    /// settled system whose polish CG did not finish; normally 0).
     pub factorizations: usize,
     /// The domain solved on: the scene's own, or the Gmsh file given with `--msh`.
     pub domain: String,
@@ -712,9 +713,10 @@ fn check_stabilization_above_rounding(
             return Ok(());
         }
         return Err(Error::Input(format!(
-            "--alpha {alpha:e} makes the stabilization of a well-shaped triangle {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}: {} would run practically unstabilized, with λ_h lost in rounding (its Newton Hessian is then not positive definite in floating point); give --alpha 0 for the plain method, or at least {:.0e}",
+            "--alpha {alpha:e} makes the stabilization of a well-shaped triangle {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}: {} would run practically unstabilized, with λ_h lost in rounding (its Newton Hessian is then not positive definite in floating point); give --alpha 0 for the plain method, or at least {:.2e}",
             request.pair.name(),
-            SMALLEST_RELATIVE_STABILIZATION / per_alpha
+            // rounded up: the printed value itself passes
+            1.01 * SMALLEST_RELATIVE_STABILIZATION / per_alpha
         )));
     }
     if c_i <= 0.0 {
@@ -867,12 +869,20 @@ pub const MEMORY_LIMIT_BYTES: f64 = 16.0 * (1u64 << 30) as f64;
 pub const AVAILABLE_MEMORY_SHARE: f64 = 0.8;
 
 /// The most memory a solve may plan to use here: [`MEMORY_LIMIT_BYTES`], or
-/// [`AVAILABLE_MEMORY_SHARE`] of the memory the kernel reports available if that is
-/// less (a tester's 28 GB run on a 23 GB machine passed a fixed 16 GiB check with an
-/// estimate of half its need and was killed by the kernel). Where `/proc/meminfo` cannot
-/// be read, the fixed limit.
+/// [`AVAILABLE_MEMORY_SHARE`] of the memory available if that is less: the kernel's
+/// `MemAvailable` (`/proc/meminfo`, in KiB) and a container's limit (cgroup v2
+/// `memory.max`, v1 `memory.limit_in_bytes`), which `/proc/meminfo` does not show. A
+/// tester's 28 GB run on a 23 GB machine passed a fixed 16 GiB check with an estimate of
+/// half its need and was killed by the kernel. What cannot be read does not lower it.
 pub fn memory_limit_bytes() -> f64 {
-    let available = std::fs::read_to_string("/proc/meminfo")
+    MEMORY_LIMIT_BYTES
+        .min(available_memory_bytes().map_or(f64::INFINITY, |b| AVAILABLE_MEMORY_SHARE * b))
+}
+
+/// The memory available to this process, as [`memory_limit_bytes`] reads it, in bytes;
+/// `None` where none of its sources can be read.
+fn available_memory_bytes() -> Option<f64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo")
         .ok()
         .and_then(|text| {
             text.lines()
@@ -881,15 +891,44 @@ pub fn memory_limit_bytes() -> f64 {
                 .and_then(|kb| kb.trim().parse::<f64>().ok())
                 .map(|kb| kb * 1024.0)
         });
-    match available {
-        Some(bytes) if bytes > 0.0 => MEMORY_LIMIT_BYTES.min(AVAILABLE_MEMORY_SHARE * bytes),
-        _ => MEMORY_LIMIT_BYTES,
+    // "max" (no limit) does not parse, nor does a missing file
+    let cgroup = [
+        "/sys/fs/cgroup/memory.max",
+        "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+    ]
+    .iter()
+    .find_map(|path| {
+        std::fs::read_to_string(path)
+            .ok()
+            .and_then(|text| text.trim().parse::<f64>().ok())
+    });
+    match (meminfo, cgroup) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
     }
+}
+
+/// "the 12.3 GB this solver allows itself here (80 % of the memory available now)" or,
+/// where the fixed limit is the lower one, "… (its fixed limit)", for messages.
+pub(crate) fn memory_limit_text(limit: f64) -> String {
+    let why = if limit < MEMORY_LIMIT_BYTES {
+        format!(
+            "{:.0} % of the memory available now",
+            100.0 * AVAILABLE_MEMORY_SHARE
+        )
+    } else {
+        "its fixed limit".to_string()
+    };
+    format!(
+        "the {:.1} GB this solver allows itself here ({why})",
+        limit / 1e9
+    )
 }
 
 /// Refuses, before allocating, a structured mesh whose solve would need more than
 /// [`memory_limit_bytes`]. Measured peaks per triangle (membrane-radial, 2026-12-01):
-/// p1-p0 1.2 kB at 2.1M and 1.3 kB at 8.4M triangles, p1-nodal 0.4 kB, p2-p0 4.3 kB at
+/// p1-p0 1.2 kB at 2.1M and 1.3 kB at 8.4M triangles, p1-nodal 0.4 kB at 2.1M and
+/// 8.4M, p2-p0 4.3 kB at
 /// 131k and 4.7 kB at 524k, p2-p1disc 5.6 kB at both, growing with the factor's fill
 /// (`O(N log N)` in 2D); the table's figures leave room for that growth.
 fn check_memory(request: &MembraneRequest) -> Result<()> {
@@ -902,13 +941,11 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
     let limit = memory_limit_bytes();
     if bytes > limit {
         return Err(Error::Input(format!(
-            "--mesh-size {} with {} needs about {:.1} GB of memory, more than the {:.1} GB this solver allows itself here ({:.0} % of the memory available now, at most {:.0} GB)",
+            "--mesh-size {} with {} needs about {:.1} GB of memory, more than {}",
             request.mesh_size,
             request.pair.name(),
             bytes / 1e9,
-            limit / 1e9,
-            100.0 * AVAILABLE_MEMORY_SHARE,
-            MEMORY_LIMIT_BYTES / 1e9
+            memory_limit_text(limit)
         )));
     }
     Ok(())
@@ -942,15 +979,13 @@ fn file_levels(
     let limit = memory_limit_bytes();
     if bytes > limit {
         return Err(Error::Input(format!(
-            "--mesh-size {refinements} with --msh {} refines its {} triangles {refinements} times, to {:.3e} triangles; with {} that needs about {:.1} GB of memory, more than the {:.1} GB this solver allows itself here ({:.0} % of the memory available now, at most {:.0} GB): use fewer refinements",
+            "--mesh-size {refinements} with --msh {} refines its {} triangles {refinements} times, to {:.3e} triangles; with {} that needs about {:.1} GB of memory, more than {}: use fewer refinements",
             path.display(),
             mesh.cell_count(),
             mesh.cell_count() as f64 * 4f64.powi(refinements as i32),
             pair.name(),
             bytes / 1e9,
-            limit / 1e9,
-            100.0 * AVAILABLE_MEMORY_SHARE,
-            MEMORY_LIMIT_BYTES / 1e9
+            memory_limit_text(limit)
         )));
     }
     let mut levels = vec![mesh];
@@ -1647,7 +1682,8 @@ const OPEN_GAP_ROUNDING: f64 = 1e3;
 
 /// A warning when λ_h pushes on cells that stay clear of ψ by more than
 /// [`OPEN_GAP_WARNING`] of the solution's size (docs/mathematics.md §1: the stabilized
-/// constraint `u_h − ψ = α h² (…)` on the contact cells lets `α h²` open a gap).
+/// constraint `u_h − ψ = α h² (…)` on the contact cells lets `α h²` open a gap), and by
+/// more than rounding ([`OPEN_GAP_ROUNDING`]).
 fn open_gap_warning(
     gap: f64,
     u: &TriangleField,

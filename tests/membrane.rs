@@ -765,6 +765,26 @@ fn tester_findings_on_alpha_memory_and_warnings() {
         error.contains("--alpha 1e-14") && error.contains("--alpha 0"),
         "{error}"
     );
+    // the smallest α the refusal suggests is itself accepted (P2: C_I = 48)
+    let mut p2 = MembraneRequest::new(radial());
+    p2.pair = MembranePair::P2P0;
+    p2.mesh_size = 4;
+    p2.alpha = Some(1e-16);
+    let error = membranes::solve(&p2).err().unwrap().to_string();
+    let suggested: f64 = error
+        .rsplit("at least ")
+        .next()
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no suggestion in: {error}"));
+    p2.alpha = Some(suggested);
+    let accepted = membranes::solve(&p2).map(|_| ()).map_err(|e| e.to_string());
+    assert!(
+        accepted
+            .as_ref()
+            .map_or_else(|e| !e.contains("--alpha"), |_| true),
+        "{suggested:e}: {accepted:?}"
+    );
     // ... and one that fails only on finer meshes is named in the failure
     request.mesh_size = 32;
     request.alpha = Some(1e-13);

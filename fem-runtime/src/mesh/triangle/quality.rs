@@ -45,13 +45,13 @@ pub const WARN_MIN_ANGLE_DEG: f64 = 5.0;
 pub const REFUSE_MAX_ANGLE_DEG: f64 = 179.0;
 
 impl MeshQuality {
-    /// Warnings for angles beyond [`WARN_MAX_ANGLE_DEG`] or, where the stabilization
-    /// parameter is derived from the mesh's inverse constant (`alpha_from_inverse_constant`:
-    /// `α = ½/C_I`, which one thin cell makes small everywhere), below
-    /// [`WARN_MIN_ANGLE_DEG`], naming the cell of `mesh` (the mesh `self` was computed
-    /// on) by its corners; empty for a shape-regular mesh. Without that α a small angle
-    /// is warned about for what it does there: stiffness entries of the size of its
-    /// cotangent, so the linear systems lose digits (small angles alone do not degrade P1
+    /// Warnings for angles beyond [`WARN_MAX_ANGLE_DEG`] or below [`WARN_MIN_ANGLE_DEG`],
+    /// naming the cell of `mesh` (the mesh `self` was computed on) by its corners; empty
+    /// for a shape-regular mesh. A small angle is warned about for what it does: where
+    /// the stabilization parameter comes from the mesh's inverse constant
+    /// (`alpha_from_inverse_constant`: `α = ½/C_I`, which one thin cell makes small
+    /// everywhere), that; otherwise stiffness entries of the size of its cotangent, so
+    /// that the linear systems lose digits (small angles alone do not degrade P1
     /// interpolation; the maximum-angle condition does).
     pub fn warnings(&self, mesh: &TriangleMesh, alpha_from_inverse_constant: bool) -> Vec<String> {
         let mut out = Vec::new();
