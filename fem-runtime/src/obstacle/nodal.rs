@@ -237,14 +237,8 @@ pub fn nodal_active_set_level(
                     Some(m) => m,
                     None => reduced(false)?.0,
                 };
-                if cholesky.is_none() {
-                    cholesky = Some(Cholesky::analyse(
-                        &matrix.symbolic().to_owned().map_err(linear)?,
-                    )?);
-                }
                 factorizations += 1;
-                let factor = cholesky.as_ref().expect("analysed above").factor(&matrix)?;
-                factor.solve_refined(&matrix, &rhs, 1)?
+                factored_solve(&mut cholesky, &matrix, &rhs)?
             }
         };
         let au = times_a(&u);
@@ -265,14 +259,8 @@ pub fn nodal_active_set_level(
                 // does, rather than a solution left at MULTIGRID_TOLERANCE
                 hierarchy = None;
                 let (matrix, rhs) = reduced(false)?;
-                if cholesky.is_none() {
-                    cholesky = Some(Cholesky::analyse(
-                        &matrix.symbolic().to_owned().map_err(linear)?,
-                    )?);
-                }
                 factorizations += 1;
-                let factor = cholesky.as_ref().expect("analysed above").factor(&matrix)?;
-                u = factor.solve_refined(&matrix, &rhs, 1)?;
+                u = factored_solve(&mut cholesky, &matrix, &rhs)?;
             }
             if let Polish::Done(iterations) = polished {
                 krylov_iterations += iterations;
@@ -309,6 +297,22 @@ pub fn nodal_active_set_level(
         solver: "nodal primal-dual active set",
         detail: format!("no fixed active set after {max_iterations} iterations"),
     })
+}
+
+/// `matrix⁻¹ rhs` by a Cholesky factorization with one step of refinement, the symbolic
+/// analysis made on the first call (every matrix given has the full pattern of `A`).
+fn factored_solve(
+    cholesky: &mut Option<Cholesky>,
+    matrix: &SparseMatrix,
+    rhs: &[f64],
+) -> Result<Vec<f64>> {
+    if cholesky.is_none() {
+        *cholesky = Some(Cholesky::analyse(
+            &matrix.symbolic().to_owned().map_err(linear)?,
+        )?);
+    }
+    let factor = cholesky.as_ref().expect("analysed above").factor(matrix)?;
+    factor.solve_refined(matrix, rhs, 1)
 }
 
 fn linear(e: impl std::fmt::Debug) -> Error {
