@@ -117,7 +117,7 @@ struct SolveOptions {
     /// p1-nodal, which has no multiplier). 0: the plain mixed method, solved as a QP by
     /// clarabel. Each family's default is its rule ½/C_I (contact: ½/max C_I,E); values
     /// well beyond 1/C_I make the stabilized matrix indefinite: an error names α·C_I.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_alpha)]
     alpha: Option<f64>,
     /// Element pair (beams: p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0;
     /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal; plates and contact: see `list`).
@@ -1094,6 +1094,15 @@ fn run(cli: Cli) -> Result<(), String> {
             full,
         }) => study(&name, kind.as_deref(), full, &cli.out),
     }
+}
+
+/// `--alpha`: a number, with `-0` read as 0 (the plain method), so that reports do not
+/// echo a negative zero.
+fn parse_alpha(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .map(|alpha| alpha + 0.0)
+        .map_err(|e| format!("`{text}` is not a number: {e}"))
 }
 
 fn main() -> ExitCode {

@@ -1072,6 +1072,13 @@ fn run_stabilized<M: Model>(
     }
     let u_field = M::field("u")?;
     let d = &solution.discretization;
+    let (primal_count, multiplier_count) = (d.lcp.n(), d.lcp.m());
+    if alpha == 0.0 && multiplier_count > primal_count {
+        warnings.push(format!(
+            "α = 0: the plain pair has {multiplier_count} multipliers for {primal_count} primal unknowns, so its multipliers have a kernel of dimension at least {} (no discrete inf-sup condition, docs/mathematics.md §1): u_h is unique, but λ_h, ∫λ_h and the contact set are one of many; α > 0 (the default) gives the unique stabilized λ_h",
+            multiplier_count - primal_count
+        ));
+    }
     let u = solution.view(u_field);
     let lambda = solution.view(d.multiplier_field);
     let degree = 2 * M::FIELDS[u_field].element.degree() + 4;

@@ -501,3 +501,51 @@ fn the_linear_solver_is_chosen_and_reported() {
     );
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// `--alpha -0` is the plain method (α = 0), reported as 0 and not as a negative zero;
+/// a plain pair with more multipliers than primal unknowns says that λ_h is not unique.
+#[test]
+fn a_negative_zero_alpha_is_the_plain_method_whose_multiplier_may_not_be_unique() {
+    let out = scratch("negative-zero-alpha");
+    let json = json_of(
+        &[
+            "solve",
+            "membrane-flat",
+            "--pair",
+            "p1-p0",
+            "--mesh-size",
+            "4",
+            "--alpha=-0",
+            "--json",
+        ],
+        &out,
+    );
+    let alpha = json["alpha"].as_f64().unwrap();
+    assert!(alpha == 0.0 && alpha.is_sign_positive(), "α = {alpha}");
+    // the plain P1–P0 pair has 32 multipliers for 9 free vertices: λ_h is one of many
+    // (∫λ_h came out 45.4 against the exact 48, without a word), u_h = 0 is unique
+    let warnings = json["warnings"].to_string();
+    assert!(
+        warnings.contains("32 multipliers for 9 primal unknowns")
+            && warnings.contains("at least 23"),
+        "{warnings}"
+    );
+    assert!(json["error_l2"].as_f64().unwrap() < 1e-12);
+    // P2–P0 has fewer multipliers than primal unknowns: no such warning
+    let json = json_of(
+        &[
+            "solve",
+            "membrane-flat",
+            "--pair",
+            "p2-p0",
+            "--mesh-size",
+            "4",
+            "--alpha",
+            "0",
+            "--json",
+        ],
+        &out,
+    );
+    assert!(!json["warnings"].to_string().contains("kernel"));
+    assert!((json["total_contact_force"].as_f64().unwrap() - 48.0).abs() < 1e-8);
+}

@@ -188,3 +188,52 @@ fn the_nodal_multigrid_solve_checks_its_hierarchy() {
     let e = nodal_active_set_with(&a, &f, &psi, None, 50, &wrong).unwrap_err();
     assert!(e.to_string().contains("prolongation 0 has 7 rows"), "{e}");
 }
+
+/// A start that already solves the settled system to between the polish's 1e-14 and
+/// CG's 1e-10 is still polished: the result is the factored one to rounding, not the
+/// start (which the first step used to return untouched, leaving the polish without a
+/// hierarchy of its matrix).
+#[test]
+fn a_start_that_nearly_solves_the_system_is_still_polished() {
+    // 1D Laplacian on 63 interior nodes, load −10, obstacle −0.1 + 0.2 x; 63 → 31 → 15 → 7 → 3
+    let n = 63;
+    let h = 1.0 / 64.0;
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push(Triplet::new(i, i, 2.0 / h));
+        if i + 1 < n {
+            t.push(Triplet::new(i, i + 1, -1.0 / h));
+            t.push(Triplet::new(i + 1, i, -1.0 / h));
+        }
+    }
+    let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
+    let f = vec![-10.0 * h; n];
+    let psi: Vec<f64> = (0..n).map(|i| -0.1 + 0.2 * (i + 1) as f64 * h).collect();
+    let chain = vec![
+        interpolation(31),
+        interpolation(15),
+        interpolation(7),
+        interpolation(3),
+    ];
+    let direct = nodal_active_set(&a, &f, &psi, None, 50).unwrap();
+    let free: Vec<usize> = (0..n).filter(|&i| direct.u[i] > psi[i] + 1e-9).collect();
+    assert!(free.len() > 4 && free.len() < n, "a free region and contact: {} free", free.len());
+    // the free nodes' residual `(A u − f)_i`, relative to ‖f‖₂
+    let residual = |u: &[f64]| -> f64 {
+        let au = fem_forms::lcp::cholesky::multiply(&a, u);
+        let r: f64 = free.iter().map(|&i| (au[i] - f[i]).powi(2)).sum();
+        let norm_f: f64 = f.iter().map(|x| x * x).sum();
+        (r / norm_f).sqrt()
+    };
+    let mut start = direct.u.clone();
+    start[free[free.len() / 2]] += 1e-13;
+    let before = residual(&start);
+    assert!(
+        before > 1e-12 && before < 1e-10,
+        "the start lies between the tolerances: {before:e}"
+    );
+    let multigrid = nodal_active_set_with(&a, &f, &psi, Some(&start), 50, &chain).unwrap();
+    let after = residual(&multigrid.u);
+    assert!(after <= 1e-12, "left at {after:e} (start {before:e})");
+    assert!(multigrid.kkt_residual <= 1e-12, "{:e}", multigrid.kkt_residual);
+}

@@ -358,7 +358,7 @@ const UPDATE_LIMIT: f64 = 0.01;
 /// nodes changed.) The hierarchy takes `matrix` over as its finest level (no second
 /// copy) and is left in `previous`. `Ok` gives the solution, the CG iterations and
 /// whether the hierarchy in `previous` now holds `matrix` (not when `x0` already
-/// solves it). `Err(None)` when no hierarchy can be built or CG does not reach
+/// solves it to [`POLISH_TOLERANCE`]). `Err(None)` when no hierarchy can be built or CG does not reach
 /// [`MULTIGRID_TOLERANCE`] (relative to `‖rhs‖`) even on a new one, so that the caller
 /// builds the matrix again and factors it.
 fn multigrid_solve(
@@ -377,10 +377,14 @@ fn multigrid_solve(
         *r = b - *r;
     }
     let (norm_b, norm_r) = (norm(rhs), norm(&residual));
-    if norm_r <= MULTIGRID_TOLERANCE * norm_b {
+    // Only a start already at the polish's tolerance is returned as it is: one between
+    // that and MULTIGRID_TOLERANCE still gets the hierarchy of this matrix (and a CG
+    // iteration), or the settled system's polish, which needs it, would be skipped and
+    // the solution left at 1e-10 instead of 1e-14.
+    if norm_r <= POLISH_TOLERANCE * norm_b {
         return Ok((x0.to_vec(), 0, false));
     }
-    let tolerance = MULTIGRID_TOLERANCE * norm_b / norm_r;
+    let tolerance = (MULTIGRID_TOLERANCE * norm_b / norm_r).min(1.0);
     let mut matrix = Some(matrix);
     let mut updated = None;
     if let Some(mut t) = previous.take() {
