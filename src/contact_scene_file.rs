@@ -732,6 +732,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
     let n = file.contact_direction;
     let total = -(solution.total_contact_force[0] * n[0] + solution.total_contact_force[1] * n[1]);
     let applied = solution.applied_load[0] * n[0] + solution.applied_load[1] * n[1];
+    let discretized = solution.discretized_load;
     // along the contact plane: x under a horizontal one, y beside a vertical one
     let along = crate::models::signorini::contact_tangent(n);
     let coordinate = |x: [f64; 2]| along[0] * x[0] + along[1] * x[1];
@@ -769,6 +770,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         seconds: solution.seconds,
         total_contact_force: total,
         applied_load: applied,
+        discretized_load: discretized,
         // supports acting along n_c carry part of the load: the contact force alone
         // then need not equal it (not measured: null)
         equilibrium_residual: if (n[0] != 0.0 && !file.fixed_x.is_empty())
@@ -776,7 +778,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         {
             f64::NAN
         } else {
-            (total - applied).abs() / applied.abs()
+            (total - discretized).abs() / discretized.abs()
         },
         contact_half_width: solution.contact_half_width,
         max_contact_pressure: solution.max_contact_pressure,

@@ -26,10 +26,25 @@ use std::path::Path;
 /// The obstacle side: every Kirchhoff scene's obstacle is above the plate (`w ≤ ψ`).
 const SIDE: f64 = -1.0;
 /// The largest N of the N×N×2 mesh a Kirchhoff solve accepts (Argyris: about 9 N² DOFs).
-/// Measured: N = 128 (147k DOFs) takes 1.3 GB and 12 s; the Cholesky factor's fill
-/// grows faster than N², and N = 256 passed 7.8 GB before it finished, more than a
-/// machine like these may give one run (24 GB, shared).
+/// Below it the memory is checked too ([`estimated_memory_bytes`]). Measured on
+/// kirchhoff-obstacle (2026-12-01): N = 104 takes 0.6 GB; from N = 112 on, where `C = αh⁴`
+/// falls below the rounding of `G − BU` and λ_h is recovered from an LU factorization of
+/// the saddle-point system, 5.0 GB at 112 and 6.5 GB (18 s) at 128; N = 256 passed
+/// 7.8 GB before it finished.
 pub const MAX_KIRCHHOFF_MESH_SIZE: usize = 160;
+
+/// The estimated peak memory of a Kirchhoff solve on the N×N×2 mesh, in bytes: the
+/// measurements of [`MAX_KIRCHHOFF_MESH_SIZE`] scaled by `N^2.3` (the factors' fill), with
+/// the multiplier's recovery assumed from N = 112 on (it depends on the data; this is the
+/// upper estimate).
+pub fn estimated_memory_bytes(mesh_size: usize) -> f64 {
+    let n = mesh_size as f64;
+    if mesh_size >= 112 {
+        6.5e9 * (n / 128.0).powf(2.3)
+    } else {
+        0.6e9 * (n / 104.0).powf(2.3)
+    }
+}
 /// The contact interior of the λ-scatter measure: contact cells whose centroid is at
 /// least this far from every cell outside the contact set (a fifth of the contact
 /// radius, about 0.25, at q = 20 on the flat obstacle), and two vertex rings in.
@@ -204,7 +219,7 @@ impl KirchhoffRequest {
         let s = &self.scene;
         if self.mesh_size == 0 || self.mesh_size > MAX_KIRCHHOFF_MESH_SIZE {
             return bad(format!(
-                "mesh size N = {} must lie in 1..={MAX_KIRCHHOFF_MESH_SIZE} (N = 128 already takes 1.3 GB; beyond {MAX_KIRCHHOFF_MESH_SIZE} the Argyris factorization outgrows the memory of a shared machine)",
+                "mesh size N = {} must lie in 1..={MAX_KIRCHHOFF_MESH_SIZE} (N = 128 already takes about 6.5 GB; beyond {MAX_KIRCHHOFF_MESH_SIZE} the Argyris factorizations outgrow the memory of a shared machine)",
                 self.mesh_size
             ));
         }
@@ -371,6 +386,18 @@ fn zero(_: &[f64]) -> f64 {
 /// [`KirchhoffRequest::validate`]'s, and the solver's if it does not converge.
 pub fn solve(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
     request.validate()?;
+    let (bytes, limit) = (
+        estimated_memory_bytes(request.mesh_size),
+        crate::membranes::memory_limit_bytes(),
+    );
+    if bytes > limit {
+        return Err(Error::Input(format!(
+            "--mesh-size {} needs about {:.1} GB of memory, more than {}; a smaller N does",
+            request.mesh_size,
+            bytes / 1e9,
+            crate::membranes::memory_limit_text(limit)
+        )));
+    }
     match request.pair {
         KirchhoffPair::ArgyrisP0 => solve_with::<kirchhoff_argyris_p0::Model>(request),
         KirchhoffPair::ArgyrisP1disc => solve_with::<kirchhoff_argyris_p1disc::Model>(request),

@@ -31,7 +31,8 @@ pub const STENBERG_BETA: f64 = 0.1;
 /// The default stabilization parameter α (§6: α = 1 is 5–10× less accurate, α ≤ 0.01
 /// breaks the solver on fine meshes).
 pub const PLATE_ALPHA: f64 = 0.1;
-/// The largest N of the N×N×2 mesh a plate solve accepts (memory: about 2 GB at 1024).
+/// The largest N of the N×N×2 mesh a plate solve accepts; below it the memory the solve
+/// would need is checked too ([`estimated_memory_bytes`]: about 5.5 GB at 512, 24 GB at 1024).
 pub const MAX_PLATE_MESH_SIZE: usize = 1024;
 /// The most rings of a disk mesh a plate solve accepts (6N² triangles: 393k at 256,
 /// measured 53 s and 8.8 GB on curved cells; 512 rings ran out of 24 GB).
@@ -406,11 +407,49 @@ fn zero(_: &[f64]) -> f64 {
 /// rounding through the contact rows above [`MAX_PRIMAL_ROUNDING`]).
 pub fn solve(request: &PlateRequest) -> Result<PlateReport> {
     request.validate()?;
+    check_memory(request)?;
     let run = request
         .pair
         .run(request.scene.support)
         .ok_or_else(|| Error::Input("no model for this support".into()))?;
     run(request)
+}
+
+/// The peak memory of a Mindlin solve, in bytes per triangle, `a + b·log₂(triangles)`
+/// (the direct factor's fill grows like `T log T`), for the square (N×N×2, affine cells)
+/// and the disk (6N² cells, curved at the boundary). Measured peaks of `p1-p2-p0`
+/// (2026-12-01; the plain pair needs less): square 289 MB at N = 128, 1.23 GB at 256,
+/// 5.45 GB at 512; disk 378 MB at 64 rings, 1.79 GB at 128, 8.8 GB at 256.
+/// The disk's fit is floored at the 15 kB a triangle measured on its smallest meshes.
+const PLATE_BYTES_PER_TRIANGLE: [(f64, f64, f64); 2] =
+    [(2.8e3, 0.4e3, 0.0), (-16.7e3, 2.1e3, 15e3)];
+
+/// The estimated peak memory of `request`'s solve, in bytes ([`PLATE_BYTES_PER_TRIANGLE`]).
+pub fn estimated_memory_bytes(request: &PlateRequest) -> f64 {
+    let n = request.mesh_size as f64;
+    let (triangles, (a, b, floor)) = match request.scene.domain {
+        PlateDomain::Square { .. } => (2.0 * n * n, PLATE_BYTES_PER_TRIANGLE[0]),
+        PlateDomain::Disk { .. } => (6.0 * n * n, PLATE_BYTES_PER_TRIANGLE[1]),
+    };
+    triangles * (a + b * triangles.max(1.0).log2()).max(floor)
+}
+
+/// Refuses a mesh size whose estimated peak memory exceeds what the solver allows itself
+/// ([`crate::membranes::memory_limit_bytes`]), before any allocation: the factor's
+/// allocation failing later aborts the process (`mindlin-square --mesh-size 1024` needs
+/// about 24 GB).
+fn check_memory(request: &PlateRequest) -> Result<()> {
+    let bytes = estimated_memory_bytes(request);
+    let limit = crate::membranes::memory_limit_bytes();
+    if bytes > limit {
+        return Err(Error::Input(format!(
+            "--mesh-size {} needs about {:.1} GB of memory, more than {}; a smaller N does (the memory grows about 4× per doubling)",
+            request.mesh_size,
+            bytes / 1e9,
+            crate::membranes::memory_limit_text(limit)
+        )));
+    }
+    Ok(())
 }
 
 /// The mesh of `domain` with size `n`: the N×N×2 mesh of the square (diagonals to the

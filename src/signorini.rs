@@ -207,11 +207,17 @@ pub struct ContactReport {
     /// The vertical force of the foundation on the body (the whole cylinder: twice the
     /// symmetric half's), force per unit length.
     pub total_contact_force: f64,
-    /// The applied vertical load, likewise.
+    /// The applied vertical load, likewise (the pressure integrated by 4-point
+    /// Gauss–Legendre per edge).
     pub applied_load: f64,
-    /// `|total_contact_force − applied_load| / applied_load`: 0 to solver precision (a
-    /// rigid translation lies in V_h, so equilibrium is exact); NaN (null in JSON) for a
-    /// scene file whose supports act along n_c and carry part of the load.
+    /// The applied load as the discretization integrates it (the model's quadrature of
+    /// the pressure, `models::signorini::SignoriniSolution::discretized_load`): what the
+    /// contact force balances. It differs from `applied_load` only for a pressure that
+    /// varies within an edge faster than that quadrature resolves.
+    pub discretized_load: f64,
+    /// `|total_contact_force − discretized_load| / discretized_load`: 0 to solver
+    /// precision (a rigid translation lies in V_h, so equilibrium is exact); NaN (null in
+    /// JSON) for a scene file whose supports act along n_c and carry part of the load.
     pub equilibrium_residual: f64,
     /// Half the extent along x of the edges carrying pressure (their far ends; the
     /// cylinder from its axis, `models::signorini::SignoriniSolution`).
@@ -254,14 +260,26 @@ pub struct ContactReport {
 /// 1e-13, the polished interior point (α = 0) to about 1e-12.
 pub const EQUILIBRIUM_WARNING: f64 = 1e-8;
 
+/// The relative difference between the load as discretized and as integrated by 4-point
+/// Gauss beyond which a report warns (a pressure the model's quadrature does not
+/// integrate exactly).
+pub const QUADRATURE_WARNING: f64 = 1e-8;
+
 /// The warnings of a contact report: what its own checks say about it.
 pub fn warnings(r: &ContactReport) -> Vec<String> {
     let mut out = Vec::new();
     // NaN: not measured (supports carry load along n_c)
     if r.equilibrium_residual > EQUILIBRIUM_WARNING {
         out.push(format!(
-            "the contact force misses the applied load by {:.1e} (relative; a rigid translation lies in V_h, so it should be rounding): the solve did not reach solver precision",
+            "the contact force misses the load as discretized by {:.1e} (relative; a rigid translation lies in V_h, so it should be rounding): the solve did not reach solver precision",
             r.equilibrium_residual
+        ));
+    }
+    let quadrature = (r.discretized_load - r.applied_load).abs() / r.applied_load.abs();
+    if quadrature > QUADRATURE_WARNING {
+        out.push(format!(
+            "the model integrates the pressure on Γ_N exactly only up to degree 2 along an edge: this pressure's resultant comes out {:.6e} against {:.6e} by 4-point Gauss per edge ({quadrature:.1e} relative), and the contact force balances the former; refine the mesh for a pressure that varies within an edge",
+            r.discretized_load, r.applied_load
         ));
     }
     if let (Some(accuracy), Some(error)) = (r.accuracy, r.pressure_l2_error) {
@@ -375,6 +393,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
     profile.sort_by(|a, b| a.0.total_cmp(&b.0));
     let total = factor * solution.total_contact_force[1];
     let applied = -factor * solution.applied_load[1];
+    let discretized = factor * solution.discretized_load;
     let report = ContactReport {
         scene: s.name.to_string(),
         pair: request.pair.name(),
@@ -392,7 +411,8 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         seconds: solution.seconds,
         total_contact_force: total,
         applied_load: applied,
-        equilibrium_residual: (total - applied).abs() / applied.abs(),
+        discretized_load: discretized,
+        equilibrium_residual: (total - discretized).abs() / discretized.abs(),
         contact_half_width: solution.contact_half_width,
         max_contact_pressure: largest,
         exact_half_width: hertz.map(|h| h.half_width()),

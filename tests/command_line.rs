@@ -142,6 +142,11 @@ fn bad_input_exits_with_a_message() {
             "α = -1",
         ),
         (&["study", "membrane-radial", "nonsense"][..], "nonsense"),
+        // about 24 GB: refused before any allocation (it used to abort in the factor)
+        (
+            &["solve", "mindlin-square", "--mesh-size", "1024"][..],
+            "--mesh-size 1024 needs about",
+        ),
         (
             &["solve", "bernoulli-flat", "--refinement", "1000000"][..],
             "--refinement 1000000 is out of range",

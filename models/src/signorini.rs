@@ -32,7 +32,7 @@ macro_rules! signorini_model {
                 unknowns: u: [$element]^2, λ: $multiplier >= 0;
                 tests: v, μ;
                 params: μ_L > 0, λ_L, α, n_c_x, n_c_y;
-                data: q: 0, g: 1;
+                data: q: 2, g: 1;
                 facets: Γ_C, Γ_N;
                 forms: "
                     σ(u)             := 2μ_L ε(u) + λ_L tr ε(u) I
@@ -175,6 +175,12 @@ pub struct SignoriniSolution {
     pub total_contact_force: [f64; 2],
     /// Resultant of the applied pressure, `∫_Γ_N q (−n) ds` (Gauss–Legendre, 4 points per edge).
     pub applied_load: [f64; 2],
+    /// The load's resultant along the contact direction `n_c` as the discretization
+    /// integrates it: `ℓ(t)` for the unit translation `t` along `n_c` (the model's
+    /// quadrature of `q v·n` on Γ_N, exact for the degree of `q` the model declares). The
+    /// contact force balances this one to rounding, whatever `q`; it differs from
+    /// `applied_load · n_c` by the quadrature error of a pressure that varies faster.
+    pub discretized_load: f64,
     /// Half the extent of the edges that carry pressure (λ_E > 0), holes between them
     /// included, along the contact plane (the coordinate of [`contact_tangent`]: x under
     /// a horizontal plane, y beside a vertical one); from `contact_centre` when given.
@@ -462,7 +468,7 @@ fn rigid_motions_held(
         norm(&translation) > 0.0 && norm(&product(&translation)) <= 1e-10 * scale;
     if translation_free && (work.is_nan() || work <= 0.0) {
         return Err(Error::Input(format!(
-            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0): the rigid motion is not prevented"
+            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0, with q at the quadrature points of the edges of Γ_N: a pressure confined within an edge can fall between them; refine the mesh): the rigid motion is not prevented"
         )));
     }
     let tangent = towards_foundation(problem, [-n[1], n[0]]);
@@ -715,6 +721,11 @@ fn report(
         edge_dofs: problem.edge_dofs.clone(),
         total_contact_force: force,
         applied_load: load,
+        discretized_load: towards_foundation(problem, direction)
+            .iter()
+            .zip(&lcp.f)
+            .map(|(t, f)| t * f)
+            .sum(),
         contact_half_width: half_width,
         max_contact_pressure: largest,
         complementarity_residual: complementarity,

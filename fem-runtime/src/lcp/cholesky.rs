@@ -331,8 +331,18 @@ impl LuSolver {
 
     /// The numeric factorization of `a` (same pattern as analysed).
     pub fn factor(&self, a: &SparseMatrix) -> Result<Factor> {
-        let lu = Lu::try_new_with_symbolic(self.symbolic.clone(), a.as_ref())
-            .map_err(|e| Error::LinearSolve(format!("the matrix is singular ({e:?})")))?;
+        let lu = Lu::try_new_with_symbolic(self.symbolic.clone(), a.as_ref()).map_err(|e| {
+            // faer reports an allocation failure through the same error type
+            let detail = format!("{e:?}");
+            Error::LinearSolve(if detail.contains("OutOfMemory") {
+                format!(
+                    "out of memory for the LU factor of order {} ({detail}): a coarser mesh needs less",
+                    a.nrows()
+                )
+            } else {
+                format!("the matrix is singular ({detail})")
+            })
+        })?;
         Ok(Factor::Lu(Box::new(lu)))
     }
 }
