@@ -301,6 +301,16 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             ),
         ));
     }
+    if !(1.0 / MAX_DATA..=MAX_DATA).contains(&m.young) {
+        return Err(at(
+            "material.young",
+            format!(
+                "Young's modulus E = {:e} lies outside [{:e}, {MAX_DATA:e}]: the stiffness and the stabilization's ½/C_I,E would leave the range of double precision; rescale the units",
+                m.young,
+                1.0 / MAX_DATA
+            ),
+        ));
+    }
     if !(m.poisson > -1.0 && m.poisson < 0.5) {
         return Err(at(
             "material.poisson",
@@ -362,9 +372,29 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     check_load(load).map_err(|m| at("data.load", m))?;
     let pressure = expression(&file.data.pressure, "data.pressure", path)?;
     let gap = expression(&file.data.gap, "data.gap", path)?;
-    finite_on(&mesh, &contact, &gap).map_err(|m| at("data.gap", m))?;
-    finite_on(&mesh, &load_part, &pressure).map_err(|m| at("data.pressure", m))?;
+    let largest_gap = finite_on(&mesh, &contact, &gap).map_err(|m| at("data.gap", m))?;
+    let largest_pressure =
+        finite_on(&mesh, &load_part, &pressure).map_err(|m| at("data.pressure", m))?;
     presses(&mesh, &load_part, &pressure, contact_direction).map_err(|m| at("data.pressure", m))?;
+    let extent = |k: usize| {
+        let (lo, hi) = mesh
+            .vertices()
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x[k]), hi.max(x[k]))
+            });
+        hi - lo
+    };
+    let elastic = load * largest_pressure * extent(0).hypot(extent(1)) / m.young;
+    if f64::EPSILON * largest_gap > MAX_GAP_ROUNDING * elastic {
+        return Err(at(
+            "data.gap",
+            format!(
+                "a gap of up to {largest_gap:e} is {:.1e} times the body's elastic displacement (about max|q| L/E = {elastic:.2e}): the displacement then carries the deformation only in its last digits. A uniform part of the gap only translates the body: measure the gap from a foundation placed closer",
+                largest_gap / elastic
+            ),
+        ));
+    }
     let exact_pressure = file
         .exact
         .as_ref()
@@ -578,8 +608,9 @@ fn length(ends: &[[f64; 2]; 2]) -> f64 {
 }
 
 /// `data` is finite at the ends and the Gauss points of every edge of the part.
-fn finite_on(mesh: &TriangleMesh, markers: &[u32], data: &Data) -> std::result::Result<(), String> {
+fn finite_on(mesh: &TriangleMesh, markers: &[u32], data: &Data) -> std::result::Result<f64, String> {
     let gauss = fem_runtime::gauss_legendre(GAUSS_POINTS);
+    let mut largest = 0.0f64;
     for ends in oriented_edges(mesh, markers) {
         for s in [0.0, 1.0].iter().chain(&gauss.points) {
             let p = point(&ends, *s);
@@ -590,10 +621,29 @@ fn finite_on(mesh: &TriangleMesh, markers: &[u32], data: &Data) -> std::result::
                     p[0], p[1]
                 ));
             }
+            if value.abs() > MAX_DATA {
+                return Err(format!(
+                    "the expression is {value:e} at ({}, {}) on its boundary part, beyond ±{MAX_DATA:e}: the solve's norms would overflow; rescale the units",
+                    p[0], p[1]
+                ));
+            }
+            largest = largest.max(value.abs());
         }
     }
-    Ok(())
+    Ok(largest)
 }
+
+/// The largest size of E, the pressure and the gap a contact scene file may give (the
+/// built-in scenes' load bound): beyond it the stiffness, the KKT norms or the
+/// stabilization's `½/C_I,E` leave the range of f64 (E = 1e-200 gave "α = inf").
+const MAX_DATA: f64 = 1e100;
+
+/// The largest rounding of the displacement through the gap, `ε max|g|`, relative to
+/// the body's elastic displacement `max|q| L / E`, that a contact scene file may ask
+/// for: a uniform gap only translates the body, but the translation carries the
+/// deformation's digits (a gap of 1e10 on a block with `q L/E` = 2e-3 gave a contact
+/// force 6.5 % off the load).
+const MAX_GAP_ROUNDING: f64 = 1e-6;
 
 /// The resultant `∫_Γ_N q (−n) ds` pushes along `n_c`, towards the foundation: else
 /// nothing holds the body (the foundation only pushes).

@@ -316,6 +316,29 @@ fn bad_contact_scene_files_name_the_key() {
             "accuracy",
             &["[exact] pressure"],
         ),
+        // extreme data are named, not reported as "α = inf", a non-finite facet
+        // matrix or a line search that failed; a uniform gap of 1e10 on a block whose
+        // elastic displacement is 2e-3 gave a contact force 6.5 % off the load
+        (
+            RECTANGLE.replace("young = 1000.0", "young = 1e-200"),
+            "material.young",
+            &["1e-200", "rescale"],
+        ),
+        (
+            RECTANGLE.replace("young = 1000.0", "young = 1e300"),
+            "material.young",
+            &["1e300"],
+        ),
+        (
+            RECTANGLE.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"1e200\""),
+            "data.pressure",
+            &["1e200", "rescale"],
+        ),
+        (
+            RECTANGLE.replace("gap = \"0\"", "gap = \"1e10\""),
+            "data.gap",
+            &["elastic displacement", "foundation placed closer"],
+        ),
         (
             format!("{RECTANGLE}\n[exact]\npressure = \"sqrt(x - 100)\"\n"),
             "exact.pressure",
