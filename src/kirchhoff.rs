@@ -33,6 +33,33 @@ const SIDE: f64 = -1.0;
 /// 7.8 GB before it finished.
 pub const MAX_KIRCHHOFF_MESH_SIZE: usize = 160;
 
+/// `α·C_I` below which a solver failure with an α the user gave names α: the default
+/// is [`ALPHA_FRACTION`]; at 1e-7 (`--alpha 1e-12` on kirchhoff-obstacle) Newton's
+/// active set no longer settles, the eliminated multiplier `(G − BU)/(α h⁴ …)` being
+/// rounding.
+const WEAK_ALPHA_TIMES_C_I: f64 = 1e-4;
+
+/// `error` with a hint naming `--alpha` when the user's α is far below the stability
+/// range's middle (`alpha_times_c_i` below [`WEAK_ALPHA_TIMES_C_I`]; Morley, whose
+/// `C_I` is 0, is left alone).
+fn weak_alpha_hint(error: Error, alpha: Option<f64>, alpha_times_c_i: f64) -> Error {
+    let Some(alpha) = alpha.filter(|_| alpha_times_c_i > 0.0 && alpha_times_c_i < WEAK_ALPHA_TIMES_C_I)
+    else {
+        return error;
+    };
+    let hint = format!(
+        "--alpha {alpha:e} gives α·C_I = {alpha_times_c_i:.1e}, near the plain method: the multiplier, eliminated as (G − BU)/(α h⁴ …), is then lost in rounding; raise --alpha or leave it out (α = {ALPHA_FRACTION}/C_I)"
+    );
+    match error {
+        Error::NotConverged { solver, detail } => Error::NotConverged {
+            solver,
+            detail: format!("{detail}; {hint}"),
+        },
+        Error::LinearSolve(detail) => Error::LinearSolve(format!("{detail}; {hint}")),
+        other => other,
+    }
+}
+
 /// The estimated peak memory of a Kirchhoff solve on the N×N×2 mesh, in bytes: the
 /// measurements of [`MAX_KIRCHHOFF_MESH_SIZE`] scaled by `N^2.3` (the factors' fill), with
 /// the multiplier's recovery assumed from N = 112 on (it depends on the data; this is the
@@ -486,7 +513,8 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
         solver: request.solver,
         ..ObstacleOptions::default()
     };
-    let solution = solve_nested(levels, prolong_primal_on_triangles, options)?;
+    let solution = solve_nested(levels, prolong_primal_on_triangles, options)
+        .map_err(|e| weak_alpha_hint(e, request.alpha, alpha * c_i))?;
     let w = M::field("w")?;
     let view = solution.view(w);
     let basis = TriangleBasis::new(view.map.element());

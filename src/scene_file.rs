@@ -53,7 +53,8 @@
 //! crate's `FloatOpsFactory`. A syntax error or a variable other than `x`, `y` is an
 //! error naming the file, the field and the expression. A unary minus before a power
 //! must be bracketed (`-(x^2)` or `0-x^2`): `exmex` reads `-x^2` as `(−x)²`, so it is
-//! refused rather than read against the mathematics.
+//! refused rather than read against the mathematics; so is a chained power `a^b^c`,
+//! which it reads as `(a^b)^c`.
 
 use crate::membranes::MembranePair;
 use crate::models::data::Data;
@@ -236,6 +237,25 @@ fn normalize(text: &str) -> std::result::Result<String, String> {
                         "`-{operand}^…` is ambiguous here: the expression language reads it as (−{operand})^…, not −({operand}^…); write `-({operand}^…)` or `0-{operand}^…` for the negative power, or `(-{operand})^…` for the power of the negative"
                     ));
                 }
+            }
+        }
+        if c == '^' {
+            // the exponent's own operand, after an optional sign
+            let mut k = i + 1;
+            while k < chars.len() && chars[k].is_whitespace() {
+                k += 1;
+            }
+            if matches!(chars.get(k), Some('+' | '-')) {
+                k += 1;
+            }
+            let end = operand_end(&chars, k);
+            let next = chars[end..].iter().find(|c| !c.is_whitespace());
+            if end > k && next == Some(&'^') {
+                let exponent: String = chars[k..end].iter().collect();
+                let exponent = exponent.trim();
+                return Err(format!(
+                    "`…^{exponent}^…` is ambiguous here: the expression language reads a chained power from the left, (a^{exponent})^c, where mathematics means a^({exponent}^c); write the brackets you mean"
+                ));
             }
         }
         out.push(c);
@@ -744,6 +764,25 @@ mod normalize_tests {
             ("x-y^2", 3.0 - 4.0),
             ("-x", -3.0),
             ("exp(0-(x^2+y^2))", (-13.0f64).exp()),
+        ] {
+            assert_eq!(value(text, 3.0, 2.0), expected, "{text}");
+        }
+    }
+
+    /// `a^b^c` would be read as `(a^b)^c` (2^3^2 = 64, where mathematics means 512):
+    /// refused; bracketed chains keep their meaning.
+    #[test]
+    fn a_chained_power_is_refused() {
+        for text in ["2^3^2", "x^y^2", "x ^ 2 ^ y", "x^-2^2", "x^(1)^2", "x^sin(y)^2"] {
+            let error = normalize(text).unwrap_err();
+            assert!(error.contains("chained power"), "{text}: {error}");
+        }
+        for (text, expected) in [
+            ("2^(3^2)", 512.0),
+            ("(2^3)^2", 64.0),
+            ("x^2*y^2", 36.0),
+            ("x^2+y^2", 13.0),
+            ("2^-x", 0.125),
         ] {
             assert_eq!(value(text, 3.0, 2.0), expected, "{text}");
         }

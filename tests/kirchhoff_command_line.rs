@@ -138,7 +138,7 @@ fn kirchhoff_obstacle_reports_what_the_issue_asks() {
 
 #[test]
 fn bad_kirchhoff_input_is_refused_by_name() {
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 12] = [
         (
             &["solve", "kirchhoff-obstacle", "--load", "1e100"],
             "lost to rounding",
@@ -169,6 +169,11 @@ fn bad_kirchhoff_input_is_refused_by_name() {
             "mesh size",
         ),
         (&["solve", "kirchhoff-obstacle", "--alpha", "-1"], "α"),
+        // inside the stability range but near the plain method: the failure names α
+        (
+            &["solve", "kirchhoff-obstacle", "--alpha", "1e-12"],
+            "raise --alpha",
+        ),
         (
             &["solve", "kirchhoff-obstacle", "--thickness", "0.1"],
             "--thickness",
