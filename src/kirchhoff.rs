@@ -943,7 +943,7 @@ pub fn summary(r: &KirchhoffReport) -> String {
         line += &format!(" (series {reference:.8e}, relative error {e:+.2e})");
     }
     line += &format!(
-        ", max w {:.6e}, ∫λ_h {:.6e}, contact area {:.5}",
+        ", max |w| {:.6e}, ∫λ_h {:.6e}, contact area {:.5}",
         r.max_deflection, r.total_contact_force, r.contact_area
     );
     if let Some(m) = &r.interior_multiplier {

@@ -805,7 +805,7 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             "{}",
             serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
         );
-    } else if report.relative_error.is_nan() {
+    } else if report.contact_radius.is_some() {
         println!(
             "{} {} {} t = {:.0e} N = {}: q = {}, obstacle {}: J_h {:.9e}, ∫λ_h {:.7e}, contact area {:.6}, contact radius {:.6}, centre deflection {:.8e}, {} dofs, {} iterations, {:.3} s",
             report.scene,
@@ -818,7 +818,7 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             report.energy,
             report.total_contact_force,
             report.contact_area,
-            report.contact_radius.unwrap_or(f64::NAN),
+            report.contact_radius.unwrap_or_default(),
             report.centre_deflection,
             report.dofs,
             report.iterations,

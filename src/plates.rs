@@ -710,7 +710,12 @@ where
             f64::NAN
         } else {
             let reference = unobstructed.unwrap_or(kirchhoff);
-            (centre - reference) / reference
+            // q = 0: both deflections are 0 exactly, and so is the error
+            if reference == 0.0 && centre == 0.0 {
+                0.0
+            } else {
+                (centre - reference) / reference
+            }
         },
         energy,
         max_deflection,

@@ -526,7 +526,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         at(
             "model",
             format!(
-                "`{model}` is not a model scene files can pose; they support `membrane` and `contact` (beams: the built-in scenes)"
+                "`{model}` is not a model scene files can pose; they support `membrane` and `contact` (beams, Kirchhoff and Mindlin plates: the built-in scenes, see `fem-forms list`)"
             ),
         )
     };
