@@ -444,3 +444,20 @@ fn penetration_and_small_contact_sets_are_reported_honestly() {
         assert!((mean - 7.0).abs() < 0.5, "{small}");
     }
 }
+
+/// No load on a plate without an obstacle: w = 0 exactly, the free plate's report with an
+/// error of 0 (it was NaN, which switched the line to the contact report's "contact
+/// radius NaN").
+#[test]
+fn an_unloaded_plate_reports_a_zero_error() {
+    let json = solve_json(&["--load", "0"]);
+    assert_eq!(json["centre_deflection"].as_f64(), Some(0.0));
+    assert_eq!(json["relative_error"].as_f64(), Some(0.0));
+    let run = fem_forms(&["solve", "mindlin-square", "--load", "0"]);
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success());
+    assert!(
+        text.contains("relative error +0.000e0") && !text.contains("NaN"),
+        "{text}"
+    );
+}
