@@ -54,11 +54,15 @@
 //! refining); an `accuracy` without `[exact]`; a part name the
 //! mesh does not have (`boundary.contact`, …, with the names it has); a part that holds
 //! no boundary edge (an interior Gmsh curve: "not on the boundary"); `material.young`
-//! ≤ 0; `material.poisson` outside (−1, ½); a zero `parameters.contact_direction`; a
-//! negative `parameters.alpha`; an expression that does not parse, uses a variable
-//! other than x, y, or does not evaluate to a finite number on its part (`data.gap` on
-//! Γ_C, `data.pressure` on Γ_N, `exact.pressure` on Γ_C); a pressure whose resultant pulls the body off the
-//! foundation (`data.pressure`: nothing then holds the body).
+//! ≤ 0 or outside [1e-100, 1e100]; `material.poisson` outside (−1, ½); a zero
+//! `parameters.contact_direction`; a negative `parameters.alpha`; an expression that
+//! does not parse, uses a variable other than x, y, or does not evaluate to a finite
+//! number within ±1e100 on its part (`data.gap` on Γ_C, `data.pressure` on Γ_N,
+//! `exact.pressure` on Γ_C); a pressure scale times max|q| beyond 1e100; a pressure
+//! whose resultant pulls the body off the foundation (`data.pressure`: nothing then
+//! holds the body); a gap whose smallest value is so far beyond the elastic
+//! displacement that rounding swamps it (`data.gap`, `MAX_GAP_ROUNDING`; checked again
+//! under `--load`).
 
 use crate::models::data::Data;
 use crate::models::signorini::{solve_signorini, Plane, SignoriniInput, SignoriniSolution};
@@ -90,19 +94,16 @@ fn check_memory(
     refinements: usize,
     pair: ContactPair,
 ) -> std::result::Result<(), String> {
-    let limit = crate::membranes::memory_limit_bytes();
     let bytes = fem_runtime::mesh::triangle::estimated_bytes(
         cells,
         refinements as u32,
         bytes_per_triangle(pair),
     );
-    if bytes > limit {
+    if let Some(m) = crate::membranes::beyond_memory(bytes) {
         return Err(format!(
-            "{refinements} uniform refinements of the mesh's {cells} triangles make {:.0} triangles, which with {} need about {:.1} GB of memory, more than {}",
+            "{refinements} uniform refinements of the mesh's {cells} triangles make {:.0} triangles, which with {} {m}",
             cells as f64 * 4f64.powi(refinements as i32),
             pair.name(),
-            bytes / 1e9,
-            crate::membranes::memory_limit_text(limit)
         ));
     }
     Ok(())
@@ -218,6 +219,10 @@ pub struct ContactSceneFile {
     pub pressure: Data,
     /// The gap g(x, y) on Γ_C.
     pub gap: Data,
+    /// The scales [`data_scales`] checks at every load: the largest |q| on Γ_N, the
+    /// smallest g on Γ_C, the body's diameter, and whether supports hold the
+    /// translation along n_c.
+    scales: DataScales,
     /// The exact contact pressure at the file's own `load`, where known. Contact is not
     /// linear in the load (the contact set grows with it: Hertz's pressure goes like
     /// √P), so under another `--load` it is not the solution and is not compared.
@@ -372,8 +377,8 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     check_load(load).map_err(|m| at("data.load", m))?;
     let pressure = expression(&file.data.pressure, "data.pressure", path)?;
     let gap = expression(&file.data.gap, "data.gap", path)?;
-    let largest_gap = finite_on(&mesh, &contact, &gap).map_err(|m| at("data.gap", m))?;
-    let largest_pressure =
+    let gap_range = finite_on(&mesh, &contact, &gap).map_err(|m| at("data.gap", m))?;
+    let pressure_range =
         finite_on(&mesh, &load_part, &pressure).map_err(|m| at("data.pressure", m))?;
     presses(&mesh, &load_part, &pressure, contact_direction).map_err(|m| at("data.pressure", m))?;
     let extent = |k: usize| {
@@ -385,16 +390,15 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             });
         hi - lo
     };
-    let elastic = load * largest_pressure * extent(0).hypot(extent(1)) / m.young;
-    if f64::EPSILON * largest_gap > MAX_GAP_ROUNDING * elastic {
-        return Err(at(
-            "data.gap",
-            format!(
-                "a gap of up to {largest_gap:e} is {:.1e} times the body's elastic displacement (about max|q| L/E = {elastic:.2e}): the displacement then carries the deformation only in its last digits. A uniform part of the gap only translates the body: measure the gap from a foundation placed closer",
-                largest_gap / elastic
-            ),
-        ));
-    }
+    let scales = DataScales {
+        pressure: pressure_range[0].abs().max(pressure_range[1].abs()),
+        smallest_gap: gap_range[0],
+        diameter: extent(0).hypot(extent(1)),
+        young: m.young,
+        translation_held: (contact_direction[0] != 0.0 && !fixed_x.is_empty())
+            || (contact_direction[1] != 0.0 && !fixed_y.is_empty()),
+    };
+    data_scales(&scales, load).map_err(|(key, m)| at(key, m))?;
     let exact_pressure = file
         .exact
         .as_ref()
@@ -439,6 +443,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         load,
         pressure,
         gap,
+        scales,
         exact_pressure,
         accuracy: file.accuracy,
     })
@@ -608,9 +613,13 @@ fn length(ends: &[[f64; 2]; 2]) -> f64 {
 }
 
 /// `data` is finite at the ends and the Gauss points of every edge of the part.
-fn finite_on(mesh: &TriangleMesh, markers: &[u32], data: &Data) -> std::result::Result<f64, String> {
+fn finite_on(
+    mesh: &TriangleMesh,
+    markers: &[u32],
+    data: &Data,
+) -> std::result::Result<[f64; 2], String> {
     let gauss = fem_runtime::gauss_legendre(GAUSS_POINTS);
-    let mut largest = 0.0f64;
+    let mut range = [f64::INFINITY, f64::NEG_INFINITY];
     for ends in oriented_edges(mesh, markers) {
         for s in [0.0, 1.0].iter().chain(&gauss.points) {
             let p = point(&ends, *s);
@@ -627,10 +636,10 @@ fn finite_on(mesh: &TriangleMesh, markers: &[u32], data: &Data) -> std::result::
                     p[0], p[1]
                 ));
             }
-            largest = largest.max(value.abs());
+            range = [range[0].min(value), range[1].max(value)];
         }
     }
-    Ok(largest)
+    Ok(range)
 }
 
 /// The largest size of E, the pressure and the gap a contact scene file may give (the
@@ -638,12 +647,59 @@ fn finite_on(mesh: &TriangleMesh, markers: &[u32], data: &Data) -> std::result::
 /// stabilization's `½/C_I,E` leave the range of f64 (E = 1e-200 gave "α = inf").
 const MAX_DATA: f64 = 1e100;
 
-/// The largest rounding of the displacement through the gap, `ε max|g|`, relative to
-/// the body's elastic displacement `max|q| L / E`, that a contact scene file may ask
-/// for: a uniform gap only translates the body, but the translation carries the
-/// deformation's digits (a gap of 1e10 on a block with `q L/E` = 2e-3 gave a contact
-/// force 6.5 % off the load).
-const MAX_GAP_ROUNDING: f64 = 1e-6;
+/// The largest rounding of the displacement through the gap, `ε |min g|` (the rigid
+/// translation before contact, or the initial penetration), relative to the body's
+/// elastic displacement `load · max|q| · L / E`, that a contact scene file may ask for
+/// where the translation along n_c is free: the translation carries the deformation's
+/// digits. Measured on the 2 × 1 block (`q L/E` = 2.2e-3): a uniform gap of 1e10
+/// (ε-ratio 1e-3) gave a contact force 6.5 % off the load, 1e6 (1e-7) 6.9e-6 and 1e3
+/// (1e-10) 6.5e-9, about 60 times the ratio; below this bound the equilibrium stays
+/// within [`crate::signorini::EQUILIBRIUM_WARNING`].
+const MAX_GAP_ROUNDING: f64 = 1e-10;
+
+/// What [`data_scales`] needs of a file's data, found when it is read.
+#[derive(Clone, Copy, Debug)]
+struct DataScales {
+    /// max |q| over the quadrature points of Γ_N (before the load scale).
+    pressure: f64,
+    /// min g over Γ_C.
+    smallest_gap: f64,
+    /// The mesh's bounding-box diagonal L.
+    diameter: f64,
+    /// E.
+    young: f64,
+    /// Supports fix the displacement along n_c (the gap is then no translation).
+    translation_held: bool,
+}
+
+/// Checks the data's scales at the pressure scale `load` (the file's or `--load`): the
+/// pressure `load · max|q|` at most [`MAX_DATA`], and a gap whose rounding does not
+/// swamp the elastic displacement ([`MAX_GAP_ROUNDING`]). The error names its key.
+fn data_scales(scales: &DataScales, load: f64) -> std::result::Result<(), (&'static str, String)> {
+    let pressure = load * scales.pressure;
+    if pressure > MAX_DATA {
+        return Err((
+            "data.pressure",
+            format!(
+                "the pressure reaches {pressure:e} (scale {load:e} times max|q| = {:e}), beyond {MAX_DATA:e}: the solve's norms would overflow; rescale the units",
+                scales.pressure
+            ),
+        ));
+    }
+    let elastic = pressure * scales.diameter / scales.young;
+    let translation = scales.smallest_gap.abs();
+    if !scales.translation_held && f64::EPSILON * translation > MAX_GAP_ROUNDING * elastic {
+        return Err((
+            "data.gap",
+            format!(
+                "the body moves by the gap's smallest value {:e} before it touches (or starts that far inside the foundation), {:.1e} times its elastic displacement (about load · max|q| L/E = {elastic:.2e}): the displacement then holds the deformation only in its last digits; measure the gap from a foundation placed closer (only its variation along Γ_C matters)",
+                scales.smallest_gap,
+                translation / elastic
+            ),
+        ));
+    }
+    Ok(())
+}
 
 /// The resultant `∫_Γ_N q (−n) ds` pushes along `n_c`, towards the foundation: else
 /// nothing holds the body (the foundation only pushes).
@@ -749,6 +805,11 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
     })?;
     let load = overrides.load.unwrap_or(file.load);
     check_load(load).map_err(|m| Error::Input(format!("--load: {m}")))?;
+    if overrides.load.is_some() {
+        data_scales(&file.scales, load).map_err(|(key, m)| {
+            Error::Input(format!("--load {load:e} with {}'s `{key}`: {m}", file.name))
+        })?;
+    }
     let alpha = overrides.alpha.or(file.alpha);
     let mut mesh = file.mesh.clone();
     for _ in 0..refinements {
@@ -782,7 +843,14 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
     let n = file.contact_direction;
     let total = -(solution.total_contact_force[0] * n[0] + solution.total_contact_force[1] * n[1]);
     let applied = solution.applied_load[0] * n[0] + solution.applied_load[1] * n[1];
-    let discretized = solution.discretized_load;
+    // supports along n_c carry part of the load, and the translation the load is
+    // measured on has their DOFs fixed: not a resultant (NaN, null in JSON)
+    let held = file.scales.translation_held;
+    let discretized = if held {
+        f64::NAN
+    } else {
+        solution.discretized_load
+    };
     // along the contact plane: x under a horizontal one, y beside a vertical one
     let along = crate::models::signorini::contact_tangent(n);
     let coordinate = |x: [f64; 2]| along[0] * x[0] + along[1] * x[1];
@@ -823,9 +891,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         discretized_load: discretized,
         // supports acting along n_c carry part of the load: the contact force alone
         // then need not equal it (not measured: null)
-        equilibrium_residual: if (n[0] != 0.0 && !file.fixed_x.is_empty())
-            || (n[1] != 0.0 && !file.fixed_y.is_empty())
-        {
+        equilibrium_residual: if held {
             f64::NAN
         } else {
             (total - discretized).abs() / discretized.abs()

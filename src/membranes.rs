@@ -925,6 +925,20 @@ pub(crate) fn memory_limit_text(limit: f64) -> String {
     )
 }
 
+/// "needs about 23.5 GB of memory, more than the 17.2 GB this solver allows itself here
+/// (…)" when an estimated peak of `bytes` exceeds [`memory_limit_bytes`], for the
+/// refusals of every family (each names its own input before it); `None` when it fits.
+pub(crate) fn beyond_memory(bytes: f64) -> Option<String> {
+    let limit = memory_limit_bytes();
+    (bytes > limit).then(|| {
+        format!(
+            "needs about {:.1} GB of memory, more than {}",
+            bytes / 1e9,
+            memory_limit_text(limit)
+        )
+    })
+}
+
 /// Refuses, before allocating, a structured mesh whose solve would need more than
 /// [`memory_limit_bytes`]. Measured peaks per triangle (membrane-radial, 2026-12-01):
 /// p1-p0 1.2 kB at 2.1M and 1.3 kB at 8.4M triangles, p1-nodal 0.4 kB at 2.1M and
@@ -938,14 +952,11 @@ fn check_memory(request: &MembraneRequest) -> Result<()> {
     let per_triangle = request.pair.row().bytes_per_triangle;
     let n = request.mesh_size as f64;
     let bytes = 2.0 * n * n * per_triangle;
-    let limit = memory_limit_bytes();
-    if bytes > limit {
+    if let Some(m) = beyond_memory(bytes) {
         return Err(Error::Input(format!(
-            "--mesh-size {} with {} needs about {:.1} GB of memory, more than {}",
+            "--mesh-size {} with {} {m}",
             request.mesh_size,
             request.pair.name(),
-            bytes / 1e9,
-            memory_limit_text(limit)
         )));
     }
     Ok(())
@@ -976,16 +987,13 @@ fn file_levels(
         refinements as u32,
         pair.row().bytes_per_triangle,
     );
-    let limit = memory_limit_bytes();
-    if bytes > limit {
+    if let Some(m) = beyond_memory(bytes) {
         return Err(Error::Input(format!(
-            "--mesh-size {refinements} with --msh {} refines its {} triangles {refinements} times, to {:.3e} triangles; with {} that needs about {:.1} GB of memory, more than {}: use fewer refinements",
+            "--mesh-size {refinements} with --msh {} refines its {} triangles {refinements} times, to {:.3e} triangles; with {} that {m}: use fewer refinements",
             path.display(),
             mesh.cell_count(),
             mesh.cell_count() as f64 * 4f64.powi(refinements as i32),
             pair.name(),
-            bytes / 1e9,
-            memory_limit_text(limit)
         )));
     }
     let mut levels = vec![mesh];
@@ -1075,7 +1083,7 @@ fn run_stabilized<M: Model>(
     let (primal_count, multiplier_count) = (d.lcp.n(), d.lcp.m());
     if alpha == 0.0 && multiplier_count > primal_count {
         warnings.push(format!(
-            "α = 0: the plain pair has {multiplier_count} multipliers for {primal_count} primal unknowns, so its multipliers have a kernel of dimension at least {} (no discrete inf-sup condition, docs/mathematics.md §1): u_h is unique, but λ_h, ∫λ_h and the contact set are one of many; α > 0 (the default) gives the unique stabilized λ_h",
+            "α = 0: the plain pair has {multiplier_count} multipliers for {primal_count} primal unknowns, so Bᵀ has a kernel of dimension at least {} (no discrete inf-sup condition, docs/mathematics.md §1): u_h is unique, but where that kernel meets the contact set λ_h is not, and the λ_h, ∫λ_h and contact set reported are one of many; α > 0 (the default) gives the unique stabilized λ_h",
             multiplier_count - primal_count
         ));
     }

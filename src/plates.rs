@@ -439,17 +439,13 @@ pub fn estimated_memory_bytes(request: &PlateRequest) -> f64 {
 /// allocation failing later aborts the process (`mindlin-square --mesh-size 1024` needs
 /// about 24 GB).
 fn check_memory(request: &PlateRequest) -> Result<()> {
-    let bytes = estimated_memory_bytes(request);
-    let limit = crate::membranes::memory_limit_bytes();
-    if bytes > limit {
-        return Err(Error::Input(format!(
-            "--mesh-size {} needs about {:.1} GB of memory, more than {}; a smaller N does (the memory grows about 4× per doubling)",
-            request.mesh_size,
-            bytes / 1e9,
-            crate::membranes::memory_limit_text(limit)
-        )));
+    match crate::membranes::beyond_memory(estimated_memory_bytes(request)) {
+        Some(m) => Err(Error::Input(format!(
+            "--mesh-size {} {m}; a smaller N does (the memory grows about 4× per doubling)",
+            request.mesh_size
+        ))),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// The mesh of `domain` with size `n`: the N×N×2 mesh of the square (diagonals to the
@@ -639,6 +635,14 @@ where
         }
     }
     let mut warnings = Vec::new();
+    // as beams and membranes do: the eliminated λ_h loses digits where C falls below the
+    // rounding of G − BU, and its recovery may have been skipped (out of memory)
+    if solution.multiplier_noise > 1e-6 {
+        warnings.push(format!(
+            "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁴ approaches the rounding of G − BU at this mesh size (a larger α or a coarser mesh avoids it)",
+            solution.multiplier_noise
+        ));
+    }
     // w_h ∈ P2 is determined by its nodal values; λ_h ∈ P0 holds the constraint on each
     // cell's mean, so the plate may cross ψ between nodes and at them by O(h²)
     let max_penetration = match request.obstacle().side_and_height() {

@@ -773,7 +773,14 @@ mod normalize_tests {
     /// refused; bracketed chains keep their meaning.
     #[test]
     fn a_chained_power_is_refused() {
-        for text in ["2^3^2", "x^y^2", "x ^ 2 ^ y", "x^-2^2", "x^(1)^2", "x^sin(y)^2"] {
+        for text in [
+            "2^3^2",
+            "x^y^2",
+            "x ^ 2 ^ y",
+            "x^-2^2",
+            "x^(1)^2",
+            "x^sin(y)^2",
+        ] {
             let error = normalize(text).unwrap_err();
             assert!(error.contains("chained power"), "{text}: {error}");
         }

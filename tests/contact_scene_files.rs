@@ -804,9 +804,44 @@ fn a_varying_pressure_is_integrated_and_its_quadrature_error_is_named() {
     assert!(
         r.warnings
             .iter()
-            .any(|w| w.contains("exactly only up to degree 2"))
+            .any(|w| w.contains("exact for pressures up to quadratic"))
             && r.warnings.iter().all(|w| !w.contains("solver precision")),
         "{:?}",
         r.warnings
+    );
+}
+
+/// The gap's rounding is measured by the translation it causes (its smallest value on
+/// Γ_C) against the elastic displacement at the load solved: a foundation that drops
+/// away far beyond the body (g up to 5e8 where x > 1.5, 0 elsewhere) is accepted and
+/// solved in equilibrium, while a load scaled down by `--load` until a moderate uniform
+/// gap swamps the deformation is refused by name.
+#[test]
+fn the_gap_is_measured_by_the_translation_it_causes() {
+    let ending = RECTANGLE.replace("gap = \"0\"", "gap = \"1e9 * max(0, x - 1.5)\"");
+    let r = contact_scene_file::solve(&parse(&ending).unwrap(), &Overrides::default())
+        .unwrap()
+        .report;
+    assert!(r.equilibrium_residual <= 1e-10, "{r:?}");
+    // the pressed edges end at the edge that holds x = 1.5 (1/3 wide): not the whole bottom
+    assert!(r.contact_half_width < 0.9, "{r:?}");
+    // a uniform gap of 1 on a body whose elastic displacement is 5.6e-3: fine at the
+    // file's load, swamped at 1e-9 of it
+    let file = parse(&RECTANGLE.replace("gap = \"0\"", "gap = \"1\"")).unwrap();
+    let r = contact_scene_file::solve(&file, &Overrides::default())
+        .unwrap()
+        .report;
+    assert!(r.equilibrium_residual <= 1e-8, "{r:?}");
+    let overrides = Overrides {
+        load: Some(1e-9),
+        ..Overrides::default()
+    };
+    let message = contact_scene_file::solve(&file, &overrides)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        message.contains("--load 1e-9") && message.contains("`data.gap`"),
+        "{message}"
     );
 }

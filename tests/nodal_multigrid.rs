@@ -217,7 +217,11 @@ fn a_start_that_nearly_solves_the_system_is_still_polished() {
     ];
     let direct = nodal_active_set(&a, &f, &psi, None, 50).unwrap();
     let free: Vec<usize> = (0..n).filter(|&i| direct.u[i] > psi[i] + 1e-9).collect();
-    assert!(free.len() > 4 && free.len() < n, "a free region and contact: {} free", free.len());
+    assert!(
+        free.len() > 4 && free.len() < n,
+        "a free region and contact: {} free",
+        free.len()
+    );
     // the free nodes' residual `(A u − f)_i`, relative to ‖f‖₂
     let residual = |u: &[f64]| -> f64 {
         let au = fem_forms::lcp::cholesky::multiply(&a, u);
@@ -235,5 +239,9 @@ fn a_start_that_nearly_solves_the_system_is_still_polished() {
     let multigrid = nodal_active_set_with(&a, &f, &psi, Some(&start), 50, &chain).unwrap();
     let after = residual(&multigrid.u);
     assert!(after <= 1e-12, "left at {after:e} (start {before:e})");
-    assert!(multigrid.kkt_residual <= 1e-12, "{:e}", multigrid.kkt_residual);
+    assert!(
+        multigrid.kkt_residual <= 1e-12,
+        "{:e}",
+        multigrid.kkt_residual
+    );
 }

@@ -831,13 +831,14 @@ pub fn solve_lcp_on_hierarchy(
             if lcp.elimination_noise(&solution.lambda) > 1e-6 {
                 // The recovery factors the saddle-point system by LU, whose fill under
                 // partial pivoting can be ten times the Newton factor's (the Argyris
-                // plate at N = 112: 4.5 GB against 0.5 GB). Where that factorization
-                // fails (out of memory), the solution stands with its eliminated Λ and
-                // the noise estimate that says how far to trust it.
-                Ok(
-                    recover_multiplier(lcp, solution.clone(), options.newton.refinement_steps)
-                        .unwrap_or(solution),
-                )
+                // plate at N = 112: 4.5 GB against 0.5 GB). Where faer reports that it
+                // ran out of memory, the solution stands with its eliminated Λ and the
+                // noise estimate that says how far to trust it; any other failure is
+                // reported as before.
+                match recover_multiplier(lcp, solution.clone(), options.newton.refinement_steps) {
+                    Err(Error::LinearSolve(m)) if m.contains("out of memory") => Ok(solution),
+                    recovered => recovered,
+                }
             } else {
                 Ok(solution)
             }
