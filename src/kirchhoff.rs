@@ -48,17 +48,12 @@ fn weak_alpha_hint(error: Error, alpha: Option<f64>, alpha_times_c_i: f64) -> Er
     else {
         return error;
     };
-    let hint = format!(
-        "--alpha {alpha:e} gives α·C_I = {alpha_times_c_i:.1e}, near the plain method: the multiplier, eliminated as (G − BU)/(α h⁴ …), is then lost in rounding; raise --alpha or leave it out (α = {ALPHA_FRACTION}/C_I)"
-    );
-    match error {
-        Error::NotConverged { solver, detail } => Error::NotConverged {
-            solver,
-            detail: format!("{detail}; {hint}"),
-        },
-        Error::LinearSolve(detail) => Error::LinearSolve(format!("{detail}; {hint}")),
-        other => other,
-    }
+    crate::membranes::with_solver_hint(
+        error,
+        format!(
+            "--alpha {alpha:e} gives α·C_I = {alpha_times_c_i:.1e}, near the plain method: the multiplier, eliminated as (G − BU)/(α h⁴ …), is then lost in rounding; raise --alpha or leave it out (α = {ALPHA_FRACTION}/C_I)"
+        ),
+    )
 }
 
 /// The estimated peak memory of a Kirchhoff solve on the N×N×2 mesh, in bytes, from the

@@ -749,9 +749,17 @@ fn small_alpha_hint(error: Error, alpha: Option<f64>) -> Error {
     let Some(alpha) = alpha.filter(|&a| a > 0.0 && a < SMALL_ALPHA) else {
         return error;
     };
-    let hint = format!(
-        "--alpha {alpha:e} is small: with so little stabilization the multipliers, eliminated as (G − BU)/(α h² |T|), drown in rounding on fine meshes; give --alpha 0 for the plain method, or a larger α"
-    );
+    with_solver_hint(
+        error,
+        format!(
+            "--alpha {alpha:e} is small: with so little stabilization the multipliers, eliminated as (G − BU)/(α h² |T|), drown in rounding on fine meshes; give --alpha 0 for the plain method, or a larger α"
+        ),
+    )
+}
+
+/// A solver failure (`NotConverged`, `LinearSolve`) with `hint` appended to its detail;
+/// other errors unchanged.
+pub(crate) fn with_solver_hint(error: Error, hint: String) -> Error {
     match error {
         Error::NotConverged { solver, detail } => Error::NotConverged {
             solver,

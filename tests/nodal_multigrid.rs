@@ -24,6 +24,24 @@ fn interpolation(coarse: usize) -> SparseMatrix {
     SparseColMat::try_new_from_triplets(fine, coarse, &t).unwrap()
 }
 
+/// The 1D obstacle problem on `n` interior nodes of a uniform mesh of (0, 1): the
+/// Laplacian's stiffness, the load −10, the obstacle −0.1 + 0.2 x at the nodes.
+fn obstacle_1d(n: usize) -> (SparseMatrix, Vec<f64>, Vec<f64>) {
+    let h = 1.0 / (n + 1) as f64;
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push(Triplet::new(i, i, 2.0 / h));
+        if i + 1 < n {
+            t.push(Triplet::new(i, i + 1, -1.0 / h));
+            t.push(Triplet::new(i + 1, i, -1.0 / h));
+        }
+    }
+    let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
+    let f = vec![-10.0 * h; n];
+    let psi: Vec<f64> = (0..n).map(|i| -0.1 + 0.2 * (i + 1) as f64 * h).collect();
+    (a, f, psi)
+}
+
 fn solve(n: usize, linear_solver: LinearSolver) -> (membranes::MembraneReport, Vec<f64>) {
     let mut request = MembraneRequest::new(membrane_scene("membrane-radial").unwrap());
     request.pair = MembranePair::P1Nodal;
@@ -159,20 +177,7 @@ fn the_truncated_hierarchy_composes_to_the_truncated_prolongation() {
 /// from a start far from the solution, and a malformed hierarchy is refused by name.
 #[test]
 fn the_nodal_multigrid_solve_checks_its_hierarchy() {
-    // 1D Laplacian on 15 interior nodes, load −10, obstacle −0.1 + 0.2 x
-    let n = 15;
-    let h = 1.0 / 16.0;
-    let mut t = Vec::new();
-    for i in 0..n {
-        t.push(Triplet::new(i, i, 2.0 / h));
-        if i + 1 < n {
-            t.push(Triplet::new(i, i + 1, -1.0 / h));
-            t.push(Triplet::new(i + 1, i, -1.0 / h));
-        }
-    }
-    let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
-    let f = vec![-10.0 * h; n];
-    let psi: Vec<f64> = (0..n).map(|i| -0.1 + 0.2 * (i + 1) as f64 * h).collect();
+    let (a, f, psi) = obstacle_1d(15);
     let chain = vec![interpolation(7), interpolation(3)];
     let direct = nodal_active_set(&a, &f, &psi, None, 50).unwrap();
     let multigrid = nodal_active_set_with(&a, &f, &psi, None, 50, &chain).unwrap();
@@ -195,20 +200,9 @@ fn the_nodal_multigrid_solve_checks_its_hierarchy() {
 /// hierarchy of its matrix).
 #[test]
 fn a_start_that_nearly_solves_the_system_is_still_polished() {
-    // 1D Laplacian on 63 interior nodes, load −10, obstacle −0.1 + 0.2 x; 63 → 31 → 15 → 7 → 3
+    // 63 → 31 → 15 → 7 → 3 interior nodes
     let n = 63;
-    let h = 1.0 / 64.0;
-    let mut t = Vec::new();
-    for i in 0..n {
-        t.push(Triplet::new(i, i, 2.0 / h));
-        if i + 1 < n {
-            t.push(Triplet::new(i, i + 1, -1.0 / h));
-            t.push(Triplet::new(i + 1, i, -1.0 / h));
-        }
-    }
-    let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
-    let f = vec![-10.0 * h; n];
-    let psi: Vec<f64> = (0..n).map(|i| -0.1 + 0.2 * (i + 1) as f64 * h).collect();
+    let (a, f, psi) = obstacle_1d(n);
     let chain = vec![
         interpolation(31),
         interpolation(15),
