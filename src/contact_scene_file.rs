@@ -377,6 +377,23 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     check_load(load).map_err(|m| at("data.load", m))?;
     let pressure = expression(&file.data.pressure, "data.pressure", path)?;
     let gap = expression(&file.data.gap, "data.gap", path)?;
+    // the model refuses this too, but by its boundary markers: here by the key
+    for (key, fixed, axis) in [
+        ("boundary.fixed_x", &fixed_x, 0),
+        ("boundary.fixed_y", &fixed_y, 1),
+    ] {
+        if contact_direction[axis] != 0.0 && fixed.iter().any(|m| contact.contains(m)) {
+            return Err(at(
+                key,
+                format!(
+                    "it fixes u_{} on a part of `boundary.contact` too, a component of the contact direction ({:.3}, {:.3}): the support and the contact constraint would both fix u·n_c there; drop the support on the contact part",
+                    ["x", "y"][axis],
+                    contact_direction[0],
+                    contact_direction[1]
+                ),
+            ));
+        }
+    }
     let gap_range = finite_on(&mesh, &contact, &gap).map_err(|m| at("data.gap", m))?;
     let pressure_range =
         finite_on(&mesh, &load_part, &pressure).map_err(|m| at("data.pressure", m))?;
@@ -451,12 +468,20 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
 
 /// The load scale's range (as the built-in scenes'): positive, finite, at most 1e100.
 fn check_load(load: f64) -> std::result::Result<(), String> {
-    if load.is_finite() && load > 0.0 && load <= 1e100 {
-        Ok(())
-    } else {
+    if !load.is_finite() {
         Err(format!(
-            "the pressure's scale {load} must be positive and finite (≤ 1e100); turn the pressure's direction in `data.pressure`"
+            "the pressure's scale {load} must be a finite number"
         ))
+    } else if load <= 0.0 {
+        Err(format!(
+            "the pressure's scale {load:e} must be positive; turn the pressure's direction in `data.pressure`"
+        ))
+    } else if load > MAX_DATA {
+        Err(format!(
+            "the pressure's scale {load:e} is beyond {MAX_DATA:e}: the solve's norms would overflow; rescale the units"
+        ))
+    } else {
+        Ok(())
     }
 }
 

@@ -145,7 +145,10 @@ impl ContactRequest {
                 self.pair.name()
             )));
         }
-        if self.load.is_nan() || self.load <= 0.0 {
+        if self.load.is_nan() {
+            return Err(Error::Input("--load NaN is not a number".into()));
+        }
+        if self.load <= 0.0 {
             return Err(Error::Input(format!(
                 "--load {} must be positive: the body only rests on the foundation, a pull lifts it off and nothing holds it then",
                 crate::number(self.load)

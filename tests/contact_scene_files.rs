@@ -335,6 +335,14 @@ fn bad_contact_scene_files_name_the_key() {
             &["1e200", "rescale"],
         ),
         (
+            RECTANGLE.replace(
+                "fixed_x = \"left\"",
+                "fixed_x = \"left\"\nfixed_y = \"bottom\"",
+            ),
+            "boundary.fixed_y",
+            &["`boundary.contact`", "drop the support"],
+        ),
+        (
             RECTANGLE.replace("gap = \"0\"", "gap = \"1e10\""),
             "data.gap",
             &["elastic displacement", "foundation placed closer"],

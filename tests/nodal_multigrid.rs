@@ -111,6 +111,20 @@ fn a_cold_start_without_hierarchy_is_reported() {
     request.nested = true;
     let (report, _) = membranes::solve(&request).unwrap();
     assert!(report.warnings.iter().all(|w| !w.contains("multigrid")));
+    // membrane-flat: every free node in contact, no system to solve by either solver
+    let mut request = MembraneRequest::new(membrane_scene("membrane-flat").unwrap());
+    request.pair = MembranePair::P1Nodal;
+    request.mesh_size = 16;
+    request.linear_solver = LinearSolver::Multigrid;
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert_eq!(
+        (
+            report.linear_solver,
+            report.factorizations,
+            report.krylov_iterations
+        ),
+        ("none", 0, 0)
+    );
 }
 
 /// The hierarchy truncated on a set of fine DOFs: its composed prolongation is the
