@@ -154,7 +154,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         let multiplier = multiplier_field::<M>()?;
         let form = M::form(bilinear)?;
         let bilinear = M::FORMS[form].name;
-        let plans = block_plans::<M>(form, &dofs, true)?;
+        let mut plans = block_plans::<M>(form, &dofs, true)?;
         let reduction = constraints.reduction(dofs.dof_count())?;
         let basis = constraints.change_of_basis(dofs.dof_count())?;
         let multiplier_range = dofs.range(multiplier).unwrap();
@@ -206,6 +206,16 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             rotated.push((indices, block.t));
         }
         let n_ext = n + extra_values.len();
+        // The LCP takes B from the multiplier rows of B_h alone (B_h is symmetric): the
+        // blocks of primal rows and multiplier columns would be computed, given scatter
+        // positions and discarded, 3 of the 16 entries of a P1–P0 cell. They are needed
+        // only where a multiplier DOF is fixed (its column moves to the right side).
+        if !multiplier_range
+            .clone()
+            .any(|d| matches!(target[d], Target::Fixed(_)))
+        {
+            plans.retain(|p| !(p.trial_field == multiplier && p.test_field != multiplier));
+        }
         let split = SplitPattern::new(mesh, &dofs, &plans, &target, n_ext, m)?;
         // Written, not calloc'ed: the scatter's `+=` reads a calloc'ed page first, which
         // maps the shared zero page, and its write then faults again and flushes the
