@@ -868,20 +868,28 @@ pub(super) fn newton_iteration(
         // whose λ and gap are both at rounding level flip forever while U stays put; the
         // KKT residual then certifies the point, and iterating on only ends in the
         // iteration limit with a point as good as this one.
+        //
+        // The best iterate serves only a run that reaches the iteration limit without
+        // settling: it is tracked over the second half of the iterations. Tracking it
+        // from the start cost a KKT residual and two vector copies per iteration (0.04 s
+        // at 1M unknowns) in every run, where nested starts settle in 2–5 iterations.
         if previous_active.is_some() {
             let cycling = !seen_faces.insert(faces_fingerprint(&active));
-            let residual = residual_here();
-            if cycling && last_exact && residual <= options.tolerance {
-                return Ok(done(
-                    u,
-                    lambda,
-                    iteration - 1,
-                    residual,
-                    (factorizations, low_rank_updates, iterative_steps),
-                ));
-            }
-            if best.as_ref().is_none_or(|b| residual < b.2) {
-                best = Some((u.clone(), lambda.clone(), residual));
+            let tracked = iteration > options.max_iterations / 2;
+            if (cycling && last_exact) || tracked {
+                let residual = residual_here();
+                if cycling && last_exact && residual <= options.tolerance {
+                    return Ok(done(
+                        u,
+                        lambda,
+                        iteration - 1,
+                        residual,
+                        (factorizations, low_rank_updates, iterative_steps),
+                    ));
+                }
+                if tracked && best.as_ref().is_none_or(|b| residual < b.2) {
+                    best = Some((u.clone(), lambda.clone(), residual));
+                }
             }
         }
         let gradient: Vec<f64> = (0..n).map(|i| au[i] - lcp.f[i] - btl[i]).collect();
