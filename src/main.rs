@@ -117,7 +117,7 @@ struct SolveOptions {
     /// p1-nodal, which has no multiplier). 0: the plain mixed method, solved as a QP by
     /// clarabel. Each family's default is its rule ½/C_I (contact: ½/max C_I,E); values
     /// well beyond 1/C_I make the stabilized matrix indefinite: an error names α·C_I.
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_alpha)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_alpha)]
     alpha: Option<f64>,
     /// Element pair (beams: p2-p2-p0, p1-p1-p0-reduced, p1-p1-p0-full, hermite-p0;
     /// membranes: p1-p0, p2-p0, p2-p1d, p1-nodal; plates and contact: see `list`).

@@ -142,6 +142,11 @@ fn bad_input_exits_with_a_message() {
             "α = -1",
         ),
         (&["study", "membrane-radial", "nonsense"][..], "nonsense"),
+        // a value starting with a hyphen is --alpha's (clap took `-inf` for flags)
+        (
+            &["solve", "membrane-radial", "--alpha", "-inf"][..],
+            "α = -inf",
+        ),
         // about 24 GB: refused before any allocation (it used to abort in the factor)
         (
             &["solve", "mindlin-square", "--mesh-size", "1024"][..],
