@@ -711,6 +711,28 @@ impl<G> ObstacleSolution<G> {
         }
     }
 
+    /// The contact set per cell: the share of the cell's multiplier DOFs in contact,
+    /// active (λ above 1e-8 of the multiplier scale) or touching (constraint residual
+    /// negligible; [`triangle::contact_indicator`]), so holes of zero λ_h where u_h lies
+    /// on ψ are filled. One number in `[0, 1]` per cell of the multiplier's DOF map,
+    /// `cells` of them (the mesh's cell count).
+    pub fn contact_shares(&self, cells: usize) -> Vec<f64> {
+        let d = &self.discretization;
+        let active = triangle::contact_indicator(
+            &d.lcp,
+            &d.primal_part(&self.values),
+            &d.multiplier_part(&self.values),
+        );
+        let per_cell = d.dofs.map(d.multiplier_field).unwrap().local_count();
+        let mut share = vec![0.0; cells];
+        for (k, &dof) in d.multiplier_dofs().iter().enumerate() {
+            if active[k] {
+                share[dof / per_cell] += 1.0 / per_cell as f64;
+            }
+        }
+        share
+    }
+
     /// How far the primal coefficients may be off through the rounding of the rows in
     /// contact ([`Lcp::primal_rounding`]), in the units of the primal field: compare it
     /// with the size of u, ψ or g. Far below them unless the load dwarfs the obstacle.
