@@ -235,7 +235,7 @@ impl TriangleMesh {
                         )));
                     }
                     moved |= p != self.vertices[v];
-                    self.vertices[v] = p;
+                    std::sync::Arc::make_mut(&mut self.vertices)[v] = p;
                 }
             }
         }

@@ -26,7 +26,7 @@ impl<'a> PointLocator<'a> {
     pub fn new(mesh: &'a TriangleMesh) -> Self {
         let mut lower = [f64::INFINITY; 2];
         let mut upper = [f64::NEG_INFINITY; 2];
-        for v in &mesh.vertices {
+        for v in mesh.vertices.iter() {
             for d in 0..2 {
                 lower[d] = lower[d].min(v[d]);
                 upper[d] = upper[d].max(v[d]);

@@ -51,7 +51,7 @@ impl TriangleMesh {
 
     /// Bisects the marked edges; every cell with a marked edge has its refinement edge marked.
     pub(super) fn bisect(&self, edge_marked: &[bool]) -> Result<(TriangleMesh, Vec<usize>)> {
-        let mut vertices = self.vertices.clone();
+        let mut vertices: Vec<[f64; 2]> = self.vertices.to_vec();
         let mut midpoint = vec![NONE; self.edges.len()];
         for e in (0..self.edges.len()).filter(|&e| edge_marked[e]) {
             let [a, b] = self.edges[e];
