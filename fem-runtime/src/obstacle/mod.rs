@@ -251,7 +251,6 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         basis.to_primed(&mut rhs);
         let rotation = BlockRotation::new(&rotated, n_ext);
         let (a_len, b_len) = (split.a_rows.len(), split.b_columns.len());
-        let a_vals = values[..a_len].to_vec();
         // B = −(the multiplier rows of B_h), without its zeros; rotated, B_h Tᵀ less the
         // columns of the fixed primed DOFs (moved to the multiplier rows' right side)
         let mut b_ptr = Vec::with_capacity(m + 1);
@@ -303,9 +302,13 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 "the multiplier block of `{bilinear}`: {e}; this LCP form needs multipliers coupled only within a cell (P0, P1disc)"
             ))
         })?;
+        // A's values lead the array: kept in place (a realloc that shrinks does not copy)
+        // rather than copied out, 56 MB at 2M P1–P0 cells
+        values.truncate(a_len);
+        values.shrink_to_fit();
         let a: SparseMatrix = SparseColMat::new(
             SymbolicSparseColMat::new_checked(n_ext, n_ext, split.a_ptr, None, split.a_rows),
-            a_vals,
+            values,
         );
         let free = reduction.free();
         let mut f: Vec<f64> = primal_reduced.iter().map(|&r| rhs[free[r]]).collect();

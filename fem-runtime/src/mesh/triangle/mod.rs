@@ -22,8 +22,8 @@ pub use quality::{
     estimated_bytes, MeshQuality, REFUSE_MAX_ANGLE_DEG, WARN_MAX_ANGLE_DEG, WARN_MIN_ANGLE_DEG,
 };
 
-use std::sync::Arc;
 use crate::error::{Error, Result};
+use std::sync::Arc;
 
 /// Marks "no cell" / "no midpoint" in the index tables.
 const NONE: usize = usize::MAX;
