@@ -127,7 +127,7 @@ fn check_convergence(reports: &[MembraneReport], h_ratios: &[f64], l2_rate: f64,
 fn rates(pair: MembranePair) -> (f64, f64) {
     match pair.degree() {
         1 => (1.7, 0.8),
-        _ => (1.9, 0.8),
+        _ => (1.97, 0.8),
     }
 }
 

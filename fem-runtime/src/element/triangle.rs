@@ -969,4 +969,27 @@ mod tests {
             }
         }
     }
+
+    /// The P0 fast path of `centroid_values` (the cell's coefficient) gives the value at
+    /// the centroid.
+    #[test]
+    fn p0_centroid_values_are_the_cell_values() {
+        let mesh = TriangleMesh::disk([0.3, -0.1], 1.5, 3).unwrap();
+        let map = DofMap::on_triangles(&mesh, ElementKind::P0);
+        let mut random = Random(0x2545_f491_4f6c_dd1d);
+        let coefficients: Vec<f64> = (0..map.dof_count()).map(|_| random.next()).collect();
+        let field = TriangleField {
+            mesh: &mesh,
+            map: &map,
+            coefficients: &coefficients,
+        };
+        let basis = TriangleBasis::new(ElementKind::P0);
+        for (c, value) in field.centroid_values().into_iter().enumerate() {
+            assert_eq!(
+                value,
+                field.value(&basis, c, [1.0 / 3.0, 1.0 / 3.0]),
+                "cell {c}"
+            );
+        }
+    }
 }

@@ -717,17 +717,19 @@ impl<G> ObstacleSolution<G> {
     /// The contact set per cell: the share of the cell's multiplier DOFs in contact,
     /// active (λ above 1e-8 of the multiplier scale) or touching (constraint residual
     /// negligible; [`triangle::contact_indicator`]), so holes of zero λ_h where u_h lies
-    /// on ψ are filled. One number in `[0, 1]` per cell of the multiplier's DOF map,
-    /// `cells` of them (the mesh's cell count).
-    pub fn contact_shares(&self, cells: usize) -> Vec<f64> {
+    /// on ψ are filled. One number in `[0, 1]` per cell; the multiplier's DOFs must be
+    /// owned by the cells (P0, P1disc: cell `c` owns DOFs `c·k..(c+1)·k`), as those of
+    /// the LCP models are.
+    pub fn contact_shares(&self) -> Vec<f64> {
         let d = &self.discretization;
         let active = triangle::contact_indicator(
             &d.lcp,
             &d.primal_part(&self.values),
             &d.multiplier_part(&self.values),
         );
-        let per_cell = d.dofs.map(d.multiplier_field).unwrap().local_count();
-        let mut share = vec![0.0; cells];
+        let map = d.dofs.map(d.multiplier_field).unwrap();
+        let per_cell = map.local_count();
+        let mut share = vec![0.0; map.dof_count() / per_cell.max(1)];
         for (k, &dof) in d.multiplier_dofs().iter().enumerate() {
             if active[k] {
                 share[dof / per_cell] += 1.0 / per_cell as f64;

@@ -514,7 +514,7 @@ impl ObstacleSolution<CurvedTriangleMesh> {
     /// `contact_area` on a `TriangleMesh`).
     pub fn contact_area(&self) -> f64 {
         let mesh = &self.discretization.mesh;
-        self.contact_shares(mesh.mesh().cell_count())
+        self.contact_shares()
             .iter()
             .enumerate()
             .map(|(c, s)| s * crate::mesh::Mesh::measure(mesh, c))
@@ -542,7 +542,7 @@ impl ObstacleSolution<TriangleMesh> {
     /// residual negligible), so holes of zero λ_h where u_h lies on ψ are filled.
     pub fn contact_area(&self) -> f64 {
         let mesh = &self.discretization.mesh;
-        self.contact_shares(mesh.cell_count())
+        self.contact_shares()
             .iter()
             .enumerate()
             .map(|(c, s)| s * mesh.area(c))
