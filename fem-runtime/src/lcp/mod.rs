@@ -767,7 +767,7 @@ mod tests {
     fn the_hessian_change_is_the_difference_of_the_hessians() {
         for seed in 1..8 {
             let (lcp, _, _) = blocked_lcp(seed);
-            let hessian = Hessian::new(&lcp);
+            let hessian = Hessian::new(&lcp).unwrap();
             let mut random = Random(seed + 100);
             let m = lcp.m();
             let before: Vec<bool> = (0..m).map(|_| random.next() < 0.5).collect();

@@ -24,7 +24,7 @@ impl Lcp {
         }
         let (_, active) = self.eliminate(&self.b_times(u));
         let count = active.iter().filter(|&&a| a).count();
-        Ok((Hessian::new(self).matrix(self, &active), count))
+        Ok((Hessian::new(self)?.matrix(self, &active), count))
     }
 
     /// `‖d‖∞ / ‖U‖∞` for the Newton step `d = −H⁻¹∇Φ(U)` at `U`: a forward-error
@@ -43,7 +43,7 @@ impl Lcp {
                 self.n()
             )));
         }
-        let hessian = Hessian::new(self);
+        let hessian = Hessian::new(self)?;
         let bu = self.b_times(u);
         let (lambda, active) = self.eliminate(&bu);
         let au = multiply(&self.a, u);
@@ -207,16 +207,22 @@ pub(super) struct Hessian {
     pub(super) a_positions: Option<Vec<usize>>,
     /// For each entry of `B` (in [`ConstraintRows::entries`] order), the index of its
     /// column in its block's column set J.
-    pub(super) entry_local: Vec<usize>,
+    pub(super) entry_local: Vec<u32>,
     /// Block `b`'s column count `|J|` is `widths[b]`; the value positions of its `J × J`
     /// (i-major) are `positions[position_ptr[b]..position_ptr[b + 1]]`.
-    pub(super) widths: Vec<usize>,
+    ///
+    /// These three hold 32-bit indices ([`Hessian::new`] refuses a Hessian of more
+    /// entries): at 2M P1–P0 cells, 9 positions and 3 local indices per cell were 190 MB
+    /// as `usize`, built on the thread that bounds the finest level's setup.
+    pub(super) widths: Vec<u32>,
     pub(super) position_ptr: Vec<usize>,
-    pub(super) positions: Vec<usize>,
+    pub(super) positions: Vec<u32>,
 }
 
 impl Hessian {
-    pub(super) fn new(lcp: &Lcp) -> Self {
+    /// # Errors
+    /// [`Error::Input`] for a Hessian of more than `u32::MAX` entries.
+    pub(super) fn new(lcp: &Lcp) -> Result<Self> {
         // Each block's column set J, flat (a block of size 1 is one row of B).
         let mut column_ptr = Vec::with_capacity(lcp.m() + 1);
         column_ptr.push(0);
@@ -240,7 +246,7 @@ impl Hessian {
         }
         let block_count = column_ptr.len() - 1;
         let block_columns = |b: usize| &columns[column_ptr[b]..column_ptr[b + 1]];
-        let positions_in = |pattern: &Pattern| -> Option<(Vec<usize>, Vec<usize>)> {
+        let positions_in = |pattern: &Pattern| -> Option<(Vec<usize>, Vec<u32>)> {
             let mut ptr = Vec::with_capacity(block_count + 1);
             ptr.push(0);
             // sized ahead: growing it by doubling cost half of this loop at 524k cells
@@ -252,7 +258,8 @@ impl Hessian {
                 let set = block_columns(b);
                 for &i in set {
                     for &j in set {
-                        positions.push(pattern.find(i, j)?);
+                        // in range: `fits` below checked the pattern's size
+                        positions.push(pattern.find(i, j)? as u32);
                     }
                 }
                 ptr.push(positions.len());
@@ -262,7 +269,18 @@ impl Hessian {
         // Finite element couplings usually lie inside A's pattern already (a cell's B
         // row touches the cell's own DOFs): then A's pattern is the Hessian's, and the
         // union, the costliest part of the setup, is skipped.
+        let fits = |pattern: &Pattern| {
+            if pattern.idx.len() > u32::MAX as usize {
+                return Err(Error::Input(format!(
+                    "the Newton Hessian has {} entries, beyond the 32-bit positions of its assembly ({})",
+                    pattern.idx.len(),
+                    u32::MAX
+                )));
+            }
+            Ok(())
+        };
         let own = Pattern::of(&lcp.a, lcp.n());
+        fits(&own)?;
         let (pattern, a_positions, (position_ptr, positions)) = match positions_in(&own) {
             Some(found) => (own, None, found),
             None => {
@@ -276,6 +294,7 @@ impl Hessian {
                         }
                     }
                 });
+                fits(&pattern)?;
                 let found = positions_in(&pattern).expect("the union holds every block");
                 let a_positions = pattern.positions_of(&lcp.a);
                 (pattern, Some(a_positions), found)
@@ -285,23 +304,26 @@ impl Hessian {
         for (b, block) in lcp.blocks().enumerate() {
             let set = block_columns(b);
             for k in block.range() {
+                // below `u32::MAX`: a block's columns are entries of the Hessian's pattern
                 entry_local.extend(lcp.b_rows[k].iter().map(|&(j, _)| {
                     set.binary_search(&j)
                         .expect("the block's columns hold its rows' columns")
+                        as u32
                 }));
             }
         }
+        // each at most `|J|` ≤ the Hessian's entry count, checked above
         let widths = (0..block_count)
-            .map(|b| column_ptr[b + 1] - column_ptr[b])
+            .map(|b| (column_ptr[b + 1] - column_ptr[b]) as u32)
             .collect();
-        Self {
+        Ok(Self {
             symbolic: pattern.symbolic(),
             a_positions,
             entry_local,
             widths,
             position_ptr,
             positions,
-        }
+        })
     }
 
     /// The Hessian on the faces `active` (per constraint, from [`Lcp::eliminate`]).
@@ -324,7 +346,7 @@ impl Hessian {
             if q == 0 {
                 continue;
             }
-            let width = self.widths[b];
+            let width = self.widths[b] as usize;
             let positions = &self.positions[self.position_ptr[b]..self.position_ptr[b + 1]];
             for a in 0..q {
                 let k = block.start + face[a];
@@ -337,7 +359,8 @@ impl Hessian {
                         entries[row_k.clone()].iter().zip(&self.entry_local[row_k])
                     {
                         for (&(_, vl), &il) in entries[row_l.clone()].iter().zip(local_l) {
-                            values[positions[ik * width + il]] += w * vk * vl;
+                            values[positions[ik as usize * width + il as usize] as usize] +=
+                                w * vk * vl;
                         }
                     }
                 }
@@ -638,7 +661,7 @@ impl NewtonWorkspace {
     pub fn pattern_of(lcp: &Lcp) -> Result<Self> {
         lcp.check_shapes()?;
         Ok(Self {
-            hessian: Hessian::new(lcp),
+            hessian: Hessian::new(lcp)?,
             cholesky: OnceLock::new(),
             shape: (lcp.n(), lcp.m()),
         })
