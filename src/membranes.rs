@@ -402,11 +402,16 @@ impl MembraneFields {
     }
 }
 
+/// The `--mesh-size` values of the built-in membrane domains.
+pub const MESH_SIZES: std::ops::RangeInclusive<usize> = 2..=4096;
+
 /// The structured mesh of a scene with parameter N.
 pub fn scene_mesh(scene: &MembraneScene, n: usize, diagonal: Diagonal) -> Result<TriangleMesh> {
-    if !(2..=4096).contains(&n) {
+    if !MESH_SIZES.contains(&n) {
         return Err(Error::Input(format!(
-            "--mesh-size {n} is out of range (2 to 4096)"
+            "--mesh-size {n} is out of range ({} to {})",
+            MESH_SIZES.start(),
+            MESH_SIZES.end()
         )));
     }
     match &scene.domain {
@@ -962,7 +967,12 @@ pub(crate) fn beyond_memory(bytes: f64) -> Option<String> {
 /// 131k and 4.7 kB at 524k, p2-p1disc 5.6 kB at both, growing with the factor's fill
 /// (`O(N log N)` in 2D); the table's figures leave room for that growth.
 fn check_memory(request: &MembraneRequest) -> Result<()> {
-    if request.mesh_file.is_some() || matches!(request.scene.domain, Domain::File(_)) {
+    // a size out of range is refused as such by `scene_mesh` (4097 was refused for its
+    // memory, which hid the range)
+    if request.mesh_file.is_some()
+        || matches!(request.scene.domain, Domain::File(_))
+        || !MESH_SIZES.contains(&request.mesh_size)
+    {
         return Ok(());
     }
     let per_triangle = request.pair.row().bytes_per_triangle;

@@ -232,6 +232,13 @@ fn bad_input_is_a_clear_error() {
         .unwrap()
         .to_string()
         .contains("--mesh-size 0"));
+    // beyond the range: the range is named, not the memory it would take
+    request.mesh_size = 4097;
+    let error = membranes::solve(&request).err().unwrap().to_string();
+    assert!(
+        error.contains("--mesh-size 4097 is out of range (2 to 4096)"),
+        "{error}"
+    );
     request.mesh_size = 4096;
     let error = membranes::solve(&request).err().unwrap().to_string();
     assert!(error.contains("GB of memory"), "{error}");
