@@ -232,6 +232,12 @@ fn bad_input_is_a_clear_error() {
         .unwrap()
         .to_string()
         .contains("--mesh-size 0"));
+    // no free node (the L-shape at N = 2): no contact force, printed as 0, not −0
+    let mut empty = MembraneRequest::new(membrane_scene("membrane-lshape").unwrap());
+    empty.pair = MembranePair::P1Nodal;
+    empty.mesh_size = 2;
+    let force = membranes::solve(&empty).unwrap().0.total_contact_force;
+    assert!(force == 0.0 && force.is_sign_positive(), "{force}");
     // beyond the range: the range is named, not the memory it would take
     request.mesh_size = 4097;
     let error = membranes::solve(&request).err().unwrap().to_string();
