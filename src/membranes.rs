@@ -133,8 +133,14 @@ impl MembranePair {
         self.row().name
     }
 
-    /// The pair called `name`.
+    /// The pair called `name` (`p2-p1disc` is also read as `p2-p1d`).
+    ///
+    /// # Errors
+    /// [`Error::Input`] naming the pairs for any other name.
     pub fn parse(name: &str) -> Result<Self> {
+        // the docs and the Kirchhoff family (`argyris-p1disc`) spell the multiplier
+        // space in full: that spelling names the same pair
+        let name = if name == "p2-p1disc" { "p2-p1d" } else { name };
         PAIRS
             .iter()
             .find(|p| p.name == name)

@@ -238,6 +238,15 @@ fn bad_input_is_a_clear_error() {
     empty.mesh_size = 2;
     let force = membranes::solve(&empty).unwrap().0.total_contact_force;
     assert!(force == 0.0 && force.is_sign_positive(), "{force}");
+    // the multiplier space spelled in full names the same pair
+    assert_eq!(
+        MembranePair::parse("p2-p1disc").unwrap(),
+        MembranePair::P2P1Disc
+    );
+    assert!(MembranePair::parse("p2-p1")
+        .unwrap_err()
+        .to_string()
+        .contains("p2-p1d"));
     // beyond the range: the range is named, not the memory it would take
     request.mesh_size = 4097;
     let error = membranes::solve(&request).err().unwrap().to_string();
