@@ -1,10 +1,13 @@
-//! Parallel global assembly (issue 15): the matrix assembled on 2 and 3 rayon threads
-//! (cells coloured in chunks, `assembly::CellColouring`) equals the one-thread assembly
-//! (the plain serial cell loop) to 1e-13 relative in every entry, for the P1 stiffness
-//! (the generated one-block loop), P2 (idem, 36 entries per cell), the P2–P0 membrane
-//! system `B_h` (four blocks: the cell-major loop) and the clamped Mindlin plate `B_h`
-//! (many blocks); and the same for their load vectors (`assemble_vector`). A dropped, doubled or racing chunk changes whole entries by O(1)
-//! relative, far above the rounding of a reordered sum.
+//! Parallel global assembly (issue 15): the matrix assembled on 1, 2 and 3 rayon threads
+//! (cells coloured in chunks, `assembly::CellColouring`, the colours in the same order on
+//! any thread count) is the same to the last bit, for the P1 stiffness (the generated
+//! one-block loop), P2 (idem, 36 entries per cell), the P2–P0 membrane system `B_h`
+//! (four blocks: the cell-major loop) and the clamped Mindlin plate `B_h` (many blocks);
+//! and the same for their load vectors (`assemble_vector`). Before, one thread took the
+//! plain cell loop and results differed in the last bits between thread counts. That
+//! the colouring keeps every cell once is checked by an identity of the P1 stiffness:
+//! `XᵀAX = |Ω|` for `X` the vertices' x coordinates (`∫|∇x|² = |Ω|`), which a dropped
+//! or doubled chunk changes by its area.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
@@ -79,7 +82,7 @@ fn parallel_vector_difference<M: Model>(form: &str, mesh: &TriangleMesh, c: &Coe
 }
 
 /// Largest entry difference between the 1-thread and the 2- and 3-thread assemblies,
-/// relative to the largest entry.
+/// relative to the largest entry (0: the same to the last bit).
 fn parallel_difference<M: Model>(form: &str, mesh: &TriangleMesh, c: &Coefficients) -> f64 {
     let serial = assembled::<M>(form, mesh, c, 1);
     let scale = serial.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -96,6 +99,28 @@ fn parallel_difference<M: Model>(form: &str, mesh: &TriangleMesh, c: &Coefficien
                 / scale
         })
         .fold(0.0, f64::max)
+}
+
+/// `XᵀAX` of the P1 stiffness assembled on `threads` threads, `X` the vertices' x
+/// coordinates (P1's DOF v is vertex v): `∫|∇x|² = |Ω|`.
+fn x_energy(mesh: &TriangleMesh, c: &Coefficients, threads: usize) -> f64 {
+    type P1 = membrane_p1::Model;
+    let dofs = SystemDofs::all::<P1>(mesh).unwrap();
+    let assembler = MatrixAssembler::new::<P1>("a", mesh, &dofs).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let a = pool.install(|| assembler.assemble::<P1>(mesh, c)).unwrap();
+    let x: Vec<f64> = mesh.vertices().iter().map(|v| v[0]).collect();
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    (0..a.ncols())
+        .map(|j| {
+            (col_ptr[j]..col_ptr[j + 1])
+                .map(|k| x[rows[k]] * vals[k] * x[j])
+                .sum::<f64>()
+        })
+        .sum()
 }
 
 /// Meshes above the parallel threshold (4096 cells), both diagonals, and one refined by
@@ -123,16 +148,23 @@ fn parallel_p1_and_p2_stiffness_equal_the_serial_assembly() {
         &[("f", &load), ("ψ", &obstacle), ("g", &boundary)],
     )
     .unwrap();
-    for mesh in meshes() {
+    for (mesh, area) in meshes().into_iter().zip([4.0, 2.0, 4.0]) {
         assert!(mesh.cell_count() >= 4096);
+        for threads in [1, 2] {
+            let energy = x_energy(&mesh, &p1, threads);
+            assert!(
+                (energy - area).abs() <= 1e-12 * area,
+                "{threads} threads: XᵀAX = {energy}, |Ω| = {area}"
+            );
+        }
         let d1 = parallel_difference::<P1>("a", &mesh, &p1);
-        assert!(d1 <= 1e-13, "P1 stiffness: {d1:e}");
+        assert_eq!(d1, 0.0, "P1 stiffness");
         let d2 = parallel_difference::<P2>("B_h", &mesh, &p2);
-        assert!(d2 <= 1e-13, "P2–P0 B_h: {d2:e}");
+        assert_eq!(d2, 0.0, "P2–P0 B_h");
         let v1 = parallel_vector_difference::<P1>("ℓ", &mesh, &p1);
-        assert!(v1 <= 1e-13, "P1 ℓ: {v1:e}");
+        assert_eq!(v1, 0.0, "P1 ℓ");
         let v2 = parallel_vector_difference::<P2>("L_h", &mesh, &p2);
-        assert!(v2 <= 1e-13, "P2–P0 L_h: {v2:e}");
+        assert_eq!(v2, 0.0, "P2–P0 L_h");
     }
 }
 
@@ -153,7 +185,7 @@ fn parallel_mindlin_system_equals_the_serial_assembly() {
     assert!(M::FORMS[M::form("B_h").unwrap()].blocks.len() >= 3);
     let mesh = TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 48, 48, Diagonal::Right).unwrap();
     let d = parallel_difference::<M>("B_h", &mesh, &c);
-    assert!(d <= 1e-13, "Mindlin B_h: {d:e}");
+    assert_eq!(d, 0.0, "Mindlin B_h");
     let v = parallel_vector_difference::<M>("L_h", &mesh, &c);
-    assert!(v <= 1e-13, "Mindlin L_h: {v:e}");
+    assert_eq!(v, 0.0, "Mindlin L_h");
 }

@@ -412,12 +412,14 @@ impl SharedValues {
 
 /// [`add_form_matrices`] with the cells split by `colouring` (built from the same mesh):
 /// the colours one after the other, the chunks of a colour in parallel on the current
-/// rayon pool. With one thread in the pool or no colouring, the serial loop.
+/// rayon pool. Without a colouring, the serial loop.
 ///
 /// `positions` must map two cells that share no vertex to disjoint value entries (true of
 /// a pattern built by [`MatrixAssembler::new`]: an entry is a pair of DOFs of the cell).
-/// Each entry then receives the same terms as in the serial loop, possibly in another
-/// order: the result equals the serial one up to rounding (tested to 1e-13 relative).
+/// Each entry then receives its terms in the same order on any number of threads (colour
+/// by colour, cell by cell within a chunk), so the result is the same to the last bit,
+/// one thread included; it equals the serial loop's up to rounding (the terms come in
+/// another order).
 ///
 /// # Errors
 /// Those of [`add_form_matrices`], from the first failing chunk rayon reports.
@@ -432,11 +434,8 @@ pub(crate) fn add_form_matrices_coloured<M: Model, G: Mesh>(
 ) -> Result<()> {
     use rayon::prelude::*;
     let colouring = match colouring {
-        Some(c)
-            if rayon::current_num_threads() > 1 && c.bounds.last() == Some(&mesh.cell_count()) =>
-        {
-            c
-        }
+        // in colour order on one thread too: the same sums as on two, to the last bit
+        Some(c) if c.bounds.last() == Some(&mesh.cell_count()) => c,
         _ => return add_form_matrices::<M, G>(form, plans, mesh, coefficients, positions, values),
     };
     let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
@@ -467,9 +466,9 @@ pub(crate) fn add_form_matrices_coloured<M: Model, G: Mesh>(
 /// Assembles one bilinear form of a model on a mesh, reusing its sparsity pattern.
 ///
 /// Meshes of at least [`PARALLEL_MIN_CELLS`] cells are assembled in parallel on the
-/// current rayon pool (cells coloured once here, see `CellColouring`); the result
-/// equals the one-thread assembly up to rounding (the terms of an entry may be added in
-/// another order).
+/// current rayon pool (cells coloured once here, see `CellColouring`), colour by colour
+/// on any number of threads: the result is the same to the last bit on one thread as on
+/// several.
 #[derive(Clone, Debug)]
 pub struct MatrixAssembler {
     form: usize,
@@ -702,7 +701,8 @@ impl MatrixAssembler {
 ///
 /// Meshes of at least [`PARALLEL_MIN_CELLS`] cells are assembled in parallel on the
 /// current rayon pool (the cells coloured per call, `CellColouring`: `O(cells)`, small
-/// against the kernels); the result equals the one-thread one up to rounding. An error
+/// against the kernels), colour by colour on any number of threads, so the result is the
+/// same to the last bit on one thread as on several. An error
 /// is the one of the serial loop (on an error the vector is assembled again serially, so
 /// the cell named is the first one at fault).
 pub fn assemble_vector<M: Model>(
@@ -716,12 +716,7 @@ pub fn assemble_vector<M: Model>(
     let plans = block_plans::<M>(form, dofs, false)?;
     let mut out = vec![0.0; dofs.dof_count()];
     let cells = mesh.cell_count();
-    let colouring = if rayon::current_num_threads() > 1 {
-        CellColouring::new(mesh)
-    } else {
-        None
-    };
-    if let Some(colouring) = colouring {
+    if let Some(colouring) = CellColouring::new(mesh) {
         let shared = SharedValues {
             start: out.as_mut_ptr(),
             len: out.len(),
