@@ -11,9 +11,7 @@ use crate::models::kirchhoff_scenes::{
     KirchhoffObstacle, KirchhoffScene, KirchhoffSupport, CURVED_OBSTACLE, FLAT_OBSTACLE,
 };
 use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
-use fem_runtime::obstacle::triangle::{
-    contact_indicator, prolong_primal_on_triangles, TriangleObstacleSolution,
-};
+use fem_runtime::obstacle::triangle::{prolong_primal_on_triangles, TriangleObstacleSolution};
 use fem_runtime::obstacle::{solve_nested, Discretization, ObstacleOptions, VariationalSolver};
 use fem_runtime::stabilization::inverse_constant;
 use fem_runtime::{
@@ -683,26 +681,11 @@ fn max_deflection(view: &TriangleField, basis: &TriangleBasis) -> f64 {
 /// active (λ above 1e-8 of the multiplier scale) or touching (its residual negligible),
 /// `fem_runtime::obstacle::triangle::contact_indicator`.
 pub fn contact_cells(solution: &TriangleObstacleSolution) -> Vec<bool> {
-    let d = &solution.discretization;
-    let u = d.primal_part(&solution.values);
-    let dofs = d.multiplier_dofs();
-    let all = solution.field(d.multiplier_field);
-    let lambda: Vec<f64> = dofs.iter().map(|&k| all[k]).collect();
-    let active = contact_indicator(&d.lcp, &u, &lambda);
-    let map = d.dofs.map(d.multiplier_field).unwrap();
-    let mut owner = vec![usize::MAX; map.dof_count()];
-    for c in 0..d.mesh.cell_count() {
-        for &k in map.cell_dofs(c) {
-            owner[k] = c;
-        }
-    }
-    let mut contact = vec![false; d.mesh.cell_count()];
-    for (&k, &on) in dofs.iter().zip(&active) {
-        if on && owner[k] != usize::MAX {
-            contact[owner[k]] = true;
-        }
-    }
-    contact
+    solution
+        .contact_shares()
+        .into_iter()
+        .map(|share| share > 0.0)
+        .collect()
 }
 
 /// The area enclosed by the outer boundary of the cells in `contact`: the contact cells

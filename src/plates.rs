@@ -15,7 +15,7 @@ use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
 use fem_runtime::mesh::triangle::QuadraticGeometry;
 use fem_runtime::mesh::CurvedTriangleMesh;
 use fem_runtime::obstacle::triangle::{
-    contact_indicator, solve_obstacle_on_curved_triangles, solve_obstacle_on_triangles,
+    solve_obstacle_on_curved_triangles, solve_obstacle_on_triangles,
 };
 use fem_runtime::obstacle::{ObstacleOptions, ObstacleSolution};
 use fem_runtime::reference::triangle::TriangleRule;
@@ -759,21 +759,11 @@ impl ContactGeometry {
     {
         let d = &solution.discretization;
         let mesh = solution.straight();
-        let multipliers = solution.field(d.multiplier_field);
-        let lambda: Vec<f64> = d
-            .multiplier_dofs()
-            .iter()
-            .map(|&k| multipliers[k])
+        let contact: Vec<bool> = solution
+            .contact_shares()
+            .into_iter()
+            .map(|share| share > 0.0)
             .collect();
-        let active = contact_indicator(&d.lcp, &d.primal_part(&solution.values), &lambda);
-        let per_cell = d
-            .dofs
-            .map(d.multiplier_field)
-            .map_or(1, |m| m.local_count());
-        let mut contact = vec![false; mesh.cell_count()];
-        for (k, &dof) in d.multiplier_dofs().iter().enumerate() {
-            contact[dof / per_cell] |= active[k];
-        }
         let locator = PointLocator::new(mesh);
         let h = mesh.max_h();
         let reach = mesh
