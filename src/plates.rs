@@ -620,11 +620,13 @@ where
     let q = request.load;
     let w = M::field("w")?;
     let max_deflection = solution.field(w).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // the plate's size for relative measures, never 0: an unloaded plate under an obstacle
+    // at height 0 has w_h = 0, and its rounding is still not a gap or a loss
+    let size = max_deflection.max(height.abs()).max(1e-6 * s.domain.size());
     if request.obstacle() != PlateObstacle::None {
         // as for membranes: a load (or α) that dwarfs the obstacle leaves w_h to the
         // rounding of the contact rows (q = 1e100 on the disk: w(0) = −2.7e78 under
         // ψ = 0.05), which the KKT residual cannot show
-        let size = max_deflection.max(height.abs()).max(1e-6 * s.domain.size());
         let rounding = solution.primal_rounding() / size;
         if rounding.is_nan() || rounding > MAX_PRIMAL_ROUNDING {
             return Err(Error::Input(format!(
@@ -670,10 +672,12 @@ where
         }
         None => 0.0,
     };
-    let size = max_deflection.max(height.abs());
-    if max_open_contact_gap > crate::membranes::OPEN_GAP_WARNING * size {
+    // a gap within the rounding of the contact rows is no gap
+    if max_open_contact_gap > crate::membranes::OPEN_GAP_WARNING * size
+        && max_open_contact_gap > solution.primal_rounding()
+    {
         warnings.push(format!(
-            "λ_h pushes on cells where w_h stays up to {max_open_contact_gap:.2e} clear of the obstacle ({:.1} % of its height {height}): the stabilized constraint w_h − ψ = α h⁴(…) on contact cells lets α h⁴ q (α = {}) open that gap on this mesh, so this contact set is not real; refine the mesh or lower α",
+            "λ_h pushes on cells where w_h stays up to {max_open_contact_gap:.2e} clear of the obstacle ({:.1} % of the plate's size max(|w_h|, |ψ|) = {size:.2e}): the stabilized constraint w_h − ψ = α h⁴(…) on contact cells lets α h⁴ q (α = {}) open that gap on this mesh, so this contact set is not real; refine the mesh or lower α",
             100.0 * max_open_contact_gap / size,
             request.alpha
         ));

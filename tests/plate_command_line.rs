@@ -461,3 +461,28 @@ fn an_unloaded_plate_reports_a_zero_error() {
         "{text}"
     );
 }
+
+/// α = 10 on a 4×4 disk mesh lets α h⁴ q open the stabilized constraint: λ_h pushes on
+/// cells where w_h stays clear of ψ = 0.05 by most of it, and the report says so with
+/// the gap it measured and the size it compares with. The default α on a finer mesh
+/// gives no such warning.
+#[test]
+fn a_plate_whose_contact_set_is_not_real_is_warned_about() {
+    let json = scene_json("mindlin-disk", &["--alpha", "10", "--mesh-size", "4"]);
+    let gap = json["max_open_contact_gap"].as_f64().unwrap();
+    // ψ = 0.05 is the plate's size here; the gap must be a visible share of it and
+    // cannot exceed the obstacle's height above the clamped rim
+    assert!(gap > 0.01 * 0.05 && gap <= 0.05, "{json}");
+    let warnings = json["warnings"].to_string();
+    assert!(
+        warnings.contains(&format!("{gap:.2e}")) && warnings.contains("max(|w_h|, |ψ|) = 5.00e-2"),
+        "{warnings}"
+    );
+    let json = scene_json("mindlin-disk", &["--mesh-size", "16"]);
+    assert!(
+        !json["warnings"]
+            .to_string()
+            .contains("clear of the obstacle"),
+        "{json}"
+    );
+}
