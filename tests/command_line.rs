@@ -559,3 +559,45 @@ fn a_negative_zero_alpha_is_the_plain_method_whose_multiplier_may_not_be_unique(
     assert!(!json["warnings"].to_string().contains("kernel"));
     assert!((json["total_contact_force"].as_f64().unwrap() - 48.0).abs() < 1e-8);
 }
+
+/// A tester's two-triangle square (no interior vertex, so u_h is the boundary data
+/// ≈ −0.24): under the radial ψ = √(1 − r²) the membrane lies 1.24 below ψ at the
+/// centre, between the vertices and the quadrature points, where ψ = −1. It was
+/// reported as `max_penetration` 0 (P1) or 0.95 without a warning (ψ's range was taken
+/// at the vertices only, where ψ is flat). Now the few cells are sampled on a lattice,
+/// ψ's range over the same points, and every pair warns.
+#[test]
+fn a_mesh_of_few_cells_does_not_hide_a_penetration() {
+    let out = scratch("two-triangles");
+    let mesh = out.join("two_triangles.msh");
+    std::fs::write(
+        &mesh,
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 1 0\n1 -1 -1 0 1 1 0 0 0\n$EndEntities\n\
+         $Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n-2 -2 0\n2 -2 0\n2 2 0\n-2 2 0\n$EndNodes\n\
+         $Elements\n1 2 1 2\n2 1 2 2\n1 1 2 3\n2 1 3 4\n$EndElements\n",
+    )
+    .unwrap();
+    for pair in ["p1-p0", "p1-nodal", "p2-p0"] {
+        let json = json_of(
+            &[
+                "solve",
+                "membrane-radial",
+                "--msh",
+                mesh.to_str().unwrap(),
+                "--pair",
+                pair,
+                "--json",
+            ],
+            &out,
+        );
+        // u_h(0) is the mean of the diagonal's ends, the exact u there: ψ(0) = 1 lies
+        // 1 − u(2, 2) above it (P2: u_h is the boundary data's quadratic, a little higher)
+        let depth = json["max_penetration"].as_f64().unwrap();
+        assert!(depth > 0.95 && depth < 1.3, "{pair}: {json}");
+        assert!(
+            json["warnings"].to_string().contains("dips below ψ"),
+            "{pair}: {json}"
+        );
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}

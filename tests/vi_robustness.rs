@@ -581,6 +581,31 @@ fn the_penetration_is_measured_at_vertices_and_quadrature_points() {
     }
 }
 
+/// On a mesh of two cells the vertices and a degree-2 rule miss a peak of ψ at the
+/// centre of the diagonal; the lattice of `penetration` finds it (to the lattice's
+/// spacing), and ψ's range is taken over the same points: 2, not the 0 of the corners.
+#[test]
+fn the_penetration_of_a_coarse_mesh_is_sampled_on_a_lattice() {
+    type M = membrane_p1::Model;
+    let mesh = TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 1, 1, Diagonal::Right).unwrap();
+    let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+    let map = dofs.map(0).unwrap();
+    let coefficients = vec![0.0; map.dof_count()];
+    let u = TriangleField {
+        mesh: &mesh,
+        map,
+        coefficients: &coefficients,
+    };
+    // ψ = 1 − 4r² near the origin, −1 beyond r = 1/√2: the corners and the rule's
+    // points (beyond r = 1/√2) all see −1
+    let peak = |x: &[f64]| (1.0 - 4.0 * (x[0] * x[0] + x[1] * x[1])).max(-1.0);
+    let found = fem_runtime::obstacle::triangle::penetration(&u, &peak, 2);
+    assert!(found.depth > 0.999 && found.depth <= 1.0, "{found:?}");
+    assert_eq!(found.obstacle_max, found.depth);
+    assert_eq!(found.obstacle_min, -1.0);
+    assert_eq!(max_penetration(&u, &peak, 2), found.depth);
+}
+
 /// Issue 10, item 7: the weak constraint lets u_h dip below ψ, by `O(h²)`. On the radial
 /// scene (ψ = √(1 − r²) is smooth on the contact set r ≤ r* ≈ 0.7) the penetration
 /// exists and shrinks by about 4 per halving of h, for P1–P0 and P2–P0.
