@@ -230,6 +230,10 @@ pub struct Report {
     /// Largest crossing of the obstacle, `max s(ψ − w)₊` at four points per cell (`s = +1`
     /// for an obstacle below): the weak cell-wise constraint allows it inside cells.
     pub max_penetration: f64,
+    /// The largest clearance `s(w_h − ψ)` of a cell where λ_h pushes (its smallest over
+    /// five points of the cell): 0 for a real contact set; a share of the beam's size
+    /// where α (or one long element) lets λ_h push where nothing touches (then warned).
+    pub max_open_contact_gap: f64,
     /// Contact intervals `[start, end]`, a point contact as `[x, x]`.
     pub contact_set: Vec<[f64; 2]>,
     /// `∫ λ_h`.
@@ -537,6 +541,31 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
             100.0 * max_penetration / psi_scale
         ));
     }
+    // as for membranes and plates: λ_h pushing on cells that stay clear of ψ is a
+    // contact set made by α h^k (bernoulli-flat at α = 1e10: w_h 5.6e-5, 0.05 below ψ,
+    // and all of [0, 1] "in contact"; timoshenko-a on one element)
+    let max_open_contact_gap = open_contact_gap(&mesh, solution.multiplier(), |x| {
+        scene.side * (w.at(x, 0).unwrap_or(f64::NAN) - scene.obstacle.at(x))
+    });
+    let size = max_deflection.max(psi_size).max(1e-6);
+    if max_open_contact_gap > crate::membranes::OPEN_GAP_WARNING * size
+        && max_open_contact_gap > solution.primal_rounding()
+    {
+        let large = alpha > 10.0 * pair.default_alpha();
+        warnings.push(format!(
+            "λ_h pushes on cells where w_h stays up to {max_open_contact_gap:.2e} clear of ψ ({:.1} % of the beam's size max(|w_h|, |ψ|) = {size:.2e}): the stabilized constraint on contact cells lets α h^k (…) open that gap (α = {alpha:e}{}), so this contact set is not real; {}",
+            100.0 * max_open_contact_gap / size,
+            if large { format!(", {:.0e} times the pair's default", alpha / pair.default_alpha()) } else { String::new() },
+            if large { "lower --alpha" } else { "use more elements or a smaller α" }
+        ));
+    }
+    if alpha > LARGE_ALPHA * pair.default_alpha() {
+        warnings.push(format!(
+            "α = {alpha:e} is {:.0e} times the pair's default {:e}: the stabilization's term moves the contact set and w_h with α (bernoulli-flat at q = 100 on 256 elements: L² error 1.9e-7 at the default, 4.1e-6 at α = 100, 1.1e-4 at α = 1e4)",
+            alpha / pair.default_alpha(),
+            pair.default_alpha()
+        ));
+    }
     if solution.multiplier_noise > 1e-6 {
         warnings.push(format!(
             "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁵ approaches the rounding of G − BU at this mesh size, and the saddle-point recovery of λ is no guarantee at this conditioning; w is affected too once the noise passes ~1e-3 (a larger α or a coarser mesh avoids it)",
@@ -571,6 +600,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         energy,
         max_deflection,
         max_penetration,
+        max_open_contact_gap,
         contact_set: solution.contact_set(),
         total_contact_force: solution.total_contact_force(),
         complementarity_residual: solution.kkt_residual,
@@ -591,4 +621,35 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         x,
     };
     Ok((report, profiles))
+}
+
+/// An α above this multiple of the pair's default is warned about: the error grows with
+/// α (bernoulli-flat, q = 100, 256 elements: 1.9e-7 at the default 1e-2, 2.3e-5 at
+/// 1e3, 1.1e-4 at 1e4), and the contact set widens without an open gap to show it.
+const LARGE_ALPHA: f64 = 1e3;
+
+/// The largest open gap under a pushing multiplier on an interval mesh: over the cells
+/// whose P0 multiplier `lambda` pushes (above 1e-6 of its largest), the smallest
+/// `clearance(x)` at the cell's ends, quarter points and midpoint; the largest of these,
+/// 0 where every such cell touches ψ (or none pushes, or `lambda` is not one value per
+/// cell). NaN clearances are skipped: the penetration check reports those.
+fn open_contact_gap(mesh: &IntervalMesh, lambda: &[f64], clearance: impl Fn(f64) -> f64) -> f64 {
+    if lambda.len() != mesh.cell_count() {
+        return 0.0;
+    }
+    let largest = lambda.iter().fold(0.0f64, |m, l| m.max(*l));
+    if largest <= 0.0 {
+        return 0.0;
+    }
+    (0..mesh.cell_count())
+        .filter(|&c| lambda[c] > 1e-6 * largest)
+        .map(|c| {
+            let [a, b] = mesh.cell(c);
+            (0..=4)
+                .map(|i| clearance(a + (b - a) * i as f64 / 4.0))
+                .filter(|g| !g.is_nan())
+                .fold(f64::INFINITY, f64::min)
+        })
+        .filter(|g| g.is_finite())
+        .fold(0.0, f64::max)
 }

@@ -601,3 +601,44 @@ fn a_mesh_of_few_cells_does_not_hide_a_penetration() {
     }
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// A tester's beams with a contact set that α made, with no warning: bernoulli-flat at
+/// α = 1e10 put all of [0, 1] in contact with w_h 0.05 clear of ψ, and timoshenko-a on
+/// one element (q = 1, no contact) pushed with ∫λ_h = 0.92 where w_h is 1e-8. The gap
+/// under the pushing cells is now reported and warned about, as for membranes and
+/// plates; an α far above the pair's default is warned about even without a gap. The
+/// default runs have neither warning.
+#[test]
+fn beams_warn_about_a_contact_set_that_alpha_made() {
+    let out = scratch("beam-gap");
+    let clear = |args: &[&str]| {
+        let mut all = vec!["solve"];
+        all.extend_from_slice(args);
+        all.push("--json");
+        let json = json_of(&all, &out);
+        let gap = json["max_open_contact_gap"].as_f64().unwrap();
+        (gap, json["warnings"].to_string(), json)
+    };
+    // bernoulli-flat's ψ is 0.05 away from the rest position and w_h stays near rest
+    let (gap, warnings, json) = clear(&["bernoulli-flat", "--load", "100", "--alpha", "1e10"]);
+    let max_w = json["max_deflection"].as_f64().unwrap();
+    assert!(gap > 0.05 - 2.0 * max_w && gap <= 0.05, "{json}");
+    assert!(
+        warnings.contains("clear of ψ") && warnings.contains("lower --alpha"),
+        "{warnings}"
+    );
+    let (gap, warnings, json) = clear(&["timoshenko-a", "--elements", "1"]);
+    assert!(gap > 0.04, "{json}");
+    assert!(warnings.contains("clear of ψ"), "{warnings}");
+    let (_, warnings, _) = clear(&["bernoulli-flat", "--load", "100", "--alpha", "1e4"]);
+    assert!(warnings.contains("times the pair's default"), "{warnings}");
+    for scene in [
+        &["bernoulli-flat", "--load", "100"][..],
+        &["timoshenko-a", "--load", "100"],
+    ] {
+        let (gap, warnings, json) = clear(scene);
+        assert!(gap < 1e-10, "{json}");
+        assert_eq!(warnings, "[]", "{scene:?}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
