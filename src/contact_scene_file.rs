@@ -1,4 +1,4 @@
-//! Contact scene files: a Signorini problem (MODELS.md §7) as data,
+//! Contact scene files: a Signorini problem (docs/contact.md) as data,
 //! `fem-forms solve --scene my.toml` with `model = "contact"`.
 //!
 //! The membrane scene files' conventions hold ([`crate::scene_file`]): data are

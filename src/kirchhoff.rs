@@ -913,7 +913,8 @@ fn interior_statistics(
 /// study, docs/mathematics.md §9).
 pub const DEFAULT_RECOVERY: MultiplierRecovery = MultiplierRecovery::PatchAverage;
 
-/// One line of text for a report (`solve` without `--json`).
+/// One line of text for a report (`solve` without `--json`); the command line prints the
+/// warnings apart, on stderr.
 pub fn summary(r: &KirchhoffReport) -> String {
     let mut line = format!(
         "{} {} {} obstacle {} q = {} N = {}: J_h {:.8e}, w(centre) {:.8e}",
@@ -959,9 +960,6 @@ pub fn summary(r: &KirchhoffReport) -> String {
         r.complementarity_residual,
         r.seconds
     );
-    for warning in &r.warnings {
-        line += &format!("\nwarning: {warning}");
-    }
     line
 }
 

@@ -1,4 +1,4 @@
-//! The Signorini contact scenes (MODELS.md §7, issue 14; docs/contact.md): an elastic
+//! The Signorini contact scenes (docs/contact.md, issue 14; docs/contact.md): an elastic
 //! body on a rigid foundation, frictionless, the contact pressure a P0 multiplier on the
 //! edges of the potential contact boundary, stabilized (`α = 1/(2 max_E C_I,E)` by
 //! default). `signorini-patch` checks λ_h = q; `hertz` compares the pressure with
@@ -638,7 +638,7 @@ pub fn alpha_study(scene: ContactScene, b_over_h: usize, out: &Path) -> Result<(
     }
     if let (Some(low), Some(high)) = (worked.first(), worked.last()) {
         println!(
-            "solved for α·C_I from {low} to {high} of these; the automatic α·C_I = ½ stays a factor 2–4 below where A_α turns indefinite (MODELS.md §7; 1.0–1.3 on the block patch, 1.5–1.9 here), at the price of some accuracy where a larger α is still stable"
+            "solved for α·C_I from {low} to {high} of these; the automatic α·C_I = ½ stays a factor 2–4 below where A_α turns indefinite (docs/contact.md; 1.0–1.3 on the block patch, 1.5–1.9 here), at the price of some accuracy where a larger α is still stable"
         );
     }
     profiles.extend(largest);

@@ -288,6 +288,43 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io
     std::fs::rename(tmp, path)
 }
 
+/// [`write_csv`] with a first column `pair` of names: each row's first value is the index
+/// of its pair in `pairs` (an index out of range is written as it is), `header` the
+/// other columns' names.
+pub(crate) fn write_csv_by_pair(
+    path: &Path,
+    header: &str,
+    pairs: &[&str],
+    rows: &[Vec<f64>],
+) -> std::io::Result<()> {
+    write_csv(path, &format!("pair,{header}"), rows)?;
+    // the numbers are written by `write_csv` alone; here the first cell of each line is
+    // swapped for its pair's name
+    let text = std::fs::read_to_string(path)?;
+    let mut lines = text.lines();
+    let mut named = String::with_capacity(text.len());
+    if let Some(first) = lines.next() {
+        named.push_str(first);
+        named.push('\n');
+    }
+    for line in lines {
+        let (index, rest) = line.split_once(',').unwrap_or((line, ""));
+        let name = index
+            .parse::<usize>()
+            .ok()
+            .and_then(|i| pairs.get(i))
+            .copied()
+            .unwrap_or(index);
+        named.push_str(name);
+        if !rest.is_empty() {
+            named.push(',');
+            named.push_str(rest);
+        }
+        named.push('\n');
+    }
+    std::fs::write(path, named)
+}
+
 pub(crate) fn io(e: std::io::Error) -> Error {
     Error::Input(format!("writing output: {e}"))
 }
@@ -476,9 +513,10 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
         work,
     ));
     plot::stacked(&output(out, &name, Study::Convergence, "svg"), &panels).map_err(io)?;
-    write_csv(
+    write_csv_by_pair(
         &output(out, &name, Study::Convergence, "csv"),
-        "pair_index,size,h,cells,dofs,error_l2,error_h1,error_multiplier,force_error,contact_error,iterations,seconds",
+        "size,h,cells,dofs,error_l2,error_h1,error_multiplier,force_error,contact_error,iterations,seconds",
+        &pairs,
         &csv,
     )
     .map_err(io)
@@ -657,13 +695,19 @@ fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
         ],
     )
     .map_err(io)?;
-    let mut header = "pair_index,size,alpha".to_string();
+    let mut header = "size,alpha".to_string();
     for side in ["plain", "stabilized"] {
         for k in 1..=measure.labels.len() {
             header += &format!(",{side}_{k}");
         }
     }
-    write_csv(&output(out, &name, Study::Stability, "csv"), &header, &csv).map_err(io)
+    write_csv_by_pair(
+        &output(out, &name, Study::Stability, "csv"),
+        &header,
+        &scene.stability_pairs(),
+        &csv,
+    )
+    .map_err(io)
 }
 
 /// One α of the α sweep: the solve's row, or why it failed.

@@ -229,8 +229,19 @@ fn the_stability_study_writes_its_chart_and_table() {
         String::from_utf8_lossy(&run.stderr)
     );
     let csv = std::fs::read_to_string(out.join("membrane-radial-stability.csv")).unwrap();
-    assert!(csv.starts_with("pair_index,size,alpha"));
+    // the pair by name, as the plates' and contact's CSVs have it (a tester found an
+    // index column that nothing explained)
+    assert!(csv.starts_with("pair,size,alpha"), "{csv}");
     assert!(csv.lines().count() > 6);
+    let pairs: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert!(
+        pairs.contains(&"p1-p0") && pairs.iter().all(|p| p.starts_with('p')),
+        "{csv}"
+    );
     let svg = std::fs::read_to_string(out.join("membrane-radial-stability.svg")).unwrap();
     assert!(svg.contains("<svg"));
     std::fs::remove_dir_all(&out).unwrap();
@@ -641,4 +652,38 @@ fn beams_warn_about_a_contact_set_that_alpha_made() {
         assert_eq!(warnings, "[]", "{scene:?}");
     }
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// A tester's small output faults: the plate line printed t = 0.0025 as "3e-3"; the
+/// Kirchhoff warnings went to stdout while every other family writes them to stderr;
+/// `--cold` with clarabel (which solves the finest mesh alone) was accepted and ignored.
+#[test]
+fn text_output_keeps_the_thickness_and_warnings_on_stderr() {
+    let out = scratch("text-output");
+    let run = fem_forms(&["solve", "mindlin-square", "--thickness", "0.0025"], &out);
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success() && text.contains("t = 0.0025"),
+        "{text}"
+    );
+    let run = fem_forms(&["solve", "kirchhoff-obstacle", "--mesh-size", "2"], &out);
+    let (text, errors) = (
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr),
+    );
+    assert!(run.status.success(), "{errors}");
+    assert!(
+        !text.contains("warning") && errors.contains("warning: "),
+        "{text}\n{errors}"
+    );
+    let run = fem_forms(
+        &["solve", "membrane-lshape", "--solver", "clarabel", "--cold"],
+        &out,
+    );
+    let errors = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && errors.contains("--cold does not apply"),
+        "{errors}"
+    );
+    std::fs::remove_dir_all(&out).ok();
 }

@@ -53,7 +53,7 @@ fn the_patch_test_gives_the_pressure_exactly() {
     }
 }
 
-/// MODELS.md §7's Hertz problem: b = √(4PR/(πE*)) = 0.0340389, p_max = 2P/(πb) =
+/// docs/contact.md's Hertz problem: b = √(4PR/(πE*)) = 0.0340389, p_max = 2P/(πb) =
 /// 18.7027 (computed here). The stabilized P1–P0 pressure: half-width within two
 /// cells, peak within 1 %, L² error within 1.7× the best P0 fit and falling with b/h;
 /// the foundation carries P.
@@ -84,7 +84,7 @@ fn hertz_matches_the_formulas() {
 }
 
 /// The plain mixed method (α = 0, solved as a QP) oscillates where the stabilized one
-/// does not (MODELS.md §7: a checkerboard).
+/// does not (docs/contact.md: a checkerboard).
 #[test]
 fn the_plain_method_oscillates_on_hertz() {
     // two cells per half-width leave no second difference inside 0.8 b: not measured

@@ -90,7 +90,7 @@ fn parse(text: &str) -> fem_forms::Result<contact_scene_file::ContactSceneFile> 
     contact_scene_file::parse(text, &data("scene.toml"))
 }
 
-/// MODELS.md §7's patch test from scene files: λ_h = q = 2.5 on every contact edge, for
+/// docs/contact.md's patch test from scene files: λ_h = q = 2.5 on every contact edge, for
 /// both pairs, on the rectangle and the Gmsh mesh, refined or not, with `data.load`
 /// scaling q; the foundation carries 2q (the block is 2 wide).
 #[test]
@@ -575,7 +575,7 @@ fn the_gap_scene_reaches_its_stated_accuracy() {
         panic!("a block over a gap")
     };
     let reference = Reference::new(scene.young, scene.poisson, radius, scene.load);
-    // MODELS.md §7's numbers for E = 1000, ν = 0.3, R = 1, P = 1
+    // docs/contact.md's numbers for E = 1000, ν = 0.3, R = 1, P = 1
     assert!((reference.b - 0.0340389).abs() < 1e-7);
     assert!((reference.p_max - 18.7027).abs() < 1e-4);
     for pair in ContactPair::ALL {

@@ -1,4 +1,4 @@
-//! The Kirchhoff obstacle models are written as in the mathematics (MODELS.md §5, issue
+//! The Kirchhoff obstacle models are written as in the mathematics (docs/mathematics.md §9, issue
 //! 13): `K(w) = −∇∇w`, `M(w) = D[(1−ν)K(w) + ν tr K(w) I]`, `a(w,v) = ∫ M(w):K(v)` and the
 //! stabilization with `Δ²` (`models/src/kirchhoff.rs`). Against the same forms written
 //! with `∇∇w:∇∇v`, `Δw Δv` and `ΔΔ` (the notation whose kernels tests/argyris.rs checks

@@ -1,4 +1,4 @@
-//! Signorini contact (MODELS.md §7) solved end to end: the patch test (an elastic block
+//! Signorini contact (docs/contact.md) solved end to end: the patch test (an elastic block
 //! on a rigid foundation under a uniform pressure q: λ_h = q exactly on every contact
 //! edge, which catches the sign inside `λ + σ_n`), vertical equilibrium (total contact
 //! force = load, an identity since a rigid translation lies in V_h), complementarity,

@@ -1,4 +1,4 @@
-//! Hertz line contact (MODELS.md §7): a half disc (R = 1, E = 1000, ν = 0.3, plane
+//! Hertz line contact (docs/contact.md): a half disc (R = 1, E = 1000, ν = 0.3, plane
 //! strain, P = 1; its right half with a symmetry condition) pressed onto a rigid plane,
 //! on meshes graded towards the contact zone, b/h = 8 … 64, against `b = √(4PR/(πE*))`,
 //! `p_max = 2P/(πb)`, `p(x) = p_max √(1 − x²/b²)`; the plain method (α = 0) shown worse

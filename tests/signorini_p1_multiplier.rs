@@ -1,4 +1,4 @@
-//! Signorini contact with a continuous P1 multiplier on Γ_C (MODELS.md §7, issue 14):
+//! Signorini contact with a continuous P1 multiplier on Γ_C (docs/contact.md, issue 14):
 //! one DOF per vertex of the contact edges. The patch test (λ_h = q at every vertex),
 //! vertical equilibrium (an identity), the LCP blocks against hand-coded values, Newton
 //! against clarabel's QP on the same LCP, and Hertz against the best continuous P1 fit.
@@ -137,7 +137,7 @@ fn patch_test_gives_the_pressure_at_every_vertex() {
 }
 
 /// The LCP of P1–P1 on a uniform bottom (n edges of length 1/n, h_E = |E|) against the
-/// blocks of MODELS.md §7 by hand: `C = α Σ_E h_E (μ_l, μ_k)_E` lumped by rows is
+/// blocks of docs/contact.md by hand: `C = α Σ_E h_E (μ_l, μ_k)_E` lumped by rows is
 /// `α h²` at an interior vertex and `α h²/2` at the two ends; `B` applied to a unit
 /// translation `t` along `n_c` is `−∫ μ_k ds` (σ_n(t) = 0); a constant gap g₀ gives
 /// `G_k = −g₀ ∫ μ_k ds`. Then Newton against clarabel's QP on the same LCP with a

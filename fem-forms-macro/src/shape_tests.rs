@@ -474,7 +474,7 @@ fn powers_of_derivative_operators_read_as_repeated_operators() {
 
 #[test]
 fn the_kirchhoff_moment_and_curvature_read_as_in_the_mathematics() {
-    // MODELS.md §5: K(w) = −∇∇w, M(w) = D[(1−ν)K(w) + ν tr K(w) I], a(w,v) = ∫ M(w):K(v)
+    // docs/mathematics.md §9: K(w) = −∇∇w, M(w) = D[(1−ν)K(w) + ν tr K(w) I], a(w,v) = ∫ M(w):K(v)
     let forms = "
         K(w)   := −∇∇w
         M(w)   := D[(1−ν)K(w) + ν tr K(w) I]

@@ -1,4 +1,4 @@
-//! The Signorini contact scenes (MODELS.md §7, issue 14), as data: the body, its
+//! The Signorini contact scenes (docs/contact.md, issue 14), as data: the body, its
 //! material, the load and the foundation; the solver is the CLI's (`src/signorini.rs`)
 //! over [`crate::signorini::solve_signorini`].
 
@@ -13,7 +13,7 @@ pub enum ContactBody {
     /// The block `(0, width) × (0, height)` on the foundation, a uniform pressure q on
     /// its top, a roller `u_x = 0` on its left side; no gap. The exact solution is the
     /// uniform stress `σ_yy = −q`: the contact pressure is q on every edge (the patch
-    /// test, MODELS.md §7).
+    /// test, docs/contact.md).
     Block {
         /// Width (length).
         width: f64,
@@ -102,7 +102,7 @@ impl ContactScene {
     }
 }
 
-/// The patch test of MODELS.md §7: λ_h = q exactly.
+/// The patch test of docs/contact.md: λ_h = q exactly.
 pub const SIGNORINI_PATCH: ContactScene = ContactScene {
     name: "signorini-patch",
     description: "elastic block (0,2)×(0,1) on a rigid foundation under a uniform pressure q on its top (exact: λ = q on every contact edge)",
@@ -117,7 +117,7 @@ pub const SIGNORINI_PATCH: ContactScene = ContactScene {
     mesh_size: 8,
 };
 
-/// Hertz line contact with MODELS.md §7's constants: R = 1, E = 1000, ν = 0.3, P = 1,
+/// Hertz line contact with docs/contact.md's constants: R = 1, E = 1000, ν = 0.3, P = 1,
 /// plane strain (b = 0.0340389, p_max = 18.7027).
 pub const HERTZ: ContactScene = ContactScene {
     name: "hertz",

@@ -1,5 +1,5 @@
 //! Hertz line contact (plane strain): the reference of the `hertz` scene of Signorini
-//! contact (MODELS.md §7; K. L. Johnson, *Contact Mechanics*, 1985, §4.2 and §5.2).
+//! contact (docs/contact.md; K. L. Johnson, *Contact Mechanics*, 1985, §4.2 and §5.2).
 //!
 //! A cylinder of radius `R` (per unit length), Young's modulus `E` and Poisson ratio
 //! `ν`, pressed by the resultant `P` (force per unit length) onto a rigid plane, touches
@@ -11,7 +11,7 @@
 //!
 //! The P0 multiplier of a contact discretization is compared with `p` by its relative
 //! L² error and against the best the P0 space can do: the L² projection of `p` onto the
-//! same intervals. The square-root edge at `x = ±b` caps both at O(h) (MODELS.md §7).
+//! same intervals. The square-root edge at `x = ±b` caps both at O(h) (docs/contact.md).
 //! A continuous P1 multiplier is compared the same way against the best continuous P1
 //! fit (the L² projection onto the piecewise linears on the same nodes).
 //! All integrals here are exact (closed forms of `∫p`, `∫xp` and `∫p²`), so the reference
@@ -202,7 +202,7 @@ impl HertzLineContact {
 mod tests {
     use super::*;
 
-    /// MODELS.md §7's prototype: R = 1, E = 1000, ν = 0.3, P = 1.
+    /// docs/contact.md's prototype: R = 1, E = 1000, ν = 0.3, P = 1.
     const PROTOTYPE: HertzLineContact = HertzLineContact {
         radius: 1.0,
         young: 1000.0,
@@ -266,7 +266,7 @@ mod tests {
             // O(h) up to the square-root edge's logarithm: 0.87, 0.89, 0.90
             assert!((0.85..1.1).contains(&rate), "{errors:?}");
         }
-        // MODELS.md §7: stabilized P1–P0 measured .066 at b/h = 8, "within 1.15× of the
+        // docs/contact.md: stabilized P1–P0 measured .066 at b/h = 8, "within 1.15× of the
         // best P0 fit": h = b/8 on [−1.5b, 1.5b] is 24 intervals
         assert!((0.066 / errors[0] - 1.14).abs() < 0.01, "{}", errors[0]);
         // the projection is the best P0 fit: perturbing a value increases the error

@@ -1,4 +1,4 @@
-//! Signorini contact (docs/mathematics.md §7, MODELS.md §7): a linear elastic body
+//! Signorini contact (docs/contact.md): a linear elastic body
 //! (plane strain or plane stress: the Lamé parameters `μ_L`, `λ_L` are given) on a rigid
 //! foundation, frictionless, with a multiplier λ ≥ 0 on the potential contact boundary
 //! `Γ_C`, the contact pressure `λ = −σ_n(u)`.
@@ -126,7 +126,7 @@ pub struct SignoriniInput<'a> {
     pub fixed_x: &'a [u32],
     /// Edges where `u_y = 0`.
     pub fixed_y: &'a [u32],
-    /// The stabilization parameter; `None`: `α = 1/(2 max_E C_I,E)` (MODELS.md §7);
+    /// The stabilization parameter; `None`: `α = 1/(2 max_E C_I,E)` (docs/contact.md);
     /// `Some(0.0)`: the plain mixed method, solved as a QP.
     pub alpha: Option<f64>,
     /// The middle of the contact zone, for the half-width (a symmetry line), as a
@@ -267,7 +267,7 @@ pub fn lame(young: f64, poisson: f64, plane: Plane) -> Result<(f64, f64)> {
     Ok((mu, lambda))
 }
 
-/// Solves a Signorini problem (MODELS.md §7) with the stabilized P1–P0 or P2–P0
+/// Solves a Signorini problem (docs/contact.md) with the stabilized P1–P0 or P2–P0
 /// method: the multiplier is one pressure per edge of Γ_C.
 ///
 /// # Errors
@@ -425,7 +425,7 @@ fn check_alpha(alpha: f64, constants: &[f64]) -> Result<()> {
 }
 
 /// Newton's failure, explained where α is beyond the working range `α max C_I,E ≲ 1`
-/// (MODELS.md §7: `A_α` turns indefinite near 2; measured 1.35 on the block patch).
+/// (docs/contact.md: `A_α` turns indefinite near 2; measured 1.35 on the block patch).
 fn alpha_error(alpha: f64, constants: &[f64], error: Error) -> Error {
     let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
     if alpha * c > 1.0 {
@@ -830,7 +830,7 @@ pub fn hertz_mesh(radius: f64, zone: f64, contact_h: f64, grading: f64) -> Resul
         .0)
 }
 
-/// Hertz line contact in plane strain (MODELS.md §7): the reference, with its exact
+/// Hertz line contact in plane strain (docs/contact.md): the reference, with its exact
 /// integrals, is [`crate::hertz::HertzLineContact`].
 pub use crate::hertz::HertzLineContact as Hertz;
 

@@ -1,5 +1,5 @@
 //! Obstacle problems whose multiplier lives on a boundary part only: Signorini contact
-//! (docs/mathematics.md §7, MODELS.md §7), the boundary-multiplier variant of
+//! (docs/contact.md), the boundary-multiplier variant of
 //! [`crate::obstacle::triangle::solve_obstacle_on_triangles`].
 //!
 //! The model declares its multiplier as a P0 field (`λ: P0 >= 0`) and integrates it
@@ -500,8 +500,8 @@ fn check_off_edge<M: Model>(
     Ok(())
 }
 
-/// The per-edge inverse-inequality constants `C_I,E` of the stabilization (MODELS.md
-/// §7): the smallest `C` with `h_E ‖σ_n(v)‖²_E ≤ C a_{T_E}(v, v)` for every `v` of the
+/// The per-edge inverse-inequality constants `C_I,E` of the stabilization
+/// (docs/contact.md): the smallest `C` with `h_E ‖σ_n(v)‖²_E ≤ C a_{T_E}(v, v)` for every `v` of the
 /// primal space on the cell `T_E` next to edge `E`, computed from the model's own
 /// kernels: the largest generalized eigenvalue of `S_E v = C K_T v` on the complement
 /// of the kernel of `K_T` (the rigid motions, where `S_E` vanishes too).

@@ -5,7 +5,7 @@
 //! field drives a mesh generator; vertices created on curved parts of the boundary are
 //! moved onto the curve by a caller's projection, so the polygon converges to the
 //! curve instead of staying the coarse mesh's. [`TriangleMesh::half_disk`] is the
-//! cylinder of the Hertz problem (docs/contact.md; MODELS.md §7): refining it towards
+//! cylinder of the Hertz problem (docs/contact.md; docs/contact.md): refining it towards
 //! the contact zone gives the graded meshes a contact solve needs (`b/h` ≥ 64 at the
 //! contact zone with a few ten thousand cells instead of millions).
 
