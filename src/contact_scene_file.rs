@@ -55,12 +55,15 @@
 //! mesh does not have (`boundary.contact`, …, with the names it has); a part that holds
 //! no boundary edge (an interior Gmsh curve: "not on the boundary"); `material.young`
 //! ≤ 0 or outside [1e-100, 1e100]; `material.poisson` outside (−1, ½); a zero
-//! `parameters.contact_direction`; a negative `parameters.alpha`; an expression that
+//! `parameters.contact_direction`, or one that does not point away from the body on
+//! Γ_C (the mean of the outward normal along it ≤ 0: the foundation would lie inside
+//! the body); a `parameters.contact_centre` outside Γ_C's extent along the plane; a
+//! negative `parameters.alpha`; an expression that
 //! does not parse, uses a variable other than x, y, or does not evaluate to a finite
 //! number within ±1e100 on its part (`data.gap` on Γ_C, `data.pressure` on Γ_N,
 //! `exact.pressure` on Γ_C); a pressure scale times max|q| beyond 1e100; a pressure
-//! whose resultant pulls the body off the foundation (`data.pressure`: nothing then
-//! holds the body); a gap whose smallest value is so far beyond the elastic
+//! whose resultant pulls the body off the foundation or is zero to within 1e-12 of
+//! `∫|q| ds` (`data.pressure`: nothing then holds the body); a gap whose smallest value is so far beyond the elastic
 //! displacement that rounding swamps it (`data.gap`, `MAX_GAP_ROUNDING`; checked again
 //! under `--load`).
 
@@ -365,11 +368,54 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             ));
         }
     }
+    // Γ_C must face the foundation: the body's outward normal ν along n_c on the whole
+    // (a tester's contact on the top face with n_c = (0, −1), a foundation inside the
+    // block, was solved and reported as valid)
+    let edges = oriented_edges(&mesh, &contact);
+    let (facing, total) = edges.iter().fold((0.0, 0.0), |(f, t), ends| {
+        let l = self::length(ends);
+        let nu = [ends[1][1] - ends[0][1], -(ends[1][0] - ends[0][0])];
+        (
+            f + nu[0] * contact_direction[0] + nu[1] * contact_direction[1],
+            t + l,
+        )
+    });
+    if facing <= 1e-9 * total {
+        return Err(at(
+            "parameters.contact_direction",
+            format!(
+                "({:.3}, {:.3}) does not point away from the body on `boundary.contact`: its outward normal ν has mean ν·n_c = {:.3} there, so the foundation would lie inside the body; n_c is the foundation plane's normal away from the body (e.g. [0.0, 1.0] for a contact part on the top)",
+                contact_direction[0],
+                contact_direction[1],
+                facing / total
+            ),
+        ));
+    }
     if let Some(c) = file.parameters.contact_centre {
         if !c.is_finite() {
             return Err(at(
                 "parameters.contact_centre",
                 format!("{c} must be finite"),
+            ));
+        }
+        // measured along the plane: the half-width is taken from c, which must lie
+        // on Γ_C's extent (a tester's 5.0 beside a 1-wide block reported a half-width 5)
+        let along = crate::models::signorini::contact_tangent(contact_direction);
+        let (lo, hi) = edges
+            .iter()
+            .flatten()
+            .map(|p| along[0] * p[0] + along[1] * p[1])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+                (lo.min(s), hi.max(s))
+            });
+        let slack = 1e-9 * (hi - lo).abs().max(lo.abs()).max(hi.abs());
+        if !(c >= lo - slack && c <= hi + slack) {
+            return Err(at(
+                "parameters.contact_centre",
+                format!(
+                    "{c} lies outside `boundary.contact`, which spans {lo} to {hi} along the contact plane ({}): the half-width is measured from it",
+                    if along[0].abs() >= along[1].abs() { "x" } else { "y" }
+                ),
             ));
         }
     }
@@ -734,9 +780,16 @@ fn presses(
     pressure: &Data,
     direction: [f64; 2],
 ) -> std::result::Result<(), String> {
-    let force = resultant(mesh, markers, pressure);
+    let (force, magnitude) = resultant_and_magnitude(mesh, markers, pressure);
     let along = force[0] * direction[0] + force[1] * direction[1];
-    if along > 0.0 {
+    // a resultant within the rounding of its own quadrature is zero, whichever its sign
+    // (a tester's x − 0.5 on the top face came out +7e-18 and was accepted, sin(2πx)
+    // −4e-17 and was refused)
+    if along.abs() <= RESULTANT_ROUNDING * magnitude {
+        Err(format!(
+            "the pressure's resultant along the contact direction is zero (to the rounding {along:.1e} of ∫|q| ds = {magnitude:.3e}): it does not push the body towards the foundation, and nothing else holds it then"
+        ))
+    } else if along > 0.0 {
         Ok(())
     } else {
         Err(format!(
@@ -746,10 +799,16 @@ fn presses(
     }
 }
 
-/// `∫_part q (−n) ds` (Gauss–Legendre, exact for q of degree 7).
-fn resultant(mesh: &TriangleMesh, markers: &[u32], pressure: &Data) -> [f64; 2] {
+/// The resultant `∫_part q (−n) ds` and `∫_part |q| ds`, the size the resultant's
+/// rounding is relative to (Gauss–Legendre, exact for q of degree 7).
+fn resultant_and_magnitude(
+    mesh: &TriangleMesh,
+    markers: &[u32],
+    pressure: &Data,
+) -> ([f64; 2], f64) {
     let gauss = fem_runtime::gauss_legendre(GAUSS_POINTS);
     let mut force = [0.0; 2];
+    let mut magnitude = 0.0;
     for ends in oriented_edges(mesh, markers) {
         let l = length(&ends);
         let n = [
@@ -763,11 +822,21 @@ fn resultant(mesh: &TriangleMesh, markers: &[u32], pressure: &Data) -> [f64; 2] 
             .map(|(&s, &w)| w * pressure.at(&point(&ends, s)))
             .sum::<f64>()
             * l;
+        magnitude += gauss
+            .points
+            .iter()
+            .zip(&gauss.weights)
+            .map(|(&s, &w)| w * pressure.at(&point(&ends, s)).abs())
+            .sum::<f64>()
+            * l;
         force[0] -= q * n[0];
         force[1] -= q * n[1];
     }
-    force
+    (force, magnitude)
 }
+
+/// A pressure resultant below this fraction of `∫|q| ds` is the rounding of a zero one.
+const RESULTANT_ROUNDING: f64 = 1e-12;
 
 /// Why `pair` (a P1-multiplier pair) cannot solve a contact scene file.
 fn p0_pairs_only(pair: ContactPair) -> String {

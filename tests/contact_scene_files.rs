@@ -457,6 +457,38 @@ fn bad_contact_scene_files_name_the_key() {
             &["non-zero"],
         ),
         (
+            format!("{RECTANGLE}\n[parameters]\ncontact_direction = [0.0, 1.0]\n"),
+            "parameters.contact_direction",
+            &["does not point away from the body", "ν·n_c = -1.000"],
+        ),
+        // a tester's: the contact part on the top with n_c downwards, the foundation
+        // inside the block, was solved and reported
+        (
+            RECTANGLE
+                .replace("contact = \"bottom\"", "contact = \"top\"")
+                .replace("load = \"top\"", "load = \"bottom\""),
+            "parameters.contact_direction",
+            &["does not point away from the body"],
+        ),
+        // the centre the half-width is measured from must lie on Γ_C (0 to 2 here)
+        (
+            format!("{RECTANGLE}\n[parameters]\ncontact_centre = 5.0\n"),
+            "parameters.contact_centre",
+            &["5 lies outside", "spans 0 to 2", "(x)"],
+        ),
+        // a resultant that is zero to rounding is refused whatever the sign of its
+        // rounding (x − 1 came out on one side, sin(πx) on the other)
+        (
+            RECTANGLE.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"x - 1\""),
+            "data.pressure",
+            &["resultant along the contact direction is zero"],
+        ),
+        (
+            RECTANGLE.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"sin(PI*x)\""),
+            "data.pressure",
+            &["resultant along the contact direction is zero"],
+        ),
+        (
             format!("{RECTANGLE}\n[parameters]\nalpha = -1.0\n"),
             "parameters.alpha",
             &["≥ 0"],
