@@ -158,6 +158,9 @@ struct SolveOptions {
     /// Hertz's (hertz, signorini-gap).
     #[arg(long)]
     plot: bool,
+    /// A membrane scene file's `accuracy` (not an option: the file states it).
+    #[arg(skip)]
+    accuracy: Option<f64>,
 }
 
 impl SolveOptions {
@@ -947,6 +950,7 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
     request.solver = options.solver();
     request.nested = !options.cold;
     request.linear_solver = options.linear_solver()?;
+    request.accuracy = options.accuracy;
     let (report, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
     if options.json {
         println!(
@@ -1082,6 +1086,7 @@ fn run(cli: Cli) -> Result<(), String> {
                         options.mesh_size.get_or_insert(file.mesh_size);
                     }
                     options.alpha = options.alpha.or(file.alpha);
+                    options.accuracy = file.accuracy;
                     SceneEntry {
                         kind: SceneKind::Membrane(file.scene),
                         pairs: MEMBRANE_PAIRS,

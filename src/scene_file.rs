@@ -80,7 +80,7 @@ struct SceneToml {
     parameters: ParametersToml,
     data: DataToml,
     exact: Option<ExactToml>,
-    /// The asked accuracy (L² error of u).
+    /// The asked accuracy (L² error of u; needs `[exact]`).
     accuracy: Option<f64>,
 }
 
@@ -136,6 +136,9 @@ pub struct SceneFile {
     pub mesh_size: usize,
     /// α where the file fixes it.
     pub alpha: Option<f64>,
+    /// The L² error of u the file asks for (`accuracy`), where it states one: the solve
+    /// compares `error_l2` with it and warns when it is missed.
+    pub accuracy: Option<f64>,
 }
 
 /// The variables an expression may use, in the order of the point's coordinates.
@@ -666,6 +669,27 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
             return Err(at("data.load", format!("{q} must be finite")));
         }
     }
+    if let Some(e) = &file.exact {
+        for (key, value) in [
+            ("exact.contact_force", e.contact_force),
+            ("exact.contact_area", e.contact_area),
+        ] {
+            if let Some(v) = value {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(at(
+                        key,
+                        format!("{v} must be a finite number ≥ 0 (∫λ and the contact area cannot be negative)"),
+                    ));
+                }
+            }
+        }
+    }
+    if file.accuracy.is_some() && file.exact.is_none() {
+        return Err(at(
+            "accuracy",
+            "an accuracy needs an `[exact] u` to measure the L² error against".into(),
+        ));
+    }
     let exact = match &file.exact {
         None => Exact::Unknown,
         Some(e) => Exact::AtDefaultLoad(ExactMembrane {
@@ -706,6 +730,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         pair,
         mesh_size,
         alpha: file.parameters.alpha,
+        accuracy: file.accuracy,
     })
 }
 

@@ -387,3 +387,70 @@ fn a_scene_without_a_name_is_named_after_its_file() {
     let file = scene_file::parse(&unnamed, Path::new("my scenes/flat one.toml")).unwrap();
     assert_eq!(file.scene.name, "flat-one");
 }
+
+/// A tester's silent scene-file inputs: `accuracy` was accepted and ignored, `[exact]`
+/// constants could be NaN or negative, and another `--load` dropped the exact solution
+/// without a word. Now: the accuracy needs `[exact]`, is reported and checked against
+/// `error_l2` (a warning when missed); the constants are refused by key; another load
+/// warns that the exact solution is not compared.
+#[test]
+fn a_scene_files_accuracy_and_exact_solution_are_checked_or_refused() {
+    let text = std::fs::read_to_string(example("membrane-flat.toml")).unwrap();
+    let mine = Path::new("mine.toml");
+    let without_exact = text[..text.find("[exact]").unwrap()].to_string();
+    let e = scene_file::parse(&format!("accuracy = 1e-3\n{without_exact}"), mine)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`accuracy`") && e.contains("[exact] u"), "{e}");
+    for (from, to, key) in [
+        (
+            "contact_area = 16.0",
+            "contact_area = -1.0",
+            "exact.contact_area",
+        ),
+        (
+            "contact_force = 48.0",
+            "contact_force = nan",
+            "exact.contact_force",
+        ),
+    ] {
+        assert!(text.contains(from), "the example changed: {from}");
+        let e = scene_file::parse(&text.replace(from, to), mine)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(key) && e.contains("≥ 0"), "{to}: {e}");
+    }
+    // u = 0 exactly: P2 reaches it to rounding on membrane-flat, so an accuracy of 1e-6
+    // is met and one of 1e-30 is not
+    for (accuracy, missed) in [(1e-6, false), (1e-30, true)] {
+        let file = scene_file::parse(&format!("accuracy = {accuracy:e}\n{text}"), mine).unwrap();
+        assert_eq!(file.accuracy, Some(accuracy));
+        let mut request = request_of(&file);
+        request.mesh_size = 8;
+        request.accuracy = file.accuracy;
+        let (report, _) = membranes::solve(&request).unwrap();
+        let error = report.error_l2.unwrap();
+        assert_eq!(error > accuracy, missed, "{error}");
+        assert_eq!(report.accuracy, Some(accuracy));
+        assert_eq!(
+            report
+                .warnings
+                .iter()
+                .any(|w| w.contains("exceeds the accuracy")),
+            missed,
+            "{:?}",
+            report.warnings
+        );
+    }
+    let file = scene_file::parse(&text, mine).unwrap();
+    let mut request = request_of(&file);
+    request.mesh_size = 8;
+    request.load = Some(1.0);
+    let (report, _) = membranes::solve(&request).unwrap();
+    assert!(report.error_l2.is_none() && report.exact_contact_force.is_none());
+    assert!(
+        report.warnings.iter().any(|w| w.contains("not compared")),
+        "{:?}",
+        report.warnings
+    );
+}
