@@ -110,7 +110,7 @@ struct SolveOptions {
     /// 1), the scale of a contact scene file's pressure.
     #[arg(long, allow_negative_numbers = true)]
     load: Option<f64>,
-    /// Beam thickness t (Timoshenko scenes).
+    /// Thickness t (Timoshenko beams and the Reissner–Mindlin plates).
     #[arg(long, allow_negative_numbers = true)]
     thickness: Option<f64>,
     /// Stabilization parameter α (negative values are refused with a reason; not for
@@ -910,6 +910,8 @@ fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String
         let path = out.join(format!("{}-q{load}.svg", s.name));
         plot::profiles(&path, &format!("{} q = {load}", s.name), &profiles)
             .map_err(|e| e.to_string())?;
+        // as every other written file: the user learns where it went
+        eprintln!("→ {}", path.display());
     }
     Ok(())
 }
