@@ -603,11 +603,13 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
             match generator.as_str() {
                 "square" => {
                     let a = mesh.half_width.unwrap_or(1.0);
-                    // beyond this range the cells' areas under- or overflow
-                    if !(1e-100..=1e100).contains(&a) {
+                    // below this the cells' areas underflow; above, the mesh's coordinate
+                    // bound (the kernels' powers of lengths overflow)
+                    let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
+                    if !(1e-100..=largest).contains(&a) {
                         return Err(at(
                             "mesh.half_width",
-                            format!("{a} must be positive and within 1e-100 to 1e100"),
+                            format!("{a} must be positive and within 1e-100 to {largest:e}"),
                         ));
                     }
                     (Domain::Square(a), size)

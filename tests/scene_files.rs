@@ -183,6 +183,9 @@ fn scene_file_errors_name_the_field() {
     for (from, to, field) in [
         ("half_width = 2.0", "half_width = 1e-200", "mesh.half_width"),
         ("half_width = 2.0", "half_width = 1e200", "mesh.half_width"),
+        // within the field's old bound but beyond the mesh's: refused by the mesh,
+        // whose message named no field
+        ("half_width = 2.0", "half_width = 1e60", "mesh.half_width"),
     ] {
         let e = scene_file::parse(&text.replace(from, to), Path::new("mine.toml"))
             .unwrap_err()
