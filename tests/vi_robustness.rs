@@ -526,6 +526,19 @@ fn no_multiplier_noise_without_a_multiplier() {
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }
 
+/// The first field of `dofs` on `mesh` with `coefficients` (the penetration tests' u_h).
+fn zero_p1_field<'a>(
+    mesh: &'a TriangleMesh,
+    dofs: &'a SystemDofs,
+    coefficients: &'a [f64],
+) -> TriangleField<'a> {
+    TriangleField {
+        mesh,
+        map: dofs.map(0).unwrap(),
+        coefficients,
+    }
+}
+
 /// The penetration by hand: u_h = 0 under ψ = 1 − |x|² on a mesh with a vertex at the
 /// origin is 1 there (and nowhere more); under ψ = −1 − |x|² it is 0; a NaN is reported.
 #[test]
@@ -533,13 +546,8 @@ fn the_penetration_is_measured_at_vertices_and_quadrature_points() {
     type M = membrane_p1::Model;
     let mesh = TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 2, 2, Diagonal::Right).unwrap();
     let dofs = SystemDofs::all::<M>(&mesh).unwrap();
-    let map = dofs.map(0).unwrap();
-    let coefficients = vec![0.0; map.dof_count()];
-    let u = TriangleField {
-        mesh: &mesh,
-        map,
-        coefficients: &coefficients,
-    };
+    let coefficients = vec![0.0; dofs.map(0).unwrap().dof_count()];
+    let u = zero_p1_field(&mesh, &dofs, &coefficients);
     let bump = |x: &[f64]| 1.0 - x[0] * x[0] - x[1] * x[1];
     assert_eq!(max_penetration(&u, &bump, 2), 1.0);
     let below = |x: &[f64]| -1.0 - x[0] * x[0] - x[1] * x[1];
@@ -589,13 +597,8 @@ fn the_penetration_of_a_coarse_mesh_is_sampled_on_a_lattice() {
     type M = membrane_p1::Model;
     let mesh = TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 1, 1, Diagonal::Right).unwrap();
     let dofs = SystemDofs::all::<M>(&mesh).unwrap();
-    let map = dofs.map(0).unwrap();
-    let coefficients = vec![0.0; map.dof_count()];
-    let u = TriangleField {
-        mesh: &mesh,
-        map,
-        coefficients: &coefficients,
-    };
+    let coefficients = vec![0.0; dofs.map(0).unwrap().dof_count()];
+    let u = zero_p1_field(&mesh, &dofs, &coefficients);
     // ψ = 1 − 4r² near the origin, −1 beyond r = 1/√2: the corners and the rule's
     // points (beyond r = 1/√2) all see −1
     let peak = |x: &[f64]| (1.0 - 4.0 * (x[0] * x[0] + x[1] * x[1])).max(-1.0);
