@@ -6,7 +6,7 @@ use crate::beams::{self, Pair, Profiles, Report, Request};
 use crate::models::scenes::{exact_solution, Beam, Scene, SCENES};
 use crate::plot::{self, Axes, Series};
 use crate::studies::{
-    io, output, write_csv_by_pair, ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study,
+    io, output, write_csv_named, ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study,
     StudyScene,
 };
 use fem_runtime::obstacle::VariationalSolver;
@@ -445,8 +445,9 @@ fn run_locking(scene: &Scene, full: bool, out: &Path) -> Result<()> {
         ],
     )
     .map_err(io)?;
-    write_csv_by_pair(
+    write_csv_named(
         &output(out, name, Study::Locking, "csv"),
+        "pair",
         "thickness,max_deflection,difference_to_bernoulli,energy_difference",
         &pairs.map(Pair::name),
         &rows

@@ -555,14 +555,14 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         warnings.push(format!(
             "λ_h pushes on cells where w_h stays up to {max_open_contact_gap:.2e} clear of ψ ({:.1} % of the beam's size max(|w_h|, |ψ|) = {size:.2e}): the stabilized constraint on contact cells lets α h^k (…) open that gap (α = {alpha:e}{}), so this contact set is not real; {}",
             100.0 * max_open_contact_gap / size,
-            if large { format!(", {:.0e} times the pair's default", alpha / pair.default_alpha()) } else { String::new() },
+            if large { format!(", {} times the pair's default", crate::number(alpha / pair.default_alpha())) } else { String::new() },
             if large { "lower --alpha" } else { "use more elements or a smaller α" }
         ));
     }
     if alpha > LARGE_ALPHA * pair.default_alpha() {
         warnings.push(format!(
-            "α = {alpha:e} is {:.0e} times the pair's default {:e}: the stabilization's term moves the contact set and w_h with α (bernoulli-flat at q = 100 on 256 elements: L² error 1.9e-7 at the default, 4.1e-6 at α = 100, 1.1e-4 at α = 1e4)",
-            alpha / pair.default_alpha(),
+            "α = {alpha:e} is {} times the pair's default {:e}, more than {LARGE_ALPHA:e}: the stabilization's term moves the contact set and w_h with α (bernoulli-flat at q = 100 on 256 elements: L² error 1.9e-7 at the default, 4.1e-6 at α = 100, 1.1e-4 at α = 1e4)",
+            crate::number(alpha / pair.default_alpha()),
             pair.default_alpha()
         ));
     }

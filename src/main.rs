@@ -37,7 +37,7 @@ struct Cli {
     out: PathBuf,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum SolverName {
     /// Semismooth Newton / primal–dual active set (nested iteration).
     Pdas,
@@ -264,7 +264,15 @@ fn table_row(r: &Report) {
         "{:<15} {:>5} {:>7} {:>6} {:>6} {:>5} {:>8.4} {:>14.8e} {:<24} {:>9.1e} {:>10}",
         r.scene,
         fem_forms::number(r.load),
-        r.thickness.map_or("-".into(), fem_forms::number),
+        // in full where it fits the column, else to three digits
+        r.thickness.map_or("-".into(), |t| {
+            let full = fem_forms::number(t);
+            if full.chars().count() <= 7 {
+                full
+            } else {
+                format!("{t:.2e}")
+            }
+        }),
         r.elements,
         r.dofs,
         r.iterations,
@@ -939,6 +947,17 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
             &["--alpha", "--solver"],
             "p1-nodal has no multiplier to stabilize and solves its nodal constraints by its own active-set method",
         )?;
+    }
+    if options.alpha == Some(0.0) {
+        // the plain method goes to clarabel on the finest mesh whatever was asked: a
+        // flag that cannot act is refused, as with --solver clarabel
+        options.refuse(
+            &["--cold"],
+            "α = 0 (the plain mixed method) is solved by clarabel on the finest mesh alone, with no nested start to turn off",
+        )?;
+        if options.solver == Some(SolverName::Pdas) {
+            return Err("--solver pdas does not apply with α = 0: the plain mixed method has C = 0, which leaves semismooth Newton nothing to eliminate the multiplier with; it is solved by clarabel".into());
+        }
     }
     scene.load_magnitude(options.load)?;
     request.load = options.load;

@@ -660,9 +660,12 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     report
         .warnings
         .extend(quality.warnings(finest, alpha_from_inverse_constant));
+    let (penetration_scale, penetration_rounding) =
+        penetration_scales(&report, &fields, posed.data.load.as_data_fn());
     if let Some(warning) = penetration_warning(
         report.max_penetration,
-        report.obstacle_range,
+        penetration_scale,
+        penetration_rounding,
         request.pair == MembranePair::P1Nodal,
     ) {
         report.warnings.push(warning);
@@ -712,7 +715,7 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     if report.max_penetration.is_nan() {
         // JSON has no NaN: the field prints as null, so the reason must be said here
         report.warnings.push(
-            "max_penetration is not a number: the obstacle ψ or u_h is not finite at some vertex or quadrature point".into(),
+            "max_penetration is not a number: the obstacle ψ or u_h is not finite at some point the penetration check samples (the vertices, quadrature points and, on meshes of few cells, a lattice on each cell)".into(),
         );
     }
     report.mesh_quality = MeshQualityReport {
@@ -1801,15 +1804,7 @@ fn open_gap_warning(
                 l.max(load(x).abs()),
             )
         });
-    let extent = |k: usize| {
-        let (lo, hi) = vertices
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                (lo.min(x[k]), hi.max(x[k]))
-            });
-        hi - lo
-    };
-    let diameter = extent(0).hypot(extent(1));
+    let diameter = bounding_diameter(u.mesh);
     let rounding = OPEN_GAP_ROUNDING * f64::EPSILON * size.max(largest_load * diameter * diameter);
     (gap > OPEN_GAP_WARNING * size && gap > rounding).then(|| {
         format!(
@@ -1819,26 +1814,79 @@ fn open_gap_warning(
     })
 }
 
-/// Largest `max_penetration`, relative to the obstacle's range over the points sampled,
-/// that passes without a warning.
+/// The diagonal of `mesh`'s bounding box.
+fn bounding_diameter(mesh: &TriangleMesh) -> f64 {
+    let extent = |k: usize| {
+        let (lo, hi) = mesh
+            .vertices()
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x[k]), hi.max(x[k]))
+            });
+        hi - lo
+    };
+    extent(0).hypot(extent(1))
+}
+
+/// Largest `max_penetration`, relative to the larger of ψ's range over the points
+/// sampled and u_h's range over the vertices, that passes without a warning.
 const PENETRATION_WARNING: f64 = 1e-2;
 
-/// A warning when u_h dips below ψ by more than [`PENETRATION_WARNING`] of ψ's range
-/// `range` (`max ψ − min ψ` over the points `max_penetration` sampled, so that a peak of
-/// ψ between the vertices counts; nothing to compare with for a flat ψ): the weak
-/// cell-wise constraint lets u_h cross ψ by O(h²|∇²(u − ψ)|), and a load that bends u
-/// sharply at the free boundary (membrane-lshape at q = 1e4: 0.38 on N = 64, falling
-/// to 0.034 on N = 256) makes that visible on the mesh.
-fn penetration_warning(penetration: f64, range: f64, nodal: bool) -> Option<String> {
+/// What `max_penetration` is compared with ([`penetration_warning`]), from the solved
+/// fields: `scale`, the larger of ψ's range over the penetration's samples and u_h's
+/// range over the vertices (a flat ψ under a bent membrane still has a size to compare
+/// with: a tester's ψ = 0 under g = 1 dipped 0.62 without a word), and `rounding`, the
+/// rounding of the values compared ([`OPEN_GAP_ROUNDING`] ε times the largest of |u_h|,
+/// |ψ| and |f| d²: ψ = 10¹² + 10⁻³x dipped one ulp of 10¹², "9.4 %" of its range).
+fn penetration_scales(
+    report: &MembraneReport,
+    fields: &MembraneFields,
+    load: &fem_runtime::DataFn,
+) -> (f64, f64) {
+    let extremes = |values: &[f64]| {
+        values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    let (u_lo, u_hi) = extremes(&fields.u);
+    let (psi_lo, psi_hi) = extremes(&fields.psi);
+    let largest_load = fields
+        .mesh
+        .vertices()
+        .iter()
+        .map(|x| load(x).abs())
+        .filter(|f| f.is_finite())
+        .fold(0.0f64, f64::max);
+    let diameter = bounding_diameter(&fields.mesh);
+    let level = [u_lo, u_hi, psi_lo, psi_hi]
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(largest_load * diameter * diameter, |m, v| m.max(v.abs()));
+    let u_range = if u_hi >= u_lo { u_hi - u_lo } else { 0.0 };
+    (
+        report.obstacle_range.max(u_range),
+        OPEN_GAP_ROUNDING * f64::EPSILON * level,
+    )
+}
+
+/// A warning when u_h dips below ψ by more than [`PENETRATION_WARNING`] of `range` and
+/// by more than `rounding` ([`penetration_scales`]): the weak cell-wise constraint lets
+/// u_h cross ψ by O(h²|∇²(u − ψ)|), and a load that bends u sharply at the free boundary
+/// (membrane-lshape at q = 1e4: 0.38 on N = 64, falling to 0.034 on N = 256) makes that
+/// visible on the mesh.
+fn penetration_warning(penetration: f64, range: f64, rounding: f64, nodal: bool) -> Option<String> {
     let share = 100.0 * penetration / range;
-    (range > 0.0 && penetration > PENETRATION_WARNING * range).then(|| {
+    (range > 0.0 && penetration > PENETRATION_WARNING * range && penetration > rounding).then(|| {
         if nodal {
             format!(
-                "u_h dips below ψ between the vertices by up to {penetration:.2e}, {share:.1}% of ψ's range: the nodal constraint holds at the vertices only, and this mesh does not resolve ψ's curvature (refine)"
+                "u_h dips below ψ between the vertices by up to {penetration:.2e}, {share:.1}% of the larger of ψ's and u_h's ranges ({range:.2e}): the nodal constraint holds at the vertices only, and this mesh does not resolve ψ's curvature (refine)"
             )
         } else {
             format!(
-                "u_h dips below ψ by up to {penetration:.2e}, {share:.1}% of ψ's range: the cell-wise constraint does not resolve the free boundary at this mesh size (refine, or use p1-nodal, which keeps u_h ≥ ψ at the vertices)"
+                "u_h dips below ψ by up to {penetration:.2e}, {share:.1}% of the larger of ψ's and u_h's ranges ({range:.2e}): the cell-wise constraint does not resolve the free boundary at this mesh size (refine, or use p1-nodal, which keeps u_h ≥ ψ at the vertices)"
             )
         }
     })

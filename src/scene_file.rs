@@ -677,6 +677,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
             ("exact.contact_area", e.contact_area),
         ] {
             if let Some(v) = value {
+                // −0.0 passes (it is ≥ 0) and is read as 0, not echoed as −0
                 if !(v.is_finite() && v >= 0.0) {
                     return Err(at(
                         key,
@@ -702,13 +703,16 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
                 .as_deref()
                 .map(|l| expression(l, "exact.lambda", path))
                 .transpose()?,
-            total_contact_force: e.contact_force,
-            contact_area: e.contact_area,
+            total_contact_force: e.contact_force.map(|v| v + 0.0),
+            contact_area: e.contact_area.map(|v| v + 0.0),
         }),
     };
     let target_l2 = file.accuracy.unwrap_or(1e-3);
     if !(target_l2 > 0.0 && target_l2.is_finite()) {
-        return Err(at("accuracy", format!("{target_l2} must be positive")));
+        return Err(at(
+            "accuracy",
+            format!("{target_l2} must be positive and finite"),
+        ));
     }
     let name = scene_name(file.name.as_deref(), path, "scene").map_err(|m| at("name", m))?;
     let scene = MembraneScene {

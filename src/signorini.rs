@@ -219,7 +219,9 @@ pub struct ContactReport {
     /// varies within an edge faster than that quadrature resolves. NaN (null in JSON)
     /// for a scene file whose supports hold the body along n_c.
     pub discretized_load: f64,
-    /// `|total_contact_force − discretized_load| / discretized_load`: 0 to solver
+    /// `|total_contact_force − discretized_load| / discretized_load` (a scene file's: over
+    /// the larger of that and `∫|q| ds`, so that a pressure whose resultant is a small
+    /// share of its size is not judged by the rounding of the rest): 0 to solver
     /// precision (a rigid translation lies in V_h, so equilibrium is exact); NaN (null in
     /// JSON) for a scene file whose supports act along n_c and carry part of the load.
     pub equilibrium_residual: f64,

@@ -288,16 +288,17 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io
     std::fs::rename(tmp, path)
 }
 
-/// [`write_csv`] with a first column `pair` of names: each row's first value is the index
-/// of its pair in `pairs` (an index out of range is written as it is), `header` the
-/// other columns' names.
-pub(crate) fn write_csv_by_pair(
+/// [`write_csv`] with a first column `column` of names (a pair, a method): each row's
+/// first value is the index of its name in `names` (an index out of range is written as
+/// it is), `header` the other columns' names.
+pub(crate) fn write_csv_named(
     path: &Path,
+    column: &str,
     header: &str,
-    pairs: &[&str],
+    names: &[&str],
     rows: &[Vec<f64>],
 ) -> std::io::Result<()> {
-    write_csv(path, &format!("pair,{header}"), rows)?;
+    write_csv(path, &format!("{column},{header}"), rows)?;
     // the numbers are written by `write_csv` alone; here the first cell of each line is
     // swapped for its pair's name
     let text = std::fs::read_to_string(path)?;
@@ -312,7 +313,7 @@ pub(crate) fn write_csv_by_pair(
         let name = index
             .parse::<usize>()
             .ok()
-            .and_then(|i| pairs.get(i))
+            .and_then(|i| names.get(i))
             .copied()
             .unwrap_or(index);
         named.push_str(name);
@@ -513,8 +514,9 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
         work,
     ));
     plot::stacked(&output(out, &name, Study::Convergence, "svg"), &panels).map_err(io)?;
-    write_csv_by_pair(
+    write_csv_named(
         &output(out, &name, Study::Convergence, "csv"),
+        "pair",
         "size,h,cells,dofs,error_l2,error_h1,error_multiplier,force_error,contact_error,iterations,seconds",
         &pairs,
         &csv,
@@ -701,8 +703,9 @@ fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
             header += &format!(",{side}_{k}");
         }
     }
-    write_csv_by_pair(
+    write_csv_named(
         &output(out, &name, Study::Stability, "csv"),
+        "pair",
         &header,
         &scene.stability_pairs(),
         &csv,
@@ -1033,9 +1036,11 @@ fn run_work_precision(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<
         &series,
     )
     .map_err(io)?;
-    write_csv(
+    write_csv_named(
         &output(out, &name, Study::WorkPrecision, "csv"),
-        "method_index,size,seconds,error_l2,error_h1,iterations",
+        "method",
+        "size,seconds,error_l2,error_h1,iterations",
+        &METHODS.map(|(method, _, _)| method),
         &csv,
     )
     .map_err(io)

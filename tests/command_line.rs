@@ -685,5 +685,18 @@ fn text_output_keeps_the_thickness_and_warnings_on_stderr() {
         !run.status.success() && errors.contains("--cold does not apply"),
         "{errors}"
     );
+    // α = 0 goes to clarabel too: --cold and an explicit --solver pdas cannot act
+    for (extra, refused) in [
+        (&["--cold"][..], "--cold does not apply"),
+        (&["--solver", "pdas"], "--solver pdas does not apply"),
+    ] {
+        let args = [&["solve", "membrane-flat", "--alpha", "0"][..], extra].concat();
+        let run = fem_forms(&args, &out);
+        let errors = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            !run.status.success() && errors.contains(refused),
+            "{errors}"
+        );
+    }
     std::fs::remove_dir_all(&out).ok();
 }

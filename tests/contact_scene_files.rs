@@ -474,7 +474,7 @@ fn bad_contact_scene_files_name_the_key() {
         (
             format!("{RECTANGLE}\n[parameters]\ncontact_centre = 5.0\n"),
             "parameters.contact_centre",
-            &["5 lies outside", "spans 0 to 2", "(x)"],
+            &["5 lies outside", "spans 0 to 2 in x"],
         ),
         // a resultant that is zero to rounding is refused whatever the sign of its
         // rounding (x − 1 came out on one side, sin(πx) on the other)
@@ -883,5 +883,52 @@ fn the_gap_is_measured_by_the_translation_it_causes() {
     assert!(
         message.contains("--load 1e-9") && message.contains("`data.gap`"),
         "{message}"
+    );
+}
+
+/// A second tester's bypasses of today's checks: a contact part whose faces point both
+/// ways passes the mean of ν·n_c on a trapezoid (bottom 2 long, top 1 long: the tester's
+/// mesh, `tests/data/trapezoid_faces.msh`), and tripled the peak pressure; it is refused
+/// by the face turned away. A pressure whose resultant is small but real (1e-9 of
+/// ∫|q| ds) solves without the equilibrium warning, which compared the contact force's
+/// rounding of ∫|q| with the resultant alone.
+#[test]
+fn faces_turned_away_and_small_resultants_are_judged_by_their_size() {
+    let text = r#"
+    model = "contact"
+    [mesh]
+    file = "trapezoid_faces.msh"
+    [material]
+    young = 1000.0
+    poisson = 0.3
+    [boundary]
+    contact = ["bottom", "top"]
+    load = "right"
+    fixed_x = "left"
+    [data]
+    pressure = "1"
+    gap = "0"
+"#;
+    let message = parse(text).unwrap_err().to_string();
+    assert!(
+        message.contains("`boundary.contact`") && message.contains("faces away"),
+        "{message}"
+    );
+    let small = RECTANGLE.replace(
+        "pressure = \"0.5 * (2 + 3)\"",
+        "pressure = \"x - 1 + 1e-9\"",
+    );
+    let solved = contact_scene_file::solve(&parse(&small).unwrap(), &Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let warnings = fem_forms::signorini::warnings(&solved.report);
+    assert!(
+        !warnings.iter().any(|w| w.contains("misses the load")),
+        "{warnings:?}"
+    );
+    // the contact force balances the 2e-9 resultant to the rounding of ∫|q| ds = 1
+    let r = &solved.report;
+    assert!(
+        (r.total_contact_force - r.discretized_load).abs() < 1e-12,
+        "{r:?}"
     );
 }
