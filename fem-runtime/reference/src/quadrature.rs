@@ -45,6 +45,9 @@ pub fn points_for_degree(degree: usize) -> usize {
 /// Nodes are the roots of the Legendre polynomial `P_n`, found by Newton's method from
 /// Tricomi's initial guesses; the recurrence is stable, so nodes and weights are accurate
 /// to a few ulps for the moderate `n` used by element kernels.
+///
+/// # Panics
+/// For `n = 0` (no rule has no points; [`points_for_degree`] never gives 0).
 pub fn gauss_legendre(n: usize) -> QuadratureRule {
     assert!(n >= 1, "a Gauss–Legendre rule needs at least one point");
     let mut points = vec![0.0; n];

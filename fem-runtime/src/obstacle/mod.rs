@@ -1181,6 +1181,10 @@ fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
 
 impl<G> ObstacleSolution<G> {
     /// The coefficients of model field `field`.
+    ///
+    /// # Panics
+    /// When `field` is not a field of the solved model: take the index from
+    /// `Model::field(name)`, which names the fields when it errs.
     pub fn field(&self, field: usize) -> &[f64] {
         &self.values[self.discretization.dofs.range(field).unwrap()]
     }
