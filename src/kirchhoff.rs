@@ -354,7 +354,7 @@ pub struct KirchhoffReport {
     /// Without an obstacle: the series' centre deflection `c q a⁴/D` (clamped: the
     /// tabulated 0.00126532, six digits; simply supported: Navier's series summed).
     pub reference_centre_deflection: Option<f64>,
-    /// Without an obstacle (and q ≠ 0): `(w_h(centre) − reference)/reference`.
+    /// Without an obstacle: `(w_h(centre) − reference)/reference`, 0 at q = 0 (both 0).
     pub relative_error: Option<f64>,
     /// `max |w_h|` over the vertices, edge midpoints and centroids of the cells.
     pub max_deflection: f64,
@@ -426,12 +426,12 @@ pub fn solve(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
     }
 }
 
-/// The N of the nested levels ending at `n`: `n/2^k ≥ NESTED_FROM`, …, `n/2`, `n`.
 /// N of the N×N×2 mesh of `triangles` cells.
 fn mesh_size_of(triangles: usize) -> usize {
     ((triangles / 2) as f64).sqrt().round() as usize
 }
 
+/// The N of the nested levels ending at `n`: `n/2^k ≥ NESTED_FROM`, …, `n/2`, `n`.
 fn level_sizes(n: usize, nested: bool) -> Vec<usize> {
     let mut sizes = vec![n];
     while nested && sizes[0] % 2 == 0 && sizes[0] / 2 >= NESTED_FROM {
@@ -513,6 +513,9 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
     let view = solution.view(w);
     let basis = TriangleBasis::new(view.map.element());
     let mut warnings = Vec::new();
+    if request.nested && newton && obstacle != KirchhoffObstacle::None {
+        warnings.extend(crate::plates::cold_coarsest_warning(&sizes, NESTED_FROM));
+    }
     // as beams and membranes do: the eliminated λ_h loses digits where C falls below the
     // rounding of G − BU, and its recovery may have been skipped (out of memory)
     if solution.multiplier_noise > 1e-6 {
@@ -590,7 +593,13 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
         centre_deflection: centre,
         reference_centre_deflection: reference,
         // q = 0: w_h = 0 = reference, no relative error to speak of
-        relative_error: reference.filter(|&r| r != 0.0).map(|r| (centre - r) / r),
+        // q = 0: both deflections are 0 exactly, and so is the error, as the Mindlin
+        // plates report it (a 0/0 left out would read as "not measured")
+        relative_error: reference.and_then(|r| match (r, centre) {
+            (r, c) if r == 0.0 && c == 0.0 => Some(0.0),
+            (r, _) if r == 0.0 => None,
+            (r, c) => Some((c - r) / r),
+        }),
         max_deflection: max_deflection(&view, &basis),
         total_contact_force: solution.total_contact_force(),
         contact_area: filled_area(&solution.discretization.mesh, &contact),
@@ -1159,7 +1168,13 @@ fn obstacle_convergence(scene: KirchhoffScene, full: bool, out: &Path) -> Result
                     values.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
                 let rates: Vec<String> = crate::studies::rates(&differences)
                     .iter()
-                    .map(|r| format!("{r:.2}"))
+                    .map(|r| {
+                        if r.is_nan() {
+                            "-".into()
+                        } else {
+                            format!("{r:.2}")
+                        }
+                    })
                     .collect();
                 println!(
                     "  {name:<13} differences {} rates {}",
@@ -1175,7 +1190,10 @@ fn obstacle_convergence(scene: KirchhoffScene, full: bool, out: &Path) -> Result
                     meshes[1..]
                         .iter()
                         .zip(&differences)
-                        .map(|(&n, &d)| (n as f64, (d / values.last().unwrap().abs()).max(1e-14)))
+                        // a log axis has no 0: a difference of 0 (a contact area equal on
+                        // two meshes) is left out, not drawn at 1e-14
+                        .map(|(&n, &d)| (n as f64, d / values.last().unwrap().abs()))
+                        .filter(|&(_, d)| d > 0.0 && d.is_finite())
                         .collect(),
                 ));
             }

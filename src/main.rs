@@ -64,10 +64,11 @@ enum Command {
         #[command(flatten)]
         options: Box<SolveOptions>,
     },
-    /// Run a study and write its chart and CSV (out/<scene>-<study>.svg, .csv):
-    /// `study <scene> [study]` runs one study the scene hosts (all of them when left
-    /// out; see `list`); `study <study>` runs it on every scene that hosts it (convergence,
-    /// locking, stability, alpha, work-precision, iterations).
+    /// Run a study and write its chart and CSV (out/<scene>-<study>.svg, .csv; the
+    /// lambda-scatter study also out/<scene>-lambda-layer.*): `study <scene> [study]`
+    /// runs one study the scene hosts (all of them when left out; see `list`);
+    /// `study <study>` runs it on every scene that hosts it (convergence, locking,
+    /// stability, alpha, work-precision, iterations, lambda-scatter).
     Study {
         /// A scene name, or a study.
         study: String,
@@ -790,13 +791,19 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
             "--plot",
         ],
         &format!(
-            "`{}` is a plate scene on {mesh} (--mesh-size, --thickness, --load, --alpha, --pair, --cold, --no-obstacle, --json)",
-            scene.name
+            "`{}` is a plate scene on {mesh} ({})",
+            scene.name,
+            if scene.obstacle == PlateObstacle::None {
+                "--mesh-size, --thickness, --load, --pair, --json"
+            } else {
+                "--mesh-size, --thickness, --load, --alpha, --pair, --cold, --no-obstacle, --json"
+            }
         ),
     )?;
     if scene.obstacle == PlateObstacle::None || options.no_obstacle {
-        // Without an obstacle the plate is one linear solve on the finest mesh: α and the
-        // nested start only act on contact, so accepting them would suggest an effect.
+        // Without an obstacle the plate is one linear solve on the finest mesh (plates::solve
+        // does not nest then): α and the nested start only act on contact, so accepting
+        // them would suggest an effect.
         options.refuse(
             &["--alpha", "--cold"],
             &format!(

@@ -256,9 +256,20 @@ pub fn study_scene(entry: &SceneEntry) -> Result<Box<dyn StudyScene>> {
     }
 }
 
-/// Observed rates `log2(e_k / e_{k+1})` of errors on meshes halved each time.
+/// Observed rates `log2(e_k / e_{k+1})` of errors on meshes halved each time; NaN
+/// (printed `-`) where either error is 0 or not finite, which has no rate (a contact
+/// area equal on two meshes printed `inf -inf`).
 pub fn rates(errors: &[f64]) -> Vec<f64> {
-    errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect()
+    errors
+        .windows(2)
+        .map(|e| {
+            if e[0] > 0.0 && e[1] > 0.0 && e[0].is_finite() && e[1].is_finite() {
+                (e[0] / e[1]).log2()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect()
 }
 
 pub(crate) fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io::Result<()> {
@@ -1146,6 +1157,30 @@ pub fn run(scene: &dyn StudyScene, study: Study, full: bool, out: &Path) -> Resu
 
 #[cfg(test)]
 mod tests {
+    /// A zero or infinite error has no rate: NaN (printed `-`), not `inf` or `-inf` (a
+    /// tester's contact area equal on two meshes); the others are log₂ of the ratio.
+    #[test]
+    fn rates_of_zero_differences_are_not_a_number() {
+        let r = super::rates(&[4.0, 1.0, 0.0, 2.0, f64::INFINITY, 1.0]);
+        assert_eq!(r[0], 2.0);
+        assert!(
+            r[1].is_nan() && r[2].is_nan() && r[3].is_nan() && r[4].is_nan(),
+            "{r:?}"
+        );
+    }
+
+    /// The name column of `write_csv_named`: indices become names, one out of range
+    /// stays a number.
+    #[test]
+    fn named_csv_rows_start_with_their_names() {
+        let path = std::env::temp_dir().join(format!("fem-forms-named-{}.csv", std::process::id()));
+        let rows = vec![vec![1.0, 8.0], vec![0.0, 16.0], vec![5.0, 32.0]];
+        super::write_csv_named(&path, "pair", "size", &["p1-p0", "p2-p0"], &rows).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text, "pair,size\np2-p0,8\np1-p0,16\n5,32\n");
+        std::fs::remove_file(&path).unwrap();
+    }
+
     /// Counts come out as integers (a tester found `8e0` for a mesh size), measurements
     /// with every digit, missing values as `NaN`, and each reads back exactly.
     #[test]

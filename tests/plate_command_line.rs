@@ -486,3 +486,30 @@ fn a_plate_whose_contact_set_is_not_real_is_warned_about() {
         "{json}"
     );
 }
+
+/// A third tester's plate findings: an odd N (no coarser nested level) started Newton
+/// cold without a word, and `--cold` then changed nothing; without an obstacle the plate
+/// was solved on every nested level although the refusal of `--alpha` called it one
+/// linear solve, and its JSON reported an α; kirchhoff-square at q = 0 had a null
+/// relative error where the Mindlin plates report 0; the refusal on mindlin-square listed
+/// options it refuses.
+#[test]
+fn plates_say_when_nesting_is_lost_and_solve_unobstructed_once() {
+    let odd = scene_json("mindlin-disk", &["--mesh-size", "33"]);
+    assert!(odd["warnings"].to_string().contains("is odd"), "{odd}");
+    assert_eq!(odd["levels"].as_array().unwrap().len(), 1, "{odd}");
+    let even = scene_json("mindlin-disk", &["--mesh-size", "32"]);
+    assert!(!even["warnings"].to_string().contains("nested"), "{even}");
+    let free = scene_json("mindlin-disk", &["--no-obstacle", "--mesh-size", "16"]);
+    assert_eq!(free["levels"].as_array().unwrap().len(), 1, "{free}");
+    assert!(free["alpha"].is_null(), "{free}");
+    assert!(!even["alpha"].is_null(), "{even}");
+    let unloaded = scene_json("kirchhoff-square", &["--load", "0"]);
+    assert_eq!(unloaded["relative_error"].as_f64(), Some(0.0), "{unloaded}");
+    let run = fem_forms(&["solve", "mindlin-square", "--plot"]);
+    let errors = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        errors.contains("--plot does not apply") && !errors.contains("--alpha"),
+        "{errors}"
+    );
+}
