@@ -595,10 +595,12 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
         // q = 0: w_h = 0 = reference, no relative error to speak of
         // q = 0: both deflections are 0 exactly, and so is the error, as the Mindlin
         // plates report it (a 0/0 left out would read as "not measured")
-        relative_error: reference.and_then(|r| match (r, centre) {
-            (r, c) if r == 0.0 && c == 0.0 => Some(0.0),
-            (r, _) if r == 0.0 => None,
-            (r, c) => Some((c - r) / r),
+        relative_error: reference.and_then(|r| {
+            if r != 0.0 {
+                Some((centre - r) / r)
+            } else {
+                (centre == 0.0).then_some(0.0)
+            }
         }),
         max_deflection: max_deflection(&view, &basis),
         total_contact_force: solution.total_contact_force(),
@@ -937,7 +939,7 @@ pub fn summary(r: &KirchhoffReport) -> String {
         r.centre_deflection
     );
     if let (Some(reference), Some(e)) = (r.reference_centre_deflection, r.relative_error) {
-        line += &format!(" (series {reference:.8e}, relative error {e:+.2e})");
+        line += &format!(" (reference {reference:.8e}, relative error {e:+.2e})");
     }
     line += &format!(
         ", max |w| {:.6e}, ∫λ_h {:.6e}, contact area {:.5}",
@@ -1025,7 +1027,7 @@ fn square_convergence(scene: KirchhoffScene, full: bool, out: &Path) -> Result<(
         String::from("support,pair,mesh_size,centre_deflection,relative_error,difference,rate\n");
     let mut series = Vec::new();
     println!(
-        "\nconvergence: {}, centre deflection against the series",
+        "\nconvergence: {}, centre deflection against the reference (simply supported: Navier's series; clamped: the tabulated 0.00126532, whose six digits floor the error near 7e-7)",
         scene.name
     );
     println!(
@@ -1091,7 +1093,7 @@ fn square_convergence(scene: KirchhoffScene, full: bool, out: &Path) -> Result<(
         ),
         crate::plot::Axes {
             x: "N (N×N×2 mesh)",
-            y: "|w_h(centre) / series − 1|",
+            y: "|w_h(centre) / reference − 1|",
             log_x: true,
             log_y: true,
         },
