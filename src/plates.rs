@@ -687,7 +687,7 @@ where
     };
     if max_penetration > 1e-2 * height.abs().max(1e-300) {
         warnings.push(format!(
-            "w_h crosses the obstacle by up to {max_penetration:.2e} ({:.1} % of its height {height}): the constraint holds on each cell's mean, so coarse meshes let the plate pass ψ by O(h²); refine the mesh",
+            "w_h crosses the obstacle by up to {max_penetration:.2e} ({:.1} % of the obstacle's height {height}, the size a crossing is judged by): the constraint holds on each cell's mean, so coarse meshes let the plate pass ψ by O(h²); refine the mesh",
             100.0 * max_penetration / height.abs()
         ));
     }
