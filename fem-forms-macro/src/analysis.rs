@@ -511,6 +511,30 @@ impl<'a> Context<'a> {
         let value = self.value(&d.body, true);
         self.in_expression = false;
         let value = value?;
+        // a function of its arguments only: where it is called they are substituted, and
+        // a function not among them would have no image (a tester's `γ(θ) := ∇w − θ`
+        // panicked the macro)
+        let allowed: Vec<usize> = groups.iter().flatten().copied().collect();
+        let stray = value.clone().entries().into_iter().flatten().find_map(|t| {
+            t.args
+                .iter()
+                .find(|a| !allowed.contains(&a.symbol))
+                .map(|a| (a.symbol, t.origin))
+        });
+        if let Some((symbol, at)) = stray {
+            let function = self.symbols.function_name(symbol).to_string();
+            self.errors.push(
+                Diagnostic::text(
+                    at,
+                    format!("`{function}` is not an argument of `{}`", d.name.text),
+                )
+                .help(format!(
+                    "a named expression is a function of its arguments only: add `{function}` to them, e.g. `{}(…, {function}) := …`",
+                    d.name.text
+                )),
+            );
+            return None;
+        }
         Some(Form {
             name: d.name.text.clone(),
             source: source(d, forms_text),
@@ -551,11 +575,11 @@ impl<'a> Context<'a> {
                     Diagnostic::text(
                         t.origin,
                         format!(
-                            "the coefficient of this term of `{}` overflows ({})",
+                            "the coefficient of this term of `{}` overflows or underflows ({})",
                             d.name.text, t.coefficient
                         ),
                     )
-                    .help("products and quotients of the constants must stay finite (below about 1.8e308)"),
+                    .help("products, quotients and powers of the constants must stay within the normal range of f64, about 2.2e-308 to 1.8e308 in size"),
                 );
                 continue;
             }
@@ -1005,6 +1029,40 @@ impl<'a> Context<'a> {
             .collect()
     }
 
+    /// `Et³`, `αh_T²`, `fv'`: a power or primes after a run of juxtaposed names belong to
+    /// its last name, as mathematics reads them (`E·t³`, `f·v'`); applied to the whole
+    /// run they gave `(Et)³` without a word (a tester's `Et³` kernel was 4× too large).
+    /// The run rewritten as the product of its names with `apply` on the last, or `None`
+    /// when `a` is not such a run.
+    fn last_of_run(&self, a: &Expr, apply: impl FnOnce(Box<Expr>) -> ExprKind) -> Option<Expr> {
+        let ExprKind::Symbol(name) = &a.kind else {
+            return None;
+        };
+        if self.symbols.all_names().contains(&name.as_str()) {
+            return None;
+        }
+        let mut parts = self.split(name)?;
+        let last = parts.pop()?;
+        let loc = a.loc;
+        let symbol = |text: String| {
+            Box::new(Expr {
+                kind: ExprKind::Symbol(text),
+                loc,
+            })
+        };
+        let mut e = Expr {
+            kind: apply(symbol(last)),
+            loc,
+        };
+        for part in parts.into_iter().rev() {
+            e = Expr {
+                kind: ExprKind::Mul(symbol(part), Box::new(e)),
+                loc,
+            };
+        }
+        Some(e)
+    }
+
     /// Splits `sλ` into declared names (longest first), if it can be done.
     fn split(&self, name: &str) -> Option<Vec<String>> {
         let names = self.symbols.all_names();
@@ -1170,7 +1228,25 @@ impl<'a> Context<'a> {
         let loc = e.loc;
         match &e.kind {
             ExprKind::Symbol(name) => self.symbol(name, loc, inside_integral),
-            ExprKind::Call { name, groups } => self.call(name, groups, loc),
+            ExprKind::Call { name, groups } => {
+                let called = self.call(name, groups, loc)?;
+                // a form is a sum of integrals: inside another integral it would be
+                // integrated twice, or over another measure (a tester's `∫ g(μ)` with
+                // `g = ∫_Γ_C … ds` became a cell integral without a word)
+                if inside_integral
+                    && called
+                        .clone()
+                        .entries()
+                        .iter()
+                        .any(|e| e.iter().any(|t| t.integrated))
+                {
+                    return self.fail_value(
+                        Diagnostic::text(loc, format!("integral inside an integral: the form `{name}` is a sum of integrals"))
+                            .help(format!("call forms outside integrals (`∫ A + {name}(…)`); a quantity to integrate is a named expression `X(u) := …`")),
+                    );
+                }
+                Some(called)
+            }
             ExprKind::Neg(a) => Some(self.value(a, inside_integral)?.map(symbolic::neg)),
             ExprKind::Add(..) | ExprKind::Sub(..) => self.sum_value(e, inside_integral),
             ExprKind::Mul(a, b) => {
@@ -1414,6 +1490,9 @@ impl<'a> Context<'a> {
         match &e.kind {
             ExprKind::Number(v) => Some(vec![Monomial::constant(*v, loc)]),
             ExprKind::Pow(a, n) => {
+                if let Some(e) = self.last_of_run(a, |last| ExprKind::Pow(last, *n)) {
+                    return self.expand(&e, inside_integral);
+                }
                 let x = self.expand(a, inside_integral)?;
                 if x.iter().any(|t| t.integrated) {
                     return self.fail(Diagnostic::text(loc, "power of an integral"));
@@ -1436,6 +1515,9 @@ impl<'a> Context<'a> {
                         Diagnostic::text(loc, "a prime ′ is the derivative along an interval")
                             .help("on triangles write ∇ (grad) for the gradient and Δ (lap) for the Laplacian"),
                     );
+                }
+                if let Some(e) = self.last_of_run(a, |last| ExprKind::Derivative(last, *k)) {
+                    return self.expand(&e, inside_integral);
                 }
                 let x = self.expand(a, inside_integral)?;
                 self.partial(&x, 0, *k, loc)

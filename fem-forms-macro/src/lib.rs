@@ -163,9 +163,11 @@
 //! literal with the line, the column and a caret in the message, plus a hint; errors in
 //! several definitions are reported together. No input makes the macro panic (a
 //! property test feeds it random texts): in particular
-//! - a number or a product of constants that overflows `f64` is an error at the term;
+//! - a number or a product of constants that overflows or underflows `f64` is an error
+//!   at the term;
 //! - expressions nest at most 100 levels (parentheses, signs, ∇/Δ, integrals, the
-//!   factors of one product, powers and primes); a sum may have any number of terms;
+//!   factors of one product, powers and primes); a sum has at most 10,000 terms
+//!   (split longer ones into forms), `Δ` and `∂` powers go up to 8;
 //! - exponents may build powers up to 1000 in all (`f^999999`, `t⁻²¹⁴⁷⁴⁸³⁶⁴⁸` or
 //!   `((f^10)^10)^11` are errors at the power: the expansion multiplies bases out and
 //!   adds exponents in integers);

@@ -250,6 +250,16 @@ fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
 /// expansion recurse on it, and a deeper text must be an error, not a stack overflow.
 pub const MAX_NESTING: usize = 100;
 
+/// Most terms of one sum: the syntax tree of a sum is a left spine as long as the sum,
+/// and the compiler's own passes over the macro's output (and the tree's drop) recurse
+/// on it. 20,000 terms compiled; a tester's 60,000 overflowed rustc's stack.
+pub const MAX_TERMS: usize = 10_000;
+
+/// Highest power of `Δ` or `∂` (`Δ³ w` is of order 6): beyond any element's degree (the
+/// quintic Argyris) every such derivative vanishes, and a tester's `Δ^999999` built a
+/// million nested nodes that overflowed the stack.
+pub const MAX_OPERATOR_POWER: i32 = 8;
+
 /// Where `body` is nested deeper than [`MAX_NESTING`], counting every node except the
 /// left spine of a sum (expanded in a loop), if it is. Walks with an explicit stack.
 fn too_deep(body: &Expr) -> Option<Loc> {
@@ -631,9 +641,20 @@ impl<'a> Parser<'a> {
 
     fn sum(&mut self, integrand: bool) -> Result<Expr> {
         let mut lhs = self.term()?;
+        let mut terms = 1usize;
         while let Some(Tok::Plus | Tok::Minus) = self.peek_tok() {
             if integrand && self.starts_form_term(self.pos + 1) {
                 break;
+            }
+            terms += 1;
+            if terms > MAX_TERMS {
+                return Err(Diagnostic::text(
+                    self.peek().map_or(lhs.loc, |t| t.loc),
+                    format!("a sum of more than {MAX_TERMS} terms"),
+                )
+                .help(
+                    "split it into several forms and add their calls: `a(u;v) = a₁(u;v) + a₂(u;v)`",
+                ));
             }
             let op = self.bump().unwrap().tok.clone();
             let rhs = self.term()?;
@@ -842,6 +863,17 @@ impl<'a> Parser<'a> {
                 ),
             )
             .help("write a positive integer power: Δ² w, ∂_x² w"));
+        }
+        if n > MAX_OPERATOR_POWER {
+            return Err(Diagnostic::text(
+                whole,
+                format!(
+                    "{} raised to {n}: a derivative of order {} or more",
+                    describe(op),
+                    n.saturating_mul(if matches!(op, Tok::Laplacian) { 2 } else { 1 })
+                ),
+            )
+            .help(format!("powers up to {MAX_OPERATOR_POWER} are derivatives some element can carry; the highest-degree element, Argyris, is quintic, and every derivative of order 6 or more of it is zero")));
         }
         Ok((n as u32, whole))
     }

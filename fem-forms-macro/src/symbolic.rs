@@ -220,19 +220,48 @@ impl Monomial {
     }
 }
 
-/// Merges equal monomials and drops those whose coefficient is zero.
+/// Merges equal monomials and drops those whose coefficient is zero, or cancels to
+/// within the rounding of its summands. A non-finite one (an overflow, or an underflow
+/// that [`mul`] made NaN) is kept for the definition's check to report.
 pub fn normalize(terms: Expansion) -> Expansion {
-    let mut out: Expansion = Vec::with_capacity(terms.len());
+    // each merged monomial with the largest magnitude among its summands
+    let mut out: Vec<(Monomial, f64)> = Vec::with_capacity(terms.len());
     for t in terms {
-        match out.iter_mut().find(|o| o.key_eq(&t)) {
-            Some(o) => o.coefficient += t.coefficient,
-            None => out.push(t),
+        let size = t.coefficient.abs();
+        match out.iter_mut().find(|(o, _)| o.key_eq(&t)) {
+            Some((o, largest)) => {
+                o.coefficient += t.coefficient;
+                *largest = largest.max(size);
+            }
+            None => out.push((t, size)),
         }
     }
     // Cancellation leaves exact zeros only when the sums cancel exactly; terms that
-    // cancel up to rounding (1e-16 relative) are dropped as well.
-    out.retain(|t| t.coefficient != 0.0 && t.coefficient.abs() > 1e-300);
-    out
+    // cancel up to rounding (relative to their largest summand) are dropped as well. An
+    // absolute threshold (1e-300 until a tester's `∫ 1e-301 u v` vanished without a
+    // word) would drop small constants that cancel nothing.
+    out.into_iter()
+        .filter(|(t, largest)| {
+            let c = t.coefficient;
+            !c.is_finite() || (c != 0.0 && c.abs() > CANCELLATION * largest)
+        })
+        .map(|(t, _)| t)
+        .collect()
+}
+
+/// A merged coefficient below this fraction of its largest summand is their rounding.
+const CANCELLATION: f64 = 64.0 * f64::EPSILON;
+
+/// `c` of a product or power of non-zero coefficients, NaN where it underflowed (to 0 or
+/// to a subnormal, which has lost digits): the term would vanish or be inexact without
+/// a word (a tester's `(1e-5)^100`), and the definition reports the NaN as it reports an
+/// overflow.
+fn representable(c: f64) -> f64 {
+    if c == 0.0 || c.is_subnormal() {
+        f64::NAN
+    } else {
+        c
+    }
 }
 
 /// `a + b`
@@ -253,7 +282,11 @@ pub fn mul(a: &Expansion, b: &Expansion, origin: Loc) -> Expansion {
     let mut out = Vec::with_capacity(a.len() * b.len());
     for x in a {
         for y in b {
-            out.push(x.times(y, origin));
+            let mut m = x.times(y, origin);
+            if x.coefficient != 0.0 && y.coefficient != 0.0 {
+                m.coefficient = representable(m.coefficient);
+            }
+            out.push(m);
         }
     }
     normalize(out)
@@ -273,7 +306,7 @@ pub fn pow(a: &Expansion, n: i32, origin: Loc) -> Option<Expansion> {
         [m] if m.is_scalar() && m.coefficient != 0.0 => {
             let k = -n;
             Some(vec![Monomial {
-                coefficient: m.coefficient.powi(-k),
+                coefficient: representable(m.coefficient.powi(-k)),
                 params: m.params.iter().map(|&(i, e)| (i, -e * k)).collect(),
                 h_power: -m.h_power * k,
                 divisors: m

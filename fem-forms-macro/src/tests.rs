@@ -548,7 +548,10 @@ fn overflowing_constants_are_located_errors() {
             "a(u;v) = ∫ (1e999 − 1e999) u v",
             "number `1e999` is too large",
         ),
-        ("a(u;v) = ∫ 1e200·1e200 f u v", "overflows (inf)"),
+        ("a(u;v) = ∫ 1e200·1e200 f u v", "overflows or underflows (inf)"),
+        // a tester's silently vanished terms: an underflow is an error too
+        ("a(u;v) = ∫ 1e-200·1e-200 f u v", "overflows or underflows (NaN)"),
+        ("a(u;v) = ∫ (1e-5)^100 u v", "overflows or underflows (NaN)"),
     ] {
         let errors = rendered_errors(&expand(membrane("P2", forms)));
         assert!(
@@ -849,4 +852,126 @@ fn facet_integrals_ascii_and_unicode_agree() {
     assert_eq!(block.terms[0].normal, [2, 0]);
     assert_eq!(block.terms[0].h_power, 1);
     assert!(unicode[1].0.is_empty());
+}
+
+/// A model on intervals with the parameters E, t, α and the data f, for the runs of
+/// juxtaposed names below.
+fn run_model(forms: &str) -> TokenStream {
+    quote! {
+        /// Runs of names.
+        pub mod runs on interval {
+            unknowns: u: P2;
+            tests: v;
+            params: E, t, α;
+            data: f;
+            forms: #forms;
+        }
+    }
+}
+
+/// A tester's wrong kernels: a power or primes after a run of juxtaposed names applied
+/// to the whole run, so `Et³` was `(Et)³` and `αh_T²` was `α²h²` without a word, and
+/// `fv'` was refused as a derivative of data. They belong to the run's last name, as
+/// mathematics reads them: the expansion equals the spaced spelling's, kernel for kernel.
+#[test]
+fn powers_and_primes_bind_to_the_last_name_of_a_run() {
+    for (run, spaced) in [
+        ("a(u;v) = ∫ Et³ u'v'", "a(u;v) = ∫ E t³ u'v'"),
+        (
+            "a(u;v) = Σ_T αh_T² (u, v)_T",
+            "a(u;v) = Σ_T α h_T² (u, v)_T",
+        ),
+        ("a(u;v) = ∫ Et⁻² u'v'", "a(u;v) = ∫ E t⁻² u'v'"),
+        ("ℓ(v) = ∫ fv'", "ℓ(v) = ∫ f v'"),
+        ("a(u;v) = ∫ uv' + u'v", "a(u;v) = ∫ u v' + u'v"),
+    ] {
+        let joined = expand(run_model(run)).to_string();
+        assert!(!joined.contains("compile_error"), "{run}: {joined}");
+        let spaced_out = expand(run_model(spaced)).to_string();
+        // the form's text is embedded in the output: compare all else
+        assert_eq!(joined.replace(run, spaced), spaced_out, "{run}");
+    }
+    // and the whole run still multiplies where nothing follows it
+    let product = expand(run_model("a(u;v) = ∫ Et u'v'")).to_string();
+    let spaced = expand(run_model("a(u;v) = ∫ E t u'v'")).to_string();
+    assert_eq!(product.replace("Et u'v'", "E t u'v'"), spaced);
+}
+
+/// A tester's macro panic: a named expression using a function that is not its argument
+/// (`γ(θ) := ∇w − θ`, the Mindlin shear strain written with one argument) unwrapped a
+/// missing substitution. It is an error at the function, naming the expression.
+#[test]
+fn a_named_expression_uses_only_its_arguments() {
+    let out = expand(quote! {
+        /// Shear strain.
+        pub mod shear on triangle {
+            unknowns: θ: [P1]^2, w: P2;
+            tests: η, v;
+            forms: "
+                γ(θ) := ∇w − θ
+                a(θ,w;η,v) = ∫ γ(θ)·γ(η)
+            ";
+        }
+    });
+    let errors = rendered_errors(&out).join("\n");
+    assert!(
+        errors.contains("is not an argument of `γ`") && errors.contains("w"),
+        "{errors}"
+    );
+}
+
+/// A tester's wrong measure: a form called inside an integral (`∫ g(μ)` with `g` a
+/// boundary integral, `∫_Γ_C m(λ;μ) ds` with `m` a cell integral) compiled as the outer
+/// integral's kind. It is the "integral inside an integral" that `∫ ∫` already is.
+#[test]
+fn a_form_called_inside_an_integral_is_refused() {
+    for forms in [
+        "g(μ) = ∫_Γ_C ψ μ ds\n G(μ) = ∫ g(μ)",
+        "m(λ;μ) = ∫ λ μ\n M(λ;μ) = ∫_Γ_C m(λ;μ) ds",
+    ] {
+        let out = expand(quote! {
+            /// Facets.
+            pub mod facets on triangle {
+                unknowns: u: P1, λ: P0 >= 0;
+                tests: v, μ;
+                data: ψ;
+                facets: Γ_C;
+                forms: #forms;
+            }
+        });
+        let errors = rendered_errors(&out).join("\n");
+        assert!(
+            errors.contains("integral inside an integral"),
+            "{forms}: {errors}"
+        );
+    }
+}
+
+/// A tester's stack overflows in rustc: a sum of 60,000 terms and `Δ^999999 u`. Both are
+/// errors at the place now, and the limits are where the messages say.
+#[test]
+fn huge_sums_and_operator_powers_are_errors() {
+    let long = vec!["u v"; crate::parser::MAX_TERMS + 1].join(" + ");
+    let out = expand(run_model(&format!("a(u;v) = ∫ {long}")));
+    let errors = rendered_errors(&out).join("\n");
+    assert!(
+        errors.contains("a sum of more than 10000 terms"),
+        "{}",
+        &errors[..errors.len().min(400)]
+    );
+    let at_limit = vec!["u v"; crate::parser::MAX_TERMS].join(" + ");
+    let out = expand(run_model(&format!("a(u;v) = ∫ {at_limit}")));
+    assert!(!out.to_string().contains("compile_error"));
+    for (power, order) in [("Δ^999999", "1999998"), ("Δ^9", "18")] {
+        let out = expand(membrane("P2", &format!("a(u;v) = ∫ {power} u v")));
+        let errors = rendered_errors(&out).join("\n");
+        assert!(
+            errors.contains(&format!("order {order}")),
+            "{power}: {errors}"
+        );
+    }
+    let out = expand(membrane("P2", "a(u;v) = ∫ Δ^8 u v"));
+    assert!(!rendered_errors(&out)
+        .iter()
+        .any(|e| e.contains("raised to")));
 }
