@@ -901,7 +901,8 @@ impl<'a> Context<'a> {
             );
         }
         let names = self.symbols.all_names();
-        let hint = lookalike(name, names.iter().copied())
+        // ε is an operator, not a declared name, but `ϵ(θ)` is the same typo
+        let hint = lookalike(name, names.iter().copied().chain(["ε"]))
             .map(|h| format!("{h}; "))
             .or_else(|| {
                 closest(name, names.iter().copied()).map(|c| format!("did you mean `{c}`? "))

@@ -572,9 +572,30 @@ impl Declaration {
                 );
                 continue;
             }
+            // `int_…` is the ASCII boundary integral `∫_…`: such a name could never be
+            // used in the forms (a tester's parameter `int_k`)
+            if text.starts_with("int_") {
+                errors.push(
+                    Diagnostic::token(name.span(), format!("`{text}` starts with `int_`"))
+                        .help("`int_Γ … ds` is the ASCII spelling of the boundary integral ∫_Γ: the forms text would read the name as one; pick another name"),
+                );
+                continue;
+            }
             // The components of a vector field are names too (`θ_x`, `η_y`).
             let mut new = vec![(text.clone(), name, None)];
             let n = components(name);
+            let reserved_component = (n > 1)
+                .then(|| component_names(&text, n))
+                .and_then(|c| c.into_iter().find(|c| RESERVED.contains(&c.as_str())));
+            if let Some(component) = reserved_component {
+                // `d` would have the components d_x, d_y: the ASCII ∂_x, ∂_y (a tester's
+                // vector field `d` had its components read as derivatives)
+                errors.push(
+                    Diagnostic::token(name.span(), format!("the vector field `{text}` would have the reserved component `{component}`"))
+                        .help("`d_x` and `d_y` are ∂_x and ∂_y in ASCII: pick another name for the field"),
+                );
+                continue;
+            }
             if n > 1 {
                 new.extend(
                     component_names(&text, n)

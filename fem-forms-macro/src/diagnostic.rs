@@ -153,6 +153,14 @@ pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) ->
 
 /// Letters that look like a Latin letter: Cyrillic and Greek lookalikes, mapped to it.
 const LOOKALIKES: &[(char, char)] = &[
+    // the micro sign that keyboards type for μ, and the Greek variant letters
+    ('µ', 'μ'),
+    ('ϑ', 'θ'),
+    ('ϵ', 'ε'),
+    ('ϕ', 'φ'),
+    ('ϰ', 'κ'),
+    ('ϱ', 'ρ'),
+    ('ϖ', 'π'),
     ('а', 'a'),
     ('е', 'e'),
     ('о', 'o'),
@@ -214,7 +222,9 @@ fn skeleton(c: char) -> char {
 
 fn script(c: char) -> &'static str {
     match c as u32 {
-        0x0370..=0x03FF => "Greek",
+        0x00B5 => "the micro sign",
+        0x03D0..=0x03FF => "a Greek variant form",
+        0x0370..=0x03CF => "Greek",
         0x0400..=0x052F => "Cyrillic",
         _ if c.is_ascii() => "Latin",
         _ => "another script",
@@ -245,7 +255,7 @@ pub fn lookalike<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) 
         })
         .collect();
     Some(format!(
-        "`{name}` looks like the declared `{candidate}` but is not the same name: {}",
+        "`{name}` looks like `{candidate}` but is not the same name: {}",
         differences.join(", ")
     ))
 }
@@ -291,6 +301,11 @@ mod tests {
         assert!(lookalike("ν", ["u", "v"]).unwrap().contains("Greek"));
         assert!(lookalike("wа", ["w", "wa"]).unwrap().contains("`wa`"));
         assert_eq!(lookalike("x", ["T", "v"]), None);
+        // a tester's: the micro sign typed for μ, ϑ for θ
+        assert!(lookalike("µ", ["u", "μ"])
+            .unwrap()
+            .contains("the micro sign"));
+        assert!(lookalike("ϑ", ["θ"]).unwrap().contains("Greek variant"));
         assert_eq!(lookalike("v", ["v"]), None);
     }
 }

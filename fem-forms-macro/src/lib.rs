@@ -40,8 +40,10 @@
 //!   the scalar fields `θ_x` and `θ_y` (tests `η_x`, `η_y`), which is what the runtime
 //!   sees, so its DOF map, assembly and kernels are those of scalar fields.
 //! - `tests: …` one test function per unknown, in order: `η` goes with `θ`.
-//! - `params: …` runtime scalars (on triangles, two parameters `d_x`, `d_y` also
-//!   make the constant vector `d`: `n_c` in the forms is `(n_c_x, n_c_y)`); `β > 0` declares one positive (the runtime's
+//! - `params: …` runtime scalars (on triangles, two parameters `a_x`, `a_y` also
+//!   make the constant vector `a`: with `n_c_x, n_c_y` declared, `n_c` in the forms is
+//!   `(n_c_x, n_c_y)`; `d_x`, `d_y` are reserved, the ASCII ∂_x, ∂_y, so there is no
+//!   vector `d`); `β > 0` declares one positive (the runtime's
 //!   `Coefficients` refuses other values), which lets the forms divide by sums that are
 //!   positive only then. `data: f, ψ: 0` functions of x (the number is the
 //!   polynomial degree assumed for quadrature, default 2, at most 40; the degrees of

@@ -548,9 +548,15 @@ fn overflowing_constants_are_located_errors() {
             "a(u;v) = ∫ (1e999 − 1e999) u v",
             "number `1e999` is too large",
         ),
-        ("a(u;v) = ∫ 1e200·1e200 f u v", "overflows or underflows (inf)"),
+        (
+            "a(u;v) = ∫ 1e200·1e200 f u v",
+            "overflows or underflows (inf)",
+        ),
         // a tester's silently vanished terms: an underflow is an error too
-        ("a(u;v) = ∫ 1e-200·1e-200 f u v", "overflows or underflows (NaN)"),
+        (
+            "a(u;v) = ∫ 1e-200·1e-200 f u v",
+            "overflows or underflows (NaN)",
+        ),
         ("a(u;v) = ∫ (1e-5)^100 u v", "overflows or underflows (NaN)"),
     ] {
         let errors = rendered_errors(&expand(membrane("P2", forms)));
@@ -974,4 +980,34 @@ fn huge_sums_and_operator_powers_are_errors() {
     assert!(!rendered_errors(&out)
         .iter()
         .any(|e| e.contains("raised to")));
+}
+
+/// A tester's unusable names: a parameter `int_k` (the forms read `int_` as the ASCII
+/// boundary integral) and a vector field `d` (its components `d_x`, `d_y` are ∂_x, ∂_y)
+/// were accepted and then failed with messages about something else. Both are refused
+/// at the declaration; `ϵ` for the operator ε gets the lookalike hint.
+#[test]
+fn names_the_forms_cannot_use_are_refused_where_declared() {
+    let out = expand(quote! {
+        /// Names.
+        pub mod names on triangle {
+            unknowns: d: [P1]^2;
+            tests: e;
+            params: int_k;
+            forms: "a(d;e) = ∫ d·e";
+        }
+    });
+    let errors = rendered_errors(&out).join("\n");
+    assert!(errors.contains("starts with `int_`"), "{errors}");
+    assert!(errors.contains("reserved component `d_x`"), "{errors}");
+    let out = expand(quote! {
+        /// Lookalike.
+        pub mod lookalike on triangle {
+            unknowns: θ: [P1]^2;
+            tests: η;
+            forms: "a(θ;η) = ∫ ϵ(θ):ε(η)";
+        }
+    });
+    let errors = rendered_errors(&out).join("\n");
+    assert!(errors.contains("looks like `ε`"), "{errors}");
 }
