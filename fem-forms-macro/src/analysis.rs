@@ -1641,6 +1641,13 @@ impl<'a> Context<'a> {
     ) -> Option<(&'a Form, Vec<(usize, usize)>)> {
         let forms = self.forms;
         let Some(callee) = forms.iter().find(|f| f.name == name) else {
+            // the first of the later forms is the one being defined
+            if self.later_forms.first() == Some(&name) {
+                return self.fail_mapping(
+                    Diagnostic::text(loc, format!("form `{name}` calls itself"))
+                        .help("a form is a finite sum of integrals and calls of forms defined above it; it cannot be recursive"),
+                );
+            }
             return self.fail_mapping(
                 Diagnostic::text(loc, format!("form `{name}` is used before its definition"))
                     .help("define a form above the forms that call it"),

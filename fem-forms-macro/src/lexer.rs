@@ -286,9 +286,12 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 '∫' => Some(Tok::Integral),
                 '∇' => Some(Tok::Grad),
                 'Δ' => Some(Tok::Laplacian),
+                // `∂_xu` is ∂_x u, as `Δu` is Δ u: no name starts with ∂ (a tester's
+                // `∂_xu ∂_xv` was told that a partial derivative is written ∂_x); `∂_xy`
+                // stays an error, a mixed derivative to some readers
                 '∂' if chars.get(i + 1) == Some(&'_')
                     && matches!(chars.get(i + 2), Some('x' | 'y'))
-                    && !chars.get(i + 3).is_some_and(|&d| is_ident_continue(d)) =>
+                    && !matches!(chars.get(i + 3), Some('x' | 'y')) =>
                 {
                     j = i + 3;
                     Some(Tok::Partial(u8::from(chars[i + 2] == 'y')))

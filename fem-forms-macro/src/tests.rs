@@ -1011,3 +1011,15 @@ fn names_the_forms_cannot_use_are_refused_where_declared() {
     let errors = rendered_errors(&out).join("\n");
     assert!(errors.contains("looks like `ε`"), "{errors}");
 }
+
+/// A tester's misleading messages: `∂_xu ∂_xv` (no space) is ∂_x u ∂_x v, as `Δu` is Δ u;
+/// a form that calls itself is told so, not that it is "used before its definition".
+#[test]
+fn partials_without_spaces_and_self_calls() {
+    let joined = expand(membrane("P2", "a(u;v) = ∫ ∂_xu ∂_xv")).to_string();
+    let spaced = expand(membrane("P2", "a(u;v) = ∫ ∂_x u ∂_x v")).to_string();
+    assert!(!joined.contains("compile_error"), "{joined}");
+    assert_eq!(joined.replace("∂_xu ∂_xv", "∂_x u ∂_x v"), spaced);
+    let errors = rendered_errors(&expand(membrane("P2", "a(u;v) = ∫ u v + a(u;v)"))).join("\n");
+    assert!(errors.contains("form `a` calls itself"), "{errors}");
+}
