@@ -103,7 +103,9 @@
 //!   `6κ(1−ν)D/(t² + β h_T²)` with `β > 0` is such a quotient; `1/(t − β)` or
 //!   `1/(ν + t)` with `ν` not declared positive are errors at the divisor.
 //! - Names: declared symbols, `h` or `h_T` (element size); names written together that
-//!   are declared symbols multiply (`sλ` = `s·λ`).
+//!   are declared symbols multiply (`sλ` = `s·λ`), and a power or primes after them
+//!   belong to the last one, as in mathematics (`Et³` = `E·t³`, `αh_T²` = `α·h_T²`,
+//!   `fv'` = `f·v'`); `(Et)³` needs its parentheses.
 //! - `Cε(θ) := D[(1−ν)ε(θ) + ν tr ε(θ) I]` (with `:=`) names an expression of its
 //!   arguments, of any shape, substituted where it is called (`∫ Cε(θ):ε(η)`,
 //!   `div div Cε(η)`); it generates no code of its own.
