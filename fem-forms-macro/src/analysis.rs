@@ -498,6 +498,11 @@ fn source(d: &Definition, forms_text: &str) -> String {
         .join(" ")
 }
 
+/// Longest run of juxtaposed names (in bytes) that is split into declared names; a
+/// longer one is an unknown symbol (a tester's run of 30,000 letters overflowed the
+/// stack of the split's search).
+const MAX_RUN_BYTES: usize = 1024;
+
 fn scalar(loc: Loc) -> Monomial {
     Monomial::constant(1.0, loc)
 }
@@ -574,10 +579,18 @@ impl<'a> Context<'a> {
                 self.errors.push(
                     Diagnostic::text(
                         t.origin,
-                        format!(
-                            "the coefficient of this term of `{}` overflows or underflows ({})",
-                            d.name.text, t.coefficient
-                        ),
+                        // NaN marks an underflow (`symbolic::mul`), ±inf an overflow
+                        if t.coefficient.is_nan() {
+                            format!(
+                                "the coefficient of this term of `{}` underflows: a product or power of its constants is below about 2.2e-308",
+                                d.name.text
+                            )
+                        } else {
+                            format!(
+                                "the coefficient of this term of `{}` overflows ({})",
+                                d.name.text, t.coefficient
+                            )
+                        },
                     )
                     .help("products, quotients and powers of the constants must stay within the normal range of f64, about 2.2e-308 to 1.8e308 in size"),
                 );
@@ -1035,15 +1048,29 @@ impl<'a> Context<'a> {
     /// run they gave `(Et)³` without a word (a tester's `Et³` kernel was 4× too large).
     /// The run rewritten as the product of its names with `apply` on the last, or `None`
     /// when `a` is not such a run.
-    fn last_of_run(&self, a: &Expr, apply: impl FnOnce(Box<Expr>) -> ExprKind) -> Option<Expr> {
+    fn last_of_run(
+        &self,
+        a: &Expr,
+        derivative: bool,
+        apply: impl FnOnce(Box<Expr>) -> ExprKind,
+    ) -> Option<Expr> {
         let ExprKind::Symbol(name) = &a.kind else {
             return None;
         };
         if self.symbols.all_names().contains(&name.as_str()) {
             return None;
         }
-        let mut parts = self.split(name)?;
-        let last = parts.pop()?;
+        let parts = self.split(name)?;
+        let last = parts.last()?.clone();
+        if derivative {
+            // primes on a parameter are 0: `uE'` keeps its old reading (uE)' = E u',
+            // rather than vanishing without a word; only functions and data take them
+            let differentiable = self.symbols.function_symbols(&last).is_some()
+                || self.symbols.data.iter().any(|(d, _)| *d == last);
+            if !differentiable {
+                return None;
+            }
+        }
         let loc = a.loc;
         let symbol = |text: String| {
             Box::new(Expr {
@@ -1051,42 +1078,60 @@ impl<'a> Context<'a> {
                 loc,
             })
         };
-        let mut e = Expr {
-            kind: apply(symbol(last)),
+        // the run before its last name stays one symbol (split again the same way, as
+        // the split is the first in a fixed order): a product as deep as the run
+        // overflowed the stack for a run of 1000 names
+        let prefix = name[..name.len() - last.len()].to_string();
+        Some(Expr {
+            kind: ExprKind::Mul(
+                symbol(prefix),
+                Box::new(Expr {
+                    kind: apply(symbol(last)),
+                    loc,
+                }),
+            ),
             loc,
-        };
-        for part in parts.into_iter().rev() {
-            e = Expr {
-                kind: ExprKind::Mul(symbol(part), Box::new(e)),
-                loc,
-            };
-        }
-        Some(e)
+        })
     }
 
     /// Splits `sλ` into declared names (longest first), if it can be done.
     fn split(&self, name: &str) -> Option<Vec<String>> {
-        let names = self.symbols.all_names();
-        fn go(rest: &str, names: &[&str], out: &mut Vec<String>) -> bool {
-            if rest.is_empty() {
+        // the search recurses once per name of the run: bounded, as the nesting is
+        if name.len() > MAX_RUN_BYTES {
+            return None;
+        }
+        let mut names = self.symbols.all_names();
+        names.retain(|n| !n.is_empty());
+        names.sort_by_key(|n| std::cmp::Reverse(n.len()));
+        // `dead[i]`: the rest from byte i has no split. Remembered, so that the search
+        // is linear in the run (it was exponential: a tester's 29 a's against the names
+        // a, aa, aaa took 12 s to say "unknown symbol").
+        fn go(
+            name: &str,
+            at: usize,
+            names: &[&str],
+            dead: &mut [bool],
+            out: &mut Vec<String>,
+        ) -> bool {
+            if at == name.len() {
                 return true;
             }
-            let mut candidates: Vec<&&str> = names
-                .iter()
-                .filter(|n| !n.is_empty() && rest.starts_with(**n))
-                .collect();
-            candidates.sort_by_key(|n| std::cmp::Reverse(n.len()));
-            for c in candidates {
+            if dead[at] {
+                return false;
+            }
+            for c in names.iter().filter(|n| name[at..].starts_with(**n)) {
                 out.push(c.to_string());
-                if go(&rest[c.len()..], names, out) {
+                if go(name, at + c.len(), names, dead, out) {
                     return true;
                 }
                 out.pop();
             }
+            dead[at] = true;
             false
         }
+        let mut dead = vec![false; name.len() + 1];
         let mut out = Vec::new();
-        (go(name, &names, &mut out) && out.len() > 1).then_some(out)
+        (go(name, 0, &names, &mut dead, &mut out) && out.len() > 1).then_some(out)
     }
 
     /// Expands a scalar expression; a vector or matrix here is an error.
@@ -1491,7 +1536,7 @@ impl<'a> Context<'a> {
         match &e.kind {
             ExprKind::Number(v) => Some(vec![Monomial::constant(*v, loc)]),
             ExprKind::Pow(a, n) => {
-                if let Some(e) = self.last_of_run(a, |last| ExprKind::Pow(last, *n)) {
+                if let Some(e) = self.last_of_run(a, false, |last| ExprKind::Pow(last, *n)) {
                     return self.expand(&e, inside_integral);
                 }
                 let x = self.expand(a, inside_integral)?;
@@ -1517,7 +1562,7 @@ impl<'a> Context<'a> {
                             .help("on triangles write ∇ (grad) for the gradient and Δ (lap) for the Laplacian"),
                     );
                 }
-                if let Some(e) = self.last_of_run(a, |last| ExprKind::Derivative(last, *k)) {
+                if let Some(e) = self.last_of_run(a, true, |last| ExprKind::Derivative(last, *k)) {
                     return self.expand(&e, inside_integral);
                 }
                 let x = self.expand(a, inside_integral)?;

@@ -212,7 +212,23 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 }
             }
             let raw: String = chars[i..j].iter().collect();
+            // a literal with a non-zero digit that reads as 0 or a subnormal underflowed
+            // (a tester's `1e-400` vanished from its form without a word)
+            let nonzero = raw
+                .chars()
+                .take_while(|c| !matches!(c, 'e' | 'E'))
+                .any(|c| c.is_ascii_digit() && c != '0');
             match raw.parse::<f64>() {
+                Ok(v) if nonzero && (v == 0.0 || v.is_subnormal()) => errors.push(
+                    Diagnostic::text(
+                        Loc {
+                            len: j - i,
+                            ..start
+                        },
+                        format!("number `{raw}` is too small: it underflows a 64-bit float"),
+                    )
+                    .help("non-zero constants must be at least about 2.2e-308 in size; rescale the units"),
+                ),
                 Ok(v) if v.is_finite() => push(Tok::Number(v), j - i, &mut tokens),
                 Ok(_) => errors.push(
                     Diagnostic::text(

@@ -246,6 +246,24 @@ fn header_end(tokens: &[Token], i: usize) -> Option<usize> {
     None
 }
 
+/// `(e)` or `[e]` at `loc` (a bracketed run of names followed by a power or primes is
+/// kept together by `factor`, see [`kept_together`]).
+fn grouped(e: Expr, loc: Loc) -> Expr {
+    Expr::new(e.kind, loc)
+}
+
+/// `1·e` at `e`'s place, for a bracketed run of names followed by a power or primes:
+/// they take the whole run (`(Et)³` is `(E·t)³`), where after a bare run they take its
+/// last name (`Et³` is `E·t³`, see the analysis). A tester found the brackets dropped,
+/// `(Et)³` computed as `E·t³`.
+fn kept_together(e: Expr) -> Expr {
+    let loc = e.loc;
+    Expr::new(
+        ExprKind::Mul(Box::new(Expr::new(ExprKind::Number(1.0), loc)), Box::new(e)),
+        loc,
+    )
+}
+
 /// Deepest nesting of parentheses, integrals, signs and ∇/Δ: the parser and the
 /// expansion recurse on it, and a deeper text must be an error, not a stack overflow.
 pub const MAX_NESTING: usize = 100;
@@ -775,6 +793,17 @@ impl<'a> Parser<'a> {
             return Ok(e);
         }
         let mut e = self.primary()?;
+        let bracketed =
+            self.pos > 0 && matches!(self.tokens[self.pos - 1].tok, Tok::RParen | Tok::RBracket);
+        if bracketed
+            && matches!(e.kind, ExprKind::Symbol(_))
+            && matches!(
+                self.peek_tok(),
+                Some(Tok::Prime(_) | Tok::Superscript(..) | Tok::Caret)
+            )
+        {
+            e = kept_together(e);
+        }
         loop {
             match self.peek() {
                 Some(Token {
@@ -993,7 +1022,7 @@ impl<'a> Parser<'a> {
                         Err(Diagnostic::text(self.here(), "`(X)_T` needs two arguments")
                             .help("an L² product over an element is written `(X, Y)_T`"))
                     }
-                    (None, false) => Ok(Expr::new(first.kind, loc.to(close))),
+                    (None, false) => Ok(grouped(first, loc.to(close))),
                 }
             }
             Tok::LBracket => {
@@ -1014,7 +1043,7 @@ impl<'a> Parser<'a> {
                     }
                 }
                 let close = self.bump().unwrap().loc;
-                Ok(Expr::new(inner.kind, loc.to(close)))
+                Ok(grouped(inner, loc.to(close)))
             }
             Tok::Integral | Tok::SumT => {
                 let kind = if token.tok == Tok::Integral {
