@@ -472,19 +472,10 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     let pressure_range =
         finite_on(&mesh, &load_part, &pressure).map_err(|m| at("data.pressure", m))?;
     presses(&mesh, &load_part, &pressure, contact_direction).map_err(|m| at("data.pressure", m))?;
-    let extent = |k: usize| {
-        let (lo, hi) = mesh
-            .vertices()
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                (lo.min(x[k]), hi.max(x[k]))
-            });
-        hi - lo
-    };
     let scales = DataScales {
         pressure: pressure_range[0].abs().max(pressure_range[1].abs()),
         smallest_gap: gap_range[0],
-        diameter: extent(0).hypot(extent(1)),
+        diameter: crate::membranes::bounding_diameter(&mesh),
         young: m.young,
         translation_held: (contact_direction[0] != 0.0 && !fixed_x.is_empty())
             || (contact_direction[1] != 0.0 && !fixed_y.is_empty()),

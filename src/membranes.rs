@@ -1814,8 +1814,8 @@ fn open_gap_warning(
     })
 }
 
-/// The diagonal of `mesh`'s bounding box.
-fn bounding_diameter(mesh: &TriangleMesh) -> f64 {
+/// The diagonal of `mesh`'s bounding box (its vertices' coordinates' extents).
+pub(crate) fn bounding_diameter(mesh: &TriangleMesh) -> f64 {
     let extent = |k: usize| {
         let (lo, hi) = mesh
             .vertices()
