@@ -915,7 +915,8 @@ impl<'a> Context<'a> {
         }
         let names = self.symbols.all_names();
         // ε is an operator, not a declared name, but `ϵ(θ)` is the same typo
-        let hint = lookalike(name, names.iter().copied().chain(["ε"]))
+        let hint = ascii_partial_hint(name)
+            .or_else(|| lookalike(name, names.iter().copied().chain(["ε"])))
             .map(|h| format!("{h}; "))
             .or_else(|| {
                 closest(name, names.iter().copied()).map(|c| format!("did you mean `{c}`? "))
@@ -1775,4 +1776,21 @@ impl<'a> Context<'a> {
         self.errors.push(d);
         None
     }
+}
+
+/// The hint for an unknown name that starts with the ASCII partial `d_x` or `d_y`:
+/// `d_xu` is one identifier, unlike `∂_xu`, since ASCII names may hold `_`.
+fn ascii_partial_hint(name: &str) -> Option<String> {
+    let (op, rest) = ["d_x", "d_y"]
+        .into_iter()
+        .find_map(|op| name.strip_prefix(op).map(|rest| (op, rest)))?;
+    if rest.is_empty() {
+        return None;
+    }
+    Some(match rest.chars().next() {
+        Some(c @ ('x' | 'y')) if rest.len() == 1 || op.ends_with(c) => {
+            format!("`{name}` is one name; for a derivative write {op} d_{c} (or {op}^2 for a second derivative along one axis) with spaces")
+        }
+        _ => format!("`{name}` is one name; for the derivative write `{op} {rest}` with a space"),
+    })
 }

@@ -38,10 +38,11 @@ pub enum Tok {
     FacetIntegral(String),
     /// `ds`: closes a boundary integral `∫_Γ … ds`.
     Ds,
-    /// A run of primes: the derivative order.
-    Prime(u8),
-    /// A run of superscript characters, e.g. `⁻²`; `None` when malformed.
-    Superscript(Option<i32>, String),
+    /// A run of primes: the derivative order (counted in full, so that 300 primes are
+    /// reported as order 300).
+    Prime(u32),
+    /// A run of superscript characters, e.g. `⁻²`, with its value, or why it has none.
+    Superscript(Result<i32, ExponentFault>, String),
     /// `^`
     Caret,
     /// `+`
@@ -88,6 +89,29 @@ pub enum Tok {
     SubscriptT,
     /// End of a line (definitions start at the beginning of a line).
     Newline,
+}
+
+/// Why a run of superscripts is no exponent.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ExponentFault {
+    /// Not an integer: `⁻⁻²`, `⁺⁻`.
+    Malformed,
+    /// An integer beyond `i32`: `⁹⁹⁹⁹⁹⁹⁹⁹⁹⁹⁹`.
+    TooLarge,
+}
+
+impl ExponentFault {
+    /// The value of the ASCII spelling `ascii` of a superscript run (`-2` for `⁻²`).
+    fn parse(ascii: &str) -> Result<i32, ExponentFault> {
+        let digits = ascii.strip_prefix(['+', '-']).unwrap_or(ascii);
+        if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+            return Err(ExponentFault::Malformed);
+        }
+        ascii
+            .trim_start_matches('+')
+            .parse::<i32>()
+            .map_err(|_| ExponentFault::TooLarge)
+    }
 }
 
 /// A token with its place.
@@ -183,14 +207,18 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 }
                 j += 1;
             }
-            push(Tok::Prime(order.min(255) as u8), j - i, &mut tokens);
+            push(
+                Tok::Prime(u32::try_from(order).unwrap_or(u32::MAX)),
+                j - i,
+                &mut tokens,
+            );
         } else if superscript_value(c).is_some() {
             while j < chars.len() && superscript_value(chars[j]).is_some() {
                 j += 1;
             }
             let raw: String = chars[i..j].iter().collect();
             let ascii: String = raw.chars().filter_map(superscript_value).collect();
-            let value = ascii.trim_start_matches('+').parse::<i32>().ok();
+            let value = ExponentFault::parse(&ascii);
             push(Tok::Superscript(value, raw), j - i, &mut tokens);
         } else if c.is_ascii_digit()
             || (c == '.' && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit()))
@@ -287,6 +315,29 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 _ => Tok::Ident(name),
             };
             push(tok, j - i, &mut tokens);
+        } else if c == '∂'
+            && chars.get(i + 1) == Some(&'_')
+            && matches!(chars.get(i + 2), Some('x' | 'y'))
+            && matches!(chars.get(i + 3), Some('x' | 'y'))
+        {
+            // One error for the whole operator, and the first partial in its place, so
+            // that the parse goes on without a cascade about a symbol `_xy`.
+            j = i + 4;
+            let written: String = chars[i..j].iter().collect();
+            let (a, b) = (chars[i + 2], chars[i + 3]);
+            let help = if a == b {
+                format!("write ∂_{a}² for the second derivative (ASCII d_{a}^2)")
+            } else {
+                format!("write ∂_{a} ∂_{b} for the mixed derivative (ASCII d_{a} d_{b})")
+            };
+            errors.push(
+                Diagnostic::text(
+                    Loc { len: 4, ..start },
+                    format!("`{written}` is ambiguous: a mixed derivative to some readers, ∂_{a} of a name `{b}…` to others"),
+                )
+                .help(help),
+            );
+            push(Tok::Partial(u8::from(a == 'y')), 4, &mut tokens);
         } else {
             let tok = match c {
                 // `∫_Γ_C`: the boundary part's name follows the underscore.
@@ -368,7 +419,7 @@ mod tests {
         let strip = |v: Vec<Tok>| -> Vec<Tok> {
             v.into_iter()
                 .map(|t| match t {
-                    Tok::Superscript(Some(n), _) => Tok::Superscript(Some(n), String::new()),
+                    Tok::Superscript(Ok(n), _) => Tok::Superscript(Ok(n), String::new()),
                     t => t,
                 })
                 .collect()
@@ -376,7 +427,7 @@ mod tests {
         let unicode = strip(unicode);
         // The ASCII power is Caret, Minus, Number: compare everything else.
         assert_eq!(unicode[0], Tok::Ident("a".into()));
-        assert!(unicode.contains(&Tok::Superscript(Some(-2), String::new())));
+        assert!(unicode.contains(&Tok::Superscript(Ok(-2), String::new())));
         assert_eq!(
             unicode.iter().filter(|t| **t == Tok::Prime(1)).count(),
             ascii.iter().filter(|t| **t == Tok::Prime(1)).count()
@@ -407,8 +458,11 @@ mod tests {
                 Tok::Ident("d_xx".into())
             ]
         );
-        let (_, errors) = tokenize("∂_xy w");
+        let (tokens, errors) = tokenize("∂_xy w");
         assert_eq!(errors.len(), 1);
+        assert!(errors[0].help.as_deref().unwrap_or("").contains("∂_x ∂_y"));
+        assert_eq!(tokens[0].tok, Tok::Partial(0));
+        let (_, errors) = tokenize("∂_z w");
         assert!(errors[0]
             .help
             .as_deref()

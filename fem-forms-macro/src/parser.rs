@@ -24,7 +24,7 @@
 //! continues the previous line, so long forms may wrap.
 
 use crate::diagnostic::{Diagnostic, Loc};
-use crate::lexer::{Tok, Token};
+use crate::lexer::{ExponentFault, Tok, Token};
 use std::collections::HashSet;
 
 /// A name with its place.
@@ -318,6 +318,19 @@ fn too_deep(body: &Expr) -> Option<Loc> {
 /// symbolic expansion multiplies a base `n` times and adds exponents in `i32`, so
 /// `t^999999` would take quadratic time and nested powers would overflow.
 pub const MAX_TOTAL_POWER: f64 = 1000.0;
+
+/// The error for a run of superscripts `raw` at `loc` that has no value.
+fn bad_superscript(fault: ExponentFault, raw: &str, loc: Loc) -> Diagnostic {
+    match fault {
+        ExponentFault::TooLarge => Diagnostic::text(
+            loc,
+            format!("exponent `{raw}` is beyond the limit {MAX_TOTAL_POWER}"),
+        )
+        .help("a form is a polynomial of low degree in its fields and data: write the power you mean (h_T⁴, t⁻²)"),
+        ExponentFault::Malformed => Diagnostic::text(loc, format!("malformed exponent `{raw}`"))
+            .help("write an integer exponent such as ² or ⁻² (ASCII: ^2, ^-2)"),
+    }
+}
 
 /// Where the exponents of `body` can multiply to more than [`MAX_TOTAL_POWER`], with the
 /// bound reached there. A product adds its factors' bounds, a power multiplies its
@@ -812,18 +825,23 @@ impl<'a> Parser<'a> {
                 }) => {
                     self.pos += 1;
                     let l = e.loc.to(*loc);
-                    e = Expr::new(ExprKind::Derivative(Box::new(e), *n), l);
+                    let Ok(order) = u8::try_from(*n) else {
+                        return Err(Diagnostic::text(
+                            l,
+                            format!("derivative of order {n}: the DSL supports up to order 4"),
+                        )
+                        .help("write at most four primes (w''''), or ∇/Δ of order ≤ 4"));
+                    };
+                    e = Expr::new(ExprKind::Derivative(Box::new(e), order), l);
                 }
                 Some(Token {
                     tok: Tok::Superscript(value, raw),
                     loc,
                 }) => {
                     self.pos += 1;
-                    let Some(n) = value else {
-                        return Err(
-                            Diagnostic::text(*loc, format!("malformed exponent `{raw}`"))
-                                .help("write an integer exponent such as ² or ⁻² (ASCII: ^2, ^-2)"),
-                        );
+                    let n = match value {
+                        Ok(n) => n,
+                        Err(fault) => return Err(bad_superscript(*fault, raw, *loc)),
                     };
                     let l = e.loc.to(*loc);
                     e = Expr::new(ExprKind::Pow(Box::new(e), *n), l);
@@ -855,9 +873,9 @@ impl<'a> Parser<'a> {
             }) => {
                 let (value, raw, end) = (*value, raw.clone(), *end);
                 self.pos += 1;
-                let Some(n) = value else {
-                    return Err(Diagnostic::text(end, format!("malformed exponent `{raw}`"))
-                        .help("write a positive integer power: Δ² w, ∂_x² w"));
+                let n = match value {
+                    Ok(n) => n,
+                    Err(fault) => return Err(bad_superscript(fault, &raw, end)),
                 };
                 (n, end)
             }
@@ -935,6 +953,23 @@ impl<'a> Parser<'a> {
                 tok: Tok::Number(v),
                 loc,
             }) if v.fract() == 0.0 && v.abs() < 1e6 => (sign * v, *loc),
+            Some(Token {
+                tok: Tok::Number(v),
+                loc,
+            }) => {
+                let (what, help) = if v.fract() == 0.0 {
+                    (
+                        format!("exponent {v} is beyond the limit {MAX_TOTAL_POWER}"),
+                        "a form is a polynomial of low degree in its fields and data: write the power you mean (h_T^4, t^-2)",
+                    )
+                } else {
+                    (
+                        format!("exponent {v} is not an integer"),
+                        "powers in forms are integers: t^2, t^-2; a fractional power of data belongs in the data's own expression",
+                    )
+                };
+                return Err(Diagnostic::text(caret.to(*loc), what).help(help));
+            }
             Some(t) => return Err(malformed(caret.to(t.loc))),
             None => return Err(malformed(caret)),
         };

@@ -1042,3 +1042,53 @@ fn brackets_keep_a_run_together() {
         .to_string()
         .contains("compile_error"));
 }
+
+/// The model-language testers' leftovers: `∂_xy` is one error at the operator (it had
+/// cascaded into "unknown symbol `_xy`"), ASCII `d_xu` is told to add a space, a run of
+/// 300 primes is order 300 (a `u8` had saturated at 255), and an exponent too large for
+/// an integer is called too large, not "malformed".
+#[test]
+fn derivative_and_exponent_spellings_get_one_precise_error() {
+    for (forms, message, help) in [
+        (
+            "a(u;v) = ∫ ∂_xy u v",
+            "`∂_xy` is ambiguous",
+            "write ∂_x ∂_y",
+        ),
+        ("a(u;v) = ∫ ∂_yyu v", "`∂_yy` is ambiguous", "write ∂_y²"),
+        (
+            "a(u;v) = ∫ d_xu d_x v",
+            "unknown symbol `d_xu`",
+            "write `d_x u` with a space",
+        ),
+        ("a(u;v) = ∫ d_xy u v", "unknown symbol `d_xy`", "d_x d_y"),
+    ] {
+        let errors = rendered_errors(&expand(membrane("P2", forms)));
+        assert_eq!(errors.len(), 1, "{forms}: {errors:?}");
+        assert!(
+            errors[0].contains(message) && errors[0].contains(help),
+            "{forms}: {errors:?}"
+        );
+    }
+    let primes = "'".repeat(300);
+    for (forms, message) in [
+        (format!("a(u;v) = ∫ u{primes} v"), "derivative of order 300"),
+        (
+            "a(u;v) = ∫ t⁹⁹⁹⁹⁹⁹⁹⁹⁹⁹⁹ u v".into(),
+            "exponent `⁹⁹⁹⁹⁹⁹⁹⁹⁹⁹⁹` is beyond the limit 1000",
+        ),
+        (
+            "a(u;v) = ∫ t^99999999 u v".into(),
+            "exponent 99999999 is beyond the limit 1000",
+        ),
+        (
+            "a(u;v) = ∫ t^2.5 u v".into(),
+            "exponent 2.5 is not an integer",
+        ),
+        ("a(u;v) = ∫ t⁻⁻² u v".into(), "malformed exponent `⁻⁻²`"),
+    ] {
+        let errors = rendered_errors(&expand(run_model(&forms)));
+        assert_eq!(errors.len(), 1, "{forms}: {errors:?}");
+        assert!(errors[0].contains(message), "{forms}: {errors:?}");
+    }
+}
