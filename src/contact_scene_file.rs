@@ -129,12 +129,31 @@ struct ContactToml {
     accuracy: Option<f64>,
 }
 
+/// A pair written as a TOML array of exactly two entries: serde's arrays read the
+/// first two of a longer one and drop the rest (`x = [0, 1, 2]` solved on (0, 1)).
+fn two<'de, D, T>(deserializer: D) -> std::result::Result<Option<[T; 2]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let entries = Vec::<T>::deserialize(deserializer)?;
+    let count = entries.len();
+    <[T; 2]>::try_from(entries).map(Some).map_err(|_| {
+        serde::de::Error::custom(format!(
+            "an array of {count} entries where two are expected"
+        ))
+    })
+}
+
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 struct MeshToml {
     generator: Option<String>,
+    #[serde(default, deserialize_with = "two")]
     x: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "two")]
     y: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "two")]
     cells: Option<[usize; 2]>,
     file: Option<PathBuf>,
     refinements: Option<usize>,
@@ -160,6 +179,7 @@ struct BoundaryToml {
 #[derive(Deserialize, Debug, Default)]
 #[serde(deny_unknown_fields)]
 struct ParametersToml {
+    #[serde(default, deserialize_with = "two")]
     contact_direction: Option<[f64; 2]>,
     alpha: Option<f64>,
     contact_centre: Option<f64>,
@@ -292,6 +312,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         None => ContactPair::P1P0,
     };
     let mesh = mesh_of(&file.mesh, path, &at)?;
+    one_body(&mesh).map_err(|m| at("mesh", m))?;
     let refinements = file.mesh.refinements.unwrap_or(0);
     if refinements > MAX_REFINEMENTS {
         return Err(at(
@@ -551,6 +572,24 @@ fn check_load(load: f64) -> std::result::Result<(), String> {
 }
 
 /// The mesh of `[mesh]`.
+/// An error when the mesh falls into separate pieces: a contact scene poses one body
+/// on the foundation, whose rigid motions the supports, the contact and the load's
+/// direction are checked to hold; a second piece escapes those checks (a tester's
+/// floating second block ended in "the matrix is not positive definite").
+fn one_body(mesh: &TriangleMesh) -> std::result::Result<(), String> {
+    let (piece, count) = mesh.vertex_pieces();
+    if count < 2 {
+        return Ok(());
+    }
+    let sizes = (0..count)
+        .map(|p| piece.iter().filter(|&&q| q == p).count().to_string())
+        .collect::<Vec<_>>();
+    Err(format!(
+        "the mesh falls into {count} separate pieces (of {} vertices): a contact scene file poses one elastic body on a rigid foundation; mesh one connected body (in Gmsh, a coherent geometry), or pose each body in its own scene",
+        sizes.join(", ")
+    ))
+}
+
 fn mesh_of(
     mesh: &MeshToml,
     path: &Path,

@@ -1110,8 +1110,18 @@ fn run(cli: Cli) -> Result<(), String> {
                         .get_or_insert_with(|| file.pair.name().to_string());
                     // the file's size belongs to its own mesh: with --msh replacing it,
                     // --mesh-size (refinements of that file) defaults to 0 as for built-in scenes
-                    if options.msh.is_none() {
-                        options.mesh_size.get_or_insert(file.mesh_size);
+                    match &options.msh {
+                        None => {
+                            options.mesh_size.get_or_insert(file.mesh_size);
+                        }
+                        // said, so that the file's size is not dropped unseen
+                        Some(msh) if options.mesh_size.is_none() => eprintln!(
+                            "warning: --msh {} replaces the mesh of {}, and with it the file's mesh size or refinements ({}); --mesh-size gives the refinements of the --msh mesh (0 here)",
+                            msh.display(),
+                            path.display(),
+                            file.mesh_size
+                        ),
+                        Some(_) => {}
                     }
                     options.alpha = options.alpha.or(file.alpha);
                     options.accuracy = file.accuracy;

@@ -316,6 +316,20 @@ fn bad_contact_scene_files_name_the_key() {
             "accuracy",
             &["[exact] pressure"],
         ),
+        // a second, floating body escaped the checks of the supports and ended in "the
+        // matrix is not positive definite"
+        (
+            RECTANGLE
+                .replace(
+                    "generator = \"rectangle\"",
+                    &format!("file = \"{}\"", data("two_blocks_apart.msh").display()),
+                )
+                .replace("x = [0.0, 2.0]\n", "")
+                .replace("y = [0.0, 1.0]\n", "")
+                .replace("cells = [6, 3]\n", ""),
+            "mesh",
+            &["2 separate pieces", "one elastic body"],
+        ),
         // extreme data are named, not reported as "α = inf", a non-finite facet
         // matrix or a line search that failed; a uniform gap of 1e10 on a block whose
         // elastic displacement is 2e-3 gave a contact force 6.5 % off the load
@@ -534,6 +548,18 @@ fn bad_contact_scene_files_name_the_key() {
                 && message.contains("scene.toml")
                 && words.iter().all(|w| message.contains(w)),
             "{key}: {message}"
+        );
+    }
+    // serde's arrays read the first two entries of a longer one: `x = [0, 2, 5]` solved
+    // on (0, 2) without a word; the TOML reader names the line
+    for (from, to) in [
+        ("x = [0.0, 2.0]", "x = [0.0, 2.0, 5.0]"),
+        ("cells = [6, 3]", "cells = [6, 3, 99]"),
+    ] {
+        let message = parse(&RECTANGLE.replace(from, to)).unwrap_err().to_string();
+        assert!(
+            message.contains("3 entries where two are expected") && message.contains(to),
+            "{message}"
         );
     }
     // an unknown key is named by the TOML reader

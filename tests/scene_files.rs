@@ -492,3 +492,61 @@ fn penetration_warnings_compare_with_the_solution_and_its_rounding() {
         );
     }
 }
+
+/// A tester's mesh of two squares apart, the Dirichlet part on one of them: the other
+/// piece had only the natural condition, and the solve "succeeded" with u ≈ 6e15 there
+/// (KKT residual 2e-16, no warning). Every piece needs a Dirichlet part, as the whole
+/// mesh does; with both rims Dirichlet the same mesh solves.
+#[test]
+fn a_mesh_piece_without_a_dirichlet_part_is_refused() {
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/two_squares_apart.msh");
+    let text = |dirichlet: &str| {
+        format!(
+            "model = \"membrane\"\n[mesh]\nfile = \"{}\"\n[boundary]\ndirichlet = {dirichlet}\n[data]\nf = \"1\"\npsi = \"-100\"\ng = \"0\"\n",
+            mesh.display()
+        )
+    };
+    let file = scene_file::parse(&text("\"A\""), Path::new("mine.toml")).unwrap();
+    let Err(e) = membranes::solve(&request_of(&file)) else {
+        panic!("the unheld piece was solved");
+    };
+    let e = e.to_string();
+    for word in ["2 separate pieces", "[0.5, 2] × [-1, 1]", "not coercive"] {
+        assert!(e.contains(word), "{word}: {e}");
+    }
+    let file = scene_file::parse(&text("[\"A\", \"B\"]"), Path::new("mine.toml")).unwrap();
+    let (report, _) = membranes::solve(&request_of(&file)).unwrap();
+    // no contact: −Δu = 1 on each square, u = 0 on its rim, so 0 < u < 1/8 (the strip's)
+    assert!(
+        report.total_contact_force == 0.0,
+        "{}",
+        report.total_contact_force
+    );
+}
+
+/// `--msh` replaces a scene file's mesh, and with it the file's refinements: a tester's
+/// `refinements = 2` was dropped without a word (128 triangles instead of 2048). It is
+/// said on stderr, and `--mesh-size` refines the `--msh` mesh.
+#[test]
+fn msh_over_a_scene_file_says_what_it_replaces() {
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+            .args(["solve", "--scene"])
+            .arg(example("membrane-strip.toml"))
+            .arg("--msh")
+            .arg(example("square_named.msh"))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let plain = run(&[]);
+    let stderr = String::from_utf8_lossy(&plain.stderr);
+    assert!(plain.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("replaces the mesh of") && stderr.contains("(2)"),
+        "{stderr}"
+    );
+    let refined = run(&["--mesh-size", "2"]);
+    assert!(refined.status.success());
+    assert!(!String::from_utf8_lossy(&refined.stderr).contains("replaces"));
+}

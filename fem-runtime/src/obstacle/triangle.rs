@@ -67,6 +67,46 @@ pub fn curved_dirichlet_constraints_on<M: Model>(
     })
 }
 
+/// An error when a connected piece of `mesh` holds no vertex of the Dirichlet `part`:
+/// on that piece the natural condition holds on its whole boundary, which does not
+/// determine the solution (a tester's two squares, one held, one free under f = 1 and a
+/// far obstacle: u ≈ 6e15 on the free one, KKT residual 2e-16, no warning), as the
+/// whole mesh without a Dirichlet part does not.
+fn unheld_piece(mesh: &TriangleMesh, part: &DirichletPart) -> Result<()> {
+    let (piece, count) = mesh.vertex_pieces();
+    if count < 2 {
+        return Ok(());
+    }
+    let mut held = vec![false; count];
+    for (v, &on) in part.vertices(mesh).iter().enumerate() {
+        held[piece[v]] |= on;
+    }
+    let Some(free) = held.iter().position(|&h| !h) else {
+        return Ok(());
+    };
+    let vertices: Vec<usize> = (0..piece.len()).filter(|&v| piece[v] == free).collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for &v in &vertices {
+        let x = mesh.vertices()[v];
+        for k in 0..2 {
+            lo[k] = lo[k].min(x[k]);
+            hi[k] = hi[k].max(x[k]);
+        }
+    }
+    Err(Error::Input(format!(
+        "the mesh falls into {count} separate pieces, and the piece of {} vertices within [{}, {}] × [{}, {}] touches no part of the Dirichlet boundary (markers {}): with the natural condition on all of its boundary the problem is not coercive there (u + constant solves it wherever contact does not hold it); give that piece a Dirichlet part, or mesh the domain as one piece (in Gmsh, a coherent geometry)",
+        vertices.len(),
+        lo[0],
+        hi[0],
+        lo[1],
+        hi[1],
+        match part {
+            DirichletPart::All => "all".to_string(),
+            DirichletPart::Markers(m) => format!("{m:?}"),
+        },
+    )))
+}
+
 /// The body of [`dirichlet_constraints_on`], with the DOF nodes of each field's map
 /// given by `nodes`.
 fn constraints_at_nodes<M: Model>(
@@ -91,6 +131,9 @@ fn constraints_at_nodes<M: Model>(
                 .collect::<Vec<_>>()
                 .join(", ")
         )));
+    }
+    if !M::DIRICHLET.is_empty() {
+        unheld_piece(mesh, part)?;
     }
     for &(field, data) in M::DIRICHLET {
         let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {

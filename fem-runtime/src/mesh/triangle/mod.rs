@@ -680,11 +680,67 @@ impl TriangleMesh {
         }
         flags
     }
+
+    /// The connected pieces of the mesh: for each vertex the index of its piece, pieces
+    /// numbered in the order of their first vertex, and the number of pieces. Cells are
+    /// connected through shared vertices (a piece that touches another at one vertex
+    /// shares that vertex's DOF, so a condition on one holds the other there too).
+    pub fn vertex_pieces(&self) -> (Vec<usize>, usize) {
+        let mut parent: Vec<usize> = (0..self.vertices.len()).collect();
+        fn root(parent: &mut [usize], mut v: usize) -> usize {
+            while parent[v] != v {
+                parent[v] = parent[parent[v]];
+                v = parent[v];
+            }
+            v
+        }
+        for cell in self.cells.iter() {
+            for k in 1..3 {
+                let (a, b) = (root(&mut parent, cell[0]), root(&mut parent, cell[k]));
+                if a != b {
+                    parent[a.max(b)] = a.min(b);
+                }
+            }
+        }
+        let mut index = vec![usize::MAX; self.vertices.len()];
+        let mut count = 0;
+        let mut piece = vec![0; self.vertices.len()];
+        for v in 0..self.vertices.len() {
+            let r = root(&mut parent, v);
+            if index[r] == usize::MAX {
+                index[r] = count;
+                count += 1;
+            }
+            piece[v] = index[r];
+        }
+        (piece, count)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pieces_are_joined_through_shared_vertices() {
+        // two unit squares side by side, apart, then touching at one corner
+        let square = |x: f64| vec![[x, 0.0], [x + 1.0, 0.0], [x + 1.0, 1.0], [x, 1.0]];
+        let cells = |o: usize| [[o, o + 1, o + 2], [o, o + 2, o + 3]];
+        let mut vertices = square(0.0);
+        vertices.extend(square(2.0));
+        let apart: Vec<[usize; 3]> = cells(0).into_iter().chain(cells(4)).collect();
+        let mesh = TriangleMesh::new(vertices.clone(), apart, &[]).unwrap();
+        assert_eq!(mesh.vertex_pieces(), (vec![0, 0, 0, 0, 1, 1, 1, 1], 2));
+        // the second square's first corner moved onto the first's (1, 1)
+        let mut touching = vertices;
+        touching.truncate(7);
+        let touching_cells = vec![[0, 1, 2], [0, 2, 3], [2, 4, 5], [2, 5, 6]];
+        touching[4] = [2.0, 1.0];
+        touching[5] = [2.0, 2.0];
+        touching[6] = [1.0, 2.0];
+        let mesh = TriangleMesh::new(touching[..7].to_vec(), touching_cells, &[]).unwrap();
+        assert_eq!(mesh.vertex_pieces().1, 1);
+    }
 
     /// A small deterministic generator (xorshift64*), so the tests need no dependencies.
     struct Rng(u64);
