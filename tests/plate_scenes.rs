@@ -90,3 +90,29 @@ fn nested_iterations_stay_flat_on_the_disk() {
     let finest = levels.last().unwrap();
     assert!(finest.cold.unwrap() > finest.nested, "{levels:?}");
 }
+
+/// The plain pair chosen by hand locks once its cells are wider than the plate is
+/// thick (a tester's mindlin-disk at N = 32: ∫λ_h 6.5 against 18.7, without a word):
+/// warned there, and not on cells thinner than the plate.
+#[test]
+fn the_locking_plate_pair_is_warned_about_where_it_locks() {
+    use fem_forms::plates::PlatePair;
+    let request = |n: usize| PlateRequest {
+        pair: PlatePair::P1P1P0Plain,
+        thickness: 0.2,
+        mesh_size: n,
+        ..PlateRequest::new(MINDLIN_SQUARE)
+    };
+    let coarse = solve(&request(4)).unwrap();
+    assert!(
+        coarse.warnings.iter().any(|w| w.contains("locks")),
+        "{:?}",
+        coarse.warnings
+    );
+    let fine = solve(&request(16)).unwrap();
+    assert!(
+        !fine.warnings.iter().any(|w| w.contains("locks")),
+        "{:?}",
+        fine.warnings
+    );
+}

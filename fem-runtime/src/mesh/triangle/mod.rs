@@ -704,15 +704,16 @@ impl TriangleMesh {
         }
         let mut index = vec![usize::MAX; self.vertices.len()];
         let mut count = 0;
-        let mut piece = vec![0; self.vertices.len()];
-        for v in 0..self.vertices.len() {
-            let r = root(&mut parent, v);
-            if index[r] == usize::MAX {
-                index[r] = count;
-                count += 1;
-            }
-            piece[v] = index[r];
-        }
+        let piece = (0..self.vertices.len())
+            .map(|v| {
+                let r = root(&mut parent, v);
+                if index[r] == usize::MAX {
+                    index[r] = count;
+                    count += 1;
+                }
+                index[r]
+            })
+            .collect();
         (piece, count)
     }
 }
