@@ -227,6 +227,71 @@ impl Form {
     pub fn arity(&self) -> usize {
         self.groups.len()
     }
+
+    /// A cell block `(test field, trial field)` of a bilinear form that is not the
+    /// transpose of its mirror block `(trial field, test field)` (each term with its
+    /// test and trial derivatives swapped, coefficients equal to 1e-12 relative); `None`
+    /// when the form is symmetric. The obstacle solvers need `B_h` symmetric: they read
+    /// `B` from its multiplier rows alone and factor its primal block by Cholesky (a
+    /// tester's `− b(v;λ) + b(u;μ)` solved to a membrane 0.93 through the obstacle with
+    /// a KKT residual of 1e-16).
+    pub fn asymmetry(&self) -> Option<(usize, usize)> {
+        if self.arity() != 2 {
+            return None;
+        }
+        let merged = |terms: &mut dyn Iterator<Item = Term>| {
+            let mut out: Vec<Term> = Vec::new();
+            for t in terms {
+                match out.iter_mut().find(|o| {
+                    Term {
+                        coefficient: t.coefficient,
+                        ..(*o).clone()
+                    } == t
+                }) {
+                    Some(o) => o.coefficient += t.coefficient,
+                    None => out.push(t),
+                }
+            }
+            out
+        };
+        let terms_of = |test: usize, trial: usize| {
+            merged(
+                &mut self
+                    .blocks
+                    .iter()
+                    .filter(|b| b.test_field == test && b.trial_field == Some(trial))
+                    .flat_map(|b| b.terms.iter().cloned()),
+            )
+        };
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs());
+        for block in &self.blocks {
+            let (test, Some(trial)) = (block.test_field, block.trial_field) else {
+                continue;
+            };
+            let mine = terms_of(test, trial);
+            let mirrored = merged(&mut terms_of(trial, test).into_iter().map(|t| Term {
+                test_derivative: t.trial_derivative.unwrap_or([0, 0]),
+                trial_derivative: Some(t.test_derivative),
+                ..t
+            }));
+            let matches = |a: &[Term], b: &[Term]| {
+                a.iter().all(|t| {
+                    t.coefficient == 0.0
+                        || b.iter().any(|u| {
+                            close(t.coefficient, u.coefficient)
+                                && Term {
+                                    coefficient: t.coefficient,
+                                    ..u.clone()
+                                } == *t
+                        })
+                })
+            };
+            if !(matches(&mine, &mirrored) && matches(&mirrored, &mine)) {
+                return Some((test, trial));
+            }
+        }
+        None
+    }
 }
 
 /// Analyses every definition in order; a definition may call those above it.

@@ -111,6 +111,10 @@ pub struct FormInfo {
     pub dropped_terms: usize,
     /// Nonzero blocks.
     pub blocks: &'static [BlockInfo],
+    /// A bilinear form's cell block `[test field, trial field]` (indices into the
+    /// model's fields) that is not the transpose of its mirror block, found when the
+    /// macro expanded the form; `None` when the form is symmetric (and for linear forms).
+    pub asymmetry: Option<[usize; 2]>,
 }
 
 /// A model compiled by `model!`.
