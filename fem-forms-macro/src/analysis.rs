@@ -1656,6 +1656,17 @@ impl<'a> Context<'a> {
                                 "boundary integrals `∫_Γ … ds` are available on triangles only",
                             ))
                         }
+                        None if self.symbols.dimension == 1 => {
+                            // `facets:` is refused on intervals: the help below would send
+                            // the user there
+                            return self.fail(
+                                Diagnostic::text(
+                                    name.loc,
+                                    "boundary integrals `∫_Γ … ds` are available on triangles only",
+                                )
+                                .help("an interval's boundary is its two end points: a point term there is not a form the language writes; impose values with `boundary:`"),
+                            );
+                        }
                         None => {
                             let declared = &self.symbols.facets;
                             let hint = closest(&name.text, declared.iter().map(String::as_str))

@@ -1124,3 +1124,25 @@ fn asymmetric_forms_are_marked_in_their_form_info() {
     assert_ne!(one_sided, TIMOSHENKO);
     assert!(asymmetry_of_b_h(&one_sided).starts_with("Some("));
 }
+
+/// A tester's `∫_Ω T ∇u·∇v` (the domain's integral as many write it) was read as a
+/// boundary integral over a part `Ω` and cascaded into "form `a` is used before its
+/// definition"; it is the cell integral now, in both spellings. On an interval a
+/// boundary integral no longer sends the user to `facets:`, which intervals refuse.
+#[test]
+fn the_integral_over_omega_is_the_cell_integral() {
+    let plain = expand(membrane("P2", "a(u;v) = ∫ ∇u·∇v"))
+        .to_string()
+        .replace("a(u;v) = ∫ ∇u·∇v", "SOURCE");
+    for spelling in ["a(u;v) = ∫_Ω ∇u·∇v", "a(u;v) = int_Omega grad u dot grad v"] {
+        let text = expand(membrane("P2", spelling)).to_string();
+        assert!(!text.contains("compile_error"), "{spelling}");
+        // the same code but for the source text it quotes
+        assert!(text.replace(spelling, "SOURCE") == plain, "{spelling}");
+    }
+    let errors = rendered_errors(&expand(timoshenko("a(θ,w;η,v) = ∫θ'η' + ∫_Γ w v ds"))).join("\n");
+    assert!(
+        errors.contains("available on triangles only") && !errors.contains("facets:"),
+        "{errors}"
+    );
+}
