@@ -51,6 +51,43 @@ string_model!(
     "
 );
 
+string_model!(
+    added_stabilization,
+    "
+    a(u;v)     = ∫ u'v'
+    b(v;μ)     = ∫ s v μ
+    S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
+    ℓ(v)       = ∫ f v
+    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    g(μ)       = ∫ s ψ μ
+    B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) + α S(u,λ;v,μ)
+    L_h(v,μ)     = ℓ(v) − g(μ) + α ℓ_S(v,μ)
+    "
+);
+
+/// The stabilization added instead of subtracted makes `C = −αS` negative: a tester was
+/// told "α ≤ 0 gives the plain mixed method" with α = 0.04. The error now says which
+/// sign the system form needs.
+#[test]
+fn a_stabilization_of_the_wrong_sign_is_named() {
+    let mesh = IntervalMesh::uniform(-1.0, 1.0, 32).unwrap();
+    let load = |_: &[f64]| -4.0;
+    let obstacle = |_: &[f64]| -0.1;
+    let data: [(&str, &fem_runtime::DataFn); 2] = [("f", &load), ("ψ", &obstacle)];
+    let c =
+        Coefficients::new::<added_stabilization::Model>(&[("α", 0.04), ("s", 1.0)], &data).unwrap();
+    let Err(e) =
+        solve_obstacle::<added_stabilization::Model>(&mesh, &c, &["u"], ObstacleOptions::default())
+    else {
+        panic!("B_h = … + α S was solved");
+    };
+    let e = e.to_string();
+    assert!(
+        e.contains("must be positive") && e.contains("subtracts the stabilization"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_system_form_with_couplings_of_different_signs_is_refused() {
     let mesh = IntervalMesh::uniform(-1.0, 1.0, 32).unwrap();

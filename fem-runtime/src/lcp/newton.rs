@@ -437,8 +437,9 @@ impl Lcp {
             if block.size == 1 {
                 if self.c[k].is_nan() || self.c[k] <= 0.0 {
                     return Err(Error::Input(format!(
-                        "{method} needs C > 0 (it uses Φ and Λ = C⁻¹(G − BU)₊); C_{k} = {}: α ≤ 0 gives the plain mixed method, solve it with the QP solver",
-                        self.c[k]
+                        "{method} needs C > 0 (it uses Φ and Λ = C⁻¹(G − BU)₊); C_{k} = {}: {}",
+                        self.c[k],
+                        c_fault(self.c[k])
                     )));
                 }
                 continue;
@@ -1079,4 +1080,19 @@ pub(super) fn updated_solve(
     let backward =
         max_norm(&residual) / (row_sum_norm(h) * max_norm(&d) + max_norm(b)).max(f64::MIN_POSITIVE);
     (backward <= LOW_RANK_BACKWARD_ERROR).then_some(d)
+}
+
+/// Why a diagonal entry `c` of `C` is not positive, for the error of
+/// [`Lcp::require_positive_c`]. `C = αS` restricted to the multipliers, so a negative
+/// entry with α > 0 is a sign in the forms (a tester's `B_h = … + α S` was told that
+/// "α ≤ 0 gives the plain mixed method" with α = 0.04), and a zero one is α = 0 or an
+/// `αh^k` that underflows on tiny cells.
+fn c_fault(c: f64) -> &'static str {
+    if c < 0.0 {
+        "C = αS on the multipliers must be positive: with α > 0 the system form subtracts the stabilization (B_h = a − b − b − α S, L_h = ℓ − g − α ℓ_S, S a sum of squares); with α < 0 use α > 0, or α = 0 for the plain mixed method (the QP solver)"
+    } else if c == 0.0 {
+        "α = 0 gives the plain mixed method, solve it with the QP solver; with α > 0 the stabilization αh^k underflowed (cells far below the unit length: rescale the problem)"
+    } else {
+        "C is not a number: the stabilization's data or parameters are not finite"
+    }
 }
