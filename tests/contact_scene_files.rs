@@ -128,6 +128,31 @@ fn the_patch_test_from_a_scene_file_gives_the_pressure_exactly() {
     }
 }
 
+/// A tester's E = 1e25, 1e35 or 1e38, inside the accepted [1e-100, 1e100]: "not positive
+/// definite", or a contact force of 0 against a load of 6. Newton's start pressed the
+/// body 1e-3 h into the foundation whatever its elastic displacement (here 1e-25 h);
+/// it now starts by the displacement's own size, and the patch test holds over the
+/// whole range.
+#[test]
+fn the_patch_test_holds_for_every_accepted_young_modulus() {
+    for young in ["1e-100", "1e-30", "1e25", "1e35", "1e38", "1e60", "1e100"] {
+        let file =
+            parse(&RECTANGLE.replace("young = 1000.0", &format!("young = {young}"))).unwrap();
+        let solved = contact_scene_file::solve(&file, &Overrides::default()).unwrap();
+        for &(x0, x1, p) in &solved.profile {
+            assert!(
+                (p - 2.5).abs() <= 1e-9 * 2.5,
+                "E = {young}: λ_h = {p} on [{x0}, {x1}]"
+            );
+        }
+        let force = solved.report.total_contact_force;
+        assert!(
+            (force - 5.0).abs() <= 1e-9 * 5.0,
+            "E = {young}: ∫λ_h = {force}"
+        );
+    }
+}
+
 /// A block (0,1)×(0,2) pressed sideways onto a wall on its left (n_c = (−1, 0)): the
 /// patch test's λ_h = q on every edge, the profile along the wall (y) covering its
 /// length 2, and the half-width measured along the wall: 1 (from `contact_centre` = 0:

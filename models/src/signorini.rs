@@ -390,7 +390,16 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
             .iter()
             .zip(problem.multiplier_integrals())
             .fold(0.0f64, |m, (g, w)| m.max(-g / w));
-        let scale = 2.0 * depth + 1e-3 * mesh.max_h();
+        // beyond the gaps by the size of the elastic displacement (‖F‖∞/‖A‖∞, both in
+        // the units of E): a fixed 1e-3 h was 1e22 times it at E = 1e25, and its
+        // multipliers C⁻¹(G − BU) left Newton a Hessian that was not positive definite
+        let lcp = &problem.lcp;
+        let a_norm = (0..lcp.n())
+            .map(|j| lcp.a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0f64, f64::max);
+        let f_norm = lcp.f.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+        let elastic = f_norm / a_norm.max(f64::MIN_POSITIVE);
+        let scale = 2.0 * depth + elastic.min(1e-3 * mesh.max_h());
         let start: Vec<f64> = translation.iter().map(|t| scale * t).collect();
         check_alpha(alpha, &constants)?;
         semismooth_newton(&problem.lcp, Some(&start), NewtonOptions::default())
