@@ -179,6 +179,11 @@ fn parse_checked(text: &str, field: &str, file: &Path) -> Result<FlatEx<f64>> {
     Ok(parsed)
 }
 
+/// The smallest `mesh.half_width` of a square: a tester's problem solved at 1e-39 and
+/// failed at 1e-40, where `α h⁴` of the cells of a fine mesh (h ~ 1e-43) falls to
+/// 1e-172 and below, near the end of double precision's normal range.
+const MIN_HALF_WIDTH: f64 = 1e-30;
+
 /// What `exmex` reads differently from the mathematics, made right or refused before it
 /// parses: numbers in scientific notation (`1e-3`, which `exmex` cannot parse) become
 /// their decimal expansion, exactly the same `f64`; a unary minus whose operand is
@@ -328,6 +333,11 @@ fn operand_end(chars: &[char], from: usize) -> usize {
             }
         }
         Some('(') => group(i),
+        // a braced variable `{x}` (a tester's `-{x}^2` passed the guard as a plain minus)
+        Some('{') => chars[i..]
+            .iter()
+            .position(|&c| c == '}')
+            .map_or(chars.len(), |k| i + k + 1),
         _ => from,
     }
 }
@@ -603,13 +613,15 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
             match generator.as_str() {
                 "square" => {
                     let a = mesh.half_width.unwrap_or(1.0);
-                    // below this the cells' areas underflow; above, the mesh's coordinate
-                    // bound (the kernels' powers of lengths overflow)
+                    // below this the stabilization's αh⁴ of the finest cells underflows
+                    // (a tester's half_width 1e-40 to 1e-100 failed with "C_0 = -0");
+                    // above, the mesh's coordinate bound (the kernels' powers of lengths
+                    // overflow)
                     let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
-                    if !(1e-100..=largest).contains(&a) {
+                    if !(MIN_HALF_WIDTH..=largest).contains(&a) {
                         return Err(at(
                             "mesh.half_width",
-                            format!("{a} must be positive and within 1e-100 to {largest:e}"),
+                            format!("{a} must be within {MIN_HALF_WIDTH:e} to {largest:e}: below, the stabilization's α h⁴ underflows; rescale the units"),
                         ));
                     }
                     (Domain::Square(a), size)
@@ -780,6 +792,8 @@ mod normalize_tests {
             "-1^2",
             "2*-x^2",
             "-(x)^2",
+            "-{x}^2",
+            "2^-{x}^2",
             "-sin(x)^2",
             "- x ^ 2",
             "-1e2^2",

@@ -983,3 +983,20 @@ fn faces_turned_away_and_small_resultants_are_judged_by_their_size() {
         "{r:?}"
     );
 }
+
+/// Where supports along the contact direction carry part of the load there is no
+/// equilibrium check (JSON null): the text line said "equilibrium residual NaN", which a
+/// tester read as a failure. It says why there is none.
+#[test]
+fn the_text_line_says_why_there_is_no_equilibrium_check() {
+    let oblique = format!("{RECTANGLE}\n[parameters]\ncontact_direction = [1.0, -1.0]\n");
+    let report = contact_scene_file::solve(&parse(&oblique).unwrap(), &Overrides::default())
+        .unwrap()
+        .report;
+    assert!(report.equilibrium_residual.is_nan());
+    let line = contact::summary(&report);
+    assert!(
+        line.contains("no equilibrium check") && !line.contains("NaN"),
+        "{line}"
+    );
+}

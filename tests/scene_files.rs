@@ -182,6 +182,8 @@ fn scene_file_errors_name_the_field() {
     );
     for (from, to, field) in [
         ("half_width = 2.0", "half_width = 1e-200", "mesh.half_width"),
+        // a tester's 1e-40 failed with "C_0 = -0": the stabilization underflows
+        ("half_width = 2.0", "half_width = 1e-40", "mesh.half_width"),
         ("half_width = 2.0", "half_width = 1e200", "mesh.half_width"),
         // within the field's old bound but beyond the mesh's: refused by the mesh,
         // whose message named no field
