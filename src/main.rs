@@ -855,15 +855,22 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
         );
     } else {
         println!(
-            "{} {} {} t = {} N = {}: centre deflection {:.8e}, {} {:.8e}, relative error {:+.3e}, J_h {:.6e}, {} dofs, {} iterations, {:.3} s",
+            "{} {} {} t = {} N = {}: centre deflection {:.8e}, {} {:.8e}, {} {:+.3e}, J_h {:.6e}, {} dofs, {} iterations, {:.3} s",
             report.scene,
             report.pair,
             report.support,
             fem_forms::number(report.thickness),
             report.mesh_size,
             report.centre_deflection,
-            if report.unobstructed_reference.is_some() { "exact" } else { "Kirchhoff" },
+            if report.unobstructed_reference.is_some() { "exact" } else { "Kirchhoff (t → 0)" },
             report.unobstructed_reference.unwrap_or(report.kirchhoff_reference),
+            // against Kirchhoff the O(t²) difference of the two models is in it (13.6 %
+            // at t = 0.1 on the simply supported square, which a tester took for error)
+            if report.unobstructed_reference.is_some() {
+                "relative error"
+            } else {
+                "relative difference (the O(t²) Mindlin–Kirchhoff difference included)"
+            },
             report.relative_error,
             report.energy,
             report.dofs,

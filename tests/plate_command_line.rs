@@ -456,8 +456,12 @@ fn an_unloaded_plate_reports_a_zero_error() {
     let run = fem_forms(&["solve", "mindlin-square", "--load", "0"]);
     let text = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success());
+    // against Kirchhoff's value the text says the models' difference is in it (a
+    // tester took 13.6 % at t = 0.1 for a discretization error)
     assert!(
-        text.contains("relative error +0.000e0") && !text.contains("NaN"),
+        text.contains(
+            "relative difference (the O(t²) Mindlin–Kirchhoff difference included) +0.000e0"
+        ) && !text.contains("NaN"),
         "{text}"
     );
 }

@@ -467,3 +467,23 @@ fn beam_pairs_have_a_vanishing_inverse_constant() {
         );
     }
 }
+
+/// bernoulli-b is bernoulli-flat mirrored (pushed up by +q against w ≤ 0.05): a tester
+/// found the two equal to every digit, but bernoulli-b reported no error. Its exact
+/// solution is the mirror of the flat obstacle's, and its errors are bernoulli-flat's.
+#[test]
+fn bernoulli_b_is_measured_against_the_mirrored_exact_solution() {
+    let run = |name: &str| {
+        let mut r = Request::new(scene(name).unwrap());
+        r.load = 100.0;
+        r.elements = 128;
+        solve(&r).unwrap().0
+    };
+    let (up, down) = (run("bernoulli-b"), run("bernoulli-flat"));
+    let (e_up, e_down) = (up.error_l2.unwrap(), down.error_l2.unwrap());
+    assert!(
+        e_up < 1e-5 && (e_up - e_down).abs() <= 1e-9 * e_down,
+        "{e_up} {e_down}"
+    );
+    assert!((up.total_contact_force - down.total_contact_force).abs() < 1e-9);
+}

@@ -164,7 +164,8 @@ fn free(beam: Beam, f: f64, t: f64) -> ExactSolution {
 }
 
 /// The exact solution of `scene` at load `q` and thickness `t`, where one is known: when
-/// the free beam does not touch the obstacle, and for `bernoulli-flat` always.
+/// the free beam does not touch the obstacle, and for `bernoulli-flat` and its mirror
+/// image `bernoulli-b` always.
 pub fn exact_solution(scene: &Scene, q: f64, t: f64) -> Option<ExactSolution> {
     let f = scene.load_sign * q;
     let free_solution = free(scene.beam, f, t);
@@ -180,6 +181,18 @@ pub fn exact_solution(scene: &Scene, q: f64, t: f64) -> Option<ExactSolution> {
             if s == 1.0 && sign == -1.0 && psi < 0.0 =>
         {
             Some(flat_obstacle(q, -psi))
+        }
+        // the mirror image (w ↦ −w): pushed up by +q against w ≤ d, as bernoulli-b; a
+        // tester found it equal to bernoulli-flat to every digit, with no error reported
+        (Beam::EulerBernoulli, Obstacle::Constant(psi), s, sign)
+            if s == -1.0 && sign == 1.0 && psi > 0.0 =>
+        {
+            let below = flat_obstacle(q, psi);
+            let w = below.w;
+            Some(ExactSolution {
+                w: Box::new(move |x, k| -w(x, k)),
+                ..below
+            })
         }
         _ => None,
     }
