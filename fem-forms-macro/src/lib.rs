@@ -131,8 +131,10 @@
 //!
 //! A misspelled handle is a compile error, and since each handle carries its model's
 //! type, a handle of one model passed where another model is expected does not compile
-//! either. The runtime's name-taking functions accept a handle or a string (scene files
-//! name things by string): `Model::form(NAME::forms::B_h)` and `Model::form("B_h")`
+//! either. The runtime's functions that take one form, field, parameter or data name
+//! accept a handle or a string (scene files name things by string; lists of names, such
+//! as `solve_obstacle`'s clamped fields, take strings): `Model::form(NAME::forms::B_h)`
+//! and `Model::form("B_h")`
 //! give the same index; `Coefficients::from_ids(&[(NAME::params::α, 0.1)], &[(NAME::data::f,
 //! &f)])` is the handle form of `Coefficients::new::<NAME::Model>(&[("α", 0.1)], &[("f",
 //! &f)])`. (The same design as serde's derives: the generated code exposes plain items

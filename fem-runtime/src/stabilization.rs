@@ -12,6 +12,7 @@
 //! (Δ vanishes on each cell), as for the beam pairs whose `θ'''` or `w''''` vanishes.
 
 use crate::mesh::Mesh;
+use crate::model::IntoFormIndex;
 use crate::{DataFn, Error, Model, Result};
 use nalgebra::{DMatrix, SymmetricEigen};
 
@@ -211,9 +212,12 @@ pub fn element_inverse_constant<M: Model>(
 pub fn inverse_constant<M: Model, G: Mesh>(
     mesh: &G,
     params: &[f64],
-    stabilization: &str,
-    bilinear: &str,
+    stabilization: impl IntoFormIndex<M>,
+    bilinear: impl IntoFormIndex<M>,
 ) -> Result<f64> {
+    // by handle (`NAME::forms::S`) or by name (`"S"`), as the crate docs promise
+    let stabilization = M::FORMS[M::form(stabilization)?].name;
+    let bilinear = M::FORMS[M::form(bilinear)?].name;
     let width = match G::CELL {
         crate::CellKind::Interval => 2,
         crate::CellKind::Triangle => 6,

@@ -1227,7 +1227,7 @@ impl<G> ObstacleSolution<G> {
 impl<G: DofNumbering> ObstacleSolution<G> {
     /// The energy `½ a(u,u) − ℓ(u)` of the primal fields `u` (all fields but the
     /// multiplier) of the solution, with the model's forms named `a` (bilinear) and `ℓ`
-    /// (linear) and the parameters and data of `coefficients`; the boundary values of
+    /// (linear; in ASCII `l` or `ell`) and the parameters and data of `coefficients`; the boundary values of
     /// the solution are included as they are. For the exact solution of the obstacle
     /// problem it is the minimum of the energy over the admissible set.
     ///
@@ -1261,7 +1261,12 @@ impl<G: DofNumbering> ObstacleSolution<G> {
         }
         let a = crate::assembly::MatrixAssembler::new::<M>("a", &d.mesh, &dofs)?
             .assemble::<M>(&d.mesh, coefficients)?;
-        let l = assemble_vector::<M>("ℓ", &d.mesh, &dofs, coefficients)?;
+        // the load form's ASCII spellings too (a tester's all-ASCII model named it `l`)
+        let load = ["ℓ", "l", "ell"]
+            .into_iter()
+            .find(|name| M::FORMS.iter().any(|f| f.name == *name && f.arity == 1))
+            .unwrap_or("ℓ");
+        let l = assemble_vector::<M>(load, &d.mesh, &dofs, coefficients)?;
         Ok(0.5 * crate::lcp::cholesky::quadratic_form(&a, &u, &u)
             - crate::lcp::cholesky::dot(&l, &u))
     }

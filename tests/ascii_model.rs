@@ -1,0 +1,55 @@
+//! A model written in ASCII only, used through the library as the crate docs say: its
+//! load form `l` serves `energy` (a tester's all-ASCII model was told it "has no form
+//! ℓ"), and `stabilization::inverse_constant` takes form handles as well as names.
+
+use fem_runtime::obstacle::{solve_obstacle, ObstacleOptions};
+use fem_runtime::{stabilization, Coefficients, IntervalMesh};
+
+fem_runtime::model! {
+    /// A string over an obstacle, in ASCII.
+    pub mod ascii_string on interval {
+        unknowns: u: P1, lam: P0 >= 0;
+        tests: v, mu;
+        params: alpha, s;
+        data: f, psi;
+        forms: "
+            a(u;v)         = int u'v'
+            b(v;mu)        = int s v mu
+            S(u,lam;v,mu)  = sum_T h_T^2 (u'' + s lam, v'' + s mu)_T
+            l(v)           = int f v
+            lS(v,mu)       = sum_T h_T^2 (f, v'' + s mu)_T
+            g(mu)          = int s psi mu
+            B_h(u,lam;v,mu) = a(u;v) - b(v;lam) - b(u;mu) - alpha S(u,lam;v,mu)
+            L_h(v,mu)       = l(v) - g(mu) - alpha lS(v,mu)
+        ";
+    }
+}
+
+#[test]
+fn an_ascii_model_has_its_energy_and_its_inverse_constant_by_handle() {
+    let mesh = IntervalMesh::uniform(-1.0, 1.0, 64).unwrap();
+    // a load too small to reach the obstacle: the free string u = q(1 − x²)/2
+    let q = 0.1;
+    let load = move |_: &[f64]| -q;
+    let obstacle = |_: &[f64]| -1.0;
+    let data: [(&str, &fem_runtime::DataFn); 2] = [("f", &load), ("psi", &obstacle)];
+    let c = Coefficients::new::<ascii_string::Model>(&[("alpha", 0.1), ("s", 1.0)], &data).unwrap();
+    let by_name =
+        stabilization::inverse_constant::<ascii_string::Model, _>(&mesh, &c.params, "S", "a")
+            .unwrap();
+    let by_handle = stabilization::inverse_constant::<ascii_string::Model, _>(
+        &mesh,
+        &c.params,
+        ascii_string::forms::S,
+        ascii_string::forms::a,
+    )
+    .unwrap();
+    assert_eq!(by_name, by_handle);
+    let solution =
+        solve_obstacle::<ascii_string::Model>(&mesh, &c, &["u"], ObstacleOptions::default())
+            .unwrap();
+    // ½a(u,u) − ℓ(u) of u = −q(1 − x²)/2 on (−1, 1): ½∫q²x² − ∫q²(1 − x²)/2 = −q²/3
+    let energy = solution.energy::<ascii_string::Model>(&c).unwrap();
+    // P1 energies converge like h² (h = 1/32 here)
+    assert!((energy + q * q / 3.0).abs() < 1e-3 * q * q, "{energy}");
+}
