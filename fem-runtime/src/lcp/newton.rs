@@ -965,7 +965,10 @@ pub(super) fn newton_iteration(
                     }
                     None => {
                         factorizations += 1;
-                        let factor = workspace.analyse()?.factor_cholesky(&h)?;
+                        let factor = workspace
+                            .analyse()?
+                            .factor_cholesky(&h)
+                            .map_err(hessian_not_positive)?;
                         let d = refined(&h, &minus_gradient, options.refinement_steps, |b| {
                             factor.solve(b)
                         })?;
@@ -1080,6 +1083,17 @@ pub(super) fn updated_solve(
     let backward =
         max_norm(&residual) / (row_sum_norm(h) * max_norm(&d) + max_norm(b)).max(f64::MIN_POSITIVE);
     (backward <= LOW_RANK_BACKWARD_ERROR).then_some(d)
+}
+
+/// A failed factorization of Newton's Hessian `A + BᵀC⁻¹B` (with `C > 0` checked before)
+/// with its usual causes: a tester's α·C_I = 1e6 was told only "not positive definite".
+fn hessian_not_positive(error: Error) -> Error {
+    match error {
+        Error::LinearSolve(m) => Error::LinearSolve(format!(
+            "{m}: Newton's matrix A + BᵀC⁻¹B is not positive definite, so A = a − αS on the primal fields is not: α·C_I ≥ 1 makes it indefinite (stabilization::inverse_constant gives C_I; α = ½/C_I is the usual choice), as do a bilinear form `a` that is not positive (a wrong sign, a derivative the element does not carry) and, for thin structures, rounding"
+        )),
+        other => other,
+    }
 }
 
 /// Why a diagonal entry `c` of `C` is not positive, for the error of
