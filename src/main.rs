@@ -1130,6 +1130,16 @@ fn run(cli: Cli) -> Result<(), String> {
                         ),
                         Some(_) => {}
                     }
+                    // the file's α, not an --alpha, where the pair has none to take
+                    if options.alpha.is_none()
+                        && file.alpha.is_some()
+                        && options.pair.as_deref() == Some(MembranePair::P1Nodal.name())
+                    {
+                        return Err(format!(
+                            "{}: key `parameters.alpha` does not apply to the pair p1-nodal: it has no multiplier to stabilize; drop the key or choose a stabilized pair",
+                            path.display()
+                        ));
+                    }
                     options.alpha = options.alpha.or(file.alpha);
                     options.accuracy = file.accuracy;
                     SceneEntry {

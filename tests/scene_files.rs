@@ -552,3 +552,29 @@ fn msh_over_a_scene_file_says_what_it_replaces() {
     assert!(refined.status.success());
     assert!(!String::from_utf8_lossy(&refined.stderr).contains("replaces"));
 }
+
+/// A scene file's `parameters.alpha` with the pair p1-nodal was refused as "--alpha does
+/// not apply", an option the tester had not given: the key is named now.
+#[test]
+fn a_file_alpha_for_the_nodal_pair_names_its_key() {
+    let dir = std::env::temp_dir().join(format!("fem-forms-nodal-alpha-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("nodal.toml");
+    std::fs::write(
+        &scene,
+        "model = \"membrane\"\npair = \"p1-nodal\"\n[mesh]\ngenerator = \"square\"\nsize = 8\n[parameters]\nalpha = 0.1\n[data]\nf = \"-1\"\npsi = \"-0.1\"\ng = \"0\"\n",
+    )
+    .unwrap();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["solve", "--scene"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(
+        stderr.contains("parameters.alpha") && !stderr.contains("--alpha"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
