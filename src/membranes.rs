@@ -876,8 +876,11 @@ pub fn dirichlet_part(
     // `"all"` is the keyword for the whole boundary: a mesh with a boundary part of that
     // name would make `"all"` and `["all"]` mean different sets under one printed name
     if mesh.boundary_part_names().contains(&"all") {
-        return Err(at(format!(
-            "the mesh ({domain}) has a boundary part named `all`, which is also the keyword for the whole boundary: rename the Gmsh physical group (e.g. Physical Curve(\"outer\")) so that the choice is unambiguous"
+        // not `at`: the field may not be written at all (a tester's file had no
+        // `[boundary]`, and was told its `boundary.dirichlet` was at fault)
+        return Err(Error::Input(format!(
+            "scene `{}`: the mesh ({domain}) has a boundary part named `all`, which is the keyword of `boundary.dirichlet` (and its default) for the whole boundary: rename the Gmsh physical group (e.g. Physical Curve(\"outer\")) so that the choice is unambiguous",
+            scene.name
         )));
     }
     let DirichletParts::Named(names) = &scene.dirichlet else {

@@ -331,12 +331,19 @@ fn a_boundary_group_named_like_the_keyword_is_refused() {
     std::fs::create_dir_all(&dir).unwrap();
     let mesh = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/annulus_group_named_all.msh");
-    for choice in [r#""all""#, r#"["all"]"#, r#"["hole"]"#] {
+    // the last: no `[boundary]` at all, where the default "all" meets the group (a
+    // tester was told the `boundary.dirichlet` they had not written was at fault)
+    for choice in [r#""all""#, r#"["all"]"#, r#"["hole"]"#, ""] {
         let scene = dir.join("annulus.toml");
+        let boundary = if choice.is_empty() {
+            String::new()
+        } else {
+            format!("[boundary]\ndirichlet = {choice}\n")
+        };
         std::fs::write(
             &scene,
             format!(
-                "name = \"annulus\"\nmodel = \"membrane\"\npair = \"p1-p0\"\n[mesh]\nfile = {:?}\n[boundary]\ndirichlet = {choice}\n[data]\nf = \"-1\"\npsi = \"-1\"\ng = \"0\"\n",
+                "name = \"annulus\"\nmodel = \"membrane\"\npair = \"p1-p0\"\n[mesh]\nfile = {:?}\n{boundary}[data]\nf = \"-1\"\npsi = \"-1\"\ng = \"0\"\n",
                 mesh.display().to_string()
             ),
         )
@@ -349,7 +356,10 @@ fn a_boundary_group_named_like_the_keyword_is_refused() {
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert!(!run.status.success(), "{choice}: solved");
         assert!(
-            stderr.contains("boundary part named `all`") && !stderr.contains("panicked"),
+            stderr.contains("boundary part named `all`")
+                && stderr.contains("its default")
+                && !stderr.contains("field `boundary.dirichlet`")
+                && !stderr.contains("panicked"),
             "{choice}: {stderr}"
         );
     }
