@@ -542,3 +542,17 @@ fn anisotropic_cells_give_the_direct_answer_on_the_multigrid_path() {
     let residual = multigrid["complementarity_residual"].as_f64().unwrap();
     assert!(residual <= 1e-12, "{residual:e}");
 }
+
+/// A tester's Gmsh file whose curve lines are listed in two physical groups (`left` and
+/// `sides`) was refused naming only the markers 4 and 5. The refusal names the groups and
+/// what to change.
+#[test]
+fn an_edge_in_two_physical_groups_is_refused_naming_the_groups() {
+    let e = read_msh(&data("edges_in_two_groups.msh"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`left` and `sides`") && e.contains("one Physical Curve"),
+        "{e}"
+    );
+}

@@ -171,7 +171,30 @@ fn parse(bytes: &[u8], quadratic: bool) -> Result<(TriangleMesh, Option<Quadrati
             }
         }
     }
-    mesh.apply_markers(&markers).map_err(annotate)?;
+    mesh.apply_markers(&markers).map_err(|e| {
+        // a line in two physical curves: name the groups, which the user wrote, beside
+        // the markers (a tester was told only "markers 4 and 5")
+        let Error::Mesh(message) = annotate(e) else {
+            unreachable!("apply_markers fails with a mesh error")
+        };
+        let named = |marker: &str| {
+            let tag: i32 = marker.trim().parse().ok()?;
+            names
+                .iter()
+                .find(|(dimension, t, _)| *dimension == 1 && *t == tag)
+                .map(|(_, _, name)| format!("`{name}`"))
+        };
+        let groups = message
+            .split_once("two markers, ")
+            .and_then(|(_, pair)| pair.split_once(" and "))
+            .and_then(|(a, b)| Some((named(a)?, named(b)?)));
+        Error::Mesh(match groups {
+            Some((a, b)) => format!(
+                "{message} (the physical groups {a} and {b}): a boundary edge belongs to one group only; in Gmsh, put each curve in one Physical Curve"
+            ),
+            None => message,
+        })
+    })?;
     mesh.set_named_groups(named_groups(&file, &names, &boundary_curves));
     if elements.edge_nodes.is_empty() {
         return Ok((mesh, None));
