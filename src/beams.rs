@@ -389,7 +389,8 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
     }
     if scene.beam == Beam::Timoshenko && !(thickness > 0.0 && thickness.is_finite()) {
         return Err(Error::Input(format!(
-            "thickness t = {thickness} must be positive and finite"
+            "thickness t = {} must be positive and finite",
+            crate::number(thickness)
         )));
     }
     if scene.beam == Beam::Timoshenko && thickness > 1.0 {

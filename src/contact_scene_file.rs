@@ -385,7 +385,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         if !(a.is_finite() && a >= 0.0) {
             return Err(at(
                 "parameters.alpha",
-                format!("α = {a} must be ≥ 0 (0: the plain method)"),
+                format!("α = {} must be ≥ 0 (0: the plain method)", crate::number(a)),
             ));
         }
     }
@@ -433,7 +433,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         if !c.is_finite() {
             return Err(at(
                 "parameters.contact_centre",
-                format!("{c} must be finite"),
+                format!("{} must be finite", crate::number(c)),
             ));
         }
         // measured along the plane: the half-width is taken from c, which must lie
@@ -512,7 +512,10 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     }
     if let Some(a) = file.accuracy {
         if !(a.is_finite() && a > 0.0) {
-            return Err(at("accuracy", format!("{a} must be positive")));
+            return Err(at(
+                "accuracy",
+                format!("{} must be positive", crate::number(a)),
+            ));
         }
         if exact_pressure.is_none() {
             return Err(at(

@@ -195,7 +195,7 @@ impl PlateRequest {
         if !(self.thickness.is_finite() && self.thickness > 0.0) {
             return bad(format!(
                 "thickness t = {} must be positive and finite",
-                self.thickness
+                crate::number(self.thickness)
             ));
         }
         if self.thickness < MIN_PLATE_THICKNESS {
@@ -216,7 +216,7 @@ impl PlateRequest {
         if self.thickness > size {
             return bad(format!(
                 "thickness t = {} exceeds the plate's {size_name} {size}: plate theory describes thin bodies (t well below the {size_name}); a thicker body is a problem of elasticity",
-                self.thickness
+                crate::number(self.thickness)
             ));
         }
         if !(s.poisson_ratio > -1.0 && s.poisson_ratio < 0.5) {

@@ -621,7 +621,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
                     if !(MIN_HALF_WIDTH..=largest).contains(&a) {
                         return Err(at(
                             "mesh.half_width",
-                            format!("{a} must be within {MIN_HALF_WIDTH:e} to {largest:e}: below, the stabilization's α h⁴ underflows; rescale the units"),
+                            format!("{} must be within {MIN_HALF_WIDTH:e} to {largest:e}: below, the stabilization's α h⁴ underflows; rescale the units", crate::number(a)),
                         ));
                     }
                     (Domain::Square(a), size)
@@ -680,7 +680,10 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
     let data = &file.data;
     if let Some(q) = data.load {
         if !q.is_finite() {
-            return Err(at("data.load", format!("{q} must be finite")));
+            return Err(at(
+                "data.load",
+                format!("{} must be finite", crate::number(q)),
+            ));
         }
     }
     if let Some(e) = &file.exact {
@@ -693,7 +696,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
                 if !(v.is_finite() && v >= 0.0) {
                     return Err(at(
                         key,
-                        format!("{v} must be a finite number ≥ 0 (∫λ and the contact area cannot be negative)"),
+                        format!("{} must be a finite number ≥ 0 (∫λ and the contact area cannot be negative)", crate::number(v)),
                     ));
                 }
             }

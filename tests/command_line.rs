@@ -700,3 +700,28 @@ fn text_output_keeps_the_thickness_and_warnings_on_stderr() {
     }
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// Extreme numbers a user gives are echoed as they were written, not as 300-digit
+/// decimals (a tester's --thickness 1e300 and half_width 1e-200).
+#[test]
+fn refusals_echo_extreme_numbers_in_scientific_notation() {
+    let out = scratch("extreme-numbers");
+    for (args, number) in [
+        (
+            &["solve", "mindlin-square", "--thickness", "1e300"][..],
+            "1e300",
+        ),
+        (
+            &["solve", "timoshenko-a", "--thickness", "-1e300"][..],
+            "-1e300",
+        ),
+    ] {
+        let run = fem_forms(args, &out);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success());
+        assert!(
+            stderr.contains(&format!("t = {number}")) && !stderr.contains("00000000"),
+            "{stderr}"
+        );
+    }
+}
