@@ -576,6 +576,40 @@ fn validate(data: &SceneData, mesh: &TriangleMesh, part: &DirichletPart) -> Resu
     Ok(())
 }
 
+/// An error for an exact solution no obstacle problem can have on `mesh`: a multiplier
+/// below 0 at a vertex, or a contact area beyond the domain's (a tester's `[exact]
+/// lambda = "-2"` and `contact_area = 100` on a domain of area 4 were accepted and
+/// compared with).
+fn validate_exact(exact: &ExactMembrane, mesh: &TriangleMesh, scene: &str) -> Result<()> {
+    if let Some(lambda) = &exact.multiplier {
+        let values: Vec<f64> = mesh.vertices().iter().map(|x| lambda.at(x)).collect();
+        let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if let Some((x, v)) = mesh
+            .vertices()
+            .iter()
+            .zip(&values)
+            .find(|(_, &v)| !v.is_finite() || v < -1e-12 * largest)
+        {
+            return Err(Error::Input(format!(
+                "scene `{scene}`: field `exact.lambda`: λ = {} at ({}, {}); the multiplier of u ≥ ψ is a pressure, finite and ≥ 0",
+                crate::number(*v),
+                x[0],
+                x[1]
+            )));
+        }
+    }
+    if let Some(area) = exact.contact_area {
+        let domain: f64 = (0..mesh.cell_count()).map(|c| mesh.area(c)).sum();
+        if area > domain * (1.0 + 1e-9) {
+            return Err(Error::Input(format!(
+                "scene `{scene}`: field `exact.contact_area`: {} exceeds the domain's area {domain}",
+                crate::number(area)
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// The meshes of a nested solve: N/2^k ≥ 4, …, N (just N without nesting).
 fn level_sizes(n: usize, nested: bool, even: bool) -> Vec<usize> {
     let mut sizes = vec![n];
@@ -636,6 +670,9 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     };
     let mesh = meshes.last().expect("at least one level");
     validate(&posed.data, mesh, &posed.part)?;
+    if let Some(exact) = &posed.exact {
+        validate_exact(exact, mesh, &scene.name)?;
+    }
     let quality = mesh.quality();
     quality.check(mesh)?;
     let (alpha, c_i) = alpha_of(request, mesh).map_err(|e| match e {

@@ -588,3 +588,28 @@ fn a_file_alpha_for_the_nodal_pair_names_its_key() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// An exact solution no obstacle problem has: a negative multiplier, or a contact area
+/// beyond the domain's (a tester's `lambda = "-2"` and `contact_area = 100` on a domain
+/// of area 4 were accepted and compared with). The membrane pressed flat (u = 0, λ = 3)
+/// with its true data solves.
+#[test]
+fn an_impossible_exact_solution_is_refused() {
+    let text = |lambda: &str, area: f64| {
+        format!(
+            "model = \"membrane\"\n[mesh]\ngenerator = \"square\"\nhalf_width = 1.0\nsize = 8\n[data]\nf = \"-3\"\npsi = \"0\"\ng = \"0\"\n[exact]\nu = \"0\"\nlambda = \"{lambda}\"\ncontact_area = {area:?}\n"
+        )
+    };
+    for (lambda, area, key) in [
+        ("-2", 4.0, "exact.lambda"),
+        ("3", 100.0, "exact.contact_area"),
+    ] {
+        let file = scene_file::parse(&text(lambda, area), Path::new("mine.toml")).unwrap();
+        let Err(e) = membranes::solve(&request_of(&file)) else {
+            panic!("{key}: accepted");
+        };
+        assert!(e.to_string().contains(key), "{e}");
+    }
+    let file = scene_file::parse(&text("3", 4.0), Path::new("mine.toml")).unwrap();
+    assert!(membranes::solve(&request_of(&file)).is_ok());
+}
