@@ -88,6 +88,39 @@ fn a_stabilization_of_the_wrong_sign_is_named() {
     );
 }
 
+string_model!(
+    mixed_rules,
+    "
+    a(u;v)     = ∫ u'v'
+    S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
+    ℓ(v)       = ∫ f v
+    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    g(μ)       = ∫ s ψ μ
+    B_h(u,λ;v,μ) = a(u;v) − ∫[degree=1] s v λ − ∫ s u μ − α S(u,λ;v,μ)
+    L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
+    "
+);
+
+/// The re-test of the symmetry check: equal couplings written with different rules
+/// (`∫[degree=1]` beside the exact one, both exact for P1·P0) were refused when the
+/// check compared symbols; it compares the element matrices now, and this model solves
+/// to the same string as the plain one.
+#[test]
+fn equal_couplings_written_differently_are_symmetric() {
+    let mesh = IntervalMesh::uniform(-1.0, 1.0, 32).unwrap();
+    let load = |_: &[f64]| -4.0;
+    let obstacle = |_: &[f64]| -0.1;
+    let params = [("α", 0.1), ("s", 1.0)];
+    let data: [(&str, &fem_runtime::DataFn); 2] = [("f", &load), ("ψ", &obstacle)];
+    let c = Coefficients::new::<mixed_rules::Model>(&params, &data).unwrap();
+    let mixed = solve_obstacle::<mixed_rules::Model>(&mesh, &c, &["u"], ObstacleOptions::default())
+        .unwrap();
+    let c = Coefficients::new::<symmetric::Model>(&params, &data).unwrap();
+    let plain =
+        solve_obstacle::<symmetric::Model>(&mesh, &c, &["u"], ObstacleOptions::default()).unwrap();
+    assert!((mixed.total_contact_force() - plain.total_contact_force()).abs() < 1e-12);
+}
+
 #[test]
 fn a_system_form_with_couplings_of_different_signs_is_refused() {
     let mesh = IntervalMesh::uniform(-1.0, 1.0, 32).unwrap();

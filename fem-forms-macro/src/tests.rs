@@ -1093,38 +1093,6 @@ fn derivative_and_exponent_spellings_get_one_precise_error() {
     }
 }
 
-/// A tester's non-symmetric `B_h` (`− b(v;λ) + b(u;μ)`) compiled, and the solver, which
-/// reads B from the multiplier rows, solved another problem without a word. Each form's
-/// `FormInfo` now names a block that is not the transpose of its mirror, and the
-/// obstacle solvers refuse such a system form.
-#[test]
-fn asymmetric_forms_are_marked_in_their_form_info() {
-    let asymmetry_of_b_h = |forms: &str| {
-        let text = expand(timoshenko(forms)).to_string();
-        assert!(!text.contains("compile_error"), "{text}");
-        let after = text.split("name : \"B_h\"").nth(1).unwrap().to_string();
-        after
-            .split("asymmetry :")
-            .nth(1)
-            .unwrap()
-            .split('}')
-            .next()
-            .unwrap()
-            .replace([' ', ','], "")
-    };
-    assert_eq!(asymmetry_of_b_h(TIMOSHENKO), "None");
-    let flipped = TIMOSHENKO.replace("− b(θ,w;μ)", "+ b(θ,w;μ)");
-    assert_ne!(flipped, TIMOSHENKO);
-    assert!(asymmetry_of_b_h(&flipped).starts_with("Some("));
-    // a one-sided stabilization: S couples θ''' to μ but not η''' to λ
-    let one_sided = TIMOSHENKO.replace(
-        "S(θ,λ;η,μ) = Σ_T h_T⁴ (θ''' − sλ, η''' − sμ)_T",
-        "S(θ,λ;η,μ) = Σ_T h_T⁴ (θ'' − sλ, η'' − sμ)_T + Σ_T h_T⁴ (θ'', sμ)_T",
-    );
-    assert_ne!(one_sided, TIMOSHENKO);
-    assert!(asymmetry_of_b_h(&one_sided).starts_with("Some("));
-}
-
 /// A tester's `∫_Ω T ∇u·∇v` (the domain's integral as many write it) was read as a
 /// boundary integral over a part `Ω` and cascaded into "form `a` is used before its
 /// definition"; it is the cell integral now, in both spellings. On an interval a

@@ -111,10 +111,6 @@ pub struct FormInfo {
     pub dropped_terms: usize,
     /// Nonzero blocks.
     pub blocks: &'static [BlockInfo],
-    /// A bilinear form's cell block `[test field, trial field]` (indices into the
-    /// model's fields) that is not the transpose of its mirror block, found when the
-    /// macro expanded the form; `None` when the form is symmetric (and for linear forms).
-    pub asymmetry: Option<[usize; 2]>,
 }
 
 /// A model compiled by `model!`.
@@ -659,4 +655,82 @@ impl<'a> Coefficients<'a> {
             data: functions.into_iter().map(Option::unwrap).collect(),
         })
     }
+}
+
+/// An error unless the cell blocks of bilinear form `form` are symmetric on the first
+/// cell of `mesh` (block `(i, j)` the transpose of block `(j, i)`, to 1e-9 of their
+/// largest entry), with the parameters and data of `coefficients`. The obstacle solvers
+/// need their system form `B_h` symmetric: they read `B` from its multiplier rows alone
+/// and factor its primal block by Cholesky, so a tester's `− b(v;λ) + b(u;μ)` was solved
+/// to a string 0.93 through its obstacle with a KKT residual of 1e-16. Compared in
+/// numbers, not symbols, so that equal terms written differently (`∫[degree=1]` beside
+/// an exact rule, `1/(2 + 2t²)` beside `0.5/(1 + t²)`) pass. Boundary-integral blocks
+/// are not compared.
+///
+/// # Errors
+/// [`Error::Input`] naming the fields of the first block that is not the transpose of
+/// its mirror.
+pub fn require_symmetric<M: Model, G: crate::mesh::Mesh>(
+    form: usize,
+    mesh: &G,
+    coefficients: &Coefficients,
+) -> Result<()> {
+    if mesh.cell_count() == 0 || M::FORMS[form].arity != 2 {
+        return Ok(());
+    }
+    let width = match G::CELL {
+        CellKind::Interval => 2,
+        CellKind::Triangle => 6,
+    };
+    let mut x = vec![0.0; width];
+    mesh.cell_coordinates_into(0, &mut x);
+    let counts: Vec<usize> = M::FIELDS
+        .iter()
+        .map(|field| field.element.local_dof_count(M::CELL))
+        .collect();
+    let mut blocks: Vec<((usize, usize), Vec<f64>)> = Vec::new();
+    for (b, block) in M::FORMS[form].blocks.iter().enumerate() {
+        let Some(trial) = block.trial_field else {
+            continue;
+        };
+        let test = block.test_field;
+        let mut out = vec![0.0; counts[test] * counts[trial]];
+        M::element_matrix(
+            form,
+            b,
+            &x,
+            &coefficients.params,
+            &coefficients.data,
+            &mut out,
+        );
+        match blocks.iter_mut().find(|(key, _)| *key == (test, trial)) {
+            Some((_, sum)) => sum.iter_mut().zip(&out).for_each(|(s, o)| *s += o),
+            None => blocks.push(((test, trial), out)),
+        }
+    }
+    let largest = |m: &[f64]| m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for ((test, trial), mine) in &blocks {
+        let (rows, cols) = (counts[*test], counts[*trial]);
+        let zero = vec![0.0; rows * cols];
+        let mirror = blocks
+            .iter()
+            .find(|(key, _)| *key == (*trial, *test))
+            .map_or(&zero, |(_, m)| m);
+        let tolerance = 1e-9 * largest(mine).max(largest(mirror));
+        let transposed = (0..rows).all(|i| {
+            (0..cols).all(|j| (mine[i * cols + j] - mirror[j * rows + i]).abs() <= tolerance)
+        });
+        if !transposed {
+            let (name, fields) = (M::FORMS[form].name, M::FIELDS);
+            return Err(Error::Input(format!(
+                "`{name}` of model `{}` is not symmetric: on cell 0 its block of `{}` rows and `{}` columns is not the transpose of the block of `{}` rows and `{}` columns. The obstacle solvers read B from the multiplier rows alone and factor the primal block by Cholesky, so they would solve another problem; write `{name}` as a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ) with a and S symmetric",
+                M::NAME,
+                fields[*test].test_name,
+                fields[*trial].name,
+                fields[*trial].test_name,
+                fields[*test].name,
+            )));
+        }
+    }
+    Ok(())
 }

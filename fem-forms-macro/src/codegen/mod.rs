@@ -167,10 +167,6 @@ fn form_code(
         }
     };
     let name = &form.name;
-    let asymmetry = match form.asymmetry() {
-        Some((test, trial)) => quote! { Some([#test, #trial]) },
-        None => quote! { None },
-    };
     let info = quote! {
         #runtime::FormInfo {
             name: #name,
@@ -178,7 +174,6 @@ fn form_code(
             arity: #arity,
             dropped_terms: #dropped,
             blocks: &[#(#block_infos),*],
-            asymmetry: #asymmetry,
         }
     };
     FormCode { module, info }

@@ -165,6 +165,7 @@ pub fn discretize_boundary_multiplier<M: Model>(
 ) -> Result<BoundaryMultiplierProblem> {
     let (bilinear_id, linear_id) = system_forms::<M>()?;
     let (bilinear, linear) = (M::form(bilinear_id)?, M::form(linear_id)?);
+    crate::model::require_symmetric::<M, TriangleMesh>(bilinear, mesh, coefficients)?;
     let multiplier = multiplier_field::<M>()?;
     let space = match M::FIELDS[multiplier].element {
         ElementKind::P0 => BoundaryMultiplier::P0,

@@ -154,16 +154,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         let multiplier = multiplier_field::<M>()?;
         let form = M::form(bilinear)?;
         let bilinear = M::FORMS[form].name;
-        if let Some([test, trial]) = M::FORMS[form].asymmetry {
-            return Err(Error::Input(format!(
-                "`{bilinear}` of model `{}` is not symmetric: its block of `{}` rows and `{}` columns is not the transpose of the block of `{}` rows and `{}` columns. The obstacle solvers read B from the multiplier rows alone and factor the primal block by Cholesky, so they would solve another problem; write `{bilinear}` with the same sign on both couplings, e.g. a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ), S symmetric",
-                M::NAME,
-                M::FIELDS[test].name,
-                M::FIELDS[trial].name,
-                M::FIELDS[trial].name,
-                M::FIELDS[test].name,
-            )));
-        }
+        crate::model::require_symmetric::<M, G>(form, mesh, coefficients)?;
         let mut plans = block_plans::<M>(form, &dofs, true)?;
         let reduction = constraints.reduction(dofs.dof_count())?;
         let basis = constraints.change_of_basis(dofs.dof_count())?;
