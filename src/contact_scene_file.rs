@@ -580,7 +580,7 @@ fn check_load(load: f64) -> std::result::Result<(), String> {
 /// direction are checked to hold; a second piece escapes those checks (a tester's
 /// floating second block ended in "the matrix is not positive definite").
 fn one_body(mesh: &TriangleMesh) -> std::result::Result<(), String> {
-    let (piece, count) = mesh.vertex_pieces();
+    let (piece, count) = mesh.cell_pieces();
     if count < 2 {
         return Ok(());
     }
@@ -588,7 +588,7 @@ fn one_body(mesh: &TriangleMesh) -> std::result::Result<(), String> {
         .map(|p| piece.iter().filter(|&&q| q == p).count().to_string())
         .collect::<Vec<_>>();
     Err(format!(
-        "the mesh falls into {count} separate pieces (of {} vertices): a contact scene file poses one elastic body on a rigid foundation; mesh one connected body (in Gmsh, a coherent geometry), or pose each body in its own scene",
+        "the mesh falls into {count} pieces joined by no edge (of {} cells; pieces that share only a vertex are a hinge, which holds nothing): a contact scene file poses one elastic body on a rigid foundation; mesh one connected body (in Gmsh, a coherent geometry), or pose each body in its own scene",
         sizes.join(", ")
     ))
 }

@@ -161,7 +161,14 @@ fn the_locking_timoshenko_pair_is_warned_about_where_it_locks() {
         "{:?}",
         report.warnings
     );
+    // the re-test: at h = t the error is 8 %, and was not warned about
+    r.thickness = Some(0.01);
+    r.elements = 100;
+    let (report, _) = solve(&r).unwrap();
+    assert!((report.max_deflection / centre_deflection(0.01) - 1.0).abs() > 0.05);
+    assert!(report.warnings.iter().any(|w| w.contains("locks")));
     r.thickness = Some(0.1);
+    r.elements = 256;
     let (report, _) = solve(&r).unwrap();
     assert!((report.max_deflection / centre_deflection(0.1) - 1.0).abs() < 1e-3);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);

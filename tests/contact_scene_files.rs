@@ -353,7 +353,7 @@ fn bad_contact_scene_files_name_the_key() {
                 .replace("y = [0.0, 1.0]\n", "")
                 .replace("cells = [6, 3]\n", ""),
             "mesh",
-            &["2 separate pieces", "one elastic body"],
+            &["2 pieces joined by no edge", "one elastic body"],
         ),
         // extreme data are named, not reported as "α = inf", a non-finite facet
         // matrix or a line search that failed; a uniform gap of 1e10 on a block whose

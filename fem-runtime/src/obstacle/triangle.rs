@@ -73,29 +73,34 @@ pub fn curved_dirichlet_constraints_on<M: Model>(
 /// far obstacle: u ≈ 6e15 on the free one, KKT residual 2e-16, no warning), as the
 /// whole mesh without a Dirichlet part does not.
 fn unheld_piece(mesh: &TriangleMesh, part: &DirichletPart) -> Result<()> {
-    let (piece, count) = mesh.vertex_pieces();
+    let (piece, count) = mesh.cell_pieces();
     if count < 2 {
         return Ok(());
     }
+    // held by an edge of the part: a vertex alone holds nothing in H¹
     let mut held = vec![false; count];
-    for (v, &on) in part.vertices(mesh).iter().enumerate() {
-        held[piece[v]] |= on;
+    for &(e, marker) in mesh.boundary_edges() {
+        if part.contains(marker) {
+            held[piece[mesh.edge_cells(e).0]] = true;
+        }
     }
     let Some(free) = held.iter().position(|&h| !h) else {
         return Ok(());
     };
-    let vertices: Vec<usize> = (0..piece.len()).filter(|&v| piece[v] == free).collect();
+    let cells: Vec<usize> = (0..piece.len()).filter(|&c| piece[c] == free).collect();
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for &v in &vertices {
-        let x = mesh.vertices()[v];
-        for k in 0..2 {
-            lo[k] = lo[k].min(x[k]);
-            hi[k] = hi[k].max(x[k]);
+    for &c in &cells {
+        for v in mesh.cell(c) {
+            let x = mesh.vertices()[v];
+            for k in 0..2 {
+                lo[k] = lo[k].min(x[k]);
+                hi[k] = hi[k].max(x[k]);
+            }
         }
     }
     Err(Error::Input(format!(
-        "the mesh falls into {count} separate pieces, and the piece of {} vertices within [{}, {}] × [{}, {}] touches no part of the Dirichlet boundary (markers {}): with the natural condition on all of its boundary the problem is not coercive there (u + constant solves it wherever contact does not hold it); give that piece a Dirichlet part, or mesh the domain as one piece (in Gmsh, a coherent geometry)",
-        vertices.len(),
+        "the mesh falls into {count} pieces joined by no edge, and the piece of {} cells within [{}, {}] × [{}, {}] has no edge on the Dirichlet boundary (markers {}): with the natural condition on all of its boundary (a shared vertex holds nothing) the problem is not coercive there (u + constant solves it wherever contact does not hold it); give that piece a Dirichlet part, or mesh the domain as one piece (in Gmsh, a coherent geometry)",
+        cells.len(),
         lo[0],
         hi[0],
         lo[1],

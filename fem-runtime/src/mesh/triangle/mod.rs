@@ -681,32 +681,33 @@ impl TriangleMesh {
         flags
     }
 
-    /// The connected pieces of the mesh: for each vertex the index of its piece, pieces
-    /// numbered in the order of their first vertex, and the number of pieces. Cells are
-    /// connected through shared vertices (a piece that touches another at one vertex
-    /// shares that vertex's DOF, so a condition on one holds the other there too).
-    pub fn vertex_pieces(&self) -> (Vec<usize>, usize) {
-        let mut parent: Vec<usize> = (0..self.vertices.len()).collect();
-        fn root(parent: &mut [usize], mut v: usize) -> usize {
-            while parent[v] != v {
-                parent[v] = parent[parent[v]];
-                v = parent[v];
+    /// The connected pieces of the mesh: for each cell the index of its piece, pieces
+    /// numbered in the order of their first cell, and the number of pieces. Cells are
+    /// connected through shared edges: two pieces that touch at one vertex are two
+    /// pieces, since a point holds nothing in H¹ (a tester's square hinged at a corner
+    /// to a clamped one sagged like log h as the mesh was refined).
+    pub fn cell_pieces(&self) -> (Vec<usize>, usize) {
+        let mut parent: Vec<usize> = (0..self.cells.len()).collect();
+        fn root(parent: &mut [usize], mut c: usize) -> usize {
+            while parent[c] != c {
+                parent[c] = parent[parent[c]];
+                c = parent[c];
             }
-            v
+            c
         }
-        for cell in self.cells.iter() {
-            for k in 1..3 {
-                let (a, b) = (root(&mut parent, cell[0]), root(&mut parent, cell[k]));
+        for e in 0..self.edges.len() {
+            if let (a, Some(b)) = self.edge_cells(e) {
+                let (a, b) = (root(&mut parent, a), root(&mut parent, b));
                 if a != b {
                     parent[a.max(b)] = a.min(b);
                 }
             }
         }
-        let mut index = vec![usize::MAX; self.vertices.len()];
+        let mut index = vec![usize::MAX; self.cells.len()];
         let mut count = 0;
-        let piece = (0..self.vertices.len())
-            .map(|v| {
-                let r = root(&mut parent, v);
+        let piece = (0..self.cells.len())
+            .map(|c| {
+                let r = root(&mut parent, c);
                 if index[r] == usize::MAX {
                     index[r] = count;
                     count += 1;
@@ -723,24 +724,35 @@ mod tests {
     use super::*;
 
     #[test]
-    fn pieces_are_joined_through_shared_vertices() {
+    fn pieces_are_joined_through_shared_edges_only() {
         // two unit squares side by side, apart, then touching at one corner
         let square = |x: f64| vec![[x, 0.0], [x + 1.0, 0.0], [x + 1.0, 1.0], [x, 1.0]];
         let cells = |o: usize| [[o, o + 1, o + 2], [o, o + 2, o + 3]];
         let mut vertices = square(0.0);
         vertices.extend(square(2.0));
         let apart: Vec<[usize; 3]> = cells(0).into_iter().chain(cells(4)).collect();
-        let mesh = TriangleMesh::new(vertices.clone(), apart, &[]).unwrap();
-        assert_eq!(mesh.vertex_pieces(), (vec![0, 0, 0, 0, 1, 1, 1, 1], 2));
-        // the second square's first corner moved onto the first's (1, 1)
-        let mut touching = vertices;
-        touching.truncate(7);
-        let touching_cells = vec![[0, 1, 2], [0, 2, 3], [2, 4, 5], [2, 5, 6]];
-        touching[4] = [2.0, 1.0];
-        touching[5] = [2.0, 2.0];
-        touching[6] = [1.0, 2.0];
-        let mesh = TriangleMesh::new(touching[..7].to_vec(), touching_cells, &[]).unwrap();
-        assert_eq!(mesh.vertex_pieces().1, 1);
+        let mesh = TriangleMesh::new(vertices, apart, &[]).unwrap();
+        assert_eq!(mesh.cell_pieces(), (vec![0, 0, 1, 1], 2));
+        // the second square hinged at the first's corner (1, 1): still two pieces
+        let hinged = vec![
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 1.0],
+            [0.0, 1.0],
+            [2.0, 1.0],
+            [2.0, 2.0],
+            [1.0, 2.0],
+        ];
+        let cells = vec![[0, 1, 2], [0, 2, 3], [2, 4, 5], [2, 5, 6]];
+        let mesh = TriangleMesh::new(hinged, cells, &[]).unwrap();
+        assert_eq!(mesh.cell_pieces(), (vec![0, 0, 1, 1], 2));
+        // one square: one piece
+        let mesh = TriangleMesh::new(square(0.0), cells_of_square(), &[]).unwrap();
+        assert_eq!(mesh.cell_pieces().1, 1);
+    }
+
+    fn cells_of_square() -> Vec<[usize; 3]> {
+        vec![[0, 1, 2], [0, 2, 3]]
     }
 
     /// A small deterministic generator (xorshift64*), so the tests need no dependencies.
