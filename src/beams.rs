@@ -515,7 +515,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
                 if setup.timoshenko && shear_conditioning(thickness, request.elements) > 1e-3 =>
             {
                 Error::Input(format!(
-                    "{e}; at t = {} on {} elements the shear term t⁻²(w′ − θ) conditions the system like t⁻²h⁻² ≈ {:.0e} ε, beyond double precision: use fewer elements, a larger t, or the Euler–Bernoulli limit (bernoulli-a, bernoulli-b)",
+                    "{e}; at t = {} on {} elements the shear term t⁻²(w′ − θ) conditions the system like t⁻²h⁻², and its rounding ε t⁻²h⁻² ≈ {:.0e} is not small against the bending term the answer lives in: use fewer elements, a larger t, or the Euler–Bernoulli limit (bernoulli-a, bernoulli-b)",
                     crate::number(thickness),
                     request.elements,
                     shear_conditioning(thickness, request.elements)

@@ -45,6 +45,11 @@ fn an_ascii_model_has_its_energy_and_its_inverse_constant_by_handle() {
     )
     .unwrap();
     assert_eq!(by_name, by_handle);
+    // a linear form has no C_I against anything (it returned 0 before)
+    let e = stabilization::inverse_constant::<ascii_string::Model, _>(&mesh, &c.params, "S", "l")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`l`") && e.contains("linear"), "{e}");
     let solution =
         solve_obstacle::<ascii_string::Model>(&mesh, &c, &["u"], ObstacleOptions::default())
             .unwrap();

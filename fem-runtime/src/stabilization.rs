@@ -208,7 +208,8 @@ pub fn element_inverse_constant<M: Model>(
 /// 64 distinct shapes are remembered: structured meshes have one or two).
 ///
 /// # Errors
-/// Those of [`element_inverse_constant`].
+/// [`Error::Input`] for a form that is not bilinear; those of
+/// [`element_inverse_constant`].
 pub fn inverse_constant<M: Model, G: Mesh>(
     mesh: &G,
     params: &[f64],
@@ -216,8 +217,17 @@ pub fn inverse_constant<M: Model, G: Mesh>(
     bilinear: impl IntoFormIndex<M>,
 ) -> Result<f64> {
     // by handle (`NAME::forms::S`) or by name (`"S"`), as the crate docs promise
-    let stabilization = M::FORMS[M::form(stabilization)?].name;
-    let bilinear = M::FORMS[M::form(bilinear)?].name;
+    let (s, a) = (M::form(stabilization)?, M::form(bilinear)?);
+    for f in [s, a] {
+        if M::FORMS[f].arity != 2 {
+            return Err(Error::Input(format!(
+                "C_I compares two bilinear forms; `{}` of model `{}` is linear",
+                M::FORMS[f].name,
+                M::NAME
+            )));
+        }
+    }
+    let (stabilization, bilinear) = (M::FORMS[s].name, M::FORMS[a].name);
     let width = match G::CELL {
         crate::CellKind::Interval => 2,
         crate::CellKind::Triangle => 6,

@@ -448,8 +448,10 @@ impl Lcp {
             block.dense(&self.c, &mut dense[..s * s]);
             if !small_cholesky(&mut dense, s) {
                 return Err(Error::Input(format!(
-                    "{method} needs C positive definite (it uses Φ and the eliminated Λ); its block of constraints {k} to {} is not: α ≤ 0 gives the plain mixed method, solve it with the QP solver",
-                    k + s - 1
+                    "{method} needs C positive definite (it uses Φ and the eliminated Λ); its block of constraints {k} to {} is not: {}",
+                    k + s - 1,
+                    // the block's diagonal says which sign it has
+                    c_fault((0..s).map(|i| block.entry(&self.c, i, i)).fold(f64::INFINITY, f64::min))
                 )));
             }
         }
@@ -1096,8 +1098,8 @@ fn hessian_not_positive(error: Error) -> Error {
     }
 }
 
-/// Why a diagonal entry `c` of `C` is not positive, for the error of
-/// [`Lcp::require_positive_c`]. `C = αS` restricted to the multipliers, so a negative
+/// Why a block of `C` whose smallest diagonal entry is `c` is not positive definite, for
+/// the error of [`Lcp::require_positive_c`]. `C = αS` restricted to the multipliers, so a negative
 /// entry with α > 0 is a sign in the forms (a tester's `B_h = … + α S` was told that
 /// "α ≤ 0 gives the plain mixed method" with α = 0.04), and a zero one is α = 0 or an
 /// `αh^k` that underflows on tiny cells.
@@ -1106,7 +1108,23 @@ fn c_fault(c: f64) -> &'static str {
         "C = αS on the multipliers must be positive: with α > 0 the system form subtracts the stabilization (B_h = a − b − b − α S, L_h = ℓ − g − α ℓ_S, S a sum of squares); with α < 0 use α > 0, or α = 0 for the plain mixed method (the QP solver)"
     } else if c == 0.0 {
         "α = 0 gives the plain mixed method, solve it with the QP solver; with α > 0 the stabilization αh^k underflowed (cells far below the unit length: rescale the problem)"
-    } else {
+    } else if c.is_nan() {
         "C is not a number: the stabilization's data or parameters are not finite"
+    } else {
+        "its diagonal is positive but the block is not positive definite: the stabilization S must be a sum of squares on the multipliers, (R(u,λ), R(v,μ)) with the same residual R on both sides"
+    }
+}
+
+#[cfg(test)]
+mod c_fault_tests {
+    /// Each sign of a block of C gets its own cause: a block with a positive diagonal
+    /// that is not positive definite (a P1disc multiplier's S of the wrong shape) was told
+    /// "α ≤ 0 gives the plain mixed method".
+    #[test]
+    fn each_kind_of_c_that_is_not_positive_gets_its_cause() {
+        assert!(super::c_fault(-1.0).contains("subtracts the stabilization"));
+        assert!(super::c_fault(0.0).contains("α = 0"));
+        assert!(super::c_fault(f64::NAN).contains("not a number"));
+        assert!(super::c_fault(1.0).contains("sum of squares"));
     }
 }
