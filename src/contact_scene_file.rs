@@ -139,9 +139,10 @@ where
     let entries = Vec::<T>::deserialize(deserializer)?;
     let count = entries.len();
     <[T; 2]>::try_from(entries).map(Some).map_err(|_| {
-        serde::de::Error::custom(format!(
-            "an array of {count} entries where two are expected"
-        ))
+        serde::de::Error::custom(match count {
+            1 => "an array of one entry where two are expected".to_string(),
+            _ => format!("an array of {count} entries where two are expected"),
+        })
     })
 }
 

@@ -323,9 +323,12 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             && matches!(chars.get(i + 2), Some('x' | 'y'))
             && matches!(chars.get(i + 3), Some('x' | 'y'))
         {
-            // One error for the whole operator, and the first partial in its place, so
-            // that the parse goes on without a cascade about a symbol `_xy`.
+            // One error for the whole operator (`∂_xyz` too), and the first partial in
+            // its place, so that the parse goes on without a cascade about a symbol `_xy`.
             j = i + 4;
+            while matches!(chars.get(j), Some('x' | 'y' | 'z')) {
+                j += 1;
+            }
             let written: String = chars[i..j].iter().collect();
             let (a, b) = (chars[i + 2], chars[i + 3]);
             let help = if a == b {
@@ -335,12 +338,31 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             };
             errors.push(
                 Diagnostic::text(
-                    Loc { len: 4, ..start },
+                    Loc { len: j - i, ..start },
                     format!("`{written}` is ambiguous: a mixed derivative to some readers, ∂_{a} of a name `{b}…` to others"),
                 )
                 .help(help),
             );
-            push(Tok::Partial(u8::from(a == 'y')), 4, &mut tokens);
+            push(Tok::Partial(u8::from(a == 'y')), j - i, &mut tokens);
+        } else if c == '∂'
+            && chars.get(i + 1) == Some(&'_')
+            && chars.get(i + 2).is_some_and(|&d| is_ident_start(d))
+            && !matches!(chars.get(i + 2), Some('x' | 'y'))
+        {
+            // `∂_X u`, `∂_t u`: one error at the operator, not a cascade about `_X`
+            j = i + 2;
+            while j < chars.len() && is_ident_continue(chars[j]) {
+                j += 1;
+            }
+            let written: String = chars[i..j].iter().collect();
+            errors.push(
+                Diagnostic::text(
+                    Loc { len: j - i, ..start },
+                    format!("`{written}` is not a partial derivative of the forms: the coordinates are x and y"),
+                )
+                .help("write ∂_x or ∂_y (ASCII d_x, d_y), then the field: ∂_x u"),
+            );
+            push(Tok::Partial(0), j - i, &mut tokens);
         } else {
             let tok = match c {
                 // `∫_Γ_C`: the boundary part's name follows the underscore.

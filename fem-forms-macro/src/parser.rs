@@ -959,12 +959,12 @@ impl<'a> Parser<'a> {
             }) => {
                 let (what, help) = if v.fract() == 0.0 {
                     (
-                        format!("exponent {v} is beyond the limit {MAX_TOTAL_POWER}"),
+                        format!("exponent {} is beyond the limit {MAX_TOTAL_POWER}", sign * v),
                         "a form is a polynomial of low degree in its fields and data: write the power you mean (h_T^4, t^-2)",
                     )
                 } else {
                     (
-                        format!("exponent {v} is not an integer"),
+                        format!("exponent {} is not an integer", sign * v),
                         "powers in forms are integers: t^2, t^-2; a fractional power of data belongs in the data's own expression",
                     )
                 };

@@ -1056,6 +1056,17 @@ fn derivative_and_exponent_spellings_get_one_precise_error() {
             "write ∂_x ∂_y",
         ),
         ("a(u;v) = ∫ ∂_yyu v", "`∂_yy` is ambiguous", "write ∂_y²"),
+        // the re-test: a longer run and a capital were still cascades
+        (
+            "a(u;v) = ∫ ∂_xyz u v",
+            "`∂_xyz` is ambiguous",
+            "write ∂_x ∂_y",
+        ),
+        (
+            "a(u;v) = ∫ ∂_X u v",
+            "`∂_X` is not a partial derivative",
+            "write ∂_x or ∂_y",
+        ),
         (
             "a(u;v) = ∫ d_xu d_x v",
             "unknown symbol `d_xu`",
@@ -1086,6 +1097,11 @@ fn derivative_and_exponent_spellings_get_one_precise_error() {
             "exponent 2.5 is not an integer",
         ),
         ("a(u;v) = ∫ t⁻⁻² u v".into(), "malformed exponent `⁻⁻²`"),
+        // the re-test: the sign was dropped from the message
+        (
+            "a(u;v) = ∫ t^-2147483648 u v".into(),
+            "exponent -2147483648 is beyond",
+        ),
     ] {
         let errors = rendered_errors(&expand(run_model(&forms)));
         assert_eq!(errors.len(), 1, "{forms}: {errors:?}");

@@ -439,7 +439,7 @@ fn alpha_error(alpha: f64, constants: &[f64], error: Error) -> Error {
     let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
     if alpha * c > 1.0 {
         Error::Input(format!(
-            "α = {alpha:e} gives α·max C_I,E = {:.3}, beyond the working range (measured: up to 1.0–1.3 on the block patch, 1.5–1.9 on Hertz; the automatic α is ½/max C_I,E = {:.3e}): B_h = a − α S_h is no longer positive on the displacements ({error})",
+            "α = {alpha:e} gives α·max C_I,E = {:.3e}, beyond the working range (measured: up to 1.0–1.3 on the block patch, 1.5–1.9 on Hertz; the automatic α is ½/max C_I,E = {:.3e}): B_h = a − α S_h is no longer positive on the displacements ({error})",
             alpha * c,
             0.5 / c
         ))
