@@ -149,3 +149,85 @@ fn a_system_form_with_couplings_of_different_signs_is_refused() {
         "{e}"
     );
 }
+
+/// Signorini's forms with the contact couplings (boundary integrals over Γ_C) of
+/// different signs: the cell blocks are symmetric, so only the facet blocks show it.
+macro_rules! contact_model {
+    ($name:ident, $system:literal) => {
+        fem_runtime::model! {
+            /// An elastic body on a rigid foundation, u ∈ `[P1]²`, λ ∈ P0 on Γ_C.
+            pub mod $name on triangle {
+                unknowns: u: [P1]^2, λ: P0 >= 0;
+                tests: v, μ;
+                params: μ_L > 0, λ_L, α, n_c_x, n_c_y;
+                data: q: 2, g: 1;
+                facets: Γ_C, Γ_N;
+                forms: $system;
+            }
+        }
+    };
+}
+
+contact_model!(
+    contact_symmetric,
+    "
+    σ(u)         := 2μ_L ε(u) + λ_L tr ε(u) I
+    σ_n(u)       := (σ(u)·n)·n_c
+    a(u;v)       = ∫ σ(u):ε(v)
+    b(v;μ)       = −∫_Γ_C μ v·n_c ds
+    S(u,λ;v,μ)   = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds
+    ℓ(v)         = −∫_Γ_N q v·n ds
+    G(μ)         = −∫_Γ_C g μ ds
+    B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
+    L_h(v,μ)     = ℓ(v) − G(μ)
+    "
+);
+
+contact_model!(
+    contact_flipped,
+    "
+    σ(u)         := 2μ_L ε(u) + λ_L tr ε(u) I
+    σ_n(u)       := (σ(u)·n)·n_c
+    a(u;v)       = ∫ σ(u):ε(v)
+    b(v;μ)       = −∫_Γ_C μ v·n_c ds
+    S(u,λ;v,μ)   = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds
+    ℓ(v)         = −∫_Γ_N q v·n ds
+    G(μ)         = −∫_Γ_C g μ ds
+    B_h(u,λ;v,μ) = a(u;v) + b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
+    L_h(v,μ)     = ℓ(v) − G(μ)
+    "
+);
+
+/// The symmetry check reaches the boundary integrals: the contact form with couplings
+/// of different signs is refused naming the part, the one with equal signs discretizes.
+#[test]
+fn a_contact_form_with_couplings_of_different_signs_is_refused() {
+    use fem_runtime::contact::discretize_boundary_multiplier;
+    use fem_runtime::mesh::triangle::Diagonal;
+    use fem_runtime::TriangleMesh;
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Alternating).unwrap();
+    let pressure = |_: &[f64]| 1.0;
+    let gap = |_: &[f64]| 0.0;
+    let params = [
+        ("μ_L", 1.0),
+        ("λ_L", 1.0),
+        ("α", 0.01),
+        ("n_c_x", 0.0),
+        ("n_c_y", -1.0),
+    ];
+    let data: [(&str, &fem_runtime::DataFn); 2] = [("q", &pressure), ("g", &gap)];
+    let parts: [(&str, &[u32]); 2] = [("Γ_C", &[1]), ("Γ_N", &[3])];
+    let c = Coefficients::new::<contact_symmetric::Model>(&params, &data).unwrap();
+    discretize_boundary_multiplier::<contact_symmetric::Model>(&mesh, &c, &parts, &[]).unwrap();
+    let c = Coefficients::new::<contact_flipped::Model>(&params, &data).unwrap();
+    let Err(e) = discretize_boundary_multiplier::<contact_flipped::Model>(&mesh, &c, &parts, &[])
+    else {
+        panic!("the asymmetric contact B_h was discretized");
+    };
+    let e = e.to_string();
+    assert!(
+        e.contains("`B_h` of model `contact_flipped` is not symmetric")
+            && e.contains("boundary integral over `Γ_C`"),
+        "{e}"
+    );
+}

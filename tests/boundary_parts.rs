@@ -234,7 +234,8 @@ fn the_binary_file_names_the_same_parts() {
 /// part: u = g would hold nowhere, so the solve is refused, not run pure Neumann.
 #[test]
 fn a_part_without_boundary_edges_is_refused() {
-    let dir = std::env::temp_dir().join(format!("fem-forms-slit-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-slit-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let text = std::fs::read_to_string(data("square_named.msh")).unwrap();
     let with_slit = text.replace("$PhysicalNames\n6\n", "$PhysicalNames\n7\n1 15 \"slit\"\n");

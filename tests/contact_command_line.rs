@@ -6,7 +6,8 @@
 use std::process::Command;
 
 fn fem_forms(args: &[&str], out: &str) -> std::process::Output {
-    let out = std::env::temp_dir().join(format!("fem-forms-contact-{out}-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-contact-{out}-{}", std::process::id()));
     Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(args)
         .arg("--out")
@@ -165,7 +166,8 @@ fn an_accuracy_not_reached_is_a_warning() {
 /// The α study writes its chart and table; `--plot` writes the pressure chart.
 #[test]
 fn the_hertz_study_and_chart_are_written() {
-    let out = std::env::temp_dir().join(format!("fem-forms-contact-study-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-contact-study-{}", std::process::id()));
     let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(["study", "hertz", "alpha", "--out"])
         .arg(&out)

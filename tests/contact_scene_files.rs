@@ -733,7 +733,8 @@ fn the_finite_block_deviates_from_the_half_plane_well_below_the_accuracy() {
 }
 
 fn fem_forms(args: &[&str]) -> std::process::Output {
-    let out = std::env::temp_dir().join(format!("fem-forms-contact-files-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-contact-files-{}", std::process::id()));
     Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(args)
         .arg("--out")
@@ -789,7 +790,8 @@ fn the_gap_scene_from_the_command_line() {
     assert!(number(&json, "pressure_l2_error") > number(&json, "accuracy"));
     let run = fem_forms(&["solve", "signorini-gap", "--plot"]);
     assert!(run.status.success());
-    let out = std::env::temp_dir().join(format!("fem-forms-contact-files-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-contact-files-{}", std::process::id()));
     assert!(out.join("signorini-gap-pressure.svg").exists());
     let run = fem_forms(&["solve", "signorini-gap", "--load", "-1"]);
     assert!(!run.status.success());
@@ -814,7 +816,8 @@ fn contact_scene_files_from_the_command_line() {
     assert!(error < 0.06, "{json}");
     assert!(number(&json, "best_p0_l2_error") <= error);
 
-    let dir = std::env::temp_dir().join(format!("fem-forms-contact-scene-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-contact-scene-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::copy(data("contact_block.msh"), dir.join("contact_block.msh")).unwrap();
     let file = dir.join("block.toml");

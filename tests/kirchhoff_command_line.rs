@@ -6,7 +6,8 @@
 use std::process::Command;
 
 fn fem_forms(args: &[&str]) -> std::process::Output {
-    let out = std::env::temp_dir().join(format!("fem-forms-kirchhoff-cli-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-kirchhoff-cli-{}", std::process::id()));
     Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(args)
         .arg("--out")

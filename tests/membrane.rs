@@ -420,7 +420,8 @@ fn vtk_output_names_every_field() {
     let mut request = MembraneRequest::new(radial());
     request.mesh_size = 4;
     let (_, fields) = membranes::solve(&request).unwrap();
-    let dir = std::env::temp_dir().join(format!("fem-forms-vtk-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-vtk-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("radial.vtu");
     membranes::write_vtk(&path, &fields).unwrap();
@@ -474,7 +475,8 @@ $EndElements
 /// and a broken file is a clear error.
 #[test]
 fn a_gmsh_mesh_refined_uniformly_converges() {
-    let dir = std::env::temp_dir().join(format!("fem-forms-msh-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-msh-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("square.msh");
     std::fs::write(&path, SQUARE_MSH).unwrap();

@@ -192,7 +192,8 @@ fn the_form_compiler_has_no_import_cycle() {
 
 #[test]
 fn a_cycle_is_found() {
-    let dir = std::env::temp_dir().join(format!("fem-forms-cycle-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-cycle-{}", std::process::id()));
     std::fs::create_dir_all(dir.join("a")).unwrap();
     std::fs::write(dir.join("lib.rs"), "pub mod a;\npub mod b;\n").unwrap();
     std::fs::write(

@@ -8,7 +8,8 @@
 use std::process::Command;
 
 fn fem_forms(args: &[&str]) -> std::process::Output {
-    let out = std::env::temp_dir().join(format!("fem-forms-plate-cli-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-plate-cli-{}", std::process::id()));
     Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(args)
         .arg("--out")
@@ -123,7 +124,8 @@ fn bad_plate_input_exits_with_a_message() {
 /// deflection collapses (relative error below −0.99 at t = 1e-4).
 #[test]
 fn the_locking_study_writes_its_chart_and_table() {
-    let out = std::env::temp_dir().join(format!("fem-forms-plate-study-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-plate-study-{}", std::process::id()));
     let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(["study", "mindlin-square", "locking", "--out"])
         .arg(&out)
@@ -374,7 +376,8 @@ fn bad_disk_input_exits_with_a_message() {
 /// shrinking).
 #[test]
 fn the_disk_studies_write_their_charts_and_tables() {
-    let out = std::env::temp_dir().join(format!("fem-forms-disk-study-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-disk-study-{}", std::process::id()));
     let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(["study", "mindlin-disk", "--out"])
         .arg(&out)

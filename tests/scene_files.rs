@@ -292,7 +292,8 @@ fn the_strip_example_solves_with_named_boundary_parts() {
 /// the field, the name and the file's names, not a panic.
 #[test]
 fn an_unknown_boundary_part_is_refused_by_the_command_line() {
-    let dir = std::env::temp_dir().join(format!("fem-forms-parts-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-parts-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let text = std::fs::read_to_string(example("membrane-strip.toml")).unwrap();
     let scene = dir.join("strip.toml");
@@ -327,7 +328,8 @@ fn an_unknown_boundary_part_is_refused_by_the_command_line() {
 /// a message that says how to fix the mesh.
 #[test]
 fn a_boundary_group_named_like_the_keyword_is_refused() {
-    let dir = std::env::temp_dir().join(format!("fem-forms-all-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-all-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mesh = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/annulus_group_named_all.msh");
@@ -586,7 +588,8 @@ fn msh_over_a_scene_file_says_what_it_replaces() {
 /// not apply", an option the tester had not given: the key is named now.
 #[test]
 fn a_file_alpha_for_the_nodal_pair_names_its_key() {
-    let dir = std::env::temp_dir().join(format!("fem-forms-nodal-alpha-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-nodal-alpha-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("nodal.toml");
     std::fs::write(

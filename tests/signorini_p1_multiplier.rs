@@ -333,7 +333,8 @@ fn hertz_p1_multiplier_against_the_best_p1_fit() {
 #[test]
 fn the_command_line_pairs() {
     use std::process::Command;
-    let out = std::env::temp_dir().join(format!("fem-forms-p1m-{}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-p1m-{}", std::process::id()));
     let run = |args: &[&str]| {
         let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
             .args(args)
