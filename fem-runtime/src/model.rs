@@ -657,19 +657,20 @@ impl<'a> Coefficients<'a> {
     }
 }
 
-/// An error unless the cell blocks of bilinear form `form` are symmetric on the first
-/// cell of `mesh` (block `(i, j)` the transpose of block `(j, i)`, to 1e-9 of their
-/// largest entry), with the parameters and data of `coefficients`. The obstacle solvers
-/// need their system form `B_h` symmetric: they read `B` from its multiplier rows alone
-/// and factor its primal block by Cholesky, so a tester's `− b(v;λ) + b(u;μ)` was solved
-/// to a string 0.93 through its obstacle with a KKT residual of 1e-16. Compared in
-/// numbers, not symbols, so that equal terms written differently (`∫[degree=1]` beside
-/// an exact rule, `1/(2 + 2t²)` beside `0.5/(1 + t²)`) pass. Boundary-integral blocks
-/// are not compared.
+/// An error unless bilinear form `form` is symmetric on the first cell of `mesh`: each
+/// cell block `(i, j)` the transpose of block `(j, i)`, and likewise each boundary part's
+/// facet blocks (`facets:`) on the cell's first edge, to 1e-9 of their largest entry,
+/// with the parameters and data of `coefficients`. The obstacle and contact solvers need
+/// their system form `B_h` symmetric: they read `B` from its multiplier rows alone and
+/// factor its primal block by Cholesky, so a tester's `− b(v;λ) + b(u;μ)` was solved to
+/// a string 0.93 through its obstacle with a KKT residual of 1e-16. Compared in numbers,
+/// not symbols, so that equal terms written differently (`∫[degree=1]` beside an exact
+/// rule, `1/(2 + 2t²)` beside `0.5/(1 + t²)`) pass. A facet kernel is evaluated on the
+/// first edge whether or not it lies on the boundary: it is the same polynomial there.
 ///
 /// # Errors
-/// [`Error::Input`] naming the fields of the first block that is not the transpose of
-/// its mirror.
+/// [`Error::Input`] naming the fields (and, for a facet block, the boundary part) of the
+/// first block that is not the transpose of its mirror; a facet kernel's own error.
 pub fn require_symmetric<M: Model, G: crate::mesh::Mesh>(
     form: usize,
     mesh: &G,
@@ -688,7 +689,7 @@ pub fn require_symmetric<M: Model, G: crate::mesh::Mesh>(
         .iter()
         .map(|field| field.element.local_dof_count(M::CELL))
         .collect();
-    let mut blocks: Vec<((usize, usize), Vec<f64>)> = Vec::new();
+    let mut cell = Blocks::default();
     for (b, block) in M::FORMS[form].blocks.iter().enumerate() {
         let Some(trial) = block.trial_field else {
             continue;
@@ -703,34 +704,79 @@ pub fn require_symmetric<M: Model, G: crate::mesh::Mesh>(
             &coefficients.data,
             &mut out,
         );
-        match blocks.iter_mut().find(|(key, _)| *key == (test, trial)) {
-            Some((_, sum)) => sum.iter_mut().zip(&out).for_each(|(s, o)| *s += o),
-            None => blocks.push(((test, trial), out)),
-        }
+        cell.add((test, trial), out);
     }
-    let largest = |m: &[f64]| m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    for ((test, trial), mine) in &blocks {
-        let (rows, cols) = (counts[*test], counts[*trial]);
-        let zero = vec![0.0; rows * cols];
-        let mirror = blocks
-            .iter()
-            .find(|(key, _)| *key == (*trial, *test))
-            .map_or(&zero, |(_, m)| m);
-        let tolerance = 1e-9 * largest(mine).max(largest(mirror));
-        let transposed = (0..rows).all(|i| {
-            (0..cols).all(|j| (mine[i * cols + j] - mirror[j * rows + i]).abs() <= tolerance)
-        });
-        if !transposed {
-            let (name, fields) = (M::FORMS[form].name, M::FIELDS);
-            return Err(Error::Input(format!(
-                "`{name}` of model `{}` is not symmetric: on cell 0 its block of `{}` rows and `{}` columns is not the transpose of the block of `{}` rows and `{}` columns. The obstacle solvers read B from the multiplier rows alone and factor the primal block by Cholesky, so they would solve another problem; write `{name}` as a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ) with a and S symmetric",
-                M::NAME,
-                fields[*test].test_name,
-                fields[*trial].name,
-                fields[*trial].test_name,
-                fields[*test].name,
-            )));
+    cell.require_transposes::<M>(form, &counts, "")?;
+    if G::CELL != CellKind::Triangle {
+        return Ok(());
+    }
+    for (part, part_name) in M::FACET_PARTS.iter().enumerate() {
+        let mut facet = Blocks::default();
+        for (b, block) in M::FACET_BLOCKS.iter().enumerate() {
+            let Some(trial) = block.trial_field else {
+                continue;
+            };
+            if block.form != form || block.part != part {
+                continue;
+            }
+            let test = block.test_field;
+            let mut out = vec![0.0; counts[test] * counts[trial]];
+            M::facet_matrix(b, &x, 0, &coefficients.params, &coefficients.data, &mut out)?;
+            facet.add((test, trial), out);
         }
+        facet.require_transposes::<M>(
+            form,
+            &counts,
+            &format!(" in the boundary integral over `{part_name}` (edge 0)"),
+        )?;
     }
     Ok(())
+}
+
+/// The blocks of one form on one cell (or edge), summed by `(test field, trial field)`.
+#[derive(Default)]
+struct Blocks(Vec<((usize, usize), Vec<f64>)>);
+
+impl Blocks {
+    fn add(&mut self, key: (usize, usize), out: Vec<f64>) {
+        match self.0.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, sum)) => sum.iter_mut().zip(&out).for_each(|(s, o)| *s += o),
+            None => self.0.push((key, out)),
+        }
+    }
+
+    /// `what` names the integral (empty for the cell's) in the message.
+    fn require_transposes<M: Model>(
+        &self,
+        form: usize,
+        counts: &[usize],
+        what: &str,
+    ) -> Result<()> {
+        let largest = |m: &[f64]| m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        for ((test, trial), mine) in &self.0 {
+            let (rows, cols) = (counts[*test], counts[*trial]);
+            let zero = vec![0.0; rows * cols];
+            let mirror = self
+                .0
+                .iter()
+                .find(|(key, _)| *key == (*trial, *test))
+                .map_or(&zero, |(_, m)| m);
+            let tolerance = 1e-9 * largest(mine).max(largest(mirror));
+            let transposed = (0..rows).all(|i| {
+                (0..cols).all(|j| (mine[i * cols + j] - mirror[j * rows + i]).abs() <= tolerance)
+            });
+            if !transposed {
+                let (name, fields) = (M::FORMS[form].name, M::FIELDS);
+                return Err(Error::Input(format!(
+                    "`{name}` of model `{}` is not symmetric: on cell 0 its block of `{}` rows and `{}` columns{what} is not the transpose of the block of `{}` rows and `{}` columns. The obstacle solvers read B from the multiplier rows alone and factor the primal block by Cholesky, so they would solve another problem; write `{name}` as a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ) with a and S symmetric",
+                    M::NAME,
+                    fields[*test].test_name,
+                    fields[*trial].name,
+                    fields[*trial].test_name,
+                    fields[*test].name,
+                )));
+            }
+        }
+        Ok(())
+    }
 }
