@@ -25,18 +25,19 @@ pub fn read_msh(path: &Path) -> Result<TriangleMesh> {
 /// Parses the contents of a Gmsh `.msh` file (MSH 4.1, ASCII or binary) into a [`TriangleMesh`].
 ///
 /// 3-node triangles (Gmsh type 2) become the cells and 2-node lines (type 1) on boundary
-/// edges give the boundary markers: the first physical tag of the line's curve if it has
-/// one, else the curve's entity tag. Lines on interior edges (embedded curves) are
+/// edges give the boundary markers. Lines on interior edges (embedded curves) are
 /// ignored, and so are point elements. Nodes no triangle uses are dropped and the rest
 /// numbered compactly in increasing tag order. All nodes must lie in the plane `z = 0`
 /// (up to 1e-12 of the mesh's extent). The `$PhysicalNames` section (ASCII in ASCII and
 /// binary files alike) names the mesh's groups ([`TriangleMesh::named_groups`]): a named
-/// curve group (dimension 1) is a boundary part, the boundary edges whose marker is the
-/// first physical tag of one of its curves; point and surface names are kept so that
-/// choosing them as boundary parts is a clear error. A group whose curves share a marker
-/// with a curve outside it (a curve in two groups, or a curve without group whose entity
-/// tag equals a physical tag) cannot be chosen by marker: it is kept with the reason,
-/// given when it is chosen. Each clockwise triangle (of a surface whose
+/// curve group (dimension 1) is a boundary part, the boundary edges of its curves; point
+/// and surface names are kept so that choosing them as boundary parts is a clear error.
+/// A boundary edge may be in several groups, through a curve in several physical groups
+/// or through several curves listing the same edge (as writers of one curve per group
+/// do), and each group is exactly its edges: the edges of each distinct combination of
+/// groups get a marker of their own, the lowest physical tag of the combination (a
+/// curve in no group: its own tag) unless another combination has it, else a new one
+/// above every tag in the file. Each clockwise triangle (of a surface whose
 /// normal is −z) is made counter-clockwise by itself, so surfaces of opposite normals
 /// can be mixed. Parametric node coordinates (`Mesh.SaveParametric = 1`) are dropped
 /// from ASCII files; binary files with them are refused with that hint.
@@ -143,9 +144,19 @@ fn parse(bytes: &[u8], quadratic: bool) -> Result<(TriangleMesh, Option<Quadrati
     let mut mesh = TriangleMesh::new(vertices, cells, &[]).map_err(annotate)?;
     refuse_duplicate_nodes(&mesh).map_err(annotate)?;
 
-    let mut markers = Vec::with_capacity(elements.lines.len());
-    let mut boundary_curves = Vec::new();
-    for &(element, [n0, n1], marker, curve) in &elements.lines {
+    // what the lines say about each boundary edge: a curve may be in several physical
+    // groups, and an edge may be listed by several curves (one per group, as MSH 2
+    // writers and some exporters do)
+    let groups_of_curve = |curve: i32| -> &[i32] {
+        file.data
+            .entities
+            .as_ref()
+            .and_then(|e| e.curves.iter().find(|c| c.tag == curve))
+            .map_or(&[][..], |c| c.physical_tags.as_slice())
+    };
+    let mut labelled: Vec<(usize, [usize; 2], Vec<Label>)> = Vec::new();
+    let mut slot_of_edge: std::collections::HashMap<usize, usize> = Default::default();
+    for &(element, [n0, n1], curve) in &elements.lines {
         for n in [n0, n1] {
             if nodes.get(n).is_none() {
                 return Err(Error::Mesh(format!(
@@ -164,38 +175,38 @@ fn parse(bytes: &[u8], quadratic: bool) -> Result<(TriangleMesh, Option<Quadrati
             )));
         };
         // Lines on interior edges belong to embedded curves, which carry no boundary marker.
-        if mesh.edge_cells(edge).1.is_none() {
-            markers.push((a, b, marker));
-            if !boundary_curves.contains(&curve) {
-                boundary_curves.push(curve);
+        if mesh.edge_cells(edge).1.is_some() {
+            continue;
+        }
+        let groups = groups_of_curve(curve);
+        let labels: Vec<Label> = if groups.is_empty() {
+            vec![Label::Curve(curve)]
+        } else {
+            groups.iter().map(|&g| Label::Group(g)).collect()
+        };
+        for label in labels {
+            if label.tag() < 0 {
+                return Err(Error::Mesh(format!(
+                    "line element {element} is on curve {curve}, whose {label} has a negative tag; boundary markers must be non-negative"
+                )));
+            }
+            let slot = *slot_of_edge.entry(edge).or_insert_with(|| {
+                labelled.push((edge, [a, b], Vec::new()));
+                labelled.len() - 1
+            });
+            let set = &mut labelled[slot].2;
+            if !set.contains(&label) {
+                set.push(label);
             }
         }
     }
-    mesh.apply_markers(&markers).map_err(|e| {
-        // a line in two physical curves: name the groups, which the user wrote, beside
-        // the markers (a tester was told only "markers 4 and 5")
-        let Error::Mesh(message) = annotate(e) else {
-            unreachable!("apply_markers fails with a mesh error")
-        };
-        let named = |marker: &str| {
-            let tag: i32 = marker.trim().parse().ok()?;
-            names
-                .iter()
-                .find(|(dimension, t, _)| *dimension == 1 && *t == tag)
-                .map(|(_, _, name)| format!("`{name}`"))
-        };
-        let groups = message
-            .split_once("two markers, ")
-            .and_then(|(_, pair)| pair.split_once(" and "))
-            .and_then(|(a, b)| Some((named(a)?, named(b)?)));
-        Error::Mesh(match groups {
-            Some((a, b)) => format!(
-                "{message} (the physical groups {a} and {b}): a boundary edge belongs to one group only; in Gmsh, put each curve in one Physical Curve"
-            ),
-            None => message,
-        })
-    })?;
-    mesh.set_named_groups(named_groups(&file, &names, &boundary_curves));
+    let sets = LabelSets::new(&mut labelled, &file, &names)?;
+    let markers: Vec<(usize, usize, u32)> = labelled
+        .iter()
+        .map(|(_, [a, b], set)| (*a, *b, sets.marker(set)))
+        .collect();
+    mesh.apply_markers(&markers).map_err(annotate)?;
+    mesh.set_named_groups(named_groups(&file, &names, &sets));
     if elements.edge_nodes.is_empty() {
         return Ok((mesh, None));
     }
@@ -331,26 +342,115 @@ fn physical_names(bytes: &[u8]) -> Result<Vec<(usize, i32, String)>> {
     Ok(names)
 }
 
-/// The mesh's named groups from the `$PhysicalNames` entries and the curves' physical
-/// tags; `boundary_curves` are the curves whose lines gave boundary markers.
+/// What a boundary line says about its edge: one physical group of its curve, or, for
+/// a curve in no physical group, the curve itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+enum Label {
+    Group(i32),
+    Curve(i32),
+}
+
+impl Label {
+    fn tag(self) -> i32 {
+        match self {
+            Label::Group(t) | Label::Curve(t) => t,
+        }
+    }
+}
+
+impl std::fmt::Display for Label {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Label::Group(t) => write!(f, "physical group {t}"),
+            Label::Curve(t) => write!(f, "curve {t}"),
+        }
+    }
+}
+
+/// The distinct label sets of the boundary edges, each with its own boundary marker, so
+/// that a group is exactly the edges whose marker is one of its markers
+/// ([`crate::mesh::NamedGroup`]). A set takes the tag of its first label (its lowest
+/// physical group, else the curve's own tag) as Gmsh users expect to see it, unless
+/// another set took it first (single groups before curves without a group before
+/// combinations); then it gets a new marker above every tag in the file.
+struct LabelSets(Vec<(Vec<Label>, u32)>);
+
+impl LabelSets {
+    /// Sorts each edge's labels and numbers the sets.
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] when the file's tags leave no room for a new marker (tags near
+    /// 2³²).
+    fn new(
+        labelled: &mut [(usize, [usize; 2], Vec<Label>)],
+        file: &MshFile<u64, i32, f64>,
+        names: &[(usize, i32, String)],
+    ) -> Result<Self> {
+        let mut sets: Vec<Vec<Label>> = labelled
+            .iter_mut()
+            .map(|(_, _, set)| {
+                set.sort_unstable();
+                set.clone()
+            })
+            .collect();
+        // singletons first (groups sort before curves), then combinations
+        sets.sort_unstable_by(|a, b| (a.len(), a).cmp(&(b.len(), b)));
+        sets.dedup();
+        let curves = file
+            .data
+            .entities
+            .as_ref()
+            .map_or(&[][..], |e| e.curves.as_slice());
+        let highest = names
+            .iter()
+            .map(|n| i64::from(n.1))
+            .chain(curves.iter().map(|c| i64::from(c.tag)))
+            .chain(
+                curves
+                    .iter()
+                    .flat_map(|c| c.physical_tags.iter().map(|&t| i64::from(t))),
+            )
+            .chain(sets.iter().flatten().map(|l| i64::from(l.tag())))
+            .max()
+            .unwrap_or(0);
+        let mut next = highest.max(0) + 1;
+        let mut numbered: Vec<(Vec<Label>, u32)> = Vec::with_capacity(sets.len());
+        for set in sets {
+            let wanted = u32::try_from(set[0].tag()).ok();
+            let marker = match wanted {
+                Some(m) if numbered.iter().all(|&(_, taken)| taken != m) => m,
+                _ => {
+                    next += 1;
+                    u32::try_from(next - 1).map_err(|_| {
+                        Error::Mesh(format!(
+                            "the boundary edges of {} need a marker of their own above every tag in the file, and tag {highest} leaves none",
+                            set.iter().map(Label::to_string).collect::<Vec<_>>().join(" and ")
+                        ))
+                    })?
+                }
+            };
+            numbered.push((set, marker));
+        }
+        Ok(Self(numbered))
+    }
+
+    /// The marker of a sorted label set from [`LabelSets::new`].
+    fn marker(&self, set: &[Label]) -> u32 {
+        self.0
+            .iter()
+            .find(|(s, _)| s == set)
+            .map_or(0, |&(_, marker)| marker)
+    }
+}
+
+/// The mesh's named groups from the `$PhysicalNames` entries: a curve group is the
+/// boundary edges whose label set (`sets`) holds it. Without `$Entities` no curve is
+/// known to be in a group: the group is kept with that reason.
 fn named_groups(
     file: &MshFile<u64, i32, f64>,
     names: &[(usize, i32, String)],
-    boundary_curves: &[i32],
+    sets: &LabelSets,
 ) -> Vec<NamedGroup> {
-    let curves = file
-        .data
-        .entities
-        .as_ref()
-        .map_or(&[][..], |e| e.curves.as_slice());
-    // the marker of a curve's lines, as collect_elements gives it
-    let marker = |tag: i32| -> i32 {
-        curves
-            .iter()
-            .find(|c| c.tag == tag)
-            .and_then(|c| c.physical_tags.first().copied())
-            .unwrap_or(tag)
-    };
     names
         .iter()
         .map(|(dimension, tag, name)| {
@@ -369,28 +469,15 @@ fn named_groups(
                 );
                 return group;
             }
-            let members: Vec<i32> = curves
+            let mut markers: Vec<u32> = sets
+                .0
                 .iter()
-                .filter(|c| c.physical_tags.contains(tag))
-                .map(|c| c.tag)
+                .filter(|(set, _)| set.contains(&Label::Group(*tag)))
+                .map(|&(_, m)| m)
                 .collect();
-            let mut markers: Vec<i32> = members.iter().map(|&c| marker(c)).collect();
             markers.sort_unstable();
             markers.dedup();
-            let intruder = boundary_curves
-                .iter()
-                .find(|c| !members.contains(c) && markers.contains(&marker(**c)));
-            if let Some(&other) = intruder {
-                let m = marker(other);
-                let inside = members.iter().find(|&&c| marker(c) == m).copied().unwrap_or(m);
-                group.ambiguity = Some(format!(
-                    "its curve {inside} has boundary marker {m} (the first physical group of the curve, else the curve's own tag), and so has curve {other}, which is not in the group; in Gmsh, put each boundary curve in one physical group only (or in this one first), and every boundary curve in some physical group"
-                ));
-            }
-            group.markers = markers
-                .into_iter()
-                .filter_map(|m| u32::try_from(m).ok())
-                .collect();
+            group.markers = markers;
             group
         })
         .collect()
@@ -662,8 +749,8 @@ struct Elements {
     /// For 6-node triangles, in the order of `triangles`: (element tag, node tags of the
     /// middles of edges 0–1, 1–2, 2–0); empty for 3-node triangles.
     edge_nodes: Vec<(u64, [u64; 3])>,
-    /// (element tag, node tags, marker, curve's entity tag)
-    lines: Vec<(u64, [u64; 2], u32, i32)>,
+    /// (element tag, node tags, curve's entity tag)
+    lines: Vec<(u64, [u64; 2], i32)>,
 }
 
 fn type_name(t: ElementType) -> String {
@@ -675,18 +762,6 @@ fn collect_elements(file: &MshFile<u64, i32, f64>, quadratic: bool) -> Result<El
         return Err(Error::Mesh(
             "the .msh file has no $Elements section, so no triangles".into(),
         ));
-    };
-    // the marker of a line: its curve's first physical tag, else the curve's tag
-    let physical = |curve: i32| -> Option<i32> {
-        file.data
-            .entities
-            .as_ref()?
-            .curves
-            .iter()
-            .find(|c| c.tag == curve)?
-            .physical_tags
-            .first()
-            .copied()
     };
     let mut found: Vec<(ElementType, usize)> = Vec::new();
     let mut triangles = Vec::new();
@@ -712,20 +787,8 @@ fn collect_elements(file: &MshFile<u64, i32, f64>, quadratic: bool) -> Result<El
             ElementType::Lin2 | ElementType::Lin3
                 if (block.element_type == ElementType::Lin3) == quadratic =>
             {
-                let tag = physical(block.entity_tag).unwrap_or(block.entity_tag);
-                let marker = u32::try_from(tag).map_err(|_| {
-                    Error::Mesh(format!(
-                        "curve {} has marker {tag}; boundary markers must be non-negative",
-                        block.entity_tag
-                    ))
-                })?;
                 for e in &block.elements {
-                    lines.push((
-                        e.element_tag,
-                        [e.nodes[0], e.nodes[1]],
-                        marker,
-                        block.entity_tag,
-                    ));
+                    lines.push((e.element_tag, [e.nodes[0], e.nodes[1]], block.entity_tag));
                 }
             }
             _ => {}
@@ -1355,18 +1418,20 @@ $EndElements
             .is_empty());
     }
 
+    /// Curve 3 in group 4 and curve 4 in no group both wanted marker 4 (a group's tag,
+    /// a curve's own tag); they used to share it, and `top` could not be chosen. Each
+    /// kind of edge has its own marker now, and `top` is the top edge alone.
     #[test]
-    fn a_group_sharing_its_marker_with_another_curve_cannot_be_chosen() {
-        // curve 3 in group 4, curve 4 in no group: both lines get marker 4
+    fn a_group_and_a_curve_of_the_same_tag_get_their_own_markers() {
         let text = named_square()
             .replace("3 0 1 0 1 1 0 0 2 3 -4", "3 0 1 0 1 1 0 1 4 2 3 -4")
             .replace("4\n1 10 \"bottom\"", "5\n1 4 \"top\"\n1 10 \"bottom\"");
         let m = parse_msh(text.as_bytes()).unwrap();
-        let e = m.boundary_part_markers(&["top"]).unwrap_err().to_string();
-        assert!(
-            e.contains("`top`") && e.contains("curve 3") && e.contains("curve 4"),
-            "{e}"
-        );
+        let top = m.boundary_part_markers(&["top"]).unwrap();
+        assert_eq!(top, [4]);
+        assert_eq!(marker_of(&m, [1.0, 1.0], [0.0, 1.0]), 4);
+        assert_eq!(m.boundary_edges_with_markers(&top), 1);
+        assert_ne!(marker_of(&m, [0.0, 1.0], [0.0, 0.0]), 4);
         // the other groups are unaffected
         assert_eq!(m.boundary_part_markers(&["bottom"]).unwrap(), [10]);
     }

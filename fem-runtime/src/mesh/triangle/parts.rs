@@ -19,8 +19,9 @@ pub struct NamedGroup {
     /// For a curve group: the boundary markers of its edges (the group is the boundary
     /// edges whose marker is one of these). Empty for other dimensions.
     pub markers: Vec<u32>,
-    /// Why the group cannot be chosen by its markers, when another curve outside the
-    /// group shares one of them (see [`crate::mesh::gmsh::parse_msh`]).
+    /// Why the group cannot be chosen by its markers, when the file does not say which
+    /// edges are in it (a Gmsh file without `$Entities`, see
+    /// [`crate::mesh::gmsh::parse_msh`]).
     pub ambiguity: Option<String>,
 }
 
