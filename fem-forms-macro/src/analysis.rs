@@ -236,6 +236,34 @@ pub fn analyse(
     forms_text: &str,
 ) -> (Vec<Form>, Vec<Diagnostic>) {
     let mut forms: Vec<Form> = Vec::new();
+    // `tests:` out of order makes every form that uses a test function wrong, usually
+    // with errors about the wrong field's element (`v` is P0); the pairing, read off
+    // the signatures alone, is the one error worth reading, so it goes first and alone
+    // (at the first form that shows it).
+    let mut pairing = Context {
+        symbols,
+        forms: &forms,
+        later_forms: &[],
+        errors: Vec::new(),
+        facet: None,
+        in_expression: false,
+    };
+    for definition in definitions.iter().filter(|d| !d.expression) {
+        let mut signature = Context {
+            errors: Vec::new(),
+            ..pairing
+        };
+        if let Some((_, arguments)) = signature.signature(&definition.name, &definition.groups) {
+            // one cause: the first form that shows it is enough
+            if pairing.check_pairing(definition, &arguments).is_none() {
+                break;
+            }
+        }
+    }
+    let pairing = pairing.errors;
+    if !pairing.is_empty() {
+        return (forms, pairing);
+    }
     let mut errors = Vec::new();
     let all_names: Vec<&str> = definitions.iter().map(|d| d.name.text.as_str()).collect();
     for (k, definition) in definitions.iter().enumerate() {
@@ -803,6 +831,58 @@ impl<'a> Context<'a> {
         }
         blocks.sort_by_key(|b| (b.test_field, b.trial_field));
         blocks
+    }
+
+    /// A bilinear form over the same fields on both sides (`B_h(u,λ;v,μ)`) pairs its
+    /// i-th unknown with its i-th test function; the declarations pair each unknown with
+    /// the test function at its place in `tests:`. When the two disagree, `tests:` is
+    /// most likely out of order (a tester's `tests: μ, v` assembled `a(u;v)` into the
+    /// multiplier's rows, refused only at run time as "not positive definite"), and the
+    /// form is refused here. Forms over different fields (`b(v;μ)`) pair nothing.
+    fn check_pairing(&mut self, d: &Definition, arguments: &[Vec<Vec<usize>>]) -> Option<()> {
+        let [trials, tests] = arguments else {
+            return Some(());
+        };
+        let f = self.symbols.fields.len();
+        let field = |a: &Vec<usize>| self.symbols.field_of(a[0]);
+        if trials.len() < 2
+            || trials.len() != tests.len()
+            || trials.iter().any(|a| a[0] >= f)
+            || tests.iter().any(|a| a[0] < f)
+        {
+            return Some(());
+        }
+        let sorted = |group: &[Vec<usize>]| {
+            let mut fields: Vec<usize> = group.iter().map(field).collect();
+            fields.sort_unstable();
+            fields
+        };
+        if sorted(trials) != sorted(tests) {
+            return Some(());
+        }
+        let Some(i) = (0..trials.len()).find(|&i| field(&trials[i]) != field(&tests[i])) else {
+            return Some(());
+        };
+        let (unknown, declared) = self.symbols.field_names(&trials[i]);
+        let written = self.symbols.argument_name(&tests[i]);
+        let order: Vec<&str> = trials
+            .iter()
+            .map(|a| self.symbols.field_names(a).1)
+            .collect();
+        self.errors.push(
+            Diagnostic::text(
+                d.groups[1][i].loc,
+                format!(
+                    "`{}` pairs the unknown `{unknown}` with the test function `{written}`, but the declarations pair `{unknown}` with `{declared}`",
+                    d.name.text
+                ),
+            )
+            .help(format!(
+                "`tests:` lists the test functions in the order of `unknowns:`, the i-th test function belonging to the i-th unknown; if that order is right, write the test arguments in the order of the unknowns: `; {}`",
+                order.join(", ")
+            )),
+        );
+        None
     }
 
     /// The argument groups of a definition: flat symbols and, per argument, its symbols.

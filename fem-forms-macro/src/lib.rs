@@ -39,7 +39,10 @@
 //!   components (`[P1]²` cannot be written: `²` is not a Rust token); it is lowered to
 //!   the scalar fields `θ_x` and `θ_y` (tests `η_x`, `η_y`), which is what the runtime
 //!   sees, so its DOF map, assembly and kernels are those of scalar fields.
-//! - `tests: …` one test function per unknown, in order: `η` goes with `θ`.
+//! - `tests: …` one test function per unknown, in order: `η` goes with `θ`. A bilinear
+//!   form over the same fields on both sides (`B_h(θ,w,λ;η,v,μ)`) must pair its
+//!   arguments the same way (its i-th test function the i-th unknown's); otherwise
+//!   `tests:` is likely out of order, and that is the one error reported.
 //! - `params: …` runtime scalars (on triangles, two parameters `a_x`, `a_y` also
 //!   make the constant vector `a`: with `n_c_x, n_c_y` declared, `n_c` in the forms is
 //!   `(n_c_x, n_c_y)`; `d_x`, `d_y` are reserved, the ASCII ∂_x, ∂_y, so there is no

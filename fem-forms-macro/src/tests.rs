@@ -1130,3 +1130,36 @@ fn the_integral_over_omega_is_the_cell_integral() {
         "{errors}"
     );
 }
+
+/// `tests:` out of order with a vector field (the plate's `tests: v, η, μ` for
+/// `unknowns: θ, w, λ`): the first signature over the same fields on both sides shows
+/// it (`a(θ,w;η,v)`), and it is the only error
+/// (the forms' own errors about the wrong field's element would mislead). Written in
+/// the declared order, the same forms compile.
+#[test]
+fn tests_out_of_order_are_one_error_at_the_signature() {
+    let model = |tests: proc_macro2::TokenStream| {
+        expand(quote! {
+            /// Plate.
+            pub mod plate on triangle {
+                unknowns: θ: [P1]^2, w: P2, λ: P0 >= 0;
+                tests: #tests;
+                params: α;
+                data: f, ψ;
+                forms: "
+                    a(θ,w;η,v)       = ∫ ∇θ:∇η + (∇w − θ)·(∇v − η)
+                    B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − ∫ v λ − ∫ w μ − α ∫ λ μ
+                    L_h(η,v,μ)       = ∫ f v − ∫ ψ μ
+                ";
+            }
+        })
+    };
+    let errors = rendered_errors(&model(quote! { v, η, μ }));
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(
+        errors[0].contains("`a` pairs the unknown `θ` with the test function `η`")
+            && errors[0].contains("pair `θ` with `v`"),
+        "{errors:?}"
+    );
+    assert!(rendered_errors(&model(quote! { η, v, μ })).is_empty());
+}
