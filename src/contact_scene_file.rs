@@ -303,13 +303,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         ));
     }
     let pair = match &file.pair {
-        Some(p) => {
-            let pair = ContactPair::parse(p).map_err(|e| at("pair", e.to_string()))?;
-            if pair.multiplier() != crate::models::signorini::Multiplier::P0 {
-                return Err(at("pair", p0_pairs_only(pair)));
-            }
-            pair
-        }
+        Some(p) => pair_of_file(p).map_err(|m| at("pair", m))?,
         None => ContactPair::P1P0,
     };
     let mesh = mesh_of(&file.mesh, path, &at)?;
@@ -405,11 +399,16 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     // and edge by edge: a face of Γ_C turned away from the foundation is inside the
     // body's shadow, and its constraint acts through the body (a tester's trapezoid with
     // its top and bottom as Γ_C passed the mean and tripled the peak pressure)
-    let turned_away = edges.iter().find(|ends| {
+    let cosine = |ends: &&[[f64; 2]; 2]| {
         let nu = [ends[1][1] - ends[0][1], -(ends[1][0] - ends[0][0])];
-        (nu[0] * contact_direction[0] + nu[1] * contact_direction[1]) / self::length(ends) < -1e-6
-    });
-    if let Some(ends) = turned_away.filter(|_| facing > 1e-9 * total) {
+        (nu[0] * contact_direction[0] + nu[1] * contact_direction[1]) / self::length(ends)
+    };
+    let turned_away = edges.iter().find(|ends| cosine(ends) < -1e-6);
+    // some edge faces the foundation: n_c is right for it, and the edges turned away are
+    // at fault (a tester's top and bottom as Γ_C have mean ν·n_c = 0, and were told to
+    // flip n_c, whichever way it pointed)
+    let some_facing = edges.iter().any(|ends| cosine(&ends) > 1e-6);
+    if let Some(ends) = turned_away.filter(|_| some_facing) {
         let middle = point(ends, 0.5);
         return Err(at(
             "boundary.contact",
@@ -423,10 +422,19 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         return Err(at(
             "parameters.contact_direction",
             format!(
-                "({:.3}, {:.3}) does not point away from the body on `boundary.contact`: its outward normal ν has mean ν·n_c = {:.3} there, so the foundation would lie inside the body; n_c is the foundation plane's normal away from the body (e.g. [0.0, 1.0] for a contact part on the top)",
+                "({:.3}, {:.3}) does not point away from the body on `boundary.contact`: its outward normal ν has mean ν·n_c = {:.3} there, so the foundation would lie inside the body; n_c is the foundation plane's normal away from the body{}",
                 contact_direction[0],
                 contact_direction[1],
-                facing / total
+                facing / total,
+                if turned_away.is_some() {
+                    format!(
+                        ": here [{}, {}]",
+                        -contact_direction[0] + 0.0,
+                        -contact_direction[1] + 0.0
+                    )
+                } else {
+                    " (e.g. [0.0, 1.0] for a contact part on the top)".to_string()
+                }
             ),
         ));
     }
@@ -900,6 +908,21 @@ fn resultant_and_magnitude(
 /// A pressure resultant below this fraction of `∫|q| ds` is the rounding of a zero one.
 const RESULTANT_ROUNDING: f64 = 1e-12;
 
+/// The pair called `name`, for a contact scene file: p1-p0 or p2-p0.
+///
+/// # Errors
+/// A message listing those two for any other name (a tester was offered p1-p1 and
+/// p2-p1 for a file, which the file then refused).
+pub fn pair_of_file(name: &str) -> std::result::Result<ContactPair, String> {
+    let pair = ContactPair::parse(name).map_err(|_| {
+        format!("unknown contact pair `{name}`: contact scene files take p1-p0 and p2-p0")
+    })?;
+    if pair.multiplier() != crate::models::signorini::Multiplier::P0 {
+        return Err(p0_pairs_only(pair));
+    }
+    Ok(pair)
+}
+
 /// Why `pair` (a P1-multiplier pair) cannot solve a contact scene file.
 fn p0_pairs_only(pair: ContactPair) -> String {
     format!(
@@ -1080,6 +1103,9 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
     };
     let mut warnings = crate::signorini::warnings(&report);
     warnings.extend(quality.warnings(&mesh, alpha.is_none()));
+    for (key, names) in &file.part_names {
+        warnings.extend(crate::interior_curve_warnings(key, &mesh, names));
+    }
     if file.exact_pressure.is_some() && !own_load {
         warnings.push(format!(
             "exact.pressure is the pressure at the file's data.load = {}; at --load {load} it is not known (contact is not linear in the load: the contact set changes with it), so no pressure error is reported",

@@ -35,6 +35,25 @@ pub fn number(x: f64) -> String {
     }
 }
 
+/// Warnings for the boundary parts `names` (chosen under the scene-file key `key`) whose
+/// Gmsh groups hold interior edges (embedded curves): a boundary part holds boundary
+/// edges only, so a condition the user put on an interior wire is not imposed there. A
+/// tester's `sides` (left, right and the line y = 0) solved as left and right alone.
+pub fn interior_curve_warnings<S: AsRef<str>>(
+    key: &str,
+    mesh: &TriangleMesh,
+    names: &[S],
+) -> Vec<String> {
+    mesh.interior_edges_of(names)
+        .into_iter()
+        .map(|(name, count)| {
+            format!(
+                "{key}: the group `{name}` has {count} edge(s) inside the domain (an embedded curve); a boundary part holds boundary edges only, so nothing is imposed on them"
+            )
+        })
+        .collect()
+}
+
 /// A table line with every `NaN` cell (a difference or rate not defined on the first
 /// rows, a quantity without a value) shown as `-`, keeping the columns aligned.
 pub fn dash_nan(line: String) -> String {

@@ -705,9 +705,9 @@ fn solve_contact_file(path: &Path, options: &SolveOptions) -> Result<(), String>
         pair: options
             .pair
             .as_deref()
-            .map(contact::ContactPair::parse)
+            .map(file::pair_of_file)
             .transpose()
-            .map_err(|e| e.to_string())?,
+            .map_err(|m| format!("invalid input: --pair: {m}"))?,
         refinements: options.mesh_size,
         load: options.load,
         alpha: options.alpha,

@@ -539,30 +539,40 @@ pub fn alpha_of(request: &MembraneRequest, mesh: &TriangleMesh) -> Result<(f64, 
 
 /// Checks the scene's data on the mesh: finite values, obstacle not above the boundary
 /// data where u = g is imposed (`part`).
-fn validate(data: &SceneData, mesh: &TriangleMesh, part: &DirichletPart) -> Result<()> {
-    for (name, f) in [
-        ("load f", &data.load),
-        ("obstacle ψ", &data.obstacle),
-        ("boundary data g", &data.boundary),
+fn validate(
+    data: &SceneData,
+    mesh: &TriangleMesh,
+    part: &DirichletPart,
+    scene: &str,
+) -> Result<()> {
+    let on_part = part.vertices(mesh);
+    // g is used on the Dirichlet part only: a tester's g = ln(x + 1) held on the right
+    // side was refused for its value on the free left side
+    for (name, key, f, only_on_part) in [
+        ("load f", "data.f", &data.load, false),
+        ("obstacle ψ", "data.psi", &data.obstacle, false),
+        ("boundary data g", "data.g", &data.boundary, true),
     ] {
-        for x in mesh.vertices() {
+        for (i, x) in mesh.vertices().iter().enumerate() {
+            if only_on_part && !on_part[i] {
+                continue;
+            }
             let v = f.at(x);
             if !v.is_finite() {
                 return Err(Error::Input(format!(
-                    "the {name} is {v} at ({}, {})",
+                    "scene `{scene}`: field `{key}`: the {name} is {v} at ({}, {})",
                     x[0], x[1]
                 )));
             }
             // as for --load: beyond it the norms that certify the solve may overflow
             if v.abs() > MAX_LOAD {
                 return Err(Error::Input(format!(
-                    "the {name} is {v:e} at ({}, {}), beyond ±{MAX_LOAD:e}: norms in the solve would overflow double precision",
+                    "scene `{scene}`: field `{key}`: the {name} is {v:e} at ({}, {}), beyond ±{MAX_LOAD:e}: norms in the solve would overflow double precision",
                     x[0], x[1]
                 )));
             }
         }
     }
-    let on_part = part.vertices(mesh);
     for v in (0..mesh.vertex_count()).filter(|&v| on_part[v]) {
         let x = mesh.vertices()[v];
         let (psi, g) = (data.obstacle.at(&x), data.boundary.at(&x));
@@ -674,7 +684,7 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
         part,
     };
     let mesh = meshes.last().expect("at least one level");
-    validate(&posed.data, mesh, &posed.part)?;
+    validate(&posed.data, mesh, &posed.part, &scene.name)?;
     if let Some(exact) = &posed.exact {
         validate_exact(exact, mesh, &scene.name)?;
     }
@@ -702,6 +712,13 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     report
         .warnings
         .extend(quality.warnings(finest, alpha_from_inverse_constant));
+    if let DirichletParts::Named(names) = &scene.dirichlet {
+        report.warnings.extend(crate::interior_curve_warnings(
+            "boundary.dirichlet",
+            finest,
+            names,
+        ));
+    }
     let (penetration_scale, penetration_rounding) =
         penetration_scales(&report, &fields, posed.data.load.as_data_fn());
     if let Some(warning) = penetration_warning(
@@ -934,7 +951,15 @@ pub fn dirichlet_part(
         ));
     }
     let markers = mesh.boundary_part_markers(names).map_err(|e| match e {
-        Error::Input(message) => at(format!("{message} (domain: {domain})")),
+        Error::Input(message) => {
+            // `["all"]`: the keyword is a plain string, not a name in a list
+            let keyword = if names.iter().any(|n| n == "all") && message.contains("`all`") {
+                "; \"all\" (the whole boundary) is a keyword on its own, `dirichlet = \"all\"`, not a name in a list"
+            } else {
+                ""
+            };
+            at(format!("{message} (domain: {domain}){keyword}"))
+        }
         other => other,
     })?;
     // a part listed beside others must hold boundary edges of its own: an interior
@@ -1083,7 +1108,7 @@ fn file_levels(
 ) -> Result<Vec<TriangleMesh>> {
     if refinements > 8 {
         return Err(Error::Input(format!(
-            "--mesh-size {refinements} with --msh means {refinements} uniform refinements (4^{refinements} times the triangles); at most 8"
+            "--mesh-size {refinements} on a Gmsh mesh (--msh, or a scene file's mesh.file) means {refinements} uniform refinements of the file's mesh (4^{refinements} times the triangles); at most 8"
         )));
     }
     let mesh = fem_runtime::mesh::gmsh::read_msh(path)?;

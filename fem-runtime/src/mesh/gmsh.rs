@@ -147,14 +147,22 @@ fn parse(bytes: &[u8], quadratic: bool) -> Result<(TriangleMesh, Option<Quadrati
     // what the lines say about each boundary edge: a curve may be in several physical
     // groups, and an edge may be listed by several curves (one per group, as MSH 2
     // writers and some exporters do)
-    let groups_of_curve = |curve: i32| -> &[i32] {
-        file.data
-            .entities
-            .as_ref()
-            .and_then(|e| e.curves.iter().find(|c| c.tag == curve))
-            .map_or(&[][..], |c| c.physical_tags.as_slice())
-    };
+    let curves = file
+        .data
+        .entities
+        .as_ref()
+        .map_or(&[][..], |e| e.curves.as_slice());
+    let mut groups_of_curve: std::collections::HashMap<i32, &[i32]> = Default::default();
+    for c in curves {
+        if groups_of_curve.insert(c.tag, &c.physical_tags).is_some() {
+            return Err(Error::Mesh(format!(
+                "curve {} is listed twice in the $Entities section: its physical groups would be ambiguous",
+                c.tag
+            )));
+        }
+    }
     let mut labelled: Vec<(usize, [usize; 2], Vec<Label>)> = Vec::new();
+    let mut interior: std::collections::HashSet<(i32, usize)> = Default::default();
     let mut slot_of_edge: std::collections::HashMap<usize, usize> = Default::default();
     for &(element, [n0, n1], curve) in &elements.lines {
         for n in [n0, n1] {
@@ -174,22 +182,22 @@ fn parse(bytes: &[u8], quadratic: bool) -> Result<(TriangleMesh, Option<Quadrati
                 "line element {element} (nodes {n0}, {n1}) is not an edge of the triangles"
             )));
         };
-        // Lines on interior edges belong to embedded curves, which carry no boundary marker.
+        let groups = groups_of_curve.get(&curve).copied().unwrap_or(&[]);
+        // Lines on interior edges belong to embedded curves, which carry no boundary
+        // marker; their groups count them, to warn where such a group is a boundary part.
         if mesh.edge_cells(edge).1.is_some() {
+            for &g in groups {
+                interior.insert((g, edge));
+            }
             continue;
         }
-        let groups = groups_of_curve(curve);
         let labels: Vec<Label> = if groups.is_empty() {
             vec![Label::Curve(curve)]
         } else {
             groups.iter().map(|&g| Label::Group(g)).collect()
         };
+        // a negative tag (which Gmsh does not write) cannot be a marker: its set gets a new one
         for label in labels {
-            if label.tag() < 0 {
-                return Err(Error::Mesh(format!(
-                    "line element {element} is on curve {curve}, whose {label} has a negative tag; boundary markers must be non-negative"
-                )));
-            }
             let slot = *slot_of_edge.entry(edge).or_insert_with(|| {
                 labelled.push((edge, [a, b], Vec::new()));
                 labelled.len() - 1
@@ -206,7 +214,7 @@ fn parse(bytes: &[u8], quadratic: bool) -> Result<(TriangleMesh, Option<Quadrati
         .map(|(_, [a, b], set)| (*a, *b, sets.marker(set)))
         .collect();
     mesh.apply_markers(&markers).map_err(annotate)?;
-    mesh.set_named_groups(named_groups(&file, &names, &sets));
+    mesh.set_named_groups(named_groups(&file, &names, &sets, &interior));
     if elements.edge_nodes.is_empty() {
         return Ok((mesh, None));
     }
@@ -373,7 +381,10 @@ impl std::fmt::Display for Label {
 /// physical group, else the curve's own tag) as Gmsh users expect to see it, unless
 /// another set took it first (single groups before curves without a group before
 /// combinations); then it gets a new marker above every tag in the file.
-struct LabelSets(Vec<(Vec<Label>, u32)>);
+struct LabelSets(
+    Vec<(Vec<Label>, u32)>,
+    std::collections::HashMap<Vec<Label>, usize>,
+);
 
 impl LabelSets {
     /// Sorts each edge's labels and numbers the sets.
@@ -415,10 +426,12 @@ impl LabelSets {
             .unwrap_or(0);
         let mut next = highest.max(0) + 1;
         let mut numbered: Vec<(Vec<Label>, u32)> = Vec::with_capacity(sets.len());
+        // 0 marks the boundary edges no line lists: a group of tag 0 must not take them in
+        let mut taken: std::collections::HashSet<u32> = [0].into();
         for set in sets {
             let wanted = u32::try_from(set[0].tag()).ok();
             let marker = match wanted {
-                Some(m) if numbered.iter().all(|&(_, taken)| taken != m) => m,
+                Some(m) if taken.insert(m) => m,
                 _ => {
                     next += 1;
                     u32::try_from(next - 1).map_err(|_| {
@@ -431,26 +444,52 @@ impl LabelSets {
             };
             numbered.push((set, marker));
         }
-        Ok(Self(numbered))
+        let index = numbered
+            .iter()
+            .enumerate()
+            .map(|(k, (set, _))| (set.clone(), k))
+            .collect();
+        Ok(Self(numbered, index))
     }
 
     /// The marker of a sorted label set from [`LabelSets::new`].
     fn marker(&self, set: &[Label]) -> u32 {
-        self.0
-            .iter()
-            .find(|(s, _)| s == set)
-            .map_or(0, |&(_, marker)| marker)
+        self.1.get(set).map_or(0, |&k| self.0[k].1)
+    }
+
+    /// The markers of the sets holding each physical group, by tag.
+    fn markers_of_groups(&self) -> std::collections::HashMap<i32, Vec<u32>> {
+        let mut markers: std::collections::HashMap<i32, Vec<u32>> = Default::default();
+        for (set, marker) in &self.0 {
+            for label in set {
+                if let Label::Group(tag) = label {
+                    markers.entry(*tag).or_default().push(*marker);
+                }
+            }
+        }
+        for list in markers.values_mut() {
+            list.sort_unstable();
+            list.dedup();
+        }
+        markers
     }
 }
 
 /// The mesh's named groups from the `$PhysicalNames` entries: a curve group is the
-/// boundary edges whose label set (`sets`) holds it. Without `$Entities` no curve is
-/// known to be in a group: the group is kept with that reason.
+/// boundary edges whose label set (`sets`) holds it, and it counts its interior edges
+/// (`interior`: `(group tag, edge)`). Without `$Entities` no curve is known to be in a
+/// group: the group is kept with that reason.
 fn named_groups(
     file: &MshFile<u64, i32, f64>,
     names: &[(usize, i32, String)],
     sets: &LabelSets,
+    interior: &std::collections::HashSet<(i32, usize)>,
 ) -> Vec<NamedGroup> {
+    let by_group = sets.markers_of_groups();
+    let mut interior_edges: std::collections::HashMap<i32, usize> = Default::default();
+    for &(group, _) in interior {
+        *interior_edges.entry(group).or_default() += 1;
+    }
     names
         .iter()
         .map(|(dimension, tag, name)| {
@@ -458,6 +497,11 @@ fn named_groups(
                 name: name.clone(),
                 dimension: *dimension,
                 markers: Vec::new(),
+                interior_edges: if *dimension == 1 {
+                    interior_edges.get(tag).copied().unwrap_or(0)
+                } else {
+                    0
+                },
                 ambiguity: None,
             };
             if *dimension != 1 {
@@ -469,14 +513,7 @@ fn named_groups(
                 );
                 return group;
             }
-            let mut markers: Vec<u32> = sets
-                .0
-                .iter()
-                .filter(|(set, _)| set.contains(&Label::Group(*tag)))
-                .map(|&(_, m)| m)
-                .collect();
-            markers.sort_unstable();
-            markers.dedup();
+            let markers = by_group.get(tag).cloned().unwrap_or_default();
             group.markers = markers;
             group
         })
@@ -787,6 +824,15 @@ fn collect_elements(file: &MshFile<u64, i32, f64>, quadratic: bool) -> Result<El
             ElementType::Lin2 | ElementType::Lin3
                 if (block.element_type == ElementType::Lin3) == quadratic =>
             {
+                // the groups of a line are its curve's: a line block filed under a point
+                // or a surface would take the groups of the curve of the same tag
+                if block.entity_dim != 1 {
+                    let first = block.elements.first().map_or(0, |e| e.element_tag);
+                    return Err(Error::Mesh(format!(
+                        "the block of line elements from element {first} belongs to an entity of dimension {} (tag {}), not to a curve (dimension 1): its lines cannot be given the curve's physical groups; write each line block under its curve",
+                        block.entity_dim, block.entity_tag
+                    )));
+                }
                 for e in &block.elements {
                     lines.push((e.element_tag, [e.nodes[0], e.nodes[1]], block.entity_tag));
                 }
@@ -1434,6 +1480,65 @@ $EndElements
         assert_ne!(marker_of(&m, [0.0, 1.0], [0.0, 0.0]), 4);
         // the other groups are unaffected
         assert_eq!(m.boundary_part_markers(&["bottom"]).unwrap(), [10]);
+    }
+
+    /// A tester's group of physical tag 0: boundary edges no line lists are marked 0, and
+    /// the group took them in (its membrane was held on a side it did not name). The
+    /// group gets a marker of its own.
+    #[test]
+    fn a_group_of_tag_zero_does_not_take_the_unlisted_edges() {
+        // curve 4 (the left side) in group 0, curve 2's line (the right side) removed
+        let text = named_square()
+            .replace("4 0 0 0 0 1 0 0 2 4 -1", "4 0 0 0 0 1 0 1 0 2 4 -1")
+            .replace("4\n1 10 \"bottom\"", "5\n1 0 \"left\"\n1 10 \"bottom\"")
+            .replace("7 8 1 8\n", "6 7 1 8\n")
+            .replace("1 2 1 1\n2 2 3\n", "");
+        let m = parse_msh(text.as_bytes()).unwrap();
+        let left = m.boundary_part_markers(&["left"]).unwrap();
+        assert_eq!(m.boundary_edges_with_markers(&left), 1);
+        assert_eq!(left, [marker_of(&m, [0.0, 1.0], [0.0, 0.0])]);
+        assert_eq!(marker_of(&m, [1.0, 0.0], [1.0, 1.0]), 0);
+        assert!(!left.contains(&0));
+    }
+
+    /// Lines filed under a surface (or point) would take the groups of the curve of the
+    /// same tag: refused, naming the block. A curve listed twice in `$Entities` has
+    /// ambiguous groups: refused, naming the curve.
+    #[test]
+    fn lines_outside_curves_and_curves_listed_twice_are_refused() {
+        let e = error(&SQUARE.replace("1 1 1 1\n1 1 2\n", "2 1 1 1\n1 1 2\n"));
+        assert!(
+            e.contains("element 1") && e.contains("dimension 2") && e.contains("not to a curve"),
+            "{e}"
+        );
+        let twice = SQUARE.replace("5 4 1 0\n", "5 5 1 0\n").replace(
+            "4 0 0 0 0 1 0 0 2 4 -1\n",
+            "4 0 0 0 0 1 0 0 2 4 -1\n4 0 0 0 0 1 0 1 30 2 4 -1\n",
+        );
+        let e = error(&twice);
+        assert!(e.contains("curve 4 is listed twice"), "{e}");
+    }
+
+    /// Lines on interior edges (an embedded curve) give no marker, but their groups count
+    /// them, so that a boundary part with an interior wire is warned about.
+    #[test]
+    fn groups_count_their_interior_edges() {
+        // curve 3 (the top) in the group `wire`, with a second line on the diagonal from
+        // node 1 to node 3, the edge the two triangles share
+        let text = named_square()
+            .replace("3 0 1 0 1 1 0 0 2 3 -4", "3 0 1 0 1 1 0 1 30 2 3 -4")
+            .replace("4\n1 10 \"bottom\"", "5\n1 30 \"wire\"\n1 10 \"bottom\"")
+            .replace("7 8 1 8\n", "7 9 1 9\n")
+            .replace("1 3 1 1\n3 3 4\n", "1 3 1 2\n3 3 4\n9 1 3\n");
+        let m = parse_msh(text.as_bytes()).unwrap();
+        assert_eq!(
+            m.interior_edges_of(&["wire", "bottom"]),
+            [("wire".to_string(), 1)]
+        );
+        assert_eq!(
+            m.boundary_edges_with_markers(&m.boundary_part_markers(&["wire"]).unwrap()),
+            1
+        );
     }
 
     #[test]

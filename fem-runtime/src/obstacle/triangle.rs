@@ -107,7 +107,21 @@ fn unheld_piece(mesh: &TriangleMesh, part: &DirichletPart) -> Result<()> {
         hi[1],
         match part {
             DirichletPart::All => "all".to_string(),
-            DirichletPart::Markers(m) => format!("{m:?}"),
+            // the names the user chose, where the mesh has them (markers of edges in
+            // several Gmsh groups are numbers of the reader's own)
+            DirichletPart::Markers(m) => {
+                let names: Vec<String> = mesh
+                    .named_groups()
+                    .iter()
+                    .filter(|g| g.dimension == 1 && g.markers.iter().any(|k| m.contains(k)))
+                    .map(|g| format!("`{}`", g.name))
+                    .collect();
+                if names.is_empty() {
+                    format!("{m:?}")
+                } else {
+                    format!("{m:?}, of the groups {}", names.join(", "))
+                }
+            }
         },
     )))
 }

@@ -19,6 +19,9 @@ pub struct NamedGroup {
     /// For a curve group: the boundary markers of its edges (the group is the boundary
     /// edges whose marker is one of these). Empty for other dimensions.
     pub markers: Vec<u32>,
+    /// The interior edges of a curve group (lines of embedded curves), which a boundary
+    /// part leaves out: reported so that a part with them can be warned about.
+    pub interior_edges: usize,
     /// Why the group cannot be chosen by its markers, when the file does not say which
     /// edges are in it (a Gmsh file without `$Entities`, see
     /// [`crate::mesh::gmsh::parse_msh`]).
@@ -70,6 +73,7 @@ impl TriangleMesh {
                 name: name.to_string(),
                 dimension: 1,
                 markers: markers.to_vec(),
+                interior_edges: 0,
                 ambiguity: None,
             });
         }
@@ -166,6 +170,26 @@ impl TriangleMesh {
         Ok(markers)
     }
 
+    /// The interior edges (of embedded curves) of each of the groups `names` that has
+    /// any, as `(name, count)`: a boundary part holds boundary edges only, so these are
+    /// left out of it (unknown names are skipped: [`TriangleMesh::boundary_part_markers`]
+    /// reports them).
+    pub fn interior_edges_of<S: AsRef<str>>(&self, names: &[S]) -> Vec<(String, usize)> {
+        names
+            .iter()
+            .filter_map(|name| {
+                let name = name.as_ref();
+                let count: usize = self
+                    .groups
+                    .iter()
+                    .filter(|g| g.dimension == 1 && g.name == name)
+                    .map(|g| g.interior_edges)
+                    .sum();
+                (count > 0).then(|| (name.to_string(), count))
+            })
+            .collect()
+    }
+
     /// The number of boundary edges whose marker is one of `markers`.
     pub fn boundary_edges_with_markers(&self, markers: &[u32]) -> usize {
         self.boundary_edges
@@ -244,6 +268,7 @@ mod tests {
             name: "domain".into(),
             dimension: 2,
             markers: Vec::new(),
+            interior_edges: 0,
             ambiguity: None,
         }]);
         let e = named
