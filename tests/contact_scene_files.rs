@@ -1030,3 +1030,114 @@ fn thin_cells_are_warned_about() {
         report.warnings
     );
 }
+
+/// A tester's Γ_C = top and bottom of the block: the mean of ν·n_c over Γ_C is 0, and
+/// they were told to flip n_c whichever way it pointed. The edge turned away is named
+/// for both directions; a direction wrong for every edge is answered with its opposite.
+#[test]
+fn a_contact_part_facing_both_ways_names_the_face_turned_away() {
+    for direction in ["[0.0, -1.0]", "[0.0, 1.0]"] {
+        let text = RECTANGLE
+            .replace(
+                "contact = \"bottom\"",
+                "contact = [\"bottom\", \"top\"]\n    load = \"right\"",
+            )
+            .replace("    load = \"top\"\n", "")
+            + &format!("\n[parameters]\ncontact_direction = {direction}\n");
+        let message = parse(&text).unwrap_err().to_string();
+        assert!(
+            message.contains("`boundary.contact`")
+                && message.contains("faces away")
+                && !message.contains("does not point away"),
+            "{direction}: {message}"
+        );
+    }
+    let upwards = format!("{RECTANGLE}\n[parameters]\ncontact_direction = [0.0, 1.0]\n");
+    let message = parse(&upwards).unwrap_err().to_string();
+    assert!(
+        message.contains("does not point away") && message.contains("here [0, -1]"),
+        "{message}"
+    );
+}
+
+/// A pressure on edges of both Γ_C and Γ_N makes the stabilized method inconsistent
+/// (λ + σ_n(u) = −q n·n_c there at the exact solution): a tester's block loaded on its
+/// top and its bottom got pressures 8 % off the exact 2.5 without a word. Refused, for
+/// every pair; a pressure that vanishes on the shared edges is accepted, and the patch
+/// test holds.
+#[test]
+fn a_pressure_on_the_contact_boundary_is_refused() {
+    let both = RECTANGLE.replace("load = \"top\"", "load = [\"top\", \"bottom\"]");
+    // q = 1 + y: 2 on the top, 1 on the bottom, a net push onto the foundation
+    let pushed = both.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"1 + y\"");
+    for pair in [ContactPair::P1P0, ContactPair::P2P0] {
+        let overrides = Overrides {
+            pair: Some(pair),
+            ..Overrides::default()
+        };
+        let message = contact_scene_file::solve(&parse(&pushed).unwrap(), &overrides)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("both on the contact boundary Γ_C and on the loaded boundary Γ_N"),
+            "{pair:?}: {message}"
+        );
+    }
+    // q = 2.5 y: zero on the bottom, 2.5 on the top
+    let vanishing = both.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"2.5 * y\"");
+    let solved =
+        contact_scene_file::solve(&parse(&vanishing).unwrap(), &Overrides::default()).unwrap();
+    for &(x0, x1, p) in &solved.profile {
+        assert!((p - 2.5).abs() <= 1e-9, "λ_h = {p} on [{x0}, {x1}]");
+    }
+}
+
+/// A contact scene file takes the P0-multiplier pairs only: an unknown pair lists those
+/// two (a tester was offered p1-p1 and p2-p1, which the file then refused).
+#[test]
+fn an_unknown_pair_lists_the_pairs_a_file_takes() {
+    let message = contact_scene_file::pair_of_file("p1-nodal").unwrap_err();
+    assert!(
+        message.contains("p1-p0 and p2-p0") && !message.contains("p1-p1"),
+        "{message}"
+    );
+    assert!(contact_scene_file::pair_of_file("p2-p1")
+        .unwrap_err()
+        .contains("P1 multiplier"));
+    assert_eq!(
+        contact_scene_file::pair_of_file("p2-p0").unwrap(),
+        ContactPair::P2P0
+    );
+}
+
+/// A group that holds an embedded curve beside boundary curves (here `top` with the
+/// midline y = ½): a boundary part holds boundary edges only, so the pressure on the
+/// midline is not applied. A tester's membrane held on such a group solved without a
+/// word; the solve warns, naming the key and the group.
+#[test]
+fn a_part_with_interior_edges_is_warned_about() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-interior-part-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = std::fs::read_to_string(data("contact_block.msh")).unwrap();
+    let wired = mesh.replace(
+        "5 0.0 0.5 0 2.0 0.5 0 1 35 0",
+        "5 0.0 0.5 0 2.0 0.5 0 2 33 35 0",
+    );
+    assert_ne!(wired, mesh);
+    std::fs::write(dir.join("contact_block.msh"), wired).unwrap();
+    let file = contact_scene_file::parse(GMSH, &dir.join("scene.toml")).unwrap();
+    let solved = contact_scene_file::solve(&file, &Overrides::default()).unwrap();
+    let warnings = &solved.report.warnings;
+    assert!(
+        warnings.iter().any(|w| w.contains("boundary.load")
+            && w.contains("`top`")
+            && w.contains("inside the domain")),
+        "{warnings:?}"
+    );
+    // the boundary edges of `top` still carry the load: the patch test holds
+    for &(_, _, p) in &solved.profile {
+        assert!((p - 2.5).abs() <= 1e-9, "{p}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -635,3 +635,89 @@ fn an_impossible_exact_solution_is_refused() {
     let file = scene_file::parse(&text("3", 4.0), Path::new("mine.toml")).unwrap();
     assert!(membranes::solve(&request_of(&file)).is_ok());
 }
+
+/// The strip example's text with `[boundary]` and `[data]` lines replaced, its mesh
+/// named by absolute path, parsed as a file in `dir`.
+fn strip_with(dir: &Path, mesh: &Path, dirichlet: &str, g: &str, psi: &str) -> SceneFile {
+    let text = std::fs::read_to_string(example("membrane-strip.toml"))
+        .unwrap()
+        .replace(r#"["left", "right"]"#, dirichlet)
+        .replace("g = \"1\"", &format!("g = \"{g}\""))
+        .replace("psi = \"0\"", &format!("psi = \"{psi}\""))
+        .replace("square_named.msh", &mesh.display().to_string());
+    scene_file::parse(&text, &dir.join("strip.toml")).unwrap()
+}
+
+/// The boundary data g is used on the Dirichlet part only: a tester's g = ln(x + 1)
+/// held on the right side was refused for its value −∞ on the free left side. Data that
+/// are not finite where they are used are refused naming the scene's field.
+#[test]
+fn data_are_checked_where_they_are_used_and_named_by_field() {
+    let dir = example("");
+    let mesh = example("square_named.msh");
+    let file = strip_with(&dir, &mesh, r#""right""#, "ln(x + 1) + 1", "0");
+    let (report, _) = membranes::solve(&request_of(&file)).unwrap();
+    assert_eq!(report.dirichlet_parts, ["right"]);
+    let file = strip_with(&dir, &mesh, r#""left""#, "ln(x + 1) + 1", "0");
+    let e = refusal(&file);
+    assert!(e.contains("field `data.g`") && e.contains("-inf"), "{e}");
+    let file = strip_with(&dir, &mesh, r#""left""#, "1", "1/x - 10");
+    let e = refusal(&file);
+    assert!(e.contains("field `data.psi`") && e.contains("inf"), "{e}");
+}
+
+/// `"all"` is a keyword on its own; inside a list it is a name the mesh lacks, and the
+/// refusal says how to write the keyword.
+#[test]
+fn all_in_a_list_is_explained() {
+    let dir = example("");
+    let file = strip_with(&dir, &example("square_named.msh"), r#"["all"]"#, "1", "0");
+    let e = refusal(&file);
+    assert!(
+        e.contains("boundary.dirichlet") && e.contains(r#"`dirichlet = "all"`"#),
+        "{e}"
+    );
+}
+
+/// A Dirichlet group holding an embedded curve beside boundary curves: nothing is
+/// imposed on the interior edges, and the solve says so.
+#[test]
+fn a_dirichlet_group_with_interior_edges_is_warned_about() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "fem-forms-interior-dirichlet-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/contact_block.msh"),
+    )
+    .unwrap();
+    // the midline y = ½ of the block joins the group `side`
+    let wired = mesh.replace(
+        "5 0.0 0.5 0 2.0 0.5 0 1 35 0",
+        "5 0.0 0.5 0 2.0 0.5 0 2 32 35 0",
+    );
+    assert_ne!(wired, mesh);
+    let path = dir.join("block.msh");
+    std::fs::write(&path, wired).unwrap();
+    let file = strip_with(&dir, &path, r#""side""#, "1", "0");
+    let (report, _) = membranes::solve(&request_of(&file)).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("boundary.dirichlet")
+                && w.contains("`side`")
+                && w.contains("inside the domain")),
+        "{:?}",
+        report.warnings
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn refusal(file: &SceneFile) -> String {
+    match membranes::solve(&request_of(file)) {
+        Ok(_) => panic!("the scene was solved"),
+        Err(e) => e.to_string(),
+    }
+}
