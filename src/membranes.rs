@@ -1274,7 +1274,12 @@ fn run_stabilized<M: Model>(
             solution.multiplier_noise
         ));
     }
-    let primal_rounding = primal_rounding(&solution, u_field, posed.data.obstacle.as_data_fn());
+    let primal_rounding = primal_rounding(
+        &solution,
+        u_field,
+        posed.data.obstacle.as_data_fn(),
+        posed.data.load.as_data_fn(),
+    );
     if primal_rounding > MAX_PRIMAL_ROUNDING {
         return Err(Error::Input(format!(
             "the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves u by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it)"
@@ -1817,13 +1822,12 @@ fn accuracy_rung(scene: &MembraneScene, pair: MembranePair) -> Result<AccuracyRu
 const MAX_PRIMAL_ROUNDING: f64 = 1e-3;
 
 /// [`fem_runtime::obstacle::ObstacleSolution::primal_rounding`] relative to the size of
-/// the answer: the larger of `max|u_h|`, `max|ψ|` at the vertices and, so that a
-/// membrane pressed flat onto ψ = 0 (u ≡ 0) is judged against something, 1e-6 of the
-/// mesh's diameter.
+/// the answer ([`answer_level`]).
 fn primal_rounding(
     solution: &TriangleObstacleSolution,
     u_field: usize,
     obstacle: &fem_runtime::DataFn,
+    load: &fem_runtime::DataFn,
 ) -> f64 {
     let mesh = &solution.discretization.mesh;
     let largest = |values: &mut dyn Iterator<Item = f64>| {
@@ -1833,23 +1837,44 @@ fn primal_rounding(
     };
     let u_size = largest(&mut solution.field(u_field).iter().copied());
     let psi_size = largest(&mut mesh.vertices().iter().map(|p| obstacle(p)));
-    let corners = |k: usize| {
-        let values = mesh.vertices().iter().map(|p| p[k]);
-        values.clone().fold(f64::INFINITY, f64::min)..=values.fold(f64::NEG_INFINITY, f64::max)
-    };
-    let (x, y) = (corners(0), corners(1));
-    let diameter = (x.end() - x.start()).hypot(y.end() - y.start());
-    solution.primal_rounding() / u_size.max(psi_size).max(1e-6 * diameter)
+    let load_size = largest(&mut mesh.vertices().iter().map(|p| load(p)));
+    let level = answer_level(u_size, psi_size, load_size, bounding_diameter(mesh));
+    if level > 0.0 {
+        solution.primal_rounding() / level
+    } else {
+        0.0
+    }
+}
+
+/// The size an error in u_h is judged against: the largest `|u_h|` and `|ψ|` (both
+/// scale with the data, so that scaling f, ψ and g together, which scales the exact
+/// solution, leaves every judgement the same), or, where ψ is exactly 0 (a membrane
+/// pressed flat onto ψ = 0 has u ≡ 0, and any rounding would be infinitely large
+/// against it), the larger of `|u_h|` and `|f| d²`, the deflection the load alone would
+/// make over the mesh's diameter `d`.
+///
+/// A fixed floor (it was 1e-6 of the diameter) broke the scaling: a tester's
+/// membrane-lshape with ψ, f and g scaled by 1e-20 was judged against the floor, and
+/// its u_h, 25 times ψ's range below ψ, passed without a word while the same problem at
+/// scale 1 (q = 1e20) was refused.
+fn answer_level(u_size: f64, psi_size: f64, load_size: f64, diameter: f64) -> f64 {
+    if psi_size > 0.0 {
+        u_size.max(psi_size)
+    } else {
+        u_size.max(load_size * diameter * diameter)
+    }
 }
 
 /// Largest open gap under a pushing λ_h, relative to the size of u_h and ψ (the largest
 /// `|u_h|`, `|ψ|` at the vertices), that passes without a warning.
 pub const OPEN_GAP_WARNING: f64 = 1e-2;
 
-/// Gaps below this multiple of the machine epsilon times the problem's scale (the
-/// largest of `|u_h|`, `|ψ|` and `|f| d²`, `d` the mesh's diameter: the deflection the
-/// load alone would make) are rounding, whatever the solution's size: on membrane-flat
-/// `u = ψ = 0` exactly, and a gap of 5e-17 was once called "not real".
+/// Gaps below this multiple of the machine epsilon times the answer's level
+/// ([`answer_level`]: the largest `|u_h|` and `|ψ|`, or `|f| d²` where ψ ≡ 0) are
+/// rounding, whatever the solution's size: on membrane-flat `u = ψ = 0` exactly, and a
+/// gap of 5e-17 was once called "not real". (`|f| d²` was once part of the level
+/// everywhere: at q = 1e12 on membrane-lshape it was 1.8, above ψ's whole range, and
+/// hid a penetration of 53 %.)
 const OPEN_GAP_ROUNDING: f64 = 1e3;
 
 /// A warning when λ_h pushes on cells that stay clear of ψ by more than
@@ -1864,18 +1889,21 @@ fn open_gap_warning(
     alpha: f64,
 ) -> Option<String> {
     let vertices = u.mesh.vertices();
-    let (size, largest_load) = vertices
-        .iter()
-        .zip(0..)
-        .fold((0.0f64, 0.0f64), |(s, l), (x, v)| {
-            let value = u.coefficients[u.map.vertex_dofs(v).start];
-            (
-                s.max(value.abs()).max(obstacle(x).abs()),
-                l.max(load(x).abs()),
-            )
-        });
-    let diameter = bounding_diameter(u.mesh);
-    let rounding = OPEN_GAP_ROUNDING * f64::EPSILON * size.max(largest_load * diameter * diameter);
+    let (u_size, psi_size, largest_load) =
+        vertices
+            .iter()
+            .zip(0..)
+            .fold((0.0f64, 0.0f64, 0.0f64), |(s, p, l), (x, v)| {
+                let value = u.coefficients[u.map.vertex_dofs(v).start];
+                (
+                    s.max(value.abs()),
+                    p.max(obstacle(x).abs()),
+                    l.max(load(x).abs()),
+                )
+            });
+    let size = u_size.max(psi_size);
+    let level = answer_level(u_size, psi_size, largest_load, bounding_diameter(u.mesh));
+    let rounding = OPEN_GAP_ROUNDING * f64::EPSILON * level;
     (gap > OPEN_GAP_WARNING * size && gap > rounding).then(|| {
         format!(
             "λ_h pushes on cells where u_h stays up to {gap:.2e} clear of ψ ({:.1} % of the solution's size {size:.2e}): the stabilized constraint u_h − ψ = α h²(…) on contact cells lets α h² (α = {alpha:e}) open that gap, so this contact set is not real; refine the mesh or lower α",
@@ -1906,8 +1934,8 @@ const PENETRATION_WARNING: f64 = 1e-2;
 /// fields: `scale`, the larger of ψ's range over the penetration's samples and u_h's
 /// range over the vertices (a flat ψ under a bent membrane still has a size to compare
 /// with: a tester's ψ = 0 under g = 1 dipped 0.62 without a word), and `rounding`, the
-/// rounding of the values compared ([`OPEN_GAP_ROUNDING`] ε times the largest of |u_h|,
-/// |ψ| and |f| d²: ψ = 10¹² + 10⁻³x dipped one ulp of 10¹², "9.4 %" of its range).
+/// rounding of the values compared ([`OPEN_GAP_ROUNDING`] ε times [`answer_level`]:
+/// ψ = 10¹² + 10⁻³x dipped one ulp of 10¹², "9.4 %" of its range).
 fn penetration_scales(
     report: &MembraneReport,
     fields: &MembraneFields,
@@ -1930,11 +1958,18 @@ fn penetration_scales(
         .map(|x| load(x).abs())
         .filter(|f| f.is_finite())
         .fold(0.0f64, f64::max);
-    let diameter = bounding_diameter(&fields.mesh);
-    let level = [u_lo, u_hi, psi_lo, psi_hi]
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold(largest_load * diameter * diameter, |m, v| m.max(v.abs()));
+    let size = |lo: f64, hi: f64| {
+        [lo, hi]
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    let level = answer_level(
+        size(u_lo, u_hi),
+        size(psi_lo, psi_hi),
+        largest_load,
+        bounding_diameter(&fields.mesh),
+    );
     let u_range = if u_hi >= u_lo { u_hi - u_lo } else { 0.0 };
     (
         report.obstacle_range.max(u_range),

@@ -721,3 +721,44 @@ fn refusal(file: &SceneFile) -> String {
         Err(e) => e.to_string(),
     }
 }
+
+/// membrane-lshape's obstacle as a scene file, with f = `load` and ψ scaled by `scale`.
+fn lshape(load: &str, scale: &str) -> SceneFile {
+    let text = format!(
+        "name = \"lsh\"\nmodel = \"membrane\"\npair = \"p2-p0\"\n[mesh]\ngenerator = \"l-shape\"\nsize = 32\n[data]\nf = \"{load}\"\npsi = \"{scale}*(-0.05 - 0.6*((x + 0.35)^2 + 0.5*(y - 0.4)^2) + 0.1*x)\"\ng = \"0\"\n"
+    );
+    scene_file::parse(&text, Path::new("lsh.toml")).unwrap()
+}
+
+/// Scaling f, ψ and g together scales the exact solution, so every judgement of the
+/// answer must stay the same: a tester's ψ × 1e-20 under f = −1 (the refused q = 1e20
+/// at scale 1e-20) passed without a word, its u_h 25 times ψ's range below ψ, because
+/// the rounding was judged against a fixed floor of 1e-6 of the diameter. And the
+/// penetration at q = 1e12 (53 %, a matter of the mesh) was hidden behind a rounding
+/// level of |f| d² = 1.8.
+#[test]
+fn judgements_of_the_answer_do_not_depend_on_the_data_scale() {
+    for (load, scale) in [("-1e20", "1"), ("-1", "1e-20")] {
+        let e = refusal(&lshape(load, scale));
+        assert!(
+            e.contains("the load dwarfs the obstacle"),
+            "{load} {scale}: {e}"
+        );
+    }
+    let (big, _) = membranes::solve(&request_of(&lshape("-1e16", "1"))).unwrap();
+    let (small, _) = membranes::solve(&request_of(&lshape("-1", "1e-16"))).unwrap();
+    let ratio = big.primal_rounding / small.primal_rounding;
+    assert!((0.5..2.0).contains(&ratio), "{big:?} {small:?}");
+    assert!(big.primal_rounding > 1e-8, "{big:?}");
+    assert_eq!(
+        big.warnings.len(),
+        small.warnings.len(),
+        "{big:?} {small:?}"
+    );
+    let (pressed, _) = membranes::solve(&request_of(&lshape("-1e12", "1"))).unwrap();
+    assert!(
+        pressed.max_penetration > 0.1
+            && pressed.warnings.iter().any(|w| w.contains("dips below ψ")),
+        "{pressed:?}"
+    );
+}
