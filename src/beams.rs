@@ -574,6 +574,15 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     // 1e-6 of the beam's length: so that a beam at rest on ψ = 0 is judged against something
     let primal_rounding = solution.primal_rounding() / max_deflection.max(psi_size).max(1e-6);
     if primal_rounding > MAX_PRIMAL_ROUNDING {
+        // the rows' large terms are the load's, or αC Λ's when the user's α is far above
+        // the default (a tester's α = 1e30 at q = 100 was told the load was at fault)
+        if alpha > LARGE_ALPHA * pair.default_alpha() {
+            return Err(Error::Input(format!(
+                "α = {alpha:e} ({} times the pair's default {:e}) makes the stabilization's terms in the constraint rows so large that their rounding moves w by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it): lower --alpha",
+                crate::number(alpha / pair.default_alpha()),
+                pair.default_alpha()
+            )));
+        }
         return Err(Error::Input(format!(
             "the load q = {q:e} dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves w by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it)"
         )));

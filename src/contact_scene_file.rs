@@ -578,6 +578,11 @@ fn check_load(load: f64) -> std::result::Result<(), String> {
         Err(format!(
             "the pressure's scale {load:e} is beyond {MAX_DATA:e}: the solve's norms would overflow; rescale the units"
         ))
+    } else if load < f64::MIN_POSITIVE {
+        Err(format!(
+            "the pressure's scale {load:e} is subnormal (below {:e}, the smallest normal double): the solve would lose its digits; rescale the units",
+            f64::MIN_POSITIVE
+        ))
     } else {
         Ok(())
     }

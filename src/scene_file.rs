@@ -685,6 +685,15 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
                 format!("{} must be finite", crate::number(q)),
             ));
         }
+        if q != 0.0 && q.abs() < f64::MIN_POSITIVE {
+            return Err(at(
+                "data.load",
+                format!(
+                    "{q:e} is subnormal (non-zero and below {:e}, the smallest normal double): the solve would lose its digits",
+                    f64::MIN_POSITIVE
+                ),
+            ));
+        }
     }
     if let Some(e) = &file.exact {
         for (key, value) in [

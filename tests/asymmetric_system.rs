@@ -231,3 +231,113 @@ fn a_contact_form_with_couplings_of_different_signs_is_refused() {
         "{e}"
     );
 }
+
+fem_runtime::model! {
+    /// A string over an obstacle in a wind β (convection), u ∈ P1, λ ∈ P0.
+    pub mod wind on interval {
+        unknowns: u: P1, λ: P0 >= 0;
+        tests: v, μ;
+        params: α, s;
+        data: f, ψ, β;
+        forms: "
+    a(u;v)     = ∫ u'v' + β u' v
+    b(v;μ)     = ∫ s v μ
+    S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
+    ℓ(v)       = ∫ f v
+    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    g(μ)       = ∫ s ψ μ
+    B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
+    L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
+    ";
+    }
+}
+
+/// A tester's convection `β u'v` with a wind that vanishes on the left half, cell 0
+/// included: the check compared cell 0 alone and the string was solved (KKT residual
+/// 7e-17) as if the solver could take a non-symmetric A. Every cell is compared now,
+/// and the refusal names one on the right; without wind the model solves. A wind that
+/// is NaN on a cell is named as non-finite data, not as an asymmetry.
+#[test]
+fn an_asymmetry_away_from_the_first_cell_is_refused() {
+    let mesh = IntervalMesh::uniform(-1.0, 1.0, 32).unwrap();
+    let load = |_: &[f64]| -4.0;
+    let obstacle = |_: &[f64]| -0.1;
+    let params = [("α", 0.1), ("s", 1.0)];
+    let half = |x: &[f64]| 20.0 * x[0].max(0.0);
+    let calm = |_: &[f64]| 0.0;
+    let nan = |x: &[f64]| (x[0] + 0.9).sqrt();
+    let solve = |wind: &fem_runtime::DataFn| {
+        let data: [(&str, &fem_runtime::DataFn); 3] = [("f", &load), ("ψ", &obstacle), ("β", wind)];
+        let c = Coefficients::new::<wind::Model>(&params, &data).unwrap();
+        solve_obstacle::<wind::Model>(&mesh, &c, &["u"], ObstacleOptions::default())
+    };
+    assert!(solve(&calm).is_ok());
+    let Err(e) = solve(&half) else {
+        panic!("the convection was solved")
+    };
+    let e = e.to_string();
+    assert!(
+        e.contains("not symmetric") && e.contains("on cell") && !e.contains("on cell 0 "),
+        "{e}"
+    );
+    let Err(e) = solve(&nan) else {
+        panic!("NaN data were solved")
+    };
+    assert!(
+        matches!(e, fem_runtime::Error::NonFinite { cell: 0, .. }),
+        "{e}"
+    );
+}
+
+contact_model!(
+    contact_true_normal,
+    "
+    σ(u)         := 2μ_L ε(u) + λ_L tr ε(u) I
+    σ_n(u)       := (σ(u)·n)·n_c
+    a(u;v)       = ∫ σ(u):ε(v)
+    b(v;μ)       = −∫_Γ_C μ v·n_c ds
+    bn(v;μ)      = −∫_Γ_C μ v·n ds
+    S(u,λ;v,μ)   = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds
+    ℓ(v)         = −∫_Γ_N q v·n ds
+    G(μ)         = −∫_Γ_C g μ ds
+    B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − bn(u;μ) − α S(u,λ;v,μ)
+    L_h(v,μ)     = ℓ(v) − G(μ)
+    "
+);
+
+/// Couplings written with the normal n on one side and n_c on the other are symmetric
+/// on Γ_C, where n = n_c: a tester's model was refused because the facet blocks were
+/// compared on the first edge of cell 0, an interior edge. They are compared on the
+/// part's own edges now.
+#[test]
+fn facet_blocks_are_compared_on_their_own_edges() {
+    use fem_runtime::contact::discretize_boundary_multiplier;
+    use fem_runtime::mesh::triangle::Diagonal;
+    use fem_runtime::TriangleMesh;
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Alternating).unwrap();
+    let pressure = |_: &[f64]| 1.0;
+    let gap = |_: &[f64]| 0.0;
+    let params = [
+        ("μ_L", 1.0),
+        ("λ_L", 1.0),
+        ("α", 0.01),
+        ("n_c_x", 0.0),
+        ("n_c_y", -1.0),
+    ];
+    let data: [(&str, &fem_runtime::DataFn); 2] = [("q", &pressure), ("g", &gap)];
+    let c = Coefficients::new::<contact_true_normal::Model>(&params, &data).unwrap();
+    // the bottom (marker 1), where n = n_c = (0, −1)
+    let parts: [(&str, &[u32]); 2] = [("Γ_C", &[1]), ("Γ_N", &[3])];
+    discretize_boundary_multiplier::<contact_true_normal::Model>(&mesh, &c, &parts, &[]).unwrap();
+    // the right side (marker 2), where n = (1, 0) ≠ n_c: not symmetric there
+    let parts: [(&str, &[u32]); 2] = [("Γ_C", &[2]), ("Γ_N", &[3])];
+    let Err(e) =
+        discretize_boundary_multiplier::<contact_true_normal::Model>(&mesh, &c, &parts, &[])
+    else {
+        panic!("n ≠ n_c on Γ_C was accepted")
+    };
+    assert!(
+        e.to_string().contains("boundary integral over `Γ_C`"),
+        "{e}"
+    );
+}

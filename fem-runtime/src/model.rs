@@ -657,20 +657,28 @@ impl<'a> Coefficients<'a> {
     }
 }
 
-/// An error unless bilinear form `form` is symmetric on the first cell of `mesh`: each
-/// cell block `(i, j)` the transpose of block `(j, i)`, and likewise each boundary part's
-/// facet blocks (`facets:`) on the cell's first edge, to 1e-9 of their largest entry,
-/// with the parameters and data of `coefficients`. The obstacle and contact solvers need
-/// their system form `B_h` symmetric: they read `B` from its multiplier rows alone and
-/// factor its primal block by Cholesky, so a tester's `− b(v;λ) + b(u;μ)` was solved to
-/// a string 0.93 through its obstacle with a KKT residual of 1e-16. Compared in numbers,
+/// Cells whose blocks [`require_symmetric`] compares at most: every cell up to this
+/// many, else every k-th cell. At about 0.1 µs per kernel call that is well under a
+/// second on the largest meshes, against an assembly that visits every cell anyway.
+pub const MAX_SYMMETRY_CELLS: usize = 1 << 18;
+
+/// An error unless the cell blocks of bilinear form `form` are symmetric on `mesh`:
+/// on each cell (every cell, or every k-th beyond [`MAX_SYMMETRY_CELLS`]) block
+/// `(i, j)` the transpose of block `(j, i)`, to 1e-9 of their largest entry, with the
+/// parameters and data of `coefficients`. The obstacle and contact solvers need their
+/// system form `B_h` symmetric: they read `B` from its multiplier rows alone and factor
+/// its primal block by Cholesky, so a tester's `− b(v;λ) + b(u;μ)` was solved to a
+/// string 0.93 through its obstacle with a KKT residual of 1e-16. Compared in numbers,
 /// not symbols, so that equal terms written differently (`∫[degree=1]` beside an exact
-/// rule, `1/(2 + 2t²)` beside `0.5/(1 + t²)`) pass. A facet kernel is evaluated on the
-/// first edge whether or not it lies on the boundary: it is the same polynomial there.
+/// rule, `1/(2 + 2t²)` beside `0.5/(1 + t²)`) pass; and on every cell, not the first
+/// alone, since data can make a form symmetric on some cells only (a tester's
+/// convection `β u'v` with β = 0 on half the domain, including cell 0). Boundary
+/// integrals are compared on their own edges by [`require_symmetric_facets`].
 ///
 /// # Errors
-/// [`Error::Input`] naming the fields (and, for a facet block, the boundary part) of the
-/// first block that is not the transpose of its mirror; a facet kernel's own error.
+/// [`Error::Input`] naming the cell and the fields of the first block that is not the
+/// transpose of its mirror; [`Error::NonFinite`] for a cell whose blocks are not finite
+/// (NaN or infinite data there).
 pub fn require_symmetric<M: Model, G: crate::mesh::Mesh>(
     form: usize,
     mesh: &G,
@@ -684,34 +692,73 @@ pub fn require_symmetric<M: Model, G: crate::mesh::Mesh>(
         CellKind::Triangle => 6,
     };
     let mut x = vec![0.0; width];
-    mesh.cell_coordinates_into(0, &mut x);
     let counts: Vec<usize> = M::FIELDS
         .iter()
         .map(|field| field.element.local_dof_count(M::CELL))
         .collect();
-    let mut cell = Blocks::default();
-    for (b, block) in M::FORMS[form].blocks.iter().enumerate() {
-        let Some(trial) = block.trial_field else {
-            continue;
-        };
-        let test = block.test_field;
-        let mut out = vec![0.0; counts[test] * counts[trial]];
-        M::element_matrix(
-            form,
-            b,
-            &x,
-            &coefficients.params,
-            &coefficients.data,
-            &mut out,
-        );
-        cell.add((test, trial), out);
+    let mut blocks = Blocks::default();
+    let mut out = Vec::new();
+    let step = mesh.cell_count().div_ceil(MAX_SYMMETRY_CELLS);
+    for cell in (0..mesh.cell_count()).step_by(step) {
+        mesh.cell_coordinates_into(cell, &mut x);
+        blocks.clear();
+        for (b, block) in M::FORMS[form].blocks.iter().enumerate() {
+            let Some(trial) = block.trial_field else {
+                continue;
+            };
+            let test = block.test_field;
+            out.clear();
+            out.resize(counts[test] * counts[trial], 0.0);
+            M::element_matrix(
+                form,
+                b,
+                &x,
+                &coefficients.params,
+                &coefficients.data,
+                &mut out,
+            );
+            blocks.add((test, trial), &out);
+        }
+        if !blocks.finite() {
+            return Err(Error::NonFinite {
+                what: "matrix",
+                cell,
+            });
+        }
+        blocks.require_transposes::<M>(form, &counts, &format!("on cell {cell}"))?;
     }
-    cell.require_transposes::<M>(form, &counts, "")?;
-    if G::CELL != CellKind::Triangle {
+    Ok(())
+}
+
+/// [`require_symmetric`] for the boundary integrals of `form` over the boundary part
+/// `part` (an index in `FACET_PARTS`), on its edges `edges` (`(cell, local edge)`): the
+/// facet blocks are compared where they are integrated, since a form can be symmetric
+/// on the part and not elsewhere (`v·n` beside `v·n_c`, equal where n = n_c).
+///
+/// # Errors
+/// [`Error::Input`] naming the part, the edge's cell and the fields of the first block
+/// that is not the transpose of its mirror; [`Error::NonFinite`] for non-finite blocks;
+/// the facet kernels' errors.
+pub fn require_symmetric_facets<M: Model>(
+    form: usize,
+    part: usize,
+    mesh: &crate::mesh::TriangleMesh,
+    coefficients: &Coefficients,
+    edges: &[(usize, usize)],
+) -> Result<()> {
+    if M::FORMS[form].arity != 2 || M::CELL != CellKind::Triangle {
         return Ok(());
     }
-    for (part, part_name) in M::FACET_PARTS.iter().enumerate() {
-        let mut facet = Blocks::default();
+    let counts: Vec<usize> = M::FIELDS
+        .iter()
+        .map(|field| field.element.local_dof_count(M::CELL))
+        .collect();
+    let mut x = vec![0.0; 6];
+    let mut blocks = Blocks::default();
+    let mut out = Vec::new();
+    for &(cell, local) in edges {
+        crate::mesh::Mesh::cell_coordinates_into(mesh, cell, &mut x);
+        blocks.clear();
         for (b, block) in M::FACET_BLOCKS.iter().enumerate() {
             let Some(trial) = block.trial_field else {
                 continue;
@@ -720,60 +767,108 @@ pub fn require_symmetric<M: Model, G: crate::mesh::Mesh>(
                 continue;
             }
             let test = block.test_field;
-            let mut out = vec![0.0; counts[test] * counts[trial]];
-            M::facet_matrix(b, &x, 0, &coefficients.params, &coefficients.data, &mut out)?;
-            facet.add((test, trial), out);
+            out.clear();
+            out.resize(counts[test] * counts[trial], 0.0);
+            M::facet_matrix(
+                b,
+                &x,
+                local,
+                &coefficients.params,
+                &coefficients.data,
+                &mut out,
+            )?;
+            blocks.add((test, trial), &out);
         }
-        facet.require_transposes::<M>(
+        if !blocks.finite() {
+            return Err(Error::NonFinite {
+                what: "facet matrix",
+                cell,
+            });
+        }
+        blocks.require_transposes::<M>(
             form,
             &counts,
-            &format!(" in the boundary integral over `{part_name}` (edge 0)"),
+            &format!(
+                "on the edge of cell {cell} in the boundary integral over `{}`",
+                M::FACET_PARTS[part]
+            ),
         )?;
     }
     Ok(())
 }
 
-/// The blocks of one form on one cell (or edge), summed by `(test field, trial field)`.
+/// The blocks of one form on one cell (or edge), summed by `(test field, trial field)`;
+/// cleared and refilled cell by cell without allocating.
 #[derive(Default)]
-struct Blocks(Vec<((usize, usize), Vec<f64>)>);
+struct Blocks(Vec<((usize, usize), Vec<f64>, bool)>);
 
 impl Blocks {
-    fn add(&mut self, key: (usize, usize), out: Vec<f64>) {
-        match self.0.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, sum)) => sum.iter_mut().zip(&out).for_each(|(s, o)| *s += o),
-            None => self.0.push((key, out)),
+    /// Marks every block unused (its storage stays).
+    fn clear(&mut self) {
+        for (_, sum, used) in &mut self.0 {
+            sum.iter_mut().for_each(|s| *s = 0.0);
+            *used = false;
         }
     }
 
-    /// `what` names the integral (empty for the cell's) in the message.
+    fn add(&mut self, key: (usize, usize), out: &[f64]) {
+        match self.0.iter_mut().find(|(k, _, _)| *k == key) {
+            Some((_, sum, used)) => {
+                sum.iter_mut().zip(out).for_each(|(s, o)| *s += o);
+                *used = true;
+            }
+            None => self.0.push((key, out.to_vec(), true)),
+        }
+    }
+
+    fn finite(&self) -> bool {
+        self.0
+            .iter()
+            .all(|(_, sum, _)| sum.iter().all(|v| v.is_finite()))
+    }
+
+    /// `place` says where the blocks were computed (`on cell 7`).
     fn require_transposes<M: Model>(
         &self,
         form: usize,
         counts: &[usize],
-        what: &str,
+        place: &str,
     ) -> Result<()> {
         let largest = |m: &[f64]| m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        for ((test, trial), mine) in &self.0 {
+        for ((test, trial), mine, used) in &self.0 {
+            if !used {
+                continue;
+            }
             let (rows, cols) = (counts[*test], counts[*trial]);
             let zero = vec![0.0; rows * cols];
             let mirror = self
                 .0
                 .iter()
-                .find(|(key, _)| *key == (*trial, *test))
-                .map_or(&zero, |(_, m)| m);
+                .find(|(key, _, used)| *used && *key == (*trial, *test))
+                .map_or(&zero, |(_, m, _)| m);
             let tolerance = 1e-9 * largest(mine).max(largest(mirror));
             let transposed = (0..rows).all(|i| {
                 (0..cols).all(|j| (mine[i * cols + j] - mirror[j * rows + i]).abs() <= tolerance)
             });
             if !transposed {
                 let (name, fields) = (M::FORMS[form].name, M::FIELDS);
+                let which = if test == trial {
+                    format!(
+                        "its block of `{}` rows and `{}` columns is not symmetric",
+                        fields[*test].test_name, fields[*trial].name
+                    )
+                } else {
+                    format!(
+                        "its block of `{}` rows and `{}` columns is not the transpose of the block of `{}` rows and `{}` columns",
+                        fields[*test].test_name,
+                        fields[*trial].name,
+                        fields[*trial].test_name,
+                        fields[*test].name,
+                    )
+                };
                 return Err(Error::Input(format!(
-                    "`{name}` of model `{}` is not symmetric: on cell 0 its block of `{}` rows and `{}` columns{what} is not the transpose of the block of `{}` rows and `{}` columns. The obstacle solvers read B from the multiplier rows alone and factor the primal block by Cholesky, so they would solve another problem; write `{name}` as a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ) with a and S symmetric",
+                    "`{name}` of model `{}` is not symmetric: {place} {which}. The obstacle solvers read B from the multiplier rows alone and factor the primal block by Cholesky, so they would solve another problem; write `{name}` as a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ) with a and S symmetric",
                     M::NAME,
-                    fields[*test].test_name,
-                    fields[*trial].name,
-                    fields[*trial].test_name,
-                    fields[*test].name,
                 )));
             }
         }

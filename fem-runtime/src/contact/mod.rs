@@ -227,6 +227,10 @@ pub fn discretize_boundary_multiplier<M: Model>(
         }
         edges_of_part.push(edges);
     }
+    for (part, edges) in edges_of_part.iter().enumerate() {
+        let places: Vec<(usize, usize)> = edges.iter().map(|e| (e.cell, e.local)).collect();
+        crate::model::require_symmetric_facets::<M>(bilinear, part, mesh, coefficients, &places)?;
+    }
     let contact_edges = edges_of_part[multiplier_part].clone();
     let (contact_vertices, edge_dofs) = multiplier_dofs(mesh, &contact_edges, space);
     if space == BoundaryMultiplier::P1 {
