@@ -109,7 +109,7 @@ struct SolveOptions {
     /// (membrane-radial: f = 0). Contact: the pressure q on signorini-patch's top
     /// (default 1), the resultant P per unit length of hertz and signorini-gap (default
     /// 1), the scale of a contact scene file's pressure.
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_load)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_load)]
     load: Option<f64>,
     /// Thickness t (Timoshenko beams and the Reissner–Mindlin plates).
     #[arg(long, allow_negative_numbers = true)]

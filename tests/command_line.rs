@@ -183,6 +183,27 @@ fn bad_input_exits_with_a_message() {
             &["solve", "timoshenko-a", "--load", "1e25"][..],
             "dwarfs the obstacle",
         ),
+        // a user's α far above the default, not the load, makes the rows' terms large
+        (
+            &[
+                "solve",
+                "bernoulli-flat",
+                "--load",
+                "100",
+                "--alpha",
+                "1e30",
+            ][..],
+            "makes the stabilization's terms in the constraint rows so large",
+        ),
+        // subnormal loads lose their digits (Newton stopped at a residual of 8e-3)
+        (
+            &["solve", "bernoulli-flat", "--load", "1e-315"][..],
+            "is subnormal",
+        ),
+        (
+            &["solve", "membrane-flat", "--load", "-1e-310"][..],
+            "is subnormal",
+        ),
         (
             &["solve", "bernoulli-a", "--load", "1e200"][..],
             "would overflow",

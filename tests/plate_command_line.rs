@@ -520,3 +520,21 @@ fn plates_say_when_nesting_is_lost_and_solve_unobstructed_once() {
         "{errors}"
     );
 }
+
+/// The square (it has no obstacle): its relative_error is against Kirchhoff's t → 0 limit:
+/// a tester's t = 1 read +1672 % as the discretization's error. A thick plate says so;
+/// a thin one (the default t) does not.
+#[test]
+fn a_thick_plates_error_against_kirchhoff_is_explained() {
+    let warned = |json: &serde_json::Value| {
+        json["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("the limit t → 0"))
+    };
+    let thick = solve_json(&["--thickness", "0.5", "--mesh-size", "8"]);
+    assert!(warned(&thick), "{thick}");
+    let thin = solve_json(&["--mesh-size", "8"]);
+    assert!(!warned(&thin), "{thin}");
+}

@@ -1163,3 +1163,33 @@ fn tests_out_of_order_are_one_error_at_the_signature() {
     );
     assert!(rendered_errors(&model(quote! { η, v, μ })).is_empty());
 }
+
+/// Names written together with two readings (`params: s, t, st`: `stu` is `st·u` or
+/// `s·t·u`) are an error naming both; one reading (`sλ`) multiplies as before.
+#[test]
+fn juxtaposed_names_with_two_readings_are_refused() {
+    let out = expand(quote! {
+        /// Ambiguous.
+        pub mod ambiguous on interval {
+            unknowns: u: P1;
+            tests: v;
+            params: s, t, st;
+            forms: "a(u;v) = ∫ stu v";
+        }
+    });
+    let errors = rendered_errors(&out).join("\n");
+    assert!(
+        errors.contains("`stu` can be read as `st·u` or as `s·t·u`"),
+        "{errors}"
+    );
+    let out = expand(quote! {
+        /// Plain.
+        pub mod plain on interval {
+            unknowns: u: P1;
+            tests: v;
+            params: s, t;
+            forms: "a(u;v) = ∫ stu v";
+        }
+    });
+    assert!(rendered_errors(&out).is_empty());
+}
