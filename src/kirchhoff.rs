@@ -548,6 +548,11 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
                 "w_h is lost to rounding: in contact the constraint rows subtract terms of the size of the load and of α h⁴ q (q = {q:e}, α = {alpha:e}), which dwarf the obstacle, and their rounding moves w_h by {rounding:.0e} of its own size; use a smaller load or α"
             )));
         }
+        if rounding > crate::plates::ROUNDING_WARNING {
+            warnings.push(format!(
+                "w_h may be off by {rounding:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)"
+            ));
+        }
         let open = max_open_contact_gap;
         if open > crate::membranes::OPEN_GAP_WARNING * gap {
             warnings.push(format!(

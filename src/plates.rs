@@ -46,6 +46,10 @@ pub const MIN_PLATE_THICKNESS: f64 = 1e-8;
 /// the larger of max|w_h|, |ψ| and 1e-6 of the domain's size, accepted in a result
 /// (fem_runtime `Lcp::primal_rounding`; the membranes' bound).
 pub const MAX_PRIMAL_ROUNDING: f64 = 1e-3;
+
+/// Rounding of w_h through the contact rows, relative to its size, above which a plate
+/// solve warns (as beams and membranes do from 1e-8).
+pub const ROUNDING_WARNING: f64 = 1e-8;
 /// The coarsest level of a nested solve: N/2^k ≥ this (N×N×2 squares, or rings).
 pub const COARSEST_LEVEL: usize = 4;
 
@@ -674,6 +678,7 @@ where
     // the plate's size for relative measures, never 0: an unloaded plate under an obstacle
     // at height 0 has w_h = 0, and its rounding is still not a gap or a loss
     let size = max_deflection.max(height.abs()).max(1e-6 * s.domain.size());
+    let mut primal_rounding = 0.0;
     if request.obstacle() != PlateObstacle::None {
         // as for membranes: a load (or α) that dwarfs the obstacle leaves w_h to the
         // rounding of the contact rows (q = 1e100 on the disk: w(0) = −2.7e78 under
@@ -686,8 +691,15 @@ where
                 request.obstacle().describe()
             )));
         }
+        primal_rounding = rounding;
     }
     let mut warnings = Vec::new();
+    // below the refusal, as beams and membranes do: say how far the rounding reaches
+    if primal_rounding > ROUNDING_WARNING {
+        warnings.push(format!(
+            "w_h may be off by {primal_rounding:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)"
+        ));
+    }
     // as beams and membranes do: the eliminated λ_h loses digits where C falls below the
     // rounding of G − BU, and its recovery may have been skipped (out of memory)
     if solution.multiplier_noise > 1e-6 {

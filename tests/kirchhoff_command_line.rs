@@ -194,3 +194,21 @@ fn bad_kirchhoff_input_is_refused_by_name() {
         );
     }
 }
+
+/// Below the refusal (1e-3), a rounding of w_h through the contact rows above 1e-8 is
+/// a warning, as for beams and membranes: a tester's q = 5e16 was silent, and q = 1e17
+/// refused.
+#[test]
+fn rounding_below_the_refusal_is_a_warning() {
+    let warned = |json: &serde_json::Value| {
+        json["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("may be off by"))
+    };
+    let heavy = solve_json("kirchhoff-obstacle", &["--load", "5e16"]);
+    assert!(warned(&heavy), "{heavy}");
+    let plain = solve_json("kirchhoff-obstacle", &[]);
+    assert!(!warned(&plain), "{plain}");
+}
