@@ -108,7 +108,9 @@
 //! - Names: declared symbols, `h` or `h_T` (element size); names written together that
 //!   are declared symbols multiply (`sλ` = `s·λ`), and a power or primes after them
 //!   belong to the last one, as in mathematics (`Et³` = `E·t³`, `αh_T²` = `α·h_T²`,
-//!   `fv'` = `f·v'`); `(Et)³` needs its parentheses.
+//!   `fv'` = `f·v'`); `(Et)³` needs its parentheses. A declared name is read as itself
+//!   (with `params: s, t, st`, `st` is the parameter `st`); a run that splits into
+//!   declared names in two ways (`stu`: `st·u` or `s·t·u`) is an error.
 //! - `Cε(θ) := D[(1−ν)ε(θ) + ν tr ε(θ) I]` (with `:=`) names an expression of its
 //!   arguments, of any shape, substituted where it is called (`∫ Cε(θ):ε(η)`,
 //!   `div div Cε(η)`); it generates no code of its own.
