@@ -310,3 +310,48 @@ fn bad_boundary_parts_are_refused_with_clear_messages() {
         );
     }
 }
+
+fem_forms::model! {
+    /// A string over an obstacle held at u = γ at its ends, u ∈ P1, λ ∈ P0.
+    pub mod held_string on interval {
+        unknowns: u: P1, λ: P0 >= 0;
+        tests: v, μ;
+        params: α;
+        data: f, ψ, γ;
+        boundary: u = γ;
+        forms: "
+            a(u;v)       = ∫ u'v'
+            b(v;μ)       = ∫ v μ
+            B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α Σ_T h_T² (λ, μ)_T
+            L_h(v,μ)     = ∫ f v − ∫ ψ μ
+        ";
+    }
+}
+
+/// A field without slope DOFs both clamped and given by `boundary:` has two values at
+/// its ends: a tester's clamped string ended at γ = 0.05 without a word. Refused; the
+/// `boundary:` alone holds the string at γ.
+#[test]
+fn a_clamp_and_a_boundary_value_of_one_field_are_refused() {
+    use fem_forms::obstacle::{solve_obstacle, ObstacleOptions};
+    use fem_forms::{Coefficients, IntervalMesh};
+    let mesh = IntervalMesh::uniform(-1.0, 1.0, 16).unwrap();
+    let (load, obstacle, held) = (|_: &[f64]| -4.0, |_: &[f64]| -10.0, |_: &[f64]| 0.05);
+    let data: [(&str, &fem_forms::DataFn); 3] = [("f", &load), ("ψ", &obstacle), ("γ", &held)];
+    let c = Coefficients::new::<held_string::Model>(&[("α", 0.1)], &data).unwrap();
+    let Err(e) =
+        solve_obstacle::<held_string::Model>(&mesh, &c, &["u"], ObstacleOptions::default())
+    else {
+        panic!("the clamp and u = γ were both imposed")
+    };
+    assert!(
+        e.to_string().contains("two values for the same DOFs"),
+        "{e}"
+    );
+    let s =
+        solve_obstacle::<held_string::Model>(&mesh, &c, &[], ObstacleOptions::default()).unwrap();
+    let u = s.view(0);
+    for x in [-1.0, 1.0] {
+        assert!((u.at(x, 0).unwrap() - 0.05).abs() < 1e-12);
+    }
+}

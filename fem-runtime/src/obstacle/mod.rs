@@ -87,12 +87,14 @@ pub fn multiplier_field<M: Model>() -> Result<usize> {
 impl Discretization<IntervalMesh> {
     /// Assembles `bilinear` and `linear` (normally `B_h`, `L_h`) of `M` on `mesh`, with the
     /// fields in `clamped` clamped at both ends and the model's `boundary: u = g`
-    /// conditions imposed at both ends (`u = g(x)` at the end points `x`; where a field is
-    /// both, `g` gives its value and the clamp its zero slope).
+    /// conditions imposed at both ends (`u = g(x)` at the end points `x`; where a field
+    /// with slope DOFs (Hermite) is both, `g` gives its value and the clamp its zero
+    /// slope).
     ///
     /// # Errors
-    /// Unknown field names, boundary data that is not finite at an end (the message
-    /// names the data and the point), and those of [`Discretization::with_constraints`].
+    /// Unknown field names, a field without slope DOFs both clamped and given by
+    /// `boundary:`, boundary data that is not finite at an end (the message names the
+    /// data and the point), and those of [`Discretization::with_constraints`].
     pub fn new<M: Model>(
         mesh: &IntervalMesh,
         coefficients: &Coefficients,
@@ -112,6 +114,16 @@ impl Discretization<IntervalMesh> {
             (Side::Right, *mesh.vertices().last().unwrap()),
         ];
         for &(field, data) in M::DIRICHLET {
+            // a clamp of a field without slope DOFs is its value 0 alone, which `u = g`
+            // would replace without a word (a tester's clamped `u` ended at g = 0.05)
+            let name = M::FIELDS[field].name;
+            if clamped.contains(&name) && M::FIELDS[field].element.dofs_per_vertex() == 1 {
+                return Err(Error::Input(format!(
+                    "field `{name}` of `{}` is clamped (`{name}` = 0 at both ends) and its `boundary:` gives `{name} = {}`: two values for the same DOFs; drop it from the clamped fields or from `boundary:`",
+                    M::NAME,
+                    M::DATA[data]
+                )));
+            }
             let g = coefficients.data.get(data).ok_or_else(|| {
                 Error::Input(format!(
                     "boundary data `{}` of model `{}` is not given",
