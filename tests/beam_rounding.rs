@@ -173,3 +173,44 @@ fn the_locking_timoshenko_pair_is_warned_about_where_it_locks() {
     assert!((report.max_deflection / centre_deflection(0.1) - 1.0).abs() < 1e-3);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }
+
+/// A tester's silent wrong answers on fine Euler–Bernoulli meshes: the stiffness
+/// conditions the system like h⁻⁴, and bernoulli-a (no contact, max w = q/384) was
+/// 2–7 % off at 65536 elements with a KKT residual of 8e-17 and no warning. The rounding
+/// experiment (`length_rounding`, the beam's length moved in its last bits) is compared
+/// with the true error: within a factor 3 where rounding dominates, a warning from 1e-4,
+/// a refusal from 0.1, and nothing on a mesh of a few hundred elements.
+#[test]
+fn a_fine_euler_bernoulli_beam_lost_to_rounding_is_warned_or_refused() {
+    let free = |elements: usize| {
+        let mut r = Request::new(scene("bernoulli-a").unwrap());
+        r.elements = elements;
+        r
+    };
+    for elements in [4096, 16384] {
+        let (report, _) = solve(&free(elements)).expect("rounding-limited, not lost");
+        let error = (report.max_deflection * 384.0 - 1.0).abs();
+        let estimate = report.length_rounding.unwrap();
+        assert!(
+            error > 1e-7 && estimate > error / 3.0 && estimate < 3.0 * error,
+            "{elements}: error {error:e}, estimate {estimate:e}"
+        );
+        assert_eq!(
+            report
+                .warnings
+                .iter()
+                .any(|w| w.contains("rounding-limited")),
+            estimate > 1e-4,
+            "{:?}",
+            report.warnings
+        );
+    }
+    let Err(e) = solve(&free(65536)) else {
+        panic!("65536 Hermite elements (2–7 % off) were accepted");
+    };
+    assert!(e.to_string().contains("w_h is rounding"), "{e}");
+    let (report, _) = solve(&free(256)).unwrap();
+    assert!(report.length_rounding.unwrap() < 1e-8, "{report:?}");
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert!(report.thickness_rounding.is_none());
+}
