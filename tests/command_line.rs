@@ -195,6 +195,16 @@ fn bad_input_exits_with_a_message() {
             ][..],
             "makes the stabilization's terms in the constraint rows so large",
         ),
+        // memory estimated before: a tester's 4M Timoshenko elements took 21 GB
+        (
+            &["solve", "timoshenko-a", "--elements", "20000000"][..],
+            "needs about 110.0 GB",
+        ),
+        // the Hermite stiffness's h⁻⁴ is named (it was α·C_I and a free rigid motion)
+        (
+            &["solve", "bernoulli-flat", "--load", "1", "--elements", "100000"][..],
+            "conditions the system like h⁻⁴",
+        ),
         // subnormal loads lose their digits (Newton stopped at a residual of 8e-3)
         (
             &["solve", "bernoulli-flat", "--load", "1e-315"][..],
