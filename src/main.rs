@@ -112,7 +112,7 @@ struct SolveOptions {
     #[arg(long, allow_hyphen_values = true, value_parser = parse_load)]
     load: Option<f64>,
     /// Thickness t (Timoshenko beams and the Reissner–Mindlin plates).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     thickness: Option<f64>,
     /// Stabilization parameter α (negative values are refused with a reason; not for
     /// p1-nodal, which has no multiplier). 0: the plain mixed method, solved as a QP by
@@ -1092,6 +1092,13 @@ fn run(cli: Cli) -> Result<(), String> {
             cli.out.display()
         )
     })?;
+    // and writable: a tester's read-only --out failed after a whole study, naming no file
+    let probe = cli
+        .out
+        .join(format!(".fem-forms-write-check-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| format!("--out {}: cannot write files there: {e}", cli.out.display()))?;
+    let _ = std::fs::remove_file(&probe);
     match cli.command {
         None => default_job(&cli.out),
         Some(Command::List) => {

@@ -296,7 +296,11 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io
             writeln!(file, "{}", cells.join(","))?;
         }
     }
-    std::fs::rename(tmp, path)
+    // a CSV path that is a directory (a tester's) left the .partial file behind
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        std::io::Error::new(e.kind(), format!("{}: {e}", path.display()))
+    })
 }
 
 /// [`write_csv`] with a first column `column` of names (a pair, a method): each row's

@@ -202,7 +202,14 @@ fn bad_input_exits_with_a_message() {
         ),
         // the Hermite stiffness's h⁻⁴ is named (it was α·C_I and a free rigid motion)
         (
-            &["solve", "bernoulli-flat", "--load", "1", "--elements", "100000"][..],
+            &[
+                "solve",
+                "bernoulli-flat",
+                "--load",
+                "1",
+                "--elements",
+                "100000",
+            ][..],
             "conditions the system like h⁻⁴",
         ),
         // subnormal loads lose their digits (Newton stopped at a residual of 8e-3)
@@ -230,6 +237,11 @@ fn bad_input_exits_with_a_message() {
             &["solve", "timoshenko-a", "--thickness", "1e-8"][..],
             "the Euler–Bernoulli model is the limit",
         ),
+        // a negative exponent is a value, not an option (clap read it as a flag)
+        (
+            &["solve", "timoshenko-a", "--thickness", "-1e-3"][..],
+            "must be positive and finite",
+        ),
     ] {
         let run = fem_forms(args, &out);
         let stderr = String::from_utf8_lossy(&run.stderr);
@@ -246,6 +258,17 @@ fn bad_input_exits_with_a_message() {
     assert!(!run.status.success());
     assert!(
         stderr.contains("exists and is not a directory") && stderr.contains("a-file"),
+        "{stderr}"
+    );
+    // an --out where no file can be written (here /proc) is refused before any work,
+    // naming it (a tester's read-only --out failed after the whole study)
+    let run = fem_forms(
+        &["study", "bernoulli-flat", "alpha"],
+        &PathBuf::from("/proc"),
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && stderr.contains("--out /proc: cannot write files there"),
         "{stderr}"
     );
     std::fs::remove_dir_all(&out).unwrap();
