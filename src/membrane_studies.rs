@@ -265,8 +265,8 @@ impl StudyScene for MembraneStudies {
 
     fn measure(&self) -> Measure {
         Measure {
-            title: "smallest eigenvalues γ of M_h⁻¹(B A⁻¹ Bᵀ + C), h-weighted norm (inf-sup constant = √γ)",
-            labels: &["γ₁", "γ₂"],
+            title: "√γ, γ the smallest eigenvalues of M_h⁻¹(B A⁻¹ Bᵀ + C), h-weighted norm (√γ₁: the inf-sup constant; a zero γ, a kernel, drawn at 1e-8)",
+            labels: &["√γ₁", "√γ₂"],
             axis: "√γ",
             // numerically zero γ (a kernel) drawn at 1e-8
             plotted: |g| g.max(1e-16).sqrt(),

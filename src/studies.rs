@@ -699,7 +699,7 @@ fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
             ),
             (
                 format!(
-                    "{name}, {pair}, {} = {n}: λ_h; plain (α = 0) oscillates, stabilized does not",
+                    "{name}, {pair}, {} = {n}: λ_h of the plain (α = 0) and the stabilized method",
                     scene.size_name()
                 ),
                 Axes {
