@@ -1274,12 +1274,7 @@ fn run_stabilized<M: Model>(
             solution.multiplier_noise
         ));
     }
-    let primal_rounding = primal_rounding(
-        &solution,
-        u_field,
-        posed.data.obstacle.as_data_fn(),
-        posed.data.load.as_data_fn(),
-    );
+    let primal_rounding = primal_rounding(&solution, u_field, posed.data.obstacle.as_data_fn());
     if primal_rounding > MAX_PRIMAL_ROUNDING {
         return Err(Error::Input(format!(
             "the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves u by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it)"
@@ -1827,7 +1822,6 @@ fn primal_rounding(
     solution: &TriangleObstacleSolution,
     u_field: usize,
     obstacle: &fem_runtime::DataFn,
-    load: &fem_runtime::DataFn,
 ) -> f64 {
     let mesh = &solution.discretization.mesh;
     let largest = |values: &mut dyn Iterator<Item = f64>| {
@@ -1837,8 +1831,7 @@ fn primal_rounding(
     };
     let u_size = largest(&mut solution.field(u_field).iter().copied());
     let psi_size = largest(&mut mesh.vertices().iter().map(|p| obstacle(p)));
-    let load_size = largest(&mut mesh.vertices().iter().map(|p| load(p)));
-    let level = answer_level(u_size, psi_size, load_size, bounding_diameter(mesh));
+    let level = answer_level(u_size, psi_size, bounding_diameter(mesh));
     if level > 0.0 {
         solution.primal_rounding() / level
     } else {
@@ -1850,31 +1843,39 @@ fn primal_rounding(
 /// scale with the data, so that scaling f, ψ and g together, which scales the exact
 /// solution, leaves every judgement the same), or, where ψ is exactly 0 (a membrane
 /// pressed flat onto ψ = 0 has u ≡ 0, and any rounding would be infinitely large
-/// against it), the larger of `|u_h|` and `|f| d²`, the deflection the load alone would
-/// make over the mesh's diameter `d`.
+/// against it), the larger of `|u_h|` and 1e-6 of the mesh's diameter `d` (a
+/// deflection is a length: one a millionth of the domain is the least that is judged).
 ///
-/// A fixed floor (it was 1e-6 of the diameter) broke the scaling: a tester's
-/// membrane-lshape with ψ, f and g scaled by 1e-20 was judged against the floor, and
-/// its u_h, 25 times ψ's range below ψ, passed without a word while the same problem at
-/// scale 1 (q = 1e20) was refused.
-fn answer_level(u_size: f64, psi_size: f64, load_size: f64, diameter: f64) -> f64 {
+/// The floor applied everywhere broke the scaling: a tester's membrane-lshape with ψ, f
+/// and g scaled by 1e-20 was judged against it, and its u_h, 25 times ψ's range below ψ,
+/// passed without a word while the same problem at scale 1 (q = 1e20) was refused. And
+/// `|f| d²` in its place where ψ ≡ 0 (the re-test) hid membrane-flat at q = 1e20, whose
+/// u_h is 46 against the exact 0.
+fn answer_level(u_size: f64, psi_size: f64, diameter: f64) -> f64 {
     if psi_size > 0.0 {
         u_size.max(psi_size)
     } else {
-        u_size.max(load_size * diameter * diameter)
+        u_size.max(1e-6 * diameter)
     }
+}
+
+/// The rounding of the values of u_h and ψ that penetration and open-gap judgements
+/// compare: [`OPEN_GAP_ROUNDING`] ε times the largest `|u_h|` and `|ψ|` (ψ = 10¹² +
+/// 10⁻³x dipped one ulp of 10¹², "9.4 %" of its range), plus 10 ε `|f| d²`, the
+/// rounding of a solve under the load `f` over the diameter `d` (membrane-flat's u = ψ
+/// = 0 showed gaps of 5e-17 under f = −3). With 1e3 ε on the load term too, the
+/// threshold at q = 1e12 on membrane-lshape was 1.8, and hid a penetration of 53 %.
+fn value_rounding(u_size: f64, psi_size: f64, load_size: f64, diameter: f64) -> f64 {
+    OPEN_GAP_ROUNDING * f64::EPSILON * u_size.max(psi_size)
+        + 10.0 * f64::EPSILON * load_size * diameter * diameter
 }
 
 /// Largest open gap under a pushing λ_h, relative to the size of u_h and ψ (the largest
 /// `|u_h|`, `|ψ|` at the vertices), that passes without a warning.
 pub const OPEN_GAP_WARNING: f64 = 1e-2;
 
-/// Gaps below this multiple of the machine epsilon times the answer's level
-/// ([`answer_level`]: the largest `|u_h|` and `|ψ|`, or `|f| d²` where ψ ≡ 0) are
-/// rounding, whatever the solution's size: on membrane-flat `u = ψ = 0` exactly, and a
-/// gap of 5e-17 was once called "not real". (`|f| d²` was once part of the level
-/// everywhere: at q = 1e12 on membrane-lshape it was 1.8, above ψ's whole range, and
-/// hid a penetration of 53 %.)
+/// Gaps and crossings below this multiple of the machine epsilon times the largest
+/// `|u_h|` and `|ψ|` are rounding ([`value_rounding`]).
 const OPEN_GAP_ROUNDING: f64 = 1e3;
 
 /// A warning when λ_h pushes on cells that stay clear of ψ by more than
@@ -1902,8 +1903,7 @@ fn open_gap_warning(
                 )
             });
     let size = u_size.max(psi_size);
-    let level = answer_level(u_size, psi_size, largest_load, bounding_diameter(u.mesh));
-    let rounding = OPEN_GAP_ROUNDING * f64::EPSILON * level;
+    let rounding = value_rounding(u_size, psi_size, largest_load, bounding_diameter(u.mesh));
     (gap > OPEN_GAP_WARNING * size && gap > rounding).then(|| {
         format!(
             "λ_h pushes on cells where u_h stays up to {gap:.2e} clear of ψ ({:.1} % of the solution's size {size:.2e}): the stabilized constraint u_h − ψ = α h²(…) on contact cells lets α h² (α = {alpha:e}) open that gap, so this contact set is not real; refine the mesh or lower α",
@@ -1934,8 +1934,7 @@ const PENETRATION_WARNING: f64 = 1e-2;
 /// fields: `scale`, the larger of ψ's range over the penetration's samples and u_h's
 /// range over the vertices (a flat ψ under a bent membrane still has a size to compare
 /// with: a tester's ψ = 0 under g = 1 dipped 0.62 without a word), and `rounding`, the
-/// rounding of the values compared ([`OPEN_GAP_ROUNDING`] ε times [`answer_level`]:
-/// ψ = 10¹² + 10⁻³x dipped one ulp of 10¹², "9.4 %" of its range).
+/// rounding of the values compared ([`value_rounding`]).
 fn penetration_scales(
     report: &MembraneReport,
     fields: &MembraneFields,
@@ -1964,16 +1963,15 @@ fn penetration_scales(
             .filter(|v| v.is_finite())
             .fold(0.0f64, |m, v| m.max(v.abs()))
     };
-    let level = answer_level(
-        size(u_lo, u_hi),
-        size(psi_lo, psi_hi),
-        largest_load,
-        bounding_diameter(&fields.mesh),
-    );
     let u_range = if u_hi >= u_lo { u_hi - u_lo } else { 0.0 };
     (
         report.obstacle_range.max(u_range),
-        OPEN_GAP_ROUNDING * f64::EPSILON * level,
+        value_rounding(
+            size(u_lo, u_hi),
+            size(psi_lo, psi_hi),
+            largest_load,
+            bounding_diameter(&fields.mesh),
+        ),
     )
 }
 

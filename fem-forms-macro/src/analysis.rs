@@ -1704,6 +1704,28 @@ impl<'a> Context<'a> {
                 if let Some(e) = self.last_of_run(a, true, |last| ExprKind::Derivative(last, *k)) {
                     return self.expand(&e, inside_integral);
                 }
+                // a prime on a parameter alone is 0: with `params: k, ku` a tester's
+                // `∫ ku'v'` (meant k·u'v') was a form without a kernel, without a word
+                if let ExprKind::Symbol(name) = &a.kind {
+                    if self.symbols.params.iter().any(|p| p == name) {
+                        let hint = self
+                            .other_split(name, std::slice::from_ref(name))
+                            .map(|parts| {
+                                format!(
+                                    "; if you meant `{}'`, write it with a space or `·`",
+                                    parts.join(" ")
+                                )
+                            })
+                            .unwrap_or_default();
+                        return self.fail(
+                            Diagnostic::text(
+                                loc,
+                                format!("`{name}` is a parameter: its derivative is 0"),
+                            )
+                            .help(format!("a prime applies to a field or data{hint}")),
+                        );
+                    }
+                }
                 let x = self.expand(a, inside_integral)?;
                 self.partial(&x, 0, *k, loc)
             }

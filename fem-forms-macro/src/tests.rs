@@ -1193,3 +1193,24 @@ fn juxtaposed_names_with_two_readings_are_refused() {
     });
     assert!(rendered_errors(&out).is_empty());
 }
+
+/// A prime on a parameter alone is 0: with `params: k, ku` the re-tester's `∫ ku'v'`
+/// (meant k·u'v') compiled to a form without a kernel. It is an error with the reading
+/// the user likely meant.
+#[test]
+fn a_prime_on_a_parameter_is_refused() {
+    let out = expand(quote! {
+        /// Primed parameter.
+        pub mod primed on interval {
+            unknowns: u: P1;
+            tests: v;
+            params: k, ku;
+            forms: "a(u;v) = ∫ ku'v'";
+        }
+    });
+    let errors = rendered_errors(&out).join("\n");
+    assert!(
+        errors.contains("`ku` is a parameter: its derivative is 0") && errors.contains("`k u'`"),
+        "{errors}"
+    );
+}
