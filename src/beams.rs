@@ -621,7 +621,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         // the default (a tester's α = 1e30 at q = 100 was told the load was at fault)
         if alpha > LARGE_ALPHA * pair.default_alpha() {
             return Err(Error::Input(format!(
-                "α = {alpha:e} ({} times the pair's default {:e}) makes the stabilization's terms in the constraint rows so large that their rounding moves w by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it): lower --alpha",
+                "the load q = {q:e} with α = {alpha:e} ({} times the pair's default {:e}) makes the terms of the constraint rows so large that their rounding moves w by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it): lower --alpha first, then the load",
                 crate::number(alpha / pair.default_alpha()),
                 pair.default_alpha()
             )));

@@ -578,10 +578,10 @@ fn check_load(load: f64) -> std::result::Result<(), String> {
         Err(format!(
             "the pressure's scale {load:e} is beyond {MAX_DATA:e}: the solve's norms would overflow; rescale the units"
         ))
-    } else if load < f64::MIN_POSITIVE {
+    } else if load < crate::MIN_DATA_SIZE {
         Err(format!(
-            "the pressure's scale {load:e} is subnormal (below {:e}, the smallest normal double): the solve would lose its digits; rescale the units",
-            f64::MIN_POSITIVE
+            "the pressure's scale {load:e} is below {:e}: the solve multiplies it by powers of h and would underflow; rescale the units",
+            crate::MIN_DATA_SIZE
         ))
     } else {
         Ok(())
@@ -823,6 +823,18 @@ struct DataScales {
 /// swamp the elastic displacement ([`MAX_GAP_ROUNDING`]). The error names its key.
 fn data_scales(scales: &DataScales, load: f64) -> std::result::Result<(), (&'static str, String)> {
     let pressure = load * scales.pressure;
+    // the smallest pressure the range of E allows (a tester's pressure = "1e-320" stopped
+    // Newton at a KKT residual of 5e-3)
+    if pressure > 0.0 && pressure < 1.0 / MAX_DATA {
+        return Err((
+            "data.pressure",
+            format!(
+                "the pressure reaches at most {pressure:e} (scale {load:e} times max|q| = {:e}), below {:e}: the solve would underflow; rescale the units",
+                scales.pressure,
+                1.0 / MAX_DATA
+            ),
+        ));
+    }
     if pressure > MAX_DATA {
         return Err((
             "data.pressure",

@@ -1192,10 +1192,15 @@ fn parse_load(text: &str) -> Result<f64, String> {
         .trim()
         .parse::<f64>()
         .map_err(|e| format!("`{text}` is not a number: {e}"))?;
-    if q != 0.0 && q.abs() < f64::MIN_POSITIVE {
+    if q != 0.0 && q.abs() < fem_forms::MIN_DATA_SIZE {
+        let subnormal = if q.abs() < f64::MIN_POSITIVE {
+            " (subnormal)"
+        } else {
+            ""
+        };
         return Err(format!(
-            "{q:e} is subnormal (non-zero and below {:e}, the smallest normal double): the solve would lose its digits; give 0 or a load of at least that size",
-            f64::MIN_POSITIVE
+            "{q:e}{subnormal} is below {:e} in size: the solve multiplies it by powers of h and would underflow; give 0 or rescale the units",
+            fem_forms::MIN_DATA_SIZE
         ));
     }
     Ok(q)

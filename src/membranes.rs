@@ -553,6 +553,7 @@ fn validate(
         ("obstacle ψ", "data.psi", &data.obstacle, false),
         ("boundary data g", "data.g", &data.boundary, true),
     ] {
+        let mut largest = 0.0f64;
         for (i, x) in mesh.vertices().iter().enumerate() {
             if only_on_part && !on_part[i] {
                 continue;
@@ -571,6 +572,13 @@ fn validate(
                     x[0], x[1]
                 )));
             }
+            largest = largest.max(v.abs());
+        }
+        if largest > 0.0 && largest < crate::MIN_DATA_SIZE {
+            return Err(Error::Input(format!(
+                "scene `{scene}`: field `{key}`: the {name} is at most {largest:e} in size, below {:e}: the solve multiplies it by powers of h and would underflow; rescale the units",
+                crate::MIN_DATA_SIZE
+            )));
         }
     }
     for v in (0..mesh.vertex_count()).filter(|&v| on_part[v]) {

@@ -669,10 +669,20 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         };
         if let Some(mesh) = sample {
             mesh.boundary_part_markers(names).map_err(|e| match e {
-                Error::Input(message) => at(
-                    "boundary.dirichlet",
-                    format!("{message} (generator `{}`)", mesh_generator_name(&domain)),
-                ),
+                Error::Input(message) => {
+                    let keyword = if names.iter().any(|n| n == "all") {
+                        "; \"all\" (the whole boundary) is a keyword on its own, `dirichlet = \"all\"`, not a name in a list"
+                    } else {
+                        ""
+                    };
+                    at(
+                        "boundary.dirichlet",
+                        format!(
+                            "{message} (generator `{}`){keyword}",
+                            mesh_generator_name(&domain)
+                        ),
+                    )
+                }
                 other => other,
             })?;
         }
@@ -685,12 +695,12 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
                 format!("{} must be finite", crate::number(q)),
             ));
         }
-        if q != 0.0 && q.abs() < f64::MIN_POSITIVE {
+        if q != 0.0 && q.abs() < crate::MIN_DATA_SIZE {
             return Err(at(
                 "data.load",
                 format!(
-                    "{q:e} is subnormal (non-zero and below {:e}, the smallest normal double): the solve would lose its digits",
-                    f64::MIN_POSITIVE
+                    "{q:e} is below {:e} in size: the solve multiplies it by powers of h and would underflow; give 0 or rescale the units",
+                    crate::MIN_DATA_SIZE
                 ),
             ));
         }

@@ -1083,10 +1083,37 @@ fn a_pressure_on_the_contact_boundary_is_refused() {
             "{pair:?}: {message}"
         );
     }
+    // a bump between the ends and the middle of the first bottom edge (x in (0, 1/3)):
+    // sampling 3 points per edge missed it
+    let bump = both.replace(
+        "pressure = \"0.5 * (2 + 3)\"",
+        "pressure = \"1 + y + (1 - y) * 2000 * x * (x - 1/6) * (x - 1/3) * ceil(max(0, 1/3 - x))\"",
+    );
+    let message = contact_scene_file::solve(&parse(&bump).unwrap(), &Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("both on the contact boundary"),
+        "{message}"
+    );
     // q = 2.5 y: zero on the bottom, 2.5 on the top
     let vanishing = both.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"2.5 * y\"");
     let solved =
         contact_scene_file::solve(&parse(&vanishing).unwrap(), &Overrides::default()).unwrap();
+    for &(x0, x1, p) in &solved.profile {
+        assert!((p - 2.5).abs() <= 1e-9, "λ_h = {p} on [{x0}, {x1}]");
+    }
+    // a pressure zero to rounding on the shared edges (cos(πy/2) is 6e-17 at y = 1) is
+    // zero: contact on the top, pushed from the bottom
+    let rounded = both
+        .replace("contact = \"bottom\"", "contact = \"top\"")
+        .replace(
+            "pressure = \"0.5 * (2 + 3)\"",
+            "pressure = \"2.5 * cos(PI * y / 2)\"",
+        )
+        + "\n[parameters]\ncontact_direction = [0.0, 1.0]\n";
+    let solved =
+        contact_scene_file::solve(&parse(&rounded).unwrap(), &Overrides::default()).unwrap();
     for &(x0, x1, p) in &solved.profile {
         assert!((p - 2.5).abs() <= 1e-9, "λ_h = {p} on [{x0}, {x1}]");
     }

@@ -664,6 +664,13 @@ fn data_are_checked_where_they_are_used_and_named_by_field() {
     let file = strip_with(&dir, &mesh, r#""left""#, "1", "1/x - 10");
     let e = refusal(&file);
     assert!(e.contains("field `data.psi`") && e.contains("inf"), "{e}");
+    // data too small to survive the powers of h (Newton stopped at a residual of 5e-3)
+    let file = strip_with(&dir, &mesh, r#""left""#, "1e-320", "0");
+    let e = refusal(&file);
+    assert!(
+        e.contains("field `data.g`") && e.contains("below 1e-200"),
+        "{e}"
+    );
 }
 
 /// `"all"` is a keyword on its own; inside a list it is a name the mesh lacks, and the
@@ -677,6 +684,13 @@ fn all_in_a_list_is_explained() {
         e.contains("boundary.dirichlet") && e.contains(r#"`dirichlet = "all"`"#),
         "{e}"
     );
+    // and on a generated mesh, whose names are checked when the file is read
+    let text = "model = \"membrane\"\n[mesh]\ngenerator = \"square\"\nsize = 8\n[boundary]\ndirichlet = [\"all\"]\n[data]\nf = \"-1\"\npsi = \"-1\"\ng = \"0\"\n";
+    let e = scene_file::parse(text, Path::new("all.toml"))
+        .err()
+        .expect("[\"all\"] was read")
+        .to_string();
+    assert!(e.contains(r#"`dirichlet = "all"`"#), "{e}");
 }
 
 /// A Dirichlet group holding an embedded curve beside boundary curves: nothing is
