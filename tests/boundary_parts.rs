@@ -9,6 +9,8 @@
 //! boundary instead gives another solution (u = 1 ≠ 4 (|x| − ½)₊² on top and bottom),
 //! so a wrong Dirichlet part cannot pass.
 
+#![allow(confusable_idents, mixed_script_confusables, uncommon_codepoints)]
+
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::mesh::gmsh::read_msh;
 use fem_forms::models::data::Data;

@@ -686,10 +686,10 @@ fn all_in_a_list_is_explained() {
     );
     // and on a generated mesh, whose names are checked when the file is read
     let text = "model = \"membrane\"\n[mesh]\ngenerator = \"square\"\nsize = 8\n[boundary]\ndirichlet = [\"all\"]\n[data]\nf = \"-1\"\npsi = \"-1\"\ng = \"0\"\n";
-    let e = scene_file::parse(text, Path::new("all.toml"))
-        .err()
-        .expect("[\"all\"] was read")
-        .to_string();
+    let Err(e) = scene_file::parse(text, Path::new("all.toml")) else {
+        panic!("[\"all\"] was read")
+    };
+    let e = e.to_string();
     assert!(e.contains(r#"`dirichlet = "all"`"#), "{e}");
 }
 

@@ -336,7 +336,7 @@ pub fn refuse_pressure_on_contact(mesh: &TriangleMesh, input: &SignoriniInput) -
         let (p, q) = (v[a], v[b]);
         for x in edge_points(e) {
             let pressure = (input.pressure)(&x);
-            if !(pressure.abs() <= 1e-12 * largest) {
+            if pressure.is_nan() || pressure.abs() > 1e-12 * largest {
                 return Err(Error::Input(format!(
                     "the edge from ({}, {}) to ({}, {}) is both on the contact boundary Γ_C and on the loaded boundary Γ_N, and the pressure there is {pressure:e} at ({}, {}): the stabilization assumes no load on Γ_C (its residual λ + σ_n(u) would be −q n·n_c at the exact solution, and the pressures wrong); take the edge out of one of the two parts, or make the pressure vanish on it",
                     p[0], p[1], q[0], q[1], x[0], x[1]
