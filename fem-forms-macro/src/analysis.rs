@@ -1190,13 +1190,32 @@ impl<'a> Context<'a> {
 
     /// Splits `sλ` into declared names (longest first), if it can be done.
     fn split(&self, name: &str) -> Option<Vec<String>> {
+        self.reading(name, true, &[])
+            .filter(|parts| parts.len() > 1)
+    }
+
+    /// A second way to split `name` into declared names, other than `first`: with
+    /// `params: s, t, st`, `stu` is `st·u` or `s·t·u`, and taking the longest names first
+    /// chose one without a word (a tester's kernel was 33.3 instead of 2).
+    fn other_split(&self, name: &str, first: &[String]) -> Option<Vec<String>> {
+        // shortest first: a reading that differs from the longest-first one, if any
+        self.reading(name, false, first)
+    }
+
+    /// A split of `name` into declared names other than `avoid` (none: any), trying the
+    /// longest or the shortest names first.
+    fn reading(&self, name: &str, longest_first: bool, avoid: &[String]) -> Option<Vec<String>> {
         // the search recurses once per name of the run: bounded, as the nesting is
         if name.len() > MAX_RUN_BYTES {
             return None;
         }
         let mut names = self.symbols.all_names();
         names.retain(|n| !n.is_empty());
-        names.sort_by_key(|n| std::cmp::Reverse(n.len()));
+        if longest_first {
+            names.sort_by_key(|n| std::cmp::Reverse(n.len()));
+        } else {
+            names.sort_by_key(|n| n.len());
+        }
         // `dead[i]`: the rest from byte i has no split. Remembered, so that the search
         // is linear in the run (it was exponential: a tester's 29 a's against the names
         // a, aa, aaa took 12 s to say "unknown symbol").
@@ -1206,71 +1225,31 @@ impl<'a> Context<'a> {
             names: &[&str],
             dead: &mut [bool],
             out: &mut Vec<String>,
+            avoid: &[String],
         ) -> bool {
             if at == name.len() {
-                return true;
+                return avoid.is_empty() || out.as_slice() != avoid;
             }
             if dead[at] {
                 return false;
             }
             for c in names.iter().filter(|n| name[at..].starts_with(**n)) {
                 out.push(c.to_string());
-                if go(name, at + c.len(), names, dead, out) {
+                if go(name, at + c.len(), names, dead, out, avoid) {
                     return true;
                 }
                 out.pop();
             }
-            dead[at] = true;
-            false
-        }
-        let mut dead = vec![false; name.len() + 1];
-        let mut out = Vec::new();
-        (go(name, 0, &names, &mut dead, &mut out) && out.len() > 1).then_some(out)
-    }
-
-    /// A second way to split `name` into declared names, other than `first`: with
-    /// `params: s, t, st`, `stu` is `st·u` or `s·t·u`, and taking the longest names first
-    /// chose one without a word (a tester's kernel was 33.3 instead of 2).
-    fn other_split(&self, name: &str, first: &[String]) -> Option<Vec<String>> {
-        let mut names = self.symbols.all_names();
-        names.retain(|n| !n.is_empty());
-        // shortest first: a reading that differs from the longest-first one, if any
-        names.sort_by_key(|n| n.len());
-        // `dead[i]`: no split of the rest from byte i; remembered, so the search is linear
-        fn go(
-            name: &str,
-            at: usize,
-            names: &[&str],
-            dead: &mut [bool],
-            out: &mut Vec<String>,
-            first: &[String],
-        ) -> bool {
-            if at == name.len() {
-                return out.as_slice() != first;
-            }
-            if dead[at] {
-                return false;
-            }
-            for c in names.iter().filter(|n| name[at..].starts_with(**n)) {
-                out.push(c.to_string());
-                if go(name, at + c.len(), names, dead, out, first) {
-                    return true;
-                }
-                out.pop();
-            }
-            // a prefix of `first` may still be completed differently later: only a rest
-            // that no reading finishes is dead
-            if out.as_slice() != &first[..out.len().min(first.len())] {
+            // while `out` is a prefix of `avoid` the rest may still be completed
+            // differently later: only a rest that no reading finishes is dead
+            if avoid.is_empty() || out.as_slice() != &avoid[..out.len().min(avoid.len())] {
                 dead[at] = true;
             }
             false
         }
-        if name.len() > MAX_RUN_BYTES {
-            return None;
-        }
         let mut dead = vec![false; name.len() + 1];
         let mut out = Vec::new();
-        go(name, 0, &names, &mut dead, &mut out, first).then_some(out)
+        go(name, 0, &names, &mut dead, &mut out, avoid).then_some(out)
     }
 
     /// Expands a scalar expression; a vector or matrix here is an error.
