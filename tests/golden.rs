@@ -1,0 +1,151 @@
+//! Golden data guarding the one-pipeline refactor (issue 31): the JSON report of every
+//! built-in scene (default options and a few others) and of every example scene file,
+//! recorded by the code before the refactor (`tests/golden/*.json`, the commands in
+//! `tests/golden/cases.txt`, one per line, in file order).
+//!
+//! These numbers were produced by the code they guard: they do not show that an answer
+//! is right (the other tests compare with exact solutions and independent references),
+//! only that moving the code changed no number. Every recorded number must still be
+//! reported, under the same key or the one [`RENAMED`] gives, and agree to rounding;
+//! wall times are not compared.
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+/// Keys renamed by the refactor: `(old path, new path)`, paths joined by `.`.
+const RENAMED: &[(&str, &str)] = &[];
+
+/// Quantities that are themselves rounding measurements (residuals, noise estimates):
+/// compared by order of magnitude, since a change of summation order moves them.
+const ROUNDING: &[&str] = &[
+    "complementarity_residual",
+    "kkt_residual",
+    "multiplier_noise",
+    "primal_rounding",
+    "thickness_rounding",
+    "length_rounding",
+    "equilibrium_residual",
+];
+
+fn is_time(key: &str) -> bool {
+    key.contains("seconds") || key.starts_with("phases")
+}
+
+fn lookup<'a>(root: &'a Value, path: &str) -> Option<&'a Value> {
+    path.split('.').try_fold(root, |v, k| v.get(k))
+}
+
+/// The leaves of `value` (arrays count as leaves) with their paths.
+fn leaves<'a>(value: &'a Value, path: String, out: &mut Vec<(String, &'a Value)>) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                leaves(v, p, out);
+            }
+        }
+        _ => out.push((path, value)),
+    }
+}
+
+/// Whether `new` reports `old` to rounding; `leaf` is the key's last part.
+fn agree(old: &Value, new: &Value, leaf: &str) -> bool {
+    match (old, new) {
+        (Value::Array(a), Value::Array(b)) => {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| agree(x, y, leaf))
+        }
+        (Value::Number(a), Value::Number(b)) => {
+            let (x, y) = (a.as_f64().unwrap(), b.as_f64().unwrap());
+            if ROUNDING.contains(&leaf) {
+                (x - y).abs() <= 1e-12
+                    || (x.abs().max(1e-300) / y.abs().max(1e-300)).log10().abs() <= 2.0
+            } else if a.is_u64() && b.is_u64() {
+                x == y
+            } else {
+                (x - y).abs() <= 1e-8 * x.abs().max(y.abs()) + 1e-14
+            }
+        }
+        _ => old == new,
+    }
+}
+
+/// What of `old` `new` lost or changed, one line each.
+fn differences(old: &Value, new: &Value) -> Vec<String> {
+    let mut recorded = Vec::new();
+    leaves(old, String::new(), &mut recorded);
+    let mut faults = Vec::new();
+    for (path, value) in recorded {
+        if is_time(&path) {
+            continue;
+        }
+        let target = RENAMED
+            .iter()
+            .find(|(from, _)| *from == path)
+            .map_or(path.as_str(), |(_, to)| to);
+        let leaf = path.rsplit('.').next().unwrap_or(&path);
+        match lookup(new, target) {
+            None => faults.push(format!("{path}: missing (was {value})")),
+            Some(now) if !agree(value, now, leaf) => {
+                faults.push(format!("{path}: {now}, was {value}"))
+            }
+            Some(_) => {}
+        }
+    }
+    faults
+}
+
+#[test]
+fn every_recorded_report_keeps_its_numbers() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = root.join("tests/golden");
+    let cases = std::fs::read_to_string(dir.join("cases.txt")).unwrap();
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    files.sort();
+    let lines: Vec<&str> = cases.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(files.len(), lines.len(), "one golden file per case");
+    let mut failures = Vec::new();
+    for (line, file) in lines.iter().zip(&files) {
+        let output = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+            .current_dir(root)
+            .arg("solve")
+            .args(line.split_whitespace())
+            .arg("--json")
+            .output()
+            .unwrap();
+        if !output.status.success() {
+            failures.push(format!(
+                "`solve {line}` failed: {}",
+                String::from_utf8_lossy(&output.stderr)
+            ));
+            continue;
+        }
+        let new: Value = serde_json::from_slice(&output.stdout)
+            .unwrap_or_else(|e| panic!("`solve {line} --json`: {e}"));
+        let old: Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
+        let faults = differences(&old, &new);
+        if !faults.is_empty() {
+            failures.push(format!("`solve {line}`:\n    {}", faults.join("\n    ")));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The comparison sees a changed number, a lost key and a renamed one.
+#[test]
+fn the_comparison_can_fail() {
+    let old: Value =
+        serde_json::json!({"energy": 1.0, "levels": [[8, 2]], "seconds": 1.0, "a": {"b": 3.0}});
+    let same: Value = serde_json::json!({"energy": 1.0 + 1e-12, "levels": [[8, 2]], "seconds": 9.0, "a": {"b": 3.0}});
+    assert!(differences(&old, &same).is_empty());
+    let changed: Value = serde_json::json!({"energy": 1.001, "levels": [[8, 3]], "a": {}});
+    assert_eq!(differences(&old, &changed).len(), 3);
+}
