@@ -152,7 +152,9 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     );
 
     /// Adds the element matrices of `block` of bilinear `form` over all cells of `mesh`
-    /// into `values`, entry `(i, j)` of cell `c` at `positions[c·stride + offset + i·cols + j]`.
+    /// into `values`, entry `(i, j)` of cell `c` at `positions[c·stride + offset + i·cols + j]`
+    /// (through the accumulator: parallel assembly gives each thread its own over one
+    /// array).
     #[allow(clippy::too_many_arguments)]
     fn add_element_matrices<G: crate::mesh::Mesh>(
         form: usize,
@@ -163,7 +165,7 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         positions: &[crate::kernel::Position],
         stride: usize,
         offset: usize,
-        values: &mut [f64],
+        values: &mut crate::kernel::Accumulator,
     );
 
     /// Element vector of `block` of linear `form` into `out`.

@@ -577,7 +577,7 @@ fn model_impl(
                 positions: &[#runtime::kernel::Position],
                 stride: usize,
                 offset: usize,
-                values: &mut [f64],
+                values: &mut #runtime::kernel::Accumulator,
             ) {
                 let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
                 let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");

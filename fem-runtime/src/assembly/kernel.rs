@@ -30,6 +30,61 @@ pub fn position(index: usize) -> crate::Result<Position> {
     })
 }
 
+/// The value array that element matrices and vectors are added into, entry by entry.
+///
+/// Safe code makes one from a `&mut [f64]` ([`Accumulator::new`]): it is then the only
+/// access to the array. Parallel assembly gives each thread one over the same array
+/// (`Accumulator::shared`, crate-internal and `unsafe`), where the colouring of the cells
+/// guarantees that no two threads add to one entry: every write goes through the raw
+/// pointer to its own entry, so no two `&mut` to the array (or to one element) exist at
+/// once, as they would if each thread held the whole array as a slice.
+pub struct Accumulator<'a> {
+    start: *mut f64,
+    len: usize,
+    array: std::marker::PhantomData<&'a mut [f64]>,
+}
+
+impl<'a> Accumulator<'a> {
+    /// Adds into `values`, which it borrows exclusively.
+    pub fn new(values: &'a mut [f64]) -> Self {
+        Self {
+            start: values.as_mut_ptr(),
+            len: values.len(),
+            array: std::marker::PhantomData,
+        }
+    }
+
+    /// One of several accumulators over the array of `len` values at `start`.
+    ///
+    /// # Safety
+    /// For `'a` the array must be valid and accessed through accumulators alone, and no
+    /// two of them (on any threads) may add to one entry unless one add happens before
+    /// the other (no data race on any element).
+    pub(crate) unsafe fn shared(start: *mut f64, len: usize) -> Self {
+        Self {
+            start,
+            len,
+            array: std::marker::PhantomData,
+        }
+    }
+
+    /// Adds `value` to entry `index`.
+    ///
+    /// # Panics
+    /// When `index` is out of the array's range, as slice indexing would.
+    #[inline(always)]
+    pub fn add(&mut self, index: usize, value: f64) {
+        assert!(
+            index < self.len,
+            "scatter index {index} beyond {}",
+            self.len
+        );
+        // SAFETY: in range (checked above), and by the construction's contract this
+        // accumulator is the only access to the entry while it adds.
+        unsafe { *self.start.add(index) += value }
+    }
+}
+
 /// Copies an element vector into `out`.
 #[inline(always)]
 pub fn store_vector<const R: usize>(k: &[f64; R], out: &mut [f64]) {
@@ -37,7 +92,7 @@ pub fn store_vector<const R: usize>(k: &[f64; R], out: &mut [f64]) {
 }
 
 /// Adds the element matrices of one block over every cell of `mesh` into `values`: cell
-/// `c`'s entry `(i, j)` goes to `values[positions[c·stride + offset + i·C + j]]`.
+/// `c`'s entry `(i, j)` goes to entry `positions[c·stride + offset + i·C + j]`.
 ///
 /// Generated per block, so the kernel inlines into the cell loop and the block dispatch
 /// happens once per assembly, not once per cell.
@@ -47,7 +102,7 @@ pub fn add_matrices<G: crate::mesh::Mesh, const N: usize, const R: usize, const 
     positions: &[Position],
     stride: usize,
     offset: usize,
-    values: &mut [f64],
+    values: &mut Accumulator,
     kernel: impl Fn(&[f64; N]) -> [[f64; C]; R],
 ) {
     let mut x = [0.0; N];
@@ -56,7 +111,7 @@ pub fn add_matrices<G: crate::mesh::Mesh, const N: usize, const R: usize, const 
         let k = kernel(&x);
         let at = &positions[c * stride + offset..][..R * C];
         for (&p, &v) in at.iter().zip(k.iter().flatten()) {
-            values[p as usize] += v;
+            values.add(p as usize, v);
         }
     }
 }
@@ -75,7 +130,7 @@ pub fn add_matrices_on_cells<
     positions: &[Position],
     stride: usize,
     offset: usize,
-    values: &mut [f64],
+    values: &mut Accumulator,
     kernel: impl Fn(&[f64; N], &[usize; 3]) -> [[f64; C]; R],
 ) {
     let mut x = [0.0; N];
@@ -89,7 +144,7 @@ pub fn add_matrices_on_cells<
         };
         let at = &positions[c * stride + offset..][..R * C];
         for (&p, &v) in at.iter().zip(k.iter().flatten()) {
-            values[p as usize] += v;
+            values.add(p as usize, v);
         }
     }
 }

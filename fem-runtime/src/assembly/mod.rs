@@ -16,7 +16,7 @@ use crate::mesh::Mesh;
 use crate::model::{Coefficients, IntoFormIndex, Model};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
-use kernel::Position;
+use kernel::{Accumulator, Position};
 
 /// One block of a form on a system of DOFs: which fields, the element-matrix size and
 /// the fields' offsets in the system numbering.
@@ -131,7 +131,7 @@ pub(crate) fn add_block_matrices<M: Model, G: Mesh>(
     positions: &[Position],
     stride: usize,
     offset: usize,
-    values: &mut [f64],
+    values: &mut Accumulator,
 ) -> Result<()> {
     let (params, data) = (&coefficients.params, &coefficients.data);
     if !mesh.has_curved_cells() {
@@ -156,7 +156,7 @@ pub(crate) fn add_block_matrices<M: Model, G: Mesh>(
         }
         let at = &positions[c * stride + offset..][..size];
         for (&p, &v) in at.iter().zip(&local) {
-            values[p as usize] += v;
+            values.add(p as usize, v);
         }
     }
     Ok(())
@@ -183,7 +183,7 @@ pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
     mesh: &G,
     coefficients: &Coefficients,
     positions: &[Position],
-    values: &mut [f64],
+    values: &mut Accumulator,
 ) -> Result<()> {
     let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
     if plans.len() < CELL_MAJOR_MIN_BLOCKS {
@@ -232,7 +232,7 @@ pub(crate) fn add_form_matrices<M: Model, G: Mesh>(
                 M::element_matrix(form, plan.block, x, params, data, out);
             }
             for (&p, &v) in cell[offset..offset + size].iter().zip(out.iter()) {
-                values[p as usize] += v;
+                values.add(p as usize, v);
             }
             offset += size;
         }
@@ -385,28 +385,35 @@ impl<G: Mesh> Mesh for CellRange<'_, G> {
 }
 
 /// A value array shared by the threads of one colour, each adding into entries no
-/// other thread of that colour touches.
+/// other thread of that colour touches, through an [`Accumulator`] of its own.
 #[derive(Clone, Copy)]
 struct SharedValues {
     start: *mut f64,
     len: usize,
 }
 
-// SAFETY: only used in `add_form_matrices_coloured`, where the threads of one colour
-// write disjoint entries (the colouring's invariant) and the colours run one after the
-// other (each colour's parallel loop joins before the next starts).
+// SAFETY: the pointer is only turned into accumulators (`SharedValues::accumulator`),
+// whose contract the callers keep; sending or sharing the address itself is harmless.
 unsafe impl Send for SharedValues {}
 unsafe impl Sync for SharedValues {}
 
 impl SharedValues {
-    /// The whole array.
+    fn of(values: &mut [f64]) -> Self {
+        Self {
+            start: values.as_mut_ptr(),
+            len: values.len(),
+        }
+    }
+
+    /// An accumulator over the whole array for one thread.
     ///
     /// # Safety
-    /// No two threads may access one element at the same time (see
+    /// The array must outlive the accumulator and be accessed through accumulators alone
+    /// meanwhile, and no two threads may add to one entry concurrently (see
     /// `add_form_matrices_coloured`).
-    #[allow(clippy::mut_from_ref)]
-    unsafe fn values(&self) -> &mut [f64] {
-        unsafe { std::slice::from_raw_parts_mut(self.start, self.len) }
+    unsafe fn accumulator<'a>(&self) -> Accumulator<'a> {
+        // SAFETY: the caller's contract is the accumulator's.
+        unsafe { Accumulator::shared(self.start, self.len) }
     }
 }
 
@@ -436,13 +443,19 @@ pub(crate) fn add_form_matrices_coloured<M: Model, G: Mesh>(
     let colouring = match colouring {
         // in colour order on one thread too: the same sums as on two, to the last bit
         Some(c) if c.bounds.last() == Some(&mesh.cell_count()) => c,
-        _ => return add_form_matrices::<M, G>(form, plans, mesh, coefficients, positions, values),
+        _ => {
+            return add_form_matrices::<M, G>(
+                form,
+                plans,
+                mesh,
+                coefficients,
+                positions,
+                &mut Accumulator::new(values),
+            )
+        }
     };
     let stride: usize = plans.iter().map(|p| p.rows * p.cols).sum();
-    let shared = SharedValues {
-        start: values.as_mut_ptr(),
-        len: values.len(),
-    };
+    let shared = SharedValues::of(values);
     for colour in 0..colouring.colour_count() {
         let ranges: Vec<_> = colouring.ranges(colour).collect();
         ranges.into_par_iter().try_for_each(|range| {
@@ -452,12 +465,12 @@ pub(crate) fn add_form_matrices_coloured<M: Model, G: Mesh>(
                 count: range.len(),
             };
             let at = &positions[range.start * stride..range.end * stride];
-            // SAFETY: `shared` is `values`, borrowed mutably for this whole call; the
-            // chunks of this colour share no vertex, hence (see above) no entry of
-            // `values`: no two threads access one element, and the loop joins before
-            // the next colour starts.
-            let out = unsafe { shared.values() };
-            add_form_matrices::<M, _>(form, plans, &part, coefficients, at, out)
+            // SAFETY: `shared` is `values`, borrowed mutably for this whole call and
+            // touched by accumulators alone; the chunks of this colour share no vertex,
+            // hence (see above) no entry of `values`: no two threads add to one element,
+            // and the loop joins before the next colour starts.
+            let mut out = unsafe { shared.accumulator() };
+            add_form_matrices::<M, _>(form, plans, &part, coefficients, at, &mut out)
         })?;
     }
     Ok(())
@@ -717,19 +730,17 @@ pub fn assemble_vector<M: Model>(
     let mut out = vec![0.0; dofs.dof_count()];
     let cells = mesh.cell_count();
     if let Some(colouring) = CellColouring::new(mesh) {
-        let shared = SharedValues {
-            start: out.as_mut_ptr(),
-            len: out.len(),
-        };
+        let shared = SharedValues::of(&mut out);
         let mut failed = false;
         for colour in 0..colouring.colour_count() {
             let ranges: Vec<_> = colouring.ranges(colour).collect();
-            // SAFETY: as in `add_form_matrices_coloured`: the chunks of one colour share
-            // no vertex, hence no DOF, hence no entry of `out`; colours run in sequence.
             let result = ranges.into_par_iter().try_for_each(|range| {
-                add_vectors::<M, _>(form, &plans, mesh, dofs, coefficients, range, unsafe {
-                    shared.values()
-                })
+                // SAFETY: as in `add_form_matrices_coloured`: `out` is touched by
+                // accumulators alone until the loop ends, the chunks of one colour share
+                // no vertex, hence no DOF, hence no entry of `out`; colours run in
+                // sequence.
+                let mut sink = unsafe { shared.accumulator() };
+                add_vectors::<M, _>(form, &plans, mesh, dofs, coefficients, range, &mut sink)
             });
             if result.is_err() {
                 failed = true;
@@ -741,7 +752,15 @@ pub fn assemble_vector<M: Model>(
         }
         out.fill(0.0);
     }
-    add_vectors::<M, _>(form, &plans, mesh, dofs, coefficients, 0..cells, &mut out)?;
+    add_vectors::<M, _>(
+        form,
+        &plans,
+        mesh,
+        dofs,
+        coefficients,
+        0..cells,
+        &mut Accumulator::new(&mut out),
+    )?;
     Ok(out)
 }
 
@@ -758,7 +777,7 @@ fn add_vectors<M: Model, G: Mesh>(
     dofs: &SystemDofs,
     coefficients: &Coefficients,
     cells: std::ops::Range<usize>,
-    out: &mut [f64],
+    out: &mut Accumulator,
 ) -> Result<()> {
     let mut local = [0.0; 64];
     let mut local_vec;
@@ -797,7 +816,7 @@ fn add_vectors<M: Model, G: Mesh>(
             }
             let rows = map.cell_dofs(c);
             for (&r, &v) in rows.iter().zip(&local[..plan.rows]) {
-                out[r + plan.row_offset] += v;
+                out.add(r + plan.row_offset, v);
             }
             if local[..plan.rows].iter().any(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {

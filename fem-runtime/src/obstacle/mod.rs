@@ -243,7 +243,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             mesh,
             coefficients,
             &split.positions,
-            &mut values,
+            &mut crate::kernel::Accumulator::new(&mut values),
         )?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
             let entry = split
