@@ -528,8 +528,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     let coefficients = setup.coefficients::<M>()?;
     let clamped = setup.clamped;
     let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
-    let inverse_constant =
-        stabilization::inverse_constant::<M, _>(&mesh, &coefficients.params, "S", "a")?;
+    let inverse_constant = stabilization::inverse_constant::<M, _>(&mesh, &coefficients.params)?;
     let options = ObstacleOptions {
         solver: request.solver,
         nested_from: request.nested_from,

@@ -296,7 +296,7 @@ impl KirchhoffRequest {
         let s = &self.scene;
         let params = [s.bending_stiffness, s.poisson_ratio, 1.0, SIDE];
         let shapes = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 1, 1, Diagonal::Right)?;
-        let c_i = inverse_constant::<M, _>(&shapes, &params, "S", "a")?;
+        let c_i = inverse_constant::<M, _>(&shapes, &params)?;
         let alpha = match (self.alpha, c_i > 0.0) {
             (Some(alpha), _) => alpha,
             (None, true) => ALPHA_FRACTION / c_i,

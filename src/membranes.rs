@@ -453,12 +453,12 @@ pub fn scene_mesh(scene: &MembraneScene, n: usize, diagonal: Diagonal) -> Result
 /// [`fem_runtime::stabilization::element_inverse_constant`]). 0 when Δ vanishes on the
 /// element.
 pub fn element_inverse_constant<M: Model>(x: &[f64; 6]) -> Result<f64> {
-    stabilization::element_inverse_constant::<M>(x, &vec![0.0; M::PARAMS.len()], "S", "a")
+    stabilization::element_inverse_constant::<M>(x, &vec![0.0; M::PARAMS.len()])
 }
 
 /// `max_T C_I(T)` over a mesh (shapes repeated by translation are computed once).
 pub fn inverse_constant<M: Model>(mesh: &TriangleMesh) -> Result<f64> {
-    stabilization::inverse_constant::<M, _>(mesh, &vec![0.0; M::PARAMS.len()], "S", "a")
+    stabilization::inverse_constant::<M, _>(mesh, &vec![0.0; M::PARAMS.len()])
 }
 
 /// The data a solve uses: the load f (the scene's load field times q), the obstacle ψ

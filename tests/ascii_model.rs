@@ -1,6 +1,7 @@
 //! A model written in ASCII only, used through the library as the crate docs say: its
 //! load form `l` serves `energy` (a tester's all-ASCII model was told it "has no form
-//! ℓ"), and `stabilization::inverse_constant` takes form handles as well as names.
+//! ℓ"), and its roles (system, energy, stabilization) are found by their conventional
+//! names: `stabilization::inverse_constant` needs no form named at run time.
 
 use fem_runtime::obstacle::{solve_obstacle, ObstacleOptions};
 use fem_runtime::{stabilization, Coefficients, IntervalMesh};
@@ -34,21 +35,42 @@ fn an_ascii_model_has_its_energy_and_its_inverse_constant_by_handle() {
     let obstacle = |_: &[f64]| -1.0;
     let data: [(&str, &fem_runtime::DataFn); 2] = [("f", &load), ("psi", &obstacle)];
     let c = Coefficients::new::<ascii_string::Model>(&[("alpha", 0.1), ("s", 1.0)], &data).unwrap();
-    let by_name =
-        stabilization::inverse_constant::<ascii_string::Model, _>(&mesh, &c.params, "S", "a")
-            .unwrap();
-    let by_handle = stabilization::inverse_constant::<ascii_string::Model, _>(
+    use fem_runtime::Model;
+    let role = ascii_string::Model::STABILIZATION.unwrap();
+    assert_eq!(
+        (role.form, role.against, role.alpha),
+        (
+            ascii_string::Model::form(ascii_string::forms::S).unwrap(),
+            ascii_string::Model::form(ascii_string::forms::a).unwrap(),
+            Some(ascii_string::Model::param(ascii_string::params::alpha).unwrap())
+        )
+    );
+    assert_eq!(
+        ascii_string::Model::ENERGY,
+        Some([
+            ascii_string::Model::form(ascii_string::forms::a).unwrap(),
+            ascii_string::Model::form(ascii_string::forms::l).unwrap()
+        ])
+    );
+    let by_role =
+        stabilization::inverse_constant::<ascii_string::Model, _>(&mesh, &c.params).unwrap();
+    let by_handle = stabilization::inverse_constant_between::<ascii_string::Model, _>(
         &mesh,
         &c.params,
         ascii_string::forms::S,
         ascii_string::forms::a,
     )
     .unwrap();
-    assert_eq!(by_name, by_handle);
+    assert_eq!(by_role, by_handle);
     // a linear form has no C_I against anything (it returned 0 before)
-    let e = stabilization::inverse_constant::<ascii_string::Model, _>(&mesh, &c.params, "S", "l")
-        .unwrap_err()
-        .to_string();
+    let e = stabilization::inverse_constant_between::<ascii_string::Model, _>(
+        &mesh,
+        &c.params,
+        ascii_string::forms::S,
+        ascii_string::forms::l,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("`l`") && e.contains("linear"), "{e}");
     let solution =
         solve_obstacle::<ascii_string::Model>(&mesh, &c, &["u"], ObstacleOptions::default())
@@ -89,9 +111,7 @@ fn an_alpha_beyond_the_stability_range_is_named_when_newton_fails() {
     let data: [(&str, &fem_runtime::DataFn); 2] = [("f", &load), ("psi", &obstacle)];
     let params = [("alpha", 1e6), ("s", 1.0), ("k", 1.0)];
     let c = Coefficients::new::<ascii_winkler::Model>(&params, &data).unwrap();
-    let c_i =
-        stabilization::inverse_constant::<ascii_winkler::Model, _>(&mesh, &c.params, "S", "a")
-            .unwrap();
+    let c_i = stabilization::inverse_constant::<ascii_winkler::Model, _>(&mesh, &c.params).unwrap();
     assert!(1e6 * c_i > 100.0, "α·C_I = {}", 1e6 * c_i);
     let Err(e) =
         solve_obstacle::<ascii_winkler::Model>(&mesh, &c, &["u"], ObstacleOptions::default())

@@ -80,8 +80,6 @@ impl Problem {
         let c_i = stabilization::inverse_constant::<winkler_string::Model, _>(
             &mesh,
             &coefficients.params,
-            "S",
-            "a",
         )?;
         if self.alpha * c_i >= 1.0 {
             return Err(fem_runtime::Error::Input(format!(

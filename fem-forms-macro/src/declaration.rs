@@ -10,6 +10,13 @@
 //!     boundary: w = g;         // optional: Dirichlet data, a declared data function
 //!     facets:   Γ_C;           // optional (triangles): boundary parts for `∫_Γ_C … ds`
 //!     forms:    "…";
+//!     // the roles of forms and parameters in the obstacle problem (optional: where a
+//!     // section is left out, the names below are taken where the model has them)
+//!     system:        B_h, L_h;     // the stabilized system the solvers assemble
+//!     energy:        a, ℓ;         // J(u) = ½ a(u,u) − ℓ(u)
+//!     stabilization: α S against a; // α's parameter, S_h, and the form C_I bounds it by
+//!     side:          s;            // the parameter holding the obstacle side s = ±1
+//!     obstacle:      w >= ψ;       // the constrained field and the obstacle: s·w ≥ s·ψ
 //! }
 //! ```
 //!
@@ -72,6 +79,34 @@ pub struct DataDecl {
     pub degree: usize,
 }
 
+/// `stabilization: α S against a;`: the parameter α of `B_h = … − α S`, the
+/// stabilization form `S` and the form `a` that `C_I` measures it against.
+#[derive(Clone, Debug)]
+pub struct StabilizationDecl {
+    /// The parameter α (absent in `stabilization: S against a`).
+    pub alpha: Option<Ident>,
+    /// The stabilization form.
+    pub form: Ident,
+    /// The form it is bounded by (`S_T(v, v) ≤ C_I a_T(v, v)`).
+    pub against: Ident,
+}
+
+/// The roles the model declares for its forms and parameters (each `None` where its
+/// section is left out).
+#[derive(Clone, Debug, Default)]
+pub struct RolesDecl {
+    /// `system: B_h, L_h;`
+    pub system: Option<(Ident, Ident)>,
+    /// `energy: a, ℓ;`
+    pub energy: Option<(Ident, Ident)>,
+    /// `stabilization: α S against a;`
+    pub stabilization: Option<StabilizationDecl>,
+    /// `side: s;`
+    pub side: Option<Ident>,
+    /// `obstacle: w >= ψ;`: the constrained field and the obstacle's data function.
+    pub obstacle: Option<(Ident, Ident)>,
+}
+
 /// Everything the macro input declares.
 #[derive(Clone)]
 pub struct Declaration {
@@ -103,8 +138,36 @@ pub struct Declaration {
     pub facets: Vec<Ident>,
     /// The forms text.
     pub forms: LitStr,
+    /// The roles of forms and parameters.
+    pub roles: RolesDecl,
     /// Span of the section list, for "missing section" errors.
     pub body_span: Span,
+}
+
+/// The sections a model may have.
+const SECTIONS: [&str; 12] = [
+    "unknowns",
+    "tests",
+    "params",
+    "data",
+    "boundary",
+    "facets",
+    "forms",
+    "system",
+    "energy",
+    "stabilization",
+    "side",
+    "obstacle",
+];
+
+/// Two names separated by a comma (`B_h, L_h`); `example` for the error.
+fn name_pair(input: ParseStream, example: &str) -> syn::Result<(Ident, Ident)> {
+    let first: Ident = input.parse()?;
+    input.parse::<Token![,]>().map_err(|e| {
+        syn::Error::new(e.span(), format!("expected two names, as in `{example};`"))
+    })?;
+    let second: Ident = input.parse()?;
+    Ok((first, second))
 }
 
 fn comma_list<T>(
@@ -179,6 +242,7 @@ impl Parse for Declaration {
             dirichlet: Vec::new(),
             facets: Vec::new(),
             forms: LitStr::new("", brace.span.join()),
+            roles: RolesDecl::default(),
             body_span: brace.span.join(),
         };
         let mut seen: Vec<Ident> = Vec::new();
@@ -316,16 +380,55 @@ impl Parse for Declaration {
                     declaration.forms = content.parse()?;
                     have_forms = true;
                 }
+                "system" => {
+                    declaration.roles.system = Some(name_pair(&content, "system: B_h, L_h")?)
+                }
+                "energy" => declaration.roles.energy = Some(name_pair(&content, "energy: a, ℓ")?),
+                "stabilization" => {
+                    // `α S against a` or `S against a`
+                    let first: Ident = content.parse()?;
+                    let second: Ident = content.parse().map_err(|e| {
+                        syn::Error::new(e.span(), "expected `stabilization: α S against a;` (the parameter, the stabilization form, `against` and the form it is bounded by)")
+                    })?;
+                    let (alpha, form) = if second == "against" {
+                        (None, first)
+                    } else {
+                        let word: Ident = content.parse()?;
+                        if word != "against" {
+                            return Err(syn::Error::new(
+                                word.span(),
+                                format!("expected `against`, as in `stabilization: {first} {second} against a;`"),
+                            ));
+                        }
+                        (Some(first), second)
+                    };
+                    let against: Ident = content.parse()?;
+                    declaration.roles.stabilization = Some(StabilizationDecl {
+                        alpha,
+                        form,
+                        against,
+                    });
+                }
+                "side" => declaration.roles.side = Some(content.parse()?),
+                "obstacle" => {
+                    let field: Ident = content.parse()?;
+                    content.parse::<Token![>=]>().map_err(|e| {
+                        syn::Error::new(e.span(), format!("expected `obstacle: {field} >= ψ;` (the constrained field, `>=`, the obstacle's data function; `side:` turns it into s·{field} ≥ s·ψ)"))
+                    })?;
+                    let data: Ident = content.parse()?;
+                    declaration.roles.obstacle = Some((field, data));
+                }
                 other => {
-                    let sections = [
-                        "unknowns", "tests", "params", "data", "boundary", "facets", "forms",
-                    ];
+                    let sections = SECTIONS;
                     let hint = closest(other, sections)
                         .map(|s| format!("; did you mean `{s}`?"))
                         .unwrap_or_default();
                     return Err(syn::Error::new(
                         key.span(),
-                        format!("unknown section `{other}`: expected one of unknowns, tests, params, data, boundary, facets, forms{hint}"),
+                        format!(
+                            "unknown section `{other}`: expected one of {}{hint}",
+                            SECTIONS.join(", ")
+                        ),
                     ));
                 }
             }

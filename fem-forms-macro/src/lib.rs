@@ -195,6 +195,7 @@ mod declaration;
 mod diagnostic;
 mod lexer;
 mod parser;
+mod roles;
 mod symbolic;
 
 use analysis::{Field, Symbols, Vector};
@@ -232,7 +233,15 @@ fn expand(input: TokenStream) -> TokenStream {
     }
     // Named expressions (`Cε(θ) := …`) were substituted where called: no code of their own.
     let forms: Vec<_> = forms.into_iter().filter(|f| f.value.is_none()).collect();
-    let code = codegen::generate(&declaration, &symbols, &forms);
+    let (roles, role_errors) = roles::resolve(&declaration, &symbols, &forms);
+    if !role_errors.is_empty() {
+        let span = declaration.forms.span();
+        return role_errors
+            .iter()
+            .map(|e| e.to_compile_error(&text, span))
+            .collect();
+    }
+    let code = codegen::generate(&declaration, &symbols, &forms, &roles);
     if let Ok(dir) = std::env::var("FEM_FORMS_DUMP_DIR") {
         dump(&dir, &declaration.name.to_string(), &code);
     }

@@ -113,6 +113,18 @@ pub struct FormInfo {
     pub blocks: &'static [BlockInfo],
 }
 
+/// The stabilization's role in a model ([`Model::STABILIZATION`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StabilizationRole {
+    /// Index in `PARAMS` of α (`None` for `stabilization: S against a`, a model that
+    /// leaves α to its forms).
+    pub alpha: Option<usize>,
+    /// Index in `FORMS` of the stabilization form `S`.
+    pub form: usize,
+    /// Index in `FORMS` of the bilinear form `a` that `C_I` measures `S` against.
+    pub against: usize,
+}
+
 /// A model compiled by `model!`.
 pub trait Model: Copy + Default + Send + Sync + 'static {
     /// Module name of the model.
@@ -131,11 +143,30 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     const FORMS: &'static [FormInfo];
     /// Dirichlet conditions `(field, data function)` declared under `boundary:`.
     const DIRICHLET: &'static [(usize, usize)] = &[];
-    /// The discrete obstacle system `[B_h, L_h]` as indices in `FORMS`: the bilinear form
-    /// named `B_h` and the linear form named `L_h`, the names the form language gives the
-    /// stabilized system (docs/mathematics.md §1); `None` for a model without them.
+    /// The discrete obstacle system `[B_h, L_h]` as indices in `FORMS`: the forms the
+    /// model declares under `system:`, or else the bilinear form named `B_h` and the
+    /// linear form named `L_h` (docs/mathematics.md §1); `None` for a model without them.
     /// Found at compile time, so the solvers need no name at run time.
     const SYSTEM: Option<[usize; 2]> = system_forms(Self::FORMS);
+    /// The energy `J(u) = ½ a(u,u) − ℓ(u)` as `[a, ℓ]` (indices in `FORMS`): the forms
+    /// declared under `energy:`, or else `a` and `ℓ` (`l`, `ell`) where the model has
+    /// them; `None` otherwise.
+    const ENERGY: Option<[usize; 2]> = None;
+    /// The stabilization: the parameter α of `B_h = … − α S`, the form `S` and the form
+    /// `a` that bounds it, `S_T(v, v) ≤ C_I a_T(v, v)` on the primal functions of a cell
+    /// ([`crate::stabilization`]); declared under `stabilization: α S against a`, or else
+    /// taken from those names where the model has them; `None` otherwise.
+    const STABILIZATION: Option<StabilizationRole> = None;
+    /// Index in `PARAMS` of the obstacle side `s` (`s·Bv ≥ s·ψ`, +1 below, −1 above):
+    /// declared under `side:`, or else the parameter named `s`; `None` for a model whose
+    /// obstacle is always below.
+    const SIDE: Option<usize> = None;
+    /// `[field, data]`: the constrained field `w` and the obstacle `ψ` (indices in
+    /// `FIELDS` and `DATA`) of `s·w ≥ s·ψ`, declared under `obstacle: w >= ψ`, or else a
+    /// field `u` or `w` and data `ψ` (`psi`) of a model with a multiplier; `None` where
+    /// the constraint is not of this form (Signorini's `u·n_c ≤ g` on a boundary part).
+    /// The reports measure penetration and open gaps pointwise with it.
+    const OBSTACLE: Option<[usize; 2]> = None;
     /// Indices in `PARAMS` of the parameters declared `> 0` (`params: β > 0`): the
     /// forms may divide by sums that are positive only for positive values of them, so
     /// [`Coefficients`] refuses other values.
@@ -318,6 +349,15 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
             "model `{}` has no boundary integrals (`facets:`)",
             Self::NAME
         )))
+    }
+
+    /// Index in `FACET_PARTS` of a boundary part the forms integrate over: its handle
+    /// (`model::facets::Γ_C`) or its name (`"Γ_C"`).
+    ///
+    /// # Errors
+    /// [`Error::UnknownName`] for a name the model does not declare under `facets:`.
+    fn facet_part(part: impl IntoPartIndex<Self>) -> Result<usize> {
+        part.part_index()
     }
 
     /// Index in `FORMS` of a form: its handle (`model::forms::B_h`) or its name (`"B_h"`).
@@ -532,6 +572,15 @@ handle!(
     |name| M::DATA.iter().position(|p| *p == name),
     M::DATA.iter().copied(),
     M::DATA.len()
+);
+
+handle!(
+    /// Typed handle of a boundary part of model `M` (declared under `facets:`), e.g.
+    /// `signorini_p1::facets::Γ_C`.
+    PartId, IntoPartIndex, part_index, "boundary part",
+    |name| M::FACET_PARTS.iter().position(|p| *p == name),
+    M::FACET_PARTS.iter().copied(),
+    M::FACET_PARTS.len()
 );
 
 fn unknown<M: Model>(

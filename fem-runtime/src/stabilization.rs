@@ -12,7 +12,7 @@
 //! (Δ vanishes on each cell), as for the beam pairs whose `θ'''` or `w''''` vanishes.
 
 use crate::mesh::Mesh;
-use crate::model::IntoFormIndex;
+use crate::model::{FormId, IntoFormIndex, StabilizationRole};
 use crate::{DataFn, Error, Model, Result};
 use nalgebra::{DMatrix, SymmetricEigen};
 
@@ -75,11 +75,10 @@ impl Alpha {
 /// the sum of its blocks between primal fields, on the primal fields' local DOFs in field
 /// order. `None` when the form has no such block.
 fn primal_matrix<M: Model>(
-    form: &str,
+    f: usize,
     vertices: &[f64],
     params: &[f64],
 ) -> Result<Option<DMatrix<f64>>> {
-    let f = M::form(form)?;
     let primal: Vec<usize> = (0..M::FIELDS.len())
         .filter(|&k| !M::FIELDS[k].nonnegative)
         .collect();
@@ -120,23 +119,47 @@ fn primal_matrix<M: Model>(
     Ok(any.then_some(matrix))
 }
 
+/// The model's stabilization role ([`Model::STABILIZATION`]).
+///
+/// # Errors
+/// [`Error::Input`] for a model that declares none.
+pub fn role<M: Model>() -> Result<StabilizationRole> {
+    M::STABILIZATION.ok_or_else(|| {
+        Error::Input(format!(
+            "model `{}` declares no stabilization (`stabilization: α S against a;`), so no C_I or α can be derived for it",
+            M::NAME
+        ))
+    })
+}
+
 /// `C_I(T) = max S_T(v, v) / a_T(v, v)` over the primal functions v of one cell (μ = 0),
-/// from the model's forms named `stabilization` (its `S`) and `bilinear` (its `a`),
-/// with the model's parameters `params` in declaration order (e.g. the beam's t and s).
-/// `vertices` are the cell's coordinates as the kernels take them (`x₀ x₁` on
-/// intervals, `x₀ y₀ x₁ y₁ x₂ y₂` on triangles). 0 when `S` has no primal block.
+/// for the model's stabilization `S` against the form `a` it declares
+/// ([`Model::STABILIZATION`]), with the model's parameters `params` in declaration
+/// order (e.g. the beam's t and s). `vertices` are the cell's coordinates as the kernels
+/// take them (`x₀ x₁` on intervals, `x₀ y₀ x₁ y₁ x₂ y₂` on triangles). 0 when `S` has no
+/// primal block.
 ///
 /// The maximum is taken on the complement of the kernel of `a_T` (constants for the
 /// membrane, rigid motions for beams), found from the eigenvalues of `a_T`.
 ///
 /// # Errors
-/// Unknown form names; `S_T` not vanishing on the kernel of `a_T` (then no `C_I`
-/// exists: the stabilization is not bounded by `a`).
-pub fn element_inverse_constant<M: Model>(
+/// A model without a stabilization role; `S_T` not vanishing on the kernel of `a_T`
+/// (then no `C_I` exists: the stabilization is not bounded by `a`).
+pub fn element_inverse_constant<M: Model>(vertices: &[f64], params: &[f64]) -> Result<f64> {
+    let role = role::<M>()?;
+    element_inverse_constant_between::<M>(vertices, params, role.form, role.against)
+}
+
+/// [`element_inverse_constant`] of the bilinear forms `stabilization` and `bilinear`
+/// (indices in `FORMS`) in place of the model's declared ones.
+///
+/// # Errors
+/// As [`element_inverse_constant`].
+pub fn element_inverse_constant_between<M: Model>(
     vertices: &[f64],
     params: &[f64],
-    stabilization: &str,
-    bilinear: &str,
+    stabilization: usize,
+    bilinear: usize,
 ) -> Result<f64> {
     let (Some(s), Some(a)) = (
         primal_matrix::<M>(stabilization, vertices, params)?,
@@ -185,8 +208,10 @@ pub fn element_inverse_constant<M: Model>(
             let sv = (&s * v).norm();
             if sv > 1e-8 * s_scale {
                 return Err(Error::Input(format!(
-                    "`{stabilization}` of {} does not vanish on the kernel of `{bilinear}` (a function with a_T(v, v) = 0 has S_T(v, v) ≠ 0): no inverse constant bounds it",
-                    M::NAME
+                    "`{}` of {} does not vanish on the kernel of `{}` (a function with a_T(v, v) = 0 has S_T(v, v) ≠ 0): no inverse constant bounds it",
+                    M::FORMS[stabilization].name,
+                    M::NAME,
+                    M::FORMS[bilinear].name
                 )));
             }
         }
@@ -203,20 +228,35 @@ pub fn element_inverse_constant<M: Model>(
         .fold(0.0, f64::max))
 }
 
-/// `max_T C_I(T)` over the cells of `mesh` (see [`element_inverse_constant`]). Cells
-/// that are translates of one another at the same size are computed once (the first
-/// 64 distinct shapes are remembered: structured meshes have one or two).
+/// `max_T C_I(T)` over the cells of `mesh` (see [`element_inverse_constant`]) for the
+/// model's declared stabilization. Cells that are translates of one another at the same
+/// size are computed once (the first 64 distinct shapes are remembered: structured
+/// meshes have one or two).
+///
+/// # Errors
+/// Those of [`element_inverse_constant`].
+pub fn inverse_constant<M: Model, G: Mesh>(mesh: &G, params: &[f64]) -> Result<f64> {
+    let role = role::<M>()?;
+    inverse_constant_between::<M, G>(
+        mesh,
+        params,
+        FormId::new(role.form),
+        FormId::new(role.against),
+    )
+}
+
+/// [`inverse_constant`] of two bilinear forms given by handle (`NAME::forms::S`) in
+/// place of the model's declared ones.
 ///
 /// # Errors
 /// [`Error::Input`] for a form that is not bilinear; those of
 /// [`element_inverse_constant`].
-pub fn inverse_constant<M: Model, G: Mesh>(
+pub fn inverse_constant_between<M: Model, G: Mesh>(
     mesh: &G,
     params: &[f64],
     stabilization: impl IntoFormIndex<M>,
     bilinear: impl IntoFormIndex<M>,
 ) -> Result<f64> {
-    // by handle (`NAME::forms::S`) or by name (`"S"`), as the crate docs promise
     let (s, a) = (M::form(stabilization)?, M::form(bilinear)?);
     for f in [s, a] {
         if M::FORMS[f].arity != 2 {
@@ -227,7 +267,6 @@ pub fn inverse_constant<M: Model, G: Mesh>(
             )));
         }
     }
-    let (stabilization, bilinear) = (M::FORMS[s].name, M::FORMS[a].name);
     let width = match G::CELL {
         crate::CellKind::Interval => 2,
         crate::CellKind::Triangle => 6,
@@ -252,12 +291,7 @@ pub fn inverse_constant<M: Model, G: Mesh>(
         if seen.len() < 64 {
             seen.push(key);
         }
-        largest = largest.max(element_inverse_constant::<M>(
-            &x,
-            params,
-            stabilization,
-            bilinear,
-        )?);
+        largest = largest.max(element_inverse_constant_between::<M>(&x, params, s, a)?);
     }
     Ok(largest)
 }
@@ -322,12 +356,12 @@ mod tests {
             ([0.0, 0.0, s3, 0.0, 0.5 * s3, 0.5], 240.0),
         ];
         for (x, expected) in cases {
-            let c = element_inverse_constant::<membrane_p2::Model>(&x, &[], "S", "a").unwrap();
+            let c = element_inverse_constant::<membrane_p2::Model>(&x, &[]).unwrap();
             assert!((c - expected).abs() < 1e-8 * expected, "{c} vs {expected}");
             let moved = x.map(|v| 3.7 * v + 1.0);
-            let d = element_inverse_constant::<membrane_p2::Model>(&moved, &[], "S", "a").unwrap();
+            let d = element_inverse_constant::<membrane_p2::Model>(&moved, &[]).unwrap();
             assert!((c - d).abs() < 1e-8 * c, "{c} vs {d}");
-            let p1 = element_inverse_constant::<membrane_p1::Model>(&x, &[], "S", "a").unwrap();
+            let p1 = element_inverse_constant::<membrane_p1::Model>(&x, &[]).unwrap();
             assert_eq!(p1, 0.0);
         }
     }
@@ -337,11 +371,11 @@ mod tests {
     #[test]
     fn interval_constant_matches_its_closed_form() {
         for x in [[0.0, 1.0], [2.0, 2.25]] {
-            let c = element_inverse_constant::<interval_p2::Model>(&x, &[], "S", "a").unwrap();
+            let c = element_inverse_constant::<interval_p2::Model>(&x, &[]).unwrap();
             assert!((c - 12.0).abs() < 1e-9, "{c}");
         }
         let mesh = crate::IntervalMesh::uniform(0.0, 1.0, 7).unwrap();
-        let c = inverse_constant::<interval_p2::Model, _>(&mesh, &[], "S", "a").unwrap();
+        let c = inverse_constant::<interval_p2::Model, _>(&mesh, &[]).unwrap();
         assert!((c - 12.0).abs() < 1e-9, "{c}");
     }
 
@@ -351,7 +385,7 @@ mod tests {
         let mesh =
             crate::TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 4, 4, crate::Diagonal::Right)
                 .unwrap();
-        let c = inverse_constant::<membrane_p2::Model, _>(&mesh, &[], "S", "a").unwrap();
+        let c = inverse_constant::<membrane_p2::Model, _>(&mesh, &[]).unwrap();
         assert!((c - 96.0).abs() < 1e-8 * 96.0, "{c}");
     }
 

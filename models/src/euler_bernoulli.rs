@@ -21,5 +21,10 @@ fem_runtime::model! {
             B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
             L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
         ";
+        system:        B_h, L_h;
+        energy:        a, ℓ;
+        stabilization: α S against a;
+        side:          s;
+        obstacle:      w >= ψ;
     }
 }

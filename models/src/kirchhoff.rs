@@ -19,6 +19,7 @@ macro_rules! kirchhoff_model {
                     a(w;v) = ∫ D[(1−ν) ∇∇w:∇∇v + ν Δw Δv]
                     ℓ(v)   = ∫ f v
                 ";
+                energy: a, ℓ;
             }
         }
     };
@@ -64,6 +65,11 @@ macro_rules! kirchhoff_obstacle_model {
                     B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
                     L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
                 ";
+                system:        B_h, L_h;
+                energy:        a, ℓ;
+                stabilization: α S against a;
+                side:          s;
+                obstacle:      w >= ψ;
             }
         }
     };

@@ -27,6 +27,10 @@ macro_rules! membrane_model {
                     B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
                     L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
                 ";
+                system:        B_h, L_h;
+                energy:        a, ℓ;
+                stabilization: α S against a;
+                obstacle:      u >= ψ;
             }
         }
     };
@@ -59,5 +63,6 @@ fem_runtime::model! {
             a(u;v) = ∫ ∇u·∇v
             ℓ(v)   = ∫ f v
         ";
+        energy: a, ℓ;
     }
 }

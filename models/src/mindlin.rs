@@ -41,6 +41,11 @@ macro_rules! mindlin_model {
                     B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(v;λ) − b(w;μ) − α S(θ,λ;η,μ)
                     L_h(η,v,μ)       = ℓ(v) − G(μ) − α ℓ_S(η,μ)
                 ";
+                system:        B_h, L_h;
+                energy:        a, ℓ;
+                stabilization: α S against a;
+                side:          s;
+                obstacle:      w >= ψ;
             }
         }
     };
@@ -79,5 +84,10 @@ fem_runtime::model! {
             B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(v;λ) − b(w;μ) − α S(θ,λ;η,μ)
             L_h(η,v,μ)       = ℓ(v) − G(μ) − α ℓ_S(η,μ)
         ";
+        system:        B_h, L_h;
+        energy:        a, ℓ;
+        stabilization: α S against a;
+        side:          s;
+        obstacle:      w >= ψ;
     }
 }

@@ -45,6 +45,9 @@ macro_rules! signorini_model {
                     B_h(u,λ;v,μ)     = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
                     L_h(v,μ)         = ℓ(v) − G(μ)
                 ";
+                system:        B_h, L_h;
+                energy:        a, ℓ;
+                stabilization: α S against a;
             }
         }
     };
@@ -420,7 +423,7 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
         coefficients,
     } = Setup::new::<M>(input)?;
     let problem = discretize_boundary_multiplier::<M>(mesh, &coefficients(0.0)?, &parts, &fixed)?;
-    let constants = inverse_constants::<M>(mesh, &problem, &coefficients(0.0)?, "a", "S")?;
+    let constants = inverse_constants::<M>(mesh, &problem, &coefficients(0.0)?)?;
     let alpha = match input.alpha {
         Some(a) => a,
         None => {
@@ -1356,7 +1359,7 @@ fn solve_level<M: Model>(
         .unwrap_or(0.0);
     let mut problem =
         discretize_boundary_multiplier::<M>(&mesh, &coefficients(guess)?, &parts, &fixed)?;
-    let constants = inverse_constants::<M>(&mesh, &problem, &coefficients(guess)?, "a", "S")?;
+    let constants = inverse_constants::<M>(&mesh, &problem, &coefficients(guess)?)?;
     let alpha = match input.alpha {
         Some(a) => a,
         None => {

@@ -21,6 +21,11 @@ fem_runtime::model! {
             B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(η,v;λ) − b(θ,w;μ) − α S(θ,λ;η,μ)
             L_h(η,v,μ)       = ℓ(η,v) − g(μ) − α ℓ_S(η,μ)
         ";
+        system:        B_h, L_h;
+        energy:        a, ℓ;
+        stabilization: α S against a;
+        side:          s;
+        obstacle:      w >= ψ;
     }
 }
 
@@ -41,6 +46,11 @@ fem_runtime::model! {
             B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(η,v;λ) − b(θ,w;μ) − α S(θ,λ;η,μ)
             L_h(η,v,μ)       = ℓ(η,v) − g(μ) − α ℓ_S(η,μ)
         ";
+        system:        B_h, L_h;
+        energy:        a, ℓ;
+        stabilization: α S against a;
+        side:          s;
+        obstacle:      w >= ψ;
     }
 }
 
@@ -62,5 +72,10 @@ fem_runtime::model! {
             B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) - b(η,v;λ) - b(θ,w;μ) - α S(θ,λ;η,μ)
             L_h(η,v,μ)       = ℓ(η,v) - g(μ) - α ℓ_S(η,μ)
         ";
+        system:        B_h, L_h;
+        energy:        a, ℓ;
+        stabilization: α S against a;
+        side:          s;
+        obstacle:      w >= ψ;
     }
 }

@@ -355,6 +355,11 @@ fn handles(symbols: &Symbols, forms: &[Form], runtime: &TokenStream) -> TokenStr
         .iter()
         .enumerate()
         .map(|(i, (d, _))| handle(d, "DataId", i, &format!(" Data function `{d}`."), runtime));
+    let parts = symbols
+        .facets
+        .iter()
+        .enumerate()
+        .map(|(i, p)| handle(p, "PartId", i, &format!(" Boundary part `{p}`."), runtime));
     quote! {
         /// Typed handles of the forms, for `Model::form` and the functions that take a form.
         pub mod forms {
@@ -372,6 +377,10 @@ fn handles(symbols: &Symbols, forms: &[Form], runtime: &TokenStream) -> TokenStr
         /// Typed handles of the data functions, for `Coefficients::from_ids`.
         pub mod data {
             #(#data)*
+        }
+        /// Typed handles of the boundary parts the forms integrate over (`facets:`).
+        pub mod facets {
+            #(#parts)*
         }
     }
 }
@@ -415,6 +424,47 @@ fn field_tables(
     (dirichlet, field_infos)
 }
 
+/// The role constants of the `Model` impl (`SYSTEM`, `ENERGY`, `STABILIZATION`, `SIDE`).
+fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream {
+    let pair = |p: Option<[usize; 2]>| match p {
+        Some([a, b]) => quote!(::core::option::Option::Some([#a, #b])),
+        None => quote!(::core::option::Option::None),
+    };
+    let system = pair(roles.system);
+    let energy = pair(roles.energy);
+    let stabilization = match roles.stabilization {
+        Some((alpha, form, against)) => {
+            let alpha = match alpha {
+                Some(a) => quote!(::core::option::Option::Some(#a)),
+                None => quote!(::core::option::Option::None),
+            };
+            quote! {
+            ::core::option::Option::Some(#runtime::model::StabilizationRole {
+                alpha: #alpha,
+                form: #form,
+                against: #against,
+            })
+            }
+        }
+        None => quote!(::core::option::Option::None),
+    };
+    let side = match roles.side {
+        Some(s) => quote!(::core::option::Option::Some(#s)),
+        None => quote!(::core::option::Option::None),
+    };
+    let obstacle = match roles.obstacle {
+        Some((field, data)) => quote!(::core::option::Option::Some([#field, #data])),
+        None => quote!(::core::option::Option::None),
+    };
+    quote! {
+        const OBSTACLE: ::core::option::Option<[usize; 2]> = #obstacle;
+        const SYSTEM: ::core::option::Option<[usize; 2]> = #system;
+        const ENERGY: ::core::option::Option<[usize; 2]> = #energy;
+        const STABILIZATION: ::core::option::Option<#runtime::model::StabilizationRole> = #stabilization;
+        const SIDE: ::core::option::Option<usize> = #side;
+    }
+}
+
 /// The `runtime::Model` impl: names, fields, forms and the dispatch to the kernels.
 fn model_impl(
     declaration: &Declaration,
@@ -422,8 +472,10 @@ fn model_impl(
     backend: &dyn CellBackend,
     form_infos: &[TokenStream],
     dispatch: &Dispatch,
+    roles: &crate::roles::Roles,
 ) -> TokenStream {
     let runtime = &declaration.runtime;
+    let role_items = role_items(roles, runtime);
     let model_name = declaration.name.to_string();
     let np = symbols.params.len();
     let nd = symbols.data.len();
@@ -550,6 +602,7 @@ fn model_impl(
             const DATA: &'static [&'static str] = &[#(#data),*];
             const FORMS: &'static [#runtime::FormInfo] = &[#(#form_infos),*];
             #positive
+            #role_items
 
             fn element_matrix(
                 form: usize,
@@ -614,7 +667,12 @@ fn model_impl(
 }
 
 /// The whole generated module.
-pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) -> TokenStream {
+pub fn generate(
+    declaration: &Declaration,
+    symbols: &Symbols,
+    forms: &[Form],
+    roles: &crate::roles::Roles,
+) -> TokenStream {
     let runtime = &declaration.runtime;
     let backend = backend(declaration.cell);
     let mut dispatch = Dispatch::default();
@@ -628,7 +686,7 @@ pub fn generate(declaration: &Declaration, symbols: &Symbols, forms: &[Form]) ->
         .unzip();
     dispatch.facet_items =
         facet::model_items(symbols, forms, runtime, &declaration.name.to_string());
-    let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch);
+    let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch, roles);
     let handles = handles(symbols, forms, runtime);
     let module = &declaration.name;
     let vis = &declaration.vis;

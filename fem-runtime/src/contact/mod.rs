@@ -511,32 +511,22 @@ fn check_off_edge<M: Model>(
 /// kernels: the largest generalized eigenvalue of `S_E v = C K_T v` on the complement
 /// of the kernel of `K_T` (the rigid motions, where `S_E` vanishes too).
 ///
-/// `energy` names the bilinear cell form `a(u;v)` (its blocks give `K_T`), `stabilization`
-/// the form whose facet blocks on the multiplier's part, restricted to the primal
-/// fields, give `S_E` (`S(u,λ;v,μ) = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds`). One value
-/// per edge of `problem.contact_edges`; `α = 1/(2 max_E C_I,E)` is the rule of §1.
+/// The forms are the model's stabilization role ([`Model::STABILIZATION`]): the cell
+/// form it is measured against (`a(u;v)`, its blocks give `K_T`) and the stabilization
+/// form, whose facet blocks on the multiplier's part, restricted to the primal fields,
+/// give `S_E` (`S(u,λ;v,μ) = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds`). One value per edge
+/// of `problem.contact_edges`; `α = 1/(2 max_E C_I,E)` is the rule of §1.
 ///
 /// # Errors
-/// [`Error::Input`] for unknown forms, a form of the wrong arity; the kernels' errors;
+/// [`Error::Input`] for a model without a stabilization role; the kernels' errors;
 /// [`Error::NonFinite`] when a local matrix is not finite.
 pub fn inverse_constants<M: Model>(
     mesh: &TriangleMesh,
     problem: &BoundaryMultiplierProblem,
     coefficients: &Coefficients,
-    energy: impl crate::model::IntoFormIndex<M>,
-    stabilization: impl crate::model::IntoFormIndex<M>,
 ) -> Result<Vec<f64>> {
-    let energy = M::form(energy)?;
-    let stabilization = M::form(stabilization)?;
-    for (form, what) in [(energy, "energy"), (stabilization, "stabilization")] {
-        if M::FORMS[form].arity != 2 {
-            return Err(Error::Input(format!(
-                "the {what} form `{}` of `{}` is not bilinear",
-                M::FORMS[form].name,
-                M::NAME
-            )));
-        }
-    }
+    let role = crate::stabilization::role::<M>()?;
+    let (energy, stabilization) = (role.against, role.form);
     // Local numbering: the primal fields' local DOFs one after the other.
     let fields = problem.dofs.fields();
     let counts: Vec<usize> = fields

@@ -1229,17 +1229,17 @@ impl<G> ObstacleSolution<G> {
 
 impl<G: DofNumbering> ObstacleSolution<G> {
     /// The energy `½ a(u,u) − ℓ(u)` of the primal fields `u` (all fields but the
-    /// multiplier) of the solution, with the model's forms named `a` (bilinear) and `ℓ`
-    /// (linear; in ASCII `l` or `ell`) and the parameters and data of `coefficients`; the boundary values of
-    /// the solution are included as they are. For the exact solution of the obstacle
+    /// multiplier) of the solution, with the model's energy forms ([`Model::ENERGY`])
+    /// and the parameters and data of `coefficients`; the boundary values of the
+    /// solution are included as they are. For the exact solution of the obstacle
     /// problem it is the minimum of the energy over the admissible set.
     ///
     /// Computed in twice the working precision: `½uᵀAu` of a thin structure is a small
     /// difference of huge terms.
     ///
     /// # Errors
-    /// If `M` has no form `a` or `ℓ`, or if `M` is not the model the solution was
-    /// computed with (its fields do not fit the mesh).
+    /// If `M` declares no energy, or if `M` is not the model the solution was computed
+    /// with (its fields do not fit the mesh).
     pub fn energy<M: Model>(&self, coefficients: &Coefficients) -> Result<f64> {
         let d = &self.discretization;
         let primal: Vec<usize> = (0..M::FIELDS.len())
@@ -1262,14 +1262,15 @@ impl<G: DofNumbering> ObstacleSolution<G> {
                 M::NAME
             )));
         }
-        let a = crate::assembly::MatrixAssembler::new::<M>("a", &d.mesh, &dofs)?
+        let [a, load] = M::ENERGY.ok_or_else(|| {
+            Error::Input(format!(
+                "model `{}` declares no energy (`energy: a, ℓ;`)",
+                M::NAME
+            ))
+        })?;
+        let a = crate::assembly::MatrixAssembler::new::<M>(FormId::new(a), &d.mesh, &dofs)?
             .assemble::<M>(&d.mesh, coefficients)?;
-        // the load form's ASCII spellings too (a tester's all-ASCII model named it `l`)
-        let load = ["ℓ", "l", "ell"]
-            .into_iter()
-            .find(|name| M::FORMS.iter().any(|f| f.name == *name && f.arity == 1))
-            .unwrap_or("ℓ");
-        let l = assemble_vector::<M>(load, &d.mesh, &dofs, coefficients)?;
+        let l = assemble_vector::<M>(FormId::new(load), &d.mesh, &dofs, coefficients)?;
         Ok(0.5 * crate::lcp::cholesky::quadratic_form(&a, &u, &u)
             - crate::lcp::cholesky::dot(&l, &u))
     }
