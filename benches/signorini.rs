@@ -16,14 +16,14 @@
 //! (`u_y = 0` on Γ_C): the linear problem of the same mesh and size.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::contact::discretize_boundary_multiplier;
 use fem_forms::lcp::cholesky::Cholesky;
 use fem_forms::models::signorini::{
     hertz_input, hertz_mesh, hertz_snap, lame, signorini_p1, solve_signorini,
     solve_signorini_nested, straight_boundary, Displacement, Hertz, HertzData, Plane,
     SignoriniInput, Snap,
 };
-use fem_forms::{Coefficients, Diagonal, Model, TriangleMesh};
+use fem_forms::obstacle::boundary_multiplier::discretize_on_parts;
+use fem_forms::{Coefficients, Diagonal, TriangleMesh};
 use std::time::Instant;
 
 /// Seconds of one Cholesky (symbolic + numeric) and solve of the elasticity matrix on
@@ -43,14 +43,17 @@ fn linear_solve(mesh: &TriangleMesh, input: &SignoriniInput) -> (f64, usize) {
     )
     .unwrap();
     let held: Vec<u32> = input.fixed_y.iter().chain(input.contact).copied().collect();
-    let fixed: [(usize, &[u32]); 2] = [
-        (M::field("u_x").unwrap(), input.fixed_x),
-        (M::field("u_y").unwrap(), &held),
+    let fixed = [
+        (signorini_p1::fields::u_x, input.fixed_x),
+        (signorini_p1::fields::u_y, &held[..]),
     ];
-    let d = discretize_boundary_multiplier::<M>(
+    let d = discretize_on_parts::<M, _, _>(
         mesh,
         &coefficients,
-        &[("Γ_C", input.contact), ("Γ_N", input.load)],
+        &[
+            (signorini_p1::facets::Γ_C, input.contact),
+            (signorini_p1::facets::Γ_N, input.load),
+        ],
         &fixed,
     )
     .unwrap();

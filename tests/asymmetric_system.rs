@@ -202,8 +202,8 @@ contact_model!(
 /// of different signs is refused naming the part, the one with equal signs discretizes.
 #[test]
 fn a_contact_form_with_couplings_of_different_signs_is_refused() {
-    use fem_runtime::contact::discretize_boundary_multiplier;
     use fem_runtime::mesh::triangle::Diagonal;
+    use fem_runtime::obstacle::boundary_multiplier::discretize_on_parts;
     use fem_runtime::TriangleMesh;
     let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Alternating).unwrap();
     let pressure = |_: &[f64]| 1.0;
@@ -218,9 +218,9 @@ fn a_contact_form_with_couplings_of_different_signs_is_refused() {
     let data: [(&str, &fem_runtime::DataFn); 2] = [("q", &pressure), ("g", &gap)];
     let parts: [(&str, &[u32]); 2] = [("Γ_C", &[1]), ("Γ_N", &[3])];
     let c = Coefficients::new::<contact_symmetric::Model>(&params, &data).unwrap();
-    discretize_boundary_multiplier::<contact_symmetric::Model>(&mesh, &c, &parts, &[]).unwrap();
+    discretize_on_parts::<contact_symmetric::Model, _, &str>(&mesh, &c, &parts, &[]).unwrap();
     let c = Coefficients::new::<contact_flipped::Model>(&params, &data).unwrap();
-    let Err(e) = discretize_boundary_multiplier::<contact_flipped::Model>(&mesh, &c, &parts, &[])
+    let Err(e) = discretize_on_parts::<contact_flipped::Model, _, &str>(&mesh, &c, &parts, &[])
     else {
         panic!("the asymmetric contact B_h was discretized");
     };
@@ -311,8 +311,8 @@ contact_model!(
 /// part's own edges now.
 #[test]
 fn facet_blocks_are_compared_on_their_own_edges() {
-    use fem_runtime::contact::discretize_boundary_multiplier;
     use fem_runtime::mesh::triangle::Diagonal;
+    use fem_runtime::obstacle::boundary_multiplier::discretize_on_parts;
     use fem_runtime::TriangleMesh;
     let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Alternating).unwrap();
     let pressure = |_: &[f64]| 1.0;
@@ -328,11 +328,10 @@ fn facet_blocks_are_compared_on_their_own_edges() {
     let c = Coefficients::new::<contact_true_normal::Model>(&params, &data).unwrap();
     // the bottom (marker 1), where n = n_c = (0, −1)
     let parts: [(&str, &[u32]); 2] = [("Γ_C", &[1]), ("Γ_N", &[3])];
-    discretize_boundary_multiplier::<contact_true_normal::Model>(&mesh, &c, &parts, &[]).unwrap();
+    discretize_on_parts::<contact_true_normal::Model, _, &str>(&mesh, &c, &parts, &[]).unwrap();
     // the right side (marker 2), where n = (1, 0) ≠ n_c: not symmetric there
     let parts: [(&str, &[u32]); 2] = [("Γ_C", &[2]), ("Γ_N", &[3])];
-    let Err(e) =
-        discretize_boundary_multiplier::<contact_true_normal::Model>(&mesh, &c, &parts, &[])
+    let Err(e) = discretize_on_parts::<contact_true_normal::Model, _, &str>(&mesh, &c, &parts, &[])
     else {
         panic!("n ≠ n_c on Γ_C was accepted")
     };

@@ -216,10 +216,10 @@ fn parabolic_gap(x: &[f64]) -> f64 {
 /// a contact zone that is neither empty nor the whole bottom.
 #[test]
 fn non_flat_gap_newton_agrees_with_the_qp() {
-    use fem_forms::contact::discretize_boundary_multiplier;
     use fem_forms::lcp::{quadratic_program, semismooth_newton, NewtonOptions};
     use fem_forms::models::signorini::signorini_p1::{self, Model as M};
-    use fem_forms::{Coefficients, Model};
+    use fem_forms::obstacle::boundary_multiplier::discretize_on_parts;
+    use fem_forms::Coefficients;
     let mesh = block(8, Diagonal::Alternating);
     let mut input = block_input(Displacement::P1, None);
     input.gap = &parabolic_gap;
@@ -253,12 +253,14 @@ fn non_flat_gap_newton_agrees_with_the_qp() {
         ],
     )
     .unwrap();
-    let fixed: [(usize, &[u32]); 1] = [(M::field("u_x").unwrap(), &[4])];
-    let problem = discretize_boundary_multiplier::<M>(
+    let problem = discretize_on_parts::<M, _, _>(
         &mesh,
         &coefficients,
-        &[("Γ_C", &[1]), ("Γ_N", &[3])],
-        &fixed,
+        &[
+            (signorini_p1::facets::Γ_C, &[1]),
+            (signorini_p1::facets::Γ_N, &[3]),
+        ],
+        &[(signorini_p1::fields::u_x, &[4])],
     )
     .unwrap();
     let n = problem.lcp.n();

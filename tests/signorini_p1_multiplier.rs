@@ -144,10 +144,10 @@ fn patch_test_gives_the_pressure_at_every_vertex() {
 /// parabolic gap (only part of Γ_C touches), and the force against the load.
 #[test]
 fn the_lcp_blocks_by_hand_and_newton_against_the_qp() {
-    use fem_forms::contact::discretize_boundary_multiplier;
     use fem_forms::lcp::{quadratic_program, semismooth_newton, NewtonOptions};
     use fem_forms::models::signorini::lame;
     use fem_forms::models::signorini::signorini_p1_p1::{self, Model as M};
+    use fem_forms::obstacle::boundary_multiplier::discretize_on_parts;
     use fem_forms::{Coefficients, DataFn, Model};
     let n = 8;
     let h = 1.0 / n as f64;
@@ -170,30 +170,33 @@ fn the_lcp_blocks_by_hand_and_newton_against_the_qp() {
             ],
         )
         .unwrap();
-        let fixed: [(usize, &[u32]); 1] = [(M::field("u_x").unwrap(), &[4])];
-        discretize_boundary_multiplier::<M>(
+        discretize_on_parts::<M, _, _>(
             &mesh,
             &coefficients,
-            &[("Γ_C", &[1]), ("Γ_N", &[3])],
-            &fixed,
+            &[
+                (signorini_p1_p1::facets::Γ_C, &[1]),
+                (signorini_p1_p1::facets::Γ_N, &[3]),
+            ],
+            &[(signorini_p1_p1::fields::u_x, &[4])],
         )
         .unwrap()
     };
     let p = problem(alpha, &constant_gap);
+    let b = p.boundary().expect("a multiplier on Γ_C");
     assert_eq!(p.lcp.m(), n + 1);
     assert!(p.lcp.c_blocks.is_empty(), "C is lumped: diagonal");
     // the vertices are those at y = 0, ascending; edge_dofs point at the edge's ends
     let vertices = mesh.vertices();
-    for &v in &p.contact_vertices {
+    for &v in &b.vertices {
         assert!(vertices[v][1].abs() < 1e-15);
     }
-    for (e, dofs) in p.contact_edges.iter().zip(&p.edge_dofs) {
+    for (e, dofs) in b.edges.iter().zip(&b.edge_dofs) {
         for (end, &k) in e.ends.iter().zip(dofs) {
-            assert_eq!(vertices[p.contact_vertices[k]], *end);
+            assert_eq!(vertices[b.vertices[k]], *end);
         }
     }
-    let weights = p.multiplier_integrals();
-    for (k, &v) in p.contact_vertices.iter().enumerate() {
+    let weights = b.integrals();
+    for (k, &v) in b.vertices.iter().enumerate() {
         let at_end = vertices[v][0].abs() < 1e-12 || (vertices[v][0] - 1.0).abs() < 1e-12;
         let (c, w) = if at_end {
             (0.5 * alpha * h * h, 0.5 * h)

@@ -28,7 +28,6 @@
 #![cfg_attr(test, allow(confusable_idents, mixed_script_confusables))]
 
 pub mod assembly;
-pub mod contact;
 pub mod element;
 pub mod error;
 pub mod io;

@@ -17,7 +17,7 @@
 //! on the edge); it lives on the edges of `Γ_C` only: the solver gives it one DOF per
 //! contact edge (`fem_models::signorini` solver below). Declared P1 (the `_p1` models)
 //! it is continuous on `Γ_C`, one DOF per vertex of its edges
-//! ([`fem_runtime::contact::discretize_boundary_multiplier`]).
+//! ([`fem_runtime::obstacle::boundary_multiplier::discretize`]).
 
 /// One elasticity–contact model per displacement and multiplier element: the forms are
 /// one text.
@@ -77,10 +77,93 @@ signorini_model! {
 
 /// The multiplier's space on Γ_C: P0 (one pressure per edge) or continuous P1 (one per
 /// vertex of the edges of Γ_C), chosen with [`solve_signorini_with`].
-pub use fem_runtime::contact::BoundaryMultiplier as Multiplier;
-use fem_runtime::contact::{
-    discretize_boundary_multiplier, inverse_constants, BoundaryMultiplierProblem, ContactEdge,
-};
+pub use fem_runtime::obstacle::boundary_multiplier::BoundaryMultiplier as Multiplier;
+use fem_runtime::obstacle::boundary_multiplier::{self, ContactEdge};
+
+/// A contact problem discretized: primal DOFs, their elimination, the LCP and the
+/// multiplier's DOFs on Γ_C.
+#[derive(Clone, Debug)]
+struct BoundaryMultiplierProblem {
+    dofs: fem_runtime::SystemDofs,
+    reduction: fem_runtime::Reduction,
+    lcp: fem_runtime::lcp::Lcp,
+    boundary: boundary_multiplier::BoundaryMultiplierDofs,
+    contact_edges: Vec<ContactEdge>,
+    multiplier_space: Multiplier,
+    contact_vertices: Vec<usize>,
+    edge_dofs: Vec<[usize; 2]>,
+}
+
+impl BoundaryMultiplierProblem {
+    fn multiplier_integrals(&self) -> Vec<f64> {
+        self.boundary.integrals()
+    }
+}
+
+/// The discretization of a contact model with the model's parts by marker and the
+/// fields `fixed` held at 0 on the given markers.
+fn discretize_boundary_multiplier<M: Model>(
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    parts: &[(&str, &[u32])],
+    fixed: &[(usize, &[u32])],
+) -> Result<BoundaryMultiplierProblem> {
+    let markers = M::FACET_PARTS
+        .iter()
+        .map(|name| {
+            parts
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, m)| m.to_vec())
+                .ok_or_else(|| {
+                    Error::Input(format!("the boundary part `{name}` is not given markers"))
+                })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let dofs = boundary_multiplier::primal_dofs::<M>(mesh)?;
+    let mut constraints = fem_runtime::Constraints::new();
+    for &(field, on) in fixed {
+        let map = dofs.map(field).ok_or_else(|| {
+            Error::Input(format!(
+                "field {field} is not a primal field of `{}`",
+                M::NAME
+            ))
+        })?;
+        let offset = dofs.offset(field).unwrap_or(0);
+        for d in fem_runtime::DirichletPart::Markers(on.to_vec()).dofs(map, mesh) {
+            constraints.fix_dof(offset + d, 0.0)?;
+        }
+    }
+    let d = boundary_multiplier::discretize::<M>(mesh, coefficients, &markers, dofs, &constraints)?;
+    let fem_runtime::obstacle::Multipliers::Boundary(boundary) = d.multipliers else {
+        return Err(Error::Input(
+            "the multiplier is not on a boundary part".into(),
+        ));
+    };
+    Ok(BoundaryMultiplierProblem {
+        dofs: d.dofs,
+        reduction: d.reduction,
+        lcp: d.lcp,
+        contact_edges: boundary.edges.clone(),
+        multiplier_space: boundary.space,
+        contact_vertices: boundary.vertices.clone(),
+        edge_dofs: boundary.edge_dofs.clone(),
+        boundary,
+    })
+}
+
+fn inverse_constants<M: Model>(
+    mesh: &TriangleMesh,
+    problem: &BoundaryMultiplierProblem,
+    coefficients: &Coefficients,
+) -> Result<Vec<f64>> {
+    boundary_multiplier::inverse_constants::<M>(
+        mesh,
+        &problem.boundary,
+        &problem.dofs,
+        coefficients,
+    )
+}
 use fem_runtime::lcp::{quadratic_program, semismooth_newton, LcpSolution, NewtonOptions};
 use fem_runtime::{Coefficients, DataFn, Error, Model, Result, TriangleMesh};
 
@@ -284,7 +367,7 @@ pub fn solve_signorini(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Si
 
 /// [`solve_signorini`] with the multiplier's space chosen: P0 (the same) or continuous
 /// P1 on Γ_C ([`signorini_p1_p1`], [`signorini_p2_p1`]; its `C` block lumped, see
-/// [`discretize_boundary_multiplier`]).
+/// `fem_runtime::obstacle::boundary_multiplier::discretize`).
 ///
 /// # Errors
 /// Those of [`solve_signorini`].

@@ -3,6 +3,7 @@
 //! `A_α, B_α, C_α, F_α, G_α` of docs/mathematics.md §1 (the KKT matrix is
 //! `[[A_α, −B_αᵀ], [−B_α, −C_α]]`, its right-hand side `[F_α; −G_α]`).
 
+pub mod boundary_multiplier;
 pub mod hierarchy;
 pub mod nodal;
 pub mod triangle;
@@ -64,9 +65,23 @@ pub struct Discretization<G = IntervalMesh> {
     pub lcp: Lcp,
     /// The model field that holds the multiplier.
     pub multiplier_field: usize,
+    /// Where the multiplier's DOFs live: on the cells (then they are DOFs of `dofs`) or
+    /// on the edges of a boundary part.
+    pub multipliers: Multipliers,
     roles: Vec<Role>,
     primal_reduced: Vec<usize>,
     multiplier_reduced: Vec<usize>,
+}
+
+/// Where a discretization's multiplier lives.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Multipliers {
+    /// On the cells: the multiplier field's DOF map (P0, P1disc), part of
+    /// [`Discretization::dofs`].
+    Cells,
+    /// On the edges of a boundary part ([`boundary_multiplier`]): not in
+    /// [`Discretization::dofs`], which holds the primal fields only.
+    Boundary(boundary_multiplier::BoundaryMultiplierDofs),
 }
 
 /// The multiplier field of a model: the one declared `>= 0`.
@@ -357,6 +372,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 g,
             },
             multiplier_field: multiplier,
+            multipliers: Multipliers::Cells,
             basis,
             roles,
             primal_reduced,
@@ -559,9 +575,20 @@ enum Slot {
 }
 
 impl<G> Discretization<G> {
+    /// The multiplier's DOFs on a boundary part; `None` for a multiplier on the cells.
+    pub fn boundary(&self) -> Option<&boundary_multiplier::BoundaryMultiplierDofs> {
+        match &self.multipliers {
+            Multipliers::Boundary(b) => Some(b),
+            Multipliers::Cells => None,
+        }
+    }
+
     /// For each constraint of the LCP, the DOF (numbered within the multiplier field) of
-    /// its multiplier.
+    /// its multiplier; on a boundary part, the constraint's own index.
     pub fn multiplier_dofs(&self) -> Vec<usize> {
+        if let Multipliers::Boundary(b) = &self.multipliers {
+            return (0..b.count()).collect();
+        }
         let offset = self.dofs.offset(self.multiplier_field).unwrap_or(0);
         self.multiplier_reduced
             .iter()
@@ -571,8 +598,13 @@ impl<G> Discretization<G> {
 
     /// The full coefficient vector (all fields, boundary values included, Cartesian
     /// DOFs: mapped back from the primed ones of [`Discretization::basis`]) of an LCP
-    /// solution.
+    /// solution: the DOFs of `dofs`, followed on a boundary part by the multiplier's.
     pub fn full(&self, solution: &LcpSolution) -> Vec<f64> {
+        if let Multipliers::Boundary(_) = &self.multipliers {
+            let mut full = self.reduction.expand(&solution.u);
+            full.extend_from_slice(&solution.lambda);
+            return full;
+        }
         let mut reduced = vec![0.0; self.roles.len()];
         for (p, &r) in self.primal_reduced.iter().enumerate() {
             reduced[r] = solution.u[p];
@@ -587,10 +619,22 @@ impl<G> Discretization<G> {
 
     /// The multipliers of a full coefficient vector, in the order of the LCP's constraints.
     pub fn multiplier_part(&self, full: &[f64]) -> Vec<f64> {
+        if let Multipliers::Boundary(_) = &self.multipliers {
+            return full[self.dofs.dof_count()..].to_vec();
+        }
         self.multiplier_reduced
             .iter()
             .map(|&r| full[self.reduction.free()[r]])
             .collect()
+    }
+
+    /// The coefficients of the multiplier in a full coefficient vector, numbered as its
+    /// field's DOFs (on a boundary part: its constraints).
+    pub fn multiplier_coefficients<'v>(&self, full: &'v [f64]) -> &'v [f64] {
+        match &self.multipliers {
+            Multipliers::Boundary(_) => &full[self.dofs.dof_count()..],
+            Multipliers::Cells => &full[self.dofs.range(self.multiplier_field).unwrap()],
+        }
     }
 
     /// The primal unknowns of a full coefficient vector (Cartesian DOFs, as
@@ -1199,7 +1243,11 @@ impl<G> ObstacleSolution<G> {
     /// When `field` is not a field of the solved model: take the index from
     /// `Model::field(name)`, which names the fields when it errs.
     pub fn field(&self, field: usize) -> &[f64] {
-        &self.values[self.discretization.dofs.range(field).unwrap()]
+        let d = &self.discretization;
+        if field == d.multiplier_field {
+            return d.multiplier_coefficients(&self.values);
+        }
+        &self.values[d.dofs.range(field).unwrap()]
     }
 
     /// The contact cells: indices of the cells on which some multiplier coefficient is

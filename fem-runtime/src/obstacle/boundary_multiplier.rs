@@ -1,31 +1,30 @@
-//! Obstacle problems whose multiplier lives on a boundary part only: Signorini contact
-//! (docs/contact.md), the boundary-multiplier variant of
-//! [`crate::obstacle::triangle::solve_obstacle_on_triangles`].
+//! Multipliers on a boundary part: the discretization of a model whose multiplier lives
+//! on the edges of one of its boundary parts (`facets:`), as Signorini contact's does on
+//! `Γ_C` (docs/contact.md). It yields the same [`Discretization`] as a multiplier on the
+//! cells, so the same solvers, nested iteration, checks and reports serve both.
 //!
 //! The model declares its multiplier as a P0 field (`λ: P0 >= 0`) and integrates it
-//! only in boundary integrals `∫_Γ_C … ds` (`facets:`); here it gets one DOF per edge
-//! of `Γ_C` (the edge's P0 function), not one per cell. Declared P1 (`λ: P1 >= 0`) it
-//! is continuous and piecewise linear on `Γ_C`: one DOF per vertex of the edges of
-//! `Γ_C` (a facet-space DOF map, [`BoundaryMultiplierProblem::contact_vertices`]); its
-//! `C` block is lumped (see [`discretize_boundary_multiplier`]). The system is the one
-//! of §1:
-//! from `B_h` and `L_h` (cell and facet blocks),
+//! only in boundary integrals `∫_Γ_C … ds`; here it gets one DOF per edge of the part (the
+//! edge's P0 function), not one per cell. Declared P1 (`λ: P1 >= 0`) it is continuous
+//! and piecewise linear on the part: one DOF per vertex of its edges
+//! ([`BoundaryMultiplierDofs::vertices`]); its `C` block is lumped (see
+//! [`discretize`]). From `B_h` and `L_h` (cell and facet blocks),
 //!
 //! ```text
 //! A = (v, u) blocks,  B = −(μ, u) blocks,  C = −(μ, λ) blocks,  F = ℓ part,  G = −(μ part of L_h)
 //! ```
 //!
-//! an LCP `A U − Bᵀ Λ = F, 0 ≤ Λ ⊥ B U + C Λ − G ≥ 0` for [`crate::lcp`]'s solvers
-//! (semismooth Newton needs `C > 0`, i.e. α > 0; the plain method `α = 0` goes to the QP).
+//! the LCP `A U − Bᵀ Λ = F, 0 ≤ Λ ⊥ B U + C Λ − G ≥ 0` of [`crate::lcp`] (semismooth
+//! Newton needs `C > 0`, i.e. α > 0; the plain method `α = 0` goes to the QP).
 
-use crate::assembly::boundary::{Constraints, DirichletPart, Reduction};
+use crate::assembly::boundary::{Constraints, DirichletPart};
 use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::error::{Error, Result};
 use crate::lcp::{ConstraintRows, Lcp};
 use crate::mesh::TriangleMesh;
-use crate::model::{Coefficients, Model};
-use crate::obstacle::{multiplier_field, system_forms};
+use crate::model::{Coefficients, IntoFieldIndex, IntoPartIndex, Model};
+use crate::obstacle::{multiplier_field, system_forms, Discretization, Multipliers};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, Triplet};
 use fem_reference::ElementKind;
@@ -55,52 +54,59 @@ impl ContactEdge {
         let [a, b] = self.ends;
         [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
     }
+
+    /// The outward unit normal (the edge's cell is counter-clockwise).
+    pub fn outward_normal(&self) -> [f64; 2] {
+        let [a, b] = self.ends;
+        let (tx, ty) = (b[0] - a[0], b[1] - a[1]);
+        let l = tx.hypot(ty);
+        [ty / l, -tx / l]
+    }
 }
 
-/// The multiplier's space on the contact boundary.
+/// The multiplier's space on the boundary part.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BoundaryMultiplier {
-    /// Piecewise constant: one DOF per edge of `Γ_C`.
+    /// Piecewise constant: one DOF per edge of the part.
     P0,
-    /// Continuous piecewise linear on `Γ_C`: one DOF per vertex of its edges.
+    /// Continuous piecewise linear on the part: one DOF per vertex of its edges.
     P1,
 }
 
-/// The discrete problem: primal DOFs, their elimination, the LCP and the multiplier's
-/// DOFs: for P0 constraint `k` is the multiplier of `contact_edges[k]`; for P1 it is the
-/// nodal value at vertex `contact_vertices[k]`.
-#[derive(Clone, Debug)]
-pub struct BoundaryMultiplierProblem {
-    /// DOFs of the primal fields (every field but the multiplier).
-    pub dofs: SystemDofs,
-    /// Elimination of the fixed primal DOFs.
-    pub reduction: Reduction,
-    /// The LCP in the free primal DOFs and the edge multipliers.
-    pub lcp: Lcp,
-    /// The edges of the multiplier's part (in constraint order for P0).
-    pub contact_edges: Vec<ContactEdge>,
-    /// The multiplier's space.
-    pub multiplier_space: BoundaryMultiplier,
-    /// P1: the mesh vertices of the edges of `Γ_C`, ascending by vertex number; constraint
-    /// `k` is the multiplier's value at `contact_vertices[k]`. Empty for P0.
-    pub contact_vertices: Vec<usize>,
-    /// Per contact edge (same order as `contact_edges`), the constraints of its two
-    /// ends `ends[0]`, `ends[1]` (P1), or `[k, k]` for the edge's own constraint (P0):
-    /// `λ_h` on edge `e` is `(1−s) Λ[edge_dofs[e][0]] + s Λ[edge_dofs[e][1]]`, s ∈ [0, 1].
-    pub edge_dofs: Vec<[usize; 2]>,
-    /// The model's multiplier field.
-    pub multiplier_field: usize,
+/// The DOFs of a multiplier on a boundary part: for P0 constraint `k` is the multiplier
+/// of `edges[k]`; for P1 it is the nodal value at vertex `vertices[k]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoundaryMultiplierDofs {
     /// The boundary part (index in `M::FACET_PARTS`) the multiplier lives on.
-    pub multiplier_part: usize,
+    pub part: usize,
+    /// The edges of the part (in constraint order for P0).
+    pub edges: Vec<ContactEdge>,
+    /// The multiplier's space.
+    pub space: BoundaryMultiplier,
+    /// P1: the mesh vertices of the part's edges, ascending by vertex number; constraint
+    /// `k` is the multiplier's value at `vertices[k]`. Empty for P0.
+    pub vertices: Vec<usize>,
+    /// Per edge (same order as `edges`), the constraints of its two ends `ends[0]`,
+    /// `ends[1]` (P1), or `[k, k]` for the edge's own constraint (P0): `λ_h` on edge `e`
+    /// is `(1−s) Λ[edge_dofs[e][0]] + s Λ[edge_dofs[e][1]]`, s ∈ [0, 1].
+    pub edge_dofs: Vec<[usize; 2]>,
 }
 
-impl BoundaryMultiplierProblem {
-    /// `∫_Γ_C μ_k ds` for each multiplier basis function `μ_k` (length): the edge's
+impl BoundaryMultiplierDofs {
+    /// The number of multiplier DOFs (constraints).
+    pub fn count(&self) -> usize {
+        match self.space {
+            BoundaryMultiplier::P0 => self.edges.len(),
+            BoundaryMultiplier::P1 => self.vertices.len(),
+        }
+    }
+
+    /// `∫_part μ_k ds` for each multiplier basis function `μ_k` (a length): the edge's
     /// length for P0, half the lengths of the (one or two) edges at the vertex for P1.
-    /// `Σ_k Λ_k w_k` is the total `∫_Γ_C λ_h ds`.
-    pub fn multiplier_integrals(&self) -> Vec<f64> {
-        let mut w = vec![0.0; self.lcp.m()];
-        for (e, dofs) in self.contact_edges.iter().zip(&self.edge_dofs) {
+    /// `Σ_k Λ_k w_k` is the total `∫ λ_h ds`.
+    pub fn integrals(&self) -> Vec<f64> {
+        let mut w = vec![0.0; self.count()];
+        for (e, dofs) in self.edges.iter().zip(&self.edge_dofs) {
             let l = e.length();
             w[dofs[0]] += 0.5 * l;
             w[dofs[1]] += 0.5 * l;
@@ -110,7 +116,7 @@ impl BoundaryMultiplierProblem {
 }
 
 /// The boundary edges of `mesh` with one of `markers`, with their cell and local number.
-fn part_edges(mesh: &TriangleMesh, markers: &[u32]) -> Vec<ContactEdge> {
+pub fn part_edges(mesh: &TriangleMesh, markers: &[u32]) -> Vec<ContactEdge> {
     let vertices = mesh.vertices();
     mesh.boundary_edges()
         .iter()
@@ -133,92 +139,203 @@ fn part_edges(mesh: &TriangleMesh, markers: &[u32]) -> Vec<ContactEdge> {
         .collect()
 }
 
-/// Assembles `B_h`, `L_h` of `M` (cell and facet blocks) on `mesh` with the multiplier
-/// on the edges of its boundary part, and eliminates the homogeneous Dirichlet
-/// conditions `fixed` (`(field, boundary markers)`: that field is 0 on those edges).
-///
-/// `parts` names the boundary edges of each of the model's `FACET_PARTS` by marker
-/// (`("Γ_C", &[1])`, e.g. from [`TriangleMesh::boundary_part_markers`]).
-///
-/// A P1 multiplier's facet kernels see its three local DOFs on the cell; on the edge only
-/// the two end vertices' functions are nonzero, so the third vertex's rows and columns
-/// must vanish (checked: an error otherwise, e.g. a derivative of λ in a boundary
-/// integral). Its `(μ, λ)` block, `C = α Σ_E h_E (μ_l, μ_k)_E`, couples neighbouring
-/// vertices along the whole of `Γ_C`: a chain, not the small blocks of consecutive
-/// constraints [`crate::lcp::CouplingBlocks`] holds (at most
-/// [`crate::lcp::MAX_BLOCK`]), so it is lumped by rows: `C_kk = Σ_l C_kl`. That is exact
-/// on constant pressures (the patch test keeps `λ_h = q`), keeps `C` diagonal and
-/// positive for the semismooth Newton solver, and leaves `B`, `A` and `G` consistent.
+/// [`discretize`] with the model's boundary parts given by markers, by handle or name
+/// (`(model::facets::Γ_C, &[1])`; every part of the model once), and the fields of
+/// `fixed` held at 0 on the boundary edges of their markers
+/// (`(model::fields::u_x, &[4])`).
 ///
 /// # Errors
-/// [`Error::Input`] when the model has no `B_h`/`L_h`, no single multiplier, a
-/// multiplier that is neither P0 nor P1 or that appears in no boundary integral or on two
-/// parts, a P1 multiplier whose facet terms reach the vertex off the edge; a
-/// model part `parts` does not name, or one that holds no boundary edge of the mesh (a
-/// contact part that is not on the boundary); a field index out of range in `fixed`;
-/// the errors of the kernels ([`Error::NonFinite`] for a non-finite entry).
-pub fn discretize_boundary_multiplier<M: Model>(
+/// A part or field the model does not have, a part of the model without markers, and
+/// those of [`discretize`].
+pub fn discretize_on_parts<M, P, F>(
     mesh: &TriangleMesh,
     coefficients: &Coefficients,
-    parts: &[(&str, &[u32])],
-    fixed: &[(usize, &[u32])],
-) -> Result<BoundaryMultiplierProblem> {
-    let (bilinear_id, linear_id) = system_forms::<M>()?;
-    let (bilinear, linear) = (M::form(bilinear_id)?, M::form(linear_id)?);
-    crate::model::require_symmetric::<M, TriangleMesh>(bilinear, mesh, coefficients)?;
-    let multiplier = multiplier_field::<M>()?;
-    let space = match M::FIELDS[multiplier].element {
-        ElementKind::P0 => BoundaryMultiplier::P0,
-        ElementKind::P1 => BoundaryMultiplier::P1,
-        other => {
+    parts: &[(P, &[u32])],
+    fixed: &[(F, &[u32])],
+) -> Result<Discretization<TriangleMesh>>
+where
+    M: Model,
+    P: IntoPartIndex<M> + Copy,
+    F: IntoFieldIndex<M> + Copy,
+{
+    let mut markers: Vec<Option<Vec<u32>>> = vec![None; M::FACET_PARTS.len()];
+    for &(part, on) in parts {
+        markers[M::facet_part(part)?] = Some(on.to_vec());
+    }
+    let markers = markers
+        .into_iter()
+        .enumerate()
+        .map(|(k, m)| {
+            m.ok_or_else(|| {
+                Error::Input(format!(
+                    "the boundary part `{}` of `{}` is not given markers",
+                    M::FACET_PARTS[k],
+                    M::NAME
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let dofs = primal_dofs::<M>(mesh)?;
+    let mut constraints = Constraints::new();
+    for &(field, on) in fixed {
+        let field = M::field(field)?;
+        let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
             return Err(Error::Input(format!(
-                "the boundary multiplier `{}` of `{}` must be P0 (one value per edge) or P1 (one per vertex of Γ_C), not {}",
-                M::FIELDS[multiplier].name,
-                M::NAME,
-                other.name()
-            )))
+                "field `{}` is not a primal field of `{}`",
+                M::FIELDS[field].name,
+                M::NAME
+            )));
+        };
+        for d in DirichletPart::Markers(on.to_vec()).dofs(map, mesh) {
+            constraints.fix_dof(offset + d, 0.0)?;
         }
-    };
-    let mut multiplier_parts: Vec<usize> = M::FACET_BLOCKS
+    }
+    discretize::<M>(mesh, coefficients, &markers, dofs, &constraints)
+}
+
+/// Which of the model's boundary parts its multiplier lives on: the one part of the
+/// boundary integrals of `B_h` in which the multiplier appears; `None` when it appears in
+/// none (a multiplier on the cells).
+///
+/// # Errors
+/// [`Error::Input`] for a multiplier in the boundary integrals of several parts, and
+/// those of [`multiplier_field`] and [`system_forms`].
+pub fn multiplier_part<M: Model>() -> Result<Option<usize>> {
+    let (bilinear, _) = system_forms::<M>()?;
+    let bilinear = M::form(bilinear)?;
+    let multiplier = multiplier_field::<M>()?;
+    let mut parts: Vec<usize> = M::FACET_BLOCKS
         .iter()
         .filter(|b| {
             b.form == bilinear && (b.test_field == multiplier || b.trial_field == Some(multiplier))
         })
         .map(|b| b.part)
         .collect();
-    multiplier_parts.dedup();
-    let multiplier_part = match multiplier_parts.as_slice() {
-        [p] => *p,
-        [] => {
+    parts.sort_unstable();
+    parts.dedup();
+    match parts.as_slice() {
+        [] => Ok(None),
+        [p] => Ok(Some(*p)),
+        _ => Err(Error::Input(format!(
+            "the multiplier `{}` of `{}` appears in boundary integrals over several parts; it must live on one",
+            M::FIELDS[multiplier].name,
+            M::NAME
+        ))),
+    }
+}
+
+/// The DOFs of a model whose multiplier lives on a boundary part: its primal fields
+/// (the multiplier's DOFs are the part's, [`BoundaryMultiplierDofs`]).
+///
+/// # Errors
+/// Those of [`SystemDofs::new`] and [`multiplier_field`].
+pub fn primal_dofs<M: Model>(mesh: &TriangleMesh) -> Result<SystemDofs> {
+    let multiplier = multiplier_field::<M>()?;
+    let primal: Vec<usize> = (0..M::FIELDS.len()).filter(|&f| f != multiplier).collect();
+    SystemDofs::new::<M>(mesh, &primal)
+}
+
+/// The multiplier's DOFs on the edges of its part `part`, whose boundary markers are
+/// `markers`.
+///
+/// # Errors
+/// [`Error::Input`] for a multiplier that is neither P0 nor P1, and for a part that holds
+/// no boundary edge of `mesh`.
+pub fn multiplier_dofs_on<M: Model>(
+    mesh: &TriangleMesh,
+    part: usize,
+    markers: &[u32],
+) -> Result<BoundaryMultiplierDofs> {
+    let multiplier = multiplier_field::<M>()?;
+    let space = match M::FIELDS[multiplier].element {
+        ElementKind::P0 => BoundaryMultiplier::P0,
+        ElementKind::P1 => BoundaryMultiplier::P1,
+        other => {
             return Err(Error::Input(format!(
-                "the multiplier `{}` of `{}` appears in no boundary integral of `{}`: it has no boundary part to live on",
+                "the boundary multiplier `{}` of `{}` must be P0 (one value per edge) or P1 (one per vertex of its part), not {}",
                 M::FIELDS[multiplier].name,
                 M::NAME,
-                M::FORMS[bilinear].name
-            )))
-        }
-        _ => {
-            return Err(Error::Input(format!(
-                "the multiplier `{}` of `{}` appears in boundary integrals over several parts; it must live on one",
-                M::FIELDS[multiplier].name,
-                M::NAME
+                other.name()
             )))
         }
     };
+    let edges = part_edges(mesh, markers);
+    if edges.is_empty() {
+        return Err(Error::Input(format!(
+            "the boundary part `{}` (markers {markers:?}) holds no boundary edge of the mesh: it is not on the boundary",
+            M::FACET_PARTS[part]
+        )));
+    }
+    let (vertices, edge_dofs) = multiplier_dofs(mesh, &edges, space);
+    Ok(BoundaryMultiplierDofs {
+        part,
+        edges,
+        space,
+        vertices,
+        edge_dofs,
+    })
+}
+
+/// Assembles `B_h`, `L_h` of `M` (cell and facet blocks) on `mesh` with the multiplier
+/// on the edges of its boundary part, and eliminates the fixed DOFs of `constraints`
+/// (on `dofs`, the model's primal fields: [`primal_dofs`]).
+///
+/// `parts` gives the boundary markers of each of the model's `FACET_PARTS`, in their
+/// order (e.g. from [`TriangleMesh::boundary_part_markers`]).
+///
+/// A P1 multiplier's facet kernels see its three local DOFs on the cell; on the edge only
+/// the two end vertices' functions are nonzero, so the third vertex's rows and columns
+/// must vanish (checked: an error otherwise, e.g. a derivative of λ in a boundary
+/// integral). Its `(μ, λ)` block, `C = α Σ_E h_E (μ_l, μ_k)_E`, couples neighbouring
+/// vertices along the whole part: a chain, not the small blocks of consecutive
+/// constraints [`crate::lcp::CouplingBlocks`] holds (at most
+/// [`crate::lcp::MAX_BLOCK`]), so it is lumped by rows: `C_kk = Σ_l C_kl`. That is exact
+/// on constant pressures (the patch test keeps `λ_h = q`), keeps `C` diagonal and
+/// positive for the semismooth Newton solver, and leaves `B`, `A` and `G` consistent.
+///
+/// # Errors
+/// [`Error::Input`] when the model has no system, no single multiplier, a multiplier that
+/// is neither P0 nor P1 or that appears in no boundary integral or on two parts, a P1
+/// multiplier whose facet terms reach the vertex off the edge; `parts` not one list of
+/// markers per part of the model, or a part that holds no boundary edge of the mesh;
+/// conditions on vertex combinations in `constraints` (rotated DOFs: supported on the
+/// cells' multipliers only); the errors of the kernels ([`Error::NonFinite`] for a
+/// non-finite entry).
+pub fn discretize<M: Model>(
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    parts: &[Vec<u32>],
+    dofs: SystemDofs,
+    constraints: &Constraints,
+) -> Result<Discretization<TriangleMesh>> {
+    let (bilinear_id, linear_id) = system_forms::<M>()?;
+    let (bilinear, linear) = (M::form(bilinear_id)?, M::form(linear_id)?);
+    crate::model::require_symmetric::<M, TriangleMesh>(bilinear, mesh, coefficients)?;
+    let multiplier = multiplier_field::<M>()?;
+    let Some(multiplier_part) = multiplier_part::<M>()? else {
+        return Err(Error::Input(format!(
+            "the multiplier `{}` of `{}` appears in no boundary integral of `{}`: it has no boundary part to live on",
+            M::FIELDS[multiplier].name,
+            M::NAME,
+            M::FORMS[bilinear].name
+        )));
+    };
+    if parts.len() != M::FACET_PARTS.len() {
+        return Err(Error::Input(format!(
+            "model `{}` integrates over the boundary parts {}: give markers for each ({} given)",
+            M::NAME,
+            M::FACET_PARTS.join(", "),
+            parts.len()
+        )));
+    }
+    if !constraints.vertex_conditions().is_empty() {
+        return Err(Error::Input(
+            "conditions on combinations of vertex DOFs (a rotated basis) are not supported with a multiplier on a boundary part".into(),
+        ));
+    }
     // The edges of every part of the model.
     let mut edges_of_part = Vec::with_capacity(M::FACET_PARTS.len());
-    for &name in M::FACET_PARTS {
-        let markers = parts
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, m)| *m)
-            .ok_or_else(|| {
-                Error::Input(format!(
-                    "the boundary part `{name}` of `{}` is not given markers (given: {})",
-                    M::NAME,
-                    parts.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
-                ))
-            })?;
+    for (name, markers) in M::FACET_PARTS.iter().zip(parts) {
         let edges = part_edges(mesh, markers);
         if edges.is_empty() {
             return Err(Error::Input(format!(
@@ -231,8 +348,8 @@ pub fn discretize_boundary_multiplier<M: Model>(
         let places: Vec<(usize, usize)> = edges.iter().map(|e| (e.cell, e.local)).collect();
         crate::model::require_symmetric_facets::<M>(bilinear, part, mesh, coefficients, &places)?;
     }
-    let contact_edges = edges_of_part[multiplier_part].clone();
-    let (contact_vertices, edge_dofs) = multiplier_dofs(mesh, &contact_edges, space);
+    let boundary = multiplier_dofs_on::<M>(mesh, multiplier_part, &parts[multiplier_part])?;
+    let space = boundary.space;
     if space == BoundaryMultiplier::P1 {
         if let Some(b) = M::FACET_BLOCKS.iter().find(|b| {
             (b.form == bilinear || b.form == linear)
@@ -249,13 +366,9 @@ pub fn discretize_boundary_multiplier<M: Model>(
             )));
         }
     }
-    let primal: Vec<usize> = (0..M::FIELDS.len()).filter(|&f| f != multiplier).collect();
-    let dofs = SystemDofs::new::<M>(mesh, &primal)?;
     let n_full = dofs.dof_count();
-    let m = match space {
-        BoundaryMultiplier::P0 => contact_edges.len(),
-        BoundaryMultiplier::P1 => contact_vertices.len(),
-    };
+    let m = boundary.count();
+    let edge_dofs = &boundary.edge_dofs;
 
     // A: the cell part, then the facet blocks.
     let cell_part =
@@ -284,8 +397,7 @@ pub fn discretize_boundary_multiplier<M: Model>(
         .max()
         .unwrap_or(0);
     let mut out = vec![0.0; largest * largest];
-    // The global rows of a field's local DOFs on an edge's cell; for the multiplier, its
-    // constraint (the edge's position in the part).
+    // The global rows of a field's local DOFs on an edge's cell.
     let place = |field: usize, cell: usize| -> Option<Vec<usize>> {
         let map = dofs.map(field)?;
         let offset = dofs.offset(field)?;
@@ -323,7 +435,7 @@ pub fn discretize_boundary_multiplier<M: Model>(
                         edge,
                     )?;
                     match (mrows, mcols) {
-                        // lumped by rows: the chain of Γ_C does not fit CouplingBlocks
+                        // lumped by rows: the chain of the part does not fit CouplingBlocks
                         (true, true) => {
                             for (a, &i) in on_edge.iter().enumerate() {
                                 let row: f64 = on_edge.iter().map(|&j| local[i * cols + j]).sum();
@@ -395,54 +507,45 @@ pub fn discretize_boundary_multiplier<M: Model>(
         }
     }
     let a_full: SparseMatrix = SparseColMat::try_new_from_triplets(n_full, n_full, &triplets)
-        .map_err(|e| Error::Input(format!("assembling the contact system: {e:?}")))?;
-    // Homogeneous Dirichlet conditions, eliminated.
-    let mut constraints = Constraints::new();
-    for &(field, markers) in fixed {
-        let map = dofs.map(field).ok_or_else(|| {
-            Error::Input(format!(
-                "field {field} is not a primal field of `{}`",
-                M::NAME
-            ))
-        })?;
-        let offset = dofs.offset(field).unwrap_or(0);
-        for d in DirichletPart::Markers(markers.to_vec()).dofs(map, mesh) {
-            constraints.fix_dof(offset + d, 0.0)?;
-        }
-    }
+        .map_err(|e| Error::Input(format!("assembling the system: {e:?}")))?;
     let reduction = constraints.reduction(n_full)?;
     let a = reduction.matrix(&a_full);
     let f = reduction.rhs(&a_full, &f_full);
+    // B U_full = B U_free + B U_fixed: the fixed columns move to G
     let b_rows: Vec<Vec<(usize, f64)>> = b_full
         .into_iter()
-        .map(|row| {
+        .zip(&mut g)
+        .map(|(row, g)| {
             let mut out: Vec<(usize, f64)> = Vec::with_capacity(row.len());
             for (col, v) in row {
-                if let Some(j) = reduction.free_index(col) {
-                    match out.iter_mut().find(|(c, _)| *c == j) {
+                match reduction.free_index(col) {
+                    Some(j) => match out.iter_mut().find(|(c, _)| *c == j) {
                         Some(e) => e.1 += v,
                         None => out.push((j, v)),
-                    }
+                    },
+                    None => *g -= v * reduction.fixed_value(col),
                 }
             }
             out.sort_by_key(|e| e.0);
             out
         })
         .collect();
-    Ok(BoundaryMultiplierProblem {
+    let n = reduction.free().len();
+    Ok(Discretization {
+        mesh: mesh.clone(),
         dofs,
         reduction,
+        basis: Default::default(),
         lcp: Lcp::new(a, ConstraintRows::from(b_rows), c, f, g),
-        contact_edges,
-        multiplier_space: space,
-        contact_vertices,
-        edge_dofs,
         multiplier_field: multiplier,
-        multiplier_part,
+        multipliers: Multipliers::Boundary(boundary),
+        roles: Vec::new(),
+        primal_reduced: (0..n).collect(),
+        multiplier_reduced: Vec::new(),
     })
 }
 
-/// The multiplier's DOF map on the contact edges: for P1 the vertices of the edges
+/// The multiplier's DOF map on the part's edges: for P1 the vertices of the edges
 /// (ascending) and each edge's two constraints; for P0 no vertices and `[k, k]`.
 fn multiplier_dofs(
     mesh: &TriangleMesh,
@@ -513,22 +616,23 @@ fn check_off_edge<M: Model>(
 ///
 /// The forms are the model's stabilization role ([`Model::STABILIZATION`]): the cell
 /// form it is measured against (`a(u;v)`, its blocks give `K_T`) and the stabilization
-/// form, whose facet blocks on the multiplier's part, restricted to the primal fields,
-/// give `S_E` (`S(u,λ;v,μ) = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds`). One value per edge
-/// of `problem.contact_edges`; `α = 1/(2 max_E C_I,E)` is the rule of §1.
+/// form, whose facet blocks on the multiplier's part, restricted to the primal fields
+/// `dofs`, give `S_E` (`S(u,λ;v,μ) = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds`). One value
+/// per edge of `boundary.edges`; `α = 1/(2 max_E C_I,E)` is the rule of §1.
 ///
 /// # Errors
 /// [`Error::Input`] for a model without a stabilization role; the kernels' errors;
 /// [`Error::NonFinite`] when a local matrix is not finite.
 pub fn inverse_constants<M: Model>(
     mesh: &TriangleMesh,
-    problem: &BoundaryMultiplierProblem,
+    boundary: &BoundaryMultiplierDofs,
+    dofs: &SystemDofs,
     coefficients: &Coefficients,
 ) -> Result<Vec<f64>> {
     let role = crate::stabilization::role::<M>()?;
     let (energy, stabilization) = (role.against, role.form);
     // Local numbering: the primal fields' local DOFs one after the other.
-    let fields = problem.dofs.fields();
+    let fields = dofs.fields();
     let counts: Vec<usize> = fields
         .iter()
         .map(|&f| M::FIELDS[f].element.local_dof_count(M::CELL))
@@ -550,8 +654,8 @@ pub fn inverse_constants<M: Model>(
         .max()
         .unwrap_or(0);
     let mut out = vec![0.0; largest * largest];
-    let mut constants = Vec::with_capacity(problem.contact_edges.len());
-    for edge in &problem.contact_edges {
+    let mut constants = Vec::with_capacity(boundary.edges.len());
+    for edge in &boundary.edges {
         let x = mesh.cell_coordinates(edge.cell);
         let mut k = nalgebra::DMatrix::<f64>::zeros(size, size);
         let mut s = nalgebra::DMatrix::<f64>::zeros(size, size);
@@ -570,7 +674,7 @@ pub fn inverse_constants<M: Model>(
             }
         }
         for (index, block) in M::FACET_BLOCKS.iter().enumerate() {
-            if block.form != stabilization || block.part != problem.multiplier_part {
+            if block.form != stabilization || block.part != boundary.part {
                 continue;
             }
             let Some(trial) = block.trial_field else {
