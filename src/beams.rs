@@ -5,11 +5,10 @@ use crate::models::scenes::{exact_solution, Beam, Scene};
 use crate::models::{bernoulli, timoshenko_p1_full, timoshenko_p1_reduced, timoshenko_p2};
 use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::hierarchy::LinearSolver;
-use fem_runtime::obstacle::{
-    solve_obstacle, system_forms, Discretization, ObstacleOptions, VariationalSolver,
-};
-use fem_runtime::stabilization;
-use fem_runtime::{Coefficients, DataFn, Error, IntervalMesh, Model, Result};
+use fem_runtime::obstacle::{system_forms, Discretization, ObstacleOptions, VariationalSolver};
+use fem_runtime::problem::{Condition, Exact, MemoryModel, ObstacleSide, Problem, SolveOptions};
+use fem_runtime::stabilization::Alpha;
+use fem_runtime::{Coefficients, DataFn, DirichletPart, Error, IntervalMesh, Model, Result};
 use serde::Serialize;
 
 /// The element pairs a beam scene can be solved with.
@@ -461,62 +460,11 @@ fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
     Ok(())
 }
 
-/// The rounding experiment of a Timoshenko solve: the larger change of w_h (as
-/// `solve_at(t')` measures it against the solution at `thickness`) when the thickness
-/// moves by `2⁻⁴⁰` and `−2⁻³⁹` of itself. That changes the rounding of every entry of
-/// the shear term `t⁻²(w′ − θ)` and, to first order, nothing else (`∂w/∂t ~ t` moves w
-/// by ~1e-12 t² relative): the change is the rounding of the solve. Two moves, since
-/// one can land on a rounding close to the first. Measured on timoshenko-a at q = 1
-/// against its exact solution (t = 1e-2 … 1e-5, 256 … 16384 elements), the larger change
-/// is within a factor 3 of the true error wherever rounding dominates it, while a
-/// first-order estimate from random ±ε perturbations of the matrix entries came out
-/// 1000× too small and the norm-wise `ε κ(A)` 100× too large.
-///
-/// # Errors
-/// Those of `solve_at`.
-fn thickness_rounding(solve_at: impl Fn(f64) -> Result<f64>, thickness: f64) -> Result<f64> {
-    let up = solve_at(thickness * (1.0 + 2f64.powi(-40)))?;
-    let down = solve_at(thickness * (1.0 - 2f64.powi(-39)))?;
-    Ok(up.max(down))
-}
-
-/// The Euler–Bernoulli beam's rounding experiment: solves it on `[0, L]` for L = 1 moved
-/// in its last bits both ways (`1 + 2⁻⁴⁰`, `1 − 2⁻³⁹`) and returns the larger change
-/// `solve_on` reports. The exact solution moves by O(2⁻⁴⁰), far below what is reported;
-/// every stiffness entry moves in its last bits, so the rounding of the solve, ~ε h⁻⁴ of
-/// w, is drawn anew. Measured on bernoulli-a (relative error of max w_h against q/384
-/// from the rounding alone): 1e-7 at 1024 elements, 8.5e-6 at 4096, 1.3e-3 at 16384,
-/// 2–7 % at 65536 with a KKT residual of 8e-17 and no warning before this check.
-fn length_rounding(solve_on: impl Fn(f64) -> Result<f64>) -> Result<f64> {
-    let up = solve_on(1.0 + 2f64.powi(-40))?;
-    let down = solve_on(1.0 - 2f64.powi(-39))?;
-    Ok(up.max(down))
-}
-
 /// `ε t⁻² h⁻²` on `elements` elements of the unit beam: the relative size of the rounding
 /// of the shear term against the bending term it leaves (near 1 no digit is left).
 fn shear_conditioning(thickness: f64, elements: usize) -> f64 {
     f64::EPSILON * ((elements as f64) / thickness).powi(2)
 }
-
-/// [`Report::thickness_rounding`] above which a solve is refused: w_h has no correct
-/// digit (a tester's timoshenko-a at t = 1e-5 on 4096 elements was 18 % off, with a KKT
-/// residual of 5e-17 and no warning).
-const MAX_THICKNESS_ROUNDING: f64 = 0.1;
-
-/// [`Report::thickness_rounding`] above which a solve warns: w_h keeps fewer than four
-/// digits.
-const THICKNESS_ROUNDING_WARNING: f64 = 1e-4;
-
-/// Largest estimated relative rounding noise of λ_h accepted in a result (with a warning
-/// above 1e-6): beyond it λ_h has no correct digit. The estimate is a bound, loose by up
-/// to 10× (timoshenko-a, q = 100, 32768 elements: 0.1 with ∫λ_h still right to 4 digits);
-/// on bernoulli-flat at q = 100 it is 1.8 at 20000 elements, where ∫λ_h is off by 6×.
-const MAX_MULTIPLIER_NOISE: f64 = 1.0;
-
-/// Largest rounding of w through the contact rows, relative to its size, accepted in a
-/// result ([`Report::primal_rounding`]).
-const MAX_PRIMAL_ROUNDING: f64 = 1e-3;
 
 /// Most rounds of iterative refinement per linear solve that `--refinement` accepts.
 pub const MAX_REFINEMENT_STEPS: usize = 10;
@@ -525,64 +473,73 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     let scene = request.scene;
     let setup = Setup::new(request, pair)?;
     let (alpha, thickness, q) = (setup.alpha, setup.thickness, request.load);
-    let coefficients = setup.coefficients::<M>()?;
-    let clamped = setup.clamped;
-    let mesh = IntervalMesh::uniform(0.0, 1.0, request.elements)?;
-    let inverse_constant = stabilization::inverse_constant::<M, _>(&mesh, &coefficients.params)?;
-    let options = ObstacleOptions {
-        solver: request.solver,
-        nested_from: request.nested_from,
-        newton: NewtonOptions {
-            refinement_steps: request.refinement_steps,
-            ..NewtonOptions::default()
-        },
-        linear_solver: request.linear_solver,
-        ..ObstacleOptions::default()
-    };
-    let solution = solve_obstacle::<M>(&mesh, &coefficients, clamped, options).map_err(|e| {
-        match e {
-            // the stiffness's h⁻⁴ first: a tester's bernoulli-flat without contact at 100000
-            // elements was told of α·C_I and a free rigid motion (C_I = 0 for Hermite)
-            Error::NotConverged { .. } | Error::LinearSolve(_)
-                if pair == Pair::BernoulliHermite && request.elements > 2000 =>
-            {
-                Error::Input(format!(
-                    "{e}; at {} Hermite elements the bending stiffness conditions the system like h⁻⁴ (N⁴ = {:.0e}), and where the beam is in contact the multiplier's stabilization C = αh⁵ = {:.0e} lies below the rounding of the gap G − BU: use fewer elements (the error against the exact solutions is smallest near 1000; Hermite cubics reach 1e-12 at 256), or for contact a larger α",
-                    request.elements,
-                    (request.elements as f64).powi(4),
-                    alpha * (1.0 / request.elements as f64).powi(5)
-                ))
-            }
-            Error::NotConverged { .. } | Error::LinearSolve(_)
-                if setup.timoshenko && shear_conditioning(thickness, request.elements) > 1e-3 =>
-            {
-                Error::Input(format!(
-                    "{e}; at t = {} on {} elements the shear term t⁻²(w′ − θ) conditions the system like t⁻²h⁻², and its rounding ε t⁻²h⁻² ≈ {:.0e} is not small against the bending term the answer lives in: use fewer elements, a larger t, or the Euler–Bernoulli limit (bernoulli-a, bernoulli-b)",
-                    crate::number(thickness),
-                    request.elements,
-                    shear_conditioning(thickness, request.elements)
-                ))
-            }
-            e => e,
+    let exact = exact_solution(&scene, q, thickness).map(std::sync::Arc::new);
+    let (for_value, for_slope) = (exact.clone(), exact.clone());
+    let exact_value = move |x: &[f64]| for_value.as_ref().map_or(f64::NAN, |e| (e.w)(x[0], 0));
+    let exact_slope =
+        move |x: &[f64]| [for_slope.as_ref().map_or(f64::NAN, |e| (e.w)(x[0], 1)), 0.0];
+    // nested iteration over uniform meshes N/2^k ≥ 16 (Newton only)
+    let mut sizes = vec![request.elements];
+    if let (Some(min), VariationalSolver::SemismoothNewton) = (request.nested_from, request.solver)
+    {
+        while sizes[0] % 2 == 0 && sizes[0] / 2 >= min.max(1) {
+            sizes.insert(0, sizes[0] / 2);
         }
-    })?;
-    if solution.multiplier_noise > MAX_MULTIPLIER_NOISE {
-        return Err(Error::Input(format!(
-            "at {} elements λ_h is rounding noise (estimated {:.0e} relative; ∫λ_h would be off by as much, and w follows it): the multiplier's stabilization C = αh⁵ lies below the rounding of the gap G − BU; use fewer elements or a larger α",
-            request.elements, solution.multiplier_noise
-        )));
     }
-    let w_field = M::field("w")?;
-    let energy = solution.energy::<M>(&coefficients)?;
-    let w = solution.view(w_field);
-    let exact = exact_solution(&scene, q, thickness);
-    let (error_l2, error_h1) = match &exact {
-        Some(e) => (
-            Some(w.error(0, &|x| (e.w)(x, 0), 6)),
-            Some(w.error(1, &|x| (e.w)(x, 1), 6)),
-        ),
-        None => (None, None),
+    let meshes = sizes
+        .iter()
+        .map(|&n| IntervalMesh::uniform(0.0, 1.0, n))
+        .collect::<Result<Vec<_>>>()?;
+    let options = SolveOptions {
+        obstacle: ObstacleOptions {
+            solver: request.solver,
+            newton: NewtonOptions {
+                refinement_steps: request.refinement_steps,
+                ..NewtonOptions::default()
+            },
+            linear_solver: request.linear_solver,
+            ..ObstacleOptions::default()
+        },
+        nested: request.nested_from.is_some(),
+        rounding_experiment: true,
     };
+    let side = if scene.side > 0.0 {
+        ObstacleSide::Below
+    } else {
+        ObstacleSide::Above
+    };
+    let mut problem = Problem::<M, IntervalMesh>::new(meshes)
+        .data("f", &*setup.load)
+        .data("ψ", &*setup.obstacle)
+        .side(side)
+        .alpha(
+            request.alpha.map_or(Alpha::default(), Alpha::Fixed),
+            pair.default_alpha(),
+        )
+        .options(options)
+        .memory(
+            MemoryModel::per_cell(BYTES_PER_ELEMENT),
+            format!("--elements {}", request.elements),
+        );
+    for field in setup.clamped {
+        problem = problem.support(DirichletPart::All, *field, Condition::Clamped);
+    }
+    if setup.timoshenko {
+        problem = problem.param("t", thickness);
+    }
+    if exact.is_some() {
+        problem = problem.exact(Exact {
+            value: &exact_value,
+            gradient: Some(&exact_slope),
+            multiplier: None,
+        });
+    }
+    let solved = problem
+        .solve()
+        .map_err(|e| conditioning_hint(e, request, pair, thickness))?;
+    let solution = &solved.solution;
+    let runtime = &solved.report;
+    let w = solution.view(M::field("w")?);
     let samples = 8 * request.elements.min(512) + 1;
     let x: Vec<f64> = (0..samples)
         .map(|i| i as f64 / (samples - 1) as f64)
@@ -595,124 +552,16 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
                 .abs()
         })
         .fold(0.0, f64::max);
-    // the weak (cell-wise) constraint lets w cross ψ inside cells: s(ψ − w)₊ at 4 points per cell
-    let max_penetration = (0..=4 * request.elements)
-        .map(|i| {
-            let x = i as f64 / (4 * request.elements) as f64;
-            let gap = scene.side * (w.at(x, 0).unwrap_or(f64::NAN) - scene.obstacle.at(x));
-            (-gap).max(0.0)
-        })
-        .fold(0.0, f64::max);
     let theta = M::field("θ").ok().map(|f| {
         let view = solution.view(f);
         x.iter()
             .map(|&x| view.at(x, 0).unwrap_or(f64::NAN))
             .collect()
     });
-    let psi_size = x
-        .iter()
-        .map(|&x| scene.obstacle.at(x).abs())
-        .fold(0.0, f64::max);
-    // 1e-6 of the beam's length: so that a beam at rest on ψ = 0 is judged against something
-    let primal_rounding = solution.primal_rounding() / max_deflection.max(psi_size).max(1e-6);
-    if primal_rounding > MAX_PRIMAL_ROUNDING {
-        // the rows' large terms are the load's, or αC Λ's when the user's α is far above
-        // the default (a tester's α = 1e30 at q = 100 was told the load was at fault)
-        if alpha > LARGE_ALPHA * pair.default_alpha() {
-            return Err(Error::Input(format!(
-                "the load q = {q:e} with α = {alpha:e} ({} times the pair's default {:e}) makes the terms of the constraint rows so large that their rounding moves w by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it): lower --alpha first, then the load",
-                crate::number(alpha / pair.default_alpha()),
-                pair.default_alpha()
-            )));
-        }
-        return Err(Error::Input(format!(
-            "the load q = {q:e} dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves w by {primal_rounding:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it)"
-        )));
-    }
-    let size = max_deflection.max(psi_size).max(1e-6);
-    let rounding_clock = std::time::Instant::now();
-    let thickness_rounding = if setup.timoshenko {
-        let moved = thickness_rounding(
-            |t| {
-                let coefficients = setup.coefficients_at::<M>(t)?;
-                let other = solve_obstacle::<M>(&mesh, &coefficients, clamped, options)?;
-                let view = other.view(w_field);
-                Ok((0..=4 * request.elements)
-                    .map(|i| {
-                        let x = i as f64 / (4 * request.elements) as f64;
-                        (view.at(x, 0).unwrap_or(f64::NAN) - w.at(x, 0).unwrap_or(f64::NAN)).abs()
-                    })
-                    .fold(0.0, f64::max))
-            },
-            thickness,
-        )
-        // a perturbed solve that fails has no digit to lose either
-        .unwrap_or(f64::INFINITY);
-        // relative to w_h itself: ψ can be far larger than a stiff beam's deflection
-        Some(if moved == 0.0 {
-            0.0
-        } else {
-            moved / max_deflection
-        })
-    } else {
-        None
-    };
-    let length_rounding = if setup.timoshenko {
-        None
-    } else {
-        let force = solution.total_contact_force();
-        let moved = length_rounding(|length| {
-            let mesh = IntervalMesh::uniform(0.0, length, request.elements)?;
-            let other = solve_obstacle::<M>(&mesh, &coefficients, clamped, options)?;
-            let view = other.view(w_field);
-            let w_moved = (0..=4 * request.elements)
-                .map(|i| {
-                    let x = i as f64 / (4 * request.elements) as f64;
-                    (view.at(x * length, 0).unwrap_or(f64::NAN) - w.at(x, 0).unwrap_or(f64::NAN))
-                        .abs()
-                })
-                .fold(0.0, f64::max);
-            // ∫λ_h against the load it carries (a tester's ∫λ_h was 6× the exact at
-            // 65536 elements, with a multiplier-noise estimate of 2e-2)
-            let force_moved = (other.total_contact_force() - force).abs();
-            let load = q.abs().max(f64::MIN_POSITIVE);
-            // against 1e-6 of the length at least: a beam pressed flat onto ψ = 0 has
-            // w ≡ 0, and its 1e-17 of noise would be judged against itself
-            Ok((w_moved / max_deflection.max(1e-6)).max(force_moved / load))
-        })
-        .unwrap_or(f64::INFINITY);
-        Some(moved)
-    };
-    let rounding_seconds = rounding_clock.elapsed().as_secs_f64();
-    if let Some(r) = length_rounding.filter(|&r| r > MAX_THICKNESS_ROUNDING || r.is_nan()) {
-        let moved = if r.is_finite() {
-            format!("moves w_h or ∫λ_h by {r:.0e} of their size")
-        } else {
-            "makes the solve fail".to_string()
-        };
-        return Err(Error::Input(format!(
-            "on {} elements w_h is rounding: moving the beam's length in its last bits {moved}; the bending stiffness conditions the system like h⁻⁴, which leaves no digit here; use fewer elements (Hermite cubics reach 1e-12 at 256)",
-            request.elements
-        )));
-    }
-    if let Some(r) = thickness_rounding.filter(|&r| r > MAX_THICKNESS_ROUNDING || r.is_nan()) {
-        let moved = if r.is_finite() {
-            format!("moves w_h by {r:.0e} of its size")
-        } else {
-            "makes the solve fail".to_string()
-        };
-        return Err(Error::Input(format!(
-            "at t = {} on {} elements w_h is rounding: moving t in its last bits {moved}; the shear term t⁻²(w′ − θ) conditions the system like t⁻²h⁻², which leaves the bending part no digit; use fewer elements, a larger t, or the Euler–Bernoulli limit (bernoulli-a, bernoulli-b)",
-            crate::number(thickness),
-            request.elements
-        )));
-    }
-    let mut warnings = Vec::new();
+    let mut warnings = runtime.warnings.clone();
     let h = 1.0 / request.elements as f64;
-    // from a tenth of t on: at h = t the error is already 8 % (the re-test)
+    // from a tenth of t on: at h = t the error is already 8 %
     if pair == Pair::TimoshenkoP1Full && (h / thickness).powi(2) / 12.0 > 1e-3 {
-        // the locking study's collapsing pair: a tester's t = 1e-5 got max|w| 2e-7
-        // against the true 2.6e-3, without a word
         warnings.push(format!(
             "p1-p1-p0-full locks here: its elements (h = {}) are not short against the beam's thickness (t = {}), and its fully integrated shear term t⁻²(w′ − θ) then stiffens w_h by about (h/t)²/12 = {:.0e}; it is the locking pair of the locking study, shown for comparison: use p2-p2-p0 or p1-p1-p0-reduced",
             crate::number(h),
@@ -720,107 +569,40 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
             (h / thickness).powi(2) / 12.0
         ));
     }
-    if let Some(r) = length_rounding.filter(|&r| r > THICKNESS_ROUNDING_WARNING) {
-        warnings.push(format!(
-            "w_h is rounding-limited to about {r:.0e} of its size on {} elements (moving the beam's length in its last bits moves w_h or ∫λ_h that much; the bending stiffness conditions the system like h⁻⁴): fewer elements give more correct digits here (Hermite cubics reach 1e-12 at 256)",
-            request.elements
-        ));
-    }
-    if let Some(r) = thickness_rounding.filter(|&r| r > THICKNESS_ROUNDING_WARNING) {
-        warnings.push(format!(
-            "w_h is rounding-limited to about {r:.0e} of its size at t = {} on {} elements (moving t in its last bits moves w_h that much; the shear term t⁻²(w′ − θ) conditions the system like t⁻²h⁻²): fewer elements give more correct digits here, or use the Euler–Bernoulli limit",
-            crate::number(thickness),
-            request.elements
-        ));
-    }
-    if request.linear_solver == LinearSolver::Multigrid && solution.iterative_steps == 0 {
-        warnings.push(crate::membranes::multigrid_unused(
-            request.solver,
-            "a cold start, and an element count that is odd or below twice the coarsest level's (16 by default)",
-        ));
-    }
-    // as for membranes: relative to ψ's size (its range, or |ψ| for a flat one)
-    let psi_values: Vec<f64> = x.iter().map(|&x| scene.obstacle.at(x)).collect();
-    let psi_range = psi_values.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
-        - psi_values.iter().cloned().fold(f64::INFINITY, f64::min);
-    let psi_scale = if psi_range > 0.0 { psi_range } else { psi_size };
-    if psi_scale > 0.0 && max_penetration > 1e-2 * psi_scale {
-        warnings.push(format!(
-            "w_h crosses ψ by up to {max_penetration:.2e}, {:.1}% of ψ's size: the cell-wise constraint does not resolve the contact at this mesh size and load (refine, or lower the load)",
-            100.0 * max_penetration / psi_scale
-        ));
-    }
-    // as for membranes and plates: λ_h pushing on cells that stay clear of ψ is a
-    // contact set made by α h^k (bernoulli-flat at α = 1e10: w_h 5.6e-5, 0.05 below ψ,
-    // and all of [0, 1] "in contact"; timoshenko-a on one element)
-    let max_open_contact_gap = open_contact_gap(&mesh, solution.multiplier(), |x| {
-        scene.side * (w.at(x, 0).unwrap_or(f64::NAN) - scene.obstacle.at(x))
-    });
-    if max_open_contact_gap > crate::membranes::OPEN_GAP_WARNING * size
-        && max_open_contact_gap > solution.primal_rounding()
-    {
-        let large = alpha > 10.0 * pair.default_alpha();
-        warnings.push(format!(
-            "λ_h pushes on cells where w_h stays up to {max_open_contact_gap:.2e} clear of ψ ({:.1} % of the beam's size max(|w_h|, |ψ|) = {size:.2e}): the stabilized constraint on contact cells lets α h^k (…) open that gap (α = {alpha:e}{}), so this contact set is not real; {}",
-            100.0 * max_open_contact_gap / size,
-            if large { format!(", {} times the pair's default", crate::number(alpha / pair.default_alpha())) } else { String::new() },
-            if large { "lower --alpha" } else { "use more elements or a smaller α" }
-        ));
-    }
-    if alpha > LARGE_ALPHA * pair.default_alpha() {
-        warnings.push(format!(
-            "α = {alpha:e} is {} times the pair's default {:e}, more than {LARGE_ALPHA:e}: the stabilization's term moves the contact set and w_h with α (bernoulli-flat at q = 100 on 256 elements: L² error 1.9e-7 at the default, 4.1e-6 at α = 100, 1.1e-4 at α = 1e4)",
-            crate::number(alpha / pair.default_alpha()),
-            pair.default_alpha()
-        ));
-    }
-    if solution.multiplier_noise > 1e-6 {
-        warnings.push(format!(
-            "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁵ approaches the rounding of G − BU at this mesh size, and the saddle-point recovery of λ is no guarantee at this conditioning; w is affected too once the noise passes ~1e-3 (a larger α or a coarser mesh avoids it)",
-            solution.multiplier_noise
-        ));
-    }
-    if primal_rounding > 1e-8 {
-        warnings.push(format!(
-            "w may be off by {primal_rounding:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)"
-        ));
-    }
     let d = &solution.discretization;
     let report = Report {
         scene: scene.name.to_string(),
         pair: pair.name().to_string(),
-        solver: match request.solver {
-            VariationalSolver::SemismoothNewton => "pdas".into(),
-            VariationalSolver::Clarabel => "clarabel".into(),
-        },
+        solver: runtime.solver.into(),
         load: q,
         thickness: (scene.beam == Beam::Timoshenko).then_some(thickness),
         alpha,
-        inverse_constant,
+        inverse_constant: runtime.inverse_constant,
         elements: request.elements,
         dofs: d.lcp.n() + d.lcp.m(),
-        iterations: solution.iterations,
-        linear_solver: solution.linear_solver_name(),
-        krylov_iterations: solution.krylov_iterations,
-        factorizations: solution.factorizations,
-        levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
-        seconds: solution.seconds,
-        rounding_seconds,
-        energy,
+        iterations: runtime.iterations,
+        linear_solver: runtime.linear_solver,
+        krylov_iterations: runtime.krylov_iterations,
+        factorizations: runtime.factorizations,
+        levels: runtime.levels.clone(),
+        seconds: runtime.seconds,
+        rounding_seconds: runtime.rounding_seconds.unwrap_or(0.0),
+        energy: runtime.energy.unwrap_or(f64::NAN),
         max_deflection,
-        max_penetration,
-        max_open_contact_gap,
+        max_penetration: runtime.max_penetration.unwrap_or(0.0),
+        max_open_contact_gap: runtime.max_open_contact_gap.unwrap_or(0.0),
         contact_set: solution.contact_set(),
-        total_contact_force: solution.total_contact_force(),
-        complementarity_residual: solution.kkt_residual,
-        error_l2,
-        error_h1,
-        multiplier_noise: solution.multiplier_noise,
-        primal_rounding,
-        thickness_rounding,
-        length_rounding,
+        total_contact_force: runtime.total_contact_force,
+        complementarity_residual: runtime.kkt_residual,
+        error_l2: runtime.error_l2,
+        error_h1: runtime.error_h1,
+        multiplier_noise: runtime.multiplier_noise,
+        primal_rounding: runtime.primal_rounding,
+        thickness_rounding: setup.timoshenko.then(|| runtime.rounding.unwrap_or(0.0)),
+        length_rounding: (!setup.timoshenko).then(|| runtime.rounding.unwrap_or(0.0)),
         warnings,
     };
+    let mesh = &d.mesh;
     let profiles = Profiles {
         psi: x.iter().map(|&x| scene.obstacle.at(x)).collect(),
         w: w_values,
@@ -834,33 +616,33 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
     Ok((report, profiles))
 }
 
-/// An α above this multiple of the pair's default is warned about: the error grows with
-/// α (bernoulli-flat, q = 100, 256 elements: 1.9e-7 at the default 1e-2, 2.3e-5 at
-/// 1e3, 1.1e-4 at 1e4), and the contact set widens without an open gap to show it.
-const LARGE_ALPHA: f64 = 1e3;
-
-/// The largest open gap under a pushing multiplier on an interval mesh: over the cells
-/// whose P0 multiplier `lambda` pushes (above 1e-6 of its largest), the smallest
-/// `clearance(x)` at the cell's ends, quarter points and midpoint; the largest of these,
-/// 0 where every such cell touches ψ (or none pushes, or `lambda` is not one value per
-/// cell). NaN clearances are skipped: the penetration check reports those.
-fn open_contact_gap(mesh: &IntervalMesh, lambda: &[f64], clearance: impl Fn(f64) -> f64) -> f64 {
-    if lambda.len() != mesh.cell_count() {
-        return 0.0;
+/// A solver's failure where the beam's conditioning is the likely cause: the Hermite
+/// stiffness's `h⁻⁴` on many elements, or the shear term's `t⁻²h⁻²` of a thin
+/// Timoshenko beam.
+fn conditioning_hint(e: Error, request: &Request, pair: Pair, thickness: f64) -> Error {
+    let alpha = request.alpha.unwrap_or(pair.default_alpha());
+    match e {
+        Error::NotConverged { .. } | Error::LinearSolve(_)
+            if pair == Pair::BernoulliHermite && request.elements > 2000 =>
+        {
+            Error::Input(format!(
+                "{e}; at {} Hermite elements the bending stiffness conditions the system like h⁻⁴ (N⁴ = {:.0e}), and where the beam is in contact the multiplier's stabilization C = αh⁵ = {:.0e} lies below the rounding of the gap G − BU: use fewer elements (the error against the exact solutions is smallest near 1000; Hermite cubics reach 1e-12 at 256), or for contact a larger α",
+                request.elements,
+                (request.elements as f64).powi(4),
+                alpha * (1.0 / request.elements as f64).powi(5)
+            ))
+        }
+        Error::NotConverged { .. } | Error::LinearSolve(_)
+            if pair.beam() == Beam::Timoshenko
+                && shear_conditioning(thickness, request.elements) > 1e-3 =>
+        {
+            Error::Input(format!(
+                "{e}; at t = {} on {} elements the shear term t⁻²(w′ − θ) conditions the system like t⁻²h⁻², and its rounding ε t⁻²h⁻² ≈ {:.0e} is not small against the bending term the answer lives in: use fewer elements, a larger t, or the Euler–Bernoulli limit (bernoulli-a, bernoulli-b)",
+                crate::number(thickness),
+                request.elements,
+                shear_conditioning(thickness, request.elements)
+            ))
+        }
+        e => e,
     }
-    let largest = lambda.iter().fold(0.0f64, |m, l| m.max(*l));
-    if largest <= 0.0 {
-        return 0.0;
-    }
-    (0..mesh.cell_count())
-        .filter(|&c| lambda[c] > 1e-6 * largest)
-        .map(|c| {
-            let [a, b] = mesh.cell(c);
-            (0..=4)
-                .map(|i| clearance(a + (b - a) * i as f64 / 4.0))
-                .filter(|g| !g.is_nan())
-                .fold(f64::INFINITY, f64::min)
-        })
-        .filter(|g| g.is_finite())
-        .fold(0.0, f64::max)
 }

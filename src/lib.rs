@@ -31,16 +31,7 @@ pub use fem_runtime::*;
 /// and an energy of 0).
 pub const MIN_DATA_SIZE: f64 = 1e-200;
 
-/// A user-given number (a load, a parameter) as a report prints it: as written for
-/// magnitudes in [10⁻³, 10⁶) and zero, in scientific notation otherwise, so that
-/// `1e-300` is not printed as three hundred digits.
-pub fn number(x: f64) -> String {
-    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
-        x.to_string()
-    } else {
-        format!("{x:e}")
-    }
-}
+pub use fem_runtime::problem::number;
 
 /// Warnings for the boundary parts `names` (chosen under the scene-file key `key`) whose
 /// Gmsh groups hold interior edges (embedded curves): a boundary part holds boundary

@@ -3,7 +3,7 @@
 use thiserror::Error;
 
 /// What can go wrong when meshing, assembling or solving.
-#[derive(Debug, Error)]
+#[derive(Clone, Debug, Error)]
 pub enum Error {
     /// A mesh that cannot be used.
     #[error("invalid mesh: {0}")]

@@ -37,6 +37,7 @@ pub mod model;
 pub mod multigrid;
 pub mod norms;
 pub mod obstacle;
+pub mod problem;
 pub mod stabilization;
 
 pub use assembly::boundary::{Constraints, DirichletPart, PlateSupport, Reduction, Side};

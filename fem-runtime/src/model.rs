@@ -648,6 +648,28 @@ impl<'a> Coefficients<'a> {
         Self::from_indices::<M>(&params, &data)
     }
 
+    /// Every parameter's value and every data function, in declaration order, checked as
+    /// [`Coefficients::new`] checks them.
+    ///
+    /// # Errors
+    /// Counts that do not match the model's, a non-finite value, or a value ≤ 0 of a
+    /// parameter declared `> 0`.
+    pub fn of_values<M: Model>(params: &[f64], data: &[&'a DataFn]) -> Result<Self> {
+        if params.len() != M::PARAMS.len() || data.len() != M::DATA.len() {
+            return Err(Error::Input(format!(
+                "model `{}` has {} parameters and {} data functions, given {} and {}",
+                M::NAME,
+                M::PARAMS.len(),
+                M::DATA.len(),
+                params.len(),
+                data.len()
+            )));
+        }
+        let params: Vec<(usize, f64)> = params.iter().copied().enumerate().collect();
+        let data: Vec<(usize, &'a DataFn)> = data.iter().copied().enumerate().collect();
+        Self::from_indices::<M>(&params, &data)
+    }
+
     /// The checks shared by [`Coefficients::new`] and [`Coefficients::from_ids`], on
     /// indices in declaration order.
     fn from_indices<M: Model>(

@@ -122,9 +122,9 @@ pub fn scene(name: &str) -> Option<Scene> {
 /// An exact solution: deflection (and rotation) with derivatives, contact set and force.
 pub struct ExactSolution {
     /// `w^{(k)}(x)` for k = 0, 1, 2.
-    pub w: Box<dyn Fn(f64, usize) -> f64 + Sync>,
+    pub w: Box<dyn Fn(f64, usize) -> f64 + Send + Sync>,
     /// `θ^{(k)}(x)` (Timoshenko) for k = 0, 1.
-    pub theta: Option<Box<dyn Fn(f64, usize) -> f64 + Sync>>,
+    pub theta: Option<Box<dyn Fn(f64, usize) -> f64 + Send + Sync>>,
     /// Contact intervals (a point contact as `[x, x]`).
     pub contact_set: Vec<[f64; 2]>,
     /// `∫ λ` (point forces included).
@@ -157,7 +157,7 @@ fn free(beam: Beam, f: f64, t: f64) -> ExactSolution {
     ExactSolution {
         w: Box::new(w),
         theta: (beam == Beam::Timoshenko)
-            .then(|| Box::new(theta) as Box<dyn Fn(f64, usize) -> f64 + Sync>),
+            .then(|| Box::new(theta) as Box<dyn Fn(f64, usize) -> f64 + Send + Sync>),
         contact_set: Vec::new(),
         total_contact_force: 0.0,
     }

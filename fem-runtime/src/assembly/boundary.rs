@@ -553,6 +553,19 @@ impl Constraints {
         Ok(())
     }
 
+    /// Adds the conditions and warnings of `other` (on the same DOFs) to these.
+    ///
+    /// # Errors
+    /// None today; the signature leaves room for conflicting conditions.
+    pub fn merge(&mut self, other: Constraints) -> Result<()> {
+        for (dof, value) in other.fixed {
+            self.fix_dof(dof, value)?;
+        }
+        self.vertex.extend(other.vertex);
+        self.warnings.extend(other.warnings);
+        Ok(())
+    }
+
     /// Warnings about the supports given so far: a simply supported Argyris part that
     /// looks like a polygonal approximation of a curve (consecutive edges turning by at
     /// most [`CURVE_TURNING_ANGLE`]) converges to the wrong plate.

@@ -114,6 +114,15 @@ impl IntervalMesh {
             .expect("bisecting a valid mesh gives a valid mesh")
     }
 
+    /// The mesh with every coordinate multiplied by `factor > 0` (the same cells): the
+    /// rounding experiment solves on it ([`crate::problem`]).
+    ///
+    /// # Errors
+    /// A factor that is not positive and finite.
+    pub fn scaled(&self, factor: f64) -> Result<Self> {
+        Self::new(self.vertices.iter().map(|x| x * factor).collect())
+    }
+
     /// The vertices, increasing.
     pub fn vertices(&self) -> &[f64] {
         &self.vertices

@@ -1043,6 +1043,27 @@ where
     G: DofNumbering + Send + Sync,
     B: FnOnce() -> Result<Discretization<G>> + Send,
 {
+    solve_nested_from(levels, prolong, primal_prolongation, None, options)
+}
+
+/// The start of the first (coarsest) level of a nested solve: the primal unknowns to
+/// start Newton from, or `None` for zero; an error refuses the problem (e.g. a body
+/// whose rigid motion nothing holds).
+pub type FirstStart<G> = dyn Fn(&Discretization<G>) -> Result<Option<Vec<f64>>> + Sync;
+
+/// [`solve_nested_on_hierarchy`] whose coarsest level starts from `first_start`'s
+/// vector (semismooth Newton from zero otherwise).
+pub fn solve_nested_from<G, B>(
+    levels: Vec<B>,
+    prolong: impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
+    primal_prolongation: Option<&PrimalProlongation<G>>,
+    first_start: Option<&FirstStart<G>>,
+    options: ObstacleOptions,
+) -> Result<ObstacleSolution<G>>
+where
+    G: DofNumbering + Send + Sync,
+    B: FnOnce() -> Result<Discretization<G>> + Send,
+{
     let clock = Instant::now();
     // Only a multigrid step reads the prolongations: with `auto` choosing the direct
     // path they would be built on every level for nothing (0.3 s at 1M unknowns).
@@ -1067,9 +1088,10 @@ where
     let solve_finest = |coarse: Option<SolvedLevel<G>>,
                         d: &Discretization<G>,
                         workspace: Option<&NewtonWorkspace>| {
-        let start = coarse
-            .as_ref()
-            .map(|(c, values, _, _)| d.primal_part(&prolong(c, values, d)));
+        let start = match &coarse {
+            Some((c, values, _, _)) => Some(d.primal_part(&prolong(c, values, d))),
+            None => first_start.map(|f| f(d)).transpose()?.flatten(),
+        };
         let hierarchy = extend_hierarchy(coarse.as_ref(), d, primal_prolongation);
         let solution =
             solve_lcp_on_hierarchy(&d.lcp, workspace, &hierarchy, start.as_deref(), options)?;
@@ -1078,7 +1100,7 @@ where
         Ok::<_, Error>((solution, counts))
     };
     let (discretization, (solution, counts)) = if levels.is_empty() || !options.pipelined {
-        let coarse = solve_levels(levels, &prolong, primal_prolongation, options)?;
+        let coarse = solve_levels(levels, &prolong, primal_prolongation, first_start, options)?;
         let d = finest()?;
         let workspace = pattern_of(&d);
         let solved = solve_finest(coarse, &d, workspace.as_ref())?;
@@ -1112,7 +1134,7 @@ where
             }
         };
         let (solved, shared) = alongside(worker, || {
-            let coarse = solve_levels(levels, &prolong, primal_prolongation, options);
+            let coarse = solve_levels(levels, &prolong, primal_prolongation, first_start, options);
             // the coarse levels' error first, as in the sequential order
             match (coarse, receiver.recv()) {
                 (Err(e), _) | (Ok(_), Ok(Err(e))) => (Err(e), None),
@@ -1218,14 +1240,16 @@ fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
     levels: Vec<B>,
     prolong: &impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
     primal_prolongation: Option<&PrimalProlongation<G>>,
+    first_start: Option<&FirstStart<G>>,
     options: ObstacleOptions,
 ) -> Result<Option<SolvedLevel<G>>> {
     let mut last: Option<SolvedLevel<G>> = None;
     for build in levels {
         let d = build()?;
-        let start = last
-            .as_ref()
-            .map(|(coarse, values, _, _)| d.primal_part(&prolong(coarse, values, &d)));
+        let start = match &last {
+            Some((coarse, values, _, _)) => Some(d.primal_part(&prolong(coarse, values, &d))),
+            None => first_start.map(|f| f(&d)).transpose()?.flatten(),
+        };
         let hierarchy = extend_hierarchy(last.as_ref(), &d, primal_prolongation);
         let solution = solve_lcp_on_hierarchy(&d.lcp, None, &hierarchy, start.as_deref(), options)?;
         let mut counts = last.map(|(_, _, counts, _)| counts).unwrap_or_default();
@@ -1248,6 +1272,12 @@ impl<G> ObstacleSolution<G> {
             return d.multiplier_coefficients(&self.values);
         }
         &self.values[d.dofs.range(field).unwrap()]
+    }
+
+    /// The multiplier's coefficients (by its DOFs on the cells, or by the constraints of
+    /// a boundary part).
+    pub fn multiplier_values(&self) -> &[f64] {
+        self.field(self.discretization.multiplier_field)
     }
 
     /// The contact cells: indices of the cells on which some multiplier coefficient is

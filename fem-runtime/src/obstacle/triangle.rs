@@ -621,7 +621,11 @@ impl ObstacleSolution<TriangleMesh> {
 /// error of ψ on the cell: `u_h − ψ` has a nonnegative mean and a second derivative
 /// bounded by ψ's); the nodal method imposes `U_i ≥ ψ_i` at the vertices, where its
 /// penetration is 0 (between them, where ψ is curved, it is `O(h²)` too).
-pub fn max_penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: usize) -> f64 {
+pub fn max_penetration(
+    u: &TriangleField,
+    psi: &(dyn Fn(&[f64]) -> f64 + Sync),
+    degree: usize,
+) -> f64 {
     penetration(u, psi, degree).depth
 }
 
@@ -662,7 +666,11 @@ const PENETRATION_MAX_LATTICE: usize = 128;
 /// vertices (each cell's corners, so discontinuous fields count from every side), the
 /// points of the symmetric rule exact for degree `degree` on every cell and, on meshes of
 /// few cells, a lattice on each cell ([`PENETRATION_MIN_SAMPLES`]).
-pub fn penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: usize) -> Penetration {
+pub fn penetration(
+    u: &TriangleField,
+    psi: &(dyn Fn(&[f64]) -> f64 + Sync),
+    degree: usize,
+) -> Penetration {
     use crate::element::triangle::{over_cell_chunks, AffineMap, Tabulation};
     use rayon::prelude::*;
     let basis = TriangleBasis::new(u.map.element());
@@ -745,7 +753,7 @@ pub fn penetration(u: &TriangleField, psi: &crate::model::DataFn, degree: usize)
 pub fn max_open_contact_gap(
     u: &TriangleField,
     multiplier: &TriangleField,
-    psi: &crate::model::DataFn,
+    psi: &(dyn Fn(&[f64]) -> f64 + Sync),
     side: f64,
 ) -> f64 {
     let largest = multiplier.coefficients.iter().cloned().fold(0.0, f64::max);

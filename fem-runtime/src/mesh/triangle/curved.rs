@@ -248,6 +248,23 @@ impl CurvedTriangleMesh {
         })
     }
 
+    /// The mesh with every coordinate (vertices and edge nodes) multiplied by `factor`.
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] for a factor that is not positive and finite.
+    pub fn scaled(&self, factor: f64) -> Result<Self> {
+        let mesh = self.mesh.scaled(factor)?;
+        let geometry = QuadraticGeometry {
+            edge_nodes: self
+                .geometry
+                .edge_nodes
+                .iter()
+                .map(|x| [x[0] * factor, x[1] * factor])
+                .collect(),
+        };
+        Self::new(mesh, geometry)
+    }
+
     /// The disk of `radius` about `centre` with `rings` rings ([`TriangleMesh::disk`]) and
     /// its boundary edges curved onto the circle ([`QuadraticGeometry::circle`]).
     ///

@@ -581,6 +581,27 @@ impl TriangleMesh {
         self.vertices.len()
     }
 
+    /// The mesh with every coordinate multiplied by `factor` (the same cells, edges and
+    /// boundary parts): the rounding experiment solves on it ([`crate::problem`]).
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] for a factor that is not positive and finite.
+    pub fn scaled(&self, factor: f64) -> Result<Self> {
+        if !(factor > 0.0 && factor.is_finite()) {
+            return Err(mesh_error(format!(
+                "a mesh is scaled by a positive finite factor, not {factor}"
+            )));
+        }
+        let mut scaled = self.clone();
+        scaled.vertices = Arc::new(
+            self.vertices
+                .iter()
+                .map(|x| [x[0] * factor, x[1] * factor])
+                .collect(),
+        );
+        Ok(scaled)
+    }
+
     /// Number of cells.
     pub fn cell_count(&self) -> usize {
         self.cells.len()

@@ -1,0 +1,1321 @@
+//! One obstacle problem, one solve, one report, for any model the macro accepts.
+//!
+//! A [`Problem`] holds the model (its type), the meshes of its nested levels, the
+//! parameters and data by typed handle, the supports by boundary part and field, the
+//! markers of the model's boundary parts (where a boundary multiplier lives), the
+//! obstacle side and the α policy. [`Problem::solve`] derives C_I and α from the
+//! model's declared stabilization, fills α and the side, checks what can be checked
+//! before any work (memory, data, feasibility, the stabilization's size against
+//! rounding), solves the levels by nested iteration and returns the solution with one
+//! [`Report`]: the fields every model has and the guards every solve needs (penetration
+//! and open gap, rounding through the contact rows, multiplier noise, the KKT
+//! certificate, the rounding experiment, warnings).
+//!
+//! ```
+//! use fem_runtime::problem::{Condition, ObstacleSide, Problem, SolveOptions};
+//! use fem_runtime::{DirichletPart, IntervalMesh};
+//! fem_runtime::model! {
+//!     /// A string over an obstacle, P1–P0.
+//!     pub mod string on interval {
+//!         unknowns: u: P1, λ: P0 >= 0;
+//!         tests: v, μ;
+//!         params: α;
+//!         data: f, ψ;
+//!         forms: "
+//!             a(u;v)       = ∫ u'v'
+//!             S(u,λ;v,μ)   = Σ_T h_T² (−u'' − λ, −v'' − μ)_T
+//!             ℓ(v)         = ∫ f v
+//!             ℓ_S(v,μ)     = Σ_T h_T² (f, −v'' − μ)_T
+//!             B_h(u,λ;v,μ) = a(u;v) − ∫ v λ − ∫ u μ − α S(u,λ;v,μ)
+//!             L_h(v,μ)     = ℓ(v) − ∫ ψ μ − α ℓ_S(v,μ)
+//!         ";
+//!         system: B_h, L_h;
+//!         energy: a, ℓ;
+//!         stabilization: α S against a;
+//!         obstacle: u >= ψ;
+//!     }
+//! }
+//! // pressed onto ψ = 0 everywhere: u = 0, λ = 1
+//! let (load, obstacle) = (|_: &[f64]| -1.0, |_: &[f64]| 0.0);
+//! let mesh = IntervalMesh::uniform(0.0, 1.0, 16).unwrap();
+//! let solved = Problem::<string::Model, _>::new(vec![mesh])
+//!     .data(string::data::f, &load)
+//!     .data(string::data::ψ, &obstacle)
+//!     .support(DirichletPart::All, string::fields::u, Condition::Zero)
+//!     .side(ObstacleSide::Below)
+//!     .solve()
+//!     .unwrap();
+//! assert!((solved.report.total_contact_force - 1.0).abs() < 1e-10);
+//! ```
+
+pub mod domain;
+pub mod memory;
+pub mod report;
+
+pub use domain::{error_rule_degree, Domain, Errors, Penetration};
+pub use memory::MemoryModel;
+pub use report::{MeshQualityReport, Report};
+
+use crate::assembly::boundary::{Constraints, DirichletPart};
+use crate::error::{Error, Result};
+use crate::lcp::Lcp;
+use crate::mesh::Mesh;
+use crate::model::{
+    Coefficients, DataFn, IntoDataIndex, IntoFieldIndex, IntoParamIndex, IntoPartIndex, Model,
+};
+use crate::obstacle::{
+    multiplier_field, solve_nested_from, Discretization, FirstStart, ObstacleOptions,
+    ObstacleSolution, VariationalSolver,
+};
+use crate::stabilization::Alpha;
+use report::{
+    answer_level, value_rounding, MAX_MULTIPLIER_NOISE, MAX_PRIMAL_ROUNDING, MAX_ROUNDING,
+    MULTIPLIER_NOISE_WARNING, OPEN_GAP_WARNING, PENETRATION_WARNING, PRIMAL_ROUNDING_WARNING,
+    ROUNDING_WARNING,
+};
+use std::marker::PhantomData;
+use std::time::Instant;
+
+/// What a support holds on its boundary part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Condition {
+    /// The model's boundary data: `field = g` for its `boundary: field = g` (for a plate
+    /// field, Argyris or Morley, the simple support with g = 0).
+    Data,
+    /// `field = 0` and what that implies along the part (for a plate field the simple
+    /// support: value and tangential derivatives).
+    Zero,
+    /// `field = 0` and its normal derivative too where the element has one: clamped
+    /// (Hermite ends, Argyris and Morley edges); `Zero` for Lagrange fields.
+    Clamped,
+}
+
+/// A support: `condition` on `field` along `part` of the boundary (intervals: marker 1
+/// is the left end, 2 the right one).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Support {
+    /// Where it holds.
+    pub part: DirichletPart,
+    /// The field (index in `M::FIELDS`).
+    pub field: usize,
+    /// What it holds.
+    pub condition: Condition,
+}
+
+/// Which side of the structure the obstacle is on: `s·w ≥ s·ψ` with `s = +1` below,
+/// `s = −1` above (docs/mathematics.md §1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ObstacleSide {
+    /// `w ≥ ψ`.
+    #[default]
+    Below,
+    /// `w ≤ ψ`.
+    Above,
+}
+
+impl ObstacleSide {
+    /// `s`: +1 below, −1 above.
+    pub fn sign(self) -> f64 {
+        match self {
+            ObstacleSide::Below => 1.0,
+            ObstacleSide::Above => -1.0,
+        }
+    }
+}
+
+/// A gradient of the point: `[∂_x, ∂_y]` (on intervals `[u', 0]`).
+pub type GradientFn = dyn Fn(&[f64]) -> [f64; 2] + Sync;
+
+/// An exact solution to measure errors against: the constrained field's values (the
+/// model's `obstacle:` role), its gradient and the multiplier, where known.
+#[derive(Clone, Copy)]
+pub struct Exact<'a> {
+    /// `u(x)`.
+    pub value: &'a DataFn,
+    /// `∇u(x)`.
+    pub gradient: Option<&'a GradientFn>,
+    /// `λ(x)`.
+    pub multiplier: Option<&'a DataFn>,
+}
+
+/// How [`Problem::solve`] solves.
+#[derive(Clone, Copy, Debug)]
+pub struct SolveOptions {
+    /// The complementarity solver and its options.
+    pub obstacle: ObstacleOptions,
+    /// Nested iteration over every mesh given (`false`: the finest alone, from the
+    /// problem's start or from zero). The QP solver always takes the finest alone.
+    pub nested: bool,
+    /// Run the rounding experiment ([`Report::rounding`]): two more solves on the mesh
+    /// scaled in its last bits.
+    pub rounding_experiment: bool,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        Self {
+            obstacle: ObstacleOptions::default(),
+            nested: true,
+            rounding_experiment: false,
+        }
+    }
+}
+
+/// A solved problem: the discrete solution and its report.
+pub struct Solved<M, G> {
+    /// The solution on the finest mesh.
+    pub solution: ObstacleSolution<G>,
+    /// What the solve reports.
+    pub report: Report,
+    /// Every parameter's value as solved with (α and s filled in), in declaration order.
+    pub params: Vec<f64>,
+    model: PhantomData<M>,
+}
+
+impl<M: Model, G> Solved<M, G> {
+    /// The coefficients of a field (by handle or name).
+    ///
+    /// # Errors
+    /// A field the model does not have.
+    pub fn field(&self, field: impl IntoFieldIndex<M>) -> Result<&[f64]> {
+        Ok(self.solution.field(M::field(field)?))
+    }
+
+    /// The finest mesh.
+    pub fn mesh(&self) -> &G {
+        &self.solution.discretization.mesh
+    }
+}
+
+/// An obstacle problem of model `M` on meshes of kind `G` (see the module's docs).
+pub struct Problem<'a, M: Model, G: Domain> {
+    meshes: Vec<G>,
+    params: Vec<Option<f64>>,
+    data: Vec<Option<&'a DataFn>>,
+    supports: Vec<Support>,
+    parts: Vec<Option<Vec<u32>>>,
+    side: ObstacleSide,
+    alpha: Alpha,
+    alpha_when_zero: f64,
+    options: SolveOptions,
+    start: Option<&'a FirstStart<G>>,
+    exact: Option<Exact<'a>>,
+    memory: MemoryModel,
+    size: Option<String>,
+    invalid: Option<Error>,
+    model: PhantomData<M>,
+}
+
+/// α where `C_I = 0` and nothing else is said: the stabilization is then `α Σ h^p (λ,
+/// μ)`, stable for every α > 0 and limited by accuracy only (membranes and plates: 0.1).
+pub const ALPHA_WHEN_CI_VANISHES: f64 = 0.1;
+
+/// `α` times the stabilization's constant on a regular cell below which the
+/// stabilization is lost in rounding: λ_h's rounding noise grows like `ε / (α C_I)` (a
+/// needle mesh measured 2e-4 at 4e-12 and 2 at 4e-16).
+pub const SMALLEST_RELATIVE_STABILIZATION: f64 = 1e-13;
+
+/// `α·max C_I,E` below which a multiplier on a boundary part is refused: semismooth
+/// Newton stalls there (contact on Hertz: 200 iterations at 3e-9, still failing up to
+/// 3e-4), and the pressure oscillates like the plain method's; α = 0 is the plain method.
+pub const MIN_BOUNDARY_ALPHA_TIMES_C_I: f64 = 1e-3;
+
+impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
+    /// A problem on `meshes`, the levels of nested iteration coarsest first (the last is
+    /// solved): no data, no support, the obstacle below, `α = ½/C_I` (or
+    /// [`ALPHA_WHEN_CI_VANISHES`] where C_I = 0), nested semismooth Newton.
+    pub fn new(meshes: Vec<G>) -> Self {
+        Self {
+            meshes,
+            params: vec![None; M::PARAMS.len()],
+            data: vec![None; M::DATA.len()],
+            supports: Vec::new(),
+            parts: vec![None; M::FACET_PARTS.len()],
+            side: ObstacleSide::Below,
+            alpha: Alpha::default(),
+            alpha_when_zero: ALPHA_WHEN_CI_VANISHES,
+            options: SolveOptions::default(),
+            start: None,
+            exact: None,
+            memory: MemoryModel::of_model::<M>(),
+            size: None,
+            invalid: None,
+            model: PhantomData,
+        }
+    }
+
+    /// Keeps the first invalid input, which [`Problem::solve`] reports.
+    fn refuse(mut self, error: Error) -> Self {
+        self.invalid.get_or_insert(error);
+        self
+    }
+
+    /// Sets a parameter (by handle, or by name for readers of scene files). The roles α
+    /// and s are the solve's to set ([`Problem::alpha`], [`Problem::side`]).
+    pub fn param(mut self, param: impl IntoParamIndex<M>, value: f64) -> Self {
+        match M::param(param) {
+            Ok(p) if M::STABILIZATION.and_then(|s| s.alpha) == Some(p) => {
+                let name = M::PARAMS[p];
+                self.refuse(Error::Input(format!(
+                    "`{name}` is the stabilization parameter of `{}`: give it through the α policy (Problem::alpha), not as a value",
+                    M::NAME
+                )))
+            }
+            Ok(p) if M::SIDE == Some(p) => {
+                let name = M::PARAMS[p];
+                self.refuse(Error::Input(format!(
+                    "`{name}` is the obstacle side of `{}`: give it through Problem::side",
+                    M::NAME
+                )))
+            }
+            Ok(p) => {
+                self.params[p] = Some(value);
+                self
+            }
+            Err(e) => self.refuse(e),
+        }
+    }
+
+    /// Sets a data function (by handle, or by name).
+    pub fn data(mut self, data: impl IntoDataIndex<M>, function: &'a DataFn) -> Self {
+        match M::data_function(data) {
+            Ok(d) => {
+                self.data[d] = Some(function);
+                self
+            }
+            Err(e) => self.refuse(e),
+        }
+    }
+
+    /// Holds `field` on `part` of the boundary with `condition`.
+    pub fn support(
+        mut self,
+        part: DirichletPart,
+        field: impl IntoFieldIndex<M>,
+        condition: Condition,
+    ) -> Self {
+        match M::field(field) {
+            Ok(field) => {
+                self.supports.push(Support {
+                    part,
+                    field,
+                    condition,
+                });
+                self
+            }
+            Err(e) => self.refuse(e),
+        }
+    }
+
+    /// The model's boundary data (`boundary:`) on every field that has them, on `part`.
+    pub fn boundary_data(mut self, part: DirichletPart) -> Self {
+        for &(field, _) in M::DIRICHLET {
+            self.supports.push(Support {
+                part: part.clone(),
+                field,
+                condition: Condition::Data,
+            });
+        }
+        self
+    }
+
+    /// The boundary markers of one of the model's boundary parts (`facets:`).
+    pub fn part(mut self, part: impl IntoPartIndex<M>, markers: Vec<u32>) -> Self {
+        match M::facet_part(part) {
+            Ok(p) => {
+                self.parts[p] = Some(markers);
+                self
+            }
+            Err(e) => self.refuse(e),
+        }
+    }
+
+    /// The obstacle's side (needs the model's `side:` role for `Above`).
+    pub fn side(mut self, side: ObstacleSide) -> Self {
+        self.side = side;
+        self
+    }
+
+    /// The α policy, and the α where `C_I = 0`.
+    pub fn alpha(mut self, alpha: Alpha, when_inverse_constant_vanishes: f64) -> Self {
+        self.alpha = alpha;
+        self.alpha_when_zero = when_inverse_constant_vanishes;
+        self
+    }
+
+    /// How to solve.
+    pub fn options(mut self, options: SolveOptions) -> Self {
+        self.options = options;
+        self
+    }
+
+    /// The start of the coarsest level (it may also refuse the problem).
+    pub fn start(mut self, start: &'a FirstStart<G>) -> Self {
+        self.start = Some(start);
+        self
+    }
+
+    /// The exact solution, for the report's errors.
+    pub fn exact(mut self, exact: Exact<'a>) -> Self {
+        self.exact = Some(exact);
+        self
+    }
+
+    /// The memory model of the solve and what sets its size, for the refusal's message
+    /// (e.g. `--mesh-size 512 with p2-p0`).
+    pub fn memory(mut self, memory: MemoryModel, size: impl Into<String>) -> Self {
+        self.memory = memory;
+        self.size = Some(size.into());
+        self
+    }
+
+    /// The meshes of the levels, coarsest first.
+    pub fn meshes(&self) -> &[G] {
+        &self.meshes
+    }
+
+    /// The parameter values with α and s filled in.
+    fn param_values(&self, alpha: f64) -> Result<Vec<f64>> {
+        let mut values = Vec::with_capacity(M::PARAMS.len());
+        let mut missing = Vec::new();
+        for (p, value) in self.params.iter().enumerate() {
+            let role = if M::STABILIZATION.and_then(|s| s.alpha) == Some(p) {
+                Some(alpha)
+            } else if M::SIDE == Some(p) {
+                Some(self.side.sign())
+            } else {
+                None
+            };
+            match role.or(*value) {
+                Some(v) => values.push(v),
+                None => {
+                    missing.push(M::PARAMS[p]);
+                    values.push(f64::NAN);
+                }
+            }
+        }
+        if !missing.is_empty() {
+            return Err(Error::Input(format!(
+                "model `{}` needs values for {}",
+                M::NAME,
+                missing.join(", ")
+            )));
+        }
+        if self.side == ObstacleSide::Above && M::SIDE.is_none() {
+            return Err(Error::Input(format!(
+                "model `{}` has no obstacle side (`side: s`): its obstacle is below",
+                M::NAME
+            )));
+        }
+        Ok(values)
+    }
+
+    fn data_functions(&self) -> Result<Vec<&'a DataFn>> {
+        let missing: Vec<&str> = (0..M::DATA.len())
+            .filter(|&d| self.data[d].is_none())
+            .map(|d| M::DATA[d])
+            .collect();
+        if !missing.is_empty() {
+            return Err(Error::Input(format!(
+                "model `{}` needs the data {}",
+                M::NAME,
+                missing.join(", ")
+            )));
+        }
+        Ok(self.data.iter().map(|d| d.expect("checked")).collect())
+    }
+
+    fn part_markers(&self) -> Result<Vec<Vec<u32>>> {
+        self.parts
+            .iter()
+            .enumerate()
+            .map(|(p, markers)| {
+                markers.clone().ok_or_else(|| {
+                    Error::Input(format!(
+                        "the boundary part `{}` of `{}` is not given markers",
+                        M::FACET_PARTS[p],
+                        M::NAME
+                    ))
+                })
+            })
+            .collect()
+    }
+
+    /// Solves the problem (see the module's docs).
+    ///
+    /// # Errors
+    /// An invalid input given to the builder, a missing parameter, data function or part,
+    /// an estimated memory beyond what the solver allows itself, data that are not finite
+    /// or too large or small for double precision, an obstacle that contradicts a support,
+    /// an α that the stabilization cannot use, the solvers' failures (with α·C_I named
+    /// where it is the likely cause), and an answer lost to rounding (the rows in contact,
+    /// the multiplier, the rounding experiment).
+    pub fn solve(&self) -> Result<Solved<M, G>> {
+        if let Some(e) = &self.invalid {
+            return Err(e.clone());
+        }
+        let finest = self
+            .meshes
+            .last()
+            .ok_or_else(|| Error::Input("no mesh to solve on".into()))?;
+        let memory_estimate = self.memory.bytes(finest.cell_count());
+        let size = self
+            .size
+            .clone()
+            .unwrap_or_else(|| format!("a mesh of {} cells", finest.cell_count()));
+        memory::check_memory(memory_estimate, &size)?;
+        multiplier_field::<M>()?;
+        let data = self.data_functions()?;
+        let parts = self.part_markers()?;
+        self.check_data(finest, &data)?;
+        let mut warnings = Vec::new();
+        // C_I with α = 0: the stabilization form's primal blocks do not hold α
+        let c_i = self.inverse_constant(finest, &self.param_values(0.0)?, &data, &parts)?;
+        let alpha = self.alpha.value(c_i, self.alpha_when_zero)?;
+        self.check_alpha(alpha, c_i, &mut warnings)?;
+        let params = self.param_values(alpha)?;
+        let coefficients = Coefficients::of_values::<M>(&params, &data)?;
+        // the finest level's constraints: the feasibility check, and the level's own
+        let dofs = finest.system_dofs::<M>()?;
+        let constraints = finest.constraints::<M>(&dofs, &coefficients, &self.supports)?;
+        warnings.extend(constraints.warnings().iter().cloned());
+        self.check_feasible(finest, &dofs, &constraints, &data)?;
+        let mut options = self.options.obstacle;
+        if alpha == 0.0 && options.solver == VariationalSolver::SemismoothNewton {
+            warnings.push("α = 0 (the plain mixed method): C = 0 leaves nothing to eliminate Λ with, so the QP solver (clarabel) is used".into());
+            options.solver = VariationalSolver::Clarabel;
+        }
+        let nested = self.options.nested && options.solver == VariationalSolver::SemismoothNewton;
+        let first = if nested { 0 } else { self.meshes.len() - 1 };
+        let solution = self
+            .solve_levels(
+                &self.meshes[first..],
+                &coefficients,
+                Some((dofs, constraints)),
+                &parts,
+                options,
+            )
+            .map_err(|e| alpha_hint(e, alpha, c_i))?;
+        let mut report = self.report(&solution, &coefficients, alpha, c_i, options)?;
+        // where the user's α is far above the default, it is the likelier cause
+        if let Some(default) = self.default_alpha(c_i) {
+            if alpha > LARGE_ALPHA * default {
+                report.warnings.push(format!(
+                    "α = {alpha:e} is {} times the default {default:e}, more than {LARGE_ALPHA:e}: the stabilization's term moves the contact set and the answer with α (bernoulli-flat at q = 100 on 256 elements: L² error 1.9e-7 at the default, 4.1e-6 at 1e4 times it, 1.1e-4 at 1e6 times it)",
+                    number(alpha / default)
+                ));
+            }
+        }
+        report.memory_estimate = memory_estimate;
+        warnings.append(&mut report.warnings);
+        report.warnings = warnings;
+        if self.options.rounding_experiment {
+            let clock = Instant::now();
+            let rounding = self
+                .rounding_experiment(&solution, &coefficients, &parts, options)
+                .unwrap_or(f64::INFINITY);
+            report.rounding_seconds = Some(clock.elapsed().as_secs_f64());
+            report.rounding = Some(rounding);
+            if rounding.is_nan() || rounding > MAX_ROUNDING {
+                let moved = if rounding.is_finite() {
+                    format!("moves the answer by {rounding:.0e} of its size")
+                } else {
+                    "makes the solve fail".to_string()
+                };
+                return Err(Error::Input(format!(
+                    "{} is rounding: moving the mesh in its last bits {moved}; the system's condition leaves no correct digit here; use fewer cells (elements)",
+                    answer_name::<M>()
+                )));
+            }
+            if rounding > ROUNDING_WARNING {
+                report.warnings.push(format!(
+                    "{} is rounding-limited to about {rounding:.0e} of its size (moving the mesh in its last bits moves it that much): fewer cells (elements) give more correct digits here",
+                    answer_name::<M>()
+                ));
+            }
+        }
+        Ok(Solved {
+            solution,
+            report,
+            params,
+            model: PhantomData,
+        })
+    }
+
+    /// Nested iteration over `meshes`; `finest` are the DOFs and constraints of the last
+    /// mesh, when already built.
+    fn solve_levels(
+        &self,
+        meshes: &[G],
+        coefficients: &Coefficients,
+        finest: Option<(crate::SystemDofs, Constraints)>,
+        parts: &[Vec<u32>],
+        options: ObstacleOptions,
+    ) -> Result<ObstacleSolution<G>> {
+        let supports = &self.supports;
+        let last = meshes.len() - 1;
+        let mut finest = finest;
+        let levels: Vec<_> = meshes
+            .iter()
+            .enumerate()
+            .map(|(k, mesh)| {
+                let built = if k == last { finest.take() } else { None };
+                move || -> Result<Discretization<G>> {
+                    let (dofs, constraints) = match built {
+                        Some(b) => b,
+                        None => {
+                            let dofs = mesh.system_dofs::<M>()?;
+                            let constraints =
+                                mesh.constraints::<M>(&dofs, coefficients, supports)?;
+                            (dofs, constraints)
+                        }
+                    };
+                    mesh.discretize::<M>(coefficients, dofs, &constraints, parts)
+                }
+            })
+            .collect();
+        let prolongation = G::primal_prolongation();
+        solve_nested_from(
+            levels,
+            |coarse, values, fine| G::prolong::<M>(coarse, values, fine),
+            prolongation,
+            self.start,
+            options,
+        )
+    }
+
+    /// The α the default policy would give, where the problem's α is a value of the
+    /// user's (`None` where the policy is the default one).
+    fn default_alpha(&self, c_i: f64) -> Option<f64> {
+        match self.alpha {
+            Alpha::Fixed(_) => Alpha::default().value(c_i, self.alpha_when_zero).ok(),
+            Alpha::FromInverseConstant(_) => None,
+        }
+        .filter(|&d| d > 0.0)
+    }
+
+    /// `max C_I` of the model's stabilization on `mesh`: per cell, or per edge of the
+    /// boundary part its multiplier lives on; 0 for a model without a stabilization.
+    fn inverse_constant(
+        &self,
+        mesh: &G,
+        params: &[f64],
+        data: &[&DataFn],
+        parts: &[Vec<u32>],
+    ) -> Result<f64> {
+        if M::STABILIZATION.is_none() {
+            return Ok(0.0);
+        }
+        let Some(part) = crate::obstacle::boundary_multiplier::multiplier_part::<M>()? else {
+            return crate::stabilization::inverse_constant::<M, G>(mesh, params);
+        };
+        let coefficients = Coefficients::of_values::<M>(params, data)?;
+        let constants = mesh.boundary_inverse_constants::<M>(&coefficients, part, &parts[part])?;
+        Ok(constants.iter().fold(0.0f64, |m, &c| m.max(c)))
+    }
+
+    /// The stabilization's size against rounding and its stability range.
+    fn check_alpha(&self, alpha: f64, c_i: f64, warnings: &mut Vec<String>) -> Result<()> {
+        if alpha == 0.0 {
+            return Ok(());
+        }
+        let boundary = crate::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
+        if boundary && c_i > 0.0 && alpha * c_i < MIN_BOUNDARY_ALPHA_TIMES_C_I {
+            return Err(Error::Input(format!(
+                "α = {alpha:e} gives α·max C_I,E = {:.1e}, below {MIN_BOUNDARY_ALPHA_TIMES_C_I:e}: the stabilization is too weak for semismooth Newton (it stalls or needs hundreds of iterations, and the pressure oscillates like the plain method's); use α = 0 (the plain method, solved as a QP) or α·max C_I,E from 0.1 to 1 (the automatic α is ½/max C_I,E = {:.3e})",
+                alpha * c_i,
+                0.5 / c_i
+            )));
+        }
+        if !boundary {
+            // against a well-shaped cell's constant, where there is one (P1's S_h is
+            // α h² (λ, μ): relative to the stiffness it is α itself)
+            let regular = regular_inverse_constant::<M>(&self.param_values(0.0)?)?;
+            let relative = alpha * if regular > 0.0 { regular } else { 1.0 };
+            if relative < SMALLEST_RELATIVE_STABILIZATION {
+                let why = match self.alpha {
+                    Alpha::Fixed(_) => format!("α = {alpha:e}"),
+                    Alpha::FromInverseConstant(_) => format!(
+                        "the mesh's worst cell, with C_I = {c_i:.3e}, forces α = {alpha:.3e}, which"
+                    ),
+                };
+                return Err(Error::Input(format!(
+                    "{why} makes the stabilization of a well-shaped cell {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}: the method would run practically unstabilized, with λ_h lost in rounding; give α = 0 for the plain method, at least {:.2e}, or better-shaped cells",
+                    1.01 * SMALLEST_RELATIVE_STABILIZATION / if regular > 0.0 { regular } else { 1.0 }
+                )));
+            }
+        }
+        if c_i > 0.0 && alpha * c_i >= 1.0 {
+            warnings.push(format!(
+                "α·C_I = {:.2} ≥ 1: outside the stability range 0 < α < 1/C_I = {:.3e}; expect a degraded or unstable solution",
+                alpha * c_i,
+                1.0 / c_i
+            ));
+        }
+        Ok(())
+    }
+
+    /// Every data function finite and within double precision's useful range at the
+    /// vertices of `mesh` (boundary data: on the vertices of its supports' parts only,
+    /// the only place it is used).
+    fn check_data(&self, mesh: &G, data: &[&DataFn]) -> Result<()> {
+        for (d, f) in data.iter().enumerate() {
+            let values = mesh.at_vertices(*f);
+            let on_part = self.boundary_data_vertices(mesh, d);
+            let mut largest = 0.0f64;
+            for (v, &value) in values.iter().enumerate() {
+                if on_part.as_ref().is_some_and(|on| !on[v]) {
+                    continue;
+                }
+                if !value.is_finite() {
+                    return Err(Error::Input(format!(
+                        "data `{}` of `{}` is {value} at vertex {v} of the mesh",
+                        M::DATA[d],
+                        M::NAME
+                    )));
+                }
+                if value.abs() > MAX_DATA {
+                    return Err(Error::Input(format!(
+                        "data `{}` of `{}` is {value:e} at vertex {v} of the mesh, beyond ±{MAX_DATA:e}: norms in the solve would overflow double precision",
+                        M::DATA[d],
+                        M::NAME
+                    )));
+                }
+                largest = largest.max(value.abs());
+            }
+            if largest > 0.0 && largest < MIN_DATA_SIZE {
+                return Err(Error::Input(format!(
+                    "data `{}` of `{}` is at most {largest:e} in size, below {MIN_DATA_SIZE:e}: the solve multiplies it by powers of h and would underflow; rescale the units",
+                    M::DATA[d],
+                    M::NAME
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// For boundary data `d` (of a `boundary:` condition with a `Data` support), which
+    /// vertices lie on its supports' parts; `None` for data used everywhere.
+    fn boundary_data_vertices(&self, mesh: &G, d: usize) -> Option<Vec<bool>> {
+        let fields: Vec<usize> = M::DIRICHLET
+            .iter()
+            .filter(|&&(_, data)| data == d)
+            .map(|&(f, _)| f)
+            .collect();
+        let used_elsewhere = M::OBSTACLE.is_some_and(|[_, obstacle]| obstacle == d);
+        if fields.is_empty() || used_elsewhere {
+            return None;
+        }
+        let parts: Vec<&DirichletPart> = self
+            .supports
+            .iter()
+            .filter(|s| s.condition == Condition::Data && fields.contains(&s.field))
+            .map(|s| &s.part)
+            .collect();
+        let mut on = vec![false; mesh.vertex_points().len()];
+        for part in parts {
+            for (o, p) in on.iter_mut().zip(mesh.vertices_on(part)) {
+                *o |= p;
+            }
+        }
+        Some(on)
+    }
+
+    /// An error where a support holds the constrained field on the wrong side of the
+    /// obstacle: no admissible state exists.
+    fn check_feasible(
+        &self,
+        mesh: &G,
+        dofs: &crate::SystemDofs,
+        constraints: &Constraints,
+        data: &[&DataFn],
+    ) -> Result<()> {
+        let Some([field, obstacle]) = M::OBSTACLE else {
+            return Ok(());
+        };
+        let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
+            return Ok(());
+        };
+        let side = self.side.sign();
+        let fixed: std::collections::HashMap<usize, f64> =
+            constraints.fixed().iter().copied().collect();
+        let vertices = mesh.vertex_points();
+        for (v, x) in vertices.iter().enumerate() {
+            let Some(&value) = fixed.get(&(offset + map.vertex_dofs(v).start)) else {
+                continue;
+            };
+            let psi = data[obstacle](x);
+            if side * (value - psi) < -1e-12 * (1.0 + value.abs().max(psi.abs())) {
+                let name = M::FIELDS[field].name;
+                let at = x
+                    .iter()
+                    .map(|c| c.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                return Err(Error::Input(format!(
+                    "infeasible: a support holds `{name}` = {value} at ({at}), but the obstacle requires {name} {} ψ = {psi} there, so no admissible {name} exists",
+                    if side > 0.0 { "≥" } else { "≤" }
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The report of a solution.
+    fn report(
+        &self,
+        solution: &ObstacleSolution<G>,
+        coefficients: &Coefficients,
+        alpha: f64,
+        c_i: f64,
+        options: ObstacleOptions,
+    ) -> Result<Report> {
+        let d = &solution.discretization;
+        let lcp: &Lcp = &d.lcp;
+        let mut warnings = Vec::new();
+        let (u, lambda) = (
+            d.primal_part(&solution.values),
+            d.multiplier_part(&solution.values),
+        );
+        let energy = match M::ENERGY {
+            Some(_) => Some(solution.energy::<M>(coefficients)?),
+            None => None,
+        };
+        let on_triangles = G::CELL == crate::CellKind::Triangle;
+        let measure = G::contact_measure(solution);
+        let mut report = Report {
+            model: M::NAME,
+            cells: d.mesh.cell_count(),
+            dofs: lcp.n() + lcp.m(),
+            multiplier_dofs: lcp.m(),
+            alpha: Some(alpha),
+            inverse_constant: c_i,
+            solver: match options.solver {
+                VariationalSolver::SemismoothNewton => "pdas",
+                VariationalSolver::Clarabel => "clarabel",
+            },
+            linear_solver: solution.linear_solver_name(),
+            iterations: solution.iterations,
+            levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
+            factorizations: solution.factorizations,
+            krylov_iterations: solution.krylov_iterations,
+            seconds: solution.seconds,
+            energy,
+            total_contact_force: G::total_contact_force(solution),
+            contact_area: (on_triangles && d.boundary().is_none()).then_some(measure),
+            contact_length: (!on_triangles || d.boundary().is_some()).then_some(measure),
+            kkt_residual: solution.kkt_residual,
+            complementarity_residual: lcp.complementarity_residual(&u, &lambda),
+            multiplier_noise: solution.multiplier_noise,
+            ..Report::default()
+        };
+        if solution.multiplier_noise > MAX_MULTIPLIER_NOISE {
+            return Err(Error::Input(format!(
+                "λ_h is rounding noise (estimated {:.0e} relative; ∫λ_h would be off by as much, and {} follows it): the multiplier's stabilization C = α h^p lies below the rounding of the gap G − BU; use fewer cells (elements) or a larger α",
+                solution.multiplier_noise,
+                answer_name::<M>()
+            )));
+        }
+        if solution.multiplier_noise > MULTIPLIER_NOISE_WARNING {
+            warnings.push(format!(
+                "λ_h may carry rounding noise of up to {:.0e} relative: C = α h^p approaches the rounding of G − BU at this mesh size, and its recovery is no guarantee at this conditioning (a larger α or a coarser mesh avoids it)",
+                solution.multiplier_noise
+            ));
+        }
+        if alpha == 0.0 && lcp.m() > lcp.n() {
+            warnings.push(format!(
+                "α = 0: the plain pair has {} multipliers for {} primal unknowns, so Bᵀ has a kernel of dimension at least {} (no discrete inf-sup condition, docs/mathematics.md §1): u_h is unique, but where that kernel meets the contact set λ_h is not, and the λ_h, ∫λ_h and contact set reported are one of many; α > 0 (the default) gives the unique stabilized λ_h",
+                lcp.m(),
+                lcp.n(),
+                lcp.m() - lcp.n()
+            ));
+        }
+        if options.linear_solver == crate::obstacle::hierarchy::LinearSolver::Multigrid
+            && solution.iterative_steps == 0
+        {
+            warnings.push(if options.solver == VariationalSolver::SemismoothNewton {
+                "--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level and elements with a prolongation; or CG did not converge), so they were factored".to_string()
+            } else {
+                "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string()
+            });
+        }
+        // the pointwise checks of the constrained field against the obstacle
+        let diameter = d.mesh.extent();
+        let size_of = |values: &[f64]| {
+            values
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold(0.0f64, |m, v| m.max(v.abs()))
+        };
+        let (u_size, psi_size, u_range) = match M::OBSTACLE {
+            Some([field, obstacle]) => {
+                let u_values = G::field_at_vertices(solution, field);
+                let psi = d.mesh.at_vertices(coefficients.data[obstacle]);
+                let (lo, hi) = u_values
+                    .iter()
+                    .filter(|v| v.is_finite())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                        (lo.min(v), hi.max(v))
+                    });
+                (
+                    size_of(&u_values),
+                    size_of(&psi),
+                    if hi >= lo { hi - lo } else { 0.0 },
+                )
+            }
+            None => (size_of(&u), 0.0, 0.0),
+        };
+        let level = answer_level(u_size, psi_size, diameter);
+        let primal_rounding = solution.primal_rounding();
+        report.primal_rounding = if level > 0.0 {
+            primal_rounding / level
+        } else {
+            0.0
+        };
+        let large_alpha = self
+            .default_alpha(c_i)
+            .filter(|&default| alpha > LARGE_ALPHA * default);
+        if report.primal_rounding.is_nan() || report.primal_rounding > MAX_PRIMAL_ROUNDING {
+            if let Some(default) = large_alpha {
+                return Err(Error::Input(format!(
+                    "the load with α = {alpha:e} ({} times the default {default:e}) makes the terms of the constraint rows so large that their rounding moves {} by {:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it): lower α first, then the load",
+                    number(alpha / default),
+                    answer_name::<M>(),
+                    report.primal_rounding
+                )));
+            }
+            return Err(Error::Input(format!(
+                "the load (or α) dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves {} by {:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it); use a smaller load or α",
+                answer_name::<M>(),
+                report.primal_rounding
+            )));
+        }
+        if report.primal_rounding > PRIMAL_ROUNDING_WARNING {
+            warnings.push(format!(
+                "{} may be off by {:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)",
+                answer_name::<M>(),
+                report.primal_rounding
+            ));
+        }
+        if let Some([field, obstacle]) = M::OBSTACLE {
+            let name = M::FIELDS[field].name;
+            let psi = coefficients.data[obstacle];
+            let side = self.side.sign();
+            let penetration = G::penetration(solution, field, psi, side);
+            let gap = if d.boundary().is_some() {
+                0.0
+            } else {
+                G::open_gap(solution, field, psi, side)
+            };
+            report.max_penetration = Some(penetration.depth);
+            report.max_open_contact_gap = Some(gap);
+            // the rounding of the compared values: of their size, and of the solve
+            // through the rows in contact
+            let rounding = value_rounding(u_size, psi_size) + primal_rounding;
+            let range = penetration.obstacle_range.max(u_range);
+            if penetration.depth.is_nan() {
+                warnings.push(format!(
+                    "max_penetration is not a number: the obstacle ψ or {name}_h is not finite at some point the penetration check samples"
+                ));
+            } else if range > 0.0
+                && penetration.depth > PENETRATION_WARNING * range
+                && penetration.depth > rounding
+            {
+                warnings.push(format!(
+                    "{name}_h crosses ψ by up to {:.2e}, {:.1} % of the larger of ψ's and {name}_h's ranges ({range:.2e}): the constraint holds on each cell's mean, so a mesh that does not resolve the contact lets {name}_h pass ψ by O(h²) inside cells; refine the mesh (or lower the load)",
+                    penetration.depth,
+                    100.0 * penetration.depth / range
+                ));
+                if let Some(default) = self
+                    .default_alpha(c_i)
+                    .filter(|&default| alpha > 10.0 * default)
+                {
+                    warnings.push(format!(
+                        "α = {alpha:e} is {:.0e} times the default {default:.3e}: the stabilized constraint lets {name}_h cross ψ by about α h^p λ_h, so lower α before refining",
+                        alpha / default
+                    ));
+                }
+            }
+            if gap > OPEN_GAP_WARNING * level && gap > rounding {
+                let cure = if self
+                    .default_alpha(c_i)
+                    .is_some_and(|default| alpha > 10.0 * default)
+                {
+                    "lower α"
+                } else {
+                    "refine the mesh or lower α"
+                };
+                warnings.push(format!(
+                    "λ_h pushes on cells where {name}_h stays up to {gap:.2e} clear of ψ ({:.1} % of the answer's size {level:.2e}): the stabilized constraint on contact cells lets α h^p(…) (α = {alpha:e}) open that gap, so this contact set is not real; {cure}",
+                    100.0 * gap / level
+                ));
+            }
+        }
+        if let (Some(exact), Some([field, _])) = (&self.exact, M::OBSTACLE) {
+            let errors = G::errors(solution, field, exact);
+            report.error_l2 = errors.l2;
+            report.error_h1 = errors.h1;
+            report.error_multiplier = errors.multiplier;
+            report.error_vertex_max = errors.vertex_max;
+            report.error_vertex_mean = errors.vertex_mean;
+            let not_a_number = |e: Option<f64>| e.is_some_and(|e| !e.is_finite());
+            if not_a_number(errors.l2) || not_a_number(errors.h1) || not_a_number(errors.multiplier)
+            {
+                warnings.push("an error against the exact solution is not a number: the exact u, its gradient or λ is not finite at some quadrature point".into());
+            }
+        }
+        report.warnings = warnings;
+        Ok(report)
+    }
+
+    /// The rounding experiment: the largest relative change of the constrained field
+    /// (at the vertices, against the answer's size) and of `∫ λ_h` (against the larger
+    /// of itself and the load's force scale) when the mesh is scaled by `1 + 2⁻⁴⁰` and
+    /// `1 − 2⁻³⁹`. The exact solution moves by O(2⁻⁴⁰); every entry of the system moves
+    /// in its last bits, so the rounding of the solve is drawn anew. Measured on the
+    /// Euler–Bernoulli beam against its exact solution (1024 to 65536 elements), the
+    /// change is within a factor 3 of the true error wherever rounding dominates it,
+    /// while a first-order estimate from random perturbations of the entries came out
+    /// 1000× too small and the norm-wise `ε κ(A)` 100× too large.
+    fn rounding_experiment(
+        &self,
+        solution: &ObstacleSolution<G>,
+        coefficients: &Coefficients,
+        parts: &[Vec<u32>],
+        options: ObstacleOptions,
+    ) -> Result<f64> {
+        let d = &solution.discretization;
+        let field = M::OBSTACLE.map_or(0, |[f, _]| f);
+        let reference = G::field_at_vertices(solution, field);
+        let force = G::total_contact_force(solution);
+        let diameter = d.mesh.extent();
+        let size = reference
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-6 * diameter);
+        let force_scale = force
+            .abs()
+            .max(d.lcp.multiplier_scale() * domain_measure(&d.mesh))
+            .max(f64::MIN_POSITIVE);
+        let mut largest = 0.0f64;
+        for factor in [1.0 + 2f64.powi(-40), 1.0 - 2f64.powi(-39)] {
+            let meshes = self
+                .meshes
+                .iter()
+                .map(|m| m.scaled(factor))
+                .collect::<Result<Vec<G>>>()?;
+            let first =
+                if self.options.nested && options.solver == VariationalSolver::SemismoothNewton {
+                    0
+                } else {
+                    meshes.len() - 1
+                };
+            let moved = self.solve_levels(&meshes[first..], coefficients, None, parts, options)?;
+            let values = G::field_at_vertices(&moved, field);
+            let change = values
+                .iter()
+                .zip(&reference)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let force_change = (G::total_contact_force(&moved) - force).abs();
+            largest = largest.max((change / size).max(force_change / force_scale));
+        }
+        Ok(largest)
+    }
+}
+
+/// An α above this multiple of the default is warned about: the error grows with α
+/// (bernoulli-flat, q = 100, 256 elements: 1.9e-7 at the default 1e-2, 2.3e-5 at 1e3,
+/// 1.1e-4 at 1e4), and the contact set widens without an open gap to show it.
+pub const LARGE_ALPHA: f64 = 1e3;
+
+/// A user's number as a message prints it: as written for magnitudes in [10⁻³, 10⁶)
+/// and zero, in scientific notation otherwise (`1e-300` is not three hundred digits).
+pub fn number(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Largest size of a data function a solve accepts: beyond it the norms that certify a
+/// solution (`‖A‖∞‖U‖∞` in the KKT residual) may overflow.
+pub const MAX_DATA: f64 = 1e100;
+
+/// The smallest size a non-zero data function may have: the solves multiply it by
+/// `h⁴`, `αh^k` and rounding-sized weights, which underflow below it.
+pub const MIN_DATA_SIZE: f64 = 1e-200;
+
+/// C_I of the model's stabilization on a regular cell (the unit interval, the
+/// equilateral triangle of side 1).
+fn regular_inverse_constant<M: Model>(params: &[f64]) -> Result<f64> {
+    let cell: &[f64] = match M::CELL {
+        crate::CellKind::Interval => &[0.0, 1.0],
+        crate::CellKind::Triangle => &[0.0, 0.0, 1.0, 0.0, 0.5, 0.866_025_403_784_438_6],
+    };
+    if M::STABILIZATION.is_none() {
+        return Ok(0.0);
+    }
+    crate::stabilization::element_inverse_constant::<M>(cell, params)
+}
+
+/// What the reports call the answer: the constrained field with `_h` (`w_h`), or "the
+/// answer" for a model without a pointwise obstacle.
+fn answer_name<M: Model>() -> String {
+    match M::OBSTACLE {
+        Some([field, _]) => format!("{}_h", M::FIELDS[field].name),
+        None => "the answer".to_string(),
+    }
+}
+
+/// The total measure of a mesh (its cells' lengths or areas).
+fn domain_measure<G: Mesh>(mesh: &G) -> f64 {
+    (0..mesh.cell_count()).map(|c| mesh.measure(c)).sum()
+}
+
+/// A solver's failure with α named where it is the likely cause: beyond the stability
+/// range `A_α` is indefinite; a small α leaves the eliminated multipliers
+/// `(G − BU)/(α h^p |T|)` to rounding on fine meshes.
+fn alpha_hint(error: Error, alpha: f64, c_i: f64) -> Error {
+    let hint = if c_i > 0.0 && alpha * c_i >= 1.0 {
+        return Error::Input(format!(
+            "α·C_I = {:.2} is outside the stability range 0 < α < 1/C_I = {:.3e}, where A_α = a − αS is indefinite, and the solve failed: {error}",
+            alpha * c_i,
+            1.0 / c_i
+        ));
+    } else if alpha > 0.0 && (alpha < 1e-6 || (c_i > 0.0 && alpha * c_i < 1e-4)) {
+        format!(
+            "α = {alpha:e} is small: with so little stabilization the multipliers, eliminated as (G − BU)/(α h^p |T|), drown in rounding on fine meshes; give α = 0 for the plain method, or a larger α"
+        )
+    } else {
+        return error;
+    };
+    match error {
+        Error::NotConverged { solver, detail } => Error::NotConverged {
+            solver,
+            detail: format!("{detail}; {hint}"),
+        },
+        Error::LinearSolve(detail) => Error::LinearSolve(format!("{detail}; {hint}")),
+        other => other,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{Diagonal, IntervalMesh, TriangleMesh};
+    use crate::obstacle::{solve_obstacle, triangle::solve_obstacle_on_triangles};
+
+    crate::model! {
+        /// A string over an obstacle on either side, P1–P0, with boundary data.
+        pub mod string on interval {
+            unknowns: u: P1, lam: P0 >= 0;
+            tests: v, mu;
+            params: alpha, s, k;
+            data: f, psi, g;
+            boundary: u = g;
+            forms: "
+                a(u;v)           = ∫ u'v' + k u v
+                b(v;mu)          = ∫ s v mu
+                S(u,lam;v,mu)    = Σ_T h_T² (−u'' + k u − s lam, −v'' + k v − s mu)_T
+                l(v)             = ∫ f v
+                lS(v,mu)         = Σ_T h_T² (f, −v'' + k v − s mu)_T
+                G(mu)            = ∫ s psi mu
+                B_h(u,lam;v,mu)  = a(u;v) − b(v;lam) − b(u;mu) − alpha S(u,lam;v,mu)
+                L_h(v,mu)        = l(v) − G(mu) − alpha lS(v,mu)
+            ";
+            system: B_h, L_h;
+            energy: a, l;
+            stabilization: alpha S against a;
+            side: s;
+            obstacle: u >= psi;
+        }
+    }
+
+    crate::model! {
+        /// The P1–P0 membrane with boundary data.
+        pub mod membrane on triangle {
+            unknowns: u: P1, lam: P0 >= 0;
+            tests: v, mu;
+            params: alpha;
+            data: f, psi, g;
+            boundary: u = g;
+            forms: "
+                a(u;v)          = ∫ ∇u·∇v
+                S(u,lam;v,mu)   = Σ_T h_T² (−Δu − lam, −Δv − mu)_T
+                l(v)            = ∫ f v
+                lS(v,mu)        = Σ_T h_T² (f, −Δv − mu)_T
+                B_h(u,lam;v,mu) = a(u;v) − ∫ v lam − ∫ u mu − alpha S(u,lam;v,mu)
+                L_h(v,mu)       = l(v) − ∫ psi mu − alpha lS(v,mu)
+            ";
+        }
+    }
+
+    fn string_meshes() -> Vec<IntervalMesh> {
+        [16, 32, 64]
+            .map(|n| IntervalMesh::uniform(0.0, 1.0, n).unwrap())
+            .to_vec()
+    }
+
+    /// The one solve gives the same solution as the interval entry point it replaces,
+    /// with α and s filled from the roles, and reports its integrals.
+    #[test]
+    fn the_interval_solve_agrees_with_solve_obstacle() {
+        let (f, psi, zero) = (|_: &[f64]| -8.0, |_: &[f64]| -0.3, |_: &[f64]| 0.0);
+        let solved = Problem::<string::Model, _>::new(string_meshes())
+            .param(string::params::k, 1.0)
+            .data(string::data::f, &f)
+            .data(string::data::psi, &psi)
+            .data(string::data::g, &zero)
+            .boundary_data(DirichletPart::All)
+            .alpha(Alpha::Fixed(0.1), 0.1)
+            .solve()
+            .unwrap();
+        let c = Coefficients::new::<string::Model>(
+            &[("alpha", 0.1), ("s", 1.0), ("k", 1.0)],
+            &[("f", &f), ("psi", &psi), ("g", &zero)],
+        )
+        .unwrap();
+        let mesh = string_meshes().pop().unwrap();
+        let old =
+            solve_obstacle::<string::Model>(&mesh, &c, &[], ObstacleOptions::default()).unwrap();
+        for (a, b) in solved.solution.values.iter().zip(&old.values) {
+            assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} vs {b}");
+        }
+        let r = &solved.report;
+        assert!((r.total_contact_force - old.total_contact_force()).abs() < 1e-12);
+        assert!(r.total_contact_force > 0.0 && r.contact_length.unwrap() > 0.0);
+        assert_eq!(r.levels.len(), 3);
+        assert_eq!(solved.params, [0.1, 1.0, 1.0]);
+        assert!(r.kkt_residual < 1e-10 && r.warnings.is_empty(), "{r:?}");
+    }
+
+    /// The obstacle above (`s = −1`): a string pushed up against ψ = 0.1 touches it, and
+    /// the same problem mirrored (w ↦ −w) below gives the mirrored solution.
+    #[test]
+    fn the_side_turns_the_constraint() {
+        fn up(_: &[f64]) -> f64 {
+            8.0
+        }
+        fn down(_: &[f64]) -> f64 {
+            -8.0
+        }
+        fn above(_: &[f64]) -> f64 {
+            0.3
+        }
+        fn below(_: &[f64]) -> f64 {
+            -0.3
+        }
+        let zero = |_: &[f64]| 0.0;
+        let solve = |f: &'static DataFn, psi: &'static DataFn, side| {
+            Problem::<string::Model, _>::new(string_meshes())
+                .param(string::params::k, 0.0)
+                .data(string::data::f, f)
+                .data(string::data::psi, psi)
+                .data(string::data::g, &zero)
+                .boundary_data(DirichletPart::All)
+                .side(side)
+                .solve()
+                .unwrap()
+        };
+        let a = solve(&up, &above, ObstacleSide::Above);
+        let b = solve(&down, &below, ObstacleSide::Below);
+        let (ua, ub) = (
+            a.field(string::fields::u).unwrap(),
+            b.field(string::fields::u).unwrap(),
+        );
+        for (x, y) in ua.iter().zip(ub) {
+            assert!((x + y).abs() < 1e-12, "{x} vs {y}");
+        }
+        // the cell-wise constraint: at most the reported crossing, which is small
+        let crossing = a.report.max_penetration.unwrap();
+        assert!(crossing < 1e-2, "{crossing}");
+        assert!(ua.iter().all(|&u| u <= 0.3 + crossing + 1e-12));
+        assert!((a.report.total_contact_force - b.report.total_contact_force).abs() < 1e-12);
+        assert_eq!(a.params[1], -1.0);
+    }
+
+    /// Pressed flat onto ψ = 0 = g: u = 0 and λ = 1 on every cell, the contact area the
+    /// square's, the energy 0; the same as the triangle entry point.
+    #[test]
+    fn a_membrane_pressed_flat_touches_everywhere() {
+        let (f, zero) = (|_: &[f64]| -1.0, |_: &[f64]| 0.0);
+        let meshes = vec![
+            TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap(),
+            TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 8, 8, Diagonal::Right).unwrap(),
+        ];
+        let solved = Problem::<membrane::Model, _>::new(meshes.clone())
+            .data(membrane::data::f, &f)
+            .data(membrane::data::psi, &zero)
+            .data(membrane::data::g, &zero)
+            .boundary_data(DirichletPart::All)
+            .solve()
+            .unwrap();
+        let r = &solved.report;
+        assert!((r.total_contact_force - 1.0).abs() < 1e-10, "{r:?}");
+        assert!((r.contact_area.unwrap() - 1.0).abs() < 1e-12);
+        assert!(r.energy.unwrap().abs() < 1e-12);
+        assert_eq!(r.alpha, Some(ALPHA_WHEN_CI_VANISHES));
+        assert_eq!(r.inverse_constant, 0.0);
+        assert!(r.mesh_quality.is_none() || r.warnings.is_empty());
+        let c = Coefficients::new::<membrane::Model>(
+            &[("alpha", ALPHA_WHEN_CI_VANISHES)],
+            &[("f", &f), ("psi", &zero), ("g", &zero)],
+        )
+        .unwrap();
+        let old =
+            solve_obstacle_on_triangles::<membrane::Model>(&meshes, &c, ObstacleOptions::default())
+                .unwrap();
+        for (a, b) in solved.solution.values.iter().zip(&old.values) {
+            assert!((a - b).abs() < 1e-12);
+        }
+    }
+
+    /// What the solve refuses before any work, each naming its cause.
+    #[test]
+    fn refusals_name_their_cause() {
+        let (f, psi, zero, bad) = (
+            |_: &[f64]| -1.0,
+            |_: &[f64]| 0.5,
+            |_: &[f64]| 0.0,
+            |x: &[f64]| 1.0 / x[0],
+        );
+        let base = || {
+            Problem::<string::Model, _>::new(string_meshes())
+                .param(string::params::k, 0.0)
+                .data(string::data::f, &f)
+                .data(string::data::g, &zero)
+                .boundary_data(DirichletPart::All)
+        };
+        let error = |p: Problem<string::Model, IntervalMesh>| p.solve().err().unwrap().to_string();
+        // the obstacle above the boundary data: nothing admissible
+        let e = error(base().data(string::data::psi, &psi));
+        assert!(e.contains("infeasible") && e.contains("ψ = 0.5"), "{e}");
+        // a missing parameter, and the roles given as values
+        let e = error(
+            Problem::<string::Model, _>::new(string_meshes())
+                .data(string::data::f, &f)
+                .data(string::data::psi, &zero)
+                .data(string::data::g, &zero),
+        );
+        assert!(e.contains("needs values for k"), "{e}");
+        let e = error(base().data(string::data::psi, &zero).param("alpha", 0.3));
+        assert!(e.contains("stabilization parameter"), "{e}");
+        let e = error(base().data(string::data::psi, &zero).param("s", 1.0));
+        assert!(e.contains("obstacle side"), "{e}");
+        // data not finite where used
+        let e = error(base().data(string::data::psi, &bad));
+        assert!(e.contains("data `psi`") && e.contains("inf"), "{e}");
+        // memory beyond what the machine allows
+        let huge = MemoryModel::per_cell(1e20);
+        let e = error(
+            base()
+                .data(string::data::psi, &zero)
+                .memory(huge, "--elements 64"),
+        );
+        assert!(e.contains("--elements 64 needs about"), "{e}");
+        // an unknown name from a reader
+        let e = error(base().data(string::data::psi, &zero).param("kappa", 1.0));
+        assert!(e.contains("no parameter `kappa`"), "{e}");
+    }
+}
