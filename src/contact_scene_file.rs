@@ -505,7 +505,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     let scales = DataScales {
         pressure: pressure_range[0].abs().max(pressure_range[1].abs()),
         smallest_gap: gap_range[0],
-        diameter: crate::membranes::bounding_diameter(&mesh),
+        diameter: fem_runtime::problem::domain::bounding_diameter(&mesh),
         young: m.young,
         translation_held: (contact_direction[0] != 0.0 && !fixed_x.is_empty())
             || (contact_direction[1] != 0.0 && !fixed_y.is_empty()),

@@ -81,7 +81,7 @@ fn the_obstacle_crossing_is_reported_and_warned_when_visible() {
     assert!((loud.max_deflection - 0.05 - loud.max_penetration).abs() < 1e-9);
     assert!(loud.max_penetration > 0.005);
     assert!(
-        loud.warnings.iter().any(|w| w.contains("crosses ψ")),
+        loud.warnings.iter().any(|w| w.contains("dips below ψ")),
         "{:?}",
         loud.warnings
     );

@@ -239,7 +239,10 @@ fn scene_file_loads_are_read_as_meant_or_refused() {
         Ok(_) => panic!("a load of 3e300 was solved"),
         Err(e) => e.to_string(),
     };
-    assert!(e.contains("load f") && e.contains("overflow"), "{e}");
+    assert!(
+        e.contains("field `data.f`") && e.contains("overflow"),
+        "{e}"
+    );
     let ambiguous = text.replace("f = \"-1\"", "f = \"-x^2\"");
     let e = scene_file::parse(&ambiguous, Path::new("minus.toml"))
         .unwrap_err()

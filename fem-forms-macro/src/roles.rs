@@ -27,6 +27,10 @@ pub struct Roles {
     pub side: Option<usize>,
     /// `(field, data)`: the constrained field and the obstacle.
     pub obstacle: Option<(usize, usize)>,
+    /// The order `p` of the operator whose residual the stabilization measures: the
+    /// power of h in the stabilization's terms (`Σ_T h_T^p (…)`), or else the total
+    /// derivative order of the energy's bilinear form; 0 where neither is known.
+    pub order: u8,
 }
 
 /// The roles of `declaration` among `forms` (the forms that generate code, in the order
@@ -164,6 +168,7 @@ pub fn resolve(
             ))
         }),
         side: side.unwrap_or_else(|| param_named(&["s"])),
+        order: 0,
         obstacle: obstacle.unwrap_or_else(|| {
             let data = symbols
                 .data
@@ -180,7 +185,29 @@ pub fn resolve(
                 .then_some((field, data))
         }),
     };
-    (roles, errors)
+    let order = roles
+        .stabilization
+        .map(|(_, s, _)| {
+            forms[s]
+                .terms
+                .iter()
+                .map(|t| t.h_power.max(0) as u8)
+                .max()
+                .unwrap_or(0)
+        })
+        .filter(|&p| p > 0)
+        .or_else(|| {
+            roles.energy.map(|[a, _]| {
+                forms[a]
+                    .terms
+                    .iter()
+                    .map(|t| t.args.iter().map(|a| a.order()).sum::<u8>())
+                    .max()
+                    .unwrap_or(0)
+            })
+        })
+        .unwrap_or(0);
+    (Roles { order, ..roles }, errors)
 }
 
 fn kind(arity: usize) -> &'static str {

@@ -167,6 +167,11 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// the constraint is not of this form (Signorini's `u·n_c ≤ g` on a boundary part).
     /// The reports measure penetration and open gaps pointwise with it.
     const OBSTACLE: Option<[usize; 2]> = None;
+    /// The order `p` of the operator of the contact equation: the power of h in the
+    /// stabilization's terms (`Σ_T h_T^p (…)`: 2 for membranes, 4 for beams and plates),
+    /// or else the total derivative order of the energy's bilinear form; 0 where
+    /// neither is known. A load `f` bends the structure by about `f·L^p` over a length L.
+    const ORDER: u8 = 0;
     /// Indices in `PARAMS` of the parameters declared `> 0` (`params: β > 0`): the
     /// forms may divide by sums that are positive only for positive values of them, so
     /// [`Coefficients`] refuses other values.

@@ -456,7 +456,9 @@ fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream
         Some((field, data)) => quote!(::core::option::Option::Some([#field, #data])),
         None => quote!(::core::option::Option::None),
     };
+    let order = roles.order;
     quote! {
+        const ORDER: u8 = #order;
         const OBSTACLE: ::core::option::Option<[usize; 2]> = #obstacle;
         const SYSTEM: ::core::option::Option<[usize; 2]> = #system;
         const ENERGY: ::core::option::Option<[usize; 2]> = #energy;

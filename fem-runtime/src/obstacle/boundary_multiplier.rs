@@ -198,12 +198,14 @@ where
 /// none (a multiplier on the cells).
 ///
 /// # Errors
-/// [`Error::Input`] for a multiplier in the boundary integrals of several parts, and
-/// those of [`multiplier_field`] and [`system_forms`].
+/// [`Error::Input`] for a multiplier in the boundary integrals of several parts.
 pub fn multiplier_part<M: Model>() -> Result<Option<usize>> {
-    let (bilinear, _) = system_forms::<M>()?;
-    let bilinear = M::form(bilinear)?;
-    let multiplier = multiplier_field::<M>()?;
+    // the nodal method's model has neither: no multiplier to place
+    let (Some([bilinear, _]), Some(multiplier)) =
+        (M::SYSTEM, M::FIELDS.iter().position(|f| f.nonnegative))
+    else {
+        return Ok(None);
+    };
     let mut parts: Vec<usize> = M::FACET_BLOCKS
         .iter()
         .filter(|b| {

@@ -43,7 +43,7 @@ pub enum VariationalSolver {
 }
 
 #[derive(Clone, Copy, Debug)]
-enum Role {
+pub(crate) enum Role {
     Primal(usize),
     Multiplier(usize),
 }
@@ -68,9 +68,9 @@ pub struct Discretization<G = IntervalMesh> {
     /// Where the multiplier's DOFs live: on the cells (then they are DOFs of `dofs`) or
     /// on the edges of a boundary part.
     pub multipliers: Multipliers,
-    roles: Vec<Role>,
-    primal_reduced: Vec<usize>,
-    multiplier_reduced: Vec<usize>,
+    pub(crate) roles: Vec<Role>,
+    pub(crate) primal_reduced: Vec<usize>,
+    pub(crate) multiplier_reduced: Vec<usize>,
 }
 
 /// Where a discretization's multiplier lives.
@@ -82,6 +82,9 @@ pub enum Multipliers {
     /// On the edges of a boundary part ([`boundary_multiplier`]): not in
     /// [`Discretization::dofs`], which holds the primal fields only.
     Boundary(boundary_multiplier::BoundaryMultiplierDofs),
+    /// The nodal method's contact forces, one per free node (`B = I`, `C = 0`): the
+    /// model has no multiplier field ([`crate::problem::nodal`]).
+    Nodal,
 }
 
 /// The multiplier field of a model: the one declared `>= 0`.
@@ -579,15 +582,17 @@ impl<G> Discretization<G> {
     pub fn boundary(&self) -> Option<&boundary_multiplier::BoundaryMultiplierDofs> {
         match &self.multipliers {
             Multipliers::Boundary(b) => Some(b),
-            Multipliers::Cells => None,
+            Multipliers::Cells | Multipliers::Nodal => None,
         }
     }
 
     /// For each constraint of the LCP, the DOF (numbered within the multiplier field) of
     /// its multiplier; on a boundary part, the constraint's own index.
     pub fn multiplier_dofs(&self) -> Vec<usize> {
-        if let Multipliers::Boundary(b) = &self.multipliers {
-            return (0..b.count()).collect();
+        match &self.multipliers {
+            Multipliers::Boundary(b) => return (0..b.count()).collect(),
+            Multipliers::Nodal => return (0..self.lcp.m()).collect(),
+            Multipliers::Cells => {}
         }
         let offset = self.dofs.offset(self.multiplier_field).unwrap_or(0);
         self.multiplier_reduced
@@ -600,7 +605,7 @@ impl<G> Discretization<G> {
     /// DOFs: mapped back from the primed ones of [`Discretization::basis`]) of an LCP
     /// solution: the DOFs of `dofs`, followed on a boundary part by the multiplier's.
     pub fn full(&self, solution: &LcpSolution) -> Vec<f64> {
-        if let Multipliers::Boundary(_) = &self.multipliers {
+        if !matches!(self.multipliers, Multipliers::Cells) {
             let mut full = self.reduction.expand(&solution.u);
             full.extend_from_slice(&solution.lambda);
             return full;
@@ -619,7 +624,7 @@ impl<G> Discretization<G> {
 
     /// The multipliers of a full coefficient vector, in the order of the LCP's constraints.
     pub fn multiplier_part(&self, full: &[f64]) -> Vec<f64> {
-        if let Multipliers::Boundary(_) = &self.multipliers {
+        if !matches!(self.multipliers, Multipliers::Cells) {
             return full[self.dofs.dof_count()..].to_vec();
         }
         self.multiplier_reduced
@@ -632,7 +637,7 @@ impl<G> Discretization<G> {
     /// field's DOFs (on a boundary part: its constraints).
     pub fn multiplier_coefficients<'v>(&self, full: &'v [f64]) -> &'v [f64] {
         match &self.multipliers {
-            Multipliers::Boundary(_) => &full[self.dofs.dof_count()..],
+            Multipliers::Boundary(_) | Multipliers::Nodal => &full[self.dofs.dof_count()..],
             Multipliers::Cells => &full[self.dofs.range(self.multiplier_field).unwrap()],
         }
     }

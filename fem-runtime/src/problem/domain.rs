@@ -158,6 +158,50 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
 
     /// Errors of `field` (and the multiplier) against `exact`.
     fn errors(solution: &ObstacleSolution<Self>, field: usize, exact: &Exact) -> Errors;
+
+    /// The shape of the mesh's cells, checked: `None` where shape is not measured
+    /// (intervals); the measures and their warnings otherwise (`alpha_from_inverse_constant`:
+    /// whether α comes from the mesh's `C_I`, which a thin cell makes small).
+    ///
+    /// # Errors
+    /// A mesh with a nearly flat cell (see [`crate::mesh::triangle::MeshQuality::check`]).
+    fn shape(
+        &self,
+        alpha_from_inverse_constant: bool,
+    ) -> Result<Option<(crate::mesh::triangle::MeshQuality, Vec<String>)>> {
+        let _ = alpha_from_inverse_constant;
+        Ok(None)
+    }
+
+    /// "cell 3 with corners (…), (…), (…) and angles …°, …°, …°": the cell of the
+    /// smallest angle, which bounds the stabilization's α = ½/C_I (`None` on intervals).
+    fn worst_cell(&self) -> Option<String> {
+        None
+    }
+
+    /// The nodal method on nested `meshes` ([`super::nodal`]).
+    ///
+    /// # Errors
+    /// On meshes other than affine triangles, and those of [`super::nodal::solve`].
+    fn solve_nodal<M: Model>(
+        meshes: &[Self],
+        coefficients: &Coefficients,
+        supports: &[Support],
+        obstacle: &DataFn,
+        linear_solver: crate::obstacle::hierarchy::LinearSolver,
+    ) -> Result<ObstacleSolution<Self>> {
+        let _ = (meshes, coefficients, supports, obstacle, linear_solver);
+        Err(Error::Input(
+            "the nodal method is solved on affine triangle meshes".into(),
+        ))
+    }
+
+    /// The nodal method's contact area and whether its contact reaches the fixed
+    /// boundary nodes ([`super::nodal::contact_shares`]).
+    fn nodal_contact(solution: &ObstacleSolution<Self>, obstacle: &DataFn) -> (f64, bool) {
+        let _ = (solution, obstacle);
+        (f64::NAN, false)
+    }
 }
 
 /// `DirichletPart` of the interval's ends: marker 1 is the left end, 2 the right one.
@@ -601,6 +645,8 @@ impl Domain for TriangleMesh {
         match &solution.discretization.multipliers {
             Multipliers::Cells => solution.total_contact_force(),
             Multipliers::Boundary(b) => boundary_force(solution, b),
+            // from +0: a float `sum` of no terms is −0, which a report would print
+            Multipliers::Nodal => solution.multiplier_values().iter().fold(0.0, |s, l| s + l),
         }
     }
 
@@ -608,6 +654,8 @@ impl Domain for TriangleMesh {
         match &solution.discretization.multipliers {
             Multipliers::Cells => solution.contact_area(),
             Multipliers::Boundary(b) => boundary_contact_length(solution, b),
+            // the nodal method's needs its obstacle: set by `Problem::solve`
+            Multipliers::Nodal => f64::NAN,
         }
     }
 
@@ -635,6 +683,61 @@ impl Domain for TriangleMesh {
 
     fn errors(solution: &ObstacleSolution<Self>, field: usize, exact: &Exact) -> Errors {
         triangle_errors(solution.view(field), solution, exact)
+    }
+
+    fn shape(
+        &self,
+        alpha_from_inverse_constant: bool,
+    ) -> Result<Option<(crate::mesh::triangle::MeshQuality, Vec<String>)>> {
+        let quality = self.quality();
+        quality.check(self)?;
+        Ok(Some((
+            quality,
+            quality.warnings(self, alpha_from_inverse_constant),
+        )))
+    }
+
+    fn solve_nodal<M: Model>(
+        meshes: &[Self],
+        coefficients: &Coefficients,
+        supports: &[Support],
+        obstacle: &DataFn,
+        linear_solver: crate::obstacle::hierarchy::LinearSolver,
+    ) -> Result<ObstacleSolution<Self>> {
+        super::nodal::solve::<M>(meshes, coefficients, supports, obstacle, linear_solver)
+    }
+
+    fn worst_cell(&self) -> Option<String> {
+        let c = self.quality().min_angle_cell;
+        let angles: Vec<String> = self
+            .cell_angles(c)
+            .iter()
+            .map(|a| match a.to_degrees() {
+                d if d >= 0.01 => format!("{d:.4}°"),
+                d => format!("{d:.3e}°"),
+            })
+            .collect();
+        let corners: Vec<String> = self
+            .cell(c)
+            .iter()
+            .map(|&v| format!("({}, {})", self.vertices()[v][0], self.vertices()[v][1]))
+            .collect();
+        Some(format!(
+            "cell {c} with corners {} and angles {}",
+            corners.join(", "),
+            angles.join(", ")
+        ))
+    }
+
+    fn nodal_contact(solution: &ObstacleSolution<Self>, obstacle: &DataFn) -> (f64, bool) {
+        let (shares, boundary) = super::nodal::contact_shares(solution, obstacle);
+        let mesh = &solution.discretization.mesh;
+        let area = shares
+            .iter()
+            .enumerate()
+            .map(|(c, s)| s * mesh.area(c))
+            .sum();
+        (area, boundary)
     }
 }
 
@@ -868,5 +971,16 @@ impl Domain for CurvedTriangleMesh {
 
     fn errors(solution: &ObstacleSolution<Self>, field: usize, exact: &Exact) -> Errors {
         triangle_errors(solution.view(field), solution, exact)
+    }
+
+    fn shape(
+        &self,
+        alpha_from_inverse_constant: bool,
+    ) -> Result<Option<(crate::mesh::triangle::MeshQuality, Vec<String>)>> {
+        self.mesh().shape(alpha_from_inverse_constant)
+    }
+
+    fn worst_cell(&self) -> Option<String> {
+        self.mesh().worst_cell()
     }
 }

@@ -50,6 +50,7 @@
 
 pub mod domain;
 pub mod memory;
+pub mod nodal;
 pub mod report;
 
 pub use domain::{error_rule_degree, Domain, Errors, Penetration};
@@ -69,9 +70,9 @@ use crate::obstacle::{
 };
 use crate::stabilization::Alpha;
 use report::{
-    answer_level, value_rounding, MAX_MULTIPLIER_NOISE, MAX_PRIMAL_ROUNDING, MAX_ROUNDING,
-    MULTIPLIER_NOISE_WARNING, OPEN_GAP_WARNING, PENETRATION_WARNING, PRIMAL_ROUNDING_WARNING,
-    ROUNDING_WARNING,
+    answer_level, load_rounding, value_rounding, MAX_MULTIPLIER_NOISE, MAX_PRIMAL_ROUNDING,
+    MAX_ROUNDING, MULTIPLIER_NOISE_WARNING, OPEN_GAP_WARNING, PENETRATION_WARNING,
+    PRIMAL_ROUNDING_WARNING, ROUNDING_WARNING,
 };
 use std::marker::PhantomData;
 use std::time::Instant;
@@ -200,6 +201,7 @@ pub struct Problem<'a, M: Model, G: Domain> {
     options: SolveOptions,
     start: Option<&'a FirstStart<G>>,
     exact: Option<Exact<'a>>,
+    nodal: Option<&'a DataFn>,
     memory: MemoryModel,
     size: Option<String>,
     invalid: Option<Error>,
@@ -237,6 +239,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             options: SolveOptions::default(),
             start: None,
             exact: None,
+            nodal: None,
             memory: MemoryModel::of_model::<M>(),
             size: None,
             invalid: None,
@@ -355,6 +358,13 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         self
     }
 
+    /// The nodal method's constraint `u_i ≥ ψ(x_i)` at the free nodes, for a model of
+    /// one P1 field without multiplier ([`nodal`]).
+    pub fn nodal(mut self, obstacle: &'a DataFn) -> Self {
+        self.nodal = Some(obstacle);
+        self
+    }
+
     /// The exact solution, for the report's errors.
     pub fn exact(mut self, exact: Exact<'a>) -> Self {
         self.exact = Some(exact);
@@ -464,15 +474,21 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             .clone()
             .unwrap_or_else(|| format!("a mesh of {} cells", finest.cell_count()));
         memory::check_memory(memory_estimate, &size)?;
+        if let Some(obstacle) = self.nodal {
+            return self.solve_nodal(obstacle, memory_estimate);
+        }
         multiplier_field::<M>()?;
         let data = self.data_functions()?;
         let parts = self.part_markers()?;
         self.check_data(finest, &data)?;
         let mut warnings = Vec::new();
+        let alpha_from_inverse_constant = matches!(self.alpha, Alpha::FromInverseConstant(_));
+        // before C_I, whose eigenproblem a flat cell would make fail
+        let shape = finest.shape(false)?;
         // C_I with α = 0: the stabilization form's primal blocks do not hold α
         let c_i = self.inverse_constant(finest, &self.param_values(0.0)?, &data, &parts)?;
         let alpha = self.alpha.value(c_i, self.alpha_when_zero)?;
-        self.check_alpha(alpha, c_i, &mut warnings)?;
+        self.check_alpha(finest, alpha, c_i, &mut warnings)?;
         let params = self.param_values(alpha)?;
         let coefficients = Coefficients::of_values::<M>(&params, &data)?;
         // the finest level's constraints: the feasibility check, and the level's own
@@ -509,6 +525,20 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         report.memory_estimate = memory_estimate;
         warnings.append(&mut report.warnings);
         report.warnings = warnings;
+        if shape.is_some() {
+            if let Some((quality, shape_warnings)) =
+                finest.shape(alpha_from_inverse_constant && c_i > 0.0)?
+            {
+                report.warnings.extend(shape_warnings);
+                report.mesh_quality = Some(MeshQualityReport {
+                    min_angle_deg: quality.min_angle_deg,
+                    max_angle_deg: quality.max_angle_deg,
+                    max_aspect_ratio: quality.max_aspect_ratio,
+                    worst_inverse_constant: c_i,
+                    forced_alpha: (c_i > 0.0).then(|| 0.5 / c_i),
+                });
+            }
+        }
         if self.options.rounding_experiment {
             let clock = Instant::now();
             let rounding = self
@@ -533,6 +563,147 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                     answer_name::<M>()
                 ));
             }
+        }
+        Ok(Solved {
+            solution,
+            report,
+            params,
+            model: PhantomData,
+        })
+    }
+
+    /// The nodal method: the model is one P1 field, the constraint `u_i ≥ ψ(x_i)` at the
+    /// free nodes, its multipliers the nodal forces.
+    fn solve_nodal(&self, obstacle: &'a DataFn, memory_estimate: f64) -> Result<Solved<M, G>> {
+        let finest = self.meshes.last().expect("checked");
+        let data = self.data_functions()?;
+        self.check_data(finest, &data)?;
+        let shape = finest.shape(false)?;
+        let params = self.param_values(0.0)?;
+        let coefficients = Coefficients::of_values::<M>(&params, &data)?;
+        let dofs = finest.system_dofs::<M>()?;
+        let constraints = finest.constraints::<M>(&dofs, &coefficients, &self.supports)?;
+        check_feasible_at(
+            finest,
+            &dofs,
+            &constraints,
+            0,
+            obstacle,
+            1.0,
+            M::FIELDS[0].name,
+        )?;
+        let options = self.options.obstacle;
+        let meshes = if self.options.nested {
+            &self.meshes[..]
+        } else {
+            &self.meshes[self.meshes.len() - 1..]
+        };
+        let solution = G::solve_nodal::<M>(
+            meshes,
+            &coefficients,
+            &self.supports,
+            obstacle,
+            options.linear_solver,
+        )?;
+        let d = &solution.discretization;
+        let (u, lambda) = (
+            d.primal_part(&solution.values),
+            d.multiplier_part(&solution.values),
+        );
+        let (contact_area, boundary_contact) = G::nodal_contact(&solution, obstacle);
+        let penetration = G::penetration(&solution, 0, obstacle, 1.0);
+        let mut report = Report {
+            model: M::NAME,
+            cells: d.mesh.cell_count(),
+            dofs: d.lcp.n(),
+            multiplier_dofs: d.lcp.m(),
+            alpha: None,
+            inverse_constant: 0.0,
+            solver: "nodal active set",
+            // every free node in contact (or the start already the solution): no system
+            linear_solver: if solution.krylov_iterations > 0 {
+                "multigrid"
+            } else if solution.factorizations > 0 {
+                "direct"
+            } else {
+                "none"
+            },
+            iterations: solution.iterations,
+            levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
+            factorizations: solution.factorizations,
+            krylov_iterations: solution.krylov_iterations,
+            seconds: solution.seconds,
+            memory_estimate,
+            energy: match M::ENERGY {
+                Some(_) => Some(solution.energy::<M>(&coefficients)?),
+                None => None,
+            },
+            total_contact_force: G::total_contact_force(&solution),
+            contact_area: Some(contact_area),
+            // the nodal constraint holds exactly at the nodes: a pushing node touches ψ
+            max_open_contact_gap: Some(0.0),
+            max_penetration: Some(penetration.depth),
+            kkt_residual: solution.kkt_residual,
+            complementarity_residual: d.lcp.complementarity_residual(&u, &lambda),
+            ..Report::default()
+        };
+        if boundary_contact {
+            report.warnings.push("∫λ_h of the nodal method sums the forces at the free nodes: contact reaches the boundary where u = g = ψ, whose nodes carry a share of order h it leaves out (for example membrane-flat at N = 16 and q = 1: 14.06 of the exact 16); a stabilized pair or a finer mesh gives it".into());
+        }
+        if options.linear_solver == crate::obstacle::hierarchy::LinearSolver::Multigrid
+            && solution.krylov_iterations == 0
+            && solution.factorizations > 0
+        {
+            report.warnings.push("--linear-solver multigrid: no active-set step of the finest level was solved by multigrid (it needs a coarser nested level: a cold start, a single level or N below 8 have none; or CG did not converge), so they were factored".into());
+        }
+        let u_values = G::field_at_vertices(&solution, 0);
+        let psi_values = d.mesh.at_vertices(obstacle);
+        let size = |v: &[f64]| {
+            v.iter()
+                .filter(|x| x.is_finite())
+                .fold(0.0f64, |m, x| m.max(x.abs()))
+        };
+        let (lo, hi) = u_values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        let range = penetration
+            .obstacle_range
+            .max(if hi >= lo { hi - lo } else { 0.0 });
+        let rounding = value_rounding(size(&u_values), size(&psi_values))
+            + load_rounding(
+                largest_load::<M, G>(&d.mesh, &coefficients),
+                d.mesh.extent(),
+                M::ORDER,
+            );
+        let share = 100.0 * penetration.depth / range;
+        if range > 0.0
+            && penetration.depth > PENETRATION_WARNING * range
+            && penetration.depth > rounding
+        {
+            report.warnings.push(format!(
+                "u_h dips below ψ between the vertices by up to {:.2e}, {share:.1}% of the larger of ψ's and u_h's ranges ({range:.2e}): the nodal constraint holds at the vertices only, and this mesh does not resolve ψ's curvature (refine)",
+                penetration.depth
+            ));
+        }
+        if let Some(exact) = &self.exact {
+            let errors = G::errors(&solution, 0, exact);
+            report.error_l2 = errors.l2;
+            report.error_h1 = errors.h1;
+            report.error_vertex_max = errors.vertex_max;
+            report.error_vertex_mean = errors.vertex_mean;
+        }
+        if let Some((quality, shape_warnings)) = shape {
+            report.warnings.extend(shape_warnings);
+            report.mesh_quality = Some(MeshQualityReport {
+                min_angle_deg: quality.min_angle_deg,
+                max_angle_deg: quality.max_angle_deg,
+                max_aspect_ratio: quality.max_aspect_ratio,
+                worst_inverse_constant: 0.0,
+                forced_alpha: None,
+            });
         }
         Ok(Solved {
             solution,
@@ -615,7 +786,13 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     }
 
     /// The stabilization's size against rounding and its stability range.
-    fn check_alpha(&self, alpha: f64, c_i: f64, warnings: &mut Vec<String>) -> Result<()> {
+    fn check_alpha(
+        &self,
+        mesh: &G,
+        alpha: f64,
+        c_i: f64,
+        warnings: &mut Vec<String>,
+    ) -> Result<()> {
         if alpha == 0.0 {
             return Ok(());
         }
@@ -633,16 +810,17 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             let regular = regular_inverse_constant::<M>(&self.param_values(0.0)?)?;
             let relative = alpha * if regular > 0.0 { regular } else { 1.0 };
             if relative < SMALLEST_RELATIVE_STABILIZATION {
-                let why = match self.alpha {
-                    Alpha::Fixed(_) => format!("α = {alpha:e}"),
-                    Alpha::FromInverseConstant(_) => format!(
-                        "the mesh's worst cell, with C_I = {c_i:.3e}, forces α = {alpha:.3e}, which"
+                let smallest = 1.01 * SMALLEST_RELATIVE_STABILIZATION
+                    / if regular > 0.0 { regular } else { 1.0 };
+                return Err(Error::Input(match self.alpha {
+                    Alpha::Fixed(_) => format!(
+                        "α = {alpha:e} makes the stabilization of a well-shaped cell {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}: the method would run practically unstabilized, with λ_h lost in rounding; give α = 0 for the plain method or at least {smallest:.2e} (rounded up: that value itself is accepted)"
                     ),
-                };
-                return Err(Error::Input(format!(
-                    "{why} makes the stabilization of a well-shaped cell {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}: the method would run practically unstabilized, with λ_h lost in rounding; give α = 0 for the plain method, at least {:.2e}, or better-shaped cells",
-                    1.01 * SMALLEST_RELATIVE_STABILIZATION / if regular > 0.0 { regular } else { 1.0 }
-                )));
+                    Alpha::FromInverseConstant(_) => format!(
+                        "the mesh's worst triangle, {}, has C_I = {c_i:.3e}, which forces α = ½/C_I = {alpha:.3e}: the stabilization of a well-shaped cell is then {relative:.1e} of its stiffness, below {SMALLEST_RELATIVE_STABILIZATION:.0e}, so the method would run practically unstabilized with λ_h lost in rounding; remesh with better-shaped triangles (or give α explicitly)",
+                        mesh.worst_cell().unwrap_or_else(|| "a cell".into())
+                    ),
+                }));
             }
         }
         if c_i > 0.0 && alpha * c_i >= 1.0 {
@@ -659,6 +837,14 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// vertices of `mesh` (boundary data: on the vertices of its supports' parts only,
     /// the only place it is used).
     fn check_data(&self, mesh: &G, data: &[&DataFn]) -> Result<()> {
+        let points = mesh.vertex_points();
+        let at = |v: usize| {
+            points[v]
+                .iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         for (d, f) in data.iter().enumerate() {
             let values = mesh.at_vertices(*f);
             let on_part = self.boundary_data_vertices(mesh, d);
@@ -669,16 +855,18 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 }
                 if !value.is_finite() {
                     return Err(Error::Input(format!(
-                        "data `{}` of `{}` is {value} at vertex {v} of the mesh",
+                        "data `{}` of `{}` is {value} at ({})",
                         M::DATA[d],
-                        M::NAME
+                        M::NAME,
+                        at(v)
                     )));
                 }
                 if value.abs() > MAX_DATA {
                     return Err(Error::Input(format!(
-                        "data `{}` of `{}` is {value:e} at vertex {v} of the mesh, beyond ±{MAX_DATA:e}: norms in the solve would overflow double precision",
+                        "data `{}` of `{}` is {value:e} at ({}), beyond ±{MAX_DATA:e}: norms in the solve would overflow double precision",
                         M::DATA[d],
-                        M::NAME
+                        M::NAME,
+                        at(v)
                     )));
                 }
                 largest = largest.max(value.abs());
@@ -733,32 +921,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         let Some([field, obstacle]) = M::OBSTACLE else {
             return Ok(());
         };
-        let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
-            return Ok(());
-        };
-        let side = self.side.sign();
-        let fixed: std::collections::HashMap<usize, f64> =
-            constraints.fixed().iter().copied().collect();
-        let vertices = mesh.vertex_points();
-        for (v, x) in vertices.iter().enumerate() {
-            let Some(&value) = fixed.get(&(offset + map.vertex_dofs(v).start)) else {
-                continue;
-            };
-            let psi = data[obstacle](x);
-            if side * (value - psi) < -1e-12 * (1.0 + value.abs().max(psi.abs())) {
-                let name = M::FIELDS[field].name;
-                let at = x
-                    .iter()
-                    .map(|c| c.to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                return Err(Error::Input(format!(
-                    "infeasible: a support holds `{name}` = {value} at ({at}), but the obstacle requires {name} {} ψ = {psi} there, so no admissible {name} exists",
-                    if side > 0.0 { "≥" } else { "≤" }
-                )));
-            }
-        }
-        Ok(())
+        check_feasible_at(
+            mesh,
+            dofs,
+            constraints,
+            field,
+            data[obstacle],
+            self.side.sign(),
+            M::FIELDS[field].name,
+        )
     }
 
     /// The report of a solution.
@@ -885,7 +1056,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 )));
             }
             return Err(Error::Input(format!(
-                "the load (or α) dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves {} by {:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it); use a smaller load or α",
+                "the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves {} by {:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it); use a smaller load (or α)",
                 answer_name::<M>(),
                 report.primal_rounding
             )));
@@ -909,9 +1080,12 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             };
             report.max_penetration = Some(penetration.depth);
             report.max_open_contact_gap = Some(gap);
-            // the rounding of the compared values: of their size, and of the solve
-            // through the rows in contact
-            let rounding = value_rounding(u_size, psi_size) + primal_rounding;
+            // the rounding of the compared values: of their size, of the solve under
+            // its load, and of the solve through the rows in contact
+            let load = largest_load::<M, G>(&d.mesh, coefficients);
+            let rounding = value_rounding(u_size, psi_size)
+                + load_rounding(load, diameter, M::ORDER)
+                + primal_rounding;
             let range = penetration.obstacle_range.max(u_range);
             if penetration.depth.is_nan() {
                 warnings.push(format!(
@@ -922,7 +1096,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 && penetration.depth > rounding
             {
                 warnings.push(format!(
-                    "{name}_h crosses ψ by up to {:.2e}, {:.1} % of the larger of ψ's and {name}_h's ranges ({range:.2e}): the constraint holds on each cell's mean, so a mesh that does not resolve the contact lets {name}_h pass ψ by O(h²) inside cells; refine the mesh (or lower the load)",
+                    "{name}_h {} ψ by up to {:.2e}, {:.1} % of the larger of ψ's and {name}_h's ranges ({range:.2e}): the constraint holds on each cell's mean, so a mesh that does not resolve the contact lets {name}_h pass ψ by O(h²) inside cells; refine the mesh (or lower the load)",
+                    if side > 0.0 { "dips below" } else { "rises above" },
                     penetration.depth,
                     100.0 * penetration.depth / range
                 ));
@@ -1059,6 +1234,17 @@ fn regular_inverse_constant<M: Model>(params: &[f64]) -> Result<f64> {
     crate::stabilization::element_inverse_constant::<M>(cell, params)
 }
 
+/// The largest `|f|` at the vertices over the model's data other than the obstacle and
+/// the boundary data: the size of its loads.
+fn largest_load<M: Model, G: Domain>(mesh: &G, coefficients: &Coefficients) -> f64 {
+    let obstacle = M::OBSTACLE.map(|[_, d]| d);
+    (0..M::DATA.len())
+        .filter(|&d| Some(d) != obstacle && !M::DIRICHLET.iter().any(|&(_, g)| g == d))
+        .flat_map(|d| mesh.at_vertices(coefficients.data[d]))
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
 /// What the reports call the answer: the constrained field with `_h` (`w_h`), or "the
 /// answer" for a model without a pointwise obstacle.
 fn answer_name<M: Model>() -> String {
@@ -1071,6 +1257,42 @@ fn answer_name<M: Model>() -> String {
 /// The total measure of a mesh (its cells' lengths or areas).
 fn domain_measure<G: Mesh>(mesh: &G) -> f64 {
     (0..mesh.cell_count()).map(|c| mesh.measure(c)).sum()
+}
+
+/// An error where a support holds `field` (named `name`) on the wrong side of the
+/// obstacle `psi` at a vertex: no admissible state exists.
+fn check_feasible_at<G: Domain>(
+    mesh: &G,
+    dofs: &crate::SystemDofs,
+    constraints: &Constraints,
+    field: usize,
+    psi: &DataFn,
+    side: f64,
+    name: &str,
+) -> Result<()> {
+    let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
+        return Ok(());
+    };
+    let fixed: std::collections::HashMap<usize, f64> =
+        constraints.fixed().iter().copied().collect();
+    for (v, x) in mesh.vertex_points().iter().enumerate() {
+        let Some(&value) = fixed.get(&(offset + map.vertex_dofs(v).start)) else {
+            continue;
+        };
+        let obstacle = psi(x);
+        if side * (value - obstacle) < -1e-12 * (1.0 + value.abs().max(obstacle.abs())) {
+            let at = x
+                .iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(", ");
+            return Err(Error::Input(format!(
+                "infeasible: a support holds `{name}` = {value} at ({at}), but the obstacle requires {name} {} ψ = {obstacle} there, so no admissible {name} exists",
+                if side > 0.0 { "≥" } else { "≤" }
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// A solver's failure with α named where it is the likely cause: beyond the stability

@@ -1,0 +1,319 @@
+//! The classical nodal-constraint method as a [`super::Problem`]'s constraint: a model
+//! without multiplier (P1 on triangles), `U_i ≥ ψ(x_i)` at its free nodes, solved by
+//! nested primal–dual active sets ([`crate::obstacle::nodal`]), the finest level built
+//! on the second core while the coarser ones solve. Its multipliers are the nodal
+//! contact forces.
+
+use super::{Domain, Support};
+use crate::assembly::dof_map::SystemDofs;
+use crate::assembly::{assemble_vector, MatrixAssembler};
+use crate::error::{Error, Result};
+use crate::lcp::cholesky::multiply;
+use crate::lcp::LcpSolution;
+use crate::mesh::TriangleMesh;
+use crate::model::{Coefficients, DataFn, FormId, Model};
+use crate::multigrid::{parents_by_location, prolongation, reduced_prolongation, NestedLevel};
+use crate::obstacle::hierarchy::LinearSolver;
+use crate::obstacle::nodal::{nodal_active_set_level, nodal_lcp, NODAL_AUTO_MULTIGRID_UNKNOWNS};
+use crate::obstacle::{alongside, Discretization, Multipliers, ObstacleSolution};
+use crate::{Reduction, SparseMatrix};
+use std::time::Instant;
+
+/// From this many triangles on, the finest level is built on the second core while the
+/// coarser levels solve (below it a thread's start costs more than it saves).
+const PIPELINED_CELLS: usize = 32_768;
+
+/// One level before its solve: DOFs, elimination of the boundary DOFs, stiffness `a`,
+/// load `f` and obstacle `ψ` on the free nodes, and the prolongations from the next
+/// coarser level (all DOFs; free DOFs) if there is one.
+struct NodalLevel {
+    dofs: SystemDofs,
+    reduction: Reduction,
+    a: SparseMatrix,
+    f: Vec<f64>,
+    psi: Vec<f64>,
+    prolongations: Option<(SparseMatrix, SparseMatrix)>,
+}
+
+/// The nested iteration so far: (cells, iterations) per level, the prolongations of the
+/// free DOFs finest first, the last level's full coefficients and that level.
+#[derive(Default)]
+struct NodalState {
+    levels: Vec<(usize, usize)>,
+    prolongations: Vec<SparseMatrix>,
+    values: Option<Vec<f64>>,
+    finest: Option<(NodalLevelSolved, LcpSolution)>,
+}
+
+/// A solved level's system, kept for the finest one's discretization.
+struct NodalLevelSolved {
+    dofs: SystemDofs,
+    reduction: Reduction,
+    a: SparseMatrix,
+    f: Vec<f64>,
+    psi: Vec<f64>,
+}
+
+/// Solves the nodal method of `M` (one P1 field, no multiplier) on the nested
+/// `meshes` with the fixed DOFs of `supports` and the obstacle `obstacle`.
+///
+/// # Errors
+/// A model that is not one P1 field without multiplier, a model without an energy
+/// (`energy: a, ℓ`), the supports' and the assembly's errors, the solver's failure.
+pub fn solve<M: Model>(
+    meshes: &[TriangleMesh],
+    coefficients: &Coefficients,
+    supports: &[Support],
+    obstacle: &DataFn,
+    linear_solver: LinearSolver,
+) -> Result<ObstacleSolution<TriangleMesh>> {
+    let clock = Instant::now();
+    if M::FIELDS.len() != 1
+        || M::FIELDS[0].nonnegative
+        || M::FIELDS[0].element != crate::ElementKind::P1
+    {
+        return Err(Error::Input(format!(
+            "the nodal method takes a model of one P1 field without multiplier; `{}` has {}",
+            M::NAME,
+            M::FIELDS
+                .iter()
+                .map(|f| format!("{} ({})", f.name, f.element.name()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    let [stiffness, load] = M::ENERGY.ok_or_else(|| {
+        Error::Input(format!(
+            "the nodal method assembles the energy of `{}`, which declares none (`energy: a, ℓ;`)",
+            M::NAME
+        ))
+    })?;
+    let free_dofs = |mesh: &TriangleMesh| -> Result<(SystemDofs, Reduction)> {
+        let dofs = SystemDofs::all::<M>(mesh)?;
+        let constraints = mesh.constraints::<M>(&dofs, coefficients, supports)?;
+        let reduction = constraints.reduction(dofs.dof_count())?;
+        Ok((dofs, reduction))
+    };
+    let setup = |i: usize| -> Result<NodalLevel> {
+        let mesh = &meshes[i];
+        let (dofs, reduction) = free_dofs(mesh)?;
+        // the pattern moves into `k` and `k`'s arrays into `a` (no copies: peak memory)
+        let k = MatrixAssembler::new::<M>(FormId::new(stiffness), mesh, &dofs)?
+            .into_matrix::<M>(mesh, coefficients)?;
+        let l = assemble_vector::<M>(FormId::new(load), mesh, &dofs, coefficients)?;
+        let f = reduction.rhs(&k, &l);
+        drop(l);
+        let a = reduction.into_matrix(k);
+        let nodes = dofs.map(0).expect("one field").nodes(mesh);
+        let psi: Vec<f64> = reduction
+            .free()
+            .iter()
+            .map(|&d| obstacle(&nodes[d]))
+            .collect();
+        let prolongations = match i.checked_sub(1).map(|c| &meshes[c]) {
+            Some(coarse) => {
+                let (coarse_dofs, coarse_reduction) = free_dofs(coarse)?;
+                let parents = parents_by_location(coarse, mesh)?;
+                let level = |mesh, dofs, reduction| NestedLevel {
+                    mesh,
+                    dofs,
+                    reduction,
+                };
+                let all = prolongation(
+                    &level(coarse, &coarse_dofs, None),
+                    &level(mesh, &dofs, None),
+                    &parents,
+                )?;
+                let free = reduced_prolongation(&all, &coarse_reduction, &reduction)?;
+                Some((all, free))
+            }
+            None => None,
+        };
+        Ok(NodalLevel {
+            dofs,
+            reduction,
+            a,
+            f,
+            psi,
+            prolongations,
+        })
+    };
+    let level_count = meshes.len();
+    let step = |state: &mut NodalState, level: NodalLevel, cells: usize| -> Result<()> {
+        let NodalLevel {
+            dofs,
+            reduction,
+            a,
+            f,
+            psi,
+            prolongations,
+        } = level;
+        // the coarser level's system goes before this level's solve allocates
+        state.finest = None;
+        // the coarse solution interpolated at the fine nodes, boundary values included
+        let start = match (prolongations, state.values.take()) {
+            (Some((all, free)), Some(values)) => {
+                let fine = multiply(&all, &values);
+                state.prolongations.insert(0, free);
+                Some(
+                    reduction
+                        .free()
+                        .iter()
+                        .map(|&d| fine[d])
+                        .collect::<Vec<f64>>(),
+                )
+            }
+            _ => None,
+        };
+        let multigrid = match linear_solver {
+            LinearSolver::Direct => false,
+            LinearSolver::Multigrid => !state.prolongations.is_empty(),
+            LinearSolver::Auto => {
+                a.nrows() >= NODAL_AUTO_MULTIGRID_UNKNOWNS && state.prolongations.len() >= 2
+            }
+        };
+        let hierarchy: &[SparseMatrix] = if multigrid { &state.prolongations } else { &[] };
+        let last = state.levels.len() + 1 == level_count;
+        let solution =
+            nodal_active_set_level(&a, &f, &psi, start.as_deref(), 500, hierarchy, last)?;
+        state.levels.push((cells, solution.iterations));
+        state.values = Some(reduction.expand(&solution.u));
+        state.finest = Some((
+            NodalLevelSolved {
+                dofs,
+                reduction,
+                a,
+                f,
+                psi,
+            },
+            solution,
+        ));
+        Ok(())
+    };
+    let mut state = NodalState::default();
+    let count = meshes.len();
+    if count >= 3 && meshes[count - 1].cell_count() >= PIPELINED_CELLS {
+        let mut finest = None;
+        alongside(
+            || finest = Some(setup(count - 1)),
+            || -> Result<()> {
+                for (i, mesh) in meshes[..count - 1].iter().enumerate() {
+                    step(&mut state, setup(i)?, mesh.cell_count())?;
+                }
+                Ok(())
+            },
+        )?;
+        let finest = finest.expect("the worker has run")?;
+        step(&mut state, finest, meshes[count - 1].cell_count())?;
+    } else {
+        for (i, mesh) in meshes.iter().enumerate() {
+            step(&mut state, setup(i)?, mesh.cell_count())?;
+        }
+    }
+    let values = state.values.expect("at least one mesh");
+    let (level, solution) = state.finest.expect("at least one mesh");
+    let mut values = values;
+    values.extend_from_slice(&solution.lambda);
+    let n = level.reduction.free().len();
+    let discretization = Discretization {
+        mesh: meshes[count - 1].clone(),
+        dofs: level.dofs,
+        reduction: level.reduction,
+        basis: Default::default(),
+        lcp: nodal_lcp(&level.a, &level.f, &level.psi),
+        multiplier_field: M::FIELDS.len(),
+        multipliers: Multipliers::Nodal,
+        roles: Vec::new(),
+        primal_reduced: (0..n).collect(),
+        multiplier_reduced: Vec::new(),
+    };
+    Ok(ObstacleSolution {
+        iterations: solution.iterations,
+        factorizations: solution.factorizations,
+        low_rank_updates: solution.low_rank_updates,
+        kkt_residual: solution.kkt_residual,
+        solve_seconds: solution.seconds,
+        multiplier_noise: 0.0,
+        iterative_steps: solution.iterative_steps,
+        krylov_iterations: solution.krylov_iterations,
+        discretization,
+        values,
+        levels: state.levels,
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+/// The nodal method's contact set, per cell: the share of its vertices in contact. A
+/// free vertex touches where its force is positive or it lies on ψ; a boundary vertex
+/// where g = ψ lies on the obstacle whether or not the membrane touches it, so it counts
+/// only next to contact, found in two steps (next to interior contact, then next to
+/// those, which reaches a corner cell whose three vertices are all on the boundary).
+/// Also whether such a boundary vertex is in contact (its force is not in ∫λ_h).
+pub fn contact_shares(
+    solution: &ObstacleSolution<TriangleMesh>,
+    obstacle: &DataFn,
+) -> (Vec<f64>, bool) {
+    let d = &solution.discretization;
+    let mesh = &d.mesh;
+    let values = &solution.values[..d.dofs.dof_count()];
+    let lambda = solution.multiplier_values();
+    let scale = lambda.iter().cloned().fold(0.0, f64::max);
+    let mut vertex_force = vec![0.0; mesh.vertex_count()];
+    let mut free = vec![false; mesh.vertex_count()];
+    for (k, &dof) in d.reduction.free().iter().enumerate() {
+        vertex_force[dof] = lambda[k];
+        free[dof] = true;
+    }
+    let on_obstacle = |v: usize| {
+        let gap = values[v] - obstacle(&mesh.vertices()[v]);
+        gap.abs() <= 1e-10 * (1.0 + values[v].abs())
+    };
+    let interior: Vec<bool> = (0..mesh.vertex_count())
+        .map(|v| free[v] && (vertex_force[v] > 1e-8 * scale.max(1e-300) || on_obstacle(v)))
+        .collect();
+    let spread = |active: &[bool]| -> Vec<bool> {
+        let mut next = active.to_vec();
+        for c in 0..mesh.cell_count() {
+            let cell = mesh.cell(c);
+            if cell.iter().any(|&v| active[v]) {
+                for v in cell {
+                    next[v] |= !free[v] && on_obstacle(v);
+                }
+            }
+        }
+        next
+    };
+    let active = spread(&spread(&interior));
+    let shares = (0..mesh.cell_count())
+        .map(|c| mesh.cell(c).iter().filter(|&&v| active[v]).count() as f64 / 3.0)
+        .collect();
+    let boundary_contact = (0..mesh.vertex_count()).any(|v| !free[v] && active[v]);
+    (shares, boundary_contact)
+}
+
+/// The nodal forces as a density per cell: each vertex's force over its share of the
+/// area (a third of the cells around it), averaged over the cell's vertices.
+pub fn force_density(solution: &ObstacleSolution<TriangleMesh>) -> Vec<f64> {
+    let d = &solution.discretization;
+    let mesh = &d.mesh;
+    let lambda = solution.multiplier_values();
+    let mut vertex_force = vec![0.0; mesh.vertex_count()];
+    for (k, &dof) in d.reduction.free().iter().enumerate() {
+        vertex_force[dof] = lambda[k];
+    }
+    let mut vertex_area = vec![0.0; mesh.vertex_count()];
+    for c in 0..mesh.cell_count() {
+        for v in mesh.cell(c) {
+            vertex_area[v] += mesh.area(c) / 3.0;
+        }
+    }
+    (0..mesh.cell_count())
+        .map(|c| {
+            mesh.cell(c)
+                .iter()
+                .map(|&v| vertex_force[v] / vertex_area[v])
+                .sum::<f64>()
+                / 3.0
+        })
+        .collect()
+}
