@@ -14,13 +14,12 @@ use crate::studies::{io, output, write_csv, Study};
 use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
 use fem_runtime::mesh::triangle::QuadraticGeometry;
 use fem_runtime::mesh::CurvedTriangleMesh;
-use fem_runtime::obstacle::triangle::{
-    solve_obstacle_on_curved_triangles, solve_obstacle_on_triangles,
-};
-use fem_runtime::obstacle::{ObstacleOptions, ObstacleSolution};
+use fem_runtime::obstacle::ObstacleSolution;
+use fem_runtime::problem::{Domain, MemoryModel, ObstacleSide, Problem, Report};
 use fem_runtime::reference::triangle::TriangleRule;
+use fem_runtime::stabilization::Alpha;
 use fem_runtime::{
-    Coefficients, Diagonal, DofNumbering, Error, Model, PointLocator, Result, TriangleMesh,
+    Diagonal, DirichletPart, DofNumbering, Error, Model, PointLocator, Result, TriangleMesh,
 };
 use serde::Serialize;
 use std::path::Path;
@@ -487,8 +486,6 @@ trait PlateCells {
     fn straight(&self) -> &TriangleMesh;
     /// The view of a field.
     fn field_view(&self, field: usize) -> TriangleField<'_>;
-    /// `∫λ_h` over the cells.
-    fn contact_force(&self) -> f64;
     /// The contact area over the cells.
     fn area_in_contact(&self) -> f64;
     /// `∫ u_h` of `field` over the cells.
@@ -501,9 +498,6 @@ impl PlateCells for ObstacleSolution<TriangleMesh> {
     }
     fn field_view(&self, field: usize) -> TriangleField<'_> {
         self.view(field)
-    }
-    fn contact_force(&self) -> f64 {
-        self.total_contact_force()
     }
     fn area_in_contact(&self) -> f64 {
         self.contact_area()
@@ -519,9 +513,6 @@ impl PlateCells for ObstacleSolution<CurvedTriangleMesh> {
     }
     fn field_view(&self, field: usize) -> TriangleField<'_> {
         self.view(field)
-    }
-    fn contact_force(&self) -> f64 {
-        self.total_contact_force()
     }
     fn area_in_contact(&self) -> f64 {
         self.contact_area()
@@ -544,18 +535,12 @@ impl PlateCells for ObstacleSolution<CurvedTriangleMesh> {
 }
 
 /// Solves the plate on its meshes, coarsest first (each level started from the one
-/// before), and reports: on straight cells for the square, on isoparametric
-/// (quadratic-geometry) cells for the disk, whose boundary edges follow the circle
-/// (`QuadraticGeometry::circle`; docs/mathematics.md §8: the polygon adds ~3e-4 relative
-/// to J).
+/// before), through the runtime's one pipeline: on straight cells for the square, on
+/// isoparametric (quadratic-geometry) cells for the disk, whose boundary edges follow the
+/// circle (`QuadraticGeometry::circle`; docs/mathematics.md §8: the polygon adds ~3e-4
+/// relative to J).
 fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
     let s = &request.scene;
-    let (params, height) = plate_parameters::<M>(request);
-    let q = request.load;
-    let load = move |_: &[f64]| q;
-    let obstacle = move |_: &[f64]| height;
-    let coefficients =
-        Coefficients::new::<M>(&params, &[("f", &load), ("ψ", &obstacle), ("g", &zero)])?;
     // without an obstacle the plate is one linear solve: the nested start serves contact
     // (mindlin-disk --no-obstacle solved five levels of one iteration each)
     let nested = request.nested && request.obstacle() != PlateObstacle::None;
@@ -567,32 +552,62 @@ fn solve_with<M: Model>(request: &PlateRequest) -> Result<PlateReport> {
         .into_iter()
         .map(|n| plate_mesh(s.domain, n))
         .collect::<Result<Vec<_>>>()?;
-    let options = ObstacleOptions::default();
+    let h = meshes.last().map_or(0.0, |m| m.max_h());
     let mut report = match s.domain {
-        PlateDomain::Square { .. } => {
-            let solution = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options)?;
-            report::<M, _>(request, &solution, &coefficients, height)
-        }
+        PlateDomain::Square { .. } => solve_on::<M, _>(request, meshes),
         PlateDomain::Disk { radius } => {
-            let geometries = meshes
-                .iter()
-                .map(|mesh| QuadraticGeometry::circle(mesh, s.domain.centre(), radius))
+            let curved = meshes
+                .into_iter()
+                .map(|mesh| {
+                    let geometry = QuadraticGeometry::circle(&mesh, s.domain.centre(), radius)?;
+                    CurvedTriangleMesh::new(mesh, geometry)
+                })
                 .collect::<Result<Vec<_>>>()?;
-            let solution = solve_obstacle_on_curved_triangles::<M>(
-                &meshes,
-                &geometries,
-                &coefficients,
-                options,
-            )?;
-            report::<M, _>(request, &solution, &coefficients, height)
+            solve_on::<M, _>(request, curved)
         }
     }?;
     report.warnings.extend(coarse_start);
-    let h = meshes.last().map_or(0.0, |m| m.max_h());
     report
         .warnings
         .extend(locking_warning(request.pair, h, request.thickness));
     Ok(report)
+}
+
+/// The plate's problem on `meshes` and its report.
+fn solve_on<M: Model, G>(request: &PlateRequest, meshes: Vec<G>) -> Result<PlateReport>
+where
+    G: Domain,
+    ObstacleSolution<G>: PlateCells,
+{
+    let (params, side, height) = plate_parameters::<M>(request);
+    let q = request.load;
+    let load = move |_: &[f64]| q;
+    let obstacle = move |_: &[f64]| height;
+    let mut problem = Problem::<M, G>::new(meshes)
+        .data("f", &load)
+        .data("ψ", &obstacle)
+        .data("g", &zero)
+        .boundary_data(DirichletPart::All)
+        .side(side)
+        .alpha(Alpha::Fixed(request.alpha), PLATE_ALPHA)
+        .memory(
+            MemoryModel::per_cell(estimated_memory_bytes(request) / triangles_of(request)),
+            format!("--mesh-size {}", request.mesh_size),
+        );
+    for (name, value) in params {
+        problem = problem.param(name, value);
+    }
+    let solved = problem.solve()?;
+    report::<M, G>(request, &solved.solution, &solved.report)
+}
+
+/// The triangles of the finest mesh of `request` (the square's 2N², the disk's 6N²).
+fn triangles_of(request: &PlateRequest) -> f64 {
+    let n = request.mesh_size as f64;
+    match request.scene.domain {
+        PlateDomain::Square { .. } => 2.0 * n * n,
+        PlateDomain::Disk { .. } => 6.0 * n * n,
+    }
 }
 
 /// The warning of the plain pair where it locks: its shear term `t⁻²(∇w − θ)` with
@@ -632,9 +647,11 @@ pub(crate) fn cold_coarsest_warning(sizes: &[usize], coarsest: usize) -> Option<
     })
 }
 
-/// The parameters of `request` for model `M` and the obstacle's height (far below the
-/// plate when the scene has none).
-fn plate_parameters<M: Model>(request: &PlateRequest) -> (Vec<(&'static str, f64)>, f64) {
+/// The parameters of `request` for model `M` (all but α and s, which the solve sets),
+/// the obstacle's side and its height (far below the plate when the scene has none).
+fn plate_parameters<M: Model>(
+    request: &PlateRequest,
+) -> (Vec<(&'static str, f64)>, ObstacleSide, f64) {
     let s = &request.scene;
     let q = request.load;
     let length = s.domain.length();
@@ -652,21 +669,23 @@ fn plate_parameters<M: Model>(request: &PlateRequest) -> (Vec<(&'static str, f64
         ("ν", s.poisson_ratio),
         ("κ", s.shear_correction),
         ("t", request.thickness),
-        ("α", request.alpha),
-        ("s", side),
     ];
     if M::param("β").is_ok() {
         params.push(("β", STENBERG_BETA));
     }
-    (params, height)
+    let side = if side > 0.0 {
+        ObstacleSide::Below
+    } else {
+        ObstacleSide::Above
+    };
+    (params, side, height)
 }
 
-/// The report of a solved plate.
+/// The report of a solved plate: the runtime's report and the plate's own quantities.
 fn report<M: Model, G: DofNumbering>(
     request: &PlateRequest,
     solution: &ObstacleSolution<G>,
-    coefficients: &Coefficients,
-    height: f64,
+    runtime: &Report,
 ) -> Result<PlateReport>
 where
     ObstacleSolution<G>: PlateCells,
@@ -675,76 +694,7 @@ where
     let q = request.load;
     let w = M::field("w")?;
     let max_deflection = solution.field(w).iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    // the plate's size for relative measures, never 0: an unloaded plate under an obstacle
-    // at height 0 has w_h = 0, and its rounding is still not a gap or a loss
-    let size = max_deflection.max(height.abs()).max(1e-6 * s.domain.size());
-    let mut primal_rounding = 0.0;
-    if request.obstacle() != PlateObstacle::None {
-        // as for membranes: a load (or α) that dwarfs the obstacle leaves w_h to the
-        // rounding of the contact rows (q = 1e100 on the disk: w(0) = −2.7e78 under
-        // ψ = 0.05), which the KKT residual cannot show
-        let rounding = solution.primal_rounding() / size;
-        if rounding.is_nan() || rounding > MAX_PRIMAL_ROUNDING {
-            return Err(Error::Input(format!(
-                "w_h is lost to rounding: in contact the constraint rows subtract terms of the size of the load and of α h⁴ q (q = {q:e}, α = {:e}), which dwarf the obstacle ({}), and their rounding moves w_h by {rounding:.0e} of its own size; use a smaller load or α",
-                request.alpha,
-                request.obstacle().describe()
-            )));
-        }
-        primal_rounding = rounding;
-    }
-    let mut warnings = Vec::new();
-    // below the refusal, as beams and membranes do: say how far the rounding reaches
-    if primal_rounding > ROUNDING_WARNING {
-        warnings.push(format!(
-            "w_h may be off by {primal_rounding:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)"
-        ));
-    }
-    // as beams and membranes do: the eliminated λ_h loses digits where C falls below the
-    // rounding of G − BU, and its recovery may have been skipped (out of memory)
-    if solution.multiplier_noise > 1e-6 {
-        warnings.push(format!(
-            "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁴ approaches the rounding of G − BU at this mesh size (a larger α or a coarser mesh avoids it)",
-            solution.multiplier_noise
-        ));
-    }
-    // w_h ∈ P2 is determined by its nodal values; λ_h ∈ P0 holds the constraint on each
-    // cell's mean, so the plate may cross ψ between nodes and at them by O(h²)
-    let max_penetration = match request.obstacle().side_and_height() {
-        Some((side, psi)) => solution
-            .field(w)
-            .iter()
-            .fold(0.0f64, |m, &v| m.max(side * (psi - v))),
-        None => 0.0,
-    };
-    if max_penetration > 1e-2 * height.abs().max(1e-300) {
-        warnings.push(format!(
-            "w_h crosses the obstacle by up to {max_penetration:.2e} ({:.1} % of the obstacle's height {height}, the size a crossing is judged by): the constraint holds on each cell's mean, so coarse meshes let the plate pass ψ by O(h²); refine the mesh",
-            100.0 * max_penetration / height.abs()
-        ));
-    }
-    let max_open_contact_gap = match request.obstacle().side_and_height() {
-        Some((side, psi)) => {
-            let obstacle = move |_: &[f64]| psi;
-            fem_runtime::obstacle::triangle::max_open_contact_gap(
-                &solution.field_view(w),
-                &solution.field_view(solution.discretization.multiplier_field),
-                &obstacle,
-                side,
-            )
-        }
-        None => 0.0,
-    };
-    // a gap within the rounding of the contact rows is no gap
-    if max_open_contact_gap > crate::membranes::OPEN_GAP_WARNING * size
-        && max_open_contact_gap > solution.primal_rounding()
-    {
-        warnings.push(format!(
-            "λ_h pushes on cells where w_h stays up to {max_open_contact_gap:.2e} clear of the obstacle ({:.1} % of the plate's size max(|w_h|, |ψ|) = {size:.2e}): the stabilized constraint w_h − ψ = α h⁴(…) on contact cells lets α h⁴ q (α = {}) open that gap on this mesh, so this contact set is not real; refine the mesh or lower α",
-            100.0 * max_open_contact_gap / size,
-            request.alpha
-        ));
-    }
+    let mut warnings = runtime.warnings.clone();
     if request.alpha > 1.0 {
         warnings.push(format!(
             "α = {} is above 1: the stabilization's term α h⁴ s²(λ, μ) then moves the constraint visibly (docs/mathematics.md §6: α = 1 is already 5–10× less accurate than the default {PLATE_ALPHA})",
@@ -760,7 +710,7 @@ where
         s.mindlin_deflection_at(q, request.thickness)
     };
     // without a closed form for the thick plate, relative_error is against Kirchhoff's
-    // t → 0 limit: a tester's t = 1 read +1672 % as the discretization's error
+    // t → 0 limit: a thick plate's difference is the models', not the discretization's
     let plate_size = s.domain.size();
     if !in_contact && unobstructed.is_none() && request.thickness > 0.02 * plate_size {
         warnings.push(format!(
@@ -769,7 +719,6 @@ where
             100.0 * request.thickness / plate_size
         ));
     }
-    let energy = solution.energy::<M>(coefficients)?;
     let contact = ContactGeometry::of(solution, s.domain.centre());
     let mesh = solution.straight();
     Ok(PlateReport {
@@ -798,21 +747,25 @@ where
                 (centre - reference) / reference
             }
         },
-        energy,
+        energy: runtime.energy.unwrap_or(f64::NAN),
         max_deflection,
         deflection_integral: solution.integral(w),
-        total_contact_force: solution.contact_force(),
+        total_contact_force: runtime.total_contact_force,
         contact_area: contact.area,
         contact_radius: in_contact.then_some(contact.radius),
         lambda_interior_mean: contact.interior.map(|(mean, _)| mean),
         lambda_interior_spread: contact.interior.map(|(_, spread)| spread),
-        complementarity_residual: solution.kkt_residual,
+        complementarity_residual: runtime.kkt_residual,
         dofs: solution.discretization.dofs.dof_count(),
-        iterations: solution.iterations,
-        levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
-        seconds: solution.seconds,
-        max_penetration,
-        max_open_contact_gap,
+        iterations: runtime.iterations,
+        levels: runtime.levels.clone(),
+        seconds: runtime.seconds,
+        max_penetration: if in_contact {
+            runtime.max_penetration.unwrap_or(0.0)
+        } else {
+            0.0
+        },
+        max_open_contact_gap: runtime.max_open_contact_gap.unwrap_or(0.0),
         warnings,
     })
 }

@@ -16,6 +16,21 @@ use std::process::Command;
 /// Keys renamed by the refactor: `(old path, new path)`, paths joined by `.`.
 const RENAMED: &[(&str, &str)] = &[];
 
+/// Numbers and messages the refactor changed on purpose: `(command, key, why)`. The new
+/// value is checked by the tests of the concept named; for `warnings`, the count stays.
+const CHANGED: &[(&str, &str, &str)] = &[
+    (
+        "mindlin-disk --mesh-size 8",
+        "max_penetration",
+        "the runtime's one penetration check samples each cell's vertices, quadrature points and, on coarse meshes, a lattice (the plates sampled w's nodes only): 1.50e-3 instead of 1.47e-3 (tests/plate_scenes.rs)",
+    ),
+    (
+        "mindlin-disk --mesh-size 8",
+        "warnings",
+        "the penetration warning is the runtime's, judged against ψ's and w_h's ranges",
+    ),
+];
+
 /// Quantities that are themselves rounding measurements (residuals, noise estimates):
 /// compared by order of magnitude, since a change of summation order moves them.
 const ROUNDING: &[&str] = &[
@@ -74,13 +89,14 @@ fn agree(old: &Value, new: &Value, leaf: &str) -> bool {
     }
 }
 
-/// What of `old` `new` lost or changed, one line each.
-fn differences(old: &Value, new: &Value) -> Vec<String> {
+/// What of `old` `new` lost or changed, one line each, but for the keys `changed`
+/// allows (a changed `warnings` keeps its count).
+fn differences(old: &Value, new: &Value, changed: &[&str]) -> Vec<String> {
     let mut recorded = Vec::new();
     leaves(old, String::new(), &mut recorded);
     let mut faults = Vec::new();
     for (path, value) in recorded {
-        if is_time(&path) {
+        if is_time(&path) || (changed.contains(&path.as_str()) && path != "warnings") {
             continue;
         }
         let target = RENAMED
@@ -88,7 +104,19 @@ fn differences(old: &Value, new: &Value) -> Vec<String> {
             .find(|(from, _)| *from == path)
             .map_or(path.as_str(), |(_, to)| to);
         let leaf = path.rsplit('.').next().unwrap_or(&path);
-        match lookup(new, target) {
+        let value = &match (path.as_str(), value) {
+            ("warnings", Value::Array(a)) if changed.contains(&"warnings") => Value::from(a.len()),
+            _ => value.clone(),
+        };
+        let count;
+        let now = match (path.as_str(), lookup(new, target)) {
+            ("warnings", Some(Value::Array(a))) if changed.contains(&"warnings") => {
+                count = Value::from(a.len());
+                Some(&count)
+            }
+            (_, found) => found,
+        };
+        match now {
             None => faults.push(format!("{path}: missing (was {value})")),
             Some(now) if !agree(value, now, leaf) => {
                 faults.push(format!("{path}: {now}, was {value}"))
@@ -131,7 +159,12 @@ fn every_recorded_report_keeps_its_numbers() {
         let new: Value = serde_json::from_slice(&output.stdout)
             .unwrap_or_else(|e| panic!("`solve {line} --json`: {e}"));
         let old: Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
-        let faults = differences(&old, &new);
+        let changed: Vec<&str> = CHANGED
+            .iter()
+            .filter(|(case, _, _)| case == line)
+            .map(|(_, key, _)| *key)
+            .collect();
+        let faults = differences(&old, &new, &changed);
         if !faults.is_empty() {
             failures.push(format!("`solve {line}`:\n    {}", faults.join("\n    ")));
         }
@@ -145,7 +178,8 @@ fn the_comparison_can_fail() {
     let old: Value =
         serde_json::json!({"energy": 1.0, "levels": [[8, 2]], "seconds": 1.0, "a": {"b": 3.0}});
     let same: Value = serde_json::json!({"energy": 1.0 + 1e-12, "levels": [[8, 2]], "seconds": 9.0, "a": {"b": 3.0}});
-    assert!(differences(&old, &same).is_empty());
+    assert!(differences(&old, &same, &[]).is_empty());
     let changed: Value = serde_json::json!({"energy": 1.001, "levels": [[8, 3]], "a": {}});
-    assert_eq!(differences(&old, &changed).len(), 3);
+    assert_eq!(differences(&old, &changed, &[]).len(), 3);
+    assert_eq!(differences(&old, &changed, &["energy"]).len(), 2);
 }

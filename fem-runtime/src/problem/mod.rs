@@ -1049,14 +1049,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         if report.primal_rounding.is_nan() || report.primal_rounding > MAX_PRIMAL_ROUNDING {
             if let Some(default) = large_alpha {
                 return Err(Error::Input(format!(
-                    "the load with α = {alpha:e} ({} times the default {default:e}) makes the terms of the constraint rows so large that their rounding moves {} by {:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it): lower α first, then the load",
-                    number(alpha / default),
+                    "{} is lost to rounding: the load with α = {alpha:e} ({} times the default {default:e}) makes the terms of the constraint rows so large that their rounding moves it by {:.0e} of its own size (its KKT residual cannot show it): lower α first, then the load",
                     answer_name::<M>(),
+                    number(alpha / default),
                     report.primal_rounding
                 )));
             }
             return Err(Error::Input(format!(
-                "the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves {} by {:.0e} of its own size; the answer would be rounding (its KKT residual cannot show it); use a smaller load (or α)",
+                "{} is lost to rounding: the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves {} by {:.0e} of its own size (its KKT residual cannot show it); use a smaller load (or α)",
+                answer_name::<M>(),
                 answer_name::<M>(),
                 report.primal_rounding
             )));
@@ -1121,7 +1122,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                     "refine the mesh or lower α"
                 };
                 warnings.push(format!(
-                    "λ_h pushes on cells where {name}_h stays up to {gap:.2e} clear of ψ ({:.1} % of the answer's size {level:.2e}): the stabilized constraint on contact cells lets α h^p(…) (α = {alpha:e}) open that gap, so this contact set is not real; {cure}",
+                    "λ_h pushes on cells where {name}_h stays up to {gap:.2e} clear of ψ ({:.1} % of the answer's size max(|{name}_h|, |ψ|) = {level:.2e}): the stabilized constraint on contact cells lets α h^p(…) (α = {alpha:e}) open that gap, so this contact set is not real; {cure}",
                     100.0 * gap / level
                 ));
             }
