@@ -10,14 +10,12 @@ use crate::models::kirchhoff::{
 use crate::models::kirchhoff_scenes::{
     KirchhoffObstacle, KirchhoffScene, KirchhoffSupport, CURVED_OBSTACLE, FLAT_OBSTACLE,
 };
-use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
-use fem_runtime::obstacle::triangle::{prolong_primal_on_triangles, TriangleObstacleSolution};
-use fem_runtime::obstacle::{solve_nested, Discretization, ObstacleOptions, VariationalSolver};
-use fem_runtime::stabilization::inverse_constant;
-use fem_runtime::{
-    Coefficients, Constraints, Diagonal, DirichletPart, Error, Model, PlateSupport, PointLocator,
-    Result, SystemDofs, TriangleMesh,
-};
+use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
+use fem_runtime::obstacle::triangle::TriangleObstacleSolution;
+use fem_runtime::obstacle::{ObstacleOptions, VariationalSolver};
+use fem_runtime::problem::{Condition, MemoryModel, ObstacleSide, Problem, SolveOptions};
+use fem_runtime::stabilization::{inverse_constant, Alpha};
+use fem_runtime::{Diagonal, DirichletPart, Error, Model, PointLocator, Result, TriangleMesh};
 use serde::Serialize;
 use std::path::Path;
 
@@ -30,29 +28,6 @@ const SIDE: f64 = -1.0;
 /// the saddle-point system, 5.0 GB at 112 and 6.5 GB (18 s) at 128; N = 256 passed
 /// 7.8 GB before it finished.
 pub const MAX_KIRCHHOFF_MESH_SIZE: usize = 160;
-
-/// `α·C_I` below which a solver failure with an α the user gave names α: the default
-/// is [`ALPHA_FRACTION`]; at 1e-7 (`--alpha 1e-12` on kirchhoff-obstacle) Newton's
-/// active set no longer settles, the eliminated multiplier `(G − BU)/(α h⁴ …)` being
-/// rounding.
-const WEAK_ALPHA_TIMES_C_I: f64 = 1e-4;
-
-/// `error` with a hint naming `--alpha` when the user's α is far below the stability
-/// range's middle (`alpha_times_c_i` below [`WEAK_ALPHA_TIMES_C_I`]; Morley, whose
-/// `C_I` is 0, is left alone).
-fn weak_alpha_hint(error: Error, alpha: Option<f64>, alpha_times_c_i: f64) -> Error {
-    let Some(alpha) =
-        alpha.filter(|_| alpha_times_c_i > 0.0 && alpha_times_c_i < WEAK_ALPHA_TIMES_C_I)
-    else {
-        return error;
-    };
-    crate::membranes::with_solver_hint(
-        error,
-        format!(
-            "--alpha {alpha:e} gives α·C_I = {alpha_times_c_i:.1e}, near the plain method: the multiplier, eliminated as (G − BU)/(α h⁴ …), is then lost in rounding; raise --alpha or leave it out (α = {ALPHA_FRACTION}/C_I)"
-        ),
-    )
-}
 
 /// The estimated peak memory of a Kirchhoff solve on the N×N×2 mesh, in bytes, from the
 /// measurements of [`MAX_KIRCHHOFF_MESH_SIZE`]: without recovery of the multiplier
@@ -453,119 +428,53 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
     };
     let load = move |_: &[f64]| q;
     let n = request.mesh_size;
-    let square = |n: usize| TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right);
-    let finest = square(n)?;
-    let (alpha, c_i) = request.alpha_on::<M>()?;
-    if c_i > 0.0 && alpha * c_i >= 1.0 {
-        return Err(Error::Input(format!(
-            "α = {alpha:e} is outside the stability range 0 < α < 1/C_I = {:.3e} of {} (α·C_I = {:.2}): A_α = a − αS would be indefinite; leave --alpha out for α = {ALPHA_FRACTION}/C_I",
-            1.0 / c_i,
-            request.pair.name(),
-            alpha * c_i
-        )));
-    }
-    let coefficients = Coefficients::new::<M>(
-        &[
-            ("D", s.bending_stiffness),
-            ("ν", s.poisson_ratio),
-            ("α", alpha),
-            ("s", SIDE),
-        ],
-        &[("f", &load), ("ψ", &psi), ("g", &zero)],
-    )?;
-    let support = match request.support {
-        KirchhoffSupport::Clamped => PlateSupport::Clamped,
-        KirchhoffSupport::SimplySupported => PlateSupport::SimplySupported,
-    };
     let newton = request.solver == VariationalSolver::SemismoothNewton;
     let sizes = level_sizes(n, request.nested && newton);
-    let mut meshes = Vec::with_capacity(sizes.len());
-    for &size in &sizes[..sizes.len() - 1] {
-        meshes.push(square(size)?);
-    }
-    meshes.push(finest);
-    let coefficients = &coefficients;
-    let levels: Vec<_> = meshes
+    let meshes = sizes
         .iter()
-        .map(|mesh| {
-            move || {
-                let dofs = SystemDofs::all::<M>(mesh)?;
-                let mut constraints = Constraints::new();
-                constraints.support_plate::<M>(mesh, &dofs, "w", &DirichletPart::All, support)?;
-                Discretization::with_constraints::<M>(
-                    mesh,
-                    coefficients,
-                    dofs,
-                    &constraints,
-                    "B_h",
-                    "L_h",
-                )
-            }
-        })
-        .collect();
-    let options = ObstacleOptions {
-        solver: request.solver,
-        ..ObstacleOptions::default()
+        .map(|&n| TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right))
+        .collect::<Result<Vec<_>>>()?;
+    let support = match request.support {
+        KirchhoffSupport::Clamped => Condition::Clamped,
+        KirchhoffSupport::SimplySupported => Condition::Zero,
     };
-    let solution = solve_nested(levels, prolong_primal_on_triangles, options)
-        .map_err(|e| weak_alpha_hint(e, request.alpha, alpha * c_i))?;
+    let alpha = match request.alpha {
+        Some(alpha) => Alpha::Fixed(alpha),
+        None => Alpha::FromInverseConstant(ALPHA_FRACTION),
+    };
+    let solved = Problem::<M, TriangleMesh>::new(meshes)
+        .param("D", s.bending_stiffness)
+        .param("ν", s.poisson_ratio)
+        .data("f", &load)
+        .data("ψ", &psi)
+        .data("g", &zero)
+        .support(DirichletPart::All, "w", support)
+        .side(ObstacleSide::Above)
+        .alpha(alpha, MORLEY_ALPHA)
+        .options(SolveOptions {
+            obstacle: ObstacleOptions {
+                solver: request.solver,
+                ..ObstacleOptions::default()
+            },
+            nested: request.nested && newton,
+            rounding_experiment: false,
+        })
+        .memory(
+            MemoryModel::per_cell(
+                estimated_memory_bytes(n, obstacle != KirchhoffObstacle::None)
+                    / (2.0 * (n * n) as f64),
+            ),
+            format!("--mesh-size {n}"),
+        )
+        .solve()?;
+    let runtime = &solved.report;
+    let solution = &solved.solution;
     let w = M::field("w")?;
     let view = solution.view(w);
     let basis = TriangleBasis::new(view.map.element());
-    let mut warnings = Vec::new();
+    let mut warnings = runtime.warnings.clone();
     if request.nested && newton && obstacle != KirchhoffObstacle::None {
         warnings.extend(crate::plates::cold_coarsest_warning(&sizes, NESTED_FROM));
-    }
-    // as beams and membranes do: the eliminated λ_h loses digits where C falls below the
-    // rounding of G − BU, and its recovery may have been skipped (out of memory)
-    if solution.multiplier_noise > 1e-6 {
-        warnings.push(format!(
-            "λ_h may carry rounding noise of up to {:.0e} relative: C = αh⁴ approaches the rounding of G − BU at this mesh size (a larger α or a coarser mesh avoids it)",
-            solution.multiplier_noise
-        ));
-    }
-    let max_open_contact_gap = match obstacle {
-        KirchhoffObstacle::None => 0.0,
-        _ => fem_runtime::obstacle::triangle::max_open_contact_gap(
-            &view,
-            &solution.view(solution.discretization.multiplier_field),
-            &psi,
-            SIDE,
-        ),
-    };
-    let max_penetration = match obstacle {
-        KirchhoffObstacle::None => 0.0,
-        _ => penetration(&view, &basis, &psi),
-    };
-    if !matches!(obstacle, KirchhoffObstacle::None) {
-        // as for membranes and Mindlin plates: a load (or α) that dwarfs the obstacle
-        // leaves w_h to the rounding of the contact rows, which the KKT residual cannot show
-        let gap = obstacle.height(0.0).unwrap_or(1.0).abs();
-        let size = max_deflection(&view, &basis).max(gap).max(1e-12);
-        let rounding = solution.primal_rounding() / size;
-        if rounding.is_nan() || rounding > crate::plates::MAX_PRIMAL_ROUNDING {
-            return Err(Error::Input(format!(
-                "w_h is lost to rounding: in contact the constraint rows subtract terms of the size of the load and of α h⁴ q (q = {q:e}, α = {alpha:e}), which dwarf the obstacle, and their rounding moves w_h by {rounding:.0e} of its own size; use a smaller load or α"
-            )));
-        }
-        if rounding > crate::plates::ROUNDING_WARNING {
-            warnings.push(format!(
-                "w_h may be off by {rounding:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)"
-            ));
-        }
-        let open = max_open_contact_gap;
-        if open > crate::membranes::OPEN_GAP_WARNING * gap {
-            warnings.push(format!(
-                "λ_h pushes on cells where w_h stays up to {open:.2e} below the obstacle ({:.1} % of the gap {gap}): the stabilized constraint w_h − ψ = α h⁴(…) on contact cells lets α h⁴ q (α = {alpha:e}) open that gap on this mesh, so this contact set is not real; refine the mesh or lower α",
-                100.0 * open / gap
-            ));
-        }
-        if max_penetration > 1e-2 * gap {
-            warnings.push(format!(
-                "w_h passes the obstacle by up to {max_penetration:.2e} ({:.1} % of the gap {gap}): the constraint holds on each cell's mean (λ_h ∈ P0), so the plate may cross ψ inside a cell by O(h²); refine the mesh",
-                100.0 * max_penetration / gap
-            ));
-        }
     }
     let locator = PointLocator::new(view.mesh);
     let centre = view
@@ -577,13 +486,14 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
     };
     let reference =
         matches!(obstacle, KirchhoffObstacle::None).then(|| coefficient * q / s.bending_stiffness);
-    let contact = contact_cells(&solution);
+    let contact = contact_cells(solution);
     let interior = if matches!(obstacle, KirchhoffObstacle::None) || q <= 0.0 {
         Vec::new()
     } else {
         interior_cells(&solution.discretization.mesh, &contact)
     };
-    let statistics = |recovery| interior_statistics(&solution, &interior, recovery, q);
+    let statistics = |recovery| interior_statistics(solution, &interior, recovery, q);
+    let in_contact = !matches!(obstacle, KirchhoffObstacle::None);
     Ok(KirchhoffReport {
         scene: s.name.to_string(),
         pair: request.pair.name(),
@@ -591,13 +501,12 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
         obstacle: obstacle.name(),
         mesh_size: n,
         load: q,
-        alpha,
-        inverse_constant: c_i,
+        alpha: runtime.alpha.unwrap_or(0.0),
+        inverse_constant: runtime.inverse_constant,
         solver: if newton { "pdas" } else { "clarabel" },
-        energy: solution.energy::<M>(coefficients)?,
+        energy: runtime.energy.unwrap_or(f64::NAN),
         centre_deflection: centre,
         reference_centre_deflection: reference,
-        // q = 0: w_h = 0 = reference, no relative error to speak of
         // q = 0: both deflections are 0 exactly, and so is the error, as the Mindlin
         // plates report it (a 0/0 left out would read as "not measured")
         relative_error: reference.and_then(|r| {
@@ -608,49 +517,34 @@ fn solve_with<M: Model>(request: &KirchhoffRequest) -> Result<KirchhoffReport> {
             }
         }),
         max_deflection: max_deflection(&view, &basis),
-        total_contact_force: solution.total_contact_force(),
+        total_contact_force: runtime.total_contact_force,
         contact_area: filled_area(&solution.discretization.mesh, &contact),
         interior_multiplier: statistics(request.pair.recovery()),
         interior_multiplier_raw: statistics(MultiplierRecovery::Raw),
         multiplier_layer: if interior.is_empty() {
             Vec::new()
         } else {
-            layer_profile(&solution, &contact, q)
+            layer_profile(solution, &contact, q)
         },
         interior_multiplier_twice_averaged: statistics(MultiplierRecovery::TwicePatchAverage),
-        multiplier_noise: solution.multiplier_noise,
-        complementarity_residual: solution.kkt_residual,
+        multiplier_noise: runtime.multiplier_noise,
+        complementarity_residual: runtime.kkt_residual,
         dofs: solution.discretization.dofs.dof_count(),
-        iterations: solution.iterations,
-        levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
-        seconds: solution.seconds,
-        max_penetration,
-        max_open_contact_gap,
+        iterations: runtime.iterations,
+        levels: runtime.levels.clone(),
+        seconds: runtime.seconds,
+        max_penetration: if in_contact {
+            runtime.max_penetration.unwrap_or(0.0)
+        } else {
+            0.0
+        },
+        max_open_contact_gap: if in_contact {
+            runtime.max_open_contact_gap.unwrap_or(0.0)
+        } else {
+            0.0
+        },
         warnings,
     })
-}
-
-/// The largest `w_h − ψ` (the obstacle lies above) at the vertices, edge midpoints and
-/// centroids of the cells, 0 when the plate stays below it there.
-fn penetration(view: &TriangleField, basis: &TriangleBasis, psi: &dyn Fn(&[f64]) -> f64) -> f64 {
-    let points = [
-        [0.0, 0.0],
-        [1.0, 0.0],
-        [0.0, 1.0],
-        [0.5, 0.0],
-        [0.5, 0.5],
-        [0.0, 0.5],
-        [1.0 / 3.0, 1.0 / 3.0],
-    ];
-    let mut worst = 0.0f64;
-    for c in 0..view.mesh.cell_count() {
-        let map = AffineMap::of(view.mesh, c);
-        for xi in points {
-            let x = map.point(xi);
-            worst = worst.max(view.value(basis, c, xi) - psi(&x));
-        }
-    }
-    worst
 }
 
 /// The centre deflection of the simply supported unit square under a unit load with

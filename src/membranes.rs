@@ -648,19 +648,6 @@ pub fn solve(request: &MembraneRequest) -> Result<(MembraneReport, MembraneField
     Ok((report, fields))
 }
 
-/// A solver failure (`NotConverged`, `LinearSolve`) with `hint` appended to its detail;
-/// other errors unchanged.
-pub(crate) fn with_solver_hint(error: Error, hint: String) -> Error {
-    match error {
-        Error::NotConverged { solver, detail } => Error::NotConverged {
-            solver,
-            detail: format!("{detail}; {hint}"),
-        },
-        Error::LinearSolve(detail) => Error::LinearSolve(format!("{detail}; {hint}")),
-        other => other,
-    }
-}
-
 /// A pair's solve through the runtime's one pipeline: the stabilized pairs with their
 /// model's multiplier, `p1-nodal` (a model without one) with the nodal constraint.
 fn run<M: Model>(

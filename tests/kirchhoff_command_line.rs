@@ -173,7 +173,7 @@ fn bad_kirchhoff_input_is_refused_by_name() {
         // inside the stability range but near the plain method: the failure names α
         (
             &["solve", "kirchhoff-obstacle", "--alpha", "1e-12"],
-            "raise --alpha",
+            "or a larger α",
         ),
         (
             &["solve", "kirchhoff-obstacle", "--thickness", "0.1"],

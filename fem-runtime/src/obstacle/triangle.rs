@@ -663,9 +663,10 @@ pub const PENETRATION_MIN_SAMPLES: usize = 1 << 14;
 const PENETRATION_MAX_LATTICE: usize = 128;
 
 /// `max(ψ − u_h, 0)` of `u` into the obstacle `psi`, and ψ's range, over the mesh
-/// vertices (each cell's corners, so discontinuous fields count from every side), the
-/// points of the symmetric rule exact for degree `degree` on every cell and, on meshes of
-/// few cells, a lattice on each cell ([`PENETRATION_MIN_SAMPLES`]).
+/// vertices (each cell's corners, so discontinuous fields count from every side), each
+/// cell's edge midpoints and centroid, the points of the symmetric rule exact for degree
+/// `degree` on every cell and, on meshes of few cells, a lattice on each cell
+/// ([`PENETRATION_MIN_SAMPLES`]).
 pub fn penetration(
     u: &TriangleField,
     psi: &(dyn Fn(&[f64]) -> f64 + Sync),
@@ -676,7 +677,15 @@ pub fn penetration(
     let basis = TriangleBasis::new(u.map.element());
     let rule = fem_reference::triangle::TriangleRule::exact_for_degree(degree);
     let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-    let mut points: Vec<[f64; 2]> = corners.iter().chain(&rule.points).copied().collect();
+    // the edge midpoints and the centroid too: where P2 and Morley fields peak between
+    // the quadrature points
+    let middles = [[0.5, 0.0], [0.5, 0.5], [0.0, 0.5], [1.0 / 3.0, 1.0 / 3.0]];
+    let mut points: Vec<[f64; 2]> = corners
+        .iter()
+        .chain(&middles)
+        .chain(&rule.points)
+        .copied()
+        .collect();
     let cells = u.mesh.cell_count().max(1);
     // the lattice order m whose (m+1)(m+2)/2 points a cell reach the minimum in all
     let order = (1..=PENETRATION_MAX_LATTICE)
@@ -686,7 +695,7 @@ pub fn penetration(
         for i in 0..=order {
             for j in 0..=order - i {
                 let xi = [i as f64 / order as f64, j as f64 / order as f64];
-                if !corners.contains(&xi) {
+                if !corners.contains(&xi) && !middles.contains(&xi) {
                     points.push(xi);
                 }
             }
