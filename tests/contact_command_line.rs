@@ -243,7 +243,7 @@ fn bad_contact_input_exits_with_a_message() {
         (
             "hertz",
             &["--alpha", "4e-4"][..],
-            "beyond the working range",
+            "outside the stability range",
         ),
         ("signorini-patch", &["--alpha", "1e-300"][..], "below 1e-3"),
         ("hertz", &["--alpha", "1e-9"][..], "below 1e-3"),

@@ -78,94 +78,78 @@ signorini_model! {
 /// The multiplier's space on Γ_C: P0 (one pressure per edge) or continuous P1 (one per
 /// vertex of the edges of Γ_C), chosen with [`solve_signorini_with`].
 pub use fem_runtime::obstacle::boundary_multiplier::BoundaryMultiplier as Multiplier;
-use fem_runtime::obstacle::boundary_multiplier::{self, ContactEdge};
+use fem_runtime::obstacle::boundary_multiplier::ContactEdge;
 
-/// A contact problem discretized: primal DOFs, their elimination, the LCP and the
-/// multiplier's DOFs on Γ_C.
-#[derive(Clone, Debug)]
-struct BoundaryMultiplierProblem {
-    dofs: fem_runtime::SystemDofs,
-    reduction: fem_runtime::Reduction,
-    lcp: fem_runtime::lcp::Lcp,
-    boundary: boundary_multiplier::BoundaryMultiplierDofs,
-    contact_edges: Vec<ContactEdge>,
-    multiplier_space: Multiplier,
-    contact_vertices: Vec<usize>,
-    edge_dofs: Vec<[usize; 2]>,
-}
+use fem_runtime::obstacle::Discretization;
+use fem_runtime::problem::{Condition, Domain, Problem, Solved as ProblemSolved};
+use fem_runtime::stabilization::Alpha;
+use fem_runtime::{DataFn, DirichletPart, Error, Model, Result, TriangleMesh};
 
-impl BoundaryMultiplierProblem {
-    fn multiplier_integrals(&self) -> Vec<f64> {
-        self.boundary.integrals()
-    }
-}
-
-/// The discretization of a contact model with the model's parts by marker and the
-/// fields `fixed` held at 0 on the given markers.
-fn discretize_boundary_multiplier<M: Model>(
-    mesh: &TriangleMesh,
-    coefficients: &Coefficients,
-    parts: &[(&str, &[u32])],
-    fixed: &[(usize, &[u32])],
-) -> Result<BoundaryMultiplierProblem> {
-    let markers = M::FACET_PARTS
-        .iter()
-        .map(|name| {
-            parts
-                .iter()
-                .find(|(n, _)| n == name)
-                .map(|(_, m)| m.to_vec())
-                .ok_or_else(|| {
-                    Error::Input(format!("the boundary part `{name}` is not given markers"))
-                })
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let dofs = boundary_multiplier::primal_dofs::<M>(mesh)?;
-    let mut constraints = fem_runtime::Constraints::new();
-    for &(field, on) in fixed {
-        let map = dofs.map(field).ok_or_else(|| {
-            Error::Input(format!(
-                "field {field} is not a primal field of `{}`",
-                M::NAME
-            ))
-        })?;
-        let offset = dofs.offset(field).unwrap_or(0);
-        for d in fem_runtime::DirichletPart::Markers(on.to_vec()).dofs(map, mesh) {
-            constraints.fix_dof(offset + d, 0.0)?;
+/// The contact problem of `input` for model `M` on `meshes` (nested levels, coarsest
+/// first), with the start that holds its rigid motions: the body pressed into the
+/// foundation beyond the gaps (checked first: the load must press it on, and supports
+/// must hold what the contact cannot).
+fn contact_problem<'a, M: Model>(
+    meshes: Vec<TriangleMesh>,
+    input: &'a SignoriniInput<'a>,
+    setup: &'a Setup<'a>,
+    start: &'a fem_runtime::obstacle::FirstStart<'a, TriangleMesh>,
+) -> Problem<'a, M, TriangleMesh> {
+    let mut problem = Problem::<M, TriangleMesh>::new(meshes)
+        .param("μ_L", setup.lame[0])
+        .param("λ_L", setup.lame[1])
+        .param("n_c_x", setup.direction[0])
+        .param("n_c_y", setup.direction[1])
+        .data("q", input.pressure)
+        .data("g", input.gap)
+        .part("Γ_C", input.contact.to_vec())
+        .part("Γ_N", input.load.to_vec())
+        .alpha(
+            input.alpha.map_or(Alpha::default(), Alpha::Fixed),
+            fem_runtime::problem::ALPHA_WHEN_CI_VANISHES,
+        )
+        .start(start);
+    for (field, markers) in [("u_x", input.fixed_x), ("u_y", input.fixed_y)] {
+        if !markers.is_empty() {
+            problem = problem.support(
+                DirichletPart::Markers(markers.to_vec()),
+                field,
+                Condition::Zero,
+            );
         }
     }
-    let d = boundary_multiplier::discretize::<M>(mesh, coefficients, &markers, dofs, &constraints)?;
-    let fem_runtime::obstacle::Multipliers::Boundary(boundary) = d.multipliers else {
-        return Err(Error::Input(
-            "the multiplier is not on a boundary part".into(),
-        ));
-    };
-    Ok(BoundaryMultiplierProblem {
-        dofs: d.dofs,
-        reduction: d.reduction,
-        lcp: d.lcp,
-        contact_edges: boundary.edges.clone(),
-        multiplier_space: boundary.space,
-        contact_vertices: boundary.vertices.clone(),
-        edge_dofs: boundary.edge_dofs.clone(),
-        boundary,
-    })
+    problem
 }
 
-fn inverse_constants<M: Model>(
-    mesh: &TriangleMesh,
-    problem: &BoundaryMultiplierProblem,
-    coefficients: &Coefficients,
-) -> Result<Vec<f64>> {
-    boundary_multiplier::inverse_constants::<M>(
-        mesh,
-        &problem.boundary,
-        &problem.dofs,
-        coefficients,
-    )
+/// The start of a contact solve's first level: the body pressed into the foundation
+/// (every constraint active) beyond the gaps, by the size of the elastic displacement;
+/// the problem is refused first where the load does not press the body on or the
+/// supports leave a motion free that contact cannot hold ([`rigid_motions_held`]).
+fn pressed_start(
+    d: &Discretization<TriangleMesh>,
+    direction: [f64; 2],
+) -> Result<Option<Vec<f64>>> {
+    let translation = rigid_motions_held(d, direction)?;
+    let b = d.boundary().expect("a boundary multiplier");
+    // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
+    let depth = d
+        .lcp
+        .g
+        .iter()
+        .zip(b.integrals())
+        .fold(0.0f64, |m, (g, w)| m.max(-g / w));
+    // beyond the gaps by the size of the elastic displacement (‖F‖∞/‖A‖∞, both in the
+    // units of E): a fixed 1e-3 h was 1e22 times it at E = 1e25, and its multipliers
+    // C⁻¹(G − BU) left Newton a Hessian that was not positive definite
+    let lcp = &d.lcp;
+    let a_norm = (0..lcp.n())
+        .map(|j| lcp.a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    let f_norm = lcp.f.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let elastic = f_norm / a_norm.max(f64::MIN_POSITIVE);
+    let scale = 2.0 * depth + elastic.min(1e-3 * d.mesh.max_h());
+    Ok(Some(translation.iter().map(|t| scale * t).collect()))
 }
-use fem_runtime::lcp::{quadratic_program, semismooth_newton, LcpSolution, NewtonOptions};
-use fem_runtime::{Coefficients, DataFn, Error, Model, Result, TriangleMesh};
 
 /// Plane strain (`ε_zz = 0`, a long body) or plane stress (`σ_zz = 0`, a thin plate).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -436,20 +420,26 @@ pub fn refuse_pressure_on_contact(mesh: &TriangleMesh, input: &SignoriniInput) -
 /// Intervals per edge at which [`refuse_pressure_on_contact`] samples the pressure.
 const SAMPLES: usize = 16;
 
-/// What every Signorini solve of `M` derives from its input: the unit contact
-/// direction, the model's boundary parts by marker, the fixed displacement components,
-/// and the coefficients for a given α.
+/// What every Signorini solve derives from its input: the Lamé parameters and the unit
+/// contact direction.
 struct Setup<'a> {
+    lame: [f64; 2],
     direction: [f64; 2],
-    parts: [(&'static str, &'a [u32]); 2],
-    fixed: [(usize, &'a [u32]); 2],
-    coefficients: Box<dyn Fn(f64) -> Result<Coefficients<'a>> + 'a>,
+    input: std::marker::PhantomData<&'a ()>,
 }
 
-impl<'a> Setup<'a> {
+impl Setup<'_> {
     /// # Errors
-    /// [`Error::Input`] for E, ν out of range ([`lame`]) or a zero contact direction.
-    fn new<M: Model>(input: &'a SignoriniInput<'a>) -> Result<Self> {
+    /// [`Error::Input`] for E, ν out of range ([`lame`]), a zero contact direction, a
+    /// negative α, and a support along the contact direction on Γ_C itself.
+    fn new(input: &SignoriniInput) -> Result<Self> {
+        if let Some(a) = input.alpha {
+            if !(a.is_finite() && a >= 0.0) {
+                return Err(Error::Input(format!(
+                    "the stabilization parameter α = {a} must be ≥ 0"
+                )));
+            }
+        }
         let (mu, lambda) = lame(input.young, input.poisson, input.plane)?;
         let [cx, cy] = input.contact_direction;
         let length = cx.hypot(cy);
@@ -460,7 +450,7 @@ impl<'a> Setup<'a> {
         }
         let direction = [cx / length, cy / length];
         // a support along n_c on Γ_C itself fights the contact constraint for u·n_c (a
-        // tester's fixed_y on the contact side gave a force of 0.001 for a load of 5)
+        // fixed_y on the contact side gave a force of 0.001 for a load of 5)
         for (axis, fixed, name) in [(0, input.fixed_x, "x"), (1, input.fixed_y, "y")] {
             if direction[axis] != 0.0 && fixed.iter().any(|m| input.contact.contains(m)) {
                 return Err(Error::Input(format!(
@@ -469,122 +459,20 @@ impl<'a> Setup<'a> {
                 )));
             }
         }
-        let (ux, uy) = (M::field("u_x")?, M::field("u_y")?);
-        let (pressure, gap) = (input.pressure, input.gap);
         Ok(Self {
+            lame: [mu, lambda],
             direction,
-            parts: [("Γ_C", input.contact), ("Γ_N", input.load)],
-            fixed: [(ux, input.fixed_x), (uy, input.fixed_y)],
-            coefficients: Box::new(move |alpha: f64| {
-                Coefficients::new::<M>(
-                    &[
-                        ("μ_L", mu),
-                        ("λ_L", lambda),
-                        ("α", alpha),
-                        ("n_c_x", direction[0]),
-                        ("n_c_y", direction[1]),
-                    ],
-                    &[("q", pressure), ("g", gap)],
-                )
-            }),
+            input: std::marker::PhantomData,
         })
     }
 }
 
 fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<SignoriniSolution> {
-    if let Some(a) = input.alpha {
-        if !(a.is_finite() && a >= 0.0) {
-            return Err(Error::Input(format!(
-                "the stabilization parameter α = {a} must be ≥ 0"
-            )));
-        }
-    }
-    let Setup {
-        direction,
-        parts,
-        fixed,
-        coefficients,
-    } = Setup::new::<M>(input)?;
-    let problem = discretize_boundary_multiplier::<M>(mesh, &coefficients(0.0)?, &parts, &fixed)?;
-    let constants = inverse_constants::<M>(mesh, &problem, &coefficients(0.0)?)?;
-    let alpha = match input.alpha {
-        Some(a) => a,
-        None => {
-            let max = constants.iter().fold(0.0f64, |m, &c| m.max(c));
-            0.5 / max
-        }
-    };
-    let problem = if alpha == 0.0 {
-        problem
-    } else {
-        discretize_boundary_multiplier::<M>(mesh, &coefficients(alpha)?, &parts, &fixed)?
-    };
-    let translation = rigid_motions_held(mesh, &problem, direction)?;
-    let solution = if alpha > 0.0 {
-        // Start pressed into the foundation (every constraint active), beyond the gaps.
-        // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
-        let depth = problem
-            .lcp
-            .g
-            .iter()
-            .zip(problem.multiplier_integrals())
-            .fold(0.0f64, |m, (g, w)| m.max(-g / w));
-        // beyond the gaps by the size of the elastic displacement (‖F‖∞/‖A‖∞, both in
-        // the units of E): a fixed 1e-3 h was 1e22 times it at E = 1e25, and its
-        // multipliers C⁻¹(G − BU) left Newton a Hessian that was not positive definite
-        let lcp = &problem.lcp;
-        let a_norm = (0..lcp.n())
-            .map(|j| lcp.a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
-            .fold(0.0f64, f64::max);
-        let f_norm = lcp.f.iter().fold(0.0f64, |m, f| m.max(f.abs()));
-        let elastic = f_norm / a_norm.max(f64::MIN_POSITIVE);
-        let scale = 2.0 * depth + elastic.min(1e-3 * mesh.max_h());
-        let start: Vec<f64> = translation.iter().map(|t| scale * t).collect();
-        check_alpha(alpha, &constants)?;
-        semismooth_newton(&problem.lcp, Some(&start), NewtonOptions::default())
-            .map_err(|e| alpha_error(alpha, &constants, e))?
-    } else {
-        quadratic_program(&problem.lcp)?
-    };
-    Ok(report(
-        mesh, input, direction, &problem, solution, alpha, constants,
-    ))
-}
-
-/// The smallest `α max_E C_I,E` semismooth Newton is given: below it `C = α h_E (μ, λ)`
-/// is lost against the rounding of `B U − G` and the Hessian turns singular (a tester's
-/// α = 1e-12 on Hertz, α·C_I = 3e-9, ran 200 iterations).
-/// A tester then found Newton failing up to about 3e-4 (200 iterations) and needing 150
-/// at 1e-3, where the error is 3.5× the best fit's: below 1e-3 the plain method (α = 0)
-/// is the one to use.
-pub const MIN_ALPHA_TIMES_C_I: f64 = 1e-3;
-
-/// Refuses an α too small for Newton, naming `α·max C_I,E` and the alternatives.
-fn check_alpha(alpha: f64, constants: &[f64]) -> Result<()> {
-    let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
-    if alpha > 0.0 && alpha * c < MIN_ALPHA_TIMES_C_I {
-        return Err(Error::Input(format!(
-            "α = {alpha:e} gives α·max C_I,E = {:.1e}, below {MIN_ALPHA_TIMES_C_I:e}: the stabilization is too weak for semismooth Newton (it stalls or needs hundreds of iterations, and the pressure oscillates like the plain method's); use α = 0 (the plain method, solved as a QP) or α·max C_I,E from 0.1 to 1 (the automatic α is ½/max C_I,E = {:.3e})",
-            alpha * c,
-            0.5 / c
-        )));
-    }
-    Ok(())
-}
-
-/// Newton's failure, explained where α is beyond the working range `α max C_I,E ≲ 1`
-/// (docs/contact.md: `A_α` turns indefinite near 2; measured 1.35 on the block patch).
-fn alpha_error(alpha: f64, constants: &[f64], error: Error) -> Error {
-    let c = constants.iter().fold(0.0f64, |m, &c| m.max(c));
-    if alpha * c > 1.0 {
-        Error::Input(format!(
-            "α = {alpha:e} gives α·max C_I,E = {:.3e}, beyond the working range (measured: up to 1.0–1.3 on the block patch, 1.5–1.9 on Hertz; the automatic α is ½/max C_I,E = {:.3e}): B_h = a − α S_h is no longer positive on the displacements ({error})",
-            alpha * c,
-            0.5 / c
-        ))
-    } else {
-        error
-    }
+    let setup = Setup::new(input)?;
+    let direction = setup.direction;
+    let start = move |d: &Discretization<TriangleMesh>| pressed_start(d, direction);
+    let solved = contact_problem::<M>(vec![mesh.clone()], input, &setup, &start).solve()?;
+    report::<M>(input, direction, &solved)
 }
 
 /// Checks that the load holds the body on the foundation, and returns the free-DOF
@@ -598,11 +486,8 @@ fn alpha_error(alpha: f64, constants: &[f64], error: Error) -> Error {
 ///
 /// # Errors
 /// [`Error::Input`] naming the unbalanced component.
-fn rigid_motions_held(
-    mesh: &TriangleMesh,
-    problem: &BoundaryMultiplierProblem,
-    n: [f64; 2],
-) -> Result<Vec<f64>> {
+fn rigid_motions_held(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Result<Vec<f64>> {
+    let mesh = &problem.mesh;
     let f = &problem.lcp.f;
     let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
     let translation = towards_foundation(problem, n);
@@ -653,7 +538,7 @@ fn rigid_motions_held(
 /// block against a wall "solved" with the contact force 39 % off the load).
 fn rotation_held(
     mesh: &TriangleMesh,
-    problem: &BoundaryMultiplierProblem,
+    problem: &Discretization<TriangleMesh>,
     n: [f64; 2],
     [translation, tangent]: [&[f64]; 2],
     translation_free: bool,
@@ -703,7 +588,9 @@ fn rotation_held(
     // s(x) = Z(x)·n = (−y, x)·n + a_t (S is normal to n)
     let s_of = |x: [f64; 2]| -x[1] * n[0] + x[0] * n[1] + a_t;
     let (s_min, s_max) = problem
-        .contact_edges
+        .boundary()
+        .expect("a boundary multiplier")
+        .edges
         .iter()
         .flat_map(|e| e.ends)
         .map(s_of)
@@ -757,7 +644,7 @@ fn rotation_held(
 
 /// The free-DOF vector of a unit translation along the contact direction: towards the
 /// foundation.
-fn towards_foundation(problem: &BoundaryMultiplierProblem, n: [f64; 2]) -> Vec<f64> {
+fn towards_foundation(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Vec<f64> {
     let fields = problem.dofs.fields();
     let mut full = vec![0.0; problem.dofs.dof_count()];
     for (axis, &field) in fields.iter().take(2).enumerate() {
@@ -768,40 +655,22 @@ fn towards_foundation(problem: &BoundaryMultiplierProblem, n: [f64; 2]) -> Vec<f
     problem.reduction.free().iter().map(|&d| full[d]).collect()
 }
 
-/// The outward unit normal of a boundary edge (its cell is counter-clockwise).
-fn outward_normal(e: &ContactEdge) -> [f64; 2] {
-    let [a, b] = e.ends;
-    let (tx, ty) = (b[0] - a[0], b[1] - a[1]);
-    let l = tx.hypot(ty);
-    [ty / l, -tx / l]
-}
-
-fn report(
-    mesh: &TriangleMesh,
+fn report<M: Model>(
     input: &SignoriniInput,
     direction: [f64; 2],
-    problem: &BoundaryMultiplierProblem,
-    solution: LcpSolution,
-    alpha: f64,
-    constants: Vec<f64>,
-) -> SignoriniSolution {
+    solved: &ProblemSolved<M, TriangleMesh>,
+) -> Result<SignoriniSolution> {
+    let solution = &solved.solution;
+    let problem = &solution.discretization;
+    let mesh = &problem.mesh;
+    let boundary = problem.boundary().expect("a boundary multiplier");
     let lcp = &problem.lcp;
-    let pressure = solution.lambda.clone();
+    let pressure = solution.multiplier_values().to_vec();
     let mut force = [0.0; 2];
-    match problem.multiplier_space {
-        Multiplier::P0 => {
-            for (e, &p) in problem.contact_edges.iter().zip(&pressure) {
-                force[0] -= p * e.length() * direction[0];
-                force[1] -= p * e.length() * direction[1];
-            }
-        }
-        // ∫_E λ_h ds = |E| (λ_a + λ_b)/2 on each edge
-        Multiplier::P1 => {
-            for (&p, w) in pressure.iter().zip(problem.multiplier_integrals()) {
-                force[0] -= p * w * direction[0];
-                force[1] -= p * w * direction[1];
-            }
-        }
+    // ∫_E λ_h ds = |E| (λ_a + λ_b)/2 on each edge (P1), λ_E |E| (P0)
+    for (&p, w) in pressure.iter().zip(boundary.integrals()) {
+        force[0] -= p * w * direction[0];
+        force[1] -= p * w * direction[1];
     }
     let mut load = [0.0; 2];
     let gauss = fem_runtime::gauss_legendre(4);
@@ -825,7 +694,7 @@ fn report(
                 mesh.vertices()[c[(local + 1) % 3]],
             ],
         };
-        let n = outward_normal(&edge);
+        let n = edge.outward_normal();
         let [a, b] = edge.ends;
         let q: f64 = gauss
             .points
@@ -842,7 +711,7 @@ fn report(
     let largest = pressure.iter().fold(0.0f64, |m, &p| m.max(p));
     let along = contact_tangent(direction);
     let (mut x_min, mut x_max) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (e, &[a, b]) in problem.contact_edges.iter().zip(&problem.edge_dofs) {
+    for (e, &[a, b]) in boundary.edges.iter().zip(&boundary.edge_dofs) {
         // the edges where λ_h is not identically 0 (for P1: either end positive)
         if pressure[a].max(pressure[b]) > 1e-10 * largest {
             for end in e.ends {
@@ -857,16 +726,20 @@ fn report(
         (true, None) => 0.5 * (x_max - x_min),
         (true, Some(c)) => (x_max - c).abs().max((x_min - c).abs()),
     };
-    let complementarity = lcp.complementarity_residual(&solution.u, &pressure);
-    SignoriniSolution {
+    let alpha = solved.report.alpha.unwrap_or(0.0);
+    let coefficients =
+        fem_runtime::Coefficients::of_values::<M>(&solved.params, &[input.pressure, input.gap])?;
+    let constants =
+        mesh.boundary_inverse_constants::<M>(&coefficients, boundary.part, input.contact)?;
+    Ok(SignoriniSolution {
         alpha,
         inverse_constants: constants,
-        displacement: problem.reduction.expand(&solution.u),
+        displacement: solution.values[..problem.dofs.dof_count()].to_vec(),
         pressure,
-        contact_edges: problem.contact_edges.clone(),
-        multiplier: problem.multiplier_space,
-        contact_vertices: problem.contact_vertices.clone(),
-        edge_dofs: problem.edge_dofs.clone(),
+        contact_edges: boundary.edges.clone(),
+        multiplier: boundary.space,
+        contact_vertices: boundary.vertices.clone(),
+        edge_dofs: boundary.edge_dofs.clone(),
         total_contact_force: force,
         applied_load: load,
         discretized_load: towards_foundation(problem, direction)
@@ -876,12 +749,12 @@ fn report(
             .sum(),
         contact_half_width: half_width,
         max_contact_pressure: largest,
-        complementarity_residual: complementarity,
+        complementarity_residual: solved.report.complementarity_residual,
         kkt_residual: solution.kkt_residual,
         dofs: lcp.n() + lcp.m(),
         iterations: solution.iterations,
-        seconds: solution.seconds,
-    }
+        seconds: solution.solve_seconds,
+    })
 }
 
 /// The Hertz comparison of a continuous P1 pressure: exact integrals over the edges'
@@ -1145,7 +1018,6 @@ pub fn solve_hertz_on_with(
 // Nested iteration and the accuracy-driven stop (issue 14, "Speed"; docs/contact.md §7).
 // ---------------------------------------------------------------------------------------
 
-use fem_runtime::multigrid::{prolongation, NestedLevel};
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -1358,62 +1230,14 @@ fn nested(
     }
 }
 
-/// A solved level, kept for the next one's start and pressure comparison.
-struct Solved {
-    mesh: TriangleMesh,
-    problem: BoundaryMultiplierProblem,
-    u: Vec<f64>,
-    solution: SignoriniSolution,
-}
-
+/// The runtime's solve that builds its levels as it goes ([`Problem::solve_refining`]):
+/// each next level the uniform refinement of the last, made while `more` says so.
 fn nested_with<M: Model>(
     coarse: &TriangleMesh,
     snap: Snap,
     input: &SignoriniInput,
     more: &mut dyn FnMut(&[NestedLevelReport], usize) -> Result<bool>,
 ) -> Result<NestedSignoriniSolution> {
-    let clock = Instant::now();
-    let named = |level: usize, e: Error| match e {
-        Error::Input(m) => Error::Input(format!("nested level {level}: {m}")),
-        other => other,
-    };
-    let (mut current, report) =
-        solve_level::<M>(coarse.clone(), input, None).map_err(|e| named(0, e))?;
-    let mut levels = vec![report];
-    let mut refinements = 0;
-    while more(&levels, refinements)? {
-        refinements += 1;
-        let level_clock = Instant::now();
-        let (fine, parents) = current.mesh.refine_uniformly_onto(snap)?;
-        let previous = current;
-        let (next, mut report) = solve_level::<M>(fine, input, Some((&previous, &parents)))
-            .map_err(|e| named(refinements, e))?;
-        let change = pressure_change(&previous, &next, &parents);
-        report.pressure_change = Some(change);
-        // two differences: one alone can be small by a coincidence (docs/contact.md §7)
-        report.estimated_error = levels
-            .last()
-            .and_then(|l| l.pressure_change)
-            .map(|before| change.max(before) / (2f64.powf(PRESSURE_RATE) - 1.0));
-        report.seconds = level_clock.elapsed().as_secs_f64();
-        levels.push(report);
-        current = next;
-    }
-    Ok(NestedSignoriniSolution {
-        mesh: current.mesh,
-        solution: current.solution,
-        levels,
-        seconds: clock.elapsed().as_secs_f64(),
-    })
-}
-
-/// [`solve`] on one level, from the prolongated displacement of `coarser` when given
-/// (falling back to the pressed start when Newton fails from it).
-fn solve_level<M: Model>(
-    mesh: TriangleMesh,
-    input: &SignoriniInput,
-    coarser: Option<(&Solved, &[usize])>,
-) -> Result<(Solved, NestedLevelReport)> {
     let clock = Instant::now();
     if let Some(a) = input.alpha {
         if !(a.is_finite() && a > 0.0) {
@@ -1422,144 +1246,77 @@ fn solve_level<M: Model>(
             )));
         }
     }
-    refuse_pressure_on_contact(&mesh, input)?;
-    let Setup {
-        direction,
-        parts,
-        fixed,
-        coefficients,
-    } = Setup::new::<M>(input)?;
-    // The constants do not depend on α (only on the mesh, the DOFs and the kernels of
-    // `a` and `S`), so the problem is assembled with the previous level's α first. It is
-    // kept where it lies in [0.9, 1] × this level's automatic value (α max C_I ∈
-    // [0.45, 0.5], inside the working range of §7): uniform refinement keeps the cells'
-    // shapes up to the snapping of new boundary vertices, which moved max C_I by
-    // 0.1–0.4 % per level on Hertz, and a second assembly would cost as much as the
-    // finest level's Newton solve.
-    let guess = input
-        .alpha
-        .or_else(|| coarser.map(|(previous, _)| previous.solution.alpha))
-        .unwrap_or(0.0);
-    let mut problem =
-        discretize_boundary_multiplier::<M>(&mesh, &coefficients(guess)?, &parts, &fixed)?;
-    let constants = inverse_constants::<M>(&mesh, &problem, &coefficients(guess)?)?;
-    let alpha = match input.alpha {
-        Some(a) => a,
-        None => {
-            let automatic = 0.5 / constants.iter().fold(0.0f64, |m, &c| m.max(c));
-            if guess <= automatic && guess >= 0.9 * automatic {
-                guess
-            } else {
-                automatic
+    refuse_pressure_on_contact(coarse, input)?;
+    let setup = Setup::new(input)?;
+    let direction = setup.direction;
+    let start = move |d: &Discretization<TriangleMesh>| pressed_start(d, direction);
+    let problem = contact_problem::<M>(vec![coarse.clone()], input, &setup, &start);
+    let mut levels: Vec<NestedLevelReport> = Vec::new();
+    let mut previous: Option<(SignoriniSolution, Vec<usize>)> = None;
+    let mut level_clock = Instant::now();
+    let mut last = None;
+    let solved = problem
+        .solve_refining(|solved| {
+            let solution = report::<M>(input, direction, solved)?;
+            let start = match (&solved.fell_back, levels.is_empty()) {
+                (_, true) => LevelStart::Pressed,
+                (Some(e), false) => LevelStart::FellBack(e.clone()),
+                (None, false) => LevelStart::Prolongated,
+            };
+            let mut level = NestedLevelReport {
+                cells: solved.mesh().cell_count(),
+                dofs: solution.dofs,
+                contact_edges: solution.contact_edges.len(),
+                start,
+                iterations: solution.iterations,
+                newton_seconds: solution.seconds,
+                seconds: level_clock.elapsed().as_secs_f64(),
+                pressure_change: None,
+                estimated_error: None,
+            };
+            if let Some((coarse, parents)) = &previous {
+                let change = pressure_change(coarse, &solution, parents);
+                level.pressure_change = Some(change);
+                // two differences: one alone can be small by a coincidence (docs/contact.md §7)
+                level.estimated_error = levels
+                    .last()
+                    .and_then(|l| l.pressure_change)
+                    .map(|before| change.max(before) / (2f64.powf(PRESSURE_RATE) - 1.0));
             }
-        }
-    };
-    if alpha != guess {
-        problem =
-            discretize_boundary_multiplier::<M>(&mesh, &coefficients(alpha)?, &parts, &fixed)?;
-    }
-    let translation = rigid_motions_held(&mesh, &problem, direction)?;
-    let pressed = || {
-        let depth = problem
-            .lcp
-            .g
-            .iter()
-            .zip(&problem.contact_edges)
-            .fold(0.0f64, |m, (g, e)| m.max(-g / e.length()));
-        let scale = 2.0 * depth + 1e-3 * mesh.max_h();
-        let start: Vec<f64> = translation.iter().map(|t| scale * t).collect();
-        semismooth_newton(&problem.lcp, Some(&start), NewtonOptions::default())
-    };
-    check_alpha(alpha, &constants)?;
-    let (solution, start) = match coarser {
-        None => (
-            pressed().map_err(|e| alpha_error(alpha, &constants, e))?,
-            LevelStart::Pressed,
-        ),
-        Some((previous, parents)) => {
-            let from_coarse = prolongated(previous, &mesh, &problem, parents)
-                .and_then(|u| semismooth_newton(&problem.lcp, Some(&u), NewtonOptions::default()));
-            match from_coarse {
-                Ok(s) => (s, LevelStart::Prolongated),
-                Err(e) => (pressed()?, LevelStart::FellBack(e.to_string())),
+            levels.push(level);
+            if !more(&levels, levels.len() - 1)? {
+                last = Some(solution);
+                return Ok(None);
             }
-        }
-    };
-    let u = solution.u.clone();
-    let newton_seconds = solution.seconds;
-    let iterations = solution.iterations;
-    let solution = report(
-        &mesh, input, direction, &problem, solution, alpha, constants,
-    );
-    let level = NestedLevelReport {
-        cells: mesh.cell_count(),
-        dofs: solution.dofs,
-        contact_edges: problem.contact_edges.len(),
-        start,
-        iterations,
-        newton_seconds,
+            let (fine, parents) = solved.mesh().refine_uniformly_onto(snap)?;
+            refuse_pressure_on_contact(&fine, input)?;
+            previous = Some((solution, parents));
+            level_clock = Instant::now();
+            Ok(Some(fine))
+        })
+        .map_err(|e| match e {
+            Error::Input(m) => Error::Input(format!("nested level {}: {m}", levels.len())),
+            other => other,
+        })?;
+    Ok(NestedSignoriniSolution {
+        mesh: solved.mesh().clone(),
+        solution: last.expect("the last level was reported"),
+        levels,
         seconds: clock.elapsed().as_secs_f64(),
-        pressure_change: None,
-        estimated_error: None,
-    };
-    Ok((
-        Solved {
-            mesh,
-            problem,
-            u,
-            solution,
-        },
-        level,
-    ))
-}
-
-/// The displacement of `coarse` interpolated at the DOFs of `problem` on `mesh` (its
-/// free DOFs, the LCP's primal unknowns).
-fn prolongated(
-    coarse: &Solved,
-    mesh: &TriangleMesh,
-    problem: &BoundaryMultiplierProblem,
-    parents: &[usize],
-) -> Result<Vec<f64>> {
-    let p = prolongation(
-        &NestedLevel {
-            mesh: &coarse.mesh,
-            dofs: &coarse.problem.dofs,
-            reduction: Some(&coarse.problem.reduction),
-        },
-        &NestedLevel {
-            mesh,
-            dofs: &problem.dofs,
-            reduction: Some(&problem.reduction),
-        },
-        parents,
-    )?;
-    let mut u = vec![0.0; p.nrows()];
-    let (ptr, rows, values) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
-    for (j, &x) in coarse.u.iter().enumerate().take(p.ncols()) {
-        for k in ptr[j]..ptr[j + 1] {
-            u[rows[k]] += values[k] * x;
-        }
-    }
-    Ok(u)
+    })
 }
 
 /// `‖λ_c − λ_f‖ / ‖λ_f‖` in `L²(Γ_C)` over the fine contact edges, `λ_c` taken on each
 /// fine edge from the coarse contact edge of its parent cell nearest to it.
-fn pressure_change(coarse: &Solved, fine: &Solved, parents: &[usize]) -> f64 {
-    let coarse_edges = &coarse.solution.contact_edges;
+fn pressure_change(coarse: &SignoriniSolution, fine: &SignoriniSolution, parents: &[usize]) -> f64 {
+    let coarse_edges = &coarse.contact_edges;
     let mut by_cell: HashMap<usize, Vec<usize>> = HashMap::new();
     for (k, e) in coarse_edges.iter().enumerate() {
         by_cell.entry(e.cell).or_default().push(k);
     }
     let distance = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     let (mut difference, mut norm) = (0.0, 0.0);
-    for (e, &lambda) in fine
-        .solution
-        .contact_edges
-        .iter()
-        .zip(&fine.solution.pressure)
-    {
+    for (e, &lambda) in fine.contact_edges.iter().zip(&fine.pressure) {
         let m = e.midpoint();
         let nearest = |candidates: &mut dyn Iterator<Item = usize>| {
             candidates.min_by(|&a, &b| {
@@ -1572,7 +1329,7 @@ fn pressure_change(coarse: &Solved, fine: &Solved, parents: &[usize]) -> f64 {
             .get(&parents[e.cell])
             .and_then(|ks| nearest(&mut ks.iter().copied()))
             .or_else(|| nearest(&mut (0..coarse_edges.len())));
-        let previous = k.map_or(0.0, |k| coarse.solution.pressure[k]);
+        let previous = k.map_or(0.0, |k| coarse.pressure[k]);
         difference += e.length() * (previous - lambda) * (previous - lambda);
         norm += e.length() * lambda * lambda;
     }

@@ -1054,7 +1054,7 @@ where
 /// The start of the first (coarsest) level of a nested solve: the primal unknowns to
 /// start Newton from, or `None` for zero; an error refuses the problem (e.g. a body
 /// whose rigid motion nothing holds).
-pub type FirstStart<G> = dyn Fn(&Discretization<G>) -> Result<Option<Vec<f64>>> + Sync;
+pub type FirstStart<'a, G> = dyn Fn(&Discretization<G>) -> Result<Option<Vec<f64>>> + Sync + 'a;
 
 /// [`solve_nested_on_hierarchy`] whose coarsest level starts from `first_start`'s
 /// vector (semismooth Newton from zero otherwise).
@@ -1062,7 +1062,7 @@ pub fn solve_nested_from<G, B>(
     levels: Vec<B>,
     prolong: impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
     primal_prolongation: Option<&PrimalProlongation<G>>,
-    first_start: Option<&FirstStart<G>>,
+    first_start: Option<&FirstStart<'_, G>>,
     options: ObstacleOptions,
 ) -> Result<ObstacleSolution<G>>
 where
@@ -1245,7 +1245,7 @@ fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
     levels: Vec<B>,
     prolong: &impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
     primal_prolongation: Option<&PrimalProlongation<G>>,
-    first_start: Option<&FirstStart<G>>,
+    first_start: Option<&FirstStart<'_, G>>,
     options: ObstacleOptions,
 ) -> Result<Option<SolvedLevel<G>>> {
     let mut last: Option<SolvedLevel<G>> = None;

@@ -233,7 +233,8 @@ pub fn discretize_on_part<M: Model>(
 }
 
 /// Interpolates every field of `coarse_values` (on `coarse`) at the DOF nodes of `fine`
-/// (a start for nested iteration; nodes outside the coarse mesh get 0).
+/// (a start for nested iteration; a node outside the coarse mesh, as a refined disk's
+/// boundary nodes are, takes the polynomial of the nearest coarse cell continued to it).
 pub fn prolong_on_triangles(
     coarse: &Discretization<TriangleMesh>,
     coarse_values: &[f64],
@@ -270,7 +271,7 @@ fn prolong_c1(
     let [per_vertex, _, _] = map_f.element().triangle_layout();
     let mut hint = None;
     let mut evaluate = |x: [f64; 2]| {
-        let (c, b) = locator.locate_near(x, hint)?;
+        let (c, b) = locator.locate_or_nearest(x, hint)?;
         hint = Some(c);
         let map = AffineMap::of(view.mesh, c);
         let xi = [b[1], b[2]];
@@ -337,7 +338,7 @@ fn prolong_fields(
         }
         let mut hint = None;
         for (dof, x) in map_f.nodes(&fine.mesh).into_iter().enumerate() {
-            out[offset + dof] = match locator.locate_near(x, hint) {
+            out[offset + dof] = match locator.locate_or_nearest(x, hint) {
                 Some((c, b)) => {
                     hint = Some(c);
                     view.value(&basis, c, [b[1], b[2]])
@@ -428,8 +429,9 @@ pub fn discretize_on_curved_part<M: Model>(
 /// The primal fields of `coarse_values` on the curved mesh `coarse` interpolated at the
 /// isoparametric DOF nodes of `fine`, the multiplier left 0: a start for nested
 /// iteration. The coarse field is evaluated in the straight cell that holds the node
-/// (exact on affine cells, O(h²)-close on curved ones: a start needs no more); nodes
-/// outside the coarse polygon get 0.
+/// (exact on affine cells, O(h²)-close on curved ones: a start needs no more); a node
+/// outside the coarse polygon, on the arc, takes the nearest straight cell's polynomial
+/// continued to it.
 pub fn prolong_primal_on_curved(
     coarse: &Discretization<CurvedTriangleMesh>,
     coarse_values: &[f64],
@@ -455,7 +457,7 @@ pub fn prolong_primal_on_curved(
         let offset = fine.dofs.offset(field).unwrap();
         let mut hint = None;
         for (dof, x) in map_f.curved_nodes(&fine.mesh).into_iter().enumerate() {
-            if let Some((c, b)) = locator.locate_near(x, hint) {
+            if let Some((c, b)) = locator.locate_or_nearest(x, hint) {
                 hint = Some(c);
                 out[offset + dof] = view.value(&basis, c, [b[1], b[2]]);
             }

@@ -170,6 +170,9 @@ pub struct Solved<M, G> {
     pub report: Report,
     /// Every parameter's value as solved with (α and s filled in), in declaration order.
     pub params: Vec<f64>,
+    /// Where a level of [`Problem::solve_refining`] failed from the previous level's
+    /// solution and was solved again from the problem's start: that failure.
+    pub fell_back: Option<String>,
     model: PhantomData<M>,
 }
 
@@ -199,7 +202,7 @@ pub struct Problem<'a, M: Model, G: Domain> {
     alpha: Alpha,
     alpha_when_zero: f64,
     options: SolveOptions,
-    start: Option<&'a FirstStart<G>>,
+    start: Option<&'a FirstStart<'a, G>>,
     exact: Option<Exact<'a>>,
     nodal: Option<&'a DataFn>,
     memory: MemoryModel,
@@ -353,7 +356,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     }
 
     /// The start of the coarsest level (it may also refuse the problem).
-    pub fn start(mut self, start: &'a FirstStart<G>) -> Self {
+    pub fn start(mut self, start: &'a FirstStart<'a, G>) -> Self {
         self.start = Some(start);
         self
     }
@@ -464,19 +467,76 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         if let Some(e) = &self.invalid {
             return Err(e.clone());
         }
-        let finest = self
-            .meshes
+        if self.meshes.is_empty() {
+            return Err(Error::Input("no mesh to solve on".into()));
+        }
+        if let Some(obstacle) = self.nodal {
+            let finest = self.meshes.last().expect("checked");
+            let memory_estimate = self.memory.bytes(finest.cell_count());
+            memory::check_memory(memory_estimate, &self.size_text(finest))?;
+            return self.solve_nodal(obstacle, memory_estimate);
+        }
+        self.solve_on(&self.meshes, None)
+    }
+
+    /// Solves on the problem's meshes, then on each mesh `next` makes from the solution
+    /// so far (the next level is a function of the current solution: uniform refinement,
+    /// or a refinement marked by an estimate), until it returns `None`. Each new level
+    /// starts from the previous level's solution interpolated at its DOFs; where Newton
+    /// fails from there, from the problem's start ([`Problem::start`]) if it has one.
+    /// The report's `levels` list every level solved.
+    ///
+    /// # Errors
+    /// Those of [`Problem::solve`] on any level, and those of `next`.
+    pub fn solve_refining(
+        &self,
+        mut next: impl FnMut(&Solved<M, G>) -> Result<Option<G>>,
+    ) -> Result<Solved<M, G>> {
+        let mut current = self.solve()?;
+        while let Some(mesh) = next(&current)? {
+            let previous = &current.solution;
+            let solved = match self.solve_on(std::slice::from_ref(&mesh), Some(previous)) {
+                Err(e @ (Error::NotConverged { .. } | Error::LinearSolve(_)))
+                    if self.start.is_some() =>
+                {
+                    let mut again = self.solve_on(std::slice::from_ref(&mesh), None)?;
+                    again.fell_back = Some(e.to_string());
+                    again
+                }
+                other => other?,
+            };
+            let mut levels = current.report.levels.clone();
+            levels.extend(solved.report.levels.iter().copied());
+            current = solved;
+            current.report.levels = levels;
+        }
+        Ok(current)
+    }
+
+    /// The input that sets the size, for the memory refusal.
+    fn size_text(&self, finest: &G) -> String {
+        self.size
+            .clone()
+            .unwrap_or_else(|| format!("a mesh of {} cells", finest.cell_count()))
+    }
+
+    /// [`Problem::solve`] on `meshes` (nested levels, coarsest first): the coarsest one
+    /// starts from `previous` interpolated at its DOFs where given, else from the
+    /// problem's start.
+    fn solve_on(
+        &self,
+        meshes: &[G],
+        previous: Option<&ObstacleSolution<G>>,
+    ) -> Result<Solved<M, G>> {
+        if let Some(e) = &self.invalid {
+            return Err(e.clone());
+        }
+        let finest = meshes
             .last()
             .ok_or_else(|| Error::Input("no mesh to solve on".into()))?;
         let memory_estimate = self.memory.bytes(finest.cell_count());
-        let size = self
-            .size
-            .clone()
-            .unwrap_or_else(|| format!("a mesh of {} cells", finest.cell_count()));
-        memory::check_memory(memory_estimate, &size)?;
-        if let Some(obstacle) = self.nodal {
-            return self.solve_nodal(obstacle, memory_estimate);
-        }
+        memory::check_memory(memory_estimate, &self.size_text(finest))?;
+
         multiplier_field::<M>()?;
         let data = self.data_functions()?;
         let parts = self.part_markers()?;
@@ -502,14 +562,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             options.solver = VariationalSolver::Clarabel;
         }
         let nested = self.options.nested && options.solver == VariationalSolver::SemismoothNewton;
-        let first = if nested { 0 } else { self.meshes.len() - 1 };
+        let first = if nested { 0 } else { meshes.len() - 1 };
         let solution = self
             .solve_levels(
-                &self.meshes[first..],
+                &meshes[first..],
                 &coefficients,
                 Some((dofs, constraints)),
                 &parts,
                 options,
+                previous,
             )
             .map_err(|e| alpha_hint(e, alpha, c_i))?;
         let mut report = self.report(&solution, &coefficients, alpha, c_i, options)?;
@@ -542,7 +603,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         if self.options.rounding_experiment {
             let clock = Instant::now();
             let rounding = self
-                .rounding_experiment(&solution, &coefficients, &parts, options)
+                .rounding_experiment(meshes, &solution, &coefficients, &parts, options)
                 .unwrap_or(f64::INFINITY);
             report.rounding_seconds = Some(clock.elapsed().as_secs_f64());
             report.rounding = Some(rounding);
@@ -568,6 +629,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             solution,
             report,
             params,
+            fell_back: None,
             model: PhantomData,
         })
     }
@@ -709,6 +771,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             solution,
             report,
             params,
+            fell_back: None,
             model: PhantomData,
         })
     }
@@ -722,6 +785,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         finest: Option<(crate::SystemDofs, Constraints)>,
         parts: &[Vec<u32>],
         options: ObstacleOptions,
+        previous: Option<&ObstacleSolution<G>>,
     ) -> Result<ObstacleSolution<G>> {
         let supports = &self.supports;
         let last = meshes.len() - 1;
@@ -746,11 +810,23 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             })
             .collect();
         let prolongation = G::primal_prolongation();
+        let from_previous = |d: &Discretization<G>| -> Result<Option<Vec<f64>>> {
+            let p = previous.expect("used with a previous level");
+            Ok(Some(d.primal_part(&G::prolong::<M>(
+                &p.discretization,
+                &p.values,
+                d,
+            ))))
+        };
+        let start: Option<&FirstStart<'_, G>> = match previous {
+            Some(_) => Some(&from_previous),
+            None => self.start,
+        };
         solve_nested_from(
             levels,
             |coarse, values, fine| G::prolong::<M>(coarse, values, fine),
             prolongation,
-            self.start,
+            start,
             options,
         )
     }
@@ -1155,6 +1231,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// 1000× too small and the norm-wise `ε κ(A)` 100× too large.
     fn rounding_experiment(
         &self,
+        meshes: &[G],
         solution: &ObstacleSolution<G>,
         coefficients: &Coefficients,
         parts: &[Vec<u32>],
@@ -1175,8 +1252,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             .max(f64::MIN_POSITIVE);
         let mut largest = 0.0f64;
         for factor in [1.0 + 2f64.powi(-40), 1.0 - 2f64.powi(-39)] {
-            let meshes = self
-                .meshes
+            let meshes = meshes
                 .iter()
                 .map(|m| m.scaled(factor))
                 .collect::<Result<Vec<G>>>()?;
@@ -1186,7 +1262,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 } else {
                     meshes.len() - 1
                 };
-            let moved = self.solve_levels(&meshes[first..], coefficients, None, parts, options)?;
+            let moved =
+                self.solve_levels(&meshes[first..], coefficients, None, parts, options, None)?;
             let values = G::field_at_vertices(&moved, field);
             let change = values
                 .iter()

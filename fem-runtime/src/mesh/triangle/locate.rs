@@ -114,6 +114,71 @@ impl<'a> PointLocator<'a> {
         self.locate(p)
     }
 
+    /// [`PointLocator::locate_near`], or else the cell nearest to `p` with `p`'s
+    /// barycentric coordinates in it (some negative): the point at which a field on this
+    /// mesh is continued by its nearest cell's polynomial, as a finer mesh's boundary
+    /// nodes lying on a curve the coarse chords cut need. `None` only for a non-finite
+    /// point or a mesh without cells.
+    pub fn locate_or_nearest(&self, p: [f64; 2], hint: Option<usize>) -> Option<(usize, [f64; 3])> {
+        if let Some(found) = self.locate_near(p, hint) {
+            return Some(found);
+        }
+        let c = self.nearest(p)?;
+        let (v, w) = self.sub_areas(c, p);
+        let twice_area = cross(v[0], v[1], v[2]);
+        Some((c, w.map(|x| x / twice_area)))
+    }
+
+    /// The cell at the least distance from `p`, searching rings of buckets outward from
+    /// the bucket of `p` clamped to the grid. Clamping only brings a point closer to every
+    /// point of the grid, so ring `r` lies at least `(r − 1)·w` from `p` (`w` the smaller
+    /// bucket side) and the search stops once that passes the best distance found.
+    fn nearest(&self, p: [f64; 2]) -> Option<usize> {
+        if !(p[0].is_finite() && p[1].is_finite()) || self.mesh.cells.is_empty() {
+            return None;
+        }
+        let (i0, j0) = self.bucket(p);
+        let width = (1.0 / self.scale[0]).min(1.0 / self.scale[1]);
+        let mut best: Option<(f64, usize)> = None;
+        let rings = self.nx.max(self.ny);
+        for r in 0..=rings {
+            if let Some((d, _)) = best {
+                if (r as f64 - 1.0) * width > d {
+                    break;
+                }
+            }
+            let (i_lo, i_hi) = (i0.saturating_sub(r), (i0 + r).min(self.nx - 1));
+            let (j_lo, j_hi) = (j0.saturating_sub(r), (j0 + r).min(self.ny - 1));
+            for j in j_lo..=j_hi {
+                for i in i_lo..=i_hi {
+                    // the ring only: buckets at Chebyshev distance exactly r
+                    if i.abs_diff(i0).max(j.abs_diff(j0)) != r {
+                        continue;
+                    }
+                    let b = j * self.nx + i;
+                    for &c in &self.items[self.start[b]..self.start[b + 1]] {
+                        let d = self.distance(c, p);
+                        if best.is_none_or(|(e, _)| d < e) {
+                            best = Some((d, c));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, c)| c)
+    }
+
+    /// The distance from `p` to cell `c` (0 inside).
+    pub(super) fn distance(&self, c: usize, p: [f64; 2]) -> f64 {
+        let (v, w) = self.sub_areas(c, p);
+        if w.iter().all(|&w| w >= 0.0) {
+            return 0.0;
+        }
+        (0..3)
+            .map(|k| segment_distance(p, v[k], v[(k + 1) % 3]))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Whether `p` lies in cell `c` (on its boundary included), by the signs of the
     /// sub-triangle areas: the test [`PointLocator::locate_near`] makes of its hint.
     #[inline]
@@ -171,4 +236,16 @@ impl<'a> PointLocator<'a> {
         }
         best.map(|(_, c, lambda)| (c, lambda))
     }
+}
+
+/// The distance from `p` to the segment from `a` to `b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let e = [b[0] - a[0], b[1] - a[1]];
+    let length2 = e[0] * e[0] + e[1] * e[1];
+    let t = if length2 > 0.0 {
+        (((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1]) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist2(p, [a[0] + t * e[0], a[1] + t * e[1]]).sqrt()
 }

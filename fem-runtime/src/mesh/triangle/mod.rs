@@ -1385,6 +1385,36 @@ mod tests {
             .is_some());
     }
 
+    /// Outside the mesh, `locate_or_nearest` finds a cell at the least distance (checked
+    /// against every cell) and coordinates that reproduce the point; inside, it agrees
+    /// with `locate`.
+    #[test]
+    fn nearest_cell_is_the_closest_of_all() {
+        let disk = TriangleMesh::disk([0.5, 0.5], 2.0, 4).unwrap();
+        let locator = PointLocator::new(&disk);
+        let mut rng = Rng(7);
+        for _ in 0..300 {
+            let angle = rng.uniform() * std::f64::consts::TAU;
+            let radius = 2.0 * (0.5 + rng.uniform());
+            let p = [0.5 + radius * angle.cos(), 0.5 + radius * angle.sin()];
+            let (c, lambda) = locator.locate_or_nearest(p, None).unwrap();
+            let brute = (0..disk.cell_count())
+                .map(|k| locator.distance(k, p))
+                .fold(f64::INFINITY, f64::min);
+            assert!((locator.distance(c, p) - brute).abs() <= 1e-12, "{p:?}");
+            let y = disk.cell_coordinates(c);
+            let q = [
+                lambda[0] * y[0] + lambda[1] * y[2] + lambda[2] * y[4],
+                lambda[0] * y[1] + lambda[1] * y[3] + lambda[2] * y[5],
+            ];
+            assert!(dist2(p, q).sqrt() < 1e-12, "{p:?}");
+            if let Some((inside, _)) = locator.locate(p) {
+                assert!(locator.contains(inside, p) && locator.contains(c, p));
+            }
+        }
+        assert!(locator.locate_or_nearest([f64::NAN, 0.0], None).is_none());
+    }
+
     /// The 32-bit index tables: the largest index kept is `u32::MAX − 1` (`u32::MAX`
     /// marks "no cell"); beyond it the mesh is refused by name, not truncated.
     #[test]
