@@ -2,7 +2,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use clap::{Parser, Subcommand, ValueEnum};
-use fem_forms::beams::{self, Pair, Report, Request};
+use fem_forms::beams::Pair;
 use fem_forms::kirchhoff::{self, KirchhoffPair, KirchhoffRequest};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::contact_scenes::{ContactBody, ContactScene};
@@ -12,7 +12,6 @@ use fem_forms::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene};
 use fem_forms::models::registry::{
     find, names, registry, Family, SceneEntry, SceneKind, MEMBRANE_PAIRS,
 };
-use fem_forms::models::scenes::{Beam, Scene};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::plates::{self, PlatePair, PlateRequest};
@@ -21,6 +20,8 @@ use fem_forms::studies::{self, Study};
 use fem_forms::{plot, scene_file};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+mod solve;
 
 #[derive(Parser)]
 #[command(
@@ -253,20 +254,22 @@ fn fmt_contact(set: &[[f64; 2]]) -> String {
         .join(" ")
 }
 
-fn table_row(r: &Report) {
-    for w in &r.warnings {
-        eprintln!(
-            "warning ({} q = {}): {w}",
-            r.scene,
-            fem_forms::number(r.load)
-        );
+fn table_row(r: &fem_forms::models::run::Report) {
+    let load = r.load.unwrap_or(1.0);
+    for w in &r.solve.warnings {
+        eprintln!("warning ({} q = {}): {w}", r.scene, fem_forms::number(load));
     }
+    let contact_set: Vec<[f64; 2]> = r
+        .quantities
+        .get("contact_set")
+        .and_then(|v| serde_json::from_value(v.clone()).ok())
+        .unwrap_or_default();
     println!(
         "{:<15} {:>5} {:>7} {:>6} {:>6} {:>5} {:>8.4} {:>14.8e} {:<24} {:>9.1e} {:>10}",
         r.scene,
-        fem_forms::number(r.load),
+        fem_forms::number(load),
         // in full where it fits the column, else to three digits
-        r.thickness.map_or("-".into(), |t| {
+        r.parameters.get("t").map_or("-".into(), |&t| {
             let full = fem_forms::number(t);
             if full.chars().count() <= 7 {
                 full
@@ -274,14 +277,14 @@ fn table_row(r: &Report) {
                 format!("{t:.2e}")
             }
         }),
-        r.elements,
-        r.dofs,
-        r.iterations,
-        r.seconds,
-        r.energy,
-        fmt_contact(&r.contact_set),
-        r.complementarity_residual,
-        r.error_l2.map_or("-".into(), |e| format!("{e:.2e}")),
+        r.solve.cells,
+        r.solve.dofs,
+        r.solve.iterations,
+        r.solve.seconds,
+        r.solve.energy.unwrap_or(f64::NAN),
+        fmt_contact(&contact_set),
+        r.solve.kkt_residual,
+        r.solve.error_l2.map_or("-".into(), |e| format!("{e:.2e}")),
     );
 }
 
@@ -336,18 +339,21 @@ fn default_job(out: &Path) -> Result<(), String> {
         .into_iter()
         .filter(|e| e.in_default_job)
         .collect();
-    for e in &entries {
-        let SceneKind::Beam(s) = e.kind else {
-            continue;
-        };
+    let beams: Vec<_> = fem_forms::models::family::scenes()
+        .into_iter()
+        .filter(|s| s.family == "beam" && s.in_default_job)
+        .collect();
+    for scene in &beams {
         for q in [1.0, 100.0] {
-            let mut request = Request::new(s);
-            request.load = q;
-            let (report, profiles) =
-                beams::solve(&request).map_err(|e| format!("{}: {e}", s.name))?;
-            table_row(&report);
-            let path = out.join(format!("{}-q{q}.svg", s.name));
-            plot::profiles(&path, &format!("{} q = {q}", s.name), &profiles)
+            let settings = fem_forms::models::run::Settings {
+                load: Some(q),
+                ..Default::default()
+            };
+            let outcome = fem_forms::models::run::solve(scene, &settings)
+                .map_err(|e| format!("{}: {e}", scene.name))?;
+            table_row(&outcome.report);
+            let path = out.join(format!("{}-q{q}.svg", scene.name));
+            plot::profiles(&path, &format!("{} q = {q}", scene.name), &outcome.fields)
                 .map_err(|e| format!("{}: {e}", path.display()))?;
         }
     }
@@ -587,7 +593,7 @@ fn solve(entry: &SceneEntry, options: &SolveOptions, out: &Path) -> Result<(), S
     match &entry.kind {
         SceneKind::Kirchhoff(scene) => solve_kirchhoff(*scene, options),
         SceneKind::Contact(scene) => solve_contact(*scene, options, out),
-        SceneKind::Beam(scene) => solve_beam(*scene, options, out),
+        SceneKind::Beam(_) => Err("beam scenes are solved through the registry".into()),
         SceneKind::Membrane(scene) => solve_membrane(scene, options, out),
         SceneKind::Plate(scene) => solve_plate(*scene, options),
     }
@@ -884,60 +890,6 @@ fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> 
     Ok(())
 }
 
-fn solve_beam(s: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {
-    options.refuse(
-        &["--mesh-size", "--msh", "--vtk", "--no-obstacle"],
-        &format!(
-            "`{}` is a beam scene on a uniform interval mesh (--elements)",
-            s.name
-        ),
-    )?;
-    if s.beam == Beam::EulerBernoulli {
-        options.refuse(
-            &["--thickness"],
-            &format!("`{}` is an Euler–Bernoulli beam (no thickness)", s.name),
-        )?;
-    }
-    let pair = options
-        .pair
-        .as_deref()
-        .map(|p| Pair::parse(p, s.beam))
-        .transpose()
-        .map_err(|e| e.to_string())?;
-    let load = options.load.unwrap_or(1.0);
-    let request = Request {
-        scene: s,
-        elements: options.elements.unwrap_or(256),
-        load,
-        thickness: options.thickness,
-        alpha: options.alpha,
-        pair,
-        solver: options.solver(),
-        nested_from: (!options.cold).then_some(16),
-        refinement_steps: options.refinement.unwrap_or(1),
-        linear_solver: options.linear_solver()?,
-        plain: false,
-    };
-    let (report, profiles) = beams::solve(&request).map_err(|e| e.to_string())?;
-    if options.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
-    } else {
-        table_header();
-        table_row(&report);
-    }
-    if options.plot {
-        let path = out.join(format!("{}-q{load}.svg", s.name));
-        plot::profiles(&path, &format!("{} q = {load}", s.name), &profiles)
-            .map_err(|e| e.to_string())?;
-        // as every other written file: the user learns where it went
-        eprintln!("→ {}", path.display());
-    }
-    Ok(())
-}
-
 fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> Result<(), String> {
     options.refuse(
         &[
@@ -1155,6 +1107,10 @@ fn run(cli: Cli) -> Result<(), String> {
                         studies: &[],
                         in_default_job: false,
                     }
+                }
+                (Some(scene), None) if fem_forms::models::family::scene(&scene).is_some() => {
+                    let scene = fem_forms::models::family::scene(&scene).expect("found");
+                    return solve::solve_scene(scene, &options, &cli.out);
                 }
                 (Some(scene), None) => find(&scene).ok_or_else(|| {
                     format!(

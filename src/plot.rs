@@ -1,7 +1,7 @@
 //! SVG charts (plotters). Each chart is drawn to a temporary file and renamed into
 //! place, so a failed run never leaves a chart that looks complete.
 
-use crate::beams::Profiles;
+use fem_models::geometry::Fields;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -220,48 +220,48 @@ pub fn stacked(path: &Path, panels: &[(String, Axes, Vec<Series>)]) -> std::io::
     })
 }
 
-/// w with ψ, θ (Timoshenko) and λ of a solved scene.
-pub fn profiles(path: &Path, title: &str, p: &Profiles) -> std::io::Result<()> {
-    let zip = |y: &[f64]| {
-        p.x.iter()
-            .copied()
-            .zip(y.iter().copied())
-            .collect::<Vec<_>>()
+/// The primal fields with ψ, and λ, of a scene solved on an interval (w with ψ, θ of a
+/// Timoshenko beam, λ_h as steps); other fields draw nothing.
+pub fn profiles(path: &Path, title: &str, fields: &Fields) -> std::io::Result<()> {
+    let Fields::Interval {
+        x,
+        fields,
+        psi,
+        cell_x,
+        lambda,
+    } = fields
+    else {
+        return Ok(());
     };
-    let mut panels = vec![(
-        format!("{title}: deflection"),
-        Axes {
-            x: "x",
-            y: "w",
-            ..Axes::default()
-        },
-        vec![
-            Series::line("w_h", zip(&p.w)),
-            Series::line("obstacle ψ", zip(&p.psi)),
-        ],
-    )];
-    if let Some(theta) = &p.theta {
+    let zip = |y: &[f64]| x.iter().copied().zip(y.iter().copied()).collect::<Vec<_>>();
+    let mut panels = Vec::new();
+    for (k, (name, values)) in fields.iter().enumerate() {
+        let mut series = vec![Series::line(format!("{name}_h"), zip(values))];
+        // the constrained field comes first; ψ beside it
+        if k == 0 {
+            series.push(Series::line("obstacle ψ", zip(psi)));
+        }
         panels.push((
-            format!("{title}: rotation"),
+            format!("{title}: {name}"),
             Axes {
                 x: "x",
-                y: "θ",
+                y: name,
                 ..Axes::default()
             },
-            vec![Series::line("θ_h", zip(theta))],
+            series,
         ));
     }
     // λ is piecewise constant: draw it as steps.
-    let mut steps = Vec::with_capacity(2 * p.lambda.len());
-    for (k, &l) in p.lambda.iter().enumerate() {
-        let half = if p.cell_x.len() > 1 {
-            0.5 * (p.cell_x[1] - p.cell_x[0])
-        } else {
-            0.5
-        };
-        steps.push((p.cell_x[k] - half, l));
-        steps.push((p.cell_x[k] + half, l));
-    }
+    let half = if cell_x.len() > 1 {
+        0.5 * (cell_x[1] - cell_x[0])
+    } else {
+        0.5
+    };
+    let steps: Vec<(f64, f64)> = cell_x
+        .iter()
+        .zip(lambda)
+        .flat_map(|(&c, &l)| [(c - half, l), (c + half, l)])
+        .collect();
     panels.push((
         format!("{title}: contact multiplier"),
         Axes {

@@ -13,8 +13,29 @@ use serde_json::Value;
 use std::path::Path;
 use std::process::Command;
 
-/// Keys renamed by the refactor: `(old path, new path)`, paths joined by `.`.
-const RENAMED: &[(&str, &str)] = &[];
+/// Keys renamed by the refactor: `(scenes, old path, new path)`, paths joined by `.`;
+/// `scenes` are the first words of the cases it applies to (`*`: every case).
+const RENAMED: &[(&[&str], &str, &str)] = &[
+    // one report for every family: the finest mesh's cells, the KKT residual under its
+    // name (the families called it complementarity_residual; the runtime's
+    // complementarity_residual is its complementarity part), the rounding experiment's
+    // result under one name
+    (BEAMS, "elements", "cells"),
+    (BEAMS, "complementarity_residual", "kkt_residual"),
+    (TIMOSHENKO, "thickness_rounding", "rounding"),
+    (BERNOULLI, "length_rounding", "rounding"),
+];
+
+/// The beam scenes.
+const BEAMS: &[&str] = &[
+    "timoshenko-a",
+    "timoshenko-b",
+    "bernoulli-a",
+    "bernoulli-b",
+    "bernoulli-flat",
+];
+const TIMOSHENKO: &[&str] = &["timoshenko-a", "timoshenko-b"];
+const BERNOULLI: &[&str] = &["bernoulli-a", "bernoulli-b", "bernoulli-flat"];
 
 /// Numbers and messages the refactor changed on purpose: `(command, key, why)`. The new
 /// value is checked by the tests of the concept named; for `warnings`, the count stays.
@@ -127,8 +148,8 @@ fn agree(old: &Value, new: &Value, leaf: &str) -> bool {
 }
 
 /// What of `old` `new` lost or changed, one line each, but for the keys `changed`
-/// allows (a changed `warnings` keeps its count).
-fn differences(old: &Value, new: &Value, changed: &[&str]) -> Vec<String> {
+/// allows (a changed `warnings` keeps its count); `scene` is the case's first word.
+fn differences(old: &Value, new: &Value, changed: &[&str], scene: &str) -> Vec<String> {
     let mut recorded = Vec::new();
     leaves(old, String::new(), &mut recorded);
     let mut faults = Vec::new();
@@ -138,8 +159,10 @@ fn differences(old: &Value, new: &Value, changed: &[&str]) -> Vec<String> {
         }
         let target = RENAMED
             .iter()
-            .find(|(from, _)| *from == path)
-            .map_or(path.as_str(), |(_, to)| to);
+            .find(|(scenes, from, _)| {
+                *from == path && (scenes.contains(&"*") || scenes.contains(&scene))
+            })
+            .map_or(path.as_str(), |(_, _, to)| to);
         let leaf = path.rsplit('.').next().unwrap_or(&path);
         let value = &match (path.as_str(), value) {
             ("warnings", Value::Array(a)) if changed.contains(&"warnings") => Value::from(a.len()),
@@ -154,6 +177,9 @@ fn differences(old: &Value, new: &Value, changed: &[&str]) -> Vec<String> {
             (_, found) => found,
         };
         match now {
+            // a recorded null is no number: the key may go (the other beam theory's
+            // rounding experiment, which the report now gives under one name)
+            None if value.is_null() => {}
             None => faults.push(format!("{path}: missing (was {value})")),
             Some(now) if !agree(value, now, leaf) => {
                 faults.push(format!("{path}: {now}, was {value}"))
@@ -201,7 +227,8 @@ fn every_recorded_report_keeps_its_numbers() {
             .filter(|(case, _, _)| case == line)
             .map(|(_, key, _)| *key)
             .collect();
-        let faults = differences(&old, &new, &changed);
+        let scene = line.split_whitespace().next().unwrap_or_default();
+        let faults = differences(&old, &new, &changed, scene);
         if !faults.is_empty() {
             failures.push(format!("`solve {line}`:\n    {}", faults.join("\n    ")));
         }
@@ -215,8 +242,8 @@ fn the_comparison_can_fail() {
     let old: Value =
         serde_json::json!({"energy": 1.0, "levels": [[8, 2]], "seconds": 1.0, "a": {"b": 3.0}});
     let same: Value = serde_json::json!({"energy": 1.0 + 1e-12, "levels": [[8, 2]], "seconds": 9.0, "a": {"b": 3.0}});
-    assert!(differences(&old, &same, &[]).is_empty());
+    assert!(differences(&old, &same, &[], "x").is_empty());
     let changed: Value = serde_json::json!({"energy": 1.001, "levels": [[8, 3]], "a": {}});
-    assert_eq!(differences(&old, &changed, &[]).len(), 3);
-    assert_eq!(differences(&old, &changed, &["energy"]).len(), 2);
+    assert_eq!(differences(&old, &changed, &[], "x").len(), 3);
+    assert_eq!(differences(&old, &changed, &["energy"], "x").len(), 2);
 }

@@ -47,8 +47,11 @@ pub use assembly::{assemble_vector, kernel, MatrixAssembler};
 pub use error::{Error, Result};
 pub use fem_reference as reference;
 pub use fem_reference::{gauss_legendre, CellKind, ElementKind, QuadratureRule};
-pub use mesh::{Diagonal, IntervalMesh, Mesh, PointLocator, TriangleMesh};
-pub use model::{BlockInfo, Coefficients, DataFn, FacetBlockInfo, FieldInfo, FormInfo, Model};
+pub use mesh::{CurvedTriangleMesh, Diagonal, IntervalMesh, Mesh, PointLocator, TriangleMesh};
+pub use model::{
+    BlockInfo, Coefficients, DataFn, DataId, FacetBlockInfo, FieldId, FieldInfo, FormId, FormInfo,
+    Model, ParamId,
+};
 pub use stabilization::Alpha;
 
 /// Re-exported sparse matrix type of the assembled systems.

@@ -34,6 +34,16 @@ impl<T> Data<T> {
     }
 }
 
+impl<T> Data<T> {
+    /// The function as a trait object.
+    pub fn as_fn(&self) -> &(dyn Fn(&[f64]) -> T + Sync + 'static) {
+        match self {
+            Data::Fn(f) => f,
+            Data::Shared(f) => &**f,
+        }
+    }
+}
+
 impl Data<f64> {
     /// The function as the runtime's data type (what `Coefficients` take).
     pub fn as_data_fn(&self) -> &DataFn {

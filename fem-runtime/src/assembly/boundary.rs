@@ -3,10 +3,10 @@
 //! Elimination keeps a symmetric matrix symmetric (and SPD stays SPD), which the
 //! Cholesky solve and the active-set solvers rely on.
 
-use crate::assembly::dof_map::{DofMap, SystemDofs};
-use crate::assembly::plate_basis::{
-    resolve_vertex, ChangeOfBasis, RotatedVertex, VertexResolution, VERTEX_DOFS,
+use crate::assembly::change_of_basis::{
+    resolve_group, ChangeOfBasis, DofGroup, GroupResolution, RotatedBlock, MAX_GROUP, VERTEX_DOFS,
 };
+use crate::assembly::dof_map::{DofMap, SystemDofs};
 use crate::error::{Error, Result};
 use crate::mesh::{IntervalMesh, TriangleMesh};
 use crate::model::Model;
@@ -359,14 +359,15 @@ impl DirichletPart {
     }
 }
 
-/// Fixed DOFs with their values, and linear conditions on the six DOFs of Argyris
-/// vertices (plate supports on edges that are not along x or y), which
-/// [`Constraints::change_of_basis`] turns into fixed DOFs of a rotated basis.
+/// Fixed DOFs with their values, and linear conditions on small groups of DOFs (the six
+/// DOFs of an Argyris vertex on an edge that is not along x or y, the two components of
+/// a vector field at a node of a slanted edge), which [`Constraints::change_of_basis`]
+/// turns into fixed DOFs of a rotated basis.
 #[derive(Clone, Debug, Default)]
 pub struct Constraints {
     fixed: Vec<(usize, f64)>,
-    /// `(first global DOF of the vertex, row, value)`: `row · U_v = value`.
-    vertex: Vec<(usize, [f64; VERTEX_DOFS], f64)>,
+    /// `(group of global DOFs, row, value)`: `row · U_g = value`.
+    combinations: Vec<(DofGroup, [f64; MAX_GROUP], f64)>,
     warnings: Vec<String>,
 }
 
@@ -379,6 +380,15 @@ fn dot6(a: &[f64; 6], b: &[f64; 6]) -> f64 {
 /// (and warns about, [`Constraints::warnings`]): 30°. Real polygonal plates have a few
 /// larger angles (90° for a rectangle, 60° for a hexagon).
 pub const CURVE_TURNING_ANGLE: f64 = std::f64::consts::PI / 6.0;
+
+/// The direction [`Constraints::hold_component`] holds a vector along.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ComponentDirection {
+    /// The boundary's unit tangent at each node (`θ·t = 0`).
+    Tangent,
+    /// A fixed direction (`u·n = 0`).
+    Fixed([f64; 2]),
+}
 
 /// The boundary curve a part of a polygonal mesh approximates, at a vertex `x` of the
 /// part: `(outward unit normal, curvature)`, the curvature positive where the domain is
@@ -561,7 +571,7 @@ impl Constraints {
         for (dof, value) in other.fixed {
             self.fix_dof(dof, value)?;
         }
-        self.vertex.extend(other.vertex);
+        self.combinations.extend(other.combinations);
         self.warnings.extend(other.warnings);
         Ok(())
     }
@@ -728,6 +738,126 @@ impl Constraints {
         Ok(())
     }
 
+    /// Holds the component of the vector field `fields = [x, y]` (its two Lagrange
+    /// component fields, same element) along `direction` at every node of `part`:
+    /// `θ·t = 0` with the boundary's tangent (the hard simple support) or `u·n = 0` for a
+    /// fixed `n` (a roller). Where a vertex joins two edges of the part that turn by at
+    /// most [`CURVE_TURNING_ANGLE`] (a polygon approximating a curve), their tangents'
+    /// mean is the curve's; at a sharper corner both tangents hold and the vector is 0
+    /// there. A direction that is a coordinate axis fixes a single component DOF.
+    ///
+    /// # Errors
+    /// Fields that are not two Lagrange fields of the same element in `dofs`, a
+    /// direction that is zero or not finite, and a part holding no boundary edge.
+    pub fn hold_component(
+        &mut self,
+        mesh: &TriangleMesh,
+        dofs: &SystemDofs,
+        fields: [usize; 2],
+        part: &DirichletPart,
+        direction: ComponentDirection,
+    ) -> Result<()> {
+        let (Some(map_x), Some(map_y), Some(offset_x), Some(offset_y)) = (
+            dofs.map(fields[0]),
+            dofs.map(fields[1]),
+            dofs.offset(fields[0]),
+            dofs.offset(fields[1]),
+        ) else {
+            return Err(Error::Input(
+                "the components of a held vector are not part of this system".into(),
+            ));
+        };
+        if map_x.element() != map_y.element() || map_x.element().needs_transformation() {
+            return Err(Error::Input(format!(
+                "a held vector's components are Lagrange fields of one element ({} and {} given)",
+                map_x.element().name(),
+                map_y.element().name()
+            )));
+        }
+        if let ComponentDirection::Fixed(n) = direction {
+            if !(n[0].is_finite() && n[1].is_finite()) || n[0] == 0.0 && n[1] == 0.0 {
+                return Err(Error::Input(format!(
+                    "the held direction ({}, {}) is zero or not finite",
+                    n[0], n[1]
+                )));
+            }
+        }
+        let [per_vertex, per_edge, _] = map_x.element().triangle_layout();
+        // every node of the part with the unit tangents of its part edges
+        let mut tangents: BTreeMap<usize, Vec<[f64; 2]>> = BTreeMap::new();
+        let mut edges = 0;
+        for &(e, m) in mesh.boundary_edges() {
+            if !part.contains(m) {
+                continue;
+            }
+            edges += 1;
+            let [a, b] = mesh.edges()[e];
+            let (pa, pb) = (mesh.vertices()[a], mesh.vertices()[b]);
+            let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+            let t = [(pb[0] - pa[0]) / length, (pb[1] - pa[1]) / length];
+            let (c, _) = mesh.edge_cells(e);
+            let Some(k) = mesh.cell_edges(c).iter().position(|&x| x == e) else {
+                continue;
+            };
+            let local = map_x.cell_dofs(c);
+            let mut nodes: Vec<usize> = Vec::new();
+            for v in [k, (k + 1) % 3] {
+                nodes.extend((v * per_vertex..(v + 1) * per_vertex).map(|j| local[j]));
+            }
+            let start = 3 * per_vertex + k * per_edge;
+            nodes.extend((start..start + per_edge).map(|j| local[j]));
+            for node in nodes {
+                // the tangent's sign does not matter; keep one orientation per curve
+                let list = tangents.entry(node).or_default();
+                let t = match list.first() {
+                    Some(s) if s[0] * t[0] + s[1] * t[1] < 0.0 => [-t[0], -t[1]],
+                    _ => t,
+                };
+                list.push(t);
+            }
+        }
+        if edges == 0 {
+            return Err(Error::Input(format!(
+                "the boundary part {part:?} where a vector's component is held holds none of the mesh's {} boundary edges",
+                mesh.boundary_edges().len()
+            )));
+        }
+        for (node, list) in tangents {
+            let directions: Vec<[f64; 2]> = match direction {
+                ComponentDirection::Fixed(n) => vec![n],
+                ComponentDirection::Tangent => {
+                    let smooth = list.windows(2).all(|w| {
+                        let cos = w[0][0] * w[1][0] + w[0][1] * w[1][1];
+                        cos >= CURVE_TURNING_ANGLE.cos()
+                    });
+                    if smooth {
+                        let sum = list
+                            .iter()
+                            .fold([0.0, 0.0], |s, t| [s[0] + t[0], s[1] + t[1]]);
+                        vec![sum]
+                    } else {
+                        list
+                    }
+                }
+            };
+            // the same place in the y field's numbering (one element, one numbering)
+            let dof_y = offset_y + node;
+            let dof_x = offset_x + node;
+            for d in directions {
+                let length = d[0].hypot(d[1]);
+                let d = [d[0] / length, d[1] / length];
+                if d[1] == 0.0 {
+                    self.fix_dof(dof_x, 0.0)?;
+                } else if d[0] == 0.0 {
+                    self.fix_dof(dof_y, 0.0)?;
+                } else {
+                    self.fix_combination(&[dof_x, dof_y], &d, 0.0)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Imposes `Σ_k row[k] U[start + k] = value` on the six DOFs of an Argyris vertex
     /// (`u, u_x, u_y, u_xx, u_xy, u_yy` from global DOF `start`).
     ///
@@ -739,77 +869,95 @@ impl Constraints {
         row: [f64; VERTEX_DOFS],
         value: f64,
     ) -> Result<()> {
-        if !value.is_finite() || !row.iter().all(|x| x.is_finite()) || row.iter().all(|&x| x == 0.0)
+        let dofs: [usize; VERTEX_DOFS] = std::array::from_fn(|k| start + k);
+        self.fix_combination(&dofs, &row, value)
+    }
+
+    /// Imposes `Σ_k row[k] U[dofs[k]] = value` on a group of up to [`MAX_GROUP`] DOFs
+    /// (the components `θ_x`, `θ_y` of a vector field at one node: `θ·t = 0`). Every
+    /// condition on a DOF of a group must name the same group.
+    ///
+    /// # Errors
+    /// [`Error::Input`] for a row or value that is not finite, a zero row, a row of
+    /// another length than `dofs`, and an empty, repeating or too large group.
+    pub fn fix_combination(&mut self, dofs: &[usize], row: &[f64], value: f64) -> Result<()> {
+        if row.len() != dofs.len()
+            || !value.is_finite()
+            || !row.iter().all(|x| x.is_finite())
+            || row.iter().all(|&x| x == 0.0)
         {
             return Err(Error::Input(format!(
-                "vertex condition {row:?} = {value} at DOF {start} is zero or not finite"
+                "condition {row:?} = {value} on DOFs {dofs:?} is zero, not finite or of another length"
             )));
         }
-        self.vertex.push((start, row, value));
+        let group = DofGroup::new(dofs)?;
+        let mut padded = [0.0; MAX_GROUP];
+        padded[..row.len()].copy_from_slice(row);
+        self.combinations.push((group, padded, value));
         Ok(())
     }
 
-    /// The conditions on vertex DOFs (`(first DOF, row, value)`), in the order given.
-    pub fn vertex_conditions(&self) -> &[(usize, [f64; VERTEX_DOFS], f64)] {
-        &self.vertex
+    /// The conditions on groups of DOFs (`(group, row, value)`), in the order given.
+    pub fn combinations(&self) -> &[(DofGroup, [f64; MAX_GROUP], f64)] {
+        &self.combinations
     }
 
     /// The fixed DOFs in the primed numbering and the change of basis (module
-    /// [`crate::assembly::plate_basis`]).
+    /// [`crate::assembly::change_of_basis`]).
     fn resolve(&self, n: usize) -> Result<(Vec<(usize, f64)>, ChangeOfBasis)> {
-        let mut groups: BTreeMap<usize, Vec<([f64; VERTEX_DOFS], f64)>> = BTreeMap::new();
-        for &(start, row, value) in &self.vertex {
-            if start + VERTEX_DOFS > n {
+        let mut groups: BTreeMap<DofGroup, Vec<([f64; MAX_GROUP], f64)>> = BTreeMap::new();
+        for &(group, row, value) in &self.combinations {
+            if let Some(&d) = group.as_slice().iter().find(|&&d| d >= n) {
                 return Err(Error::Input(format!(
-                    "vertex DOFs {start}..{} outside a system of {n}",
-                    start + VERTEX_DOFS
+                    "conditioned DOF {d} outside a system of {n}"
                 )));
             }
-            groups.entry(start).or_default().push((row, value));
+            groups.entry(group).or_default().push((row, value));
         }
-        let starts: Vec<usize> = groups.keys().copied().collect();
-        if let Some(w) = starts.windows(2).find(|w| w[1] < w[0] + VERTEX_DOFS) {
-            return Err(Error::Input(format!(
-                "vertex conditions from DOF {} and from DOF {} overlap",
-                w[0], w[1]
-            )));
+        let mut group_of: BTreeMap<usize, DofGroup> = BTreeMap::new();
+        for group in groups.keys() {
+            for &d in group.as_slice() {
+                if let Some(other) = group_of.insert(d, *group) {
+                    return Err(Error::Input(format!(
+                        "conditions on DOFs {:?} and on DOFs {:?} overlap at DOF {d}",
+                        other.as_slice(),
+                        group.as_slice()
+                    )));
+                }
+            }
         }
-        let block_of = |d: usize| {
-            let i = starts.partition_point(|&s| s <= d);
-            (i > 0 && d < starts[i - 1] + VERTEX_DOFS).then(|| starts[i - 1])
-        };
-        // a single DOF fixed inside a conditioned vertex is one more condition there
+        // a single DOF fixed inside a conditioned group is one more condition there
         let mut fixed = Vec::with_capacity(self.fixed.len());
         for &(d, v) in &self.fixed {
-            match block_of(d) {
-                Some(start) => {
-                    let mut row = [0.0; VERTEX_DOFS];
-                    row[d - start] = 1.0;
-                    groups.get_mut(&start).expect("a block").push((row, v));
+            match group_of.get(&d) {
+                Some(group) => {
+                    let mut row = [0.0; MAX_GROUP];
+                    row[group.position(d).expect("in its group")] = 1.0;
+                    groups.get_mut(group).expect("a group").push((row, v));
                 }
                 None => fixed.push((d, v)),
             }
         }
         let mut blocks = Vec::new();
-        for (start, conditions) in groups {
-            match resolve_vertex(&conditions)
-                .map_err(|e| Error::Input(format!("vertex DOFs from {start}: {e}")))?
+        for (group, conditions) in groups {
+            match resolve_group(group.len, &conditions)
+                .map_err(|e| Error::Input(format!("DOFs {:?}: {e}", group.as_slice())))?
             {
-                VertexResolution::Direct(single) => {
-                    fixed.extend(single.into_iter().map(|(k, v)| (start + k, v)));
+                GroupResolution::Direct(single) => {
+                    fixed.extend(single.into_iter().map(|(k, v)| (group.dofs[k], v)));
                 }
-                VertexResolution::Rotated(r) => {
-                    fixed.extend((0..r.fixed).map(|k| (start + k, r.values[k])));
-                    blocks.push(RotatedVertex { start, ..*r });
+                GroupResolution::Rotated(r) => {
+                    fixed.extend((0..r.fixed).map(|k| (group.dofs[k], r.values[k])));
+                    blocks.push(RotatedBlock { group, ..*r });
                 }
             }
         }
         Ok((fixed, ChangeOfBasis::new(blocks)))
     }
 
-    /// The change of basis of the DOFs of a system of `n` DOFs that turns the vertex
-    /// conditions into fixed DOFs: the identity where every condition of a vertex is a
-    /// single DOF (edges along x or y, fixed as they are), a rotation of the vertex's six
+    /// The change of basis of the DOFs of a system of `n` DOFs that turns the conditions
+    /// on groups of DOFs into fixed DOFs: the identity where every condition of a group
+    /// is a single DOF (edges along x or y, fixed as they are), a rotation of the group's
     /// DOFs elsewhere. [`Constraints::reduction`] is in its primed numbering: a system
     /// `K U = F` is to be solved as `K' U' = F'` (`K' = Rᵀ K R`,
     /// [`ChangeOfBasis::transform_matrix`]; `F' = Rᵀ F`, [`ChangeOfBasis::to_primed`])
@@ -817,8 +965,8 @@ impl Constraints {
     /// obstacle discretization do.
     ///
     /// # Errors
-    /// [`Error::Input`] for vertex DOFs outside the system, overlapping vertex blocks,
-    /// and conditions at a vertex that contradict each other.
+    /// [`Error::Input`] for DOFs outside the system, overlapping groups, and conditions
+    /// on a group that contradict each other.
     pub fn change_of_basis(&self, n: usize) -> Result<ChangeOfBasis> {
         Ok(self.resolve(n)?.1)
     }
@@ -835,7 +983,7 @@ impl Constraints {
     }
 
     /// The DOFs fixed as they are ([`Constraints::fix_dof`], single-DOF plate conditions
-    /// are in [`Constraints::vertex_conditions`]) and their values.
+    /// are in [`Constraints::combinations`]) and their values.
     pub fn fixed(&self) -> &[(usize, f64)] {
         &self.fixed
     }
@@ -1165,7 +1313,7 @@ mod tests {
             .unwrap()
             .blocks()
             .iter()
-            .map(|b| b.start)
+            .map(|b| b.group.dofs[0])
             .collect();
         assert_eq!(starts, [6, 12]);
         let morley = DofMap::on_triangles(&m, ElementKind::Morley);

@@ -5,10 +5,10 @@
 //! assembly then only zeroes the values and adds the element matrices in place.
 
 pub mod boundary;
+pub mod change_of_basis;
 pub mod dof_map;
 pub mod kernel;
 pub mod linear_problem;
-pub mod plate_basis;
 
 use crate::assembly::dof_map::{DofMap, SystemDofs};
 use crate::error::{Error, Result};

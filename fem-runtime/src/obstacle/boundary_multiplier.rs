@@ -330,7 +330,7 @@ pub fn discretize<M: Model>(
             parts.len()
         )));
     }
-    if !constraints.vertex_conditions().is_empty() {
+    if !constraints.combinations().is_empty() {
         return Err(Error::Input(
             "conditions on combinations of vertex DOFs (a rotated basis) are not supported with a multiplier on a boundary part".into(),
         ));

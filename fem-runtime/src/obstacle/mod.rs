@@ -9,10 +9,10 @@ pub mod nodal;
 pub mod triangle;
 
 use crate::assembly::boundary::{Constraints, Reduction, Side};
+use crate::assembly::change_of_basis::{congruence, BlockRotation, ChangeOfBasis};
 use crate::assembly::dof_map::DofNumbering;
 use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::kernel::{self, Position};
-use crate::assembly::plate_basis::{congruence, BlockRotation, ChangeOfBasis, VERTEX_DOFS};
 use crate::assembly::{assemble_vector, block_plans, for_each_entry, BlockPlan};
 use crate::element::interval::PhysicalBasis;
 use crate::element::mapping::Affine;
@@ -211,15 +211,15 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 Role::Multiplier(k) => Target::Multiplier(k),
             };
         }
-        // A rotated vertex is assembled in its Cartesian DOFs, all six primal unknowns (its
-        // fixed primed DOFs as extra unknowns n..), then rotated (T A Tᵀ, B Tᵀ, T F) and
-        // its fixed primed DOFs eliminated.
+        // A rotated group is assembled in its Cartesian DOFs, all of them primal unknowns
+        // (its fixed primed DOFs as extra unknowns n..), then rotated (T A Tᵀ, B Tᵀ, T F)
+        // and its fixed primed DOFs eliminated.
         let mut extra_values = Vec::new();
         let mut rotated = Vec::with_capacity(basis.blocks().len());
         for block in basis.blocks() {
-            let mut indices = [0; VERTEX_DOFS];
-            for (k, index) in indices.iter_mut().enumerate() {
-                let d = block.start + k;
+            let mut indices = block.group;
+            for (k, index) in indices.dofs[..indices.len].iter_mut().enumerate() {
+                let d = block.group.dofs[k];
                 *index = match target[d] {
                     Target::Primal(p) => p,
                     Target::Fixed(v) => {
@@ -229,7 +229,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                     }
                     Target::Multiplier(_) => {
                         return Err(Error::Input(format!(
-                            "DOF {d} of the multiplier has a vertex condition: plate supports are for the plate field"
+                            "DOF {d} of the multiplier has a condition combining DOFs: supports are for the primal fields"
                         )))
                     }
                 };

@@ -913,9 +913,9 @@ pub fn dirichlet_constraints_per_field<M: Model>(
                 constraints.fix_dof(dof, value)?;
             }
         }
-        for &(start, row, value) in on_part.vertex_conditions() {
-            if range.contains(&start) {
-                constraints.fix_vertex_combination(start, row, value)?;
+        for &(group, row, value) in on_part.combinations() {
+            if range.contains(&group.dofs[0]) {
+                constraints.fix_combination(group.as_slice(), &row[..group.len], value)?;
             }
         }
     }

@@ -4,7 +4,9 @@
 //! method here, implemented once per kind of cell.
 
 use super::{Condition, Exact, Support};
-use crate::assembly::boundary::{Constraints, DirichletPart, PlateSupport, Side as End};
+use crate::assembly::boundary::{
+    ComponentDirection, Constraints, DirichletPart, PlateSupport, Side as End,
+};
 use crate::assembly::dof_map::{DofNumbering, SystemDofs};
 use crate::element::interval::PhysicalBasis;
 use crate::element::triangle::TriangleField;
@@ -270,6 +272,11 @@ impl Domain for IntervalMesh {
             let name = M::FIELDS[support.field].name;
             for end in ends(&support.part) {
                 match support.condition {
+                    Condition::Tangential | Condition::Along(_) => {
+                        return Err(Error::Input(format!(
+                            "`{name}`: a vector's component is held on triangle meshes; an interval's fields are scalars"
+                        )))
+                    }
                     Condition::Clamped => constraints.clamp::<M>(self, dofs, name, end)?,
                     Condition::Zero => constraints.dirichlet::<M>(self, dofs, name, end, 0.0)?,
                     Condition::Data => {
@@ -505,9 +512,9 @@ fn triangle_constraints<M: Model>(
                     constraints.fix_dof(dof, value)?;
                 }
             }
-            for &(start, row, value) in on_part.vertex_conditions() {
-                if range.contains(&start) {
-                    constraints.fix_vertex_combination(start, row, value)?;
+            for &(group, row, value) in on_part.combinations() {
+                if range.contains(&group.dofs[0]) {
+                    constraints.fix_combination(group.as_slice(), &row[..group.len], value)?;
                 }
             }
         }
@@ -515,6 +522,26 @@ fn triangle_constraints<M: Model>(
     for support in supports.iter().filter(|s| s.condition != Condition::Data) {
         let field = support.field;
         let name = M::FIELDS[field].name;
+        if let Condition::Tangential | Condition::Along(_) = support.condition {
+            let partner = name
+                .strip_suffix("_x")
+                .and_then(|stem| {
+                    M::FIELDS
+                        .iter()
+                        .position(|f| f.name.strip_suffix("_y") == Some(stem))
+                })
+                .ok_or_else(|| {
+                    Error::Input(format!(
+                        "`{name}` is not the x component of a vector field (`θ_x` beside `θ_y`)"
+                    ))
+                })?;
+            let direction = match support.condition {
+                Condition::Along(n) => ComponentDirection::Fixed(n),
+                _ => ComponentDirection::Tangent,
+            };
+            constraints.hold_component(mesh, dofs, [field, partner], &support.part, direction)?;
+            continue;
+        }
         let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
             return Err(Error::Input(format!(
                 "field `{name}` is not part of this system"

@@ -78,7 +78,7 @@ use std::marker::PhantomData;
 use std::time::Instant;
 
 /// What a support holds on its boundary part.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Condition {
     /// The model's boundary data: `field = g` for its `boundary: field = g` (for a plate
     /// field, Argyris or Morley, the simple support with g = 0).
@@ -89,6 +89,13 @@ pub enum Condition {
     /// `field = 0` and its normal derivative too where the element has one: clamped
     /// (Hermite ends, Argyris and Morley edges); `Zero` for Lagrange fields.
     Clamped,
+    /// The tangential component of the vector field whose x component is `field` (its
+    /// y component the field of the same name ending in `_y`): `θ·t = 0`, the hard
+    /// simple support's condition on the rotations.
+    Tangential,
+    /// The component of the vector field whose x component is `field` along the unit
+    /// vector `n`: `u·n = 0`, a roller.
+    Along([f64; 2]),
 }
 
 /// A support: `condition` on `field` along `part` of the boundary (intervals: marker 1

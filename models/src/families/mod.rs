@@ -1,0 +1,4 @@
+//! The model families of the registry ([`crate::family`]): each one's pairs, scenes and
+//! own quantities.
+
+pub mod beam;

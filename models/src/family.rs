@@ -1,0 +1,237 @@
+//! The registry: every model family, its element pairs, the options it accepts and its
+//! built-in scenes. A family is data plus its model files: a [`Family`] value, one
+//! [`Pair`] per model, and where it has any, its own quantities ([`crate::run::Quantities`]).
+//! The command line's `list`, `solve` and `study` go through [`families`] alone.
+
+use crate::run::{Outcome, Settings};
+use crate::scene::{Scene, Support};
+use fem_runtime::problem::MemoryModel;
+use fem_runtime::stabilization::Alpha;
+use fem_runtime::{Error, Result};
+
+/// An option of `solve` a family may accept. Each family lists those that mean something
+/// for it; any other given option is an error naming it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Opt {
+    /// `--elements N` (the beams' size).
+    Elements,
+    /// `--mesh-size N`.
+    MeshSize,
+    /// `--msh FILE`: the scene on a Gmsh mesh.
+    Msh,
+    /// `--vtk`: a `.vtu` of the fields.
+    Vtk,
+    /// `--load q`.
+    Load,
+    /// `--thickness t`.
+    Thickness,
+    /// `--alpha α`.
+    Alpha,
+    /// `--pair NAME`.
+    Pair,
+    /// `--solver pdas|clarabel`.
+    Solver,
+    /// `--cold`.
+    Cold,
+    /// `--linear-solver auto|direct|multigrid`.
+    LinearSolver,
+    /// `--refinement k`.
+    Refinement,
+    /// `--support NAME`.
+    Support,
+    /// `--obstacle NAME`.
+    Obstacle,
+    /// `--no-obstacle`.
+    NoObstacle,
+    /// `--plot`.
+    Plot,
+}
+
+impl Opt {
+    /// Every option.
+    pub const ALL: [Opt; 16] = [
+        Opt::Elements,
+        Opt::MeshSize,
+        Opt::Msh,
+        Opt::Vtk,
+        Opt::Load,
+        Opt::Thickness,
+        Opt::Alpha,
+        Opt::Pair,
+        Opt::Solver,
+        Opt::Cold,
+        Opt::LinearSolver,
+        Opt::Refinement,
+        Opt::Support,
+        Opt::Obstacle,
+        Opt::NoObstacle,
+        Opt::Plot,
+    ];
+
+    /// Its spelling on the command line.
+    pub fn flag(self) -> &'static str {
+        match self {
+            Opt::Elements => "--elements",
+            Opt::MeshSize => "--mesh-size",
+            Opt::Msh => "--msh",
+            Opt::Vtk => "--vtk",
+            Opt::Load => "--load",
+            Opt::Thickness => "--thickness",
+            Opt::Alpha => "--alpha",
+            Opt::Pair => "--pair",
+            Opt::Solver => "--solver",
+            Opt::Cold => "--cold",
+            Opt::LinearSolver => "--linear-solver",
+            Opt::Refinement => "--refinement",
+            Opt::Support => "--support",
+            Opt::Obstacle => "--obstacle",
+            Opt::NoObstacle => "--no-obstacle",
+            Opt::Plot => "--plot",
+        }
+    }
+}
+
+/// A pair's solve: [`crate::run::run`] for its model, mesh kind and family.
+pub type PairSolve = fn(&Pair, &Scene, &Settings) -> Result<Outcome>;
+
+/// One element pair of a family: a model file's model and how it is solved.
+pub struct Pair {
+    /// Its name on the command line (`p2-p0`).
+    pub name: &'static str,
+    /// One line for `list`.
+    pub note: &'static str,
+    /// The α rule where `--alpha` is not given.
+    pub alpha: Alpha,
+    /// α where the rule's `C_I` vanishes.
+    pub alpha_when_zero: f64,
+    /// The memory a solve needs (`None`: [`MemoryModel::of_model`]).
+    pub memory: Option<MemoryModel>,
+    /// The solve.
+    pub solve: PairSolve,
+}
+
+impl std::fmt::Debug for Pair {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pair").field("name", &self.name).finish()
+    }
+}
+
+/// A change `--support`, `--obstacle` or `--no-obstacle` asks of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Adjustment {
+    /// Every support of the scene replaced by this one.
+    Support(Support),
+    /// The obstacle replaced by one the family names.
+    Obstacle(String),
+    /// No obstacle: the unconstrained problem.
+    NoObstacle,
+}
+
+/// A model family: its pairs, options and scenes.
+pub trait Family: Sync {
+    /// Its name (`beam`, `membrane`, `plate`).
+    fn name(&self) -> &'static str;
+
+    /// One line for `list`.
+    fn description(&self) -> &'static str;
+
+    /// Its pairs; each scene takes those it names (all where it names none).
+    fn pairs(&self) -> &'static [Pair];
+
+    /// The options of `solve` that mean something for it.
+    fn options(&self) -> &'static [Opt];
+
+    /// Its built-in scenes.
+    fn scenes(&self) -> Vec<Scene>;
+
+    /// The names a scene file may use for the model's parameters and data, beside the
+    /// model's own (`thickness` for `t`): `(alias, model name)`.
+    fn aliases(&self) -> &'static [(&'static str, &'static str)] {
+        &[]
+    }
+
+    /// Applies `adjustment` to `scene`: by default a support replaces every support of
+    /// the scene and `--no-obstacle` removes the obstacle; other obstacles are the
+    /// family's to name.
+    ///
+    /// # Errors
+    /// An adjustment the family does not take, with the reason.
+    fn adjust(&self, scene: &mut Scene, adjustment: &Adjustment) -> Result<()> {
+        match adjustment {
+            Adjustment::Support(support) => {
+                for s in &mut scene.supports {
+                    s.support = *support;
+                }
+                Ok(())
+            }
+            Adjustment::NoObstacle => {
+                scene.obstacle = false;
+                Ok(())
+            }
+            Adjustment::Obstacle(name) => Err(Error::Input(format!(
+                "--obstacle {name} does not apply: the {} family names no obstacles",
+                self.name()
+            ))),
+        }
+    }
+}
+
+/// Every family, in the order `list` prints them.
+pub fn families() -> &'static [&'static dyn Family] {
+    &FAMILIES
+}
+
+static FAMILIES: [&dyn Family; 1] = [&crate::families::beam::BEAMS];
+
+/// The family called `name`.
+pub fn family(name: &str) -> Option<&'static dyn Family> {
+    families().iter().copied().find(|f| f.name() == name)
+}
+
+/// Every built-in scene, family by family.
+pub fn scenes() -> Vec<Scene> {
+    families().iter().flat_map(|f| f.scenes()).collect()
+}
+
+/// The built-in scene called `name`.
+pub fn scene(name: &str) -> Option<Scene> {
+    scenes().into_iter().find(|s| s.name == name)
+}
+
+/// The pairs `scene` takes, its default first: those it names, else its family's.
+pub fn pairs_of(scene: &Scene) -> Vec<&'static Pair> {
+    let Some(family) = family(scene.family) else {
+        return Vec::new();
+    };
+    if scene.pairs.is_empty() {
+        family.pairs().iter().collect()
+    } else {
+        scene
+            .pairs
+            .iter()
+            .filter_map(|name| family.pairs().iter().find(|p| p.name == *name))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_names_are_unique_and_their_pairs_exist() {
+        let scenes = scenes();
+        for (k, s) in scenes.iter().enumerate() {
+            assert!(
+                !scenes[..k].iter().any(|t| t.name == s.name),
+                "{} twice",
+                s.name
+            );
+            assert_eq!(scene(&s.name).unwrap().name, s.name);
+            assert!(family(s.family).is_some(), "{}", s.family);
+            assert_eq!(pairs_of(s).len(), s.pairs.len().max(pairs_of(s).len()));
+            assert!(!pairs_of(s).is_empty(), "{}", s.name);
+        }
+        assert!(scene("no-such-scene").is_none());
+    }
+}

@@ -1,0 +1,784 @@
+//! Solving a scene: one path for every family and pair. A [`Scene`] is bound to the
+//! model of the chosen pair (its parameters and data by the model's declared names,
+//! its supports by the fields' roles), meshed for the asked size, solved through the
+//! runtime's one pipeline ([`fem_runtime::problem::Problem`]) and reported once
+//! ([`Report`]); a family adds its own quantities through [`Quantities`].
+
+use crate::data::Data;
+use crate::family::{self, Pair};
+use crate::geometry::{Fields, Geometry};
+use crate::scene::{ExactSolution, Name, Part, Posed, Scene, Support};
+use fem_runtime::lcp::NewtonOptions;
+use fem_runtime::obstacle::hierarchy::LinearSolver;
+use fem_runtime::obstacle::{FirstStart, ObstacleOptions, VariationalSolver};
+use fem_runtime::problem::memory::check_memory;
+use fem_runtime::problem::{
+    self, Condition, Exact, GradientFn, MemoryModel, Problem, SolveOptions, Solved,
+};
+use fem_runtime::stabilization::Alpha;
+use fem_runtime::{
+    CurvedTriangleMesh, DataFn, DataId, Diagonal, DirichletPart, Error, FieldId, Model, ParamId,
+    Result, TriangleMesh,
+};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// What a request may change of a scene's solve (the command line's options).
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// The pair by name (`None`: the scene's default).
+    pub pair: Option<String>,
+    /// N (`None`: the scene's).
+    pub mesh_size: Option<usize>,
+    /// The load magnitude q (`None`: the scene's; refused where its load is fixed).
+    pub load: Option<f64>,
+    /// α (`None`: the pair's rule).
+    pub alpha: Option<f64>,
+    /// Parameters replacing the scene's, by the model's names (`--thickness` sets `t`).
+    pub parameters: Vec<(Name, f64)>,
+    /// The complementarity solver.
+    pub solver: VariationalSolver,
+    /// The solver of the Newton steps.
+    pub linear_solver: LinearSolver,
+    /// Nested iteration over coarser meshes (`false`: a cold start on the finest).
+    pub nested: bool,
+    /// Rounds of iterative refinement per linear solve (`None`: the family's).
+    pub refinement: Option<usize>,
+    /// How the squares of a structured mesh are split (`None`: the scene's).
+    pub diagonal: Option<Diagonal>,
+    /// Run the rounding experiment (`None`: where the family does).
+    pub rounding_experiment: Option<bool>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            pair: None,
+            mesh_size: None,
+            load: None,
+            alpha: None,
+            parameters: Vec::new(),
+            solver: VariationalSolver::SemismoothNewton,
+            linear_solver: LinearSolver::Auto,
+            nested: true,
+            refinement: None,
+            diagonal: None,
+            rounding_experiment: None,
+        }
+    }
+}
+
+/// Most rounds of iterative refinement per linear solve accepted.
+pub const MAX_REFINEMENT_STEPS: usize = 10;
+
+/// Wall time of the parts of a solve, in seconds.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Phases {
+    /// Building the meshes.
+    pub meshes: f64,
+    /// Binding the scene to the model and checking it.
+    pub checks: f64,
+    /// The runtime's solve (assembly and every level).
+    pub solve: f64,
+    /// The family's quantities and the output fields.
+    pub evaluation: f64,
+}
+
+/// What a solve reports (the CLI's `--json` object): what every solve has, from the
+/// runtime's report, and the family's own quantities beside it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Scene name.
+    pub scene: String,
+    /// Family name.
+    pub family: &'static str,
+    /// Pair name.
+    pub pair: &'static str,
+    /// The domain solved on.
+    pub domain: String,
+    /// N as solved (the beams' elements; a file's refinements).
+    pub mesh_size: usize,
+    /// The load magnitude q (`null` where the scene's load is fixed).
+    pub load: Option<f64>,
+    /// Every parameter of the scene by the model's name, as solved.
+    pub parameters: BTreeMap<String, f64>,
+    /// Each support as `name on parts`.
+    pub supports: Vec<String>,
+    /// The runtime's report.
+    #[serde(flatten)]
+    pub solve: fem_runtime::problem::Report,
+    /// `∫ λ` of the exact solution over the scene's own domain, where known.
+    pub exact_contact_force: Option<f64>,
+    /// The exact contact set's area over the scene's own domain, where known.
+    pub exact_contact_area: Option<f64>,
+    /// The L² error the scene asks for.
+    pub accuracy: Option<f64>,
+    /// Where the time went.
+    pub phases: Phases,
+    /// The family's own quantities (a plate's centre deflection, Hertz's half-width).
+    #[serde(flatten)]
+    pub quantities: BTreeMap<String, serde_json::Value>,
+}
+
+impl Report {
+    /// Sets the family quantity `key`.
+    pub fn set(&mut self, key: &str, value: impl Serialize) {
+        let value = serde_json::to_value(value).unwrap_or(serde_json::Value::Null);
+        self.quantities.insert(key.to_string(), value);
+    }
+
+    /// A family quantity as a number (`None` where absent or not a number).
+    pub fn number(&self, key: &str) -> Option<f64> {
+        self.quantities.get(key).and_then(serde_json::Value::as_f64)
+    }
+
+    /// Adds a warning.
+    pub fn warn(&mut self, warning: impl Into<String>) {
+        self.solve.warnings.push(warning.into());
+    }
+}
+
+/// A solved scene: its report and its fields for output.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The report.
+    pub report: Report,
+    /// The fields, sampled for charts and ParaView.
+    pub fields: Fields,
+}
+
+/// What a family adds to the one solve: its own quantities, and where it must, its own
+/// settings of the solve. Every method has a default, so a family with nothing of its
+/// own implements nothing.
+pub trait Quantities<G: Geometry>: 'static {
+    /// The coarsest N of nested iteration.
+    const COARSEST: usize = 4;
+
+    /// Whether the rounding experiment runs by default.
+    const ROUNDING_EXPERIMENT: bool = false;
+
+    /// The complementarity solver's options.
+    fn obstacle_options(settings: &Settings) -> ObstacleOptions {
+        let defaults = ObstacleOptions::default();
+        ObstacleOptions {
+            solver: settings.solver,
+            linear_solver: settings.linear_solver,
+            newton: NewtonOptions {
+                refinement_steps: settings
+                    .refinement
+                    .unwrap_or(defaults.newton.refinement_steps),
+                ..defaults.newton
+            },
+            ..defaults
+        }
+    }
+
+    /// Checks what the model cannot: the ranges of the family's parameters.
+    ///
+    /// # Errors
+    /// A parameter out of its range, with the reason.
+    fn check(scene: &Scene, posed: &Posed) -> Result<()> {
+        let _ = (scene, posed);
+        Ok(())
+    }
+
+    /// The start of the coarsest level, where the family has one (a body pressed onto
+    /// its foundation); `None`: from zero.
+    fn start(scene: &Scene, posed: &Posed) -> Option<Box<FirstStart<'static, G>>> {
+        let _ = (scene, posed);
+        None
+    }
+
+    /// Adds the family's quantities and warnings to `report`.
+    ///
+    /// # Errors
+    /// A quantity that cannot be evaluated.
+    fn add<M: Model>(solved: &Run<'_, M, G>, report: &mut Report) -> Result<()> {
+        let _ = (solved, report);
+        Ok(())
+    }
+
+    /// A solver's failure, explained where the family knows a likely cause (`alpha`:
+    /// the α asked for, `cells`: of the finest mesh).
+    fn explain(
+        error: Error,
+        pair: &Pair,
+        posed: &Posed,
+        alpha: Option<f64>,
+        cells: usize,
+    ) -> Error {
+        let _ = (pair, posed, alpha, cells);
+        error
+    }
+}
+
+/// A finished solve, as a family's [`Quantities::add`] reads it.
+pub struct Run<'r, M: Model, G: Geometry> {
+    /// The scene solved.
+    pub scene: &'r Scene,
+    /// The values it was solved at.
+    pub posed: &'r Posed,
+    /// The request.
+    pub settings: &'r Settings,
+    /// The pair.
+    pub pair: &'r Pair,
+    /// The runtime's solution and report.
+    pub solved: &'r Solved<M, G>,
+    /// The obstacle as solved.
+    pub psi: &'r DataFn,
+}
+
+impl<M: Model, G: Geometry> Run<'_, M, G> {
+    /// The constrained field (the model's `obstacle:` role; the first field otherwise).
+    pub fn constrained_field(&self) -> usize {
+        constrained_field::<M>()
+    }
+
+    /// The value of the constrained field at `x`, where `x` lies in the mesh.
+    pub fn value_at(&self, x: &[f64]) -> Option<f64> {
+        G::value_at(&self.solved.solution, self.constrained_field(), x)
+    }
+}
+
+/// The constrained field of model `M`: its `obstacle:` role, else its first field.
+pub fn constrained_field<M: Model>() -> usize {
+    M::OBSTACLE.map_or(0, |[field, _]| field)
+}
+
+/// Solves `scene` with the pair `settings` name (its default otherwise).
+///
+/// # Errors
+/// A pair the scene's family does not have or the scene does not take, and the solve's.
+pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
+    let pair = pair_of(scene, settings.pair.as_deref())?;
+    (pair.solve)(pair, scene, settings)
+}
+
+/// The pair called `name` (`None`: the scene's default) of the scene's family.
+///
+/// # Errors
+/// An unknown family, and a pair the scene does not take (the message lists those it
+/// takes).
+pub fn pair_of(scene: &Scene, name: Option<&str>) -> Result<&'static Pair> {
+    let family = family::family(scene.family).ok_or_else(|| {
+        Error::Input(format!(
+            "scene `{}` is of the unknown family `{}`",
+            scene.name, scene.family
+        ))
+    })?;
+    let offered = family::pairs_of(scene);
+    let name = match name {
+        Some(name) => name,
+        None => offered
+            .first()
+            .map(|p| p.name)
+            .ok_or_else(|| Error::Input(format!("scene `{}` takes no pair", scene.name)))?,
+    };
+    if let Some(pair) = offered.iter().find(|p| p.name == name) {
+        return Ok(pair);
+    }
+    let names: Vec<&str> = offered.iter().map(|p| p.name).collect();
+    let other = family.pairs().iter().any(|p| p.name == name);
+    Err(Error::Input(if other {
+        format!(
+            "pair `{name}` does not discretize scene `{}`; it takes {}",
+            scene.name,
+            names.join(", ")
+        )
+    } else {
+        format!(
+            "unknown pair `{name}`; scene `{}` takes {}",
+            scene.name,
+            names.join(", ")
+        )
+    }))
+}
+
+/// [`run`] on straight triangles, or on curved ones where the scene's disk is curved.
+///
+/// # Errors
+/// Those of [`run`].
+pub fn run_on_triangles<M, Q>(pair: &Pair, scene: &Scene, settings: &Settings) -> Result<Outcome>
+where
+    M: Model,
+    Q: Quantities<TriangleMesh> + Quantities<CurvedTriangleMesh>,
+{
+    match scene.domain {
+        crate::scene::Domain::Disk { curved: true, .. } => {
+            run::<M, CurvedTriangleMesh, Q>(pair, scene, settings)
+        }
+        _ => run::<M, TriangleMesh, Q>(pair, scene, settings),
+    }
+}
+
+/// Solves `scene` with model `M` (the pair `pair`) on meshes of kind `G`, the family's
+/// quantities from `Q`.
+///
+/// # Errors
+/// Invalid settings, a parameter, data function or boundary part the model or mesh does
+/// not have, the memory estimate beyond what the machine allows, and the runtime's
+/// refusals and failures.
+pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
+    pair: &Pair,
+    scene: &Scene,
+    settings: &Settings,
+) -> Result<Outcome> {
+    let clock = Instant::now();
+    let posed = pose(scene, settings)?;
+    Q::check(scene, &posed)?;
+    let n = settings.mesh_size.unwrap_or(scene.mesh_size);
+    let memory = pair.memory.unwrap_or_else(MemoryModel::of_model::<M>);
+    let size_text = size_text(scene, pair, n);
+    if let Some(cells) = G::cells_of(&scene.domain, n) {
+        check_memory(memory.bytes(cells as usize), &size_text)?;
+    }
+    let nested = settings.nested && settings.solver == VariationalSolver::SemismoothNewton;
+    let mut domain = scene.domain.clone();
+    if let (Some(diagonal), crate::scene::Domain::Rectangle { diagonal: d, .. }) =
+        (settings.diagonal, &mut domain)
+    {
+        *d = diagonal;
+    }
+    let meshes = G::levels(&domain, n, nested, Q::COARSEST)?;
+    let finest = meshes.last().expect("at least one level").clone();
+    let meshes_seconds = clock.elapsed().as_secs_f64();
+
+    let bound = bind::<M>(scene, &posed)?;
+    let supports = supports::<M, G>(scene, &finest)?;
+    let exact = scene.exact_at(&posed);
+    let exact_fns = exact.as_ref().map(ExactFns::new);
+    if let Some(e) = &exact {
+        validate_exact(e, &finest, scene)?;
+    }
+    let start = Q::start(scene, &posed);
+    let psi_index = M::OBSTACLE.map(|[_, d]| d);
+    let psi: &DataFn = psi_index
+        .and_then(|d| bound.data.iter().find(|(k, _)| *k == d))
+        .map_or(&zero, |(_, f)| &**f);
+    let checks_seconds = clock.elapsed().as_secs_f64() - meshes_seconds;
+
+    let alpha = settings.alpha.map_or(pair.alpha, Alpha::Fixed);
+    let mut problem = Problem::<M, G>::new(meshes)
+        .side(scene.side)
+        .alpha(alpha, pair.alpha_when_zero)
+        .options(SolveOptions {
+            obstacle: Q::obstacle_options(settings),
+            nested,
+            rounding_experiment: settings
+                .rounding_experiment
+                .unwrap_or(Q::ROUNDING_EXPERIMENT),
+        })
+        .memory(memory, size_text);
+    for &(p, value) in &bound.params {
+        problem = problem.param(ParamId::<M>::new(p), value);
+    }
+    let nodal = M::SYSTEM.is_none();
+    for (d, f) in &bound.data {
+        if nodal && Some(*d) == psi_index {
+            problem = problem.nodal(&**f);
+        } else {
+            problem = problem.data(DataId::<M>::new(*d), &**f);
+        }
+    }
+    for (part, field, condition) in supports.conditions {
+        problem = problem.support(part, FieldId::<M>::new(field), condition);
+    }
+    for part in supports.data {
+        problem = problem.boundary_data(part);
+    }
+    for (name, part) in &scene.facets {
+        let markers = match finest.part(part)? {
+            DirichletPart::Markers(m) => m,
+            DirichletPart::All => Vec::new(),
+        };
+        problem = problem.part(&**name, markers);
+    }
+    if let Some(start) = &start {
+        problem = problem.start(&**start);
+    }
+    if let Some(fns) = &exact_fns {
+        problem = problem.exact(fns.exact());
+    }
+    let cells = finest.cell_count();
+    let solved = problem.solve().map_err(|e| {
+        Q::explain(
+            scene_field_of(e, scene),
+            pair,
+            &posed,
+            settings.alpha,
+            cells,
+        )
+    })?;
+    let solve_seconds = clock.elapsed().as_secs_f64() - meshes_seconds - checks_seconds;
+
+    let mut report = Report {
+        scene: scene.name.to_string(),
+        family: scene.family,
+        pair: pair.name,
+        domain: domain.describe(),
+        mesh_size: n,
+        load: posed.load,
+        parameters: posed
+            .parameters
+            .iter()
+            .map(|(k, v)| (k.to_string(), *v))
+            .collect(),
+        supports: scene
+            .supports
+            .iter()
+            .map(|s| format!("{} on {}", s.support.name(), s.part.names().join(", ")))
+            .collect(),
+        solve: solved.report.clone(),
+        exact_contact_force: exact.as_ref().and_then(|e| e.total_contact_force),
+        exact_contact_area: exact.as_ref().and_then(|e| e.contact_area),
+        accuracy: scene.accuracy,
+        phases: Phases::default(),
+        quantities: BTreeMap::new(),
+    };
+    report.solve.warnings.extend(supports.warnings);
+    common_warnings(scene, &posed, &mut report);
+    let run = Run {
+        scene,
+        posed: &posed,
+        settings,
+        pair,
+        solved: &solved,
+        psi,
+    };
+    Q::add(&run, &mut report)?;
+    let fields = G::fields::<M>(&solved.solution, psi);
+    report.phases = Phases {
+        meshes: meshes_seconds,
+        checks: checks_seconds,
+        solve: report.solve.seconds,
+        evaluation: (clock.elapsed().as_secs_f64()
+            - meshes_seconds
+            - checks_seconds
+            - solve_seconds)
+            .max(0.0)
+            + (solve_seconds - report.solve.seconds).max(0.0),
+    };
+    Ok(Outcome { report, fields })
+}
+
+fn zero(_: &[f64]) -> f64 {
+    0.0
+}
+
+/// The values a request solves the scene at: its load and every parameter (the scene's,
+/// replaced by the request's).
+///
+/// # Errors
+/// A load the scene refuses (see [`Scene::load_magnitude`]), a refinement count out of
+/// range, and a parameter that is not finite.
+pub fn pose(scene: &Scene, settings: &Settings) -> Result<Posed> {
+    let load = scene.load_magnitude(settings.load).map_err(Error::Input)?;
+    if let Some(r) = settings.refinement {
+        if r > MAX_REFINEMENT_STEPS {
+            return Err(Error::Input(format!(
+                "--refinement {r} is out of range (0 to {MAX_REFINEMENT_STEPS}): each round is one more solve, and 2 or 3 already reach rounding"
+            )));
+        }
+    }
+    let mut parameters = scene.parameters.clone();
+    for (name, value) in &settings.parameters {
+        match parameters.iter_mut().find(|(n, _)| n == name) {
+            Some(entry) => entry.1 = *value,
+            None => parameters.push((name.clone(), *value)),
+        }
+    }
+    for (name, value) in &parameters {
+        if !value.is_finite() {
+            return Err(Error::Input(format!(
+                "scene `{}`: parameter `{name}` = {value} is not finite",
+                scene.name
+            )));
+        }
+    }
+    Ok(Posed { load, parameters })
+}
+
+/// What sets the size, for the memory refusal's message.
+fn size_text(scene: &Scene, pair: &Pair, n: usize) -> String {
+    let option = if matches!(scene.domain, crate::scene::Domain::Interval { .. }) {
+        "--elements"
+    } else {
+        "--mesh-size"
+    };
+    format!("{option} {n} with {}", pair.name)
+}
+
+/// A scene bound to model `M`: parameter and data indices with their values.
+struct Bound {
+    params: Vec<(usize, f64)>,
+    data: Vec<(usize, Box<DataFn>)>,
+}
+
+/// Binds the scene's parameters and data to model `M` by name; the data `--load` scales
+/// are multiplied by q. The one place a scene's names meet the model's.
+fn bind<M: Model>(scene: &Scene, posed: &Posed) -> Result<Bound> {
+    let unknown = |kind: &str, name: &str, names: Vec<&str>| {
+        Error::Input(format!(
+            "scene `{}`: {kind} `{name}` is not one of model `{}`'s ({})",
+            scene.name,
+            M::NAME,
+            names.join(", ")
+        ))
+    };
+    let mut params = Vec::new();
+    for (name, value) in &posed.parameters {
+        let p = M::PARAMS
+            .iter()
+            .position(|p| *p == &**name)
+            .ok_or_else(|| unknown("parameter", name, M::PARAMS.to_vec()))?;
+        params.push((p, *value));
+    }
+    let mut data: Vec<(usize, Box<DataFn>)> = Vec::new();
+    for (name, f) in &scene.data {
+        let d = M::DATA
+            .iter()
+            .position(|d| *d == &**name)
+            .ok_or_else(|| unknown("data function", name, M::DATA.to_vec()))?;
+        let scaled = scene
+            .load
+            .as_ref()
+            .is_some_and(|l| l.scales.iter().any(|s| s == name));
+        let f = f.clone();
+        let function: Box<DataFn> = match (scaled, posed.load) {
+            (true, Some(q)) => Box::new(move |x: &[f64]| q * f.at(x)),
+            _ => Box::new(move |x: &[f64]| f.at(x)),
+        };
+        data.push((d, function));
+    }
+    // a model's data the scene leaves out is 0 (a boundary value g on a clamped plate)
+    for d in 0..M::DATA.len() {
+        if !data.iter().any(|(k, _)| *k == d) {
+            data.push((d, Box::new(zero)));
+        }
+    }
+    Ok(Bound { params, data })
+}
+
+/// The runtime's supports of a scene on one mesh.
+struct Supports {
+    conditions: Vec<(DirichletPart, usize, Condition)>,
+    data: Vec<DirichletPart>,
+    warnings: Vec<String>,
+}
+
+/// The scene's supports as conditions on model `M`'s fields, by their roles (see
+/// [`Support`]).
+fn supports<M: Model, G: Geometry>(scene: &Scene, mesh: &G) -> Result<Supports> {
+    let mut out = Supports {
+        conditions: Vec::new(),
+        data: Vec::new(),
+        warnings: Vec::new(),
+    };
+    let multiplier = (0..M::FIELDS.len()).find(|&f| M::FIELDS[f].nonnegative);
+    let primal: Vec<usize> = (0..M::FIELDS.len())
+        .filter(|&f| Some(f) != multiplier)
+        .collect();
+    let at = |message: String, part: &Part| {
+        Error::Input(format!(
+            "scene `{}`: support on {}: {message}",
+            scene.name,
+            part.names().join(", ")
+        ))
+    };
+    for s in &scene.supports {
+        let part = mesh.part(&s.part).map_err(|e| match e {
+            Error::Input(m) => at(m, &s.part),
+            other => other,
+        })?;
+        if let Part::Named(names) = &s.part {
+            out.warnings.extend(mesh.interior_part_warnings(names));
+        }
+        match s.support {
+            Support::Free => {}
+            Support::Data => out.data.push(part),
+            Support::Clamped => {
+                for &f in &primal {
+                    out.conditions.push((part.clone(), f, Condition::Clamped));
+                }
+            }
+            Support::SimplySupported { hard } => {
+                let [w, _] = M::OBSTACLE.ok_or_else(|| {
+                    at(
+                        format!(
+                            "a simple support holds the constrained field, and model `{}` declares none (its `obstacle:` role)",
+                            M::NAME
+                        ),
+                        &s.part,
+                    )
+                })?;
+                out.conditions.push((part.clone(), w, Condition::Zero));
+                if hard {
+                    for [x, _] in vector_fields::<M>(&primal) {
+                        out.conditions
+                            .push((part.clone(), x, Condition::Tangential));
+                    }
+                }
+            }
+            Support::Roller { normal } => {
+                let vectors = vector_fields::<M>(&primal);
+                let [[x, y]] = vectors.as_slice() else {
+                    return Err(at(
+                        format!(
+                            "a roller holds a displacement, and model `{}` has {} vector fields",
+                            M::NAME,
+                            vectors.len()
+                        ),
+                        &s.part,
+                    ));
+                };
+                let length = normal[0].hypot(normal[1]);
+                if !(length.is_finite() && length > 0.0) {
+                    return Err(at(
+                        format!("the roller's direction {normal:?} is not a direction"),
+                        &s.part,
+                    ));
+                }
+                let n = [normal[0] / length, normal[1] / length];
+                let condition = if n[1] == 0.0 {
+                    (*x, Condition::Zero)
+                } else if n[0] == 0.0 {
+                    (*y, Condition::Zero)
+                } else {
+                    (*x, Condition::Along(n))
+                };
+                out.conditions.push((part, condition.0, condition.1));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The vector fields among `primal`: pairs of component fields `stem_x`, `stem_y`.
+fn vector_fields<M: Model>(primal: &[usize]) -> Vec<[usize; 2]> {
+    primal
+        .iter()
+        .filter_map(|&f| {
+            let stem = M::FIELDS[f].name.strip_suffix("_x")?;
+            let y = primal
+                .iter()
+                .copied()
+                .find(|&g| M::FIELDS[g].name.strip_suffix("_y") == Some(stem))?;
+            Some([f, y])
+        })
+        .collect()
+}
+
+/// The exact solution's functions in the runtime's types.
+struct ExactFns {
+    value: Option<Data>,
+    gradient: Option<Data<[f64; 2]>>,
+    multiplier: Option<Data>,
+}
+
+impl ExactFns {
+    fn new(e: &ExactSolution) -> Self {
+        Self {
+            value: e.value.clone(),
+            gradient: e.gradient.clone(),
+            multiplier: e.multiplier.clone(),
+        }
+    }
+
+    fn exact(&self) -> Exact<'_> {
+        Exact {
+            value: self.value.as_ref().map_or(&nan, Data::as_data_fn),
+            gradient: self.gradient.as_ref().map(|g| g.as_fn() as &GradientFn),
+            multiplier: self.multiplier.as_ref().map(Data::as_data_fn),
+        }
+    }
+}
+
+fn nan(_: &[f64]) -> f64 {
+    f64::NAN
+}
+
+/// Refuses an exact solution no obstacle problem can have on `mesh`: a multiplier below
+/// 0 at a vertex, or a contact area beyond the domain's.
+fn validate_exact<G: Geometry>(exact: &ExactSolution, mesh: &G, scene: &Scene) -> Result<()> {
+    if let Some(lambda) = &exact.multiplier {
+        let points = mesh.vertex_points();
+        let values: Vec<f64> = points.iter().map(|x| lambda.at(x)).collect();
+        // not-a-number values are left to the report, which says the error cannot be
+        // measured
+        let largest = values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        if let Some((x, v)) = points
+            .iter()
+            .zip(&values)
+            .find(|(_, &v)| v < -1e-12 * largest)
+        {
+            let at: Vec<String> = x.iter().map(|c| c.to_string()).collect();
+            return Err(Error::Input(format!(
+                "scene `{}`: field `exact.lambda`: λ = {} at ({}); the multiplier of the constraint is a pressure, ≥ 0",
+                scene.name,
+                problem::number(*v),
+                at.join(", ")
+            )));
+        }
+    }
+    if let Some(area) = exact.contact_area {
+        let domain = mesh.total_measure();
+        if area > domain * (1.0 + 1e-9) {
+            return Err(Error::Input(format!(
+                "scene `{}`: field `exact.contact_area`: {} exceeds the domain's area {domain}",
+                scene.name,
+                problem::number(area)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The warnings every scene may earn: an exact solution that does not hold at the load
+/// asked, and an accuracy the solve does not reach or cannot check.
+fn common_warnings(scene: &Scene, posed: &Posed, report: &mut Report) {
+    if scene.exact_dropped_at(posed) {
+        let own = scene.load.as_ref().map(|l| l.default);
+        report.warn(format!(
+            "the scene's exact solution holds at its own load q = {}; under --load {} it is not compared (the contact set is not linear in the load)",
+            own.map_or("?".into(), problem::number),
+            posed.load.map_or("?".into(), problem::number)
+        ));
+    }
+    if let Some(accuracy) = scene.accuracy {
+        match report.solve.error_l2 {
+            Some(e) if e > accuracy => report.warn(format!(
+                "the L² error {e:.3e} exceeds the accuracy the scene asks for, {accuracy:e}: refine (--mesh-size) or take a pair of higher order"
+            )),
+            Some(_) => {}
+            None => report.warn(format!(
+                "the accuracy {accuracy:e} the scene asks for is not checked: there is no exact solution to measure the error against here"
+            )),
+        }
+    }
+}
+
+/// A runtime error about a data function, with the scene named: "data `ψ` of
+/// `membrane_p2_p0` is inf at (1, 0)" becomes "scene `radial`: field `data.psi`: data
+/// `ψ` …" (the scene file's key of the function).
+fn scene_field_of(error: Error, scene: &Scene) -> Error {
+    let Error::Input(message) = error else {
+        return error;
+    };
+    let key = scene
+        .data
+        .iter()
+        .map(|(name, _)| name)
+        .find(|name| message.starts_with(&format!("data `{name}` of ")))
+        .map(|name| crate::scene_file::data_key(name));
+    match key {
+        Some(key) => Error::Input(format!(
+            "scene `{}`: field `data.{key}`: {message}",
+            scene.name
+        )),
+        None => Error::Input(message),
+    }
+}

@@ -1,0 +1,308 @@
+//! `fem-forms solve`: a scene (built-in or from a file) with the command line's options,
+//! through the registry's one path ([`fem_forms::models::run::solve`]), printed as a
+//! summary or as JSON, with its chart or ParaView file where asked.
+
+use crate::{SolveOptions, SolverName};
+use fem_forms::models::family::{self, Adjustment, Opt};
+use fem_forms::models::geometry::Fields;
+use fem_forms::models::run::{self, Outcome, Report, Settings};
+use fem_forms::models::scene::{Scene, Support};
+use fem_forms::obstacle::hierarchy::LinearSolver;
+use fem_forms::obstacle::VariationalSolver;
+use fem_forms::plot;
+use std::path::Path;
+
+impl SolveOptions {
+    /// The given options (flag spellings).
+    pub fn given_options(&self) -> Vec<Opt> {
+        let flags = [
+            (self.elements.is_some(), Opt::Elements),
+            (self.mesh_size.is_some(), Opt::MeshSize),
+            (self.vtk, Opt::Vtk),
+            (self.msh.is_some(), Opt::Msh),
+            (self.load.is_some(), Opt::Load),
+            (self.thickness.is_some(), Opt::Thickness),
+            (self.alpha.is_some(), Opt::Alpha),
+            (self.pair.is_some(), Opt::Pair),
+            (self.solver.is_some(), Opt::Solver),
+            (self.cold, Opt::Cold),
+            (self.linear_solver.is_some(), Opt::LinearSolver),
+            (self.refinement.is_some(), Opt::Refinement),
+            (self.plot, Opt::Plot),
+            (self.support.is_some(), Opt::Support),
+            (self.obstacle.is_some(), Opt::Obstacle),
+            (self.no_obstacle, Opt::NoObstacle),
+        ];
+        flags
+            .into_iter()
+            .filter(|(given, _)| *given)
+            .map(|(_, o)| o)
+            .collect()
+    }
+
+    /// An error naming the first given option of `not_applicable`, with `why`.
+    fn refuse_options(&self, not_applicable: &[Opt], why: &str) -> Result<(), String> {
+        match self
+            .given_options()
+            .into_iter()
+            .find(|o| not_applicable.contains(o))
+        {
+            Some(option) => Err(format!("{} does not apply: {why}", option.flag())),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The options a scene takes: its family's, less those the scene itself has no use for.
+fn accepted(scene: &Scene, options: &[Opt]) -> Vec<Opt> {
+    options
+        .iter()
+        .copied()
+        .filter(|o| match o {
+            Opt::Load => scene.load.is_some(),
+            Opt::Thickness => scene.parameter("t").is_some(),
+            Opt::NoObstacle => scene.obstacle,
+            Opt::Alpha | Opt::Cold => scene.obstacle,
+            _ => true,
+        })
+        .collect()
+}
+
+/// The settings of a solve from the command line's options.
+fn settings(options: &SolveOptions) -> Result<Settings, String> {
+    let linear_solver = options
+        .linear_solver
+        .as_deref()
+        .map_or(Ok(LinearSolver::Auto), LinearSolver::parse)
+        .map_err(|e| format!("--linear-solver: {e}"))?;
+    let mut parameters = Vec::new();
+    if let Some(t) = options.thickness {
+        parameters.push(("t".into(), t));
+    }
+    Ok(Settings {
+        pair: options.pair.clone(),
+        mesh_size: options.elements.or(options.mesh_size),
+        load: options.load,
+        alpha: options.alpha,
+        parameters,
+        solver: match options.solver.unwrap_or(SolverName::Pdas) {
+            SolverName::Pdas => VariationalSolver::SemismoothNewton,
+            SolverName::Clarabel => VariationalSolver::Clarabel,
+        },
+        linear_solver,
+        nested: !options.cold,
+        refinement: options.refinement,
+        ..Settings::default()
+    })
+}
+
+/// Solves `scene` as `options` ask and prints the result.
+pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {
+    let family = family::family(scene.family)
+        .ok_or_else(|| format!("scene `{}` names no known family", scene.name))?;
+    let accepted_options = accepted(&scene, family.options());
+    let not_accepted: Vec<Opt> = Opt::ALL
+        .into_iter()
+        .filter(|o| !accepted_options.contains(o))
+        .collect();
+    let list: Vec<&str> = accepted_options
+        .iter()
+        .map(|o| o.flag())
+        .chain(["--json"])
+        .collect();
+    options.refuse_options(
+        &not_accepted,
+        &format!(
+            "`{}` is a {} scene on the {} ({})",
+            scene.name,
+            family.name(),
+            scene.domain.describe(),
+            list.join(", ")
+        ),
+    )?;
+    if options.cold && options.solver == Some(SolverName::Clarabel) {
+        // every family hands clarabel the finest level alone: there is no nested start
+        // to turn off, and an accepted flag that changes nothing misleads
+        return Err(
+            "--cold does not apply with --solver clarabel: the QP solver solves the finest mesh alone, with no nested start to turn off".into(),
+        );
+    }
+    if options.alpha == Some(0.0) {
+        options.refuse_options(
+            &[Opt::Cold],
+            "α = 0 (the plain mixed method) is solved by clarabel on the finest mesh alone, with no nested start to turn off",
+        )?;
+        if options.solver == Some(SolverName::Pdas) {
+            return Err("--solver pdas does not apply with α = 0: the plain mixed method has C = 0, which leaves semismooth Newton nothing to eliminate the multiplier with; it is solved by clarabel".into());
+        }
+    }
+    if let Some(name) = &options.support {
+        let support = Support::parse(name).ok_or_else(|| {
+            format!(
+                "--support {name}: unknown support; the supports are {}",
+                Support::NAMES.join(", ")
+            )
+        })?;
+        family
+            .adjust(&mut scene, &Adjustment::Support(support))
+            .map_err(|e| e.to_string())?;
+    }
+    if let Some(name) = &options.obstacle {
+        family
+            .adjust(&mut scene, &Adjustment::Obstacle(name.clone()))
+            .map_err(|e| e.to_string())?;
+    }
+    if options.no_obstacle {
+        family
+            .adjust(&mut scene, &Adjustment::NoObstacle)
+            .map_err(|e| e.to_string())?;
+        options.refuse_options(
+            &[Opt::Alpha, Opt::Cold],
+            &format!(
+                "`{}` is solved without an obstacle (one linear solve); α and the nested start concern contact",
+                scene.name
+            ),
+        )?;
+    }
+    let mut settings = settings(options)?;
+    if let Some(path) = &options.msh {
+        scene = scene.on_mesh_file(path.clone());
+        settings.mesh_size = Some(options.mesh_size.unwrap_or(0));
+    }
+    let outcome = run::solve(&scene, &settings).map_err(|e| format!("{}: {e}", scene.name))?;
+    print(&outcome.report, options.json)?;
+    write_outputs(&scene, &outcome, options, out)
+}
+
+/// The report as JSON, or as a summary with its warnings on stderr.
+fn print(report: &Report, json: bool) -> Result<(), String> {
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(report).map_err(|e| e.to_string())?
+        );
+        return Ok(());
+    }
+    println!("{}", summary(report));
+    // on stderr: a summary piped to a file stays a summary
+    for warning in &report.solve.warnings {
+        eprintln!("warning ({} {}): {warning}", report.scene, report.pair);
+    }
+    Ok(())
+}
+
+/// A few lines of what a solve found: the discretization, the solver's work, the answer's
+/// integrals and certificate, the error where an exact solution is known, and the
+/// family's own quantities.
+pub fn summary(r: &Report) -> String {
+    let number = fem_forms::number;
+    let s = &r.solve;
+    let mut lines = vec![format!(
+        "{} ({}, {}): {} on the {}, N = {}, {} cells, {} unknowns",
+        r.scene, r.family, r.pair, s.model, r.domain, r.mesh_size, s.cells, s.dofs
+    )];
+    let mut posed: Vec<String> = r
+        .parameters
+        .iter()
+        .map(|(k, v)| format!("{k} = {}", number(*v)))
+        .collect();
+    if let Some(q) = r.load {
+        posed.insert(0, format!("q = {}", number(q)));
+    }
+    if let Some(alpha) = s.alpha {
+        posed.push(format!("α = {}", number(alpha)));
+    }
+    if !r.supports.is_empty() {
+        posed.push(r.supports.join("; "));
+    }
+    lines.push(format!("  posed: {}", posed.join(", ")));
+    lines.push(format!(
+        "  solved: {} ({} linear steps), {} iterations on the finest level, {:.3} s",
+        s.solver, s.linear_solver, s.iterations, s.seconds
+    ));
+    let mut answer = Vec::new();
+    if let Some(e) = s.energy {
+        answer.push(format!("energy {e:.10e}"));
+    }
+    answer.push(format!("∫λ_h {:.8e}", s.total_contact_force));
+    if let Some(a) = s.contact_area {
+        answer.push(format!("contact area {a:.6}"));
+    }
+    if let Some(l) = s.contact_length {
+        answer.push(format!("contact length {l:.6}"));
+    }
+    answer.push(format!("KKT residual {:.1e}", s.kkt_residual));
+    lines.push(format!("  answer: {}", answer.join(", ")));
+    let errors: Vec<String> = [
+        ("L²", s.error_l2),
+        ("H¹", s.error_h1),
+        ("λ", s.error_multiplier),
+        ("vertex max", s.error_vertex_max),
+    ]
+    .iter()
+    .filter_map(|(name, e)| e.map(|e| format!("{name} {e:.3e}")))
+    .collect();
+    if !errors.is_empty() {
+        lines.push(format!(
+            "  error against the exact solution: {}",
+            errors.join(", ")
+        ));
+    }
+    let quantities: Vec<String> = r
+        .quantities
+        .iter()
+        .filter(|(_, v)| !v.is_null())
+        .map(|(k, v)| match v.as_f64() {
+            Some(x) if !v.is_u64() && !v.is_i64() => format!("{k} {x:.8e}"),
+            _ => format!("{k} {v}"),
+        })
+        .collect();
+    if !quantities.is_empty() {
+        lines.push(format!("  {}", quantities.join(", ")));
+    }
+    lines.join("\n")
+}
+
+/// The chart (`--plot`) and the ParaView file (`--vtk`) of a solve.
+fn write_outputs(
+    scene: &Scene,
+    outcome: &Outcome,
+    options: &SolveOptions,
+    out: &Path,
+) -> Result<(), String> {
+    if options.plot {
+        let Fields::Interval { .. } = &outcome.fields else {
+            return Err(format!(
+                "--plot does not apply: `{}` has no profile chart",
+                scene.name
+            ));
+        };
+        let load = outcome.report.load.unwrap_or(1.0);
+        let path = out.join(format!("{}-q{load}.svg", scene.name));
+        plot::profiles(
+            &path,
+            &format!("{} q = {load}", scene.name),
+            &outcome.fields,
+        )
+        .map_err(|e| e.to_string())?;
+        eprintln!("→ {}", path.display());
+    }
+    if options.vtk {
+        let Fields::Triangles { mesh, vertex, cell } = &outcome.fields else {
+            return Err(format!(
+                "--vtk does not apply: `{}` is not solved on triangles",
+                scene.name
+            ));
+        };
+        let path = out.join(format!(
+            "{}-{}-{}.vtu",
+            scene.name, outcome.report.pair, outcome.report.mesh_size
+        ));
+        std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
+        let vertex: Vec<(&str, &[f64])> = vertex.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+        let cell: Vec<(&str, &[f64])> = cell.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+        fem_forms::io::vtk::write_vtu(&path, mesh, &vertex, &cell).map_err(|e| e.to_string())?;
+        eprintln!("→ {}", path.display());
+    }
+    Ok(())
+}
