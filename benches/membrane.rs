@@ -67,7 +67,11 @@ fn assembly(n: usize, rounds: usize) {
     type P1 = membrane_p1::Model;
     let coefficients = Coefficients::from_ids::<P1>(
         &[],
-        &[(membrane_p1::data::f, &zero), (membrane_p1::data::g, &zero)],
+        &[
+            (membrane_p1::data::f, &zero),
+            (membrane_p1::data::ψ, &zero),
+            (membrane_p1::data::g, &zero),
+        ],
     )
     .unwrap();
     let dofs = SystemDofs::all::<P1>(&mesh).unwrap();

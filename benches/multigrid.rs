@@ -312,7 +312,11 @@ fn parallel(quick: bool) {
     type P1 = membrane_p1::Model;
     let c1 = Coefficients::from_ids::<P1>(
         &[],
-        &[(membrane_p1::data::f, &zero), (membrane_p1::data::g, &zero)],
+        &[
+            (membrane_p1::data::f, &zero),
+            (membrane_p1::data::ψ, &zero),
+            (membrane_p1::data::g, &zero),
+        ],
     )
     .unwrap();
     parallel_kernels::<P1>("P1", n1, &c1);

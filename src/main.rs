@@ -9,9 +9,7 @@ use fem_forms::models::contact_scenes::{ContactBody, ContactScene};
 use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene};
-use fem_forms::models::registry::{
-    find, names, registry, Family, SceneEntry, SceneKind, MEMBRANE_PAIRS,
-};
+use fem_forms::models::registry::{find, names, registry, Family, SceneEntry, SceneKind};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::plates::{self, PlatePair, PlateRequest};
@@ -1100,13 +1098,11 @@ fn run(cli: Cli) -> Result<(), String> {
                         ));
                     }
                     options.alpha = options.alpha.or(file.alpha);
-                    options.accuracy = file.accuracy;
-                    SceneEntry {
-                        kind: SceneKind::Membrane(file.scene),
-                        pairs: MEMBRANE_PAIRS,
-                        studies: &[],
-                        in_default_job: false,
-                    }
+                    let mut scene =
+                        fem_forms::models::families::membrane::membrane_scene(&file.scene);
+                    scene.mesh_size = file.mesh_size;
+                    scene.accuracy = file.accuracy;
+                    return solve::solve_scene(scene, &options, &cli.out);
                 }
                 (Some(scene), None) if fem_forms::models::family::scene(&scene).is_some() => {
                     let scene = fem_forms::models::family::scene(&scene).expect("found");

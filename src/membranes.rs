@@ -701,11 +701,10 @@ fn run<M: Model>(
             MemoryModel::per_cell(pair.row().bytes_per_triangle),
             format!("--mesh-size {mesh_size} with {}", pair.name()),
         );
-    problem = if nodal {
-        problem.nodal(&psi)
-    } else {
-        problem.data("ψ", &psi)
-    };
+    problem = problem.data("ψ", &psi);
+    if nodal {
+        problem = problem.nodal(&psi);
+    }
     if exact.is_some() {
         problem = problem.exact(problem::Exact {
             value: &exact_u,

@@ -120,6 +120,16 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
             list.join(", ")
         ),
     )?;
+    let pair = run::pair_of(&scene, options.pair.as_deref()).map_err(|e| e.to_string())?;
+    if pair.nodal {
+        options.refuse_options(
+            &[Opt::Alpha, Opt::Solver],
+            &format!(
+                "{} has no multiplier to stabilize and solves its nodal constraints by its own active-set method",
+                pair.name
+            ),
+        )?;
+    }
     if options.cold && options.solver == Some(SolverName::Clarabel) {
         // every family hands clarabel the finest level alone: there is no nested start
         // to turn off, and an accepted flag that changes nothing misleads

@@ -139,9 +139,11 @@ fn meshes() -> Vec<TriangleMesh> {
 #[test]
 fn pattern_and_positions_match_a_dense_assembly_from_element_matrices() {
     for mesh in meshes() {
-        let membrane =
-            Coefficients::new::<membrane_p1::Model>(&[], &[("f", &load), ("g", &boundary)])
-                .unwrap();
+        let membrane = Coefficients::new::<membrane_p1::Model>(
+            &[],
+            &[("f", &load), ("ψ", &obstacle), ("g", &boundary)],
+        )
+        .unwrap();
         check::<membrane_p1::Model>("a", &mesh, &membrane);
         let stabilized = Coefficients::new::<membrane_p2_p0::Model>(
             &[("α", 0.1)],

@@ -125,7 +125,7 @@ fn bad_input_exits_with_a_message() {
     for (args, message) in [
         (
             &["solve", "membrane-radial", "--pair", "p9-p9"][..],
-            "unknown membrane pair",
+            "unknown pair `p9-p9`",
         ),
         (
             &["solve", "membrane-radial", "--msh", "/nonexistent/mesh.msh"][..],

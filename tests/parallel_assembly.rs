@@ -141,7 +141,8 @@ fn meshes() -> Vec<TriangleMesh> {
 #[test]
 fn parallel_p1_and_p2_stiffness_equal_the_serial_assembly() {
     type P1 = membrane_p1::Model;
-    let p1 = Coefficients::new::<P1>(&[], &[("f", &load), ("g", &boundary)]).unwrap();
+    let p1 =
+        Coefficients::new::<P1>(&[], &[("f", &load), ("ψ", &obstacle), ("g", &boundary)]).unwrap();
     type P2 = membrane_p2_p0::Model;
     let p2 = Coefficients::new::<P2>(
         &[("α", 0.3)],

@@ -287,7 +287,7 @@ fn parametric_nodes_are_read_by_dropping_their_parametric_coordinates() {
     assert!((boundary_length(&m, 1) - 4.0).abs() < 1e-12);
     assert!((boundary_length(&m, 2) - (2.0 + 2.0 * 2f64.sqrt())).abs() < 1e-12);
     let report = json(&solve(&data("trapezoid_parametric.msh"), "p1-p0", &[]));
-    assert_eq!(report["triangles"], 5);
+    assert_eq!(report["cells"], 5);
     // its $PhysicalNames name the groups: the curve groups are boundary parts
     assert_eq!(m.boundary_part_names(), ["neumann", "dirichlet"]);
     assert_eq!(m.boundary_part_markers(&["dirichlet"]).unwrap(), [2]);

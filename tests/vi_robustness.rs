@@ -197,7 +197,7 @@ fn solve_nodal(
     obstacle: &DataFn,
 ) -> fem_forms::Result<(Lcp, LcpSolution)> {
     type M = membrane_p1::Model;
-    let coefficients = Coefficients::new::<M>(&[], &[("f", load), ("g", &zero)])?;
+    let coefficients = Coefficients::new::<M>(&[], &[("f", load), ("ψ", obstacle), ("g", &zero)])?;
     let mut previous: Option<(TriangleMesh, SystemDofs, Vec<f64>)> = None;
     let mut last = None;
     for mesh in levels {
@@ -690,7 +690,8 @@ fn the_noise_estimate_follows_its_formula() {
 fn misfit_inputs_are_errors() {
     let mesh = square(4);
     type M = membrane_p1::Model;
-    let coefficients = Coefficients::new::<M>(&[], &[("f", &zero), ("g", &zero)]).unwrap();
+    let coefficients =
+        Coefficients::new::<M>(&[], &[("f", &zero), ("ψ", &zero), ("g", &zero)]).unwrap();
     let dofs = SystemDofs::all::<M>(&mesh).unwrap();
     let constraints = dirichlet_constraints::<M>(&mesh, &dofs, &coefficients).unwrap();
     let k = MatrixAssembler::new::<M>("a", &mesh, &dofs)

@@ -106,6 +106,9 @@ pub struct Pair {
     pub alpha_when_zero: f64,
     /// The memory a solve needs (`None`: [`MemoryModel::of_model`]).
     pub memory: Option<MemoryModel>,
+    /// The nodal method: the constraint at the nodes, no multiplier space to stabilize
+    /// (`--alpha` and `--solver` do not apply).
+    pub nodal: bool,
     /// The solve.
     pub solve: PairSolve,
 }
@@ -181,7 +184,10 @@ pub fn families() -> &'static [&'static dyn Family] {
     &FAMILIES
 }
 
-static FAMILIES: [&dyn Family; 1] = [&crate::families::beam::BEAMS];
+static FAMILIES: [&dyn Family; 2] = [
+    &crate::families::beam::BEAMS,
+    &crate::families::membrane::MEMBRANES,
+];
 
 /// The family called `name`.
 pub fn family(name: &str) -> Option<&'static dyn Family> {

@@ -20,20 +20,27 @@ pub const MAX_MESH_SIZE: usize = 1 << 26;
 /// Most uniform refinements of a Gmsh mesh (`4^k` times its triangles).
 pub const MAX_REFINEMENTS: usize = 8;
 
+/// The check a solve makes of the finest mesh's cell count before any mesh is built
+/// (the memory estimate): an error refuses the size.
+pub type CellBudget<'a> = &'a dyn Fn(f64) -> Result<()>;
+
 /// A kind of mesh a scene can be solved on.
 pub trait Geometry: MeshKind {
     /// The meshes for size `n` on `domain`, coarsest first: `n` halved while it stays
     /// even and at least `coarsest` (without `nested`, `n` alone); a Gmsh file and its
-    /// `n` uniform refinements.
+    /// `n` uniform refinements. `budget` sees the finest mesh's cell count first (a
+    /// file's after reading it, before refining).
     ///
     /// # Errors
-    /// A domain this kind of mesh does not cover, a size out of range, and the mesh
-    /// generators' and the Gmsh reader's errors.
-    fn levels(domain: &Domain, n: usize, nested: bool, coarsest: usize) -> Result<Vec<Self>>;
-
-    /// The number of cells of the mesh for size `n` (before building it, for the memory
-    /// estimate; `None` where only the mesh says, e.g. a file's).
-    fn cells_of(domain: &Domain, n: usize) -> Option<f64>;
+    /// A domain this kind of mesh does not cover, a size out of range, the budget's
+    /// refusal, and the mesh generators' and the Gmsh reader's errors.
+    fn levels(
+        domain: &Domain,
+        n: usize,
+        nested: bool,
+        coarsest: usize,
+        budget: CellBudget,
+    ) -> Result<Vec<Self>>;
 
     /// The runtime's part of the named boundary parts on this mesh.
     ///
@@ -117,7 +124,13 @@ fn size_error(n: usize, what: &str) -> Error {
 }
 
 impl Geometry for IntervalMesh {
-    fn levels(domain: &Domain, n: usize, nested: bool, coarsest: usize) -> Result<Vec<Self>> {
+    fn levels(
+        domain: &Domain,
+        n: usize,
+        nested: bool,
+        coarsest: usize,
+        budget: CellBudget,
+    ) -> Result<Vec<Self>> {
         let &Domain::Interval { start, end } = domain else {
             return Err(Error::Input(format!(
                 "the {} is not an interval: a model on intervals cannot be solved on it",
@@ -127,14 +140,11 @@ impl Geometry for IntervalMesh {
         if n == 0 || n > MAX_MESH_SIZE {
             return Err(size_error(n, "an interval's elements"));
         }
+        budget(n as f64)?;
         halving_sizes(n, nested, coarsest, false)
             .into_iter()
             .map(|k| IntervalMesh::uniform(start, end, k))
             .collect()
-    }
-
-    fn cells_of(_: &Domain, n: usize) -> Option<f64> {
-        Some(n as f64)
     }
 
     fn total_measure(&self) -> f64 {
@@ -202,9 +212,15 @@ impl Geometry for IntervalMesh {
 }
 
 impl Geometry for TriangleMesh {
-    fn levels(domain: &Domain, n: usize, nested: bool, coarsest: usize) -> Result<Vec<Self>> {
+    fn levels(
+        domain: &Domain,
+        n: usize,
+        nested: bool,
+        coarsest: usize,
+        budget: CellBudget,
+    ) -> Result<Vec<Self>> {
         match domain {
-            Domain::Gmsh(path) => gmsh_levels(path, n, nested),
+            Domain::Gmsh(path) => gmsh_levels(path, n, nested, budget),
             Domain::Generated(generator) => {
                 if n == 0 || n > MAX_MESH_SIZE {
                     return Err(Error::Input(format!(
@@ -212,7 +228,9 @@ impl Geometry for TriangleMesh {
                         generator.size_meaning
                     )));
                 }
-                Ok(vec![(generator.build)(n)?])
+                let mesh = (generator.build)(n)?;
+                budget(mesh.cell_count() as f64)?;
+                Ok(vec![mesh])
             }
             Domain::Disk { curved: true, .. } => Err(Error::Input(
                 "a curved disk is solved on curved triangles".into(),
@@ -227,6 +245,7 @@ impl Geometry for TriangleMesh {
                         "the L-shape needs an even --mesh-size, got {n}"
                     )));
                 }
+                budget(structured_cells(domain, n))?;
                 use rayon::prelude::*;
                 // the coarser levels on the second core while the finest builds
                 halving_sizes(n, nested, coarsest, even)
@@ -237,14 +256,58 @@ impl Geometry for TriangleMesh {
         }
     }
 
-    fn cells_of(domain: &Domain, n: usize) -> Option<f64> {
-        let n = n as f64;
-        match domain {
-            Domain::Rectangle { cells, .. } => Some(2.0 * n * n * (cells[0] * cells[1]) as f64),
-            Domain::LShape => Some(1.5 * n * n),
-            Domain::Disk { .. } => Some(6.0 * n * n),
-            _ => None,
+    /// The part's markers, checked: `all` is the keyword for the whole boundary (a mesh
+    /// with a part of that name would make `all` and `["all"]` mean different sets
+    /// under one printed name), a list names at least one part, and every part listed
+    /// holds boundary edges of its own (an interior curve or an empty group would
+    /// otherwise be reported as held and hold nothing).
+    fn part(&self, part: &Part) -> Result<DirichletPart> {
+        let domain = || format!("{} triangles", self.cell_count());
+        let Part::Named(names) = part else {
+            return Ok(DirichletPart::All);
+        };
+        if names.is_empty() {
+            return Err(Error::Input(
+                "no boundary part is chosen: choose at least one part".into(),
+            ));
         }
+        let markers_of = |names: &[&str]| {
+            self.boundary_part_markers(names).map_err(|e| match e {
+                Error::Input(message) => {
+                    // `["all"]`: the keyword is a plain string, not a name in a list
+                    let keyword = if names.contains(&"all") && message.contains("`all`") {
+                        "; \"all\" (the whole boundary) is a keyword on its own, not a name in a list"
+                    } else {
+                        ""
+                    };
+                    Error::Input(format!("{message} ({}){keyword}", domain()))
+                }
+                other => other,
+            })
+        };
+        let all: Vec<&str> = names.iter().map(String::as_str).collect();
+        let markers = markers_of(&all)?;
+        if names.len() > 1 {
+            for name in &all {
+                let own = DirichletPart::Markers(markers_of(&[name])?);
+                if own.edge_count(self) == 0 {
+                    return Err(Error::Input(format!(
+                        "the boundary part `{name}` holds no boundary edge of the mesh ({}): an interior curve or an empty group cannot carry a condition; remove it from the list",
+                        domain()
+                    )));
+                }
+            }
+        }
+        let part = DirichletPart::Markers(markers);
+        if part.edge_count(self) == 0 {
+            let listed: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+            return Err(Error::Input(format!(
+                "the boundary parts {} hold no boundary edge of the mesh ({}): the condition would hold nowhere; refused",
+                listed.join(", "),
+                domain()
+            )));
+        }
+        Ok(part)
     }
 
     fn value_at(solution: &ObstacleSolution<Self>, field: usize, x: &[f64]) -> Option<f64> {
@@ -271,12 +334,29 @@ impl Geometry for TriangleMesh {
     }
 
     fn fields<M: Model>(solution: &ObstacleSolution<Self>, psi: &DataFn) -> Fields {
-        triangle_fields::<M, _>(solution, &solution.discretization.mesh, psi)
+        let mut fields = triangle_fields::<M, _>(solution, &solution.discretization.mesh, psi);
+        if let (Fields::Triangles { cell, .. }, fem_runtime::obstacle::Multipliers::Nodal) =
+            (&mut fields, &solution.discretization.multipliers)
+        {
+            let (shares, _) = fem_runtime::problem::nodal::contact_shares(solution, psi);
+            cell.push((
+                "lambda",
+                fem_runtime::problem::nodal::force_density(solution),
+            ));
+            cell.push(("contact", shares));
+        }
+        fields
     }
 }
 
 impl Geometry for CurvedTriangleMesh {
-    fn levels(domain: &Domain, n: usize, nested: bool, coarsest: usize) -> Result<Vec<Self>> {
+    fn levels(
+        domain: &Domain,
+        n: usize,
+        nested: bool,
+        coarsest: usize,
+        budget: CellBudget,
+    ) -> Result<Vec<Self>> {
         let &Domain::Disk {
             centre,
             radius,
@@ -291,6 +371,7 @@ impl Geometry for CurvedTriangleMesh {
         if n == 0 || n > MAX_MESH_SIZE {
             return Err(size_error(n, "a disk's rings"));
         }
+        budget(structured_cells(domain, n))?;
         halving_sizes(n, nested, coarsest, false)
             .into_iter()
             .map(|k| {
@@ -299,10 +380,6 @@ impl Geometry for CurvedTriangleMesh {
                 CurvedTriangleMesh::new(mesh, geometry)
             })
             .collect()
-    }
-
-    fn cells_of(_: &Domain, n: usize) -> Option<f64> {
-        Some(6.0 * (n * n) as f64)
     }
 
     fn part(&self, part: &Part) -> Result<DirichletPart> {
@@ -355,6 +432,17 @@ fn point_value(view: &TriangleField, x: &[f64]) -> Option<f64> {
     view.at(&basis, &locator, [x[0], x[1]])
 }
 
+/// The cells of the structured mesh of `domain` for size `n`.
+fn structured_cells(domain: &Domain, n: usize) -> f64 {
+    let n = n as f64;
+    match domain {
+        Domain::Rectangle { cells, .. } => 2.0 * n * n * (cells[0] * cells[1]) as f64,
+        Domain::LShape => 1.5 * n * n,
+        Domain::Disk { .. } => 6.0 * n * n,
+        _ => 0.0,
+    }
+}
+
 /// A structured mesh of a generated domain for size `n`.
 fn structured(domain: &Domain, n: usize) -> Result<TriangleMesh> {
     match domain {
@@ -379,6 +467,7 @@ fn gmsh_levels(
     path: &std::path::Path,
     refinements: usize,
     nested: bool,
+    budget: CellBudget,
 ) -> Result<Vec<TriangleMesh>> {
     if refinements > MAX_REFINEMENTS {
         return Err(Error::Input(format!(
@@ -391,6 +480,7 @@ fn gmsh_levels(
         Error::Mesh(m) => Error::Mesh(format!("{}: {m}", path.display())),
         other => other,
     })?;
+    budget(mesh.cell_count() as f64 * 4f64.powi(refinements as i32))?;
     let mut levels = vec![mesh];
     for _ in 0..refinements {
         let finer = levels.last().expect("a level").refine_uniformly();

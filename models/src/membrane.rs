@@ -53,16 +53,18 @@ membrane_model! {
 
 fem_runtime::model! {
     /// The membrane without a multiplier, u ∈ P1: the stiffness and load of the classical
-    /// nodal-constraint method `u_i ≥ ψ(x_i)`.
+    /// nodal-constraint method `u_i ≥ ψ(x_i)` (the obstacle enters at the nodes, not in
+    /// a form).
     pub mod membrane_p1 on triangle {
         unknowns: u: P1;
         tests: v;
-        data: f, g;
+        data: f, ψ, g;
         boundary: u = g;
         forms: "
             a(u;v) = ∫ ∇u·∇v
             ℓ(v)   = ∫ f v
         ";
         energy: a, ℓ;
+        obstacle: u >= ψ;
     }
 }

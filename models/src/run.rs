@@ -330,9 +330,6 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     let n = settings.mesh_size.unwrap_or(scene.mesh_size);
     let memory = pair.memory.unwrap_or_else(MemoryModel::of_model::<M>);
     let size_text = size_text(scene, pair, n);
-    if let Some(cells) = G::cells_of(&scene.domain, n) {
-        check_memory(memory.bytes(cells as usize), &size_text)?;
-    }
     let nested = settings.nested && settings.solver == VariationalSolver::SemismoothNewton;
     let mut domain = scene.domain.clone();
     if let (Some(diagonal), crate::scene::Domain::Rectangle { diagonal: d, .. }) =
@@ -340,7 +337,8 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     {
         *d = diagonal;
     }
-    let meshes = G::levels(&domain, n, nested, Q::COARSEST)?;
+    let budget = |cells: f64| check_memory(memory.bytes(cells as usize), &size_text);
+    let meshes = G::levels(&domain, n, nested, Q::COARSEST, &budget)?;
     let finest = meshes.last().expect("at least one level").clone();
     let meshes_seconds = clock.elapsed().as_secs_f64();
 
@@ -369,17 +367,17 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
                 .rounding_experiment
                 .unwrap_or(Q::ROUNDING_EXPERIMENT),
         })
-        .memory(memory, size_text);
+        .memory(memory, size_text.clone());
     for &(p, value) in &bound.params {
         problem = problem.param(ParamId::<M>::new(p), value);
     }
     let nodal = M::SYSTEM.is_none();
     for (d, f) in &bound.data {
+        // the nodal method takes its obstacle at the nodes
         if nodal && Some(*d) == psi_index {
             problem = problem.nodal(&**f);
-        } else {
-            problem = problem.data(DataId::<M>::new(*d), &**f);
         }
+        problem = problem.data(DataId::<M>::new(*d), &**f);
     }
     for (part, field, condition) in supports.conditions {
         problem = problem.support(part, FieldId::<M>::new(field), condition);
@@ -501,12 +499,15 @@ pub fn pose(scene: &Scene, settings: &Settings) -> Result<Posed> {
 
 /// What sets the size, for the memory refusal's message.
 fn size_text(scene: &Scene, pair: &Pair, n: usize) -> String {
-    let option = if matches!(scene.domain, crate::scene::Domain::Interval { .. }) {
-        "--elements"
-    } else {
-        "--mesh-size"
-    };
-    format!("{option} {n} with {}", pair.name)
+    match &scene.domain {
+        crate::scene::Domain::Interval { .. } => format!("--elements {n} with {}", pair.name),
+        crate::scene::Domain::Gmsh(path) => format!(
+            "--mesh-size {n} ({n} uniform refinements of {}, 4^{n} times its triangles) with {}",
+            path.display(),
+            pair.name
+        ),
+        _ => format!("--mesh-size {n} with {}", pair.name),
+    }
 }
 
 /// A scene bound to model `M`: parameter and data indices with their values.
@@ -579,16 +580,28 @@ fn supports<M: Model, G: Geometry>(scene: &Scene, mesh: &G) -> Result<Supports> 
     let primal: Vec<usize> = (0..M::FIELDS.len())
         .filter(|&f| Some(f) != multiplier)
         .collect();
-    let at = |message: String, part: &Part| {
-        Error::Input(format!(
-            "scene `{}`: support on {}: {message}",
-            scene.name,
-            part.names().join(", ")
-        ))
+    let at = |message: String, support: &crate::scene::PartSupport| {
+        Error::Input(match &support.key {
+            Some(key) => format!("scene `{}`: field `{key}`: {message}", scene.name),
+            None => format!(
+                "scene `{}`: support on {}: {message}",
+                scene.name,
+                support.part.names().join(", ")
+            ),
+        })
     };
+    // `all` is the keyword for the whole boundary: a mesh with a part of that name would
+    // make `all` and `["all"]` mean different sets under one printed name
+    if !scene.supports.is_empty() && mesh.part_markers(&["all"]).is_ok() {
+        return Err(Error::Input(format!(
+            "scene `{}`: the mesh ({}) has a boundary part named `all`, which is the keyword for the whole boundary (and its default where a scene names no part): rename the Gmsh physical group (e.g. Physical Curve(\"outer\")) so that the choice is unambiguous",
+            scene.name,
+            scene.domain.describe()
+        )));
+    }
     for s in &scene.supports {
         let part = mesh.part(&s.part).map_err(|e| match e {
-            Error::Input(m) => at(m, &s.part),
+            Error::Input(m) => at(m, s),
             other => other,
         })?;
         if let Part::Named(names) = &s.part {
@@ -609,7 +622,7 @@ fn supports<M: Model, G: Geometry>(scene: &Scene, mesh: &G) -> Result<Supports> 
                             "a simple support holds the constrained field, and model `{}` declares none (its `obstacle:` role)",
                             M::NAME
                         ),
-                        &s.part,
+                        s,
                     )
                 })?;
                 out.conditions.push((part.clone(), w, Condition::Zero));
@@ -629,14 +642,14 @@ fn supports<M: Model, G: Geometry>(scene: &Scene, mesh: &G) -> Result<Supports> 
                             M::NAME,
                             vectors.len()
                         ),
-                        &s.part,
+                        s,
                     ));
                 };
                 let length = normal[0].hypot(normal[1]);
                 if !(length.is_finite() && length > 0.0) {
                     return Err(at(
                         format!("the roller's direction {normal:?} is not a direction"),
-                        &s.part,
+                        s,
                     ));
                 }
                 let n = [normal[0] / length, normal[1] / length];

@@ -265,6 +265,8 @@ pub struct PartSupport {
     pub part: Part,
     /// What.
     pub support: Support,
+    /// The scene file's key it was read from (`boundary.dirichlet`), which errors name.
+    pub key: Option<Name>,
 }
 
 /// The load magnitude `q` of `--load`: the named data are `q` times the scene's fields.
@@ -474,7 +476,11 @@ impl Scene {
 
     /// Adds a support on `part`.
     pub fn with_support(mut self, part: Part, support: Support) -> Self {
-        self.supports.push(PartSupport { part, support });
+        self.supports.push(PartSupport {
+            part,
+            support,
+            key: None,
+        });
         self
     }
 

@@ -46,6 +46,7 @@ const fn pair(
         // that the obstacle shift α h⁴|f| stays negligible (docs/mathematics.md)
         alpha_when_zero: alpha,
         memory: Some(MemoryModel::per_cell(BYTES_PER_ELEMENT)),
+        nodal: false,
         solve,
     }
 }

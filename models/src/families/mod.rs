@@ -2,3 +2,4 @@
 //! own quantities.
 
 pub mod beam;
+pub mod membrane;
