@@ -53,17 +53,26 @@ impl SolveOptions {
     }
 }
 
-/// The options a scene takes: its family's, less those the scene itself has no use for.
-fn accepted(scene: &Scene, options: &[Opt]) -> Vec<Opt> {
+/// The options of its family that a scene has no use for, each with the reason.
+fn unused(scene: &Scene, options: &[Opt]) -> Vec<(Opt, String)> {
+    let name = &scene.name;
     options
         .iter()
-        .copied()
-        .filter(|o| match o {
-            Opt::Load => scene.load.is_some(),
-            Opt::Thickness => scene.parameter("t").is_some(),
-            Opt::NoObstacle => scene.obstacle,
-            Opt::Alpha | Opt::Cold => scene.obstacle,
-            _ => true,
+        .filter_map(|&o| {
+            let why = match o {
+                Opt::Load if scene.load.is_none() => {
+                    format!("the load of `{name}` is fixed (not a scaled field)")
+                }
+                Opt::Thickness if scene.parameter("t").is_none() => {
+                    format!("`{name}` has no thickness t")
+                }
+                Opt::NoObstacle if !scene.obstacle => format!("`{name}` has no obstacle"),
+                Opt::Alpha | Opt::Cold if !scene.obstacle => format!(
+                    "`{name}` is solved without an obstacle (one linear solve); α and the nested start concern contact"
+                ),
+                _ => return None,
+            };
+            Some((o, why))
         })
         .collect()
 }
@@ -100,18 +109,20 @@ fn settings(options: &SolveOptions) -> Result<Settings, String> {
 pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {
     let family = family::family(scene.family)
         .ok_or_else(|| format!("scene `{}` names no known family", scene.name))?;
-    let accepted_options = accepted(&scene, family.options());
-    let not_accepted: Vec<Opt> = Opt::ALL
-        .into_iter()
-        .filter(|o| !accepted_options.contains(o))
-        .collect();
-    let list: Vec<&str> = accepted_options
+    let unused = unused(&scene, family.options());
+    let list: Vec<&str> = family
+        .options()
         .iter()
+        .filter(|o| !unused.iter().any(|(u, _)| u == *o))
         .map(|o| o.flag())
         .chain(["--json"])
         .collect();
+    let foreign: Vec<Opt> = Opt::ALL
+        .into_iter()
+        .filter(|o| !family.options().contains(o))
+        .collect();
     options.refuse_options(
-        &not_accepted,
+        &foreign,
         &format!(
             "`{}` is a {} scene on the {} ({})",
             scene.name,
@@ -120,6 +131,9 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
             list.join(", ")
         ),
     )?;
+    for (option, why) in unused {
+        options.refuse_options(&[option], &why)?;
+    }
     let pair = run::pair_of(&scene, options.pair.as_deref()).map_err(|e| e.to_string())?;
     if pair.nodal {
         options.refuse_options(

@@ -151,7 +151,7 @@ fn bad_input_exits_with_a_message() {
         // about 24 GB: refused before any allocation (it used to abort in the factor)
         (
             &["solve", "mindlin-square", "--mesh-size", "1024"][..],
-            "--mesh-size 1024 needs about",
+            "--mesh-size 1024 with p1-p2-p0 needs about",
         ),
         (
             &["solve", "bernoulli-flat", "--refinement", "1000000"][..],

@@ -23,6 +23,8 @@ const RENAMED: &[(&[&str], &str, &str)] = &[
     (BEAMS, "elements", "cells"),
     (BEAMS, "complementarity_residual", "kkt_residual"),
     (MEMBRANES, "triangles", "cells"),
+    (PLATES, "triangles", "cells"),
+    (PLATES, "complementarity_residual", "kkt_residual"),
     (MEMBRANES, "complementarity_residual", "kkt_residual"),
     (TIMOSHENKO, "thickness_rounding", "rounding"),
     (BERNOULLI, "length_rounding", "rounding"),
@@ -43,6 +45,8 @@ const MEMBRANES: &[&str] = &[
     "membrane-flat",
     "--scene",
 ];
+/// The Mindlin plate scenes.
+const PLATES: &[&str] = &["mindlin-square", "mindlin-square-ss", "mindlin-disk"];
 const TIMOSHENKO: &[&str] = &["timoshenko-a", "timoshenko-b"];
 const BERNOULLI: &[&str] = &["bernoulli-a", "bernoulli-b", "bernoulli-flat"];
 
@@ -58,7 +62,56 @@ const BERNOULLI: &[&str] = &["bernoulli-a", "bernoulli-b", "bernoulli-flat"];
 /// `ACCURACY`: built-in membrane scenes state the accuracy they ask for (the one the
 /// cheapest-pair choice aims at), and the report checks it as it did for scene files:
 /// a solve that misses it, or cannot measure it, says so (tests/membrane.rs).
+///
+/// `DOFS`: the plates counted every DOF; every report counts the unknowns left after the
+/// supports' DOFs are eliminated (primal and multiplier).
+///
+/// `UNCONSTRAINED`: a scene without obstacle is the unconstrained problem (λ = 0, the
+/// primal block alone), which has no crossing of an obstacle and no open gap to report
+/// (null, not 0); its numbers are those of the far obstacle the plates used before.
 const CHANGED: &[(&str, &str, &str)] = &[
+    ("mindlin-square", "dofs", "DOFS"),
+    ("mindlin-square", "max_penetration", "UNCONSTRAINED"),
+    ("mindlin-square", "max_open_contact_gap", "UNCONSTRAINED"),
+    (
+        "mindlin-square --thickness 0.01 --pair p1-p1-p0-plain --mesh-size 16",
+        "dofs",
+        "DOFS",
+    ),
+    (
+        "mindlin-square --thickness 0.01 --pair p1-p1-p0-plain --mesh-size 16",
+        "max_penetration",
+        "UNCONSTRAINED",
+    ),
+    (
+        "mindlin-square --thickness 0.01 --pair p1-p1-p0-plain --mesh-size 16",
+        "max_open_contact_gap",
+        "UNCONSTRAINED",
+    ),
+    ("mindlin-square-ss --thickness 0.05", "dofs", "DOFS"),
+    ("mindlin-square-ss --thickness 0.05", "max_penetration", "UNCONSTRAINED"),
+    (
+        "mindlin-square-ss --thickness 0.05",
+        "max_open_contact_gap",
+        "UNCONSTRAINED",
+    ),
+    (
+        "mindlin-square-ss --thickness 0.05",
+        "warnings",
+        "the soft simple support's O(t) boundary layer is named, with the hard support as its cure (tests/plate_supports.rs)",
+    ),
+    ("mindlin-disk --mesh-size 8", "dofs", "DOFS"),
+    ("mindlin-disk --no-obstacle --mesh-size 8", "dofs", "DOFS"),
+    (
+        "mindlin-disk --no-obstacle --mesh-size 8",
+        "max_penetration",
+        "UNCONSTRAINED",
+    ),
+    (
+        "mindlin-disk --no-obstacle --mesh-size 8",
+        "max_open_contact_gap",
+        "UNCONSTRAINED",
+    ),
     (
         "membrane-radial --pair p1-p0 --mesh-size 32",
         "warnings+",

@@ -109,6 +109,9 @@ pub struct Pair {
     /// The nodal method: the constraint at the nodes, no multiplier space to stabilize
     /// (`--alpha` and `--solver` do not apply).
     pub nodal: bool,
+    /// Parameters of the discretization, not of the scene (the Stenberg weight's β), by
+    /// the model's names; a scene's value of the same name wins.
+    pub parameters: &'static [(&'static str, f64)],
     /// The solve.
     pub solve: PairSolve,
 }
@@ -184,9 +187,10 @@ pub fn families() -> &'static [&'static dyn Family] {
     &FAMILIES
 }
 
-static FAMILIES: [&dyn Family; 2] = [
+static FAMILIES: [&dyn Family; 3] = [
     &crate::families::beam::BEAMS,
     &crate::families::membrane::MEMBRANES,
+    &crate::families::plate::PLATES,
 ];
 
 /// The family called `name`.

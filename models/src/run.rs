@@ -174,6 +174,12 @@ pub trait Quantities<G: Geometry>: 'static {
         }
     }
 
+    /// The memory a solve of model `M` needs on `scene`'s domain.
+    fn memory<M: Model>(pair: &Pair, scene: &Scene) -> MemoryModel {
+        let _ = scene;
+        pair.memory.unwrap_or_else(MemoryModel::of_model::<M>)
+    }
+
     /// Checks what the model cannot: the ranges of the family's parameters.
     ///
     /// # Errors
@@ -227,6 +233,8 @@ pub struct Run<'r, M: Model, G: Geometry> {
     pub solved: &'r Solved<M, G>,
     /// The obstacle as solved.
     pub psi: &'r DataFn,
+    /// The solution's fields, sampled for output.
+    pub fields: &'r Fields,
 }
 
 impl<M: Model, G: Geometry> Run<'_, M, G> {
@@ -326,11 +334,22 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
 ) -> Result<Outcome> {
     let clock = Instant::now();
     let posed = pose(scene, settings)?;
+    // the family's checks first: they name the parameter as its users know it
     Q::check(scene, &posed)?;
+    for (name, value) in &posed.parameters {
+        if !value.is_finite() {
+            return Err(Error::Input(format!(
+                "scene `{}`: parameter `{name}` = {value} is not finite",
+                scene.name
+            )));
+        }
+    }
     let n = settings.mesh_size.unwrap_or(scene.mesh_size);
-    let memory = pair.memory.unwrap_or_else(MemoryModel::of_model::<M>);
+    let memory = Q::memory::<M>(pair, scene);
     let size_text = size_text(scene, pair, n);
-    let nested = settings.nested && settings.solver == VariationalSolver::SemismoothNewton;
+    // without an obstacle the problem is one linear solve: nothing to nest for
+    let nested =
+        settings.nested && settings.solver == VariationalSolver::SemismoothNewton && scene.obstacle;
     let mut domain = scene.domain.clone();
     if let (Some(diagonal), crate::scene::Domain::Rectangle { diagonal: d, .. }) =
         (settings.diagonal, &mut domain)
@@ -342,7 +361,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     let finest = meshes.last().expect("at least one level").clone();
     let meshes_seconds = clock.elapsed().as_secs_f64();
 
-    let bound = bind::<M>(scene, &posed)?;
+    let bound = bind::<M>(scene, pair, &posed)?;
     let supports = supports::<M, G>(scene, &finest)?;
     let exact = scene.exact_at(&posed);
     let exact_fns = exact.as_ref().map(ExactFns::new);
@@ -398,6 +417,9 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     if let Some(fns) = &exact_fns {
         problem = problem.exact(fns.exact());
     }
+    if !scene.obstacle {
+        problem = problem.unconstrained();
+    }
     let cells = finest.cell_count();
     let solved = problem.solve().map_err(|e| {
         Q::explain(
@@ -436,6 +458,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     };
     report.solve.warnings.extend(supports.warnings);
     common_warnings(scene, &posed, &mut report);
+    let fields = G::fields::<M>(&solved.solution, psi);
     let run = Run {
         scene,
         posed: &posed,
@@ -443,9 +466,9 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         pair,
         solved: &solved,
         psi,
+        fields: &fields,
     };
     Q::add(&run, &mut report)?;
-    let fields = G::fields::<M>(&solved.solution, psi);
     report.phases = Phases {
         meshes: meshes_seconds,
         checks: checks_seconds,
@@ -486,14 +509,6 @@ pub fn pose(scene: &Scene, settings: &Settings) -> Result<Posed> {
             None => parameters.push((name.clone(), *value)),
         }
     }
-    for (name, value) in &parameters {
-        if !value.is_finite() {
-            return Err(Error::Input(format!(
-                "scene `{}`: parameter `{name}` = {value} is not finite",
-                scene.name
-            )));
-        }
-    }
     Ok(Posed { load, parameters })
 }
 
@@ -518,7 +533,7 @@ struct Bound {
 
 /// Binds the scene's parameters and data to model `M` by name; the data `--load` scales
 /// are multiplied by q. The one place a scene's names meet the model's.
-fn bind<M: Model>(scene: &Scene, posed: &Posed) -> Result<Bound> {
+fn bind<M: Model>(scene: &Scene, pair: &Pair, posed: &Posed) -> Result<Bound> {
     let unknown = |kind: &str, name: &str, names: Vec<&str>| {
         Error::Input(format!(
             "scene `{}`: {kind} `{name}` is not one of model `{}`'s ({})",
@@ -534,6 +549,15 @@ fn bind<M: Model>(scene: &Scene, posed: &Posed) -> Result<Bound> {
             .position(|p| *p == &**name)
             .ok_or_else(|| unknown("parameter", name, M::PARAMS.to_vec()))?;
         params.push((p, *value));
+    }
+    for &(name, value) in pair.parameters {
+        let p = M::PARAMS
+            .iter()
+            .position(|p| *p == name)
+            .ok_or_else(|| unknown("parameter", name, M::PARAMS.to_vec()))?;
+        if !params.iter().any(|(k, _)| *k == p) {
+            params.push((p, value));
+        }
     }
     let mut data: Vec<(usize, Box<DataFn>)> = Vec::new();
     for (name, f) in &scene.data {

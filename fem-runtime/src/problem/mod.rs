@@ -212,6 +212,7 @@ pub struct Problem<'a, M: Model, G: Domain> {
     start: Option<&'a FirstStart<'a, G>>,
     exact: Option<Exact<'a>>,
     nodal: Option<&'a DataFn>,
+    unconstrained: bool,
     memory: MemoryModel,
     size: Option<String>,
     invalid: Option<Error>,
@@ -250,6 +251,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             start: None,
             exact: None,
             nodal: None,
+            unconstrained: false,
             memory: MemoryModel::of_model::<M>(),
             size: None,
             invalid: None,
@@ -372,6 +374,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// one P1 field without multiplier ([`nodal`]).
     pub fn nodal(mut self, obstacle: &'a DataFn) -> Self {
         self.nodal = Some(obstacle);
+        self
+    }
+
+    /// The problem without its constraint (no obstacle): the multiplier is 0 and the
+    /// primal block of `B_h` is solved alone, `A U = F`, on the finest mesh: the obstacle
+    /// problem whose constraint is nowhere active, one linear solve. The report has no
+    /// penetration, open gap or contact set, and no rounding experiment.
+    pub fn unconstrained(mut self) -> Self {
+        self.unconstrained = true;
         self
     }
 
@@ -562,7 +573,9 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         let dofs = finest.system_dofs::<M>()?;
         let constraints = finest.constraints::<M>(&dofs, &coefficients, &self.supports)?;
         warnings.extend(constraints.warnings().iter().cloned());
-        self.check_feasible(finest, &dofs, &constraints, &data)?;
+        if !self.unconstrained {
+            self.check_feasible(finest, &dofs, &constraints, &data)?;
+        }
         let mut options = self.options.obstacle;
         if alpha == 0.0 && options.solver == VariationalSolver::SemismoothNewton {
             warnings.push("α = 0 (the plain mixed method): C = 0 leaves nothing to eliminate Λ with, so the QP solver (clarabel) is used".into());
@@ -570,8 +583,11 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         }
         let nested = self.options.nested && options.solver == VariationalSolver::SemismoothNewton;
         let first = if nested { 0 } else { meshes.len() - 1 };
-        let solution = self
-            .solve_levels(
+        let solution = if self.unconstrained {
+            let d = finest.discretize::<M>(&coefficients, dofs, &constraints, &parts)?;
+            unconstrained_solution(d).map_err(|e| alpha_hint(e, alpha, c_i))?
+        } else {
+            self.solve_levels(
                 &meshes[first..],
                 &coefficients,
                 Some((dofs, constraints)),
@@ -579,8 +595,20 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 options,
                 previous,
             )
-            .map_err(|e| alpha_hint(e, alpha, c_i))?;
+            .map_err(|e| alpha_hint(e, alpha, c_i))?
+        };
         let mut report = self.report(&solution, &coefficients, alpha, c_i, options)?;
+        if self.unconstrained {
+            report.solver = "linear";
+            // α acts without contact only through the stabilization's primal part
+            if c_i == 0.0 {
+                report.alpha = None;
+            }
+            report.complementarity_residual = 0.0;
+            // no constraint, no contact set
+            report.contact_area = report.contact_area.map(|_| 0.0);
+            report.contact_length = report.contact_length.map(|_| 0.0);
+        }
         // where the user's α is far above the default, it is the likelier cause
         if let Some(default) = self.default_alpha(c_i) {
             if alpha > LARGE_ALPHA * default {
@@ -607,7 +635,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 });
             }
         }
-        if self.options.rounding_experiment {
+        if self.options.rounding_experiment && !self.unconstrained {
             let clock = Instant::now();
             let rounding = self
                 .rounding_experiment(meshes, &solution, &coefficients, &parts, options)
@@ -1152,7 +1180,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 report.primal_rounding
             ));
         }
-        if let Some([field, obstacle]) = M::OBSTACLE {
+        // without a constraint there is nothing to cross
+        if let (Some([field, obstacle]), false) = (M::OBSTACLE, self.unconstrained) {
             let name = M::FIELDS[field].name;
             let psi = coefficients.data[obstacle];
             let side = self.side.sign();
@@ -1287,6 +1316,58 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
 /// (bernoulli-flat, q = 100, 256 elements: 1.9e-7 at the default 1e-2, 2.3e-5 at 1e3,
 /// 1.1e-4 at 1e4), and the contact set widens without an open gap to show it.
 pub const LARGE_ALPHA: f64 = 1e3;
+
+/// The solution of `d` with every constraint inactive: `Λ = 0` and `A U = F` by sparse
+/// Cholesky (`A`, the primal block of `B_h`, is SPD for `α < 1/C_I`); its residual is
+/// the equilibrium backward error `‖AU − F‖∞ / (‖A‖∞‖U‖∞ + ‖F‖∞)`.
+fn unconstrained_solution<G: crate::DofNumbering>(
+    d: Discretization<G>,
+) -> Result<ObstacleSolution<G>> {
+    let clock = Instant::now();
+    let lcp = &d.lcp;
+    let u = crate::lcp::cholesky::solve_spd(&lcp.a, &lcp.f)?;
+    let au = crate::lcp::cholesky::multiply(&lcp.a, &u);
+    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let a_norm = (0..lcp.n())
+        .map(|j| lcp.a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    let difference: Vec<f64> = au.iter().zip(&lcp.f).map(|(a, f)| a - f).collect();
+    let scale = a_norm * inf(&u) + inf(&lcp.f);
+    let residual = if scale > 0.0 {
+        inf(&difference) / scale
+    } else {
+        0.0
+    };
+    let seconds = clock.elapsed().as_secs_f64();
+    let solution = crate::lcp::LcpSolution {
+        u,
+        lambda: vec![0.0; lcp.m()],
+        iterations: 1,
+        kkt_residual: residual,
+        seconds,
+        factorizations: 1,
+        low_rank_updates: 0,
+        multiplier_noise: 0.0,
+        iterative_steps: 0,
+        krylov_iterations: 0,
+    };
+    let values = d.full(&solution);
+    let cells = d.mesh.cell_count();
+    Ok(ObstacleSolution {
+        discretization: d,
+        values,
+        iterations: 1,
+        factorizations: 1,
+        low_rank_updates: 0,
+        levels: vec![(cells, 1)],
+        kkt_residual: residual,
+        seconds,
+        solve_seconds: seconds,
+        multiplier_noise: 0.0,
+        iterative_steps: 0,
+        krylov_iterations: 0,
+    })
+}
 
 /// A user's number as a message prints it: as written for magnitudes in [10⁻³, 10⁶)
 /// and zero, in scientific notation otherwise (`1e-300` is not three hundred digits).

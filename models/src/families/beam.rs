@@ -47,6 +47,7 @@ const fn pair(
         alpha_when_zero: alpha,
         memory: Some(MemoryModel::per_cell(BYTES_PER_ELEMENT)),
         nodal: false,
+        parameters: &[],
         solve,
     }
 }

@@ -43,6 +43,7 @@ const fn pair(
         alpha_when_zero: ALPHA_WHEN_CI_VANISHES,
         memory: Some(MemoryModel::per_cell(bytes_per_triangle)),
         nodal,
+        parameters: &[],
         solve,
     }
 }

@@ -3,3 +3,4 @@
 
 pub mod beam;
 pub mod membrane;
+pub mod plate;
