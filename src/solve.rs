@@ -210,7 +210,7 @@ fn print(report: &Report, json: bool) -> Result<(), String> {
     println!("{}", summary(report));
     // on stderr: a summary piped to a file stays a summary
     for warning in &report.solve.warnings {
-        eprintln!("warning ({} {}): {warning}", report.scene, report.pair);
+        eprintln!("warning: {warning}");
     }
     Ok(())
 }

@@ -167,7 +167,7 @@ fn bad_kirchhoff_input_is_refused_by_name() {
         (&["solve", "kirchhoff-obstacle", "--pair", "p2-p0"], "p2-p0"),
         (
             &["solve", "kirchhoff-obstacle", "--mesh-size", "0"],
-            "mesh size",
+            "--mesh-size 0 is out of range",
         ),
         (&["solve", "kirchhoff-obstacle", "--alpha", "-1"], "α"),
         // inside the stability range but near the plain method: the failure names α
@@ -211,4 +211,77 @@ fn rounding_below_the_refusal_is_a_warning() {
     assert!(warned(&heavy), "{heavy}");
     let plain = solve_json("kirchhoff-obstacle", &[]);
     assert!(!warned(&plain), "{plain}");
+}
+
+/// A mesh whose supports fix every DOF to 0 is refused, not solved to u ≡ 0 (the
+/// trapezoid of five cells has no interior vertex: under membrane-flat's u = 0 its P1
+/// membrane has nothing left to solve); a mesh with few free unknowns is solved with a
+/// warning (the clamped Argyris square on one cell per corner keeps one, Morley's simply
+/// supported one, 294 % off at the centre, five); and the mesh limit is each pair's own
+/// memory estimate: Morley passes N = 200, beyond the Argyris limit of the shared
+/// machine, and matches Navier's value there (Morley converges as h², 1.2e-4 off at N = 200), while Argyris with the obstacle at N = 256
+/// is refused with the memory it would need.
+#[test]
+fn meshes_without_free_unknowns_are_refused_and_each_pair_has_its_own_limit() {
+    let trapezoid = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/trapezoid_parametric.msh"
+    );
+    let run = fem_forms(&[
+        "solve",
+        "membrane-flat",
+        "--msh",
+        trapezoid,
+        "--pair",
+        "p1-p0",
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && stderr.contains("fix every DOF"),
+        "{stderr}"
+    );
+    for (scene, args) in [
+        ("kirchhoff-obstacle", &["--mesh-size", "1"][..]),
+        (
+            "kirchhoff-square",
+            &[
+                "--mesh-size",
+                "1",
+                "--pair",
+                "morley-p0",
+                "--support",
+                "simply-supported",
+            ][..],
+        ),
+    ] {
+        let coarse = solve_json(scene, args);
+        assert!(
+            coarse["warnings"]
+                .to_string()
+                .contains("free primal unknowns"),
+            "{coarse}"
+        );
+    }
+    let fine = solve_json(
+        "kirchhoff-square",
+        &[
+            "--mesh-size",
+            "200",
+            "--pair",
+            "morley-p0",
+            "--support",
+            "simply-supported",
+        ],
+    );
+    let w = number(&fine, "centre_deflection");
+    assert!(
+        (w / navier_centre_deflection() - 1.0).abs() < 2e-4,
+        "Morley N = 200: {w}"
+    );
+    let run = fem_forms(&["solve", "kirchhoff-obstacle", "--mesh-size", "256"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && stderr.contains("--mesh-size 256 with argyris-p0 needs about"),
+        "{stderr}"
+    );
 }

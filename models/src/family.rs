@@ -187,10 +187,11 @@ pub fn families() -> &'static [&'static dyn Family] {
     &FAMILIES
 }
 
-static FAMILIES: [&dyn Family; 3] = [
+static FAMILIES: [&dyn Family; 4] = [
     &crate::families::beam::BEAMS,
     &crate::families::membrane::MEMBRANES,
     &crate::families::plate::PLATES,
+    &crate::families::kirchhoff::KIRCHHOFF,
 ];
 
 /// The family called `name`.

@@ -174,9 +174,9 @@ pub trait Quantities<G: Geometry>: 'static {
         }
     }
 
-    /// The memory a solve of model `M` needs on `scene`'s domain.
-    fn memory<M: Model>(pair: &Pair, scene: &Scene) -> MemoryModel {
-        let _ = scene;
+    /// The memory a solve of model `M` needs on `scene`'s domain at size `n`.
+    fn memory<M: Model>(pair: &Pair, scene: &Scene, n: usize) -> MemoryModel {
+        let _ = (scene, n);
         pair.memory.unwrap_or_else(MemoryModel::of_model::<M>)
     }
 
@@ -345,7 +345,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         }
     }
     let n = settings.mesh_size.unwrap_or(scene.mesh_size);
-    let memory = Q::memory::<M>(pair, scene);
+    let memory = Q::memory::<M>(pair, scene, n);
     let size_text = size_text(scene, pair, n);
     // without an obstacle the problem is one linear solve: nothing to nest for
     let nested =

@@ -573,6 +573,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         let dofs = finest.system_dofs::<M>()?;
         let constraints = finest.constraints::<M>(&dofs, &coefficients, &self.supports)?;
         warnings.extend(constraints.warnings().iter().cloned());
+        warnings.extend(free_unknowns::<M>(finest, &dofs, &constraints)?);
         if !self.unconstrained {
             self.check_feasible(finest, &dofs, &constraints, &data)?;
         }
@@ -1316,6 +1317,45 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
 /// (bernoulli-flat, q = 100, 256 elements: 1.9e-7 at the default 1e-2, 2.3e-5 at 1e3,
 /// 1.1e-4 at 1e4), and the contact set widens without an open gap to show it.
 pub const LARGE_ALPHA: f64 = 1e3;
+
+/// Fewer free primal unknowns than this on the finest mesh earn a warning: the answer is
+/// then a coarse-mesh approximation, off by O(1) in what it reports (Morley's simply
+/// supported square on one cell per corner: +294 % at the centre).
+pub const FEW_UNKNOWNS: usize = 16;
+
+/// Refuses a mesh on which the supports fix every primal DOF to 0 (the answer would be
+/// 0 whatever the load: the Kirchhoff square of one cell per corner), and warns where
+/// fewer than [`FEW_UNKNOWNS`] are free (with none free and nonzero boundary data, u_h
+/// is the data's interpolant).
+fn free_unknowns<M: Model>(
+    mesh: &impl Mesh,
+    dofs: &crate::SystemDofs,
+    constraints: &Constraints,
+) -> Result<Option<String>> {
+    let reduction = constraints.reduction(dofs.dof_count())?;
+    let multiplier = multiplier_field::<M>()?;
+    let multipliers = dofs.range(multiplier).unwrap_or(0..0);
+    let free = reduction
+        .free()
+        .iter()
+        .filter(|d| !multipliers.contains(d))
+        .count();
+    let homogeneous = (0..dofs.dof_count())
+        .filter(|d| !multipliers.contains(d) && reduction.free_index(*d).is_none())
+        .all(|d| reduction.fixed_value(d) == 0.0);
+    if free == 0 && homogeneous {
+        return Err(Error::Input(format!(
+            "the supports fix every DOF of the primal fields on this mesh of {} cells: the solution would be 0 whatever the load; refine the mesh",
+            mesh.cell_count()
+        )));
+    }
+    Ok((free < FEW_UNKNOWNS).then(|| {
+        format!(
+            "the mesh of {} cells leaves {free} free primal unknowns: the answer is a coarse-mesh approximation, possibly off by O(1) in every quantity reported; refine the mesh",
+            mesh.cell_count()
+        )
+    }))
+}
 
 /// The solution of `d` with every constraint inactive: `Λ = 0` and `A U = F` by sparse
 /// Cholesky (`A`, the primal block of `B_h`, is SPD for `α < 1/C_I`); its residual is

@@ -2,5 +2,6 @@
 //! own quantities.
 
 pub mod beam;
+pub mod kirchhoff;
 pub mod membrane;
 pub mod plate;

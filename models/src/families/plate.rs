@@ -350,7 +350,7 @@ pub fn cold_coarsest_warning(sizes: &[usize], coarsest: usize) -> Option<String>
 pub const SOFT_SUPPORT_LAYER: f64 = 0.8;
 
 impl<G: Geometry> Quantities<G> for Plates {
-    fn memory<M: Model>(pair: &Pair, scene: &Scene) -> MemoryModel {
+    fn memory<M: Model>(pair: &Pair, scene: &Scene, _: usize) -> MemoryModel {
         match scene.domain {
             Domain::Disk { curved: true, .. } => CURVED_MEMORY,
             _ => pair.memory.unwrap_or_else(MemoryModel::of_model::<M>),

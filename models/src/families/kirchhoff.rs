@@ -1,0 +1,671 @@
+//! Kirchhoff plates (docs/mathematics.md §9) on the C¹ Argyris quintic and the
+//! non-conforming Morley quadratic, with or without an obstacle. The family's own
+//! quantities: the centre deflection against the series, the largest deflection, the
+//! contact area with its holes filled, and λ_h over the contact interior read raw and
+//! patch-averaged (the cure of the Argyris multiplier's scatter).
+
+use crate::data::Data;
+use crate::family::{Adjustment, Family, Opt, Pair, PairSolve};
+use crate::geometry::{halving_sizes, Fields};
+use crate::kirchhoff::{kirchhoff_argyris_p0, kirchhoff_argyris_p1disc, kirchhoff_morley_p0};
+use crate::run::{run, Quantities, Report, Run};
+use crate::scene::{Domain, Load, Part, Posed, Scene, Support};
+use fem_runtime::element::triangle::TriangleBasis;
+use fem_runtime::problem::{MemoryModel, ObstacleSide};
+use fem_runtime::stabilization::Alpha;
+use fem_runtime::{Error, Model, Result, TriangleMesh};
+use serde::Serialize;
+use std::sync::Arc;
+
+/// The Kirchhoff plate family.
+pub struct KirchhoffPlates;
+
+/// The registry's Kirchhoff family.
+pub static KIRCHHOFF: KirchhoffPlates = KirchhoffPlates;
+
+/// The default α of the Argyris pairs as a fraction of `1/C_I` (docs/mathematics.md §1:
+/// stable for `0 < α < 1/C_I`; ½ is the middle of the range).
+pub const ALPHA_FRACTION: f64 = 0.5;
+
+/// The default α of Morley–P0, where `C_I = 0` (every α > 0 is stable): the term adds
+/// `α h⁴ |T|` to the multiplier's diagonal and shifts the obstacle by `α h⁴ f` where
+/// λ = 0: at q = 20, 0.04 % of the gap 0.002 at N = 32 and 10 % at N = 8 (α = 1 shifted
+/// it by 4 % at N = 32 and grew the contact area from 0.25 to 0.31); below 1e-4 Newton
+/// needs more iterations on the coarse levels (40 at N = 4 for α = 1e-12).
+pub const MORLEY_ALPHA: f64 = 0.01;
+
+/// The contact interior of the λ-scatter measure: contact cells whose centroid is at
+/// least this far from every cell outside the contact set (a fifth of the contact
+/// radius, about 0.25, at q = 20 on the flat obstacle), and two vertex rings in.
+pub const INTERIOR_MARGIN: f64 = 0.05;
+
+const fn pair(name: &'static str, note: &'static str, solve: PairSolve) -> Pair {
+    Pair {
+        name,
+        note,
+        alpha: Alpha::FromInverseConstant(ALPHA_FRACTION),
+        alpha_when_zero: MORLEY_ALPHA,
+        // the pair's own model: `KirchhoffPlates::memory`
+        memory: None,
+        nodal: false,
+        parameters: &[],
+        solve,
+    }
+}
+
+static PAIRS: [Pair; 3] = [
+    pair(
+        "argyris-p0",
+        "w ∈ Argyris (P5, C¹), λ ∈ P0; α = ½/C_I",
+        run::<kirchhoff_argyris_p0::Model, TriangleMesh, KirchhoffPlates>,
+    ),
+    pair(
+        "argyris-p1disc",
+        "w ∈ Argyris, λ ∈ P1 discontinuous; α = ½/C_I",
+        run::<kirchhoff_argyris_p1disc::Model, TriangleMesh, KirchhoffPlates>,
+    ),
+    pair(
+        "morley-p0",
+        "w ∈ Morley (P2, non-conforming), λ ∈ P0; C_I = 0, α = 0.01",
+        run::<kirchhoff_morley_p0::Model, TriangleMesh, KirchhoffPlates>,
+    ),
+];
+
+/// A named obstacle of the Kirchhoff scenes, above the plate (`w ≤ ψ`), `r` the distance
+/// from the centre of the square: `ψ = gap + curvature · r²` (`Δ²ψ = 0`, so λ = q in
+/// the interior of contact).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NamedObstacle {
+    /// `flat` or `curved`.
+    pub name: &'static str,
+    /// The gap at the centre.
+    pub gap: f64,
+    /// The coefficient of r².
+    pub curvature: f64,
+}
+
+/// The obstacles `--obstacle` names.
+pub const OBSTACLES: [NamedObstacle; 2] = [
+    NamedObstacle {
+        name: "flat",
+        gap: 0.002,
+        curvature: 0.0,
+    },
+    NamedObstacle {
+        name: "curved",
+        gap: 0.002,
+        curvature: 0.01,
+    },
+];
+
+/// What a Kirchhoff scene's report compares with, and how it names its obstacle.
+#[derive(Clone, Debug)]
+pub struct KirchhoffFacts {
+    /// The obstacle's name (`none`, `flat`, `curved`).
+    pub obstacle: &'static str,
+}
+
+/// Puts `obstacle` (or none) above the plate of `scene`.
+fn place(scene: &mut Scene, obstacle: Option<NamedObstacle>) {
+    match obstacle {
+        Some(o) => {
+            let (gap, curvature) = (o.gap, o.curvature);
+            scene.set_data(
+                "ψ",
+                Data::shared(move |x| {
+                    let r2 = (x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2);
+                    gap + curvature * r2
+                }),
+            );
+            scene.obstacle = true;
+        }
+        None => scene.obstacle = false,
+    }
+    scene.reference = Some(Arc::new(KirchhoffFacts {
+        obstacle: obstacle.map_or("none", |o| o.name),
+    }));
+}
+
+fn kirchhoff_scene(
+    name: &'static str,
+    description: &'static str,
+    load: f64,
+    obstacle: Option<NamedObstacle>,
+    mesh_size: usize,
+) -> Scene {
+    let mut scene = Scene::new(
+        name,
+        description,
+        "kirchhoff",
+        Domain::square(0.0, 1.0),
+        mesh_size,
+    )
+    .with_parameter("D", 1.0)
+    .with_parameter("ν", 0.3)
+    .with_data("f", Data::shared(|_| 1.0))
+    .with_support(Part::All, Support::Clamped);
+    scene.load = Some(Load {
+        default: load,
+        scales: vec!["f".into()],
+        symbol: "q",
+        nonnegative: false,
+    });
+    scene.side = ObstacleSide::Above;
+    place(&mut scene, obstacle);
+    scene.studies = match obstacle {
+        Some(_) => vec!["convergence", "lambda-scatter"],
+        None => vec!["convergence"],
+    };
+    scene
+}
+
+impl Family for KirchhoffPlates {
+    fn name(&self) -> &'static str {
+        "kirchhoff"
+    }
+
+    fn description(&self) -> &'static str {
+        "Kirchhoff plates (Argyris, Morley) on triangles, with or without an obstacle"
+    }
+
+    fn pairs(&self) -> &'static [Pair] {
+        &PAIRS
+    }
+
+    fn options(&self) -> &'static [Opt] {
+        &[
+            Opt::MeshSize,
+            Opt::Load,
+            Opt::Alpha,
+            Opt::Pair,
+            Opt::Solver,
+            Opt::Cold,
+            Opt::Support,
+            Opt::Obstacle,
+        ]
+    }
+
+    fn scenes(&self) -> Vec<Scene> {
+        vec![
+            kirchhoff_scene(
+                "kirchhoff-square",
+                "unit square Kirchhoff plate (clamped or simply supported), uniform load, no contact; centre deflection against the series",
+                1.0,
+                None,
+                16,
+            ),
+            kirchhoff_scene(
+                "kirchhoff-obstacle",
+                "clamped unit square Kirchhoff plate pushed up by q = 5 against w ≤ 0.002 (--obstacle curved: 0.002 + 0.01 r²)",
+                5.0,
+                Some(OBSTACLES[0]),
+                32,
+            ),
+        ]
+    }
+
+    fn aliases(&self) -> &'static [(&'static str, &'static str)] {
+        &[
+            ("bending_stiffness", "D"),
+            ("poisson_ratio", "ν"),
+            ("nu", "ν"),
+            ("load", "f"),
+            ("obstacle", "ψ"),
+            ("psi", "ψ"),
+        ]
+    }
+
+    /// `--obstacle none|flat|curved` places the named obstacle; supports as every family.
+    fn adjust(&self, scene: &mut Scene, adjustment: &Adjustment) -> Result<()> {
+        match adjustment {
+            Adjustment::Obstacle(name) => {
+                let obstacle = match name.as_str() {
+                    "none" => None,
+                    other => Some(
+                        OBSTACLES
+                            .iter()
+                            .copied()
+                            .find(|o| o.name == other)
+                            .ok_or_else(|| {
+                                Error::Input(format!(
+                                    "unknown obstacle `{other}`; the obstacles are none, flat (w ≤ 0.002), curved (w ≤ 0.002 + 0.01 r²)"
+                                ))
+                            })?,
+                    ),
+                };
+                place(scene, obstacle);
+                Ok(())
+            }
+            Adjustment::Support(support) => {
+                for s in &mut scene.supports {
+                    s.support = *support;
+                }
+                Ok(())
+            }
+            Adjustment::NoObstacle => {
+                place(scene, None);
+                Ok(())
+            }
+        }
+    }
+}
+
+/// The estimated peak memory of a Kirchhoff solve on the N×N×2 mesh, in bytes: without
+/// recovery of the multiplier 0.93 GB at N = 128 (kirchhoff-square) scaled by `N^2.3`
+/// (the factor's fill; 0.6 GB at 104 with the obstacle); with it, 6.5 GB at 128 scaled
+/// by `N²` (5.0 GB at 112). The recovery (an LU of the saddle-point system, where
+/// `C = αh⁴` falls below the rounding of `G − BU`) is assumed for a scene with an
+/// obstacle from N = 112 on, where the default α needs it.
+pub fn argyris_memory_bytes(mesh_size: usize, obstacle: bool) -> f64 {
+    let n = mesh_size as f64 / 128.0;
+    if obstacle && mesh_size >= 112 {
+        6.5e9 * n * n
+    } else {
+        0.93e9 * n.powf(2.3)
+    }
+}
+
+/// The unobstructed centre deflection of the simply supported unit square under a unit
+/// load with D = 1 from Navier's double sine series (Timoshenko and Woinowsky-Krieger
+/// §30): `16/π⁶ Σ_{m,n odd} (−1)^{(m+n)/2−1} / (mn(m²+n²)²)` = 0.0040623527; 200 odd
+/// terms each way leave an error below 1e-12 (the terms fall like `1/m⁵`).
+pub fn navier_centre_coefficient() -> f64 {
+    let mut sum = 0.0;
+    for m in (1..400usize).step_by(2) {
+        for n in (1..400usize).step_by(2) {
+            let sign = if ((m + n) / 2 - 1) % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let (m, n) = (m as f64, n as f64);
+            sum += sign / (m * n * (m * m + n * n).powi(2));
+        }
+    }
+    16.0 / std::f64::consts::PI.powi(6) * sum
+}
+
+/// The clamped unit square's centre deflection in units of `q a⁴/D` (Timoshenko and
+/// Woinowsky-Krieger, *Theory of Plates and Shells*, Table 35, ν = 0.3; six digits).
+pub const CLAMPED_CENTRE_COEFFICIENT: f64 = 0.00126532;
+
+/// How λ is read in the contact interior.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MultiplierRecovery {
+    /// λ_h as computed.
+    Raw,
+    /// The patch average: each vertex gets the area-weighted mean of λ_h over the cells
+    /// around it, each cell the mean of its three vertex values (a continuous P1 field,
+    /// the local L² projection of λ_h onto the patch's constants).
+    PatchAverage,
+    /// The patch average applied twice: a support of about two vertex rings.
+    TwicePatchAverage,
+}
+
+/// λ over the contact interior against its exact value there.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct InteriorMultiplier {
+    /// How λ is read.
+    pub recovery: MultiplierRecovery,
+    /// Number of interior cells.
+    pub cells: usize,
+    /// The exact λ there: `q` (`λ = s(DΔ²ψ − f)` with `Δ²ψ = 0`, `s = −1`, `f = q`).
+    pub exact: f64,
+    /// Smallest value (P1disc: over the cells' vertex values).
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+    /// Mean value.
+    pub mean: f64,
+    /// `max |λ − exact| / exact`.
+    pub max_relative_error: f64,
+}
+
+impl Quantities<TriangleMesh> for KirchhoffPlates {
+    /// Morley's own model; Argyris's measured one on the N×N×2 square (the recovery
+    /// regime included), its fit `a + b log₂(cells)` elsewhere.
+    fn memory<M: Model>(_: &Pair, scene: &Scene, n: usize) -> MemoryModel {
+        let argyris = M::FIELDS.iter().any(|f| f.element.needs_transformation())
+            && M::FIELDS
+                .iter()
+                .any(|f| f.element == fem_runtime::ElementKind::Argyris);
+        if !argyris {
+            return MemoryModel::of_model::<M>();
+        }
+        match scene.domain {
+            Domain::Rectangle { cells, .. } if n > 0 => {
+                let triangles = 2.0 * (n * n * cells[0] * cells[1]) as f64;
+                MemoryModel::per_cell(argyris_memory_bytes(n, scene.obstacle) / triangles)
+            }
+            _ => MemoryModel {
+                per_cell: -4.6e3,
+                per_cell_log: 2.2e3,
+                floor: 10e3,
+            },
+        }
+    }
+
+    fn check(_: &Scene, posed: &Posed) -> Result<()> {
+        if let Some(nu) = posed.parameter("ν") {
+            if !(nu > -1.0 && nu < 0.5) {
+                return Err(Error::Input(format!(
+                    "Poisson's ratio ν = {nu} must lie in (−1, ½)"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn add<M: Model>(run: &Run<'_, M, TriangleMesh>, report: &mut Report) -> Result<()> {
+        let solution = &run.solved.solution;
+        let q = run.posed.load.unwrap_or(0.0);
+        let facts = run.scene.reference::<KirchhoffFacts>();
+        report.set(
+            "support",
+            run.scene
+                .supports
+                .iter()
+                .map(|s| s.support.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        );
+        report.set("obstacle", facts.map_or("ψ", |f| f.obstacle));
+        let w = run.constrained_field();
+        let view = solution.view(w);
+        let basis = TriangleBasis::new(view.map.element());
+        report.set("max_deflection", max_deflection(&view, &basis));
+        if let Some(centre) = run.scene.domain.centre() {
+            let deflection = run.value_at(&centre).ok_or_else(|| {
+                Error::Input(format!(
+                    "the centre ({}, {}) is outside the mesh",
+                    centre[0], centre[1]
+                ))
+            })?;
+            report.set("centre_deflection", deflection);
+            if !run.scene.obstacle {
+                if let Some(reference) = series_reference(run.scene, run.posed) {
+                    report.set("reference_centre_deflection", reference);
+                    // q = 0: both deflections are 0 exactly, and so is the error
+                    let relative = if reference != 0.0 {
+                        Some((deflection - reference) / reference)
+                    } else {
+                        (deflection == 0.0).then_some(0.0)
+                    };
+                    report.set("relative_error", relative);
+                }
+            }
+        }
+        let Fields::Triangles { mesh, cell, .. } = run.fields else {
+            return Ok(());
+        };
+        if run.scene.obstacle {
+            let contact: Vec<bool> = cell
+                .iter()
+                .find(|(n, _)| *n == "contact")
+                .map(|(_, v)| v.iter().map(|&s| s > 0.0).collect())
+                .unwrap_or_default();
+            report.solve.contact_area = Some(filled_area(mesh, &contact));
+            let interior = if q > 0.0 {
+                interior_cells(mesh, &contact)
+            } else {
+                Vec::new()
+            };
+            let morley = run.pair.name.starts_with("morley");
+            // Morley's patch average measured worse than its raw λ_h (max relative
+            // error 1.16 against 0.44 at N = 32, q = 20): its scatter is not the Argyris
+            // line-force tail
+            let recovery = if morley {
+                MultiplierRecovery::Raw
+            } else {
+                MultiplierRecovery::PatchAverage
+            };
+            let statistics = |r| interior_statistics(solution, &interior, r, q);
+            report.set("interior_multiplier", statistics(recovery));
+            report.set(
+                "interior_multiplier_raw",
+                statistics(MultiplierRecovery::Raw),
+            );
+            report.set(
+                "interior_multiplier_twice_averaged",
+                statistics(MultiplierRecovery::TwicePatchAverage),
+            );
+            let n = run.settings.mesh_size.unwrap_or(run.scene.mesh_size);
+            let newton =
+                run.settings.solver == fem_runtime::obstacle::VariationalSolver::SemismoothNewton;
+            if run.settings.nested && newton {
+                let sizes = halving_sizes(n, true, Self::COARSEST, false);
+                if let Some(w) = super::plate::cold_coarsest_warning(&sizes, Self::COARSEST) {
+                    report.warn(w);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The series' centre deflection of an unobstructed unit square, `c q a⁴/D` (clamped:
+/// the tabulated coefficient; simply supported: Navier's series summed); `None` for
+/// another domain or mixed supports.
+fn series_reference(scene: &Scene, posed: &Posed) -> Option<f64> {
+    let Domain::Rectangle { x, y, .. } = scene.domain else {
+        return None;
+    };
+    if x != [0.0, 1.0] || y != [0.0, 1.0] {
+        return None;
+    }
+    let supports: Vec<Support> = scene.supports.iter().map(|s| s.support).collect();
+    let coefficient = match supports.as_slice() {
+        [Support::Clamped] => CLAMPED_CENTRE_COEFFICIENT,
+        [Support::SimplySupported { .. }] => navier_centre_coefficient(),
+        _ => return None,
+    };
+    Some(coefficient * posed.load? / posed.parameter("D")?)
+}
+
+/// `max |w_h|` over each cell's vertices, edge midpoints and centroid.
+fn max_deflection(
+    view: &fem_runtime::element::triangle::TriangleField,
+    basis: &TriangleBasis,
+) -> f64 {
+    const POINTS: [[f64; 2]; 7] = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [0.0, 1.0],
+        [0.5, 0.0],
+        [0.5, 0.5],
+        [0.0, 0.5],
+        [1.0 / 3.0, 1.0 / 3.0],
+    ];
+    let mut largest = 0.0f64;
+    for c in 0..view.mesh.cell_count() {
+        for xi in POINTS {
+            largest = largest.max(view.value(basis, c, xi).abs());
+        }
+    }
+    largest
+}
+
+/// The area enclosed by the outer boundary of the cells in `contact`: the contact cells
+/// and every other cell that cannot be reached from a boundary cell through non-contact
+/// cells across edges (a hole of zero λ_h inside the contact set counts as contact,
+/// docs/mathematics.md §9). Cells touched only partly count fully, so the area carries
+/// an O(h) error at the free boundary.
+pub fn filled_area(mesh: &TriangleMesh, contact: &[bool]) -> f64 {
+    let cells = mesh.cell_count();
+    if contact.len() != cells {
+        return 0.0;
+    }
+    let mut outside = vec![false; cells];
+    let mut stack = Vec::new();
+    for &(e, _) in mesh.boundary_edges() {
+        let (c, _) = mesh.edge_cells(e);
+        if !contact[c] && !outside[c] {
+            outside[c] = true;
+            stack.push(c);
+        }
+    }
+    while let Some(c) = stack.pop() {
+        for e in mesh.cell_edges(c) {
+            let (a, b) = mesh.edge_cells(e);
+            for n in std::iter::once(a).chain(b) {
+                if !contact[n] && !outside[n] {
+                    outside[n] = true;
+                    stack.push(n);
+                }
+            }
+        }
+    }
+    // from +0: an empty f64 sum is −0
+    (0..cells)
+        .filter(|&c| !outside[c])
+        .fold(0.0, |sum, c| sum + mesh.area(c))
+}
+
+/// The contact interior: contact cells whose three vertices are in contact (every cell
+/// around them is a contact cell), and the same once more, so that every interior cell
+/// is two vertex rings away from the free boundary (where λ carries a line force), and
+/// whose centroid is at least [`INTERIOR_MARGIN`] from the centroid of every cell
+/// outside the contact set.
+pub fn interior_cells(mesh: &TriangleMesh, contact: &[bool]) -> Vec<usize> {
+    if contact.len() != mesh.cell_count() {
+        return Vec::new();
+    }
+    let distance = frontier_distances(mesh, contact);
+    let erode = |inside: &[bool]| -> Vec<bool> {
+        let mut vertex = vec![true; mesh.vertex_count()];
+        for (c, &on) in inside.iter().enumerate() {
+            if !on {
+                for v in mesh.cell(c) {
+                    vertex[v] = false;
+                }
+            }
+        }
+        (0..mesh.cell_count())
+            .map(|c| inside[c] && mesh.cell(c).iter().all(|&v| vertex[v]))
+            .collect()
+    };
+    let once = erode(contact);
+    let twice = erode(&once);
+    (0..mesh.cell_count())
+        .filter(|&c| twice[c] && distance[c] >= INTERIOR_MARGIN)
+        .collect()
+}
+
+/// For each contact cell, the distance from its centroid to the nearest centroid of a
+/// cell outside the contact set (∞ when there is none); 0 for the cells outside.
+pub fn frontier_distances(mesh: &TriangleMesh, contact: &[bool]) -> Vec<f64> {
+    let centroid = |c: usize| {
+        let x = mesh.cell_coordinates(c);
+        [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0]
+    };
+    // only the cells outside contact next to it can be nearest
+    let frontier: Vec<[f64; 2]> = (0..mesh.cell_count())
+        .filter(|&c| {
+            !contact[c]
+                && mesh.cell_edges(c).iter().any(|&e| {
+                    let (a, b) = mesh.edge_cells(e);
+                    contact[a] || b.is_some_and(|b| contact[b])
+                })
+        })
+        .map(centroid)
+        .collect();
+    (0..mesh.cell_count())
+        .map(|c| {
+            if !contact[c] {
+                return 0.0;
+            }
+            let x = centroid(c);
+            frontier
+                .iter()
+                .map(|y| (x[0] - y[0]).hypot(x[1] - y[1]))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect()
+}
+
+/// The cell values `values` patch-averaged `passes` times
+/// ([`MultiplierRecovery::PatchAverage`]).
+pub fn averaged_cells(mesh: &TriangleMesh, values: &[f64], passes: usize) -> Vec<f64> {
+    let mut cells = values.to_vec();
+    for _ in 0..passes {
+        let at_vertices = patch_average(mesh, &cells);
+        cells = (0..mesh.cell_count())
+            .map(|c| mesh.cell(c).iter().map(|&v| at_vertices[v]).sum::<f64>() / 3.0)
+            .collect();
+    }
+    cells
+}
+
+/// The multiplier's cell means (P0: its values; P1disc: the mean of the three).
+pub fn cell_means(solution: &fem_runtime::obstacle::ObstacleSolution<TriangleMesh>) -> Vec<f64> {
+    let d = &solution.discretization;
+    let map = d.dofs.map(d.multiplier_field).expect("the multiplier");
+    let lambda = solution.field(d.multiplier_field);
+    (0..d.mesh.cell_count())
+        .map(|c| {
+            let dofs = map.cell_dofs(c);
+            dofs.iter().map(|&k| lambda[k]).sum::<f64>() / dofs.len() as f64
+        })
+        .collect()
+}
+
+/// The patch average of the cell values `means` at every vertex
+/// ([`MultiplierRecovery::PatchAverage`]).
+fn patch_average(mesh: &TriangleMesh, means: &[f64]) -> Vec<f64> {
+    let (mut sum, mut weight) = (
+        vec![0.0; mesh.vertex_count()],
+        vec![0.0; mesh.vertex_count()],
+    );
+    for (c, &m) in means.iter().enumerate() {
+        let area = mesh.area(c);
+        for v in mesh.cell(c) {
+            sum[v] += area * m;
+            weight[v] += area;
+        }
+    }
+    sum.iter().zip(&weight).map(|(s, w)| s / w).collect()
+}
+
+/// λ over `interior` read as `recovery`, against the exact `q`; `None` for no cells.
+pub fn interior_statistics(
+    solution: &fem_runtime::obstacle::ObstacleSolution<TriangleMesh>,
+    interior: &[usize],
+    recovery: MultiplierRecovery,
+    q: f64,
+) -> Option<InteriorMultiplier> {
+    if interior.is_empty() {
+        return None;
+    }
+    let d = &solution.discretization;
+    let values: Vec<f64> = match recovery {
+        MultiplierRecovery::Raw => {
+            let map = d.dofs.map(d.multiplier_field)?;
+            let lambda = solution.field(d.multiplier_field);
+            interior
+                .iter()
+                .flat_map(|&c| map.cell_dofs(c).iter().map(|&k| lambda[k]))
+                .collect()
+        }
+        MultiplierRecovery::PatchAverage | MultiplierRecovery::TwicePatchAverage => {
+            let passes = if recovery == MultiplierRecovery::PatchAverage {
+                1
+            } else {
+                2
+            };
+            let cells = averaged_cells(&d.mesh, &cell_means(solution), passes);
+            interior.iter().map(|&c| cells[c]).collect()
+        }
+    };
+    let min = values.iter().cloned().fold(f64::INFINITY, f64::min);
+    let max = values.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    Some(InteriorMultiplier {
+        recovery,
+        cells: interior.len(),
+        exact: q,
+        min,
+        max,
+        mean: values.iter().sum::<f64>() / values.len() as f64,
+        max_relative_error: (max - q).abs().max((min - q).abs()) / q,
+    })
+}
