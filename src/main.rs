@@ -337,7 +337,7 @@ fn default_job(out: &Path) -> Result<(), String> {
         .into_iter()
         .filter(|e| e.in_default_job)
         .collect();
-    let beams: Vec<_> = fem_forms::models::family::scenes()
+    let beams: Vec<_> = fem_forms::models::families::scenes()
         .into_iter()
         .filter(|s| s.family == "beam" && s.in_default_job)
         .collect();
@@ -347,7 +347,7 @@ fn default_job(out: &Path) -> Result<(), String> {
                 load: Some(q),
                 ..Default::default()
             };
-            let outcome = fem_forms::models::run::solve(scene, &settings)
+            let outcome = fem_forms::models::families::solve(scene, &settings)
                 .map_err(|e| format!("{}: {e}", scene.name))?;
             table_row(&outcome.report);
             let path = out.join(format!("{}-q{q}.svg", scene.name));
@@ -1104,8 +1104,8 @@ fn run(cli: Cli) -> Result<(), String> {
                     scene.accuracy = file.accuracy;
                     return solve::solve_scene(scene, &options, &cli.out);
                 }
-                (Some(scene), None) if fem_forms::models::family::scene(&scene).is_some() => {
-                    let scene = fem_forms::models::family::scene(&scene).expect("found");
+                (Some(scene), None) if fem_forms::models::families::scene(&scene).is_some() => {
+                    let scene = fem_forms::models::families::scene(&scene).expect("found");
                     return solve::solve_scene(scene, &options, &cli.out);
                 }
                 (Some(scene), None) => find(&scene).ok_or_else(|| {

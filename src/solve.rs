@@ -1,11 +1,12 @@
 //! `fem-forms solve`: a scene (built-in or from a file) with the command line's options,
-//! through the registry's one path ([`fem_forms::models::run::solve`]), printed as a
+//! through the registry's one path ([`fem_forms::models::families::solve`]), printed as a
 //! summary or as JSON, with its chart or ParaView file where asked.
 
 use crate::{SolveOptions, SolverName};
-use fem_forms::models::family::{self, Adjustment, Opt};
+use fem_forms::models::families;
+use fem_forms::models::family::{Adjustment, Opt};
 use fem_forms::models::geometry::Fields;
-use fem_forms::models::run::{self, Outcome, Report, Settings};
+use fem_forms::models::report::{Outcome, Report, Settings};
 use fem_forms::models::scene::{Scene, Support};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
@@ -107,7 +108,7 @@ fn settings(options: &SolveOptions) -> Result<Settings, String> {
 
 /// Solves `scene` as `options` ask and prints the result.
 pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Result<(), String> {
-    let family = family::family(scene.family)
+    let family = families::family(scene.family)
         .ok_or_else(|| format!("scene `{}` names no known family", scene.name))?;
     let unused = unused(&scene, family.options());
     let list: Vec<&str> = family
@@ -134,7 +135,7 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
     for (option, why) in unused {
         options.refuse_options(&[option], &why)?;
     }
-    let pair = run::pair_of(&scene, options.pair.as_deref()).map_err(|e| e.to_string())?;
+    let pair = families::pair_of(&scene, options.pair.as_deref()).map_err(|e| e.to_string())?;
     if pair.nodal {
         options.refuse_options(
             &[Opt::Alpha, Opt::Solver],
@@ -193,7 +194,7 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
         scene = scene.on_mesh_file(path.clone());
         settings.mesh_size = Some(options.mesh_size.unwrap_or(0));
     }
-    let outcome = run::solve(&scene, &settings).map_err(|e| format!("{}: {e}", scene.name))?;
+    let outcome = families::solve(&scene, &settings).map_err(|e| format!("{}: {e}", scene.name))?;
     print(&outcome.report, options.json)?;
     write_outputs(&scene, &outcome, options, out)
 }

@@ -177,6 +177,12 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// [`Coefficients`] refuses other values.
     const POSITIVE_PARAMS: &'static [usize] = &[];
 
+    /// The constrained field: the `obstacle:` role's field ([`Model::OBSTACLE`]), else
+    /// the first field (a model without a pointwise obstacle, e.g. Signorini's).
+    fn constrained_field() -> usize {
+        Self::OBSTACLE.map_or(0, |[field, _]| field)
+    }
+
     /// Element matrix of `block` of bilinear `form`, row-major into `out`.
     fn element_matrix(
         form: usize,

@@ -3,7 +3,7 @@
 //! [`Pair`] per model, and where it has any, its own quantities ([`crate::run::Quantities`]).
 //! The command line's `list`, `solve` and `study` go through [`families`] alone.
 
-use crate::run::{Outcome, Settings};
+use crate::report::{Outcome, Settings};
 use crate::scene::{Scene, Support};
 use fem_runtime::problem::MemoryModel;
 use fem_runtime::stabilization::Alpha;
@@ -179,70 +179,5 @@ pub trait Family: Sync {
                 self.name()
             ))),
         }
-    }
-}
-
-/// Every family, in the order `list` prints them.
-pub fn families() -> &'static [&'static dyn Family] {
-    &FAMILIES
-}
-
-static FAMILIES: [&dyn Family; 4] = [
-    &crate::families::beam::BEAMS,
-    &crate::families::membrane::MEMBRANES,
-    &crate::families::plate::PLATES,
-    &crate::families::kirchhoff::KIRCHHOFF,
-];
-
-/// The family called `name`.
-pub fn family(name: &str) -> Option<&'static dyn Family> {
-    families().iter().copied().find(|f| f.name() == name)
-}
-
-/// Every built-in scene, family by family.
-pub fn scenes() -> Vec<Scene> {
-    families().iter().flat_map(|f| f.scenes()).collect()
-}
-
-/// The built-in scene called `name`.
-pub fn scene(name: &str) -> Option<Scene> {
-    scenes().into_iter().find(|s| s.name == name)
-}
-
-/// The pairs `scene` takes, its default first: those it names, else its family's.
-pub fn pairs_of(scene: &Scene) -> Vec<&'static Pair> {
-    let Some(family) = family(scene.family) else {
-        return Vec::new();
-    };
-    if scene.pairs.is_empty() {
-        family.pairs().iter().collect()
-    } else {
-        scene
-            .pairs
-            .iter()
-            .filter_map(|name| family.pairs().iter().find(|p| p.name == *name))
-            .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn scene_names_are_unique_and_their_pairs_exist() {
-        let scenes = scenes();
-        for (k, s) in scenes.iter().enumerate() {
-            assert!(
-                !scenes[..k].iter().any(|t| t.name == s.name),
-                "{} twice",
-                s.name
-            );
-            assert_eq!(scene(&s.name).unwrap().name, s.name);
-            assert!(family(s.family).is_some(), "{}", s.family);
-            assert_eq!(pairs_of(s).len(), s.pairs.len().max(pairs_of(s).len()));
-            assert!(!pairs_of(s).is_empty(), "{}", s.name);
-        }
-        assert!(scene("no-such-scene").is_none());
     }
 }

@@ -187,7 +187,7 @@ impl Geometry for IntervalMesh {
             .collect();
         let multiplier = solution.discretization.multiplier_field;
         // the constrained field first (charts draw ψ beside it), then the others
-        let first = crate::run::constrained_field::<M>();
+        let first = M::constrained_field();
         let fields = std::iter::once(first)
             .chain((0..M::FIELDS.len()).filter(|&f| f != multiplier && f != first))
             .map(|f| {

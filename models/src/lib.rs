@@ -19,6 +19,7 @@ pub mod membrane_scenes;
 pub mod mindlin;
 pub mod plate_scenes;
 pub mod registry;
+pub mod report;
 pub mod run;
 pub mod scene;
 pub mod scene_file;

@@ -5,11 +5,11 @@
 //! ([`Report`]); a family adds its own quantities through [`Quantities`].
 
 use crate::data::Data;
-use crate::family::{self, Pair};
+use crate::family::Pair;
 use crate::geometry::{Fields, Geometry};
-use crate::scene::{ExactSolution, Name, Part, Posed, Scene, Support};
+pub use crate::report::{Outcome, Phases, Report, Settings, MAX_REFINEMENT_STEPS};
+use crate::scene::{ExactSolution, Part, Posed, Scene, Support};
 use fem_runtime::lcp::NewtonOptions;
-use fem_runtime::obstacle::hierarchy::LinearSolver;
 use fem_runtime::obstacle::{FirstStart, ObstacleOptions, VariationalSolver};
 use fem_runtime::problem::memory::check_memory;
 use fem_runtime::problem::{
@@ -17,136 +17,11 @@ use fem_runtime::problem::{
 };
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{
-    CurvedTriangleMesh, DataFn, DataId, Diagonal, DirichletPart, Error, FieldId, Model, ParamId,
-    Result, TriangleMesh,
+    CurvedTriangleMesh, DataFn, DataId, DirichletPart, Error, FieldId, Model, ParamId, Result,
+    TriangleMesh,
 };
-use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Instant;
-
-/// What a request may change of a scene's solve (the command line's options).
-#[derive(Clone, Debug)]
-pub struct Settings {
-    /// The pair by name (`None`: the scene's default).
-    pub pair: Option<String>,
-    /// N (`None`: the scene's).
-    pub mesh_size: Option<usize>,
-    /// The load magnitude q (`None`: the scene's; refused where its load is fixed).
-    pub load: Option<f64>,
-    /// α (`None`: the pair's rule).
-    pub alpha: Option<f64>,
-    /// Parameters replacing the scene's, by the model's names (`--thickness` sets `t`).
-    pub parameters: Vec<(Name, f64)>,
-    /// The complementarity solver.
-    pub solver: VariationalSolver,
-    /// The solver of the Newton steps.
-    pub linear_solver: LinearSolver,
-    /// Nested iteration over coarser meshes (`false`: a cold start on the finest).
-    pub nested: bool,
-    /// Rounds of iterative refinement per linear solve (`None`: the family's).
-    pub refinement: Option<usize>,
-    /// How the squares of a structured mesh are split (`None`: the scene's).
-    pub diagonal: Option<Diagonal>,
-    /// Run the rounding experiment (`None`: where the family does).
-    pub rounding_experiment: Option<bool>,
-}
-
-impl Default for Settings {
-    fn default() -> Self {
-        Self {
-            pair: None,
-            mesh_size: None,
-            load: None,
-            alpha: None,
-            parameters: Vec::new(),
-            solver: VariationalSolver::SemismoothNewton,
-            linear_solver: LinearSolver::Auto,
-            nested: true,
-            refinement: None,
-            diagonal: None,
-            rounding_experiment: None,
-        }
-    }
-}
-
-/// Most rounds of iterative refinement per linear solve accepted.
-pub const MAX_REFINEMENT_STEPS: usize = 10;
-
-/// Wall time of the parts of a solve, in seconds.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct Phases {
-    /// Building the meshes.
-    pub meshes: f64,
-    /// Binding the scene to the model and checking it.
-    pub checks: f64,
-    /// The runtime's solve (assembly and every level).
-    pub solve: f64,
-    /// The family's quantities and the output fields.
-    pub evaluation: f64,
-}
-
-/// What a solve reports (the CLI's `--json` object): what every solve has, from the
-/// runtime's report, and the family's own quantities beside it.
-#[derive(Clone, Debug, Serialize)]
-pub struct Report {
-    /// Scene name.
-    pub scene: String,
-    /// Family name.
-    pub family: &'static str,
-    /// Pair name.
-    pub pair: &'static str,
-    /// The domain solved on.
-    pub domain: String,
-    /// N as solved (the beams' elements; a file's refinements).
-    pub mesh_size: usize,
-    /// The load magnitude q (`null` where the scene's load is fixed).
-    pub load: Option<f64>,
-    /// Every parameter of the scene by the model's name, as solved.
-    pub parameters: BTreeMap<String, f64>,
-    /// Each support as `name on parts`.
-    pub supports: Vec<String>,
-    /// The runtime's report.
-    #[serde(flatten)]
-    pub solve: fem_runtime::problem::Report,
-    /// `∫ λ` of the exact solution over the scene's own domain, where known.
-    pub exact_contact_force: Option<f64>,
-    /// The exact contact set's area over the scene's own domain, where known.
-    pub exact_contact_area: Option<f64>,
-    /// The L² error the scene asks for.
-    pub accuracy: Option<f64>,
-    /// Where the time went.
-    pub phases: Phases,
-    /// The family's own quantities (a plate's centre deflection, Hertz's half-width).
-    #[serde(flatten)]
-    pub quantities: BTreeMap<String, serde_json::Value>,
-}
-
-impl Report {
-    /// Sets the family quantity `key`.
-    pub fn set(&mut self, key: &str, value: impl Serialize) {
-        let value = serde_json::to_value(value).unwrap_or(serde_json::Value::Null);
-        self.quantities.insert(key.to_string(), value);
-    }
-
-    /// A family quantity as a number (`None` where absent or not a number).
-    pub fn number(&self, key: &str) -> Option<f64> {
-        self.quantities.get(key).and_then(serde_json::Value::as_f64)
-    }
-
-    /// Adds a warning.
-    pub fn warn(&mut self, warning: impl Into<String>) {
-        self.solve.warnings.push(warning.into());
-    }
-}
-
-/// A solved scene: its report and its fields for output.
-#[derive(Clone, Debug)]
-pub struct Outcome {
-    /// The report.
-    pub report: Report,
-    /// The fields, sampled for charts and ParaView.
-    pub fields: Fields,
-}
 
 /// What a family adds to the one solve: its own quantities, and where it must, its own
 /// settings of the solve. Every method has a default, so a family with nothing of its
@@ -240,67 +115,13 @@ pub struct Run<'r, M: Model, G: Geometry> {
 impl<M: Model, G: Geometry> Run<'_, M, G> {
     /// The constrained field (the model's `obstacle:` role; the first field otherwise).
     pub fn constrained_field(&self) -> usize {
-        constrained_field::<M>()
+        M::constrained_field()
     }
 
     /// The value of the constrained field at `x`, where `x` lies in the mesh.
     pub fn value_at(&self, x: &[f64]) -> Option<f64> {
         G::value_at(&self.solved.solution, self.constrained_field(), x)
     }
-}
-
-/// The constrained field of model `M`: its `obstacle:` role, else its first field.
-pub fn constrained_field<M: Model>() -> usize {
-    M::OBSTACLE.map_or(0, |[field, _]| field)
-}
-
-/// Solves `scene` with the pair `settings` name (its default otherwise).
-///
-/// # Errors
-/// A pair the scene's family does not have or the scene does not take, and the solve's.
-pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
-    let pair = pair_of(scene, settings.pair.as_deref())?;
-    (pair.solve)(pair, scene, settings)
-}
-
-/// The pair called `name` (`None`: the scene's default) of the scene's family.
-///
-/// # Errors
-/// An unknown family, and a pair the scene does not take (the message lists those it
-/// takes).
-pub fn pair_of(scene: &Scene, name: Option<&str>) -> Result<&'static Pair> {
-    let family = family::family(scene.family).ok_or_else(|| {
-        Error::Input(format!(
-            "scene `{}` is of the unknown family `{}`",
-            scene.name, scene.family
-        ))
-    })?;
-    let offered = family::pairs_of(scene);
-    let name = match name {
-        Some(name) => name,
-        None => offered
-            .first()
-            .map(|p| p.name)
-            .ok_or_else(|| Error::Input(format!("scene `{}` takes no pair", scene.name)))?,
-    };
-    if let Some(pair) = offered.iter().find(|p| p.name == name) {
-        return Ok(pair);
-    }
-    let names: Vec<&str> = offered.iter().map(|p| p.name).collect();
-    let other = family.pairs().iter().any(|p| p.name == name);
-    Err(Error::Input(if other {
-        format!(
-            "pair `{name}` does not discretize scene `{}`; it takes {}",
-            scene.name,
-            names.join(", ")
-        )
-    } else {
-        format!(
-            "unknown pair `{name}`; scene `{}` takes {}",
-            scene.name,
-            names.join(", ")
-        )
-    }))
 }
 
 /// [`run`] on straight triangles, or on curved ones where the scene's disk is curved.

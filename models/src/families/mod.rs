@@ -1,7 +1,126 @@
-//! The model families of the registry ([`crate::family`]): each one's pairs, scenes and
-//! own quantities.
+//! The registry: every model family ([`crate::family::Family`]) with its pairs, scenes
+//! and own quantities, and the one entry point that solves a scene ([`solve`]).
 
 pub mod beam;
 pub mod kirchhoff;
 pub mod membrane;
 pub mod plate;
+
+use crate::family::{Family, Pair};
+use crate::report::{Outcome, Settings};
+use crate::scene::Scene;
+use fem_runtime::{Error, Result};
+
+/// Every family, in the order `list` prints them.
+pub fn families() -> &'static [&'static dyn Family] {
+    &FAMILIES
+}
+
+static FAMILIES: [&dyn Family; 4] = [
+    &beam::BEAMS,
+    &membrane::MEMBRANES,
+    &plate::PLATES,
+    &kirchhoff::KIRCHHOFF,
+];
+
+/// The family called `name`.
+pub fn family(name: &str) -> Option<&'static dyn Family> {
+    families().iter().copied().find(|f| f.name() == name)
+}
+
+/// Every built-in scene, family by family.
+pub fn scenes() -> Vec<Scene> {
+    families().iter().flat_map(|f| f.scenes()).collect()
+}
+
+/// The built-in scene called `name`.
+pub fn scene(name: &str) -> Option<Scene> {
+    scenes().into_iter().find(|s| s.name == name)
+}
+
+/// The pairs `scene` takes, its default first: those it names, else its family's.
+pub fn pairs_of(scene: &Scene) -> Vec<&'static Pair> {
+    let Some(family) = family(scene.family) else {
+        return Vec::new();
+    };
+    if scene.pairs.is_empty() {
+        family.pairs().iter().collect()
+    } else {
+        scene
+            .pairs
+            .iter()
+            .filter_map(|name| family.pairs().iter().find(|p| p.name == *name))
+            .collect()
+    }
+}
+
+/// Solves `scene` with the pair `settings` name (its default otherwise).
+///
+/// # Errors
+/// A pair the scene's family does not have or the scene does not take, and the solve's.
+pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
+    let pair = pair_of(scene, settings.pair.as_deref())?;
+    (pair.solve)(pair, scene, settings)
+}
+
+/// The pair called `name` (`None`: the scene's default) of the scene's family.
+///
+/// # Errors
+/// An unknown family, and a pair the scene does not take (the message lists those it
+/// takes).
+pub fn pair_of(scene: &Scene, name: Option<&str>) -> Result<&'static Pair> {
+    let family = family(scene.family).ok_or_else(|| {
+        Error::Input(format!(
+            "scene `{}` is of the unknown family `{}`",
+            scene.name, scene.family
+        ))
+    })?;
+    let offered = pairs_of(scene);
+    let name = match name {
+        Some(name) => name,
+        None => offered
+            .first()
+            .map(|p| p.name)
+            .ok_or_else(|| Error::Input(format!("scene `{}` takes no pair", scene.name)))?,
+    };
+    if let Some(pair) = offered.iter().find(|p| p.name == name) {
+        return Ok(pair);
+    }
+    let names: Vec<&str> = offered.iter().map(|p| p.name).collect();
+    let other = family.pairs().iter().any(|p| p.name == name);
+    Err(Error::Input(if other {
+        format!(
+            "pair `{name}` does not discretize scene `{}`; it takes {}",
+            scene.name,
+            names.join(", ")
+        )
+    } else {
+        format!(
+            "unknown pair `{name}`; scene `{}` takes {}",
+            scene.name,
+            names.join(", ")
+        )
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_names_are_unique_and_their_pairs_exist() {
+        let scenes = scenes();
+        for (k, s) in scenes.iter().enumerate() {
+            assert!(
+                !scenes[..k].iter().any(|t| t.name == s.name),
+                "{} twice",
+                s.name
+            );
+            assert_eq!(scene(&s.name).unwrap().name, s.name);
+            assert!(family(s.family).is_some(), "{}", s.family);
+            assert_eq!(pairs_of(s).len(), s.pairs.len().max(pairs_of(s).len()));
+            assert!(!pairs_of(s).is_empty(), "{}", s.name);
+        }
+        assert!(scene("no-such-scene").is_none());
+    }
+}

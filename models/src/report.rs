@@ -1,0 +1,134 @@
+//! What a solve is asked ([`Settings`]) and what it returns ([`Outcome`]: the one
+//! [`Report`] of every family and the fields for output).
+
+use crate::geometry::Fields;
+use crate::scene::Name;
+use fem_runtime::obstacle::hierarchy::LinearSolver;
+use fem_runtime::obstacle::VariationalSolver;
+use fem_runtime::Diagonal;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// What a request may change of a scene's solve (the command line's options).
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// The pair by name (`None`: the scene's default).
+    pub pair: Option<String>,
+    /// N (`None`: the scene's).
+    pub mesh_size: Option<usize>,
+    /// The load magnitude q (`None`: the scene's; refused where its load is fixed).
+    pub load: Option<f64>,
+    /// α (`None`: the pair's rule).
+    pub alpha: Option<f64>,
+    /// Parameters replacing the scene's, by the model's names (`--thickness` sets `t`).
+    pub parameters: Vec<(Name, f64)>,
+    /// The complementarity solver.
+    pub solver: VariationalSolver,
+    /// The solver of the Newton steps.
+    pub linear_solver: LinearSolver,
+    /// Nested iteration over coarser meshes (`false`: a cold start on the finest).
+    pub nested: bool,
+    /// Rounds of iterative refinement per linear solve (`None`: the family's).
+    pub refinement: Option<usize>,
+    /// How the squares of a structured mesh are split (`None`: the scene's).
+    pub diagonal: Option<Diagonal>,
+    /// Run the rounding experiment (`None`: where the family does).
+    pub rounding_experiment: Option<bool>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            pair: None,
+            mesh_size: None,
+            load: None,
+            alpha: None,
+            parameters: Vec::new(),
+            solver: VariationalSolver::SemismoothNewton,
+            linear_solver: LinearSolver::Auto,
+            nested: true,
+            refinement: None,
+            diagonal: None,
+            rounding_experiment: None,
+        }
+    }
+}
+
+/// Most rounds of iterative refinement per linear solve accepted.
+pub const MAX_REFINEMENT_STEPS: usize = 10;
+
+/// Wall time of the parts of a solve, in seconds.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Phases {
+    /// Building the meshes.
+    pub meshes: f64,
+    /// Binding the scene to the model and checking it.
+    pub checks: f64,
+    /// The runtime's solve (assembly and every level).
+    pub solve: f64,
+    /// The family's quantities and the output fields.
+    pub evaluation: f64,
+}
+
+/// What a solve reports (the CLI's `--json` object): what every solve has, from the
+/// runtime's report, and the family's own quantities beside it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Scene name.
+    pub scene: String,
+    /// Family name.
+    pub family: &'static str,
+    /// Pair name.
+    pub pair: &'static str,
+    /// The domain solved on.
+    pub domain: String,
+    /// N as solved (the beams' elements; a file's refinements).
+    pub mesh_size: usize,
+    /// The load magnitude q (`null` where the scene's load is fixed).
+    pub load: Option<f64>,
+    /// Every parameter of the scene by the model's name, as solved.
+    pub parameters: BTreeMap<String, f64>,
+    /// Each support as `name on parts`.
+    pub supports: Vec<String>,
+    /// The runtime's report.
+    #[serde(flatten)]
+    pub solve: fem_runtime::problem::Report,
+    /// `∫ λ` of the exact solution over the scene's own domain, where known.
+    pub exact_contact_force: Option<f64>,
+    /// The exact contact set's area over the scene's own domain, where known.
+    pub exact_contact_area: Option<f64>,
+    /// The L² error the scene asks for.
+    pub accuracy: Option<f64>,
+    /// Where the time went.
+    pub phases: Phases,
+    /// The family's own quantities (a plate's centre deflection, Hertz's half-width).
+    #[serde(flatten)]
+    pub quantities: BTreeMap<String, serde_json::Value>,
+}
+
+impl Report {
+    /// Sets the family quantity `key`.
+    pub fn set(&mut self, key: &str, value: impl Serialize) {
+        let value = serde_json::to_value(value).unwrap_or(serde_json::Value::Null);
+        self.quantities.insert(key.to_string(), value);
+    }
+
+    /// A family quantity as a number (`None` where absent or not a number).
+    pub fn number(&self, key: &str) -> Option<f64> {
+        self.quantities.get(key).and_then(serde_json::Value::as_f64)
+    }
+
+    /// Adds a warning.
+    pub fn warn(&mut self, warning: impl Into<String>) {
+        self.solve.warnings.push(warning.into());
+    }
+}
+
+/// A solved scene: its report and its fields for output.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The report.
+    pub report: Report,
+    /// The fields, sampled for charts and ParaView.
+    pub fields: Fields,
+}
