@@ -8,9 +8,6 @@
 //! A study of scene `s` prints a table and writes `out/<s>-<study>.svg` and `.csv`; the
 //! functions behind each (the tests run small versions) return their rows.
 
-use crate::beam_studies::BeamStudies;
-use crate::membrane_studies::MembraneStudies;
-use crate::models::registry::{SceneEntry, SceneKind};
 use crate::plot::{self, Axes, Series};
 use fem_runtime::obstacle::VariationalSolver;
 use fem_runtime::{Error, Result};
@@ -229,30 +226,6 @@ pub trait StudyScene {
             "scene `{}` has no locking study (t → 0 is a Timoshenko study)",
             self.name()
         )))
-    }
-}
-
-/// The study implementation of a registry scene.
-///
-/// # Errors
-/// [`Error::Input`] for a family without one (plates: their locking chart is written by
-/// `plates::locking_study`).
-pub fn study_scene(entry: &SceneEntry) -> Result<Box<dyn StudyScene>> {
-    match &entry.kind {
-        SceneKind::Beam(s) => Ok(Box::new(BeamStudies::new(*s))),
-        SceneKind::Membrane(s) => Ok(Box::new(MembraneStudies::new(s.clone()))),
-        SceneKind::Plate(s) => Err(Error::Input(format!(
-            "plate scene `{}` hosts no study of this kind",
-            s.name
-        ))),
-        SceneKind::Kirchhoff(s) => Err(Error::Input(format!(
-            "Kirchhoff scene `{}` runs its studies in fem_forms::kirchhoff",
-            s.name
-        ))),
-        SceneKind::Contact(s) => Err(Error::Input(format!(
-            "contact scene `{}` runs its studies in fem_forms::signorini",
-            s.name
-        ))),
     }
 }
 
