@@ -232,7 +232,7 @@ pub fn summary(r: &Report) -> String {
         .map(|(k, v)| format!("{k} = {}", number(*v)))
         .collect();
     if let Some(q) = r.load {
-        posed.insert(0, format!("q = {}", number(q)));
+        posed.insert(0, format!("load = {}", number(q)));
     }
     if let Some(alpha) = s.alpha {
         posed.push(format!("α = {}", number(alpha)));
@@ -295,7 +295,28 @@ fn write_outputs(
     options: &SolveOptions,
     out: &Path,
 ) -> Result<(), String> {
-    if options.plot {
+    if let (true, Some(profile)) = (options.plot, &outcome.profile) {
+        let path = out.join(format!("{}-pressure.svg", scene.name));
+        std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
+        let mut series = Vec::new();
+        if let Some((label, curve)) = &profile.reference {
+            series.push(plot::Series::line(label.clone(), curve.clone()));
+        }
+        let steps = profile
+            .computed
+            .1
+            .iter()
+            .flat_map(|&(x0, x1, p)| [(x0, p), (x1, p)])
+            .collect();
+        series.push(plot::Series::line(profile.computed.0.clone(), steps));
+        let axes = plot::Axes {
+            x: profile.x,
+            y: profile.y,
+            ..plot::Axes::default()
+        };
+        plot::chart(&path, &profile.title, axes, &series).map_err(|e| e.to_string())?;
+        eprintln!("→ {}", path.display());
+    } else if options.plot {
         let Fields::Interval { .. } = &outcome.fields else {
             return Err(format!(
                 "--plot does not apply: `{}` has no profile chart",

@@ -292,7 +292,21 @@ pub fn solve_gap_block(
         contact_centre: Some(0.0),
     };
     let solution = solve_signorini(&mesh, &input)?;
-    // the whole contact line: each half edge and its mirror image
+    let (pressure_l2_error, best_fit_l2_error) = compare_gap_block(&hertz, &solution);
+    Ok(GapBlockResult {
+        hertz,
+        contact_h: h,
+        pressure_l2_error,
+        best_fit_l2_error,
+        solution,
+    })
+}
+
+/// The relative L² errors against Hertz's pressure of a solution on the half block
+/// ([`gap_block_mesh`]) and of the best P0 fit on its edges, over the whole contact line
+/// (each half edge and its mirror image), with the exact integrals of
+/// [`Hertz::relative_l2_error_p0`].
+pub fn compare_gap_block(hertz: &Hertz, solution: &SignoriniSolution) -> (f64, f64) {
     let mut intervals = Vec::with_capacity(2 * solution.contact_edges.len());
     let mut values = Vec::with_capacity(intervals.capacity());
     for (e, &p) in solution.contact_edges.iter().zip(&solution.pressure) {
@@ -302,11 +316,8 @@ pub fn solve_gap_block(
         intervals.push([-x1, -x0]);
         values.extend([p, p]);
     }
-    Ok(GapBlockResult {
-        hertz,
-        contact_h: h,
-        pressure_l2_error: hertz.relative_l2_error_p0(&intervals, &values),
-        best_fit_l2_error: hertz.best_p0_relative_l2_error(&intervals),
-        solution,
-    })
+    (
+        hertz.relative_l2_error_p0(&intervals, &values),
+        hertz.best_p0_relative_l2_error(&intervals),
+    )
 }

@@ -29,7 +29,8 @@ pub trait Geometry: MeshKind {
     /// The meshes for size `n` on `domain`, coarsest first: `n` halved while it stays
     /// even and at least `coarsest` (without `nested`, `n` alone); a Gmsh file and its
     /// `n` uniform refinements. `budget` sees the finest mesh's cell count first (a
-    /// file's after reading it, before refining).
+    /// file's after reading it, before refining). `load` is the load magnitude solved
+    /// at, which a generated mesh may be graded to.
     ///
     /// # Errors
     /// A domain this kind of mesh does not cover, a size out of range, the budget's
@@ -39,6 +40,7 @@ pub trait Geometry: MeshKind {
         n: usize,
         nested: bool,
         coarsest: usize,
+        load: Option<f64>,
         budget: CellBudget,
     ) -> Result<Vec<Self>>;
 
@@ -129,6 +131,7 @@ impl Geometry for IntervalMesh {
         n: usize,
         nested: bool,
         coarsest: usize,
+        _load: Option<f64>,
         budget: CellBudget,
     ) -> Result<Vec<Self>> {
         let &Domain::Interval { start, end } = domain else {
@@ -217,18 +220,19 @@ impl Geometry for TriangleMesh {
         n: usize,
         nested: bool,
         coarsest: usize,
+        load: Option<f64>,
         budget: CellBudget,
     ) -> Result<Vec<Self>> {
         match domain {
             Domain::Gmsh(path) => gmsh_levels(path, n, nested, budget),
             Domain::Generated(generator) => {
-                if n == 0 || n > MAX_MESH_SIZE {
+                if n == 0 || n > generator.max_size {
                     return Err(Error::Input(format!(
-                        "--mesh-size {n} ({}) is out of range (1 to {MAX_MESH_SIZE})",
-                        generator.size_meaning
+                        "--mesh-size {n} ({}) is out of range (1 to {})",
+                        generator.size_meaning, generator.max_size
                     )));
                 }
-                let mesh = (generator.build)(n)?;
+                let mesh = (generator.build)(n, load)?;
                 budget(mesh.cell_count() as f64)?;
                 Ok(vec![mesh])
             }
@@ -355,6 +359,7 @@ impl Geometry for CurvedTriangleMesh {
         n: usize,
         nested: bool,
         coarsest: usize,
+        _load: Option<f64>,
         budget: CellBudget,
     ) -> Result<Vec<Self>> {
         let &Domain::Disk {

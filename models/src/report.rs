@@ -131,4 +131,24 @@ pub struct Outcome {
     pub report: Report,
     /// The fields, sampled for charts and ParaView.
     pub fields: Fields,
+    /// The multiplier along the boundary part it lives on, where the family charts it
+    /// (`--plot`).
+    pub profile: Option<Profile>,
+}
+
+/// A multiplier along a boundary part (the contact pressure along Γ_C), against its
+/// reference where one is known.
+#[derive(Clone, Debug)]
+pub struct Profile {
+    /// The chart's title.
+    pub title: String,
+    /// The abscissa's name (`x`).
+    pub x: &'static str,
+    /// The ordinate's name (`pressure`).
+    pub y: &'static str,
+    /// The computed multiplier's label and values as steps `(x0, x1, λ)`: one per edge
+    /// (x0 < x1, piecewise constant) or per vertex (x0 = x1, linear in between).
+    pub computed: (String, Vec<(f64, f64, f64)>),
+    /// The reference's label and curve `(x, λ)`.
+    pub reference: Option<(String, Vec<(f64, f64)>)>,
 }

@@ -7,7 +7,7 @@
 use crate::data::Data;
 use crate::family::Pair;
 use crate::geometry::{Fields, Geometry};
-pub use crate::report::{Outcome, Phases, Report, Settings, MAX_REFINEMENT_STEPS};
+pub use crate::report::{Outcome, Phases, Profile, Report, Settings, MAX_REFINEMENT_STEPS};
 use crate::scene::{ExactSolution, Part, Posed, Scene, Support};
 use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::{FirstStart, ObstacleOptions, VariationalSolver};
@@ -29,6 +29,14 @@ use std::time::Instant;
 pub trait Quantities<G: Geometry>: 'static {
     /// The coarsest N of nested iteration.
     const COARSEST: usize = 4;
+
+    /// What a scene's accuracy is compared with: a quantity the family reports (its key
+    /// and its words for messages); `None`: the L² error of the constrained field.
+    const ACCURACY_MEASURE: Option<(&'static str, &'static str)> = None;
+
+    /// Whether the family's solves nest by default (each level started from the
+    /// coarser one's solution).
+    const NESTED: bool = true;
 
     /// Whether the rounding experiment runs by default.
     const ROUNDING_EXPERIMENT: bool = false;
@@ -64,6 +72,16 @@ pub trait Quantities<G: Geometry>: 'static {
         Ok(())
     }
 
+    /// Checks what the model cannot on the finest mesh, before any solve: the data
+    /// against the boundary parts (a contact load on the contact boundary).
+    ///
+    /// # Errors
+    /// The first offending place, named.
+    fn check_on_mesh(scene: &Scene, posed: &Posed, mesh: &G) -> Result<()> {
+        let _ = (scene, posed, mesh);
+        Ok(())
+    }
+
     /// The start of the coarsest level, where the family has one (a body pressed onto
     /// its foundation); `None`: from zero.
     fn start(scene: &Scene, posed: &Posed) -> Option<Box<FirstStart<'static, G>>> {
@@ -78,6 +96,12 @@ pub trait Quantities<G: Geometry>: 'static {
     fn add<M: Model>(solved: &Run<'_, M, G>, report: &mut Report) -> Result<()> {
         let _ = (solved, report);
         Ok(())
+    }
+
+    /// The multiplier along its boundary part, where the family charts it.
+    fn profile<M: Model>(run: &Run<'_, M, G>, report: &Report) -> Option<Profile> {
+        let _ = (run, report);
+        None
     }
 
     /// A solver's failure, explained where the family knows a likely cause (`alpha`:
@@ -169,8 +193,10 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     let memory = Q::memory::<M>(pair, scene, n);
     let size_text = size_text(scene, pair, n);
     // without an obstacle the problem is one linear solve: nothing to nest for
-    let nested =
-        settings.nested && settings.solver == VariationalSolver::SemismoothNewton && scene.obstacle;
+    let nested = Q::NESTED
+        && settings.nested
+        && settings.solver == VariationalSolver::SemismoothNewton
+        && scene.obstacle;
     let mut domain = scene.domain.clone();
     if let (Some(diagonal), crate::scene::Domain::Rectangle { diagonal: d, .. }) =
         (settings.diagonal, &mut domain)
@@ -178,7 +204,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         *d = diagonal;
     }
     let budget = |cells: f64| check_memory(memory.bytes(cells as usize), &size_text);
-    let meshes = G::levels(&domain, n, nested, Q::COARSEST, &budget)?;
+    let meshes = G::levels(&domain, n, nested, Q::COARSEST, posed.load, &budget)?;
     let finest = meshes.last().expect("at least one level").clone();
     let meshes_seconds = clock.elapsed().as_secs_f64();
 
@@ -189,6 +215,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     if let Some(e) = &exact {
         validate_exact(e, &finest, scene)?;
     }
+    Q::check_on_mesh(scene, &posed, &finest)?;
     let start = Q::start(scene, &posed);
     let psi_index = M::OBSTACLE.map(|[_, d]| d);
     let psi: &DataFn = psi_index
@@ -278,7 +305,6 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         quantities: BTreeMap::new(),
     };
     report.solve.warnings.extend(supports.warnings);
-    common_warnings(scene, &posed, &mut report);
     let fields = G::fields::<M>(&solved.solution, psi);
     let run = Run {
         scene,
@@ -290,6 +316,8 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         fields: &fields,
     };
     Q::add(&run, &mut report)?;
+    common_warnings(scene, &posed, Q::ACCURACY_MEASURE, &mut report);
+    let profile = Q::profile(&run, &report);
     report.phases = Phases {
         meshes: meshes_seconds,
         checks: checks_seconds,
@@ -301,7 +329,11 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
             .max(0.0)
             + (solve_seconds - report.solve.seconds).max(0.0),
     };
-    Ok(Outcome { report, fields })
+    Ok(Outcome {
+        report,
+        fields,
+        profile,
+    })
 }
 
 fn zero(_: &[f64]) -> f64 {
@@ -597,7 +629,12 @@ fn validate_exact<G: Geometry>(exact: &ExactSolution, mesh: &G, scene: &Scene) -
 
 /// The warnings every scene may earn: an exact solution that does not hold at the load
 /// asked, and an accuracy the solve does not reach or cannot check.
-fn common_warnings(scene: &Scene, posed: &Posed, report: &mut Report) {
+fn common_warnings(
+    scene: &Scene,
+    posed: &Posed,
+    measure: Option<(&str, &str)>,
+    report: &mut Report,
+) {
     if scene.exact_dropped_at(posed) {
         let own = scene.load.as_ref().map(|l| l.default);
         report.warn(format!(
@@ -607,9 +644,13 @@ fn common_warnings(scene: &Scene, posed: &Posed, report: &mut Report) {
         ));
     }
     if let Some(accuracy) = scene.accuracy {
-        match report.solve.error_l2 {
+        let (error, words) = match measure {
+            Some((key, words)) => (report.number(key), words),
+            None => (report.solve.error_l2, "L² error"),
+        };
+        match error {
             Some(e) if e > accuracy => report.warn(format!(
-                "the L² error {e:.3e} exceeds the accuracy the scene asks for, {accuracy:e}: refine (--mesh-size) or take a pair of higher order"
+                "the {words} {e:.3e} exceeds the accuracy the scene asks for, {accuracy:e}: refine (--mesh-size) or take a pair of higher order"
             )),
             Some(_) => {}
             None => report.warn(format!(

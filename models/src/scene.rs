@@ -63,15 +63,21 @@ pub enum Domain {
     Generated(Generator),
 }
 
-/// A family's mesh generator: `build(N)` is the mesh for `--mesh-size N`.
+/// A family's mesh generator: `build(N, q)` is the mesh for `--mesh-size N` at the load
+/// magnitude q (a mesh graded to a contact zone whose width grows with the load).
 #[derive(Clone)]
 pub struct Generator {
     /// Words for reports.
     pub description: Cow<'static, str>,
     /// What N counts, for messages ("cells per contact half-width b/h").
     pub size_meaning: &'static str,
+    /// The largest N it takes: beyond it the mesh alone (built before the memory
+    /// estimate can see its cells) would take minutes.
+    pub max_size: usize,
     /// The mesh for N.
-    pub build: Arc<dyn Fn(usize) -> fem_runtime::Result<fem_runtime::TriangleMesh> + Send + Sync>,
+    pub build: Arc<
+        dyn Fn(usize, Option<f64>) -> fem_runtime::Result<fem_runtime::TriangleMesh> + Send + Sync,
+    >,
 }
 
 impl fmt::Debug for Domain {

@@ -125,7 +125,7 @@ fn contact_problem<'a, M: Model>(
 /// (every constraint active) beyond the gaps, by the size of the elastic displacement;
 /// the problem is refused first where the load does not press the body on or the
 /// supports leave a motion free that contact cannot hold ([`rigid_motions_held`]).
-fn pressed_start(
+pub(crate) fn pressed_start(
     d: &Discretization<TriangleMesh>,
     direction: [f64; 2],
 ) -> Result<Option<Vec<f64>>> {
@@ -655,7 +655,11 @@ fn towards_foundation(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Ve
     problem.reduction.free().iter().map(|&d| full[d]).collect()
 }
 
-fn report<M: Model>(
+/// The contact quantities of a solved problem (`direction` the unit `n_c`).
+///
+/// # Errors
+/// The boundary inverse constants' errors.
+pub(crate) fn report<M: Model>(
     input: &SignoriniInput,
     direction: [f64; 2],
     solved: &ProblemSolved<M, TriangleMesh>,
@@ -968,8 +972,15 @@ pub fn solve_hertz_on_with(
         contact_centre: Some(0.0),
     };
     let solution = solve_signorini_with(mesh, &input, multiplier)?;
-    if multiplier == Multiplier::P1 {
-        return Ok(hertz_p1(hertz, h, solution));
+    Ok(compare_with_hertz(hertz, h, solution))
+}
+
+/// The comparison of a solution on [`hertz_mesh`] with Hertz's pressure: the relative
+/// L² error, the best fit's in the multiplier's space and the checkerboard measure
+/// (see [`HertzResult`]; P0: 16-point Gauss–Legendre per edge, P1: exact integrals).
+pub fn compare_with_hertz(hertz: Hertz, h: f64, solution: SignoriniSolution) -> HertzResult {
+    if solution.multiplier == Multiplier::P1 {
+        return hertz_p1(hertz, h, solution);
     }
     let gauss = fem_runtime::gauss_legendre(16);
     let (mut error, mut best, mut norm) = (0.0, 0.0, 0.0);
@@ -1004,14 +1015,14 @@ pub fn solve_hertz_on_with(
         .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
         .fold(0.0f64, f64::max)
         / hertz.max_pressure();
-    Ok(HertzResult {
+    HertzResult {
         hertz,
         contact_h: h,
         oscillation,
         solution,
         pressure_l2_error: (error / norm).sqrt(),
         best_fit_l2_error: (best / norm).sqrt(),
-    })
+    }
 }
 
 // ---------------------------------------------------------------------------------------

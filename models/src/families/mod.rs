@@ -2,6 +2,7 @@
 //! and own quantities, and the one entry point that solves a scene ([`solve`]).
 
 pub mod beam;
+pub mod contact;
 pub mod kirchhoff;
 pub mod membrane;
 pub mod plate;
@@ -16,11 +17,12 @@ pub fn families() -> &'static [&'static dyn Family] {
     &FAMILIES
 }
 
-static FAMILIES: [&dyn Family; 4] = [
+static FAMILIES: [&dyn Family; 5] = [
     &beam::BEAMS,
     &membrane::MEMBRANES,
     &plate::PLATES,
     &kirchhoff::KIRCHHOFF,
+    &contact::CONTACT,
 ];
 
 /// The family called `name`.

@@ -1,0 +1,640 @@
+//! Signorini contact (docs/contact.md): a linear elastic body on a rigid foundation,
+//! frictionless, the contact pressure a multiplier on the edges of the contact boundary
+//! Γ_C (the model's `facets:`), stabilized. Pairs P1 or P2 displacements with a P0 or a
+//! continuous P1 multiplier on Γ_C. The family's own quantities are the equilibrium of
+//! the contact force with the load, the contact half-width and peak pressure, and
+//! against Hertz's pressure where the scene has it, the relative L² error, the best
+//! fit's and the checkerboard measure.
+
+use crate::contact_scenes::{
+    compare_gap_block, gap_block_mesh, ContactBody, ContactScene, CONTACT_SCENES,
+};
+use crate::data::Data;
+use crate::family::{Family, Opt, Pair};
+use crate::report::{Profile, Report};
+use crate::run::{run, Quantities, Run};
+use crate::scene::{Domain, Generator, Load, Part, PartSupport, Posed, Scene, Support};
+use crate::signorini::{
+    self, compare_with_hertz, hertz_mesh, lame, signorini_p1, signorini_p1_p1, signorini_p2,
+    signorini_p2_p1, Displacement, Hertz, Multiplier, Plane, SignoriniInput, SignoriniSolution,
+};
+use fem_runtime::obstacle::{Discretization, FirstStart};
+use fem_runtime::problem::ALPHA_WHEN_CI_VANISHES;
+use fem_runtime::stabilization::Alpha;
+use fem_runtime::{DirichletPart, Error, Model, Result, TriangleMesh};
+use std::sync::Arc;
+
+/// The contact family.
+pub struct Contact;
+
+/// The registry's contact family.
+pub static CONTACT: Contact = Contact;
+
+/// The contact boundary's name in the model's `facets:`.
+pub const CONTACT_PART: &str = "Γ_C";
+/// The loaded boundary's name in the model's `facets:`.
+pub const LOAD_PART: &str = "Γ_N";
+
+/// The contact half-widths `b/R` the Hertz scenes accept (`--load`): Hertz's theory
+/// wants b ≪ R (at b/R = 0.34 the peak was 2 % low, at 3.4 the error 91 %), and below
+/// about 1e-7 the gap `x²/2R` is lost against the rounding of coordinates of size R.
+pub const HERTZ_HALF_WIDTH_RANGE: (f64, f64) = (1e-6, 0.1);
+
+/// The largest b/h of the graded meshes (b/h = 512 has 0.4M cells on the quarter disc).
+pub const MAX_GRADED_SIZE: usize = 512;
+
+/// The equilibrium residual beyond which a report warns: Newton meets it to about
+/// 1e-13, the polished interior point (α = 0) to about 1e-12.
+pub const EQUILIBRIUM_WARNING: f64 = 1e-8;
+
+/// The relative difference between the load as discretized and as integrated by 4-point
+/// Gauss beyond which a report warns: a pressure the model's quadrature does not
+/// integrate (a kink inside an edge: 7e-2 on the 2 × 1 block with q = max(0, x − 1.9)).
+/// A smooth pressure differs by far less (1e-7 for 1 + 0.1 sin x at h = 0.25), below the
+/// discretization error of λ_h.
+pub const QUADRATURE_WARNING: f64 = 1e-6;
+
+/// What a contact scene poses beyond its parameters and data: the material as its user
+/// gives it, the foundation's direction, and the built-in body where the scene is one
+/// (its reference: Hertz's pressure, the patch test's).
+#[derive(Clone, Copy, Debug)]
+pub struct ContactFacts {
+    /// Young's modulus E (force per area).
+    pub young: f64,
+    /// Poisson's ratio ν.
+    pub poisson: f64,
+    /// Plane strain or plane stress.
+    pub plane: Plane,
+    /// The contact direction `n_c` (unit): the foundation's normal pointing away from
+    /// the body.
+    pub direction: [f64; 2],
+    /// The middle of the contact zone along the contact plane (a symmetry line), for the
+    /// half-width; `None`: the middle of the pressed edges.
+    pub centre: Option<f64>,
+    /// The built-in body, where the scene is one.
+    pub body: Option<ContactBody>,
+}
+
+impl ContactFacts {
+    /// The Hertz reference at load `load`, for the bodies that have one.
+    pub fn hertz(&self, load: f64) -> Option<Hertz> {
+        let radius = match self.body? {
+            ContactBody::Cylinder { radius } | ContactBody::GapBlock { radius, .. } => radius,
+            ContactBody::Block { .. } => return None,
+        };
+        Some(Hertz {
+            radius,
+            young: self.young,
+            poisson: self.poisson,
+            load,
+        })
+    }
+
+    /// The share of the body solved: a half (a symmetry line) counts twice.
+    fn whole(&self) -> f64 {
+        match self.body {
+            Some(ContactBody::Cylinder { .. } | ContactBody::GapBlock { .. }) => 2.0,
+            _ => 1.0,
+        }
+    }
+}
+
+const fn pair(name: &'static str, note: &'static str, solve: crate::family::PairSolve) -> Pair {
+    Pair {
+        name,
+        note,
+        alpha: Alpha::FromInverseConstant(0.5),
+        alpha_when_zero: ALPHA_WHEN_CI_VANISHES,
+        memory: None,
+        nodal: false,
+        parameters: &[],
+        solve,
+    }
+}
+
+static PAIRS: [Pair; 4] = [
+    pair(
+        "p1-p0",
+        "u ∈ [P1]², λ ∈ P0 on the edges of Γ_C, stabilized",
+        run::<signorini_p1::Model, TriangleMesh, Contact>,
+    ),
+    pair(
+        "p2-p0",
+        "u ∈ [P2]², λ ∈ P0 on the edges of Γ_C, stabilized",
+        run::<signorini_p2::Model, TriangleMesh, Contact>,
+    ),
+    pair(
+        "p1-p1",
+        "u ∈ [P1]², λ continuous P1 on Γ_C, stabilized",
+        run::<signorini_p1_p1::Model, TriangleMesh, Contact>,
+    ),
+    pair(
+        "p2-p1",
+        "u ∈ [P2]², λ continuous P1 on Γ_C, stabilized",
+        run::<signorini_p2_p1::Model, TriangleMesh, Contact>,
+    ),
+];
+
+/// The scene's parameters of the material and the direction: the Lamé parameters of E
+/// and ν, and `n_c`.
+///
+/// # Errors
+/// E, ν out of range ([`lame`]).
+pub fn material_parameters(facts: &ContactFacts) -> Result<Vec<(&'static str, f64)>> {
+    let (mu, lambda) = lame(facts.young, facts.poisson, facts.plane)?;
+    Ok(vec![
+        ("μ_L", mu),
+        ("λ_L", lambda),
+        ("n_c_x", facts.direction[0]),
+        ("n_c_y", facts.direction[1]),
+    ])
+}
+
+/// The registry's scene of a built-in contact body.
+fn contact_scene(old: &ContactScene) -> Scene {
+    let facts = ContactFacts {
+        young: old.young,
+        poisson: old.poisson,
+        plane: old.plane,
+        direction: [0.0, -1.0],
+        centre: match old.body {
+            ContactBody::Block { .. } => None,
+            _ => Some(0.0),
+        },
+        body: Some(old.body),
+    };
+    let default_load = old.load;
+    let hertz_at = move |load: Option<f64>| facts.hertz(load.unwrap_or(default_load));
+    let (domain, contact, loaded, axis, pressure, gap, symbol): (
+        Domain,
+        &str,
+        &str,
+        &str,
+        f64,
+        Data,
+        &str,
+    ) = match old.body {
+        ContactBody::Block { width, height } => (
+            Domain::Rectangle {
+                x: [0.0, width],
+                y: [0.0, height],
+                cells: [((width / height).round() as usize).max(1), 1],
+                diagonal: fem_runtime::Diagonal::Right,
+            },
+            "bottom",
+            "top",
+            "left",
+            1.0,
+            Data::from(zero as fn(&[f64]) -> f64),
+            "q",
+        ),
+        ContactBody::Cylinder { radius } => (
+            Domain::Generated(Generator {
+                description: format!("quarter disc of radius {radius} graded to the contact")
+                    .into(),
+                size_meaning: "cells per contact half-width b/h",
+                max_size: MAX_GRADED_SIZE,
+                build: Arc::new(move |n, load| {
+                    let hertz = hertz_at(load).expect("a cylinder");
+                    let h = hertz.half_width() / n as f64;
+                    // uniform cells a little beyond b; the grading tightens with b/h
+                    // (docs/contact.md §4)
+                    let grading = (4.0 / n as f64).min(0.25);
+                    hertz_mesh(radius, 1.25 * hertz.half_width(), h, grading)
+                }),
+            }),
+            "arc",
+            "top",
+            "axis",
+            // the half carries P/2 over its top of width R
+            1.0 / (2.0 * radius),
+            // the gap to the plane y = 0, measured vertically
+            Data::shared(|x| x[1]),
+            "P",
+        ),
+        ContactBody::GapBlock {
+            half_width,
+            height,
+            radius,
+            ..
+        } => (
+            Domain::Generated(Generator {
+                description: format!(
+                    "half block (0,{half_width})×(0,{height}) graded to the contact"
+                )
+                .into(),
+                size_meaning: "cells per contact half-width b/h",
+                max_size: MAX_GRADED_SIZE,
+                build: Arc::new(move |n, load| {
+                    let hertz = hertz_at(load).expect("a gap block");
+                    let b = hertz.half_width();
+                    let grading = (4.0 / n as f64).min(0.25);
+                    gap_block_mesh(half_width, height, 1.25 * b, b / n as f64, grading)
+                }),
+            }),
+            "bottom",
+            "top",
+            "left",
+            1.0 / (2.0 * half_width),
+            Data::shared(move |x| x[0] * x[0] / (2.0 * radius)),
+            "P",
+        ),
+    };
+    let mut scene = Scene::new(old.name, old.description, "contact", domain, old.mesh_size);
+    for (name, value) in material_parameters(&facts).expect("valid built-in material") {
+        scene.set_parameter(name, value);
+    }
+    scene.set_data("g", gap);
+    scene.set_data("q", Data::shared(move |_| pressure));
+    scene.load = Some(Load {
+        default: old.load,
+        scales: vec!["q".into()],
+        symbol,
+        nonnegative: true,
+    });
+    scene.facets = vec![
+        (CONTACT_PART.into(), Part::named(contact)),
+        (LOAD_PART.into(), Part::named(loaded)),
+    ];
+    scene.supports.push(PartSupport {
+        part: Part::named(axis),
+        support: Support::Roller { normal: [1.0, 0.0] },
+        key: None,
+    });
+    scene.accuracy = old.accuracy();
+    scene.pairs = match old.body {
+        ContactBody::GapBlock { .. } => vec!["p1-p0", "p2-p0"],
+        _ => PAIRS.iter().map(|p| p.name).collect(),
+    };
+    scene.studies = match old.body {
+        ContactBody::Cylinder { .. } => vec!["convergence", "alpha"],
+        _ => Vec::new(),
+    };
+    scene.in_default_job = true;
+    scene.reference = Some(Arc::new(facts));
+    scene
+}
+
+impl Family for Contact {
+    fn name(&self) -> &'static str {
+        "contact"
+    }
+
+    fn description(&self) -> &'static str {
+        "Signorini contact of an elastic body on a rigid foundation, the pressure on Γ_C"
+    }
+
+    fn pairs(&self) -> &'static [Pair] {
+        &PAIRS
+    }
+
+    fn options(&self) -> &'static [Opt] {
+        &[Opt::MeshSize, Opt::Load, Opt::Alpha, Opt::Pair, Opt::Plot]
+    }
+
+    fn scenes(&self) -> Vec<Scene> {
+        CONTACT_SCENES.iter().map(contact_scene).collect()
+    }
+
+    fn aliases(&self) -> &'static [(&'static str, &'static str)] {
+        &[("pressure", "q"), ("gap", "g")]
+    }
+}
+
+/// The scene's own description; scenes of this family always carry one.
+fn facts(scene: &Scene) -> Result<ContactFacts> {
+    scene.reference::<ContactFacts>().copied().ok_or_else(|| {
+        Error::Input(format!(
+            "scene `{}` states no material (E, ν) and contact direction",
+            scene.name
+        ))
+    })
+}
+
+/// The boundary markers of the scene's facet part `name` on `mesh`.
+fn facet_markers(scene: &Scene, mesh: &TriangleMesh, name: &str) -> Result<Vec<u32>> {
+    let part = scene
+        .facets
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, p)| p.clone())
+        .ok_or_else(|| {
+            Error::Input(format!(
+                "scene `{}` names no boundary part {name}",
+                scene.name
+            ))
+        })?;
+    Ok(match crate::geometry::Geometry::part(mesh, &part)? {
+        DirichletPart::Markers(m) => m,
+        DirichletPart::All => mesh.boundary_edges().iter().map(|&(_, m)| m).collect(),
+    })
+}
+
+/// The markers held along x and along y by the scene's rollers (for the checks of the
+/// rigid motions, which see the discretization, and of a support on Γ_C).
+fn rollers(scene: &Scene) -> Vec<(&Part, [f64; 2])> {
+    scene
+        .supports
+        .iter()
+        .filter_map(|s| match s.support {
+            Support::Roller { normal } => Some((&s.part, normal)),
+            _ => None,
+        })
+        .collect()
+}
+
+impl Quantities<TriangleMesh> for Contact {
+    /// One level: the pressed start holds the rigid motions of the level it starts, and
+    /// the graded meshes have no coarser level.
+    const NESTED: bool = false;
+
+    const ACCURACY_MEASURE: Option<(&'static str, &'static str)> =
+        Some(("pressure_l2_error", "pressure's relative L² error"));
+
+    fn check(scene: &Scene, posed: &Posed) -> Result<()> {
+        let facts = facts(scene)?;
+        let load = posed.load.unwrap_or(1.0);
+        if load.is_nan() {
+            return Err(Error::Input("--load NaN is not a number".into()));
+        }
+        if load <= 0.0 {
+            return Err(Error::Input(format!(
+                "--load {} must be positive: the body only rests on the foundation, a pull lifts it off and nothing holds it then",
+                fem_runtime::problem::number(load)
+            )));
+        }
+        if let Some(hertz) = facts.hertz(load) {
+            let ratio = hertz.half_width() / hertz.radius;
+            if !(HERTZ_HALF_WIDTH_RANGE.0..=HERTZ_HALF_WIDTH_RANGE.1).contains(&ratio) {
+                let at = |r: f64| load * (r / ratio).powi(2);
+                return Err(Error::Input(format!(
+                    "--load {} gives a contact half-width b = {ratio:.3e} R; `{}` compares with Hertz's theory, which needs b ≪ R, and the mesh resolves b only while the gap b²/2R is well above the rounding of R: loads from {:.3e} to {:.3e} keep {:e} ≤ b/R ≤ {}",
+                    fem_runtime::problem::number(load),
+                    scene.name,
+                    at(HERTZ_HALF_WIDTH_RANGE.0),
+                    at(HERTZ_HALF_WIDTH_RANGE.1),
+                    HERTZ_HALF_WIDTH_RANGE.0,
+                    HERTZ_HALF_WIDTH_RANGE.1
+                )));
+            }
+        }
+        lame(facts.young, facts.poisson, facts.plane)?;
+        // a roller across n_c on Γ_C itself fights the contact constraint for u·n_c
+        let contact = scene.facets.iter().find(|(n, _)| n == CONTACT_PART);
+        for (part, normal) in rollers(scene) {
+            let across = normal[0] * facts.direction[0] + normal[1] * facts.direction[1];
+            if contact.is_some_and(|(_, c)| c == part) && across.abs() > 1e-12 {
+                return Err(Error::Input(format!(
+                    "scene `{}`: the contact boundary ({}) also has a roller along ({}, {}), which has a component along the contact direction: the support and the contact constraint both fix u·n_c there; drop the support on the contact part",
+                    scene.name,
+                    part.names().join(", "),
+                    normal[0],
+                    normal[1]
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn check_on_mesh(scene: &Scene, posed: &Posed, mesh: &TriangleMesh) -> Result<()> {
+        let facts = facts(scene)?;
+        let contact = facet_markers(scene, mesh, CONTACT_PART)?;
+        let loaded = facet_markers(scene, mesh, LOAD_PART)?;
+        let pressure = pressure_of(scene, posed);
+        let input = input(&facts, &contact, &loaded, pressure.as_data_fn(), &zero);
+        signorini::refuse_pressure_on_contact(mesh, &input)
+    }
+
+    fn start(scene: &Scene, _: &Posed) -> Option<Box<FirstStart<'static, TriangleMesh>>> {
+        let direction = facts(scene).ok()?.direction;
+        Some(Box::new(move |d: &Discretization<TriangleMesh>| {
+            signorini::pressed_start(d, direction)
+        }))
+    }
+
+    fn add<M: Model>(run: &Run<'_, M, TriangleMesh>, report: &mut Report) -> Result<()> {
+        let facts = facts(run.scene)?;
+        let mesh = &run.solved.solution.discretization.mesh;
+        let contact = facet_markers(run.scene, mesh, CONTACT_PART)?;
+        let loaded = facet_markers(run.scene, mesh, LOAD_PART)?;
+        let pressure = pressure_of(run.scene, run.posed);
+        let gap = data_of(run.scene, "g");
+        let input = input(
+            &facts,
+            &contact,
+            &loaded,
+            pressure.as_data_fn(),
+            gap.as_data_fn(),
+        );
+        let solution = signorini::report::<M>(&input, facts.direction, run.solved)?;
+        add_quantities(&facts, run, &solution, report);
+        Ok(())
+    }
+
+    fn profile<M: Model>(run: &Run<'_, M, TriangleMesh>, report: &Report) -> Option<Profile> {
+        let facts = facts(run.scene).ok()?;
+        let hertz = facts.hertz(run.posed.load?)?;
+        let b = hertz.half_width();
+        let mut computed: Vec<(f64, f64, f64)> = pressure_steps(run);
+        computed.retain(|e| e.0 <= 1.5 * b);
+        let exact = (0..=300)
+            .map(|i| {
+                let x = 1.5 * b * i as f64 / 300.0;
+                (x, hertz.pressure(x))
+            })
+            .collect();
+        Some(Profile {
+            title: format!(
+                "{}: contact pressure, b/h = {}",
+                run.scene.name, report.mesh_size
+            ),
+            x: "x",
+            y: "pressure",
+            computed: (format!("λ_h ({})", run.pair.name), computed),
+            reference: Some(("Hertz p(x)".into(), exact)),
+        })
+    }
+}
+
+fn zero(_: &[f64]) -> f64 {
+    0.0
+}
+
+/// The scene's data function `name` (0 where it sets none).
+fn data_of(scene: &Scene, name: &str) -> Data {
+    scene
+        .data_fn(name)
+        .cloned()
+        .unwrap_or_else(|| Data::from(zero as fn(&[f64]) -> f64))
+}
+
+/// The pressure as solved: the scene's `q` times the load magnitude.
+fn pressure_of(scene: &Scene, posed: &Posed) -> Data {
+    let q = data_of(scene, "q");
+    let scale = posed.load.unwrap_or(1.0);
+    Data::shared(move |x| scale * q.at(x))
+}
+
+/// The contact problem's description for the checks and quantities of
+/// [`crate::signorini`].
+fn input<'a>(
+    facts: &ContactFacts,
+    contact: &'a [u32],
+    loaded: &'a [u32],
+    pressure: &'a fem_runtime::DataFn,
+    gap: &'a fem_runtime::DataFn,
+) -> SignoriniInput<'a> {
+    SignoriniInput {
+        young: facts.young,
+        poisson: facts.poisson,
+        plane: facts.plane,
+        element: Displacement::P1,
+        contact,
+        load: loaded,
+        pressure,
+        gap,
+        contact_direction: facts.direction,
+        fixed_x: &[],
+        fixed_y: &[],
+        alpha: None,
+        contact_centre: facts.centre,
+    }
+}
+
+/// The pressure along Γ_C as steps `(x0, x1, λ)` sorted by x0 (see [`Profile`]).
+fn pressure_steps<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Vec<(f64, f64, f64)> {
+    let solution = &run.solved.solution;
+    let Some(boundary) = solution.discretization.boundary() else {
+        return Vec::new();
+    };
+    let pressure = solution.multiplier_values();
+    let mut steps: Vec<(f64, f64, f64)> = match boundary.space {
+        Multiplier::P0 => boundary
+            .edges
+            .iter()
+            .zip(pressure)
+            .map(|(e, &p)| {
+                let (a, b) = (e.ends[0][0], e.ends[1][0]);
+                (a.min(b), a.max(b), p)
+            })
+            .collect(),
+        Multiplier::P1 => {
+            let mut points = vec![(0.0, 0.0, 0.0); pressure.len()];
+            for (e, dofs) in boundary.edges.iter().zip(&boundary.edge_dofs) {
+                for (end, &k) in e.ends.iter().zip(dofs) {
+                    points[k] = (end[0], end[0], pressure[k]);
+                }
+            }
+            points
+        }
+    };
+    steps.sort_by(|a, b| a.0.total_cmp(&b.0));
+    steps
+}
+
+/// The family's quantities and warnings.
+fn add_quantities<M: Model>(
+    facts: &ContactFacts,
+    run: &Run<'_, M, TriangleMesh>,
+    solution: &SignoriniSolution,
+    report: &mut Report,
+) {
+    let factor = facts.whole();
+    let n = facts.direction;
+    let along = |v: [f64; 2]| -(v[0] * n[0] + v[1] * n[1]);
+    let total = factor * along(solution.total_contact_force);
+    // the load's resultant pushes the body towards the foundation, along n_c
+    let applied = -factor * along(solution.applied_load);
+    let discretized = factor * solution.discretized_load;
+    let equilibrium = (total - discretized).abs() / discretized.abs();
+    report.set("young", facts.young);
+    report.set("poisson", facts.poisson);
+    report.set(
+        "plane",
+        match facts.plane {
+            Plane::Strain => "strain",
+            Plane::Stress => "stress",
+        },
+    );
+    report.set("contact_edges", solution.contact_edges.len());
+    report.set("total_contact_force", total);
+    report.set("applied_load", applied);
+    report.set("discretized_load", discretized);
+    report.set("equilibrium_residual", equilibrium);
+    report.set("contact_half_width", solution.contact_half_width);
+    report.set("max_contact_pressure", solution.max_contact_pressure);
+    if equilibrium > EQUILIBRIUM_WARNING {
+        report.warn(format!(
+            "the contact force misses the load as discretized by {equilibrium:.1e} (relative; a rigid translation lies in V_h, so it should be rounding): the solve did not reach solver precision, or the data's scales (a gap far beyond the elastic displacement) leave the displacement too few digits"
+        ));
+    }
+    let quadrature = (discretized - applied).abs() / applied.abs();
+    if quadrature > QUADRATURE_WARNING {
+        report.warn(format!(
+            "the model integrates the pressure on Γ_N with a rule exact for pressures up to quadratic along an edge: this pressure's resultant comes out {discretized:.6e} against {applied:.6e} by 4-point Gauss per edge ({quadrature:.1e} relative), and the contact force balances the former; refine the mesh for a pressure that varies within an edge"
+        ));
+    }
+    let load = run.posed.load.unwrap_or(1.0);
+    match (facts.body, facts.hertz(load)) {
+        (Some(ContactBody::Block { .. }), _) => {
+            let q = load;
+            report.set(
+                "patch_pressure_error",
+                solution
+                    .pressure
+                    .iter()
+                    .fold(0.0f64, |m, &p| m.max((p - q).abs() / q)),
+            );
+        }
+        (Some(body), Some(hertz)) => {
+            let (error, best, oscillation) = match body {
+                ContactBody::GapBlock { .. } => {
+                    let (error, best) = compare_gap_block(&hertz, solution);
+                    (error, best, p0_oscillation(solution, &hertz))
+                }
+                _ => {
+                    let h = hertz.half_width() / report.mesh_size as f64;
+                    let r = compare_with_hertz(hertz, h, solution.clone());
+                    (r.pressure_l2_error, r.best_fit_l2_error, r.oscillation)
+                }
+            };
+            report.set("exact_half_width", hertz.half_width());
+            report.set("exact_max_pressure", hertz.max_pressure());
+            report.set("pressure_l2_error", error);
+            report.set("best_fit_l2_error", best);
+            if solution.multiplier == Multiplier::P0 {
+                report.set("best_p0_l2_error", best);
+            }
+            // a second difference needs three pressures inside 0.8 b (b/h = 1, 2 have
+            // fewer: nothing measured, not 0)
+            let inside = pressure_steps(run)
+                .iter()
+                .filter(|p| p.1.abs() < 0.8 * hertz.half_width())
+                .count();
+            if inside >= 3 {
+                report.set("oscillation", oscillation);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The checkerboard measure of [`crate::signorini::HertzResult::oscillation`] on a P0
+/// solution symmetric about `x = 0`: `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
+/// consecutive contact edges (by x) inside `x < 0.8 b`.
+fn p0_oscillation(solution: &SignoriniSolution, hertz: &Hertz) -> f64 {
+    let mut profile: Vec<(f64, f64)> = solution
+        .contact_edges
+        .iter()
+        .zip(&solution.pressure)
+        .map(|(e, &p)| (e.midpoint()[0], p))
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let inside = 0.8 * hertz.half_width();
+    profile
+        .windows(3)
+        .filter(|w| w[2].0 < inside)
+        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
+        .fold(0.0f64, f64::max)
+        / hertz.max_pressure()
+}
