@@ -2,7 +2,7 @@
 //! `fem-forms solve --scene my.toml` with `model = "contact"`.
 //!
 //! The membrane scene files' conventions hold ([`crate::scene_file`]): data are
-//! expressions in `x` and `y` (parsed once by [`crate::scene_file::expression`]), boundary
+//! expressions in `x` and `y` (parsed once by [`crate::models::scene_file::expression`]), boundary
 //! parts are chosen by name (Gmsh physical names of curve groups, or the generator's
 //! sides), and every error names the file and the key at fault. An example, the patch
 //! test with a pressure given as an expression:
@@ -68,8 +68,8 @@
 //! under `--load`).
 
 use crate::models::data::Data;
+use crate::models::scene_file::expression;
 use crate::models::signorini::{solve_signorini, Plane, SignoriniInput, SignoriniSolution};
-use crate::scene_file::expression;
 use crate::signorini::{ContactPair, ContactReport, PressureProfile};
 use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
 use serde::Deserialize;
@@ -533,7 +533,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             ));
         }
     }
-    let name = crate::scene_file::scene_name(file.name.as_deref(), path, "contact")
+    let name = crate::models::scene_file::scene_name(file.name.as_deref(), path, "contact")
         .map_err(|m| at("name", m))?;
     Ok(ContactSceneFile {
         name,

@@ -434,6 +434,18 @@ fn study_scene(entry: &SceneEntry) -> fem_forms::Result<Box<dyn studies::StudySc
     }
 }
 
+/// The registry family of a scene file read by the one reader
+/// ([`fem_forms::models::scene_file::read_scene`]): every family but the membranes' and
+/// contact's, whose files have readers of their own.
+fn registry_family_file(path: &Path) -> Option<&'static dyn fem_forms::models::family::Family> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let name = fem_forms::models::scene_file::family_of(&text)?;
+    if name == "membrane" || name == "contact" {
+        return None;
+    }
+    fem_forms::models::families::family(&name)
+}
+
 /// Runs the study called `kind` on a registry scene.
 fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(), String> {
     if let SceneKind::Kirchhoff(scene) = &entry.kind {
@@ -1092,6 +1104,16 @@ fn run(cli: Cli) -> Result<(), String> {
                         .is_ok_and(|t| fem_forms::contact_scene_file::names_contact(&t)) =>
                 {
                     return solve_contact_file(&path, &options);
+                }
+                (_, Some(path)) if registry_family_file(&path).is_some() => {
+                    let family = registry_family_file(&path).expect("checked");
+                    let text = std::fs::read_to_string(&path).map_err(|e| e.to_string())?;
+                    let file = fem_forms::models::scene_file::read_scene(&text, &path, family)
+                        .map_err(|e| e.to_string())?;
+                    if options.pair.is_none() {
+                        options.pair = file.pair;
+                    }
+                    return solve::solve_scene(file.scene, &options, &cli.out);
                 }
                 (_, Some(path)) => {
                     let file = scene_file::read(&path).map_err(|e| e.to_string())?;

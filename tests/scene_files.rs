@@ -376,7 +376,7 @@ fn a_boundary_group_named_like_the_keyword_is_refused() {
 /// `flat-one`); a `name` written in the file is taken as written or refused.
 #[test]
 fn a_scene_without_a_name_is_named_after_its_file() {
-    use fem_forms::scene_file::scene_name;
+    use fem_forms::models::scene_file::scene_name;
     for (path, expected) in [
         ("dir/flat one.toml", "flat-one"),
         ("-x y.toml", "x-y"),

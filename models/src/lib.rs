@@ -26,6 +26,7 @@ pub mod scene_file;
 pub mod signorini;
 pub mod timoshenko;
 pub mod vector_forms;
+pub mod winkler;
 
 pub use euler_bernoulli::bernoulli;
 pub use membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};

@@ -1,4 +1,16 @@
 //! The one scene-file reader: a TOML file of any family read into a [`crate::scene::Scene`].
+//!
+//! Expressions use `+ − * / ^`, parentheses, numbers (`2.5`, `1e-3`), `PI`, `E`, and the
+//! functions `sqrt`, `exp`, `ln`, `sin`, `cos`, `tan`, `abs`, `min`, `max`, … of the
+//! `exmex` crate's `FloatOpsFactory`, in the variables `x` and `y`. A unary minus before
+//! a power must be bracketed (`-(x^2)` or `0-x^2`): `exmex` reads `-x^2` as `(−x)²`, so
+//! it is refused rather than read against the mathematics; so is a chained power
+//! `a^b^c`, which it reads as `(a^b)^c`.
+
+use crate::data::Data;
+use exmex::prelude::*;
+use fem_runtime::{Error, Result};
+use std::path::Path;
 
 /// The key under `[data]` of a scene file for the model's data function `name`: its
 /// ASCII spelling (`ψ` is `psi`).
@@ -8,4 +20,881 @@ pub fn data_key(name: &str) -> String {
         "λ" => "lambda".into(),
         other => other.into(),
     }
+}
+
+/// The variables an expression may use, in the order of the point's coordinates.
+const VARIABLES: [&str; 2] = ["x", "y"];
+
+/// Parses `text` (the field `field` of `file`) into a function of the point: checks
+/// that it uses no variable but `x` and `y`.
+///
+/// # Errors
+/// [`Error::Input`] naming the file, the field and the expression: a syntax error, a
+/// variable other than x, y, and the spellings `exmex` reads against the mathematics
+/// (`-x^2`, `a^b^c`).
+pub fn expression(text: &str, field: &str, file: &Path) -> Result<Data> {
+    let parsed = parse_checked(text, field, file)?;
+    Ok(function_of_point(parsed))
+}
+
+pub(crate) fn parse_checked(text: &str, field: &str, file: &Path) -> Result<FlatEx<f64>> {
+    // TOML's multi-line strings let long expressions span lines; exmex wants one line
+    let one_line = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let one_line = normalize(&one_line).map_err(|why| {
+        Error::Input(format!(
+            "{}: field `{field}`: the expression `{text}`: {why}",
+            file.display()
+        ))
+    })?;
+    let parsed = exmex::parse::<f64>(&one_line).map_err(|e| {
+        Error::Input(format!(
+            "{}: field `{field}`: cannot parse the expression `{text}`: {e}",
+            file.display()
+        ))
+    })?;
+    if let Some(unknown) = parsed
+        .var_names()
+        .iter()
+        .find(|v| !VARIABLES.contains(&v.as_str()))
+    {
+        return Err(Error::Input(format!(
+            "{}: field `{field}`: unknown variable `{unknown}` in `{text}` (expressions are functions of x and y)",
+            file.display()
+        )));
+    }
+    Ok(parsed)
+}
+
+/// What `exmex` reads differently from the mathematics, made right or refused before it
+/// parses: numbers in scientific notation (`1e-3`, which `exmex` cannot parse) become
+/// their decimal expansion, exactly the same `f64`; a unary minus whose operand is
+/// raised to a power (`-x^2`, which `exmex` reads as `(−x)²` where mathematics means
+/// `−(x²)`) is refused with the two unambiguous spellings.
+fn normalize(text: &str) -> std::result::Result<String, String> {
+    let chars: Vec<char> = text.chars().collect();
+    let is_name = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let starts_number = (c.is_ascii_digit() || c == '.')
+            && (i == 0 || !(is_name(chars[i - 1]) || chars[i - 1] == '.'));
+        if starts_number {
+            let start = i;
+            while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
+                i += 1;
+            }
+            // an exponent: e or E, an optional sign, at least one digit
+            let mut j = i;
+            if j < chars.len() && (chars[j] == 'e' || chars[j] == 'E') {
+                j += 1;
+                if j < chars.len() && (chars[j] == '+' || chars[j] == '-') {
+                    j += 1;
+                }
+                let digits = j;
+                while j < chars.len() && chars[j].is_ascii_digit() {
+                    j += 1;
+                }
+                let followed_by_name = j < chars.len() && is_name(chars[j]);
+                if j > digits && !followed_by_name {
+                    let literal: String = chars[start..j].iter().collect();
+                    let value: f64 = literal
+                        .parse()
+                        .map_err(|_| format!("`{literal}` is not a number"))?;
+                    if !value.is_finite() {
+                        return Err(format!("the number `{literal}` is not finite"));
+                    }
+                    // Display never uses an exponent and round-trips the value exactly
+                    out.push_str(&format!("({value})"));
+                    i = j;
+                    continue;
+                }
+            }
+            out.extend(&chars[start..i]);
+            continue;
+        }
+        if c == '-' {
+            let previous = chars[..i].iter().rev().find(|c| !c.is_whitespace());
+            let unary = previous.is_none_or(|p| "(,+-*/^".contains(*p));
+            if unary {
+                let end = operand_end(&chars, i + 1);
+                let next = chars[end..].iter().find(|c| !c.is_whitespace());
+                if end > i + 1 && next == Some(&'^') {
+                    let operand: String = chars[i + 1..end].iter().collect::<String>();
+                    let operand = operand.trim();
+                    return Err(format!(
+                        "`-{operand}^…` is ambiguous here: the expression language reads it as (−{operand})^…, not −({operand}^…); write `-({operand}^…)` or `0-{operand}^…` for the negative power, or `(-{operand})^…` for the power of the negative"
+                    ));
+                }
+            }
+        }
+        if c == '^' {
+            // the exponent's own operand, after an optional sign
+            let mut k = i + 1;
+            while k < chars.len() && chars[k].is_whitespace() {
+                k += 1;
+            }
+            if matches!(chars.get(k), Some('+' | '-')) {
+                k += 1;
+            }
+            let end = operand_end(&chars, k);
+            let next = chars[end..].iter().find(|c| !c.is_whitespace());
+            if end > k && next == Some(&'^') {
+                let exponent: String = chars[k..end].iter().collect();
+                let exponent = exponent.trim();
+                return Err(format!(
+                    "`…^{exponent}^…` is ambiguous here: the expression language reads a chained power from the left, (a^{exponent})^c, where mathematics means a^({exponent}^c); write the brackets you mean"
+                ));
+            }
+        }
+        out.push(c);
+        i += 1;
+    }
+    Ok(out)
+}
+
+/// The end of the operand that starts at `from` (after spaces): a number, a name with an
+/// optional call `f(…)`, or a bracketed group; `from` itself where there is none.
+fn operand_end(chars: &[char], from: usize) -> usize {
+    let mut i = from;
+    while i < chars.len() && chars[i].is_whitespace() {
+        i += 1;
+    }
+    let group = |mut i: usize| {
+        // i at '(': to just past its matching ')'
+        let mut depth = 0usize;
+        while i < chars.len() {
+            match chars[i] {
+                '(' => depth += 1,
+                ')' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return i + 1;
+                    }
+                }
+                _ => {}
+            }
+            i += 1;
+        }
+        i
+    };
+    match chars.get(i) {
+        Some(c) if c.is_ascii_digit() || *c == '.' => {
+            while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
+                i += 1;
+            }
+            // and its exponent, if any
+            if matches!(chars.get(i), Some('e' | 'E')) {
+                let mut j = i + 1;
+                if matches!(chars.get(j), Some('+' | '-')) {
+                    j += 1;
+                }
+                let digits = j;
+                while j < chars.len() && chars[j].is_ascii_digit() {
+                    j += 1;
+                }
+                if j > digits {
+                    i = j;
+                }
+            }
+            i
+        }
+        Some(c) if c.is_ascii_alphabetic() || *c == '_' => {
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            let mut j = i;
+            while j < chars.len() && chars[j].is_whitespace() {
+                j += 1;
+            }
+            if chars.get(j) == Some(&'(') {
+                group(j)
+            } else {
+                i
+            }
+        }
+        Some('(') => group(i),
+        // a braced variable `{x}` (a tester's `-{x}^2` passed the guard as a plain minus)
+        Some('{') => chars[i..]
+            .iter()
+            .position(|&c| c == '}')
+            .map_or(chars.len(), |k| i + k + 1),
+        _ => from,
+    }
+}
+
+/// The expression as a function of `[x, y]`: its variables (alphabetical in `exmex`)
+/// mapped to coordinates once, here. An evaluation error (none is known for the float
+/// operators) gives NaN, which the solver's data checks refuse.
+fn function_of_point(parsed: FlatEx<f64>) -> Data {
+    let coordinates: Vec<usize> = parsed
+        .var_names()
+        .iter()
+        .map(|v| VARIABLES.iter().position(|c| c == v).expect("checked"))
+        .collect();
+    Data::shared(move |x: &[f64]| {
+        let mut values = [0.0; 2];
+        for (k, &c) in coordinates.iter().enumerate() {
+            values[k] = x.get(c).copied().unwrap_or(0.0);
+        }
+        parsed
+            .eval(&values[..coordinates.len()])
+            .unwrap_or(f64::NAN)
+    })
+}
+
+/// `∂/∂x` and `∂/∂y` of an expression (0 for a variable it does not use), each
+/// derived once, symbolically, by `exmex`.
+///
+/// # Errors
+/// As [`expression`]; an expression longer than 1000 characters, and one `exmex`
+/// cannot differentiate.
+pub fn gradient(text: &str, field: &str, file: &Path) -> Result<Data<[f64; 2]>> {
+    // exmex differentiates by recursion over the expression tree, and its simplification
+    // can take long on long expressions: bound the text, and give the work a large stack
+    if text.len() > MAX_DIFFERENTIATED_LENGTH {
+        return Err(Error::Input(format!(
+            "{}: field `{field}`: the expression has {} characters; an exact solution to differentiate may have at most {MAX_DIFFERENTIATED_LENGTH}",
+            file.display(),
+            text.len()
+        )));
+    }
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .stack_size(256 << 20)
+            .spawn_scoped(scope, || gradient_on_this_thread(text, field, file))
+            .map_err(|e| {
+                Error::Input(format!(
+                    "cannot start the differentiation of `{field}`: {e}"
+                ))
+            })?
+            .join()
+            .unwrap_or_else(|_| {
+                Err(Error::Input(format!(
+                    "{}: field `{field}`: differentiating `{text}` failed",
+                    file.display()
+                )))
+            })
+    })
+}
+
+/// Longest `exact.u` text that is differentiated symbolically.
+const MAX_DIFFERENTIATED_LENGTH: usize = 1000;
+
+fn gradient_on_this_thread(text: &str, field: &str, file: &Path) -> Result<Data<[f64; 2]>> {
+    let parsed = parse_checked(text, field, file)?;
+    let mut parts: Vec<Option<Data>> = Vec::new();
+    for variable in VARIABLES {
+        match parsed.var_names().iter().position(|v| v == variable) {
+            Some(k) => {
+                let derivative = parsed.clone().partial(k).map_err(|e| {
+                    Error::Input(format!(
+                        "{}: field `{field}`: cannot differentiate `{text}` by {variable}: {e}",
+                        file.display()
+                    ))
+                })?;
+                parts.push(Some(function_of_point(derivative)));
+            }
+            None => parts.push(None),
+        }
+    }
+    Ok(Data::shared(move |x: &[f64]| {
+        let mut out = [0.0; 2];
+        for (k, part) in parts.iter().enumerate() {
+            if let Some(d) = part {
+                out[k] = d.at(x);
+            }
+        }
+        out
+    }))
+}
+
+/// The name of a scene file's scene, which becomes part of output file names
+/// (`out/<name>-<pair>-<N>.vtu`): the file's `name` as given, or else its file name's
+/// stem with every character other than letters, digits, `-`, `_` and `.` turned into
+/// `-` (`my gap.toml` → `my-gap`), `default` if nothing is left.
+///
+/// # Errors
+/// The reason, for a given `name` that is empty, starts with `.` or `-` (a leading `-`
+/// would read as an option to a shell command given the output file) or has other
+/// characters.
+pub fn scene_name(
+    name: Option<&str>,
+    path: &Path,
+    default: &str,
+) -> std::result::Result<String, String> {
+    let plain = |c: char| c.is_alphanumeric() || c == '-' || c == '_' || c == '.';
+    let Some(name) = name else {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy())
+            .unwrap_or_default();
+        let cleaned: String = stem
+            .chars()
+            .map(|c| if plain(c) { c } else { '-' })
+            .collect();
+        let cleaned = cleaned.trim_start_matches(['.', '-']);
+        return Ok(if cleaned.is_empty() {
+            default.to_string()
+        } else {
+            cleaned.to_string()
+        });
+    };
+    if name.is_empty() || name.starts_with(['.', '-']) || !name.chars().all(plain) {
+        return Err(format!(
+            "`{name}` cannot name output files: use letters, digits, `-`, `_` and `.` (not first, nor `-`)"
+        ));
+    }
+    Ok(name.to_string())
+}
+
+#[cfg(test)]
+mod normalize_tests {
+    use super::*;
+
+    fn value(text: &str, x: f64, y: f64) -> f64 {
+        let parsed = parse_checked(text, "f", Path::new("t.toml")).unwrap();
+        let names: Vec<String> = parsed.var_names().to_vec();
+        let args: Vec<f64> = names.iter().map(|n| if n == "x" { x } else { y }).collect();
+        parsed.eval(&args).unwrap()
+    }
+
+    /// Scientific notation gives the same f64 as Rust's parser, wherever it stands.
+    #[test]
+    fn scientific_notation_is_read_exactly() {
+        for (text, expected) in [
+            ("1e20", 1e20),
+            ("-1e20", -1e20),
+            ("2.5e-3", 2.5e-3),
+            ("1E5 + 1", 1e5 + 1.0),
+            ("x*1e-3", 2.0 * 1e-3),
+            ("3e+2", 300.0),
+            ("1e-300", 1e-300),
+            ("exp(0) + 2", 3.0),
+        ] {
+            let v = value(text, 2.0, 0.0);
+            assert_eq!(v, expected, "{text}");
+        }
+        assert!(normalize("1e999").unwrap_err().contains("not finite"));
+    }
+
+    /// `-x^2` would be read as `(−x)²`: refused with the spellings that say what is meant;
+    /// the unambiguous forms keep their meaning.
+    #[test]
+    fn a_unary_minus_before_a_power_is_refused() {
+        for text in [
+            "-x^2",
+            "exp(-x^2-y^2)",
+            "-1^2",
+            "2*-x^2",
+            "-(x)^2",
+            "-{x}^2",
+            "2^-{x}^2",
+            "-sin(x)^2",
+            "- x ^ 2",
+            "-1e2^2",
+        ] {
+            let error = normalize(text).unwrap_err();
+            assert!(error.contains("ambiguous"), "{text}: {error}");
+        }
+        for (text, expected) in [
+            ("0-x^2", -9.0),
+            ("-(x^2)", -9.0),
+            ("(-x)^2", 9.0),
+            ("2^-x", 0.125),
+            ("x-y^2", 3.0 - 4.0),
+            ("-x", -3.0),
+            ("exp(0-(x^2+y^2))", (-13.0f64).exp()),
+        ] {
+            assert_eq!(value(text, 3.0, 2.0), expected, "{text}");
+        }
+    }
+
+    /// `a^b^c` would be read as `(a^b)^c` (2^3^2 = 64, where mathematics means 512):
+    /// refused; bracketed chains keep their meaning.
+    #[test]
+    fn a_chained_power_is_refused() {
+        for text in [
+            "2^3^2",
+            "x^y^2",
+            "x ^ 2 ^ y",
+            "x^-2^2",
+            "x^(1)^2",
+            "x^sin(y)^2",
+        ] {
+            let error = normalize(text).unwrap_err();
+            assert!(error.contains("chained power"), "{text}: {error}");
+        }
+        for (text, expected) in [
+            ("2^(3^2)", 512.0),
+            ("(2^3)^2", 64.0),
+            ("x^2*y^2", 36.0),
+            ("x^2+y^2", 13.0),
+            ("2^-x", 0.125),
+        ] {
+            assert_eq!(value(text, 3.0, 2.0), expected, "{text}");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The scene of any registry family
+// ---------------------------------------------------------------------------------------
+
+use crate::family::Family;
+use crate::scene::{Domain, Exact, ExactSolution, Load, Part, PartSupport, Scene, Support};
+use serde::Deserialize;
+use std::path::PathBuf;
+
+/// A scene file as written; the family's own keys go under `[parameters]` and `[data]`
+/// by the model's declared names or the family's aliases.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileToml {
+    name: Option<String>,
+    description: Option<String>,
+    model: String,
+    pair: Option<String>,
+    accuracy: Option<f64>,
+    mesh: MeshToml,
+    #[serde(default)]
+    boundary: BoundaryToml,
+    #[serde(default)]
+    parameters: toml::Table,
+    #[serde(default)]
+    data: toml::Table,
+    exact: Option<ExactToml>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MeshToml {
+    generator: Option<String>,
+    x: Option<[f64; 2]>,
+    y: Option<[f64; 2]>,
+    cells: Option<[usize; 2]>,
+    start: Option<f64>,
+    end: Option<f64>,
+    centre: Option<[f64; 2]>,
+    radius: Option<f64>,
+    curved: Option<bool>,
+    size: Option<usize>,
+    file: Option<PathBuf>,
+    refinements: Option<usize>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+struct BoundaryToml {
+    clamped: Option<toml::Value>,
+    simply_supported: Option<toml::Value>,
+    simply_supported_hard: Option<toml::Value>,
+    free: Option<toml::Value>,
+    dirichlet: Option<toml::Value>,
+    #[serde(default)]
+    roller: Vec<RollerToml>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct RollerToml {
+    part: toml::Value,
+    normal: [f64; 2],
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct ExactToml {
+    #[serde(alias = "u", alias = "w")]
+    value: Option<String>,
+    gradient: Option<[String; 2]>,
+    hessian: Option<[[String; 2]; 2]>,
+    lambda: Option<String>,
+    contact_force: Option<f64>,
+    contact_area: Option<f64>,
+}
+
+/// A scene read from a file with the pair it names (the command line's `--pair` wins).
+#[derive(Clone, Debug)]
+pub struct FileScene {
+    /// The scene.
+    pub scene: Scene,
+    /// The pair the file names.
+    pub pair: Option<String>,
+}
+
+/// The family a scene file names under `model`, read before the rest of the file.
+pub fn family_of(text: &str) -> Option<String> {
+    #[derive(Deserialize)]
+    struct ModelOnly {
+        model: Option<String>,
+    }
+    toml::from_str::<ModelOnly>(text).ok()?.model
+}
+
+/// Reads a scene file of a registry family (docs/scene-files.md): the mesh, the supports
+/// per boundary part, the parameters and data by the model's names or the family's
+/// aliases, the exact solution with its derivatives given or derived.
+///
+/// # Errors
+/// [`Error::Input`] naming the file and the field: TOML errors, unknown keys, a family
+/// or generator the registry does not have, boundary parts that are not names,
+/// expressions that do not parse, an exact gradient or Hessian that the finite
+/// differences of the value (or gradient) contradict.
+pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileScene> {
+    let at = |field: &str, message: String| {
+        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
+    };
+    let file: FileToml = toml::from_str(text)
+        .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
+    if file.model != family.name() {
+        return Err(at(
+            "model",
+            format!("`{}` is read as the family `{}`", file.model, family.name()),
+        ));
+    }
+    let name = scene_name(file.name.as_deref(), path, "scene").map_err(|m| at("name", m))?;
+    let (domain, mesh_size) = domain_of(&file.mesh, path).map_err(|(f, m)| at(&f, m))?;
+    let description = file
+        .description
+        .clone()
+        .unwrap_or_else(|| format!("scene file {}", path.display()));
+    let mut scene = Scene::new(name, description, family.name(), domain, mesh_size);
+    let model_name = |key: &str| -> String {
+        family
+            .aliases()
+            .iter()
+            .find(|(alias, _)| *alias == key)
+            .map_or(key.to_string(), |(_, name)| name.to_string())
+    };
+    for (key, value) in &file.parameters {
+        let v = value
+            .as_float()
+            .or_else(|| value.as_integer().map(|i| i as f64))
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                at(
+                    &format!("parameters.{key}"),
+                    format!("{value} is not a finite number"),
+                )
+            })?;
+        scene.set_parameter(model_name(key), v);
+    }
+    let mut load = None;
+    for (key, value) in &file.data {
+        let field = format!("data.{key}");
+        if key == "load" {
+            let q = value
+                .as_float()
+                .or_else(|| value.as_integer().map(|i| i as f64))
+                .filter(|q| q.is_finite())
+                .ok_or_else(|| at(&field, format!("{value} is not a finite number")))?;
+            load = Some(q);
+            continue;
+        }
+        let text = match value {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Float(v) => v.to_string(),
+            toml::Value::Integer(v) => v.to_string(),
+            other => return Err(at(&field, format!("{other} is not an expression"))),
+        };
+        scene.set_data(model_name(key), expression(&text, &field, path)?);
+    }
+    let scaled = model_name("f");
+    if scene.data_fn(&scaled).is_some() {
+        scene.load = Some(Load {
+            default: load.unwrap_or(1.0),
+            scales: vec![scaled.into()],
+            symbol: "q",
+            nonnegative: false,
+        });
+    } else if load.is_some() {
+        return Err(at(
+            "data.load",
+            "scales the load `f`, which the file does not give".into(),
+        ));
+    }
+    scene.supports = supports(&file.boundary).map_err(|(f, m)| at(&f, m))?;
+    if let Some(e) = &file.exact {
+        let exact = exact_of(e, &scene.domain, path)?;
+        // the contact set is not linear in the load: the file's exact solution holds at
+        // its own load
+        scene.exact = Exact::AtDefaultLoad(exact);
+    }
+    if let Some(a) = file.accuracy {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(at("accuracy", format!("{a} must be positive and finite")));
+        }
+        if file.exact.is_none() {
+            return Err(at(
+                "accuracy",
+                "an accuracy needs an `[exact]` value to measure the L² error against".into(),
+            ));
+        }
+        scene.accuracy = Some(a);
+    }
+    Ok(FileScene {
+        scene,
+        pair: file.pair,
+    })
+}
+
+/// The domain and `N` of `[mesh]`; errors as `(field, message)`.
+fn domain_of(
+    mesh: &MeshToml,
+    path: &Path,
+) -> std::result::Result<(Domain, usize), (String, String)> {
+    let err = |f: &str, m: &str| Err((format!("mesh.{f}"), m.to_string()));
+    match (&mesh.generator, &mesh.file) {
+        (Some(_), Some(_)) => err("file", "give either `generator` or `file`, not both"),
+        (None, None) => err(
+            "generator",
+            "give a `generator` (interval, rectangle, square, l-shape, disk) or a Gmsh `file`",
+        ),
+        (None, Some(msh)) => {
+            let base = path.parent().unwrap_or(Path::new("."));
+            Ok((Domain::Gmsh(base.join(msh)), mesh.refinements.unwrap_or(0)))
+        }
+        (Some(generator), None) => {
+            if mesh.refinements.is_some() {
+                return err(
+                    "refinements",
+                    "applies to a Gmsh `file`; a generator takes `size`",
+                );
+            }
+            let size = mesh.size.unwrap_or(16);
+            let domain = match generator.as_str() {
+                "interval" => Domain::Interval {
+                    start: mesh.start.unwrap_or(0.0),
+                    end: mesh.end.unwrap_or(1.0),
+                },
+                "rectangle" | "square" => {
+                    let x = mesh.x.unwrap_or([0.0, 1.0]);
+                    let y = mesh.y.unwrap_or(x);
+                    if !(x[0] < x[1] && y[0] < y[1]) {
+                        return err("x", "the sides need x[0] < x[1] and y[0] < y[1]");
+                    }
+                    Domain::Rectangle {
+                        x,
+                        y,
+                        cells: mesh.cells.unwrap_or([1, 1]),
+                        diagonal: fem_runtime::Diagonal::Right,
+                    }
+                }
+                "l-shape" => Domain::LShape,
+                "disk" => Domain::Disk {
+                    centre: mesh.centre.unwrap_or([0.0, 0.0]),
+                    radius: mesh.radius.unwrap_or(1.0),
+                    curved: mesh.curved.unwrap_or(false),
+                },
+                other => {
+                    return err(
+                        "generator",
+                        &format!("unknown generator `{other}`; the generators are interval, rectangle, square, l-shape, disk"),
+                    )
+                }
+            };
+            Ok((domain, size))
+        }
+    }
+}
+
+/// The parts a `[boundary]` key names: `"all"`, a name or a list of names.
+fn part_of(value: &toml::Value) -> std::result::Result<Part, String> {
+    use toml::Value;
+    let name = |v: &Value| {
+        match v {
+        Value::String(s) if !s.trim().is_empty() => Ok(s.clone()),
+        Value::Integer(i) => Err(format!(
+            "{i} is a number: boundary parts are chosen by name (Gmsh physical names of curve groups, or a generator's side names)"
+        )),
+        other => Err(format!("{other} is not a name")),
+    }
+    };
+    match value {
+        Value::String(s) if s == "all" => Ok(Part::All),
+        Value::Array(list) if list.is_empty() => Err("an empty list names no part".into()),
+        Value::Array(list) => Ok(Part::Named(
+            list.iter()
+                .map(name)
+                .collect::<std::result::Result<_, _>>()?,
+        )),
+        v => Ok(Part::Named(vec![name(v)?])),
+    }
+}
+
+/// The supports of `[boundary]`, in the order clamped, simply supported (soft, hard),
+/// free, dirichlet, rollers: later entries win where parts overlap.
+fn supports(b: &BoundaryToml) -> std::result::Result<Vec<PartSupport>, (String, String)> {
+    let mut out = Vec::new();
+    for (key, value, support) in [
+        ("clamped", &b.clamped, Support::Clamped),
+        (
+            "simply_supported",
+            &b.simply_supported,
+            Support::SimplySupported { hard: false },
+        ),
+        (
+            "simply_supported_hard",
+            &b.simply_supported_hard,
+            Support::SimplySupported { hard: true },
+        ),
+        ("free", &b.free, Support::Free),
+        ("dirichlet", &b.dirichlet, Support::Data),
+    ] {
+        if let Some(v) = value {
+            let field = format!("boundary.{key}");
+            let part = part_of(v).map_err(|m| (field.clone(), m))?;
+            out.push(PartSupport {
+                part,
+                support,
+                key: Some(field.into()),
+            });
+        }
+    }
+    for (k, r) in b.roller.iter().enumerate() {
+        let field = format!("boundary.roller[{k}]");
+        let part = part_of(&r.part).map_err(|m| (field.clone(), m))?;
+        out.push(PartSupport {
+            part,
+            support: Support::Roller { normal: r.normal },
+            key: Some(field.into()),
+        });
+    }
+    Ok(out)
+}
+
+/// Points inside the domain's bounding box at which given derivatives are checked
+/// (irrational offsets: unlikely to sit on a kink of `max` or `abs`).
+fn check_points(domain: &Domain) -> Vec<[f64; 2]> {
+    let (x, y) = match domain {
+        Domain::Interval { start, end } => ([*start, *end], [0.0, 0.0]),
+        Domain::Rectangle { x, y, .. } => (*x, *y),
+        Domain::Disk { centre, radius, .. } => {
+            let r = radius / std::f64::consts::SQRT_2;
+            (
+                [centre[0] - r, centre[0] + r],
+                [centre[1] - r, centre[1] + r],
+            )
+        }
+        _ => ([-1.0, 1.0], [-1.0, 1.0]),
+    };
+    [0.1234, 0.3711, 0.5827, 0.7419, 0.9137]
+        .iter()
+        .zip([0.8191, 0.2347, 0.6553, 0.4271, 0.1619])
+        .map(|(s, t)| [x[0] + s * (x[1] - x[0]), y[0] + t * (y[1] - y[0])])
+        .collect()
+}
+
+/// Checks `derivative` (the given `∂f/∂x_k` as `d(x)[k]`) against the central
+/// differences of `f` at a few points.
+fn check_derivative(
+    f: &dyn Fn(&[f64]) -> f64,
+    derivative: &dyn Fn(&[f64], usize) -> f64,
+    points: &[[f64; 2]],
+    dimension: usize,
+) -> std::result::Result<(), String> {
+    for p in points {
+        for k in 0..dimension {
+            let step = 1e-5 * (1.0 + p[k].abs());
+            let (mut a, mut b) = (*p, *p);
+            a[k] += step;
+            b[k] -= step;
+            let difference = (f(&a) - f(&b)) / (2.0 * step);
+            let given = derivative(p, k);
+            let scale = 1.0 + difference.abs().max(given.abs());
+            let agrees = (given - difference).abs() <= 1e-4 * scale;
+            // NaN (a derivative undefined where the function is) fails too
+            if !agrees {
+                return Err(format!(
+                    "at ({}, {}) its component {} is {given:e}, the finite difference of the function {difference:e}",
+                    p[0], p[1], k + 1
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The exact solution of `[exact]`, its gradient and Hessian given (and checked) or
+/// derived symbolically.
+fn exact_of(e: &ExactToml, domain: &Domain, path: &Path) -> Result<ExactSolution> {
+    let at = |field: &str, message: String| {
+        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
+    };
+    let dimension = if matches!(domain, Domain::Interval { .. }) {
+        1
+    } else {
+        2
+    };
+    let points = check_points(domain);
+    let mut out = ExactSolution {
+        multiplier: e
+            .lambda
+            .as_deref()
+            .map(|l| expression(l, "exact.lambda", path))
+            .transpose()?,
+        total_contact_force: e.contact_force,
+        contact_area: e.contact_area,
+        ..ExactSolution::default()
+    };
+    let Some(value) = &e.value else {
+        return Ok(out);
+    };
+    let u = expression(value, "exact.value", path)?;
+    let gradient = match &e.gradient {
+        Some([gx, gy]) => {
+            let (gx, gy) = (
+                expression(gx, "exact.gradient[0]", path)?,
+                expression(gy, "exact.gradient[1]", path)?,
+            );
+            let g = Data::shared(move |x: &[f64]| [gx.at(x), gy.at(x)]);
+            check_derivative(&|x| u.at(x), &|x, k| g.at(x)[k], &points, dimension).map_err(
+                |m| at("exact.gradient", format!("does not match `exact.value`: {m}")),
+            )?;
+            g
+        }
+        None => gradient(value, "exact.value", path).map_err(|e| match e {
+            Error::Input(m) => Error::Input(format!(
+                "{m}; give the derivatives as `gradient = [\"∂u/∂x\", \"∂u/∂y\"]` (a kink of max or abs is not differentiated)"
+            )),
+            other => other,
+        })?,
+    };
+    if let Some(h) = &e.hessian {
+        let mut rows = Vec::new();
+        for (i, row) in h.iter().enumerate() {
+            let entries = [
+                expression(&row[0], &format!("exact.hessian[{i}][0]"), path)?,
+                expression(&row[1], &format!("exact.hessian[{i}][1]"), path)?,
+            ];
+            rows.push(entries);
+        }
+        let rows = std::sync::Arc::new(rows);
+        for i in 0..dimension {
+            let g = gradient.clone();
+            let r = rows.clone();
+            check_derivative(
+                &move |x| g.at(x)[i],
+                &move |x, k| r[i][k].at(x),
+                &points,
+                dimension,
+            )
+            .map_err(|m| {
+                at(
+                    &format!("exact.hessian[{i}]"),
+                    format!("does not match the gradient: {m}"),
+                )
+            })?;
+        }
+        out.hessian = Some(Data::shared(move |x: &[f64]| {
+            [
+                [rows[0][0].at(x), rows[0][1].at(x)],
+                [rows[1][0].at(x), rows[1][1].at(x)],
+            ]
+        }));
+    }
+    out.value = Some(u);
+    out.gradient = Some(gradient);
+    Ok(out)
 }

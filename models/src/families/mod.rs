@@ -6,6 +6,7 @@ pub mod contact;
 pub mod kirchhoff;
 pub mod membrane;
 pub mod plate;
+pub mod winkler;
 
 use crate::family::{Family, Pair};
 use crate::report::{Outcome, Settings};
@@ -17,12 +18,13 @@ pub fn families() -> &'static [&'static dyn Family] {
     &FAMILIES
 }
 
-static FAMILIES: [&dyn Family; 5] = [
+static FAMILIES: [&dyn Family; 6] = [
     &beam::BEAMS,
     &membrane::MEMBRANES,
     &plate::PLATES,
     &kirchhoff::KIRCHHOFF,
     &contact::CONTACT,
+    &winkler::WINKLER,
 ];
 
 /// The family called `name`.
