@@ -2,14 +2,13 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use clap::{Parser, Subcommand, ValueEnum};
-use fem_forms::beams::Pair;
 use fem_forms::kirchhoff::{self, KirchhoffPair, KirchhoffRequest};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::contact_scenes::{ContactBody, ContactScene};
 use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene};
-use fem_forms::models::registry::{find, names, registry, Family, SceneEntry, SceneKind};
+use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::plates::{self, PlatePair, PlateRequest};
@@ -543,70 +542,57 @@ fn membrane_job(scenes: &[MembraneScene], out: &Path) -> Result<(), String> {
 }
 
 fn list() {
+    use fem_forms::models::families;
     println!("scenes (family, pairs with the default first, studies):");
-    for e in registry() {
-        let load = e.default_load().map_or("fixed load".to_string(), |q| {
-            // the cylinder and the gap block take a resultant, not a pressure
-            let symbol = match e.family() {
-                Family::Contact if e.name() != "signorini-patch" => "P",
-                _ => "q",
-            };
-            format!("--load {symbol} = {q} by default")
+    for scene in families::scenes() {
+        let load = scene.load.as_ref().map_or("fixed load".to_string(), |l| {
+            format!(
+                "--load {} = {} by default",
+                l.symbol,
+                fem_forms::number(l.default)
+            )
         });
-        println!("  {:<17} {}", e.name(), e.description());
+        let pairs: Vec<&str> = families::pairs_of(&scene).iter().map(|p| p.name).collect();
+        println!("  {:<18} {}", scene.name, scene.description);
         println!(
-            "  {:<17} {} scene; pairs {}; {load}{}",
+            "  {:<18} {} scene; pairs {}; {load}{}",
             "",
-            e.family().name(),
-            e.pairs.join(", "),
-            if e.studies.is_empty() {
+            scene.family,
+            pairs.join(", "),
+            if scene.studies.is_empty() {
                 String::new()
             } else {
-                format!("; studies {}", e.studies.join(", "))
+                format!("; studies {}", scene.studies.join(", "))
             }
         );
     }
-    println!("beam pairs:");
-    for p in Pair::ALL {
+    for family in families::families() {
+        let options: Vec<&str> = family.options().iter().map(|o| o.flag()).collect();
         println!(
-            "  {:<17} {:?} (default α = {})",
-            p.name(),
-            p.beam(),
-            p.default_alpha()
+            "{} ({}); options {}:",
+            family.name(),
+            family.description(),
+            options.join(", ")
         );
+        for p in family.pairs() {
+            println!("  {:<18} {} (α: {})", p.name, p.note, alpha_rule(p));
+        }
     }
-    println!(
-        "membrane pairs (--mesh-size N, or --msh FILE; default p2-p0; α = ½/C_I, or {} where C_I = 0):",
-        membranes::ALPHA_WHEN_CI_VANISHES
-    );
-    for p in MembranePair::ALL {
-        println!("  {}", p.name());
+}
+
+/// A pair's α rule in words.
+fn alpha_rule(pair: &fem_forms::models::family::Pair) -> String {
+    use fem_forms::stabilization::Alpha;
+    if pair.nodal {
+        return "none: no multiplier space".into();
     }
-    println!(
-        "plate pairs (θ, w, λ; --mesh-size N, --thickness t; default p1-p2-p0, α = {}):",
-        plates::PLATE_ALPHA
-    );
-    for p in PlatePair::ALL {
-        println!("  {}", p.name());
-    }
-    println!(
-        "Kirchhoff pairs (w, λ; --mesh-size N, --support, --obstacle; default argyris-p0, α = {}/C_I; morley-p0 α = {}):",
-        kirchhoff::ALPHA_FRACTION,
-        kirchhoff::MORLEY_ALPHA
-    );
-    for p in KirchhoffPair::ALL {
-        println!("  {}", p.name());
-    }
-    println!(
-        "contact pairs (u, λ on Γ_C; --mesh-size N of the block, b/h of Hertz's graded mesh; default p1-p0, α = ½/max C_I,E; --alpha 0: the plain method):"
-    );
-    for p in contact::ContactPair::EVERY {
-        let note = if contact::ContactPair::ALL.contains(&p) {
-            ""
-        } else {
-            " (λ continuous P1; signorini-patch and hertz)"
-        };
-        println!("  {}{note}", p.name());
+    match pair.alpha {
+        Alpha::Fixed(a) => fem_forms::number(a),
+        Alpha::FromInverseConstant(c) => format!(
+            "{}/C_I, or {} where C_I = 0",
+            fem_forms::number(c),
+            fem_forms::number(pair.alpha_when_zero)
+        ),
     }
 }
 
