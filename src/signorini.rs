@@ -372,7 +372,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
                 )));
             }
             let r = solve_gap_block(s, q, n as f64, element, request.alpha)?;
-            let oscillation = oscillation(&r.solution, &r.hertz);
+            let oscillation = crate::models::signorini::checkerboard(&r.solution, &r.hertz);
             (
                 r.solution,
                 Some(r.hertz),
@@ -458,26 +458,6 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
         ..report
     };
     Ok((report, profile))
-}
-
-/// The checkerboard measure of `models::signorini::HertzResult::oscillation` on any
-/// solution symmetric about `x = 0`: `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
-/// consecutive contact edges (by x) inside `x < 0.8 b`.
-fn oscillation(solution: &crate::models::signorini::SignoriniSolution, hertz: &Hertz) -> f64 {
-    let mut profile: Vec<(f64, f64)> = solution
-        .contact_edges
-        .iter()
-        .zip(&solution.pressure)
-        .map(|(e, &p)| (e.midpoint()[0], p))
-        .collect();
-    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let inside = 0.8 * hertz.half_width();
-    profile
-        .windows(3)
-        .filter(|w| w[2].0 < inside)
-        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
-        .fold(0.0f64, f64::max)
-        / hertz.max_pressure()
 }
 
 /// One line for a report (`solve` without `--json`).

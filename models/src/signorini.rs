@@ -777,15 +777,8 @@ fn hertz_p1(hertz: Hertz, h: f64, solution: SignoriniSolution) -> HertzResult {
             }
         })
         .unzip();
-    let profile = solution.pressure_profile();
-    let nodes: Vec<f64> = profile.iter().map(|p| p.0).collect();
-    let inside = 0.8 * hertz.half_width();
-    let oscillation = profile
-        .windows(3)
-        .filter(|w| w[2].0 < inside)
-        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
-        .fold(0.0f64, f64::max)
-        / hertz.max_pressure();
+    let nodes: Vec<f64> = solution.pressure_profile().iter().map(|p| p.0).collect();
+    let oscillation = checkerboard(&solution, &hertz);
     HertzResult {
         hertz,
         contact_h: h,
@@ -975,6 +968,22 @@ pub fn solve_hertz_on_with(
     Ok(compare_with_hertz(hertz, h, solution))
 }
 
+/// The checkerboard measure of a pressure against Hertz's (see
+/// [`HertzResult::oscillation`]): `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
+/// consecutive multiplier DOFs along x ([`SignoriniSolution::pressure_profile`]: edge
+/// midpoints for P0, vertices for P1) inside `x < 0.8 b`; 0 where fewer than three lie
+/// there.
+pub fn checkerboard(solution: &SignoriniSolution, hertz: &Hertz) -> f64 {
+    let inside = 0.8 * hertz.half_width();
+    solution
+        .pressure_profile()
+        .windows(3)
+        .filter(|w| w[2].0 < inside)
+        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
+        .fold(0.0f64, f64::max)
+        / hertz.max_pressure()
+}
+
 /// The comparison of a solution on [`hertz_mesh`] with Hertz's pressure: the relative
 /// L² error, the best fit's in the multiplier's space and the checkerboard measure
 /// (see [`HertzResult`]; P0: 16-point Gauss–Legendre per edge, P1: exact integrals).
@@ -1001,20 +1010,7 @@ pub fn compare_with_hertz(hertz: Hertz, h: f64, solution: SignoriniSolution) -> 
             norm += w * l * p * p;
         }
     }
-    let mut profile: Vec<(f64, f64)> = solution
-        .contact_edges
-        .iter()
-        .zip(&solution.pressure)
-        .map(|(e, &p)| (e.midpoint()[0], p))
-        .collect();
-    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let inside = 0.8 * hertz.half_width();
-    let oscillation = profile
-        .windows(3)
-        .filter(|w| w[2].0 < inside)
-        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
-        .fold(0.0f64, f64::max)
-        / hertz.max_pressure();
+    let oscillation = checkerboard(&solution, &hertz);
     HertzResult {
         hertz,
         contact_h: h,

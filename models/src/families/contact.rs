@@ -15,8 +15,9 @@ use crate::report::{Profile, Report};
 use crate::run::{run, Quantities, Run};
 use crate::scene::{Domain, Generator, Load, Part, PartSupport, Posed, Scene, Support};
 use crate::signorini::{
-    self, compare_with_hertz, hertz_mesh, lame, signorini_p1, signorini_p1_p1, signorini_p2,
-    signorini_p2_p1, Displacement, Hertz, Multiplier, Plane, SignoriniInput, SignoriniSolution,
+    self, checkerboard, compare_with_hertz, hertz_mesh, lame, signorini_p1, signorini_p1_p1,
+    signorini_p2, signorini_p2_p1, Displacement, Hertz, Multiplier, Plane, SignoriniInput,
+    SignoriniSolution,
 };
 use fem_runtime::obstacle::{Discretization, FirstStart};
 use fem_runtime::problem::ALPHA_WHEN_CI_VANISHES;
@@ -590,7 +591,7 @@ fn add_quantities<M: Model>(
             let (error, best, oscillation) = match body {
                 ContactBody::GapBlock { .. } => {
                     let (error, best) = compare_gap_block(&hertz, solution);
-                    (error, best, p0_oscillation(solution, &hertz))
+                    (error, best, checkerboard(solution, &hertz))
                 }
                 _ => {
                     let h = hertz.half_width() / report.mesh_size as f64;
@@ -617,24 +618,4 @@ fn add_quantities<M: Model>(
         }
         _ => {}
     }
-}
-
-/// The checkerboard measure of [`crate::signorini::HertzResult::oscillation`] on a P0
-/// solution symmetric about `x = 0`: `max |λ_{k−1} − 2λ_k + λ_{k+1}| / p_max` over
-/// consecutive contact edges (by x) inside `x < 0.8 b`.
-fn p0_oscillation(solution: &SignoriniSolution, hertz: &Hertz) -> f64 {
-    let mut profile: Vec<(f64, f64)> = solution
-        .contact_edges
-        .iter()
-        .zip(&solution.pressure)
-        .map(|(e, &p)| (e.midpoint()[0], p))
-        .collect();
-    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let inside = 0.8 * hertz.half_width();
-    profile
-        .windows(3)
-        .filter(|w| w[2].0 < inside)
-        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
-        .fold(0.0f64, f64::max)
-        / hertz.max_pressure()
 }
