@@ -1,7 +1,7 @@
 //! Contact scene files: a Signorini problem (docs/contact.md) as data,
 //! `fem-forms solve --scene my.toml` with `model = "contact"`.
 //!
-//! The membrane scene files' conventions hold ([`crate::scene_file`]): data are
+//! The membrane scene files' conventions hold ([`crate::models::scene_file`]): data are
 //! expressions in `x` and `y` (parsed once by [`crate::models::scene_file::expression`]), boundary
 //! parts are chosen by name (Gmsh physical names of curve groups, or the generator's
 //! sides), and every error names the file and the key at fault. An example, the patch
@@ -256,7 +256,7 @@ pub struct ContactSceneFile {
 }
 
 /// Whether the TOML text names the contact model (`model = "contact"`): the CLI's
-/// choice between this reader and [`crate::scene_file`]'s. Text that is not TOML is
+/// choice between this reader and [`crate::models::scene_file`]'s. Text that is not TOML is
 /// left to the membrane reader, whose error names the line.
 pub fn names_contact(text: &str) -> bool {
     text.parse::<toml::Table>()

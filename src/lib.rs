@@ -17,19 +17,14 @@ pub mod membrane_studies;
 pub mod membranes;
 pub mod plates;
 pub mod plot;
-pub mod scene_file;
 pub mod signorini;
 pub mod studies;
 
 pub use fem_models as models;
 pub use fem_runtime::*;
 
-/// The smallest size a non-zero load (or the largest value of a data function) may
-/// have: the solves multiply it by `h⁴`, `αh^k` and rounding-sized weights, which
-/// underflow below it (a tester's `--load 2.3e-308` and `f = "1e-320"` stopped Newton at
-/// a KKT residual of 5e-3; `timoshenko-a` at 2.3e-308 returned a subnormal deflection
-/// and an energy of 0).
-pub const MIN_DATA_SIZE: f64 = 1e-200;
+/// The smallest size a non-zero load may have (see the runtime's).
+pub use fem_runtime::problem::MIN_DATA_SIZE;
 
 pub use fem_runtime::problem::number;
 

@@ -12,9 +12,9 @@ use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::plates::{self, PlatePair, PlateRequest};
+use fem_forms::plot;
 use fem_forms::signorini as contact;
 use fem_forms::studies::{self, Study};
-use fem_forms::{plot, scene_file};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -433,16 +433,48 @@ fn study_scene(entry: &SceneEntry) -> fem_forms::Result<Box<dyn studies::StudySc
     }
 }
 
-/// The registry family of a scene file read by the one reader
-/// ([`fem_forms::models::scene_file::read_scene`]): every family but the membranes' and
-/// contact's, whose files have readers of their own.
-fn registry_family_file(path: &Path) -> Option<&'static dyn fem_forms::models::family::Family> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let name = fem_forms::models::scene_file::family_of(&text)?;
-    if name == "membrane" || name == "contact" {
-        return None;
+/// `solve --scene FILE`: the file's scene with its pair, α and mesh size where the
+/// command line gives none.
+fn solve_file(
+    file: fem_forms::models::scene_file::FileScene,
+    path: &Path,
+    mut options: SolveOptions,
+    out: &Path,
+) -> Result<(), String> {
+    if options.pair.is_none() {
+        options.pair = file.pair.clone();
     }
-    fem_forms::models::families::family(&name)
+    // the file's size belongs to its own mesh: with --msh replacing it, --mesh-size
+    // (refinements of that file) defaults to 0 as for built-in scenes
+    match &options.msh {
+        None => {
+            options.mesh_size.get_or_insert(file.scene.mesh_size);
+        }
+        // said, so that the file's size is not dropped unseen
+        Some(msh) if options.mesh_size.is_none() => eprintln!(
+            "warning: --msh {} replaces the mesh of {}, and with it the file's mesh size or refinements ({}); --mesh-size gives the refinements of the --msh mesh (0 here)",
+            msh.display(),
+            path.display(),
+            file.scene.mesh_size
+        ),
+        Some(_) => {}
+    }
+    if options.alpha.is_none() {
+        if let Some(alpha) = file.alpha {
+            // the file's α, not an --alpha, where the pair has none to take
+            let pair = fem_forms::models::families::pair_of(&file.scene, options.pair.as_deref())
+                .map_err(|e| e.to_string())?;
+            if pair.nodal {
+                return Err(format!(
+                    "{}: key `parameters.alpha` does not apply to the pair {}: it has no multiplier to stabilize; drop the key or choose a stabilized pair",
+                    path.display(),
+                    pair.name
+                ));
+            }
+            options.alpha = Some(alpha);
+        }
+    }
+    solve::solve_scene(file.scene, &options, out)
 }
 
 /// Runs the study called `kind` on a registry scene.
@@ -1082,7 +1114,7 @@ fn run(cli: Cli) -> Result<(), String> {
         Some(Command::Solve {
             name,
             scene_file,
-            mut options,
+            options,
         }) => {
             let entry = match (name, scene_file) {
                 (_, Some(path))
@@ -1091,52 +1123,10 @@ fn run(cli: Cli) -> Result<(), String> {
                 {
                     return solve_contact_file(&path, &options);
                 }
-                (_, Some(path)) if registry_family_file(&path).is_some() => {
-                    let family = registry_family_file(&path).expect("checked");
-                    let text = std::fs::read_to_string(&path).map_err(|e| e.to_string())?;
-                    let file = fem_forms::models::scene_file::read_scene(&text, &path, family)
-                        .map_err(|e| e.to_string())?;
-                    if options.pair.is_none() {
-                        options.pair = file.pair;
-                    }
-                    return solve::solve_scene(file.scene, &options, &cli.out);
-                }
                 (_, Some(path)) => {
-                    let file = scene_file::read(&path).map_err(|e| e.to_string())?;
-                    options
-                        .pair
-                        .get_or_insert_with(|| file.pair.name().to_string());
-                    // the file's size belongs to its own mesh: with --msh replacing it,
-                    // --mesh-size (refinements of that file) defaults to 0 as for built-in scenes
-                    match &options.msh {
-                        None => {
-                            options.mesh_size.get_or_insert(file.mesh_size);
-                        }
-                        // said, so that the file's size is not dropped unseen
-                        Some(msh) if options.mesh_size.is_none() => eprintln!(
-                            "warning: --msh {} replaces the mesh of {}, and with it the file's mesh size or refinements ({}); --mesh-size gives the refinements of the --msh mesh (0 here)",
-                            msh.display(),
-                            path.display(),
-                            file.mesh_size
-                        ),
-                        Some(_) => {}
-                    }
-                    // the file's α, not an --alpha, where the pair has none to take
-                    if options.alpha.is_none()
-                        && file.alpha.is_some()
-                        && options.pair.as_deref() == Some(MembranePair::P1Nodal.name())
-                    {
-                        return Err(format!(
-                            "{}: key `parameters.alpha` does not apply to the pair p1-nodal: it has no multiplier to stabilize; drop the key or choose a stabilized pair",
-                            path.display()
-                        ));
-                    }
-                    options.alpha = options.alpha.or(file.alpha);
-                    let mut scene =
-                        fem_forms::models::families::membrane::membrane_scene(&file.scene);
-                    scene.mesh_size = file.mesh_size;
-                    scene.accuracy = file.accuracy;
-                    return solve::solve_scene(scene, &options, &cli.out);
+                    let file =
+                        fem_forms::models::scene_file::read(&path).map_err(|e| e.to_string())?;
+                    return solve_file(file, &path, *options, &cli.out);
                 }
                 (Some(scene), None) if fem_forms::models::families::scene(&scene).is_some() => {
                     let scene = fem_forms::models::families::scene(&scene).expect("found");

@@ -53,7 +53,7 @@ fn a_kirchhoff_scene_file_meets_navier() {
     let path = dir.join("ss.toml");
     std::fs::write(
         &path,
-        "model = \"kirchhoff\"\npair = \"argyris-p0\"\n[mesh]\ngenerator = \"square\"\nsize = 8\n[boundary]\nsimply_supported = \"all\"\n[parameters]\nD = 2.0\nnu = 0.3\n[data]\nf = \"1\"\npsi = \"-1\"\n",
+        "model = \"kirchhoff\"\npair = \"argyris-p0\"\n[mesh]\ngenerator = \"rectangle\"\nsize = 8\n[boundary]\nsimply_supported = \"all\"\n[parameters]\nD = 2.0\nnu = 0.3\n[data]\nf = \"1\"\npsi = \"-1\"\n",
     )
     .unwrap();
     let report = solve_json(&["--scene", path.to_str().unwrap()]);

@@ -101,7 +101,7 @@ fn a_scene_file_s_exact_derivatives_are_checked() {
         std::fs::write(
             &path,
             format!(
-                "model = \"kirchhoff\"\npair = \"argyris-p0\"\n[mesh]\ngenerator = \"square\"\nsize = 4\n[boundary]\nclamped = \"all\"\n[parameters]\nD = 1.0\nnu = 0.3\n[data]\nf = \"0\"\npsi = \"-1\"\n[exact]\n{exact}\n"
+                "model = \"kirchhoff\"\npair = \"argyris-p0\"\n[mesh]\ngenerator = \"rectangle\"\nsize = 4\n[boundary]\nclamped = \"all\"\n[parameters]\nD = 1.0\nnu = 0.3\n[data]\nf = \"0\"\npsi = \"-1\"\n[exact]\n{exact}\n"
             ),
         )
         .unwrap();

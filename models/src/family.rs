@@ -156,6 +156,12 @@ pub trait Family: Sync {
         &[]
     }
 
+    /// The support a scene file without `[boundary]` keys has on its whole boundary,
+    /// with the key its errors name (the membrane's `u = g`); `None`: free.
+    fn default_support(&self) -> Option<(Support, &'static str)> {
+        None
+    }
+
     /// Applies `adjustment` to `scene`: by default a support replaces every support of
     /// the scene and `--no-obstacle` removes the obstacle; other obstacles are the
     /// family's to name.

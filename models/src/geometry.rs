@@ -280,7 +280,7 @@ impl Geometry for TriangleMesh {
                 Error::Input(message) => {
                     // `["all"]`: the keyword is a plain string, not a name in a list
                     let keyword = if names.contains(&"all") && message.contains("`all`") {
-                        "; \"all\" (the whole boundary) is a keyword on its own, not a name in a list"
+                        "; \"all\" (the whole boundary) is a keyword on its own, `dirichlet = \"all\"` in a scene file, not a name in a list"
                     } else {
                         ""
                     };

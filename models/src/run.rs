@@ -478,11 +478,15 @@ fn supports<M: Model, G: Geometry>(scene: &Scene, mesh: &G) -> Result<Supports> 
     }
     for s in &scene.supports {
         let part = mesh.part(&s.part).map_err(|e| match e {
-            Error::Input(m) => at(m, s),
+            Error::Input(m) => at(format!("{m}, on the {}", scene.domain.describe()), s),
             other => other,
         })?;
         if let Part::Named(names) = &s.part {
-            out.warnings.extend(mesh.interior_part_warnings(names));
+            let warnings = mesh.interior_part_warnings(names).into_iter();
+            out.warnings.extend(warnings.map(|w| match &s.key {
+                Some(key) => format!("field `{key}`: {w}"),
+                None => w,
+            }));
         }
         match s.support {
             Support::Free => {}
@@ -672,7 +676,7 @@ fn scene_field_of(error: Error, scene: &Scene) -> Error {
         .iter()
         .map(|(name, _)| name)
         .find(|name| message.starts_with(&format!("data `{name}` of ")))
-        .map(|name| crate::scene_file::data_key(name));
+        .map(|name| crate::scene::data_key(name));
     match key {
         Some(key) => Error::Input(format!(
             "scene `{}`: field `data.{key}`: {message}",

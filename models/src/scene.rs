@@ -569,3 +569,13 @@ impl Scene {
         matches!(self.exact, Exact::AtDefaultLoad(_)) && self.exact_at(posed).is_none()
     }
 }
+
+/// The key under `[data]` of a scene file for the model's data function `name`: its
+/// ASCII spelling (`ψ` is `psi`).
+pub fn data_key(name: &str) -> String {
+    match name {
+        "ψ" => "psi".into(),
+        "λ" => "lambda".into(),
+        other => other.into(),
+    }
+}

@@ -12,16 +12,6 @@ use exmex::prelude::*;
 use fem_runtime::{Error, Result};
 use std::path::Path;
 
-/// The key under `[data]` of a scene file for the model's data function `name`: its
-/// ASCII spelling (`ψ` is `psi`).
-pub fn data_key(name: &str) -> String {
-    match name {
-        "ψ" => "psi".into(),
-        "λ" => "lambda".into(),
-        other => other.into(),
-    }
-}
-
 /// The variables an expression may use, in the order of the point's coordinates.
 const VARIABLES: [&str; 2] = ["x", "y"];
 
@@ -348,6 +338,706 @@ pub fn scene_name(
     Ok(name.to_string())
 }
 
+// ---------------------------------------------------------------------------------------
+// The scene of any registry family
+// ---------------------------------------------------------------------------------------
+
+use crate::family::Family;
+use crate::report::Settings;
+use crate::scene::{Domain, Exact, ExactSolution, Load, Part, PartSupport, Scene, Support};
+use fem_runtime::problem::MIN_DATA_SIZE;
+use fem_runtime::TriangleMesh;
+use serde::Deserialize;
+use std::path::PathBuf;
+
+/// A scene file as written; the family's own keys go under `[parameters]` and `[data]`
+/// by the model's declared names or the family's aliases.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileToml {
+    name: Option<String>,
+    description: Option<String>,
+    model: String,
+    pair: Option<String>,
+    /// The L² error of the constrained field the scene asks for (needs `[exact]`).
+    accuracy: Option<f64>,
+    mesh: MeshToml,
+    #[serde(default)]
+    boundary: BoundaryToml,
+    #[serde(default)]
+    parameters: toml::Table,
+    #[serde(default)]
+    data: toml::Table,
+    exact: Option<ExactToml>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MeshToml {
+    generator: Option<String>,
+    half_width: Option<f64>,
+    x: Option<[f64; 2]>,
+    y: Option<[f64; 2]>,
+    cells: Option<[usize; 2]>,
+    start: Option<f64>,
+    end: Option<f64>,
+    centre: Option<[f64; 2]>,
+    radius: Option<f64>,
+    curved: Option<bool>,
+    size: Option<usize>,
+    file: Option<PathBuf>,
+    refinements: Option<usize>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+struct BoundaryToml {
+    clamped: Option<toml::Value>,
+    simply_supported: Option<toml::Value>,
+    simply_supported_hard: Option<toml::Value>,
+    free: Option<toml::Value>,
+    dirichlet: Option<toml::Value>,
+    #[serde(default)]
+    roller: Vec<RollerToml>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct RollerToml {
+    part: toml::Value,
+    normal: [f64; 2],
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct ExactToml {
+    #[serde(alias = "u", alias = "w")]
+    value: Option<String>,
+    gradient: Option<[String; 2]>,
+    hessian: Option<[[String; 2]; 2]>,
+    lambda: Option<String>,
+    contact_force: Option<f64>,
+    contact_area: Option<f64>,
+}
+
+/// A scene read from a file, with the solve settings it names (the command line's
+/// options win).
+#[derive(Clone, Debug)]
+pub struct FileScene {
+    /// The scene.
+    pub scene: Scene,
+    /// The pair the file names.
+    pub pair: Option<String>,
+    /// The α the file fixes (`parameters.alpha`).
+    pub alpha: Option<f64>,
+}
+
+impl FileScene {
+    /// The settings the file asks for: its pair and α, the rest the defaults.
+    pub fn settings(&self) -> Settings {
+        Settings {
+            pair: self.pair.clone(),
+            alpha: self.alpha,
+            ..Settings::default()
+        }
+    }
+}
+
+/// The family a scene file names under `model`, read before the rest of the file.
+pub fn family_of(text: &str) -> Option<String> {
+    #[derive(Deserialize)]
+    struct ModelOnly {
+        model: Option<String>,
+    }
+    toml::from_str::<ModelOnly>(text).ok()?.model
+}
+
+/// The smallest `mesh.half_width` of a square: below it `α h⁴` of a fine mesh's cells
+/// falls near the end of double precision's normal range (1e-40 failed with C_0 = −0).
+const MIN_HALF_WIDTH: f64 = 1e-30;
+
+/// The most uniform refinements of a Gmsh file (4⁸ times its triangles).
+const MAX_REFINEMENTS: usize = 8;
+
+/// Reads a scene file ([`parse`]).
+///
+/// # Errors
+/// An unreadable file, and those of [`parse`].
+pub fn read(path: &Path) -> Result<FileScene> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        Error::Input(format!(
+            "cannot read the scene file {}: {e}",
+            path.display()
+        ))
+    })?;
+    parse(&text, path)
+}
+
+/// Parses a scene file of any registry family (docs/scene-files.md) whose relative paths
+/// are relative to `path`.
+///
+/// # Errors
+/// As [`read_scene`]; a `model` that is no family of the registry.
+pub fn parse(text: &str, path: &Path) -> Result<FileScene> {
+    let names: Vec<&str> = crate::families::families()
+        .iter()
+        .map(|f| f.name())
+        .collect();
+    let model = family_of(text);
+    let family = model.as_deref().and_then(crate::families::family);
+    match (model, family) {
+        (Some(_), Some(family)) => read_scene(text, path, family),
+        (Some(model), None) => Err(Error::Input(format!(
+            "{}: field `model`: `{model}` is not a family scene files can pose; the families are {}",
+            path.display(),
+            names.join(", ")
+        ))),
+        // the TOML error (a syntax error, or `model` missing) names the place
+        (None, _) => toml::from_str::<FileToml>(text)
+            .map(|_| unreachable!("a file that deserializes has a model"))
+            .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display()))),
+    }
+}
+
+/// Reads a scene file of `family` (docs/scene-files.md): the mesh, the supports per
+/// boundary part, the parameters and data by the model's names or the family's aliases,
+/// the exact solution with its derivatives given or derived.
+///
+/// # Errors
+/// [`Error::Input`] naming the file and the field: TOML errors, unknown keys, a mesh
+/// given both ways or neither or out of range, boundary parts that are not names or not
+/// the generator's, a load that is not finite or would underflow, expressions that do
+/// not parse, an exact gradient or Hessian that the finite differences of the value
+/// (or gradient) contradict, exact integrals that are negative, an accuracy without an
+/// exact solution.
+pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileScene> {
+    let at = |field: &str, message: String| {
+        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
+    };
+    let file: FileToml = toml::from_str(text)
+        .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
+    if file.model != family.name() {
+        return Err(at(
+            "model",
+            format!("`{}` is read as the family `{}`", file.model, family.name()),
+        ));
+    }
+    let name = scene_name(file.name.as_deref(), path, "scene").map_err(|m| at("name", m))?;
+    let (domain, mesh_size) = domain_of(&file.mesh, path).map_err(|(f, m)| at(&f, m))?;
+    let description = file
+        .description
+        .clone()
+        .unwrap_or_else(|| format!("scene file {}", path.display()));
+    let mut scene = Scene::new(name, description, family.name(), domain, mesh_size);
+    let model_name = |key: &str| -> String {
+        family
+            .aliases()
+            .iter()
+            .find(|(alias, _)| *alias == key)
+            .map_or(key.to_string(), |(_, name)| name.to_string())
+    };
+    let number = |field: &str, value: &toml::Value| {
+        value
+            .as_float()
+            .or_else(|| value.as_integer().map(|i| i as f64))
+            .filter(|v| v.is_finite())
+            .map(|v| v + 0.0)
+            .ok_or_else(|| at(field, format!("{value} is not a finite number")))
+    };
+    let mut alpha = None;
+    for (key, value) in &file.parameters {
+        let field = format!("parameters.{key}");
+        let v = number(&field, value)?;
+        if key == "alpha" || key == "α" {
+            alpha = Some(v);
+        } else {
+            scene.set_parameter(model_name(key), v);
+        }
+    }
+    let mut load = None;
+    for (key, value) in &file.data {
+        let field = format!("data.{key}");
+        if key == "load" {
+            let q = number(&field, value)?;
+            if q != 0.0 && q.abs() < MIN_DATA_SIZE {
+                return Err(at(
+                    &field,
+                    format!("{q:e} is below {MIN_DATA_SIZE:e} in size: the solve multiplies it by powers of h and would underflow; give 0 or rescale the units"),
+                ));
+            }
+            load = Some(q);
+            continue;
+        }
+        let text = match value {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Float(v) => v.to_string(),
+            toml::Value::Integer(v) => v.to_string(),
+            other => return Err(at(&field, format!("{other} is not an expression"))),
+        };
+        scene.set_data(model_name(key), expression(&text, &field, path)?);
+    }
+    let scaled = model_name("f");
+    if scene.data_fn(&scaled).is_some() {
+        scene.load = Some(Load {
+            default: load.unwrap_or(1.0),
+            scales: vec![scaled.into()],
+            symbol: "q",
+            nonnegative: false,
+        });
+    } else if load.is_some() {
+        return Err(at(
+            "data.load",
+            "scales the load `f`, which the file does not give".into(),
+        ));
+    }
+    scene.supports = supports(&file.boundary, family).map_err(|(f, m)| at(&f, m))?;
+    check_parts(&scene).map_err(|(f, m)| at(&f, m))?;
+    if let Some(e) = &file.exact {
+        // the contact set is not linear in the load: the file's exact solution holds at
+        // its own load
+        scene.exact = Exact::AtDefaultLoad(exact_of(e, &scene.domain, path)?);
+    }
+    if let Some(a) = file.accuracy {
+        if file.exact.as_ref().is_none_or(|e| e.value.is_none()) {
+            return Err(at(
+                "accuracy",
+                "an accuracy needs an `[exact] u` to measure the L² error against".into(),
+            ));
+        }
+        if !(a.is_finite() && a > 0.0) {
+            return Err(at("accuracy", format!("{a} must be positive and finite")));
+        }
+        scene.accuracy = Some(a);
+    }
+    Ok(FileScene {
+        scene,
+        pair: file.pair,
+        alpha,
+    })
+}
+
+/// The domain and `N` of `[mesh]`; errors as `(field, message)`.
+fn domain_of(
+    mesh: &MeshToml,
+    path: &Path,
+) -> std::result::Result<(Domain, usize), (String, String)> {
+    let err = |f: &str, m: String| Err((f.to_string(), m));
+    match (&mesh.generator, &mesh.file) {
+        (Some(_), Some(_)) => err("mesh", "give either `generator` or `file`, not both".into()),
+        (None, None) => err(
+            "mesh",
+            "give a `generator` (interval, rectangle, square, l-shape, disk) or a Gmsh `file`"
+                .into(),
+        ),
+        (None, Some(msh)) => {
+            if mesh.size.is_some() || mesh.half_width.is_some() {
+                return err(
+                    "mesh",
+                    "a Gmsh `file` takes `refinements`, not `size` or `half_width`".into(),
+                );
+            }
+            let refinements = mesh.refinements.unwrap_or(0);
+            if refinements > MAX_REFINEMENTS {
+                return err(
+                    "mesh.refinements",
+                    format!("{refinements} uniform refinements (4^{refinements} times the triangles): at most {MAX_REFINEMENTS}"),
+                );
+            }
+            let base = path.parent().unwrap_or(Path::new("."));
+            Ok((Domain::Gmsh(base.join(msh)), refinements))
+        }
+        (Some(generator), None) => {
+            if mesh.refinements.is_some() {
+                return err(
+                    "mesh.refinements",
+                    "applies to a Gmsh `file`; a generator takes `size`".into(),
+                );
+            }
+            let interval = generator == "interval";
+            let size = mesh.size.unwrap_or(if interval { 256 } else { 64 });
+            let range = if interval { 1..=1 << 20 } else { 2..=4096 };
+            if !range.contains(&size) {
+                return err(
+                    "mesh.size",
+                    format!(
+                        "{size} is out of range ({} to {})",
+                        range.start(),
+                        range.end()
+                    ),
+                );
+            }
+            let no_half_width = |what: &str| match mesh.half_width {
+                Some(_) => Err((
+                    "mesh.half_width".to_string(),
+                    format!("{what}; it takes no half_width"),
+                )),
+                None => Ok(()),
+            };
+            let domain = match generator.as_str() {
+                "interval" => {
+                    no_half_width("the interval is (start, end)")?;
+                    Domain::Interval {
+                        start: mesh.start.unwrap_or(0.0),
+                        end: mesh.end.unwrap_or(1.0),
+                    }
+                }
+                "square" => {
+                    if mesh.x.is_some() || mesh.y.is_some() {
+                        return err(
+                            "mesh.x",
+                            "a square is (−a, a)² with a = half_width; `rectangle` takes x and y".into(),
+                        );
+                    }
+                    let a = mesh.half_width.unwrap_or(1.0);
+                    let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
+                    if !(MIN_HALF_WIDTH..=largest).contains(&a) {
+                        return err(
+                            "mesh.half_width",
+                            format!("{} must be within {MIN_HALF_WIDTH:e} to {largest:e}: below, the stabilization's α h⁴ underflows; rescale the units", fem_runtime::problem::number(a)),
+                        );
+                    }
+                    Domain::square(-a, 2.0 * a)
+                }
+                "rectangle" => {
+                    no_half_width("a rectangle is x × y")?;
+                    let x = mesh.x.unwrap_or([0.0, 1.0]);
+                    let y = mesh.y.unwrap_or(x);
+                    let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
+                    let fine = |s: [f64; 2]| {
+                        s[0] < s[1] && s.iter().all(|c| c.is_finite() && c.abs() <= largest)
+                    };
+                    if !(fine(x) && fine(y)) {
+                        return err(
+                            "mesh.x",
+                            format!("the sides {x:?} × {y:?} need finite ends, the first below the second, within ±{largest:e}"),
+                        );
+                    }
+                    Domain::Rectangle {
+                        x,
+                        y,
+                        cells: mesh.cells.unwrap_or([1, 1]),
+                        diagonal: fem_runtime::Diagonal::Right,
+                    }
+                }
+                "l-shape" => {
+                    no_half_width("the L-shape is (−1,1)² ∖ [0,1]×[−1,0]")?;
+                    if size % 2 != 0 {
+                        return err(
+                            "mesh.size",
+                            format!("the L-shape needs an even size, got {size}"),
+                        );
+                    }
+                    Domain::LShape
+                }
+                "disk" => {
+                    no_half_width("a disk has a radius")?;
+                    Domain::Disk {
+                        centre: mesh.centre.unwrap_or([0.0, 0.0]),
+                        radius: mesh.radius.unwrap_or(1.0),
+                        curved: mesh.curved.unwrap_or(false),
+                    }
+                }
+                other => {
+                    return err(
+                        "mesh.generator",
+                        format!("unknown generator `{other}`; the generators are interval, rectangle, square, l-shape, disk"),
+                    )
+                }
+            };
+            Ok((domain, size))
+        }
+    }
+}
+
+/// The generator's name in the scene file.
+fn generator_name(domain: &Domain) -> &'static str {
+    match domain {
+        Domain::Interval { .. } => "interval",
+        Domain::Rectangle { x, y, .. } if x[0] == -x[1] && x == y => "square",
+        Domain::Rectangle { .. } => "rectangle",
+        Domain::LShape => "l-shape",
+        Domain::Disk { .. } => "disk",
+        Domain::Gmsh(_) | Domain::Generated(_) => "file",
+    }
+}
+
+/// The parts a `[boundary]` key names: `"all"`, a name or a list of names (repeats
+/// dropped). The error is the message for the field.
+fn part_of(key: &str, value: &toml::Value) -> std::result::Result<Part, String> {
+    use toml::Value;
+    let by_name = "boundary parts are chosen by name (Gmsh physical names of curve groups, or a generator's side names), not by number; a Gmsh group without a name cannot be chosen: name it (Physical Curve(\"outer\") = {…};)";
+    let name = |v: &Value| {
+        match v {
+        Value::String(s) if s.trim().is_empty() => Err("an empty name".to_string()),
+        Value::String(s) => Ok(s.clone()),
+        Value::Integer(i) => Err(format!("{i} is a number: {by_name}")),
+        other => Err(format!(
+            "{other} is not a name: write \"all\", a name, or a list of names such as [\"left\", \"right\"]"
+        )),
+    }
+    };
+    match value {
+        Value::String(s) if s == "all" => Ok(Part::All),
+        Value::Array(list) if list.is_empty() && key == "dirichlet" => Err(
+            "an empty list: u = g would hold nowhere, and with ∂u/∂n = 0 on the whole boundary the membrane is determined only up to a constant where contact does not hold it; name at least one boundary part (or \"all\")".into(),
+        ),
+        Value::Array(list) if list.is_empty() => {
+            Err("an empty list names no part; leave the key out instead".into())
+        }
+        Value::Array(list) => {
+            let mut names: Vec<String> = Vec::with_capacity(list.len());
+            for v in list {
+                let n = name(v)?;
+                if !names.contains(&n) {
+                    names.push(n);
+                }
+            }
+            Ok(Part::Named(names))
+        }
+        v => Ok(Part::Named(vec![name(v)?])),
+    }
+}
+
+/// The supports of `[boundary]`, in the order clamped, simply supported (soft, hard),
+/// free, dirichlet, rollers: later entries win where parts overlap. Without any, the
+/// family's default ([`Family::default_support`]) on the whole boundary.
+fn supports(
+    b: &BoundaryToml,
+    family: &dyn Family,
+) -> std::result::Result<Vec<PartSupport>, (String, String)> {
+    let mut out = Vec::new();
+    for (key, value, support) in [
+        ("clamped", &b.clamped, Support::Clamped),
+        (
+            "simply_supported",
+            &b.simply_supported,
+            Support::SimplySupported { hard: false },
+        ),
+        (
+            "simply_supported_hard",
+            &b.simply_supported_hard,
+            Support::SimplySupported { hard: true },
+        ),
+        ("free", &b.free, Support::Free),
+        ("dirichlet", &b.dirichlet, Support::Data),
+    ] {
+        if let Some(v) = value {
+            let field = format!("boundary.{key}");
+            let part = part_of(key, v).map_err(|m| (field.clone(), m))?;
+            out.push(PartSupport {
+                part,
+                support,
+                key: Some(field.into()),
+            });
+        }
+    }
+    for (k, r) in b.roller.iter().enumerate() {
+        let field = format!("boundary.roller[{k}]");
+        let part = part_of("roller", &r.part).map_err(|m| (field.clone(), m))?;
+        out.push(PartSupport {
+            part,
+            support: Support::Roller { normal: r.normal },
+            key: Some(field.into()),
+        });
+    }
+    if out.is_empty() {
+        if let Some((support, key)) = family.default_support() {
+            out.push(PartSupport {
+                part: Part::All,
+                support,
+                key: Some(key.into()),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The named parts of every support, checked against a coarse mesh of the generator
+/// (a Gmsh file's names are checked when it is read).
+fn check_parts(scene: &Scene) -> std::result::Result<(), (String, String)> {
+    let sample = match &scene.domain {
+        Domain::Rectangle { x, y, .. } => {
+            TriangleMesh::rectangle(x[0], x[1], y[0], y[1], 2, 2, fem_runtime::Diagonal::Right).ok()
+        }
+        Domain::LShape => TriangleMesh::l_shape(2).ok(),
+        _ => None,
+    };
+    let Some(mesh) = sample else {
+        return Ok(());
+    };
+    for s in &scene.supports {
+        let Part::Named(names) = &s.part else {
+            continue;
+        };
+        if let Err(Error::Input(message)) = mesh.boundary_part_markers(names) {
+            let keyword = if names.iter().any(|n| n == "all") {
+                "; \"all\" (the whole boundary) is a keyword on its own, `dirichlet = \"all\"`, not a name in a list"
+            } else {
+                ""
+            };
+            let field = s.key.as_deref().unwrap_or("boundary").to_string();
+            return Err((
+                field,
+                format!(
+                    "{message} (generator `{}`){keyword}",
+                    generator_name(&scene.domain)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Points inside the domain's bounding box at which given derivatives are checked
+/// (irrational offsets: unlikely to sit on a kink of `max` or `abs`).
+fn check_points(domain: &Domain) -> Vec<[f64; 2]> {
+    let (x, y) = match domain {
+        Domain::Interval { start, end } => ([*start, *end], [0.0, 0.0]),
+        Domain::Rectangle { x, y, .. } => (*x, *y),
+        Domain::Disk { centre, radius, .. } => {
+            let r = radius / std::f64::consts::SQRT_2;
+            (
+                [centre[0] - r, centre[0] + r],
+                [centre[1] - r, centre[1] + r],
+            )
+        }
+        _ => ([-1.0, 1.0], [-1.0, 1.0]),
+    };
+    [0.1234, 0.3711, 0.5827, 0.7419, 0.9137]
+        .iter()
+        .zip([0.8191, 0.2347, 0.6553, 0.4271, 0.1619])
+        .map(|(s, t)| [x[0] + s * (x[1] - x[0]), y[0] + t * (y[1] - y[0])])
+        .collect()
+}
+
+/// Checks `derivative` (the given `∂f/∂x_k` as `derivative(x, k)`) against the central
+/// differences of `f` at `points`.
+fn check_derivative(
+    f: &dyn Fn(&[f64]) -> f64,
+    derivative: &dyn Fn(&[f64], usize) -> f64,
+    points: &[[f64; 2]],
+    dimension: usize,
+) -> std::result::Result<(), String> {
+    for p in points {
+        for k in 0..dimension {
+            let step = 1e-5 * (1.0 + p[k].abs());
+            let (mut a, mut b) = (*p, *p);
+            a[k] += step;
+            b[k] -= step;
+            let difference = (f(&a) - f(&b)) / (2.0 * step);
+            let given = derivative(p, k);
+            let scale = 1.0 + difference.abs().max(given.abs());
+            let agrees = (given - difference).abs() <= 1e-4 * scale;
+            // NaN (a derivative undefined where the function is) fails too
+            if !agrees {
+                return Err(format!(
+                    "at ({}, {}) its component {} is {given:e}, the finite difference of the function {difference:e}",
+                    p[0],
+                    p[1],
+                    k + 1
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The exact solution of `[exact]`, its gradient and Hessian given (and checked) or
+/// derived symbolically.
+fn exact_of(e: &ExactToml, domain: &Domain, path: &Path) -> Result<ExactSolution> {
+    let at = |field: &str, message: String| {
+        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
+    };
+    for (key, value) in [
+        ("exact.contact_force", e.contact_force),
+        ("exact.contact_area", e.contact_area),
+    ] {
+        if let Some(v) = value {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(at(
+                    key,
+                    format!(
+                        "{} must be a finite number ≥ 0 (∫λ and the contact area cannot be negative)",
+                        fem_runtime::problem::number(v)
+                    ),
+                ));
+            }
+        }
+    }
+    let dimension = if matches!(domain, Domain::Interval { .. }) {
+        1
+    } else {
+        2
+    };
+    let points = check_points(domain);
+    let mut out = ExactSolution {
+        multiplier: e
+            .lambda
+            .as_deref()
+            .map(|l| expression(l, "exact.lambda", path))
+            .transpose()?,
+        total_contact_force: e.contact_force.map(|v| v + 0.0),
+        contact_area: e.contact_area.map(|v| v + 0.0),
+        ..ExactSolution::default()
+    };
+    let Some(value) = &e.value else {
+        return Ok(out);
+    };
+    let u = expression(value, "exact.u", path)?;
+    let gradient = match &e.gradient {
+        Some([gx, gy]) => {
+            let (gx, gy) = (
+                expression(gx, "exact.gradient[0]", path)?,
+                expression(gy, "exact.gradient[1]", path)?,
+            );
+            let g = Data::shared(move |x: &[f64]| [gx.at(x), gy.at(x)]);
+            check_derivative(&|x| u.at(x), &|x, k| g.at(x)[k], &points, dimension)
+                .map_err(|m| at("exact.gradient", format!("does not match `exact.u`: {m}")))?;
+            g
+        }
+        None => gradient(value, "exact.u", path).map_err(|e| match e {
+            Error::Input(m) => Error::Input(format!(
+                "{m}; give the derivatives as `gradient = [\"∂u/∂x\", \"∂u/∂y\"]`"
+            )),
+            other => other,
+        })?,
+    };
+    if let Some(h) = &e.hessian {
+        let mut rows = Vec::new();
+        for (i, row) in h.iter().enumerate() {
+            rows.push([
+                expression(&row[0], &format!("exact.hessian[{i}][0]"), path)?,
+                expression(&row[1], &format!("exact.hessian[{i}][1]"), path)?,
+            ]);
+        }
+        let rows = std::sync::Arc::new(rows);
+        for i in 0..dimension {
+            let (g, r) = (gradient.clone(), rows.clone());
+            check_derivative(
+                &move |x| g.at(x)[i],
+                &move |x, k| r[i][k].at(x),
+                &points,
+                dimension,
+            )
+            .map_err(|m| {
+                at(
+                    &format!("exact.hessian[{i}]"),
+                    format!("does not match the gradient: {m}"),
+                )
+            })?;
+        }
+        out.hessian = Some(Data::shared(move |x: &[f64]| {
+            [
+                [rows[0][0].at(x), rows[0][1].at(x)],
+                [rows[1][0].at(x), rows[1][1].at(x)],
+            ]
+        }));
+    }
+    out.value = Some(u);
+    out.gradient = Some(gradient);
+    Ok(out)
+}
+
 #[cfg(test)]
 mod normalize_tests {
     use super::*;
@@ -435,466 +1125,4 @@ mod normalize_tests {
             assert_eq!(value(text, 3.0, 2.0), expected, "{text}");
         }
     }
-}
-
-// ---------------------------------------------------------------------------------------
-// The scene of any registry family
-// ---------------------------------------------------------------------------------------
-
-use crate::family::Family;
-use crate::scene::{Domain, Exact, ExactSolution, Load, Part, PartSupport, Scene, Support};
-use serde::Deserialize;
-use std::path::PathBuf;
-
-/// A scene file as written; the family's own keys go under `[parameters]` and `[data]`
-/// by the model's declared names or the family's aliases.
-#[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-struct FileToml {
-    name: Option<String>,
-    description: Option<String>,
-    model: String,
-    pair: Option<String>,
-    accuracy: Option<f64>,
-    mesh: MeshToml,
-    #[serde(default)]
-    boundary: BoundaryToml,
-    #[serde(default)]
-    parameters: toml::Table,
-    #[serde(default)]
-    data: toml::Table,
-    exact: Option<ExactToml>,
-}
-
-#[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-struct MeshToml {
-    generator: Option<String>,
-    x: Option<[f64; 2]>,
-    y: Option<[f64; 2]>,
-    cells: Option<[usize; 2]>,
-    start: Option<f64>,
-    end: Option<f64>,
-    centre: Option<[f64; 2]>,
-    radius: Option<f64>,
-    curved: Option<bool>,
-    size: Option<usize>,
-    file: Option<PathBuf>,
-    refinements: Option<usize>,
-}
-
-#[derive(Deserialize, Debug, Default)]
-#[serde(deny_unknown_fields)]
-struct BoundaryToml {
-    clamped: Option<toml::Value>,
-    simply_supported: Option<toml::Value>,
-    simply_supported_hard: Option<toml::Value>,
-    free: Option<toml::Value>,
-    dirichlet: Option<toml::Value>,
-    #[serde(default)]
-    roller: Vec<RollerToml>,
-}
-
-#[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-struct RollerToml {
-    part: toml::Value,
-    normal: [f64; 2],
-}
-
-#[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-struct ExactToml {
-    #[serde(alias = "u", alias = "w")]
-    value: Option<String>,
-    gradient: Option<[String; 2]>,
-    hessian: Option<[[String; 2]; 2]>,
-    lambda: Option<String>,
-    contact_force: Option<f64>,
-    contact_area: Option<f64>,
-}
-
-/// A scene read from a file with the pair it names (the command line's `--pair` wins).
-#[derive(Clone, Debug)]
-pub struct FileScene {
-    /// The scene.
-    pub scene: Scene,
-    /// The pair the file names.
-    pub pair: Option<String>,
-}
-
-/// The family a scene file names under `model`, read before the rest of the file.
-pub fn family_of(text: &str) -> Option<String> {
-    #[derive(Deserialize)]
-    struct ModelOnly {
-        model: Option<String>,
-    }
-    toml::from_str::<ModelOnly>(text).ok()?.model
-}
-
-/// Reads a scene file of a registry family (docs/scene-files.md): the mesh, the supports
-/// per boundary part, the parameters and data by the model's names or the family's
-/// aliases, the exact solution with its derivatives given or derived.
-///
-/// # Errors
-/// [`Error::Input`] naming the file and the field: TOML errors, unknown keys, a family
-/// or generator the registry does not have, boundary parts that are not names,
-/// expressions that do not parse, an exact gradient or Hessian that the finite
-/// differences of the value (or gradient) contradict.
-pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileScene> {
-    let at = |field: &str, message: String| {
-        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
-    };
-    let file: FileToml = toml::from_str(text)
-        .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
-    if file.model != family.name() {
-        return Err(at(
-            "model",
-            format!("`{}` is read as the family `{}`", file.model, family.name()),
-        ));
-    }
-    let name = scene_name(file.name.as_deref(), path, "scene").map_err(|m| at("name", m))?;
-    let (domain, mesh_size) = domain_of(&file.mesh, path).map_err(|(f, m)| at(&f, m))?;
-    let description = file
-        .description
-        .clone()
-        .unwrap_or_else(|| format!("scene file {}", path.display()));
-    let mut scene = Scene::new(name, description, family.name(), domain, mesh_size);
-    let model_name = |key: &str| -> String {
-        family
-            .aliases()
-            .iter()
-            .find(|(alias, _)| *alias == key)
-            .map_or(key.to_string(), |(_, name)| name.to_string())
-    };
-    for (key, value) in &file.parameters {
-        let v = value
-            .as_float()
-            .or_else(|| value.as_integer().map(|i| i as f64))
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                at(
-                    &format!("parameters.{key}"),
-                    format!("{value} is not a finite number"),
-                )
-            })?;
-        scene.set_parameter(model_name(key), v);
-    }
-    let mut load = None;
-    for (key, value) in &file.data {
-        let field = format!("data.{key}");
-        if key == "load" {
-            let q = value
-                .as_float()
-                .or_else(|| value.as_integer().map(|i| i as f64))
-                .filter(|q| q.is_finite())
-                .ok_or_else(|| at(&field, format!("{value} is not a finite number")))?;
-            load = Some(q);
-            continue;
-        }
-        let text = match value {
-            toml::Value::String(s) => s.clone(),
-            toml::Value::Float(v) => v.to_string(),
-            toml::Value::Integer(v) => v.to_string(),
-            other => return Err(at(&field, format!("{other} is not an expression"))),
-        };
-        scene.set_data(model_name(key), expression(&text, &field, path)?);
-    }
-    let scaled = model_name("f");
-    if scene.data_fn(&scaled).is_some() {
-        scene.load = Some(Load {
-            default: load.unwrap_or(1.0),
-            scales: vec![scaled.into()],
-            symbol: "q",
-            nonnegative: false,
-        });
-    } else if load.is_some() {
-        return Err(at(
-            "data.load",
-            "scales the load `f`, which the file does not give".into(),
-        ));
-    }
-    scene.supports = supports(&file.boundary).map_err(|(f, m)| at(&f, m))?;
-    if let Some(e) = &file.exact {
-        let exact = exact_of(e, &scene.domain, path)?;
-        // the contact set is not linear in the load: the file's exact solution holds at
-        // its own load
-        scene.exact = Exact::AtDefaultLoad(exact);
-    }
-    if let Some(a) = file.accuracy {
-        if !(a.is_finite() && a > 0.0) {
-            return Err(at("accuracy", format!("{a} must be positive and finite")));
-        }
-        if file.exact.is_none() {
-            return Err(at(
-                "accuracy",
-                "an accuracy needs an `[exact]` value to measure the L² error against".into(),
-            ));
-        }
-        scene.accuracy = Some(a);
-    }
-    Ok(FileScene {
-        scene,
-        pair: file.pair,
-    })
-}
-
-/// The domain and `N` of `[mesh]`; errors as `(field, message)`.
-fn domain_of(
-    mesh: &MeshToml,
-    path: &Path,
-) -> std::result::Result<(Domain, usize), (String, String)> {
-    let err = |f: &str, m: &str| Err((format!("mesh.{f}"), m.to_string()));
-    match (&mesh.generator, &mesh.file) {
-        (Some(_), Some(_)) => err("file", "give either `generator` or `file`, not both"),
-        (None, None) => err(
-            "generator",
-            "give a `generator` (interval, rectangle, square, l-shape, disk) or a Gmsh `file`",
-        ),
-        (None, Some(msh)) => {
-            let base = path.parent().unwrap_or(Path::new("."));
-            Ok((Domain::Gmsh(base.join(msh)), mesh.refinements.unwrap_or(0)))
-        }
-        (Some(generator), None) => {
-            if mesh.refinements.is_some() {
-                return err(
-                    "refinements",
-                    "applies to a Gmsh `file`; a generator takes `size`",
-                );
-            }
-            let size = mesh.size.unwrap_or(16);
-            let domain = match generator.as_str() {
-                "interval" => Domain::Interval {
-                    start: mesh.start.unwrap_or(0.0),
-                    end: mesh.end.unwrap_or(1.0),
-                },
-                "rectangle" | "square" => {
-                    let x = mesh.x.unwrap_or([0.0, 1.0]);
-                    let y = mesh.y.unwrap_or(x);
-                    if !(x[0] < x[1] && y[0] < y[1]) {
-                        return err("x", "the sides need x[0] < x[1] and y[0] < y[1]");
-                    }
-                    Domain::Rectangle {
-                        x,
-                        y,
-                        cells: mesh.cells.unwrap_or([1, 1]),
-                        diagonal: fem_runtime::Diagonal::Right,
-                    }
-                }
-                "l-shape" => Domain::LShape,
-                "disk" => Domain::Disk {
-                    centre: mesh.centre.unwrap_or([0.0, 0.0]),
-                    radius: mesh.radius.unwrap_or(1.0),
-                    curved: mesh.curved.unwrap_or(false),
-                },
-                other => {
-                    return err(
-                        "generator",
-                        &format!("unknown generator `{other}`; the generators are interval, rectangle, square, l-shape, disk"),
-                    )
-                }
-            };
-            Ok((domain, size))
-        }
-    }
-}
-
-/// The parts a `[boundary]` key names: `"all"`, a name or a list of names.
-fn part_of(value: &toml::Value) -> std::result::Result<Part, String> {
-    use toml::Value;
-    let name = |v: &Value| {
-        match v {
-        Value::String(s) if !s.trim().is_empty() => Ok(s.clone()),
-        Value::Integer(i) => Err(format!(
-            "{i} is a number: boundary parts are chosen by name (Gmsh physical names of curve groups, or a generator's side names)"
-        )),
-        other => Err(format!("{other} is not a name")),
-    }
-    };
-    match value {
-        Value::String(s) if s == "all" => Ok(Part::All),
-        Value::Array(list) if list.is_empty() => Err("an empty list names no part".into()),
-        Value::Array(list) => Ok(Part::Named(
-            list.iter()
-                .map(name)
-                .collect::<std::result::Result<_, _>>()?,
-        )),
-        v => Ok(Part::Named(vec![name(v)?])),
-    }
-}
-
-/// The supports of `[boundary]`, in the order clamped, simply supported (soft, hard),
-/// free, dirichlet, rollers: later entries win where parts overlap.
-fn supports(b: &BoundaryToml) -> std::result::Result<Vec<PartSupport>, (String, String)> {
-    let mut out = Vec::new();
-    for (key, value, support) in [
-        ("clamped", &b.clamped, Support::Clamped),
-        (
-            "simply_supported",
-            &b.simply_supported,
-            Support::SimplySupported { hard: false },
-        ),
-        (
-            "simply_supported_hard",
-            &b.simply_supported_hard,
-            Support::SimplySupported { hard: true },
-        ),
-        ("free", &b.free, Support::Free),
-        ("dirichlet", &b.dirichlet, Support::Data),
-    ] {
-        if let Some(v) = value {
-            let field = format!("boundary.{key}");
-            let part = part_of(v).map_err(|m| (field.clone(), m))?;
-            out.push(PartSupport {
-                part,
-                support,
-                key: Some(field.into()),
-            });
-        }
-    }
-    for (k, r) in b.roller.iter().enumerate() {
-        let field = format!("boundary.roller[{k}]");
-        let part = part_of(&r.part).map_err(|m| (field.clone(), m))?;
-        out.push(PartSupport {
-            part,
-            support: Support::Roller { normal: r.normal },
-            key: Some(field.into()),
-        });
-    }
-    Ok(out)
-}
-
-/// Points inside the domain's bounding box at which given derivatives are checked
-/// (irrational offsets: unlikely to sit on a kink of `max` or `abs`).
-fn check_points(domain: &Domain) -> Vec<[f64; 2]> {
-    let (x, y) = match domain {
-        Domain::Interval { start, end } => ([*start, *end], [0.0, 0.0]),
-        Domain::Rectangle { x, y, .. } => (*x, *y),
-        Domain::Disk { centre, radius, .. } => {
-            let r = radius / std::f64::consts::SQRT_2;
-            (
-                [centre[0] - r, centre[0] + r],
-                [centre[1] - r, centre[1] + r],
-            )
-        }
-        _ => ([-1.0, 1.0], [-1.0, 1.0]),
-    };
-    [0.1234, 0.3711, 0.5827, 0.7419, 0.9137]
-        .iter()
-        .zip([0.8191, 0.2347, 0.6553, 0.4271, 0.1619])
-        .map(|(s, t)| [x[0] + s * (x[1] - x[0]), y[0] + t * (y[1] - y[0])])
-        .collect()
-}
-
-/// Checks `derivative` (the given `∂f/∂x_k` as `d(x)[k]`) against the central
-/// differences of `f` at a few points.
-fn check_derivative(
-    f: &dyn Fn(&[f64]) -> f64,
-    derivative: &dyn Fn(&[f64], usize) -> f64,
-    points: &[[f64; 2]],
-    dimension: usize,
-) -> std::result::Result<(), String> {
-    for p in points {
-        for k in 0..dimension {
-            let step = 1e-5 * (1.0 + p[k].abs());
-            let (mut a, mut b) = (*p, *p);
-            a[k] += step;
-            b[k] -= step;
-            let difference = (f(&a) - f(&b)) / (2.0 * step);
-            let given = derivative(p, k);
-            let scale = 1.0 + difference.abs().max(given.abs());
-            let agrees = (given - difference).abs() <= 1e-4 * scale;
-            // NaN (a derivative undefined where the function is) fails too
-            if !agrees {
-                return Err(format!(
-                    "at ({}, {}) its component {} is {given:e}, the finite difference of the function {difference:e}",
-                    p[0], p[1], k + 1
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The exact solution of `[exact]`, its gradient and Hessian given (and checked) or
-/// derived symbolically.
-fn exact_of(e: &ExactToml, domain: &Domain, path: &Path) -> Result<ExactSolution> {
-    let at = |field: &str, message: String| {
-        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
-    };
-    let dimension = if matches!(domain, Domain::Interval { .. }) {
-        1
-    } else {
-        2
-    };
-    let points = check_points(domain);
-    let mut out = ExactSolution {
-        multiplier: e
-            .lambda
-            .as_deref()
-            .map(|l| expression(l, "exact.lambda", path))
-            .transpose()?,
-        total_contact_force: e.contact_force,
-        contact_area: e.contact_area,
-        ..ExactSolution::default()
-    };
-    let Some(value) = &e.value else {
-        return Ok(out);
-    };
-    let u = expression(value, "exact.value", path)?;
-    let gradient = match &e.gradient {
-        Some([gx, gy]) => {
-            let (gx, gy) = (
-                expression(gx, "exact.gradient[0]", path)?,
-                expression(gy, "exact.gradient[1]", path)?,
-            );
-            let g = Data::shared(move |x: &[f64]| [gx.at(x), gy.at(x)]);
-            check_derivative(&|x| u.at(x), &|x, k| g.at(x)[k], &points, dimension).map_err(
-                |m| at("exact.gradient", format!("does not match `exact.value`: {m}")),
-            )?;
-            g
-        }
-        None => gradient(value, "exact.value", path).map_err(|e| match e {
-            Error::Input(m) => Error::Input(format!(
-                "{m}; give the derivatives as `gradient = [\"∂u/∂x\", \"∂u/∂y\"]` (a kink of max or abs is not differentiated)"
-            )),
-            other => other,
-        })?,
-    };
-    if let Some(h) = &e.hessian {
-        let mut rows = Vec::new();
-        for (i, row) in h.iter().enumerate() {
-            let entries = [
-                expression(&row[0], &format!("exact.hessian[{i}][0]"), path)?,
-                expression(&row[1], &format!("exact.hessian[{i}][1]"), path)?,
-            ];
-            rows.push(entries);
-        }
-        let rows = std::sync::Arc::new(rows);
-        for i in 0..dimension {
-            let g = gradient.clone();
-            let r = rows.clone();
-            check_derivative(
-                &move |x| g.at(x)[i],
-                &move |x, k| r[i][k].at(x),
-                &points,
-                dimension,
-            )
-            .map_err(|m| {
-                at(
-                    &format!("exact.hessian[{i}]"),
-                    format!("does not match the gradient: {m}"),
-                )
-            })?;
-        }
-        out.hessian = Some(Data::shared(move |x: &[f64]| {
-            [
-                [rows[0][0].at(x), rows[0][1].at(x)],
-                [rows[1][0].at(x), rows[1][1].at(x)],
-            ]
-        }));
-    }
-    out.value = Some(u);
-    out.gradient = Some(gradient);
-    Ok(out)
 }

@@ -167,6 +167,10 @@ fn studies(name: &str) -> Vec<&'static str> {
 }
 
 impl Family for Membranes {
+    fn default_support(&self) -> Option<(Support, &'static str)> {
+        Some((Support::Data, "boundary.dirichlet"))
+    }
+
     fn name(&self) -> &'static str {
         "membrane"
     }
