@@ -1111,7 +1111,13 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         pressure_l2_error: errors.map(|e| e[0]),
         best_p0_l2_error: errors.map(|e| e[1]),
         best_fit_l2_error: errors.map(|e| e[1]),
-        oscillation: None,
+        oscillation: file
+            .exact_pressure
+            .as_ref()
+            .filter(|_| own_load)
+            .and_then(|exact| {
+                crate::models::signorini::checkerboard_against(&solution, n, exact.as_data_fn())
+            }),
         patch_pressure_error: None,
         complementarity_residual: solution.complementarity_residual,
         kkt_residual: solution.kkt_residual,
@@ -1119,6 +1125,12 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         warnings: Vec::new(),
     };
     let mut warnings = crate::signorini::warnings(&report);
+    let (mu, lambda) = crate::models::signorini::lame(file.young, file.poisson, file.plane)?;
+    warnings.extend(crate::models::families::contact::volumetric_locking(
+        pair.name(),
+        mu,
+        lambda,
+    ));
     warnings.extend(quality.warnings(&mesh, alpha.is_none()));
     for (key, names) in &file.part_names {
         warnings.extend(crate::interior_curve_warnings(key, &mesh, names));

@@ -1168,3 +1168,80 @@ fn a_part_with_interior_edges_is_warned_about() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A nearly incompressible body (`tests/data/contact_gap_nu04999.toml`: the gap block
+/// with E chosen so that E* and Hertz's pressure stay) locks a P1 displacement: its
+/// pressure error grows with ν while P2's stays. The P1 pairs warn from λ_L/μ_L = 20
+/// (ν ≈ 0.476) on, naming the cure, where P1 is measurably worse (1.6× at ν = 0.49).
+#[test]
+fn a_nearly_incompressible_body_warns_that_p1_locks() {
+    let text = std::fs::read_to_string(data("contact_gap_nu04999.toml")).unwrap();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-locking-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (nu, warned) in [
+        ("0.3", false),
+        ("0.45", false),
+        ("0.49", true),
+        ("0.4999", true),
+    ] {
+        // E* = E/(1 − ν²) kept, so that the exact pressure stays
+        let nu_value: f64 = nu.parse().unwrap();
+        let young = 824.2857032967033 / (1.0 - 0.4999f64.powi(2)) * (1.0 - nu_value * nu_value);
+        let file = dir.join(format!("nu{nu}.toml"));
+        std::fs::write(
+            &file,
+            text.replace("poisson = 0.4999", &format!("poisson = {nu}"))
+                .replace("young = 824.2857032967033", &format!("young = {young:?}")),
+        )
+        .unwrap();
+        let path = file.to_str().unwrap();
+        let p1 = json_of(&["solve", "--scene", path, "--pair", "p1-p0", "--json"]);
+        let p2 = json_of(&["solve", "--scene", path, "--pair", "p2-p0", "--json"]);
+        let locks =
+            |r: &serde_json::Value| r["warnings"].to_string().contains("locks volumetrically");
+        assert_eq!(locks(&p1), warned, "ν = {nu}: {}", p1["warnings"]);
+        assert!(!locks(&p2), "ν = {nu}: {}", p2["warnings"]);
+        let ratio = number(&p1, "pressure_l2_error") / number(&p2, "pressure_l2_error");
+        if warned {
+            assert!(ratio > 1.3, "ν = {nu}: P1/P2 error ratio {ratio}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The checkerboard measure is reported for every contact solve with an exact pressure,
+/// scene files too; against Hertz's pressure it is the built-in scenes' measure.
+#[test]
+fn the_oscillation_is_measured_against_any_exact_pressure() {
+    let report = json_of(&[
+        "solve",
+        "--scene",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/examples/contact-gap.toml"),
+        "--json",
+    ]);
+    let oscillation = number(&report, "oscillation");
+    assert!(oscillation > 0.0 && oscillation < 0.5, "{oscillation}");
+    let solved = fem_forms::models::contact_scenes::solve_gap_block(
+        &SIGNORINI_GAP,
+        1.0,
+        16.0,
+        fem_forms::models::signorini::Displacement::P1,
+        None,
+    )
+    .unwrap();
+    let hertz = solved.hertz;
+    let built_in = fem_forms::models::signorini::checkerboard(&solved.solution, &hertz);
+    let against = fem_forms::models::signorini::checkerboard_against(
+        &solved.solution,
+        [0.0, -1.0],
+        &|x: &[f64]| hertz.pressure(x[0]),
+    )
+    .unwrap();
+    // the same windows; normalized by the largest exact pressure sampled on Γ_C, which
+    // is p_max to O((h/b)²)
+    assert!(
+        (built_in - against).abs() <= 1e-3 * built_in,
+        "{built_in} against {against}"
+    );
+}

@@ -984,6 +984,52 @@ pub fn checkerboard(solution: &SignoriniSolution, hertz: &Hertz) -> f64 {
         / hertz.max_pressure()
 }
 
+/// The share of the exact peak pressure above which [`checkerboard_against`] measures:
+/// Hertz's pressure is above 0.6 p_max exactly inside 0.8 b, where [`checkerboard`]
+/// measures.
+pub const SMOOTH_PRESSURE_SHARE: f64 = 0.6;
+
+/// The checkerboard measure of a P0 pressure against any exact pressure `exact`:
+/// `max |λ_{k−1} − 2λ_k + λ_{k+1}| / max p` (p sampled at the edges' ends and
+/// midpoints) over consecutive contact edges, ordered along
+/// the contact plane (`direction` its normal `n_c`), whose midpoints all lie where
+/// `p ≥ 0.6 max p` (inside the contact zone, away from its square-root edges); for
+/// Hertz's pressure the same as [`checkerboard`]. `None` where fewer than three edges
+/// lie there, or the exact pressure vanishes on Γ_C.
+pub fn checkerboard_against(
+    solution: &SignoriniSolution,
+    direction: [f64; 2],
+    exact: &dyn Fn(&[f64]) -> f64,
+) -> Option<f64> {
+    let along = contact_tangent(direction);
+    let mut profile: Vec<(f64, f64, f64)> = solution
+        .contact_edges
+        .iter()
+        .zip(&solution.pressure)
+        .map(|(e, &p)| {
+            let m = e.midpoint();
+            (along[0] * m[0] + along[1] * m[1], p, exact(&m))
+        })
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let peak = solution
+        .contact_edges
+        .iter()
+        .flat_map(|e| [e.ends[0], e.midpoint(), e.ends[1]])
+        .map(|x| exact(&x))
+        .fold(0.0f64, f64::max);
+    if !(peak > 0.0 && peak.is_finite()) {
+        return None;
+    }
+    let smooth = SMOOTH_PRESSURE_SHARE * peak;
+    let windows: Vec<f64> = profile
+        .windows(3)
+        .filter(|w| w.iter().all(|p| p.2 >= smooth))
+        .map(|w| (w[0].1 - 2.0 * w[1].1 + w[2].1).abs())
+        .collect();
+    (!windows.is_empty()).then(|| windows.iter().fold(0.0f64, |m, &d| m.max(d)) / peak)
+}
+
 /// The comparison of a solution on [`hertz_mesh`] with Hertz's pressure: the relative
 /// L² error, the best fit's in the multiplier's space and the checkerboard measure
 /// (see [`HertzResult`]; P0: 16-point Gauss–Legendre per edge, P1: exact integrals).
