@@ -184,6 +184,7 @@ fn main() {
         contact_direction: [0.0, -1.0],
         fixed_x: &[4],
         fixed_y: &[],
+        rollers: &[],
         alpha: None,
         contact_centre: None,
     };

@@ -30,6 +30,9 @@
 //! load = "top"                    # Γ_N, where the pressure acts
 //! fixed_x = "left"                # u_x = 0 (optional)
 //! # fixed_y = []                  # u_y = 0 (optional)
+//! # [[boundary.roller]]           # u·normal = 0 on a part, any direction (optional)
+//! # part = "left"
+//! # normal = [0.866, 0.5]
 //!
 //! [parameters]
 //! contact_direction = [0.0, -1.0] # n_c: the foundation's normal away from the body
@@ -175,6 +178,16 @@ struct BoundaryToml {
     load: toml::Value,
     fixed_x: Option<toml::Value>,
     fixed_y: Option<toml::Value>,
+    #[serde(default)]
+    roller: Vec<RollerToml>,
+}
+
+/// `[[boundary.roller]]`: `u·normal = 0` on `part`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct RollerToml {
+    part: toml::Value,
+    normal: [f64; 2],
 }
 
 #[derive(Deserialize, Debug, Default)]
@@ -228,6 +241,8 @@ pub struct ContactSceneFile {
     pub fixed_x: Vec<u32>,
     /// Boundary markers where `u_y = 0`.
     pub fixed_y: Vec<u32>,
+    /// Rollers along any direction: markers and the unit direction held.
+    pub rollers: Vec<(Vec<u32>, [f64; 2])>,
     /// The boundary part names as written, per key (for the report).
     pub part_names: Vec<(String, Vec<String>)>,
     /// The contact direction n_c (unit).
@@ -367,6 +382,20 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     let load_part = part("boundary.load", Some(&b.load), true)?;
     let fixed_x = part("boundary.fixed_x", b.fixed_x.as_ref(), false)?;
     let fixed_y = part("boundary.fixed_y", b.fixed_y.as_ref(), false)?;
+    let mut rollers = Vec::with_capacity(b.roller.len());
+    for (k, r) in b.roller.iter().enumerate() {
+        let key = format!("boundary.roller[{k}]");
+        let markers = part(&key, Some(&r.part), true)?;
+        let [nx, ny] = r.normal;
+        let length = nx.hypot(ny);
+        if !(length.is_finite() && length > 0.0) {
+            return Err(at(
+                &format!("{key}.normal"),
+                format!("({nx}, {ny}) must be a non-zero finite vector"),
+            ));
+        }
+        rollers.push((markers, [nx / length, ny / length]));
+    }
     let [cx, cy] = file.parameters.contact_direction.unwrap_or([0.0, -1.0]);
     let length = cx.hypot(cy);
     if !(length.is_finite() && length > 0.0) {
@@ -508,7 +537,10 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         diameter: fem_runtime::problem::domain::bounding_diameter(&mesh),
         young: m.young,
         translation_held: (contact_direction[0] != 0.0 && !fixed_x.is_empty())
-            || (contact_direction[1] != 0.0 && !fixed_y.is_empty()),
+            || (contact_direction[1] != 0.0 && !fixed_y.is_empty())
+            || rollers.iter().any(|(_, n)| {
+                (n[0] * contact_direction[0] + n[1] * contact_direction[1]).abs() > 1e-12
+            }),
     };
     data_scales(&scales, load).map_err(|(key, m)| at(key, m))?;
     let exact_pressure = file
@@ -551,6 +583,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         load_part,
         fixed_x,
         fixed_y,
+        rollers,
         part_names,
         contact_direction,
         alpha: file.parameters.alpha,
@@ -1032,6 +1065,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         contact_direction: file.contact_direction,
         fixed_x: &file.fixed_x,
         fixed_y: &file.fixed_y,
+        rollers: &file.rollers,
         alpha,
         contact_centre: file.contact_centre,
     };

@@ -344,6 +344,7 @@ pub fn solve(request: &ContactRequest) -> Result<(ContactReport, PressureProfile
                 contact_direction: [0.0, -1.0],
                 fixed_x: &[4],
                 fixed_y: &[],
+                rollers: &[],
                 alpha: request.alpha,
                 contact_centre: None,
             };

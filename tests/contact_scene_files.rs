@@ -1245,3 +1245,57 @@ fn the_oscillation_is_measured_against_any_exact_pressure() {
         "{built_in} against {against}"
     );
 }
+
+/// A body on a foundation along neither axis, held by a roller along its turned side
+/// (`examples/contact-turned-block.toml`: the patch test turned by 30° on a Gmsh mesh):
+/// the pressure is exact, and rollers that cannot be are refused by their key.
+#[test]
+fn a_roller_along_any_direction_holds_a_turned_body() {
+    let example = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/contact-turned-block.toml"
+    );
+    for pair in ["p1-p0", "p2-p0"] {
+        let report = json_of(&["solve", "--scene", example, "--pair", pair, "--json"]);
+        let error = number(&report, "pressure_l2_error");
+        assert!(error < 1e-10, "{pair}: {error}");
+        assert!(number(&report, "equilibrium_residual") < 1e-10);
+    }
+    let text = std::fs::read_to_string(example).unwrap();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-roller-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/contact_block_turned30.msh"
+    );
+    let normal = "normal = [0.8660254037844387, 0.5]";
+    for (from, to, words) in [
+        (
+            normal,
+            "normal = [0.0, 0.0]",
+            &["boundary.roller[0].normal", "non-zero"][..],
+        ),
+        // on Γ_C, along the foundation's normal: it and the contact would both fix u·n_c
+        (
+            "part = \"axis\"\nnormal = [0.8660254037844387, 0.5]",
+            "part = \"foundation\"\nnormal = [0.5, -0.8660254037844387]",
+            &["roller", "contact direction"][..],
+        ),
+    ] {
+        let path = dir.join("bad.toml");
+        std::fs::write(
+            &path,
+            text.replace(from, to)
+                .replace("\"contact_block_turned30.msh\"", &format!("{mesh:?}")),
+        )
+        .unwrap();
+        let run = fem_forms(&["solve", "--scene", path.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{to}: solved");
+        for w in words {
+            assert!(stderr.contains(w), "{to}: {w}: {stderr}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

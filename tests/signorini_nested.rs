@@ -56,6 +56,7 @@ fn block_input(gap: &'static (dyn Fn(&[f64]) -> f64 + Sync)) -> SignoriniInput<'
         contact_direction: [0.0, -1.0],
         fixed_x: &[4],
         fixed_y: &[],
+        rollers: &[],
         alpha: None,
         contact_centre: None,
     }

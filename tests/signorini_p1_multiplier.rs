@@ -47,6 +47,7 @@ fn block_input(element: Displacement, alpha: Option<f64>) -> SignoriniInput<'sta
         contact_direction: [0.0, -1.0],
         fixed_x: &[4],
         fixed_y: &[],
+        rollers: &[],
         alpha,
         contact_centre: None,
     }

@@ -288,6 +288,7 @@ pub fn solve_gap_block(
         contact_direction: [0.0, -1.0],
         fixed_x: &[GAP_AXIS],
         fixed_y: &[],
+        rollers: &[],
         alpha,
         contact_centre: Some(0.0),
     };

@@ -118,6 +118,13 @@ fn contact_problem<'a, M: Model>(
             );
         }
     }
+    for (markers, n) in input.rollers {
+        problem = problem.support(
+            DirichletPart::Markers(markers.clone()),
+            "u_x",
+            Condition::Along(*n),
+        );
+    }
     problem
 }
 
@@ -196,6 +203,9 @@ pub struct SignoriniInput<'a> {
     pub fixed_x: &'a [u32],
     /// Edges where `u_y = 0`.
     pub fixed_y: &'a [u32],
+    /// Rollers along any direction: on the edges of the markers, `u·n = 0` for the unit
+    /// `n` (a support on a face that is neither along x nor along y).
+    pub rollers: &'a [(Vec<u32>, [f64; 2])],
     /// The stabilization parameter; `None`: `α = 1/(2 max_E C_I,E)` (docs/contact.md);
     /// `Some(0.0)`: the plain mixed method, solved as a QP.
     pub alpha: Option<f64>,
@@ -459,6 +469,15 @@ impl Setup<'_> {
                 )));
             }
         }
+        for (markers, n) in input.rollers {
+            let along = n[0] * direction[0] + n[1] * direction[1];
+            if along.abs() > 1e-12 && markers.iter().any(|m| input.contact.contains(m)) {
+                return Err(Error::Input(format!(
+                    "the contact boundary (markers {:?}) also has a roller along ({:.3}, {:.3}), which has a component along the contact direction ({:.3}, {:.3}): the support and the contact constraint both fix u·n_c there; drop the support on the contact part",
+                    input.contact, n[0], n[1], direction[0], direction[1]
+                )));
+            }
+        }
         Ok(Self {
             lame: [mu, lambda],
             direction,
@@ -554,6 +573,8 @@ fn rotation_held(
             full[d] = if axis == 0 { -x[1] } else { x[0] };
         }
     }
+    // in the primed DOFs of the supports' rotated groups (oblique rollers)
+    problem.basis.to_primed(&mut full);
     let rotation: Vec<f64> = problem.reduction.free().iter().map(|&d| full[d]).collect();
     let a = &problem.lcp.a;
     let multiply = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(a, x);
@@ -652,6 +673,8 @@ fn towards_foundation(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Ve
             full[range].fill(n[axis]);
         }
     }
+    // in the primed DOFs of the supports' rotated groups (oblique rollers)
+    problem.basis.to_primed(&mut full);
     problem.reduction.free().iter().map(|&d| full[d]).collect()
 }
 
@@ -961,6 +984,7 @@ pub fn solve_hertz_on_with(
         contact_direction: [0.0, -1.0],
         fixed_x: &[HERTZ_AXIS],
         fixed_y: &[],
+        rollers: &[],
         alpha,
         contact_centre: Some(0.0),
     };
@@ -1430,6 +1454,7 @@ pub fn hertz_input<'a>(
         contact_direction: [0.0, -1.0],
         fixed_x: &[HERTZ_AXIS],
         fixed_y: &[],
+        rollers: &[],
         alpha,
         contact_centre: Some(0.0),
     }

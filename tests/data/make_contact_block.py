@@ -9,7 +9,15 @@ groups (tags differ from the entity tags on purpose):
   ("axis") = 34 {4}, ("midline") = 35 {5},  Physical Surface("block") = 41 {1}.
 The triangles are an 2N x N grid with perturbed interior nodes (the row y = 1/2 kept
 straight) and diagonals chosen pseudo-randomly. Run: python3 make_contact_block.py
+
+With an angle in degrees (python3 make_contact_block.py 30) it writes
+contact_block_turned30.msh, the same block turned by that angle about the origin (a
+body on a foundation that is along neither axis).
 """
+import math
+import sys
+
+ANGLE = float(sys.argv[1]) if len(sys.argv) > 1 else 0.0
 
 N = 4
 NX, NY = 2 * N, N
@@ -33,6 +41,10 @@ for j in range(NY + 1):
             if j != MID:
                 y += 0.2 * h * rand(i, j, 2)
         grid[i, j] = (x, y)
+
+c_, s_ = math.cos(math.radians(ANGLE)), math.sin(math.radians(ANGLE))
+for k, (x, y) in grid.items():
+    grid[k] = (c_ * x - s_ * y, s_ * x + c_ * y) if ANGLE else (x, y)
 
 tags = {}
 blocks = []  # (dim, entity, [(tag, (x, y))])
@@ -81,8 +93,9 @@ w("$PhysicalNames\n6")
 w('1 31 "foundation"\n1 32 "side"\n1 33 "top"\n1 34 "axis"\n1 35 "midline"\n2 41 "block"')
 w("$EndPhysicalNames")
 w("$Entities\n4 5 1 0")
-for p, (x, y) in enumerate([(0, 0), (2, 0), (2, 1), (0, 1)], start=1):
-    w(f"{p} {x} {y} 0 0")
+for p, k in enumerate([(0, 0), (NX, 0), (NX, NY), (0, NY)], start=1):
+    x, y = grid[k]
+    w(f"{p} {x!r} {y!r} 0 0")
 physical = {1: 31, 2: 32, 3: 33, 4: 34, 5: 35}
 ends = {1: (1, 2), 2: (2, 3), 3: (3, 4), 4: (4, 1)}
 for c in range(1, 6):
@@ -90,7 +103,9 @@ for c in range(1, 6):
     ys = [grid[k][1] for k in curves[c]]
     bounding = f"2 {ends[c][0]} -{ends[c][1]}" if c in ends else "0"
     w(f"{c} {min(xs)} {min(ys)} 0 {max(xs)} {max(ys)} 0 1 {physical[c]} {bounding}")
-w("1 0 0 0 2 1 0 1 41 4 1 2 3 4")
+xs = [p[0] for p in grid.values()]
+ys = [p[1] for p in grid.values()]
+w(f"1 {min(xs)!r} {min(ys)!r} 0 {max(xs)!r} {max(ys)!r} 0 1 41 4 1 2 3 4")
 w("$EndEntities")
 total = sum(len(b[2]) for b in blocks)
 w(f"$Nodes\n{len(blocks)} {total} 1 {total}")
@@ -116,4 +131,5 @@ for t in triangles:
     w(f"{e} {' '.join(str(tags[k]) for k in t)}")
     e += 1
 w("$EndElements")
-open(__file__.replace("make_contact_block.py", "contact_block.msh"), "w").write("\n".join(out) + "\n")
+name = f"contact_block_turned{ANGLE:g}.msh" if ANGLE else "contact_block.msh"
+open(__file__.replace("make_contact_block.py", name), "w").write("\n".join(out) + "\n")

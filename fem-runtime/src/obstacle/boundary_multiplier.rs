@@ -18,6 +18,7 @@
 //! Newton needs `C > 0`, i.e. α > 0; the plain method `α = 0` goes to the QP).
 
 use crate::assembly::boundary::{Constraints, DirichletPart};
+use crate::assembly::change_of_basis::ChangeOfBasis;
 use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::error::{Error, Result};
@@ -300,8 +301,7 @@ pub fn multiplier_dofs_on<M: Model>(
 /// is neither P0 nor P1 or that appears in no boundary integral or on two parts, a P1
 /// multiplier whose facet terms reach the vertex off the edge; `parts` not one list of
 /// markers per part of the model, or a part that holds no boundary edge of the mesh;
-/// conditions on vertex combinations in `constraints` (rotated DOFs: supported on the
-/// cells' multipliers only); the errors of the kernels ([`Error::NonFinite`] for a
+/// the errors of the kernels ([`Error::NonFinite`] for a
 /// non-finite entry).
 pub fn discretize<M: Model>(
     mesh: &TriangleMesh,
@@ -329,11 +329,6 @@ pub fn discretize<M: Model>(
             M::FACET_PARTS.join(", "),
             parts.len()
         )));
-    }
-    if !constraints.combinations().is_empty() {
-        return Err(Error::Input(
-            "conditions on combinations of vertex DOFs (a rotated basis) are not supported with a multiplier on a boundary part".into(),
-        ));
     }
     // The edges of every part of the model.
     let mut edges_of_part = Vec::with_capacity(M::FACET_PARTS.len());
@@ -510,6 +505,20 @@ pub fn discretize<M: Model>(
     }
     let a_full: SparseMatrix = SparseColMat::try_new_from_triplets(n_full, n_full, &triplets)
         .map_err(|e| Error::Input(format!("assembling the system: {e:?}")))?;
+    // supports on combinations of DOFs (a roller along an oblique direction) rotate
+    // their groups: A' = Rᵀ A R, F' = Rᵀ F, each row of B to B R; the reduction is in
+    // the primed numbering
+    let basis = constraints.change_of_basis(n_full)?;
+    let a_full = if basis.is_identity() {
+        a_full
+    } else {
+        basis.transform_matrix(&a_full)?
+    };
+    basis.to_primed(&mut f_full);
+    let b_full: Vec<Vec<(usize, f64)>> = b_full
+        .into_iter()
+        .map(|row| rotate_row(&basis, row))
+        .collect();
     let reduction = constraints.reduction(n_full)?;
     let a = reduction.matrix(&a_full);
     let f = reduction.rhs(&a_full, &f_full);
@@ -537,7 +546,7 @@ pub fn discretize<M: Model>(
         mesh: mesh.clone(),
         dofs,
         reduction,
-        basis: Default::default(),
+        basis,
         lcp: Lcp::new(a, ConstraintRows::from(b_rows), c, f, g),
         multiplier_field: multiplier,
         multipliers: Multipliers::Boundary(boundary),
@@ -545,6 +554,33 @@ pub fn discretize<M: Model>(
         primal_reduced: (0..n).collect(),
         multiplier_reduced: Vec::new(),
     })
+}
+
+/// A sparse row `b` of B as `b R` in the primed DOFs of `basis`: at each rotated group
+/// `b'_g = T b_g` (the same map as a load vector's, [`ChangeOfBasis::to_primed`]).
+fn rotate_row(basis: &ChangeOfBasis, row: Vec<(usize, f64)>) -> Vec<(usize, f64)> {
+    if basis.is_identity() {
+        return row;
+    }
+    let mut out = row;
+    for block in basis.blocks() {
+        let group = block.group.as_slice();
+        let values: Vec<f64> = group
+            .iter()
+            .map(|d| out.iter().filter(|(c, _)| c == d).map(|(_, v)| v).sum())
+            .collect();
+        if values.iter().all(|&v| v == 0.0) {
+            continue;
+        }
+        out.retain(|(c, _)| !group.contains(c));
+        for (k, &d) in group.iter().enumerate() {
+            let v: f64 = (0..group.len()).map(|j| block.t[k][j] * values[j]).sum();
+            if v != 0.0 {
+                out.push((d, v));
+            }
+        }
+    }
+    out
 }
 
 /// The multiplier's DOF map on the part's edges: for P1 the vertices of the edges

@@ -515,6 +515,7 @@ fn input<'a>(
         contact_direction: facts.direction,
         fixed_x: &[],
         fixed_y: &[],
+        rollers: &[],
         alpha: None,
         contact_centre: facts.centre,
     }
