@@ -25,7 +25,7 @@ mod solve;
     name = "fem-forms",
     version,
     about = "Stabilized finite elements for obstacle and contact problems of beams, membranes, plates and elastic bodies: solve scenes, print tables, write charts",
-    long_about = "Without a command: solves the beam scenes at q = 1 (no contact) and q = 100 (contact), the membrane scenes and the contact scenes (signorini-patch, hertz, signorini-gap), prints tables, writes plots of w, θ, λ and ψ, the contact pressures against Hertz's, .vtu files of the membranes and the study charts to out/."
+    long_about = "Without a command: solves the beam scenes at q = 1 (no contact) and q = 100 (contact), the membrane scenes, then every plate, Kirchhoff, contact and Winkler scene at its defaults, prints tables, writes plots of w, θ, λ and ψ, the contact pressures against Hertz's, .vtu files of the membranes and the study charts to out/."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -371,27 +371,27 @@ fn default_job(out: &Path) -> Result<(), String> {
         .collect();
     membrane_job(&membranes, out)?;
     hosted_studies(&membrane_entries, out)?;
-    contact_job(out)
+    registry_job(&["plate", "kirchhoff", "contact", "winkler"], out)
 }
 
-/// The contact part of the default job: each contact scene at its defaults, one line
-/// each, and Hertz's pressure chart (out/hertz-pressure.svg).
-fn contact_job(out: &Path) -> Result<(), String> {
-    println!("\nfem-forms: Signorini contact scenes (stabilized P1–P0, α = ½/max C_I,E)\n");
-    for scene in fem_forms::models::contact_scenes::CONTACT_SCENES {
-        let request = contact::ContactRequest::new(scene);
-        let (report, profile) =
-            contact::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
-        println!("{}", contact::summary(&report));
-        if let Some(hertz) = scene.hertz(request.load) {
-            let path = contact::pressure_chart(
-                out,
-                &report,
-                &[(format!("λ_h ({})", report.pair), &profile)],
-                &hertz,
-            )
-            .map_err(|e| e.to_string())?;
-            println!("→ {}", path.display());
+/// The default job's families solved at their defaults through the registry: the
+/// plates, contact and the Winkler plate, a summary each and the family's chart where it
+/// has one (out/hertz-pressure.svg, out/signorini-gap-pressure.svg).
+fn registry_job(names: &[&str], out: &Path) -> Result<(), String> {
+    use fem_forms::models::families;
+    for family in names {
+        println!("\nfem-forms: {family} scenes at their defaults\n");
+        for scene in families::scenes().iter().filter(|s| s.family == *family) {
+            let outcome = families::solve(scene, &Default::default())
+                .map_err(|e| format!("{}: {e}", scene.name))?;
+            println!("{}", solve::summary(&outcome.report));
+            for warning in &outcome.report.solve.warnings {
+                println!("  warning: {warning}");
+            }
+            if let Some(profile) = &outcome.profile {
+                let path = solve::profile_chart(&scene.name, profile, out)?;
+                println!("→ {}", path.display());
+            }
         }
     }
     Ok(())

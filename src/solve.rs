@@ -6,12 +6,12 @@ use crate::{SolveOptions, SolverName};
 use fem_forms::models::families;
 use fem_forms::models::family::{Adjustment, Opt};
 use fem_forms::models::geometry::Fields;
-use fem_forms::models::report::{Outcome, Report, Settings};
+use fem_forms::models::report::{Outcome, Profile, Report, Settings};
 use fem_forms::models::scene::{Scene, Support};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;
 use fem_forms::plot;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 impl SolveOptions {
     /// The given options (flag spellings).
@@ -288,6 +288,34 @@ pub fn summary(r: &Report) -> String {
     lines.join("\n")
 }
 
+/// Writes `out/<scene>-pressure.svg`: the multiplier along its boundary part against its
+/// reference ([`Profile`]).
+///
+/// # Errors
+/// The output directory or chart cannot be written.
+pub fn profile_chart(scene: &str, profile: &Profile, out: &Path) -> Result<PathBuf, String> {
+    let path = out.join(format!("{scene}-pressure.svg"));
+    std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
+    let mut series = Vec::new();
+    if let Some((label, curve)) = &profile.reference {
+        series.push(plot::Series::line(label.clone(), curve.clone()));
+    }
+    let steps = profile
+        .computed
+        .1
+        .iter()
+        .flat_map(|&(x0, x1, p)| [(x0, p), (x1, p)])
+        .collect();
+    series.push(plot::Series::line(profile.computed.0.clone(), steps));
+    let axes = plot::Axes {
+        x: profile.x,
+        y: profile.y,
+        ..plot::Axes::default()
+    };
+    plot::chart(&path, &profile.title, axes, &series).map_err(|e| e.to_string())?;
+    Ok(path)
+}
+
 /// The chart (`--plot`) and the ParaView file (`--vtk`) of a solve.
 fn write_outputs(
     scene: &Scene,
@@ -296,25 +324,7 @@ fn write_outputs(
     out: &Path,
 ) -> Result<(), String> {
     if let (true, Some(profile)) = (options.plot, &outcome.profile) {
-        let path = out.join(format!("{}-pressure.svg", scene.name));
-        std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
-        let mut series = Vec::new();
-        if let Some((label, curve)) = &profile.reference {
-            series.push(plot::Series::line(label.clone(), curve.clone()));
-        }
-        let steps = profile
-            .computed
-            .1
-            .iter()
-            .flat_map(|&(x0, x1, p)| [(x0, p), (x1, p)])
-            .collect();
-        series.push(plot::Series::line(profile.computed.0.clone(), steps));
-        let axes = plot::Axes {
-            x: profile.x,
-            y: profile.y,
-            ..plot::Axes::default()
-        };
-        plot::chart(&path, &profile.title, axes, &series).map_err(|e| e.to_string())?;
+        let path = profile_chart(&scene.name, profile, out)?;
         eprintln!("→ {}", path.display());
     } else if options.plot {
         let Fields::Interval { .. } = &outcome.fields else {
