@@ -12,7 +12,7 @@
 #[path = "../examples/winkler_string/model.rs"]
 mod model;
 
-use model::Problem;
+use model::StringOnFoundation as Problem;
 
 /// The closed-form solution on `(−L, L)`: with `m = √(k/T)`,
 /// `cosh(m(L − c)) = q/(q − kd)`, `u = −d` and `λ = q − kd` on `[−c, c]`,
@@ -86,7 +86,6 @@ fn problem() -> Problem {
         stiffness: 1.0,
         load: 4.0,
         depth: 0.5,
-        alpha: 0.1,
     }
 }
 
@@ -117,8 +116,10 @@ fn the_example_converges_to_the_closed_form_contact_solution() {
         let h = 2.0 / cells as f64;
         let solved = problem().solve(cells).unwrap();
         let s = &solved.solution;
-        // C_I ≤ h²k (the module docs of the model); here a P1 cell attains it
-        assert!(solved.inverse_constant <= h * h * (1.0 + 1e-9), "C_I");
+        // C_I ≤ h²k (the module docs of the model): a P1 cell attains it
+        let c_i = solved.report.inverse_constant;
+        assert!(c_i <= h * h * (1.0 + 1e-9), "C_I");
+        assert_eq!(solved.report.alpha, Some(0.1));
         // the contact cells: all those well inside [−c, c], none well outside
         let cells_in_contact = s.contact_cells();
         for cell in 0..cells {
@@ -151,7 +152,7 @@ fn the_example_converges_to_the_closed_form_contact_solution() {
             .iter()
             .map(|&x| (u.at(x, 0).unwrap() - exact.u(x)).abs())
             .fold(0.0, f64::max);
-        let energy_error = (solved.energy - exact.energy()).abs();
+        let energy_error = (solved.report.energy.unwrap() - exact.energy()).abs();
         assert!(force_error < 2.0 * h, "{cells}: ∫λ error {force_error}");
         assert!(u_error < h * h, "{cells}: u error {u_error}");
         assert!(energy_error < h * h, "{cells}: energy error {energy_error}");

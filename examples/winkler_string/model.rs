@@ -1,21 +1,23 @@
 //! A string on a Winkler foundation over an obstacle (docs/mathematics.md, "A string on
 //! a Winkler foundation"): tension `T`, foundation stiffness `k`, load `f`, obstacle
-//! `u ≥ ψ` (side `s = 1`), `−T u'' + k u − sλ = f`, `λ ≥ 0`, `s(u − ψ) ≥ 0`,
-//! `λ s(u − ψ) = 0`.
+//! `u ≥ ψ`, `−T u'' + k u − λ = f`, `λ ≥ 0`, `u ≥ ψ`, `λ (u − ψ) = 0`.
 //!
 //! Deflection `u ∈ P1`, multiplier `λ ∈ P0`. `u'' ≡ 0` on each P1 cell, so the residual
 //! in `S_h` is `k u − sλ`; its primal part `h² k² ‖v‖²` is bounded by `h² k a_T(v, v)`,
-//! so `C_I ≤ h² k` and any `0 < α < 1/C_I` is stable.
+//! so `C_I ≤ h² k` (the runtime computes it from the declared roles and checks α
+//! against it). Its rule `α = ½/C_I` would grow like `1/h²` here and make `α S_h` of
+//! order one, so the string takes a fixed α = 0.1, well inside `0 < α < 1/C_I`.
 
-use fem_runtime::obstacle::{solve_obstacle, ObstacleOptions, ObstacleSolution};
-use fem_runtime::{stabilization, Coefficients, IntervalMesh, Result};
+use fem_runtime::problem::{Condition, Problem, Solved, ALPHA_WHEN_CI_VANISHES};
+use fem_runtime::stabilization::Alpha;
+use fem_runtime::{DirichletPart, IntervalMesh, Result};
 
 fem_runtime::model! {
     /// String on a Winkler foundation, u ∈ P1, λ ∈ P0.
     pub mod winkler_string on interval {
         unknowns: u: P1, λ: P0 >= 0;
         tests: v, μ;
-        params: α, s, T, k;
+        params: α, s, T > 0, k;
         data: f, ψ;
         forms: "
             a(u;v)     = ∫ T u'v' + k u v
@@ -23,27 +25,24 @@ fem_runtime::model! {
             S(u,λ;v,μ) = Σ_T h_T² (−T u'' + k u − sλ, −T v'' + k v − sμ)_T
             ℓ(v)       = ∫ f v
             ℓ_S(v,μ)   = Σ_T h_T² (f, −T v'' + k v − sμ)_T
-            g(μ)       = ∫ s ψ μ
+            G(μ)       = ∫ s ψ μ
             B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
-            L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
+            L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
         ";
+        system:        B_h, L_h;
+        energy:        a, ℓ;
+        stabilization: α S against a;
+        side:          s;
+        obstacle:      u >= ψ;
     }
 }
 
-/// A solved [`Problem`].
-pub struct Solved {
-    /// The discrete solution (`u` is field 0, `λ` field 1).
-    pub solution: ObstacleSolution,
-    /// `½ a(u_h, u_h) − ℓ(u_h)`.
-    pub energy: f64,
-    /// The element constant `C_I` of `S` against `a` on the mesh.
-    pub inverse_constant: f64,
-}
+use winkler_string::{data, fields, params, Model};
 
 /// A string of length `2L` on `(−L, L)`, clamped `u(±L) = 0`, under the uniform load
 /// `−q`, over the flat obstacle `u ≥ −d`.
 #[derive(Clone, Copy, Debug)]
-pub struct Problem {
+pub struct StringOnFoundation {
     /// Half-length `L`.
     pub half_length: f64,
     /// Tension `T > 0`.
@@ -54,51 +53,25 @@ pub struct Problem {
     pub load: f64,
     /// Obstacle depth `d > 0` (the obstacle is `ψ = −d`).
     pub depth: f64,
-    /// Stabilization parameter α.
-    pub alpha: f64,
 }
 
-impl Problem {
-    /// Solves the stabilized VI on a uniform mesh of `cells` cells by nested semismooth
-    /// Newton.
+impl StringOnFoundation {
+    /// Solves the stabilized VI on a uniform mesh of `cells` cells (α = 0.1).
     ///
     /// # Errors
-    /// A mesh that cannot be built, `α C_I ≥ 1` (unstable), or a solver failure.
-    pub fn solve(&self, cells: usize) -> Result<Solved> {
+    /// A mesh that cannot be built, and the solve's errors.
+    pub fn solve(&self, cells: usize) -> Result<Solved<Model, IntervalMesh>> {
         let mesh = IntervalMesh::uniform(-self.half_length, self.half_length, cells)?;
         let (q, d) = (self.load, self.depth);
         let load = move |_: &[f64]| -q;
         let obstacle = move |_: &[f64]| -d;
-        let params = [
-            ("α", self.alpha),
-            ("s", 1.0),
-            ("T", self.tension),
-            ("k", self.stiffness),
-        ];
-        let coefficients =
-            Coefficients::new::<winkler_string::Model>(&params, &[("f", &load), ("ψ", &obstacle)])?;
-        let c_i = stabilization::inverse_constant::<winkler_string::Model, _>(
-            &mesh,
-            &coefficients.params,
-        )?;
-        if self.alpha * c_i >= 1.0 {
-            return Err(fem_runtime::Error::Input(format!(
-                "α = {} is outside the stability range 0 < α < 1/C_I = {}",
-                self.alpha,
-                1.0 / c_i
-            )));
-        }
-        let solution = solve_obstacle::<winkler_string::Model>(
-            &mesh,
-            &coefficients,
-            &["u"],
-            ObstacleOptions::default(),
-        )?;
-        let energy = solution.energy::<winkler_string::Model>(&coefficients)?;
-        Ok(Solved {
-            solution,
-            energy,
-            inverse_constant: c_i,
-        })
+        Problem::<Model, IntervalMesh>::new(vec![mesh])
+            .param(params::T, self.tension)
+            .param(params::k, self.stiffness)
+            .alpha(Alpha::Fixed(0.1), ALPHA_WHEN_CI_VANISHES)
+            .data(data::f, &load)
+            .data(data::ψ, &obstacle)
+            .support(DirichletPart::All, fields::u, Condition::Zero)
+            .solve()
     }
 }

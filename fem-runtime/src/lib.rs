@@ -15,11 +15,10 @@
 //! (`tests/module_cycles.rs` checks it).
 //!
 //! To solve a model of your own from Rust, start from `examples/winkler_string.rs` in
-//! the repository (a model file and a short program: mesh, parameters and data,
-//! [`stabilization::inverse_constant`], [`obstacle::solve_obstacle`], then
-//! [`obstacle::ObstacleSolution::energy`], `contact_set`,
-//! [`obstacle::ObstacleSolution::contact_cells`] and `total_contact_force`), and the
-//! README's section "Solving your own model from Rust".
+//! the repository (a model file and a short program: a [`problem::Problem`] of the
+//! meshes, the parameters and data by typed handle, the supports, one
+//! [`problem::Problem::solve`] and its [`problem::Report`]), and the README's section
+//! "Solving your own model from Rust".
 //!
 //! Reference elements and quadrature rules come from `fem-reference`, the same crate the
 //! form compiler evaluates at compile time, and are re-exported here.
