@@ -178,17 +178,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     settings: &Settings,
 ) -> Result<Outcome> {
     let clock = Instant::now();
-    let posed = pose(scene, settings)?;
-    // the family's checks first: they name the parameter as its users know it
-    Q::check(scene, &posed)?;
-    for (name, value) in &posed.parameters {
-        if !value.is_finite() {
-            return Err(Error::Input(format!(
-                "scene `{}`: parameter `{name}` = {value} is not finite",
-                scene.name
-            )));
-        }
-    }
+    let posed = pose_checked::<G, Q>(scene, settings)?;
     let n = settings.mesh_size.unwrap_or(scene.mesh_size);
     let memory = Q::memory::<M>(pair, scene, n);
     let size_text = size_text(scene, pair, n);
@@ -235,38 +225,12 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
                 .unwrap_or(Q::ROUNDING_EXPERIMENT),
         })
         .memory(memory, size_text.clone());
-    for &(p, value) in &bound.params {
-        problem = problem.param(ParamId::<M>::new(p), value);
-    }
-    let nodal = M::SYSTEM.is_none();
-    for (d, f) in &bound.data {
-        // the nodal method takes its obstacle at the nodes
-        if nodal && Some(*d) == psi_index {
-            problem = problem.nodal(&**f);
-        }
-        problem = problem.data(DataId::<M>::new(*d), &**f);
-    }
-    for (part, field, condition) in supports.conditions {
-        problem = problem.support(part, FieldId::<M>::new(field), condition);
-    }
-    for part in supports.data {
-        problem = problem.boundary_data(part);
-    }
-    for (name, part) in &scene.facets {
-        let markers = match finest.part(part)? {
-            DirichletPart::Markers(m) => m,
-            DirichletPart::All => Vec::new(),
-        };
-        problem = problem.part(&**name, markers);
-    }
+    problem = posed_on(problem, &bound, &supports, scene, &finest)?;
     if let Some(start) = &start {
         problem = problem.start(&**start);
     }
     if let Some(fns) = &exact_fns {
         problem = problem.exact(fns.exact());
-    }
-    if !scene.obstacle {
-        problem = problem.unconstrained();
     }
     let cells = finest.cell_count();
     let solved = problem.solve().map_err(|e| {
@@ -280,30 +244,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     })?;
     let solve_seconds = clock.elapsed().as_secs_f64() - meshes_seconds - checks_seconds;
 
-    let mut report = Report {
-        scene: scene.name.to_string(),
-        family: scene.family,
-        pair: pair.name,
-        domain: domain.describe(),
-        mesh_size: n,
-        load: posed.load,
-        parameters: posed
-            .parameters
-            .iter()
-            .map(|(k, v)| (k.to_string(), *v))
-            .collect(),
-        supports: scene
-            .supports
-            .iter()
-            .map(|s| format!("{} on {}", s.support.name(), s.part.names().join(", ")))
-            .collect(),
-        solve: solved.report.clone(),
-        exact_contact_force: exact.as_ref().and_then(|e| e.total_contact_force),
-        exact_contact_area: exact.as_ref().and_then(|e| e.contact_area),
-        accuracy: scene.accuracy,
-        phases: Phases::default(),
-        quantities: BTreeMap::new(),
-    };
+    let mut report = report_of(scene, pair, &domain, n, &posed, exact.as_ref(), &solved);
     report.solve.warnings.extend(supports.warnings);
     let fields = G::fields::<M>(&solved.solution, psi);
     let run = Run {
@@ -334,6 +275,110 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         fields,
         profile,
     })
+}
+
+/// The values a request solves the scene at ([`pose`]), checked by the family
+/// ([`Quantities::check`]: it names a parameter as its users know it) and for finite
+/// parameters.
+///
+/// # Errors
+/// Those of [`pose`] and the family's check; a parameter that is not finite.
+fn pose_checked<G: Geometry, Q: Quantities<G>>(
+    scene: &Scene,
+    settings: &Settings,
+) -> Result<Posed> {
+    let posed = pose(scene, settings)?;
+    Q::check(scene, &posed)?;
+    for (name, value) in &posed.parameters {
+        if !value.is_finite() {
+            return Err(Error::Input(format!(
+                "scene `{}`: parameter `{name}` = {value} is not finite",
+                scene.name
+            )));
+        }
+    }
+    Ok(posed)
+}
+
+/// `problem` with the scene as bound to the model: its parameters and data, the
+/// supports as conditions, the boundary data's parts, the facet parts on `finest`, and
+/// the unconstrained problem where the scene has no obstacle.
+///
+/// # Errors
+/// A facet part the mesh does not have.
+fn posed_on<'a, M: Model, G: Geometry>(
+    mut problem: Problem<'a, M, G>,
+    bound: &'a Bound,
+    supports: &Supports,
+    scene: &Scene,
+    finest: &G,
+) -> Result<Problem<'a, M, G>> {
+    for &(p, value) in &bound.params {
+        problem = problem.param(ParamId::<M>::new(p), value);
+    }
+    let psi_index = M::OBSTACLE.map(|[_, d]| d);
+    let nodal = M::SYSTEM.is_none();
+    for (d, f) in &bound.data {
+        // the nodal method takes its obstacle at the nodes
+        if nodal && Some(*d) == psi_index {
+            problem = problem.nodal(&**f);
+        }
+        problem = problem.data(DataId::<M>::new(*d), &**f);
+    }
+    for (part, field, condition) in &supports.conditions {
+        problem = problem.support(part.clone(), FieldId::<M>::new(*field), *condition);
+    }
+    for part in &supports.data {
+        problem = problem.boundary_data(part.clone());
+    }
+    for (name, part) in &scene.facets {
+        let markers = match finest.part(part)? {
+            DirichletPart::Markers(m) => m,
+            DirichletPart::All => Vec::new(),
+        };
+        problem = problem.part(&**name, markers);
+    }
+    if !scene.obstacle {
+        problem = problem.unconstrained();
+    }
+    Ok(problem)
+}
+
+/// The report of a solved scene before the family's quantities: what was posed, the
+/// runtime's report and the exact integrals where known.
+fn report_of<M: Model, G: Geometry>(
+    scene: &Scene,
+    pair: &Pair,
+    domain: &crate::scene::Domain,
+    n: usize,
+    posed: &Posed,
+    exact: Option<&ExactSolution>,
+    solved: &Solved<M, G>,
+) -> Report {
+    Report {
+        scene: scene.name.to_string(),
+        family: scene.family,
+        pair: pair.name,
+        domain: domain.describe(),
+        mesh_size: n,
+        load: posed.load,
+        parameters: posed
+            .parameters
+            .iter()
+            .map(|(k, v)| (k.to_string(), *v))
+            .collect(),
+        supports: scene
+            .supports
+            .iter()
+            .map(|s| format!("{} on {}", s.support.name(), s.part.names().join(", ")))
+            .collect(),
+        solve: solved.report.clone(),
+        exact_contact_force: exact.and_then(|e| e.total_contact_force),
+        exact_contact_area: exact.and_then(|e| e.contact_area),
+        accuracy: scene.accuracy,
+        phases: Phases::default(),
+        quantities: BTreeMap::new(),
+    }
 }
 
 fn zero(_: &[f64]) -> f64 {

@@ -537,12 +537,7 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
             .map_or(key.to_string(), |(_, name)| name.to_string())
     };
     let number = |field: &str, value: &toml::Value| {
-        value
-            .as_float()
-            .or_else(|| value.as_integer().map(|i| i as f64))
-            .filter(|v| v.is_finite())
-            .map(|v| v + 0.0)
-            .ok_or_else(|| at(field, format!("{value} is not a finite number")))
+        finite(value).ok_or_else(|| at(field, format!("{value} is not a finite number")))
     };
     let mut alpha = None;
     for (key, value) in &file.parameters {
@@ -554,28 +549,7 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
             scene.set_parameter(model_name(key), v);
         }
     }
-    let mut load = None;
-    for (key, value) in &file.data {
-        let field = format!("data.{key}");
-        if key == "load" {
-            let q = number(&field, value)?;
-            if q != 0.0 && q.abs() < MIN_DATA_SIZE {
-                return Err(at(
-                    &field,
-                    format!("{q:e} is below {MIN_DATA_SIZE:e} in size: the solve multiplies it by powers of h and would underflow; give 0 or rescale the units"),
-                ));
-            }
-            load = Some(q);
-            continue;
-        }
-        let text = match value {
-            toml::Value::String(s) => s.clone(),
-            toml::Value::Float(v) => v.to_string(),
-            toml::Value::Integer(v) => v.to_string(),
-            other => return Err(at(&field, format!("{other} is not an expression"))),
-        };
-        scene.set_data(model_name(key), expression(&text, &field, path)?);
-    }
+    let load = read_data(&mut scene, &file.data, &model_name, path)?;
     let scaled = model_name("f");
     if scene.data_fn(&scaled).is_some() {
         scene.load = Some(Load {
@@ -614,6 +588,56 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
         pair: file.pair,
         alpha,
     })
+}
+
+/// A finite number of a scene file's field, `-0` read as 0.
+fn finite(value: &toml::Value) -> Option<f64> {
+    value
+        .as_float()
+        .or_else(|| value.as_integer().map(|i| i as f64))
+        .filter(|v| v.is_finite())
+        .map(|v| v + 0.0)
+}
+
+/// `[data]`: each expression set on `scene` by the model's name (`model_name` of its
+/// key); returns `data.load`, the scale of the load.
+///
+/// # Errors
+/// A load that is not finite or would underflow, a value that is not an expression, and
+/// an expression that does not parse.
+fn read_data(
+    scene: &mut Scene,
+    data: &toml::Table,
+    model_name: &dyn Fn(&str) -> String,
+    path: &Path,
+) -> Result<Option<f64>> {
+    let at = |field: &str, message: String| {
+        Error::Input(format!("{}: field `{field}`: {message}", path.display()))
+    };
+    let mut load = None;
+    for (key, value) in data {
+        let field = format!("data.{key}");
+        if key == "load" {
+            let q = finite(value)
+                .ok_or_else(|| at(&field, format!("{value} is not a finite number")))?;
+            if q != 0.0 && q.abs() < MIN_DATA_SIZE {
+                return Err(at(
+                    &field,
+                    format!("{q:e} is below {MIN_DATA_SIZE:e} in size: the solve multiplies it by powers of h and would underflow; give 0 or rescale the units"),
+                ));
+            }
+            load = Some(q);
+            continue;
+        }
+        let text = match value {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Float(v) => v.to_string(),
+            toml::Value::Integer(v) => v.to_string(),
+            other => return Err(at(&field, format!("{other} is not an expression"))),
+        };
+        scene.set_data(model_name(key), expression(&text, &field, path)?);
+    }
+    Ok(load)
 }
 
 /// The domain and `N` of `[mesh]`; errors as `(field, message)`.
@@ -666,87 +690,98 @@ fn domain_of(
                     ),
                 );
             }
-            let no_half_width = |what: &str| match mesh.half_width {
-                Some(_) => Err((
-                    "mesh.half_width".to_string(),
-                    format!("{what}; it takes no half_width"),
-                )),
-                None => Ok(()),
-            };
-            let domain = match generator.as_str() {
-                "interval" => {
-                    no_half_width("the interval is (start, end)")?;
-                    Domain::Interval {
-                        start: mesh.start.unwrap_or(0.0),
-                        end: mesh.end.unwrap_or(1.0),
-                    }
-                }
-                "square" => {
-                    if mesh.x.is_some() || mesh.y.is_some() {
-                        return err(
-                            "mesh.x",
-                            "a square is (−a, a)² with a = half_width; `rectangle` takes x and y".into(),
-                        );
-                    }
-                    let a = mesh.half_width.unwrap_or(1.0);
-                    let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
-                    if !(MIN_HALF_WIDTH..=largest).contains(&a) {
-                        return err(
-                            "mesh.half_width",
-                            format!("{} must be within {MIN_HALF_WIDTH:e} to {largest:e}: below, the stabilization's α h⁴ underflows; rescale the units", fem_runtime::problem::number(a)),
-                        );
-                    }
-                    Domain::square(-a, 2.0 * a)
-                }
-                "rectangle" => {
-                    no_half_width("a rectangle is x × y")?;
-                    let x = mesh.x.unwrap_or([0.0, 1.0]);
-                    let y = mesh.y.unwrap_or(x);
-                    let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
-                    let fine = |s: [f64; 2]| {
-                        s[0] < s[1] && s.iter().all(|c| c.is_finite() && c.abs() <= largest)
-                    };
-                    if !(fine(x) && fine(y)) {
-                        return err(
-                            "mesh.x",
-                            format!("the sides {x:?} × {y:?} need finite ends, the first below the second, within ±{largest:e}"),
-                        );
-                    }
-                    Domain::Rectangle {
-                        x,
-                        y,
-                        cells: mesh.cells.unwrap_or([1, 1]),
-                        diagonal: fem_runtime::Diagonal::Right,
-                    }
-                }
-                "l-shape" => {
-                    no_half_width("the L-shape is (−1,1)² ∖ [0,1]×[−1,0]")?;
-                    if size % 2 != 0 {
-                        return err(
-                            "mesh.size",
-                            format!("the L-shape needs an even size, got {size}"),
-                        );
-                    }
-                    Domain::LShape
-                }
-                "disk" => {
-                    no_half_width("a disk has a radius")?;
-                    Domain::Disk {
-                        centre: mesh.centre.unwrap_or([0.0, 0.0]),
-                        radius: mesh.radius.unwrap_or(1.0),
-                        curved: mesh.curved.unwrap_or(false),
-                    }
-                }
-                other => {
-                    return err(
-                        "mesh.generator",
-                        format!("unknown generator `{other}`; the generators are interval, rectangle, square, l-shape, disk"),
-                    )
-                }
-            };
-            Ok((domain, size))
+            Ok((generated(generator, mesh, size)?, size))
         }
     }
+}
+
+/// The domain of a `[mesh]` generator at size `size` (checked by the caller); errors as
+/// `(field, message)`.
+fn generated(
+    generator: &str,
+    mesh: &MeshToml,
+    size: usize,
+) -> std::result::Result<Domain, (String, String)> {
+    let err = |f: &str, m: String| Err((f.to_string(), m));
+    let no_half_width = |what: &str| match mesh.half_width {
+        Some(_) => Err((
+            "mesh.half_width".to_string(),
+            format!("{what}; it takes no half_width"),
+        )),
+        None => Ok(()),
+    };
+    let domain = match generator {
+        "interval" => {
+            no_half_width("the interval is (start, end)")?;
+            Domain::Interval {
+                start: mesh.start.unwrap_or(0.0),
+                end: mesh.end.unwrap_or(1.0),
+            }
+        }
+        "square" => {
+            if mesh.x.is_some() || mesh.y.is_some() {
+                return err(
+                    "mesh.x",
+                    "a square is (−a, a)² with a = half_width; `rectangle` takes x and y".into(),
+                );
+            }
+            let a = mesh.half_width.unwrap_or(1.0);
+            let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
+            if !(MIN_HALF_WIDTH..=largest).contains(&a) {
+                return err(
+                    "mesh.half_width",
+                    format!("{} must be within {MIN_HALF_WIDTH:e} to {largest:e}: below, the stabilization's α h⁴ underflows; rescale the units", fem_runtime::problem::number(a)),
+                );
+            }
+            Domain::square(-a, 2.0 * a)
+        }
+        "rectangle" => {
+            no_half_width("a rectangle is x × y")?;
+            let x = mesh.x.unwrap_or([0.0, 1.0]);
+            let y = mesh.y.unwrap_or(x);
+            let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
+            let fine = |s: [f64; 2]| {
+                s[0] < s[1] && s.iter().all(|c| c.is_finite() && c.abs() <= largest)
+            };
+            if !(fine(x) && fine(y)) {
+                return err(
+                    "mesh.x",
+                    format!("the sides {x:?} × {y:?} need finite ends, the first below the second, within ±{largest:e}"),
+                );
+            }
+            Domain::Rectangle {
+                x,
+                y,
+                cells: mesh.cells.unwrap_or([1, 1]),
+                diagonal: fem_runtime::Diagonal::Right,
+            }
+        }
+        "l-shape" => {
+            no_half_width("the L-shape is (−1,1)² ∖ [0,1]×[−1,0]")?;
+            if size % 2 != 0 {
+                return err(
+                    "mesh.size",
+                    format!("the L-shape needs an even size, got {size}"),
+                );
+            }
+            Domain::LShape
+        }
+        "disk" => {
+            no_half_width("a disk has a radius")?;
+            Domain::Disk {
+                centre: mesh.centre.unwrap_or([0.0, 0.0]),
+                radius: mesh.radius.unwrap_or(1.0),
+                curved: mesh.curved.unwrap_or(false),
+            }
+        }
+        other => {
+            return err(
+                "mesh.generator",
+                format!("unknown generator `{other}`; the generators are interval, rectangle, square, l-shape, disk"),
+            )
+        }
+    };
+    Ok(domain)
 }
 
 /// The generator's name in the scene file.

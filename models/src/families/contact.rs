@@ -182,17 +182,67 @@ fn contact_scene(old: &ContactScene) -> Scene {
         },
         body: Some(old.body),
     };
+    let Layout {
+        domain,
+        contact,
+        loaded,
+        axis,
+        pressure,
+        gap,
+        symbol,
+    } = layout(old, facts);
+    let mut scene = Scene::new(old.name, old.description, "contact", domain, old.mesh_size);
+    for (name, value) in material_parameters(&facts).expect("valid built-in material") {
+        scene.set_parameter(name, value);
+    }
+    scene.set_data("g", gap);
+    scene.set_data("q", Data::shared(move |_| pressure));
+    scene.load = Some(Load {
+        default: old.load,
+        scales: vec!["q".into()],
+        symbol,
+        nonnegative: true,
+    });
+    scene.facets = vec![
+        (CONTACT_PART.into(), Part::named(contact)),
+        (LOAD_PART.into(), Part::named(loaded)),
+    ];
+    scene.supports.push(PartSupport {
+        part: Part::named(axis),
+        support: Support::Roller { normal: [1.0, 0.0] },
+        key: None,
+    });
+    scene.accuracy = old.accuracy();
+    scene.pairs = match old.body {
+        ContactBody::GapBlock { .. } => vec!["p1-p0", "p2-p0"],
+        _ => PAIRS.iter().map(|p| p.name).collect(),
+    };
+    scene.studies = match old.body {
+        ContactBody::Cylinder { .. } => vec!["convergence", "alpha"],
+        _ => Vec::new(),
+    };
+    scene.in_default_job = true;
+    scene.reference = Some(Arc::new(facts));
+    scene
+}
+
+/// How a built-in body is posed: its mesh, the names of its contact, loaded and held
+/// parts, the pressure per unit load, the gap and the load's symbol.
+struct Layout {
+    domain: Domain,
+    contact: &'static str,
+    loaded: &'static str,
+    axis: &'static str,
+    pressure: f64,
+    gap: Data,
+    symbol: &'static str,
+}
+
+/// The [`Layout`] of a built-in contact body.
+fn layout(old: &ContactScene, facts: ContactFacts) -> Layout {
     let default_load = old.load;
     let hertz_at = move |load: Option<f64>| facts.hertz(load.unwrap_or(default_load));
-    let (domain, contact, loaded, axis, pressure, gap, symbol): (
-        Domain,
-        &str,
-        &str,
-        &str,
-        f64,
-        Data,
-        &str,
-    ) = match old.body {
+    let (domain, contact, loaded, axis, pressure, gap, symbol) = match old.body {
         ContactBody::Block { width, height } => (
             Domain::Rectangle {
                 x: [0.0, width],
@@ -259,39 +309,15 @@ fn contact_scene(old: &ContactScene) -> Scene {
             "P",
         ),
     };
-    let mut scene = Scene::new(old.name, old.description, "contact", domain, old.mesh_size);
-    for (name, value) in material_parameters(&facts).expect("valid built-in material") {
-        scene.set_parameter(name, value);
-    }
-    scene.set_data("g", gap);
-    scene.set_data("q", Data::shared(move |_| pressure));
-    scene.load = Some(Load {
-        default: old.load,
-        scales: vec!["q".into()],
+    Layout {
+        domain,
+        contact,
+        loaded,
+        axis,
+        pressure,
+        gap,
         symbol,
-        nonnegative: true,
-    });
-    scene.facets = vec![
-        (CONTACT_PART.into(), Part::named(contact)),
-        (LOAD_PART.into(), Part::named(loaded)),
-    ];
-    scene.supports.push(PartSupport {
-        part: Part::named(axis),
-        support: Support::Roller { normal: [1.0, 0.0] },
-        key: None,
-    });
-    scene.accuracy = old.accuracy();
-    scene.pairs = match old.body {
-        ContactBody::GapBlock { .. } => vec!["p1-p0", "p2-p0"],
-        _ => PAIRS.iter().map(|p| p.name).collect(),
-    };
-    scene.studies = match old.body {
-        ContactBody::Cylinder { .. } => vec!["convergence", "alpha"],
-        _ => Vec::new(),
-    };
-    scene.in_default_job = true;
-    scene.reference = Some(Arc::new(facts));
-    scene
+    }
 }
 
 impl Family for Contact {
