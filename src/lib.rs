@@ -17,6 +17,7 @@ pub mod membrane_studies;
 pub mod membranes;
 pub mod plates;
 pub mod plot;
+pub mod registry_studies;
 pub mod signorini;
 pub mod studies;
 

@@ -1023,6 +1023,9 @@ fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> 
 /// `study <scene> [kind]` through the registry, or `study <kind>` on every scene that
 /// hosts it.
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
+    if let (None, Some(scene)) = (find(name), fem_forms::models::families::scene(name)) {
+        return registry_study(scene, kind, full, out);
+    }
     let Some(entry) = find(name) else {
         if let Some(kind) = kind {
             let swapped = if find(kind).is_some() && Study::parse(name).is_some() {
@@ -1080,6 +1083,34 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
     };
     for k in kinds {
         run_study(&entry, k, full, out)?;
+    }
+    Ok(())
+}
+
+/// A study of a registry scene of a family without studies of its own, through the one
+/// implementation over the one solve ([`fem_forms::registry_studies`]).
+fn registry_study(
+    scene: fem_forms::models::scene::Scene,
+    kind: Option<&str>,
+    full: bool,
+    out: &Path,
+) -> Result<(), String> {
+    let name = scene.name.to_string();
+    let hosted = scene.studies.clone();
+    let kinds: Vec<&str> = match kind {
+        Some(k) if hosted.contains(&k) => vec![k],
+        Some(k) => {
+            return Err(format!(
+                "scene `{name}` hosts no study `{k}`; its studies are {}",
+                hosted.join(", ")
+            ))
+        }
+        None => hosted.clone(),
+    };
+    let studies = fem_forms::registry_studies::RegistryStudies::new(scene);
+    for k in kinds {
+        let study = Study::parse(k).ok_or_else(|| format!("unknown study `{k}`"))?;
+        studies::run(&studies, study, full, out).map_err(|e| format!("study {name} {k}: {e}"))?;
     }
     Ok(())
 }

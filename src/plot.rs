@@ -94,7 +94,8 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
         return (0.0, 1.0);
     }
     if log {
-        (lo / 1.5, hi * 1.5)
+        // within the normal doubles: a log axis up to infinity has no end to its ticks
+        ((lo / 1.5).max(1e-300), (hi * 1.5).min(1e300))
     } else if hi - lo < 1e-300 {
         (lo - 1.0, hi + 1.0)
     } else {

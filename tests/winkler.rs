@@ -138,3 +138,48 @@ fn a_scene_file_s_exact_derivatives_are_checked() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The family hosts the study kinds that need only solves through the one study
+/// implementation (`fem_forms::registry_studies`), with no study code of its own: the α
+/// sweep shows the method consistent (∫λ_h the same to 1e-4 over the stable range
+/// 0 < α·C_I < 1, the plain method α = 0 included), and the iterations study solves
+/// every mesh nested and cold.
+#[test]
+fn the_family_hosts_the_generic_studies() {
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("winkler-studies-{}", std::process::id()));
+    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["study", "winkler-square", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("winkler-square-alpha.csv")).unwrap();
+    let forces: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[1], v[7])
+        })
+        .filter(|&(ac, _)| ac < 1.0)
+        .collect();
+    assert!(forces.len() > 10, "{csv}");
+    let reference = forces[0].1;
+    for (ac, force) in &forces {
+        assert!(
+            (force - reference).abs() < 1e-4 * reference,
+            "α·C_I = {ac}: ∫λ_h = {force} against {reference}"
+        );
+    }
+    let iterations = std::fs::read_to_string(out.join("winkler-square-iterations.csv")).unwrap();
+    for line in iterations.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        assert!(v[1] >= 1.0 && v[2] >= 1.0, "{line}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}

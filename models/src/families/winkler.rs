@@ -73,6 +73,8 @@ impl Family for Winkler {
         .with_data("ψ", crate::data::Data::shared(|_| -0.002))
         .with_support(Part::All, Support::SimplySupported { hard: false });
         vec![Scene {
+            // the kinds that need no exact solution, through the one study implementation
+            studies: vec!["alpha", "iterations"],
             load: Some(Load {
                 default: 1.0,
                 scales: vec!["f".into()],

@@ -1,0 +1,221 @@
+//! The studies of any registry scene ([`crate::models::families`]): one implementation of
+//! [`StudyScene`] over the one solve, so that a family added as a model file and a
+//! registry entry hosts the study kinds that need nothing but solves (convergence, α
+//! range, work–precision, iterations) without code of its own. The stability measure
+//! and the multiplier profiles are a family's own (the beams' LCP condition, the
+//! membranes' inf-sup constants) and are refused here with that reason.
+
+use crate::models::families;
+use crate::models::geometry::Fields;
+use crate::models::report::{Outcome, Settings};
+use crate::models::scene::{Domain, Scene};
+use crate::studies::{ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study, StudyScene};
+use fem_runtime::{Error, Result};
+
+/// A registry scene as the studies see it.
+pub struct RegistryStudies {
+    scene: Scene,
+}
+
+impl RegistryStudies {
+    /// The studies of `scene`.
+    pub fn new(scene: Scene) -> Self {
+        Self { scene }
+    }
+
+    fn outcome(&self, run: &Run) -> Result<Outcome> {
+        let settings = Settings {
+            pair: Some(run.pair.to_string()),
+            mesh_size: Some(run.size),
+            alpha: run.alpha,
+            solver: run.solver,
+            nested: run.nested,
+            ..Settings::default()
+        };
+        families::solve(&self.scene, &settings)
+    }
+
+    /// The default size and its halvings: `[N/4, N/2, N]` (quick) or up to `4N` (full),
+    /// even on the L-shape, at least 1.
+    fn ladder(&self, full: bool) -> Vec<usize> {
+        let n = self.scene.mesh_size.max(4);
+        let even = matches!(self.scene.domain, Domain::LShape);
+        let mut sizes: Vec<usize> = [n / 4, n / 2, n]
+            .into_iter()
+            .chain(if full { vec![2 * n, 4 * n] } else { vec![] })
+            .filter(|&k| k >= 1 && (!even || k % 2 == 0))
+            .collect();
+        sizes.dedup();
+        sizes
+    }
+
+    fn unsupported(&self, what: &str) -> Error {
+        Error::Input(format!(
+            "scene `{}` (family {}) has no {what}: it is a family's own study",
+            self.scene.name, self.scene.family
+        ))
+    }
+}
+
+/// The largest cell diameter of a solve's mesh.
+fn largest_h(fields: &Fields) -> f64 {
+    match fields {
+        Fields::Interval { x, .. } => x.windows(2).map(|w| w[1] - w[0]).fold(0.0f64, f64::max),
+        Fields::Triangles { mesh, .. } => mesh.max_h(),
+    }
+}
+
+impl StudyScene for RegistryStudies {
+    fn name(&self) -> String {
+        self.scene.name.to_string()
+    }
+
+    fn setting(&self) -> String {
+        match &self.scene.load {
+            Some(l) => format!(
+                "{} {} = {}",
+                self.scene.name,
+                l.symbol,
+                fem_runtime::problem::number(l.default)
+            ),
+            None => self.scene.name.to_string(),
+        }
+    }
+
+    fn size_name(&self) -> &'static str {
+        match self.scene.domain {
+            Domain::Interval { .. } => "elements",
+            _ => "N",
+        }
+    }
+
+    fn h(&self, size: usize) -> f64 {
+        self.scene
+            .domain
+            .size()
+            .map_or(f64::NAN, |d| d / size as f64)
+    }
+
+    fn contact_names(&self) -> [&'static str; 2] {
+        ["contact area", "|area error|"]
+    }
+
+    fn pairs(&self) -> Vec<&'static str> {
+        families::pairs_of(&self.scene)
+            .iter()
+            .map(|p| p.name)
+            .collect()
+    }
+
+    fn plan(&self, study: Study, pair: &'static str, full: bool) -> Plan {
+        let default = self.pairs()[0];
+        let n = self.scene.mesh_size.max(1);
+        match study {
+            Study::Alpha => {
+                // α·C_I from 1e-3 to 2.5 where C_I is known, else α itself; and 0
+                let c_i = self.inverse_constant(default, n).unwrap_or(0.0);
+                let scale = if c_i > 0.0 { 1.0 / c_i } else { 1.0 };
+                Plan {
+                    pair: default,
+                    sizes: vec![n],
+                    cold_max: 0,
+                    alphas: (0..=17)
+                        .map(|k| Some(scale * 10f64.powf(-3.0 + 0.2 * k as f64)))
+                        .chain([Some(0.0)])
+                        .collect(),
+                }
+            }
+            Study::WorkPrecision | Study::Iterations => Plan {
+                pair: default,
+                sizes: self.ladder(full),
+                cold_max: usize::MAX,
+                alphas: vec![],
+            },
+            _ => Plan {
+                pair,
+                sizes: self.ladder(full),
+                cold_max: 0,
+                alphas: vec![],
+            },
+        }
+    }
+
+    fn profiles(&self, _full: bool) -> Plan {
+        Plan {
+            pair: self.pairs()[0],
+            sizes: vec![self.scene.mesh_size],
+            cold_max: 0,
+            alphas: vec![None],
+        }
+    }
+
+    fn solve(&self, run: &Run) -> Result<Row> {
+        let outcome = self.outcome(run)?;
+        let r = &outcome.report;
+        let s = &r.solve;
+        let contact = s.contact_area.or(s.contact_length).unwrap_or(f64::NAN);
+        Ok(Row {
+            pair: run.pair,
+            size: run.size,
+            h: largest_h(&outcome.fields),
+            cells: s.cells,
+            dofs: s.dofs,
+            alpha: s.alpha.unwrap_or(0.0),
+            error_l2: s.error_l2,
+            error_h1: s.error_h1,
+            error_multiplier: s.error_multiplier,
+            total_contact_force: s.total_contact_force,
+            force_error: r
+                .exact_contact_force
+                .map(|e| (s.total_contact_force - e).abs()),
+            contact,
+            contact_error: r.exact_contact_area.map(|e| (contact - e).abs()),
+            iterations: s.iterations,
+            seconds: s.seconds,
+            kkt_residual: s.kkt_residual,
+            warnings: s.warnings.clone(),
+        })
+    }
+
+    fn inverse_constant(&self, pair: &'static str, size: usize) -> Result<f64> {
+        Ok(self
+            .outcome(&Run::new(pair, size))?
+            .report
+            .solve
+            .inverse_constant)
+    }
+
+    fn exact_contact(&self) -> Option<f64> {
+        let posed = crate::models::run::pose(&self.scene, &Settings::default()).ok()?;
+        self.scene.exact_at(&posed)?.contact_area
+    }
+
+    fn stability_pairs(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
+
+    fn measure(&self) -> Measure {
+        Measure {
+            title: "no stability measure",
+            labels: &[],
+            axis: "",
+            plotted: |v| v,
+        }
+    }
+
+    fn stability(&self, _pair: &'static str, _size: usize) -> Result<StabilityRow> {
+        Err(self.unsupported("stability measure"))
+    }
+
+    fn multiplier_profile(&self, _run: &Run) -> Result<Vec<(f64, f64)>> {
+        Err(self.unsupported("multiplier profile"))
+    }
+
+    fn exact_multiplier(&self) -> Option<ExactMultiplier> {
+        None
+    }
+
+    fn profile_window(&self) -> [f64; 2] {
+        [0.0, 1.0]
+    }
+}
