@@ -2,16 +2,12 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use clap::{Parser, Subcommand, ValueEnum};
-use fem_forms::kirchhoff::{self, KirchhoffPair, KirchhoffRequest};
+use fem_forms::kirchhoff;
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
-use fem_forms::models::contact_scenes::{ContactBody, ContactScene};
 use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
-use fem_forms::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene};
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind};
-use fem_forms::obstacle::hierarchy::LinearSolver;
-use fem_forms::obstacle::VariationalSolver;
-use fem_forms::plates::{self, PlatePair, PlateRequest};
+use fem_forms::plates;
 use fem_forms::plot;
 use fem_forms::signorini as contact;
 use fem_forms::studies::{self, Study};
@@ -157,9 +153,6 @@ struct SolveOptions {
     /// Hertz's (hertz, signorini-gap).
     #[arg(long)]
     plot: bool,
-    /// A membrane scene file's `accuracy` (not an option: the file states it).
-    #[arg(skip)]
-    accuracy: Option<f64>,
 }
 
 impl SolveOptions {
@@ -200,20 +193,6 @@ impl SolveOptions {
         {
             Some(option) => Err(format!("{option} does not apply: {why}")),
             None => Ok(()),
-        }
-    }
-
-    fn linear_solver(&self) -> Result<LinearSolver, String> {
-        self.linear_solver
-            .as_deref()
-            .map_or(Ok(LinearSolver::Auto), LinearSolver::parse)
-            .map_err(|e| format!("--linear-solver: {e}"))
-    }
-
-    fn solver(&self) -> VariationalSolver {
-        match self.solver.unwrap_or(SolverName::Pdas) {
-            SolverName::Pdas => VariationalSolver::SemismoothNewton,
-            SolverName::Clarabel => VariationalSolver::Clarabel,
         }
     }
 }
@@ -628,31 +607,6 @@ fn alpha_rule(pair: &fem_forms::models::family::Pair) -> String {
     }
 }
 
-/// The one family-dispatch point of `solve`: options checked against the scene's family,
-/// then the family's solver.
-fn solve(entry: &SceneEntry, options: &SolveOptions, out: &Path) -> Result<(), String> {
-    if !matches!(entry.kind, SceneKind::Kirchhoff(_)) {
-        options.refuse(
-            &["--support", "--obstacle"],
-            &format!("`{}` is not a Kirchhoff plate scene", entry.name()),
-        )?;
-    }
-    if options.cold && options.solver() == VariationalSolver::Clarabel {
-        // every family hands clarabel the finest level alone: there is no nested start
-        // to turn off, and an accepted flag that changes nothing misleads
-        return Err(
-            "--cold does not apply with --solver clarabel: the QP solver solves the finest mesh alone, with no nested start to turn off".into(),
-        );
-    }
-    match &entry.kind {
-        SceneKind::Kirchhoff(scene) => solve_kirchhoff(*scene, options),
-        SceneKind::Contact(scene) => solve_contact(*scene, options, out),
-        SceneKind::Beam(_) => Err("beam scenes are solved through the registry".into()),
-        SceneKind::Membrane(scene) => solve_membrane(scene, options, out),
-        SceneKind::Plate(scene) => solve_plate(*scene, options),
-    }
-}
-
 /// A Kirchhoff study: `convergence` or `lambda-scatter` (fem_forms::kirchhoff).
 fn run_kirchhoff_study(
     scene: KirchhoffScene,
@@ -666,74 +620,6 @@ fn run_kirchhoff_study(
         _ => return Err(format!("unknown Kirchhoff study `{kind}`")),
     }
     .map_err(|e| e.to_string())
-}
-
-fn solve_contact(scene: ContactScene, options: &SolveOptions, out: &Path) -> Result<(), String> {
-    let mesh = match scene.body {
-        ContactBody::Block { .. } => "an N×N×2 mesh of the block (2N×N×2 on its 2:1 shape)",
-        ContactBody::Cylinder { .. } => "a mesh graded to b/h = N cells per contact half-width",
-        ContactBody::GapBlock { .. } => {
-            "a half block graded to b/h = N cells per contact half-width"
-        }
-    };
-    options.refuse(
-        &[
-            "--elements",
-            "--msh",
-            "--vtk",
-            "--thickness",
-            "--refinement",
-            "--no-obstacle",
-            "--linear-solver",
-            "--solver",
-            "--cold",
-        ],
-        &format!(
-            "`{}` is a contact scene on {mesh} (--mesh-size, --load, --alpha, --pair, --plot, --json)",
-            scene.name
-        ),
-    )?;
-    if options.plot
-        && !matches!(
-            scene.body,
-            ContactBody::Cylinder { .. } | ContactBody::GapBlock { .. }
-        )
-    {
-        return Err(format!(
-            "--plot does not apply: `{}` has no reference pressure profile to chart (its pressure is q on every edge: see --json's patch_pressure_error)",
-            scene.name
-        ));
-    }
-    let mut request = contact::ContactRequest::new(scene);
-    if let Some(name) = &options.pair {
-        request.pair = contact::ContactPair::parse(name).map_err(|e| e.to_string())?;
-    }
-    request.mesh_size = options.mesh_size.unwrap_or(request.mesh_size);
-    request.load = options.load.unwrap_or(request.load);
-    if let Some(alpha) = options.alpha {
-        request.alpha = Some(alpha);
-    }
-    let (report, profile) = contact::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
-    if options.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
-    } else {
-        println!("{}", contact::summary(&report));
-    }
-    if options.plot {
-        let hertz = scene.hertz(request.load).expect("checked: a cylinder");
-        let path = contact::pressure_chart(
-            out,
-            &report,
-            &[(format!("λ_h ({})", report.pair), &profile)],
-            &hertz,
-        )
-        .map_err(|e| e.to_string())?;
-        eprintln!("→ {}", path.display());
-    }
-    Ok(())
 }
 
 /// `solve --scene FILE` for a file with `model = "contact"` (fem_forms::contact_scene_file):
@@ -783,239 +669,6 @@ fn solve_contact_file(path: &Path, options: &SolveOptions) -> Result<(), String>
         if let Some(e) = solved.report.pressure_l2_error {
             println!("pressure L² error against exact.pressure: {e:.3e}");
         }
-    }
-    Ok(())
-}
-
-fn solve_kirchhoff(scene: KirchhoffScene, options: &SolveOptions) -> Result<(), String> {
-    options.refuse(
-        &[
-            "--elements",
-            "--msh",
-            "--vtk",
-            "--thickness",
-            "--refinement",
-            "--plot",
-            "--no-obstacle",
-            "--linear-solver",
-        ],
-        &format!(
-            "`{}` is a Kirchhoff plate scene on an N×N×2 mesh (--mesh-size, --load, --alpha, --pair, --support, --obstacle, --solver, --cold, --json)",
-            scene.name
-        ),
-    )?;
-    let mut request = KirchhoffRequest::new(scene);
-    if let Some(name) = &options.pair {
-        request.pair = KirchhoffPair::parse(name).map_err(|e| e.to_string())?;
-    }
-    if let Some(name) = &options.support {
-        request.support = kirchhoff::parse_support(name).map_err(|e| e.to_string())?;
-    }
-    if let Some(name) = &options.obstacle {
-        request.obstacle = kirchhoff::parse_obstacle(name).map_err(|e| e.to_string())?;
-    }
-    request.mesh_size = options.mesh_size.unwrap_or(request.mesh_size);
-    request.load = options.load.unwrap_or(request.load);
-    request.alpha = options.alpha.or(request.alpha);
-    request.solver = options.solver();
-    request.nested = !options.cold;
-    let report = kirchhoff::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
-    if options.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
-    } else {
-        println!("{}", kirchhoff::summary(&report));
-    }
-    // on stderr, as every other family's: a table piped to a file stays a table
-    for warning in &report.warnings {
-        eprintln!("warning: {warning}");
-    }
-    Ok(())
-}
-
-fn solve_plate(scene: PlateScene, options: &SolveOptions) -> Result<(), String> {
-    let mesh = match scene.domain {
-        PlateDomain::Square { .. } => "an N×N×2 mesh",
-        PlateDomain::Disk { .. } => "a disk mesh of N rings",
-    };
-    options.refuse(
-        &[
-            "--elements",
-            "--msh",
-            "--vtk",
-            "--solver",
-            "--linear-solver",
-            "--refinement",
-            "--plot",
-        ],
-        &format!(
-            "`{}` is a plate scene on {mesh} ({})",
-            scene.name,
-            if scene.obstacle == PlateObstacle::None {
-                "--mesh-size, --thickness, --load, --pair, --json"
-            } else {
-                "--mesh-size, --thickness, --load, --alpha, --pair, --cold, --no-obstacle, --json"
-            }
-        ),
-    )?;
-    if scene.obstacle == PlateObstacle::None || options.no_obstacle {
-        // Without an obstacle the plate is one linear solve on the finest mesh (plates::solve
-        // does not nest then): α and the nested start only act on contact, so accepting
-        // them would suggest an effect.
-        options.refuse(
-            &["--alpha", "--cold"],
-            &format!(
-                "`{}` is solved without an obstacle (one linear solve); α and the nested start concern contact",
-                scene.name
-            ),
-        )?;
-    }
-    if scene.obstacle == PlateObstacle::None {
-        options.refuse(
-            &["--no-obstacle"],
-            &format!("`{}` has no obstacle", scene.name),
-        )?;
-    }
-    let mut request = PlateRequest::new(scene);
-    if let Some(name) = &options.pair {
-        request.pair = PlatePair::parse(name).map_err(|e| e.to_string())?;
-    }
-    request.thickness = options.thickness.unwrap_or(request.thickness);
-    request.mesh_size = options.mesh_size.unwrap_or(request.mesh_size);
-    request.load = options.load.unwrap_or(request.load);
-    request.alpha = options.alpha.unwrap_or(request.alpha);
-    request.obstacle = !options.no_obstacle;
-    request.nested &= !options.cold;
-    let report = plates::solve(&request).map_err(|e| format!("{}: {e}", scene.name))?;
-    if options.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
-    } else if report.contact_radius.is_some() {
-        println!(
-            "{} {} {} t = {} N = {}: q = {}, obstacle {}: J_h {:.9e}, ∫λ_h {:.7e}, contact area {:.6}, contact radius {:.6}, centre deflection {:.8e}, {} dofs, {} iterations, {:.3} s",
-            report.scene,
-            report.pair,
-            report.support,
-            fem_forms::number(report.thickness),
-            report.mesh_size,
-            fem_forms::number(report.load),
-            report.obstacle,
-            report.energy,
-            report.total_contact_force,
-            report.contact_area,
-            report.contact_radius.unwrap_or_default(),
-            report.centre_deflection,
-            report.dofs,
-            report.iterations,
-            report.seconds
-        );
-    } else {
-        println!(
-            "{} {} {} t = {} N = {}: centre deflection {:.8e}, {} {:.8e}, {} {:+.3e}, J_h {:.6e}, {} dofs, {} iterations, {:.3} s",
-            report.scene,
-            report.pair,
-            report.support,
-            fem_forms::number(report.thickness),
-            report.mesh_size,
-            report.centre_deflection,
-            if report.unobstructed_reference.is_some() { "exact" } else { "Kirchhoff (t → 0)" },
-            report.unobstructed_reference.unwrap_or(report.kirchhoff_reference),
-            // against Kirchhoff the O(t²) difference of the two models is in it (13.6 %
-            // at t = 0.1 on the simply supported square, which a tester took for error)
-            if report.unobstructed_reference.is_some() {
-                "relative error"
-            } else {
-                "relative difference (the O(t²) Mindlin–Kirchhoff difference included)"
-            },
-            report.relative_error,
-            report.energy,
-            report.dofs,
-            report.iterations,
-            report.seconds
-        );
-    }
-    for warning in &report.warnings {
-        eprintln!("warning: {warning}");
-    }
-    Ok(())
-}
-
-fn solve_membrane(scene: &MembraneScene, options: &SolveOptions, out: &Path) -> Result<(), String> {
-    options.refuse(
-        &[
-            "--elements",
-            "--thickness",
-            "--refinement",
-            "--plot",
-            "--no-obstacle",
-        ],
-        &format!(
-            "`{}` is a membrane scene on a triangle mesh (--mesh-size, --msh; --vtk writes its fields)",
-            scene.name
-        ),
-    )?;
-    let mut request = MembraneRequest::new(scene.clone());
-    if let Some(p) = &options.pair {
-        request.pair = MembranePair::parse(p).map_err(|e| e.to_string())?;
-    }
-    if request.pair == MembranePair::P1Nodal {
-        options.refuse(
-            &["--alpha", "--solver"],
-            "p1-nodal has no multiplier to stabilize and solves its nodal constraints by its own active-set method",
-        )?;
-    }
-    if options.alpha == Some(0.0) {
-        // the plain method goes to clarabel on the finest mesh whatever was asked: a
-        // flag that cannot act is refused, as with --solver clarabel
-        options.refuse(
-            &["--cold"],
-            "α = 0 (the plain mixed method) is solved by clarabel on the finest mesh alone, with no nested start to turn off",
-        )?;
-        if options.solver == Some(SolverName::Pdas) {
-            return Err("--solver pdas does not apply with α = 0: the plain mixed method has C = 0, which leaves semismooth Newton nothing to eliminate the multiplier with; it is solved by clarabel".into());
-        }
-    }
-    scene.load_magnitude(options.load)?;
-    request.load = options.load;
-    if let Some(n) = options.mesh_size {
-        request.mesh_size = n;
-    } else if options.msh.is_some() {
-        request.mesh_size = 0;
-    }
-    request.mesh_file.clone_from(&options.msh);
-    request.alpha = options.alpha;
-    request.solver = options.solver();
-    request.nested = !options.cold;
-    request.linear_solver = options.linear_solver()?;
-    request.accuracy = options.accuracy;
-    let (report, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
-    if options.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
-    } else {
-        membrane_header();
-        membrane_row(&report);
-        if report.dirichlet_parts != ["all"] {
-            println!(
-                "u = g on the boundary parts {}; ∂u/∂n = 0 on the rest of the boundary",
-                report.dirichlet_parts.join(", ")
-            );
-        }
-    }
-    if options.vtk {
-        let path = out.join(format!(
-            "{}-{}-{}.vtu",
-            scene.name, report.pair, request.mesh_size
-        ));
-        std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
-        membranes::write_vtk(&path, &fields).map_err(|e| e.to_string())?;
-        eprintln!("→ {}", path.display());
     }
     Ok(())
 }
@@ -1146,33 +799,32 @@ fn run(cli: Cli) -> Result<(), String> {
             name,
             scene_file,
             options,
-        }) => {
-            let entry = match (name, scene_file) {
-                (_, Some(path))
-                    if std::fs::read_to_string(&path)
-                        .is_ok_and(|t| fem_forms::contact_scene_file::names_contact(&t)) =>
-                {
-                    return solve_contact_file(&path, &options);
-                }
-                (_, Some(path)) => {
-                    let file =
-                        fem_forms::models::scene_file::read(&path).map_err(|e| e.to_string())?;
-                    return solve_file(file, &path, *options, &cli.out);
-                }
-                (Some(scene), None) if fem_forms::models::families::scene(&scene).is_some() => {
-                    let scene = fem_forms::models::families::scene(&scene).expect("found");
-                    return solve::solve_scene(scene, &options, &cli.out);
-                }
-                (Some(scene), None) => find(&scene).ok_or_else(|| {
+        }) => match (name, scene_file) {
+            (_, Some(path))
+                if std::fs::read_to_string(&path)
+                    .is_ok_and(|t| fem_forms::contact_scene_file::names_contact(&t)) =>
+            {
+                solve_contact_file(&path, &options)
+            }
+            (_, Some(path)) => {
+                let file = fem_forms::models::scene_file::read(&path).map_err(|e| e.to_string())?;
+                solve_file(file, &path, *options, &cli.out)
+            }
+            (Some(name), None) => {
+                let scene = fem_forms::models::families::scene(&name).ok_or_else(|| {
+                    let names: Vec<String> = fem_forms::models::families::scenes()
+                        .iter()
+                        .map(|s| s.name.to_string())
+                        .collect();
                     format!(
-                        "unknown scene `{scene}`; the scenes are {}",
-                        names().join(", ")
+                        "unknown scene `{name}`; the scenes are {}",
+                        names.join(", ")
                     )
-                })?,
-                (None, None) => return Err("give a scene name or --scene FILE".into()),
-            };
-            solve(&entry, &options, &cli.out)
-        }
+                })?;
+                solve::solve_scene(scene, &options, &cli.out)
+            }
+            (None, None) => Err("give a scene name or --scene FILE".into()),
+        },
         Some(Command::Study {
             study: name,
             kind,
