@@ -376,7 +376,7 @@ const MIN_THICKNESS: f64 = 1e-6;
 fn validate(request: &Request, alpha: f64, thickness: f64) -> Result<()> {
     let scene = &request.scene;
     // measured peaks: 1.36 GB at 262144 Timoshenko elements, 5.5 GB at 1M, 21.3 GB at 4M
-    // (a tester's 4M run took the machine's memory); refused before, with the figure
+    // (a 4M run took the machine's memory); refused before, with the figure
     let bytes = BYTES_PER_ELEMENT * request.elements as f64;
     let limit = crate::membranes::memory_limit_bytes();
     if bytes > limit {

@@ -414,7 +414,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         }
     }
     // Γ_C must face the foundation: the body's outward normal ν along n_c on the whole
-    // (a tester's contact on the top face with n_c = (0, −1), a foundation inside the
+    // (a contact on the top face with n_c = (0, −1), a foundation inside the
     // block, was solved and reported as valid)
     let edges = oriented_edges(&mesh, &contact);
     let (facing, total) = edges.iter().fold((0.0, 0.0), |(f, t), ends| {
@@ -426,7 +426,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
         )
     });
     // and edge by edge: a face of Γ_C turned away from the foundation is inside the
-    // body's shadow, and its constraint acts through the body (a tester's trapezoid with
+    // body's shadow, and its constraint acts through the body (a trapezoid with
     // its top and bottom as Γ_C passed the mean and tripled the peak pressure)
     let cosine = |ends: &&[[f64; 2]; 2]| {
         let nu = [ends[1][1] - ends[0][1], -(ends[1][0] - ends[0][0])];
@@ -434,7 +434,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
     };
     let turned_away = edges.iter().find(|ends| cosine(ends) < -1e-6);
     // some edge faces the foundation: n_c is right for it, and the edges turned away are
-    // at fault (a tester's top and bottom as Γ_C have mean ν·n_c = 0, and were told to
+    // at fault (top and bottom as Γ_C have mean ν·n_c = 0, and were told to
     // flip n_c, whichever way it pointed)
     let some_facing = edges.iter().any(|ends| cosine(&ends) > 1e-6);
     if let Some(ends) = turned_away.filter(|_| some_facing) {
@@ -475,7 +475,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ContactSceneFile> {
             ));
         }
         // measured along the plane: the half-width is taken from c, which must lie
-        // on Γ_C's extent (a tester's 5.0 beside a 1-wide block reported a half-width 5)
+        // on Γ_C's extent (5.0 beside a 1-wide block reported a half-width 5)
         let along = crate::models::signorini::contact_tangent(contact_direction);
         let (lo, hi) = edges
             .iter()
@@ -624,7 +624,7 @@ fn check_load(load: f64) -> std::result::Result<(), String> {
 /// The mesh of `[mesh]`.
 /// An error when the mesh falls into separate pieces: a contact scene poses one body
 /// on the foundation, whose rigid motions the supports, the contact and the load's
-/// direction are checked to hold; a second piece escapes those checks (a tester's
+/// direction are checked to hold; a second piece escapes those checks (a
 /// floating second block ended in "the matrix is not positive definite").
 fn one_body(mesh: &TriangleMesh) -> std::result::Result<(), String> {
     let (piece, count) = mesh.cell_pieces();
@@ -856,7 +856,7 @@ struct DataScales {
 /// swamp the elastic displacement ([`MAX_GAP_ROUNDING`]). The error names its key.
 fn data_scales(scales: &DataScales, load: f64) -> std::result::Result<(), (&'static str, String)> {
     let pressure = load * scales.pressure;
-    // the smallest pressure the range of E allows (a tester's pressure = "1e-320" stopped
+    // the smallest pressure the range of E allows (pressure = "1e-320" stopped
     // Newton at a KKT residual of 5e-3)
     if pressure > 0.0 && pressure < 1.0 / MAX_DATA {
         return Err((
@@ -903,7 +903,7 @@ fn presses(
     let (force, magnitude) = resultant_and_magnitude(mesh, markers, pressure);
     let along = force[0] * direction[0] + force[1] * direction[1];
     // a resultant within the rounding of its own quadrature is zero, whichever its sign
-    // (a tester's x − 0.5 on the top face came out +7e-18 and was accepted, sin(2πx)
+    // (x − 0.5 on the top face came out +7e-18 and was accepted, sin(2πx)
     // −4e-17 and was refused)
     if along.abs() <= RESULTANT_ROUNDING * magnitude {
         Err(format!(
@@ -961,7 +961,7 @@ const RESULTANT_ROUNDING: f64 = 1e-12;
 /// The pair called `name`, for a contact scene file: p1-p0 or p2-p0.
 ///
 /// # Errors
-/// A message listing those two for any other name (a tester was offered p1-p1 and
+/// A message listing those two for any other name (it once offered p1-p1 and
 /// p2-p1 for a file, which the file then refused).
 pub fn pair_of_file(name: &str) -> std::result::Result<ContactPair, String> {
     let pair = ContactPair::parse(name).map_err(|_| {
@@ -1044,7 +1044,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
     for _ in 0..refinements {
         mesh = mesh.refine_uniformly();
     }
-    // as for membranes: near-flat cells refused, thin ones named (a tester's block with
+    // as for membranes: near-flat cells refused, thin ones named (a block with
     // 0.45° cells far from the contact set got α = ½/max C_I,E 1.5e-6 from them and a
     // pressure error 3.6× the best fit's, without a word)
     let quality = mesh.quality();
@@ -1130,7 +1130,7 @@ pub fn solve(file: &ContactSceneFile, overrides: &Overrides) -> Result<ContactFi
         // then need not equal it (not measured: null)
         // relative to the pressure's size, ∫|q| ds, not to its resultant alone: a
         // resultant of 1e-9 ∫|q| leaves the contact force rounding of ∫|q|, which is
-        // no failure of the solve (a tester's x − 0.5 + 1e-9 warned "1.8e-5")
+        // no failure of the solve (x − 0.5 + 1e-9 warned "1.8e-5")
         equilibrium_residual: if held {
             f64::NAN
         } else {

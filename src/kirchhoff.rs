@@ -75,7 +75,7 @@ pub enum KirchhoffPair {
 impl KirchhoffPair {
     /// How the report reads λ_h in the contact interior: [`DEFAULT_RECOVERY`] (the patch
     /// average) for the Argyris pairs; the raw λ_h for Morley, whose patch average a
-    /// tester measured worse than the raw value (max relative error 1.16 against 0.44 at
+    /// measured worse than the raw value (max relative error 1.16 against 0.44 at
     /// N = 32, q = 20): its scatter is not the Argyris line-force tail.
     pub fn recovery(self) -> MultiplierRecovery {
         match self {

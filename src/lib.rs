@@ -31,8 +31,8 @@ pub use fem_runtime::problem::number;
 
 /// Warnings for the boundary parts `names` (chosen under the scene-file key `key`) whose
 /// Gmsh groups hold interior edges (embedded curves): a boundary part holds boundary
-/// edges only, so a condition the user put on an interior wire is not imposed there. A
-/// tester's `sides` (left, right and the line y = 0) solved as left and right alone.
+/// edges only, so a condition the user put on an interior wire is not imposed there (a
+/// group `sides` of left, right and the line y = 0 acts as left and right alone).
 pub fn interior_curve_warnings<S: AsRef<str>>(
     key: &str,
     mesh: &TriangleMesh,

@@ -782,7 +782,7 @@ fn run(cli: Cli) -> Result<(), String> {
             cli.out.display()
         )
     })?;
-    // and writable: a tester's read-only --out failed after a whole study, naming no file
+    // and writable: a read-only --out failed after a whole study, naming no file
     let probe = cli
         .out
         .join(format!(".fem-forms-write-check-{}", std::process::id()));
@@ -843,8 +843,8 @@ fn parse_alpha(text: &str) -> Result<f64, String> {
 }
 
 /// `--load`: a number, refused when subnormal (non-zero below 2.2e-308, the smallest
-/// normal double). Its products with the forms' coefficients lose their digits: a
-/// tester's 1e-315 made Newton stop at a KKT residual of 8e-3 on a problem whose answer
+/// normal double). Its products with the forms' coefficients lose their digits:
+/// 1e-315 made Newton stop at a KKT residual of 8e-3 on a problem whose answer
 /// is the load times a fixed field.
 fn parse_load(text: &str) -> Result<f64, String> {
     let q = text

@@ -508,7 +508,7 @@ pub fn alpha_of(request: &MembraneRequest, mesh: &TriangleMesh) -> Result<(f64, 
 }
 
 /// An error for an exact solution no obstacle problem can have on `mesh`: a multiplier
-/// below 0 at a vertex, or a contact area beyond the domain's (a tester's `[exact]
+/// below 0 at a vertex, or a contact area beyond the domain's (a `[exact]
 /// lambda = "-2"` and `contact_area = 100` on a domain of area 4 were accepted and
 /// compared with).
 fn validate_exact(exact: &ExactMembrane, mesh: &TriangleMesh, scene: &str) -> Result<()> {
@@ -831,7 +831,7 @@ pub fn dirichlet_part(
     // `"all"` is the keyword for the whole boundary: a mesh with a boundary part of that
     // name would make `"all"` and `["all"]` mean different sets under one printed name
     if mesh.boundary_part_names().contains(&"all") {
-        // not `at`: the field may not be written at all (a tester's file had no
+        // not `at`: the field may not be written at all (a file had no
         // `[boundary]`, and was told its `boundary.dirichlet` was at fault)
         return Err(Error::Input(format!(
             "scene `{}`: the mesh ({domain}) has a boundary part named `all`, which is the keyword of `boundary.dirichlet` (and its default) for the whole boundary: rename the Gmsh physical group (e.g. Physical Curve(\"outer\")) so that the choice is unambiguous",

@@ -613,7 +613,7 @@ fn triangles_of(request: &PlateRequest) -> f64 {
 /// The warning of the plain pair where it locks: its shear term `t⁻²(∇w − θ)` with
 /// w ∈ P1 forces `∇w_h = θ_h` cell by cell as the cells grow against the thickness,
 /// and w_h collapses (the locking study: the deflection falls like `(t/h)²`;
-/// a tester's mindlin-disk at N = 32 got ∫λ_h = 6.5 against 18.7, without a word).
+/// a mindlin-disk at N = 32 got ∫λ_h = 6.5 against 18.7, without a word).
 /// `h` is the largest cell diameter.
 fn locking_warning(pair: PlatePair, h: f64, thickness: f64) -> Option<String> {
     // from a tenth of t on: at h ≈ t the deflection is already 12–15 % low (the re-test)
@@ -627,7 +627,7 @@ fn locking_warning(pair: PlatePair, h: f64, thickness: f64) -> Option<String> {
 }
 
 /// The warning of a nested solve whose coarsest level is still fine: the levels halve N
-/// while it is even, so an N with few factors of 2 gets no coarse start (a tester's
+/// while it is even, so an N with few factors of 2 gets no coarse start (a
 /// mindlin-disk at N = 63: one level of 14 Newton iterations in 1.56 s, against 3
 /// iterations and 0.62 s at N = 64; `--cold` then changed nothing, unsaid). `sizes` are
 /// the levels, coarsest first; `coarsest` the smallest N a level may have.

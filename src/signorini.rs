@@ -21,11 +21,11 @@ pub const MAX_CONTACT_MESH_SIZE: usize = 512;
 
 /// The contact half-widths `b/R` the curved scenes accept (`--load`): Hertz's theory
 /// wants b ≪ R (at b/R = 0.34 the peak was 2 % low, at 3.4 the error 91 %), and below
-/// about 1e-7 the gap `x²/2R` is lost against the rounding of coordinates of size R (a
-/// tester's P = 1e-11 had 10× the best fit's error).
+/// about 1e-7 the gap `x²/2R` is lost against the rounding of coordinates of size R
+/// (P = 1e-11 had 10× the best fit's error).
 pub const HERTZ_HALF_WIDTH_RANGE: (f64, f64) = (1e-6, 0.1);
 
-/// The largest `--mesh-size` of the P2 pairs (a tester's p2-p0 at 512 ran out of 8 GB in
+/// The largest `--mesh-size` of the P2 pairs (a p2-p0 at 512 ran out of 8 GB in
 /// the assembly).
 pub const MAX_P2_CONTACT_MESH_SIZE: usize = 256;
 
@@ -474,7 +474,7 @@ pub fn summary(r: &ContactReport) -> String {
         r.total_contact_force,
         r.applied_load,
         // NaN where supports along the contact direction carry part of the load (JSON
-        // null): a tester read "equilibrium residual NaN" as a failure
+        // null): "equilibrium residual NaN" reads as a failure
         if r.equilibrium_residual.is_nan() {
             "no equilibrium check: supports along the contact direction carry part of the load".to_string()
         } else {

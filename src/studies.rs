@@ -269,7 +269,7 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> std::io
             writeln!(file, "{}", cells.join(","))?;
         }
     }
-    // a CSV path that is a directory (a tester's) left the .partial file behind
+    // a CSV path that is a directory left the .partial file behind
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         std::io::Error::new(e.kind(), format!("{}: {e}", path.display()))
@@ -436,7 +436,7 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
                 r.iterations,
                 r.seconds
             );
-            // the solve's own warnings under its row: a tester read rates of −6.8 at
+            // the solve's own warnings under its row: rates of −6.8 at
             // 16384 Hermite elements with no note, where the single solve warned
             for warning in &r.warnings {
                 println!("    warning ({} {}): {warning}", r.pair, r.size);
@@ -1142,8 +1142,8 @@ pub fn run(scene: &dyn StudyScene, study: Study, full: bool, out: &Path) -> Resu
 
 #[cfg(test)]
 mod tests {
-    /// A zero or infinite error has no rate: NaN (printed `-`), not `inf` or `-inf` (a
-    /// tester's contact area equal on two meshes); the others are log₂ of the ratio.
+    /// A zero or infinite error has no rate: NaN (printed `-`), not `inf` or `-inf` (
+    /// contact area equal on two meshes); the others are log₂ of the ratio.
     #[test]
     fn rates_of_zero_differences_are_not_a_number() {
         let r = super::rates(&[4.0, 1.0, 0.0, 2.0, f64::INFINITY, 1.0]);
@@ -1166,7 +1166,7 @@ mod tests {
         std::fs::remove_file(&path).unwrap();
     }
 
-    /// Counts come out as integers (a tester found `8e0` for a mesh size), measurements
+    /// Counts come out as integers (`8e0` appeared for a mesh size), measurements
     /// with every digit, missing values as `NaN`, and each reads back exactly.
     #[test]
     fn csv_cells_are_integers_or_full_precision() {

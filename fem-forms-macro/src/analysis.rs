@@ -527,7 +527,7 @@ fn source(d: &Definition, forms_text: &str) -> String {
 }
 
 /// Longest run of juxtaposed names (in bytes) that is split into declared names; a
-/// longer one is an unknown symbol (a tester's run of 30,000 letters overflowed the
+/// longer one is an unknown symbol (a run of 30,000 letters overflowed the
 /// stack of the split's search).
 const MAX_RUN_BYTES: usize = 1024;
 
@@ -545,7 +545,7 @@ impl<'a> Context<'a> {
         self.in_expression = false;
         let value = value?;
         // a function of its arguments only: where it is called they are substituted, and
-        // a function not among them would have no image (a tester's `γ(θ) := ∇w − θ`
+        // a function not among them would have no image (a `γ(θ) := ∇w − θ`
         // panicked the macro)
         let allowed: Vec<usize> = groups.iter().flatten().copied().collect();
         let stray = value.clone().entries().into_iter().flatten().find_map(|t| {
@@ -836,7 +836,7 @@ impl<'a> Context<'a> {
     /// A bilinear form over the same fields on both sides (`B_h(u,λ;v,μ)`) pairs its
     /// i-th unknown with its i-th test function; the declarations pair each unknown with
     /// the test function at its place in `tests:`. When the two disagree, `tests:` is
-    /// most likely out of order (a tester's `tests: μ, v` assembled `a(u;v)` into the
+    /// most likely out of order (a `tests: μ, v` assembled `a(u;v)` into the
     /// multiplier's rows, refused only at run time as "not positive definite"), and the
     /// form is refused here. Forms over different fields (`b(v;μ)`) pair nothing.
     fn check_pairing(&mut self, d: &Definition, arguments: &[Vec<Vec<usize>>]) -> Option<()> {
@@ -1139,7 +1139,7 @@ impl<'a> Context<'a> {
 
     /// `Et³`, `αh_T²`, `fv'`: a power or primes after a run of juxtaposed names belong to
     /// its last name, as mathematics reads them (`E·t³`, `f·v'`); applied to the whole
-    /// run they gave `(Et)³` without a word (a tester's `Et³` kernel was 4× too large).
+    /// run they gave `(Et)³` without a word (a `Et³` kernel was 4× too large).
     /// The run rewritten as the product of its names with `apply` on the last, or `None`
     /// when `a` is not such a run.
     fn last_of_run(
@@ -1196,7 +1196,7 @@ impl<'a> Context<'a> {
 
     /// A second way to split `name` into declared names, other than `first`: with
     /// `params: s, t, st`, `stu` is `st·u` or `s·t·u`, and taking the longest names first
-    /// chose one without a word (a tester's kernel was 33.3 instead of 2).
+    /// chose one without a word (a kernel was 33.3 instead of 2).
     fn other_split(&self, name: &str, first: &[String]) -> Option<Vec<String>> {
         // shortest first: a reading that differs from the longest-first one, if any
         self.reading(name, false, first)
@@ -1217,7 +1217,7 @@ impl<'a> Context<'a> {
             names.sort_by_key(|n| n.len());
         }
         // `dead[i]`: the rest from byte i has no split. Remembered, so that the search
-        // is linear in the run (it was exponential: a tester's 29 a's against the names
+        // is linear in the run (it was exponential: 29 a's against the names
         // a, aa, aaa took 12 s to say "unknown symbol").
         fn go(
             name: &str,
@@ -1395,7 +1395,7 @@ impl<'a> Context<'a> {
             ExprKind::Call { name, groups } => {
                 let called = self.call(name, groups, loc)?;
                 // a form is a sum of integrals: inside another integral it would be
-                // integrated twice, or over another measure (a tester's `∫ g(μ)` with
+                // integrated twice, or over another measure (a `∫ g(μ)` with
                 // `g = ∫_Γ_C … ds` became a cell integral without a word)
                 if inside_integral
                     && called
@@ -1683,7 +1683,7 @@ impl<'a> Context<'a> {
                 if let Some(e) = self.last_of_run(a, true, |last| ExprKind::Derivative(last, *k)) {
                     return self.expand(&e, inside_integral);
                 }
-                // a prime on a parameter alone is 0: with `params: k, ku` a tester's
+                // a prime on a parameter alone is 0: with `params: k, ku` a
                 // `∫ ku'v'` (meant k·u'v') was a form without a kernel, without a word
                 if let ExprKind::Symbol(name) = &a.kind {
                     if self.symbols.params.iter().any(|p| p == name) {

@@ -676,7 +676,7 @@ impl Declaration {
                 continue;
             }
             // `int_…` is the ASCII boundary integral `∫_…`: such a name could never be
-            // used in the forms (a tester's parameter `int_k`)
+            // used in the forms (a parameter `int_k`)
             if text.starts_with("int_") {
                 errors.push(
                     Diagnostic::token(name.span(), format!("`{text}` starts with `int_`"))
@@ -691,7 +691,7 @@ impl Declaration {
                 .then(|| component_names(&text, n))
                 .and_then(|c| c.into_iter().find(|c| RESERVED.contains(&c.as_str())));
             if let Some(component) = reserved_component {
-                // `d` would have the components d_x, d_y: the ASCII ∂_x, ∂_y (a tester's
+                // `d` would have the components d_x, d_y: the ASCII ∂_x, ∂_y (a
                 // vector field `d` had its components read as derivatives)
                 errors.push(
                     Diagnostic::token(name.span(), format!("the vector field `{text}` would have the reserved component `{component}`"))

@@ -301,7 +301,7 @@ mod tests {
         assert!(lookalike("ν", ["u", "v"]).unwrap().contains("Greek"));
         assert!(lookalike("wа", ["w", "wa"]).unwrap().contains("`wa`"));
         assert_eq!(lookalike("x", ["T", "v"]), None);
-        // a tester's: the micro sign typed for μ, ϑ for θ
+        // as people type them: the micro sign typed for μ, ϑ for θ
         assert!(lookalike("µ", ["u", "μ"])
             .unwrap()
             .contains("the micro sign"));

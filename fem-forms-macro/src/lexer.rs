@@ -241,7 +241,7 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             }
             let raw: String = chars[i..j].iter().collect();
             // a literal with a non-zero digit that reads as 0 or a subnormal underflowed
-            // (a tester's `1e-400` vanished from its form without a word)
+            // (a `1e-400` vanished from its form without a word)
             let nonzero = raw
                 .chars()
                 .take_while(|c| !matches!(c, 'e' | 'E'))
@@ -300,7 +300,7 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
             let tok = match name.as_str() {
                 "int" => Tok::Integral,
                 "ds" => Tok::Ds,
-                // the domain's integral as many write it (a tester's `∫_Ω T ∇u·∇v` was
+                // the domain's integral as many write it (a `∫_Ω T ∇u·∇v` was
                 // read as a boundary integral and cascaded)
                 "int_Omega" | "int_Ω" => Tok::Integral,
                 _ if name.len() > 4 && name.starts_with("int_") => {
@@ -383,7 +383,7 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 '∫' => Some(Tok::Integral),
                 '∇' => Some(Tok::Grad),
                 'Δ' => Some(Tok::Laplacian),
-                // `∂_xu` is ∂_x u, as `Δu` is Δ u: no name starts with ∂ (a tester's
+                // `∂_xu` is ∂_x u, as `Δu` is Δ u: no name starts with ∂ (a
                 // `∂_xu ∂_xv` was told that a partial derivative is written ∂_x); `∂_xy`
                 // stays an error, a mixed derivative to some readers
                 '∂' if chars.get(i + 1) == Some(&'_')

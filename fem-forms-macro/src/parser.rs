@@ -254,7 +254,7 @@ fn grouped(e: Expr, loc: Loc) -> Expr {
 
 /// `1·e` at `e`'s place, for a bracketed run of names followed by a power or primes:
 /// they take the whole run (`(Et)³` is `(E·t)³`), where after a bare run they take its
-/// last name (`Et³` is `E·t³`, see the analysis). A tester found the brackets dropped,
+/// last name (`Et³` is `E·t³`, see the analysis). The brackets were once dropped,
 /// `(Et)³` computed as `E·t³`.
 fn kept_together(e: Expr) -> Expr {
     let loc = e.loc;
@@ -270,11 +270,11 @@ pub const MAX_NESTING: usize = 100;
 
 /// Most terms of one sum: the syntax tree of a sum is a left spine as long as the sum,
 /// and the compiler's own passes over the macro's output (and the tree's drop) recurse
-/// on it. 20,000 terms compiled; a tester's 60,000 overflowed rustc's stack.
+/// on it. 20,000 terms compiled; 60,000 overflowed rustc's stack.
 pub const MAX_TERMS: usize = 10_000;
 
 /// Highest power of `Δ` or `∂` (`Δ³ w` is of order 6): beyond any element's degree (the
-/// quintic Argyris) every such derivative vanishes, and a tester's `Δ^999999` built a
+/// quintic Argyris) every such derivative vanishes, and a `Δ^999999` built a
 /// million nested nodes that overflowed the stack.
 pub const MAX_OPERATOR_POWER: i32 = 8;
 

@@ -238,7 +238,7 @@ pub fn normalize(terms: Expansion) -> Expansion {
     }
     // Cancellation leaves exact zeros only when the sums cancel exactly; terms that
     // cancel up to rounding (relative to their largest summand) are dropped as well. An
-    // absolute threshold (1e-300 until a tester's `∫ 1e-301 u v` vanished without a
+    // absolute threshold (1e-300 until a `∫ 1e-301 u v` vanished without a
     // word) would drop small constants that cancel nothing.
     out.into_iter()
         .filter(|(t, largest)| {
@@ -254,7 +254,7 @@ const CANCELLATION: f64 = 64.0 * f64::EPSILON;
 
 /// `c` of a product or power of non-zero coefficients, NaN where it underflowed (to 0 or
 /// to a subnormal, which has lost digits): the term would vanish or be inexact without
-/// a word (a tester's `(1e-5)^100`), and the definition reports the NaN as it reports an
+/// a word (a `(1e-5)^100`), and the definition reports the NaN as it reports an
 /// overflow.
 fn representable(c: f64) -> f64 {
     if c == 0.0 || c.is_subnormal() {

@@ -751,11 +751,11 @@ pub const MAX_SYMMETRY_CELLS: usize = 1 << 18;
 /// `(i, j)` the transpose of block `(j, i)`, to 1e-9 of their largest entry, with the
 /// parameters and data of `coefficients`. The obstacle and contact solvers need their
 /// system form `B_h` symmetric: they read `B` from its multiplier rows alone and factor
-/// its primal block by Cholesky, so a tester's `− b(v;λ) + b(u;μ)` was solved to a
+/// its primal block by Cholesky, so a `− b(v;λ) + b(u;μ)` was solved to a
 /// string 0.93 through its obstacle with a KKT residual of 1e-16. Compared in numbers,
 /// not symbols, so that equal terms written differently (`∫[degree=1]` beside an exact
 /// rule, `1/(2 + 2t²)` beside `0.5/(1 + t²)`) pass; and on every cell, not the first
-/// alone, since data can make a form symmetric on some cells only (a tester's
+/// alone, since data can make a form symmetric on some cells only (a
 /// convection `β u'v` with β = 0 on half the domain, including cell 0). Boundary
 /// integrals are compared on their own edges by [`require_symmetric_facets`].
 ///

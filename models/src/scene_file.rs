@@ -204,7 +204,7 @@ fn operand_end(chars: &[char], from: usize) -> usize {
             }
         }
         Some('(') => group(i),
-        // a braced variable `{x}` (a tester's `-{x}^2` passed the guard as a plain minus)
+        // a braced variable `{x}` (a `-{x}^2` passed the guard as a plain minus)
         Some('{') => chars[i..]
             .iter()
             .position(|&c| c == '}')

@@ -182,8 +182,8 @@ pub fn exact_solution(scene: &Scene, q: f64, t: f64) -> Option<ExactSolution> {
         {
             Some(flat_obstacle(q, -psi))
         }
-        // the mirror image (w ↦ −w): pushed up by +q against w ≤ d, as bernoulli-b; a
-        // tester found it equal to bernoulli-flat to every digit, with no error reported
+        // the mirror image (w ↦ −w): pushed up by +q against w ≤ d, as bernoulli-b; its
+        // solution is bernoulli-flat's mirrored, and so is its exact solution
         (Beam::EulerBernoulli, Obstacle::Constant(psi), s, sign)
             if s == -1.0 && sign == 1.0 && psi > 0.0 =>
         {

@@ -382,7 +382,7 @@ pub fn solve_signorini_with(
 /// An error when the pressure q is not zero on an edge of both Γ_C and Γ_N. There
 /// `σ(u)n = −q n − λ n_c`, so the residual the stabilization penalizes,
 /// `λ + σ_n(u) = −q n·n_c`, is not zero at the exact solution: the method would not be
-/// consistent (a tester's uniform block, loaded on its top and on its contact side,
+/// consistent (a uniform block, loaded on its top and on its contact side,
 /// gave pressures off by 8 % instead of the exact patch value). q is sampled at 17
 /// evenly spaced points of each shared edge (3 missed a bump between them), and counts
 /// as zero below 1e-12 of its largest value on Γ_N (`cos(πy/2)` is 6e-17 at y = 1).
@@ -500,7 +500,7 @@ fn solve<M: Model>(mesh: &TriangleMesh, input: &SignoriniInput) -> Result<Signor
 /// Frictionless contact resists only along `n_c`: the load must press the body on
 /// (positive work on the translation towards the foundation), and a support must fix
 /// the translation along the tangent (else `A` vanishes on it: singular, and a load
-/// with a tangential part has no equilibrium at all — a tester's block pushed sideways
+/// with a tangential part has no equilibrium at all — a block pushed sideways
 /// "solved" with a 1 % equilibrium error).
 ///
 /// # Errors
@@ -553,7 +553,7 @@ fn rigid_motions_held(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Re
 ///   `s ≤ 0` on Γ_C (then `f·Z < 0` is needed), for `β ≤ 0` if `s ≥ 0` (`f·Z > 0`),
 ///   for every β if `s ≡ 0` (`f·Z = 0`), and for none if `s` changes sign.
 ///
-/// Otherwise there is no equilibrium and Newton's answer misses the load (a tester's
+/// Otherwise there is no equilibrium and Newton's answer misses the load (a
 /// block against a wall "solved" with the contact force 39 % off the load).
 fn rotation_held(
     mesh: &TriangleMesh,

@@ -863,7 +863,7 @@ mod tests {
     #[test]
     fn a_constraint_met_exactly_is_not_judged_against_its_own_rounding() {
         // u − λ = −1 against the wall u ≥ 0 with C = 0 and G = 0: u = 0, λ = 1. A
-        // solver's u of 1e-17 meets the constraint to rounding (a tester saw the plain
+        // solver's u of 1e-17 meets the constraint to rounding (the plain
         // method's exact patch test reported with a residual of 1); u = 1e-3 does not.
         let a = SparseMatrix::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, 1.0)]).unwrap();
         let lcp = Lcp::new(a, vec![vec![(0, 1.0)]], vec![0.0], vec![-1.0], vec![0.0]);
@@ -946,7 +946,7 @@ mod tests {
         // The plain method (C = 0): a chain of springs pushed onto a wall at every
         // other node. The LCP is linear in (F, G): the data scaled by s scale (U, Λ) by
         // s. Unscaled, clarabel's absolute tolerances made a load of 1e-12 wrong by 14×
-        // and one of 1e50 "dual infeasible" (a tester's plain-method patch test).
+        // and one of 1e50 "dual infeasible" (a plain-method patch test).
         let n = 40;
         let mut triplets = Vec::new();
         for i in 0..n {

@@ -1088,7 +1088,7 @@ pub(super) fn updated_solve(
 }
 
 /// A failed factorization of Newton's Hessian `A + BᵀC⁻¹B` (with `C > 0` checked before)
-/// with its usual causes: a tester's α·C_I = 1e6 was told only "not positive definite".
+/// with its usual causes: α·C_I = 1e6 was told only "not positive definite".
 fn hessian_not_positive(error: Error) -> Error {
     match error {
         Error::LinearSolve(m) => Error::LinearSolve(format!(
@@ -1100,7 +1100,7 @@ fn hessian_not_positive(error: Error) -> Error {
 
 /// Why a block of `C` whose smallest diagonal entry is `c` is not positive definite, for
 /// the error of [`Lcp::require_positive_c`]. `C = αS` restricted to the multipliers, so a negative
-/// entry with α > 0 is a sign in the forms (a tester's `B_h = … + α S` was told that
+/// entry with α > 0 is a sign in the forms (a `B_h = … + α S` was told that
 /// "α ≤ 0 gives the plain mixed method" with α = 0.04), and a zero one is α = 0 or an
 /// `αh^k` that underflows on tiny cells.
 fn c_fault(c: f64) -> &'static str {

@@ -1482,7 +1482,7 @@ $EndElements
         assert_eq!(m.boundary_part_markers(&["bottom"]).unwrap(), [10]);
     }
 
-    /// A tester's group of physical tag 0: boundary edges no line lists are marked 0, and
+    /// A group of physical tag 0: boundary edges no line lists are marked 0, and
     /// the group took them in (its membrane was held on a side it did not name). The
     /// group gets a marker of its own.
     #[test]

@@ -322,7 +322,7 @@ pub struct MultigridSteps<'a> {
     /// A step failed (no hierarchy, or CG short of its tolerance): the later ones are
     /// left to the factorization at once. Retrying costs up to 80 CG iterations and a
     /// hierarchy per step where the smoother fails (cells of aspect ratio 80: the nodal
-    /// method's same retries made a tester's solve 10× slower than the direct one).
+    /// method's same retries made a solve 10× slower than the direct one).
     gave_up: bool,
 }
 

@@ -133,7 +133,7 @@ impl Discretization<IntervalMesh> {
         ];
         for &(field, data) in M::DIRICHLET {
             // a clamp of a field without slope DOFs is its value 0 alone, which `u = g`
-            // would replace without a word (a tester's clamped `u` ended at g = 0.05)
+            // would replace without a word (a clamped `u` ended at g = 0.05)
             let name = M::FIELDS[field].name;
             if clamped.contains(&name) && M::FIELDS[field].element.dofs_per_vertex() == 1 {
                 return Err(Error::Input(format!(

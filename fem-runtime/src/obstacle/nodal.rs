@@ -158,7 +158,7 @@ pub fn nodal_active_set_level(
     // Once a step's CG fails (on a new hierarchy too) the level's later steps are
     // factored at once: on a strip of cells with aspect ratio 90 the point smoother
     // fails every step, and retrying made the solve 8× slower than the direct path
-    // (a tester's Gmsh mesh: 1227 CG iterations and 39 factorizations).
+    // (a Gmsh mesh: 1227 CG iterations and 39 factorizations).
     let mut steps_by_multigrid = multigrid;
     for iteration in 1..=max_iterations {
         // `compact`: the exact zeros left out of the pattern (the right-diagonal P1

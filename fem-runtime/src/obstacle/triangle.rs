@@ -69,7 +69,7 @@ pub fn curved_dirichlet_constraints_on<M: Model>(
 
 /// An error when a connected piece of `mesh` holds no vertex of the Dirichlet `part`:
 /// on that piece the natural condition holds on its whole boundary, which does not
-/// determine the solution (a tester's two squares, one held, one free under f = 1 and a
+/// determine the solution (two squares, one held, one free under f = 1 and a
 /// far obstacle: u ≈ 6e15 on the free one, KKT residual 2e-16, no warning), as the
 /// whole mesh without a Dirichlet part does not.
 fn unheld_piece(mesh: &TriangleMesh, part: &DirichletPart) -> Result<()> {
@@ -654,11 +654,11 @@ impl Penetration {
 /// Sample points a penetration check takes over the whole mesh at least: on a mesh of
 /// fewer cells than about this over 6, each cell adds a lattice of points, so that an
 /// obstacle's peak between the vertices and quadrature points of a few large cells is
-/// still seen (a tester's two-triangle square under the radial ψ = √(1 − r²): ψ = −1 at
+/// still seen (a two-triangle square under the radial ψ = √(1 − r²): ψ = −1 at
 /// the corners and the quadrature points, u_h ≈ −0.24, a penetration of 1.24 at the
 /// centre reported as 0). Each is an evaluation of ψ: 16k of them resolve a two-cell
 /// mesh to 1/128 of its size, and a ψ of 300 terms costs about 0.4 s on them (65k took
-/// a tester's 1.6 s against 0.02 s for the solve).
+/// 1.6 s against 0.02 s for the solve).
 pub const PENETRATION_MIN_SAMPLES: usize = 1 << 14;
 
 /// The largest lattice order of [`PENETRATION_MIN_SAMPLES`] (8k points a cell).

@@ -705,7 +705,7 @@ impl TriangleMesh {
     /// The connected pieces of the mesh: for each cell the index of its piece, pieces
     /// numbered in the order of their first cell, and the number of pieces. Cells are
     /// connected through shared edges: two pieces that touch at one vertex are two
-    /// pieces, since a point holds nothing in H¹ (a tester's square hinged at a corner
+    /// pieces, since a point holds nothing in H¹ (a square hinged at a corner
     /// to a clamped one sagged like log h as the mesh was refined).
     pub fn cell_pieces(&self) -> (Vec<usize>, usize) {
         let mut parent: Vec<usize> = (0..self.cells.len()).collect();
