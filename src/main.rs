@@ -425,7 +425,15 @@ fn solve_file(
     }
     // the file's size belongs to its own mesh: with --msh replacing it, --mesh-size
     // (refinements of that file) defaults to 0 as for built-in scenes
+    let interval = matches!(
+        file.scene.domain,
+        fem_forms::models::scene::Domain::Interval { .. }
+    );
     match &options.msh {
+        // a beam's size is its number of elements (`--elements`)
+        None if interval => {
+            options.elements.get_or_insert(file.scene.mesh_size);
+        }
         None => {
             options.mesh_size.get_or_insert(file.scene.mesh_size);
         }

@@ -62,3 +62,79 @@ fn a_kirchhoff_scene_file_meets_navier() {
     assert!((w / navier - 1.0).abs() < 1e-6, "{w} against {navier}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+fn run_file(dir: &std::path::Path, name: &str, text: &str) -> std::process::Output {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["solve", "--scene"])
+        .arg(&path)
+        .args(["--json", "--out"])
+        .arg(dir)
+        .output()
+        .unwrap()
+}
+
+/// What a file may get wrong is refused or named: a beam file solves (its size is its
+/// elements), a family on the other dimension's mesh is refused, two supports on one part
+/// are refused, a non-positive declared parameter is refused before anything is computed
+/// from it, a left-out obstacle is named, a given gradient wrong only near an edge is
+/// caught, and a flat obstacle's crossing is judged against the answer's size.
+#[test]
+fn scene_file_mistakes_are_refused_or_named() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("scene-file-mistakes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let stderr = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).to_string();
+    let beam = "model = \"beam\"\n[mesh]\ngenerator = \"interval\"\nsize = 8\n[boundary]\nclamped = \"all\"\n[parameters]\nthickness = 0.1\n[data]\nf = \"-1\"\npsi = \"-0.05\"\n";
+    let o = run_file(&dir, "beam.toml", beam);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(json["cells"], 8);
+    let o = run_file(
+        &dir,
+        "beam2d.toml",
+        &beam.replace("\"interval\"", "\"rectangle\""),
+    );
+    assert!(
+        !o.status.success() && stderr(&o).contains("posed on an interval"),
+        "{}",
+        stderr(&o)
+    );
+    let plate = "model = \"winkler\"\n[mesh]\ngenerator = \"rectangle\"\nsize = 4\n[boundary]\nclamped = \"left\"\nfree = \"left\"\n[parameters]\nD = 1.0\nnu = 0.3\nfoundation_modulus = 100.0\n[data]\nf = \"-1\"\npsi = \"-1\"\n";
+    let o = run_file(&dir, "overlap.toml", plate);
+    assert!(
+        !o.status.success() && stderr(&o).contains("give each part one support"),
+        "{}",
+        stderr(&o)
+    );
+    let single = plate.replace("free = \"left\"\n", "");
+    let o = run_file(
+        &dir,
+        "negative.toml",
+        &single.replace("D = 1.0", "D = -1.0"),
+    );
+    assert!(
+        !o.status.success() && stderr(&o).contains("`D` = -1 must be positive"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run_file(&dir, "nopsi.toml", &single.replace("psi = \"-1\"\n", ""));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        json["warnings"]
+            .to_string()
+            .contains("gives no obstacle `ψ`"),
+        "{json}"
+    );
+    // wrong only for y < 0.1: the lattice samples that strip
+    let membrane = "model = \"membrane\"\n[mesh]\ngenerator = \"rectangle\"\nx = [10.0, 11.0]\ny = [0.0, 1.0]\nsize = 8\n[data]\nf = \"0\"\npsi = \"-1\"\ng = \"abs(x-10.5)\"\n[exact]\nu = \"abs(x-10.5)\"\ngradient = [\"(x-10.5)/abs(x-10.5)*(1+100*max(0.1-y,0))\", \"0\"]\n";
+    let o = run_file(&dir, "strip.toml", membrane);
+    assert!(
+        !o.status.success() && stderr(&o).contains("exact.gradient"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -183,3 +183,15 @@ fn the_family_hosts_the_generic_studies() {
     }
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// A flat obstacle under a flat answer has ranges of rounding size: a crossing of ψ is
+/// judged against the answer's size, so one cell's real crossing reads as a share of the
+/// deflection (not 1e16 % of a range of 1e-17).
+#[test]
+fn a_crossing_of_a_flat_obstacle_is_judged_against_the_answer_s_size() {
+    let report = solve_json(&["winkler-square", "--mesh-size", "1"]);
+    let warnings = report["warnings"].to_string();
+    assert!(warnings.contains("w_h's sizes"), "{warnings}");
+    let depth = number(&report, "max_penetration");
+    assert!(depth > 1e-4 && depth < 2e-3, "{depth}");
+}

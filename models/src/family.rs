@@ -156,6 +156,11 @@ pub trait Family: Sync {
         &[]
     }
 
+    /// The dimension of its domains: 1 (beams on intervals) or 2 (triangle meshes).
+    fn dimension(&self) -> usize {
+        2
+    }
+
     /// The support a scene file without `[boundary]` keys has on its whole boundary,
     /// with the key its errors name (the membrane's `u = g`); `None`: free.
     fn default_support(&self) -> Option<(Support, &'static str)> {

@@ -246,6 +246,18 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
 
     let mut report = report_of(scene, pair, &domain, n, &posed, exact.as_ref(), &solved);
     report.solve.warnings.extend(supports.warnings);
+    // the obstacle and the load are what a scene poses: left out, they are named
+    for &d in &bound.defaulted {
+        let obstacle = psi_index == Some(d) && scene.obstacle;
+        if obstacle || M::DATA[d] == "f" {
+            report.warn(format!(
+                "scene `{}` gives no {} `{}`: it is taken as 0",
+                scene.name,
+                if obstacle { "obstacle" } else { "load" },
+                M::DATA[d]
+            ));
+        }
+    }
     let fields = G::fields::<M>(&solved.solution, psi);
     let run = Run {
         scene,
@@ -427,6 +439,8 @@ fn size_text(scene: &Scene, pair: &Pair, n: usize) -> String {
 struct Bound {
     params: Vec<(usize, f64)>,
     data: Vec<(usize, Box<DataFn>)>,
+    /// The model's data the scene leaves out (taken as 0).
+    defaulted: Vec<usize>,
 }
 
 /// Binds the scene's parameters and data to model `M` by name; the data `--load` scales
@@ -475,12 +489,18 @@ fn bind<M: Model>(scene: &Scene, pair: &Pair, posed: &Posed) -> Result<Bound> {
         data.push((d, function));
     }
     // a model's data the scene leaves out is 0 (a boundary value g on a clamped plate)
+    let mut defaulted = Vec::new();
     for d in 0..M::DATA.len() {
         if !data.iter().any(|(k, _)| *k == d) {
             data.push((d, Box::new(zero)));
+            defaulted.push(d);
         }
     }
-    Ok(Bound { params, data })
+    Ok(Bound {
+        params,
+        data,
+        defaulted,
+    })
 }
 
 /// The runtime's supports of a scene on one mesh.

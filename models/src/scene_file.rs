@@ -524,6 +524,23 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
     }
     let name = scene_name(file.name.as_deref(), path, "scene").map_err(|m| at("name", m))?;
     let (domain, mesh_size) = domain_of(&file.mesh, path).map_err(|(f, m)| at(&f, m))?;
+    let interval = matches!(domain, Domain::Interval { .. });
+    if interval != (family.dimension() == 1) {
+        return Err(at(
+            "mesh",
+            if interval {
+                format!(
+                    "the {} family is posed on triangle meshes (a 2D generator or a Gmsh file), not on an interval",
+                    family.name()
+                )
+            } else {
+                format!(
+                    "the {} family is posed on an interval: generator = \"interval\" with start, end and size",
+                    family.name()
+                )
+            },
+        ));
+    }
     let description = file
         .description
         .clone()
@@ -875,6 +892,23 @@ fn supports(
             key: Some(field.into()),
         });
     }
+    // two supports on the same named part: which one holds there would be the order of
+    // the keys, which the file does not show
+    for (k, a) in out.iter().enumerate() {
+        for b in &out[..k] {
+            if let (Part::Named(x), Part::Named(y)) = (&a.part, &b.part) {
+                if let Some(name) = x.iter().find(|n| y.contains(n)) {
+                    return Err((
+                        a.key.as_deref().unwrap_or("boundary").to_string(),
+                        format!(
+                            "the part `{name}` also has `{}`: give each part one support",
+                            b.key.as_deref().unwrap_or("another support")
+                        ),
+                    ));
+                }
+            }
+        }
+    }
     if out.is_empty() {
         if let Some((support, key)) = family.default_support() {
             out.push(PartSupport {
@@ -924,7 +958,8 @@ fn check_parts(scene: &Scene) -> std::result::Result<(), (String, String)> {
 }
 
 /// Points inside the domain's bounding box at which given derivatives are checked
-/// (irrational offsets: unlikely to sit on a kink of `max` or `abs`).
+/// (irrational shares: unlikely to sit on a kink of `max` or `abs`; a strip along an
+/// edge is sampled too).
 fn check_points(domain: &Domain) -> Vec<[f64; 2]> {
     let (x, y) = match domain {
         Domain::Interval { start, end } => ([*start, *end], [0.0, 0.0]),
@@ -938,10 +973,15 @@ fn check_points(domain: &Domain) -> Vec<[f64; 2]> {
         }
         _ => ([-1.0, 1.0], [-1.0, 1.0]),
     };
-    [0.1234, 0.3711, 0.5827, 0.7419, 0.9137]
+    // a 7 × 7 lattice of shares with irrational offsets, near every edge too
+    let shares = [0.0123, 0.1617, 0.3172, 0.4714, 0.6180, 0.7861, 0.9641];
+    shares
         .iter()
-        .zip([0.8191, 0.2347, 0.6553, 0.4271, 0.1619])
-        .map(|(s, t)| [x[0] + s * (x[1] - x[0]), y[0] + t * (y[1] - y[0])])
+        .flat_map(|&s| {
+            shares
+                .iter()
+                .map(move |&t| [x[0] + s * (x[1] - x[0]), y[0] + t * (y[1] - y[0])])
+        })
         .collect()
 }
 

@@ -223,6 +223,10 @@ pub struct Problem<'a, M: Model, G: Domain> {
 /// μ)`, stable for every α > 0 and limited by accuracy only (membranes and plates: 0.1).
 pub const ALPHA_WHEN_CI_VANISHES: f64 = 0.1;
 
+/// Below this share of the answer's size the ranges of ψ and u_h count as flat, and a
+/// crossing of ψ is judged against the size instead.
+const FLAT_SHARE: f64 = 1e-3;
+
 /// `α` times the stabilization's constant on a regular cell below which the
 /// stabilization is lost in rounding: λ_h's rounding noise grows like `ε / (α C_I)` (a
 /// needle mesh measured 2e-4 at 4e-12 and 2 at 4e-16).
@@ -418,6 +422,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 None
             };
             match role.or(*value) {
+                // checked before anything is computed from it (C_I of a negative D)
+                Some(v) if v <= 0.0 && M::POSITIVE_PARAMS.contains(&p) => {
+                    return Err(Error::Input(format!(
+                        "parameter `{}` = {v} must be positive (model `{}` declares `{} > 0`)",
+                        M::PARAMS[p],
+                        M::NAME,
+                        M::PARAMS[p]
+                    )))
+                }
                 Some(v) => values.push(v),
                 None => {
                     missing.push(M::PARAMS[p]);
@@ -1200,7 +1213,16 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             let rounding = value_rounding(u_size, psi_size)
                 + load_rounding(load, diameter, M::ORDER)
                 + primal_rounding;
-            let range = penetration.obstacle_range.max(u_range);
+            // a flat obstacle under a flat answer has ranges of rounding size: the depth is
+            // judged against the answer's size there (a percentage of 1e-17 meant nothing)
+            let size = u_size.max(psi_size);
+            let ranges = penetration.obstacle_range.max(u_range);
+            let (range, measure) = if ranges < FLAT_SHARE * size {
+                (size, "the larger of ψ's and {name}_h's sizes")
+            } else {
+                (ranges, "the larger of ψ's and {name}_h's ranges")
+            };
+            let measure = measure.replace("{name}", name);
             if penetration.depth.is_nan() {
                 warnings.push(format!(
                     "max_penetration is not a number: the obstacle ψ or {name}_h is not finite at some point the penetration check samples"
@@ -1210,7 +1232,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 && penetration.depth > rounding
             {
                 warnings.push(format!(
-                    "{name}_h {} ψ by up to {:.2e}, {:.1} % of the larger of ψ's and {name}_h's ranges ({range:.2e}): the constraint holds on each cell's mean, so a mesh that does not resolve the contact lets {name}_h pass ψ by O(h²) inside cells; refine the mesh (or lower the load)",
+                    "{name}_h {} ψ by up to {:.2e}, {:.1} % of {measure} ({range:.2e}): the constraint holds on each cell's mean, so a mesh that does not resolve the contact lets {name}_h pass ψ by O(h²) inside cells; refine the mesh (or lower the load)",
                     if side > 0.0 { "dips below" } else { "rises above" },
                     penetration.depth,
                     100.0 * penetration.depth / range

@@ -146,6 +146,10 @@ fn beam_scene(old: &crate::scenes::Scene) -> Scene {
 }
 
 impl Family for Beams {
+    fn dimension(&self) -> usize {
+        1
+    }
+
     fn name(&self) -> &'static str {
         "beam"
     }

@@ -97,6 +97,20 @@ impl Family for Winkler {
 }
 
 impl Quantities<TriangleMesh> for Winkler {
+    fn check(_: &Scene, posed: &crate::scene::Posed) -> Result<()> {
+        if let Some(nu) = posed.parameter("ν").filter(|nu| !(*nu > -1.0 && *nu < 0.5)) {
+            return Err(fem_runtime::Error::Input(format!(
+                "Poisson's ratio ν = {nu} must lie in (−1, ½)"
+            )));
+        }
+        if let Some(k) = posed.parameter("k").filter(|k| *k < 0.0) {
+            return Err(fem_runtime::Error::Input(format!(
+                "the foundation modulus k = {k} must be ≥ 0 (a foundation pushes back)"
+            )));
+        }
+        Ok(())
+    }
+
     fn add<M: Model>(run: &Run<'_, M, TriangleMesh>, report: &mut Report) -> Result<()> {
         let integral = TriangleMesh::integral(&run.solved.solution, run.constrained_field());
         report.set("deflection_integral", integral);
