@@ -3,18 +3,10 @@
 //! test), equilibrium as an identity, the plain method's oscillation, the studies'
 //! files, and bad input refused with a message naming it, never a panic.
 
-use std::process::Command;
+mod common;
 
-fn fem_forms(args: &[&str], out: &str) -> std::process::Output {
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("fem-forms-contact-{out}-{}", std::process::id()));
-    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("the binary runs")
-}
+use common::{fem_forms, number};
+use std::process::Command;
 
 fn solve_json(scene: &str, args: &[&str]) -> serde_json::Value {
     let mut all = vec!["solve", scene, "--json"];
@@ -26,12 +18,6 @@ fn solve_json(scene: &str, args: &[&str]) -> serde_json::Value {
         String::from_utf8_lossy(&run.stderr)
     );
     serde_json::from_slice(&run.stdout).unwrap()
-}
-
-fn number(json: &serde_json::Value, field: &str) -> f64 {
-    json[field]
-        .as_f64()
-        .unwrap_or_else(|| panic!("{field} missing in {json}"))
 }
 
 /// The block under a uniform pressure: λ_h = q on every contact edge, for both pairs

@@ -9,7 +9,9 @@ use fem_forms::contact_scene_file::{self, Overrides};
 use fem_forms::models::contact_scenes::{ContactBody, SIGNORINI_GAP};
 use fem_forms::signorini::{self as contact, ContactPair, ContactRequest};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+
+use common::number;
 
 fn data(file: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -733,30 +735,11 @@ fn the_finite_block_deviates_from_the_half_plane_well_below_the_accuracy() {
 }
 
 fn fem_forms(args: &[&str]) -> std::process::Output {
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("fem-forms-contact-files-{}", std::process::id()));
-    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("the binary runs")
+    common::fem_forms(args, "contact-files")
 }
 
 fn json_of(args: &[&str]) -> serde_json::Value {
-    let run = fem_forms(args);
-    assert!(
-        run.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    serde_json::from_slice(&run.stdout).unwrap()
-}
-
-fn number(json: &serde_json::Value, field: &str) -> f64 {
-    json[field]
-        .as_f64()
-        .unwrap_or_else(|| panic!("{field} missing in {json}"))
+    common::json_of(args, "contact-files")
 }
 
 /// `solve signorini-gap --json`: Hertz's b and p_max (computed here), the error within

@@ -3,17 +3,12 @@
 //! fields and what they must satisfy whatever the discretization, and bad input refused
 //! with a message naming it, never a panic.
 
-use std::process::Command;
+mod common;
+
+use common::number;
 
 fn fem_forms(args: &[&str]) -> std::process::Output {
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("fem-forms-kirchhoff-cli-{}", std::process::id()));
-    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("the binary runs")
+    common::fem_forms(args, "kirchhoff-cli")
 }
 
 fn solve_json(scene: &str, args: &[&str]) -> serde_json::Value {
@@ -26,12 +21,6 @@ fn solve_json(scene: &str, args: &[&str]) -> serde_json::Value {
         String::from_utf8_lossy(&run.stderr)
     );
     serde_json::from_slice(&run.stdout).unwrap()
-}
-
-fn number(json: &serde_json::Value, field: &str) -> f64 {
-    json[field]
-        .as_f64()
-        .unwrap_or_else(|| panic!("{field} missing in {json}"))
 }
 
 /// Navier's series for the centre deflection of the simply supported unit square under a

@@ -5,17 +5,12 @@
 //! form), its studies; and bad input exits non-zero with a message naming it, never a
 //! panic.
 
+mod common;
+
 use std::process::Command;
 
 fn fem_forms(args: &[&str]) -> std::process::Output {
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("fem-forms-plate-cli-{}", std::process::id()));
-    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("the binary runs")
+    common::fem_forms(args, "plate-cli")
 }
 
 fn solve_json(args: &[&str]) -> serde_json::Value {

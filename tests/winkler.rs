@@ -4,17 +4,13 @@
 //! foundation's reaction and the contact force carry the load). Scene files of the one
 //! reader: given derivatives of an exact solution are checked.
 
+mod common;
+
+use common::number;
 use std::process::Command;
 
 fn fem_forms(args: &[&str]) -> std::process::Output {
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("fem-forms-winkler-{}", std::process::id()));
-    Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("the binary runs")
+    common::fem_forms(args, "winkler")
 }
 
 fn solve_json(args: &[&str]) -> serde_json::Value {
@@ -28,12 +24,6 @@ fn solve_json(args: &[&str]) -> serde_json::Value {
         String::from_utf8_lossy(&run.stderr)
     );
     serde_json::from_slice(&run.stdout).unwrap()
-}
-
-fn number(json: &serde_json::Value, field: &str) -> f64 {
-    json[field]
-        .as_f64()
-        .unwrap_or_else(|| panic!("{field} missing in {json}"))
 }
 
 /// `∫w` of Navier's series for the simply supported unit square on a Winkler foundation
