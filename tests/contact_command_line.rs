@@ -187,7 +187,7 @@ fn bad_contact_input_exits_with_a_message() {
         (
             "signorini-patch",
             &["--load", "-1"][..],
-            "--load -1 must be finite and ≥ 0",
+            "--load -1 must be positive",
         ),
         (
             "signorini-patch",

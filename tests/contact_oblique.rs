@@ -68,7 +68,7 @@ fn turned_patch(theta: f64) -> Scene {
         default: 1.0,
         scales: vec!["q".into()],
         symbol: "q",
-        nonnegative: true,
+        sign: fem_forms::models::scene::LoadSign::Positive,
     });
     scene.facets = vec![
         ("Γ_C".into(), Part::named("bottom")),

@@ -284,8 +284,19 @@ pub struct Load {
     pub scales: Vec<Name>,
     /// What q is called in `list` (`q`, or `P` for a resultant).
     pub symbol: &'static str,
-    /// Whether q must be ≥ 0 (the scene fixes the load's direction).
-    pub nonnegative: bool,
+    /// The values q may take.
+    pub sign: LoadSign,
+}
+
+/// The values a scene's load magnitude q may take.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadSign {
+    /// Any (the data's sign is the scene's; −q pushes the other way).
+    Any,
+    /// q ≥ 0: the scene fixes the load's direction.
+    NonNegative,
+    /// q > 0: a body that only rests on its foundation needs a load to hold it there.
+    Positive,
 }
 
 /// Largest load magnitude `|q|` a scene accepts: beyond it the norms that certify a
@@ -523,8 +534,15 @@ impl Scene {
                 "--load does not apply to `{}`: its load is fixed (not a scaled field)",
                 self.name
             )),
-            (Some(load), Some(q)) if load.nonnegative && q < 0.0 => Err(format!(
-                "--load {} must be finite and ≥ 0: the scene `{}` fixes the load's direction",
+            (Some(load), Some(q)) if load.sign == LoadSign::NonNegative && q < 0.0 => {
+                Err(format!(
+                    "--load {} must be finite and ≥ 0: the scene `{}` fixes the load's direction",
+                    number(q),
+                    self.name
+                ))
+            }
+            (Some(load), Some(q)) if load.sign == LoadSign::Positive && q <= 0.0 => Err(format!(
+                "--load {} must be positive: the body of `{}` only rests on its foundation, a pull lifts it off and nothing holds it then",
                 number(q),
                 self.name
             )),

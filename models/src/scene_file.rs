@@ -573,7 +573,7 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
             default: load.unwrap_or(1.0),
             scales: vec![scaled.into()],
             symbol: "q",
-            nonnegative: false,
+            sign: crate::scene::LoadSign::Any,
         });
     } else if load.is_some() {
         return Err(at(

@@ -113,7 +113,7 @@ fn beam_scene(old: &crate::scenes::Scene) -> Scene {
         default: 1.0,
         scales: vec!["f".into()],
         symbol: "q",
-        nonnegative: true,
+        sign: crate::scene::LoadSign::NonNegative,
     });
     scene.side = if old.side > 0.0 {
         ObstacleSide::Below

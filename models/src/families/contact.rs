@@ -201,7 +201,7 @@ fn contact_scene(old: &ContactScene) -> Scene {
         default: old.load,
         scales: vec!["q".into()],
         symbol,
-        nonnegative: true,
+        sign: crate::scene::LoadSign::Positive,
     });
     scene.facets = vec![
         (CONTACT_PART.into(), Part::named(contact)),
@@ -398,16 +398,8 @@ impl Quantities<TriangleMesh> for Contact {
 
     fn check(scene: &Scene, posed: &Posed) -> Result<()> {
         let facts = facts(scene)?;
+        // its sign is checked with the load ([`crate::scene::LoadSign::Positive`])
         let load = posed.load.unwrap_or(1.0);
-        if load.is_nan() {
-            return Err(Error::Input("--load NaN is not a number".into()));
-        }
-        if load <= 0.0 {
-            return Err(Error::Input(format!(
-                "--load {} must be positive: the body only rests on the foundation, a pull lifts it off and nothing holds it then",
-                fem_runtime::problem::number(load)
-            )));
-        }
         if let Some(hertz) = facts.hertz(load) {
             let ratio = hertz.half_width() / hertz.radius;
             if !(HERTZ_HALF_WIDTH_RANGE.0..=HERTZ_HALF_WIDTH_RANGE.1).contains(&ratio) {

@@ -148,7 +148,7 @@ fn kirchhoff_scene(
         default: load,
         scales: vec!["f".into()],
         symbol: "q",
-        nonnegative: false,
+        sign: crate::scene::LoadSign::Any,
     });
     scene.side = ObstacleSide::Above;
     place(&mut scene, obstacle);

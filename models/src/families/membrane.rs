@@ -115,7 +115,7 @@ pub fn membrane_scene(old: &MembraneScene) -> Scene {
         default: q,
         scales: vec!["f".into()],
         symbol: "q",
-        nonnegative: false,
+        sign: crate::scene::LoadSign::Any,
     });
     let convert = |e: crate::membrane_scenes::ExactMembrane| ExactSolution {
         value: Some(e.u),

@@ -124,7 +124,7 @@ fn plate_scene(old: &plate_scenes::PlateScene) -> Scene {
         default: old.load,
         scales: vec!["f".into()],
         symbol: "q",
-        nonnegative: false,
+        sign: crate::scene::LoadSign::Any,
     });
     match old.obstacle.side_and_height() {
         Some((side, height)) => {

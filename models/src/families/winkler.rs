@@ -79,7 +79,7 @@ impl Family for Winkler {
                 default: 1.0,
                 scales: vec!["f".into()],
                 symbol: "q",
-                nonnegative: false,
+                sign: crate::scene::LoadSign::Any,
             }),
             ..scene
         }]
