@@ -1,4 +1,4 @@
-//! Reissner–Mindlin plate speed (`mindlin_clamped`: θ ∈ [P1]², w ∈ P2, λ ∈ P0,
+//! Reissner–Mindlin plate speed (`mindlin_stenberg`: θ ∈ [P1]², w ∈ P2, λ ∈ P0,
 //! docs/mathematics.md §9), every ratio measured in this one run:
 //! 1. assembly of the whole system matrix `B_h` (13 × 13 local entries, the θ–λ blocks
 //!    structurally zero) in triangles per second, generated kernels through the generic
@@ -19,7 +19,7 @@
 
 use fem_forms::lcp::cholesky::Cholesky;
 use fem_forms::mesh::triangle::QuadraticGeometry;
-use fem_forms::models::mindlin::mindlin_clamped;
+use fem_forms::models::mindlin::mindlin_stenberg;
 use fem_forms::obstacle::triangle::{
     solve_obstacle_on_curved_triangles, solve_obstacle_on_triangles, CurvedObstacleSolution,
     TriangleObstacleSolution,
@@ -31,7 +31,7 @@ use fem_forms::{
 use std::hint::black_box;
 use std::time::Instant;
 
-type M = mindlin_clamped::Model;
+type M = mindlin_stenberg::Model;
 
 const D: f64 = 1.0;
 const NU: f64 = 0.3;

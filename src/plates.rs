@@ -8,7 +8,7 @@
 //! table ([`PlatePair`] with one row each naming the model of each support). Adding a
 //! scene is one constant in `models/src/plate_scenes.rs`, a pair one row here.
 
-use crate::models::mindlin::{mindlin_clamped, mindlin_plain_p1, mindlin_simply_supported};
+use crate::models::mindlin::{mindlin_plain_p1, mindlin_simply_supported, mindlin_stenberg};
 use crate::models::plate_scenes::{PlateDomain, PlateObstacle, PlateScene, PlateSupport};
 use crate::studies::{io, output, write_csv, Study};
 use fem_runtime::element::triangle::{TriangleBasis, TriangleField};
@@ -77,7 +77,7 @@ const PAIRS: [PairRow; 2] = [
     PairRow {
         pair: PlatePair::P1P2P0,
         name: "p1-p2-p0",
-        clamped: Some(solve_with::<mindlin_clamped::Model>),
+        clamped: Some(solve_with::<mindlin_stenberg::Model>),
         simply_supported: Some(solve_with::<mindlin_simply_supported::Model>),
     },
     PairRow {

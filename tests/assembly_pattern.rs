@@ -9,7 +9,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0, membrane_p2_p1disc};
-use fem_forms::models::mindlin::mindlin_clamped;
+use fem_forms::models::mindlin::mindlin_stenberg;
 use fem_forms::{Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh};
 
 fn load(x: &[f64]) -> f64 {
@@ -157,7 +157,7 @@ fn pattern_and_positions_match_a_dense_assembly_from_element_matrices() {
         )
         .unwrap();
         check::<membrane_p2_p1disc::Model>("B_h", &mesh, &p1disc);
-        let plate = Coefficients::new::<mindlin_clamped::Model>(
+        let plate = Coefficients::new::<mindlin_stenberg::Model>(
             &[
                 ("D", 1.3),
                 ("ν", 0.3),
@@ -170,6 +170,6 @@ fn pattern_and_positions_match_a_dense_assembly_from_element_matrices() {
             &[("f", &load), ("ψ", &obstacle), ("g", &boundary)],
         )
         .unwrap();
-        check::<mindlin_clamped::Model>("B_h", &mesh, &plate);
+        check::<mindlin_stenberg::Model>("B_h", &mesh, &plate);
     }
 }

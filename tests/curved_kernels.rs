@@ -11,7 +11,7 @@ use fem_forms::element::Isoparametric;
 use fem_forms::mesh::triangle::QuadraticGeometry;
 use fem_forms::models::kirchhoff::kirchhoff_argyris_p0;
 use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
-use fem_forms::models::mindlin::mindlin_clamped;
+use fem_forms::models::mindlin::mindlin_stenberg;
 use fem_forms::obstacle::triangle::{
     curved_dirichlet_constraints_on, solve_obstacle_on_curved_triangles,
     solve_obstacle_on_triangles,
@@ -159,8 +159,8 @@ fn curved_kernels_on_straight_cells_equal_the_affine_kernels() {
             v,
         );
         for t in [0.1, 1e-3] {
-            blocks += curved_equals_affine::<mindlin_clamped::Model>(
-                &mindlin_coefficients::<mindlin_clamped::Model>(t),
+            blocks += curved_equals_affine::<mindlin_stenberg::Model>(
+                &mindlin_coefficients::<mindlin_stenberg::Model>(t),
                 v,
             );
         }
@@ -268,7 +268,7 @@ fn curved_kernels_match_a_hand_coded_isoparametric_quadrature() {
     assert!(relative_difference(&expected, &affine) > 1e-2);
 
     // the Mindlin shear blocks of B_h, weight 6κ(1−ν)D/(t² + β h_T²)
-    type Plate = mindlin_clamped::Model;
+    type Plate = mindlin_stenberg::Model;
     let t = 0.05;
     let c = mindlin_coefficients::<Plate>(t);
     let h = vertex_diameter(&nodes);
@@ -502,7 +502,7 @@ fn poisson_on_the_curved_disk_converges_where_the_polygon_stalls() {
 /// polygonal disk on the same mesh.
 #[test]
 fn the_clamped_mindlin_disk_approaches_its_closed_form_on_curved_cells() {
-    type M = mindlin_clamped::Model;
+    type M = mindlin_stenberg::Model;
     let (t, q) = (0.01, 20.0);
     let exact = q / 64.0 + q * t * t / 14.0;
     let load = move |_: &[f64]| q;
@@ -765,7 +765,7 @@ fn second_order_disk_msh(rings: usize) -> String {
 /// agree to rounding) and approaches the closed form `q/64 + q t²/14`.
 #[test]
 fn a_second_order_gmsh_disk_solves_the_mindlin_plate_on_curved_cells() {
-    type M = mindlin_clamped::Model;
+    type M = mindlin_stenberg::Model;
     let (t, q) = (0.01, 20.0);
     let exact = q / 64.0 + q * t * t / 14.0;
     let load = move |_: &[f64]| q;

@@ -11,7 +11,7 @@ mod plate;
 
 use fem_forms::element::triangle::TriangleBasis;
 use fem_forms::lcp::cholesky::multiply;
-use fem_forms::models::mindlin::{mindlin_clamped, mindlin_plain_p1, mindlin_simply_supported};
+use fem_forms::models::mindlin::{mindlin_plain_p1, mindlin_simply_supported, mindlin_stenberg};
 use fem_forms::models::plate_scenes::MINDLIN_SQUARE;
 use fem_forms::obstacle::triangle::{solve_obstacle_on_triangles, TriangleObstacleSolution};
 use fem_forms::obstacle::ObstacleOptions;
@@ -210,7 +210,7 @@ fn check_kernels<M: Model>(w_degree: usize, stenberg: bool, seed: u64) {
 
 #[test]
 fn generated_system_kernels_match_hand_coded_ones_on_random_triangles() {
-    check_kernels::<mindlin_clamped::Model>(2, true, 0x9e37_79b9_7f4a_7c15);
+    check_kernels::<mindlin_stenberg::Model>(2, true, 0x9e37_79b9_7f4a_7c15);
     check_kernels::<mindlin_simply_supported::Model>(2, true, 0x2545_f491_4f6c_dd1d);
     check_kernels::<mindlin_plain_p1::Model>(1, false, 0x1234_5678_9abc_def1);
 }
@@ -223,8 +223,8 @@ fn the_boundary_conditions_are_the_declared_ones() {
             .map(|&(f, _)| fields[f].name)
             .collect::<Vec<_>>()
     };
-    use mindlin_clamped::Model as C;
     use mindlin_simply_supported::Model as S;
+    use mindlin_stenberg::Model as C;
     assert_eq!(names(C::DIRICHLET, C::FIELDS), ["θ_x", "θ_y", "w"]);
     assert_eq!(names(S::DIRICHLET, S::FIELDS), ["w"]);
     // S_h keeps only the multiplier block: div div Cε(θ) vanishes for P1 rotations
@@ -273,7 +273,7 @@ fn the_clamped_plate_tends_to_kirchhoff_without_locking_and_the_plain_method_loc
         );
     }
     // the scene poses the problem solved here through the runtime directly
-    let direct = centre_deflection::<mindlin_clamped::Model>(16, 1e-3);
+    let direct = centre_deflection::<mindlin_stenberg::Model>(16, 1e-3);
     let row = |method: &str, n: usize, t: f64| {
         rows.iter()
             .find(|r| r.pair == method && r.mesh_size == n && r.thickness == t)
@@ -353,8 +353,8 @@ fn a_plate_pressed_onto_the_obstacle_everywhere_has_lambda_equal_to_the_load() {
     let q = 3.0;
     for s in [1.0, -1.0] {
         let f = move |_: &[f64]| -s * q;
-        let c = coefficients::<mindlin_clamped::Model>(1.0, 1e-2, s, &f, &zero);
-        let solution = solve_obstacle_on_triangles::<mindlin_clamped::Model>(
+        let c = coefficients::<mindlin_stenberg::Model>(1.0, 1e-2, s, &f, &zero);
+        let solution = solve_obstacle_on_triangles::<mindlin_stenberg::Model>(
             &[square(6)],
             &c,
             ObstacleOptions::default(),
@@ -390,12 +390,12 @@ fn flat_obstacle(_: &[f64]) -> f64 {
 /// The clamped plate (D = 1, ν = 0.3, κ = 5/6, t = 1e-3) under the upward load `Q`
 /// against the flat obstacle above (`s = −1`), nested 8 → … → `n` squares a side.
 fn pressed_plate(n: usize) -> (TriangleObstacleSolution, Coefficients<'static>) {
-    let c = coefficients::<mindlin_clamped::Model>(1.0, 1e-3, -1.0, &upward_load, &flat_obstacle);
+    let c = coefficients::<mindlin_stenberg::Model>(1.0, 1e-3, -1.0, &upward_load, &flat_obstacle);
     let meshes: Vec<TriangleMesh> = std::iter::successors(Some(8), |&m| Some(2 * m))
         .take_while(|&m| m <= n)
         .map(square)
         .collect();
-    let solution = solve_obstacle_on_triangles::<mindlin_clamped::Model>(
+    let solution = solve_obstacle_on_triangles::<mindlin_stenberg::Model>(
         &meshes,
         &c,
         ObstacleOptions::default(),
@@ -452,7 +452,7 @@ fn interior_multiplier(solution: &TriangleObstacleSolution) -> (f64, f64, f64, u
 ///   obstacle and the clamped edges, which both push against it.
 #[test]
 fn a_plate_against_an_obstacle_above_satisfies_complementarity_and_equilibrium() {
-    use mindlin_clamped::Model as M;
+    use mindlin_stenberg::Model as M;
     let (solution, c) = pressed_plate(32);
     let d = &solution.discretization;
     let kkt = d.lcp.kkt_residual(
@@ -536,7 +536,7 @@ fn the_multiplier_is_smooth_in_the_contact_interior() {
         let (solution, c) = pressed_plate(n);
         let (radius, mean, spread, count) = interior_multiplier(&solution);
         let energy = solution
-            .energy::<mindlin_clamped::Model>(&c)
+            .energy::<mindlin_stenberg::Model>(&c)
             .expect("the energy of the plate");
         eprintln!(
             "N = {n}: J_h = {energy:.8}, ∫λ_h = {:.6}, contact radius ≈ {radius:.4}, {count} interior cells, λ_h mean {mean:.6}, spread {spread:.3e}, {} iterations, levels {:?}",

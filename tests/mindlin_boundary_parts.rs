@@ -1,5 +1,5 @@
 //! Boundary conditions per field and part (`solve_obstacle_on_field_parts`): one
-//! Reissner–Mindlin plate (`mindlin_clamped`, docs/mathematics.md §9) clamped on some
+//! Reissner–Mindlin plate (`mindlin_stenberg`, docs/mathematics.md §9) clamped on some
 //! sides and simply supported on the others, in one solve.
 //!
 //! The unit square clamped on x = 0 and x = 1 (θ = 0, w = 0) and simply supported on
@@ -13,7 +13,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::element::triangle::TriangleBasis;
-use fem_forms::models::mindlin::mindlin_clamped;
+use fem_forms::models::mindlin::mindlin_stenberg;
 use fem_forms::obstacle::triangle::{
     dirichlet_constraints_per_field, solve_obstacle_on_field_parts, solve_obstacle_on_triangles,
     TriangleObstacleSolution,
@@ -23,7 +23,7 @@ use fem_forms::{
     Coefficients, Diagonal, DirichletPart, Model, PointLocator, SystemDofs, TriangleMesh,
 };
 
-type M = mindlin_clamped::Model;
+type M = mindlin_stenberg::Model;
 
 /// `(field, part)` pairs, as `solve_obstacle_on_field_parts` takes them.
 type FieldParts = Vec<(&'static str, DirichletPart)>;

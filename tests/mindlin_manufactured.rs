@@ -1,5 +1,5 @@
 //! A manufactured smooth solution of the clamped Reissner–Mindlin plate
-//! (`mindlin_clamped`, docs/mathematics.md §9) and its convergence rates, at a moderate
+//! (`mindlin_stenberg`, docs/mathematics.md §9) and its convergence rates, at a moderate
 //! and at a small thickness.
 //!
 //! The model has a load f on w only, no body moment on θ, so the exact solution must
@@ -21,7 +21,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::element::triangle::TriangleField;
-use fem_forms::models::mindlin::mindlin_clamped;
+use fem_forms::models::mindlin::mindlin_stenberg;
 use fem_forms::obstacle::triangle::solve_obstacle_on_triangles;
 use fem_forms::obstacle::ObstacleOptions;
 use fem_forms::{Coefficients, Diagonal, Model, TriangleMesh};
@@ -106,7 +106,7 @@ const RULE_DEGREE: usize = 16;
 /// Solves the clamped plate of thickness `t` on the `n × n × 2` unit square and measures
 /// the errors against the closed form.
 fn errors(n: usize, t: f64) -> Errors {
-    type M = mindlin_clamped::Model;
+    type M = mindlin_stenberg::Model;
     let params = [
         ("D", D),
         ("ν", NU),

@@ -11,7 +11,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
-use fem_forms::models::mindlin::mindlin_clamped;
+use fem_forms::models::mindlin::mindlin_stenberg;
 use fem_forms::{
     assemble_vector, Coefficients, Diagonal, MatrixAssembler, Model, SystemDofs, TriangleMesh,
 };
@@ -171,7 +171,7 @@ fn parallel_p1_and_p2_stiffness_equal_the_serial_assembly() {
 
 #[test]
 fn parallel_mindlin_system_equals_the_serial_assembly() {
-    type M = mindlin_clamped::Model;
+    type M = mindlin_stenberg::Model;
     let params = [
         ("D", 1.3),
         ("ν", 0.3),

@@ -67,7 +67,7 @@ mod roles {
         check::<crate::timoshenko_p2::Model>(true, Some(("w", "ψ")));
         check::<crate::timoshenko_p1_reduced::Model>(true, Some(("w", "ψ")));
         check::<crate::timoshenko_p1_full::Model>(true, Some(("w", "ψ")));
-        check::<crate::mindlin::mindlin_clamped::Model>(true, Some(("w", "ψ")));
+        check::<crate::mindlin::mindlin_stenberg::Model>(true, Some(("w", "ψ")));
         check::<crate::mindlin::mindlin_plain_p1::Model>(true, Some(("w", "ψ")));
         check::<crate::kirchhoff::kirchhoff_argyris_p0::Model>(true, Some(("w", "ψ")));
         check::<crate::kirchhoff::kirchhoff_morley_p0::Model>(true, Some(("w", "ψ")));

@@ -52,9 +52,10 @@ macro_rules! mindlin_model {
 }
 
 mindlin_model! {
-    /// Clamped Reissner–Mindlin plate obstacle problem (`θ = g`, `w = g` on the Dirichlet
-    /// part), θ ∈ [P1]², w ∈ P2, λ ∈ P0, Stenberg shear weight: locking-free.
-    mindlin_clamped, boundary: θ_x = g, θ_y = g, w = g
+    /// Reissner–Mindlin plate obstacle problem, θ ∈ [P1]², w ∈ P2, λ ∈ P0, Stenberg shear
+    /// weight: locking-free. Its `boundary:` data hold every field (`θ = g`, `w = g`, the
+    /// clamp); the registry imposes any support by the fields' roles instead.
+    mindlin_stenberg, boundary: θ_x = g, θ_y = g, w = g
 }
 
 mindlin_model! {

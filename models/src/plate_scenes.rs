@@ -11,7 +11,7 @@
 /// How the plate is held on its boundary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PlateSupport {
-    /// `θ = 0`, `w = 0` on the whole boundary (model `mindlin_clamped`).
+    /// `θ = 0`, `w = 0` on the whole boundary (model `mindlin_stenberg`).
     Clamped,
     /// `w = 0` on the whole boundary, θ free: the "soft" simple support (model
     /// `mindlin_simply_supported`).

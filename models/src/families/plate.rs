@@ -7,7 +7,7 @@
 
 use crate::family::{Family, Opt, Pair, PairSolve};
 use crate::geometry::{halving_sizes, Fields, Geometry};
-use crate::mindlin::{mindlin_clamped, mindlin_plain_p1};
+use crate::mindlin::{mindlin_plain_p1, mindlin_stenberg};
 use crate::plate_scenes::{self, PlateDomain, PlateReference, PlateSupport};
 use crate::run::{run_on_triangles, Quantities, Report, Run};
 use crate::scene::{Domain, Load, Part, Posed, Scene, Support};
@@ -74,7 +74,7 @@ static PAIRS: [Pair; 2] = [
         "p1-p2-p0",
         "θ ∈ [P1]², w ∈ P2, λ ∈ P0, Stenberg shear weight: locking-free",
         &[("β", STENBERG_BETA)],
-        run_on_triangles::<mindlin_clamped::Model, Plates>,
+        run_on_triangles::<mindlin_stenberg::Model, Plates>,
     ),
     pair(
         "p1-p1-p0-plain",
