@@ -11,7 +11,6 @@
 pub mod allocator;
 pub mod beam_studies;
 pub mod beams;
-pub mod contact_scene_file;
 pub mod kirchhoff;
 pub mod membrane_studies;
 pub mod membranes;

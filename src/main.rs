@@ -155,48 +155,6 @@ struct SolveOptions {
     plot: bool,
 }
 
-impl SolveOptions {
-    /// The given options among `names` (flag spellings), for the error of options that
-    /// do not apply.
-    fn given(&self) -> Vec<&'static str> {
-        let mut given = Vec::new();
-        let mut note = |set: bool, name: &'static str| {
-            if set {
-                given.push(name);
-            }
-        };
-        note(self.elements.is_some(), "--elements");
-        note(self.mesh_size.is_some(), "--mesh-size");
-        note(self.vtk, "--vtk");
-        note(self.msh.is_some(), "--msh");
-        note(self.load.is_some(), "--load");
-        note(self.thickness.is_some(), "--thickness");
-        note(self.alpha.is_some(), "--alpha");
-        note(self.pair.is_some(), "--pair");
-        note(self.solver.is_some(), "--solver");
-        note(self.cold, "--cold");
-        note(self.linear_solver.is_some(), "--linear-solver");
-        note(self.refinement.is_some(), "--refinement");
-        note(self.plot, "--plot");
-        note(self.support.is_some(), "--support");
-        note(self.obstacle.is_some(), "--obstacle");
-        note(self.no_obstacle, "--no-obstacle");
-        given
-    }
-
-    /// An error naming the first given option of `not_applicable`, with `why`.
-    fn refuse(&self, not_applicable: &[&str], why: &str) -> Result<(), String> {
-        match self
-            .given()
-            .into_iter()
-            .find(|o| not_applicable.contains(o))
-        {
-            Some(option) => Err(format!("{option} does not apply: {why}")),
-            None => Ok(()),
-        }
-    }
-}
-
 fn table_header() {
     println!(
         "{:<15} {:>5} {:>7} {:>6} {:>6} {:>5} {:>8} {:>14} {:<24} {:>9} {:>10}",
@@ -434,9 +392,8 @@ fn solve_file(
         None if interval => {
             options.elements.get_or_insert(file.scene.mesh_size);
         }
-        None => {
-            options.mesh_size.get_or_insert(file.scene.mesh_size);
-        }
+        // a mesh size left out is the file's (the memory refusal then names its key)
+        None => {}
         // said, so that the file's size is not dropped unseen
         Some(msh) if options.mesh_size.is_none() => eprintln!(
             "warning: --msh {} replaces the mesh of {}, and with it the file's mesh size or refinements ({}); --mesh-size gives the refinements of the --msh mesh (0 here)",
@@ -630,57 +587,6 @@ fn run_kirchhoff_study(
     .map_err(|e| e.to_string())
 }
 
-/// `solve --scene FILE` for a file with `model = "contact"` (fem_forms::contact_scene_file):
-/// `--mesh-size` refines the file's mesh uniformly, `--load` scales its pressure.
-fn solve_contact_file(path: &Path, options: &SolveOptions) -> Result<(), String> {
-    use fem_forms::contact_scene_file as file;
-    options.refuse(
-        &[
-            "--elements",
-            "--msh",
-            "--vtk",
-            "--thickness",
-            "--refinement",
-            "--no-obstacle",
-            "--linear-solver",
-            "--solver",
-            "--cold",
-            "--plot",
-            "--support",
-            "--obstacle",
-        ],
-        &format!(
-            "{} is a contact scene file (--mesh-size: uniform refinements of its mesh, --load: its pressure's scale, --alpha, --pair, --json)",
-            path.display()
-        ),
-    )?;
-    let scene = file::read(path).map_err(|e| e.to_string())?;
-    let overrides = file::Overrides {
-        pair: options
-            .pair
-            .as_deref()
-            .map(file::pair_of_file)
-            .transpose()
-            .map_err(|m| format!("invalid input: --pair: {m}"))?,
-        refinements: options.mesh_size,
-        load: options.load,
-        alpha: options.alpha,
-    };
-    let solved = file::solve(&scene, &overrides).map_err(|e| e.to_string())?;
-    if options.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&solved.report).map_err(|e| e.to_string())?
-        );
-    } else {
-        println!("{}", contact::summary(&solved.report));
-        if let Some(e) = solved.report.pressure_l2_error {
-            println!("pressure L² error against exact.pressure: {e:.3e}");
-        }
-    }
-    Ok(())
-}
-
 /// `study <scene> [kind]` through the registry, or `study <kind>` on every scene that
 /// hosts it.
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
@@ -808,12 +714,6 @@ fn run(cli: Cli) -> Result<(), String> {
             scene_file,
             options,
         }) => match (name, scene_file) {
-            (_, Some(path))
-                if std::fs::read_to_string(&path)
-                    .is_ok_and(|t| fem_forms::contact_scene_file::names_contact(&t)) =>
-            {
-                solve_contact_file(&path, &options)
-            }
             (_, Some(path)) => {
                 let file = fem_forms::models::scene_file::read(&path).map_err(|e| e.to_string())?;
                 solve_file(file, &path, *options, &cli.out)

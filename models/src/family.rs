@@ -4,10 +4,12 @@
 //! The command line's `list`, `solve` and `study` go through [`families`] alone.
 
 use crate::report::{Outcome, Settings};
-use crate::scene::{Scene, Support};
+use crate::scene::{LoadSign, Scene, Support};
 use fem_runtime::problem::MemoryModel;
 use fem_runtime::stabilization::Alpha;
-use fem_runtime::{Error, Result};
+use fem_runtime::Error;
+
+type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// An option of `solve` a family may accept. Each family lists those that mean something
 /// for it; any other given option is an error naming it.
@@ -133,6 +135,19 @@ pub enum Adjustment {
     NoObstacle,
 }
 
+/// An error of a scene file: the field at fault (`material.young`) and the message.
+pub type FieldError = (String, String);
+
+/// The keys of a scene file a family reads itself: its `[material]`, and the
+/// `[parameters]` that are not the model's (a contact direction), taken before the
+/// reader maps the rest onto the model's names.
+pub struct FileKeys<'a> {
+    /// `[material]`, where the file has one.
+    pub material: Option<&'a toml::Table>,
+    /// `[parameters]`: the family removes the keys it reads.
+    pub parameters: &'a mut toml::Table,
+}
+
 /// A model family: its pairs, options and scenes.
 pub trait Family: Sync {
     /// Its name (`beam`, `membrane`, `plate`).
@@ -165,6 +180,54 @@ pub trait Family: Sync {
     /// with the key its errors name (the membrane's `u = g`); `None`: free.
     fn default_support(&self) -> Option<(Support, &'static str)> {
         None
+    }
+
+    /// The `[boundary]` keys of a scene file that name the model's facet parts (the
+    /// `facets:` of its model file), as `(key, facet name)`: contact's `contact = …` for
+    /// Γ_C. Each is required when the family has any.
+    fn facet_keys(&self) -> &'static [(&'static str, &'static str)] {
+        &[]
+    }
+
+    /// The data the load magnitude scales (`data.load`, `--load`), by the model's name,
+    /// and the signs it may take.
+    fn scaled_load(&self) -> (&'static str, LoadSign) {
+        ("f", LoadSign::Any)
+    }
+
+    /// The `[exact]` key of the quantity a scene file's `accuracy` is measured on (`u`;
+    /// contact's `pressure`).
+    fn accuracy_key(&self) -> &'static str {
+        "u"
+    }
+
+    /// Reads the scene file's keys of the family's own ([`FileKeys`]) into `scene`. By
+    /// default there are none: a `[material]` is refused.
+    ///
+    /// # Errors
+    /// The field at fault and why.
+    fn read_file(&self, keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
+        let _ = scene;
+        match keys.material {
+            Some(_) => Err((
+                "material".into(),
+                format!(
+                    "the {} family takes no [material]: its parameters go under [parameters] by the model's names",
+                    self.name()
+                ),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// Checks a scene read from a file as a whole, where the family knows more than the
+    /// reader (contact: its parts on the mesh, the data on them, the load's direction).
+    ///
+    /// # Errors
+    /// The field at fault and why.
+    fn check_file(&self, scene: &Scene) -> Result<(), FieldError> {
+        let _ = scene;
+        Ok(())
     }
 
     /// Applies `adjustment` to `scene`: by default a support replaces every support of

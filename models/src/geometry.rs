@@ -225,6 +225,7 @@ impl Geometry for TriangleMesh {
     ) -> Result<Vec<Self>> {
         match domain {
             Domain::Gmsh(path) => gmsh_levels(path, n, nested, budget),
+            Domain::Refined { mesh, .. } => refined_levels((**mesh).clone(), n, nested, budget),
             Domain::Generated(generator) => {
                 if n == 0 || n > generator.max_size {
                     return Err(Error::Input(format!(
@@ -485,6 +486,22 @@ fn gmsh_levels(
         Error::Mesh(m) => Error::Mesh(format!("{}: {m}", path.display())),
         other => other,
     })?;
+    refined_levels(mesh, refinements, nested, budget)
+}
+
+/// `mesh` and its `refinements` uniform refinements (all of them for nested iteration,
+/// else the finest only), the budget asked before refining.
+fn refined_levels(
+    mesh: TriangleMesh,
+    refinements: usize,
+    nested: bool,
+    budget: CellBudget,
+) -> Result<Vec<TriangleMesh>> {
+    if refinements > MAX_REFINEMENTS {
+        return Err(Error::Input(format!(
+            "--mesh-size {refinements} means {refinements} uniform refinements of the scene's mesh (4^{refinements} times the triangles); at most {MAX_REFINEMENTS}"
+        )));
+    }
     budget(mesh.cell_count() as f64 * 4f64.powi(refinements as i32))?;
     let mut levels = vec![mesh];
     for _ in 0..refinements {

@@ -71,8 +71,10 @@ pub struct Phases {
 }
 
 /// What a solve reports (the CLI's `--json` object): what every solve has, from the
-/// runtime's report, and the family's own quantities beside it.
-#[derive(Clone, Debug, Serialize)]
+/// runtime's report, and the family's own quantities beside it; a family's quantity
+/// replaces the runtime's of the same key (contact's `total_contact_force` of the whole
+/// body where the runtime's is of the half solved), so that no key appears twice.
+#[derive(Clone, Debug)]
 pub struct Report {
     /// Scene name.
     pub scene: String,
@@ -91,7 +93,6 @@ pub struct Report {
     /// Each support as `name on parts`.
     pub supports: Vec<String>,
     /// The runtime's report.
-    #[serde(flatten)]
     pub solve: fem_runtime::problem::Report,
     /// `∫ λ` of the exact solution over the scene's own domain, where known.
     pub exact_contact_force: Option<f64>,
@@ -102,8 +103,64 @@ pub struct Report {
     /// Where the time went.
     pub phases: Phases,
     /// The family's own quantities (a plate's centre deflection, Hertz's half-width).
-    #[serde(flatten)]
     pub quantities: BTreeMap<String, serde_json::Value>,
+}
+
+/// The fields of a [`Report`] before the family's quantities, as they serialize.
+#[derive(Serialize)]
+struct Common<'a> {
+    scene: &'a str,
+    family: &'static str,
+    pair: &'static str,
+    domain: &'a str,
+    mesh_size: usize,
+    load: Option<f64>,
+    parameters: &'a BTreeMap<String, f64>,
+    supports: &'a [String],
+    #[serde(flatten)]
+    solve: &'a fem_runtime::problem::Report,
+    exact_contact_force: Option<f64>,
+    exact_contact_area: Option<f64>,
+    accuracy: Option<f64>,
+    phases: &'a Phases,
+}
+
+impl Serialize for Report {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::{Error, SerializeMap};
+        let common = serde_json::to_value(Common {
+            scene: &self.scene,
+            family: self.family,
+            pair: self.pair,
+            domain: &self.domain,
+            mesh_size: self.mesh_size,
+            load: self.load,
+            parameters: &self.parameters,
+            supports: &self.supports,
+            solve: &self.solve,
+            exact_contact_force: self.exact_contact_force,
+            exact_contact_area: self.exact_contact_area,
+            accuracy: self.accuracy,
+            phases: &self.phases,
+        })
+        .map_err(S::Error::custom)?;
+        let serde_json::Value::Object(common) = common else {
+            return Err(S::Error::custom("a report serializes to an object"));
+        };
+        let mut map = serializer.serialize_map(None)?;
+        for (key, value) in &common {
+            match self.quantities.get(key) {
+                Some(own) => map.serialize_entry(key, own)?,
+                None => map.serialize_entry(key, value)?,
+            }
+        }
+        for (key, value) in &self.quantities {
+            if !common.contains_key(key) {
+                map.serialize_entry(key, value)?;
+            }
+        }
+        map.end()
+    }
 }
 
 impl Report {

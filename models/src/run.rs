@@ -181,7 +181,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     let posed = pose_checked::<G, Q>(scene, settings)?;
     let n = settings.mesh_size.unwrap_or(scene.mesh_size);
     let memory = Q::memory::<M>(pair, scene, n);
-    let size_text = size_text(scene, pair, n);
+    let size_text = size_text(scene, pair, n, settings.mesh_size.is_some());
     // without an obstacle the problem is one linear solve: nothing to nest for
     let nested = Q::NESTED
         && settings.nested
@@ -201,7 +201,13 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     let bound = bind::<M>(scene, pair, &posed)?;
     let supports = supports::<M, G>(scene, &finest)?;
     let exact = scene.exact_at(&posed);
-    let exact_fns = exact.as_ref().map(ExactFns::new);
+    // a multiplier on facets (contact's pressure on Γ_C) is measured by its family; the
+    // runtime measures the primal field and a cell multiplier
+    let on_facets = fem_runtime::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
+    let exact_fns = exact
+        .as_ref()
+        .filter(|e| e.value.is_some() || !on_facets)
+        .map(ExactFns::new);
     if let Some(e) = &exact {
         validate_exact(e, &finest, scene)?;
     }
@@ -422,16 +428,28 @@ pub fn pose(scene: &Scene, settings: &Settings) -> Result<Posed> {
     Ok(Posed { load, parameters })
 }
 
-/// What sets the size, for the memory refusal's message.
-fn size_text(scene: &Scene, pair: &Pair, n: usize) -> String {
-    match &scene.domain {
-        crate::scene::Domain::Interval { .. } => format!("--elements {n} with {}", pair.name),
-        crate::scene::Domain::Gmsh(path) => format!(
-            "--mesh-size {n} ({n} uniform refinements of {}, 4^{n} times its triangles) with {}",
-            path.display(),
+/// What sets the size, for the memory refusal's message: the option where the request
+/// gives it, else the scene's own (a scene file's key).
+fn size_text(scene: &Scene, pair: &Pair, n: usize, given: bool) -> String {
+    use crate::scene::Domain;
+    let refined = match &scene.domain {
+        Domain::Gmsh(path) => Some(path.display().to_string()),
+        Domain::Refined { description, .. } => Some(format!("the {description}")),
+        _ => None,
+    };
+    let option = match (&scene.domain, given) {
+        (Domain::Interval { .. }, true) => format!("--elements {n}"),
+        (Domain::Interval { .. }, false) => format!("the scene's {n} elements"),
+        (_, true) => format!("--mesh-size {n}"),
+        (_, false) if refined.is_some() => format!("the scene's mesh.refinements = {n}"),
+        (_, false) => format!("the scene's mesh size {n}"),
+    };
+    match refined {
+        Some(mesh) => format!(
+            "{option} ({n} uniform refinements of {mesh}, 4^{n} times its triangles) with {}",
             pair.name
         ),
-        _ => format!("--mesh-size {n} with {}", pair.name),
+        None => format!("{option} with {}", pair.name),
     }
 }
 

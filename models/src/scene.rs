@@ -59,6 +59,14 @@ pub enum Domain {
     /// A Gmsh MSH 4.1 mesh; N counts its uniform refinements. Boundary parts are its
     /// physical curve groups.
     Gmsh(PathBuf),
+    /// A mesh given whole (a scene file's rectangle of the squares it names); N counts
+    /// its uniform refinements, as for a Gmsh file.
+    Refined {
+        /// The coarsest mesh.
+        mesh: Arc<fem_runtime::TriangleMesh>,
+        /// Words for reports.
+        description: Cow<'static, str>,
+    },
     /// A mesh made by a family's own generator (the contact bodies' graded meshes).
     Generated(Generator),
 }
@@ -128,6 +136,7 @@ impl Domain {
             Domain::LShape => "L-shape (−1,1)² ∖ [0,1]×[−1,0]".into(),
             Domain::Disk { radius, .. } => format!("disk of radius {}", number(*radius)),
             Domain::Gmsh(path) => format!("Gmsh file {}", path.display()),
+            Domain::Refined { description, .. } => description.to_string(),
             Domain::Generated(g) => g.description.to_string(),
         }
     }
@@ -157,7 +166,7 @@ impl Domain {
 
     /// Whether the scene's own geometry is a file's (N then counts refinements).
     pub fn is_file(&self) -> bool {
-        matches!(self, Domain::Gmsh(_))
+        matches!(self, Domain::Gmsh(_) | Domain::Refined { .. })
     }
 }
 

@@ -342,7 +342,7 @@ pub fn scene_name(
 // The scene of any registry family
 // ---------------------------------------------------------------------------------------
 
-use crate::family::Family;
+use crate::family::{Family, FileKeys};
 use crate::report::Settings;
 use crate::scene::{Domain, Exact, ExactSolution, Load, Part, PartSupport, Scene, Support};
 use fem_runtime::problem::MIN_DATA_SIZE;
@@ -362,6 +362,8 @@ struct FileToml {
     /// The L² error of the constrained field the scene asks for (needs `[exact]`).
     accuracy: Option<f64>,
     mesh: MeshToml,
+    /// The family's material (contact's E, ν), read by the family.
+    material: Option<toml::Table>,
     #[serde(default)]
     boundary: BoundaryToml,
     #[serde(default)]
@@ -376,8 +378,11 @@ struct FileToml {
 struct MeshToml {
     generator: Option<String>,
     half_width: Option<f64>,
+    #[serde(default, deserialize_with = "two")]
     x: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "two")]
     y: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "two")]
     cells: Option<[usize; 2]>,
     start: Option<f64>,
     end: Option<f64>,
@@ -397,8 +402,33 @@ struct BoundaryToml {
     simply_supported_hard: Option<toml::Value>,
     free: Option<toml::Value>,
     dirichlet: Option<toml::Value>,
+    /// `u_x = 0`: a roller along y.
+    fixed_x: Option<toml::Value>,
+    /// `u_y = 0`: a roller along x.
+    fixed_y: Option<toml::Value>,
+    /// The facet part Γ_C of a contact model ([`Family::facet_keys`]).
+    contact: Option<toml::Value>,
+    /// The loaded facet part Γ_N of a contact model.
+    load: Option<toml::Value>,
     #[serde(default)]
     roller: Vec<RollerToml>,
+}
+
+/// A pair written as a TOML array of exactly two entries: serde's arrays read the
+/// first two of a longer one and drop the rest (`x = [0, 1, 2]` solved on (0, 1)).
+fn two<'de, D, T>(deserializer: D) -> std::result::Result<Option<[T; 2]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let entries = Vec::<T>::deserialize(deserializer)?;
+    let count = entries.len();
+    <[T; 2]>::try_from(entries).map(Some).map_err(|_| {
+        serde::de::Error::custom(match count {
+            1 => "an array of one entry where two are expected".to_string(),
+            _ => format!("an array of {count} entries where two are expected"),
+        })
+    })
 }
 
 #[derive(Deserialize, Debug)]
@@ -416,6 +446,8 @@ struct ExactToml {
     gradient: Option<[String; 2]>,
     hessian: Option<[[String; 2]; 2]>,
     lambda: Option<String>,
+    /// The contact pressure on Γ_C: the multiplier of a contact model.
+    pressure: Option<String>,
     contact_force: Option<f64>,
     contact_area: Option<f64>,
 }
@@ -556,32 +588,60 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
     let number = |field: &str, value: &toml::Value| {
         finite(value).ok_or_else(|| at(field, format!("{value} is not a finite number")))
     };
+    let mut parameters = file.parameters.clone();
+    family
+        .read_file(
+            FileKeys {
+                material: file.material.as_ref(),
+                parameters: &mut parameters,
+            },
+            &mut scene,
+        )
+        .map_err(|(f, m)| at(&f, m))?;
     let mut alpha = None;
-    for (key, value) in &file.parameters {
+    for (key, value) in &parameters {
         let field = format!("parameters.{key}");
         let v = number(&field, value)?;
         if key == "alpha" || key == "α" {
+            if v < 0.0 {
+                return Err(at(
+                    &field,
+                    format!(
+                        "α = {} must be ≥ 0 (0: the plain method)",
+                        fem_runtime::problem::number(v)
+                    ),
+                ));
+            }
             alpha = Some(v);
         } else {
             scene.set_parameter(model_name(key), v);
         }
     }
     let load = read_data(&mut scene, &file.data, &model_name, path)?;
-    let scaled = model_name("f");
+    let (scaled, sign) = family.scaled_load();
+    let scaled = model_name(scaled);
     if scene.data_fn(&scaled).is_some() {
         scene.load = Some(Load {
             default: load.unwrap_or(1.0),
             scales: vec![scaled.into()],
             symbol: "q",
-            sign: crate::scene::LoadSign::Any,
+            sign,
         });
+        // the sign and the range of the file's own load, as a --load's
+        scene
+            .load_magnitude(load)
+            .map_err(|m| at("data.load", m.replace("--load", "the load")))?;
     } else if load.is_some() {
         return Err(at(
             "data.load",
-            "scales the load `f`, which the file does not give".into(),
+            format!(
+                "scales the load `{}`, which the file does not give",
+                crate::scene::data_key(&scaled)
+            ),
         ));
     }
     scene.supports = supports(&file.boundary, family).map_err(|(f, m)| at(&f, m))?;
+    scene.facets = facets(&file.boundary, family).map_err(|(f, m)| at(&f, m))?;
     check_parts(&scene).map_err(|(f, m)| at(&f, m))?;
     if let Some(e) = &file.exact {
         // the contact set is not linear in the load: the file's exact solution holds at
@@ -589,10 +649,15 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
         scene.exact = Exact::AtDefaultLoad(exact_of(e, &scene.domain, path)?);
     }
     if let Some(a) = file.accuracy {
-        if file.exact.as_ref().is_none_or(|e| e.value.is_none()) {
+        let key = family.accuracy_key();
+        let given = file.exact.as_ref().is_some_and(|e| match key {
+            "pressure" => e.pressure.is_some(),
+            _ => e.value.is_some(),
+        });
+        if !given {
             return Err(at(
                 "accuracy",
-                "an accuracy needs an `[exact] u` to measure the L² error against".into(),
+                format!("an accuracy needs an `[exact] {key}` to measure the error against"),
             ));
         }
         if !(a.is_finite() && a > 0.0) {
@@ -600,6 +665,12 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
         }
         scene.accuracy = Some(a);
     }
+    if let Some(pair) = &file.pair {
+        if let Err(e) = crate::families::pair_of(&scene, Some(pair)) {
+            return Err(at("pair", e.to_string()));
+        }
+    }
+    family.check_file(&scene).map_err(|(f, m)| at(&f, m))?;
     Ok(FileScene {
         scene,
         pair: file.pair,
@@ -688,10 +759,14 @@ fn domain_of(
             Ok((Domain::Gmsh(base.join(msh)), refinements))
         }
         (Some(generator), None) => {
+            // a rectangle of the squares the file counts is refined like a file's mesh
+            if generator == "rectangle" && mesh.cells.is_some() && mesh.size.is_none() {
+                return refined_rectangle(mesh);
+            }
             if mesh.refinements.is_some() {
                 return err(
                     "mesh.refinements",
-                    "applies to a Gmsh `file`; a generator takes `size`".into(),
+                    "applies to a Gmsh `file` or a rectangle of given `cells` (without `size`); a generator takes `size`".into(),
                 );
             }
             let interval = generator == "interval";
@@ -754,22 +829,11 @@ fn generated(
         }
         "rectangle" => {
             no_half_width("a rectangle is x × y")?;
-            let x = mesh.x.unwrap_or([0.0, 1.0]);
-            let y = mesh.y.unwrap_or(x);
-            let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
-            let fine = |s: [f64; 2]| {
-                s[0] < s[1] && s.iter().all(|c| c.is_finite() && c.abs() <= largest)
-            };
-            if !(fine(x) && fine(y)) {
-                return err(
-                    "mesh.x",
-                    format!("the sides {x:?} × {y:?} need finite ends, the first below the second, within ±{largest:e}"),
-                );
-            }
+            let [x, y] = rectangle_sides(mesh)?;
             Domain::Rectangle {
                 x,
                 y,
-                cells: mesh.cells.unwrap_or([1, 1]),
+                cells: rectangle_cells(mesh)?,
                 diagonal: fem_runtime::Diagonal::Right,
             }
         }
@@ -801,6 +865,77 @@ fn generated(
     Ok(domain)
 }
 
+/// The sides `[x, y]` of a `[mesh]` rectangle, checked; errors as `(field, message)`.
+fn rectangle_sides(mesh: &MeshToml) -> std::result::Result<[[f64; 2]; 2], (String, String)> {
+    let x = mesh.x.unwrap_or([0.0, 1.0]);
+    let y = mesh.y.unwrap_or(x);
+    let largest = fem_runtime::mesh::triangle::MAX_COORDINATE;
+    for (field, s) in [("mesh.x", x), ("mesh.y", y)] {
+        if !(s[0] < s[1] && s.iter().all(|c| c.is_finite() && c.abs() <= largest)) {
+            return Err((
+                field.into(),
+                format!(
+                    "[{}, {}] must be finite and increasing, within ±{largest:e}",
+                    s[0], s[1]
+                ),
+            ));
+        }
+    }
+    Ok([x, y])
+}
+
+/// The most squares of a rectangle's `cells` (before `size` or `refinements`).
+const MAX_RECTANGLE_SQUARES: usize = 1 << 20;
+
+/// The squares `[nx, ny]` of a `[mesh]` rectangle (`[1, 1]` by default), checked.
+fn rectangle_cells(mesh: &MeshToml) -> std::result::Result<[usize; 2], (String, String)> {
+    let [nx, ny] = mesh.cells.unwrap_or([1, 1]);
+    if !(1..=4096).contains(&nx) || !(1..=4096).contains(&ny) || nx * ny > MAX_RECTANGLE_SQUARES {
+        return Err((
+            "mesh.cells".into(),
+            format!("[{nx}, {ny}]: each from 1 to 4096, at most 2^20 squares"),
+        ));
+    }
+    Ok([nx, ny])
+}
+
+/// A rectangle of the squares `cells` names and its `refinements` (N counts them, as for
+/// a Gmsh file); errors as `(field, message)`.
+fn refined_rectangle(mesh: &MeshToml) -> std::result::Result<(Domain, usize), (String, String)> {
+    if mesh.half_width.is_some() {
+        return Err((
+            "mesh.half_width".into(),
+            "a rectangle is x × y; it takes no half_width".into(),
+        ));
+    }
+    let [x, y] = rectangle_sides(mesh)?;
+    let [nx, ny] = rectangle_cells(mesh)?;
+    let refinements = mesh.refinements.unwrap_or(0);
+    if refinements > MAX_REFINEMENTS {
+        return Err((
+            "mesh.refinements".into(),
+            format!("{refinements} uniform refinements (4^{refinements} times the triangles): at most {MAX_REFINEMENTS}"),
+        ));
+    }
+    let coarsest =
+        TriangleMesh::rectangle(x[0], x[1], y[0], y[1], nx, ny, fem_runtime::Diagonal::Right)
+            .map_err(|e| ("mesh".to_string(), e.to_string()))?;
+    let description = format!(
+        "rectangle ({},{})×({},{}) of {nx}×{ny} squares",
+        fem_runtime::problem::number(x[0]),
+        fem_runtime::problem::number(x[1]),
+        fem_runtime::problem::number(y[0]),
+        fem_runtime::problem::number(y[1])
+    );
+    Ok((
+        Domain::Refined {
+            mesh: std::sync::Arc::new(coarsest),
+            description: description.into(),
+        },
+        refinements,
+    ))
+}
+
 /// The generator's name in the scene file.
 fn generator_name(domain: &Domain) -> &'static str {
     match domain {
@@ -809,6 +944,7 @@ fn generator_name(domain: &Domain) -> &'static str {
         Domain::Rectangle { .. } => "rectangle",
         Domain::LShape => "l-shape",
         Domain::Disk { .. } => "disk",
+        Domain::Refined { .. } => "rectangle",
         Domain::Gmsh(_) | Domain::Generated(_) => "file",
     }
 }
@@ -883,12 +1019,37 @@ fn supports(
             });
         }
     }
+    // u_x = 0 holds the displacement along (1, 0): a roller of that normal
+    for (key, value, normal) in [
+        ("fixed_x", &b.fixed_x, [1.0, 0.0]),
+        ("fixed_y", &b.fixed_y, [0.0, 1.0]),
+    ] {
+        if let Some(v) = value {
+            let field = format!("boundary.{key}");
+            let part = part_of(key, v).map_err(|m| (field.clone(), m))?;
+            out.push(PartSupport {
+                part,
+                support: Support::Roller { normal },
+                key: Some(field.into()),
+            });
+        }
+    }
     for (k, r) in b.roller.iter().enumerate() {
         let field = format!("boundary.roller[{k}]");
         let part = part_of("roller", &r.part).map_err(|m| (field.clone(), m))?;
+        let [nx, ny] = r.normal;
+        let length = nx.hypot(ny);
+        if !(length.is_finite() && length > 0.0) {
+            return Err((
+                format!("{field}.normal"),
+                format!("({nx}, {ny}) must be a non-zero finite vector"),
+            ));
+        }
         out.push(PartSupport {
             part,
-            support: Support::Roller { normal: r.normal },
+            support: Support::Roller {
+                normal: [nx / length, ny / length],
+            },
             key: Some(field.into()),
         });
     }
@@ -916,6 +1077,47 @@ fn supports(
                 support,
                 key: Some(key.into()),
             });
+        }
+    }
+    Ok(out)
+}
+
+/// The model's facet parts of `[boundary]` ([`Family::facet_keys`]): each the family
+/// has is required, and a family without facet parts takes none.
+fn facets(
+    b: &BoundaryToml,
+    family: &dyn Family,
+) -> std::result::Result<Vec<(crate::scene::Name, Part)>, (String, String)> {
+    let keys = family.facet_keys();
+    let mut out = Vec::new();
+    for (key, value) in [("contact", &b.contact), ("load", &b.load)] {
+        let field = format!("boundary.{key}");
+        match (keys.iter().find(|(k, _)| *k == key), value) {
+            (Some((_, facet)), Some(v)) => {
+                let part = match v {
+                    toml::Value::Array(list) if list.is_empty() => {
+                        return Err((field, "name at least one boundary part".into()))
+                    }
+                    v => part_of(key, v).map_err(|m| (field.clone(), m))?,
+                };
+                out.push(((*facet).into(), part));
+            }
+            (Some(_), None) => {
+                return Err((
+                    "boundary".into(),
+                    format!("the {} family needs `{key}` = the boundary part(s) of its {}", family.name(), if key == "contact" { "contact boundary Γ_C" } else { "loaded boundary Γ_N" }),
+                ))
+            }
+            (None, Some(_)) => {
+                return Err((
+                    field,
+                    format!(
+                        "the {} family has no {key} boundary (contact bodies do): its supports are clamped, simply_supported, simply_supported_hard, free, dirichlet and rollers",
+                        family.name()
+                    ),
+                ))
+            }
+            (None, None) => {}
         }
     }
     Ok(out)
@@ -964,6 +1166,16 @@ fn check_points(domain: &Domain) -> Vec<[f64; 2]> {
     let (x, y) = match domain {
         Domain::Interval { start, end } => ([*start, *end], [0.0, 0.0]),
         Domain::Rectangle { x, y, .. } => (*x, *y),
+        Domain::Refined { mesh, .. } => {
+            let box_of = |k: usize| {
+                mesh.vertices()
+                    .iter()
+                    .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
+                        [lo.min(v[k]), hi.max(v[k])]
+                    })
+            };
+            (box_of(0), box_of(1))
+        }
         Domain::Disk { centre, radius, .. } => {
             let r = radius / std::f64::consts::SQRT_2;
             (
@@ -1045,12 +1257,19 @@ fn exact_of(e: &ExactToml, domain: &Domain, path: &Path) -> Result<ExactSolution
         2
     };
     let points = check_points(domain);
+    let multiplier = match (&e.lambda, &e.pressure) {
+        (Some(_), Some(_)) => {
+            return Err(at(
+                "exact.pressure",
+                "the multiplier is given twice: `lambda` and `pressure` name the same λ".into(),
+            ))
+        }
+        (Some(l), None) => Some(expression(l, "exact.lambda", path)?),
+        (None, Some(p)) => Some(expression(p, "exact.pressure", path)?),
+        (None, None) => None,
+    };
     let mut out = ExactSolution {
-        multiplier: e
-            .lambda
-            .as_deref()
-            .map(|l| expression(l, "exact.lambda", path))
-            .transpose()?,
+        multiplier,
         total_contact_force: e.contact_force.map(|v| v + 0.0),
         contact_area: e.contact_area.map(|v| v + 0.0),
         ..ExactSolution::default()

@@ -6,23 +6,30 @@
 //! against Hertz's pressure where the scene has it, the relative L² error, the best
 //! fit's and the checkerboard measure.
 
+mod facts;
+mod file;
+
 use crate::contact_scenes::{
     compare_gap_block, gap_block_mesh, ContactBody, ContactScene, CONTACT_SCENES,
 };
 use crate::data::Data;
-use crate::family::{Family, Opt, Pair};
+use crate::family::{Family, FieldError, FileKeys, Opt, Pair};
 use crate::report::{Profile, Report};
 use crate::run::{run, Quantities, Run};
-use crate::scene::{Domain, Generator, Load, Part, PartSupport, Posed, Scene, Support};
+use crate::scene::{Domain, Generator, Load, LoadSign, Part, PartSupport, Posed, Scene, Support};
 use crate::signorini::{
-    self, checkerboard, compare_with_hertz, hertz_mesh, lame, signorini_p1, signorini_p1_p1,
-    signorini_p2, signorini_p2_p1, Displacement, Hertz, Multiplier, Plane, SignoriniInput,
-    SignoriniSolution,
+    self, checkerboard, compare_with_hertz, contact_tangent, hertz_mesh, lame, signorini_p1,
+    signorini_p1_p1, signorini_p2, signorini_p2_p1, Displacement, Multiplier, Plane,
+    SignoriniInput, SignoriniSolution,
 };
+pub use facts::{material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
 use fem_runtime::obstacle::{Discretization, FirstStart};
 use fem_runtime::problem::ALPHA_WHEN_CI_VANISHES;
 use fem_runtime::stabilization::Alpha;
-use fem_runtime::{DirichletPart, Error, Model, Result, TriangleMesh};
+use fem_runtime::{DirichletPart, Error, Model, TriangleMesh};
+use file::DataScales;
+
+type Result<T, E = Error> = std::result::Result<T, E>;
 use std::sync::Arc;
 
 /// The contact family.
@@ -30,11 +37,6 @@ pub struct Contact;
 
 /// The registry's contact family.
 pub static CONTACT: Contact = Contact;
-
-/// The contact boundary's name in the model's `facets:`.
-pub const CONTACT_PART: &str = "Γ_C";
-/// The loaded boundary's name in the model's `facets:`.
-pub const LOAD_PART: &str = "Γ_N";
 
 /// The contact half-widths `b/R` the Hertz scenes accept (`--load`): Hertz's theory
 /// wants b ≪ R (at b/R = 0.34 the peak was 2 % low, at 3.4 the error 91 %), and below
@@ -73,51 +75,6 @@ pub const EQUILIBRIUM_WARNING: f64 = 1e-8;
 /// discretization error of λ_h.
 pub const QUADRATURE_WARNING: f64 = 1e-6;
 
-/// What a contact scene poses beyond its parameters and data: the material as its user
-/// gives it, the foundation's direction, and the built-in body where the scene is one
-/// (its reference: Hertz's pressure, the patch test's).
-#[derive(Clone, Copy, Debug)]
-pub struct ContactFacts {
-    /// Young's modulus E (force per area).
-    pub young: f64,
-    /// Poisson's ratio ν.
-    pub poisson: f64,
-    /// Plane strain or plane stress.
-    pub plane: Plane,
-    /// The contact direction `n_c` (unit): the foundation's normal pointing away from
-    /// the body.
-    pub direction: [f64; 2],
-    /// The middle of the contact zone along the contact plane (a symmetry line), for the
-    /// half-width; `None`: the middle of the pressed edges.
-    pub centre: Option<f64>,
-    /// The built-in body, where the scene is one.
-    pub body: Option<ContactBody>,
-}
-
-impl ContactFacts {
-    /// The Hertz reference at load `load`, for the bodies that have one.
-    pub fn hertz(&self, load: f64) -> Option<Hertz> {
-        let radius = match self.body? {
-            ContactBody::Cylinder { radius } | ContactBody::GapBlock { radius, .. } => radius,
-            ContactBody::Block { .. } => return None,
-        };
-        Some(Hertz {
-            radius,
-            young: self.young,
-            poisson: self.poisson,
-            load,
-        })
-    }
-
-    /// The share of the body solved: a half (a symmetry line) counts twice.
-    fn whole(&self) -> f64 {
-        match self.body {
-            Some(ContactBody::Cylinder { .. } | ContactBody::GapBlock { .. }) => 2.0,
-            _ => 1.0,
-        }
-    }
-}
-
 const fn pair(name: &'static str, note: &'static str, solve: crate::family::PairSolve) -> Pair {
     Pair {
         name,
@@ -153,21 +110,6 @@ static PAIRS: [Pair; 4] = [
         run::<signorini_p2_p1::Model, TriangleMesh, Contact>,
     ),
 ];
-
-/// The scene's parameters of the material and the direction: the Lamé parameters of E
-/// and ν, and `n_c`.
-///
-/// # Errors
-/// E, ν out of range ([`lame`]).
-pub fn material_parameters(facts: &ContactFacts) -> Result<Vec<(&'static str, f64)>> {
-    let (mu, lambda) = lame(facts.young, facts.poisson, facts.plane)?;
-    Ok(vec![
-        ("μ_L", mu),
-        ("λ_L", lambda),
-        ("n_c_x", facts.direction[0]),
-        ("n_c_y", facts.direction[1]),
-    ])
-}
 
 /// The registry's scene of a built-in contact body.
 fn contact_scene(old: &ContactScene) -> Scene {
@@ -344,6 +286,27 @@ impl Family for Contact {
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[("pressure", "q"), ("gap", "g")]
     }
+
+    fn facet_keys(&self) -> &'static [(&'static str, &'static str)] {
+        &[("contact", CONTACT_PART), ("load", LOAD_PART)]
+    }
+
+    fn scaled_load(&self) -> (&'static str, LoadSign) {
+        ("q", LoadSign::Positive)
+    }
+
+    fn accuracy_key(&self) -> &'static str {
+        "pressure"
+    }
+
+    fn read_file(&self, keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
+        file::read(keys, scene)
+    }
+
+    fn check_file(&self, scene: &Scene) -> Result<(), FieldError> {
+        let facts = facts(scene).map_err(|e| ("material".to_string(), e.to_string()))?;
+        file::check(scene, &facts)
+    }
 }
 
 /// The scene's own description; scenes of this family always carry one.
@@ -439,13 +402,44 @@ impl Quantities<TriangleMesh> for Contact {
         let loaded = facet_markers(scene, mesh, LOAD_PART)?;
         let pressure = pressure_of(scene, posed);
         let input = input(&facts, &contact, &loaded, pressure.as_data_fn(), &zero);
-        signorini::refuse_pressure_on_contact(mesh, &input)
+        signorini::refuse_pressure_on_contact(mesh, &input)?;
+        let scales = DataScales::of(
+            mesh,
+            &contact,
+            &loaded,
+            &data_of(scene, "q"),
+            &data_of(scene, "g"),
+            facts.young,
+            file::translation_held(scene, &facts),
+        );
+        let load = posed.load.unwrap_or(1.0);
+        // the scene's own load passed these checks when it was read: here the load is
+        // the command line's
+        let given = if scene.load.as_ref().is_some_and(|l| l.default != load) {
+            format!(" with --load {}", fem_runtime::problem::number(load))
+        } else {
+            String::new()
+        };
+        scales.check(load).map_err(|(key, m)| {
+            Error::Input(format!("scene `{}`{given}: field `{key}`: {m}", scene.name))
+        })
     }
 
     fn start(scene: &Scene, _: &Posed) -> Option<Box<FirstStart<'static, TriangleMesh>>> {
         let direction = facts(scene).ok()?.direction;
+        let name = scene.name.to_string();
         Some(Box::new(move |d: &Discretization<TriangleMesh>| {
-            signorini::pressed_start(d, direction)
+            // a load that does not hold the body on its foundation is the pressure's
+            // fault: named by its key
+            signorini::pressed_start(d, direction).map_err(|e| match e {
+                Error::Input(m)
+                    if m.contains("rigid motion is not prevented")
+                        || m.contains("tips the body") =>
+                {
+                    Error::Input(format!("scene `{name}`: field `data.pressure`: {m}"))
+                }
+                other => other,
+            })
         }))
     }
 
@@ -464,13 +458,28 @@ impl Quantities<TriangleMesh> for Contact {
             gap.as_data_fn(),
         );
         let solution = signorini::report::<M>(&input, facts.direction, run.solved)?;
-        add_quantities(&facts, run, &solution, report);
+        // the pressure's size, which the equilibrium's rounding is relative to
+        let magnitude = pressure_of(run.scene, run.posed);
+        let magnitude = file::resultant_and_magnitude(mesh, &loaded, &magnitude).1;
+        add_quantities(&facts, run, &solution, magnitude, report);
+        for (name, part) in &run.scene.facets {
+            let key = if name == CONTACT_PART {
+                "boundary.contact"
+            } else {
+                "boundary.load"
+            };
+            for w in crate::geometry::Geometry::interior_part_warnings(mesh, &part.names()) {
+                report.warn(format!("{key}: {w}"));
+            }
+        }
         Ok(())
     }
 
     fn profile<M: Model>(run: &Run<'_, M, TriangleMesh>, report: &Report) -> Option<Profile> {
         let facts = facts(run.scene).ok()?;
-        let hertz = facts.hertz(run.posed.load?)?;
+        let Some(hertz) = facts.hertz(run.posed.load?) else {
+            return exact_profile(run, &facts);
+        };
         let b = hertz.half_width();
         let mut computed: Vec<(f64, f64, f64)> = pressure_steps(run);
         computed.retain(|e| e.0 <= 1.5 * b);
@@ -539,12 +548,64 @@ fn input<'a>(
     }
 }
 
-/// The pressure along Γ_C as steps `(x0, x1, λ)` sorted by x0 (see [`Profile`]).
+/// The chart of the pressure along Γ_C, against a scene's exact pressure (a scene
+/// file's `[exact] pressure`) where it has one at the load solved.
+fn exact_profile<M: Model>(
+    run: &Run<'_, M, TriangleMesh>,
+    facts: &ContactFacts,
+) -> Option<Profile> {
+    let boundary = run.solved.solution.discretization.boundary()?;
+    let along = contact_tangent(facts.direction);
+    let reference = run
+        .scene
+        .exact_at(run.posed)
+        .and_then(|e| e.multiplier)
+        .map(|exact| {
+            let mut samples: Vec<(f64, f64)> = boundary
+                .edges
+                .iter()
+                .flat_map(|e| {
+                    (0..=8).map(|i| {
+                        let x = file::point(&e.ends, i as f64 / 8.0);
+                        (along[0] * x[0] + along[1] * x[1], exact.at(&x))
+                    })
+                })
+                .collect();
+            samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+            ("exact pressure".to_string(), samples)
+        })
+        .or_else(|| {
+            // the patch test's exact pressure is the load q on every edge
+            let Some(ContactBody::Block { .. }) = facts.body else {
+                return None;
+            };
+            let q = run.posed.load?;
+            let ends = boundary.edges.iter().flat_map(|e| e.ends);
+            let (lo, hi) = ends
+                .map(|x| along[0] * x[0] + along[1] * x[1])
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+                    (lo.min(s), hi.max(s))
+                });
+            Some(("exact pressure q".to_string(), vec![(lo, q), (hi, q)]))
+        });
+    Some(Profile {
+        title: format!("{}: contact pressure", run.scene.name),
+        x: "coordinate along the contact plane",
+        y: "pressure",
+        computed: (format!("λ_h ({})", run.pair.name), pressure_steps(run)),
+        reference,
+    })
+}
+
+/// The pressure along Γ_C as steps `(s0, s1, λ)` sorted by s0, s the coordinate along
+/// the contact plane ([`contact_tangent`]: x under a horizontal one; see [`Profile`]).
 fn pressure_steps<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Vec<(f64, f64, f64)> {
     let solution = &run.solved.solution;
     let Some(boundary) = solution.discretization.boundary() else {
         return Vec::new();
     };
+    let along = facts(run.scene).map_or([1.0, 0.0], |f| contact_tangent(f.direction));
+    let coordinate = |x: [f64; 2]| along[0] * x[0] + along[1] * x[1];
     let pressure = solution.multiplier_values();
     let mut steps: Vec<(f64, f64, f64)> = match boundary.space {
         Multiplier::P0 => boundary
@@ -552,7 +613,7 @@ fn pressure_steps<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Vec<(f64, f64, f6
             .iter()
             .zip(pressure)
             .map(|(e, &p)| {
-                let (a, b) = (e.ends[0][0], e.ends[1][0]);
+                let (a, b) = (coordinate(e.ends[0]), coordinate(e.ends[1]));
                 (a.min(b), a.max(b), p)
             })
             .collect(),
@@ -560,7 +621,8 @@ fn pressure_steps<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Vec<(f64, f64, f6
             let mut points = vec![(0.0, 0.0, 0.0); pressure.len()];
             for (e, dofs) in boundary.edges.iter().zip(&boundary.edge_dofs) {
                 for (end, &k) in e.ends.iter().zip(dofs) {
-                    points[k] = (end[0], end[0], pressure[k]);
+                    let s = coordinate(*end);
+                    points[k] = (s, s, pressure[k]);
                 }
             }
             points
@@ -571,10 +633,15 @@ fn pressure_steps<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Vec<(f64, f64, f6
 }
 
 /// The family's quantities and warnings.
+///
+/// `magnitude` is `∫_Γ_N |q| ds` of the pressure solved, the size the equilibrium's
+/// rounding is relative to (a resultant of 1e-9 ∫|q| leaves the contact force the
+/// rounding of ∫|q|, which is no failure of the solve).
 fn add_quantities<M: Model>(
     facts: &ContactFacts,
     run: &Run<'_, M, TriangleMesh>,
     solution: &SignoriniSolution,
+    magnitude: f64,
     report: &mut Report,
 ) {
     let factor = facts.whole();
@@ -583,8 +650,15 @@ fn add_quantities<M: Model>(
     let total = factor * along(solution.total_contact_force);
     // the load's resultant pushes the body towards the foundation, along n_c
     let applied = -factor * along(solution.applied_load);
-    let discretized = factor * solution.discretized_load;
-    let equilibrium = (total - discretized).abs() / discretized.abs();
+    // supports along n_c carry part of the load, and the translation the load is
+    // measured on has their DOFs fixed: no resultant to balance (NaN, null in JSON)
+    let held = file::translation_held(run.scene, facts);
+    let discretized = if held {
+        f64::NAN
+    } else {
+        factor * solution.discretized_load
+    };
+    let equilibrium = (total - discretized).abs() / discretized.abs().max(factor * magnitude);
     report.set("young", facts.young);
     report.set("poisson", facts.poisson);
     report.set(
@@ -605,6 +679,11 @@ fn add_quantities<M: Model>(
         report.warn(format!(
             "the contact force misses the load as discretized by {equilibrium:.1e} (relative; a rigid translation lies in V_h, so it should be rounding): the solve did not reach solver precision, or the data's scales (a gap far beyond the elastic displacement) leave the displacement too few digits"
         ));
+    }
+    if held {
+        report.warn(
+            "supports hold the body along the contact direction and carry part of the load: the contact force need not balance it, and no equilibrium is checked (discretized_load and equilibrium_residual are null)",
+        );
     }
     let quadrature = (discretized - applied).abs() / applied.abs();
     if quadrature > QUADRATURE_WARNING {
@@ -660,6 +739,35 @@ fn add_quantities<M: Model>(
                 report.set("oscillation", oscillation);
             }
         }
-        _ => {}
+        _ => add_exact_pressure(run, solution, report),
+    }
+}
+
+/// The pressure's errors against a scene's exact pressure (a scene file's `[exact]
+/// pressure`) at the load solved: the relative L² error, the best P0 fit's and the
+/// checkerboard measure.
+fn add_exact_pressure<M: Model>(
+    run: &Run<'_, M, TriangleMesh>,
+    solution: &SignoriniSolution,
+    report: &mut Report,
+) {
+    let Some(exact) = run.scene.exact_at(run.posed).and_then(|e| e.multiplier) else {
+        return;
+    };
+    if solution.multiplier == Multiplier::P0 {
+        let edges: Vec<([[f64; 2]; 2], f64)> = solution
+            .contact_edges
+            .iter()
+            .zip(&solution.pressure)
+            .map(|(e, &p)| (e.ends, p))
+            .collect();
+        let [error, best] = file::pressure_errors(&edges, &exact);
+        report.set("pressure_l2_error", error);
+        report.set("best_p0_l2_error", best);
+        report.set("best_fit_l2_error", best);
+    }
+    let direction = facts(run.scene).map_or([0.0, -1.0], |f| f.direction);
+    if let Some(o) = signorini::checkerboard_against(solution, direction, exact.as_data_fn()) {
+        report.set("oscillation", o);
     }
 }
