@@ -17,7 +17,6 @@ pub mod membranes;
 pub mod plates;
 pub mod plot;
 pub mod registry_studies;
-pub mod signorini;
 pub mod studies;
 
 pub use fem_models as models;

@@ -9,7 +9,6 @@ use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind};
 use fem_forms::plates;
 use fem_forms::plot;
-use fem_forms::signorini as contact;
 use fem_forms::studies::{self, Study};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -363,10 +362,6 @@ fn study_scene(entry: &SceneEntry) -> fem_forms::Result<Box<dyn studies::StudySc
             "Kirchhoff scene `{}` runs its studies in fem_forms::kirchhoff",
             s.name
         ))),
-        SceneKind::Contact(s) => Err(fem_forms::Error::Input(format!(
-            "contact scene `{}` runs its studies in fem_forms::signorini",
-            s.name
-        ))),
     }
 }
 
@@ -426,14 +421,6 @@ fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(
     if let SceneKind::Kirchhoff(scene) = &entry.kind {
         return run_kirchhoff_study(*scene, kind, full, out)
             .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
-    }
-    if let SceneKind::Contact(scene) = &entry.kind {
-        let result = match kind {
-            "convergence" => contact::convergence_study(*scene, full, out),
-            "alpha" => contact::alpha_study(*scene, if full { 64 } else { 16 }, out),
-            _ => return Err(format!("unknown contact study `{kind}`")),
-        };
-        return result.map_err(|e| format!("study {} {kind}: {e}", entry.name()));
     }
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
     // the plate studies are the plate's own (the generic kinds need exact solutions of
@@ -610,10 +597,21 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
             .into_iter()
             .filter(|e| e.studies.contains(&name))
             .collect();
-        if hosts.is_empty() {
+        // and the scenes of the families studied through the one pipeline
+        let registry_hosts: Vec<fem_forms::models::scene::Scene> =
+            fem_forms::models::families::scenes()
+                .into_iter()
+                .filter(|s| find(&s.name).is_none() && s.studies.contains(&name))
+                .collect();
+        if hosts.is_empty() && registry_hosts.is_empty() {
             let mut kinds: Vec<&str> = registry()
                 .iter()
                 .flat_map(|e| e.studies.iter().copied())
+                .chain(
+                    fem_forms::models::families::scenes()
+                        .iter()
+                        .flat_map(|s| s.studies.clone()),
+                )
                 .collect();
             kinds.sort_unstable();
             kinds.dedup();
@@ -624,6 +622,9 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
         }
         for entry in &hosts {
             run_study(entry, name, full, out)?;
+        }
+        for scene in registry_hosts {
+            registry_study(scene, Some(name), full, out)?;
         }
         return Ok(());
     };

@@ -49,12 +49,32 @@ impl RegistryStudies {
         sizes
     }
 
+    /// The family's own error measure of the multiplier ([`crate::models::family::Family::error_measure`]).
+    fn family_measure(&self) -> Option<(&'static str, &'static str)> {
+        families::family(self.scene.family)?.error_measure()
+    }
+
     fn unsupported(&self, what: &str) -> Error {
         Error::Input(format!(
             "scene `{}` (family {}) has no {what}: it is a family's own study",
             self.scene.name, self.scene.family
         ))
     }
+}
+
+/// The piecewise linear interpolant of `samples` (sorted by x) at `x`; 0 outside.
+fn interpolate(samples: &[(f64, f64)], x: f64) -> f64 {
+    samples
+        .windows(2)
+        .find(|w| w[0].0 <= x && x <= w[1].0)
+        .map_or(0.0, |w| {
+            let width = w[1].0 - w[0].0;
+            if width > 0.0 {
+                w[0].1 + (x - w[0].0) / width * (w[1].1 - w[0].1)
+            } else {
+                w[0].1
+            }
+        })
 }
 
 /// The largest cell diameter of a solve's mesh.
@@ -97,7 +117,12 @@ impl StudyScene for RegistryStudies {
     }
 
     fn contact_names(&self) -> [&'static str; 2] {
-        ["contact area", "|area error|"]
+        // a multiplier on a boundary part touches along a length
+        if self.scene.facets.is_empty() {
+            ["contact area", "|area error|"]
+        } else {
+            ["contact length", "|length error|"]
+        }
     }
 
     fn pairs(&self) -> Vec<&'static str> {
@@ -163,7 +188,12 @@ impl StudyScene for RegistryStudies {
             alpha: s.alpha.unwrap_or(0.0),
             error_l2: s.error_l2,
             error_h1: s.error_h1,
-            error_multiplier: s.error_multiplier,
+            // the family's own measure of the multiplier where the runtime has none
+            // (contact's pressure error against Hertz's)
+            error_multiplier: s.error_multiplier.or_else(|| {
+                self.family_measure()
+                    .and_then(|(key, _)| outcome.report.number(key))
+            }),
             total_contact_force: s.total_contact_force,
             force_error: r
                 .exact_contact_force
@@ -207,12 +237,41 @@ impl StudyScene for RegistryStudies {
         Err(self.unsupported("stability measure"))
     }
 
-    fn multiplier_profile(&self, _run: &Run) -> Result<Vec<(f64, f64)>> {
-        Err(self.unsupported("multiplier profile"))
+    /// The family's chart of the multiplier along its boundary part ([`crate::models::report::Profile`]), as
+    /// points: each P0 step at its middle.
+    fn multiplier_profile(&self, run: &Run) -> Result<Vec<(f64, f64)>> {
+        let profile = self
+            .outcome(run)?
+            .profile
+            .ok_or_else(|| self.unsupported("multiplier profile"))?;
+        Ok(profile
+            .computed
+            .1
+            .iter()
+            .map(|&(x0, x1, lambda)| (0.5 * (x0 + x1), lambda))
+            .collect())
     }
 
+    /// The reference curve of the family's chart at the default solve, interpolated.
     fn exact_multiplier(&self) -> Option<ExactMultiplier> {
-        None
+        let run = Run::new(self.pairs()[0], self.scene.mesh_size);
+        let (_, samples) = self.outcome(&run).ok()?.profile?.reference?;
+        let touching: Vec<f64> = samples.iter().filter(|p| p.1 > 0.0).map(|p| p.0).collect();
+        let contact = [
+            touching.iter().copied().fold(f64::INFINITY, f64::min),
+            touching.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        ];
+        Some(ExactMultiplier {
+            contact,
+            lambda: Box::new(move |x| interpolate(&samples, x)),
+        })
+    }
+
+    fn multiplier_error_name(&self) -> String {
+        self.family_measure()
+            .map_or("h-weighted ‖λ − λ_h‖".into(), |(_, words)| {
+                words.into()
+            })
     }
 
     fn profile_window(&self) -> [f64; 2] {

@@ -220,6 +220,10 @@ pub trait StudyScene {
     fn exact_multiplier(&self) -> Option<ExactMultiplier>;
     /// The x range of the profile chart.
     fn profile_window(&self) -> [f64; 2];
+    /// What [`Row::error_multiplier`] measures, for tables and charts.
+    fn multiplier_error_name(&self) -> String {
+        "h-weighted ‖λ − λ_h‖".into()
+    }
     /// The locking study (Timoshenko beams only).
     fn locking(&self, _full: bool, _out: &Path) -> Result<()> {
         Err(Error::Input(format!(
@@ -422,9 +426,17 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
                 r.cells,
                 r.dofs,
                 cell(l2[k], 11),
-                rate(&rl2),
+                if l2[k].is_nan() {
+                    "-".into()
+                } else {
+                    rate(&rl2)
+                },
                 cell(h1[k], 11),
-                rate(&rh1),
+                if h1[k].is_nan() {
+                    "-".into()
+                } else {
+                    rate(&rh1)
+                },
                 cell(lm[k], 11),
                 if lm[k].is_nan() {
                     "-".into()
@@ -827,10 +839,11 @@ fn run_alpha(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
     // sentinels f64::MAX and f64::MIN (a log axis over them never finished its ticks)
     let (low, high) = if low <= high { (low, high) } else { (0.1, 1.0) };
     let marker = |a: f64| vec![(a, low.max(1e-12)), (a, high)];
+    let multiplier_error = scene.multiplier_error_name();
     let labels = [
         "‖u − u_h‖_L2",
         "|u − u_h|_H1",
-        "h-weighted ‖λ − λ_h‖",
+        multiplier_error.as_str(),
         "|∫λ_h − ∫λ|",
     ];
     let mut series: Vec<Series> = labels
@@ -899,12 +912,80 @@ fn run_alpha(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
         ],
     )
     .map_err(io)?;
+    alpha_profiles(scene, (pair, n), &rows, c_i, out)?;
     write_csv(
         &output(out, &name, Study::Alpha, "csv"),
         "alpha,alpha_times_CI,error_l2,error_h1,error_multiplier,force_error,contact,total_contact_force,solved",
         &csv,
     )
     .map_err(io)
+}
+
+/// The α study's second chart, `<scene>-alpha-profiles.svg`, where the family draws
+/// the multiplier along a line: λ_h of the plain method, of the default α and of the
+/// largest α of the sweep that solved, beside the exact λ where known (oscillation
+/// without stabilization, a shifted contact set with too much). Nothing where the
+/// family has no profile.
+fn alpha_profiles(
+    scene: &dyn StudyScene,
+    (pair, n): (&'static str, usize),
+    rows: &[AlphaRow],
+    c_i: f64,
+    out: &Path,
+) -> Result<()> {
+    let Ok(default) = multiplier_profile(scene, pair, n, None) else {
+        return Ok(());
+    };
+    let mut series = vec![Series::marked("default α", default)];
+    if let Ok(plain) = multiplier_profile(scene, pair, n, Some(0.0)) {
+        series.push(Series::marked("plain, α = 0", plain));
+    }
+    let largest = rows
+        .iter()
+        .filter(|r| r.result.is_ok() && r.alpha > 0.0)
+        .map(|r| r.alpha)
+        .fold(0.0, f64::max);
+    if largest > 0.0 {
+        if let Ok(p) = multiplier_profile(scene, pair, n, Some(largest)) {
+            let label = if c_i > 0.0 {
+                format!("largest that solved, α·C_I = {:.3}", largest * c_i)
+            } else {
+                format!("largest that solved, α = {largest:.3e}")
+            };
+            series.push(Series::marked(label, p));
+        }
+    }
+    let xs = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+    if let (Some(e), true) = (scene.exact_multiplier(), xs.0 < xs.1) {
+        let samples = (0..=400)
+            .map(|i| {
+                let x = xs.0 + (xs.1 - xs.0) * i as f64 / 400.0;
+                (x, (e.lambda)(x))
+            })
+            .collect();
+        series.push(Series::line("exact λ", samples));
+    }
+    let name = scene.name();
+    let path = out.join(format!("{name}-alpha-profiles.svg"));
+    plot::chart(
+        &path,
+        &format!(
+            "{name}, {pair}, {} = {n}: λ_h for α = 0, the default and the largest",
+            scene.size_name()
+        ),
+        Axes {
+            x: "x",
+            y: "λ_h",
+            ..Axes::default()
+        },
+        &series,
+    )
+    .map_err(io)?;
+    println!("→ {}", path.display());
+    Ok(())
 }
 
 /// The solvers of the work–precision study: name, solver, nested iteration.

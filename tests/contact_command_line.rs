@@ -179,6 +179,31 @@ fn the_hertz_study_and_chart_are_written() {
     let csv = std::fs::read_to_string(out.join("hertz-alpha.csv")).unwrap();
     assert!(csv.lines().count() >= 9, "{csv}");
     assert!(out.join("hertz-alpha.svg").exists());
+    // the chart of λ_h for the plain, the default and the largest α, against Hertz's
+    let profiles = std::fs::read_to_string(out.join("hertz-alpha-profiles.svg")).unwrap();
+    assert!(profiles.contains("plain") && profiles.contains("exact λ"));
+    // the one convergence study charts the family's measure of the multiplier: the
+    // pressure's error against Hertz, the single solve's at each b/h
+    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(["study", "hertz", "convergence", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let csv = std::fs::read_to_string(out.join("hertz-convergence.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let row = csv
+        .lines()
+        .find(|l| l.starts_with("p1-p0,8,"))
+        .expect("p1-p0 at b/h = 8");
+    let cells: Vec<&str> = row.split(',').collect();
+    let error: f64 = cells[column("error_multiplier")].parse().unwrap();
+    let single = solve_json("hertz", &["--mesh-size", "8"]);
+    assert!(
+        (error - number(&single, "pressure_l2_error")).abs() <= 1e-12,
+        "{row}"
+    );
     let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(["solve", "hertz", "--plot", "--mesh-size", "8", "--out"])
         .arg(&out)

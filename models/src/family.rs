@@ -195,6 +195,13 @@ pub trait Family: Sync {
         ("f", LoadSign::Any)
     }
 
+    /// The family's own error measure of the multiplier, where it has one, as the
+    /// report's key and words (contact's relative L² error of the pressure): what a
+    /// scene's `accuracy` asks of, and what the studies chart as the multiplier's error.
+    fn error_measure(&self) -> Option<(&'static str, &'static str)> {
+        None
+    }
+
     /// The `[exact]` key of the quantity a scene file's `accuracy` is measured on (`u`;
     /// contact's `pressure`).
     fn accuracy_key(&self) -> &'static str {

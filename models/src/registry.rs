@@ -8,7 +8,6 @@
 //! what the registry adds to it: the element pairs it can be solved with (the first is
 //! the default) and the studies it hosts.
 
-use crate::contact_scenes::{ContactScene, CONTACT_SCENES};
 use crate::kirchhoff_scenes::{KirchhoffScene, KIRCHHOFF_SCENES};
 use crate::membrane_scenes::{MembraneScene, MEMBRANE_FLAT, MEMBRANE_SCENES};
 use crate::plate_scenes::{PlateScene, PlateSupport, PLATE_SCENES};
@@ -26,8 +25,6 @@ pub enum Family {
     Plate,
     /// Kirchhoff plates (Argyris, Morley) on triangle meshes, with or without an obstacle.
     Kirchhoff,
-    /// Signorini contact: an elastic body on a rigid foundation.
-    Contact,
 }
 
 impl Family {
@@ -38,7 +35,6 @@ impl Family {
             Family::Membrane => "membrane",
             Family::Plate => "plate",
             Family::Kirchhoff => "kirchhoff",
-            Family::Contact => "contact",
         }
     }
 }
@@ -54,8 +50,6 @@ pub enum SceneKind {
     Plate(PlateScene),
     /// A Kirchhoff plate scene.
     Kirchhoff(KirchhoffScene),
-    /// A Signorini contact scene.
-    Contact(ContactScene),
 }
 
 /// One registry entry: the scene and what can be done with it.
@@ -82,8 +76,6 @@ pub const MEMBRANE_PAIRS: &[&str] = &["p2-p0", "p1-p0", "p2-p1d", "p1-nodal"];
 pub const PLATE_PAIRS: &[&str] = &["p1-p2-p0", "p1-p1-p0-plain"];
 /// The Kirchhoff pairs (w, λ), default first.
 pub const KIRCHHOFF_PAIRS: &[&str] = &["argyris-p0", "argyris-p1disc", "morley-p0"];
-/// The contact pairs (u, λ on Γ_C), default first.
-pub const CONTACT_PAIRS: &[&str] = &["p1-p0", "p2-p0"];
 
 impl SceneEntry {
     /// The scene's name.
@@ -93,7 +85,6 @@ impl SceneEntry {
             SceneKind::Membrane(s) => s.name.clone(),
             SceneKind::Plate(s) => Cow::Borrowed(s.name),
             SceneKind::Kirchhoff(s) => Cow::Borrowed(s.name),
-            SceneKind::Contact(s) => Cow::Borrowed(s.name),
         }
     }
 
@@ -104,7 +95,6 @@ impl SceneEntry {
             SceneKind::Membrane(s) => s.description.clone(),
             SceneKind::Plate(s) => Cow::Borrowed(s.description),
             SceneKind::Kirchhoff(s) => Cow::Borrowed(s.description),
-            SceneKind::Contact(s) => Cow::Borrowed(s.description),
         }
     }
 
@@ -115,7 +105,6 @@ impl SceneEntry {
             SceneKind::Membrane(_) => Family::Membrane,
             SceneKind::Plate(_) => Family::Plate,
             SceneKind::Kirchhoff(_) => Family::Kirchhoff,
-            SceneKind::Contact(_) => Family::Contact,
         }
     }
 
@@ -127,7 +116,6 @@ impl SceneEntry {
             SceneKind::Membrane(s) => s.load_scale,
             SceneKind::Plate(s) => Some(s.load),
             SceneKind::Kirchhoff(s) => Some(s.load),
-            SceneKind::Contact(s) => Some(s.load),
         }
     }
 
@@ -135,10 +123,7 @@ impl SceneEntry {
     /// asks for one.
     pub fn target_l2(&self) -> Option<f64> {
         match &self.kind {
-            SceneKind::Beam(_)
-            | SceneKind::Plate(_)
-            | SceneKind::Kirchhoff(_)
-            | SceneKind::Contact(_) => None,
+            SceneKind::Beam(_) | SceneKind::Plate(_) | SceneKind::Kirchhoff(_) => None,
             SceneKind::Membrane(s) => Some(s.target_l2),
         }
     }
@@ -237,16 +222,6 @@ pub fn registry() -> Vec<SceneEntry> {
         },
         in_default_job: false,
     }));
-    // and the contact scenes
-    entries.extend(CONTACT_SCENES.iter().map(|&s| SceneEntry {
-        kind: SceneKind::Contact(s),
-        pairs: CONTACT_PAIRS,
-        studies: match s.name {
-            "hertz" => &["convergence", "alpha"],
-            _ => &[],
-        },
-        in_default_job: false,
-    }));
     entries
 }
 
@@ -274,12 +249,7 @@ mod tests {
         assert!(find("no-such-scene").is_none());
         assert_eq!(
             names.len(),
-            SCENES.len()
-                + MEMBRANE_SCENES.len()
-                + 1
-                + PLATE_SCENES.len()
-                + KIRCHHOFF_SCENES.len()
-                + CONTACT_SCENES.len()
+            SCENES.len() + MEMBRANE_SCENES.len() + 1 + PLATE_SCENES.len() + KIRCHHOFF_SCENES.len()
         );
     }
 }

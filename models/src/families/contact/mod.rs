@@ -38,6 +38,10 @@ pub struct Contact;
 /// The registry's contact family.
 pub static CONTACT: Contact = Contact;
 
+/// The family's error measure ([`Family::error_measure`]): the pressure's relative L²
+/// error on Γ_C, against Hertz's or a scene file's exact pressure.
+pub const PRESSURE_ERROR: (&str, &str) = ("pressure_l2_error", "pressure's relative L² error");
+
 /// The contact half-widths `b/R` the Hertz scenes accept (`--load`): Hertz's theory
 /// wants b ≪ R (at b/R = 0.34 the peak was 2 % low, at 3.4 the error 91 %), and below
 /// about 1e-7 the gap `x²/2R` is lost against the rounding of coordinates of size R.
@@ -299,6 +303,10 @@ impl Family for Contact {
         "pressure"
     }
 
+    fn error_measure(&self) -> Option<(&'static str, &'static str)> {
+        Some(PRESSURE_ERROR)
+    }
+
     fn read_file(&self, keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
         file::read(keys, scene)
     }
@@ -356,8 +364,7 @@ impl Quantities<TriangleMesh> for Contact {
     /// the graded meshes have no coarser level.
     const NESTED: bool = false;
 
-    const ACCURACY_MEASURE: Option<(&'static str, &'static str)> =
-        Some(("pressure_l2_error", "pressure's relative L² error"));
+    const ACCURACY_MEASURE: Option<(&'static str, &'static str)> = Some(PRESSURE_ERROR);
 
     fn check(scene: &Scene, posed: &Posed) -> Result<()> {
         let facts = facts(scene)?;
