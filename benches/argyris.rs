@@ -13,17 +13,16 @@
 //!    against the flat obstacle w ≤ 0.002, Argyris–P0, α = ½/C_I), nested from N = 7 to
 //!    N = 112 (≈ 113k DOFs) as the CLI does, against one sparse Cholesky analysis +
 //!    factorization + solve of the final mesh's primal matrix `A`: once through the CLI's
-//!    library entry `fem_forms::kirchhoff::solve` (with its post-processing), once through
+//!    library entry, the one solve of the registry (`fem_forms::models::families::solve`,
+//!    with its report), once through
 //!    the same calls reproduced here, which expose the factorization count and `A`.
 //!
 //! `cargo bench --bench argyris` (add `-- --quick` for small meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::element::triangle::cell_transformation;
-use fem_forms::kirchhoff::{solve, KirchhoffRequest};
 use fem_forms::lcp::cholesky::Cholesky;
 use fem_forms::models::kirchhoff::{kirchhoff_argyris, kirchhoff_argyris_p0};
-use fem_forms::models::kirchhoff_scenes::KIRCHHOFF_OBSTACLE;
 use fem_forms::obstacle::triangle::{prolong_primal_on_triangles, TriangleObstacleSolution};
 use fem_forms::obstacle::{solve_nested, Discretization, ObstacleOptions};
 use fem_forms::reference::triangle::TriangleRule;
@@ -353,16 +352,21 @@ fn kernels_only(n: usize, rounds: usize) {
     );
 }
 
-/// The request of kirchhoff-obstacle at q = 20 (flat obstacle, clamped, Argyris–P0) on
-/// N×N×2.
-fn request(n: usize) -> KirchhoffRequest {
-    let mut r = KirchhoffRequest::new(KIRCHHOFF_OBSTACLE);
-    r.load = Q;
-    r.mesh_size = n;
-    r
+/// kirchhoff-obstacle at q = 20 (flat obstacle, clamped, Argyris–P0) on N×N×2, through
+/// the one solve: its report.
+fn solve(n: usize) -> fem_forms::models::report::Report {
+    use fem_forms::models::families;
+    let scene = families::scene("kirchhoff-obstacle").expect("the built-in scene");
+    let settings = fem_forms::models::report::Settings {
+        pair: Some("argyris-p0".into()),
+        mesh_size: Some(n),
+        load: Some(Q),
+        ..Default::default()
+    };
+    families::solve(&scene, &settings).unwrap().report
 }
 
-/// The calls of `fem_forms::kirchhoff::solve` for Argyris–P0 reproduced (levels N/2^k
+/// The calls of the one solve for Argyris–P0 reproduced (levels N/2^k
 /// down to an odd N or N/2 < 4, clamped by `Constraints::support_plate`), timed with the
 /// meshes built inside.
 fn reproduced_once(n: usize, alpha: f64) -> (TriangleObstacleSolution, f64) {
@@ -420,16 +424,17 @@ fn obstacle_solve(n: usize, rounds: usize) {
         "\nkirchhoff-obstacle (clamped, q = {Q} up against w ≤ 0.002, Argyris–P0, α = ½/C_I) on {n}×{n}×2: complete nested VI solve (meshes and assembly included) vs one Cholesky (analysis + factorization + solve) of the final primal A; medians of {rounds}"
     );
     // warm-up, and α and the level iterations from the CLI's entry
-    let report = solve(&request(n)).unwrap();
-    let (warm, _) = reproduced_once(n, report.alpha);
+    let report = solve(n).solve;
+    let alpha = report.alpha.expect("α of a stabilized pair");
+    let (warm, _) = reproduced_once(n, alpha);
     let a = warm.discretization.lcp.a.clone();
     let (mut library, mut reproduced, mut linear) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..rounds {
         linear.push(cholesky_once(&a));
         let clock = Instant::now();
-        black_box(solve(&request(n)).unwrap());
+        black_box(solve(n));
         library.push(clock.elapsed().as_secs_f64());
-        reproduced.push(reproduced_once(n, report.alpha).1);
+        reproduced.push(reproduced_once(n, alpha).1);
     }
     let (library, reproduced, linear) = (median(library), median(reproduced), median(linear));
     let levels = report
@@ -446,7 +451,7 @@ fn obstacle_solve(n: usize, rounds: usize) {
         report.dofs,
         lcp.n(),
         lcp.m(),
-        report.alpha,
+        alpha,
         warm.factorizations,
         warm.low_rank_updates,
         warm.kkt_residual,
@@ -460,7 +465,7 @@ fn obstacle_solve(n: usize, rounds: usize) {
         warm.solve_seconds
     );
     println!(
-        "  VI solve, kirchhoff::solve {library:>8.3} s   ratio {:.2}   (post-processing of the report included)",
+        "  VI solve, the one solve   {library:>8.3} s   ratio {:.2}   (post-processing of the report included)",
         library / linear
     );
 }

@@ -11,7 +11,7 @@
 pub mod allocator;
 pub mod beam_studies;
 pub mod beams;
-pub mod kirchhoff;
+pub mod kirchhoff_studies;
 pub mod membrane_studies;
 pub mod membranes;
 pub mod plates;

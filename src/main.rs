@@ -2,9 +2,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use clap::{Parser, Subcommand, ValueEnum};
-use fem_forms::kirchhoff;
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
-use fem_forms::models::kirchhoff_scenes::KirchhoffScene;
 use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind};
 use fem_forms::plates;
@@ -358,10 +356,6 @@ fn study_scene(entry: &SceneEntry) -> fem_forms::Result<Box<dyn studies::StudySc
             "plate scene `{}` hosts no study of this kind",
             s.name
         ))),
-        SceneKind::Kirchhoff(s) => Err(fem_forms::Error::Input(format!(
-            "Kirchhoff scene `{}` runs its studies in fem_forms::kirchhoff",
-            s.name
-        ))),
     }
 }
 
@@ -418,10 +412,6 @@ fn solve_file(
 
 /// Runs the study called `kind` on a registry scene.
 fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(), String> {
-    if let SceneKind::Kirchhoff(scene) = &entry.kind {
-        return run_kirchhoff_study(*scene, kind, full, out)
-            .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
-    }
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
     // the plate studies are the plate's own (the generic kinds need exact solutions of
     // the obstacle problem, which the plate scenes do not have)
@@ -559,21 +549,6 @@ fn alpha_rule(pair: &fem_forms::models::family::Pair) -> String {
     }
 }
 
-/// A Kirchhoff study: `convergence` or `lambda-scatter` (fem_forms::kirchhoff).
-fn run_kirchhoff_study(
-    scene: KirchhoffScene,
-    kind: &str,
-    full: bool,
-    out: &Path,
-) -> Result<(), String> {
-    match kind {
-        "convergence" => kirchhoff::convergence_run(scene, full, out),
-        "lambda-scatter" => kirchhoff::scatter_run(scene, full, out),
-        _ => return Err(format!("unknown Kirchhoff study `{kind}`")),
-    }
-    .map_err(|e| e.to_string())
-}
-
 /// `study <scene> [kind]` through the registry, or `study <kind>` on every scene that
 /// hosts it.
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
@@ -675,8 +650,12 @@ fn registry_study(
         }
         None => hosted.clone(),
     };
-    let studies = fem_forms::registry_studies::RegistryStudies::new(scene);
     for k in kinds {
+        if let Some(result) = fem_forms::kirchhoff_studies::run(&scene, k, full, out) {
+            result.map_err(|e| format!("study {name} {k}: {e}"))?;
+            continue;
+        }
+        let studies = fem_forms::registry_studies::RegistryStudies::new(scene.clone());
         let study = Study::parse(k).ok_or_else(|| format!("unknown study `{k}`"))?;
         studies::run(&studies, study, full, out).map_err(|e| format!("study {name} {k}: {e}"))?;
     }

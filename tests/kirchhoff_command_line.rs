@@ -274,3 +274,45 @@ fn meshes_without_free_unknowns_are_refused_and_each_pair_has_its_own_limit() {
         "{stderr}"
     );
 }
+
+/// `study kirchhoff-square convergence` through the one solve: for both supports the
+/// Argyris centre deflection converges at rates above 5 from successive differences
+/// (no reference needed), Morley's near 2, and the simply supported Argyris deflection at
+/// N = 32 meets Navier's series (summed here) to 1e-8.
+#[test]
+fn the_square_convergence_study_shows_each_elements_rate() {
+    let run = fem_forms(&["study", "kirchhoff-square", "convergence"]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("fem-forms-kirchhoff-cli-{}", std::process::id()));
+    let csv = std::fs::read_to_string(out.join("kirchhoff-square-convergence.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    for support in ["clamped", "simply-supported"] {
+        for (pair, low, high) in [("argyris-p0", 5.0, 7.5), ("morley-p0", 1.7, 2.2)] {
+            let rates: Vec<f64> = rows
+                .iter()
+                .filter(|r| r[0] == support && r[1] == pair && !r[6].is_empty())
+                .map(|r| r[6].parse().unwrap())
+                .collect();
+            assert_eq!(rates.len(), 2, "{support} {pair}: {csv}");
+            for r in rates {
+                assert!(r > low && r < high, "{support} {pair}: rate {r}");
+            }
+        }
+    }
+    let w: f64 = rows
+        .iter()
+        .find(|r| r[0] == "simply-supported" && r[1] == "argyris-p0" && r[2] == "32")
+        .map(|r| r[3].parse().unwrap())
+        .unwrap();
+    let navier = navier_centre_deflection();
+    assert!((w / navier - 1.0).abs() < 1e-8, "{w} against {navier}");
+}

@@ -276,51 +276,71 @@ fn the_argyris_prolongation_reproduces_a_quintic() {
     }
 }
 
+/// The one solve of a registry scene: `scene` with `obstacle` (where given) at N =
+/// `size`, load `load`, by `solver`.
+fn registry_solve(
+    scene: &str,
+    obstacle: Option<&str>,
+    pair: &str,
+    size: usize,
+    load: Option<f64>,
+    solver: fem_forms::obstacle::VariationalSolver,
+) -> fem_forms::models::report::Report {
+    use fem_forms::models::families;
+    use fem_forms::models::family::Adjustment;
+    let mut scene = families::scene(scene).unwrap();
+    if let Some(o) = obstacle {
+        families::family("kirchhoff")
+            .unwrap()
+            .adjust(&mut scene, &Adjustment::Obstacle(o.into()))
+            .unwrap();
+    }
+    let settings = fem_forms::models::report::Settings {
+        pair: Some(pair.into()),
+        mesh_size: Some(size),
+        load,
+        solver,
+        ..Default::default()
+    };
+    families::solve(&scene, &settings).unwrap().report
+}
+
 /// The CLI's obstacle solve (nested semismooth Newton) against clarabel's interior-point
 /// method on the same QP, N = 8, q = 20, flat and curved obstacles: J_h, ∫λ_h and the
 /// contact area agree, and both KKT residuals (computed from the solutions, not the
 /// solvers' word) are small.
 #[test]
 fn newton_agrees_with_clarabel_on_a_small_mesh() {
-    use fem_forms::kirchhoff::{parse_obstacle, solve, KirchhoffRequest};
-    use fem_forms::models::kirchhoff_scenes::KIRCHHOFF_OBSTACLE;
     use fem_forms::obstacle::VariationalSolver;
     for obstacle in ["flat", "curved"] {
-        let request = KirchhoffRequest {
-            mesh_size: 8,
-            load: 20.0,
-            obstacle: parse_obstacle(obstacle).unwrap(),
-            ..KirchhoffRequest::new(KIRCHHOFF_OBSTACLE)
+        let solve = |solver| {
+            registry_solve(
+                "kirchhoff-obstacle",
+                Some(obstacle),
+                "argyris-p0",
+                8,
+                Some(20.0),
+                solver,
+            )
         };
-        let newton = solve(&request).unwrap();
-        let clarabel = solve(&KirchhoffRequest {
-            solver: VariationalSolver::Clarabel,
-            ..request
-        })
-        .unwrap();
+        let newton = solve(VariationalSolver::SemismoothNewton);
+        let clarabel = solve(VariationalSolver::Clarabel);
+        let (n, c) = (&newton.solve, &clarabel.solve);
         let close = |a: f64, b: f64, tolerance: f64| (a - b).abs() <= tolerance * b.abs();
+        let (jn, jc) = (n.energy.unwrap(), c.energy.unwrap());
+        assert!(close(jn, jc, 1e-7), "{obstacle}: J_h {jn} vs {jc}");
         assert!(
-            close(newton.energy, clarabel.energy, 1e-7),
-            "{obstacle}: J_h {} vs {}",
-            newton.energy,
-            clarabel.energy
-        );
-        assert!(
-            close(
-                newton.total_contact_force,
-                clarabel.total_contact_force,
-                1e-5
-            ),
+            close(n.total_contact_force, c.total_contact_force, 1e-5),
             "{obstacle}: ∫λ_h {} vs {}",
-            newton.total_contact_force,
-            clarabel.total_contact_force
+            n.total_contact_force,
+            c.total_contact_force
         );
-        assert_eq!(newton.contact_area, clarabel.contact_area, "{obstacle}");
-        assert!(newton.complementarity_residual < 1e-12, "{obstacle}");
-        assert!(clarabel.complementarity_residual < 1e-6, "{obstacle}");
+        assert_eq!(n.contact_area, c.contact_area, "{obstacle}");
+        assert!(n.kkt_residual < 1e-12, "{obstacle}");
+        assert!(c.kkt_residual < 1e-6, "{obstacle}");
         // nested: N = 4, 8, each level a handful of Newton steps, no cycling
-        assert_eq!(newton.levels.len(), 2);
-        assert!(newton.levels.iter().all(|l| l[1] <= 20));
+        assert_eq!(n.levels.len(), 2);
+        assert!(n.levels.iter().all(|l| l[1] <= 20));
     }
 }
 
@@ -330,29 +350,33 @@ fn newton_agrees_with_clarabel_on_a_small_mesh() {
 /// (the default reading) by 0.74 %. The bounds leave room on both sides.
 #[test]
 fn the_patch_average_cures_the_multiplier_scatter() {
-    use fem_forms::kirchhoff::{solve, KirchhoffRequest};
-    use fem_forms::models::kirchhoff_scenes::KIRCHHOFF_OBSTACLE;
-    let report = solve(&KirchhoffRequest {
-        mesh_size: 32,
-        load: 20.0,
-        ..KirchhoffRequest::new(KIRCHHOFF_OBSTACLE)
-    })
-    .unwrap();
-    let raw = report.interior_multiplier_raw.unwrap();
-    let default = report.interior_multiplier.unwrap();
-    assert!(raw.cells >= 100, "{} interior cells", raw.cells);
-    assert_eq!(raw.exact, 20.0);
+    let report = registry_solve(
+        "kirchhoff-obstacle",
+        Some("flat"),
+        "argyris-p0",
+        32,
+        Some(20.0),
+        fem_forms::obstacle::VariationalSolver::SemismoothNewton,
+    );
+    let stat = |key: &str, field: &str| report.quantities[key][field].as_f64().unwrap();
+    let (raw, default) = ("interior_multiplier_raw", "interior_multiplier");
     assert!(
-        raw.max_relative_error > 0.08,
+        stat(raw, "cells") >= 100.0,
+        "{} interior cells",
+        stat(raw, "cells")
+    );
+    assert_eq!(stat(raw, "exact"), 20.0);
+    assert!(
+        stat(raw, "max_relative_error") > 0.08,
         "raw λ_h {}…{}",
-        raw.min,
-        raw.max
+        stat(raw, "min"),
+        stat(raw, "max")
     );
     assert!(
-        default.max_relative_error < 0.02,
+        stat(default, "max_relative_error") < 0.02,
         "patch average {}…{}",
-        default.min,
-        default.max
+        stat(default, "min"),
+        stat(default, "max")
     );
 }
 
@@ -362,28 +386,19 @@ fn the_patch_average_cures_the_multiplier_scatter() {
 /// deflection).
 #[test]
 fn the_square_plate_converges_at_the_elements_rates() {
-    use fem_forms::kirchhoff::{solve, KirchhoffPair, KirchhoffRequest};
-    use fem_forms::models::kirchhoff_scenes::{KirchhoffSupport, KIRCHHOFF_SQUARE};
-    for (pair, low, high) in [
-        (KirchhoffPair::ArgyrisP0, 5.0, 7.5),
-        (KirchhoffPair::MorleyP0, 1.7, 2.2),
-    ] {
+    for (pair, low, high) in [("argyris-p0", 5.0, 7.5), ("morley-p0", 1.7, 2.2)] {
         let w: Vec<f64> = [4, 8, 16, 32]
             .iter()
-            .map(|&mesh_size| {
-                solve(&KirchhoffRequest {
-                    pair,
-                    mesh_size,
-                    support: KirchhoffSupport::Clamped,
-                    ..KirchhoffRequest::new(KIRCHHOFF_SQUARE)
-                })
-                .unwrap()
-                .centre_deflection
+            .map(|&n| {
+                let newton = fem_forms::obstacle::VariationalSolver::SemismoothNewton;
+                registry_solve("kirchhoff-square", None, pair, n, None, newton)
+                    .number("centre_deflection")
+                    .unwrap()
             })
             .collect();
         let d: Vec<f64> = w.windows(2).map(|p| (p[1] - p[0]).abs()).collect();
         for r in d.windows(2).map(|p| (p[0] / p[1]).log2()) {
-            assert!(r > low && r < high, "{pair:?}: rate {r} from {w:?}");
+            assert!(r > low && r < high, "{pair}: rate {r} from {w:?}");
         }
     }
 }

@@ -13,7 +13,6 @@ pub mod family;
 pub mod geometry;
 pub mod hertz;
 pub mod kirchhoff;
-pub mod kirchhoff_scenes;
 pub mod membrane;
 pub mod membrane_scenes;
 pub mod mindlin;

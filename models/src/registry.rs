@@ -8,7 +8,6 @@
 //! what the registry adds to it: the element pairs it can be solved with (the first is
 //! the default) and the studies it hosts.
 
-use crate::kirchhoff_scenes::{KirchhoffScene, KIRCHHOFF_SCENES};
 use crate::membrane_scenes::{MembraneScene, MEMBRANE_FLAT, MEMBRANE_SCENES};
 use crate::plate_scenes::{PlateScene, PlateSupport, PLATE_SCENES};
 use crate::scenes::{Beam, Scene, SCENES};
@@ -23,8 +22,6 @@ pub enum Family {
     Membrane,
     /// Reissner–Mindlin plates on triangle meshes.
     Plate,
-    /// Kirchhoff plates (Argyris, Morley) on triangle meshes, with or without an obstacle.
-    Kirchhoff,
 }
 
 impl Family {
@@ -34,7 +31,6 @@ impl Family {
             Family::Beam => "beam",
             Family::Membrane => "membrane",
             Family::Plate => "plate",
-            Family::Kirchhoff => "kirchhoff",
         }
     }
 }
@@ -48,8 +44,6 @@ pub enum SceneKind {
     Membrane(MembraneScene),
     /// A plate scene.
     Plate(PlateScene),
-    /// A Kirchhoff plate scene.
-    Kirchhoff(KirchhoffScene),
 }
 
 /// One registry entry: the scene and what can be done with it.
@@ -74,8 +68,6 @@ pub const MEMBRANE_PAIRS: &[&str] = &["p2-p0", "p1-p0", "p2-p1d", "p1-nodal"];
 /// The plate pairs (θ, w, λ), default first: the locking-free Stenberg pair and the
 /// plain displacement method.
 pub const PLATE_PAIRS: &[&str] = &["p1-p2-p0", "p1-p1-p0-plain"];
-/// The Kirchhoff pairs (w, λ), default first.
-pub const KIRCHHOFF_PAIRS: &[&str] = &["argyris-p0", "argyris-p1disc", "morley-p0"];
 
 impl SceneEntry {
     /// The scene's name.
@@ -84,7 +76,6 @@ impl SceneEntry {
             SceneKind::Beam(s) => Cow::Borrowed(s.name),
             SceneKind::Membrane(s) => s.name.clone(),
             SceneKind::Plate(s) => Cow::Borrowed(s.name),
-            SceneKind::Kirchhoff(s) => Cow::Borrowed(s.name),
         }
     }
 
@@ -94,7 +85,6 @@ impl SceneEntry {
             SceneKind::Beam(s) => Cow::Borrowed(s.description),
             SceneKind::Membrane(s) => s.description.clone(),
             SceneKind::Plate(s) => Cow::Borrowed(s.description),
-            SceneKind::Kirchhoff(s) => Cow::Borrowed(s.description),
         }
     }
 
@@ -104,7 +94,6 @@ impl SceneEntry {
             SceneKind::Beam(_) => Family::Beam,
             SceneKind::Membrane(_) => Family::Membrane,
             SceneKind::Plate(_) => Family::Plate,
-            SceneKind::Kirchhoff(_) => Family::Kirchhoff,
         }
     }
 
@@ -115,7 +104,6 @@ impl SceneEntry {
             SceneKind::Beam(_) => Some(1.0),
             SceneKind::Membrane(s) => s.load_scale,
             SceneKind::Plate(s) => Some(s.load),
-            SceneKind::Kirchhoff(s) => Some(s.load),
         }
     }
 
@@ -123,7 +111,7 @@ impl SceneEntry {
     /// asks for one.
     pub fn target_l2(&self) -> Option<f64> {
         match &self.kind {
-            SceneKind::Beam(_) | SceneKind::Plate(_) | SceneKind::Kirchhoff(_) => None,
+            SceneKind::Beam(_) | SceneKind::Plate(_) => None,
             SceneKind::Membrane(s) => Some(s.target_l2),
         }
     }
@@ -212,16 +200,6 @@ pub fn registry() -> Vec<SceneEntry> {
         studies: plate_studies(s.name),
         in_default_job: false,
     }));
-    // the Kirchhoff scenes too: solved and studied on demand
-    entries.extend(KIRCHHOFF_SCENES.iter().map(|&s| SceneEntry {
-        kind: SceneKind::Kirchhoff(s),
-        pairs: KIRCHHOFF_PAIRS,
-        studies: match s.name {
-            "kirchhoff-obstacle" => &["convergence", "lambda-scatter"],
-            _ => &["convergence"],
-        },
-        in_default_job: false,
-    }));
     entries
 }
 
@@ -249,7 +227,7 @@ mod tests {
         assert!(find("no-such-scene").is_none());
         assert_eq!(
             names.len(),
-            SCENES.len() + MEMBRANE_SCENES.len() + 1 + PLATE_SCENES.len() + KIRCHHOFF_SCENES.len()
+            SCENES.len() + MEMBRANE_SCENES.len() + 1 + PLATE_SCENES.len()
         );
     }
 }

@@ -430,6 +430,9 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 "interior_multiplier_twice_averaged",
                 statistics(MultiplierRecovery::TwicePatchAverage),
             );
+            if q > 0.0 {
+                report.set("multiplier_layer", layer_profile(solution, &contact, q));
+            }
             let n = run.settings.mesh_size.unwrap_or(run.scene.mesh_size);
             let newton =
                 run.settings.solver == fem_runtime::obstacle::VariationalSolver::SemismoothNewton;
@@ -597,6 +600,54 @@ pub fn averaged_cells(mesh: &TriangleMesh, values: &[f64], passes: usize) -> Vec
     cells
 }
 
+/// One band of the multiplier's layer next to the free boundary: the contact cells whose
+/// distance to the nearest cell outside contact ([`frontier_distances`]) lies in
+/// `[k h, (k+1) h)`, h the largest cell diameter.
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
+pub struct LayerBand {
+    /// k.
+    pub distance_in_cells: usize,
+    /// Cells in the band.
+    pub cells: usize,
+    /// `max |λ_h − q| / q` over them (cell means).
+    pub max_relative_error: f64,
+    /// The same for the patch average.
+    pub patch_average_max_relative_error: f64,
+}
+
+/// The layer profile of λ_h next to the free boundary, bands k = 0, 1, … (see
+/// [`LayerBand`]), against the exact λ = q of the contact interior.
+pub fn layer_profile(
+    solution: &fem_runtime::obstacle::ObstacleSolution<TriangleMesh>,
+    contact: &[bool],
+    q: f64,
+) -> Vec<LayerBand> {
+    let mesh = &solution.discretization.mesh;
+    let distance = frontier_distances(mesh, contact);
+    let h = mesh.max_h();
+    let raw = cell_means(solution);
+    let averaged = averaged_cells(mesh, &raw, 1);
+    let mut bands: Vec<LayerBand> = Vec::new();
+    for c in (0..mesh.cell_count()).filter(|&c| contact[c] && distance[c].is_finite()) {
+        let k = (distance[c] / h).floor() as usize;
+        while bands.len() <= k {
+            bands.push(LayerBand {
+                distance_in_cells: bands.len(),
+                cells: 0,
+                max_relative_error: 0.0,
+                patch_average_max_relative_error: 0.0,
+            });
+        }
+        let band = &mut bands[k];
+        band.cells += 1;
+        band.max_relative_error = band.max_relative_error.max((raw[c] - q).abs() / q);
+        band.patch_average_max_relative_error = band
+            .patch_average_max_relative_error
+            .max((averaged[c] - q).abs() / q);
+    }
+    bands
+}
+
 /// The multiplier's cell means (P0: its values; P1disc: the mean of the three).
 pub fn cell_means(solution: &fem_runtime::obstacle::ObstacleSolution<TriangleMesh>) -> Vec<f64> {
     let d = &solution.discretization;
@@ -668,4 +719,72 @@ pub fn interior_statistics(
         mean: values.iter().sum::<f64>() / values.len() as f64,
         max_relative_error: (max - q).abs().max((min - q).abs()) / q,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fem_runtime::Diagonal;
+
+    /// A ring of contact cells around a hole: the hole counts, the cells outside the
+    /// ring do not; without contact the area is +0.
+    #[test]
+    fn the_contact_area_fills_holes_but_not_the_outside() {
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 5, 5, Diagonal::Right).unwrap();
+        let centre = |c: usize| {
+            let x = mesh.cell_coordinates(c);
+            [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0]
+        };
+        // the cells of the squares 1..4 × 1..4 (in units of 0.2) except the middle one
+        let contact: Vec<bool> = (0..mesh.cell_count())
+            .map(|c| {
+                let [x, y] = centre(c).map(|v| (v * 5.0).floor() as i32);
+                (1..4).contains(&x) && (1..4).contains(&y) && !(x == 2 && y == 2)
+            })
+            .collect();
+        assert_eq!(contact.iter().filter(|&&c| c).count(), 16);
+        let area = filled_area(&mesh, &contact);
+        assert!((area - 9.0 * 0.04).abs() < 1e-12, "{area}");
+        let none = filled_area(&mesh, &vec![false; mesh.cell_count()]);
+        assert!(none == 0.0 && none.is_sign_positive());
+    }
+
+    /// The contact interior and its distances: on a contact disk, interior cells are at
+    /// least the margin from the outside and two rings in; the layer bands count every
+    /// contact cell once.
+    #[test]
+    fn interior_cells_keep_their_distance_from_the_free_boundary() {
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 32, 32, Diagonal::Right).unwrap();
+        let centre = |c: usize| {
+            let x = mesh.cell_coordinates(c);
+            [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0]
+        };
+        let contact: Vec<bool> = (0..mesh.cell_count())
+            .map(|c| {
+                let [x, y] = centre(c);
+                (x - 0.5).hypot(y - 0.5) < 0.3
+            })
+            .collect();
+        let distance = frontier_distances(&mesh, &contact);
+        let interior = interior_cells(&mesh, &contact);
+        assert!(!interior.is_empty());
+        let h = mesh.max_h();
+        let radius = |c: usize| (centre(c)[0] - 0.5).hypot(centre(c)[1] - 0.5);
+        for &c in &interior {
+            // the cells outside the disk next to it surround r = 0.3 within a diameter
+            assert!(radius(c) < 0.3 - INTERIOR_MARGIN + h, "cell {c}");
+            assert!(distance[c] >= INTERIOR_MARGIN);
+        }
+        // and every cell well inside is interior: two vertex rings lie within 4 h
+        for c in (0..mesh.cell_count()).filter(|&c| radius(c) < 0.3 - INTERIOR_MARGIN - 4.0 * h) {
+            assert!(interior.contains(&c), "cell {c} at r = {}", radius(c));
+        }
+        // a cell right at the edge of the disk is not interior
+        let edge = (0..mesh.cell_count())
+            .filter(|&c| contact[c])
+            .max_by(|&a, &b| radius(a).total_cmp(&radius(b)))
+            .unwrap();
+        assert!(!interior.contains(&edge));
+        assert!(distance[edge] < 2.0 * h);
+    }
 }
