@@ -14,7 +14,7 @@ pub mod beams;
 pub mod kirchhoff_studies;
 pub mod membrane_studies;
 pub mod membranes;
-pub mod plates;
+pub mod plate_studies;
 pub mod plot;
 pub mod registry_studies;
 pub mod studies;

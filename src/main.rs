@@ -5,7 +5,6 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
 use fem_forms::models::membrane_scenes::MembraneScene;
 use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind};
-use fem_forms::plates;
 use fem_forms::plot;
 use fem_forms::studies::{self, Study};
 use std::path::{Path, PathBuf};
@@ -344,17 +343,12 @@ fn hosted_studies(entries: &[SceneEntry], out: &Path) -> Result<(), String> {
 /// The study implementation of a registry scene.
 ///
 /// # Errors
-/// [`Error::Input`] for a family without one (plates: their locking chart is written by
-/// `plates::locking_study`).
+/// [`Error::Input`] for a family without one.
 fn study_scene(entry: &SceneEntry) -> fem_forms::Result<Box<dyn studies::StudyScene>> {
     match &entry.kind {
         SceneKind::Beam(s) => Ok(Box::new(fem_forms::beam_studies::BeamStudies::new(*s))),
         SceneKind::Membrane(s) => Ok(Box::new(fem_forms::membrane_studies::MembraneStudies::new(
             s.clone(),
-        ))),
-        SceneKind::Plate(s) => Err(fem_forms::Error::Input(format!(
-            "plate scene `{}` hosts no study of this kind",
-            s.name
         ))),
     }
 }
@@ -415,10 +409,6 @@ fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(
     let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
     // the plate studies are the plate's own (the generic kinds need exact solutions of
     // the obstacle problem, which the plate scenes do not have)
-    if let SceneKind::Plate(scene) = &entry.kind {
-        return plates::run_study(*scene, study, full, out)
-            .map_err(|e| format!("study {} {kind}: {e}", entry.name()));
-    }
     study_scene(entry)
         .and_then(|scene| studies::run(&*scene, study, full, out))
         .map_err(|e| format!("study {} {kind}: {e}", entry.name()))
@@ -651,7 +641,9 @@ fn registry_study(
         None => hosted.clone(),
     };
     for k in kinds {
-        if let Some(result) = fem_forms::kirchhoff_studies::run(&scene, k, full, out) {
+        let own = fem_forms::kirchhoff_studies::run(&scene, k, full, out)
+            .or_else(|| fem_forms::plate_studies::run(&scene, k, full, out));
+        if let Some(result) = own {
             result.map_err(|e| format!("study {name} {k}: {e}"))?;
             continue;
         }

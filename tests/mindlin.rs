@@ -12,10 +12,9 @@ mod plate;
 use fem_forms::element::triangle::TriangleBasis;
 use fem_forms::lcp::cholesky::multiply;
 use fem_forms::models::mindlin::{mindlin_plain_p1, mindlin_simply_supported, mindlin_stenberg};
-use fem_forms::models::plate_scenes::MINDLIN_SQUARE;
 use fem_forms::obstacle::triangle::{solve_obstacle_on_triangles, TriangleObstacleSolution};
 use fem_forms::obstacle::ObstacleOptions;
-use fem_forms::plates::locking_study;
+use fem_forms::plate_studies::locking_study;
 use fem_forms::{
     assemble_vector, Coefficients, DataFn, Diagonal, MatrixAssembler, Model, PointLocator,
     TriangleMesh,
@@ -265,7 +264,8 @@ fn centre_deflection<M: Model>(n: usize, t: f64) -> f64 {
 fn the_clamped_plate_tends_to_kirchhoff_without_locking_and_the_plain_method_locks() {
     let (ns, ts) = ([8, 16, 32], [1e-1, 1e-2, 1e-3, 1e-4]);
     let csv = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("mindlin_locking.csv");
-    let rows = locking_study(MINDLIN_SQUARE, &ns, &ts, Some(&csv)).unwrap();
+    let square = fem_forms::models::families::scene("mindlin-square").unwrap();
+    let rows = locking_study(&square, &ns, &ts, Some(&csv)).unwrap();
     for r in &rows {
         eprintln!(
             "{:>15} N = {:>2} t = {:e}: w(½,½) = {:.8e}, relative error {:+.3e}",

@@ -5,8 +5,8 @@
 //! A scene says what is posed, not how it is discretized: the domain (a square or a
 //! disk), the support on its whole boundary, a uniform load along w (w positive up, so
 //! q > 0 pushes the plate up) with the list of loads its studies run, and an obstacle
-//! (none, or flat above or below at a height). The plate code (`src/plates.rs`) turns
-//! this into meshes, a model and a report.
+//! (none, or flat above or below at a height). The plate family
+//! (`crate::families::plate`) turns each into a scene of the one pipeline.
 
 /// How the plate is held on its boundary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,15 +1,13 @@
-//! One registry of every built-in scene, whatever its model family: the CLI's `list`,
-//! `solve` and `study` go through it, and a scene file (`solve --scene my.toml`) yields
-//! the same description.
+//! The older registry of the beam and membrane scenes whose studies (the beams' LCP
+//! condition and locking, the membranes' inf-sup constants and profiles, the cheapest
+//! pair for an accuracy) still run on the families' own programs in `src/`; every scene
+//! is solved, listed and read from files through [`crate::families`].
 //!
-//! A scene is data: its family's description ([`Scene`] for beams, [`MembraneScene`]
-//! for membranes: domain, parameters, data f, ψ, g, exact solution, asked accuracy;
-//! [`PlateScene`] for plates) and
-//! what the registry adds to it: the element pairs it can be solved with (the first is
-//! the default) and the studies it hosts.
+//! A scene here is its family's description ([`Scene`] for beams, [`MembraneScene`]
+//! for membranes) and what the registry adds to it: the element pairs it can be solved
+//! with (the first is the default) and the studies it hosts.
 
 use crate::membrane_scenes::{MembraneScene, MEMBRANE_FLAT, MEMBRANE_SCENES};
-use crate::plate_scenes::{PlateScene, PlateSupport, PLATE_SCENES};
 use crate::scenes::{Beam, Scene, SCENES};
 use std::borrow::Cow;
 
@@ -20,8 +18,6 @@ pub enum Family {
     Beam,
     /// Membranes on triangle meshes (structured or Gmsh), `u = g` on the boundary.
     Membrane,
-    /// Reissner–Mindlin plates on triangle meshes.
-    Plate,
 }
 
 impl Family {
@@ -30,7 +26,6 @@ impl Family {
         match self {
             Family::Beam => "beam",
             Family::Membrane => "membrane",
-            Family::Plate => "plate",
         }
     }
 }
@@ -42,8 +37,6 @@ pub enum SceneKind {
     Beam(Scene),
     /// A membrane scene.
     Membrane(MembraneScene),
-    /// A plate scene.
-    Plate(PlateScene),
 }
 
 /// One registry entry: the scene and what can be done with it.
@@ -65,9 +58,6 @@ pub const TIMOSHENKO_PAIRS: &[&str] = &["p2-p2-p0", "p1-p1-p0-reduced", "p1-p1-p
 pub const BERNOULLI_PAIRS: &[&str] = &["hermite-p0"];
 /// The membrane pairs, default first.
 pub const MEMBRANE_PAIRS: &[&str] = &["p2-p0", "p1-p0", "p2-p1d", "p1-nodal"];
-/// The plate pairs (θ, w, λ), default first: the locking-free Stenberg pair and the
-/// plain displacement method.
-pub const PLATE_PAIRS: &[&str] = &["p1-p2-p0", "p1-p1-p0-plain"];
 
 impl SceneEntry {
     /// The scene's name.
@@ -75,7 +65,6 @@ impl SceneEntry {
         match &self.kind {
             SceneKind::Beam(s) => Cow::Borrowed(s.name),
             SceneKind::Membrane(s) => s.name.clone(),
-            SceneKind::Plate(s) => Cow::Borrowed(s.name),
         }
     }
 
@@ -84,7 +73,6 @@ impl SceneEntry {
         match &self.kind {
             SceneKind::Beam(s) => Cow::Borrowed(s.description),
             SceneKind::Membrane(s) => s.description.clone(),
-            SceneKind::Plate(s) => Cow::Borrowed(s.description),
         }
     }
 
@@ -93,7 +81,6 @@ impl SceneEntry {
         match self.kind {
             SceneKind::Beam(_) => Family::Beam,
             SceneKind::Membrane(_) => Family::Membrane,
-            SceneKind::Plate(_) => Family::Plate,
         }
     }
 
@@ -103,7 +90,6 @@ impl SceneEntry {
         match &self.kind {
             SceneKind::Beam(_) => Some(1.0),
             SceneKind::Membrane(s) => s.load_scale,
-            SceneKind::Plate(s) => Some(s.load),
         }
     }
 
@@ -111,7 +97,7 @@ impl SceneEntry {
     /// asks for one.
     pub fn target_l2(&self) -> Option<f64> {
         match &self.kind {
-            SceneKind::Beam(_) | SceneKind::Plate(_) => None,
+            SceneKind::Beam(_) => None,
             SceneKind::Membrane(s) => Some(s.target_l2),
         }
     }
@@ -157,15 +143,6 @@ fn beam_studies(name: &str) -> &'static [&'static str] {
     }
 }
 
-/// The studies each built-in plate scene hosts (the plate's own: `src/plates.rs`).
-fn plate_studies(name: &str) -> &'static [&'static str] {
-    match name {
-        "mindlin-square" => &["locking"],
-        "mindlin-disk" => &["convergence", "iterations"],
-        _ => &[],
-    }
-}
-
 /// Every built-in scene, beams first, in the order `list` prints them.
 pub fn registry() -> Vec<SceneEntry> {
     let mut entries: Vec<SceneEntry> = SCENES
@@ -188,18 +165,6 @@ pub fn registry() -> Vec<SceneEntry> {
         entries.push(membrane_entry(s, studies, true));
     }
     entries.push(membrane_entry(MEMBRANE_FLAT, &[], false));
-    // the plates are solved on demand (`solve mindlin-square`, `study mindlin-square`),
-    // not in the default job
-    entries.extend(PLATE_SCENES.iter().map(|&s| SceneEntry {
-        kind: SceneKind::Plate(s),
-        // the plain pair's model is clamped only
-        pairs: match s.support {
-            PlateSupport::Clamped => PLATE_PAIRS,
-            PlateSupport::SimplySupported => &PLATE_PAIRS[..1],
-        },
-        studies: plate_studies(s.name),
-        in_default_job: false,
-    }));
     entries
 }
 
@@ -225,9 +190,6 @@ mod tests {
             assert_eq!(find(n).unwrap().name(), n.as_str());
         }
         assert!(find("no-such-scene").is_none());
-        assert_eq!(
-            names.len(),
-            SCENES.len() + MEMBRANE_SCENES.len() + 1 + PLATE_SCENES.len()
-        );
+        assert_eq!(names.len(), SCENES.len() + MEMBRANE_SCENES.len() + 1);
     }
 }
