@@ -829,6 +829,39 @@ fn run_alpha(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
             }
         }
     }
+    alpha_chart(
+        scene,
+        (pair, n),
+        &rows,
+        c_i,
+        (&alphas, &errors, contacts),
+        out,
+    )?;
+    alpha_profiles(scene, (pair, n), &rows, c_i, out)?;
+    write_csv(
+        &output(out, &name, Study::Alpha, "csv"),
+        "alpha,alpha_times_CI,error_l2,error_h1,error_multiplier,force_error,contact,total_contact_force,solved",
+        &csv,
+    )
+    .map_err(io)
+}
+
+/// Points of a chart's curve.
+type Points = Vec<(f64, f64)>;
+
+/// The α study's chart, `<scene>-alpha.svg`: the errors against α with 1/C_I and the
+/// default ½/C_I marked and the failed α drawn at the top, and the contact measure
+/// against α beside the exact one.
+fn alpha_chart(
+    scene: &dyn StudyScene,
+    (pair, n): (&'static str, usize),
+    rows: &[AlphaRow],
+    c_i: f64,
+    (alphas, errors, contacts): (&[f64], &[Points; 4], Points),
+    out: &Path,
+) -> Result<()> {
+    let name = scene.name();
+    let [contact, _] = scene.contact_names();
     let exact_contact = scene.exact_contact();
     if let Some(c) = exact_contact {
         println!("exact {contact} {c:.6}");
@@ -848,7 +881,7 @@ fn run_alpha(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
     ];
     let mut series: Vec<Series> = labels
         .iter()
-        .zip(errors)
+        .zip(errors.iter().cloned())
         .filter(|(_, points)| !points.is_empty())
         .map(|(label, points)| Series::marked(*label, points))
         .collect();
@@ -912,13 +945,7 @@ fn run_alpha(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
         ],
     )
     .map_err(io)?;
-    alpha_profiles(scene, (pair, n), &rows, c_i, out)?;
-    write_csv(
-        &output(out, &name, Study::Alpha, "csv"),
-        "alpha,alpha_times_CI,error_l2,error_h1,error_multiplier,force_error,contact,total_contact_force,solved",
-        &csv,
-    )
-    .map_err(io)
+    Ok(())
 }
 
 /// The α study's second chart, `<scene>-alpha-profiles.svg`, where the family draws

@@ -179,22 +179,14 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
 ) -> Result<Outcome> {
     let clock = Instant::now();
     let posed = pose_checked::<G, Q>(scene, settings)?;
-    let n = settings.mesh_size.unwrap_or(scene.mesh_size);
-    let memory = Q::memory::<M>(pair, scene, n);
-    let size_text = size_text(scene, pair, n, settings.mesh_size.is_some());
-    // without an obstacle the problem is one linear solve: nothing to nest for
-    let nested = Q::NESTED
-        && settings.nested
-        && settings.solver == VariationalSolver::SemismoothNewton
-        && scene.obstacle;
-    let mut domain = scene.domain.clone();
-    if let (Some(diagonal), crate::scene::Domain::Rectangle { diagonal: d, .. }) =
-        (settings.diagonal, &mut domain)
-    {
-        *d = diagonal;
-    }
-    let budget = |cells: f64| check_memory(memory.bytes(cells as usize), &size_text);
-    let meshes = G::levels(&domain, n, nested, Q::COARSEST, posed.load, &budget)?;
+    let Levels {
+        meshes,
+        domain,
+        n,
+        memory,
+        size_text,
+        nested,
+    } = levels::<M, G, Q>(pair, scene, settings, &posed)?;
     let finest = meshes.last().expect("at least one level").clone();
     let meshes_seconds = clock.elapsed().as_secs_f64();
 
@@ -252,18 +244,7 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
 
     let mut report = report_of(scene, pair, &domain, n, &posed, exact.as_ref(), &solved);
     report.solve.warnings.extend(supports.warnings);
-    // the obstacle and the load are what a scene poses: left out, they are named
-    for &d in &bound.defaulted {
-        let obstacle = psi_index == Some(d) && scene.obstacle;
-        if obstacle || M::DATA[d] == "f" {
-            report.warn(format!(
-                "scene `{}` gives no {} `{}`: it is taken as 0",
-                scene.name,
-                if obstacle { "obstacle" } else { "load" },
-                M::DATA[d]
-            ));
-        }
-    }
+    warn_defaulted::<M>(scene, &bound, &mut report);
     let fields = G::fields::<M>(&solved.solution, psi);
     let run = Run {
         scene,
@@ -293,6 +274,72 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         fields,
         profile,
     })
+}
+
+/// The meshes of a solve and what sets them: the levels (coarsest first), the domain as
+/// solved (with the request's diagonal), N, the memory model and the words for its
+/// refusal, and whether the solve nests.
+struct Levels<G> {
+    meshes: Vec<G>,
+    domain: crate::scene::Domain,
+    n: usize,
+    memory: MemoryModel,
+    size_text: String,
+    nested: bool,
+}
+
+/// The [`Levels`] of `scene` as `settings` ask, the memory estimated before any mesh is
+/// built.
+///
+/// # Errors
+/// The memory estimate's refusal and the mesh generators'.
+fn levels<M: Model, G: Geometry, Q: Quantities<G>>(
+    pair: &Pair,
+    scene: &Scene,
+    settings: &Settings,
+    posed: &Posed,
+) -> Result<Levels<G>> {
+    let n = settings.mesh_size.unwrap_or(scene.mesh_size);
+    let memory = Q::memory::<M>(pair, scene, n);
+    let size_text = size_text(scene, pair, n, settings.mesh_size.is_some());
+    // without an obstacle the problem is one linear solve: nothing to nest for
+    let nested = Q::NESTED
+        && settings.nested
+        && settings.solver == VariationalSolver::SemismoothNewton
+        && scene.obstacle;
+    let mut domain = scene.domain.clone();
+    if let (Some(diagonal), crate::scene::Domain::Rectangle { diagonal: d, .. }) =
+        (settings.diagonal, &mut domain)
+    {
+        *d = diagonal;
+    }
+    let budget = |cells: f64| check_memory(memory.bytes(cells as usize), &size_text);
+    let meshes = G::levels(&domain, n, nested, Q::COARSEST, posed.load, &budget)?;
+    Ok(Levels {
+        meshes,
+        domain,
+        n,
+        memory,
+        size_text,
+        nested,
+    })
+}
+
+/// The obstacle and the load are what a scene poses: left out (taken as 0), they are
+/// named in the report.
+fn warn_defaulted<M: Model>(scene: &Scene, bound: &Bound, report: &mut Report) {
+    let psi_index = M::OBSTACLE.map(|[_, d]| d);
+    for &d in &bound.defaulted {
+        let obstacle = psi_index == Some(d) && scene.obstacle;
+        if obstacle || M::DATA[d] == "f" {
+            report.warn(format!(
+                "scene `{}` gives no {} `{}`: it is taken as 0",
+                scene.name,
+                if obstacle { "obstacle" } else { "load" },
+                M::DATA[d]
+            ));
+        }
+    }
 }
 
 /// The values a request solves the scene at ([`pose`]), checked by the family

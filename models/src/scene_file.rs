@@ -342,7 +342,7 @@ pub fn scene_name(
 // The scene of any registry family
 // ---------------------------------------------------------------------------------------
 
-use crate::family::{Family, FileKeys};
+use crate::family::{Family, FieldError, FileKeys};
 use crate::report::Settings;
 use crate::scene::{Domain, Exact, ExactSolution, Load, Part, PartSupport, Scene, Support};
 use fem_runtime::problem::MIN_DATA_SIZE;
@@ -543,69 +543,108 @@ pub fn parse(text: &str, path: &Path) -> Result<FileScene> {
 /// (or gradient) contradict, exact integrals that are negative, an accuracy without an
 /// exact solution.
 pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileScene> {
-    let at = |field: &str, message: String| {
+    let at = |(field, message): FieldError| {
         Error::Input(format!("{}: field `{field}`: {message}", path.display()))
     };
     let file: FileToml = toml::from_str(text)
         .map_err(|e| Error::Input(format!("scene file {}: {e}", path.display())))?;
     if file.model != family.name() {
-        return Err(at(
-            "model",
+        return Err(at((
+            "model".into(),
             format!("`{}` is read as the family `{}`", file.model, family.name()),
-        ));
+        )));
     }
-    let name = scene_name(file.name.as_deref(), path, "scene").map_err(|m| at("name", m))?;
-    let (domain, mesh_size) = domain_of(&file.mesh, path).map_err(|(f, m)| at(&f, m))?;
-    let interval = matches!(domain, Domain::Interval { .. });
-    if interval != (family.dimension() == 1) {
-        return Err(at(
-            "mesh",
-            if interval {
-                format!(
-                    "the {} family is posed on triangle meshes (a 2D generator or a Gmsh file), not on an interval",
-                    family.name()
-                )
-            } else {
-                format!(
-                    "the {} family is posed on an interval: generator = \"interval\" with start, end and size",
-                    family.name()
-                )
-            },
-        ));
-    }
+    let name =
+        scene_name(file.name.as_deref(), path, "scene").map_err(|m| at(("name".into(), m)))?;
+    let (domain, mesh_size) = domain_of(&file.mesh, path).map_err(at)?;
+    check_dimension(&domain, family).map_err(at)?;
     let description = file
         .description
         .clone()
         .unwrap_or_else(|| format!("scene file {}", path.display()));
     let mut scene = Scene::new(name, description, family.name(), domain, mesh_size);
-    let model_name = |key: &str| -> String {
-        family
-            .aliases()
-            .iter()
-            .find(|(alias, _)| *alias == key)
-            .map_or(key.to_string(), |(_, name)| name.to_string())
-    };
-    let number = |field: &str, value: &toml::Value| {
-        finite(value).ok_or_else(|| at(field, format!("{value} is not a finite number")))
-    };
-    let mut parameters = file.parameters.clone();
+    let alpha = read_parameters(&file, family, &mut scene).map_err(at)?;
+    let model_name = |key: &str| model_name(family, key);
+    let load = read_data(&mut scene, &file.data, &model_name, path)?;
+    scale_load(&mut scene, family, load).map_err(at)?;
+    scene.supports = supports(&file.boundary, family).map_err(at)?;
+    scene.facets = facets(&file.boundary, family).map_err(at)?;
+    check_parts(&scene).map_err(at)?;
+    if let Some(e) = &file.exact {
+        // the contact set is not linear in the load: the file's exact solution holds at
+        // its own load
+        scene.exact = Exact::AtDefaultLoad(exact_of(e, &scene.domain, path)?);
+    }
+    scene.accuracy = accuracy_of(&file, family).map_err(at)?;
+    if let Some(pair) = &file.pair {
+        if let Err(e) = crate::families::pair_of(&scene, Some(pair)) {
+            return Err(at(("pair".into(), e.to_string())));
+        }
+    }
+    family.check_file(&scene).map_err(at)?;
+    Ok(FileScene {
+        scene,
+        pair: file.pair,
+        alpha,
+    })
+}
+
+/// The model's name of a scene file's key: the family's alias, or the key itself.
+fn model_name(family: &dyn Family, key: &str) -> String {
     family
-        .read_file(
-            FileKeys {
-                material: file.material.as_ref(),
-                parameters: &mut parameters,
-            },
-            &mut scene,
-        )
-        .map_err(|(f, m)| at(&f, m))?;
+        .aliases()
+        .iter()
+        .find(|(alias, _)| *alias == key)
+        .map_or(key.to_string(), |(_, name)| name.to_string())
+}
+
+/// The domain is of the family's dimension: an interval for beams, triangles otherwise.
+fn check_dimension(domain: &Domain, family: &dyn Family) -> std::result::Result<(), FieldError> {
+    let interval = matches!(domain, Domain::Interval { .. });
+    if interval == (family.dimension() == 1) {
+        return Ok(());
+    }
+    Err((
+        "mesh".into(),
+        if interval {
+            format!(
+                "the {} family is posed on triangle meshes (a 2D generator or a Gmsh file), not on an interval",
+                family.name()
+            )
+        } else {
+            format!(
+                "the {} family is posed on an interval: generator = \"interval\" with start, end and size",
+                family.name()
+            )
+        },
+    ))
+}
+
+/// `[material]` and the family's own parameters ([`Family::read_file`]), then every other
+/// `[parameters]` key by the model's name; returns `parameters.alpha`.
+fn read_parameters(
+    file: &FileToml,
+    family: &dyn Family,
+    scene: &mut Scene,
+) -> std::result::Result<Option<f64>, FieldError> {
+    let mut parameters = file.parameters.clone();
+    family.read_file(
+        FileKeys {
+            material: file.material.as_ref(),
+            parameters: &mut parameters,
+        },
+        scene,
+    )?;
     let mut alpha = None;
     for (key, value) in &parameters {
         let field = format!("parameters.{key}");
-        let v = number(&field, value)?;
+        let Some(v) = finite(value) else {
+            return Err((field, format!("{value} is not a finite number")));
+        };
         if key == "alpha" || key == "α" {
             if v < 0.0 {
-                return Err(at(
-                    &field,
+                return Err((
+                    field,
                     format!(
                         "α = {} must be ≥ 0 (0: the plain method)",
                         fem_runtime::problem::number(v)
@@ -614,68 +653,72 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
             }
             alpha = Some(v);
         } else {
-            scene.set_parameter(model_name(key), v);
+            scene.set_parameter(model_name(family, key), v);
         }
     }
-    let load = read_data(&mut scene, &file.data, &model_name, path)?;
+    Ok(alpha)
+}
+
+/// The load magnitude `data.load` scales the family's scaled data by
+/// ([`Family::scaled_load`]), checked for its sign and range as a `--load` is.
+fn scale_load(
+    scene: &mut Scene,
+    family: &dyn Family,
+    load: Option<f64>,
+) -> std::result::Result<(), FieldError> {
     let (scaled, sign) = family.scaled_load();
-    let scaled = model_name(scaled);
-    if scene.data_fn(&scaled).is_some() {
-        scene.load = Some(Load {
-            default: load.unwrap_or(1.0),
-            scales: vec![scaled.into()],
-            symbol: "q",
-            sign,
-        });
-        // the sign and the range of the file's own load, as a --load's
-        scene
-            .load_magnitude(load)
-            .map_err(|m| at("data.load", m.replace("--load", "the load")))?;
-    } else if load.is_some() {
-        return Err(at(
-            "data.load",
-            format!(
-                "scales the load `{}`, which the file does not give",
-                crate::scene::data_key(&scaled)
-            ),
+    let scaled = model_name(family, scaled);
+    if scene.data_fn(&scaled).is_none() {
+        return match load {
+            Some(_) => Err((
+                "data.load".into(),
+                format!(
+                    "scales the load `{}`, which the file does not give",
+                    crate::scene::data_key(&scaled)
+                ),
+            )),
+            None => Ok(()),
+        };
+    }
+    scene.load = Some(Load {
+        default: load.unwrap_or(1.0),
+        scales: vec![scaled.into()],
+        symbol: "q",
+        sign,
+    });
+    scene
+        .load_magnitude(load)
+        .map(|_| ())
+        .map_err(|m| ("data.load".into(), m.replace("--load", "the load")))
+}
+
+/// The file's `accuracy`, which needs the exact quantity it is measured on
+/// ([`Family::accuracy_key`]).
+fn accuracy_of(
+    file: &FileToml,
+    family: &dyn Family,
+) -> std::result::Result<Option<f64>, FieldError> {
+    let Some(a) = file.accuracy else {
+        return Ok(None);
+    };
+    let key = family.accuracy_key();
+    let given = file.exact.as_ref().is_some_and(|e| match key {
+        "pressure" => e.pressure.is_some(),
+        _ => e.value.is_some(),
+    });
+    if !given {
+        return Err((
+            "accuracy".into(),
+            format!("an accuracy needs an `[exact] {key}` to measure the error against"),
         ));
     }
-    scene.supports = supports(&file.boundary, family).map_err(|(f, m)| at(&f, m))?;
-    scene.facets = facets(&file.boundary, family).map_err(|(f, m)| at(&f, m))?;
-    check_parts(&scene).map_err(|(f, m)| at(&f, m))?;
-    if let Some(e) = &file.exact {
-        // the contact set is not linear in the load: the file's exact solution holds at
-        // its own load
-        scene.exact = Exact::AtDefaultLoad(exact_of(e, &scene.domain, path)?);
+    if !(a.is_finite() && a > 0.0) {
+        return Err((
+            "accuracy".into(),
+            format!("{a} must be positive and finite"),
+        ));
     }
-    if let Some(a) = file.accuracy {
-        let key = family.accuracy_key();
-        let given = file.exact.as_ref().is_some_and(|e| match key {
-            "pressure" => e.pressure.is_some(),
-            _ => e.value.is_some(),
-        });
-        if !given {
-            return Err(at(
-                "accuracy",
-                format!("an accuracy needs an `[exact] {key}` to measure the error against"),
-            ));
-        }
-        if !(a.is_finite() && a > 0.0) {
-            return Err(at("accuracy", format!("{a} must be positive and finite")));
-        }
-        scene.accuracy = Some(a);
-    }
-    if let Some(pair) = &file.pair {
-        if let Err(e) = crate::families::pair_of(&scene, Some(pair)) {
-            return Err(at("pair", e.to_string()));
-        }
-    }
-    family.check_file(&scene).map_err(|(f, m)| at(&f, m))?;
-    Ok(FileScene {
-        scene,
-        pair: file.pair,
-        alpha,
-    })
+    Ok(Some(a))
 }
 
 /// A finite number of a scene file's field, `-0` read as 0.

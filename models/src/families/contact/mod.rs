@@ -19,7 +19,7 @@ use crate::run::{run, Quantities, Run};
 use crate::scene::{Domain, Generator, Load, LoadSign, Part, PartSupport, Posed, Scene, Support};
 use crate::signorini::{
     self, checkerboard, compare_with_hertz, contact_tangent, hertz_mesh, lame, signorini_p1,
-    signorini_p1_p1, signorini_p2, signorini_p2_p1, Displacement, Multiplier, Plane,
+    signorini_p1_p1, signorini_p2, signorini_p2_p1, Displacement, Hertz, Multiplier, Plane,
     SignoriniInput, SignoriniSolution,
 };
 pub use facts::{material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
@@ -651,21 +651,6 @@ fn add_quantities<M: Model>(
     magnitude: f64,
     report: &mut Report,
 ) {
-    let factor = facts.whole();
-    let n = facts.direction;
-    let along = |v: [f64; 2]| -(v[0] * n[0] + v[1] * n[1]);
-    let total = factor * along(solution.total_contact_force);
-    // the load's resultant pushes the body towards the foundation, along n_c
-    let applied = -factor * along(solution.applied_load);
-    // supports along n_c carry part of the load, and the translation the load is
-    // measured on has their DOFs fixed: no resultant to balance (NaN, null in JSON)
-    let held = file::translation_held(run.scene, facts);
-    let discretized = if held {
-        f64::NAN
-    } else {
-        factor * solution.discretized_load
-    };
-    let equilibrium = (total - discretized).abs() / discretized.abs().max(factor * magnitude);
     report.set("young", facts.young);
     report.set("poisson", facts.poisson);
     report.set(
@@ -676,28 +661,9 @@ fn add_quantities<M: Model>(
         },
     );
     report.set("contact_edges", solution.contact_edges.len());
-    report.set("total_contact_force", total);
-    report.set("applied_load", applied);
-    report.set("discretized_load", discretized);
-    report.set("equilibrium_residual", equilibrium);
     report.set("contact_half_width", solution.contact_half_width);
     report.set("max_contact_pressure", solution.max_contact_pressure);
-    if equilibrium > EQUILIBRIUM_WARNING {
-        report.warn(format!(
-            "the contact force misses the load as discretized by {equilibrium:.1e} (relative; a rigid translation lies in V_h, so it should be rounding): the solve did not reach solver precision, or the data's scales (a gap far beyond the elastic displacement) leave the displacement too few digits"
-        ));
-    }
-    if held {
-        report.warn(
-            "supports hold the body along the contact direction and carry part of the load: the contact force need not balance it, and no equilibrium is checked (discretized_load and equilibrium_residual are null)",
-        );
-    }
-    let quadrature = (discretized - applied).abs() / applied.abs();
-    if quadrature > QUADRATURE_WARNING {
-        report.warn(format!(
-            "the model integrates the pressure on Γ_N with a rule exact for pressures up to quadratic along an edge: this pressure's resultant comes out {discretized:.6e} against {applied:.6e} by 4-point Gauss per edge ({quadrature:.1e} relative), and the contact force balances the former; refine the mesh for a pressure that varies within an edge"
-        ));
-    }
+    add_equilibrium(facts, run, solution, magnitude, report);
     let (mu, lambda) = (run.posed.parameter("μ_L"), run.posed.parameter("λ_L"));
     if let Some(w) = mu
         .zip(lambda)
@@ -717,36 +683,93 @@ fn add_quantities<M: Model>(
                     .fold(0.0f64, |m, &p| m.max((p - q).abs() / q)),
             );
         }
-        (Some(body), Some(hertz)) => {
-            let (error, best, oscillation) = match body {
-                ContactBody::GapBlock { .. } => {
-                    let (error, best) = compare_gap_block(&hertz, solution);
-                    (error, best, checkerboard(solution, &hertz))
-                }
-                _ => {
-                    let h = hertz.half_width() / report.mesh_size as f64;
-                    let r = compare_with_hertz(hertz, h, solution.clone());
-                    (r.pressure_l2_error, r.best_fit_l2_error, r.oscillation)
-                }
-            };
-            report.set("exact_half_width", hertz.half_width());
-            report.set("exact_max_pressure", hertz.max_pressure());
-            report.set("pressure_l2_error", error);
-            report.set("best_fit_l2_error", best);
-            if solution.multiplier == Multiplier::P0 {
-                report.set("best_p0_l2_error", best);
-            }
-            // a second difference needs three pressures inside 0.8 b (b/h = 1, 2 have
-            // fewer: nothing measured, not 0)
-            let inside = pressure_steps(run)
-                .iter()
-                .filter(|p| p.1.abs() < 0.8 * hertz.half_width())
-                .count();
-            if inside >= 3 {
-                report.set("oscillation", oscillation);
-            }
-        }
+        (Some(body), Some(hertz)) => add_hertz(body, hertz, run, solution, report),
         _ => add_exact_pressure(run, solution, report),
+    }
+}
+
+/// The balance of the contact force with the load along `n_c` (the whole body's where
+/// a symmetry line halves it), with its warnings: a residual beyond rounding, a load
+/// the model's quadrature does not integrate, supports that carry part of the load.
+fn add_equilibrium<M: Model>(
+    facts: &ContactFacts,
+    run: &Run<'_, M, TriangleMesh>,
+    solution: &SignoriniSolution,
+    magnitude: f64,
+    report: &mut Report,
+) {
+    let factor = facts.whole();
+    let n = facts.direction;
+    let along = |v: [f64; 2]| -(v[0] * n[0] + v[1] * n[1]);
+    let total = factor * along(solution.total_contact_force);
+    // the load's resultant pushes the body towards the foundation, along n_c
+    let applied = -factor * along(solution.applied_load);
+    // supports along n_c carry part of the load, and the translation the load is
+    // measured on has their DOFs fixed: no resultant to balance (NaN, null in JSON)
+    let held = file::translation_held(run.scene, facts);
+    let discretized = if held {
+        f64::NAN
+    } else {
+        factor * solution.discretized_load
+    };
+    let equilibrium = (total - discretized).abs() / discretized.abs().max(factor * magnitude);
+    report.set("total_contact_force", total);
+    report.set("applied_load", applied);
+    report.set("discretized_load", discretized);
+    report.set("equilibrium_residual", equilibrium);
+    if equilibrium > EQUILIBRIUM_WARNING {
+        report.warn(format!(
+            "the contact force misses the load as discretized by {equilibrium:.1e} (relative; a rigid translation lies in V_h, so it should be rounding): the solve did not reach solver precision, or the data's scales (a gap far beyond the elastic displacement) leave the displacement too few digits"
+        ));
+    }
+    if held {
+        report.warn(
+            "supports hold the body along the contact direction and carry part of the load: the contact force need not balance it, and no equilibrium is checked (discretized_load and equilibrium_residual are null)",
+        );
+    }
+    let quadrature = (discretized - applied).abs() / applied.abs();
+    if quadrature > QUADRATURE_WARNING {
+        report.warn(format!(
+            "the model integrates the pressure on Γ_N with a rule exact for pressures up to quadratic along an edge: this pressure's resultant comes out {discretized:.6e} against {applied:.6e} by 4-point Gauss per edge ({quadrature:.1e} relative), and the contact force balances the former; refine the mesh for a pressure that varies within an edge"
+        ));
+    }
+}
+
+/// The pressure against Hertz's on a built-in body that has it: the half-width, the
+/// peak, the relative L² errors of λ_h and of the best fit, and the checkerboard measure.
+fn add_hertz<M: Model>(
+    body: ContactBody,
+    hertz: Hertz,
+    run: &Run<'_, M, TriangleMesh>,
+    solution: &SignoriniSolution,
+    report: &mut Report,
+) {
+    let (error, best, oscillation) = match body {
+        ContactBody::GapBlock { .. } => {
+            let (error, best) = compare_gap_block(&hertz, solution);
+            (error, best, checkerboard(solution, &hertz))
+        }
+        _ => {
+            let h = hertz.half_width() / report.mesh_size as f64;
+            let r = compare_with_hertz(hertz, h, solution.clone());
+            (r.pressure_l2_error, r.best_fit_l2_error, r.oscillation)
+        }
+    };
+    report.set("exact_half_width", hertz.half_width());
+    report.set("exact_max_pressure", hertz.max_pressure());
+    report.set("pressure_l2_error", error);
+    report.set("best_fit_l2_error", best);
+    if solution.multiplier == Multiplier::P0 {
+        report.set("best_p0_l2_error", best);
+    }
+    // a second difference needs three pressures inside 0.8 b (b/h = 1, 2 have fewer:
+    // nothing measured, not 0)
+    let inside = pressure_steps(run)
+        .iter()
+        .filter(|p| p.1.abs() < 0.8 * hertz.half_width())
+        .count();
+    if inside >= 3 {
+        report.set("oscillation", oscillation);
     }
 }
 
