@@ -531,6 +531,7 @@ fn run<M: Model>(request: &Request, pair: Pair) -> Result<(Report, Profiles)> {
         problem = problem.exact(Exact {
             value: &exact_value,
             gradient: Some(&exact_slope),
+            hessian: None,
             multiplier: None,
         });
     }

@@ -709,6 +709,7 @@ fn run<M: Model>(
         problem = problem.exact(problem::Exact {
             value: &exact_u,
             gradient: Some(&exact_gradient),
+            hessian: None,
             multiplier: has_multiplier.then_some(&exact_multiplier as &DataFn),
         });
     }

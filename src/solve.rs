@@ -261,6 +261,7 @@ pub fn summary(r: &Report) -> String {
     let errors: Vec<String> = [
         ("L²", s.error_l2),
         ("H¹", s.error_h1),
+        ("H²", s.error_h2),
         ("λ", s.error_multiplier),
         ("vertex max", s.error_vertex_max),
     ]

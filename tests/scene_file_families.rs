@@ -138,3 +138,50 @@ fn scene_file_mistakes_are_refused_or_named() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A manufactured Kirchhoff plate from a scene file with its exact Hessian: the simply
+/// supported unit square under `f = 4π⁴ D sin(πx) sin(πy)` bends as `w = sin(πx) sin(πy)`
+/// (`Δ²w = 4π⁴ w`, and `w = w_nn = 0` on the edges), far from its obstacle. The broken
+/// H² error the report computes from `[exact] hessian` falls at Argyris's O(h⁴) and
+/// Morley's O(h).
+#[test]
+fn an_exact_hessian_gives_the_h2_error_at_each_elements_rate() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("kirchhoff-hessian-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("manufactured.toml");
+    std::fs::write(
+        &path,
+        r#"model = "kirchhoff"
+[mesh]
+generator = "rectangle"
+[boundary]
+simply_supported = "all"
+[parameters]
+D = 1.0
+nu = 0.3
+[data]
+f = "4*PI^4*sin(PI*x)*sin(PI*y)"
+psi = "-10"
+[exact]
+w = "sin(PI*x)*sin(PI*y)"
+hessian = [["-(PI^2)*sin(PI*x)*sin(PI*y)", "PI^2*cos(PI*x)*cos(PI*y)"],
+           ["PI^2*cos(PI*x)*cos(PI*y)", "-(PI^2)*sin(PI*x)*sin(PI*y)"]]
+"#,
+    )
+    .unwrap();
+    let path = path.to_str().unwrap();
+    for (pair, low, high) in [("argyris-p0", 3.6, 4.6), ("morley-p0", 0.8, 1.2)] {
+        let errors: Vec<f64> = ["4", "8", "16"]
+            .iter()
+            .map(|n| {
+                let r = solve_json(&["--scene", path, "--pair", pair, "--mesh-size", n]);
+                r["error_h2"].as_f64().unwrap()
+            })
+            .collect();
+        for w in errors.windows(2) {
+            let rate = (w[0] / w[1]).log2();
+            assert!(rate > low && rate < high, "{pair}: H² errors {errors:?}");
+        }
+    }
+}

@@ -13,7 +13,7 @@ use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::{FirstStart, ObstacleOptions, VariationalSolver};
 use fem_runtime::problem::memory::check_memory;
 use fem_runtime::problem::{
-    self, Condition, Exact, GradientFn, MemoryModel, Problem, SolveOptions, Solved,
+    self, Condition, Exact, GradientFn, HessianFn, MemoryModel, Problem, SolveOptions, Solved,
 };
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{
@@ -697,6 +697,7 @@ fn vector_fields<M: Model>(primal: &[usize]) -> Vec<[usize; 2]> {
 struct ExactFns {
     value: Option<Data>,
     gradient: Option<Data<[f64; 2]>>,
+    hessian: Option<Data<[[f64; 2]; 2]>>,
     multiplier: Option<Data>,
 }
 
@@ -705,6 +706,7 @@ impl ExactFns {
         Self {
             value: e.value.clone(),
             gradient: e.gradient.clone(),
+            hessian: e.hessian.clone(),
             multiplier: e.multiplier.clone(),
         }
     }
@@ -713,6 +715,7 @@ impl ExactFns {
         Exact {
             value: self.value.as_ref().map_or(&nan, Data::as_data_fn),
             gradient: self.gradient.as_ref().map(|g| g.as_fn() as &GradientFn),
+            hessian: self.hessian.as_ref().map(|h| h.as_fn() as &HessianFn),
             multiplier: self.multiplier.as_ref().map(Data::as_data_fn),
         }
     }

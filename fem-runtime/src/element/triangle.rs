@@ -630,6 +630,34 @@ impl TriangleField<'_> {
         (l2.sqrt(), h1.sqrt())
     }
 
+    /// The broken H² seminorm `(Σ_T ∫_T |∇²u − ∇²u_h|²)^{1/2}` (Frobenius norm of the
+    /// Hessians) against `exact(x) = ∇²u(x)`, with a rule of degree `degree` on each cell.
+    pub fn hessian_error(
+        &self,
+        exact: &(dyn Fn([f64; 2]) -> [[f64; 2]; 2] + Sync),
+        degree: usize,
+    ) -> f64 {
+        let basis = TriangleBasis::new(self.map.element());
+        let rule = TriangleRule::exact_for_degree(degree);
+        let sums = over_cell_chunks(self.mesh.cell_count(), |cells| {
+            let mut sum = 0.0;
+            for c in cells {
+                let map = AffineMap::of(self.mesh, c);
+                for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+                    let h = exact(map.point(xi));
+                    let hh = self.hessian(&basis, &map, c, xi);
+                    let e: f64 = (0..2)
+                        .flat_map(|i| (0..2).map(move |j| (i, j)))
+                        .map(|(i, j)| (h[i][j] - hh[i][j]).powi(2))
+                        .sum();
+                    sum += w * map.det * e;
+                }
+            }
+            sum
+        });
+        sums.into_iter().sum::<f64>().sqrt()
+    }
+
     /// `(Σ_T h_T^{2·power} ‖λ − λ_h‖²_T)^{1/2}` against `exact(x)`; `power = 0` is the L² norm.
     pub fn weighted_error(
         &self,

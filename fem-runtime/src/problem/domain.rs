@@ -39,6 +39,8 @@ pub struct Errors {
     pub l2: Option<f64>,
     /// `|u − u_h|_H¹`.
     pub h1: Option<f64>,
+    /// `(Σ_T |u − u_h|²_{H²(T)})^{1/2}`, the broken H² seminorm.
+    pub h2: Option<f64>,
     /// `(Σ_T h_T² ‖λ − λ_h‖²_T)^{1/2}` (multipliers on cells).
     pub multiplier: Option<f64>,
     /// `max |u_h(v) − u(v)|` over the vertices.
@@ -441,12 +443,16 @@ impl Domain for IntervalMesh {
         let h1 = exact
             .gradient
             .map(|gradient| view.error(1, &|x| gradient(&[x])[0], 6));
+        let h2 = exact
+            .hessian
+            .map(|hessian| view.error(2, &|x| hessian(&[x])[0][0], 6));
         let vertices = Self::field_at_vertices(solution, field);
         let x = solution.discretization.mesh.vertices();
         let (max, mean) = vertex_errors(&vertices, x.iter().map(|&x| value(&[x])));
         Errors {
             l2: Some(l2),
             h1,
+            h2,
             multiplier: None,
             vertex_max: Some(max),
             vertex_mean: Some(mean),
@@ -858,9 +864,13 @@ where
     } else {
         (None, None)
     };
+    let h2 = exact
+        .hessian
+        .map(|hessian| u.hessian_error(&|x| hessian(&x), degree));
     Errors {
         l2: Some(l2),
         h1,
+        h2,
         multiplier,
         vertex_max,
         vertex_mean,

@@ -134,14 +134,20 @@ impl ObstacleSide {
 /// A gradient of the point: `[∂_x, ∂_y]` (on intervals `[u', 0]`).
 pub type GradientFn = dyn Fn(&[f64]) -> [f64; 2] + Sync;
 
+/// A Hessian of the point: `[[∂_xx, ∂_xy], [∂_yx, ∂_yy]]` (on intervals
+/// `[[u'', 0], [0, 0]]`).
+pub type HessianFn = dyn Fn(&[f64]) -> [[f64; 2]; 2] + Sync;
+
 /// An exact solution to measure errors against: the constrained field's values (the
-/// model's `obstacle:` role), its gradient and the multiplier, where known.
+/// model's `obstacle:` role), its gradient, Hessian and the multiplier, where known.
 #[derive(Clone, Copy)]
 pub struct Exact<'a> {
     /// `u(x)`.
     pub value: &'a DataFn,
     /// `∇u(x)`.
     pub gradient: Option<&'a GradientFn>,
+    /// `∇²u(x)`, for the broken H² seminorm of the error (plates, beams).
+    pub hessian: Option<&'a HessianFn>,
     /// `λ(x)`.
     pub multiplier: Option<&'a DataFn>,
 }
@@ -803,6 +809,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             let errors = G::errors(&solution, 0, exact);
             report.error_l2 = errors.l2;
             report.error_h1 = errors.h1;
+            report.error_h2 = errors.h2;
             report.error_vertex_max = errors.vertex_max;
             report.error_vertex_mean = errors.vertex_mean;
         }
@@ -1266,6 +1273,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             let errors = G::errors(solution, field, exact);
             report.error_l2 = errors.l2;
             report.error_h1 = errors.h1;
+            report.error_h2 = errors.h2;
             report.error_multiplier = errors.multiplier;
             report.error_vertex_max = errors.vertex_max;
             report.error_vertex_mean = errors.vertex_mean;

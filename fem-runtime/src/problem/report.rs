@@ -61,6 +61,10 @@ pub struct Report {
     pub error_l2: Option<f64>,
     /// `|u − u_h|_H¹`, where the exact gradient is known.
     pub error_h1: Option<f64>,
+    /// The broken H² seminorm `(Σ_T |u − u_h|²_{H²(T)})^{1/2}`, where the exact Hessian
+    /// is known (a scene file's `[exact] hessian`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_h2: Option<f64>,
     /// `(Σ_T h_T² ‖λ − λ_h‖²_T)^{1/2}`, where the exact multiplier is known.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error_multiplier: Option<f64>,
