@@ -14,18 +14,20 @@ use fem_runtime::{Error, Result};
 use std::path::Path;
 
 /// Runs the Kirchhoff study `kind` on `scene` (`convergence`, `lambda-scatter`);
-/// `None` where `scene` is not a Kirchhoff scene (its studies are the generic kinds').
+/// `None` where `scene` is not a Kirchhoff scene or `kind` is a generic study kind (the
+/// one implementation runs it).
 ///
 /// # Errors
-/// An unknown study, and the study's errors.
+/// The study's errors.
 pub fn run(scene: &Scene, kind: &str, full: bool, out: &Path) -> Option<Result<()>> {
-    (scene.family == "kirchhoff").then(|| match kind {
-        "convergence" => convergence(scene, full, out),
-        "lambda-scatter" => scatter_run(scene, full, out),
-        _ => Err(Error::Input(format!(
-            "unknown Kirchhoff study `{kind}`; the studies are convergence and lambda-scatter"
-        ))),
-    })
+    if scene.family != "kirchhoff" {
+        return None;
+    }
+    match kind {
+        "convergence" => Some(convergence(scene, full, out)),
+        "lambda-scatter" => Some(scatter_run(scene, full, out)),
+        _ => None,
+    }
 }
 
 /// `scene` with `adjustment` applied by its family.

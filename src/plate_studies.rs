@@ -10,7 +10,7 @@ use crate::models::report::{Report, Settings};
 use crate::models::scene::{Domain, Name, Scene};
 use crate::plot::{self, Axes, Series};
 use crate::studies::{io, output, write_csv, Study};
-use fem_runtime::{Error, Result};
+use fem_runtime::Result;
 use std::path::Path;
 
 /// The coarsest level of a nested plate solve (the family's: N halves while it is even
@@ -18,20 +18,21 @@ use std::path::Path;
 const COARSEST_LEVEL: usize = 4;
 
 /// Runs the plate study `kind` on `scene` (`locking`, `iterations`, `convergence`);
-/// `None` where `scene` is not a plate scene.
+/// `None` where `scene` is not a plate scene or `kind` is a generic study kind (the one
+/// implementation runs it).
 ///
 /// # Errors
-/// An unknown study, and the study's errors.
+/// The study's errors.
 pub fn run(scene: &Scene, kind: &str, full: bool, out: &Path) -> Option<Result<()>> {
-    (scene.family == "plate").then(|| match kind {
-        "locking" => locking_run(scene, full, out),
-        "iterations" => iterations_run(scene, full, out),
-        "convergence" => convergence_run(scene, full, out),
-        other => Err(Error::Input(format!(
-            "plate scene `{}` hosts no study `{other}`; the plate studies are locking, iterations and convergence",
-            scene.name
-        ))),
-    })
+    if scene.family != "plate" {
+        return None;
+    }
+    match kind {
+        "locking" => Some(locking_run(scene, full, out)),
+        "iterations" => Some(iterations_run(scene, full, out)),
+        "convergence" => Some(convergence_run(scene, full, out)),
+        _ => None,
+    }
 }
 
 /// One solve of a study: `pair` (`None`: the scene's default) at N = `size`, the load

@@ -7,7 +7,7 @@
 
 use crate::models::families;
 use crate::models::geometry::Fields;
-use crate::models::report::{Outcome, Settings};
+use crate::models::report::{Outcome, Schur, Settings};
 use crate::models::scene::{Domain, Scene};
 use crate::studies::{ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study, StudyScene};
 use fem_runtime::{Error, Result};
@@ -47,6 +47,24 @@ impl RegistryStudies {
             .collect();
         sizes.dedup();
         sizes
+    }
+
+    /// The multiplier's Schur complement of `pair` at `size` with α (`None`: the pair's
+    /// rule), and the α solved with.
+    fn schur(&self, pair: &'static str, size: usize, alpha: Option<f64>) -> Result<(Schur, f64)> {
+        let settings = Settings {
+            pair: Some(pair.to_string()),
+            mesh_size: Some(size),
+            alpha,
+            schur: true,
+            ..Settings::default()
+        };
+        let outcome = families::solve(&self.scene, &settings)?;
+        let alpha = outcome.report.solve.alpha.unwrap_or(0.0);
+        let schur = outcome
+            .schur
+            .ok_or_else(|| self.unsupported("multiplier space to measure"))?;
+        Ok((schur, alpha))
     }
 
     /// The family's own error measure of the multiplier ([`crate::models::family::Family::error_measure`]).
@@ -150,6 +168,17 @@ impl StudyScene for RegistryStudies {
                         .collect(),
                 }
             }
+            // the inf-sup eigenproblem is dense in the multipliers: one halving down
+            Study::Stability => Plan {
+                pair,
+                sizes: self
+                    .ladder(full)
+                    .into_iter()
+                    .map(|k| (k / 2).max(1))
+                    .collect(),
+                cold_max: 0,
+                alphas: vec![],
+            },
             Study::WorkPrecision | Study::Iterations => Plan {
                 pair: default,
                 sizes: self.ladder(full),
@@ -165,12 +194,13 @@ impl StudyScene for RegistryStudies {
         }
     }
 
+    /// The default pair at the scene's size, plain (α = 0) and stabilized.
     fn profiles(&self, _full: bool) -> Plan {
         Plan {
             pair: self.pairs()[0],
             sizes: vec![self.scene.mesh_size],
             cold_max: 0,
-            alphas: vec![None],
+            alphas: vec![Some(0.0), None],
         }
     }
 
@@ -220,21 +250,52 @@ impl StudyScene for RegistryStudies {
         self.scene.exact_at(&posed)?.contact_area
     }
 
+    /// Every pair with a multiplier space (the nodal method has none to measure).
     fn stability_pairs(&self) -> Vec<&'static str> {
-        Vec::new()
+        families::pairs_of(&self.scene)
+            .iter()
+            .filter(|p| !p.nodal)
+            .map(|p| p.name)
+            .collect()
     }
 
     fn measure(&self) -> Measure {
         Measure {
-            title: "no stability measure",
-            labels: &[],
-            axis: "",
-            plotted: |v| v,
+            title: "inf-sup constants of the multiplier, γ₁ ≤ γ₂ of B A⁻¹ Bᵀ + C in the stabilization's norm",
+            labels: &["γ₁", "γ₂"],
+            axis: "γ",
+            plotted: |v| v.max(1e-16),
         }
     }
 
-    fn stability(&self, _pair: &'static str, _size: usize) -> Result<StabilityRow> {
-        Err(self.unsupported("stability measure"))
+    /// The two smallest eigenvalues of the multiplier's Schur complement in the norm of
+    /// the pair's stabilization (its diagonal over α, from the stabilized solve), for the
+    /// plain method (α = 0) and the stabilized one (the default α): one implementation
+    /// for every family ([`fem_runtime::stabilization::inf_sup_spectrum`]).
+    fn stability(&self, pair: &'static str, size: usize) -> Result<StabilityRow> {
+        let (stabilized, alpha) = self.schur(pair, size, None)?;
+        let norm = stabilized.norm.clone().ok_or_else(|| {
+            Error::Input(format!(
+                "pair {pair} of `{}` has no stabilization whose norm the inf-sup constants are measured in",
+                self.scene.name
+            ))
+        })?;
+        let (plain, _) = self.schur(pair, size, Some(0.0))?;
+        let two = |schur: &Schur| -> Result<Vec<f64>> {
+            let values = fem_runtime::stabilization::inf_sup_spectrum(&schur.matrix, &norm)?;
+            Ok(values
+                .into_iter()
+                .chain([f64::NAN, f64::NAN])
+                .take(2)
+                .collect())
+        };
+        Ok(StabilityRow {
+            pair,
+            size,
+            alpha,
+            plain: two(&plain)?,
+            stabilized: two(&stabilized)?,
+        })
     }
 
     /// The family's chart of the multiplier along its boundary part ([`crate::models::report::Profile`]), as
@@ -274,7 +335,19 @@ impl StudyScene for RegistryStudies {
             })
     }
 
+    /// The extent of the family's chart at the default solve.
     fn profile_window(&self) -> [f64; 2] {
-        [0.0, 1.0]
+        let run = Run::new(self.pairs()[0], self.scene.mesh_size);
+        let points = self.multiplier_profile(&run).unwrap_or_default();
+        let (lo, hi) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.0), hi.max(p.0))
+            });
+        if lo < hi {
+            [lo, hi]
+        } else {
+            [0.0, 1.0]
+        }
     }
 }

@@ -632,6 +632,41 @@ fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
     }
     let profile = scene.profiles(full);
     let (pair, n) = (profile.pair, profile.sizes[0]);
+    let mut panels = vec![(
+        format!("{name}: {}", measure.title),
+        log_axes("h", measure.axis),
+        series,
+    )];
+    // a family without a chart of its multiplier along a line has the measure alone
+    if multiplier_profile(scene, pair, n, None).is_ok() {
+        panels.push(stability_profiles(scene, &profile)?);
+    }
+    plot::stacked(&output(out, &name, Study::Stability, "svg"), &panels).map_err(io)?;
+    let mut header = "size,alpha".to_string();
+    for side in ["plain", "stabilized"] {
+        for k in 1..=measure.labels.len() {
+            header += &format!(",{side}_{k}");
+        }
+    }
+    write_csv_named(
+        &output(out, &name, Study::Stability, "csv"),
+        "pair",
+        &header,
+        &scene.stability_pairs(),
+        &csv,
+    )
+    .map_err(io)
+}
+
+/// The stability study's profiles: λ_h along the family's line for each α of the plan
+/// (the plain method and the stabilized one), with the holes, total variation and
+/// oscillation against the exact λ printed, as a chart panel.
+fn stability_profiles(
+    scene: &dyn StudyScene,
+    profile: &Plan,
+) -> Result<(String, Axes<'static>, Vec<Series>)> {
+    let name = scene.name();
+    let (pair, n) = (profile.pair, profile.sizes[0]);
     let exact = scene.exact_multiplier();
     println!(
         "\n{}, {pair}, {} = {n}: multiplier λ_h along a line through the contact set",
@@ -650,7 +685,7 @@ fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
             .collect()
     };
     let mut profiles = Vec::new();
-    for alpha in profile.alphas {
+    for &alpha in &profile.alphas {
         let p = multiplier_profile(scene, pair, n, alpha)?;
         let label = variant_label(alpha);
         println!(
@@ -679,43 +714,18 @@ fn run_stability(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
         );
         profiles.push(Series::line("exact λ", samples));
     }
-    plot::stacked(
-        &output(out, &name, Study::Stability, "svg"),
-        &[
-            (
-                format!("{name}: {}", measure.title),
-                log_axes("h", measure.axis),
-                series,
-            ),
-            (
-                format!(
-                    "{name}, {pair}, {} = {n}: λ_h of the plain (α = 0) and the stabilized method",
-                    scene.size_name()
-                ),
-                Axes {
-                    x: "x",
-                    y: "λ_h",
-                    ..Axes::default()
-                },
-                profiles,
-            ),
-        ],
-    )
-    .map_err(io)?;
-    let mut header = "size,alpha".to_string();
-    for side in ["plain", "stabilized"] {
-        for k in 1..=measure.labels.len() {
-            header += &format!(",{side}_{k}");
-        }
-    }
-    write_csv_named(
-        &output(out, &name, Study::Stability, "csv"),
-        "pair",
-        &header,
-        &scene.stability_pairs(),
-        &csv,
-    )
-    .map_err(io)
+    Ok((
+        format!(
+            "{name}, {pair}, {} = {n}: λ_h of the plain (α = 0) and the stabilized method",
+            scene.size_name()
+        ),
+        Axes {
+            x: "x",
+            y: "λ_h",
+            ..Axes::default()
+        },
+        profiles,
+    ))
 }
 
 /// One α of the α sweep: the solve's row, or why it failed.

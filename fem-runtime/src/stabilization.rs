@@ -296,6 +296,35 @@ pub fn inverse_constant_between<M: Model, G: Mesh>(
     Ok(largest)
 }
 
+/// The discrete inf-sup constants of a multiplier: the eigenvalues `γ₁ ≤ γ₂ ≤ …` of
+/// `S x = γ D x`, `S` the Schur complement `B A⁻¹ Bᵀ + C` ([`crate::lcp::Lcp::schur_complement`])
+/// and `D = diag(weights)` the mesh-dependent norm of the multipliers, the diagonal of the
+/// model's stabilization `C/α` (for a P0 membrane multiplier `h_T² |T|`: the norm
+/// `Σ_T h_T² ‖μ‖²_T` of Barbosa–Hughes; a boundary multiplier's `h_E |E|`). `√γ₁` is
+/// the inf-sup constant of the pair; the stabilized method has `γ₁ ≥ α` where `C` is
+/// diagonal (`C = αD`), whatever the pair.
+///
+/// # Errors
+/// Weights that are not positive and finite, or of another length than `schur`.
+pub fn inf_sup_spectrum(schur: &DMatrix<f64>, weights: &[f64]) -> Result<Vec<f64>> {
+    let m = schur.nrows();
+    if weights.len() != m || !weights.iter().all(|w| w.is_finite() && *w > 0.0) {
+        return Err(Error::Input(format!(
+            "the multipliers' norm needs {m} positive finite weights (the stabilization's diagonal over α), got {}",
+            weights.len()
+        )));
+    }
+    let scale: Vec<f64> = weights.iter().map(|w| 1.0 / w.sqrt()).collect();
+    let weighted = DMatrix::from_fn(m, m, |k, l| schur[(k, l)] * scale[k] * scale[l]);
+    let mut values: Vec<f64> = SymmetricEigen::new(weighted)
+        .eigenvalues
+        .iter()
+        .copied()
+        .collect();
+    values.sort_by(f64::total_cmp);
+    Ok(values)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -34,6 +34,9 @@ pub struct Settings {
     pub diagonal: Option<Diagonal>,
     /// Run the rounding experiment (`None`: where the family does).
     pub rounding_experiment: Option<bool>,
+    /// Also form the multiplier's Schur complement of the finest mesh
+    /// ([`Outcome::schur`]; the stability study).
+    pub schur: bool,
 }
 
 impl Default for Settings {
@@ -50,6 +53,7 @@ impl Default for Settings {
             refinement: None,
             diagonal: None,
             rounding_experiment: None,
+            schur: false,
         }
     }
 }
@@ -191,6 +195,20 @@ pub struct Outcome {
     /// The multiplier along the boundary part it lives on, where the family charts it
     /// (`--plot`).
     pub profile: Option<Profile>,
+    /// The multiplier's Schur complement on the finest mesh, where the settings ask for
+    /// it ([`Settings::schur`]) and the pair has a multiplier space.
+    pub schur: Option<Schur>,
+}
+
+/// The multiplier problem of a solve's finest mesh once the primal unknowns are
+/// eliminated: what the stability (inf-sup) study measures.
+#[derive(Clone, Debug)]
+pub struct Schur {
+    /// `S = B A⁻¹ Bᵀ + C` (m × m).
+    pub matrix: nalgebra::DMatrix<f64>,
+    /// The diagonal of the stabilization `C/α`, the multipliers' mesh-dependent norm
+    /// (`None` for the plain method, α = 0, which has none).
+    pub norm: Option<Vec<f64>>,
 }
 
 /// A multiplier along a boundary part (the contact pressure along Γ_C), against its

@@ -7,7 +7,7 @@
 use crate::data::Data;
 use crate::family::Pair;
 use crate::geometry::{Fields, Geometry};
-pub use crate::report::{Outcome, Phases, Profile, Report, Settings, MAX_REFINEMENT_STEPS};
+pub use crate::report::{Outcome, Phases, Profile, Report, Schur, Settings, MAX_REFINEMENT_STEPS};
 use crate::scene::{ExactSolution, Part, Posed, Scene, Support};
 use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::{FirstStart, ObstacleOptions, VariationalSolver};
@@ -269,10 +269,31 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
             .max(0.0)
             + (solve_seconds - report.solve.seconds).max(0.0),
     };
+    let schur = match (settings.schur, M::SYSTEM.is_some()) {
+        (true, true) => Some(schur_of(&solved, report.solve.alpha)?),
+        _ => None,
+    };
     Ok(Outcome {
         report,
         fields,
         profile,
+        schur,
+    })
+}
+
+/// The multiplier's Schur complement of the finest mesh, and the stabilization's
+/// diagonal over α as the multipliers' norm where α > 0.
+///
+/// # Errors
+/// [`fem_runtime::lcp::Lcp::schur_complement`]'s.
+fn schur_of<M: Model, G: Geometry>(solved: &Solved<M, G>, alpha: Option<f64>) -> Result<Schur> {
+    let lcp = &solved.solution.discretization.lcp;
+    let norm = alpha
+        .filter(|a| *a > 0.0)
+        .map(|a| lcp.c.iter().map(|c| c / a).collect());
+    Ok(Schur {
+        matrix: lcp.schur_complement()?,
+        norm,
     })
 }
 

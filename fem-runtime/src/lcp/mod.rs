@@ -258,6 +258,9 @@ impl CouplingBlocks {
     }
 }
 
+/// The most multipliers [`Lcp::schur_complement`] forms its dense matrix for (4000: 128 MB).
+pub const MAX_DENSE_MULTIPLIERS: usize = 4000;
+
 /// A solution of the LCP with how it was obtained.
 #[derive(Clone, Debug)]
 pub struct LcpSolution {
@@ -489,6 +492,55 @@ impl Lcp {
             complementarity = complementarity.max(l.min(r).abs()).max(-l).max(-r);
         }
         complementarity
+    }
+
+    /// The multiplier's Schur complement `S = B A⁻¹ Bᵀ + C` (m × m, dense, symmetric): the
+    /// matrix the multiplier sees once the primal unknowns are eliminated. Its smallest
+    /// eigenvalue in a norm of the multipliers is the discrete inf-sup constant squared
+    /// of the plain method (`C = 0`), lifted by `C` for the stabilized one.
+    ///
+    /// # Errors
+    /// More than [`MAX_DENSE_MULTIPLIERS`] multipliers (the matrix is dense), and `A` not
+    /// positive definite.
+    pub fn schur_complement(&self) -> Result<nalgebra::DMatrix<f64>> {
+        let (n, m) = (self.n(), self.m());
+        if m > MAX_DENSE_MULTIPLIERS {
+            return Err(Error::Input(format!(
+                "the Schur complement B A⁻¹ Bᵀ + C is dense: {m} multipliers are more than {MAX_DENSE_MULTIPLIERS}; take a coarser mesh"
+            )));
+        }
+        let pattern = self
+            .a
+            .symbolic()
+            .to_owned()
+            .map_err(|e| Error::LinearSolve(format!("{e:?}")))?;
+        let factor = Cholesky::analyse(&pattern)?.factor(&self.a)?;
+        // the columns A⁻¹ Bᵀ e_k, then S_kl = B_k · A⁻¹ Bᵀ e_l
+        let mut columns = Vec::with_capacity(m);
+        for row in self.b_rows.iter() {
+            let mut column = vec![0.0; n];
+            for &(j, v) in row {
+                column[j] += v;
+            }
+            columns.push(factor.solve(&column)?);
+        }
+        let mut s = nalgebra::DMatrix::<f64>::zeros(m, m);
+        for (k, row) in self.b_rows.iter().enumerate() {
+            for (l, column) in columns.iter().enumerate() {
+                s[(k, l)] = row.iter().map(|&(j, v)| v * column[j]).sum();
+            }
+        }
+        let mut dense = [0.0; MAX_BLOCK * MAX_BLOCK];
+        for block in self.blocks() {
+            block.dense(&self.c, &mut dense);
+            for i in 0..block.size {
+                for j in 0..block.size {
+                    s[(block.start + i, block.start + j)] += dense[i * block.size + j];
+                }
+            }
+        }
+        // rounding leaves B A⁻¹ Bᵀ a little off symmetric
+        Ok((&s + s.transpose()) * 0.5)
     }
 
     /// The KKT residual of `(u, λ)`, scale-invariant: the largest of

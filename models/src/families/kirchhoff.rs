@@ -153,7 +153,7 @@ fn kirchhoff_scene(
     scene.side = ObstacleSide::Above;
     place(&mut scene, obstacle);
     scene.studies = match obstacle {
-        Some(_) => vec!["convergence", "lambda-scatter"],
+        Some(_) => vec!["convergence", "lambda-scatter", "stability"],
         None => vec!["convergence"],
     };
     scene
