@@ -615,6 +615,45 @@ fn bad_contact_scene_files_name_the_key() {
             "mesh.refinements",
             &["at most"],
         ),
+        // the model's own parameters follow from [material] and contact_direction: set
+        // by name they bypassed the checks (n_c = (1, −1) unnormalized, a 122 % error)
+        (
+            format!("{RECTANGLE}\n[parameters]\nn_c_x = 1.0\n"),
+            "parameters.n_c_x",
+            &["contact_direction"],
+        ),
+        (
+            format!("{RECTANGLE}\n[parameters]\n\"μ_L\" = 1.0\n"),
+            "parameters.μ_L",
+            &["[material]"],
+        ),
+        // the contact model has no boundary data: `dirichlet` imposed nothing and only
+        // switched the equilibrium and gap checks off
+        (
+            RECTANGLE.replace(
+                "fixed_x = \"left\"",
+                "fixed_x = \"left\"\ndirichlet = \"right\"",
+            ),
+            "boundary.dirichlet",
+            &["no prescribed displacement"],
+        ),
+        // a clamp on Γ_C fought the contact (a force of 5.94 for 6)
+        (
+            RECTANGLE.replace("fixed_x = \"left\"", "clamped = \"bottom\""),
+            "boundary.clamped",
+            &["`boundary.contact`", "drop the support"],
+        ),
+        // two spellings of one datum: one of them won unseen
+        (
+            RECTANGLE.replace("gap = \"0\"", "gap = \"0\"\nq = \"2\""),
+            "data.q",
+            &["`pressure`", "give it once"],
+        ),
+        (
+            format!("{RECTANGLE}\n[exact]\nu = \"x\"\n"),
+            "exact.u",
+            &["[exact] pressure"],
+        ),
     ];
     for (text, key, words) in cases {
         let message = parse(&text).unwrap_err().to_string();
@@ -630,10 +669,15 @@ fn bad_contact_scene_files_name_the_key() {
     for (from, to) in [
         ("x = [0.0, 2.0]", "x = [0.0, 2.0, 5.0]"),
         ("cells = [6, 3]", "cells = [6, 3, 99]"),
+        (
+            "fixed_x = \"left\"",
+            "[[boundary.roller]]\npart = \"left\"\nnormal = [1.0, 0.0, 99.0]",
+        ),
     ] {
         let message = parse(&RECTANGLE.replace(from, to)).unwrap_err().to_string();
         assert!(
-            message.contains("3 entries where two are expected") && message.contains(to),
+            message.contains("3 entries where two are expected")
+                && message.contains(to.lines().last().unwrap()),
             "{message}"
         );
     }

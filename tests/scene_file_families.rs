@@ -185,3 +185,45 @@ hessian = [["-(PI^2)*sin(PI*x)*sin(PI*y)", "PI^2*cos(PI*x)*cos(PI*y)"],
         }
     }
 }
+
+/// Two spellings of one parameter or datum (a family's alias and the model's name), a
+/// Hessian that is not 2 × 2 and derivatives without the exact value are refused by
+/// their key: one of each pair used to win unseen, and a gradient without `u` gave
+/// errors of NaN.
+#[test]
+fn ambiguous_and_incomplete_keys_are_refused() {
+    let base = "model = \"membrane\"\n[mesh]\ngenerator = \"square\"\nsize = 4\n[data]\nf = \"0\"\npsi = \"-1\"\n";
+    let path = std::path::Path::new("scene.toml");
+    for (text, field, words) in [
+        (
+            format!("{base}\"ψ\" = \"-10\"\n"),
+            "data.ψ",
+            "both name the model's `ψ`",
+        ),
+        (
+            format!("{base}[exact]\ngradient = [\"0\", \"0\"]\n"),
+            "exact.gradient",
+            "need its value",
+        ),
+        (
+            format!(
+                "{base}[exact]\nu = \"0\"\nhessian = [[\"0\", \"0\", \"1\"], [\"0\", \"0\"]]\n"
+            ),
+            "hessian",
+            "two rows of two expressions",
+        ),
+        (
+            format!("{base}[parameters]\nalpha = 0.1\n\"α\" = 0.2\n"),
+            "parameters",
+            "give it once",
+        ),
+    ] {
+        let message = fem_forms::models::scene_file::parse(&text, path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains(field) && message.contains(words),
+            "{field}: {message}"
+        );
+    }
+}

@@ -193,12 +193,12 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     let bound = bind::<M>(scene, pair, &posed)?;
     let supports = supports::<M, G>(scene, &finest)?;
     let exact = scene.exact_at(&posed);
-    // a multiplier on facets (contact's pressure on Γ_C) is measured by its family; the
-    // runtime measures the primal field and a cell multiplier
-    let on_facets = fem_runtime::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
+    // the runtime measures errors of the constrained field (and of a cell multiplier
+    // beside it): without the field's value there is nothing for it to measure (a
+    // multiplier on facets, contact's pressure on Γ_C, is measured by its family)
     let exact_fns = exact
         .as_ref()
-        .filter(|e| e.value.is_some() || !on_facets)
+        .filter(|e| e.value.is_some())
         .map(ExactFns::new);
     if let Some(e) = &exact {
         validate_exact(e, &finest, scene)?;

@@ -435,7 +435,37 @@ where
 #[serde(deny_unknown_fields)]
 struct RollerToml {
     part: toml::Value,
+    #[serde(deserialize_with = "exactly_two")]
     normal: [f64; 2],
+}
+
+/// A Hessian written as exactly two rows of exactly two expressions.
+fn hessian_rows<'de, D>(deserializer: D) -> std::result::Result<Option<[[String; 2]; 2]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let rows = Vec::<Vec<String>>::deserialize(deserializer)?;
+    let shape = || {
+        serde::de::Error::custom(format!(
+            "a Hessian is two rows of two expressions, [[\"u_xx\", \"u_xy\"], [\"u_yx\", \"u_yy\"]]; got {} row(s) of {:?} entries",
+            rows.len(),
+            rows.iter().map(Vec::len).collect::<Vec<_>>()
+        ))
+    };
+    let pair = |row: &Vec<String>| <[String; 2]>::try_from(row.clone()).map_err(|_| shape());
+    match rows.as_slice() {
+        [a, b] => Ok(Some([pair(a)?, pair(b)?])),
+        _ => Err(shape()),
+    }
+}
+
+/// A required pair written as a TOML array of exactly two entries (see [`two`]).
+fn exactly_two<'de, D, T>(deserializer: D) -> std::result::Result<[T; 2], D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    two(deserializer).map(|pair| pair.expect("`two` gives a pair or an error"))
 }
 
 #[derive(Deserialize, Debug)]
@@ -443,7 +473,9 @@ struct RollerToml {
 struct ExactToml {
     #[serde(alias = "u", alias = "w")]
     value: Option<String>,
+    #[serde(default, deserialize_with = "two")]
     gradient: Option<[String; 2]>,
+    #[serde(default, deserialize_with = "hessian_rows")]
     hessian: Option<[[String; 2]; 2]>,
     lambda: Option<String>,
     /// The contact pressure on Γ_C: the multiplier of a contact model.
@@ -651,9 +683,23 @@ fn read_parameters(
                     ),
                 ));
             }
+            if alpha.is_some() {
+                return Err((field, "`alpha` and `α` both name α: give it once".into()));
+            }
             alpha = Some(v);
         } else {
-            scene.set_parameter(model_name(family, key), v);
+            let name = model_name(family, key);
+            if let Some(other) = parameters
+                .keys()
+                .take_while(|k| *k != key)
+                .find(|k| model_name(family, k) == name)
+            {
+                return Err((
+                    field,
+                    format!("`{key}` and `{other}` both name the model's `{name}`: give it once"),
+                ));
+            }
+            scene.set_parameter(name, v);
         }
     }
     Ok(alpha)
@@ -703,7 +749,7 @@ fn accuracy_of(
     };
     let key = family.accuracy_key();
     let given = file.exact.as_ref().is_some_and(|e| match key {
-        "pressure" => e.pressure.is_some(),
+        "pressure" => e.pressure.is_some() || e.lambda.is_some(),
         _ => e.value.is_some(),
     });
     if !given {
@@ -766,7 +812,18 @@ fn read_data(
             toml::Value::Integer(v) => v.to_string(),
             other => return Err(at(&field, format!("{other} is not an expression"))),
         };
-        scene.set_data(model_name(key), expression(&text, &field, path)?);
+        let name = model_name(key);
+        if let Some(other) = data
+            .keys()
+            .take_while(|k| *k != key)
+            .find(|k| *k != "load" && model_name(k) == name)
+        {
+            return Err(at(
+                &field,
+                format!("`{key}` and `{other}` both name the model's `{name}`: give it once"),
+            ));
+        }
+        scene.set_data(name, expression(&text, &field, path)?);
     }
     Ok(load)
 }
@@ -1318,6 +1375,16 @@ fn exact_of(e: &ExactToml, domain: &Domain, path: &Path) -> Result<ExactSolution
         ..ExactSolution::default()
     };
     let Some(value) = &e.value else {
+        if e.gradient.is_some() || e.hessian.is_some() {
+            return Err(at(
+                if e.gradient.is_some() {
+                    "exact.gradient"
+                } else {
+                    "exact.hessian"
+                },
+                "derivatives of an exact solution need its value, `[exact] u`".into(),
+            ));
+        }
         return Ok(out);
     };
     let u = expression(value, "exact.u", path)?;

@@ -124,6 +124,20 @@ pub fn read(keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
             )
         })?),
     };
+    // the model's own parameters are derived from the material and the direction: set
+    // by name they would bypass the checks above
+    if let Some(key) = keys
+        .parameters
+        .keys()
+        .find(|k| !["alpha", "α"].contains(&k.as_str()))
+    {
+        return err(
+            &format!("parameters.{key}"),
+            format!(
+                "a contact file's [parameters] are contact_direction, contact_centre and alpha; the model's μ_L, λ_L and n_c follow from [material] (young, poisson, plane) and contact_direction, not `{key}`"
+            ),
+        );
+    }
     let facts = ContactFacts {
         young,
         poisson,
@@ -197,9 +211,31 @@ pub fn check(scene: &Scene, facts: &ContactFacts) -> Result<(), FieldError> {
     for support in &scene.supports {
         let key = support.key.as_deref().unwrap_or("boundary").to_string();
         let held = markers_on_boundary(&mesh, &support.part).map_err(|m| (key.clone(), m))?;
+        let on_contact = held.iter().any(|m| contact.contains(m));
+        match support.support {
+            Support::Data => {
+                return Err((
+                    key,
+                    "a contact body has no prescribed displacement data: hold its parts with fixed_x, fixed_y, [[boundary.roller]] or clamped".into(),
+                ))
+            }
+            Support::Clamped if on_contact => {
+                return Err((
+                    key,
+                    "it clamps a part of `boundary.contact` too: the support and the contact constraint would both fix u·n_c there; drop the support on the contact part".into(),
+                ))
+            }
+            Support::SimplySupported { .. } | Support::Free => {
+                return Err((
+                    key,
+                    "a contact body's supports are fixed_x, fixed_y, [[boundary.roller]] and clamped (simply supported and free edges are a plate's)".into(),
+                ))
+            }
+            _ => {}
+        }
         if let Support::Roller { normal } = support.support {
             let along = normal[0] * n[0] + normal[1] * n[1];
-            if along.abs() > 1e-12 && held.iter().any(|m| contact.contains(m)) {
+            if along.abs() > 1e-12 && on_contact {
                 return Err((
                     key,
                     format!(
@@ -236,6 +272,12 @@ pub fn check(scene: &Scene, facts: &ContactFacts) -> Result<(), FieldError> {
         load: scene.load.as_ref().map(|l| l.default),
         parameters: Vec::new(),
     }) {
+        if exact.value.is_some() || exact.gradient.is_some() || exact.hessian.is_some() {
+            return Err((
+                "exact.u".into(),
+                "a contact file's exact solution is its pressure, `[exact] pressure`: the displacement is not compared".into(),
+            ));
+        }
         if let Some(p) = &exact.multiplier {
             finite_on(&mesh, &contact, p).map_err(|m| ("exact.pressure".into(), m))?;
         }
@@ -257,7 +299,7 @@ pub fn translation_held(scene: &Scene, facts: &ContactFacts) -> bool {
     let n = facts.direction;
     scene.supports.iter().any(|s| match s.support {
         Support::Roller { normal } => (normal[0] * n[0] + normal[1] * n[1]).abs() > 1e-12,
-        Support::Clamped | Support::Data => true,
+        Support::Clamped => true,
         _ => false,
     })
 }
