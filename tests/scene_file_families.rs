@@ -227,3 +227,30 @@ fn ambiguous_and_incomplete_keys_are_refused() {
         );
     }
 }
+
+/// `[mesh]` keys of another generator (or of a generator with a Gmsh file) are refused
+/// by their key, not ignored: a square's `cells`, a disk's `x`, a file's `cells`.
+#[test]
+fn mesh_keys_of_another_generator_are_refused() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scene.toml");
+    for (mesh, field) in [
+        ("generator = \"square\"\ncells = [2, 2]", "mesh.cells"),
+        ("generator = \"disk\"\nx = [0.0, 1.0]", "mesh.x"),
+        (
+            "generator = \"l-shape\"\ncentre = [0.0, 0.0]",
+            "mesh.centre",
+        ),
+        ("generator = \"rectangle\"\nradius = 2.0", "mesh.radius"),
+        ("file = \"square_named.msh\"\ncells = [2, 2]", "mesh.cells"),
+    ] {
+        let text =
+            format!("model = \"membrane\"\n[mesh]\n{mesh}\n[data]\nf = \"0\"\npsi = \"-1\"\n");
+        let message = fem_forms::models::scene_file::parse(&text, &path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains(&format!("`{field}`")) && message.contains("does not apply"),
+            "{mesh}: {message}"
+        );
+    }
+}

@@ -848,6 +848,7 @@ fn domain_of(
                     "a Gmsh `file` takes `refinements`, not `size` or `half_width`".into(),
                 );
             }
+            foreign_keys("file", mesh)?;
             let refinements = mesh.refinements.unwrap_or(0);
             if refinements > MAX_REFINEMENTS {
                 return err(
@@ -895,6 +896,7 @@ fn generated(
     size: usize,
 ) -> std::result::Result<Domain, (String, String)> {
     let err = |f: &str, m: String| Err((f.to_string(), m));
+    foreign_keys(generator, mesh)?;
     let no_half_width = |what: &str| match mesh.half_width {
         Some(_) => Err((
             "mesh.half_width".to_string(),
@@ -963,6 +965,52 @@ fn generated(
         }
     };
     Ok(domain)
+}
+
+/// Refuses the `[mesh]` keys another generator takes (a square's `cells`, a disk's `x`):
+/// left unread, they would be ignored without a word.
+fn foreign_keys(generator: &str, mesh: &MeshToml) -> std::result::Result<(), (String, String)> {
+    let given = [
+        ("half_width", mesh.half_width.is_some()),
+        ("x", mesh.x.is_some()),
+        ("y", mesh.y.is_some()),
+        ("cells", mesh.cells.is_some()),
+        ("start", mesh.start.is_some()),
+        ("end", mesh.end.is_some()),
+        ("centre", mesh.centre.is_some()),
+        ("radius", mesh.radius.is_some()),
+        ("curved", mesh.curved.is_some()),
+    ];
+    let takes: &[&str] = match generator {
+        "interval" => &["start", "end"],
+        "square" => &["half_width"],
+        "rectangle" => &["x", "y", "cells"],
+        "l-shape" => &[],
+        "disk" => &["centre", "radius", "curved"],
+        "file" => &[],
+        // an unknown generator is named by its own error
+        _ => return Ok(()),
+    };
+    // a half_width off the square, and a square's x, have their own messages that say
+    // which generator to take
+    let said = |key: &str| key == "half_width" || (key == "x" && generator == "square");
+    match given
+        .iter()
+        .find(|(key, set)| *set && !takes.contains(key) && !said(key))
+    {
+        Some((key, _)) => Err((
+            format!("mesh.{key}"),
+            if generator == "file" {
+                "does not apply to a Gmsh `file`, which takes refinements".to_string()
+            } else {
+                format!(
+                    "does not apply to the generator `{generator}`, which takes {}size",
+                    takes.iter().map(|k| format!("{k}, ")).collect::<String>()
+                )
+            },
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The sides `[x, y]` of a `[mesh]` rectangle, checked; errors as `(field, message)`.
