@@ -589,9 +589,19 @@ fn bad_contact_scene_files_name_the_key() {
             "mesh.generator",
             &["rectangle"],
         ),
-        // a disk is a body too, whose boundary part is `circle`
+        // a disk is a body too, whose boundary part is `circle`; the rectangle's keys
+        // do not apply to it
         (
             RECTANGLE.replace("\"rectangle\"", "\"disk\""),
+            "mesh.x",
+            &["does not apply", "`disk`"],
+        ),
+        (
+            RECTANGLE
+                .replace("\"rectangle\"", "\"disk\"")
+                .replace("x = [0.0, 2.0]\n", "")
+                .replace("y = [0.0, 1.0]\n", "")
+                .replace("cells = [6, 3]\n", ""),
             "boundary.contact",
             &["`bottom`", "`circle`"],
         ),

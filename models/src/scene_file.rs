@@ -1455,39 +1455,54 @@ fn exact_of(e: &ExactToml, domain: &Domain, path: &Path) -> Result<ExactSolution
         })?,
     };
     if let Some(h) = &e.hessian {
-        let mut rows = Vec::new();
-        for (i, row) in h.iter().enumerate() {
-            rows.push([
-                expression(&row[0], &format!("exact.hessian[{i}][0]"), path)?,
-                expression(&row[1], &format!("exact.hessian[{i}][1]"), path)?,
-            ]);
-        }
-        let rows = std::sync::Arc::new(rows);
-        for i in 0..dimension {
-            let (g, r) = (gradient.clone(), rows.clone());
-            check_derivative(
-                &move |x| g.at(x)[i],
-                &move |x, k| r[i][k].at(x),
-                &points,
-                dimension,
-            )
-            .map_err(|m| {
-                at(
-                    &format!("exact.hessian[{i}]"),
-                    format!("does not match the gradient: {m}"),
-                )
-            })?;
-        }
-        out.hessian = Some(Data::shared(move |x: &[f64]| {
-            [
-                [rows[0][0].at(x), rows[0][1].at(x)],
-                [rows[1][0].at(x), rows[1][1].at(x)],
-            ]
-        }));
+        out.hessian = Some(hessian_of(h, &gradient, &points, dimension, path)?);
     }
     out.value = Some(u);
     out.gradient = Some(gradient);
     Ok(out)
+}
+
+/// The exact Hessian of `[exact] hessian`, each row checked against the finite
+/// differences of the gradient at `points`.
+///
+/// # Errors
+/// An expression that does not parse, a row the gradient's differences contradict.
+fn hessian_of(
+    h: &[[String; 2]; 2],
+    gradient: &Data<[f64; 2]>,
+    points: &[[f64; 2]],
+    dimension: usize,
+    path: &Path,
+) -> Result<Data<[[f64; 2]; 2]>> {
+    let mut rows = Vec::new();
+    for (i, row) in h.iter().enumerate() {
+        rows.push([
+            expression(&row[0], &format!("exact.hessian[{i}][0]"), path)?,
+            expression(&row[1], &format!("exact.hessian[{i}][1]"), path)?,
+        ]);
+    }
+    let rows = std::sync::Arc::new(rows);
+    for i in 0..dimension {
+        let (g, r) = (gradient.clone(), rows.clone());
+        check_derivative(
+            &move |x| g.at(x)[i],
+            &move |x, k| r[i][k].at(x),
+            points,
+            dimension,
+        )
+        .map_err(|m| {
+            Error::Input(format!(
+                "{}: field `exact.hessian[{i}]`: does not match the gradient: {m}",
+                path.display()
+            ))
+        })?;
+    }
+    Ok(Data::shared(move |x: &[f64]| {
+        [
+            [rows[0][0].at(x), rows[0][1].at(x)],
+            [rows[1][0].at(x), rows[1][1].at(x)],
+        ]
+    }))
 }
 
 #[cfg(test)]

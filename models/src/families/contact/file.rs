@@ -43,7 +43,44 @@ const GAUSS_POINTS: usize = 4;
 /// direction that is not two finite numbers or is zero, a centre that is not finite.
 pub fn read(keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
     let err = |f: &str, m: String| Err((f.to_string(), m));
-    let Some(material) = keys.material else {
+    let (young, poisson, plane) = material_of(keys.material)?;
+    let (direction, centre) = direction_of(&mut *keys.parameters)?;
+    // the model's own parameters are derived from the material and the direction: set
+    // by name they would bypass the checks above
+    if let Some(key) = keys
+        .parameters
+        .keys()
+        .find(|k| !["alpha", "α"].contains(&k.as_str()))
+    {
+        return err(
+            &format!("parameters.{key}"),
+            format!(
+                "a contact file's [parameters] are contact_direction, contact_centre and alpha; the model's μ_L, λ_L and n_c follow from [material] (young, poisson, plane) and contact_direction, not `{key}`"
+            ),
+        );
+    }
+    let facts = ContactFacts {
+        young,
+        poisson,
+        plane,
+        direction,
+        centre,
+        body: None,
+    };
+    for (name, value) in
+        material_parameters(&facts).map_err(|e| ("material".into(), e.to_string()))?
+    {
+        scene.set_parameter(name, value);
+    }
+    scene.reference = Some(Arc::new(facts));
+    scene.pairs = vec!["p1-p0", "p2-p0"];
+    Ok(())
+}
+
+/// E, ν and the plane of `[material]`, checked.
+fn material_of(material: Option<&toml::Table>) -> Result<(f64, f64, Plane), FieldError> {
+    let err = |f: &str, m: String| Err((f.to_string(), m));
+    let Some(material) = material else {
         return err(
             "material",
             "a contact body needs its `[material]`: young = E, poisson = ν (plane = \"strain\" or \"stress\")".into(),
@@ -94,7 +131,13 @@ pub fn read(keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
             )
         }
     };
-    let direction = match keys.parameters.remove("contact_direction") {
+    Ok((young, poisson, plane))
+}
+
+/// The contact direction `n_c` (unit) and the centre of `[parameters]`, taken out of it.
+fn direction_of(parameters: &mut toml::Table) -> Result<([f64; 2], Option<f64>), FieldError> {
+    let err = |f: &str, m: String| Err((f.to_string(), m));
+    let direction = match parameters.remove("contact_direction") {
         None => [0.0, -1.0],
         Some(v) => {
             let field = "parameters.contact_direction";
@@ -115,7 +158,7 @@ pub fn read(keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
             [cx / length, cy / length]
         }
     };
-    let centre = match keys.parameters.remove("contact_centre") {
+    let centre = match parameters.remove("contact_centre") {
         None => None,
         Some(v) => Some(finite(&v).ok_or_else(|| {
             (
@@ -124,36 +167,7 @@ pub fn read(keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
             )
         })?),
     };
-    // the model's own parameters are derived from the material and the direction: set
-    // by name they would bypass the checks above
-    if let Some(key) = keys
-        .parameters
-        .keys()
-        .find(|k| !["alpha", "α"].contains(&k.as_str()))
-    {
-        return err(
-            &format!("parameters.{key}"),
-            format!(
-                "a contact file's [parameters] are contact_direction, contact_centre and alpha; the model's μ_L, λ_L and n_c follow from [material] (young, poisson, plane) and contact_direction, not `{key}`"
-            ),
-        );
-    }
-    let facts = ContactFacts {
-        young,
-        poisson,
-        plane,
-        direction,
-        centre,
-        body: None,
-    };
-    for (name, value) in
-        material_parameters(&facts).map_err(|e| ("material".into(), e.to_string()))?
-    {
-        scene.set_parameter(name, value);
-    }
-    scene.reference = Some(Arc::new(facts));
-    scene.pairs = vec!["p1-p0", "p2-p0"];
-    Ok(())
+    Ok((direction, centre))
 }
 
 /// A finite number of a TOML value, `-0` read as 0.
