@@ -1421,3 +1421,14 @@ fn a_roller_along_any_direction_holds_a_turned_body() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// An error of the solve about a datum names the file's own key (`data.pressure`), not
+/// the model's name of it (`data.q`).
+#[test]
+fn a_solve_error_about_a_datum_names_the_files_key() {
+    let text = RECTANGLE.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"1/y\"");
+    let message = solve(&parse(&text).unwrap(), &Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("`data.pressure`"), "{message}");
+}

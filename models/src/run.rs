@@ -830,7 +830,7 @@ fn scene_field_of(error: Error, scene: &Scene) -> Error {
         .iter()
         .map(|(name, _)| name)
         .find(|name| message.starts_with(&format!("data `{name}` of ")))
-        .map(|name| crate::scene::data_key(name));
+        .map(|name| scene.file_key(name));
     match key {
         Some(key) => Error::Input(format!(
             "scene `{}`: field `data.{key}`: {message}",

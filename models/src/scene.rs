@@ -424,6 +424,9 @@ pub struct Scene {
     pub in_default_job: bool,
     /// The family's own description (see [`Reference`]).
     pub reference: Option<Reference>,
+    /// The keys a scene file gave its data under, by the model's name (`q` was
+    /// `pressure`): errors about a datum name the user's key.
+    pub file_keys: Vec<(Name, String)>,
 }
 
 impl fmt::Debug for Scene {
@@ -467,6 +470,7 @@ impl Scene {
             studies: Vec::new(),
             in_default_job: false,
             reference: None,
+            file_keys: Vec::new(),
         }
     }
 
@@ -594,6 +598,17 @@ impl Scene {
     /// scene's own load only.
     pub fn exact_dropped_at(&self, posed: &Posed) -> bool {
         matches!(self.exact, Exact::AtDefaultLoad(_)) && self.exact_at(posed).is_none()
+    }
+}
+
+impl Scene {
+    /// The key under `[data]` of the model's data function `name`: the one the scene's
+    /// file gave it under, else its ASCII spelling ([`data_key`]).
+    pub fn file_key(&self, name: &str) -> String {
+        self.file_keys
+            .iter()
+            .find(|(n, _)| n == name)
+            .map_or_else(|| data_key(name), |(_, key)| key.clone())
     }
 }
 

@@ -715,13 +715,19 @@ fn scale_load(
     let (scaled, sign) = family.scaled_load();
     let scaled = model_name(family, scaled);
     if scene.data_fn(&scaled).is_none() {
+        // the family's word for it (contact's `pressure`), else the model's
+        let key = family
+            .aliases()
+            .iter()
+            .find(|(_, name)| *name == scaled)
+            .map_or_else(
+                || crate::scene::data_key(&scaled),
+                |(alias, _)| alias.to_string(),
+            );
         return match load {
             Some(_) => Err((
                 "data.load".into(),
-                format!(
-                    "scales the load `{}`, which the file does not give",
-                    crate::scene::data_key(&scaled)
-                ),
+                format!("scales the load `data.{key}`, which the file does not give"),
             )),
             None => Ok(()),
         };
@@ -823,7 +829,8 @@ fn read_data(
                 format!("`{key}` and `{other}` both name the model's `{name}`: give it once"),
             ));
         }
-        scene.set_data(name, expression(&text, &field, path)?);
+        scene.set_data(name.clone(), expression(&text, &field, path)?);
+        scene.file_keys.push((name.into(), key.clone()));
     }
     Ok(load)
 }
