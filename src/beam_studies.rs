@@ -50,49 +50,6 @@ impl BeamStudies {
     }
 }
 
-/// Condition number of the LCP matrix `M = B A⁻¹ Bᵀ + C` of a request: the matrix the
-/// multiplier sees once U is eliminated. Its smallest eigenvalue is the discrete inf-sup
-/// constant squared (in the Euclidean norm of the P0 coefficients); `C = αΣh⁴(λ, μ)`
-/// lifts it for the stabilized method.
-pub fn lcp_condition(request: &Request) -> Result<f64> {
-    let (d, _) = beams::discretize(request)?;
-    let lcp = &d.lcp;
-    let (n, m) = (lcp.n(), lcp.m());
-    let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
-    let (col_ptr, rows, vals) = (
-        lcp.a.symbolic().col_ptr(),
-        lcp.a.symbolic().row_idx(),
-        lcp.a.val(),
-    );
-    for j in 0..n {
-        for idx in col_ptr[j]..col_ptr[j + 1] {
-            a[(rows[idx], j)] = vals[idx];
-        }
-    }
-    let mut bt = nalgebra::DMatrix::<f64>::zeros(n, m);
-    for (k, row) in lcp.b_rows.iter().enumerate() {
-        for &(j, v) in row {
-            bt[(j, k)] = v;
-        }
-    }
-    let cholesky = a
-        .cholesky()
-        .ok_or_else(|| Error::LinearSolve("A is not positive definite".into()))?;
-    let a_inv_bt = cholesky.solve(&bt);
-    let mut schur = bt.transpose() * a_inv_bt;
-    for k in 0..m {
-        schur[(k, k)] += lcp.c[k];
-    }
-    let eigenvalues = nalgebra::SymmetricEigen::new(schur).eigenvalues;
-    let largest = eigenvalues.max();
-    let smallest = eigenvalues.min();
-    Ok(if smallest > 0.0 {
-        largest / smallest
-    } else {
-        f64::INFINITY
-    })
-}
-
 fn row(report: &Report, pair: &'static str, scene: &Scene) -> Row {
     let exact = exact_solution(scene, report.load, report.thickness.unwrap_or(0.0));
     let edge = report.contact_set.first().map_or(f64::NAN, |c| c[0]);
@@ -224,27 +181,12 @@ impl StudyScene for BeamStudies {
     }
 
     fn measure(&self) -> Measure {
-        Measure {
-            title: "condition number of the LCP matrix B A⁻¹ Bᵀ + C",
-            labels: &["κ₂"],
-            axis: "κ₂",
-            plotted: |v| v,
-        }
+        crate::studies::inf_sup_measure()
     }
 
+    /// The one measure of every family, on the registry's scene of this name.
     fn stability(&self, pair: &'static str, size: usize) -> Result<StabilityRow> {
-        let stabilized = self.request(&Run::new(pair, size))?;
-        let plain = self.request(&Run {
-            alpha: Some(0.0),
-            ..Run::new(pair, size)
-        })?;
-        Ok(StabilityRow {
-            pair,
-            size,
-            alpha: Pair::parse(pair, self.scene.beam)?.default_alpha(),
-            plain: vec![lcp_condition(&plain)?],
-            stabilized: vec![lcp_condition(&stabilized)?],
-        })
+        crate::registry_studies::RegistryStudies::of(self.scene.name)?.stability(pair, size)
     }
 
     /// `(x, λ_h)` at the cell midpoints.

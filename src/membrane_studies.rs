@@ -3,15 +3,9 @@
 //! and the multiplier along the row of cells just above the x axis.
 
 use crate::membranes::{self, alpha_of, scene_mesh, MembranePair, MembraneReport, MembraneRequest};
-use crate::models::membrane::{membrane_p1_p0, membrane_p2_p0};
 use crate::models::membrane_scenes::{Domain, MembraneScene};
 use crate::studies::{ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study, StudyScene};
-use fem_runtime::lcp::cholesky::Cholesky;
-use fem_runtime::obstacle::system_forms;
-use fem_runtime::obstacle::triangle::discretize_on_part;
-use fem_runtime::obstacle::Discretization;
-use fem_runtime::{Diagonal, Error, Model, Result, TriangleMesh};
-use nalgebra::{DMatrix, SymmetricEigen};
+use fem_runtime::{Diagonal, Result};
 
 /// A membrane scene in the studies, at its own load.
 #[derive(Clone, Debug)]
@@ -85,70 +79,6 @@ pub fn convergence_sizes(pair: MembranePair, full: bool) -> Vec<usize> {
         sizes.insert(0, sizes[0] / 2);
     }
     sizes
-}
-
-/// Discrete inf-sup constants of the multiplier: `γ_k = λ_k(M_h⁻¹ (B A⁻¹ Bᵀ + C))` in the
-/// h-weighted norm `‖μ‖²_h = Σ_T h_T² ‖μ‖²_T`, the smallest two (√ of them are the
-/// inf-sup constants; the stabilized method has γ ≥ α by construction).
-pub fn inf_sup<M: Model>(
-    scene: &MembraneScene,
-    mesh: &TriangleMesh,
-    alpha: f64,
-) -> Result<[f64; 2]> {
-    let load = scene.load_magnitude(None).map_err(Error::Input)?;
-    let data = membranes::SceneData::new(scene, load);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha)?;
-    let part = membranes::dirichlet_part(scene, mesh, "the study's mesh")?;
-    let (bilinear, linear) = system_forms::<M>()?;
-    let d: Discretization<TriangleMesh> =
-        discretize_on_part::<M>(mesh, &coefficients, &part, bilinear, linear)?;
-    let lcp = &d.lcp;
-    let (n, m) = (lcp.n(), lcp.m());
-    if m > 4000 {
-        return Err(Error::Input(format!(
-            "the inf-sup eigenproblem is dense: {m} multipliers is too many"
-        )));
-    }
-    let pattern = lcp
-        .a
-        .symbolic()
-        .to_owned()
-        .map_err(|e| Error::LinearSolve(format!("{e:?}")))?;
-    let factor = Cholesky::analyse(&pattern)?.factor(&lcp.a)?;
-    // columns of A⁻¹Bᵀ, then S = B A⁻¹ Bᵀ + C
-    let mut x = DMatrix::<f64>::zeros(n, m);
-    for k in 0..m {
-        let mut column = vec![0.0; n];
-        for &(j, v) in &lcp.b_rows[k] {
-            column[j] = v;
-        }
-        let solved = factor.solve(&column)?;
-        x.column_mut(k).copy_from_slice(&solved);
-    }
-    let mut s = DMatrix::<f64>::zeros(m, m);
-    for k in 0..m {
-        for l in 0..m {
-            s[(k, l)] = lcp.b_rows[k].iter().map(|&(j, v)| v * x[(j, l)]).sum();
-        }
-        s[(k, k)] += lcp.c[k];
-    }
-    let weight: Vec<f64> = d
-        .multiplier_dofs()
-        .iter()
-        .map(|&cell| {
-            let h = d.mesh.cell_diameter(cell);
-            (h * h * d.mesh.area(cell)).sqrt()
-        })
-        .collect();
-    for k in 0..m {
-        for l in 0..m {
-            s[(k, l)] /= weight[k] * weight[l];
-        }
-    }
-    let s = (&s + s.transpose()) * 0.5;
-    let mut values: Vec<f64> = SymmetricEigen::new(s).eigenvalues.iter().cloned().collect();
-    values.sort_by(f64::total_cmp);
-    Ok([values[0], values.get(1).copied().unwrap_or(f64::NAN)])
 }
 
 impl StudyScene for MembraneStudies {
@@ -264,42 +194,12 @@ impl StudyScene for MembraneStudies {
     }
 
     fn measure(&self) -> Measure {
-        Measure {
-            title: "√γ, γ the smallest eigenvalues of M_h⁻¹(B A⁻¹ Bᵀ + C), h-weighted norm (√γ₁: the inf-sup constant; a zero γ, a kernel, drawn at 1e-8)",
-            labels: &["√γ₁", "√γ₂"],
-            axis: "√γ",
-            // numerically zero γ (a kernel) drawn at 1e-8
-            plotted: |g| g.max(1e-16).sqrt(),
-        }
+        crate::studies::inf_sup_measure()
     }
 
+    /// The one measure of every family, on the registry's scene of this name.
     fn stability(&self, pair: &'static str, size: usize) -> Result<StabilityRow> {
-        let mesh = scene_mesh(&self.scene, size, Diagonal::Right)?;
-        let (alpha, _) = alpha_of(&self.request(&Run::new(pair, size))?, &mesh)?;
-        let s = &self.scene;
-        let (plain, stabilized) = match MembranePair::parse(pair)? {
-            MembranePair::P1P0 => (
-                inf_sup::<membrane_p1_p0::Model>(s, &mesh, 0.0)?,
-                inf_sup::<membrane_p1_p0::Model>(s, &mesh, alpha)?,
-            ),
-            MembranePair::P2P0 => (
-                inf_sup::<membrane_p2_p0::Model>(s, &mesh, 0.0)?,
-                inf_sup::<membrane_p2_p0::Model>(s, &mesh, alpha)?,
-            ),
-            other => {
-                return Err(Error::Input(format!(
-                    "the inf-sup study has the pairs p1-p0 and p2-p0, not {}",
-                    other.name()
-                )))
-            }
-        };
-        Ok(StabilityRow {
-            pair,
-            size,
-            alpha,
-            plain: plain.to_vec(),
-            stabilized: stabilized.to_vec(),
-        })
+        crate::registry_studies::RegistryStudies::of(&self.scene.name)?.stability(pair, size)
     }
 
     /// `(x, λ_h)` at the centroids of the cells in the band `0 < y < side/N` (the row of

@@ -23,6 +23,16 @@ impl RegistryStudies {
         Self { scene }
     }
 
+    /// The studies of the registry scene called `name`.
+    ///
+    /// # Errors
+    /// A name the registry does not have.
+    pub fn of(name: &str) -> Result<Self> {
+        families::scene(name)
+            .map(Self::new)
+            .ok_or_else(|| Error::Input(format!("the registry has no scene `{name}`")))
+    }
+
     fn outcome(&self, run: &Run) -> Result<Outcome> {
         let settings = Settings {
             pair: Some(run.pair.to_string()),
@@ -260,12 +270,7 @@ impl StudyScene for RegistryStudies {
     }
 
     fn measure(&self) -> Measure {
-        Measure {
-            title: "inf-sup constants of the multiplier, γ₁ ≤ γ₂ of B A⁻¹ Bᵀ + C in the stabilization's norm",
-            labels: &["γ₁", "γ₂"],
-            axis: "γ",
-            plotted: |v| v.max(1e-16),
-        }
+        crate::studies::inf_sup_measure()
     }
 
     /// The two smallest eigenvalues of the multiplier's Schur complement in the norm of

@@ -159,6 +159,19 @@ pub struct Measure {
     pub plotted: fn(f64) -> f64,
 }
 
+/// The stability study's one measure, for every family: the two smallest eigenvalues
+/// γ₁ ≤ γ₂ of the multiplier's Schur complement `B A⁻¹ Bᵀ + C` in the norm of the
+/// pair's own stabilization ([`fem_runtime::stabilization::inf_sup_spectrum`]; √γ₁ is
+/// the inf-sup constant). A zero γ (a kernel) is drawn at 1e-16.
+pub fn inf_sup_measure() -> Measure {
+    Measure {
+        title: "inf-sup constants of the multiplier, γ₁ ≤ γ₂ of B A⁻¹ Bᵀ + C in the stabilization's norm",
+        labels: &["γ₁", "γ₂"],
+        axis: "γ",
+        plotted: |v| v.max(1e-16),
+    }
+}
+
 /// The exact multiplier along the line of [`StudyScene::multiplier_profile`].
 pub struct ExactMultiplier {
     /// The contact interval on that line.

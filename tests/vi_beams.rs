@@ -295,13 +295,13 @@ fn plain_and_stabilized_multipliers_where_methods_fail() {
     assert_eq!(studies::zero_holes(&strong), 0);
     // The conditioning of the LCP matrix: plain worse than stabilized, and growing as h → 0.
     let mut r = request("timoshenko-a", 32, 100.0);
-    let stabilized = beam_studies::lcp_condition(&r).unwrap();
+    let stabilized = lcp_condition(&r).unwrap();
     r.alpha = Some(0.0);
     r.plain = true;
     r.solver = VariationalSolver::Clarabel;
-    let plain_32 = beam_studies::lcp_condition(&r).unwrap();
+    let plain_32 = lcp_condition(&r).unwrap();
     r.elements = 64;
-    let plain_64 = beam_studies::lcp_condition(&r).unwrap();
+    let plain_64 = lcp_condition(&r).unwrap();
     assert!(plain_32 > 100.0 * stabilized, "{plain_32} vs {stabilized}");
     assert!(plain_64 > 4.0 * plain_32);
 }
@@ -486,4 +486,47 @@ fn bernoulli_b_is_measured_against_the_mirrored_exact_solution() {
         "{e_up} {e_down}"
     );
     assert!((up.total_contact_force - down.total_contact_force).abs() < 1e-9);
+}
+
+/// Hand-coded for the beams: the condition number of the LCP matrix `M = B A⁻¹ Bᵀ + C` of a request: the matrix the
+/// multiplier sees once U is eliminated. Its smallest eigenvalue is the discrete inf-sup
+/// constant squared (in the Euclidean norm of the P0 coefficients); `C = αΣh⁴(λ, μ)`
+/// lifts it for the stabilized method.
+fn lcp_condition(request: &fem_forms::beams::Request) -> fem_forms::Result<f64> {
+    let (d, _) = fem_forms::beams::discretize(request)?;
+    let lcp = &d.lcp;
+    let (n, m) = (lcp.n(), lcp.m());
+    let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
+    let (col_ptr, rows, vals) = (
+        lcp.a.symbolic().col_ptr(),
+        lcp.a.symbolic().row_idx(),
+        lcp.a.val(),
+    );
+    for j in 0..n {
+        for idx in col_ptr[j]..col_ptr[j + 1] {
+            a[(rows[idx], j)] = vals[idx];
+        }
+    }
+    let mut bt = nalgebra::DMatrix::<f64>::zeros(n, m);
+    for (k, row) in lcp.b_rows.iter().enumerate() {
+        for &(j, v) in row {
+            bt[(j, k)] = v;
+        }
+    }
+    let cholesky = a
+        .cholesky()
+        .ok_or_else(|| fem_forms::Error::LinearSolve("A is not positive definite".into()))?;
+    let a_inv_bt = cholesky.solve(&bt);
+    let mut schur = bt.transpose() * a_inv_bt;
+    for k in 0..m {
+        schur[(k, k)] += lcp.c[k];
+    }
+    let eigenvalues = nalgebra::SymmetricEigen::new(schur).eigenvalues;
+    let largest = eigenvalues.max();
+    let smallest = eigenvalues.min();
+    Ok(if smallest > 0.0 {
+        largest / smallest
+    } else {
+        f64::INFINITY
+    })
 }
