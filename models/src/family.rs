@@ -138,6 +138,15 @@ pub enum Adjustment {
 /// An error of a scene file: the field at fault (`material.young`) and the message.
 pub type FieldError = (String, String);
 
+/// A finite number of a scene file's field (a float or an integer), `-0` read as 0.
+pub fn finite(value: &toml::Value) -> Option<f64> {
+    value
+        .as_float()
+        .or_else(|| value.as_integer().map(|i| i as f64))
+        .filter(|v| v.is_finite())
+        .map(|v| v + 0.0)
+}
+
 /// The keys of a scene file a family reads itself: its `[material]`, and the
 /// `[parameters]` that are not the model's (a contact direction), taken before the
 /// reader maps the rest onto the model's names.

@@ -475,11 +475,11 @@ fn gmsh_levels(
     nested: bool,
     budget: CellBudget,
 ) -> Result<Vec<TriangleMesh>> {
-    if refinements > MAX_REFINEMENTS {
-        return Err(Error::Input(format!(
-            "--mesh-size {refinements} on a Gmsh mesh (--msh, or a scene file's mesh.file) means {refinements} uniform refinements of the file's mesh (4^{refinements} times the triangles); at most {MAX_REFINEMENTS}"
-        )));
-    }
+    // refused before the file is read
+    check_refinements(
+        refinements,
+        "a Gmsh mesh (--msh, or a scene file's mesh.file)",
+    )?;
     let mesh = fem_runtime::mesh::gmsh::read_msh(path)?;
     // the file's own cells first, so a refusal names corners the user wrote
     mesh.quality().check(&mesh).map_err(|e| match e {
@@ -487,6 +487,16 @@ fn gmsh_levels(
         other => other,
     })?;
     refined_levels(mesh, refinements, nested, budget)
+}
+
+/// Refuses more than [`MAX_REFINEMENTS`] uniform refinements of `what`.
+fn check_refinements(refinements: usize, what: &str) -> Result<()> {
+    if refinements > MAX_REFINEMENTS {
+        return Err(Error::Input(format!(
+            "--mesh-size {refinements} on {what} means {refinements} uniform refinements of it (4^{refinements} times the triangles); at most {MAX_REFINEMENTS}"
+        )));
+    }
+    Ok(())
 }
 
 /// `mesh` and its `refinements` uniform refinements (all of them for nested iteration,
@@ -497,11 +507,7 @@ fn refined_levels(
     nested: bool,
     budget: CellBudget,
 ) -> Result<Vec<TriangleMesh>> {
-    if refinements > MAX_REFINEMENTS {
-        return Err(Error::Input(format!(
-            "--mesh-size {refinements} means {refinements} uniform refinements of the scene's mesh (4^{refinements} times the triangles); at most {MAX_REFINEMENTS}"
-        )));
-    }
+    check_refinements(refinements, "the scene's mesh")?;
     budget(mesh.cell_count() as f64 * 4f64.powi(refinements as i32))?;
     let mut levels = vec![mesh];
     for _ in 0..refinements {

@@ -342,7 +342,7 @@ pub fn scene_name(
 // The scene of any registry family
 // ---------------------------------------------------------------------------------------
 
-use crate::family::{Family, FieldError, FileKeys};
+use crate::family::{finite, Family, FieldError, FileKeys};
 use crate::report::Settings;
 use crate::scene::{Domain, Exact, ExactSolution, Load, Part, PartSupport, Scene, Support};
 use fem_runtime::problem::MIN_DATA_SIZE;
@@ -771,15 +771,6 @@ fn accuracy_of(
         ));
     }
     Ok(Some(a))
-}
-
-/// A finite number of a scene file's field, `-0` read as 0.
-fn finite(value: &toml::Value) -> Option<f64> {
-    value
-        .as_float()
-        .or_else(|| value.as_integer().map(|i| i as f64))
-        .filter(|v| v.is_finite())
-        .map(|v| v + 0.0)
 }
 
 /// `[data]`: each expression set on `scene` by the model's name (`model_name` of its

@@ -6,7 +6,7 @@
 
 use super::facts::{material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
 use crate::data::Data;
-use crate::family::{FieldError, FileKeys};
+use crate::family::{finite, FieldError, FileKeys};
 use crate::scene::{Domain, Part, Scene, Support};
 use crate::signorini::{contact_tangent, Plane};
 use fem_runtime::{Error, TriangleMesh};
@@ -168,15 +168,6 @@ fn direction_of(parameters: &mut toml::Table) -> Result<([f64; 2], Option<f64>),
         })?),
     };
     Ok((direction, centre))
-}
-
-/// A finite number of a TOML value, `-0` read as 0.
-fn finite(value: &toml::Value) -> Option<f64> {
-    value
-        .as_float()
-        .or_else(|| value.as_integer().map(|i| i as f64))
-        .filter(|v| v.is_finite())
-        .map(|v| v + 0.0)
 }
 
 /// The required finite number `key` of `table`.
