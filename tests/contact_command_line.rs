@@ -166,16 +166,19 @@ fn an_accuracy_not_reached_is_a_warning() {
 fn the_hertz_study_and_chart_are_written() {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("fem-forms-contact-study-{}", std::process::id()));
-    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(["study", "hertz", "alpha", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let study = |kind: &str| {
+        let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+            .args(["study", "hertz", kind, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{kind}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    };
+    study("alpha");
     let csv = std::fs::read_to_string(out.join("hertz-alpha.csv")).unwrap();
     assert!(csv.lines().count() >= 9, "{csv}");
     assert!(out.join("hertz-alpha.svg").exists());
@@ -184,16 +187,7 @@ fn the_hertz_study_and_chart_are_written() {
     assert!(profiles.contains("plain") && profiles.contains("exact λ"));
     // the one convergence study charts the family's measure of the multiplier: the
     // pressure's error against Hertz, the single solve's at each b/h
-    let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(["study", "hertz", "convergence", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    study("convergence");
     let csv = std::fs::read_to_string(out.join("hertz-convergence.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
