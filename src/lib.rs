@@ -8,10 +8,12 @@
 #![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+pub mod accuracy;
 pub mod allocator;
 pub mod beam_studies;
 pub mod beams;
 pub mod kirchhoff_studies;
+pub mod locking;
 pub mod membrane_studies;
 pub mod membranes;
 pub mod plate_studies;

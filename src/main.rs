@@ -2,9 +2,9 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use clap::{Parser, Subcommand, ValueEnum};
-use fem_forms::membranes::{self, MembranePair, MembraneReport, MembraneRequest};
-use fem_forms::models::membrane_scenes::MembraneScene;
-use fem_forms::models::registry::{find, names, registry, SceneEntry, SceneKind};
+use fem_forms::models::families;
+use fem_forms::models::report::{Report, Settings};
+use fem_forms::models::scene::Scene;
 use fem_forms::plot;
 use fem_forms::studies::{self, Study};
 use std::path::{Path, PathBuf};
@@ -218,7 +218,7 @@ fn table_row(r: &fem_forms::models::run::Report) {
     );
 }
 
-fn membrane_header() {
+fn pair_header() {
     println!(
         "{:<16} {:<8} {:>5} {:>8} {:>8} {:>5} {:>8} {:>9} {:>10} {:>10} {:>10} {:>9} {:>8} {:>9}",
         "scene",
@@ -238,49 +238,49 @@ fn membrane_header() {
     );
 }
 
-fn membrane_row(r: &MembraneReport) {
-    for w in &r.warnings {
+fn pair_row(r: &Report) {
+    let s = &r.solve;
+    for w in &s.warnings {
         eprintln!("warning ({} {}): {w}", r.scene, r.pair);
     }
     let opt = |e: Option<f64>| e.map_or("-".into(), |e| format!("{e:.3e}"));
     println!(
-        "{:<16} {:<8} {:>5} {:>8} {:>8} {:>5} {:>8.3} {:>9.2e} {:>10} {:>10} {:>10.5} {:>9.5} {:>8.1e} {:>9.3}",
+        "{:<16} {:<8} {:>5} {:>8} {:>8} {:>5} {:>8.3} {:>9} {:>10} {:>10} {:>10.5} {:>9.5} {:>8.1e} {:>9.3}",
         r.scene,
         r.pair,
         r.mesh_size,
-        r.triangles,
-        r.dofs,
-        r.iterations,
-        r.seconds,
-        r.alpha,
-        opt(r.error_l2),
-        opt(r.error_h1),
-        r.total_contact_force,
-        r.contact_area,
-        r.complementarity_residual,
-        r.inverse_constant
+        s.cells,
+        s.dofs,
+        s.iterations,
+        s.seconds,
+        s.alpha.map_or("-".into(), |a| format!("{a:.2e}")),
+        opt(s.error_l2),
+        opt(s.error_h1),
+        s.total_contact_force,
+        s.contact_area.unwrap_or(f64::NAN),
+        s.kkt_residual,
+        s.inverse_constant
     );
 }
 
 fn default_job(out: &Path) -> Result<(), String> {
     println!("fem-forms: default beam scenes (clamped on (0,1), 256 elements, nested semismooth Newton)\n");
     table_header();
-    let entries: Vec<SceneEntry> = registry()
-        .into_iter()
-        .filter(|e| e.in_default_job)
-        .collect();
-    let beams: Vec<_> = fem_forms::models::families::scenes()
-        .into_iter()
-        .filter(|s| s.family == "beam" && s.in_default_job)
-        .collect();
+    let in_job = |family: &str| -> Vec<Scene> {
+        families::scenes()
+            .into_iter()
+            .filter(|s| s.family == family && s.in_default_job)
+            .collect()
+    };
+    let beams = in_job("beam");
     for scene in &beams {
         for q in [1.0, 100.0] {
-            let settings = fem_forms::models::run::Settings {
+            let settings = Settings {
                 load: Some(q),
                 ..Default::default()
             };
-            let outcome = fem_forms::models::families::solve(scene, &settings)
-                .map_err(|e| format!("{}: {e}", scene.name))?;
+            let outcome =
+                families::solve(scene, &settings).map_err(|e| format!("{}: {e}", scene.name))?;
             table_row(&outcome.report);
             let path = out.join(format!("{}-q{q}.svg", scene.name));
             plot::profiles(&path, &format!("{} q = {q}", scene.name), &outcome.fields)
@@ -291,19 +291,10 @@ fn default_job(out: &Path) -> Result<(), String> {
         "\nplots of w, θ, λ, ψ: {}/<scene>-q<q>.svg\n",
         out.display()
     );
-    let (beam_entries, membrane_entries): (Vec<SceneEntry>, Vec<SceneEntry>) = entries
-        .into_iter()
-        .partition(|e| matches!(e.kind, SceneKind::Beam(_)));
-    hosted_studies(&beam_entries, out)?;
-    let membranes: Vec<MembraneScene> = membrane_entries
-        .iter()
-        .filter_map(|e| match &e.kind {
-            SceneKind::Membrane(s) => Some(s.clone()),
-            _ => None,
-        })
-        .collect();
+    hosted_studies(&beams, out)?;
+    let membranes = in_job("membrane");
     membrane_job(&membranes, out)?;
-    hosted_studies(&membrane_entries, out)?;
+    hosted_studies(&membranes, out)?;
     registry_job(&["plate", "kirchhoff", "contact", "winkler"], out)
 }
 
@@ -311,7 +302,6 @@ fn default_job(out: &Path) -> Result<(), String> {
 /// plates, contact and the Winkler plate, a summary each and the family's chart where it
 /// has one (out/hertz-pressure.svg, out/signorini-gap-pressure.svg).
 fn registry_job(names: &[&str], out: &Path) -> Result<(), String> {
-    use fem_forms::models::families;
     for family in names {
         println!("\nfem-forms: {family} scenes at their defaults\n");
         for scene in families::scenes().iter().filter(|s| s.family == *family) {
@@ -330,27 +320,12 @@ fn registry_job(names: &[&str], out: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Every study each of `entries` hosts, quick versions.
-fn hosted_studies(entries: &[SceneEntry], out: &Path) -> Result<(), String> {
-    for entry in entries {
-        for &kind in entry.studies {
-            run_study(entry, kind, false, out)?;
-        }
+/// Every study each of `scenes` hosts, quick versions.
+fn hosted_studies(scenes: &[Scene], out: &Path) -> Result<(), String> {
+    for scene in scenes.iter().filter(|s| !s.studies.is_empty()) {
+        registry_study(scene.clone(), None, false, out)?;
     }
     Ok(())
-}
-
-/// The study implementation of a registry scene.
-///
-/// # Errors
-/// [`Error::Input`] for a family without one.
-fn study_scene(entry: &SceneEntry) -> fem_forms::Result<Box<dyn studies::StudyScene>> {
-    match &entry.kind {
-        SceneKind::Beam(s) => Ok(Box::new(fem_forms::beam_studies::BeamStudies::new(*s))),
-        SceneKind::Membrane(s) => Ok(Box::new(fem_forms::membrane_studies::MembraneStudies::new(
-            s.clone(),
-        ))),
-    }
 }
 
 /// `solve --scene FILE`: the file's scene with its pair, α and mesh size where the
@@ -404,88 +379,89 @@ fn solve_file(
     solve::solve_scene(file.scene, &options, out)
 }
 
-/// Runs the study called `kind` on a registry scene.
-fn run_study(entry: &SceneEntry, kind: &str, full: bool, out: &Path) -> Result<(), String> {
-    let study = Study::parse(kind).ok_or_else(|| format!("unknown study `{kind}`"))?;
-    // the plate studies are the plate's own (the generic kinds need exact solutions of
-    // the obstacle problem, which the plate scenes do not have)
-    study_scene(entry)
-        .and_then(|scene| studies::run(&*scene, study, full, out))
-        .map_err(|e| format!("study {} {kind}: {e}", entry.name()))
-}
-
-/// The membrane part of the default job: every pair on the radial scene, each scene at
-/// the cheapest pair and mesh that reach its asked accuracy, VTK files, the studies.
-fn membrane_job(scenes: &[MembraneScene], out: &Path) -> Result<(), String> {
+/// The membrane part of the default job: every pair on the radial scene, for each scene
+/// the coarsest mesh of each pair that reaches its asked accuracy and the cheapest of
+/// them ([`fem_forms::accuracy`]), and the cheapest solve as a .vtu.
+fn membrane_job(scenes: &[Scene], out: &Path) -> Result<(), String> {
     println!("\nfem-forms: membrane scenes (N×N×2 triangles, nested semismooth Newton)\n");
-    membrane_header();
+    pair_header();
     let radial = scenes
         .iter()
         .find(|s| s.name == "membrane-radial")
         .ok_or("the registry has no membrane-radial")?;
-    for pair in MembranePair::ALL {
-        let mut request = MembraneRequest::new(radial.clone());
-        request.pair = pair;
-        match membranes::solve(&request) {
-            Ok((report, _)) => membrane_row(&report),
-            Err(e) => println!("{:<16} {:<8} not solved: {e}", radial.name, pair.name()),
+    for pair in families::pairs_of(radial) {
+        let settings = Settings {
+            pair: Some(pair.name.into()),
+            ..Settings::default()
+        };
+        match families::solve(radial, &settings) {
+            Ok(outcome) => pair_row(&outcome.report),
+            Err(e) => println!("{:<16} {:<8} not solved: {e}", radial.name, pair.name),
         }
     }
     std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
-    for scene in scenes {
-        let (rungs, cheapest) = membranes::cheapest_for_accuracy(scene, &MembranePair::ALL)
-            .map_err(|e| format!("{}: {e}", scene.name))?;
-        println!(
-            "\n{}: the coarsest mesh of each pair with estimated ‖u − u_h‖_L2 ≤ {:.0e} (Richardson estimate against N×2{})",
-            scene.name,
-            scene.target_l2,
-            if rungs.iter().any(|r| r.exact_l2.is_some()) { "; exact error beside" } else { "" }
-        );
-        for (k, r) in rungs.iter().enumerate() {
-            if let Some(e) = &r.failure {
-                println!("  {:<9} not solved: {e}", r.pair);
-                continue;
-            }
-            println!(
-                "  {:<9} N = {:>3} {:>8} dofs {:>8.3} s  estimated {:.2e}{}{}{}",
-                r.pair,
-                r.mesh_size,
-                r.dofs,
-                r.seconds,
-                r.estimated_l2,
-                r.exact_l2
-                    .map_or(String::new(), |e| format!(", exact {e:.2e}")),
-                if r.reached {
-                    ""
-                } else {
-                    "  (not reached by N = 512)"
-                },
-                if Some(k) == cheapest {
-                    "  ← cheapest"
-                } else {
-                    ""
-                }
-            );
-        }
-        if let Some(k) = cheapest {
-            let mut request = MembraneRequest::new(scene.clone());
-            request.pair = MembranePair::parse(&rungs[k].pair).map_err(|e| e.to_string())?;
-            request.mesh_size = rungs[k].mesh_size;
-            let (_, fields) = membranes::solve(&request).map_err(|e| e.to_string())?;
-            let path = out.join(format!("{}.vtu", scene.name));
-            membranes::write_vtk(&path, &fields).map_err(|e| e.to_string())?;
-            println!(
-                "  → {} (u, ψ, λ_h, contact set for ParaView)",
-                path.display()
-            );
-        }
+    for scene in scenes.iter().filter(|s| s.accuracy.is_some()) {
+        accuracy_table(scene, out)?;
     }
     println!();
     Ok(())
 }
 
+/// The accuracy table of one scene ([`fem_forms::accuracy::cheapest_for_accuracy`]) and
+/// the .vtu of its cheapest solve.
+fn accuracy_table(scene: &Scene, out: &Path) -> Result<(), String> {
+    let (rungs, cheapest) = fem_forms::accuracy::cheapest_for_accuracy(scene)
+        .map_err(|e| format!("{}: {e}", scene.name))?;
+    println!(
+        "\n{}: the coarsest mesh of each pair with estimated ‖u − u_h‖_L2 ≤ {:.0e} (Richardson estimate against N×2{})",
+        scene.name,
+        scene.accuracy.unwrap_or(f64::NAN),
+        if rungs.iter().any(|r| r.exact_l2.is_some()) { "; exact error beside" } else { "" }
+    );
+    for (k, r) in rungs.iter().enumerate() {
+        if let Some(e) = &r.failure {
+            println!("  {:<9} not solved: {e}", r.pair);
+            continue;
+        }
+        println!(
+            "  {:<9} N = {:>3} {:>8} dofs {:>8.3} s  estimated {:.2e}{}{}{}",
+            r.pair,
+            r.mesh_size,
+            r.dofs,
+            r.seconds,
+            r.estimated_l2,
+            r.exact_l2
+                .map_or(String::new(), |e| format!(", exact {e:.2e}")),
+            if r.reached {
+                String::new()
+            } else {
+                format!("  (not reached by N = {})", fem_forms::accuracy::FINEST)
+            },
+            if Some(k) == cheapest {
+                "  ← cheapest"
+            } else {
+                ""
+            }
+        );
+    }
+    if let Some(k) = cheapest {
+        let settings = Settings {
+            pair: Some(rungs[k].pair.into()),
+            mesh_size: Some(rungs[k].mesh_size),
+            ..Settings::default()
+        };
+        let outcome = families::solve(scene, &settings).map_err(|e| e.to_string())?;
+        let path = out.join(format!("{}.vtu", scene.name));
+        outcome.fields.write_vtu(&path).map_err(|e| e.to_string())?;
+        println!(
+            "  → {} (u, ψ, λ_h, contact set for ParaView)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 fn list() {
-    use fem_forms::models::families;
     println!("scenes (family, pairs with the default first, studies):");
     for scene in families::scenes() {
         let load = scene.load.as_ref().map_or("fixed load".to_string(), |l| {
@@ -539,89 +515,60 @@ fn alpha_rule(pair: &fem_forms::models::family::Pair) -> String {
     }
 }
 
+/// Every study kind some scene hosts, sorted.
+fn hosted_kinds() -> Vec<&'static str> {
+    let mut kinds: Vec<&str> = families::scenes()
+        .iter()
+        .flat_map(|s| s.studies.clone())
+        .collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    kinds
+}
+
 /// `study <scene> [kind]` through the registry, or `study <kind>` on every scene that
 /// hosts it.
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
-    if let (None, Some(scene)) = (find(name), fem_forms::models::families::scene(name)) {
+    if let Some(scene) = families::scene(name) {
         return registry_study(scene, kind, full, out);
     }
-    let Some(entry) = find(name) else {
-        if let Some(kind) = kind {
-            let swapped = if find(kind).is_some() && Study::parse(name).is_some() {
-                format!(" (did you mean `study {kind} {name}`?)")
-            } else {
-                String::new()
-            };
-            return Err(format!(
-                "`{name}` is not a scene, so `{kind}` cannot be its study{swapped}; the scenes are {}",
-                names().join(", ")
-            ));
-        }
-        // every study some scene hosts, the families' own (lambda-scatter, …) included
-        let hosts: Vec<SceneEntry> = registry()
-            .into_iter()
-            .filter(|e| e.studies.contains(&name))
-            .collect();
-        // and the scenes of the families studied through the one pipeline
-        let registry_hosts: Vec<fem_forms::models::scene::Scene> =
-            fem_forms::models::families::scenes()
-                .into_iter()
-                .filter(|s| find(&s.name).is_none() && s.studies.contains(&name))
-                .collect();
-        if hosts.is_empty() && registry_hosts.is_empty() {
-            let mut kinds: Vec<&str> = registry()
-                .iter()
-                .flat_map(|e| e.studies.iter().copied())
-                .chain(
-                    fem_forms::models::families::scenes()
-                        .iter()
-                        .flat_map(|s| s.studies.clone()),
-                )
-                .collect();
-            kinds.sort_unstable();
-            kinds.dedup();
-            return Err(format!(
-                "unknown study or scene `{name}`; the studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
-                kinds.join(", ")
-            ));
-        }
-        for entry in &hosts {
-            run_study(entry, name, full, out)?;
-        }
-        for scene in registry_hosts {
-            registry_study(scene, Some(name), full, out)?;
-        }
-        return Ok(());
-    };
-    if entry.studies.is_empty() {
-        let hosts: Vec<String> = registry()
+    let scene_names = || -> String {
+        let names: Vec<String> = families::scenes()
             .iter()
-            .filter(|e| !e.studies.is_empty())
-            .map(|e| e.name().to_string())
+            .map(|s| s.name.to_string())
             .collect();
+        names.join(", ")
+    };
+    if let Some(kind) = kind {
+        let swapped = if families::scene(kind).is_some() && hosted_kinds().contains(&name) {
+            format!(" (did you mean `study {kind} {name}`?)")
+        } else {
+            String::new()
+        };
         return Err(format!(
-            "scene `{name}` hosts no study; the scenes that do are {}",
-            hosts.join(", ")
+            "`{name}` is not a scene, so `{kind}` cannot be its study{swapped}; the scenes are {}",
+            scene_names()
         ));
     }
-    let kinds: Vec<&str> = match kind {
-        Some(k) if entry.studies.contains(&k) => vec![k],
-        Some(k) => {
-            return Err(format!(
-                "scene `{name}` hosts no study `{k}`; its studies are {}",
-                entry.studies.join(", ")
-            ))
-        }
-        None => entry.studies.to_vec(),
-    };
-    for k in kinds {
-        run_study(&entry, k, full, out)?;
+    let hosts: Vec<Scene> = families::scenes()
+        .into_iter()
+        .filter(|s| s.studies.contains(&name))
+        .collect();
+    if hosts.is_empty() {
+        return Err(format!(
+            "unknown study or scene `{name}`; the studies are {}, and `study <scene> <study>` runs a study a scene hosts (see `list`)",
+            hosted_kinds().join(", ")
+        ));
+    }
+    for scene in hosts {
+        registry_study(scene, Some(name), full, out)?;
     }
     Ok(())
 }
 
-/// A study of a registry scene of a family without studies of its own, through the one
-/// implementation over the one solve ([`fem_forms::registry_studies`]).
+/// A study of a registry scene: the family's own where it has one (Kirchhoff's λ-scatter,
+/// the plate's convergence without an exact solution), else the one implementation over
+/// the one solve ([`fem_forms::registry_studies`]).
 fn registry_study(
     scene: fem_forms::models::scene::Scene,
     kind: Option<&str>,
@@ -630,6 +577,17 @@ fn registry_study(
 ) -> Result<(), String> {
     let name = scene.name.to_string();
     let hosted = scene.studies.clone();
+    if hosted.is_empty() {
+        let hosts: Vec<String> = families::scenes()
+            .iter()
+            .filter(|s| !s.studies.is_empty())
+            .map(|s| s.name.to_string())
+            .collect();
+        return Err(format!(
+            "scene `{name}` hosts no study; the scenes that do are {}",
+            hosts.join(", ")
+        ));
+    }
     let kinds: Vec<&str> = match kind {
         Some(k) if hosted.contains(&k) => vec![k],
         Some(k) => {

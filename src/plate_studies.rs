@@ -1,8 +1,8 @@
 //! The Reissner–Mindlin plate's own studies (docs/mathematics.md §6) over the one solve
-//! ([`crate::models::families::solve`]): locking (the centre deflection against the
-//! Kirchhoff limit as t → 0, the Stenberg pair beside the plain one), Newton's iterations
-//! per level of a nested solve against cold starts, and convergence without an exact
-//! solution (the changes of J_h, ∫λ_h and the contact radius between meshes).
+//! ([`crate::models::families::solve`]): Newton's iterations per level of a nested solve
+//! against cold starts, and convergence without an exact solution (the changes of J_h,
+//! ∫λ_h and the contact radius between meshes). Locking is the one study of
+//! [`crate::locking`].
 
 use crate::models::families;
 use crate::models::geometry::{halving_sizes, Fields};
@@ -17,7 +17,7 @@ use std::path::Path;
 /// and at least this).
 const COARSEST_LEVEL: usize = 4;
 
-/// Runs the plate study `kind` on `scene` (`locking`, `iterations`, `convergence`);
+/// Runs the plate study `kind` on `scene` (`iterations`, `convergence`);
 /// `None` where `scene` is not a plate scene or `kind` is a generic study kind (the one
 /// implementation runs it).
 ///
@@ -28,7 +28,6 @@ pub fn run(scene: &Scene, kind: &str, full: bool, out: &Path) -> Option<Result<(
         return None;
     }
     match kind {
-        "locking" => Some(locking_run(scene, full, out)),
         "iterations" => Some(iterations_run(scene, full, out)),
         "convergence" => Some(convergence_run(scene, full, out)),
         _ => None,
@@ -81,130 +80,6 @@ fn size_name(scene: &Scene) -> &'static str {
         Domain::Disk { .. } => "rings",
         _ => "N (N×N×2 mesh)",
     }
-}
-
-/// One solve of the locking study.
-#[derive(Clone, Debug)]
-pub struct LockingRow {
-    /// The pair.
-    pub pair: &'static str,
-    /// N.
-    pub mesh_size: usize,
-    /// The thickness t.
-    pub thickness: f64,
-    /// `w_h` at the centre.
-    pub centre_deflection: f64,
-    /// The Kirchhoff plate's centre deflection (the limit t → 0).
-    pub kirchhoff_reference: f64,
-    /// `w_h / w_Kirchhoff − 1`.
-    pub relative_error: f64,
-}
-
-/// The locking study on `scene`: every pair of the scene on every N of `mesh_sizes` and
-/// t of `thicknesses`, the centre deflection against the Kirchhoff limit: flat in t for
-/// the Stenberg pair, falling to −1 for the plain pair (locking). With `csv`, also writes
-/// `pair,mesh_size,thickness,centre_deflection,relative_error` to that file.
-///
-/// # Errors
-/// The solves', and [`Error::Input`] when the file cannot be written.
-pub fn locking_study(
-    scene: &Scene,
-    mesh_sizes: &[usize],
-    thicknesses: &[f64],
-    csv: Option<&Path>,
-) -> Result<Vec<LockingRow>> {
-    let mut rows = Vec::new();
-    for pair in families::pairs_of(scene) {
-        for &n in mesh_sizes {
-            for &t in thicknesses {
-                let r = solve(scene, Some(pair.name), n, None, Some(t), true)?;
-                let (w, kirchhoff) = (
-                    quantity(&r, "centre_deflection"),
-                    quantity(&r, "kirchhoff_reference"),
-                );
-                rows.push(LockingRow {
-                    pair: pair.name,
-                    mesh_size: n,
-                    thickness: t,
-                    centre_deflection: w,
-                    kirchhoff_reference: kirchhoff,
-                    relative_error: w / kirchhoff - 1.0,
-                });
-            }
-        }
-    }
-    if let Some(path) = csv {
-        if let Some(dir) = path.parent() {
-            std::fs::create_dir_all(dir).map_err(io)?;
-        }
-        let mut text = String::from("pair,mesh_size,thickness,centre_deflection,relative_error\n");
-        for r in &rows {
-            text += &format!(
-                "{},{},{:e},{:e},{:e}\n",
-                r.pair, r.mesh_size, r.thickness, r.centre_deflection, r.relative_error
-            );
-        }
-        std::fs::write(path, text).map_err(io)?;
-    }
-    Ok(rows)
-}
-
-/// The locking study as the CLI runs it (`study mindlin-square locking`): N = 8, 16, 32
-/// (and 64 with `full`), t = 1e-1 … 1e-4, a table, `out/<scene>-locking.csv` and the chart
-/// of the relative error of the centre deflection against t, one line per (pair, N).
-///
-/// # Errors
-/// [`locking_study`]'s, and [`Error::Input`] when the chart cannot be written.
-pub fn locking_run(scene: &Scene, full: bool, out: &Path) -> Result<()> {
-    let meshes: &[usize] = if full { &[8, 16, 32, 64] } else { &[8, 16, 32] };
-    let thicknesses = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4];
-    let csv = out.join(format!("{}-locking.csv", scene.name));
-    let rows = locking_study(scene, meshes, &thicknesses, Some(&csv))?;
-    println!(
-        "\nlocking: {}, centre deflection against the Kirchhoff value {:.6e}",
-        scene.name,
-        rows.first().map_or(f64::NAN, |r| r.kirchhoff_reference)
-    );
-    println!(
-        "{:<16} {:>4} {:>8} {:>14} {:>12}",
-        "pair", "N", "t", "w(centre)", "rel. error"
-    );
-    for r in &rows {
-        println!(
-            "{:<16} {:>4} {:>8.0e} {:>14.6e} {:>12.3e}",
-            r.pair, r.mesh_size, r.thickness, r.centre_deflection, r.relative_error
-        );
-    }
-    let mut series = Vec::new();
-    for pair in families::pairs_of(scene) {
-        for &n in meshes {
-            let points: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|r| r.pair == pair.name && r.mesh_size == n)
-                .filter(|r| r.relative_error.is_finite())
-                .map(|r| (r.thickness, r.relative_error.abs().max(1e-12)))
-                .collect();
-            series.push(Series::marked(format!("{} N = {n}", pair.name), points));
-        }
-    }
-    let svg = out.join(format!("{}-locking.svg", scene.name));
-    plot::chart(
-        &svg,
-        &format!(
-            "{}: |relative error| of the centre deflection against t",
-            scene.name
-        ),
-        Axes {
-            x: "t",
-            y: "|w_h(centre) / w_Kirchhoff − 1|",
-            log_x: true,
-            log_y: true,
-        },
-        &series,
-    )
-    .map_err(io)?;
-    println!("→ {}, .csv", svg.display());
-    Ok(())
 }
 
 /// One level of the iterations study: the Newton iterations on a mesh, within a nested

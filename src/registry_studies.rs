@@ -1,14 +1,15 @@
 //! The studies of any registry scene ([`crate::models::families`]): one implementation of
 //! [`StudyScene`] over the one solve, so that a family added as a model file and a
-//! registry entry hosts the study kinds that need nothing but solves (convergence, α
-//! range, work–precision, iterations) without code of its own. The stability measure
-//! and the multiplier profiles are a family's own (the beams' LCP condition, the
-//! membranes' inf-sup constants) and are refused here with that reason.
+//! registry entry hosts every study kind without code of its own: convergence, α range,
+//! work–precision, iterations, stability (the inf-sup constants of the multiplier's
+//! Schur complement), locking where the family has a thickness ([`crate::locking`]).
+//! The multiplier is charted along the family's own line where it has one (contact's
+//! Γ_C), else along the cells met by the horizontal line through the mesh's centre.
 
 use crate::models::families;
 use crate::models::geometry::Fields;
 use crate::models::report::{Outcome, Schur, Settings};
-use crate::models::scene::{Domain, Scene};
+use crate::models::scene::{Domain, ExactSolution, Scene};
 use crate::studies::{ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study, StudyScene};
 use fem_runtime::{Error, Result};
 
@@ -18,8 +19,10 @@ pub struct RegistryStudies {
 }
 
 impl RegistryStudies {
-    /// The studies of `scene`.
-    pub fn new(scene: Scene) -> Self {
+    /// The studies of `scene`. A study chooses its own meshes, so the accuracy the
+    /// scene asks for is not checked (it would warn on every coarse mesh).
+    pub fn new(mut scene: Scene) -> Self {
+        scene.accuracy = None;
         Self { scene }
     }
 
@@ -36,6 +39,7 @@ impl RegistryStudies {
     fn outcome(&self, run: &Run) -> Result<Outcome> {
         let settings = Settings {
             pair: Some(run.pair.to_string()),
+            load: self.scene.study_load,
             mesh_size: Some(run.size),
             alpha: run.alpha,
             solver: run.solver,
@@ -65,6 +69,7 @@ impl RegistryStudies {
         let settings = Settings {
             pair: Some(pair.to_string()),
             mesh_size: Some(size),
+            load: self.scene.study_load,
             alpha,
             schur: true,
             ..Settings::default()
@@ -80,6 +85,16 @@ impl RegistryStudies {
     /// The family's own error measure of the multiplier ([`crate::models::family::Family::error_measure`]).
     fn family_measure(&self) -> Option<(&'static str, &'static str)> {
         families::family(self.scene.family)?.error_measure()
+    }
+
+    /// The exact solution at the studies' load, where known.
+    fn exact(&self) -> Option<ExactSolution> {
+        let settings = Settings {
+            load: self.scene.study_load,
+            ..Settings::default()
+        };
+        let posed = crate::models::run::pose(&self.scene, &settings).ok()?;
+        self.scene.exact_at(&posed)
     }
 
     fn unsupported(&self, what: &str) -> Error {
@@ -105,6 +120,55 @@ fn interpolate(samples: &[(f64, f64)], x: f64) -> f64 {
         })
 }
 
+/// λ as a function of the abscissa along a chart's line.
+type Curve = Box<dyn Fn(f64) -> f64>;
+
+/// The smallest and largest abscissa of `points`, where they differ.
+fn extent(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0), hi.max(p.0))
+        });
+    (lo < hi).then_some((lo, hi))
+}
+
+/// The multiplier of a solve along a line, as `(x, λ_h)` sorted by x, and the line's
+/// ordinate: on an interval λ_h at the cell midpoints (y = 0); on triangles λ_h at the
+/// centroids of the cells met by the horizontal line through the centre of the mesh's
+/// bounding box, or touching it from above (on a structured mesh, the row of cells just
+/// above it).
+pub fn line_profile(fields: &Fields) -> (Vec<(f64, f64)>, f64) {
+    match fields {
+        Fields::Interval { cell_x, lambda, .. } => (
+            cell_x.iter().copied().zip(lambda.iter().copied()).collect(),
+            0.0,
+        ),
+        Fields::Triangles { mesh, cell, .. } => {
+            let (lo, hi) = mesh
+                .vertices()
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v[1]), hi.max(v[1]))
+                });
+            let y = 0.5 * (lo + hi);
+            let tolerance = 1e-12 * (hi - lo);
+            let lambda = cell.iter().find(|c| c.0 == "lambda").map(|c| &c.1);
+            let mut points: Vec<(f64, f64)> = (0..mesh.cell_count())
+                .filter_map(|c| {
+                    let x = mesh.cell_coordinates(c);
+                    let centroid = [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0];
+                    let lowest = x[1].min(x[3]).min(x[5]);
+                    let met = centroid[1] > y && lowest <= y + tolerance;
+                    met.then(|| (centroid[0], lambda.map_or(f64::NAN, |l| l[c])))
+                })
+                .collect();
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (points, y)
+        }
+    }
+}
+
 /// The largest cell diameter of a solve's mesh.
 fn largest_h(fields: &Fields) -> f64 {
     match fields {
@@ -124,7 +188,7 @@ impl StudyScene for RegistryStudies {
                 "{} {} = {}",
                 self.scene.name,
                 l.symbol,
-                fem_runtime::problem::number(l.default)
+                fem_runtime::problem::number(self.scene.study_load.unwrap_or(l.default))
             ),
             None => self.scene.name.to_string(),
         }
@@ -145,8 +209,9 @@ impl StudyScene for RegistryStudies {
     }
 
     fn contact_names(&self) -> [&'static str; 2] {
-        // a multiplier on a boundary part touches along a length
-        if self.scene.facets.is_empty() {
+        // a multiplier on a boundary part, or on an interval, touches along a length
+        let interval = matches!(self.scene.domain, Domain::Interval { .. });
+        if self.scene.facets.is_empty() && !interval {
             ["contact area", "|area error|"]
         } else {
             ["contact length", "|length error|"]
@@ -178,17 +243,21 @@ impl StudyScene for RegistryStudies {
                         .collect(),
                 }
             }
-            // the inf-sup eigenproblem is dense in the multipliers: one halving down
-            Study::Stability => Plan {
-                pair,
-                sizes: self
-                    .ladder(full)
-                    .into_iter()
-                    .map(|k| (k / 2).max(1))
-                    .collect(),
-                cold_max: 0,
-                alphas: vec![],
-            },
+            // the inf-sup eigenproblem is dense in the multipliers: small meshes
+            Study::Stability => {
+                let sizes: &[usize] = match (&self.scene.domain, full) {
+                    (Domain::Interval { .. }, false) => &[16, 32, 64],
+                    (Domain::Interval { .. }, true) => &[16, 32, 64, 128, 256],
+                    (_, false) => &[4, 8, 16],
+                    (_, true) => &[4, 8, 16, 24, 32],
+                };
+                Plan {
+                    pair,
+                    sizes: sizes.to_vec(),
+                    cold_max: 0,
+                    alphas: vec![],
+                }
+            }
             Study::WorkPrecision | Study::Iterations => Plan {
                 pair: default,
                 sizes: self.ladder(full),
@@ -256,8 +325,7 @@ impl StudyScene for RegistryStudies {
     }
 
     fn exact_contact(&self) -> Option<f64> {
-        let posed = crate::models::run::pose(&self.scene, &Settings::default()).ok()?;
-        self.scene.exact_at(&posed)?.contact_area
+        self.exact()?.contact_area
     }
 
     /// Every pair with a multiplier space (the nodal method has none to measure).
@@ -303,33 +371,51 @@ impl StudyScene for RegistryStudies {
         })
     }
 
-    /// The family's chart of the multiplier along its boundary part ([`crate::models::report::Profile`]), as
-    /// points: each P0 step at its middle.
+    /// The family's chart of the multiplier along its boundary part
+    /// ([`crate::models::report::Profile`]), each P0 step at its middle; else
+    /// [`line_profile`] of the solve.
     fn multiplier_profile(&self, run: &Run) -> Result<Vec<(f64, f64)>> {
-        let profile = self
-            .outcome(run)?
-            .profile
-            .ok_or_else(|| self.unsupported("multiplier profile"))?;
-        Ok(profile
-            .computed
-            .1
-            .iter()
-            .map(|&(x0, x1, lambda)| (0.5 * (x0 + x1), lambda))
-            .collect())
+        let outcome = self.outcome(run)?;
+        Ok(match outcome.profile {
+            Some(profile) => profile
+                .computed
+                .1
+                .iter()
+                .map(|&(x0, x1, lambda)| (0.5 * (x0 + x1), lambda))
+                .collect(),
+            None => line_profile(&outcome.fields).0,
+        })
     }
 
-    /// The reference curve of the family's chart at the default solve, interpolated.
+    /// The reference curve of the family's chart at the default solve, interpolated;
+    /// else the exact multiplier along the line of [`line_profile`].
     fn exact_multiplier(&self) -> Option<ExactMultiplier> {
         let run = Run::new(self.pairs()[0], self.scene.mesh_size);
-        let (_, samples) = self.outcome(&run).ok()?.profile?.reference?;
+        let outcome = self.outcome(&run).ok()?;
+        let (samples, lambda): (Vec<(f64, f64)>, Curve) = match outcome.profile {
+            Some(profile) => {
+                let (_, samples) = profile.reference?;
+                let curve = samples.clone();
+                (samples, Box::new(move |x| interpolate(&curve, x)))
+            }
+            None => {
+                let multiplier = self.exact()?.multiplier?;
+                let (points, y) = line_profile(&outcome.fields);
+                let (lo, hi) = extent(&points)?;
+                let samples = (0..=4000)
+                    .map(|i| {
+                        let x = lo + (hi - lo) * i as f64 / 4000.0;
+                        (x, multiplier.at(&[x, y]))
+                    })
+                    .collect();
+                (samples, Box::new(move |x| multiplier.at(&[x, y])))
+            }
+        };
         let touching: Vec<f64> = samples.iter().filter(|p| p.1 > 0.0).map(|p| p.0).collect();
-        let contact = [
-            touching.iter().copied().fold(f64::INFINITY, f64::min),
-            touching.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        ];
+        let (lo, hi) = extent(&touching.iter().map(|&x| (x, 0.0)).collect::<Vec<_>>())?;
         Some(ExactMultiplier {
-            contact,
-            lambda: Box::new(move |x| interpolate(&samples, x)),
+            contact: [lo, hi],
+            lambda,
         })
     }
 
@@ -340,19 +426,21 @@ impl StudyScene for RegistryStudies {
             })
     }
 
-    /// The extent of the family's chart at the default solve.
+    /// The one locking study ([`crate::locking`]).
+    fn locking(&self, full: bool, out: &std::path::Path) -> Result<()> {
+        crate::locking::run(&self.scene, full, out)
+    }
+
+    /// The exact contact interval widened by a quarter of its width on each side where
+    /// it is known, else the extent of the chart at the default solve.
     fn profile_window(&self) -> [f64; 2] {
+        if let Some(exact) = self.exact_multiplier() {
+            let [a, b] = exact.contact;
+            let margin = 0.25 * (b - a).max(0.0);
+            return [a - margin, b + margin];
+        }
         let run = Run::new(self.pairs()[0], self.scene.mesh_size);
         let points = self.multiplier_profile(&run).unwrap_or_default();
-        let (lo, hi) = points
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p.0), hi.max(p.0))
-            });
-        if lo < hi {
-            [lo, hi]
-        } else {
-            [0.0, 1.0]
-        }
+        extent(&points).map_or([0.0, 1.0], |(lo, hi)| [lo, hi])
     }
 }

@@ -345,7 +345,7 @@ fn write_outputs(
         eprintln!("→ {}", path.display());
     }
     if options.vtk {
-        let Fields::Triangles { mesh, vertex, cell } = &outcome.fields else {
+        let Fields::Triangles { .. } = &outcome.fields else {
             return Err(format!(
                 "--vtk does not apply: `{}` is not solved on triangles",
                 scene.name
@@ -356,9 +356,7 @@ fn write_outputs(
             scene.name, outcome.report.pair, outcome.report.mesh_size
         ));
         std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
-        let vertex: Vec<(&str, &[f64])> = vertex.iter().map(|(n, v)| (*n, v.as_slice())).collect();
-        let cell: Vec<(&str, &[f64])> = cell.iter().map(|(n, v)| (*n, v.as_slice())).collect();
-        fem_forms::io::vtk::write_vtu(&path, mesh, &vertex, &cell).map_err(|e| e.to_string())?;
+        outcome.fields.write_vtu(&path).map_err(|e| e.to_string())?;
         eprintln!("→ {}", path.display());
     }
     Ok(())

@@ -147,6 +147,31 @@ pub fn finite(value: &toml::Value) -> Option<f64> {
         .map(|v| v + 0.0)
 }
 
+/// What the locking study compares (see [`Family::locking`]): the report's quantity
+/// `quantity` against its value in the limit t → 0.
+#[derive(Clone, Copy, Debug)]
+pub struct Locking {
+    /// The report's key of the quantity (`centre_deflection`).
+    pub quantity: &'static str,
+    /// The quantity in words, for charts (`w_h(centre)`).
+    pub quantity_words: &'static str,
+    /// Where its limit t → 0 comes from.
+    pub limit: Limit,
+    /// The limit model's name (`Kirchhoff`).
+    pub limit_words: &'static str,
+}
+
+/// The value of a [`Locking`] quantity in the limit t → 0.
+#[derive(Clone, Copy, Debug)]
+pub enum Limit {
+    /// A closed form each solve reports under this key (`kirchhoff_reference`).
+    Reported(&'static str),
+    /// The same quantity of another scene, the thin model's (the Euler–Bernoulli beam with
+    /// a Timoshenko scene's obstacle and load), solved once on a mesh sixteen times finer
+    /// than the study's finest; `None` where the scene has no such limit scene.
+    Scene(fn(&Scene) -> Option<Scene>),
+}
+
 /// The keys of a scene file a family reads itself: its `[material]`, and the
 /// `[parameters]` that are not the model's (a contact direction), taken before the
 /// reader maps the rest onto the model's names.
@@ -208,6 +233,14 @@ pub trait Family: Sync {
     /// report's key and words (contact's relative L² error of the pressure): what a
     /// scene's `accuracy` asks of, and what the studies chart as the multiplier's error.
     fn error_measure(&self) -> Option<(&'static str, &'static str)> {
+        None
+    }
+
+    /// The family's measure of locking, where it has a thickness `t` whose limit t → 0 is
+    /// a thinner model: the report's key of a quantity and of its value in that limit
+    /// (the Reissner–Mindlin plate's centre deflection against Kirchhoff's), what the
+    /// locking study compares as t falls.
+    fn locking(&self) -> Option<Locking> {
         None
     }
 

@@ -105,6 +105,25 @@ pub enum Fields {
     },
 }
 
+impl Fields {
+    /// Writes the fields on triangles as a ParaView `.vtu` file at `path`: the vertex
+    /// fields as point data, the cell fields as cell data.
+    ///
+    /// # Errors
+    /// [`fem_runtime::Error::Input`] for fields on an interval, and
+    /// [`fem_runtime::io::vtk::write_vtu`]'s.
+    pub fn write_vtu(&self, path: &std::path::Path) -> fem_runtime::Result<()> {
+        let Fields::Triangles { mesh, vertex, cell } = self else {
+            return Err(fem_runtime::Error::Input(
+                "a .vtu holds fields on triangles; these are on an interval".into(),
+            ));
+        };
+        let vertex: Vec<(&str, &[f64])> = vertex.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+        let cell: Vec<(&str, &[f64])> = cell.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+        fem_runtime::io::vtk::write_vtu(path, mesh, &vertex, &cell)
+    }
+}
+
 /// The halving sizes `n, n/2, …` down to `coarsest`, coarsest first (`n` alone without
 /// `nested`); `even` keeps every level even (the L-shape needs even N).
 pub fn halving_sizes(n: usize, nested: bool, coarsest: usize, even: bool) -> Vec<usize> {

@@ -326,7 +326,8 @@ pub struct ExactSolution {
     pub multiplier: Option<Data>,
     /// `∫ λ` over the scene's own domain.
     pub total_contact_force: Option<f64>,
-    /// The contact set's area over the scene's own domain.
+    /// The measure of the contact set over the scene's own domain: its area on
+    /// triangles, its length on an interval.
     pub contact_area: Option<f64>,
     /// The contact intervals of a beam (a point contact as `[x, x]`).
     pub contact_set: Option<Vec<[f64; 2]>>,
@@ -420,6 +421,9 @@ pub struct Scene {
     pub pairs: Vec<&'static str>,
     /// The studies it hosts.
     pub studies: Vec<&'static str>,
+    /// The load q its studies pose where it is not [`Load::default`] (the beams are
+    /// solved at q = 1, where they do not touch their obstacles, and studied at q = 100).
+    pub study_load: Option<f64>,
     /// Whether the default job (`fem-forms` without a command) solves it.
     pub in_default_job: bool,
     /// The family's own description (see [`Reference`]).
@@ -468,6 +472,7 @@ impl Scene {
             accuracy: None,
             pairs: Vec::new(),
             studies: Vec::new(),
+            study_load: None,
             in_default_job: false,
             reference: None,
             file_keys: Vec::new(),

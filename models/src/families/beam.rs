@@ -79,6 +79,39 @@ static PAIRS: [Pair; 4] = [
     ),
 ];
 
+/// The load q of the beams' studies: it presses every scene onto its obstacle.
+pub const STUDY_LOAD: f64 = 100.0;
+
+/// The multiplier of a beam on a flat obstacle with a contact interval: there
+/// `w'''' = 0`, so `λ = q` inside it (the point forces at its ends left out); `None` for
+/// other obstacles, whose λ the closed forms do not give.
+fn flat_obstacle_multiplier(
+    scene: &crate::scenes::Scene,
+    q: f64,
+    contact_set: &[[f64; 2]],
+) -> Option<Data> {
+    let flat = matches!(scene.obstacle, crate::scenes::Obstacle::Constant(_));
+    let &[[a, b]] = contact_set else {
+        return None;
+    };
+    (flat && a < b).then(|| Data::shared(move |x| if (a..=b).contains(&x[0]) { q } else { 0.0 }))
+}
+
+/// The registry's Euler–Bernoulli scene with the obstacle, side and load of the
+/// Timoshenko `scene` (its limit t → 0), with the study load of `scene`.
+fn bernoulli_limit(scene: &Scene) -> Option<Scene> {
+    let thick = scene
+        .reference::<crate::scenes::Scene>()
+        .filter(|s| s.beam == Beam::Timoshenko)?;
+    let limit = SCENES.iter().find(|s| {
+        s.beam == Beam::EulerBernoulli
+            && s.obstacle == thick.obstacle
+            && s.side == thick.side
+            && s.load_sign == thick.load_sign
+    })?;
+    Some(beam_scene(limit))
+}
+
 /// The studies each built-in beam scene hosts.
 fn studies(name: &str) -> Vec<&'static str> {
     match name {
@@ -135,12 +168,17 @@ fn beam_scene(old: &crate::scenes::Scene) -> Scene {
         Some(ExactSolution {
             value: Some(Data::shared(move |x| (value.w)(x[0], 0))),
             gradient: Some(Data::shared(move |x| [(slope.w)(x[0], 1), 0.0])),
+            multiplier: flat_obstacle_multiplier(&old, q, &e.contact_set),
+            contact_area: Some(e.contact_set.iter().map(|c| c[1] - c[0]).sum()),
             contact_set: Some(e.contact_set.clone()),
             total_contact_force: Some(e.total_contact_force),
             ..ExactSolution::default()
         })
     }));
     scene.studies = studies(old.name);
+    // at the default q = 1 no beam touches its obstacle
+    scene.study_load = Some(STUDY_LOAD);
+    scene.reference = Some(Arc::new(old));
     scene.in_default_job = true;
     scene
 }
@@ -179,6 +217,17 @@ impl Family for Beams {
 
     fn scenes(&self) -> Vec<Scene> {
         SCENES.iter().map(beam_scene).collect()
+    }
+
+    /// The largest deflection against the Euler–Bernoulli beam's (the limit t → 0), solved on
+    /// Hermite cubics.
+    fn locking(&self) -> Option<crate::family::Locking> {
+        Some(crate::family::Locking {
+            quantity: "max_deflection",
+            limit: crate::family::Limit::Scene(bernoulli_limit),
+            quantity_words: "max |w_h|",
+            limit_words: "Euler–Bernoulli",
+        })
     }
 
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
@@ -236,6 +285,7 @@ impl Quantities<IntervalMesh> for Beams {
         report.set("contact_set", solution.contact_set());
         let thickness = run.posed.parameter("t");
         report.set("thickness", thickness);
+
         if let (Some(t), "p1-p1-p0-full") = (thickness, run.pair.name) {
             let h = 1.0 / cells as f64;
             // from a tenth of t on: at h = t the error is already 8 %

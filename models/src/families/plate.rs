@@ -186,6 +186,16 @@ impl Family for Plates {
         plate_scenes::PLATE_SCENES.iter().map(plate_scene).collect()
     }
 
+    /// The centre deflection against the Kirchhoff plate's (the limit t → 0).
+    fn locking(&self) -> Option<crate::family::Locking> {
+        Some(crate::family::Locking {
+            quantity: "centre_deflection",
+            limit: crate::family::Limit::Reported("kirchhoff_reference"),
+            quantity_words: "w_h(centre)",
+            limit_words: "Kirchhoff",
+        })
+    }
+
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[
             ("thickness", "t"),
