@@ -5,20 +5,19 @@
 //! multigrid steps reaches the direct path's KKT-certified solution with CG iteration
 //! counts bounded as h → 0 on the Hermite beam.
 
-use fem_forms::beams::{self, Pair, Request};
+#[path = "common/beams.rs"]
+mod beams;
+
 use fem_forms::element::interval::PhysicalBasis;
 use fem_forms::lcp::LcpSolution;
-use fem_forms::models::scenes::scene;
+use fem_forms::models::report::Settings;
 use fem_forms::norms::FieldView;
 use fem_forms::obstacle::hierarchy::{interval_primal_prolongation, LinearSolver};
 use fem_forms::obstacle::Discretization;
 
-fn request(name: &str, pair: Pair, elements: usize, load: f64) -> Request {
-    let mut request = Request::new(scene(name).expect("a beam scene"));
-    request.pair = Some(pair);
-    request.elements = elements;
-    request.load = load;
-    request
+/// The problem of `name` with `pair` on `elements` elements at q = 1 (α = 1).
+fn discretize(name: &str, pair: &str, elements: usize) -> Discretization {
+    beams::discretize(name, pair, elements, 1.0, 1.0).unwrap()
 }
 
 /// The full coefficient vector of the primal unknowns `u` (multipliers zero).
@@ -61,12 +60,11 @@ fn evaluate(d: &Discretization, values: &[f64], x: f64) -> Vec<f64> {
 #[test]
 fn the_prolongation_reproduces_every_coarse_function_with_its_slope() {
     for (name, pair) in [
-        ("bernoulli-a", Pair::BernoulliHermite),
-        ("timoshenko-a", Pair::TimoshenkoP2),
-        ("timoshenko-a", Pair::TimoshenkoP1Reduced),
+        ("bernoulli-a", "hermite-p0"),
+        ("timoshenko-a", "p2-p2-p0"),
+        ("timoshenko-a", "p1-p1-p0-reduced"),
     ] {
-        let (coarse, _) = beams::discretize(&request(name, pair, 8, 1.0)).unwrap();
-        let (fine, _) = beams::discretize(&request(name, pair, 16, 1.0)).unwrap();
+        let (coarse, fine) = (discretize(name, pair, 8), discretize(name, pair, 16));
         let p = interval_primal_prolongation(&coarse, &fine).unwrap();
         assert_eq!((p.nrows(), p.ncols()), (fine.lcp.n(), coarse.lcp.n()));
         let dense = p.to_dense();
@@ -85,7 +83,7 @@ fn the_prolongation_reproduces_every_coarse_function_with_its_slope() {
                 for (a, b) in a.iter().zip(&b) {
                     assert!(
                         (a - b).abs() <= 1e-10 * (1.0 + a.abs()),
-                        "{name} {pair:?}: coarse function {j} at x = {x}: {a} on the coarse mesh, {b} prolonged"
+                        "{name} {pair}: coarse function {j} at x = {x}: {a} on the coarse mesh, {b} prolonged"
                     );
                 }
             }
@@ -97,37 +95,43 @@ fn the_prolongation_reproduces_every_coarse_function_with_its_slope() {
 fn newton_with_multigrid_steps_reaches_the_direct_solution_on_beams() {
     // (scene, pair, load): a contact interval on each
     let cases = [
-        ("bernoulli-flat", Pair::BernoulliHermite, 100.0),
-        ("bernoulli-a", Pair::BernoulliHermite, 40.0),
-        ("timoshenko-a", Pair::TimoshenkoP1Reduced, 40.0),
-        ("timoshenko-b", Pair::TimoshenkoP2, 100.0),
+        ("bernoulli-flat", "hermite-p0", 100.0),
+        ("bernoulli-a", "hermite-p0", 40.0),
+        ("timoshenko-a", "p1-p1-p0-reduced", 40.0),
+        ("timoshenko-b", "p2-p2-p0", 100.0),
     ];
     for (name, pair, load) in cases {
         let mut iterations_per_step = Vec::new();
         for elements in [128, 512] {
-            let mut direct = request(name, pair, elements, load);
-            direct.linear_solver = LinearSolver::Direct;
-            let mut multigrid = direct;
-            multigrid.linear_solver = LinearSolver::Multigrid;
-            let (d, _) = beams::solve(&direct).unwrap();
-            let (m, _) = beams::solve(&multigrid).unwrap();
+            let with = |linear_solver| Settings {
+                pair: Some(pair.into()),
+                linear_solver,
+                ..beams::settings(elements, load)
+            };
+            let direct = beams::solve(name, &with(LinearSolver::Direct))
+                .unwrap()
+                .report;
+            let multigrid = beams::solve(name, &with(LinearSolver::Multigrid))
+                .unwrap()
+                .report;
+            let (d, m) = (&direct.solve, &multigrid.solve);
             assert_eq!(d.linear_solver, "direct");
             assert_eq!(m.linear_solver, "multigrid", "{name} at {elements}");
             assert!(d.factorizations > 0, "{name}: the direct path factors");
             assert!(m.complementarity_residual <= 1e-10, "{name}: {m:?}");
+            let (em, ed) = (m.energy.unwrap(), d.energy.unwrap());
             assert!(
-                (m.energy - d.energy).abs() <= 1e-9 * d.energy.abs(),
-                "{name} at {elements}: energy {} with multigrid, {} direct",
-                m.energy,
-                d.energy
+                (em - ed).abs() <= 1e-9 * ed.abs(),
+                "{name} at {elements}: energy {em} with multigrid, {ed} direct"
             );
-            assert_eq!(m.contact_set.len(), d.contact_set.len(), "{name}");
-            for (a, b) in m.contact_set.iter().zip(&d.contact_set) {
+            let (cm, cd) = (beams::contact_set(&multigrid), beams::contact_set(&direct));
+            assert_eq!(cm.len(), cd.len(), "{name}");
+            for (a, b) in cm.iter().zip(&cd) {
                 assert!((a[0] - b[0]).abs() <= 1e-9 && (a[1] - b[1]).abs() <= 1e-9);
             }
             iterations_per_step.push(m.krylov_iterations as f64 / m.iterations.max(1) as f64);
         }
-        if pair == Pair::BernoulliHermite {
+        if pair == "hermite-p0" {
             // fourth order, κ ~ h⁻⁴: still no growth of the CG iterations per Newton step
             assert!(
                 iterations_per_step[1] <= 1.5 * iterations_per_step[0] + 2.0,
@@ -142,10 +146,8 @@ fn newton_with_multigrid_steps_reaches_the_direct_solution_on_beams() {
 /// cell at most: no rounding couples a row to a farther coarse DOF.
 #[test]
 fn the_hermite_prolongation_of_a_large_mesh_has_the_nested_pattern() {
-    let (coarse, _) =
-        beams::discretize(&request("bernoulli-a", Pair::BernoulliHermite, 3000, 1.0)).unwrap();
-    let (fine, _) =
-        beams::discretize(&request("bernoulli-a", Pair::BernoulliHermite, 6000, 1.0)).unwrap();
+    let coarse = discretize("bernoulli-a", "hermite-p0", 3000);
+    let fine = discretize("bernoulli-a", "hermite-p0", 6000);
     let p = interval_primal_prolongation(&coarse, &fine).unwrap();
     let pt = p.to_row_major().unwrap();
     let (row_ptr, columns, values) = (pt.symbolic().row_ptr(), pt.symbolic().col_idx(), pt.val());

@@ -3,18 +3,26 @@
 //! stability where methods fail, and bad input.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::beam_studies::{self, BeamStudies};
-use fem_forms::beams::{solve, Pair, Request};
+#[path = "common/beams.rs"]
+mod beams;
+
+use beams::{contact_set, max_deflection, settings, solve};
+use fem_forms::models::families::{self, beam::beam_scene};
+use fem_forms::models::report::{Report, Settings};
 use fem_forms::models::scenes::{exact_solution, scene, Beam, Obstacle, Scene, SCENES};
 use fem_forms::obstacle::VariationalSolver;
+use fem_forms::registry_studies::RegistryStudies;
 use fem_forms::studies;
 use fem_forms::IntervalMesh;
 
-fn request(name: &str, elements: usize, q: f64) -> Request {
-    let mut r = Request::new(scene(name).unwrap());
-    r.elements = elements;
-    r.load = q;
-    r
+/// The report of `name` on `elements` elements at load `q`.
+fn report(name: &str, elements: usize, q: f64) -> fem_forms::Result<Report> {
+    Ok(solve(name, &settings(elements, q))?.report)
+}
+
+/// The report of a beam data set that is not a registry scene.
+fn report_of(scene: &Scene, settings: &Settings) -> fem_forms::Result<Report> {
+    Ok(families::solve(&beam_scene(scene), settings)?.report)
 }
 
 /// Least-squares slope of log(error) against log(1/h): one rate for the whole sequence,
@@ -37,7 +45,7 @@ fn bernoulli_flat_converges_at_the_expected_rates() {
     // within a cell, so the error is O(h²) in L2 and H1 (the point forces' H⁻² error),
     // below the O(h^{5/2}) that the regularity H^{7/2−ε} would allow.
     let meshes = [32, 64, 128, 256, 512, 1024];
-    let flat = BeamStudies::new(scene("bernoulli-flat").unwrap());
+    let flat = RegistryStudies::of("bernoulli-flat").unwrap();
     let rows = studies::convergence(&flat, "hermite-p0", &meshes).unwrap();
     let l2: Vec<f64> = rows.iter().map(|r| r.error_l2.unwrap()).collect();
     let h1: Vec<f64> = rows.iter().map(|r| r.error_h1.unwrap()).collect();
@@ -53,15 +61,19 @@ fn bernoulli_flat_converges_at_the_expected_rates() {
     assert!((r2 - 2.0).abs() < 0.4, "L2 rate {r2}");
     assert!((r1 - 2.0).abs() < 0.4, "H1 rate {r1}");
     assert!(rf > 1.5, "total force rate {rf}");
-    // and the contact edge is found to within two cells
-    for r in &rows {
-        let edge_error = r.contact_error.unwrap();
-        assert!(
-            edge_error <= 2.0 / r.size as f64 + 1e-12,
-            "{} elements: edge error {}",
-            r.size,
-            edge_error
-        );
+    // and the contact edges are found to within two cells
+    let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
+    for &n in &meshes {
+        let set = contact_set(&report("bernoulli-flat", n, 100.0).unwrap());
+        // the outer edges (a coarse mesh may leave holes inside)
+        let edges = [set[0][0], set[set.len() - 1][1]];
+        for (k, edge) in edges.into_iter().enumerate() {
+            let error = (edge - exact.contact_set[0][k]).abs();
+            assert!(
+                error <= 2.0 / n as f64 + 1e-12,
+                "{n} elements: edge {k} off by {error}"
+            );
+        }
     }
 }
 
@@ -69,56 +81,47 @@ fn bernoulli_flat_converges_at_the_expected_rates() {
 fn every_scene_agrees_between_pdas_and_clarabel() {
     for s in SCENES {
         for q in [1.0, 40.0, 100.0] {
-            let mut newton = Request::new(s);
-            newton.elements = 128;
-            newton.load = q;
-            let (pdas, _) = solve(&newton).unwrap();
-            let mut qp = newton;
-            qp.solver = VariationalSolver::Clarabel;
-            let (clarabel, _) = solve(&qp).unwrap();
-            let relative = ((pdas.energy - clarabel.energy) / pdas.energy).abs();
+            let newton = settings(128, q);
+            let pdas = report(s.name, 128, q).unwrap();
+            let qp = Settings {
+                solver: VariationalSolver::Clarabel,
+                ..newton
+            };
+            let clarabel = solve(s.name, &qp).unwrap().report;
+            let (ep, ec) = (pdas.solve.energy.unwrap(), clarabel.solve.energy.unwrap());
+            let relative = ((ep - ec) / ep).abs();
             assert!(
                 relative <= 1e-7,
-                "{} q = {q}: energies {} vs {} ({relative:e})",
-                s.name,
-                pdas.energy,
-                clarabel.energy
+                "{} q = {q}: energies {ep} vs {ec} ({relative:e})",
+                s.name
             );
             assert!(
-                pdas.complementarity_residual <= 1e-10,
+                pdas.solve.complementarity_residual <= 1e-10,
                 "{} q = {q}: KKT residual {:e}",
                 s.name,
-                pdas.complementarity_residual
+                pdas.solve.complementarity_residual
             );
+            let (cp, cc) = (contact_set(&pdas), contact_set(&clarabel));
             if q == 1.0 {
                 // the seed load never reaches the obstacle: the multiplier vanishes
-                assert_eq!(pdas.total_contact_force, 0.0, "{}", s.name);
+                assert_eq!(pdas.solve.total_contact_force, 0.0, "{}", s.name);
+                assert!(cp.is_empty() && cc.is_empty(), "{}", s.name);
                 assert!(
-                    pdas.contact_set.is_empty() && clarabel.contact_set.is_empty(),
-                    "{}",
-                    s.name
-                );
-                assert!(
-                    clarabel.total_contact_force.abs() < 1e-8,
+                    clarabel.solve.total_contact_force.abs() < 1e-8,
                     "{}: {}",
                     s.name,
-                    clarabel.total_contact_force
+                    clarabel.solve.total_contact_force
                 );
                 // and the free beam is right: Hermite is exact at the nodes, P2 is O(h²)
                 assert!(
-                    pdas.error_l2.unwrap() < 1e-6,
+                    pdas.solve.error_l2.unwrap() < 1e-6,
                     "{}: {:?}",
                     s.name,
-                    pdas.error_l2
+                    pdas.solve.error_l2
                 );
             } else {
-                assert!(!pdas.contact_set.is_empty(), "{} q = {q} touches", s.name);
-                assert_eq!(
-                    pdas.contact_set.len(),
-                    clarabel.contact_set.len(),
-                    "{} q = {q}",
-                    s.name
-                );
+                assert!(!cp.is_empty(), "{} q = {q} touches", s.name);
+                assert_eq!(cp.len(), cc.len(), "{} q = {q}", s.name);
             }
         }
     }
@@ -127,34 +130,27 @@ fn every_scene_agrees_between_pdas_and_clarabel() {
 #[test]
 fn bernoulli_flat_matches_the_exact_contact_set_and_force() {
     let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
-    let (r, _) = solve(&request("bernoulli-flat", 512, 100.0)).unwrap();
-    let [a, b] = r.contact_set[0];
+    let r = report("bernoulli-flat", 512, 100.0).unwrap();
+    let [a, b] = contact_set(&r)[0];
     assert!((a - exact.contact_set[0][0]).abs() < 2.0 / 512.0, "{a}");
     assert!((b - exact.contact_set[0][1]).abs() < 2.0 / 512.0, "{b}");
-    assert!(
-        ((r.total_contact_force - exact.total_contact_force) / exact.total_contact_force).abs()
-            < 1e-3
-    );
+    let force = r.solve.total_contact_force;
+    assert!(((force - exact.total_contact_force) / exact.total_contact_force).abs() < 1e-3);
     // point contact regime: q = 40 touches at ½ with force q/2 − 192 d
-    let (r, _) = solve(&request("bernoulli-flat", 512, 40.0)).unwrap();
-    assert_eq!(r.contact_set.len(), 1);
-    assert!((r.contact_set[0][0] - 0.5).abs() < 1e-6 && r.contact_set[0][0] == r.contact_set[0][1]);
-    assert!(
-        (r.total_contact_force - (20.0 - 9.6)).abs() < 1e-3,
-        "{}",
-        r.total_contact_force
-    );
+    let r = report("bernoulli-flat", 512, 40.0).unwrap();
+    let set = contact_set(&r);
+    assert_eq!(set.len(), 1);
+    assert!((set[0][0] - 0.5).abs() < 1e-6 && set[0][0] == set[0][1]);
+    let force = r.solve.total_contact_force;
+    assert!((force - (20.0 - 9.6)).abs() < 1e-3, "{force}");
 }
 
 #[test]
 fn sign_test_both_sides_press_onto_the_obstacle_everywhere() {
     // docs/mathematics.md §1: ψ = 0, f = −s·q: exact u = 0, λ = q, for both s and both beams.
     for (beam, pairs) in [
-        (Beam::EulerBernoulli, vec![Pair::BernoulliHermite]),
-        (
-            Beam::Timoshenko,
-            vec![Pair::TimoshenkoP2, Pair::TimoshenkoP1Reduced],
-        ),
+        (Beam::EulerBernoulli, vec!["hermite-p0"]),
+        (Beam::Timoshenko, vec!["p2-p2-p0", "p1-p1-p0-reduced"]),
     ] {
         for s in [1.0, -1.0] {
             for pair in &pairs {
@@ -167,21 +163,17 @@ fn sign_test_both_sides_press_onto_the_obstacle_everywhere() {
                     load_sign: -s,
                     thickness: 1e-2,
                 };
-                let mut r = Request::new(scene);
-                r.elements = 64;
-                r.load = 7.0;
-                r.pair = Some(*pair);
-                let (report, profiles) = solve(&r).unwrap();
-                assert!(
-                    report.max_deflection < 1e-9,
-                    "{beam:?} s = {s}: max |w| {}",
-                    report.max_deflection
-                );
-                for &l in &profiles.lambda {
+                let r = Settings {
+                    pair: Some(pair.to_string()),
+                    ..settings(64, 7.0)
+                };
+                let outcome = families::solve(&beam_scene(&scene), &r).unwrap();
+                let w = max_deflection(&outcome.report);
+                assert!(w < 1e-9, "{beam:?} s = {s}: max |w| {w}");
+                for &l in beams::lambda(&outcome) {
                     assert!(
                         (l - 7.0).abs() < 1e-6 * 7.0,
-                        "{beam:?} {} s = {s}: λ = {l}",
-                        pair.name()
+                        "{beam:?} {pair} s = {s}: λ = {l}"
                     );
                 }
             }
@@ -191,59 +183,47 @@ fn sign_test_both_sides_press_onto_the_obstacle_everywhere() {
 
 #[test]
 fn stabilized_timoshenko_does_not_lock_and_p1_full_integration_does() {
-    let thicknesses = [1e-1, 1e-2, 1e-3, 1e-4, 1e-5];
-    let (reference, rows) = beam_studies::locking(
-        &scene("timoshenko-a").unwrap(),
-        128,
-        &thicknesses,
-        &[Pair::TimoshenkoP2, Pair::TimoshenkoP1Full],
-    )
-    .unwrap();
-    let p2: Vec<_> = rows
-        .iter()
-        .filter(|r| r.pair == Pair::TimoshenkoP2)
-        .collect();
-    let full: Vec<_> = rows
-        .iter()
-        .filter(|r| r.pair == Pair::TimoshenkoP1Full)
-        .collect();
+    // against the Euler–Bernoulli beam on 16 × 128 Hermite elements (the study's limit)
+    let thicknesses = [1e-1, 1e-2, 1e-3, 1e-4];
+    let timoshenko = families::scene("timoshenko-a").unwrap();
+    let rows = fem_forms::locking::locking_study(&timoshenko, &[128], &thicknesses, None).unwrap();
+    let of = |pair: &str| -> Vec<_> { rows.iter().filter(|r| r.pair == pair).collect() };
+    let (p2, full) = (of("p2-p2-p0"), of("p1-p1-p0-full"));
     for r in &rows {
         println!(
-            "{:<15} t = {:.0e}: max |w| {:.6e}, ‖w − w_EB‖ {:.3e}",
-            r.pair.name(),
-            r.thickness,
-            r.max_deflection,
-            r.difference_to_bernoulli
+            "{:<17} t = {:.0e}: max |w| {:.6e}, against Euler–Bernoulli {:+.3e}",
+            r.pair, r.thickness, r.quantity, r.relative_error
         );
     }
+    // the limit is the Euler–Bernoulli beam's, solved independently of the pair
+    let limit = report("bernoulli-a", 2048, 100.0).unwrap();
+    assert!(rows.iter().all(|r| r.limit == max_deflection(&limit)));
     // Converges to Euler–Bernoulli: the difference falls by ~t² until the mesh error floor…
-    assert!(p2[1].difference_to_bernoulli < p2[0].difference_to_bernoulli / 50.0);
-    // …and at fixed h it does not grow as t → 0 (1e-3 … 1e-5, the last with refinement).
-    let floor = p2[2].difference_to_bernoulli;
-    for r in &p2[2..] {
+    assert!(p2[1].relative_error.abs() < p2[0].relative_error.abs() / 50.0);
+    // …and at fixed h it does not grow as t → 0
+    for r in &p2[1..] {
         assert!(
-            r.difference_to_bernoulli < 3.0 * floor.max(1e-5),
+            r.relative_error.abs() < 3e-3,
             "t = {}: {}",
             r.thickness,
-            r.difference_to_bernoulli
+            r.relative_error
         );
-        assert!((r.max_deflection / reference.max_deflection - 1.0).abs() < 1e-3);
     }
     // P1–P1 with exact shear integration locks: its deflection collapses.
     assert!(
-        full[4].max_deflection < 0.01 * full[0].max_deflection,
+        full[3].quantity < 0.02 * full[0].quantity,
         "{} vs {}",
-        full[4].max_deflection,
-        full[0].max_deflection
+        full[3].quantity,
+        full[0].quantity
     );
-    assert!(full[3].max_deflection < 0.2 * reference.max_deflection);
+    assert!(full[2].quantity < 0.9 * full[2].limit);
 }
 
 #[test]
 fn nested_iteration_keeps_newton_iterations_flat() {
     // Timoshenko from 32 to 32,768 elements; cold starts beside for the small meshes.
     let meshes: Vec<usize> = (5..=15).map(|k| 1 << k).collect();
-    let timoshenko = BeamStudies::new(scene("timoshenko-a").unwrap());
+    let timoshenko = RegistryStudies::of("timoshenko-a").unwrap();
     let rows = studies::iteration_counts(&timoshenko, "p2-p2-p0", &meshes, 512);
     for (n, nested, cold) in &rows {
         println!("{n:>6} elements: nested {nested:?}, cold {cold:?}");
@@ -264,7 +244,7 @@ fn euler_bernoulli_iterations_are_flat_until_double_precision_runs_out() {
     // Hermite bending matrices have κ ~ h⁻⁴, past 1/ε near 10⁴ elements: up to 8192 the
     // nested Newton count stays flat; beyond it the solve reports failure (never a wrong answer).
     let meshes: Vec<usize> = (5..=13).map(|k| 1 << k).collect();
-    let flat = BeamStudies::new(scene("bernoulli-flat").unwrap());
+    let flat = RegistryStudies::of("bernoulli-flat").unwrap();
     for (n, nested, _) in studies::iteration_counts(&flat, "hermite-p0", &meshes, 0) {
         println!("{n:>6} elements: nested {nested:?}");
         let nested = nested.unwrap_or_else(|| panic!("failed at {n}"));
@@ -275,7 +255,7 @@ fn euler_bernoulli_iterations_are_flat_until_double_precision_runs_out() {
 #[test]
 fn plain_and_stabilized_multipliers_where_methods_fail() {
     let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
-    let flat = BeamStudies::new(scene("bernoulli-flat").unwrap());
+    let flat = RegistryStudies::of("bernoulli-flat").unwrap();
     let profile = |alpha| studies::multiplier_profile(&flat, "hermite-p0", 256, alpha).unwrap();
     let (plain, weak, strong) = (profile(Some(0.0)), profile(Some(1e-2)), profile(Some(1.0)));
     let contact = exact.contact_set[0];
@@ -294,14 +274,8 @@ fn plain_and_stabilized_multipliers_where_methods_fail() {
     assert!(studies::zero_holes(&plain) > 0);
     assert_eq!(studies::zero_holes(&strong), 0);
     // The conditioning of the LCP matrix: plain worse than stabilized, and growing as h → 0.
-    let mut r = request("timoshenko-a", 32, 100.0);
-    let stabilized = lcp_condition(&r).unwrap();
-    r.alpha = Some(0.0);
-    r.plain = true;
-    r.solver = VariationalSolver::Clarabel;
-    let plain_32 = lcp_condition(&r).unwrap();
-    r.elements = 64;
-    let plain_64 = lcp_condition(&r).unwrap();
+    let stabilized = lcp_condition(32, 1.0);
+    let (plain_32, plain_64) = (lcp_condition(32, 0.0), lcp_condition(64, 0.0));
     assert!(plain_32 > 100.0 * stabilized, "{plain_32} vs {stabilized}");
     assert!(plain_64 > 4.0 * plain_32);
 }
@@ -309,18 +283,27 @@ fn plain_and_stabilized_multipliers_where_methods_fail() {
 #[test]
 fn an_overlarge_alpha_shifts_the_contact_set() {
     let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
-    let flat = BeamStudies::new(scene("bernoulli-flat").unwrap());
-    let (rows, c_i) = studies::alpha_sweep(&flat, "hermite-p0", 128, &[1e-2, 1e3]).unwrap();
-    assert_eq!(c_i, 0.0, "w'''' vanishes on each Hermite cubic");
-    let rows: Vec<_> = rows.into_iter().map(|r| r.result.unwrap()).collect();
-    let h = 1.0 / 128.0;
-    assert!((rows[0].contact - exact.contact_set[0][0]).abs() < 2.0 * h);
-    assert!(
-        (rows[1].contact - exact.contact_set[0][0]).abs() > 5.0 * h,
-        "{}",
-        rows[1].contact
+    let with = |alpha: f64| {
+        let r = Settings {
+            alpha: Some(alpha),
+            ..settings(128, 100.0)
+        };
+        solve("bernoulli-flat", &r).unwrap().report
+    };
+    let (fitting, overlarge) = (with(1e-2), with(1e3));
+    assert_eq!(
+        fitting.solve.inverse_constant, 0.0,
+        "w'''' vanishes on each Hermite cubic"
     );
-    assert!(rows[1].error_l2.unwrap() > 10.0 * rows[0].error_l2.unwrap());
+    let h = 1.0 / 128.0;
+    let edge = |r: &Report| contact_set(r)[0][0];
+    assert!((edge(&fitting) - exact.contact_set[0][0]).abs() < 2.0 * h);
+    assert!(
+        (edge(&overlarge) - exact.contact_set[0][0]).abs() > 5.0 * h,
+        "{}",
+        edge(&overlarge)
+    );
+    assert!(overlarge.solve.error_l2.unwrap() > 10.0 * fitting.solve.error_l2.unwrap());
 }
 
 #[test]
@@ -337,32 +320,44 @@ fn bad_input_is_a_clear_error() {
     // an obstacle that contradicts the clamped ends
     let mut infeasible = scene("bernoulli-flat").unwrap();
     infeasible.obstacle = Obstacle::Constant(0.1);
-    let e = solve(&Request::new(infeasible)).unwrap_err().to_string();
+    let e = report_of(&infeasible, &Settings::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("infeasible"), "{e}");
     // NaN data
     let mut nan = scene("timoshenko-a").unwrap();
     nan.obstacle = Obstacle::Constant(f64::NAN);
-    assert!(solve(&Request::new(nan))
+    let e = report_of(&nan, &Settings::default())
         .unwrap_err()
-        .to_string()
-        .contains("not finite"));
-    let mut r = request("timoshenko-a", 64, f64::NAN);
-    assert!(solve(&r).unwrap_err().to_string().contains("load"));
-    // α ≤ 0, α not finite, thickness ≤ 0
-    for alpha in [0.0, -1.0, f64::INFINITY] {
-        r = request("bernoulli-a", 64, 40.0);
-        r.alpha = Some(alpha);
-        let e = solve(&r).unwrap_err().to_string();
+        .to_string();
+    assert!(e.contains("not finite") || e.contains("NaN"), "{e}");
+    let e = report("timoshenko-a", 64, f64::NAN)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("load") || e.contains("q ="), "{e}");
+    // α < 0, α not finite, thickness ≤ 0
+    for alpha in [-1.0, f64::INFINITY] {
+        let r = Settings {
+            alpha: Some(alpha),
+            ..settings(64, 40.0)
+        };
+        let e = solve("bernoulli-a", &r).unwrap_err().to_string();
         assert!(e.contains("α"), "{e}");
     }
-    r = request("timoshenko-a", 64, 40.0);
-    r.thickness = Some(0.0);
-    assert!(solve(&r).unwrap_err().to_string().contains("thickness"));
+    let r = Settings {
+        parameters: beams::thickness(0.0),
+        ..settings(64, 40.0)
+    };
+    let e = solve("timoshenko-a", &r).unwrap_err().to_string();
+    assert!(e.contains("thickness"), "{e}");
     // a pair of the other beam theory
-    assert!(Pair::parse("hermite-p0", Beam::Timoshenko).is_err());
+    let r = Settings {
+        pair: Some("hermite-p0".into()),
+        ..settings(64, 40.0)
+    };
+    assert!(solve("timoshenko-a", &r).is_err());
     // zero elements
-    r = request("timoshenko-a", 0, 40.0);
-    assert!(solve(&r).is_err());
+    assert!(report("timoshenko-a", 0, 40.0).is_err());
 }
 
 #[test]
@@ -371,7 +366,13 @@ fn saddle_point_active_set_and_multiplier_recovery_agree_with_eliminated_newton(
         primal_dual_active_set, recover_multiplier, semismooth_newton, NewtonOptions,
     };
     for name in ["timoshenko-a", "bernoulli-flat"] {
-        let (d, _) = fem_forms::beams::discretize(&request(name, 128, 100.0)).unwrap();
+        let pair = if name == "bernoulli-flat" {
+            "hermite-p0"
+        } else {
+            "p2-p2-p0"
+        };
+        let alpha = if name == "bernoulli-flat" { 1e-2 } else { 1.0 };
+        let d = beams::discretize(name, pair, 128, 100.0, alpha).unwrap();
         let options = NewtonOptions::default();
         let newton = semismooth_newton(&d.lcp, None, options).unwrap();
         let saddle = primal_dual_active_set(&d.lcp, None, options).unwrap();
@@ -402,9 +403,9 @@ fn saddle_point_active_set_and_multiplier_recovery_agree_with_eliminated_newton(
 
 #[test]
 fn multiplier_noise_is_reported_where_the_eliminated_multiplier_loses_its_digits() {
-    let (coarse, _) = solve(&request("timoshenko-a", 1024, 100.0)).unwrap();
+    let coarse = report("timoshenko-a", 1024, 100.0).unwrap().solve;
     assert!(coarse.warnings.is_empty() && coarse.multiplier_noise < 1e-6);
-    let (fine, _) = solve(&request("timoshenko-a", 16384, 100.0)).unwrap();
+    let fine = report("timoshenko-a", 16384, 100.0).unwrap().solve;
     assert!(
         fine.multiplier_noise > 1e-6 && !fine.warnings.is_empty(),
         "{:?}",
@@ -425,8 +426,9 @@ fn an_inaccurate_multiplier_never_goes_unreported() {
     // and a warning, and a solve that cannot be trusted must fail, not return λ = 0.
     let exact = exact_solution(&scene("bernoulli-flat").unwrap(), 100.0, 0.0).unwrap();
     for n in [1024, 2048, 4096, 8192, 16384] {
-        match solve(&request("bernoulli-flat", n, 100.0)) {
-            Ok((r, _)) => {
+        match report("bernoulli-flat", n, 100.0) {
+            Ok(r) => {
+                let r = r.solve;
                 let error = ((r.total_contact_force - exact.total_contact_force)
                     / exact.total_contact_force)
                     .abs();
@@ -454,17 +456,18 @@ fn an_inaccurate_multiplier_never_goes_unreported() {
 /// gives 12 for `h²(u'', v'')` on P2 (fem-runtime's tests), so 0 is measured, not assumed.
 #[test]
 fn beam_pairs_have_a_vanishing_inverse_constant() {
-    for pair in Pair::ALL {
-        let s = SCENES.into_iter().find(|s| s.beam == pair.beam()).unwrap();
-        let mut request = Request::new(s);
-        request.elements = 16;
-        request.pair = Some(pair);
-        let (report, _) = solve(&request).unwrap();
-        assert!(
-            report.inverse_constant.abs() < 1e-12,
-            "{pair:?}: C_I = {}",
-            report.inverse_constant
-        );
+    for (name, pair) in [
+        ("bernoulli-a", "hermite-p0"),
+        ("timoshenko-a", "p2-p2-p0"),
+        ("timoshenko-a", "p1-p1-p0-reduced"),
+        ("timoshenko-a", "p1-p1-p0-full"),
+    ] {
+        let r = Settings {
+            pair: Some(pair.into()),
+            ..settings(16, 1.0)
+        };
+        let c_i = solve(name, &r).unwrap().report.solve.inverse_constant;
+        assert!(c_i.abs() < 1e-12, "{pair}: C_I = {c_i}");
     }
 }
 
@@ -473,12 +476,7 @@ fn beam_pairs_have_a_vanishing_inverse_constant() {
 /// solution is the mirror of the flat obstacle's, and its errors are bernoulli-flat's.
 #[test]
 fn bernoulli_b_is_measured_against_the_mirrored_exact_solution() {
-    let run = |name: &str| {
-        let mut r = Request::new(scene(name).unwrap());
-        r.load = 100.0;
-        r.elements = 128;
-        solve(&r).unwrap().0
-    };
+    let run = |name: &str| report(name, 128, 100.0).unwrap().solve;
     let (up, down) = (run("bernoulli-b"), run("bernoulli-flat"));
     let (e_up, e_down) = (up.error_l2.unwrap(), down.error_l2.unwrap());
     assert!(
@@ -488,12 +486,13 @@ fn bernoulli_b_is_measured_against_the_mirrored_exact_solution() {
     assert!((up.total_contact_force - down.total_contact_force).abs() < 1e-9);
 }
 
-/// Hand-coded for the beams: the condition number of the LCP matrix `M = B A⁻¹ Bᵀ + C` of a request: the matrix the
+/// Hand-coded for the beams: the condition number of the LCP matrix `M = B A⁻¹ Bᵀ + C`
+/// of timoshenko-a (P2–P2–P0, q = 100) on `elements` elements with `alpha`: the matrix the
 /// multiplier sees once U is eliminated. Its smallest eigenvalue is the discrete inf-sup
 /// constant squared (in the Euclidean norm of the P0 coefficients); `C = αΣh⁴(λ, μ)`
 /// lifts it for the stabilized method.
-fn lcp_condition(request: &fem_forms::beams::Request) -> fem_forms::Result<f64> {
-    let (d, _) = fem_forms::beams::discretize(request)?;
+fn lcp_condition(elements: usize, alpha: f64) -> f64 {
+    let d = beams::discretize("timoshenko-a", "p2-p2-p0", elements, 100.0, alpha).unwrap();
     let lcp = &d.lcp;
     let (n, m) = (lcp.n(), lcp.m());
     let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
@@ -513,20 +512,17 @@ fn lcp_condition(request: &fem_forms::beams::Request) -> fem_forms::Result<f64> 
             bt[(j, k)] = v;
         }
     }
-    let cholesky = a
-        .cholesky()
-        .ok_or_else(|| fem_forms::Error::LinearSolve("A is not positive definite".into()))?;
+    let cholesky = a.cholesky().expect("A is positive definite");
     let a_inv_bt = cholesky.solve(&bt);
     let mut schur = bt.transpose() * a_inv_bt;
     for k in 0..m {
         schur[(k, k)] += lcp.c[k];
     }
     let eigenvalues = nalgebra::SymmetricEigen::new(schur).eigenvalues;
-    let largest = eigenvalues.max();
-    let smallest = eigenvalues.min();
-    Ok(if smallest > 0.0 {
+    let (largest, smallest) = (eigenvalues.max(), eigenvalues.min());
+    if smallest > 0.0 {
         largest / smallest
     } else {
         f64::INFINITY
-    })
+    }
 }

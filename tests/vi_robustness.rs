@@ -518,10 +518,15 @@ fn no_multiplier_noise_without_a_multiplier() {
         pressed.multiplier_noise
     );
     // the beams go through the same estimate: no warning at q = 0
-    let mut request =
-        fem_forms::beams::Request::new(fem_forms::models::scenes::scene("bernoulli-a").unwrap());
-    request.load = 0.0;
-    let (report, _) = fem_forms::beams::solve(&request).unwrap();
+    let scene = fem_forms::models::families::scene("bernoulli-a").unwrap();
+    let settings = fem_forms::models::report::Settings {
+        load: Some(0.0),
+        ..Default::default()
+    };
+    let report = fem_forms::models::families::solve(&scene, &settings)
+        .unwrap()
+        .report
+        .solve;
     assert_eq!(report.multiplier_noise, 0.0);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }

@@ -128,7 +128,7 @@ fn studies(name: &str) -> Vec<&'static str> {
 }
 
 /// The scene of one of the beam data sets of [`crate::scenes`].
-fn beam_scene(old: &crate::scenes::Scene) -> Scene {
+pub fn beam_scene(old: &crate::scenes::Scene) -> Scene {
     let old = *old;
     let obstacle = old.obstacle;
     let sign = old.load_sign;
