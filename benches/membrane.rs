@@ -15,10 +15,12 @@
 //! `cargo bench --bench membrane` (add `-- --quick` for smaller meshes).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+#[path = "../tests/common/membranes.rs"]
+mod membranes;
+
 use faer::sparse::Triplet;
 use fem_forms::lcp::cholesky::{Cholesky, LuSolver};
 use fem_forms::lcp::Lcp;
-use fem_forms::membranes::{self, MembranePair, MembraneRequest};
 use fem_forms::models::membrane::{membrane_p1, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene};
 use fem_forms::obstacle::triangle::{solve_obstacle_on_triangles, TriangleObstacleSolution};
@@ -191,12 +193,12 @@ fn vi_solve_once<M: Model>(
     // the solver's own
     let mut meshes: Vec<TriangleMesh> = sizes[..sizes.len() - 1]
         .iter()
-        .map(|&k| membranes::scene_mesh(scene, k, Diagonal::Right).unwrap())
+        .map(|&k| membranes::mesh(scene, k))
         .collect();
     meshes.push(mesh.clone());
     let options = ObstacleOptions {
         pipelined,
-        ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+        ..membranes::options(VariationalSolver::SemismoothNewton)
     };
     let solution = solve_obstacle_on_triangles::<M>(&meshes, coefficients, options).unwrap();
     (solution, clock.elapsed().as_secs_f64())
@@ -214,11 +216,11 @@ fn cholesky_once(a: &SparseMatrix) -> f64 {
 /// The complete VI solve against one Cholesky of the final `A_α`, all measured in this
 /// run after one untimed warm-up solve (the allocator then holds the memory, for the
 /// solve as for the baseline), medians of `rounds` interleaved repetitions.
-fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize], rounds: usize, with_lu: bool) {
+fn vi_solve<M: Model>(pair: &str, sizes: &[usize], rounds: usize, with_lu: bool) {
     let scene = membrane_scene("membrane-radial").unwrap();
     println!(
         "\n{} on membrane-radial: complete VI solve (nested from N = 4, assembly included) vs one Cholesky (analysis + factorization + solve) of the final A_α; medians of {rounds}",
-        pair.name()
+        pair
     );
     println!(
         "{:>5} {:>9} {:>9} {:>16} {:>8} {:>10} {:>11} {:>6} {:>11} {:>6} {:>9} {:>6}",
@@ -236,13 +238,9 @@ fn vi_solve<M: Model>(pair: MembranePair, sizes: &[usize], rounds: usize, with_l
         "ratio"
     );
     for &n in sizes {
-        let mut request = MembraneRequest::new(scene.clone());
-        request.pair = pair;
-        request.mesh_size = n;
-        let mesh = membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap();
-        let (alpha, _) = membranes::alpha_of(&request, &mesh).unwrap();
-        let data = membranes::SceneData::new(&scene, None);
-        let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+        let mesh = membranes::mesh(&scene, n);
+        let data = membranes::SceneData::new(&scene);
+        let coefficients = data.coefficients::<M>(membranes::alpha::<M>(&mesh));
         let (warm, _) = vi_solve_once::<M>(&scene, &coefficients, &mesh, n, true);
         let a = warm.discretization.lcp.a.clone();
         let (mut linear, mut pipelined, mut sequential) = (Vec::new(), Vec::new(), Vec::new());
@@ -324,10 +322,7 @@ fn main() {
     assembly(assembly_n, if quick { 3 } else { 9 });
     let rounds = if quick { 3 } else { 5 };
     vi_solve::<fem_forms::models::membrane::membrane_p1_p0::Model>(
-        MembranePair::P1P0,
-        &p1_sizes,
-        rounds,
-        !quick,
+        "p1-p0", &p1_sizes, rounds, !quick,
     );
-    vi_solve::<membrane_p2_p0::Model>(MembranePair::P2P0, &p2_sizes, rounds, !quick);
+    vi_solve::<membrane_p2_p0::Model>("p2-p0", &p2_sizes, rounds, !quick);
 }

@@ -16,8 +16,10 @@
 //! for the parallel kernels only).
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+#[path = "../tests/common/membranes.rs"]
+mod membranes;
+
 use fem_forms::lcp::cholesky::Cholesky;
-use fem_forms::membranes;
 use fem_forms::models::membrane::{membrane_p1, membrane_p1_p0, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::membrane_scene;
 use fem_forms::multigrid::{
@@ -64,9 +66,9 @@ fn primal_level<M: Model>(d: &Discretization<TriangleMesh>) -> (SystemDofs, Redu
 
 fn run<M: Model>(name: &str, alpha: f64, sizes: &[usize], rounds: usize) {
     let scene = membrane_scene("membrane-radial").unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
-    let solve_options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let data = membranes::SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(alpha);
+    let solve_options = membranes::options(VariationalSolver::SemismoothNewton);
     println!("{name}, α = {alpha:.4e}: seconds (median of {rounds})");
     println!(
         "| N | unknowns | Cholesky analysis | factor + solve | MG setup | MG update (all active) | V 1e-6 (its) | V 1e-10 (its) | W 1e-6 (its) | W 1e-10 (its) | setup + W 1e-6 / factor + solve |"
@@ -76,7 +78,7 @@ fn run<M: Model>(name: &str, alpha: f64, sizes: &[usize], rounds: usize) {
         let mut meshes = Vec::new();
         let mut n = 4;
         while n <= size {
-            meshes.push(membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap());
+            meshes.push(membranes::mesh(&scene, n));
             n *= 2;
         }
         let solution =

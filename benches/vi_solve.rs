@@ -7,8 +7,11 @@
 //! Newton iterations on the final mesh.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::beams::{discretize, solve, Request};
+#[path = "../tests/common/beams.rs"]
+mod beams;
+
 use fem_forms::lcp::cholesky::Cholesky;
+use fem_forms::models::report::Settings;
 use fem_forms::models::scenes::scene;
 use std::time::Instant;
 
@@ -34,20 +37,32 @@ fn main() {
             "elements", "unknowns", "VI solve s", "factor+solve", "ratio", "iterations", "levels"
         );
         for &n in &sizes {
-            let mut request = Request::new(scene(name).unwrap());
-            request.elements = n;
-            request.load = 100.0;
-            if thickness > 0.0 {
-                request.thickness = Some(thickness);
-            }
-            let (report, _) = match solve(&request) {
-                Ok(r) => r,
+            let (pair, alpha) = if thickness > 0.0 {
+                ("p2-p2-p0", 1.0)
+            } else {
+                ("hermite-p0", 1e-2)
+            };
+            let request = Settings {
+                parameters: if thickness > 0.0 {
+                    beams::thickness(thickness)
+                } else {
+                    Vec::new()
+                },
+                alpha: Some(alpha),
+                ..beams::settings(n, 100.0)
+            };
+            let report = match beams::solve(name, &request) {
+                Ok(outcome) => outcome.report.solve,
                 Err(e) => {
                     println!("{n:>9}  failed: {e}");
                     continue;
                 }
             };
-            let (d, _) = discretize(&request).unwrap();
+            let mut data = scene(name).unwrap();
+            if thickness > 0.0 {
+                data.thickness = thickness;
+            }
+            let d = beams::discretize_scene(&data, pair, n, 100.0, alpha).unwrap();
             let start = Instant::now();
             let pattern = d.lcp.a.symbolic().to_owned().unwrap();
             let factor = Cholesky::analyse(&pattern)

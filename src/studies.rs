@@ -2,8 +2,8 @@
 //! family implements [`StudyScene`]: convergence against the exact solution, stability of
 //! the plain against the stabilized pairs (the family's measure of the multiplier
 //! problem, and multiplier profiles), the α sweep, work against precision, and Newton
-//! iterations with nested iteration and from a cold start. `locking` (t → 0) belongs to
-//! the Timoshenko beams ([`crate::beam_studies`]) and uses the same CSV and chart output.
+//! iterations with nested iteration and from a cold start. `locking` (t → 0) is
+//! [`crate::locking`], once for every family with a thickness.
 //!
 //! A study of scene `s` prints a table and writes `out/<s>-<study>.svg` and `.csv`; the
 //! functions behind each (the tests run small versions) return their rows.

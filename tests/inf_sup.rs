@@ -5,8 +5,10 @@
 //! the two agree on the radial membrane, and the identities of the method hold (the
 //! stabilized γ₁ ≥ α; the plain P1–P0 pair has a kernel).
 
+#[path = "common/membranes.rs"]
+mod membranes;
+
 use fem_forms::lcp::cholesky::Cholesky;
-use fem_forms::membranes::{self, alpha_of, scene_mesh, MembraneRequest};
 use fem_forms::models::families;
 use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene};
@@ -15,7 +17,7 @@ use fem_forms::obstacle::triangle::discretize_on_part;
 use fem_forms::obstacle::Discretization;
 use fem_forms::registry_studies::RegistryStudies;
 use fem_forms::studies::StudyScene;
-use fem_forms::{Diagonal, Error, Model, Result, TriangleMesh};
+use fem_forms::{DirichletPart, Error, Model, Result, TriangleMesh};
 use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Hand-coded, independent of the one measure: discrete inf-sup constants of the
@@ -23,10 +25,10 @@ use nalgebra::{DMatrix, SymmetricEigen};
 /// h-weighted norm `‖μ‖²_h = Σ_T h_T² ‖μ‖²_T`, the smallest two (√ of them are the
 /// inf-sup constants; the stabilized method has γ ≥ α by construction).
 fn inf_sup<M: Model>(scene: &MembraneScene, mesh: &TriangleMesh, alpha: f64) -> Result<[f64; 2]> {
-    let load = scene.load_magnitude(None).map_err(Error::Input)?;
-    let data = membranes::SceneData::new(scene, load);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha)?;
-    let part = membranes::dirichlet_part(scene, mesh, "the study's mesh")?;
+    let data = membranes::SceneData::new(scene);
+    let coefficients = data.coefficients::<M>(alpha);
+    // u = g on the whole boundary (the radial scene's)
+    let part = DirichletPart::All;
     let (bilinear, linear) = system_forms::<M>()?;
     let d: Discretization<TriangleMesh> =
         discretize_on_part::<M>(mesh, &coefficients, &part, bilinear, linear)?;
@@ -86,20 +88,24 @@ fn the_one_inf_sup_measure_agrees_with_a_hand_coded_one() {
     for pair in ["p1-p0", "p2-p0"] {
         for n in [4, 8] {
             let a = one.stability(pair, n).unwrap();
-            let mesh = scene_mesh(&scene, n, Diagonal::Right).unwrap();
-            let mut request = MembraneRequest::new(scene.clone());
-            request.pair = membranes::MembranePair::parse(pair).unwrap();
-            request.mesh_size = n;
-            let (alpha, _) = alpha_of(&request, &mesh).unwrap();
-            let (plain, stabilized) = match pair {
-                "p1-p0" => (
-                    inf_sup::<membrane_p1_p0::Model>(&scene, &mesh, 0.0).unwrap(),
-                    inf_sup::<membrane_p1_p0::Model>(&scene, &mesh, alpha).unwrap(),
-                ),
-                _ => (
-                    inf_sup::<membrane_p2_p0::Model>(&scene, &mesh, 0.0).unwrap(),
-                    inf_sup::<membrane_p2_p0::Model>(&scene, &mesh, alpha).unwrap(),
-                ),
+            let mesh = membranes::mesh(&scene, n);
+            let (alpha, plain, stabilized) = match pair {
+                "p1-p0" => {
+                    let alpha = membranes::alpha::<membrane_p1_p0::Model>(&mesh);
+                    (
+                        alpha,
+                        inf_sup::<membrane_p1_p0::Model>(&scene, &mesh, 0.0).unwrap(),
+                        inf_sup::<membrane_p1_p0::Model>(&scene, &mesh, alpha).unwrap(),
+                    )
+                }
+                _ => {
+                    let alpha = membranes::alpha::<membrane_p2_p0::Model>(&mesh);
+                    (
+                        alpha,
+                        inf_sup::<membrane_p2_p0::Model>(&scene, &mesh, 0.0).unwrap(),
+                        inf_sup::<membrane_p2_p0::Model>(&scene, &mesh, alpha).unwrap(),
+                    )
+                }
             };
             assert!((a.alpha - alpha).abs() <= 1e-12 * alpha, "{pair} {n}");
             for (x, y) in a.stabilized.iter().zip(&stabilized) {

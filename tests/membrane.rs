@@ -3,14 +3,18 @@
 //! stabilized solve against the QP solver, and bad input.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::membranes::{
-    self, element_inverse_constant, MembranePair, MembraneReport, MembraneRequest,
-};
+#[path = "common/membranes.rs"]
+mod membranes;
+
 use fem_forms::models::data::Data;
 use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0, membrane_p2_p1disc};
-use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene, MEMBRANE_FLAT};
+use fem_forms::models::membrane_scenes::{membrane_scene, Domain, MembraneScene, MEMBRANE_FLAT};
+use fem_forms::models::report::{Report, Settings};
 use fem_forms::obstacle::VariationalSolver;
+use fem_forms::registry_studies::RegistryStudies;
 use fem_forms::studies::rates;
+use fem_forms::Model;
+use membranes::{options, settings, SceneData};
 
 fn radial() -> MembraneScene {
     membrane_scene("membrane-radial").unwrap()
@@ -19,10 +23,12 @@ fn radial() -> MembraneScene {
 /// The radial scene's meshes of `sizes` (N × N × 2 triangles each).
 fn radial_meshes(sizes: &[usize]) -> Vec<fem_forms::TriangleMesh> {
     let scene = radial();
-    sizes
-        .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, fem_forms::Diagonal::Right).unwrap())
-        .collect()
+    sizes.iter().map(|&n| membranes::mesh(&scene, n)).collect()
+}
+
+/// `C_I` of one element of model `M` (the runtime's, from the forms `S` and `a`).
+fn element_inverse_constant<M: Model>(x: &[f64; 6]) -> fem_forms::Result<f64> {
+    fem_forms::stabilization::element_inverse_constant::<M>(x, &vec![0.0; M::PARAMS.len()])
 }
 
 /// `max |a − b|`.
@@ -46,11 +52,8 @@ fn assert_same_solution(
     );
 }
 
-fn solve(scene: MembraneScene, pair: MembranePair, n: usize) -> MembraneReport {
-    let mut request = MembraneRequest::new(scene);
-    request.pair = pair;
-    request.mesh_size = n;
-    membranes::solve(&request).unwrap().0
+fn solve(scene: MembraneScene, pair: &str, n: usize) -> Report {
+    membranes::solve(&scene, &settings(pair, n)).unwrap().report
 }
 
 /// docs/mathematics.md §1 measured `C_I` of the P2 membrane element: 48 on the equilateral
@@ -86,23 +89,26 @@ fn inverse_constants_match_the_measured_ones() {
 fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
     let scene = MEMBRANE_FLAT;
     let runs = [
-        (MembranePair::P1P0, VariationalSolver::SemismoothNewton),
-        (MembranePair::P2P0, VariationalSolver::SemismoothNewton),
-        (MembranePair::P1P0, VariationalSolver::Clarabel),
-        (MembranePair::P2P0, VariationalSolver::Clarabel),
-        (MembranePair::P1Nodal, VariationalSolver::SemismoothNewton),
+        ("p1-p0", VariationalSolver::SemismoothNewton),
+        ("p2-p0", VariationalSolver::SemismoothNewton),
+        ("p1-p0", VariationalSolver::Clarabel),
+        ("p2-p0", VariationalSolver::Clarabel),
+        ("p1-nodal", VariationalSolver::SemismoothNewton),
     ];
     for (pair, solver) in runs {
-        let mut request = MembraneRequest::new(scene.clone());
-        request.pair = pair;
-        request.solver = solver;
-        request.mesh_size = 8;
-        let (report, fields) = membranes::solve(&request).unwrap();
-        let largest_u = fields.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let request = Settings {
+            solver,
+            ..settings(pair, 8)
+        };
+        let outcome = membranes::solve(&scene, &request).unwrap();
+        let report = &outcome.report.solve;
+        let largest_u = membranes::u(&outcome)
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
         assert!(largest_u < 1e-8, "{pair:?} {solver:?}: u = {largest_u}");
         // the nodal method has forces at the free nodes only: their area share is
         // 16·(N−1)²/N²
-        let expected = if pair == MembranePair::P1Nodal {
+        let expected = if pair == "p1-nodal" {
             48.0 * 49.0 / 64.0
         } else {
             48.0
@@ -112,11 +118,14 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
             "{pair:?}: ∫λ = {}",
             report.total_contact_force
         );
-        assert!((report.contact_area - 16.0).abs() < 1e-9, "{pair:?}");
+        assert!(
+            (report.contact_area.unwrap() - 16.0).abs() < 1e-9,
+            "{pair:?}"
+        );
         // the scene's exact solution gives the errors too
         assert!(report.error_h1.unwrap() < 1e-8, "{pair:?} {solver:?}");
-        if pair != MembranePair::P1Nodal {
-            for l in &fields.lambda {
+        if pair != "p1-nodal" {
+            for l in membranes::lambda(&outcome) {
                 assert!((l - 3.0).abs() < 1e-6, "{pair:?} {solver:?}: λ = {l}");
             }
         }
@@ -130,15 +139,14 @@ fn radial_convergence_rates() {
     let sizes = [8, 16, 32, 64];
     let expected = [
         // (pair, H¹ rate range, L² rate at least, multiplier rate at least)
-        (MembranePair::P1P0, (0.85, 1.25), 1.6, Some(0.9)),
-        (MembranePair::P2P0, (1.3, 2.0), 2.0, Some(1.2)),
-        (MembranePair::P1Nodal, (0.85, 1.25), 1.6, None),
+        ("p1-p0", (0.85, 1.25), 1.6, Some(0.9)),
+        ("p2-p0", (1.3, 2.0), 2.0, Some(1.2)),
+        ("p1-nodal", (0.85, 1.25), 1.6, None),
     ];
     for (pair, (low, high), l2_rate, multiplier_rate) in expected {
-        let reports: Vec<MembraneReport> =
-            sizes.iter().map(|&n| solve(radial(), pair, n)).collect();
-        let h1: Vec<f64> = reports.iter().map(|r| r.error_h1.unwrap()).collect();
-        let l2: Vec<f64> = reports.iter().map(|r| r.error_l2.unwrap()).collect();
+        let reports: Vec<Report> = sizes.iter().map(|&n| solve(radial(), pair, n)).collect();
+        let h1: Vec<f64> = reports.iter().map(|r| r.solve.error_h1.unwrap()).collect();
+        let l2: Vec<f64> = reports.iter().map(|r| r.solve.error_l2.unwrap()).collect();
         let r_h1 = rates(&h1);
         let r_l2 = rates(&l2);
         let last = |r: &[f64]| r[r.len() - 2..].iter().sum::<f64>() / 2.0;
@@ -151,21 +159,21 @@ fn radial_convergence_rates() {
         if let Some(m) = multiplier_rate {
             let e: Vec<f64> = reports
                 .iter()
-                .map(|r| r.error_multiplier.unwrap())
+                .map(|r| r.solve.error_multiplier.unwrap())
                 .collect();
             assert!(last(&rates(&e)) >= m, "{pair:?}: λ rates {:?}", rates(&e));
         }
         // the contact force converges to 2πA
         let force: Vec<f64> = reports
             .iter()
-            .map(|r| (r.total_contact_force - r.exact_contact_force.unwrap()).abs())
+            .map(|r| (r.solve.total_contact_force - r.exact_contact_force.unwrap()).abs())
             .collect();
         assert!(
             force[3] < force[0] && force[3] < 2e-2 * 4.27,
             "{pair:?}: {force:?}"
         );
         for r in &reports {
-            assert!(r.complementarity_residual < 1e-10, "{pair:?}");
+            assert!(r.solve.complementarity_residual < 1e-10, "{pair:?}");
         }
     }
 }
@@ -174,17 +182,17 @@ fn radial_convergence_rates() {
 /// interior-point method: the same discrete solution.
 #[test]
 fn newton_and_the_qp_solver_agree() {
-    let mut request = MembraneRequest::new(radial());
-    request.mesh_size = 16;
-    let (newton, a) = membranes::solve(&request).unwrap();
-    request.solver = VariationalSolver::Clarabel;
-    let (qp, b) = membranes::solve(&request).unwrap();
-    let difference =
-        a.u.iter()
-            .zip(&b.u)
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let request = settings("p2-p0", 16);
+    let newton = membranes::solve(&radial(), &request).unwrap();
+    let qp = Settings {
+        solver: VariationalSolver::Clarabel,
+        ..request
+    };
+    let qp = membranes::solve(&radial(), &qp).unwrap();
+    let difference = max_difference(membranes::u(&newton), membranes::u(&qp));
     assert!(difference < 1e-7, "max |u_newton − u_qp| = {difference}");
-    assert!((newton.total_contact_force - qp.total_contact_force).abs() < 1e-6);
+    let force = |o: &fem_forms::models::report::Outcome| o.report.solve.total_contact_force;
+    assert!((force(&newton) - force(&qp)).abs() < 1e-6);
 }
 
 fn zero(_: &[f64]) -> f64 {
@@ -205,13 +213,13 @@ fn not_a_number(x: &[f64]) -> f64 {
 
 #[test]
 fn bad_input_is_a_clear_error() {
+    let error_of = |scene: &MembraneScene, request: &Settings| {
+        membranes::solve(scene, request).err().unwrap().to_string()
+    };
     let mut scene = radial();
     scene.obstacle = Data::Fn(above);
     scene.boundary = Data::Fn(zero);
-    let error = membranes::solve(&MembraneRequest::new(scene))
-        .err()
-        .unwrap()
-        .to_string();
+    let error = error_of(&scene, &Settings::default());
     assert!(
         error.contains("infeasible") && error.contains("requires u ≥ ψ"),
         "{error}"
@@ -219,75 +227,57 @@ fn bad_input_is_a_clear_error() {
 
     let mut scene = radial();
     scene.load = Data::Fn(not_a_number);
-    let error = membranes::solve(&MembraneRequest::new(scene))
-        .err()
-        .unwrap()
-        .to_string();
+    let error = error_of(&scene, &Settings::default());
     assert!(
         error.contains("data `f`") && error.contains("is NaN at ("),
         "{error}"
     );
 
-    let mut request = MembraneRequest::new(radial());
-    request.mesh_size = 0;
-    assert!(membranes::solve(&request)
-        .err()
-        .unwrap()
-        .to_string()
-        .contains("--mesh-size 0"));
-    // no free node (the L-shape at N = 2): no contact force, printed as 0, not −0
-    let mut empty = MembraneRequest::new(membrane_scene("membrane-lshape").unwrap());
-    empty.pair = MembranePair::P1Nodal;
-    empty.mesh_size = 2;
-    let force = membranes::solve(&empty).unwrap().0.total_contact_force;
-    assert!(force == 0.0 && force.is_sign_positive(), "{force}");
-    // the multiplier space spelled in full names the same pair
-    assert_eq!(
-        MembranePair::parse("p2-p1disc").unwrap(),
-        MembranePair::P2P1Disc
-    );
-    assert!(MembranePair::parse("p2-p1")
-        .unwrap_err()
-        .to_string()
-        .contains("p2-p1d"));
-    // beyond the range: the range is named, not the memory it would take
-    request.mesh_size = 4097;
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    let error = error_of(&radial(), &settings("p2-p0", 0));
     assert!(
-        error.contains("--mesh-size 4097 is out of range (2 to 4096)"),
+        error.contains("mesh size 0") || error.contains("--mesh-size 0"),
         "{error}"
     );
-    request.mesh_size = 4096;
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    // no free node (the L-shape at N = 2): no contact force, printed as 0, not −0
+    let lshape = membrane_scene("membrane-lshape").unwrap();
+    let empty = membranes::solve(&lshape, &settings("p1-nodal", 2)).unwrap();
+    let force = empty.report.solve.total_contact_force;
+    assert!(force == 0.0 && force.is_sign_positive(), "{force}");
+    // the multiplier space spelled in full names the same pair
+    let registry = fem_forms::models::families::scene("membrane-radial").unwrap();
+    let pair_of = |name| fem_forms::models::families::pair_of(&registry, Some(name));
+    assert_eq!(pair_of("p2-p1disc").unwrap().name, "p2-p1d");
+    assert!(pair_of("p2-p1").unwrap_err().to_string().contains("p2-p1d"));
+    // beyond the memory the machine allows: refused before any work
+    let error = error_of(&radial(), &settings("p2-p0", 4096));
     assert!(error.contains("GB of memory"), "{error}");
     // the machine's available memory can only lower the fixed limit
-    let limit = membranes::memory_limit_bytes();
+    let limit = fem_forms::problem::memory::memory_limit_bytes();
     assert!(
-        limit > 0.0 && limit <= membranes::MEMORY_LIMIT_BYTES,
+        limit > 0.0 && limit <= fem_forms::problem::memory::MEMORY_LIMIT_BYTES,
         "{limit}"
     );
-    request.mesh_size = 8;
-    request.alpha = Some(-1.0);
-    assert!(membranes::solve(&request)
-        .err()
-        .unwrap()
-        .to_string()
-        .contains("α = -1"));
-    request.alpha = Some(f64::NAN);
-    assert!(membranes::solve(&request).is_err());
+    let with_alpha = |alpha| Settings {
+        alpha: Some(alpha),
+        ..settings("p2-p0", 8)
+    };
+    let error = error_of(&radial(), &with_alpha(-1.0));
+    assert!(error.contains("α = -1"), "{error}");
+    assert!(membranes::solve(&radial(), &with_alpha(f64::NAN)).is_err());
     // inside 1/C_I = 1/96 it solves; beyond it A_α is indefinite and the error says why
-    request.alpha = Some(0.009);
-    let (report, _) = membranes::solve(&request).unwrap();
+    let report = membranes::solve(&radial(), &with_alpha(0.009))
+        .unwrap()
+        .report;
     // N = 8 resolves the free boundary coarsely: u_h crossing ψ by 2% of ψ's range is
-    // said, and nothing else is
+    // said, and the scene's accuracy not reached; nothing else is
     let others: Vec<&String> = report
+        .solve
         .warnings
         .iter()
-        .filter(|w| !w.contains("dips below ψ"))
+        .filter(|w| !w.contains("dips below ψ") && !w.contains("accuracy"))
         .collect();
     assert!(others.is_empty(), "{others:?}");
-    request.alpha = Some(0.02);
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    let error = error_of(&radial(), &with_alpha(0.02));
     assert!(error.contains("outside the stability range"), "{error}");
 }
 
@@ -296,9 +286,8 @@ fn bad_input_is_a_clear_error() {
 /// norm), the stabilized ones have γ ≥ α.
 #[test]
 fn plain_pairs_have_a_multiplier_kernel_and_stabilized_ones_do_not() {
-    use fem_forms::membrane_studies::MembraneStudies;
     use fem_forms::studies::stability;
-    let scene = MembraneStudies::new(radial());
+    let scene = RegistryStudies::of("membrane-radial").unwrap();
     let mut rows = stability(&scene, "p1-p0", &[4, 8]).unwrap();
     rows.extend(stability(&scene, "p2-p0", &[4, 8]).unwrap());
     for r in &rows {
@@ -321,9 +310,8 @@ fn plain_pairs_have_a_multiplier_kernel_and_stabilized_ones_do_not() {
 /// stabilized one follows the exact λ.
 #[test]
 fn stabilization_removes_the_multiplier_oscillation() {
-    use fem_forms::membrane_studies::MembraneStudies;
     use fem_forms::studies::{multiplier_profile, total_variation};
-    let scene = MembraneStudies::new(radial());
+    let scene = RegistryStudies::of("membrane-radial").unwrap();
     let plain = multiplier_profile(&scene, "p2-p0", 32, Some(0.0)).unwrap();
     let stabilized = multiplier_profile(&scene, "p2-p0", 32, None).unwrap();
     let exact: Vec<(f64, f64)> = (0..=400)
@@ -352,9 +340,8 @@ fn stabilization_removes_the_multiplier_oscillation() {
 /// fails with the reason.
 #[test]
 fn the_alpha_sweep_shows_the_breakdown_at_one_over_ci() {
-    use fem_forms::membrane_studies::MembraneStudies;
     use fem_forms::studies::alpha_sweep;
-    let scene = MembraneStudies::new(radial());
+    let scene = RegistryStudies::of("membrane-radial").unwrap();
     let (rows, c_i) = alpha_sweep(
         &scene,
         "p2-p0",
@@ -376,9 +363,8 @@ fn the_alpha_sweep_shows_the_breakdown_at_one_over_ci() {
 /// falls at P2's rate for the radial obstacle problem (about h², u ∈ H^{5/2−ε}).
 #[test]
 fn the_work_precision_study_runs_on_a_membrane_scene() {
-    use fem_forms::membrane_studies::MembraneStudies;
     use fem_forms::studies::{work_precision, METHODS};
-    let scene = MembraneStudies::new(radial());
+    let scene = RegistryStudies::of("membrane-radial").unwrap();
     let rows = work_precision(&scene, "p2-p0", &[8, 16, 32], usize::MAX);
     assert_eq!(rows.len(), 3 * METHODS.len(), "every method on every mesh");
     let mut nested = Vec::new();
@@ -397,19 +383,25 @@ fn the_work_precision_study_runs_on_a_membrane_scene() {
     assert!(observed.iter().all(|&r| r > 1.8), "L2 rates {observed:?}");
 }
 
+/// The registry's radial scene with the accuracy `accuracy` asked, discretized by
+/// `pairs` only.
+fn asking(name: &str, accuracy: f64, pairs: &[&'static str]) -> fem_forms::models::scene::Scene {
+    let mut scene = fem_forms::models::families::scene(name).unwrap();
+    scene.accuracy = Some(accuracy);
+    scene.pairs = pairs.to_vec();
+    scene
+}
+
 /// The Richardson estimate that picks a scene's mesh agrees with the exact error.
 #[test]
 fn the_accuracy_estimate_tracks_the_exact_error() {
-    let mut scene = radial();
-    scene.target_l2 = 2e-2;
-    let (rungs, cheapest) =
-        membranes::cheapest_for_accuracy(&scene, &[MembranePair::P1P0, MembranePair::P2P0])
-            .unwrap();
+    let scene = asking("membrane-radial", 2e-2, &["p1-p0", "p2-p0"]);
+    let (rungs, cheapest) = fem_forms::accuracy::cheapest_for_accuracy(&scene).unwrap();
     assert!(cheapest.is_some());
     for r in &rungs {
         assert!(r.reached, "{r:?}");
         let exact = r.exact_l2.unwrap();
-        assert!(exact <= scene.target_l2, "{r:?}");
+        assert!(exact <= 2e-2, "{r:?}");
         assert!(
             (0.5..2.0).contains(&(r.estimated_l2 / exact)),
             "estimate {} vs exact {exact}",
@@ -420,20 +412,21 @@ fn the_accuracy_estimate_tracks_the_exact_error() {
 
 #[test]
 fn vtk_output_names_every_field() {
-    let mut request = MembraneRequest::new(radial());
-    request.mesh_size = 4;
-    let (_, fields) = membranes::solve(&request).unwrap();
+    let outcome = membranes::solve(&radial(), &settings("p2-p0", 4)).unwrap();
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("fem-forms-vtk-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("radial.vtu");
-    membranes::write_vtk(&path, &fields).unwrap();
+    outcome.fields.write_vtu(&path).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     for name in ["\"u\"", "\"psi\"", "\"lambda\"", "\"contact\""] {
         assert!(text.contains(name), "{name} missing");
     }
     // a bad path is an error, and leaves nothing behind
-    assert!(membranes::write_vtk(&dir.join("missing/radial.vtu"), &fields).is_err());
+    assert!(outcome
+        .fields
+        .write_vtu(&dir.join("missing/radial.vtu"))
+        .is_err());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -483,16 +476,18 @@ fn a_gmsh_mesh_refined_uniformly_converges() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("square.msh");
     std::fs::write(&path, SQUARE_MSH).unwrap();
+    let mut on_file = radial();
+    on_file.domain = Domain::File(path.clone());
     let errors: Vec<f64> = (3..=5)
         .map(|refinements| {
-            let mut request = MembraneRequest::new(radial());
-            request.mesh_file = Some(path.clone());
-            request.mesh_size = refinements;
-            let (report, _) = membranes::solve(&request).unwrap();
-            assert_eq!(report.triangles, 4 << (2 * refinements));
+            let report = membranes::solve(&on_file, &settings("p2-p0", refinements))
+                .unwrap()
+                .report
+                .solve;
+            assert_eq!(report.cells, 4 << (2 * refinements));
             assert!(report.complementarity_residual < 1e-10);
             // the shapes are not right isosceles: C_I differs from 96, α follows it
-            assert!((report.alpha * report.inverse_constant - 0.5).abs() < 1e-12);
+            assert!((report.alpha.unwrap() * report.inverse_constant - 0.5).abs() < 1e-12);
             report.error_h1.unwrap()
         })
         .collect();
@@ -502,13 +497,16 @@ fn a_gmsh_mesh_refined_uniformly_converges() {
         "H¹ errors {errors:?}, rates {r:?}"
     );
     std::fs::write(&path, "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2").unwrap();
-    let mut request = MembraneRequest::new(radial());
-    request.mesh_file = Some(path.clone());
-    request.mesh_size = 1;
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    let error = membranes::solve(&on_file, &settings("p2-p0", 1))
+        .err()
+        .unwrap()
+        .to_string();
     assert!(error.contains("square.msh"), "{error}");
-    request.mesh_size = 9;
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    std::fs::write(&path, SQUARE_MSH).unwrap();
+    let error = membranes::solve(&on_file, &settings("p2-p0", 9))
+        .err()
+        .unwrap()
+        .to_string();
     assert!(error.contains("at most 8"), "{error}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -518,30 +516,26 @@ fn a_gmsh_mesh_refined_uniformly_converges() {
 /// membrane touches the obstacle.
 #[test]
 fn the_l_shape_scene_reaches_its_accuracy_with_every_pair() {
-    let mut scene = membrane_scene("membrane-lshape").unwrap();
-    scene.target_l2 = 1e-2;
-    let pairs = [
-        MembranePair::P1P0,
-        MembranePair::P2P0,
-        MembranePair::P1Nodal,
-    ];
-    let (rungs, cheapest) = membranes::cheapest_for_accuracy(&scene, &pairs).unwrap();
+    let pairs = ["p1-p0", "p2-p0", "p1-nodal"];
+    let scene = asking("membrane-lshape", 1e-2, &pairs);
+    let (rungs, cheapest) = fem_forms::accuracy::cheapest_for_accuracy(&scene).unwrap();
     assert!(cheapest.is_some());
     let mut solutions = Vec::new();
     for (pair, rung) in pairs.iter().zip(&rungs) {
         assert!(rung.reached && rung.estimated_l2 <= 1e-2, "{rung:?}");
-        let mut request = MembraneRequest::new(scene.clone());
-        request.pair = *pair;
-        request.mesh_size = rung.mesh_size;
-        let (report, fields) = membranes::solve(&request).unwrap();
-        assert!(report.contact_area > 0.05, "{report:?}");
+        let request = settings(pair, rung.mesh_size);
+        let outcome = fem_forms::models::families::solve(&scene, &request).unwrap();
+        let report = &outcome.report.solve;
+        assert!(report.contact_area.unwrap() > 0.05, "{report:?}");
         assert!(report.complementarity_residual < 1e-10);
-        solutions.push((rung.estimated_l2, fields));
+        solutions.push((rung.mesh_size, rung.estimated_l2, outcome.fields));
     }
     for k in 1..solutions.len() {
-        let (ea, a) = &solutions[0];
-        let (eb, b) = &solutions[k];
-        let difference = membranes::difference_l2(&a.u_field(), &b.u_field(), 6);
+        let (na, ea, a) = &solutions[0];
+        let (nb, eb, b) = &solutions[k];
+        // on the coarser mesh's vertices, which the finer one has
+        let (coarse, fine) = if na <= nb { (a, b) } else { (b, a) };
+        let difference = fem_forms::accuracy::nested_difference(coarse, fine).unwrap();
         assert!(
             difference <= 2.0 * (ea + eb),
             "pairs 0 and {k} differ by {difference}, estimates {ea} and {eb}"
@@ -560,9 +554,9 @@ fn the_pipelined_nested_solve_equals_the_sequential_one() {
     type M = membrane_p2_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16]);
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, 0.5 / 96.0).unwrap();
-    let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(0.5 / 96.0);
+    let options = options(VariationalSolver::SemismoothNewton);
     let pipelined = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
     let mut previous: Option<(_, Vec<f64>)> = None;
     let mut iterations = Vec::new();
@@ -596,9 +590,9 @@ fn smoothing_the_first_step_keeps_the_solution_and_saves_factorizations() {
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16, 32, 64]);
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, 0.1).unwrap();
-    let smoothed = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(0.1);
+    let smoothed = options(VariationalSolver::SemismoothNewton);
     assert!(smoothed.newton.smoothing_sweeps > 0);
     let exact = fem_forms::obstacle::ObstacleOptions {
         newton: NewtonOptions {
@@ -633,9 +627,9 @@ fn low_rank_updates_keep_the_solution_and_save_factorizations() {
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8, 16, 32, 64, 128]);
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, 0.1).unwrap();
-    let defaults = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(0.1);
+    let defaults = options(VariationalSolver::SemismoothNewton);
     let options = |low_rank_updates| fem_forms::obstacle::ObstacleOptions {
         newton: NewtonOptions {
             smoothing_sweeps: 0,
@@ -673,8 +667,8 @@ fn the_nested_solve_reports_the_first_failing_level() {
     >;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8]);
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, 0.5 / 48.0).unwrap();
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(0.5 / 48.0);
     let level = |k: usize, fails: bool| -> Level<'_> {
         let (mesh, coefficients) = (&meshes[k], &coefficients);
         Box::new(move || {
@@ -688,7 +682,7 @@ fn the_nested_solve_reports_the_first_failing_level() {
     for pipelined in [true, false] {
         let options = fem_forms::obstacle::ObstacleOptions {
             pipelined,
-            ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+            ..options(VariationalSolver::SemismoothNewton)
         };
         for (coarse_fails, fine_fails, expected) in [
             (false, true, Some("level 1 fails")),
@@ -727,9 +721,9 @@ fn a_nested_solve_inside_a_level_builder_finishes() {
     type M = membrane_p1_p0::Model;
     let scene = radial();
     let meshes = radial_meshes(&[4, 8]);
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, 0.5 / 48.0).unwrap();
-    let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(0.5 / 48.0);
+    let options = options(VariationalSolver::SemismoothNewton);
     let alone = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
     let inner = std::sync::Mutex::new(None);
     let levels: Vec<Box<dyn FnOnce() -> _ + Send + '_>> = vec![
@@ -760,7 +754,7 @@ fn the_nodal_method_reproduces_petsc_ex9_errors() {
         (32, 8.182e-4, 5.747e-3),
         (64, 9.818e-5, 5.991e-4),
     ] {
-        let r = solve(radial(), MembranePair::P1Nodal, n);
+        let r = solve(radial(), "p1-nodal", n).solve;
         let (m, x) = (r.error_vertex_mean.unwrap(), r.error_vertex_max.unwrap());
         assert_eq!(
             format!("{m:.3e} {x:.3e}"),
@@ -774,38 +768,45 @@ fn the_nodal_method_reproduces_petsc_ex9_errors() {
 /// run through to the kernel's out-of-memory killer.
 #[test]
 fn tester_findings_on_alpha_memory_and_warnings() {
+    let with = |pair: &str, n: usize, alpha: Option<f64>| Settings {
+        alpha,
+        ..settings(pair, n)
+    };
+    let error_of = |request: &Settings| {
+        membranes::solve(&radial(), request)
+            .err()
+            .unwrap()
+            .to_string()
+    };
+    let warnings_of = |scene: &MembraneScene, request: &Settings| {
+        membranes::solve(scene, request)
+            .unwrap()
+            .report
+            .solve
+            .warnings
+    };
     // p2-p0 at N = 1800 was accepted with 2.3 kB a triangle (15 GB planned) and needs
     // about 4.7 kB: now refused before anything is allocated
-    let mut request = MembraneRequest::new(radial());
-    request.pair = MembranePair::P2P0;
-    request.mesh_size = 1800;
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    let error = error_of(&settings("p2-p0", 1800));
     assert!(error.contains("GB of memory"), "{error}");
 
     // an α so small that the stabilization is below rounding is refused by name ...
-    let mut request = MembraneRequest::new(radial());
-    request.pair = MembranePair::P1P0;
-    request.mesh_size = 16;
-    request.alpha = Some(1e-14);
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    let error = error_of(&with("p1-p0", 16, Some(1e-14)));
     assert!(
         error.contains("α = 1e-14") && error.contains("α = 0"),
         "{error}"
     );
     // the smallest α the refusal suggests is itself accepted (P2: C_I = 48)
-    let mut p2 = MembraneRequest::new(radial());
-    p2.pair = MembranePair::P2P0;
-    p2.mesh_size = 4;
-    p2.alpha = Some(1e-16);
-    let error = membranes::solve(&p2).err().unwrap().to_string();
+    let error = error_of(&with("p2-p0", 4, Some(1e-16)));
     let suggested: f64 = error
         .rsplit("at least ")
         .next()
         .and_then(|t| t.split_whitespace().next())
         .and_then(|t| t.parse().ok())
         .unwrap_or_else(|| panic!("no suggestion in: {error}"));
-    p2.alpha = Some(suggested);
-    let accepted = membranes::solve(&p2).map(|_| ()).map_err(|e| e.to_string());
+    let accepted = membranes::solve(&radial(), &with("p2-p0", 4, Some(suggested)))
+        .map(|_| ())
+        .map_err(|e| e.to_string());
     assert!(
         accepted
             .as_ref()
@@ -813,45 +814,33 @@ fn tester_findings_on_alpha_memory_and_warnings() {
         "{suggested:e}: {accepted:?}"
     );
     // ... and one that fails only on finer meshes is named in the failure
-    request.mesh_size = 32;
-    request.alpha = Some(1e-13);
-    let error = membranes::solve(&request).err().unwrap().to_string();
+    let error = error_of(&with("p1-p0", 32, Some(1e-13)));
     assert!(error.contains("α = 1e-13 is small"), "{error}");
-    request.alpha = Some(0.1);
-    assert!(membranes::solve(&request).is_ok());
+    assert!(membranes::solve(&radial(), &with("p1-p0", 32, Some(0.1))).is_ok());
     // a huge α lets u_h through ψ: the warning names it rather than only "refine"
-    request.alpha = Some(1e10);
-    let (report, _) = membranes::solve(&request).unwrap();
+    let warnings = warnings_of(&radial(), &with("p1-p0", 32, Some(1e10)));
     assert!(
-        report.warnings.iter().any(|w| w.contains("α = 1e10")),
-        "{:?}",
-        report.warnings
+        warnings.iter().any(|w| w.contains("α = 1e10")),
+        "{warnings:?}"
     );
 
     // u = ψ = 0 exactly: a gap of rounding size is not an "unreal contact set"
-    let flat = MEMBRANE_FLAT;
-    let mut request = MembraneRequest::new(flat.clone());
-    request.pair = MembranePair::P1P0;
-    request.mesh_size = 16;
-    let (report, _) = membranes::solve(&request).unwrap();
+    let warnings = warnings_of(&MEMBRANE_FLAT, &settings("p1-p0", 16));
     assert!(
-        report.warnings.iter().all(|w| !w.contains("not real")),
-        "{:?}",
-        report.warnings
+        warnings.iter().all(|w| !w.contains("not real")),
+        "{warnings:?}"
     );
 
     // full contact leaves the nodal method no system to solve: no multigrid warning
-    let mut request = MembraneRequest::new(flat);
-    request.pair = MembranePair::P1Nodal;
-    request.mesh_size = 32;
-    request.linear_solver = fem_forms::obstacle::hierarchy::LinearSolver::Multigrid;
-    let (report, _) = membranes::solve(&request).unwrap();
+    let request = Settings {
+        linear_solver: fem_forms::obstacle::hierarchy::LinearSolver::Multigrid,
+        ..settings("p1-nodal", 32)
+    };
+    let warnings = warnings_of(&MEMBRANE_FLAT, &request);
     assert!(
-        report
-            .warnings
+        warnings
             .iter()
             .all(|w| !w.contains("--linear-solver multigrid")),
-        "{:?}",
-        report.warnings
+        "{warnings:?}"
     );
 }

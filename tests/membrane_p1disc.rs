@@ -7,22 +7,28 @@
 use fem_forms::lcp::{
     primal_dual_active_set, recover_multiplier, semismooth_newton, NewtonOptions,
 };
-use fem_forms::membranes::{self, alpha_of, scene_mesh, MembranePair, MembraneRequest};
+#[path = "common/membranes.rs"]
+mod membranes;
+
 use fem_forms::models::membrane::membrane_p2_p1disc;
 use fem_forms::models::membrane_scenes::{membrane_scene, MembraneScene, MEMBRANE_FLAT};
+use fem_forms::models::report::{Outcome, Settings};
 use fem_forms::obstacle::triangle::{discretize_on_triangles, solve_obstacle_on_triangles};
 use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
 use fem_forms::Model;
+use membranes::{settings, SceneData};
 
 fn radial() -> MembraneScene {
     membrane_scene("membrane-radial").unwrap()
 }
 
-fn request(scene: MembraneScene, pair: MembranePair, n: usize) -> MembraneRequest {
-    let mut request = MembraneRequest::new(scene);
-    request.pair = pair;
-    request.mesh_size = n;
-    request
+/// `scene` solved with `pair` at N = `n` by `solver`.
+fn solve(scene: &MembraneScene, pair: &str, n: usize, solver: VariationalSolver) -> Outcome {
+    let request = Settings {
+        solver,
+        ..settings(pair, n)
+    };
+    membranes::solve(scene, &request).unwrap()
 }
 
 fn max_difference(a: &[f64], b: &[f64]) -> f64 {
@@ -37,14 +43,16 @@ fn max_difference(a: &[f64], b: &[f64]) -> f64 {
 #[test]
 fn radial_problem_with_p1disc_multipliers() {
     for n in [8, 16, 32] {
-        let (newton, newton_fields) =
-            membranes::solve(&request(radial(), MembranePair::P2P1Disc, n)).unwrap();
-        let (p0, _) = membranes::solve(&request(radial(), MembranePair::P2P0, n)).unwrap();
-        let mut qp_request = request(radial(), MembranePair::P2P1Disc, n);
-        qp_request.solver = VariationalSolver::Clarabel;
-        let (qp, qp_fields) = membranes::solve(&qp_request).unwrap();
+        let newton_outcome = solve(&radial(), "p2-p1d", n, VariationalSolver::SemismoothNewton);
+        let p0 = solve(&radial(), "p2-p0", n, VariationalSolver::SemismoothNewton)
+            .report
+            .solve;
+        let qp_outcome = solve(&radial(), "p2-p1d", n, VariationalSolver::Clarabel);
+        let difference = max_difference(membranes::u(&newton_outcome), membranes::u(&qp_outcome));
+        let exact_contact_force = newton_outcome.report.exact_contact_force;
+        let exact_contact_area = newton_outcome.report.exact_contact_area;
+        let (newton, qp) = (newton_outcome.report.solve, qp_outcome.report.solve);
         let (h1, h1_p0) = (newton.error_h1.unwrap(), p0.error_h1.unwrap());
-        let difference = max_difference(&newton_fields.u, &qp_fields.u);
         println!(
             "N = {n}: P2–P1disc H¹ {h1:.4e} (P2–P0 {h1_p0:.4e}), L² {:.3e}, λ error {:.3e} (P2–P0 {:.3e}), ∫λ_h {:.5} (clarabel {:.5}, P2–P0 {:.5}, exact {:.5}), Newton levels {:?}, clarabel {} iterations, KKT {:.1e} / {:.1e}, max |u_newton − u_qp| {difference:.1e}, contact area {:.4} (exact {:.4}), warnings {:?}",
             newton.error_l2.unwrap(),
@@ -53,13 +61,13 @@ fn radial_problem_with_p1disc_multipliers() {
             newton.total_contact_force,
             qp.total_contact_force,
             p0.total_contact_force,
-            newton.exact_contact_force.unwrap(),
+            exact_contact_force.unwrap(),
             newton.levels,
             qp.iterations,
             newton.complementarity_residual,
             qp.complementarity_residual,
-            newton.contact_area,
-            newton.exact_contact_area.unwrap(),
+            newton.contact_area.unwrap(),
+            exact_contact_area.unwrap(),
             newton.warnings,
         );
         assert!(
@@ -98,11 +106,9 @@ fn radial_problem_with_p1disc_multipliers() {
 fn newton_and_the_saddle_point_method_agree_on_the_blocked_membrane_lcp() {
     type M = membrane_p2_p1disc::Model;
     let scene = radial();
-    let r = request(scene.clone(), MembranePair::P2P1Disc, 16);
-    let mesh = scene_mesh(&scene, 16, r.diagonal).unwrap();
-    let (alpha, _) = alpha_of(&r, &mesh).unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+    let mesh = membranes::mesh(&scene, 16);
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(membranes::alpha::<M>(&mesh));
     let d = discretize_on_triangles::<M>(&mesh, &coefficients, "B_h", "L_h").unwrap();
     let lcp = &d.lcp;
     assert_eq!(lcp.c_blocks.groups().count(), 2 * 16 * 16);
@@ -150,30 +156,32 @@ fn pressing_onto_a_flat_obstacle_gives_u_zero_and_lambda_q() {
         VariationalSolver::SemismoothNewton,
         VariationalSolver::Clarabel,
     ] {
-        let mut r = request(scene.clone(), MembranePair::P2P1Disc, n);
-        r.solver = solver;
-        let (report, fields) = membranes::solve(&r).unwrap();
-        let largest_u = fields.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let outcome = solve(&scene, "p2-p1d", n, solver);
+        let report = &outcome.report.solve;
+        let largest_u = membranes::u(&outcome)
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
         assert!(largest_u < 1e-8, "{solver:?}: u = {largest_u}");
         assert!(
             (report.total_contact_force - 48.0).abs() < 1e-7 * 48.0,
             "{solver:?}: ∫λ = {}",
             report.total_contact_force
         );
-        assert!((report.contact_area - 16.0).abs() < 1e-9, "{solver:?}");
+        assert!(
+            (report.contact_area.unwrap() - 16.0).abs() < 1e-9,
+            "{solver:?}"
+        );
         assert!(report.complementarity_residual < 1e-10, "{solver:?}");
-        for l in &fields.lambda {
+        for l in membranes::lambda(&outcome) {
             assert!((l - 3.0).abs() < 1e-6, "{solver:?}: λ = {l}");
         }
     }
 
     // every coefficient of λ_h, from the runtime's solve with the same α
     type M = membrane_p2_p1disc::Model;
-    let r = request(scene.clone(), MembranePair::P2P1Disc, n);
-    let mesh = scene_mesh(&scene, n, r.diagonal).unwrap();
-    let (alpha, _) = alpha_of(&r, &mesh).unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+    let mesh = membranes::mesh(&scene, n);
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(membranes::alpha::<M>(&mesh));
     let solution =
         solve_obstacle_on_triangles::<M>(&[mesh], &coefficients, ObstacleOptions::default())
             .unwrap();

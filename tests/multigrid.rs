@@ -7,11 +7,13 @@
 //! solution must be Cholesky's.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+#[path = "common/membranes.rs"]
+mod membranes;
+
 use faer::sparse::{SparseColMat, Triplet};
 use fem_forms::lcp::cholesky::{multiply, solve_spd};
 use fem_forms::lcp::Lcp;
 use fem_forms::lcp::NewtonStep;
-use fem_forms::membranes;
 use fem_forms::models::membrane::{membrane_p1_p0, membrane_p2_p0};
 use fem_forms::models::membrane_scenes::membrane_scene;
 use fem_forms::multigrid::{
@@ -20,7 +22,8 @@ use fem_forms::multigrid::{
 use fem_forms::obstacle::hierarchy::{LinearSolver, MultigridSteps, MULTIGRID_ROUNDING_FLOOR};
 use fem_forms::obstacle::triangle::{discretize_on_triangles, solve_obstacle_on_triangles};
 use fem_forms::obstacle::{Discretization, ObstacleOptions, VariationalSolver};
-use fem_forms::{Constraints, Diagonal, Model, Reduction, SparseMatrix, SystemDofs, TriangleMesh};
+use fem_forms::{Constraints, Model, Reduction, SparseMatrix, SystemDofs, TriangleMesh};
+use membranes::{options, SceneData};
 
 /// Newton's Hessian of Φ at `u` for an LCP with a diagonal `C`: `A` plus `b_k b_kᵀ / c_k`
 /// for each constraint whose eliminated multiplier is positive (`(G − BU)_k > 0`).
@@ -81,14 +84,14 @@ fn newton_hessian_runs<M: Model>(
     options: MultigridOptions,
 ) -> Vec<(usize, usize, usize, usize, f64)> {
     let scene = membrane_scene("membrane-radial").unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
-    let solve_options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(alpha);
+    let solve_options = membranes::options(VariationalSolver::SemismoothNewton);
     let finest = *sizes.last().unwrap();
     let mut meshes = Vec::new();
     let mut n = 4;
     while n <= finest {
-        meshes.push(membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap());
+        meshes.push(membranes::mesh(&scene, n));
         n *= 2;
     }
     let discretizations: Vec<_> = meshes
@@ -265,11 +268,11 @@ fn solved_on_hierarchy<M: Model>(
     Vec<SparseMatrix>,
 ) {
     let scene = membrane_scene("membrane-radial").unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(alpha);
     let meshes: Vec<TriangleMesh> = [4, 8, 16, 32]
         .iter()
-        .map(|&n| membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap())
+        .map(|&n| membranes::mesh(&scene, n))
         .collect();
     let discretizations: Vec<_> = meshes
         .iter()
@@ -288,7 +291,7 @@ fn solved_on_hierarchy<M: Model>(
             prolongation(&level(l - 1), &level(l), &parents).unwrap()
         })
         .collect();
-    let options = membranes::membrane_options(VariationalSolver::SemismoothNewton);
+    let options = options(VariationalSolver::SemismoothNewton);
     let solution = solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap();
     (solution, prolongations)
 }
@@ -358,16 +361,16 @@ fn nested_solve<M: Model>(
     linear_solver: LinearSolver,
 ) -> fem_forms::obstacle::triangle::TriangleObstacleSolution {
     let scene = membrane_scene("membrane-radial").unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, alpha).unwrap();
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(alpha);
     let options = ObstacleOptions {
         linear_solver,
-        ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+        ..options(VariationalSolver::SemismoothNewton)
     };
     let mut meshes = Vec::new();
     let mut n = 4;
     while n <= finest {
-        meshes.push(membranes::scene_mesh(&scene, n, Diagonal::Right).unwrap());
+        meshes.push(membranes::mesh(&scene, n));
         n *= 2;
     }
     solve_obstacle_on_triangles::<M>(&meshes, &coefficients, options).unwrap()
@@ -498,13 +501,13 @@ fn small_systems_and_single_levels_are_solved_directly() {
     assert_eq!(auto.iterative_steps, 0);
     assert!(auto.factorizations > 0);
     let scene = membrane_scene("membrane-radial").unwrap();
-    let data = membranes::SceneData::new(&scene, None);
-    let coefficients = membranes::scene_coefficients::<M>(&data, 0.1).unwrap();
+    let data = SceneData::new(&scene);
+    let coefficients = data.coefficients::<M>(0.1);
     let options = ObstacleOptions {
         linear_solver: LinearSolver::Multigrid,
-        ..membranes::membrane_options(VariationalSolver::SemismoothNewton)
+        ..options(VariationalSolver::SemismoothNewton)
     };
-    let mesh = membranes::scene_mesh(&scene, 16, Diagonal::Right).unwrap();
+    let mesh = membranes::mesh(&scene, 16);
     let single = solve_obstacle_on_triangles::<M>(&[mesh], &coefficients, options).unwrap();
     assert_eq!(single.iterative_steps, 0);
     assert!(single.kkt_residual <= 1e-10);

@@ -4,9 +4,11 @@
 //! truncated hierarchy's prolongations equal to the truncated composed ones.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+#[path = "common/membranes.rs"]
+mod membranes;
+
 use faer::sparse::{SparseColMat, Triplet};
-use fem_forms::membranes::{self, MembranePair, MembraneRequest};
-use fem_forms::models::membrane_scenes::membrane_scene;
+use fem_forms::models::report::Settings;
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::nodal::{nodal_active_set, nodal_active_set_with, truncated_hierarchy};
 use fem_forms::SparseMatrix;
@@ -42,13 +44,33 @@ fn obstacle_1d(n: usize) -> (SparseMatrix, Vec<f64>, Vec<f64>) {
     (a, f, psi)
 }
 
-fn solve(n: usize, linear_solver: LinearSolver) -> (membranes::MembraneReport, Vec<f64>) {
-    let mut request = MembraneRequest::new(membrane_scene("membrane-radial").unwrap());
-    request.pair = MembranePair::P1Nodal;
-    request.mesh_size = n;
-    request.linear_solver = linear_solver;
-    let (report, fields) = membranes::solve(&request).expect("the radial membrane solves");
-    (report, fields.u)
+/// The report of the nodal method on `scene` at N = `n`, nested or from a cold start.
+fn report(
+    scene: &str,
+    n: usize,
+    linear_solver: LinearSolver,
+    nested: bool,
+) -> fem_forms::problem::Report {
+    let request = Settings {
+        linear_solver,
+        nested,
+        ..membranes::settings("p1-nodal", n)
+    };
+    membranes::solve(&membranes::scene(scene), &request)
+        .unwrap()
+        .report
+        .solve
+}
+
+fn solve(n: usize, linear_solver: LinearSolver) -> (fem_forms::problem::Report, Vec<f64>) {
+    let request = Settings {
+        linear_solver,
+        ..membranes::settings("p1-nodal", n)
+    };
+    let outcome = membranes::solve(&membranes::scene("membrane-radial"), &request)
+        .expect("the radial membrane solves");
+    let u = membranes::u(&outcome).to_vec();
+    (outcome.report.solve, u)
 }
 
 /// Both linear solvers give the solution of the same nodal LCP: the vertex values
@@ -93,12 +115,7 @@ fn multigrid_steps_give_the_direct_solution_with_iterations_bounded_in_h() {
 /// A cold start has no coarser level: `--linear-solver multigrid` factors and says so.
 #[test]
 fn a_cold_start_without_hierarchy_is_reported() {
-    let mut request = MembraneRequest::new(membrane_scene("membrane-radial").unwrap());
-    request.pair = MembranePair::P1Nodal;
-    request.mesh_size = 16;
-    request.nested = false;
-    request.linear_solver = LinearSolver::Multigrid;
-    let (report, _) = membranes::solve(&request).unwrap();
+    let report = self::report("membrane-radial", 16, LinearSolver::Multigrid, false);
     assert_eq!(report.linear_solver, "direct");
     assert!(
         report
@@ -108,15 +125,10 @@ fn a_cold_start_without_hierarchy_is_reported() {
         "{:?}",
         report.warnings
     );
-    request.nested = true;
-    let (report, _) = membranes::solve(&request).unwrap();
+    let report = self::report("membrane-radial", 16, LinearSolver::Multigrid, true);
     assert!(report.warnings.iter().all(|w| !w.contains("multigrid")));
     // membrane-flat: every free node in contact, no system to solve by either solver
-    let mut request = MembraneRequest::new(membrane_scene("membrane-flat").unwrap());
-    request.pair = MembranePair::P1Nodal;
-    request.mesh_size = 16;
-    request.linear_solver = LinearSolver::Multigrid;
-    let (report, _) = membranes::solve(&request).unwrap();
+    let report = self::report("membrane-flat", 16, LinearSolver::Multigrid, true);
     assert_eq!(
         (
             report.linear_solver,

@@ -6,6 +6,9 @@
 //! is no multiplier, and the `O(h²)` penetration of the weak constraint.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+#[path = "common/membranes.rs"]
+mod membranes;
+
 use fem_forms::element::triangle::{TriangleBasis, TriangleField};
 use fem_forms::lcp::{Lcp, LcpSolution, NewtonOptions};
 use fem_forms::models::membrane::{
@@ -76,7 +79,7 @@ fn options(low_rank_updates: bool, smoothing_sweeps: usize) -> ObstacleOptions {
 }
 
 /// A stabilized pair solved on `levels` (nested iteration; one level: a cold start) with
-/// α = ½/C_I (0.1 where C_I = 0, as the CLI).
+/// the membrane family's α (½/C_I).
 fn solve_stabilized<M: Model>(
     levels: &[TriangleMesh],
     load: &DataFn,
@@ -84,8 +87,7 @@ fn solve_stabilized<M: Model>(
     boundary: &DataFn,
     options: ObstacleOptions,
 ) -> fem_forms::Result<TriangleObstacleSolution> {
-    let c_i = fem_forms::membranes::inverse_constant::<M>(levels.last().expect("a level"))?;
-    let alpha = if c_i > 0.0 { 0.5 / c_i } else { 0.1 };
+    let alpha = membranes::alpha::<M>(levels.last().expect("a level"));
     let coefficients = Coefficients::new::<M>(
         &[("α", alpha)],
         &[("f", load), ("ψ", obstacle), ("g", boundary)],
@@ -318,7 +320,7 @@ fn p2_pairs_on_a_small_gmsh_disk_are_certified() {
     let fine = coarse.refine_uniformly();
     let nested = [coarse, fine];
     // the scene's data at its own load (f = q·f̂)
-    let data = fem_forms::membranes::SceneData::new(&scene, None);
+    let data = membranes::SceneData::new(&scene);
     let (load, obstacle, boundary) = (
         data.load.as_data_fn(),
         data.obstacle.as_data_fn(),
@@ -621,7 +623,7 @@ fn the_penetration_of_a_coarse_mesh_is_sampled_on_a_lattice() {
 fn the_penetration_of_the_weak_constraint_is_second_order() {
     let scene = membrane_scene("membrane-radial").unwrap();
     // the scene's data at its own load (f = q·f̂)
-    let data = fem_forms::membranes::SceneData::new(&scene, None);
+    let data = membranes::SceneData::new(&scene);
     let (load, obstacle, boundary) = (
         data.load.as_data_fn(),
         data.obstacle.as_data_fn(),
@@ -730,7 +732,7 @@ fn the_sliver_mesh_gives_an_error_or_a_certified_solution() {
         levels.push(finer);
     }
     // the scene's data at its own load (f = q·f̂)
-    let data = fem_forms::membranes::SceneData::new(&scene, None);
+    let data = membranes::SceneData::new(&scene);
     let (load, obstacle, boundary) = (
         data.load.as_data_fn(),
         data.obstacle.as_data_fn(),

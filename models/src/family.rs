@@ -236,6 +236,12 @@ pub trait Family: Sync {
         None
     }
 
+    /// Other spellings of its pairs' names, as `(alias, name)` (the membrane's
+    /// `p2-p1disc` for `p2-p1d`).
+    fn pair_aliases(&self) -> &'static [(&'static str, &'static str)] {
+        &[]
+    }
+
     /// The family's measure of locking, where it has a thickness `t` whose limit t → 0 is
     /// a thinner model: the report's key of a quantity and of its value in that limit
     /// (the Reissner–Mindlin plate's centre deflection against Kirchhoff's), what the

@@ -17,7 +17,6 @@ pub mod membrane;
 pub mod membrane_scenes;
 pub mod mindlin;
 pub mod plate_scenes;
-pub mod registry;
 pub mod report;
 pub mod run;
 pub mod scene;

@@ -58,14 +58,30 @@ pub fn discretize(
     q: f64,
     alpha: f64,
 ) -> Result<Discretization> {
-    let scene = scenes::scene(name).expect("a beam scene");
+    discretize_scene(
+        &scenes::scene(name).expect("a beam scene"),
+        pair,
+        elements,
+        q,
+        alpha,
+    )
+}
+
+/// [`discretize`] of a beam data set (its thickness, obstacle and load direction).
+pub fn discretize_scene(
+    scene: &scenes::Scene,
+    pair: &str,
+    elements: usize,
+    q: f64,
+    alpha: f64,
+) -> Result<Discretization> {
     match pair {
-        "hermite-p0" => discretize_with::<bernoulli::Model>(&scene, elements, q, alpha),
-        "p2-p2-p0" => discretize_with::<timoshenko_p2::Model>(&scene, elements, q, alpha),
+        "hermite-p0" => discretize_with::<bernoulli::Model>(scene, elements, q, alpha),
+        "p2-p2-p0" => discretize_with::<timoshenko_p2::Model>(scene, elements, q, alpha),
         "p1-p1-p0-reduced" => {
-            discretize_with::<timoshenko_p1_reduced::Model>(&scene, elements, q, alpha)
+            discretize_with::<timoshenko_p1_reduced::Model>(scene, elements, q, alpha)
         }
-        "p1-p1-p0-full" => discretize_with::<timoshenko_p1_full::Model>(&scene, elements, q, alpha),
+        "p1-p1-p0-full" => discretize_with::<timoshenko_p1_full::Model>(scene, elements, q, alpha),
         _ => panic!("no beam pair `{pair}`"),
     }
 }

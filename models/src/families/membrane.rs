@@ -214,6 +214,10 @@ impl Family for Membranes {
         scenes
     }
 
+    fn pair_aliases(&self) -> &'static [(&'static str, &'static str)] {
+        &[("p2-p1disc", "p2-p1d")]
+    }
+
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[
             ("load", "f"),

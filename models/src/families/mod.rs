@@ -87,6 +87,11 @@ pub fn pair_of(scene: &Scene, name: Option<&str>) -> Result<&'static Pair> {
             .map(|p| p.name)
             .ok_or_else(|| Error::Input(format!("scene `{}` takes no pair", scene.name)))?,
     };
+    let name = family
+        .pair_aliases()
+        .iter()
+        .find(|(alias, _)| *alias == name)
+        .map_or(name, |(_, name)| *name);
     if let Some(pair) = offered.iter().find(|p| p.name == name) {
         return Ok(pair);
     }
