@@ -1093,13 +1093,16 @@ where
     let solve_finest = |coarse: Option<SolvedLevel<G>>,
                         d: &Discretization<G>,
                         workspace: Option<&NewtonWorkspace>| {
-        let start = match &coarse {
-            Some((c, values, _, _)) => Some(d.primal_part(&prolong(c, values, d))),
-            None => first_start.map(|f| f(d)).transpose()?.flatten(),
-        };
         let hierarchy = extend_hierarchy(coarse.as_ref(), d, primal_prolongation);
-        let solution =
-            solve_lcp_on_hierarchy(&d.lcp, workspace, &hierarchy, start.as_deref(), options)?;
+        let solution = solve_level(
+            d,
+            coarse.as_ref(),
+            &prolong,
+            workspace,
+            &hierarchy,
+            first_start,
+            options,
+        )?;
         let mut counts = coarse.map(|(_, _, counts, _)| counts).unwrap_or_default();
         counts.push((d.mesh.cell_count(), solution.iterations));
         Ok::<_, Error>((solution, counts))
@@ -1239,6 +1242,40 @@ fn extend_hierarchy<G>(
     }
 }
 
+/// Solves level `d`: from `coarse`'s solution prolonged where there is a coarser level,
+/// else from the first start. A body that only contact holds is singular where no
+/// constraint is active, and a prolonged start can open every contact the finer level
+/// has (a block whose one coarse contact edge split in two): where Newton fails from
+/// the prolonged start, the level is solved again from the first start, which holds
+/// such a body.
+///
+/// # Errors
+/// The first start's, and the solver's from the last start tried.
+fn solve_level<G: Mesh>(
+    d: &Discretization<G>,
+    coarse: Option<&SolvedLevel<G>>,
+    prolong: &impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
+    workspace: Option<&NewtonWorkspace>,
+    hierarchy: &[SparseMatrix],
+    first_start: Option<&FirstStart<'_, G>>,
+    options: ObstacleOptions,
+) -> Result<LcpSolution> {
+    let from_first = || -> Result<LcpSolution> {
+        let start = first_start.map(|f| f(d)).transpose()?.flatten();
+        solve_lcp_on_hierarchy(&d.lcp, workspace, hierarchy, start.as_deref(), options)
+    };
+    let Some((c, values, _, _)) = coarse else {
+        return from_first();
+    };
+    let start = d.primal_part(&prolong(c, values, d));
+    match solve_lcp_on_hierarchy(&d.lcp, workspace, hierarchy, Some(&start), options) {
+        Err(Error::NotConverged { .. } | Error::LinearSolve(_)) if first_start.is_some() => {
+            from_first()
+        }
+        other => other,
+    }
+}
+
 /// Builds and solves `levels` in turn, each from the prolonged solution of the one
 /// before; the last one solved, or `None` for no levels.
 fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
@@ -1251,12 +1288,16 @@ fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
     let mut last: Option<SolvedLevel<G>> = None;
     for build in levels {
         let d = build()?;
-        let start = match &last {
-            Some((coarse, values, _, _)) => Some(d.primal_part(&prolong(coarse, values, &d))),
-            None => first_start.map(|f| f(&d)).transpose()?.flatten(),
-        };
         let hierarchy = extend_hierarchy(last.as_ref(), &d, primal_prolongation);
-        let solution = solve_lcp_on_hierarchy(&d.lcp, None, &hierarchy, start.as_deref(), options)?;
+        let solution = solve_level(
+            &d,
+            last.as_ref(),
+            prolong,
+            None,
+            &hierarchy,
+            first_start,
+            options,
+        )?;
         let mut counts = last.map(|(_, _, counts, _)| counts).unwrap_or_default();
         counts.push((d.mesh.cell_count(), solution.iterations));
         let values = d.full(&solution);
