@@ -1,15 +1,15 @@
-//! The complete Signorini contact solve (nested) against one factorization + solve of
-//! the elasticity matrix of the same mesh (issue 14, "Speed").
+//! The complete Signorini contact solve through the one pipeline against one
+//! factorization + solve of the elasticity matrix of the same mesh.
 //!
-//! `cargo bench --bench signorini` prints, for Hertz (P1–P0, quarter disc, coarse mesh
-//! `hertz_mesh` at b/h = 2 refined uniformly 3 and 4 times) and for the unit block over a
-//! parabolic gap (7 × 7 squares refined 4 and 5 times): the unknowns of the finest
-//! level, the time of the whole nested solve (every level's meshes, assembly, inverse
-//! constants, prolongation, Newton and report), the time of one sparse Cholesky
-//! (symbolic + numeric, `fem_runtime::lcp::cholesky` on faer, as the runtime factors) and
-//! solve of the finest level's elasticity matrix `A`, their ratio, and the Newton
-//! iterations per level; at the largest size also the cold single-mesh solve (every
-//! constraint active at the start) on the finest mesh.
+//! `cargo bench --bench signorini` prints, for the unit block over a parabolic gap (a
+//! scene file: 7 × 7 squares refined 3, 4 and 5 times; nested levels, and a cold start
+//! on the finest mesh) and for Hertz (the built-in scene's graded meshes, b/h = 32, 64,
+//! 128: one level each): the cells and unknowns of the finest level, the wall time of
+//! the whole solve (meshes, assembly, inverse constants, every level's Newton, the
+//! report), the time of one sparse Cholesky (symbolic + numeric,
+//! `fem_runtime::lcp::cholesky` on faer, as the runtime factors) and solve of the
+//! finest level's elasticity matrix `A`, their ratio, and the Newton iterations per
+//! level.
 //!
 //! Under pure contact `A` is singular (a translation along the contact direction), so
 //! the factored `A` is the elasticity matrix with the contact part also held
@@ -17,42 +17,58 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::lcp::cholesky::Cholesky;
-use fem_forms::models::signorini::{
-    hertz_input, hertz_mesh, hertz_snap, lame, signorini_p1, solve_signorini,
-    solve_signorini_nested, straight_boundary, Displacement, Hertz, HertzData, Plane,
-    SignoriniInput, Snap,
-};
+use fem_forms::models::contact_scenes::{hertz_mesh, HERTZ_ARC, HERTZ_AXIS, HERTZ_TOP};
+use fem_forms::models::families::{self, contact::lame, contact::Plane};
+use fem_forms::models::hertz::Hertz;
+use fem_forms::models::report::Settings;
+use fem_forms::models::scene_file;
+use fem_forms::models::signorini::signorini_p1;
 use fem_forms::obstacle::boundary_multiplier::discretize_on_parts;
-use fem_forms::{Coefficients, Diagonal, TriangleMesh};
+use fem_forms::{Coefficients, DataFn, Diagonal, TriangleMesh};
 use std::time::Instant;
 
-/// Seconds of one Cholesky (symbolic + numeric) and solve of the elasticity matrix on
-/// `mesh` with `u_y = 0` also on Γ_C, and its order; the best of three.
-fn linear_solve(mesh: &TriangleMesh, input: &SignoriniInput) -> (f64, usize) {
+/// A contact problem's boundary parts by marker: contact, load, `u_x = 0`.
+struct Parts<'a> {
+    contact: &'a [u32],
+    load: &'a [u32],
+    fixed_x: &'a [u32],
+}
+
+/// Seconds of one Cholesky (symbolic + numeric) and solve of the elasticity matrix
+/// (E = 1000, ν = 0.3, plane strain) on `mesh` with `u_y = 0` also on Γ_C, and its
+/// order; the best of three.
+fn linear_solve(
+    mesh: &TriangleMesh,
+    parts: &Parts,
+    pressure: &DataFn,
+    gap: &DataFn,
+) -> (f64, usize) {
     type M = signorini_p1::Model;
-    let (mu, lambda) = lame(input.young, input.poisson, input.plane).unwrap();
-    let coefficients = Coefficients::new::<M>(
+    let (mu, lambda) = lame(1000.0, 0.3, Plane::Strain).unwrap();
+    let coefficients = Coefficients::from_ids(
         &[
-            ("μ_L", mu),
-            ("λ_L", lambda),
-            ("α", 0.0),
-            ("n_c_x", input.contact_direction[0]),
-            ("n_c_y", input.contact_direction[1]),
+            (signorini_p1::params::μ_L, mu),
+            (signorini_p1::params::λ_L, lambda),
+            (signorini_p1::params::α, 0.0),
+            (signorini_p1::params::n_c_x, 0.0),
+            (signorini_p1::params::n_c_y, -1.0),
         ],
-        &[("q", input.pressure), ("g", input.gap)],
+        &[
+            (signorini_p1::data::q, pressure),
+            (signorini_p1::data::g, gap),
+        ],
     )
     .unwrap();
-    let held: Vec<u32> = input.fixed_y.iter().chain(input.contact).copied().collect();
     let fixed = [
-        (signorini_p1::fields::u_x, input.fixed_x),
-        (signorini_p1::fields::u_y, &held[..]),
+        (signorini_p1::fields::u_x, parts.fixed_x),
+        (signorini_p1::fields::u_y, parts.contact),
     ];
     let d = discretize_on_parts::<M, _, _>(
         mesh,
         &coefficients,
         &[
-            (signorini_p1::facets::Γ_C, input.contact),
-            (signorini_p1::facets::Γ_N, input.load),
+            (signorini_p1::facets::Γ_C, parts.contact),
+            (signorini_p1::facets::Γ_N, parts.load),
         ],
         &fixed,
     )
@@ -72,75 +88,35 @@ fn linear_solve(mesh: &TriangleMesh, input: &SignoriniInput) -> (f64, usize) {
     (best, d.lcp.n())
 }
 
-fn run(
-    name: &str,
-    coarse: &TriangleMesh,
-    refinements: &[usize],
-    snap: Snap,
-    input: &SignoriniInput,
-) {
+/// One row: the solve of `scene` with `settings`, against `linear` (seconds, order).
+fn row(scene: &fem_forms::models::scene::Scene, settings: &Settings, linear: (f64, usize)) {
+    let clock = Instant::now();
+    match families::solve(scene, settings) {
+        Ok(outcome) => {
+            let seconds = clock.elapsed().as_secs_f64();
+            let solve = &outcome.report.solve;
+            let iterations: Vec<String> = solve.levels.iter().map(|l| l[1].to_string()).collect();
+            println!(
+                "{:>9} {:>9} {:>9.3} {:>13.3} {:>7.1}  {}   (A of order {})",
+                solve.cells,
+                solve.dofs,
+                seconds,
+                linear.0,
+                seconds / linear.0,
+                iterations.join(" "),
+                linear.1
+            );
+        }
+        Err(e) => println!("failed: {e}"),
+    }
+}
+
+fn header(name: &str) {
     println!("{name}");
     println!(
-        "{:>9} {:>9} {:>13} {:>13} {:>7}  Newton iterations per level (coarse → fine)",
-        "cells", "unknowns", "nested s", "factor+solve", "ratio"
+        "{:>9} {:>9} {:>9} {:>13} {:>7}  Newton iterations per level (coarse → fine)",
+        "cells", "unknowns", "solve s", "factor+solve", "ratio"
     );
-    for (k, &l) in refinements.iter().enumerate() {
-        let nested = match solve_signorini_nested(coarse, l, snap, input) {
-            Ok(n) => n,
-            Err(e) => {
-                println!("{l} refinements: failed: {e}");
-                continue;
-            }
-        };
-        let (linear, order) = linear_solve(&nested.mesh, input);
-        let iterations: Vec<String> = nested
-            .levels
-            .iter()
-            .map(|l| l.iterations.to_string())
-            .collect();
-        let fallbacks = nested
-            .levels
-            .iter()
-            .filter(|l| {
-                matches!(
-                    l.start,
-                    fem_forms::models::signorini::LevelStart::FellBack(_)
-                )
-            })
-            .count();
-        println!(
-            "{:>9} {:>9} {:>13.3} {:>13.3} {:>7.1}  {}{}   (A of order {order}; finest level {:.3} s, its Newton {:.3} s)",
-            nested.mesh.cell_count(),
-            nested.solution.dofs,
-            nested.seconds,
-            linear,
-            nested.seconds / linear,
-            iterations.join(" "),
-            if fallbacks > 0 {
-                format!(" ({fallbacks} fell back to the pressed start)")
-            } else {
-                String::new()
-            },
-            nested.levels.last().unwrap().seconds,
-            nested.levels.last().unwrap().newton_seconds,
-        );
-        if k + 1 == refinements.len() {
-            let start = Instant::now();
-            match solve_signorini(&nested.mesh, input) {
-                Ok(cold) => {
-                    let seconds = start.elapsed().as_secs_f64();
-                    println!(
-                        "    cold start on the finest mesh: {seconds:.3} s in all ({} iterations, Newton {:.3} s), ratio {:.1}",
-                        cold.iterations,
-                        cold.seconds,
-                        seconds / linear
-                    );
-                }
-                Err(e) => println!("    cold start on the finest mesh failed: {e}"),
-            }
-        }
-    }
-    println!();
 }
 
 fn pressure(_: &[f64]) -> f64 {
@@ -151,49 +127,79 @@ fn parabolic_gap(x: &[f64]) -> f64 {
     0.02 * (x[0] - 0.5) * (x[0] - 0.5)
 }
 
+const BLOCK: &str = r#"
+model = "contact"
+[mesh]
+generator = "rectangle"
+x = [0.0, 1.0]
+y = [0.0, 1.0]
+cells = [7, 7]
+[material]
+young = 1000.0
+poisson = 0.3
+[boundary]
+contact = "bottom"
+load = "top"
+fixed_x = "left"
+[data]
+pressure = "2.5"
+gap = "0.02 * (x - 0.5)^2"
+"#;
+
 fn main() {
     fem_forms::allocator::keep_freed_memory();
     fem_forms::lcp::cholesky::factor_sequentially();
+
+    let file = scene_file::parse(BLOCK, std::path::Path::new("block.toml")).unwrap();
+    let block = Parts {
+        contact: &[1],
+        load: &[3],
+        fixed_x: &[4],
+    };
+    header("unit block over a parabolic gap 0.02 (x − ½)², q = 2.5, p1-p0, 7 × 7 squares refined");
+    for refinements in [3, 4, 5] {
+        let mut mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 7, 7, Diagonal::Right).unwrap();
+        for _ in 0..refinements {
+            mesh = mesh.refine_uniformly();
+        }
+        let linear = linear_solve(&mesh, &block, &pressure, &parabolic_gap);
+        let mut settings = file.settings();
+        settings.mesh_size = Some(refinements);
+        row(&file.scene, &settings, linear);
+        if refinements == 5 {
+            settings.nested = false;
+            print!("  cold: ");
+            row(&file.scene, &settings, linear);
+        }
+    }
+    println!();
+
     let hertz = Hertz {
         radius: 1.0,
         young: 1000.0,
         poisson: 0.3,
         load: 1.0,
     };
-    let data = HertzData::new(&hertz);
-    let input = hertz_input(&hertz, Displacement::P1, None, &data);
-    let b = hertz.half_width();
-    let coarse = hertz_mesh(1.0, 1.25 * b, b / 2.0, 0.25).unwrap();
-    let snap = hertz_snap(1.0);
-    run(
-        "hertz P1–P0, coarse b/h = 2, uniform refinements",
-        &coarse,
-        &[3, 4],
-        &snap,
-        &input,
-    );
-    let block = SignoriniInput {
-        young: 1000.0,
-        poisson: 0.3,
-        plane: Plane::Strain,
-        element: Displacement::P1,
-        contact: &[1],
-        load: &[3],
-        pressure: &pressure,
-        gap: &parabolic_gap,
-        contact_direction: [0.0, -1.0],
-        fixed_x: &[4],
-        fixed_y: &[],
-        rollers: &[],
-        alpha: None,
-        contact_centre: None,
+    let scene = families::scene("hertz").unwrap();
+    let q = hertz.load / (2.0 * hertz.radius);
+    let top = move |_: &[f64]| q;
+    let gap = |x: &[f64]| x[1];
+    let parts = Parts {
+        contact: &[HERTZ_ARC],
+        load: &[HERTZ_TOP],
+        fixed_x: &[HERTZ_AXIS],
     };
-    let coarse = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 7, 7, Diagonal::Alternating).unwrap();
-    run(
-        "unit block over a parabolic gap 0.02 (x − ½)², q = 2.5, P1–P0",
-        &coarse,
-        &[4, 5],
-        &straight_boundary,
-        &block,
-    );
+    header("hertz p1-p0, graded quarter disc (one level)");
+    for b_over_h in [32usize, 64, 128] {
+        // the scene's generator: uniform cells a little beyond b, grading tightening with b/h
+        let b = hertz.half_width();
+        let grading = (4.0 / b_over_h as f64).min(0.25);
+        let mesh = hertz_mesh(1.0, 1.25 * b, b / b_over_h as f64, grading).unwrap();
+        let linear = linear_solve(&mesh, &parts, &top, &gap);
+        let settings = Settings {
+            mesh_size: Some(b_over_h),
+            ..Settings::default()
+        };
+        row(&scene, &settings, linear);
+    }
 }

@@ -5,11 +5,11 @@
 //! the turned frame, so the contact pressure is q on every edge, whatever θ.
 
 use fem_forms::models::contact_scenes::ContactBody;
+use fem_forms::models::families::contact::Plane;
 use fem_forms::models::families::contact::{material_parameters, ContactFacts};
 use fem_forms::models::families::{self};
 use fem_forms::models::report::Settings;
 use fem_forms::models::scene::{Domain, Generator, Load, Part, PartSupport, Scene, Support};
-use fem_forms::models::signorini::Plane;
 use fem_forms::{Diagonal, TriangleMesh};
 use std::sync::Arc;
 

@@ -1,105 +1,101 @@
-//! Signorini contact (docs/contact.md) solved end to end: the patch test (an elastic block
-//! on a rigid foundation under a uniform pressure q: λ_h = q exactly on every contact
-//! edge, which catches the sign inside `λ + σ_n`), vertical equilibrium (total contact
-//! force = load, an identity since a rigid translation lies in V_h), complementarity,
-//! the inverse constants computed from the kernels against the P1 closed form, and the
-//! errors on bad input.
+//! Signorini contact (docs/contact.md) posed as scene files and solved through the one
+//! pipeline: the patch test (an elastic block on a rigid foundation under a uniform
+//! pressure q: λ_h = q exactly on every contact edge or vertex, which catches the sign
+//! inside `λ + σ_n`), for every pair, mesh diagonal and α up to `1/max C_I`; vertical
+//! equilibrium (total contact force = load, an identity since a rigid translation lies
+//! in V_h) and complementarity; the inverse constants computed from the kernels against
+//! the P1 closed form; Newton against clarabel's QP on a partial contact; nested levels
+//! against one cold level; the errors on bad input.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::models::signorini::{
-    lame, solve_signorini, Displacement, Plane, SignoriniInput, SignoriniSolution,
-};
-use fem_forms::{Diagonal, TriangleMesh};
+#[path = "common/contact.rs"]
+mod contact;
 
-const Q: f64 = 2.5;
+use contact::{block, parse, patch, solve_file, try_parse, Solved, Q};
+use fem_forms::models::families::contact::{lame, Plane};
+use fem_forms::obstacle::VariationalSolver;
+use fem_forms::Diagonal;
 
-fn pressure(_x: &[f64]) -> f64 {
-    Q
-}
-
-fn pulling(_x: &[f64]) -> f64 {
-    -Q
-}
-
-fn no_gap(_x: &[f64]) -> f64 {
-    0.0
-}
-
-/// The unit block, contact at the bottom (marker 1), pressure on the top (3), a roller
-/// `u_x = 0` on the left (4).
-fn block_input(element: Displacement, alpha: Option<f64>) -> SignoriniInput<'static> {
-    SignoriniInput {
-        young: 1000.0,
-        poisson: 0.3,
-        plane: Plane::Strain,
-        element,
-        contact: &[1],
-        load: &[3],
-        pressure: &pressure,
-        gap: &no_gap,
-        contact_direction: [0.0, -1.0],
-        fixed_x: &[4],
-        fixed_y: &[],
-        rollers: &[],
-        alpha,
-        contact_centre: None,
-    }
-}
-
-fn block(n: usize, diagonal: Diagonal) -> TriangleMesh {
-    TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, diagonal).unwrap()
-}
-
-fn check_patch(s: &SignoriniSolution, what: &str) {
-    assert!(!s.pressure.is_empty());
-    for (k, &p) in s.pressure.iter().enumerate() {
+/// The identities and the exact pressure of the patch test on the unit block: `dofs`
+/// multiplier values, each q.
+fn check_patch(s: &Solved, dofs: usize, what: &str) {
+    let pressures = s.pressures();
+    assert_eq!(pressures.len(), dofs, "{what}: {pressures:?}");
+    for (k, &p) in pressures.iter().enumerate() {
         assert!(
             (p - Q).abs() <= 1e-9 * Q,
-            "{what}: λ_h = {p} on contact edge {k}, expected q = {Q}"
+            "{what}: λ_h = {p} at multiplier DOF {k}, expected q = {Q}"
         );
     }
-    // equilibrium: the foundation carries the load
-    assert!(
-        (s.total_contact_force[1] + s.applied_load[1]).abs() <= 1e-10 * Q,
-        "{what}: contact force {:?}, load {:?}",
-        s.total_contact_force,
-        s.applied_load
+    // equilibrium: the foundation carries the load, q over the unit width
+    let (force, load) = (
+        s.quantity("total_contact_force"),
+        s.quantity("applied_load"),
     );
     assert!(
-        (s.applied_load[1] + Q).abs() <= 1e-12,
-        "{what}: load {:?}",
-        s.applied_load
+        (force - Q).abs() <= 1e-10 * Q,
+        "{what}: contact force {force}"
     );
+    assert!((load - Q).abs() <= 1e-12 * Q, "{what}: load {load}");
+    assert!(s.quantity("equilibrium_residual") <= 1e-10, "{what}");
+    let solve = &s.report.solve;
     assert!(
-        s.complementarity_residual <= 1e-9,
+        solve.complementarity_residual <= 1e-9,
         "{what}: {}",
-        s.complementarity_residual
+        solve.complementarity_residual
     );
-    assert!(s.kkt_residual <= 1e-9, "{what}: {}", s.kkt_residual);
-    assert!((s.contact_half_width - 0.5).abs() <= 1e-12);
+    assert!(solve.kkt_residual <= 1e-9, "{what}: {}", solve.kkt_residual);
+    assert!(
+        (s.quantity("contact_half_width") - 0.5).abs() <= 1e-12,
+        "{what}"
+    );
+    assert!(
+        (s.quantity("max_contact_pressure") - Q).abs() <= 1e-9 * Q,
+        "{what}"
+    );
 }
 
+/// The patch test on every pair and diagonal: P0 multipliers one per bottom edge, P1
+/// multipliers one per bottom vertex.
 #[test]
-fn patch_test_p1_gives_the_pressure_exactly() {
-    for diagonal in [
+fn the_patch_test_gives_the_pressure_exactly_for_every_pair() {
+    let file = parse(&patch());
+    let diagonals = [
         Diagonal::Right,
         Diagonal::Left,
         Diagonal::Alternating,
         Diagonal::Crossed,
+    ];
+    for (pair, sizes, diagonals) in [
+        ("p1-p0", &[2, 5][..], &diagonals[..]),
+        (
+            "p2-p0",
+            &[3][..],
+            &[Diagonal::Right, Diagonal::Alternating][..],
+        ),
+        (
+            "p1-p1",
+            &[2, 5][..],
+            &[Diagonal::Right, Diagonal::Alternating][..],
+        ),
+        (
+            "p2-p1",
+            &[3][..],
+            &[Diagonal::Right, Diagonal::Alternating][..],
+        ),
     ] {
-        for n in [2, 5] {
-            let s =
-                solve_signorini(&block(n, diagonal), &block_input(Displacement::P1, None)).unwrap();
-            check_patch(&s, &format!("P1 {diagonal:?} n = {n}"));
+        for &n in sizes {
+            for &diagonal in diagonals {
+                let s = solve_file(&file, |s| {
+                    s.pair = Some(pair.into());
+                    s.mesh_size = Some(n);
+                    s.diagonal = Some(diagonal);
+                })
+                .unwrap_or_else(|e| panic!("{pair} {diagonal:?} n = {n}: {e}"));
+                let dofs = if pair.ends_with("p1") { n + 1 } else { n };
+                check_patch(&s, dofs, &format!("{pair} {diagonal:?} n = {n}"));
+            }
         }
-    }
-}
-
-#[test]
-fn patch_test_p2_gives_the_pressure_exactly() {
-    for diagonal in [Diagonal::Right, Diagonal::Alternating] {
-        let s = solve_signorini(&block(3, diagonal), &block_input(Displacement::P2, None)).unwrap();
-        check_patch(&s, &format!("P2 {diagonal:?}"));
     }
 }
 
@@ -108,181 +104,279 @@ fn patch_test_p2_gives_the_pressure_exactly() {
 /// (At `α max C_I = 1.5` this mesh's Newton Hessian `A_α + B_αᵀC_α⁻¹B_α` is not positive
 /// definite and semismooth Newton refuses it: an error, not a wrong answer.)
 #[test]
-fn patch_test_holds_for_every_alpha() {
-    let mesh = block(4, Diagonal::Alternating);
-    let auto = solve_signorini(&mesh, &block_input(Displacement::P1, None)).unwrap();
-    let max_ci = auto.inverse_constants.iter().fold(0.0f64, |m, &c| m.max(c));
-    for factor in [0.1, 0.5, 1.0] {
-        let s = solve_signorini(&mesh, &block_input(Displacement::P1, Some(factor / max_ci)))
-            .unwrap_or_else(|e| panic!("α C_I = {factor}: {e}"));
-        check_patch(&s, &format!("α C_I = {factor}"));
-    }
-    let plain = solve_signorini(&mesh, &block_input(Displacement::P1, Some(0.0))).unwrap();
-    for &p in &plain.pressure {
-        assert!((p - Q).abs() <= 1e-6 * Q, "plain: λ_h = {p}");
+fn the_patch_test_holds_for_every_alpha() {
+    let file = parse(&patch());
+    for pair in ["p1-p0", "p1-p1"] {
+        let at = |alpha: Option<f64>| {
+            solve_file(&file, |s| {
+                s.pair = Some(pair.into());
+                s.mesh_size = Some(4);
+                s.diagonal = Some(Diagonal::Alternating);
+                s.alpha = alpha;
+            })
+        };
+        let auto = at(None).unwrap();
+        let max_ci = auto.report.solve.inverse_constant;
+        assert!(max_ci > 0.0);
+        let dofs = if pair == "p1-p1" { 5 } else { 4 };
+        for factor in [0.1, 0.5, 1.0] {
+            let s = at(Some(factor / max_ci))
+                .unwrap_or_else(|e| panic!("{pair} α C_I = {factor}: {e}"));
+            check_patch(&s, dofs, &format!("{pair} α C_I = {factor}"));
+        }
+        let plain = at(Some(0.0)).unwrap();
+        assert_eq!(plain.report.solve.solver, "clarabel", "{pair}");
+        for p in plain.pressures() {
+            assert!((p - Q).abs() <= 1e-6 * Q, "{pair} plain: λ_h = {p}");
+        }
     }
 }
 
-/// α = 1/(2 max C_I,E) with C_I,E from the kernels' generalized eigenvalue problem,
-/// against the P1 closed form `h_E |E| (λ_L + 2μ)/|T_E|`.
+/// `C_I,E` from the kernels' generalized eigenvalue problem against the P1 closed form
+/// `h_E |E| (λ_L + 2μ)/|T_E|` on a mesh of unequal cells, and the pipeline's
+/// α = 1/(2 max C_I,E) against it on the block, in plane strain and plane stress.
 #[test]
 fn inverse_constants_match_the_p1_closed_form() {
-    for plane in [Plane::Strain, Plane::Stress] {
-        let mut input = block_input(Displacement::P1, None);
-        input.plane = plane;
+    use fem_forms::models::signorini::signorini_p1::{self, Model as M};
+    use fem_forms::problem::Domain;
+    use fem_forms::{Coefficients, TriangleMesh};
+    for (plane, name) in [(Plane::Strain, "strain"), (Plane::Stress, "stress")] {
+        let (mu, lambda) = lame(1000.0, 0.3, plane).unwrap();
         let mesh = TriangleMesh::rectangle(0.0, 2.0, 0.0, 1.0, 5, 3, Diagonal::Alternating)
             .unwrap()
             .refine(&[0, 3])
             .unwrap()
             .0;
-        let s = solve_signorini(&mesh, &input).unwrap();
-        let (mu, lambda) = lame(input.young, input.poisson, plane).unwrap();
-        let mut max = 0.0f64;
-        for (e, &c) in s.contact_edges.iter().zip(&s.inverse_constants) {
-            let l = e.length();
-            let closed = l * l * (lambda + 2.0 * mu) / mesh.area(e.cell);
+        let zero = |_: &[f64]| 0.0;
+        let coefficients = Coefficients::from_ids(
+            &[
+                (signorini_p1::params::μ_L, mu),
+                (signorini_p1::params::λ_L, lambda),
+                (signorini_p1::params::α, 0.0),
+                (signorini_p1::params::n_c_x, 0.0),
+                (signorini_p1::params::n_c_y, -1.0),
+            ],
+            &[
+                (signorini_p1::data::q, &zero),
+                (signorini_p1::data::g, &zero),
+            ],
+        )
+        .unwrap();
+        let part = signorini_p1::facets::Γ_C.index();
+        let constants = mesh
+            .boundary_inverse_constants::<M>(&coefficients, part, &[1])
+            .unwrap();
+        let bottom: Vec<usize> = mesh
+            .boundary_edges()
+            .iter()
+            .filter(|(_, m)| *m == 1)
+            .map(|&(e, _)| e)
+            .collect();
+        assert_eq!(constants.len(), bottom.len());
+        for (&e, &c) in bottom.iter().zip(&constants) {
+            let [a, b] = mesh.edges()[e];
+            let (p, q) = (mesh.vertices()[a], mesh.vertices()[b]);
+            let l = (p[0] - q[0]).hypot(p[1] - q[1]);
+            let (cell, _) = mesh.edge_cells(e);
+            let closed = l * l * (lambda + 2.0 * mu) / mesh.area(cell);
             assert!(
                 (c - closed).abs() <= 1e-9 * closed,
-                "C_I = {c}, closed form {closed}"
+                "{name}: C_I = {c}, closed form {closed}"
             );
-            max = max.max(closed);
         }
-        assert!((s.alpha - 0.5 / max).abs() <= 1e-9 * s.alpha);
-    }
-}
-
-#[test]
-fn bad_input_is_an_error_not_a_panic() {
-    let mesh = block(2, Diagonal::Right);
-    let message = |input: &SignoriniInput| solve_signorini(&mesh, input).unwrap_err().to_string();
-    let mut input = block_input(Displacement::P1, None);
-    input.young = 0.0;
-    assert!(message(&input).contains("Young"), "{}", message(&input));
-    let mut input = block_input(Displacement::P1, None);
-    input.poisson = 0.5;
-    assert!(message(&input).contains("Poisson"), "{}", message(&input));
-    let mut input = block_input(Displacement::P1, None);
-    input.contact = &[9];
-    assert!(
-        message(&input).contains("not on the boundary"),
-        "{}",
-        message(&input)
-    );
-    let mut input = block_input(Displacement::P1, None);
-    input.pressure = &pulling;
-    assert!(
-        message(&input).contains("rigid motion"),
-        "{}",
-        message(&input)
-    );
-    let mut input = block_input(Displacement::P1, None);
-    input.alpha = Some(-1.0);
-    assert!(message(&input).contains("α"), "{}", message(&input));
-    // the top and the right side pressed, nothing holding the block along x: it slides
-    // (frictionless contact cannot hold it; a tester's file "solved" with a 1 % error)
-    let mut input = block_input(Displacement::P1, None);
-    input.load = &[2, 3];
-    input.fixed_x = &[];
-    assert!(
-        message(&input).contains("pushes it that way"),
-        "{}",
-        message(&input)
-    );
-    // a support along n_c on the contact part itself
-    let mut input = block_input(Displacement::P1, None);
-    input.fixed_y = &[1];
-    assert!(
-        message(&input).contains("also has u_y = 0"),
-        "{}",
-        message(&input)
-    );
-    // balanced sideways (left and right pressed alike) the translation is still free
-    let mut input = block_input(Displacement::P1, None);
-    input.load = &[2, 3, 4];
-    input.fixed_x = &[];
-    assert!(
-        message(&input).contains("no support fixes"),
-        "{}",
-        message(&input)
-    );
-}
-
-fn parabolic_gap(x: &[f64]) -> f64 {
-    // the foundation curves away from the block's bottom: contact in the middle only
-    0.02 * (x[0] - 0.5) * (x[0] - 0.5)
-}
-
-/// A non-flat initial gap: only part of Γ_C touches. Newton's answer against clarabel's
-/// QP on the same LCP (an independent solver), the contact force against the load, and
-/// a contact zone that is neither empty nor the whole bottom.
-#[test]
-fn non_flat_gap_newton_agrees_with_the_qp() {
-    use fem_forms::lcp::{quadratic_program, semismooth_newton, NewtonOptions};
-    use fem_forms::models::signorini::signorini_p1::{self, Model as M};
-    use fem_forms::obstacle::boundary_multiplier::discretize_on_parts;
-    use fem_forms::Coefficients;
-    let mesh = block(8, Diagonal::Alternating);
-    let mut input = block_input(Displacement::P1, None);
-    input.gap = &parabolic_gap;
-    let s = solve_signorini(&mesh, &input).unwrap();
-    assert!(
-        (s.total_contact_force[1] + s.applied_load[1]).abs() <= 1e-10 * Q,
-        "{:?} {:?}",
-        s.total_contact_force,
-        s.applied_load
-    );
-    let touching = s.pressure.iter().filter(|&&p| p > 0.0).count();
-    assert!(
-        touching > 0 && touching < s.pressure.len(),
-        "{touching} of {}",
-        s.pressure.len()
-    );
-    assert!(s.contact_half_width < 0.5);
-
-    let (mu, lambda) = lame(input.young, input.poisson, input.plane).unwrap();
-    let coefficients = Coefficients::from_ids(
-        &[
-            (signorini_p1::params::μ_L, mu),
-            (signorini_p1::params::λ_L, lambda),
-            (signorini_p1::params::α, s.alpha),
-            (signorini_p1::params::n_c_x, 0.0),
-            (signorini_p1::params::n_c_y, -1.0),
-        ],
-        &[
-            (signorini_p1::data::q, &pressure),
-            (signorini_p1::data::g, &parabolic_gap),
-        ],
-    )
-    .unwrap();
-    let problem = discretize_on_parts::<M, _, _>(
-        &mesh,
-        &coefficients,
-        &[
-            (signorini_p1::facets::Γ_C, &[1]),
-            (signorini_p1::facets::Γ_N, &[3]),
-        ],
-        &[(signorini_p1::fields::u_x, &[4])],
-    )
-    .unwrap();
-    let n = problem.lcp.n();
-    let newton = semismooth_newton(
-        &problem.lcp,
-        Some(&vec![-0.01; n]),
-        NewtonOptions::default(),
-    )
-    .unwrap();
-    let qp = quadratic_program(&problem.lcp).unwrap();
-    let scale = qp.lambda.iter().fold(0.0f64, |m, &l| m.max(l));
-    for (k, (a, b)) in newton.lambda.iter().zip(&qp.lambda).enumerate() {
+        // on the n × n block every bottom cell is a right triangle of legs 1/n: C_I,E
+        // = 2(λ_L + 2μ) on each, whatever n
+        let text = patch().replace(
+            "poisson = 0.3",
+            &format!("poisson = 0.3\n    plane = \"{name}\""),
+        );
+        let s = solve_file(&parse(&text), |s| s.mesh_size = Some(3)).unwrap();
+        let expected = 0.5 / (2.0 * (lambda + 2.0 * mu));
+        let alpha = s.report.solve.alpha.unwrap();
         assert!(
-            (a - b).abs() <= 1e-6 * scale,
-            "edge {k}: Newton {a}, QP {b}"
+            (alpha - expected).abs() <= 1e-9 * expected,
+            "{name}: α = {alpha}, closed form {expected}"
         );
     }
-    for (k, (a, b)) in newton.lambda.iter().zip(&s.pressure).enumerate() {
+}
+
+/// A foundation that curves away from the block's bottom: contact in the middle only.
+const PARABOLIC_GAP: &str = "0.02 * (x - 0.5)^2";
+
+/// A non-flat initial gap: only part of Γ_C touches. Newton's answer against
+/// clarabel's QP (an independent solver) through the same pipeline, the contact force
+/// against the load, and a contact zone that is neither empty nor the whole bottom.
+#[test]
+fn a_partial_contact_newton_agrees_with_the_qp() {
+    let file = parse(&block(&Q.to_string(), PARABOLIC_GAP, ""));
+    for pair in ["p1-p0", "p1-p1"] {
+        let at = |solver| {
+            solve_file(&file, |s| {
+                s.pair = Some(pair.into());
+                s.mesh_size = Some(8);
+                s.diagonal = Some(Diagonal::Alternating);
+                s.solver = solver;
+            })
+            .unwrap()
+        };
+        let newton = at(VariationalSolver::SemismoothNewton);
+        let qp = at(VariationalSolver::Clarabel);
+        assert!(newton.quantity("equilibrium_residual") <= 1e-10, "{pair}");
+        let pressures = newton.pressures();
+        let touching = pressures.iter().filter(|&&p| p > 0.0).count();
         assert!(
-            (a - b).abs() <= 1e-9 * scale,
-            "edge {k}: {a} against solve_signorini's {b}"
+            touching > 0 && touching < pressures.len(),
+            "{pair}: {touching} of {}",
+            pressures.len()
+        );
+        assert!(newton.quantity("contact_half_width") < 0.5, "{pair}");
+        let scale = pressures.iter().fold(0.0f64, |m, &p| m.max(p));
+        let others = qp.pressures();
+        assert_eq!(pressures.len(), others.len());
+        for (k, (a, b)) in pressures.iter().zip(&others).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-6 * scale,
+                "{pair} DOF {k}: Newton {a}, QP {b}"
+            );
+        }
+    }
+}
+
+/// Nested iteration (each level started from the coarser one's displacement) ends at
+/// the solution of one cold level, on a partial contact and on the patch.
+#[test]
+fn nested_levels_end_at_the_cold_solution() {
+    for (text, what) in [
+        (block(&Q.to_string(), PARABOLIC_GAP, ""), "partial contact"),
+        (patch(), "patch"),
+    ] {
+        let file = parse(&text);
+        for pair in ["p1-p0", "p2-p0", "p1-p1"] {
+            let at = |nested| {
+                solve_file(&file, |s| {
+                    s.pair = Some(pair.into());
+                    s.mesh_size = Some(16);
+                    s.nested = nested;
+                })
+                .unwrap()
+            };
+            let (nested, cold) = (at(true), at(false));
+            assert!(
+                nested.report.solve.levels.len() > 1,
+                "{what} {pair}: {:?}",
+                nested.report.solve.levels
+            );
+            assert_eq!(cold.report.solve.levels.len(), 1, "{what} {pair}");
+            let (a, b) = (nested.pressures(), cold.pressures());
+            let scale = b.iter().fold(0.0f64, |m, &p| m.max(p));
+            for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+                assert!(
+                    (x - y).abs() <= 1e-8 * scale,
+                    "{what} {pair} DOF {k}: nested {x}, cold {y}"
+                );
+            }
+            if what == "patch" {
+                check_patch(&nested, b.len(), &format!("nested {pair}"));
+            }
+        }
+    }
+}
+
+/// The unit square refined from one square: its coarsest level has one contact edge,
+/// and the prolonged start of the next opens the contact that edge split into, leaving
+/// a body only contact holds singular. That level is solved again from the pressed
+/// start: nested levels end at the cold solution (they failed before, "matrix is not
+/// positive definite").
+#[test]
+fn a_level_whose_prolonged_start_fails_starts_pressed() {
+    let text = block(&Q.to_string(), PARABOLIC_GAP, "").replace("    size = 2\n", "");
+    let file = parse(&text);
+    let at = |nested| {
+        solve_file(&file, |s| {
+            s.mesh_size = Some(3);
+            s.nested = nested;
+        })
+        .unwrap_or_else(|e| panic!("nested {nested}: {e}"))
+    };
+    let (nested, cold) = (at(true), at(false));
+    assert_eq!(
+        nested.report.solve.levels.len(),
+        4,
+        "{:?}",
+        nested.report.solve.levels
+    );
+    assert!(nested.quantity("equilibrium_residual") <= 1e-10);
+    let scale = cold.pressures().iter().fold(0.0f64, |m, &p| m.max(p));
+    for (x, y) in nested.pressures().iter().zip(cold.pressures()) {
+        assert!((x - y).abs() <= 1e-8 * scale, "nested {x}, cold {y}");
+    }
+}
+
+/// Bad material, loads the contact cannot hold and a negative α are refused with a
+/// message naming the fault, never a panic or an answer.
+#[test]
+fn bad_input_is_an_error_not_a_panic() {
+    let message = |text: &str, alpha: Option<f64>| -> String {
+        match try_parse(text) {
+            Err(e) => e.to_string(),
+            Ok(file) => solve_file(&file, |s| {
+                s.mesh_size = Some(2);
+                s.alpha = alpha;
+            })
+            .map(|s| format!("solved: {:?}", s.report.solve.warnings))
+            .unwrap_or_else(|e| e.to_string()),
+        }
+    };
+    let q = Q.to_string();
+    let cases: Vec<(String, Option<f64>, &str)> = vec![
+        (
+            patch().replace("young = 1000.0", "young = 0.0"),
+            None,
+            "young",
+        ),
+        (
+            patch().replace("poisson = 0.3", "poisson = 0.5"),
+            None,
+            "poisson",
+        ),
+        (block(&format!("-{q}"), "0", ""), None, "pulls the body off"),
+        (patch(), Some(-1.0), "α"),
+        // the top and the right side pressed, nothing holding the block along x: it
+        // slides (frictionless contact cannot hold it)
+        (
+            block(
+                &q,
+                "0",
+                "contact = \"bottom\"\n    load = [\"top\", \"right\"]",
+            ),
+            None,
+            "pushes it that way",
+        ),
+        // balanced sideways (left and right pressed alike) the translation is free
+        (
+            block(
+                &q,
+                "0",
+                "contact = \"bottom\"\n    load = [\"top\", \"right\", \"left\"]",
+            ),
+            None,
+            "no support fixes",
+        ),
+        // a support along n_c on the contact part itself
+        (
+            patch().replace(
+                "fixed_x = \"left\"",
+                "fixed_x = \"left\"\n    fixed_y = \"bottom\"",
+            ),
+            None,
+            "drop the support",
+        ),
+    ];
+    for (text, alpha, expected) in cases {
+        let m = message(&text, alpha);
+        assert!(
+            m.to_lowercase().contains(&expected.to_lowercase()),
+            "expected `{expected}` in: {m}\n{text}"
         );
     }
 }

@@ -1,11 +1,16 @@
-//! Hertz line contact (docs/contact.md): a half disc (R = 1, E = 1000, ν = 0.3, plane
-//! strain, P = 1; its right half with a symmetry condition) pressed onto a rigid plane,
-//! on meshes graded towards the contact zone, b/h = 8 … 64, against `b = √(4PR/(πE*))`,
-//! `p_max = 2P/(πb)`, `p(x) = p_max √(1 − x²/b²)`; the plain method (α = 0) shown worse
-//! and oscillating.
+//! Hertz line contact (docs/contact.md) through the one pipeline: the built-in `hertz`
+//! scene, a half disc (R = 1, E = 1000, ν = 0.3, plane strain, P = 1; its right half
+//! with a symmetry condition) pressed onto a rigid plane, on meshes graded towards the
+//! contact zone, b/h = 8 … 64, against `b = √(4PR/(πE*))`, `p_max = 2P/(πb)`,
+//! `p(x) = p_max √(1 − x²/b²)`, for P0 and continuous P1 multipliers; the plain method
+//! (α = 0) shown worse and oscillating.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
-use fem_forms::models::signorini::{solve_hertz, Displacement, Hertz, HertzResult};
+#[path = "common/contact.rs"]
+mod contact;
+
+use contact::{solve_scene, Solved};
+use fem_forms::models::hertz::Hertz;
 
 const HERTZ: Hertz = Hertz {
     radius: 1.0,
@@ -21,100 +26,138 @@ fn hertz_formulas_match_the_quoted_values() {
     assert_eq!(HERTZ.pressure(0.04), 0.0);
 }
 
-fn solve(b_over_h: f64, element: Displacement, alpha: Option<f64>) -> HertzResult {
-    solve_hertz(HERTZ, b_over_h, element, alpha).unwrap()
+/// The `hertz` scene with `pair` at `b/h`, α the automatic one or `alpha`.
+fn solve(pair: &str, b_over_h: usize, alpha: Option<f64>) -> Solved {
+    solve_scene("hertz", |s| {
+        s.pair = Some(pair.into());
+        s.mesh_size = Some(b_over_h);
+        s.alpha = alpha;
+    })
+    .unwrap_or_else(|e| panic!("{pair} b/h = {b_over_h}: {e}"))
 }
 
-/// The identities and the solver's certificate, on every run.
-fn check_common(r: &HertzResult, what: &str) {
-    let s = &r.solution;
-    // the quarter carries half the resultant; a rigid vertical translation lies in V_h
+/// The identities and the solver's certificate, on every run; with `shape`, the peak
+/// within `peak` (relative) and the half-width within two cells (not for the QP: its
+/// interior-point answer leaves λ ≈ 1e-9 p_max outside the contact zone).
+fn check(r: &Solved, what: &str, shape: Option<f64>) {
+    // a rigid vertical translation lies in V_h: the contact force is the load P
+    let force = r.quantity("total_contact_force");
     assert!(
-        (s.total_contact_force[1] - 0.5).abs() <= 1e-10,
-        "{what}: contact force {:?}",
-        s.total_contact_force
+        (force - 1.0).abs() <= 1e-10,
+        "{what}: contact force {force}"
     );
+    assert!((r.quantity("applied_load") - 1.0).abs() <= 1e-12, "{what}");
     assert!(
-        (s.applied_load[1] + 0.5).abs() <= 1e-12,
-        "{what}: load {:?}",
-        s.applied_load
-    );
-    assert!(
-        s.complementarity_residual <= 1e-6,
+        r.report.solve.complementarity_residual <= 1e-6,
         "{what}: {}",
-        s.complementarity_residual
+        r.report.solve.complementarity_residual
     );
     assert!(
-        s.pressure.iter().all(|&p| p >= 0.0),
+        r.pressures().iter().all(|&p| p >= 0.0),
         "{what}: a negative pressure"
     );
+    let Some(peak) = shape else {
+        return;
+    };
+    let b = HERTZ.half_width();
+    let h = b / r.report.mesh_size as f64;
+    let width = r.quantity("contact_half_width");
+    assert!(
+        (width - b).abs() <= 2.0 * h,
+        "{what}: half-width {width} against {b}"
+    );
+    let max = r.quantity("max_contact_pressure");
+    assert!(
+        (max / HERTZ.max_pressure() - 1.0).abs() <= peak,
+        "{what}: peak {max}"
+    );
+}
+
+/// `‖λ_h − p‖ / ‖p‖` over the best fit's in the multiplier's space.
+fn ratio(r: &Solved) -> f64 {
+    r.quantity("pressure_l2_error") / r.quantity("best_fit_l2_error")
 }
 
 /// Stabilized P1–P0 with the automatic α: the pressure converges (the square-root edge
 /// caps the rate at O(h)) within 1.7× of the best P0 fit, the half-width within two
 /// cells, the peak within 1 %.
 #[test]
-fn stabilized_p1_converges_to_hertz() {
-    let b = HERTZ.half_width();
+fn stabilized_p1_p0_converges_to_hertz() {
     let mut errors = Vec::new();
-    for b_over_h in [8.0, 16.0, 32.0, 64.0] {
-        let r = solve(b_over_h, Displacement::P1, None);
-        let what = format!("P1 b/h = {b_over_h}");
-        check_common(&r, &what);
-        let s = &r.solution;
-        assert!(
-            r.pressure_l2_error <= 1.7 * r.best_fit_l2_error,
-            "{what}: L² error {} against the best fit {}",
-            r.pressure_l2_error,
-            r.best_fit_l2_error
+    for b_over_h in [8, 16, 32, 64] {
+        let r = solve("p1-p0", b_over_h, None);
+        let what = format!("p1-p0 b/h = {b_over_h}");
+        check(&r, &what, Some(0.01));
+        assert!(ratio(&r) <= 1.7, "{what}: {}", ratio(&r));
+        assert_eq!(
+            r.quantity("best_p0_l2_error"),
+            r.quantity("best_fit_l2_error")
         );
-        assert!(
-            (s.contact_half_width - b).abs() <= 2.0 * r.contact_h,
-            "{what}: half-width {} against {b}",
-            s.contact_half_width
-        );
-        assert!(
-            (s.max_contact_pressure - HERTZ.max_pressure()).abs() <= 0.01 * HERTZ.max_pressure(),
-            "{what}: peak {}",
-            s.max_contact_pressure
-        );
-        errors.push(r.pressure_l2_error);
+        errors.push(r.quantity("pressure_l2_error"));
     }
     assert!(errors[3] < 0.3 * errors[0], "no convergence: {errors:?}");
 }
 
 /// P2–P0 is within 10 % of the best P0 fit at b/h = 32.
 #[test]
-fn stabilized_p2_is_close_to_the_best_fit() {
-    let r = solve(32.0, Displacement::P2, None);
-    check_common(&r, "P2");
-    assert!(
-        r.pressure_l2_error <= 1.1 * r.best_fit_l2_error,
-        "P2: {} against the best fit {}",
-        r.pressure_l2_error,
-        r.best_fit_l2_error
-    );
+fn stabilized_p2_p0_is_close_to_the_best_fit() {
+    let r = solve("p2-p0", 32, None);
+    check(&r, "p2-p0", None);
+    assert!(ratio(&r) <= 1.1, "p2-p0: {}", ratio(&r));
 }
 
 /// The plain P1–P0 method (α = 0, solved as a QP) on the same meshes: a larger error
 /// and an oscillating pressure, where the stabilized one is smooth.
 #[test]
 fn plain_p1_p0_oscillates() {
-    for b_over_h in [16.0, 64.0] {
-        let plain = solve(b_over_h, Displacement::P1, Some(0.0));
-        let stabilized = solve(b_over_h, Displacement::P1, None);
-        check_common(&plain, "plain");
+    for b_over_h in [16, 64] {
+        let plain = solve("p1-p0", b_over_h, Some(0.0));
+        let stabilized = solve("p1-p0", b_over_h, None);
+        check(&plain, "plain", None);
+        let error = |r: &Solved| r.quantity("pressure_l2_error");
         assert!(
-            plain.pressure_l2_error > 1.3 * stabilized.pressure_l2_error,
+            error(&plain) > 1.3 * error(&stabilized),
             "b/h = {b_over_h}: plain {} against stabilized {}",
-            plain.pressure_l2_error,
-            stabilized.pressure_l2_error
+            error(&plain),
+            error(&stabilized)
         );
+        let oscillation = |r: &Solved| r.quantity("oscillation");
         assert!(
-            plain.oscillation > 3.0 * stabilized.oscillation,
+            oscillation(&plain) > 3.0 * oscillation(&stabilized),
             "b/h = {b_over_h}: oscillation plain {} against stabilized {}",
-            plain.oscillation,
-            stabilized.oscillation
+            oscillation(&plain),
+            oscillation(&stabilized)
         );
     }
+}
+
+/// A continuous P1 multiplier at b/h = 16, 32 (measured, docs/contact.md: .0161, .0120
+/// against the best continuous P1 fit's .0094, .0084): within 2× of the best fit and
+/// decreasing, no best P0 fit reported; the plain method (α = 0, QP) for comparison:
+/// the same order (.0174, .0143), not better; P2–P1 within 1.3× of the best fit
+/// (measured 1.20 at b/h = 32).
+#[test]
+fn a_p1_multiplier_against_the_best_p1_fit() {
+    let mut errors = Vec::new();
+    for b_over_h in [16, 32] {
+        let r = solve("p1-p1", b_over_h, None);
+        let what = format!("p1-p1 b/h = {b_over_h}");
+        check(&r, &what, Some(5e-3));
+        assert!((1.0..2.0).contains(&ratio(&r)), "{what}: {}", ratio(&r));
+        assert!(r.quantity("best_p0_l2_error").is_nan(), "{what}");
+        let plain = solve("p1-p1", b_over_h, Some(0.0));
+        check(&plain, &format!("plain {what}"), None);
+        let error = |r: &Solved| r.quantity("pressure_l2_error");
+        assert!(
+            error(&plain) >= error(&r) && error(&plain) < 1.5 * error(&r),
+            "{what}: plain {} stabilized {}",
+            error(&plain),
+            error(&r)
+        );
+        errors.push(error(&r));
+    }
+    assert!(errors[1] < errors[0], "{errors:?}");
+    let p2 = solve("p2-p1", 32, None);
+    check(&p2, "p2-p1 b/h = 32", Some(5e-3));
+    assert!((1.0..1.3).contains(&ratio(&p2)), "p2-p1: {}", ratio(&p2));
 }

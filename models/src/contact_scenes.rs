@@ -1,10 +1,9 @@
-//! The Signorini contact scenes (docs/contact.md, issue 14), as data: the body, its
-//! material, the load and the foundation; the solver is the CLI's (`src/signorini.rs`)
-//! over [`crate::signorini::solve_signorini`].
+//! The Signorini contact scenes (docs/contact.md), as data: the body, its material, the
+//! load and the foundation, and the graded meshes of the bodies with a Hertz reference;
+//! the contact family ([`crate::families::contact`]) poses and solves them.
 
-use crate::signorini::{
-    solve_signorini, Displacement, Hertz, Plane, SignoriniInput, SignoriniSolution,
-};
+use crate::hertz::Hertz;
+use crate::signorini::Plane;
 use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
 
 /// The elastic body and how it meets the rigid foundation `y = 0`.
@@ -33,7 +32,7 @@ pub enum ContactBody {
     /// cylinder of radius R), pressed by the resultant P as a uniform pressure
     /// `P/(2w)` on its top; solved on its symmetric half `x ≥ 0` (`u_x = 0` on the
     /// axis, the side `x = w` free). For `b ≪ w, height` the pressure is Hertz's with
-    /// E* and R ([`gap_block_reference`]); the finite block's deviation from it was
+    /// E* and R ([`ContactScene::hertz`]); the finite block's deviation from it was
     /// measured (docs/contact.md) to lie well below `accuracy`.
     GapBlock {
         /// Half the block's width w (length).
@@ -200,125 +199,61 @@ pub fn gap_block_mesh(
     )
 }
 
-/// The reference of a [`ContactBody::GapBlock`] scene: Hertz line contact with the
-/// scene's E, ν, R and the load P (`None` for the other bodies).
-pub fn gap_block_reference(scene: &ContactScene, load: f64) -> Option<Hertz> {
-    match scene.body {
-        ContactBody::GapBlock { .. } => scene.hertz(load),
-        _ => None,
-    }
-}
+/// Boundary markers of [`hertz_mesh`]: the arc (the potential contact boundary).
+pub const HERTZ_ARC: u32 = 1;
+/// Boundary markers of [`hertz_mesh`]: the flat top `y = radius` (the load).
+pub const HERTZ_TOP: u32 = 2;
+/// Boundary markers of [`hertz_mesh`]: the symmetry line `x = 0`.
+pub const HERTZ_AXIS: u32 = 3;
 
-/// A gap-block computation against Hertz's pressure.
-#[derive(Clone, Debug)]
-pub struct GapBlockResult {
-    /// The reference.
-    pub hertz: Hertz,
-    /// The cell size over the contact zone.
-    pub contact_h: f64,
-    /// The computed solution (on the half block).
-    pub solution: SignoriniSolution,
-    /// `‖λ_h − p‖ / ‖p‖` over the whole contact line (both halves, by symmetry), with
-    /// the exact integrals of [`Hertz::relative_l2_error_p0`].
-    pub pressure_l2_error: f64,
-    /// The same error of the best P0 fit on the same edges: the floor of any P0
-    /// multiplier.
-    pub best_fit_l2_error: f64,
-}
-
-/// Solves a [`ContactBody::GapBlock`] scene at load P with cells of `b/b_over_h` over
-/// `x ≤ 1.25 b` (b Hertz's half-width), grading 0.25, and compares the pressure with
-/// Hertz's.
+/// The quarter `x ≥ 0, y ≤ radius` of the disc of radius `radius` centred at
+/// `(0, radius)` (the right half of a half disc resting on the plane `y = 0` at the
+/// origin), graded towards the contact zone, the segment from the origin to
+/// `(zone, 0)`: cells of diameter at most `contact_h` along the arc above it, growing
+/// like `grading · distance` from that part of the arc (at most `radius / 6`). Markers [`HERTZ_ARC`],
+/// [`HERTZ_TOP`], [`HERTZ_AXIS`]; the arc's vertices lie on the circle.
+///
+/// `TriangleMesh::quarter_disk` refined by `TriangleMesh::refine_to_size` (newest-vertex
+/// bisection, new arc vertices moved onto the circle).
 ///
 /// # Errors
-/// [`Error::Input`] for another body or `b_over_h` not positive and finite; those of
-/// [`gap_block_mesh`] and [`solve_signorini`].
-pub fn solve_gap_block(
-    scene: &ContactScene,
-    load: f64,
-    b_over_h: f64,
-    element: Displacement,
-    alpha: Option<f64>,
-) -> Result<GapBlockResult> {
-    let ContactBody::GapBlock {
-        half_width,
-        height,
-        radius,
-        ..
-    } = scene.body
-    else {
+/// [`Error::Input`] for a radius, `contact_h` or `grading` not positive and finite, or
+/// `contact_h > radius`; the mesh's errors.
+pub fn hertz_mesh(radius: f64, zone: f64, contact_h: f64, grading: f64) -> Result<TriangleMesh> {
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !(positive(radius) && positive(contact_h) && positive(grading))
+        || contact_h > radius
+        || !(zone.is_finite() && zone >= 0.0)
+    {
         return Err(Error::Input(format!(
-            "`{}` is not a block over a gap",
-            scene.name
-        )));
-    };
-    if !(b_over_h.is_finite() && b_over_h > 0.0) {
-        return Err(Error::Input(format!("b/h = {b_over_h} must be positive")));
-    }
-    if !(load.is_finite() && load > 0.0) {
-        return Err(Error::Input(format!(
-            "the load P = {load} must be positive and finite: a pull lifts the block off the foundation"
+            "the Hertz mesh needs 0 < contact_h ≤ radius, zone ≥ 0 and grading > 0, got radius {radius}, zone {zone}, contact_h {contact_h}, grading {grading}"
         )));
     }
-    let hertz = Hertz {
-        radius,
-        young: scene.young,
-        poisson: scene.poisson,
-        load,
+    let largest = radius / 6.0;
+    // The distance to the arc's part below x = zone (not to the flat segment under it:
+    // the arc rises like x²/2R, which at b/h = 512 already exceeds h/grading at x = b and
+    // left the edge of contact coarser than asked).
+    let angle = (zone / radius).min(1.0).asin();
+    let end = [radius * angle.sin(), radius - radius * angle.cos()];
+    let size = |p: [f64; 2]| {
+        let (dx, dy) = (p[0], p[1] - radius);
+        let d = if dx.atan2(-dy) <= angle {
+            (radius - dx.hypot(dy)).abs()
+        } else {
+            (p[0] - end[0]).hypot(p[1] - end[1])
+        };
+        contact_h.max(grading * d).min(largest)
     };
-    let b = hertz.half_width();
-    let h = b / b_over_h;
-    // the grading tightens with b/h as on Hertz's meshes (docs/contact.md §4): at a fixed
-    // 0.25 P1 stalled at 4.75× the best fit by b/h = 512, its peak 0.29 % high
-    let grading = (4.0 / b_over_h).min(0.25);
-    let mesh = gap_block_mesh(half_width, height, 1.25 * b, h, grading)?;
-    // the half block carries P/2 over its top of width w
-    let q = load / (2.0 * half_width);
-    let pressure = move |_: &[f64]| q;
-    let gap = move |x: &[f64]| x[0] * x[0] / (2.0 * radius);
-    let input = SignoriniInput {
-        young: scene.young,
-        poisson: scene.poisson,
-        plane: scene.plane,
-        element,
-        contact: &[GAP_BOTTOM],
-        load: &[GAP_TOP],
-        pressure: &pressure,
-        gap: &gap,
-        contact_direction: [0.0, -1.0],
-        fixed_x: &[GAP_AXIS],
-        fixed_y: &[],
-        rollers: &[],
-        alpha,
-        contact_centre: Some(0.0),
+    let onto_circle = |marker: u32, p: [f64; 2]| {
+        if marker != HERTZ_ARC {
+            return p;
+        }
+        let (dx, dy) = (p[0], p[1] - radius);
+        let r = dx.hypot(dy);
+        [radius * dx / r, radius + radius * dy / r]
     };
-    let solution = solve_signorini(&mesh, &input)?;
-    let (pressure_l2_error, best_fit_l2_error) = compare_gap_block(&hertz, &solution);
-    Ok(GapBlockResult {
-        hertz,
-        contact_h: h,
-        pressure_l2_error,
-        best_fit_l2_error,
-        solution,
-    })
-}
-
-/// The relative L² errors against Hertz's pressure of a solution on the half block
-/// ([`gap_block_mesh`]) and of the best P0 fit on its edges, over the whole contact line
-/// (each half edge and its mirror image), with the exact integrals of
-/// [`Hertz::relative_l2_error_p0`].
-pub fn compare_gap_block(hertz: &Hertz, solution: &SignoriniSolution) -> (f64, f64) {
-    let mut intervals = Vec::with_capacity(2 * solution.contact_edges.len());
-    let mut values = Vec::with_capacity(intervals.capacity());
-    for (e, &p) in solution.contact_edges.iter().zip(&solution.pressure) {
-        let (a, c) = (e.ends[0][0], e.ends[1][0]);
-        let (x0, x1) = (a.min(c), a.max(c));
-        intervals.push([x0, x1]);
-        intervals.push([-x1, -x0]);
-        values.extend([p, p]);
-    }
-    (
-        hertz.relative_l2_error_p0(&intervals, &values),
-        hertz.best_p0_relative_l2_error(&intervals),
-    )
+    // 4 rings: cells of R/4 to start, refined to the size field
+    Ok(TriangleMesh::quarter_disk(radius, 4)?
+        .refine_to_size(size, onto_circle, 20_000_000)?
+        .0)
 }

@@ -17,6 +17,9 @@
 //! All integrals here are exact (closed forms of `∫p`, `∫xp` and `∫p²`), so the reference
 //! adds no quadrature error of its own (no Gauss rule meets the square-root edge at ±b).
 
+/// Hertz line contact, the name the contact family uses.
+pub type Hertz = HertzLineContact;
+
 /// Hertz line contact of a cylinder on a rigid plane, plane strain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HertzLineContact {

@@ -2,8 +2,9 @@
 //! foundation's direction and the built-in body, and the model's names of its parts.
 
 use crate::contact_scenes::ContactBody;
-use crate::signorini::{lame, Hertz, Plane};
-use fem_runtime::Result;
+use crate::hertz::Hertz;
+use crate::signorini::{lame, Plane};
+use fem_runtime::{DataFn, Result};
 
 /// The contact boundary's name in the model's `facets:`.
 pub const CONTACT_PART: &str = "Γ_C";
@@ -68,4 +69,33 @@ pub fn material_parameters(facts: &ContactFacts) -> Result<Vec<(&'static str, f6
         ("n_c_x", facts.direction[0]),
         ("n_c_y", facts.direction[1]),
     ])
+}
+
+/// The unit tangent of the contact plane whose normal is `direction` (unit): `n_c`
+/// turned by a quarter, oriented so that its first non-zero component is positive, so
+/// that the coordinate `t·x` along the plane is x for `n_c = (0, ±1)` and y for
+/// `n_c = (±1, 0)`. The contact half-width and `contact_centre` are measured in it.
+pub fn contact_tangent(direction: [f64; 2]) -> [f64; 2] {
+    let t = [-direction[1], direction[0]];
+    if t[0] > 0.0 || (t[0] == 0.0 && t[1] > 0.0) {
+        t
+    } else {
+        [-t[0], -t[1]]
+    }
+}
+
+/// What the quantities of a contact solve are measured with: the boundary parts by
+/// their markers, the pressure as solved, and the middle of the contact zone.
+#[derive(Clone, Copy)]
+pub struct ContactData<'a> {
+    /// The potential contact boundary Γ_C.
+    pub contact: &'a [u32],
+    /// The loaded boundary Γ_N.
+    pub load: &'a [u32],
+    /// The pressure q on Γ_N (force per length, positive pressing in), a function of x.
+    pub pressure: &'a DataFn,
+    /// The middle of the contact zone, for the half-width (a symmetry line), as a
+    /// coordinate along the contact plane ([`contact_tangent`]: x under a horizontal
+    /// plane, y beside a vertical one); `None`: the middle of the pressed edges.
+    pub centre: Option<f64>,
 }

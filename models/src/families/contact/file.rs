@@ -4,11 +4,12 @@
 //! pressure that presses the body on, and data whose scales leave the displacement its
 //! digits. Each error names the file's key.
 
+use super::facts::contact_tangent;
 use super::facts::{material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
 use crate::data::Data;
 use crate::family::{finite, FieldError, FileKeys};
 use crate::scene::{Domain, Part, Scene, Support};
-use crate::signorini::{contact_tangent, Plane};
+use crate::signorini::Plane;
 use fem_runtime::{Error, TriangleMesh};
 use std::sync::Arc;
 
@@ -34,8 +35,7 @@ const RESULTANT_ROUNDING: f64 = 1e-12;
 const GAUSS_POINTS: usize = 4;
 
 /// Reads `[material]` and the parameters `contact_direction` and `contact_centre` into
-/// `scene`: the Lamé parameters, `n_c` and the [`ContactFacts`]; a scene file poses the
-/// P0-multiplier pairs (its pressure errors are per edge).
+/// `scene`: the Lamé parameters, `n_c` and the [`ContactFacts`].
 ///
 /// # Errors
 /// The field at fault: a missing `[material]`, an unknown key in it, E ≤ 0 or outside
@@ -73,7 +73,6 @@ pub fn read(keys: FileKeys<'_>, scene: &mut Scene) -> Result<(), FieldError> {
         scene.set_parameter(name, value);
     }
     scene.reference = Some(Arc::new(facts));
-    scene.pairs = vec!["p1-p0", "p2-p0"];
     Ok(())
 }
 
@@ -632,13 +631,14 @@ pub fn resultant_and_magnitude(
     (force, magnitude)
 }
 
-/// `‖λ_h − p‖/‖p‖` on Γ_C and the same of p's best P0 fit (the edge means), for a P0
-/// pressure `λ_E` per edge `ends`, p the exact pressure (8-point Gauss–Legendre per
-/// edge); an exact pressure of zero norm gives the absolute errors.
-pub fn pressure_errors(edges: &[([[f64; 2]; 2], f64)], exact: &Data) -> [f64; 2] {
+/// `‖λ_h − p‖/‖p‖` on Γ_C and the same of p's best P0 fit (the edge means), for a
+/// pressure linear along each edge `ends`, `[λ_h(ends[0]), λ_h(ends[1])]` (equal for
+/// P0), p the exact pressure (8-point Gauss–Legendre per edge); an exact pressure of
+/// zero norm gives the absolute errors.
+pub fn pressure_errors(edges: &[([[f64; 2]; 2], [f64; 2])], exact: &Data) -> [f64; 2] {
     let gauss = fem_runtime::gauss_legendre(8);
     let (mut error, mut best, mut norm) = (0.0, 0.0, 0.0);
-    for (ends, lambda) in edges {
+    for (ends, [start, end]) in edges {
         let l = length(ends);
         let values: Vec<f64> = gauss
             .points
@@ -646,7 +646,8 @@ pub fn pressure_errors(edges: &[([[f64; 2]; 2], f64)], exact: &Data) -> [f64; 2]
             .map(|&s| exact.at(&point(ends, s)))
             .collect();
         let mean: f64 = values.iter().zip(&gauss.weights).map(|(p, w)| w * p).sum();
-        for (&p, &w) in values.iter().zip(&gauss.weights) {
+        for ((&p, &w), &s) in values.iter().zip(&gauss.weights).zip(&gauss.points) {
+            let lambda = (1.0 - s) * start + s * end;
             error += w * l * (lambda - p) * (lambda - p);
             best += w * l * (mean - p) * (mean - p);
             norm += w * l * p * p;

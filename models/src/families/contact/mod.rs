@@ -6,28 +6,34 @@
 //! against Hertz's pressure where the scene has it, the relative L² error, the best
 //! fit's and the checkerboard measure.
 
+mod checks;
 mod facts;
 mod file;
+mod quantities;
 
 use crate::contact_scenes::{
-    compare_gap_block, gap_block_mesh, ContactBody, ContactScene, CONTACT_SCENES,
+    gap_block_mesh, hertz_mesh, ContactBody, ContactScene, CONTACT_SCENES,
 };
 use crate::data::Data;
 use crate::family::{Family, FieldError, FileKeys, Opt, Pair};
+use crate::hertz::Hertz;
 use crate::report::{Profile, Report};
 use crate::run::{run, Quantities, Run};
 use crate::scene::{Domain, Generator, Load, LoadSign, Part, PartSupport, Posed, Scene, Support};
-use crate::signorini::{
-    self, checkerboard, compare_with_hertz, contact_tangent, hertz_mesh, lame, signorini_p1,
-    signorini_p1_p1, signorini_p2, signorini_p2_p1, Displacement, Hertz, Multiplier, Plane,
-    SignoriniInput, SignoriniSolution,
-};
-pub use facts::{material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
+pub use crate::signorini::{lame, Plane};
+use crate::signorini::{signorini_p1, signorini_p1_p1, signorini_p2, signorini_p2_p1, Multiplier};
+use checks::{pressed_start, refuse_pressure_on_contact};
+use facts::ContactData;
+pub use facts::{contact_tangent, material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
 use fem_runtime::obstacle::{Discretization, FirstStart};
 use fem_runtime::problem::ALPHA_WHEN_CI_VANISHES;
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{DirichletPart, Error, Model, TriangleMesh};
 use file::DataScales;
+use quantities::{
+    checkerboard, checkerboard_against, compare_gap_block, compare_with_hertz, solution_of,
+    SignoriniSolution,
+};
 
 type Result<T, E = Error> = std::result::Result<T, E>;
 use std::sync::Arc;
@@ -115,8 +121,9 @@ static PAIRS: [Pair; 4] = [
     ),
 ];
 
-/// The registry's scene of a built-in contact body.
-fn contact_scene(old: &ContactScene) -> Scene {
+/// The registry's scene of a built-in contact body (a changed copy of one of
+/// [`CONTACT_SCENES`] gives that body's scene: a larger block, another material).
+pub fn contact_scene(old: &ContactScene) -> Scene {
     let facts = ContactFacts {
         young: old.young,
         poisson: old.poisson,
@@ -280,7 +287,15 @@ impl Family for Contact {
     }
 
     fn options(&self) -> &'static [Opt] {
-        &[Opt::MeshSize, Opt::Load, Opt::Alpha, Opt::Pair, Opt::Plot]
+        &[
+            Opt::MeshSize,
+            Opt::Load,
+            Opt::Alpha,
+            Opt::Pair,
+            Opt::Solver,
+            Opt::Cold,
+            Opt::Plot,
+        ]
     }
 
     fn scenes(&self) -> Vec<Scene> {
@@ -360,10 +375,6 @@ fn rollers(scene: &Scene) -> Vec<(&Part, [f64; 2])> {
 }
 
 impl Quantities<TriangleMesh> for Contact {
-    /// One level: the pressed start holds the rigid motions of the level it starts, and
-    /// the graded meshes have no coarser level.
-    const NESTED: bool = false;
-
     const ACCURACY_MEASURE: Option<(&'static str, &'static str)> = Some(PRESSURE_ERROR);
 
     fn check(scene: &Scene, posed: &Posed) -> Result<()> {
@@ -408,8 +419,8 @@ impl Quantities<TriangleMesh> for Contact {
         let contact = facet_markers(scene, mesh, CONTACT_PART)?;
         let loaded = facet_markers(scene, mesh, LOAD_PART)?;
         let pressure = pressure_of(scene, posed);
-        let input = input(&facts, &contact, &loaded, pressure.as_data_fn(), &zero);
-        signorini::refuse_pressure_on_contact(mesh, &input)?;
+        let input = input(&facts, &contact, &loaded, pressure.as_data_fn());
+        refuse_pressure_on_contact(mesh, &input)?;
         let scales = DataScales::of(
             mesh,
             &contact,
@@ -438,7 +449,7 @@ impl Quantities<TriangleMesh> for Contact {
         Some(Box::new(move |d: &Discretization<TriangleMesh>| {
             // a load that does not hold the body on its foundation is the pressure's
             // fault: named by its key
-            signorini::pressed_start(d, direction).map_err(|e| match e {
+            pressed_start(d, direction).map_err(|e| match e {
                 Error::Input(m)
                     if m.contains("rigid motion is not prevented")
                         || m.contains("tips the body") =>
@@ -456,15 +467,8 @@ impl Quantities<TriangleMesh> for Contact {
         let contact = facet_markers(run.scene, mesh, CONTACT_PART)?;
         let loaded = facet_markers(run.scene, mesh, LOAD_PART)?;
         let pressure = pressure_of(run.scene, run.posed);
-        let gap = data_of(run.scene, "g");
-        let input = input(
-            &facts,
-            &contact,
-            &loaded,
-            pressure.as_data_fn(),
-            gap.as_data_fn(),
-        );
-        let solution = signorini::report::<M>(&input, facts.direction, run.solved)?;
+        let input = input(&facts, &contact, &loaded, pressure.as_data_fn());
+        let solution = solution_of::<M>(&input, facts.direction, run.solved);
         // the pressure's size, which the equilibrium's rounding is relative to
         let magnitude = pressure_of(run.scene, run.posed);
         let magnitude = file::resultant_and_magnitude(mesh, &loaded, &magnitude).1;
@@ -528,30 +532,18 @@ fn pressure_of(scene: &Scene, posed: &Posed) -> Data {
     Data::shared(move |x| scale * q.at(x))
 }
 
-/// The contact problem's description for the checks and quantities of
-/// [`crate::signorini`].
+/// What the checks and quantities of a contact solve measure with.
 fn input<'a>(
     facts: &ContactFacts,
     contact: &'a [u32],
     loaded: &'a [u32],
     pressure: &'a fem_runtime::DataFn,
-    gap: &'a fem_runtime::DataFn,
-) -> SignoriniInput<'a> {
-    SignoriniInput {
-        young: facts.young,
-        poisson: facts.poisson,
-        plane: facts.plane,
-        element: Displacement::P1,
+) -> ContactData<'a> {
+    ContactData {
         contact,
         load: loaded,
         pressure,
-        gap,
-        contact_direction: facts.direction,
-        fixed_x: &[],
-        fixed_y: &[],
-        rollers: &[],
-        alpha: None,
-        contact_centre: facts.centre,
+        centre: facts.centre,
     }
 }
 
@@ -750,8 +742,7 @@ fn add_hertz<M: Model>(
             (error, best, checkerboard(solution, &hertz))
         }
         _ => {
-            let h = hertz.half_width() / report.mesh_size as f64;
-            let r = compare_with_hertz(hertz, h, solution.clone());
+            let r = compare_with_hertz(hertz, solution);
             (r.pressure_l2_error, r.best_fit_l2_error, r.oscillation)
         }
     };
@@ -774,8 +765,8 @@ fn add_hertz<M: Model>(
 }
 
 /// The pressure's errors against a scene's exact pressure (a scene file's `[exact]
-/// pressure`) at the load solved: the relative L² error, the best P0 fit's and the
-/// checkerboard measure.
+/// pressure`) at the load solved: the relative L² error, the best P0 fit's (of a P0
+/// pressure) and the checkerboard measure.
 fn add_exact_pressure<M: Model>(
     run: &Run<'_, M, TriangleMesh>,
     solution: &SignoriniSolution,
@@ -784,20 +775,21 @@ fn add_exact_pressure<M: Model>(
     let Some(exact) = run.scene.exact_at(run.posed).and_then(|e| e.multiplier) else {
         return;
     };
+    let edges: Vec<([[f64; 2]; 2], [f64; 2])> = solution
+        .contact_edges
+        .iter()
+        .zip(solution.edge_pressures())
+        .map(|(e, p)| (e.ends, p))
+        .collect();
+    let [error, best] = file::pressure_errors(&edges, &exact);
+    report.set("pressure_l2_error", error);
+    // the edge means are the best fit of a P0 pressure only
     if solution.multiplier == Multiplier::P0 {
-        let edges: Vec<([[f64; 2]; 2], f64)> = solution
-            .contact_edges
-            .iter()
-            .zip(&solution.pressure)
-            .map(|(e, &p)| (e.ends, p))
-            .collect();
-        let [error, best] = file::pressure_errors(&edges, &exact);
-        report.set("pressure_l2_error", error);
         report.set("best_p0_l2_error", best);
         report.set("best_fit_l2_error", best);
     }
     let direction = facts(run.scene).map_or([0.0, -1.0], |f| f.direction);
-    if let Some(o) = signorini::checkerboard_against(solution, direction, exact.as_data_fn()) {
+    if let Some(o) = checkerboard_against(solution, direction, exact.as_data_fn()) {
         report.set("oscillation", o);
     }
 }

@@ -1,0 +1,273 @@
+//! What a contact problem must satisfy before it is solved, and the start that checks
+//! it: the load presses the body onto its foundation, the supports hold the motions
+//! contact cannot (the translation along the foundation, a rotation that tips the body),
+//! and no pressure acts on the contact boundary itself.
+
+use super::facts::ContactData;
+use fem_runtime::obstacle::Discretization;
+use fem_runtime::{Error, Result, TriangleMesh};
+
+/// The start of a contact solve's first level: the body pressed into the foundation
+/// (every constraint active) beyond the gaps, by the size of the elastic displacement;
+/// the problem is refused first where the load does not press the body on or the
+/// supports leave a motion free that contact cannot hold ([`rigid_motions_held`]).
+pub(super) fn pressed_start(
+    d: &Discretization<TriangleMesh>,
+    direction: [f64; 2],
+) -> Result<Option<Vec<f64>>> {
+    let translation = rigid_motions_held(d, direction)?;
+    let b = d.boundary().expect("a boundary multiplier");
+    // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
+    let depth = d
+        .lcp
+        .g
+        .iter()
+        .zip(b.integrals())
+        .fold(0.0f64, |m, (g, w)| m.max(-g / w));
+    // beyond the gaps by the size of the elastic displacement (‖F‖∞/‖A‖∞, both in the
+    // units of E): a fixed 1e-3 h was 1e22 times it at E = 1e25, and its multipliers
+    // C⁻¹(G − BU) left Newton a Hessian that was not positive definite
+    let lcp = &d.lcp;
+    let a_norm = (0..lcp.n())
+        .map(|j| lcp.a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    let f_norm = lcp.f.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let elastic = f_norm / a_norm.max(f64::MIN_POSITIVE);
+    let scale = 2.0 * depth + elastic.min(1e-3 * d.mesh.max_h());
+    Ok(Some(translation.iter().map(|t| scale * t).collect()))
+}
+
+/// An error when the pressure q is not zero on an edge of both Γ_C and Γ_N. There
+/// `σ(u)n = −q n − λ n_c`, so the residual the stabilization penalizes,
+/// `λ + σ_n(u) = −q n·n_c`, is not zero at the exact solution: the method would not be
+/// consistent (a uniform block, loaded on its top and on its contact side,
+/// gave pressures off by 8 % instead of the exact patch value). q is sampled at 17
+/// evenly spaced points of each shared edge (3 missed a bump between them), and counts
+/// as zero below 1e-12 of its largest value on Γ_N (`cos(πy/2)` is 6e-17 at y = 1).
+///
+/// # Errors
+/// [`Error::Input`] naming the first shared edge where q ≠ 0 and the value there.
+pub(super) fn refuse_pressure_on_contact(mesh: &TriangleMesh, input: &ContactData) -> Result<()> {
+    let v = mesh.vertices();
+    let edge_points = |e: usize| {
+        let [a, b] = mesh.edges()[e];
+        let (p, q) = (v[a], v[b]);
+        (0..=SAMPLES).map(move |k| {
+            let t = k as f64 / SAMPLES as f64;
+            [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
+        })
+    };
+    // zero to the rounding of the pressure's size on Γ_N: cos(πy/2) on y = 1 is 6e-17
+    let largest = mesh
+        .boundary_edges()
+        .iter()
+        .filter(|(_, m)| input.load.contains(m))
+        .flat_map(|&(e, _)| edge_points(e))
+        .map(|x| (input.pressure)(&x).abs())
+        .filter(|q| q.is_finite())
+        .fold(0.0f64, f64::max);
+    for &(e, marker) in mesh.boundary_edges() {
+        if !(input.contact.contains(&marker) && input.load.contains(&marker)) {
+            continue;
+        }
+        let [a, b] = mesh.edges()[e];
+        let (p, q) = (v[a], v[b]);
+        for x in edge_points(e) {
+            let pressure = (input.pressure)(&x);
+            if pressure.is_nan() || pressure.abs() > 1e-12 * largest {
+                return Err(Error::Input(format!(
+                    "the edge from ({}, {}) to ({}, {}) is both on the contact boundary Γ_C and on the loaded boundary Γ_N, and the pressure there is {pressure:e} at ({}, {}): the stabilization assumes no load on Γ_C (its residual λ + σ_n(u) would be −q n·n_c at the exact solution, and the pressures wrong); take the edge out of one of the two parts, or make the pressure vanish on it",
+                    p[0], p[1], q[0], q[1], x[0], x[1]
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Intervals per edge at which [`refuse_pressure_on_contact`] samples the pressure.
+const SAMPLES: usize = 16;
+
+/// Checks that the load holds the body on the foundation, and returns the free-DOF
+/// vector of the unit translation towards it.
+///
+/// Frictionless contact resists only along `n_c`: the load must press the body on
+/// (positive work on the translation towards the foundation), and a support must fix
+/// the translation along the tangent (else `A` vanishes on it: singular, and a load
+/// with a tangential part has no equilibrium at all — a block pushed sideways
+/// "solved" with a 1 % equilibrium error).
+///
+/// # Errors
+/// [`Error::Input`] naming the unbalanced component.
+fn rigid_motions_held(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Result<Vec<f64>> {
+    let mesh = &problem.mesh;
+    let f = &problem.lcp.f;
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let translation = towards_foundation(problem, n);
+    let work = dot(&translation, f);
+    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale = norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
+    let product = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, x);
+    // supports along n_c hold the body whatever the load: only a free translation
+    // needs the load to press it on
+    let translation_free =
+        norm(&translation) > 0.0 && norm(&product(&translation)) <= 1e-10 * scale;
+    if translation_free && (work.is_nan() || work <= 0.0) {
+        return Err(Error::Input(format!(
+            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0, with q at the quadrature points of the edges of Γ_N: a pressure confined within an edge can fall between them; refine the mesh): the rigid motion is not prevented"
+        )));
+    }
+    let tangent = towards_foundation(problem, [-n[1], n[0]]);
+    let free = norm(&product(&tangent)) <= 1e-10 * scale;
+    let sliding = dot(&tangent, f);
+    if free && norm(&tangent) > 0.0 {
+        let load = if sliding.abs() > 1e-10 * work.abs() {
+            format!(" and the load pushes it that way (work {sliding:e} against {work:e} towards the foundation)")
+        } else {
+            String::new()
+        };
+        return Err(Error::Input(format!(
+            "no support fixes the body along the foundation, the direction ({:.3}, {:.3}){load}: frictionless contact leaves that translation free and the system singular; fix that displacement component on a symmetry line or a roller",
+            -n[1], n[0]
+        )));
+    }
+    rotation_held(mesh, problem, n, [&translation, &tangent], translation_free)?;
+    Ok(translation)
+}
+
+/// Refuses a body that tips: when the supports leave a rotation free (a rigid motion
+/// `Z = R + aT + bS` with `A Z = 0`: `R` the rotation about the origin, `T` and `S` the
+/// translations along and across `n_c`), only the contact can hold it. With
+/// `s(x) = Z(x)·n_c` the motion of point `x` towards the foundation, the load must do
+/// negative work on every free rigid motion that opens every contact (Fichera's
+/// condition), over the vertices of Γ_C:
+/// - `T` free too: the motions `Z − s_max T` and `s_min T − Z` span those, so
+///   `s_min W < f·Z < s_max W` with `W = f·T > 0`: the resultant meets Γ_C;
+/// - `T` held by supports: only `βZ`, which opens every contact for `β ≥ 0` if
+///   `s ≤ 0` on Γ_C (then `f·Z < 0` is needed), for `β ≤ 0` if `s ≥ 0` (`f·Z > 0`),
+///   for every β if `s ≡ 0` (`f·Z = 0`), and for none if `s` changes sign.
+///
+/// Otherwise there is no equilibrium and Newton's answer misses the load (a
+/// block against a wall "solved" with the contact force 39 % off the load).
+fn rotation_held(
+    mesh: &TriangleMesh,
+    problem: &Discretization<TriangleMesh>,
+    n: [f64; 2],
+    [translation, tangent]: [&[f64]; 2],
+    translation_free: bool,
+) -> Result<()> {
+    let fields = problem.dofs.fields();
+    let mut full = vec![0.0; problem.dofs.dof_count()];
+    for (axis, &field) in fields.iter().take(2).enumerate() {
+        let (Some(range), Some(map)) = (problem.dofs.range(field), problem.dofs.map(field)) else {
+            continue;
+        };
+        // (−y, x): the rotation about the origin
+        for (d, x) in range.zip(map.nodes(mesh)) {
+            full[d] = if axis == 0 { -x[1] } else { x[0] };
+        }
+    }
+    // in the primed DOFs of the supports' rotated groups (oblique rollers)
+    problem.basis.to_primed(&mut full);
+    let rotation: Vec<f64> = problem.reduction.free().iter().map(|&d| full[d]).collect();
+    let a = &problem.lcp.a;
+    let multiply = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(a, x);
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let (at, as_, ar) = (
+        multiply(translation),
+        multiply(tangent),
+        multiply(&rotation),
+    );
+    // the combination of the translations closest to making R free (least squares)
+    let (tt, ts, ss) = (dot(&at, &at), dot(&at, &as_), dot(&as_, &as_));
+    let (tr, sr) = (dot(&at, &ar), dot(&as_, &ar));
+    let det = tt * ss - ts * ts;
+    let [a_t, b_s] = if det > 1e-12 * tt * ss && det > 0.0 {
+        [(-tr * ss + sr * ts) / det, (-sr * tt + tr * ts) / det]
+    } else if ss > 0.0 {
+        [0.0, -sr / ss]
+    } else {
+        [0.0, 0.0]
+    };
+    let motion: Vec<f64> = (0..rotation.len())
+        .map(|i| rotation[i] + a_t * translation[i] + b_s * tangent[i])
+        .collect();
+    let residual: Vec<f64> = (0..rotation.len())
+        .map(|i| ar[i] + a_t * at[i] + b_s * as_[i])
+        .collect();
+    let scale = norm(a.val()).max(f64::MIN_POSITIVE) * norm(&motion);
+    if norm(&motion) == 0.0 || norm(&residual) > 1e-10 * scale {
+        return Ok(());
+    }
+    // s(x) = Z(x)·n = (−y, x)·n + a_t (S is normal to n)
+    let s_of = |x: [f64; 2]| -x[1] * n[0] + x[0] * n[1] + a_t;
+    let (s_min, s_max) = problem
+        .boundary()
+        .expect("a boundary multiplier")
+        .edges
+        .iter()
+        .flat_map(|e| e.ends)
+        .map(s_of)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        });
+    let f = &problem.lcp.f;
+    let moment = dot(&motion, f);
+    let work = dot(translation, f);
+    // rounding of the sums: a load doing (almost) no work on a motion is not refused
+    let terms: f64 = motion.iter().zip(f).map(|(z, f)| (z * f).abs()).sum();
+    let slack = 1e-9 * terms;
+    // s at rounding level of the coordinates counts as 0
+    let size = s_min.abs().max(s_max.abs()).max(f64::MIN_POSITIVE);
+    let (below, above) = (s_min < -1e-12 * size, s_max > 1e-12 * size);
+    let tips = match (translation_free, below, above) {
+        (true, _, _) => {
+            let slack = 1e-9 * work.abs() * (s_max - s_min).abs().max(1.0) + slack;
+            moment < s_min * work - slack || moment > s_max * work + slack
+        }
+        // s ≤ 0 on Γ_C: βZ opens every contact for β ≥ 0
+        (false, true, false) => moment > slack,
+        // s ≥ 0: for β ≤ 0
+        (false, false, true) => moment < -slack,
+        // s ≡ 0: the contact cannot hold Z at all
+        (false, false, false) => moment.abs() > slack,
+        // s changes sign: no βZ opens every contact
+        (false, true, true) => false,
+    };
+    if tips && !translation_free {
+        return Err(Error::Input(format!(
+            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {moment:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+        )));
+    }
+    if tips {
+        // where the resultant's line meets Γ_C, as a share of its extent from one end
+        let place = if s_max > s_min {
+            format!(
+                " (its line meets Γ_C at {:.2} of its extent, outside 0…1)",
+                (moment / work - s_min) / (s_max - s_min)
+            )
+        } else {
+            String::new()
+        };
+        return Err(Error::Input(format!(
+            "the load tips the body: the supports leave a rotation free, which only the contact can hold, but the load's resultant passes outside the contact boundary{place}: there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+        )));
+    }
+    Ok(())
+}
+
+/// The free-DOF vector of a unit translation along the contact direction: towards the
+/// foundation.
+pub(super) fn towards_foundation(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Vec<f64> {
+    let fields = problem.dofs.fields();
+    let mut full = vec![0.0; problem.dofs.dof_count()];
+    for (axis, &field) in fields.iter().take(2).enumerate() {
+        if let Some(range) = problem.dofs.range(field) {
+            full[range].fill(n[axis]);
+        }
+    }
+    // in the primed DOFs of the supports' rotated groups (oblique rollers)
+    problem.basis.to_primed(&mut full);
+    problem.reduction.free().iter().map(|&d| full[d]).collect()
+}
