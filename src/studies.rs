@@ -395,23 +395,7 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
         "{}: errors against the exact solution (rates between successive meshes)",
         scene.setting()
     );
-    println!(
-        "{:<10} {:>8} {:>9} {:>9} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>11} {:>5} {:>8}",
-        "pair",
-        scene.size_name(),
-        "cells",
-        "dofs",
-        "L2",
-        "rate",
-        "H1",
-        "rate",
-        "λ error",
-        "rate",
-        "|∫λ_h − ∫λ|",
-        contact_error,
-        "iter",
-        "seconds"
-    );
+    print_convergence_header(scene.size_name(), contact_error);
     let mut csv = Vec::new();
     let (mut l2_series, mut h1_series, mut multiplier_series, mut force_series, mut work) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -428,39 +412,7 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
         let force: Vec<f64> = column(|r| r.force_error);
         let (rl2, rh1, rlm) = (rates(&l2), rates(&h1), rates(&lm));
         for (k, r) in rows.iter().enumerate() {
-            let rate = |v: &[f64]| {
-                k.checked_sub(1)
-                    .map_or("-".to_string(), |j| format!("{:.2}", v[j]))
-            };
-            println!(
-                "{:<10} {:>8} {:>9} {:>9} {} {:>6} {} {:>6} {} {:>6} {} {} {:>5} {:>8.3}",
-                r.pair,
-                r.size,
-                r.cells,
-                r.dofs,
-                cell(l2[k], 11),
-                if l2[k].is_nan() {
-                    "-".into()
-                } else {
-                    rate(&rl2)
-                },
-                cell(h1[k], 11),
-                if h1[k].is_nan() {
-                    "-".into()
-                } else {
-                    rate(&rh1)
-                },
-                cell(lm[k], 11),
-                if lm[k].is_nan() {
-                    "-".into()
-                } else {
-                    rate(&rlm)
-                },
-                cell(force[k], 11),
-                cell(nan(r.contact_error), 11),
-                r.iterations,
-                r.seconds
-            );
+            print_convergence_row(r, k, [&l2, &h1, &lm, &force], [&rl2, &rh1, &rlm]);
             // the solve's own warnings under its row: rates of −6.8 at
             // 16384 Hermite elements with no note, where the single solve warned
             for warning in &r.warnings {
@@ -499,38 +451,10 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
                 .collect(),
         ));
     }
-    let setting = scene.setting();
-    let mut panels = vec![
-        (
-            format!("{setting}: L² error of u"),
-            log_axes("h", "‖u − u_h‖_L2"),
-            l2_series,
-        ),
-        (
-            format!("{setting}: H¹ error of u"),
-            log_axes("h", "|u − u_h|_H1"),
-            h1_series,
-        ),
-    ];
-    if !multiplier_series.is_empty() {
-        panels.push((
-            format!("{setting}: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½"),
-            log_axes("h", "h-weighted error of λ"),
-            multiplier_series,
-        ));
-    }
-    if !force_series.is_empty() {
-        panels.push((
-            format!("{setting}: error of the total contact force"),
-            log_axes("h", "|∫λ_h − ∫λ|"),
-            force_series,
-        ));
-    }
-    panels.push((
-        format!("{setting}: work against precision (complete nested solve)"),
-        log_axes("seconds", "|u − u_h|_H1"),
-        work,
-    ));
+    let panels = convergence_panels(
+        &scene.setting(),
+        [l2_series, h1_series, multiplier_series, force_series, work],
+    );
     plot::stacked(&output(out, &name, Study::Convergence, "svg"), &panels).map_err(io)?;
     write_csv_named(
         &output(out, &name, Study::Convergence, "csv"),
@@ -540,6 +464,95 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
         &csv,
     )
     .map_err(io)
+}
+
+/// The header of the convergence table (`size`: the scene's word for its mesh size,
+/// `contact_error`: its contact quantity's column).
+fn print_convergence_header(size: &str, contact_error: &str) {
+    println!(
+        "{:<10} {:>8} {:>9} {:>9} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>11} {:>5} {:>8}",
+        "pair",
+        size,
+        "cells",
+        "dofs",
+        "L2",
+        "rate",
+        "H1",
+        "rate",
+        "λ error",
+        "rate",
+        "|∫λ_h − ∫λ|",
+        contact_error,
+        "iter",
+        "seconds"
+    );
+}
+
+/// Row `k` of the convergence table: the errors `[L², H¹, λ, ∫λ]` of every row of its
+/// pair and the rates of the first three between successive rows.
+fn print_convergence_row(r: &Row, k: usize, errors: [&[f64]; 4], rates: [&[f64]; 3]) {
+    let [l2, h1, lm, force] = errors;
+    let rate = |errors: &[f64], rates: &[f64]| match k.checked_sub(1) {
+        Some(j) if !errors[k].is_nan() => format!("{:.2}", rates[j]),
+        _ => "-".to_string(),
+    };
+    println!(
+        "{:<10} {:>8} {:>9} {:>9} {} {:>6} {} {:>6} {} {:>6} {} {} {:>5} {:>8.3}",
+        r.pair,
+        r.size,
+        r.cells,
+        r.dofs,
+        cell(l2[k], 11),
+        rate(l2, rates[0]),
+        cell(h1[k], 11),
+        rate(h1, rates[1]),
+        cell(lm[k], 11),
+        rate(lm, rates[2]),
+        cell(force[k], 11),
+        cell(nan(r.contact_error), 11),
+        r.iterations,
+        r.seconds
+    );
+}
+
+/// The convergence chart's panels: the L² and H¹ errors of u, the multiplier's and the
+/// contact force's errors where any pair has them, and work against precision.
+fn convergence_panels(
+    setting: &str,
+    [l2, h1, multiplier, force, work]: [Vec<Series>; 5],
+) -> Vec<(String, Axes<'static>, Vec<Series>)> {
+    let mut panels = vec![
+        (
+            format!("{setting}: L² error of u"),
+            log_axes("h", "‖u − u_h‖_L2"),
+            l2,
+        ),
+        (
+            format!("{setting}: H¹ error of u"),
+            log_axes("h", "|u − u_h|_H1"),
+            h1,
+        ),
+    ];
+    if !multiplier.is_empty() {
+        panels.push((
+            format!("{setting}: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½"),
+            log_axes("h", "h-weighted error of λ"),
+            multiplier,
+        ));
+    }
+    if !force.is_empty() {
+        panels.push((
+            format!("{setting}: error of the total contact force"),
+            log_axes("h", "|∫λ_h − ∫λ|"),
+            force,
+        ));
+    }
+    panels.push((
+        format!("{setting}: work against precision (complete nested solve)"),
+        log_axes("seconds", "|u − u_h|_H1"),
+        work,
+    ));
+    panels
 }
 
 /// The stability measure of `pair` on each mesh of `sizes`.

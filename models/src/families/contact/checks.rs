@@ -102,10 +102,8 @@ const SAMPLES: usize = 16;
 fn rigid_motions_held(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Result<Vec<f64>> {
     let mesh = &problem.mesh;
     let f = &problem.lcp.f;
-    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
     let translation = towards_foundation(problem, n);
     let work = dot(&translation, f);
-    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let scale = norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
     let product = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, x);
     // supports along n_c hold the body whatever the load: only a free translation
@@ -156,6 +154,65 @@ fn rotation_held(
     [translation, tangent]: [&[f64]; 2],
     translation_free: bool,
 ) -> Result<()> {
+    let Some(FreeRotation { motion, along }) = free_rotation(mesh, problem, [translation, tangent])
+    else {
+        return Ok(());
+    };
+    // s(x) = Z(x)·n = (−y, x)·n + a_t (S is normal to n)
+    let s_of = |x: [f64; 2]| -x[1] * n[0] + x[0] * n[1] + along;
+    let (s_min, s_max) = problem
+        .boundary()
+        .expect("a boundary multiplier")
+        .edges
+        .iter()
+        .flat_map(|e| e.ends)
+        .map(s_of)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        });
+    let f = &problem.lcp.f;
+    let moment = dot(&motion, f);
+    let work = dot(translation, f);
+    // rounding of the sums: a load doing (almost) no work on a motion is not refused
+    let terms: f64 = motion.iter().zip(f).map(|(z, f)| (z * f).abs()).sum();
+    let slack = 1e-9 * terms;
+    if !tips(translation_free, [s_min, s_max], moment, work, slack) {
+        return Ok(());
+    }
+    if !translation_free {
+        return Err(Error::Input(format!(
+            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {moment:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+        )));
+    }
+    // where the resultant's line meets Γ_C, as a share of its extent from one end
+    let place = if s_max > s_min {
+        format!(
+            " (its line meets Γ_C at {:.2} of its extent, outside 0…1)",
+            (moment / work - s_min) / (s_max - s_min)
+        )
+    } else {
+        String::new()
+    };
+    Err(Error::Input(format!(
+        "the load tips the body: the supports leave a rotation free, which only the contact can hold, but the load's resultant passes outside the contact boundary{place}: there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+    )))
+}
+
+/// A rigid motion `Z = R + aT + bS` the supports leave free (`A Z = 0`), as free DOFs,
+/// and `a`, its part along the contact direction.
+struct FreeRotation {
+    motion: Vec<f64>,
+    along: f64,
+}
+
+/// The rotation about the origin `R` plus the combination of the translations `T`
+/// (along `n_c`) and `S` (across) closest to making it free (least squares), where that
+/// leaves `A Z = 0` to rounding; `None` where the supports hold every rotation.
+fn free_rotation(
+    mesh: &TriangleMesh,
+    problem: &Discretization<TriangleMesh>,
+    [translation, tangent]: [&[f64]; 2],
+) -> Option<FreeRotation> {
     let fields = problem.dofs.fields();
     let mut full = vec![0.0; problem.dofs.dof_count()];
     for (axis, &field) in fields.iter().take(2).enumerate() {
@@ -172,14 +229,11 @@ fn rotation_held(
     let rotation: Vec<f64> = problem.reduction.free().iter().map(|&d| full[d]).collect();
     let a = &problem.lcp.a;
     let multiply = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(a, x);
-    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
-    let norm = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let (at, as_, ar) = (
         multiply(translation),
         multiply(tangent),
         multiply(&rotation),
     );
-    // the combination of the translations closest to making R free (least squares)
     let (tt, ts, ss) = (dot(&at, &at), dot(&at, &as_), dot(&as_, &as_));
     let (tr, sr) = (dot(&at, &ar), dot(&as_, &ar));
     let det = tt * ss - ts * ts;
@@ -197,31 +251,25 @@ fn rotation_held(
         .map(|i| ar[i] + a_t * at[i] + b_s * as_[i])
         .collect();
     let scale = norm(a.val()).max(f64::MIN_POSITIVE) * norm(&motion);
-    if norm(&motion) == 0.0 || norm(&residual) > 1e-10 * scale {
-        return Ok(());
-    }
-    // s(x) = Z(x)·n = (−y, x)·n + a_t (S is normal to n)
-    let s_of = |x: [f64; 2]| -x[1] * n[0] + x[0] * n[1] + a_t;
-    let (s_min, s_max) = problem
-        .boundary()
-        .expect("a boundary multiplier")
-        .edges
-        .iter()
-        .flat_map(|e| e.ends)
-        .map(s_of)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
-            (lo.min(s), hi.max(s))
-        });
-    let f = &problem.lcp.f;
-    let moment = dot(&motion, f);
-    let work = dot(translation, f);
-    // rounding of the sums: a load doing (almost) no work on a motion is not refused
-    let terms: f64 = motion.iter().zip(f).map(|(z, f)| (z * f).abs()).sum();
-    let slack = 1e-9 * terms;
+    (norm(&motion) > 0.0 && norm(&residual) <= 1e-10 * scale)
+        .then_some(FreeRotation { motion, along: a_t })
+}
+
+/// Fichera's condition on a free rotation `Z` (see [`rotation_held`]): whether the load,
+/// doing `moment` on `Z` and `work` on the translation towards the foundation, tips the
+/// body, `[s_min, s_max]` the range of `s = Z·n_c` over Γ_C's vertices, `slack` the
+/// rounding of the sums.
+fn tips(
+    translation_free: bool,
+    [s_min, s_max]: [f64; 2],
+    moment: f64,
+    work: f64,
+    slack: f64,
+) -> bool {
     // s at rounding level of the coordinates counts as 0
     let size = s_min.abs().max(s_max.abs()).max(f64::MIN_POSITIVE);
     let (below, above) = (s_min < -1e-12 * size, s_max > 1e-12 * size);
-    let tips = match (translation_free, below, above) {
+    match (translation_free, below, above) {
         (true, _, _) => {
             let slack = 1e-9 * work.abs() * (s_max - s_min).abs().max(1.0) + slack;
             moment < s_min * work - slack || moment > s_max * work + slack
@@ -234,27 +282,16 @@ fn rotation_held(
         (false, false, false) => moment.abs() > slack,
         // s changes sign: no βZ opens every contact
         (false, true, true) => false,
-    };
-    if tips && !translation_free {
-        return Err(Error::Input(format!(
-            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {moment:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
-        )));
     }
-    if tips {
-        // where the resultant's line meets Γ_C, as a share of its extent from one end
-        let place = if s_max > s_min {
-            format!(
-                " (its line meets Γ_C at {:.2} of its extent, outside 0…1)",
-                (moment / work - s_min) / (s_max - s_min)
-            )
-        } else {
-            String::new()
-        };
-        return Err(Error::Input(format!(
-            "the load tips the body: the supports leave a rotation free, which only the contact can hold, but the load's resultant passes outside the contact boundary{place}: there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
-        )));
-    }
-    Ok(())
+}
+
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    x.iter().zip(y).map(|(a, b)| a * b).sum()
+}
+
+/// The largest absolute entry.
+fn norm(x: &[f64]) -> f64 {
+    x.iter().fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
 /// The free-DOF vector of a unit translation along the contact direction: towards the
