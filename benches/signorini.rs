@@ -2,11 +2,10 @@
 //! factorization + solve of the elasticity matrix of the same mesh.
 //!
 //! `cargo bench --bench signorini` prints, for the unit block over a parabolic gap (a
-//! scene file: 7 × 7 squares refined 3, 4 and 5 times; nested levels, and a cold start
-//! on the finest mesh) and for Hertz (the built-in scene's graded meshes, b/h = 32, 64,
-//! 128: one level each): the cells and unknowns of the finest level, the wall time of
-//! the whole solve (meshes, assembly, inverse constants, every level's Newton, the
-//! report), the time of one sparse Cholesky (symbolic + numeric,
+//! scene file: 7 × 7 squares refined 3, 4 and 5 times) and for Hertz (the built-in
+//! scene's graded meshes, b/h = 32, 64, 128), each solved on one level as the contact
+//! family does (docs/contact.md §7): the cells and unknowns, the wall time of the whole
+//! solve (meshes, assembly, inverse constants, Newton, the report), the time of one sparse Cholesky (symbolic + numeric,
 //! `fem_runtime::lcp::cholesky` on faer, as the runtime factors) and solve of the
 //! finest level's elasticity matrix `A`, their ratio, and the Newton iterations per
 //! level.
@@ -166,11 +165,6 @@ fn main() {
         let mut settings = file.settings();
         settings.mesh_size = Some(refinements);
         row(&file.scene, &settings, linear);
-        if refinements == 5 {
-            settings.nested = false;
-            print!("  cold: ");
-            row(&file.scene, &settings, linear);
-        }
     }
     println!();
 

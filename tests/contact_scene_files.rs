@@ -1256,6 +1256,44 @@ fn a_scene_file_takes_every_contact_pair() {
     }
 }
 
+/// A continuous P1 pressure cannot jump at a corner of Γ_C: the block pressed on its
+/// bottom, its right side a contact part that stays open (gap y), came out 60 % high at
+/// the corner at every mesh size without a word. The P1 pairs warn, naming the corner
+/// and the P0 pairs, which give the exact pressure.
+#[test]
+fn a_continuous_pressure_across_a_corner_of_the_contact_boundary_is_warned_about() {
+    let text = RECTANGLE
+        .replace("contact = \"bottom\"", "contact = [\"bottom\", \"right\"]")
+        .replace("gap = \"0\"", "gap = \"y\"");
+    let file = parse(&text).unwrap();
+    for pair in ["p1-p0", "p2-p0", "p1-p1", "p2-p1"] {
+        let solved = solve(
+            &file,
+            &Overrides {
+                pair: Some(pair),
+                ..Overrides::default()
+            },
+        )
+        .unwrap();
+        let warned = solved
+            .report
+            .solve
+            .warnings
+            .iter()
+            .any(|w| w.contains("passes a corner of Γ_C at (2, 0)") && w.contains("p1-p0"));
+        assert_eq!(
+            warned,
+            pair.ends_with("p1"),
+            "{pair}: {:?}",
+            solved.report.solve.warnings
+        );
+        if !warned {
+            let peak = quantity(&solved.report, "max_contact_pressure");
+            assert!((peak - 2.5).abs() <= 1e-9, "{pair}: {peak}");
+        }
+    }
+}
+
 /// A group that holds an embedded curve beside boundary curves (here `top` with the
 /// midline y = ½): a boundary part holds boundary edges only, so the pressure on the
 /// midline is not applied. A tester's membrane held on such a group solved without a
@@ -1409,8 +1447,8 @@ fn a_roller_along_any_direction_holds_a_turned_body() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// An error of the solve about a datum names the file's own key (`data.pressure`), not
-/// the model's name of it (`data.q`).
+/// An error of the solve about a datum names the file's own key (`data.pressure`,
+/// `exact.pressure`), not the model's name of it (`data.q`, `exact.lambda`).
 #[test]
 fn a_solve_error_about_a_datum_names_the_files_key() {
     let text = RECTANGLE.replace("pressure = \"0.5 * (2 + 3)\"", "pressure = \"1/y\"");
@@ -1418,4 +1456,13 @@ fn a_solve_error_about_a_datum_names_the_files_key() {
         .unwrap_err()
         .to_string();
     assert!(message.contains("`data.pressure`"), "{message}");
+    // the exact pressure under the key the file wrote, not the model's name of it
+    let text = format!("{RECTANGLE}\n[exact]\npressure = \"x - 1\"\n");
+    let message = solve(&parse(&text).unwrap(), &Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("`exact.pressure`") && message.contains("≥ 0"),
+        "{message}"
+    );
 }

@@ -4,8 +4,8 @@
 //! inside `λ + σ_n`), for every pair, mesh diagonal and α up to `1/max C_I`; vertical
 //! equilibrium (total contact force = load, an identity since a rigid translation lies
 //! in V_h) and complementarity; the inverse constants computed from the kernels against
-//! the P1 closed form; Newton against clarabel's QP on a partial contact; nested levels
-//! against one cold level; the errors on bad input.
+//! the P1 closed form; Newton against clarabel's QP on a partial contact; the runtime's
+//! nested levels against one cold level; the errors on bad input.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 #[path = "common/contact.rs"]
@@ -242,73 +242,70 @@ fn a_partial_contact_newton_agrees_with_the_qp() {
     }
 }
 
-/// Nested iteration (each level started from the coarser one's displacement) ends at
-/// the solution of one cold level, on a partial contact and on the patch.
+/// The runtime's nested solve of a contact problem (the unit square refined from one
+/// square, over a parabolic gap), each level from the one before, the coarsest pressed
+/// into the foundation: its one coarse contact edge splits, and the prolonged start of
+/// the next level opens both halves, leaving a body only contact holds singular
+/// ("matrix is not positive definite" before). Such a level is solved again from the
+/// pressed start, and the nested answer is the cold one on the finest mesh.
 #[test]
-fn nested_levels_end_at_the_cold_solution() {
-    for (text, what) in [
-        (block(&Q.to_string(), PARABOLIC_GAP, ""), "partial contact"),
-        (patch(), "patch"),
-    ] {
-        let file = parse(&text);
-        for pair in ["p1-p0", "p2-p0", "p1-p1"] {
-            let at = |nested| {
-                solve_file(&file, |s| {
-                    s.pair = Some(pair.into());
-                    s.mesh_size = Some(16);
-                    s.nested = nested;
-                })
-                .unwrap()
-            };
-            let (nested, cold) = (at(true), at(false));
-            assert!(
-                nested.report.solve.levels.len() > 1,
-                "{what} {pair}: {:?}",
-                nested.report.solve.levels
-            );
-            assert_eq!(cold.report.solve.levels.len(), 1, "{what} {pair}");
-            let (a, b) = (nested.pressures(), cold.pressures());
-            let scale = b.iter().fold(0.0f64, |m, &p| m.max(p));
-            for (k, (x, y)) in a.iter().zip(&b).enumerate() {
-                assert!(
-                    (x - y).abs() <= 1e-8 * scale,
-                    "{what} {pair} DOF {k}: nested {x}, cold {y}"
-                );
-            }
-            if what == "patch" {
-                check_patch(&nested, b.len(), &format!("nested {pair}"));
-            }
-        }
-    }
-}
-
-/// The unit square refined from one square: its coarsest level has one contact edge,
-/// and the prolonged start of the next opens the contact that edge split into, leaving
-/// a body only contact holds singular. That level is solved again from the pressed
-/// start: nested levels end at the cold solution (they failed before, "matrix is not
-/// positive definite").
-#[test]
-fn a_level_whose_prolonged_start_fails_starts_pressed() {
-    let text = block(&Q.to_string(), PARABOLIC_GAP, "").replace("    size = 2\n", "");
-    let file = parse(&text);
-    let at = |nested| {
-        solve_file(&file, |s| {
-            s.mesh_size = Some(3);
-            s.nested = nested;
-        })
-        .unwrap_or_else(|e| panic!("nested {nested}: {e}"))
+fn a_nested_level_whose_prolonged_start_fails_starts_pressed() {
+    use fem_forms::models::signorini::signorini_p1::{self, Model as M};
+    use fem_forms::obstacle::Discretization;
+    use fem_forms::problem::{Condition, Problem, ALPHA_WHEN_CI_VANISHES};
+    use fem_forms::stabilization::Alpha;
+    use fem_forms::{DirichletPart, TriangleMesh};
+    let (mu, lambda) = lame(1000.0, 0.3, Plane::Strain).unwrap();
+    let pressure = |_: &[f64]| Q;
+    let gap = |x: &[f64]| 0.02 * (x[0] - 0.5) * (x[0] - 0.5);
+    // every constraint active: the body pushed beyond the largest gap, 0.005
+    let pressed = |d: &Discretization<TriangleMesh>| -> fem_forms::Result<Option<Vec<f64>>> {
+        let mut full = vec![0.0; d.dofs.dof_count()];
+        full[d.dofs.range(signorini_p1::fields::u_y.index()).unwrap()].fill(-0.01);
+        Ok(Some(d.reduction.free().iter().map(|&k| full[k]).collect()))
     };
-    let (nested, cold) = (at(true), at(false));
-    assert_eq!(
-        nested.report.solve.levels.len(),
-        4,
-        "{:?}",
-        nested.report.solve.levels
+    let solve = |meshes: Vec<TriangleMesh>| {
+        Problem::<M, TriangleMesh>::new(meshes)
+            .param(signorini_p1::params::μ_L, mu)
+            .param(signorini_p1::params::λ_L, lambda)
+            .param(signorini_p1::params::n_c_x, 0.0)
+            .param(signorini_p1::params::n_c_y, -1.0)
+            .data(signorini_p1::data::q, &pressure)
+            .data(signorini_p1::data::g, &gap)
+            .part(signorini_p1::facets::Γ_C, vec![1])
+            .part(signorini_p1::facets::Γ_N, vec![3])
+            .support(
+                DirichletPart::Markers(vec![4]),
+                signorini_p1::fields::u_x,
+                Condition::Zero,
+            )
+            .alpha(Alpha::default(), ALPHA_WHEN_CI_VANISHES)
+            .start(&pressed)
+            .solve()
+            .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let mut levels =
+        vec![TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 1, 1, Diagonal::Right).unwrap()];
+    for _ in 0..3 {
+        let finer = levels.last().unwrap().refine_uniformly();
+        levels.push(finer);
+    }
+    let finest = levels[3].clone();
+    let nested = solve(levels);
+    let cold = solve(vec![finest]);
+    assert_eq!(nested.report.levels.len(), 4, "{:?}", nested.report.levels);
+    let (a, b) = (
+        nested.solution.multiplier_values(),
+        cold.solution.multiplier_values(),
     );
-    assert!(nested.quantity("equilibrium_residual") <= 1e-10);
-    let scale = cold.pressures().iter().fold(0.0f64, |m, &p| m.max(p));
-    for (x, y) in nested.pressures().iter().zip(cold.pressures()) {
-        assert!((x - y).abs() <= 1e-8 * scale, "nested {x}, cold {y}");
+    let scale = b.iter().fold(0.0f64, |m, &p| m.max(p));
+    assert!(scale > 0.0);
+    assert_eq!(a.len(), b.len());
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        assert!(
+            (x - y).abs() <= 1e-8 * scale,
+            "DOF {k}: nested {x}, cold {y}"
+        );
     }
 }
 

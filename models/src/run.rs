@@ -258,17 +258,11 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     Q::add(&run, &mut report)?;
     common_warnings(scene, &posed, Q::ACCURACY_MEASURE, &mut report);
     let profile = Q::profile(&run, &report);
-    report.phases = Phases {
-        meshes: meshes_seconds,
-        checks: checks_seconds,
-        solve: report.solve.seconds,
-        evaluation: (clock.elapsed().as_secs_f64()
-            - meshes_seconds
-            - checks_seconds
-            - solve_seconds)
-            .max(0.0)
-            + (solve_seconds - report.solve.seconds).max(0.0),
-    };
+    report.phases = phases(
+        [meshes_seconds, checks_seconds, solve_seconds],
+        report.solve.seconds,
+        clock.elapsed().as_secs_f64(),
+    );
     let schur = match (settings.schur, M::SYSTEM.is_some()) {
         (true, true) => Some(schur_of(&solved, report.solve.alpha)?),
         _ => None,
@@ -279,6 +273,19 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         profile,
         schur,
     })
+}
+
+/// The phases of a solve from the wall time taken by the meshes, the checks and the
+/// whole runtime solve (`[meshes, checks, solve]`), the runtime's own solve time
+/// `runtime` and the `total`: what the runtime spent outside its solve (assembly of the
+/// report) counts as evaluation, with the family's quantities and the fields.
+fn phases([meshes, checks, solve]: [f64; 3], runtime: f64, total: f64) -> Phases {
+    Phases {
+        meshes,
+        checks,
+        solve: runtime,
+        evaluation: (total - meshes - checks - solve).max(0.0) + (solve - runtime).max(0.0),
+    }
 }
 
 /// The multiplier's Schur complement of the finest mesh, and the stabilization's
@@ -765,8 +772,9 @@ fn validate_exact<G: Geometry>(exact: &ExactSolution, mesh: &G, scene: &Scene) -
         {
             let at: Vec<String> = x.iter().map(|c| c.to_string()).collect();
             return Err(Error::Input(format!(
-                "scene `{}`: field `exact.lambda`: λ = {} at ({}); the multiplier of the constraint is a pressure, ≥ 0",
+                "scene `{}`: field `{}`: λ = {} at ({}); the multiplier of the constraint is a pressure, ≥ 0",
                 scene.name,
+                exact.multiplier_key.unwrap_or("exact.lambda"),
                 problem::number(*v),
                 at.join(", ")
             )));

@@ -324,6 +324,9 @@ pub struct ExactSolution {
     pub hessian: Option<Data<[[f64; 2]; 2]>>,
     /// `λ(x)`.
     pub multiplier: Option<Data>,
+    /// The scene file's key of `multiplier` where it is not `exact.lambda` (contact's
+    /// `exact.pressure`), for messages.
+    pub multiplier_key: Option<&'static str>,
     /// `∫ λ` over the scene's own domain.
     pub total_contact_force: Option<f64>,
     /// The measure of the contact set over the scene's own domain: its area on

@@ -1416,6 +1416,7 @@ fn exact_of(e: &ExactToml, domain: &Domain, path: &Path) -> Result<ExactSolution
     };
     let mut out = ExactSolution {
         multiplier,
+        multiplier_key: e.pressure.is_some().then_some("exact.pressure"),
         total_contact_force: e.contact_force.map(|v| v + 0.0),
         contact_area: e.contact_area.map(|v| v + 0.0),
         ..ExactSolution::default()

@@ -1092,7 +1092,7 @@ pub(super) fn updated_solve(
 fn hessian_not_positive(error: Error) -> Error {
     match error {
         Error::LinearSolve(m) => Error::LinearSolve(format!(
-            "{m}: Newton's matrix A + BᵀC⁻¹B is not positive definite, so A = a − αS on the primal fields is not: α·C_I ≥ 1 makes it indefinite (stabilization::inverse_constant gives C_I; α = ½/C_I is the usual choice), as do a bilinear form `a` that is not positive (a wrong sign, a derivative the element does not carry) and, for thin structures, rounding; and where no constraint is active it is A alone, singular for a body that only contact holds (a rigid motion is free): start from an iterate in contact (as fem_models::signorini does) or hold the body"
+            "{m}: Newton's matrix A + BᵀC⁻¹B is not positive definite, so A = a − αS on the primal fields is not: α·C_I ≥ 1 makes it indefinite (stabilization::inverse_constant gives C_I; α = ½/C_I is the usual choice), as do a bilinear form `a` that is not positive (a wrong sign, a derivative the element does not carry) and, for thin structures, rounding; and where no constraint is active it is A alone, singular for a body that only contact holds (a rigid motion is free): start from an iterate in contact (as the contact family's pressed start does) or hold the body"
         )),
         other => other,
     }

@@ -1536,9 +1536,15 @@ fn check_feasible_at<G: Domain>(
 /// `(G − BU)/(α h^p |T|)` to rounding on fine meshes.
 fn alpha_hint(error: Error, alpha: f64, c_i: f64) -> Error {
     let hint = if c_i > 0.0 && alpha * c_i >= 1.0 {
+        let product = alpha * c_i;
+        // three digits: 1e300 written out is a line of digits
+        let product = if product < 1e6 {
+            format!("{product:.2}")
+        } else {
+            format!("{product:.2e}")
+        };
         return Error::Input(format!(
-            "α·C_I = {:.2} is outside the stability range 0 < α < 1/C_I = {:.3e}, where A_α = a − αS is indefinite, and the solve failed: {error}",
-            alpha * c_i,
+            "α·C_I = {product} is outside the stability range 0 < α < 1/C_I = {:.3e}, where A_α = a − αS is indefinite, and the solve failed: {error}",
             1.0 / c_i
         ));
     } else if alpha > 0.0 && (alpha < 1e-6 || (c_i > 0.0 && alpha * c_i < 1e-4)) {

@@ -35,7 +35,7 @@ pub struct SignoriniSolution {
     /// contact force balances this one to rounding, whatever `q`; it differs from
     /// `applied_load · n_c` by the quadrature error of a pressure that varies faster.
     pub discretized_load: f64,
-    /// Half the extent of the edges that carry pressure (λ_E > 0), holes between them
+    /// Half the extent of the edges that carry pressure (above 1e-7 of the peak), holes between them
     /// included, along the contact plane (the coordinate of [`contact_tangent`]: x under
     /// a horizontal plane, y beside a vertical one); from `contact_centre` when given.
     pub contact_half_width: f64,
@@ -87,6 +87,48 @@ impl SignoriniSolution {
         profile
     }
 }
+
+/// The vertices where a continuous P1 pressure passes a corner of Γ_C, and the angle the
+/// boundary turns there (degrees, above [`CORNER_DEGREES`]): one value serves both
+/// sides, so it cannot jump as a pressure at a corner may (a block pressed on its
+/// bottom and free on its side had the peak 60 % high there, at every mesh size).
+/// Empty for P0, whose values are per edge.
+pub fn p1_corners(solution: &SignoriniSolution) -> Vec<([f64; 2], f64)> {
+    if solution.multiplier != Multiplier::P1 {
+        return Vec::new();
+    }
+    let mut tangents: Vec<Vec<[f64; 2]>> = vec![Vec::new(); solution.pressure.len()];
+    let mut points = vec![[0.0; 2]; solution.pressure.len()];
+    for (e, dofs) in solution.contact_edges.iter().zip(&solution.edge_dofs) {
+        let [a, b] = e.ends;
+        let l = e.length();
+        let t = [(b[0] - a[0]) / l, (b[1] - a[1]) / l];
+        for (end, &k) in e.ends.iter().zip(dofs) {
+            tangents[k].push(t);
+            points[k] = *end;
+        }
+    }
+    tangents
+        .iter()
+        .zip(points)
+        .filter_map(|(t, x)| {
+            let [s, u] = t.as_slice() else {
+                return None;
+            };
+            // the turn between the two edges, whichever way each runs
+            let turn = (s[0] * u[1] - s[1] * u[0]).abs().asin().to_degrees();
+            (turn > CORNER_DEGREES).then_some((x, turn))
+        })
+        .collect()
+}
+
+/// The turn of Γ_C at a vertex above which a continuous pressure is warned about.
+pub const CORNER_DEGREES: f64 = 20.0;
+
+/// The share of the peak pressure above which an edge counts as pressed, for the
+/// half-width: far above the QP's residual pressures on open edges (1e-9), far below any
+/// pressure that matters.
+const CARRIES_PRESSURE: f64 = 1e-7;
 
 /// The contact quantities of a solved problem (`direction` the unit `n_c`).
 pub fn solution_of<M: Model>(
@@ -146,8 +188,10 @@ pub fn solution_of<M: Model>(
     let along = contact_tangent(direction);
     let (mut x_min, mut x_max) = (f64::INFINITY, f64::NEG_INFINITY);
     for (e, &[a, b]) in boundary.edges.iter().zip(&boundary.edge_dofs) {
-        // the edges where λ_h is not identically 0 (for P1: either end positive)
-        if pressure[a].max(pressure[b]) > 1e-10 * largest {
+        // the edges that carry pressure (for P1: either end): clarabel's interior point
+        // leaves λ ≈ 1e-10…1e-9 p_max on open edges, which counted at 1e-10 and widened
+        // the zone by an edge against semismooth Newton's exact zeros
+        if pressure[a].max(pressure[b]) > CARRIES_PRESSURE * largest {
             for end in e.ends {
                 let s = along[0] * end[0] + along[1] * end[1];
                 x_min = x_min.min(s);
