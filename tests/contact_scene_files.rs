@@ -1294,6 +1294,31 @@ fn a_continuous_pressure_across_a_corner_of_the_contact_boundary_is_warned_about
     }
 }
 
+/// A pressure that varies within the file's coarse edges is judged by its resultant,
+/// not by four Gauss points on each coarse edge: 0.1 + cos(8πx) on one square (refined
+/// four times for the solve) presses with 0.1, and was refused as pulling (−0.24).
+#[test]
+fn a_pressure_varying_within_the_files_edges_is_judged_by_its_resultant() {
+    let text = rectangle_scene(
+        1.0,
+        1.0,
+        [1, 1],
+        "contact = \"bottom\"\n    load = \"top\"\n    fixed_x = \"left\"",
+        "0.1 + cos(8*PI*x)",
+    );
+    let solved = solve(
+        &parse(&text).unwrap(),
+        &Overrides {
+            refinements: Some(4),
+            ..Overrides::default()
+        },
+    )
+    .unwrap();
+    let force = quantity(&solved.report, "total_contact_force");
+    assert!((force - 0.1).abs() <= 1e-9, "{force}");
+    assert!(quantity(&solved.report, "equilibrium_residual") <= 1e-10);
+}
+
 /// A group that holds an embedded curve beside boundary curves (here `top` with the
 /// midline y = ½): a boundary part holds boundary edges only, so the pressure on the
 /// midline is not applied. A tester's membrane held on such a group solved without a
