@@ -1228,7 +1228,8 @@ fn a_pressure_on_the_contact_boundary_is_refused() {
 
 /// A contact scene file takes every pair of the family: another is refused by the key,
 /// listing them; a continuous P1 pressure is measured against the file's exact pressure
-/// as a P0 one is (no best P0 fit: the edge means are not its space).
+/// as a P0 one is, its best fit the L² projection onto its own space (no best P0 fit:
+/// the edge means are not its space).
 #[test]
 fn a_scene_file_takes_every_contact_pair() {
     let text = RECTANGLE.replace(
@@ -1253,6 +1254,9 @@ fn a_scene_file_takes_every_contact_pair() {
         assert!(error <= 1e-9, "{pair}: {error}");
         let best = quantity(&solved.report, "best_p0_l2_error");
         assert_eq!(best.is_nan(), pair.ends_with("p1"), "{pair}: {best}");
+        // the constant is in both spaces: its best fit is exact
+        let fit = quantity(&solved.report, "best_fit_l2_error");
+        assert!(fit <= 1e-12, "{pair}: {fit}");
     }
 }
 

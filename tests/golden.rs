@@ -76,7 +76,26 @@ const BERNOULLI: &[&str] = &["bernoulli-a", "bernoulli-b", "bernoulli-flat"];
 /// Newton, so its numbers agree to rounding of the solve (the Kirchhoff square's centre
 /// deflection to 5e-13 of itself, which its relative error of 8e-7 shows in its 7th
 /// digit), and α, where the stabilization has no primal part (Morley), is null.
+///
+/// `QUADRATURE`: a scene file's pressure errors against its exact pressure integrate on
+/// 8 pieces of each edge: one 8-point rule on the edge across Hertz's square-root edge
+/// at b left the errors about 1 % low (0.0494 against 0.0498).
 const CHANGED: &[(&str, &str, &str)] = &[
+    (
+        "--scene examples/contact-gap.toml",
+        "pressure_l2_error",
+        "QUADRATURE",
+    ),
+    (
+        "--scene examples/contact-gap.toml",
+        "best_p0_l2_error",
+        "QUADRATURE",
+    ),
+    (
+        "--scene examples/contact-gap.toml",
+        "best_fit_l2_error",
+        "QUADRATURE",
+    ),
     (
         "signorini-gap --mesh-size 16",
         "warnings",

@@ -641,12 +641,109 @@ pub fn resultant_and_magnitude(
     (force, magnitude)
 }
 
+/// The rule on an edge `[0, 1]` of the errors against an exact pressure: 8-point
+/// Gauss–Legendre on each of 8 pieces. An exact contact pressure has square-root edges
+/// (Hertz's at ±b), where one 8-point rule on the edge across it missed the best P1
+/// fit's error by 12 %; the pieces bring that below 1 %.
+fn along_edge() -> fem_runtime::QuadratureRule {
+    const PIECES: usize = 8;
+    let gauss = fem_runtime::gauss_legendre(8);
+    let piece = 1.0 / PIECES as f64;
+    let (mut points, mut weights) = (Vec::new(), Vec::new());
+    for k in 0..PIECES {
+        for (&s, &w) in gauss.points.iter().zip(&gauss.weights) {
+            points.push((k as f64 + s) * piece);
+            weights.push(w * piece);
+        }
+    }
+    fem_runtime::QuadratureRule { points, weights }
+}
+
+/// `‖Πp − p‖/‖p‖` on Γ_C for `Πp` the best continuous P1 fit of the exact pressure p:
+/// its L² projection onto the piecewise linears on the vertices of Γ_C, given by
+/// `edges` (the ends of each edge and the indices of their values among `vertices`).
+/// The mass matrix, scaled by its diagonal, has a condition number bounded
+/// independently of the edges' lengths (at most 3 in 1D), so Jacobi-preconditioned CG
+/// solves it in a few dozen steps. The rule of [`along_edge`]; an exact pressure of
+/// zero norm gives the absolute error.
+pub fn best_p1_error(edges: &[([[f64; 2]; 2], [usize; 2])], vertices: usize, exact: &Data) -> f64 {
+    let gauss = along_edge();
+    let mut mass: Vec<Vec<(usize, f64)>> = vec![Vec::new(); vertices];
+    let mut rhs = vec![0.0; vertices];
+    let mut norm = 0.0;
+    for (ends, [a, b]) in edges {
+        let l = length(ends);
+        for (i, j, m) in [(a, a, 2.0), (a, b, 1.0), (b, a, 1.0), (b, b, 2.0)] {
+            mass[*i].push((*j, m * l / 6.0));
+        }
+        for (&t, &w) in gauss.points.iter().zip(&gauss.weights) {
+            let p = exact.at(&point(ends, t));
+            rhs[*a] += w * l * (1.0 - t) * p;
+            rhs[*b] += w * l * t * p;
+            norm += w * l * p * p;
+        }
+    }
+    let fit = jacobi_cg(&mass, &rhs);
+    let mut error = 0.0;
+    for (ends, [a, b]) in edges {
+        let l = length(ends);
+        for (&t, &w) in gauss.points.iter().zip(&gauss.weights) {
+            let d = (1.0 - t) * fit[*a] + t * fit[*b] - exact.at(&point(ends, t));
+            error += w * l * d * d;
+        }
+    }
+    let scale = if norm > 0.0 { norm } else { 1.0 };
+    (error / scale).sqrt()
+}
+
+/// `M x = b` for the symmetric positive definite `M` given by rows of `(column, value)`
+/// (repeated columns summed), by conjugate gradients preconditioned with the diagonal,
+/// to 1e-14 of `‖b‖`.
+fn jacobi_cg(rows: &[Vec<(usize, f64)>], b: &[f64]) -> Vec<f64> {
+    let multiply = |x: &[f64]| -> Vec<f64> {
+        rows.iter()
+            .map(|row| row.iter().map(|&(j, m)| m * x[j]).sum())
+            .collect()
+    };
+    let diagonal: Vec<f64> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, row)| row.iter().filter(|e| e.0 == i).map(|e| e.1).sum())
+        .collect();
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let mut x = vec![0.0; b.len()];
+    let mut r = b.to_vec();
+    let mut z: Vec<f64> = r.iter().zip(&diagonal).map(|(r, d)| r / d).collect();
+    let mut p = z.clone();
+    let mut rz = dot(&r, &z);
+    let tolerance = 1e-14 * dot(b, b).sqrt();
+    for _ in 0..10 * b.len().max(10) {
+        if dot(&r, &r).sqrt() <= tolerance {
+            break;
+        }
+        let q = multiply(&p);
+        let step = rz / dot(&p, &q);
+        for i in 0..x.len() {
+            x[i] += step * p[i];
+            r[i] -= step * q[i];
+        }
+        z = r.iter().zip(&diagonal).map(|(r, d)| r / d).collect();
+        let next = dot(&r, &z);
+        let beta = next / rz;
+        rz = next;
+        for i in 0..p.len() {
+            p[i] = z[i] + beta * p[i];
+        }
+    }
+    x
+}
+
 /// `‖λ_h − p‖/‖p‖` on Γ_C and the same of p's best P0 fit (the edge means), for a
 /// pressure linear along each edge `ends`, `[λ_h(ends[0]), λ_h(ends[1])]` (equal for
-/// P0), p the exact pressure (8-point Gauss–Legendre per edge); an exact pressure of
-/// zero norm gives the absolute errors.
+/// P0), p the exact pressure (the rule of [`along_edge`]); an exact pressure of zero
+/// norm gives the absolute errors.
 pub fn pressure_errors(edges: &[([[f64; 2]; 2], [f64; 2])], exact: &Data) -> [f64; 2] {
-    let gauss = fem_runtime::gauss_legendre(8);
+    let gauss = along_edge();
     let (mut error, mut best, mut norm) = (0.0, 0.0, 0.0);
     for (ends, [start, end]) in edges {
         let l = length(ends);

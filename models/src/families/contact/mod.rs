@@ -778,8 +778,8 @@ fn add_hertz<M: Model>(
 }
 
 /// The pressure's errors against a scene's exact pressure (a scene file's `[exact]
-/// pressure`) at the load solved: the relative L² error, the best P0 fit's (of a P0
-/// pressure) and the checkerboard measure.
+/// pressure`) at the load solved: the relative L² error, the best fit's in the
+/// pressure's space (P0 or continuous P1) and the checkerboard measure.
 fn add_exact_pressure<M: Model>(
     run: &Run<'_, M, TriangleMesh>,
     solution: &SignoriniSolution,
@@ -796,10 +796,23 @@ fn add_exact_pressure<M: Model>(
         .collect();
     let [error, best] = file::pressure_errors(&edges, &exact);
     report.set("pressure_l2_error", error);
-    // the edge means are the best fit of a P0 pressure only
-    if solution.multiplier == Multiplier::P0 {
-        report.set("best_p0_l2_error", best);
-        report.set("best_fit_l2_error", best);
+    // the best fit in the pressure's own space: the edge means for P0, the L²
+    // projection onto the continuous piecewise linears for P1
+    match solution.multiplier {
+        Multiplier::P0 => {
+            report.set("best_p0_l2_error", best);
+            report.set("best_fit_l2_error", best);
+        }
+        Multiplier::P1 => {
+            let edges: Vec<([[f64; 2]; 2], [usize; 2])> = solution
+                .contact_edges
+                .iter()
+                .zip(&solution.edge_dofs)
+                .map(|(e, &dofs)| (e.ends, dofs))
+                .collect();
+            let best = file::best_p1_error(&edges, solution.pressure.len(), &exact);
+            report.set("best_fit_l2_error", best);
+        }
     }
     let direction = facts(run.scene).map_or([0.0, -1.0], |f| f.direction);
     if let Some(o) = checkerboard_against(solution, direction, exact.as_data_fn()) {
