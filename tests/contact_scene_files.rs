@@ -1241,7 +1241,7 @@ fn a_scene_file_takes_every_contact_pair() {
         message.contains("`pair`") && message.contains("p1-p0, p2-p0, p1-p1, p2-p1"),
         "{message}"
     );
-    let exact = format!("{RECTANGLE}\n[exact]\npressure = \"2.5\"\n");
+    let exact = format!("{RECTANGLE}\n[exact]\npressure = \"2.5\"\ncontact_force = 5.0\n");
     for pair in ["p1-p0", "p2-p0", "p1-p1", "p2-p1"] {
         let text = exact.replace(
             "model = \"contact\"",
@@ -1254,6 +1254,9 @@ fn a_scene_file_takes_every_contact_pair() {
         assert!(error <= 1e-9, "{pair}: {error}");
         let best = quantity(&solved.report, "best_p0_l2_error");
         assert_eq!(best.is_nan(), pair.ends_with("p1"), "{pair}: {best}");
+        // the block is 2 wide: the foundation carries 2q = 5
+        let force = quantity(&solved.report, "contact_force_error");
+        assert!(force <= 1e-12, "{pair}: {force}");
         // the constant is in both spaces: its best fit is exact
         let fit = quantity(&solved.report, "best_fit_l2_error");
         assert!(fit <= 1e-12, "{pair}: {fit}");

@@ -719,6 +719,10 @@ fn add_equilibrium<M: Model>(
     };
     let equilibrium = (total - discretized).abs() / discretized.abs().max(factor * magnitude);
     report.set("total_contact_force", total);
+    // a scene's exact force (a file's `[exact] contact_force`) is compared, not only shown
+    if let Some(exact) = report.exact_contact_force.filter(|e| *e != 0.0) {
+        report.set("contact_force_error", (total - exact).abs() / exact.abs());
+    }
     report.set("applied_load", applied);
     report.set("discretized_load", discretized);
     report.set("equilibrium_residual", equilibrium);
