@@ -642,43 +642,17 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         warnings.append(&mut report.warnings);
         report.warnings = warnings;
         if shape.is_some() {
-            if let Some((quality, shape_warnings)) =
-                finest.shape(alpha_from_inverse_constant && c_i > 0.0)?
-            {
-                report.warnings.extend(shape_warnings);
-                report.mesh_quality = Some(MeshQualityReport {
-                    min_angle_deg: quality.min_angle_deg,
-                    max_angle_deg: quality.max_angle_deg,
-                    max_aspect_ratio: quality.max_aspect_ratio,
-                    worst_inverse_constant: c_i,
-                    forced_alpha: (c_i > 0.0).then(|| 0.5 / c_i),
-                });
-            }
+            record_mesh_quality(finest, alpha_from_inverse_constant, c_i, &mut report)?;
         }
         if self.options.rounding_experiment && !self.unconstrained {
-            let clock = Instant::now();
-            let rounding = self
-                .rounding_experiment(meshes, &solution, &coefficients, &parts, options)
-                .unwrap_or(f64::INFINITY);
-            report.rounding_seconds = Some(clock.elapsed().as_secs_f64());
-            report.rounding = Some(rounding);
-            if rounding.is_nan() || rounding > MAX_ROUNDING {
-                let moved = if rounding.is_finite() {
-                    format!("moves the answer by {rounding:.0e} of its size")
-                } else {
-                    "makes the solve fail".to_string()
-                };
-                return Err(Error::Input(format!(
-                    "{} is rounding: moving the mesh in its last bits {moved}; the system's condition leaves no correct digit here; use fewer cells (elements)",
-                    answer_name::<M>()
-                )));
-            }
-            if rounding > ROUNDING_WARNING {
-                report.warnings.push(format!(
-                    "{} is rounding-limited to about {rounding:.0e} of its size (moving the mesh in its last bits moves it that much): fewer cells (elements) give more correct digits here",
-                    answer_name::<M>()
-                ));
-            }
+            self.judge_rounding(
+                meshes,
+                &solution,
+                &coefficients,
+                &parts,
+                options,
+                &mut report,
+            )?;
         }
         Ok(Solved {
             solution,
@@ -687,6 +661,47 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             fell_back: None,
             model: PhantomData,
         })
+    }
+
+    /// Runs the rounding experiment on the solved levels and records it in `report`:
+    /// a warning where rounding limits the answer's digits.
+    ///
+    /// # Errors
+    /// An answer that rounding moves by more than [`MAX_ROUNDING`] of its size, or that
+    /// the moved mesh cannot be solved on.
+    fn judge_rounding(
+        &self,
+        meshes: &[G],
+        solution: &ObstacleSolution<G>,
+        coefficients: &Coefficients,
+        parts: &[Vec<u32>],
+        options: ObstacleOptions,
+        report: &mut Report,
+    ) -> Result<()> {
+        let clock = Instant::now();
+        let rounding = self
+            .rounding_experiment(meshes, solution, coefficients, parts, options)
+            .unwrap_or(f64::INFINITY);
+        report.rounding_seconds = Some(clock.elapsed().as_secs_f64());
+        report.rounding = Some(rounding);
+        if rounding.is_nan() || rounding > MAX_ROUNDING {
+            let moved = if rounding.is_finite() {
+                format!("moves the answer by {rounding:.0e} of its size")
+            } else {
+                "makes the solve fail".to_string()
+            };
+            return Err(Error::Input(format!(
+                "{} is rounding: moving the mesh in its last bits {moved}; the system's condition leaves no correct digit here; use fewer cells (elements)",
+                answer_name::<M>()
+            )));
+        }
+        if rounding > ROUNDING_WARNING {
+            report.warnings.push(format!(
+                "{} is rounding-limited to about {rounding:.0e} of its size (moving the mesh in its last bits moves it that much): fewer cells (elements) give more correct digits here",
+                answer_name::<M>()
+            ));
+        }
+        Ok(())
     }
 
     /// The nodal method: the model is one P1 field, the constraint `u_i ≥ ψ(x_i)` at the
@@ -1527,6 +1542,32 @@ fn check_feasible_at<G: Domain>(
                 if side > 0.0 { "≥" } else { "≤" }
             )));
         }
+    }
+    Ok(())
+}
+
+/// The mesh's quality in `report` with its warnings, `c_i` the worst inverse constant
+/// and the α it forces where α follows from it (`alpha_from_inverse_constant`).
+///
+/// # Errors
+/// Those of the mesh's shape measures.
+fn record_mesh_quality<G: Domain>(
+    finest: &G,
+    alpha_from_inverse_constant: bool,
+    c_i: f64,
+    report: &mut Report,
+) -> Result<()> {
+    if let Some((quality, shape_warnings)) =
+        finest.shape(alpha_from_inverse_constant && c_i > 0.0)?
+    {
+        report.warnings.extend(shape_warnings);
+        report.mesh_quality = Some(MeshQualityReport {
+            min_angle_deg: quality.min_angle_deg,
+            max_angle_deg: quality.max_angle_deg,
+            max_aspect_ratio: quality.max_aspect_ratio,
+            worst_inverse_constant: c_i,
+            forced_alpha: (c_i > 0.0).then(|| 0.5 / c_i),
+        });
     }
     Ok(())
 }
