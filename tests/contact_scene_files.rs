@@ -289,7 +289,7 @@ fn a_body_the_load_tips_is_refused() {
     .to_string();
     assert!(
         e.contains("tips the body")
-            && e.contains("-1.50 of its extent")
+            && e.contains("y = -1.500 misses Γ_C, which spans 0.000 ≤ y ≤ 1.000")
             && e.contains("data.pressure"),
         "{e}"
     );
@@ -1496,5 +1496,68 @@ fn a_solve_error_about_a_datum_names_the_files_key() {
     assert!(
         message.contains("`exact.pressure`") && message.contains("≥ 0"),
         "{message}"
+    );
+}
+
+/// A unit square free to rotate (a roller along x on its top leaves the rotation about
+/// the top free), refined four times from one square. With P0 multipliers its one
+/// coarsest contact edge holds no moment, and a nested solve that began there passed a
+/// huge rotation on; with q = x⁸ (its resultant meets the bottom at x = 9/10, by hand)
+/// the P0 constraints of 2 and 4 edges act only up to their last midpoints, 3/4 and 7/8,
+/// and the P1 ones of 2 edges up to 1 − h/3 = 5/6 (the last hat's mean of x). Nested
+/// iteration begins on the first level whose constraints reach the resultant (128
+/// cells for P0, 32 for P1), its answer is the one-level one, and one level too coarse
+/// is refused with the words to refine.
+#[test]
+fn a_nested_contact_solve_begins_on_the_first_level_that_holds_the_rotation() {
+    let square = |pressure: &str, refinements: usize| {
+        rectangle_scene(
+            1.0,
+            1.0,
+            [1, 1],
+            "contact = \"bottom\"\n    load = \"top\"\n    fixed_x = \"top\"",
+            pressure,
+        )
+        .replace(
+            "cells = [1, 1]",
+            &format!("cells = [1, 1]\n    refinements = {refinements}"),
+        )
+    };
+    let first_level = |pressure: &str, pair: &'static str| {
+        let file = parse(&square(pressure, 4)).unwrap();
+        let mut settings = file.settings();
+        settings.pair = Some(pair.into());
+        let nested = families::solve(&file.scene, &settings).unwrap().report;
+        settings.nested = false;
+        let cold = families::solve(&file.scene, &settings).unwrap().report;
+        assert_eq!(cold.solve.levels.len(), 1);
+        let [a, b] = [&nested, &cold].map(|r| r.solve.energy.unwrap());
+        let energy = (a - b).abs() / b.abs();
+        assert!(energy < 1e-10, "{pair}, q = {pressure}: {energy:e}");
+        let equilibrium = quantity(&nested, "equilibrium_residual");
+        assert!(
+            equilibrium < 1e-10,
+            "{pair}, q = {pressure}: {equilibrium:e}"
+        );
+        nested.solve.levels[0][0]
+    };
+    for (pressure, p0, p1) in [("x", 8, 2), ("x^8", 128, 32)] {
+        for pair in ["p1-p0", "p2-p0"] {
+            assert_eq!(first_level(pressure, pair), p0, "{pair}, q = {pressure}");
+        }
+        for pair in ["p1-p1", "p2-p1"] {
+            assert_eq!(first_level(pressure, pair), p1, "{pair}, q = {pressure}");
+        }
+    }
+    let file = parse(&square("x", 0)).unwrap();
+    let e = families::solve(&file.scene, &file.settings())
+        .unwrap_err()
+        .to_string();
+    // the one bottom edge acts at its midpoint, the resultant of q = x at 2/3
+    assert!(
+        e.contains("cannot hold the rotation")
+            && e.contains("act on 0.500 ≤ x ≤ 0.500, and the load's resultant on x = 0.667")
+            && e.contains("refine the mesh"),
+        "{e}"
     );
 }

@@ -251,7 +251,7 @@ fn a_partial_contact_newton_agrees_with_the_qp() {
 #[test]
 fn a_nested_level_whose_prolonged_start_fails_starts_pressed() {
     use fem_forms::models::signorini::signorini_p1::{self, Model as M};
-    use fem_forms::obstacle::Discretization;
+    use fem_forms::obstacle::{Discretization, LevelStart};
     use fem_forms::problem::{Condition, Problem, ALPHA_WHEN_CI_VANISHES};
     use fem_forms::stabilization::Alpha;
     use fem_forms::{DirichletPart, TriangleMesh};
@@ -259,10 +259,12 @@ fn a_nested_level_whose_prolonged_start_fails_starts_pressed() {
     let pressure = |_: &[f64]| Q;
     let gap = |x: &[f64]| 0.02 * (x[0] - 0.5) * (x[0] - 0.5);
     // every constraint active: the body pushed beyond the largest gap, 0.005
-    let pressed = |d: &Discretization<TriangleMesh>| -> fem_forms::Result<Option<Vec<f64>>> {
+    let pressed = |d: &Discretization<TriangleMesh>| -> fem_forms::Result<LevelStart> {
         let mut full = vec![0.0; d.dofs.dof_count()];
         full[d.dofs.range(signorini_p1::fields::u_y.index()).unwrap()].fill(-0.01);
-        Ok(Some(d.reduction.free().iter().map(|&k| full[k]).collect()))
+        Ok(LevelStart::At(
+            d.reduction.free().iter().map(|&k| full[k]).collect(),
+        ))
     };
     let solve = |meshes: Vec<TriangleMesh>| {
         Problem::<M, TriangleMesh>::new(meshes)

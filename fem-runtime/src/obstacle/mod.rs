@@ -1051,10 +1051,38 @@ where
     solve_nested_from(levels, prolong, primal_prolongation, None, options)
 }
 
-/// The start of the first (coarsest) level of a nested solve: the primal unknowns to
-/// start Newton from, or `None` for zero; an error refuses the problem (e.g. a body
-/// whose rigid motion nothing holds).
-pub type FirstStart<'a, G> = dyn Fn(&Discretization<G>) -> Result<Option<Vec<f64>>> + Sync + 'a;
+/// The first start of a nested solve: its judgement of a level ([`LevelStart`]), where
+/// Newton starts on the first level solved (and again where a prolonged start fails);
+/// an error refuses the problem (e.g. a body whose rigid motion nothing holds).
+pub type FirstStart<'a, G> = dyn Fn(&Discretization<G>) -> Result<LevelStart> + Sync + 'a;
+
+/// How a level of a nested solve starts when no coarser solution is prolonged to it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LevelStart {
+    /// From zero.
+    Zero,
+    /// From these primal unknowns (the free DOFs of the level's discretization).
+    At(Vec<f64>),
+    /// Not on this level: it has no solution (the reason), though a finer one may, e.g.
+    /// a contact boundary whose few constraints cannot hold a rigid motion the supports
+    /// leave free. Nested iteration leaves the level out; on the finest level the reason
+    /// is the solve's error ([`Error::Input`]).
+    TooCoarse(String),
+}
+
+impl LevelStart {
+    /// The start vector, `None` for zero.
+    ///
+    /// # Errors
+    /// [`Error::Input`] with the reason of a level [`LevelStart::TooCoarse`].
+    pub fn vector(self) -> Result<Option<Vec<f64>>> {
+        match self {
+            Self::Zero => Ok(None),
+            Self::At(x) => Ok(Some(x)),
+            Self::TooCoarse(reason) => Err(Error::Input(reason)),
+        }
+    }
+}
 
 /// [`solve_nested_on_hierarchy`] whose coarsest level starts from `first_start`'s
 /// vector (semismooth Newton from zero otherwise).
@@ -1093,6 +1121,8 @@ where
     let solve_finest = |coarse: Option<SolvedLevel<G>>,
                         d: &Discretization<G>,
                         workspace: Option<&NewtonWorkspace>| {
+        // the finest level is judged too: one without an equilibrium is refused
+        let first = first_start.map(|f| f(d)).transpose()?;
         let hierarchy = extend_hierarchy(coarse.as_ref(), d, primal_prolongation);
         let solution = solve_level(
             d,
@@ -1100,7 +1130,7 @@ where
             &prolong,
             workspace,
             &hierarchy,
-            first_start,
+            first,
             options,
         )?;
         let mut counts = coarse.map(|(_, _, counts, _)| counts).unwrap_or_default();
@@ -1243,41 +1273,43 @@ fn extend_hierarchy<G>(
 }
 
 /// Solves level `d`: from `coarse`'s solution prolonged where there is a coarser level,
-/// else from the first start. A body that only contact holds is singular where no
-/// constraint is active, and a prolonged start can open every contact the finer level
-/// has (a block whose one coarse contact edge split in two): where Newton fails from
-/// the prolonged start, the level is solved again from the first start, which holds
-/// such a body.
+/// else from `first`, the first start's judgement of `d` (from zero without one). A
+/// body that only contact holds is singular where no constraint is active, and a
+/// prolonged start can open every contact the finer level has (a block whose one coarse
+/// contact edge split in two): where Newton fails from the prolonged start, the level
+/// is solved again from the first start, which holds such a body.
 ///
 /// # Errors
-/// The first start's, and the solver's from the last start tried.
+/// [`Error::Input`] with the reason of a level `first` calls
+/// [`LevelStart::TooCoarse`], and the solver's from the last start tried.
 fn solve_level<G: Mesh>(
     d: &Discretization<G>,
     coarse: Option<&SolvedLevel<G>>,
     prolong: &impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
     workspace: Option<&NewtonWorkspace>,
     hierarchy: &[SparseMatrix],
-    first_start: Option<&FirstStart<'_, G>>,
+    first: Option<LevelStart>,
     options: ObstacleOptions,
 ) -> Result<LcpSolution> {
-    let from_first = || -> Result<LcpSolution> {
-        let start = first_start.map(|f| f(d)).transpose()?.flatten();
-        solve_lcp_on_hierarchy(&d.lcp, workspace, hierarchy, start.as_deref(), options)
-    };
+    let retry = first.is_some();
+    let first = first.map(LevelStart::vector).transpose()?.flatten();
+    let from_first =
+        || solve_lcp_on_hierarchy(&d.lcp, workspace, hierarchy, first.as_deref(), options);
     let Some((c, values, _, _)) = coarse else {
         return from_first();
     };
     let start = d.primal_part(&prolong(c, values, d));
     match solve_lcp_on_hierarchy(&d.lcp, workspace, hierarchy, Some(&start), options) {
-        Err(Error::NotConverged { .. } | Error::LinearSolve(_)) if first_start.is_some() => {
-            from_first()
-        }
+        Err(Error::NotConverged { .. } | Error::LinearSolve(_)) if retry => from_first(),
         other => other,
     }
 }
 
-/// Builds and solves `levels` in turn, each from the prolonged solution of the one
-/// before; the last one solved, or `None` for no levels.
+/// Builds and solves `levels` in turn, each from the prolonged solution of the last one
+/// solved; a level the first start calls [`LevelStart::TooCoarse`] is left out (nested
+/// iteration begins on the first level it accepts, and the load's quadrature on a
+/// coarse level can judge a level finer than an accepted one unbalanced). The last one
+/// solved, or `None` for no levels.
 fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
     levels: Vec<B>,
     prolong: &impl Fn(&Discretization<G>, &[f64], &Discretization<G>) -> Vec<f64>,
@@ -1288,16 +1320,12 @@ fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
     let mut last: Option<SolvedLevel<G>> = None;
     for build in levels {
         let d = build()?;
+        let first = first_start.map(|f| f(&d)).transpose()?;
+        if let Some(LevelStart::TooCoarse(_)) = first {
+            continue;
+        }
         let hierarchy = extend_hierarchy(last.as_ref(), &d, primal_prolongation);
-        let solution = solve_level(
-            &d,
-            last.as_ref(),
-            prolong,
-            None,
-            &hierarchy,
-            first_start,
-            options,
-        )?;
+        let solution = solve_level(&d, last.as_ref(), prolong, None, &hierarchy, first, options)?;
         let mut counts = last.map(|(_, _, counts, _)| counts).unwrap_or_default();
         counts.push((d.mesh.cell_count(), solution.iterations));
         let values = d.full(&solution);

@@ -65,7 +65,7 @@ use crate::model::{
     Coefficients, DataFn, IntoDataIndex, IntoFieldIndex, IntoParamIndex, IntoPartIndex, Model,
 };
 use crate::obstacle::{
-    multiplier_field, solve_nested_from, Discretization, FirstStart, ObstacleOptions,
+    multiplier_field, solve_nested_from, Discretization, FirstStart, LevelStart, ObstacleOptions,
     ObstacleSolution, VariationalSolver,
 };
 use crate::stabilization::Alpha;
@@ -881,9 +881,9 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             })
             .collect();
         let prolongation = G::primal_prolongation();
-        let from_previous = |d: &Discretization<G>| -> Result<Option<Vec<f64>>> {
+        let from_previous = |d: &Discretization<G>| -> Result<LevelStart> {
             let p = previous.expect("used with a previous level");
-            Ok(Some(d.primal_part(&G::prolong::<M>(
+            Ok(LevelStart::At(d.primal_part(&G::prolong::<M>(
                 &p.discretization,
                 &p.values,
                 d,

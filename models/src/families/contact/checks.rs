@@ -4,18 +4,26 @@
 //! and no pressure acts on the contact boundary itself.
 
 use super::facts::ContactData;
-use fem_runtime::obstacle::Discretization;
+use fem_runtime::obstacle::{Discretization, LevelStart};
 use fem_runtime::{Error, Result, TriangleMesh};
 
 /// The start of a contact solve's first level: the body pressed into the foundation
-/// (every constraint active) beyond the gaps, by the size of the elastic displacement;
-/// the problem is refused first where the load does not press the body on or the
-/// supports leave a motion free that contact cannot hold ([`rigid_motions_held`]).
+/// (every constraint active) beyond the gaps, by the size of the elastic displacement.
+/// The problem is refused where the supports leave the translation along the
+/// foundation free; the level is [`LevelStart::TooCoarse`] where its load does not hold
+/// the body on ([`load_holds`]) or its constraints cannot balance the load on the free
+/// rigid motions ([`constraints_balance`]): a finer level may, and on the finest the
+/// reason is the solve's error.
 pub(super) fn pressed_start(
     d: &Discretization<TriangleMesh>,
     direction: [f64; 2],
-) -> Result<Option<Vec<f64>>> {
-    let translation = rigid_motions_held(d, direction)?;
+) -> Result<LevelStart> {
+    let motions = free_motions(d, direction)?;
+    if let Some(reason) =
+        load_holds(d, &motions, direction).or_else(|| constraints_balance(d, direction, &motions))
+    {
+        return Ok(LevelStart::TooCoarse(reason));
+    }
     let b = d.boundary().expect("a boundary multiplier");
     // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
     let depth = d
@@ -34,7 +42,9 @@ pub(super) fn pressed_start(
     let f_norm = lcp.f.iter().fold(0.0f64, |m, f| m.max(f.abs()));
     let elastic = f_norm / a_norm.max(f64::MIN_POSITIVE);
     let scale = 2.0 * depth + elastic.min(1e-3 * d.mesh.max_h());
-    Ok(Some(translation.iter().map(|t| scale * t).collect()))
+    Ok(LevelStart::At(
+        motions.translation.iter().map(|t| scale * t).collect(),
+    ))
 }
 
 /// An error when the pressure q is not zero on an edge of both Γ_C and Γ_N. There
@@ -88,37 +98,36 @@ pub(super) fn refuse_pressure_on_contact(mesh: &TriangleMesh, input: &ContactDat
 /// Intervals per edge at which [`refuse_pressure_on_contact`] samples the pressure.
 const SAMPLES: usize = 16;
 
-/// Checks that the load holds the body on the foundation, and returns the free-DOF
-/// vector of the unit translation towards it.
-///
-/// Frictionless contact resists only along `n_c`: the load must press the body on
-/// (positive work on the translation towards the foundation), and a support must fix
-/// the translation along the tangent (else `A` vanishes on it: singular, and a load
-/// with a tangential part has no equilibrium at all — a block pushed sideways
-/// "solved" with a 1 % equilibrium error).
+/// The rigid motions of a level's discretization that its supports leave free
+/// (`A Z = 0`), as free-DOF vectors.
+struct FreeMotions {
+    /// The unit translation towards the foundation `T`.
+    translation: Vec<f64>,
+    /// Whether `A T = 0`: no support holds the body along `n_c`.
+    translation_free: bool,
+    /// A free rotation, where the supports leave one.
+    rotation: Option<FreeRotation>,
+}
+
+/// The rigid motions the supports of `problem` leave free; frictionless contact resists
+/// only along `n_c`, so a support must fix the translation along the tangent (else `A`
+/// vanishes on it: singular, and a load with a tangential part has no equilibrium at
+/// all — a block pushed sideways "solved" with a 1 % equilibrium error).
 ///
 /// # Errors
-/// [`Error::Input`] naming the unbalanced component.
-fn rigid_motions_held(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Result<Vec<f64>> {
-    let mesh = &problem.mesh;
+/// [`Error::Input`] where the translation along the foundation is free.
+fn free_motions(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Result<FreeMotions> {
     let f = &problem.lcp.f;
     let translation = towards_foundation(problem, n);
-    let work = dot(&translation, f);
     let scale = norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
     let product = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, x);
-    // supports along n_c hold the body whatever the load: only a free translation
-    // needs the load to press it on
     let translation_free =
         norm(&translation) > 0.0 && norm(&product(&translation)) <= 1e-10 * scale;
-    if translation_free && (work.is_nan() || work <= 0.0) {
-        return Err(Error::Input(format!(
-            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0, with q at the quadrature points of the edges of Γ_N: a pressure confined within an edge can fall between them; refine the mesh): the rigid motion is not prevented"
-        )));
-    }
     let tangent = towards_foundation(problem, [-n[1], n[0]]);
     let free = norm(&product(&tangent)) <= 1e-10 * scale;
-    let sliding = dot(&tangent, f);
     if free && norm(&tangent) > 0.0 {
+        let work = dot(&translation, f);
+        let sliding = dot(&tangent, f);
         let load = if sliding.abs() > 1e-10 * work.abs() {
             format!(" and the load pushes it that way (work {sliding:e} against {work:e} towards the foundation)")
         } else {
@@ -129,15 +138,37 @@ fn rigid_motions_held(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Re
             -n[1], n[0]
         )));
     }
-    rotation_held(mesh, problem, n, [&translation, &tangent], translation_free)?;
-    Ok(translation)
+    let rotation = free_rotation(&problem.mesh, problem, [&translation, &tangent]);
+    Ok(FreeMotions {
+        translation,
+        translation_free,
+        rotation,
+    })
 }
 
-/// Refuses a body that tips: when the supports leave a rotation free (a rigid motion
-/// `Z = R + aT + bS` with `A Z = 0`: `R` the rotation about the origin, `T` and `S` the
-/// translations along and across `n_c`), only the contact can hold it. With
-/// `s(x) = Z(x)·n_c` the motion of point `x` towards the foundation, the load must do
-/// negative work on every free rigid motion that opens every contact (Fichera's
+/// Why the load of `problem` does not hold the body on its foundation, if it does not:
+/// supports along `n_c` hold the body whatever the load, but a free translation needs
+/// the load to press it on (positive work on the translation towards the foundation),
+/// and a free rotation needs the load to turn it onto the contact ([`tipping`]).
+fn load_holds(
+    problem: &Discretization<TriangleMesh>,
+    motions: &FreeMotions,
+    n: [f64; 2],
+) -> Option<String> {
+    let work = dot(&motions.translation, &problem.lcp.f);
+    if motions.translation_free && (work.is_nan() || work <= 0.0) {
+        return Some(format!(
+            "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0, with q at the quadrature points of the edges of Γ_N: a pressure confined within an edge can fall between them; refine the mesh): the rigid motion is not prevented"
+        ));
+    }
+    tipping(problem, n, motions.rotation.as_ref()?, motions)
+}
+
+/// Why the load tips the body, if it does: when the supports leave a rotation free (a
+/// rigid motion `Z = R + aT + bS` with `A Z = 0`: `R` the rotation about the origin,
+/// `T` and `S` the translations along and across `n_c`), only the contact can hold it.
+/// With `s(x) = Z(x)·n_c` the motion of point `x` towards the foundation, the load must
+/// do negative work on every free rigid motion that opens every contact (Fichera's
 /// condition), over the vertices of Γ_C:
 /// - `T` free too: the motions `Z − s_max T` and `s_min T − Z` span those, so
 ///   `s_min W < f·Z < s_max W` with `W = f·T > 0`: the resultant meets Γ_C;
@@ -147,20 +178,149 @@ fn rigid_motions_held(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Re
 ///
 /// Otherwise there is no equilibrium and Newton's answer misses the load (a
 /// block against a wall "solved" with the contact force 39 % off the load).
-fn rotation_held(
-    mesh: &TriangleMesh,
+fn tipping(
     problem: &Discretization<TriangleMesh>,
     n: [f64; 2],
-    [translation, tangent]: [&[f64]; 2],
-    translation_free: bool,
-) -> Result<()> {
-    let Some(FreeRotation { motion, along }) = free_rotation(mesh, problem, [translation, tangent])
-    else {
-        return Ok(());
+    rotation: &FreeRotation,
+    motions: &FreeMotions,
+) -> Option<String> {
+    let [s_min, s_max] = vertex_range(problem, n, rotation);
+    let Moments {
+        moment,
+        work,
+        slack,
+    } = moments(problem, rotation, motions);
+    if !tips(
+        motions.translation_free,
+        [s_min, s_max],
+        moment,
+        work,
+        slack,
+    ) {
+        return None;
+    }
+    if !motions.translation_free {
+        return Some(format!(
+            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {moment:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+        ));
+    }
+    let across = Across::new(n, rotation.along);
+    let [a, b] = across.span([s_min, s_max]);
+    let place = format!(
+        " (its line {} = {:.3} misses Γ_C, which spans {a:.3} ≤ {} ≤ {b:.3})",
+        across.name,
+        across.at(moment / work),
+        across.name
+    );
+    Some(format!(
+        "the load tips the body: the supports leave a rotation free, which only the contact can hold, but the load's resultant passes outside the contact boundary{place}: there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+    ))
+}
+
+/// Why the constraints of `problem` cannot balance the load on its free rigid motions,
+/// if they cannot: [`tipping`]'s condition with the constraints in place of Γ_C's
+/// vertices. With `A Z = 0`, `A U − BᵀΛ = F` gives `Σ_k Λ_k ζ_k = f·Z` for `Λ ≥ 0`,
+/// `ζ_k = −(BZ)_k = ∫ μ_k s ds`, and `Σ_k Λ_k w_k = W` with `w_k = −(BT)_k = ∫ μ_k ds`:
+/// the load's resultant must meet Γ_C between the constraints' weighted means
+/// `r_k = ζ_k / w_k` of `s`, which lie inside Γ_C's extent. A coarse level can miss it
+/// where a finer one holds it: one P0 edge under a body free to rotate holds no moment
+/// at all (its Newton answer was a huge rotation, and the next level started from it
+/// ended 55 % off the load).
+fn constraints_balance(
+    problem: &Discretization<TriangleMesh>,
+    n: [f64; 2],
+    motions: &FreeMotions,
+) -> Option<String> {
+    let rotation = motions.rotation.as_ref()?;
+    let lcp = &problem.lcp;
+    let w: Vec<f64> = lcp
+        .b_times(&motions.translation)
+        .iter()
+        .map(|b| -b)
+        .collect();
+    let zeta: Vec<f64> = lcp.b_times(&rotation.motion).iter().map(|b| -b).collect();
+    // a constraint whose DOFs supports hold along n_c weighs nothing; only its sign of
+    // ζ counts then (the translation is held, and the range's signs are what matter)
+    let means = w
+        .iter()
+        .zip(&zeta)
+        .map(|(&w, &z)| if w > 0.0 { z / w } else { z });
+    let (r_min, r_max) = means.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+        (lo.min(r), hi.max(r))
+    });
+    let Moments {
+        moment,
+        work,
+        slack,
+    } = moments(problem, rotation, motions);
+    if !tips(
+        motions.translation_free,
+        [r_min, r_max],
+        moment,
+        work,
+        slack,
+    ) {
+        return None;
+    }
+    let reach = if motions.translation_free {
+        let across = Across::new(n, rotation.along);
+        let [a, b] = across.span([r_min, r_max]);
+        format!(
+            ": they act on {a:.3} ≤ {name} ≤ {b:.3}, and the load's resultant on {name} = {:.3}",
+            across.at(moment / work),
+            name = across.name
+        )
+    } else {
+        String::new()
     };
+    Some(format!(
+        "the contact constraints of this mesh ({}) cannot hold the rotation the supports leave free{reach}; refine the mesh",
+        lcp.m()
+    ))
+}
+
+/// A value of `s = Z·n_c` as the coordinate across `n_c` of the line along `n_c` where
+/// the rotation moves points by `s` (`s = t·x + a` with `t = (n_y, −n_x)`): `x` or `y`
+/// for a contact direction along an axis, else the coordinate along `t`.
+struct Across {
+    name: String,
+    sign: f64,
+    along: f64,
+}
+
+impl Across {
+    fn new(n: [f64; 2], along: f64) -> Self {
+        let t = [n[1], -n[0]];
+        let (name, sign) = if t[1].abs() < 1e-12 {
+            ("x".to_string(), t[0].signum())
+        } else if t[0].abs() < 1e-12 {
+            ("y".to_string(), t[1].signum())
+        } else {
+            (format!("({:.3}, {:.3})·x", t[0], t[1]), 1.0)
+        };
+        Self { name, sign, along }
+    }
+
+    fn at(&self, s: f64) -> f64 {
+        self.sign * (s - self.along)
+    }
+
+    /// The coordinates of a range of `s`, in increasing order.
+    fn span(&self, [lo, hi]: [f64; 2]) -> [f64; 2] {
+        let (a, b) = (self.at(lo), self.at(hi));
+        [a.min(b), a.max(b)]
+    }
+}
+
+/// The range `[s_min, s_max]` of `s = Z·n_c` over the vertices of Γ_C.
+fn vertex_range(
+    problem: &Discretization<TriangleMesh>,
+    n: [f64; 2],
+    rotation: &FreeRotation,
+) -> [f64; 2] {
     // s(x) = Z(x)·n = (−y, x)·n + a_t (S is normal to n)
-    let s_of = |x: [f64; 2]| -x[1] * n[0] + x[0] * n[1] + along;
-    let (s_min, s_max) = problem
+    let s_of = |x: [f64; 2]| -x[1] * n[0] + x[0] * n[1] + rotation.along;
+    let (lo, hi) = problem
         .boundary()
         .expect("a boundary multiplier")
         .edges
@@ -170,32 +330,31 @@ fn rotation_held(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
             (lo.min(s), hi.max(s))
         });
+    [lo, hi]
+}
+
+/// The load's work on a free rotation and on the translation towards the foundation,
+/// and the rounding of the first.
+struct Moments {
+    moment: f64,
+    work: f64,
+    slack: f64,
+}
+
+fn moments(
+    problem: &Discretization<TriangleMesh>,
+    rotation: &FreeRotation,
+    motions: &FreeMotions,
+) -> Moments {
     let f = &problem.lcp.f;
-    let moment = dot(&motion, f);
-    let work = dot(translation, f);
+    let motion = &rotation.motion;
     // rounding of the sums: a load doing (almost) no work on a motion is not refused
     let terms: f64 = motion.iter().zip(f).map(|(z, f)| (z * f).abs()).sum();
-    let slack = 1e-9 * terms;
-    if !tips(translation_free, [s_min, s_max], moment, work, slack) {
-        return Ok(());
+    Moments {
+        moment: dot(motion, f),
+        work: dot(&motions.translation, f),
+        slack: 1e-9 * terms,
     }
-    if !translation_free {
-        return Err(Error::Input(format!(
-            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {moment:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
-        )));
-    }
-    // where the resultant's line meets Γ_C, as a share of its extent from one end
-    let place = if s_max > s_min {
-        format!(
-            " (its line meets Γ_C at {:.2} of its extent, outside 0…1)",
-            (moment / work - s_min) / (s_max - s_min)
-        )
-    } else {
-        String::new()
-    };
-    Err(Error::Input(format!(
-        "the load tips the body: the supports leave a rotation free, which only the contact can hold, but the load's resultant passes outside the contact boundary{place}: there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
-    )))
 }
 
 /// A rigid motion `Z = R + aT + bS` the supports leave free (`A Z = 0`), as free DOFs,
@@ -255,7 +414,7 @@ fn free_rotation(
         .then_some(FreeRotation { motion, along: a_t })
 }
 
-/// Fichera's condition on a free rotation `Z` (see [`rotation_held`]): whether the load,
+/// Fichera's condition on a free rotation `Z` (see [`tipping`]): whether the load,
 /// doing `moment` on `Z` and `work` on the translation towards the foundation, tips the
 /// body, `[s_min, s_max]` the range of `s = Z·n_c` over Γ_C's vertices, `slack` the
 /// rounding of the sums.

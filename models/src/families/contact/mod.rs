@@ -25,7 +25,7 @@ use crate::signorini::{signorini_p1, signorini_p1_p1, signorini_p2, signorini_p2
 use checks::{pressed_start, refuse_pressure_on_contact};
 use facts::ContactData;
 pub use facts::{contact_tangent, material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
-use fem_runtime::obstacle::{Discretization, FirstStart};
+use fem_runtime::obstacle::{Discretization, FirstStart, LevelStart};
 use fem_runtime::problem::ALPHA_WHEN_CI_VANISHES;
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{DirichletPart, Error, Model, TriangleMesh};
@@ -292,6 +292,7 @@ impl Family for Contact {
             Opt::Load,
             Opt::Alpha,
             Opt::Pair,
+            Opt::Cold,
             Opt::Solver,
             Opt::Plot,
         ]
@@ -374,12 +375,6 @@ fn rollers(scene: &Scene) -> Vec<(&Part, [f64; 2])> {
 }
 
 impl Quantities<TriangleMesh> for Contact {
-    /// One level: a coarse level whose contact edges cannot hold the rigid motions the
-    /// supports leave free (one bottom edge under a body free to rotate) is singular,
-    /// and Newton's answer there, a huge rotation, passed on as the next level's start,
-    /// ended in an answer 55 % off the load; the graded meshes have no coarser level.
-    const NESTED: bool = false;
-
     const ACCURACY_MEASURE: Option<(&'static str, &'static str)> = Some(PRESSURE_ERROR);
 
     fn check(scene: &Scene, posed: &Posed) -> Result<()> {
@@ -454,12 +449,12 @@ impl Quantities<TriangleMesh> for Contact {
         Some(Box::new(move |d: &Discretization<TriangleMesh>| {
             // a load that does not hold the body on its foundation is the pressure's
             // fault: named by its key
-            pressed_start(d, direction).map_err(|e| match e {
-                Error::Input(m)
+            Ok(match pressed_start(d, direction)? {
+                LevelStart::TooCoarse(m)
                     if m.contains("rigid motion is not prevented")
                         || m.contains("tips the body") =>
                 {
-                    Error::Input(format!("scene `{name}`: field `data.pressure`: {m}"))
+                    LevelStart::TooCoarse(format!("scene `{name}`: field `data.pressure`: {m}"))
                 }
                 other => other,
             })
