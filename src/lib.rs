@@ -4,17 +4,16 @@
 //! This crate re-exports the runtime ([`fem_runtime`]), the `model!` macro that compiles
 //! model files, and the model files, scenes and the one solve of [`fem_models`]; it adds
 //! what the CLI needs on top: the studies (each kind once in [`studies`], over the one
-//! solve in [`registry_studies`]; locking once in [`locking`]; the plates' own in
-//! [`plate_studies`] and [`kirchhoff_studies`]), the accuracy table of the default job
+//! solve in [`registry_studies`]; locking once in [`locking`]; the λ-scatter of a plate
+//! on a flat obstacle in [`lambda_scatter`]), the accuracy table of the default job
 //! ([`accuracy`]) and charts ([`plot`]).
 #![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod accuracy;
 pub mod allocator;
-pub mod kirchhoff_studies;
+pub mod lambda_scatter;
 pub mod locking;
-pub mod plate_studies;
 pub mod plot;
 pub mod registry_studies;
 pub mod studies;

@@ -566,9 +566,10 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
     Ok(())
 }
 
-/// A study of a registry scene: the family's own where it has one (Kirchhoff's λ-scatter,
-/// the plate's convergence without an exact solution), else the one implementation over
-/// the one solve ([`fem_forms::registry_studies`]).
+/// A study of a registry scene through the one implementation over the one solve
+/// ([`fem_forms::registry_studies`]), on each of its study variants where the study
+/// depends on the data ([`Study::depends_on_data`]); the λ-scatter through its own
+/// ([`fem_forms::lambda_scatter`]).
 fn registry_study(
     scene: fem_forms::models::scene::Scene,
     kind: Option<&str>,
@@ -599,15 +600,21 @@ fn registry_study(
         None => hosted.clone(),
     };
     for k in kinds {
-        let own = fem_forms::kirchhoff_studies::run(&scene, k, full, out)
-            .or_else(|| fem_forms::plate_studies::run(&scene, k, full, out));
-        if let Some(result) = own {
-            result.map_err(|e| format!("study {name} {k}: {e}"))?;
+        let failed = |e: fem_forms::Error| format!("study {name} {k}: {e}");
+        if k == fem_forms::lambda_scatter::NAME {
+            fem_forms::lambda_scatter::scatter_run(&scene, full, out).map_err(failed)?;
             continue;
         }
-        let studies = fem_forms::registry_studies::RegistryStudies::new(scene.clone());
         let study = Study::parse(k).ok_or_else(|| format!("unknown study `{k}`"))?;
-        studies::run(&studies, study, full, out).map_err(|e| format!("study {name} {k}: {e}"))?;
+        let scenes = if study.depends_on_data() {
+            families::study_variants(&scene).map_err(failed)?
+        } else {
+            vec![scene.clone()]
+        };
+        for posed in scenes {
+            let studies = fem_forms::registry_studies::RegistryStudies::new(posed);
+            studies::run(&studies, study, full, out).map_err(failed)?;
+        }
     }
     Ok(())
 }

@@ -303,6 +303,9 @@ impl StudyScene for RegistryStudies {
                 self.family_measure()
                     .and_then(|(key, _)| outcome.report.number(key))
             }),
+            energy: s.energy,
+            // a plate's centre deflection against the series, where the family has one
+            reference_error: r.number("relative_error").map(f64::abs),
             total_contact_force: s.total_contact_force,
             force_error: r
                 .exact_contact_force

@@ -4,9 +4,10 @@
 
 use crate::{SolveOptions, SolverName};
 use fem_forms::models::families;
-use fem_forms::models::family::{Adjustment, Opt};
+use fem_forms::models::family::Opt;
 use fem_forms::models::geometry::Fields;
 use fem_forms::models::report::{Outcome, Profile, Report, Settings};
+use fem_forms::models::scene::Adjustment;
 use fem_forms::models::scene::{Scene, Support};
 use fem_forms::obstacle::hierarchy::LinearSolver;
 use fem_forms::obstacle::VariationalSolver;

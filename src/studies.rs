@@ -1,5 +1,6 @@
 //! The studies behind the charts, each kind implemented once and run on any scene whose
-//! family implements [`StudyScene`]: convergence against the exact solution, stability of
+//! family implements [`StudyScene`]: convergence (against the exact solution, or by the
+//! changes between successive meshes where there is none), stability of
 //! the plain against the stabilized pairs (the family's measure of the multiplier
 //! problem, and multiplier profiles), the α sweep, work against precision, and Newton
 //! iterations with nested iteration and from a cold start. `locking` (t → 0) is
@@ -17,7 +18,8 @@ use std::path::{Path, PathBuf};
 /// The study kinds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Study {
-    /// Errors against the exact solution and observed rates, every pair.
+    /// Errors against the exact solution (else the changes between successive meshes)
+    /// and observed rates, every pair.
     Convergence,
     /// Timoshenko → Euler–Bernoulli as t → 0; the locking P1–P1 method beside.
     Locking,
@@ -58,6 +60,14 @@ impl Study {
     /// The study called `name`.
     pub fn parse(name: &str) -> Option<Study> {
         Self::ALL.into_iter().find(|s| s.name() == name)
+    }
+
+    /// Whether its results depend on the load and the obstacle, so that it runs on each
+    /// of a scene's study variants: not the stability study (the multiplier's Schur
+    /// complement `B A⁻¹ Bᵀ + C` sees neither) nor locking (the thin limit of the same
+    /// load).
+    pub fn depends_on_data(self) -> bool {
+        !matches!(self, Study::Stability | Study::Locking)
     }
 }
 
@@ -111,6 +121,11 @@ pub struct Row {
     /// An error of the multiplier where the family measures one (membranes:
     /// `(Σ_T h_T² ‖λ − λ_h‖²_T)^½`).
     pub error_multiplier: Option<f64>,
+    /// The discrete energy `J_h`, where the model has one.
+    pub energy: Option<f64>,
+    /// The relative error of the family's reference quantity against the scene's
+    /// reference value (a plate's centre deflection against the series), where it has one.
+    pub reference_error: Option<f64>,
     /// `∫λ_h`.
     pub total_contact_force: f64,
     /// `|∫λ_h − ∫λ|` where the exact ∫λ is known.
@@ -390,34 +405,57 @@ pub fn available_pairs(scene: &dyn StudyScene) -> Vec<&'static str> {
 fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
     let name = scene.name();
     let pairs = available_pairs(scene);
-    let [_, contact_error] = scene.contact_names();
-    println!(
-        "{}: errors against the exact solution (rates between successive meshes)",
-        scene.setting()
-    );
-    print_convergence_header(scene.size_name(), contact_error);
+    let solved = pairs
+        .iter()
+        .map(|&pair| {
+            convergence(
+                scene,
+                pair,
+                &scene.plan(Study::Convergence, pair, full).sizes,
+            )
+        })
+        .collect::<Result<Vec<Vec<Row>>>>()?;
+    let exact = solved
+        .iter()
+        .flatten()
+        .any(|r| r.error_l2.is_some() || r.error_h1.is_some() || r.error_multiplier.is_some());
+    let [contact, contact_error] = scene.contact_names();
+    if exact {
+        println!(
+            "{}: errors against the exact solution (rates between successive meshes)",
+            scene.setting()
+        );
+        print_convergence_header(scene.size_name(), contact_error);
+    } else {
+        println!(
+            "{}: no exact solution; J_h, ∫λ_h and the {contact} with their changes Δ from the mesh before and the rates log2 of the ratio of successive |Δ|",
+            scene.setting()
+        );
+        print_changes_header(scene.size_name(), contact);
+    }
     let mut csv = Vec::new();
-    let (mut l2_series, mut h1_series, mut multiplier_series, mut force_series, mut work) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for (index, &pair) in pairs.iter().enumerate() {
-        let rows = convergence(
-            scene,
-            pair,
-            &scene.plan(Study::Convergence, pair, full).sizes,
-        )?;
+    let mut panels = ConvergencePanels::default();
+    for (index, (&pair, rows)) in pairs.iter().zip(&solved).enumerate() {
         let column = |f: fn(&Row) -> Option<f64>| rows.iter().map(|r| nan(f(r))).collect();
         let l2: Vec<f64> = column(|r| r.error_l2);
         let h1: Vec<f64> = column(|r| r.error_h1);
         let lm: Vec<f64> = column(|r| r.error_multiplier);
         let force: Vec<f64> = column(|r| r.force_error);
-        let (rl2, rh1, rlm) = (rates(&l2), rates(&h1), rates(&lm));
+        let reference: Vec<f64> = column(|r| r.reference_error);
+        let changes = Changes::of(rows);
         for (k, r) in rows.iter().enumerate() {
-            print_convergence_row(r, k, [&l2, &h1, &lm, &force], [&rl2, &rh1, &rlm]);
+            if exact {
+                let (rl2, rh1, rlm) = (rates(&l2), rates(&h1), rates(&lm));
+                print_convergence_row(r, k, [&l2, &h1, &lm, &force], [&rl2, &rh1, &rlm]);
+            } else {
+                print_changes_row(r, k, &changes, reference[k]);
+            }
             // the solve's own warnings under its row: rates of −6.8 at
             // 16384 Hermite elements with no note, where the single solve warned
             for warning in &r.warnings {
                 println!("    warning ({} {}): {warning}", r.pair, r.size);
             }
+            let [energy, total, measure] = changes.values.each_ref().map(|v| v[k]);
             csv.push(vec![
                 index as f64,
                 r.size as f64,
@@ -429,41 +467,218 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
                 lm[k],
                 force[k],
                 nan(r.contact_error),
+                energy,
+                total,
+                measure,
+                reference[k],
                 r.iterations as f64,
                 r.seconds,
             ]);
         }
-        let against_h =
-            |v: &[f64]| -> Vec<(f64, f64)> { rows.iter().zip(v).map(|(r, &e)| (r.h, e)).collect() };
-        l2_series.push(Series::marked(format!("{pair} L²"), against_h(&l2)));
-        h1_series.push(Series::marked(format!("{pair} H¹"), against_h(&h1)));
-        if lm.iter().all(|e| e.is_finite()) {
-            multiplier_series.push(Series::marked(format!("{pair} λ"), against_h(&lm)));
-        }
-        if force.iter().all(|e| e.is_finite()) {
-            force_series.push(Series::marked(format!("{pair} ∫λ"), against_h(&force)));
-        }
-        work.push(Series::marked(
-            format!("{pair} H¹ against seconds"),
-            rows.iter()
-                .zip(&h1)
-                .map(|(r, &e)| (r.seconds.max(1e-5), e))
-                .collect(),
-        ));
+        panels.add(pair, rows, [&l2, &h1, &lm, &force, &reference], &changes);
     }
-    let panels = convergence_panels(
-        &scene.setting(),
-        [l2_series, h1_series, multiplier_series, force_series, work],
-    );
+    let panels = panels.finish(&scene.setting(), contact, exact);
     plot::stacked(&output(out, &name, Study::Convergence, "svg"), &panels).map_err(io)?;
     write_csv_named(
         &output(out, &name, Study::Convergence, "csv"),
         "pair",
-        "size,h,cells,dofs,error_l2,error_h1,error_multiplier,force_error,contact_error,iterations,seconds",
+        "size,h,cells,dofs,error_l2,error_h1,error_multiplier,force_error,contact_error,energy,total_contact_force,contact,reference_error,iterations,seconds",
         &pairs,
         &csv,
     )
     .map_err(io)
+}
+
+/// The quantities the convergence study follows where there is no exact solution
+/// (`J_h`, `∫λ_h` and the family's contact measure) on meshes halved each time: their
+/// values, the changes `d_k = Q_{k+1} − Q_k` between successive meshes, and the observed
+/// rates `log2(|d_k| / |d_{k+1}|)` (for `Q_h = Q + C hᵖ`, `d_k ∝ h_kᵖ` and the rate is
+/// p). Shapes: `values[q]` has one entry per row, `changes[q]` one fewer, `rates[q]` two
+/// fewer.
+#[derive(Clone, Debug, Default)]
+pub struct Changes {
+    /// `[J_h, ∫λ_h, contact]` per row.
+    pub values: [Vec<f64>; 3],
+    /// Their changes to the next mesh.
+    pub changes: [Vec<f64>; 3],
+    /// The observed rates of the changes.
+    pub rates: [Vec<f64>; 3],
+}
+
+impl Changes {
+    /// The names of the quantities, in order.
+    pub const NAMES: [&'static str; 3] = ["J_h", "∫λ_h", "contact"];
+
+    /// The changes of `rows` (one pair on meshes halved each time).
+    pub fn of(rows: &[Row]) -> Self {
+        let values = [
+            rows.iter().map(|r| nan(r.energy)).collect::<Vec<_>>(),
+            rows.iter().map(|r| r.total_contact_force).collect(),
+            rows.iter().map(|r| r.contact).collect(),
+        ];
+        let changes = values
+            .each_ref()
+            .map(|v| v.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>());
+        let rates = changes
+            .each_ref()
+            .map(|d| rates(&d.iter().map(|d| d.abs()).collect::<Vec<_>>()));
+        Self {
+            values,
+            changes,
+            rates,
+        }
+    }
+}
+
+/// The header of the table of changes (`size`: the scene's word for its mesh size,
+/// `contact`: its contact measure).
+fn print_changes_header(size: &str, contact: &str) {
+    println!(
+        "{:<15} {:>8} {:>9} {:>9} {:>16} {:>10} {:>5} {:>14} {:>10} {:>5} {:>12} {:>10} {:>5} {:>11} {:>5} {:>8}",
+        "pair", size, "cells", "dofs", "J_h", "ΔJ_h", "rate", "∫λ_h", "Δ∫λ_h", "rate", contact, "Δ", "rate", "ref. error", "iter", "seconds"
+    );
+}
+
+/// Row `k` of the table of changes, with the relative error of the family's reference
+/// quantity `reference` (NaN where there is none).
+fn print_changes_row(r: &Row, k: usize, changes: &Changes, reference: f64) {
+    let entry = |v: &[f64], shift: usize| {
+        k.checked_sub(shift)
+            .and_then(|k| v.get(k).copied())
+            .unwrap_or(f64::NAN)
+    };
+    let [j, force, contact] = changes.values.each_ref().map(|v| v[k]);
+    let [dj, dforce, dcontact] = changes.changes.each_ref().map(|d| entry(d, 1));
+    let [rj, rforce, rcontact] = changes.rates.each_ref().map(|d| entry(d, 2));
+    println!(
+        "{}",
+        crate::dash_nan(format!(
+            "{:<15} {:>8} {:>9} {:>9} {j:>16.9e} {dj:>10.2e} {rj:>5.2} {force:>14.7e} {dforce:>10.2e} {rforce:>5.2} {contact:>12.6} {dcontact:>10.2e} {rcontact:>5.2} {reference:>11.2e} {:>5} {:>8.3}",
+            r.pair, r.size, r.cells, r.dofs, r.iterations, r.seconds
+        ))
+    );
+}
+
+/// The series of the convergence chart, pair by pair.
+#[derive(Default)]
+struct ConvergencePanels {
+    l2: Vec<Series>,
+    h1: Vec<Series>,
+    multiplier: Vec<Series>,
+    force: Vec<Series>,
+    reference: Vec<Series>,
+    changes: Vec<Series>,
+    work: Vec<Series>,
+}
+
+impl ConvergencePanels {
+    /// The series of `pair`'s `rows` with their errors `[L², H¹, λ, ∫λ, reference]` and
+    /// changes; a measure no row has is left out.
+    fn add(&mut self, pair: &str, rows: &[Row], errors: [&[f64]; 5], changes: &Changes) {
+        let [l2, h1, lm, force, reference] = errors;
+        let against_h =
+            |v: &[f64]| -> Vec<(f64, f64)> { rows.iter().zip(v).map(|(r, &e)| (r.h, e)).collect() };
+        let any = |v: &[f64]| v.iter().any(|e| e.is_finite());
+        for (target, values, label) in [
+            (&mut self.l2, l2, "L²"),
+            (&mut self.h1, h1, "H¹"),
+            (&mut self.multiplier, lm, "λ"),
+            (&mut self.force, force, "∫λ"),
+            (&mut self.reference, reference, "reference"),
+        ] {
+            if any(values) {
+                target.push(Series::marked(format!("{pair} {label}"), against_h(values)));
+            }
+        }
+        for (name, d) in Changes::NAMES.iter().zip(&changes.changes) {
+            // the change to the next mesh, plotted at the coarser one's h; a log axis
+            // has no 0 (a contact measure equal on two meshes)
+            let points: Vec<(f64, f64)> = rows
+                .iter()
+                .zip(d)
+                .map(|(r, d)| (r.h, d.abs()))
+                .filter(|(_, d)| d.is_finite() && *d > 0.0)
+                .collect();
+            if !points.is_empty() {
+                self.changes
+                    .push(Series::marked(format!("{pair} |Δ {name}|"), points));
+            }
+        }
+        // precision: the H¹ error where known, else the reference's, else |ΔJ_h|
+        let precision: Vec<f64> = if any(h1) {
+            h1.to_vec()
+        } else if any(reference) {
+            reference.to_vec()
+        } else {
+            changes.changes[0].iter().map(|d| d.abs()).collect()
+        };
+        self.work.push(Series::marked(
+            format!("{pair} against seconds"),
+            rows.iter()
+                .zip(&precision)
+                .map(|(r, &e)| (r.seconds.max(1e-5), e))
+                .collect(),
+        ));
+    }
+
+    /// The panels of the chart (`setting` for titles, `contact` the contact measure's
+    /// name, `exact` whether errors against an exact solution were measured).
+    fn finish(
+        self,
+        setting: &str,
+        contact: &str,
+        exact: bool,
+    ) -> Vec<(String, Axes<'static>, Vec<Series>)> {
+        let mut panels = Vec::new();
+        let mut panel = |title: String, axes: Axes<'static>, series: Vec<Series>| {
+            if !series.is_empty() {
+                panels.push((title, axes, series));
+            }
+        };
+        panel(
+            format!("{setting}: L² error of u"),
+            log_axes("h", "‖u − u_h‖_L2"),
+            self.l2,
+        );
+        panel(
+            format!("{setting}: H¹ error of u"),
+            log_axes("h", "|u − u_h|_H1"),
+            self.h1,
+        );
+        panel(
+            format!("{setting}: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½"),
+            log_axes("h", "h-weighted error of λ"),
+            self.multiplier,
+        );
+        panel(
+            format!("{setting}: error of the total contact force"),
+            log_axes("h", "|∫λ_h − ∫λ|"),
+            self.force,
+        );
+        panel(
+            format!("{setting}: relative error of the reference quantity"),
+            log_axes("h", "|relative error|"),
+            self.reference,
+        );
+        if !exact {
+            panel(
+                format!("{setting}: change of J_h, ∫λ_h and the {contact} to the next mesh"),
+                log_axes("h", "|change to the next mesh|"),
+                self.changes,
+            );
+        }
+        let precision = if exact {
+            "|u − u_h|_H1"
+        } else {
+            "H¹ error, reference error or |ΔJ_h|"
+        };
+        panel(
+            format!("{setting}: work against precision (complete nested solve)"),
+            log_axes("seconds", precision),
+            self.work,
+        );
+        panels
+    }
 }
 
 /// The header of the convergence table (`size`: the scene's word for its mesh size,
@@ -513,46 +728,6 @@ fn print_convergence_row(r: &Row, k: usize, errors: [&[f64]; 4], rates: [&[f64];
         r.iterations,
         r.seconds
     );
-}
-
-/// The convergence chart's panels: the L² and H¹ errors of u, the multiplier's and the
-/// contact force's errors where any pair has them, and work against precision.
-fn convergence_panels(
-    setting: &str,
-    [l2, h1, multiplier, force, work]: [Vec<Series>; 5],
-) -> Vec<(String, Axes<'static>, Vec<Series>)> {
-    let mut panels = vec![
-        (
-            format!("{setting}: L² error of u"),
-            log_axes("h", "‖u − u_h‖_L2"),
-            l2,
-        ),
-        (
-            format!("{setting}: H¹ error of u"),
-            log_axes("h", "|u − u_h|_H1"),
-            h1,
-        ),
-    ];
-    if !multiplier.is_empty() {
-        panels.push((
-            format!("{setting}: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½"),
-            log_axes("h", "h-weighted error of λ"),
-            multiplier,
-        ));
-    }
-    if !force.is_empty() {
-        panels.push((
-            format!("{setting}: error of the total contact force"),
-            log_axes("h", "|∫λ_h − ∫λ|"),
-            force,
-        ));
-    }
-    panels.push((
-        format!("{setting}: work against precision (complete nested solve)"),
-        log_axes("seconds", "|u − u_h|_H1"),
-        work,
-    ));
-    panels
 }
 
 /// The stability measure of `pair` on each mesh of `sizes`.
@@ -1286,6 +1461,41 @@ pub fn run(scene: &dyn StudyScene, study: Study, full: bool, out: &Path) -> Resu
 
 #[cfg(test)]
 mod tests {
+    /// The changes between meshes and their rates: `Q_h = 1 + h²` on h = ¼, ⅛, 1/16
+    /// changes by −3/64 and −3/256, a ratio of 4: rate 2.
+    #[test]
+    fn changes_between_meshes_give_the_rate_of_the_quantity() {
+        let row = |h: f64| super::Row {
+            pair: "p",
+            size: 1,
+            h,
+            cells: 1,
+            dofs: 1,
+            alpha: 0.0,
+            error_l2: None,
+            error_h1: None,
+            error_multiplier: None,
+            energy: Some(1.0 + h * h),
+            reference_error: None,
+            total_contact_force: 2.0 - h * h * h,
+            force_error: None,
+            contact: 0.5,
+            contact_error: None,
+            iterations: 1,
+            seconds: 0.0,
+            kkt_residual: 0.0,
+            warnings: Vec::new(),
+        };
+        let rows: Vec<_> = [0.25, 0.125, 0.0625].map(row).to_vec();
+        let c = super::Changes::of(&rows);
+        assert_eq!(c.changes[0], [-3.0 / 64.0, -3.0 / 256.0]);
+        assert_eq!(c.rates[0], [2.0]);
+        assert!((c.rates[1][0] - 3.0).abs() < 1e-12, "{:?}", c.rates);
+        // an unchanged contact measure has no rate
+        assert_eq!(c.changes[2], [0.0, 0.0]);
+        assert!(c.rates[2][0].is_nan());
+    }
+
     /// A zero or infinite error has no rate: NaN (printed `-`), not `inf` or `-inf` (
     /// contact area equal on two meshes); the others are log₂ of the ratio.
     #[test]

@@ -287,7 +287,7 @@ fn registry_solve(
     solver: fem_forms::obstacle::VariationalSolver,
 ) -> fem_forms::models::report::Report {
     use fem_forms::models::families;
-    use fem_forms::models::family::Adjustment;
+    use fem_forms::models::scene::Adjustment;
     let mut scene = families::scene(scene).unwrap();
     if let Some(o) = obstacle {
         families::family("kirchhoff")

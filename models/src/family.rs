@@ -4,7 +4,7 @@
 //! The command line's `list`, `solve` and `study` go through [`families`] alone.
 
 use crate::report::{Outcome, Settings};
-use crate::scene::{LoadSign, Scene, Support};
+use crate::scene::{Adjustment, LoadSign, Scene, Support};
 use fem_runtime::problem::MemoryModel;
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::Error;
@@ -122,17 +122,6 @@ impl std::fmt::Debug for Pair {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Pair").field("name", &self.name).finish()
     }
-}
-
-/// A change `--support`, `--obstacle` or `--no-obstacle` asks of a scene.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Adjustment {
-    /// Every support of the scene replaced by this one.
-    Support(Support),
-    /// The obstacle replaced by one the family names.
-    Obstacle(String),
-    /// No obstacle: the unconstrained problem.
-    NoObstacle,
 }
 
 /// An error of a scene file: the field at fault (`material.young`) and the message.

@@ -427,6 +427,8 @@ pub struct Scene {
     /// The load q its studies pose where it is not [`Load::default`] (the beams are
     /// solved at q = 1, where they do not touch their obstacles, and studied at q = 100).
     pub study_load: Option<f64>,
+    /// The variants its studies run ([`StudyVariant`]); empty: the scene itself.
+    pub study_variants: Vec<StudyVariant>,
     /// Whether the default job (`fem-forms` without a command) solves it.
     pub in_default_job: bool,
     /// The family's own description (see [`Reference`]).
@@ -446,6 +448,30 @@ impl fmt::Debug for Scene {
             .field("supports", &self.supports)
             .finish_non_exhaustive()
     }
+}
+
+/// A change `--support`, `--obstacle` or `--no-obstacle` asks of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Adjustment {
+    /// Every support of the scene replaced by this one.
+    Support(Support),
+    /// The obstacle replaced by one the family names.
+    Obstacle(String),
+    /// No obstacle: the unconstrained problem.
+    NoObstacle,
+}
+
+/// A variant of a scene that its studies run beside it (or instead: a scene with
+/// variants is studied as its variants), e.g. each load of a plate's list, or both
+/// supports of a square: applied by [`crate::families::study_variants`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct StudyVariant {
+    /// Its label, appended to the scene's name in titles and file names (`q20`).
+    pub label: String,
+    /// The load q, where the variant sets one (else the scene's study load).
+    pub load: Option<f64>,
+    /// The changes the scene's family makes ([`crate::family::Family::adjust`]).
+    pub adjustments: Vec<Adjustment>,
 }
 
 impl Scene {
@@ -476,6 +502,7 @@ impl Scene {
             pairs: Vec::new(),
             studies: Vec::new(),
             study_load: None,
+            study_variants: Vec::new(),
             in_default_job: false,
             reference: None,
             file_keys: Vec::new(),

@@ -5,11 +5,11 @@
 //! patch-averaged (the cure of the Argyris multiplier's scatter).
 
 use crate::data::Data;
-use crate::family::{Adjustment, Family, Opt, Pair, PairSolve};
+use crate::family::{Family, Opt, Pair, PairSolve};
 use crate::geometry::{halving_sizes, Fields};
 use crate::kirchhoff::{kirchhoff_argyris_p0, kirchhoff_argyris_p1disc, kirchhoff_morley_p0};
 use crate::run::{run, Quantities, Report, Run};
-use crate::scene::{Domain, Load, Part, Posed, Scene, Support};
+use crate::scene::{Adjustment, Domain, Load, Part, Posed, Scene, StudyVariant, Support};
 use fem_runtime::element::triangle::TriangleBasis;
 use fem_runtime::problem::{MemoryModel, ObstacleSide};
 use fem_runtime::stabilization::Alpha;
@@ -155,6 +155,31 @@ fn kirchhoff_scene(
     scene.studies = match obstacle {
         Some(_) => vec!["convergence", "lambda-scatter", "stability"],
         None => vec!["convergence"],
+    };
+    scene.study_variants = match obstacle {
+        // two loads, flat and curved: contact sets of different shapes and sizes
+        Some(_) => [5.0, 20.0]
+            .into_iter()
+            .flat_map(|q| {
+                ["flat", "curved"].map(|o| StudyVariant {
+                    label: format!("q{q}-{o}"),
+                    load: Some(q),
+                    adjustments: vec![Adjustment::Obstacle(o.into())],
+                })
+            })
+            .collect(),
+        // both supports against their series
+        None => [
+            ("clamped", Support::Clamped),
+            ("simply-supported", Support::SimplySupported { hard: false }),
+        ]
+        .into_iter()
+        .map(|(label, support)| StudyVariant {
+            label: label.into(),
+            load: None,
+            adjustments: vec![Adjustment::Support(support)],
+        })
+        .collect(),
     };
     scene
 }

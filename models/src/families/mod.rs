@@ -42,6 +42,36 @@ pub fn scene(name: &str) -> Option<Scene> {
     scenes().into_iter().find(|s| s.name == name)
 }
 
+/// The scenes a study of `scene` runs: its [`crate::scene::StudyVariant`]s, each named
+/// `<scene>-<label>`, its load and its family's adjustments applied, without variants
+/// of their own; `scene` itself where it has none.
+///
+/// # Errors
+/// An adjustment the family refuses, or a scene without a family.
+pub fn study_variants(scene: &Scene) -> Result<Vec<Scene>> {
+    if scene.study_variants.is_empty() {
+        return Ok(vec![scene.clone()]);
+    }
+    let family = family(scene.family)
+        .ok_or_else(|| Error::Input(format!("scene `{}` has no family", scene.name)))?;
+    scene
+        .study_variants
+        .iter()
+        .map(|variant| {
+            let mut posed = scene.clone();
+            posed.name = format!("{}-{}", scene.name, variant.label).into();
+            posed.study_variants = Vec::new();
+            if let Some(q) = variant.load {
+                posed.study_load = Some(q);
+            }
+            for adjustment in &variant.adjustments {
+                family.adjust(&mut posed, adjustment)?;
+            }
+            Ok(posed)
+        })
+        .collect()
+}
+
 /// The pairs `scene` takes, its default first: those it names, else its family's.
 pub fn pairs_of(scene: &Scene) -> Vec<&'static Pair> {
     let Some(family) = family(scene.family) else {

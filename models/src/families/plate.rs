@@ -95,8 +95,6 @@ pub struct PlateFacts {
     /// The length `L` the Kirchhoff deflections scale with (`w ~ q L⁴/D`): the side of a
     /// square, the radius of a disk.
     pub length: f64,
-    /// The loads the scene's studies run.
-    pub loads: &'static [f64],
 }
 
 /// The scene of a plate description of [`crate::plate_scenes`].
@@ -147,11 +145,22 @@ fn plate_scene(old: &plate_scenes::PlateScene) -> Scene {
         "mindlin-disk" => vec!["convergence", "iterations"],
         _ => Vec::new(),
     };
+    // a scene that lists several loads is studied at each
+    if old.loads.len() > 1 {
+        scene.study_variants = old
+            .loads
+            .iter()
+            .map(|&q| crate::scene::StudyVariant {
+                label: format!("q{q}"),
+                load: Some(q),
+                adjustments: Vec::new(),
+            })
+            .collect();
+    }
     scene.reference = Some(std::sync::Arc::new(PlateFacts {
         reference: old.reference,
         obstacle: old.obstacle.describe(),
         length: old.domain.length(),
-        loads: old.loads,
     }));
     scene
 }

@@ -1,34 +1,20 @@
-//! The Kirchhoff plate's own studies (docs/mathematics.md §9) over the one solve
-//! ([`crate::models::families::solve`]): the convergence of the centre deflection against
-//! the series (both supports, Argyris and Morley) or, with an obstacle, the successive
-//! differences of J_h, ∫λ_h, the contact area and max w; and the scatter of λ_h in the
-//! contact interior (where λ = q exactly) for several pairs, α and recoveries.
+//! The λ-scatter study (docs/mathematics.md §9) over the one solve
+//! ([`crate::models::families::solve`]): the scatter of λ_h in the contact interior of a
+//! Kirchhoff plate on a flat obstacle, where λ = q exactly, for several pairs, α and
+//! recoveries of λ (raw, patch-averaged once or twice), and its layer next to the free
+//! boundary. It reads the interior statistics the Kirchhoff family reports; the other
+//! study kinds are the one implementation of [`crate::studies`].
 
 use crate::models::families;
-use crate::models::family::Adjustment;
 use crate::models::report::{Report, Settings};
-use crate::models::scene::{Scene, Support};
+use crate::models::scene::{Adjustment, Scene};
 use crate::plot::{self, Axes, Series};
 use fem_runtime::obstacle::VariationalSolver;
 use fem_runtime::{Error, Result};
 use std::path::Path;
 
-/// Runs the Kirchhoff study `kind` on `scene` (`convergence`, `lambda-scatter`);
-/// `None` where `scene` is not a Kirchhoff scene or `kind` is a generic study kind (the
-/// one implementation runs it).
-///
-/// # Errors
-/// The study's errors.
-pub fn run(scene: &Scene, kind: &str, full: bool, out: &Path) -> Option<Result<()>> {
-    if scene.family != "kirchhoff" {
-        return None;
-    }
-    match kind {
-        "convergence" => Some(convergence(scene, full, out)),
-        "lambda-scatter" => Some(scatter_run(scene, full, out)),
-        _ => None,
-    }
-}
+/// The study's name on the command line and in a scene's list of studies.
+pub const NAME: &str = "lambda-scatter";
 
 /// `scene` with `adjustment` applied by its family.
 fn adjusted(scene: &Scene, adjustment: &Adjustment) -> Result<Scene> {
@@ -59,11 +45,6 @@ fn solve(
     Ok(families::solve(scene, &settings)?.report)
 }
 
-/// A family quantity of `report` (NaN where absent).
-fn quantity(report: &Report, key: &str) -> f64 {
-    report.number(key).unwrap_or(f64::NAN)
-}
-
 fn write_text(path: &Path, text: &str) -> Result<()> {
     let write = || -> std::io::Result<()> {
         if let Some(dir) = path.parent() {
@@ -79,212 +60,6 @@ fn chart(path: &Path, title: &str, axes: Axes, series: &[Series]) -> Result<()> 
         .map_err(|e| Error::Input(format!("cannot write {}: {e}", path.display())))?;
     println!("→ {}, .csv", path.display());
     Ok(())
-}
-
-/// Observed rates of successive differences, `-` where there is none.
-fn rate_text(rate: Option<f64>) -> String {
-    rate.filter(|r| r.is_finite())
-        .map_or("-".into(), |r| format!("{r:.2}"))
-}
-
-/// The convergence study of a Kirchhoff scene (`study <scene> convergence`).
-///
-/// Without an obstacle (kirchhoff-square): the centre deflection of both supports and
-/// the Argyris and Morley pairs on N = 4 … 32 (64 with `full`) against the series, with
-/// the observed rate from successive differences `log2(|w_N − w_{N/2}| / |w_{2N} − w_N|)`
-/// (independent of the 6-digit reference). With one (kirchhoff-obstacle): q = 5 and 20,
-/// flat and curved, the scene's default pair, N = 8 … 64 (128 with `full`): J_h, ∫λ_h,
-/// contact area and max w, their successive differences and rates. A table on stdout,
-/// `out/<scene>-convergence.csv` and the chart `.svg`.
-///
-/// # Errors
-/// The solves', and [`Error::Input`] when a file cannot be written.
-pub fn convergence(scene: &Scene, full: bool, out: &Path) -> Result<()> {
-    if scene.obstacle {
-        obstacle_convergence(scene, full, out)
-    } else {
-        square_convergence(scene, full, out)
-    }
-}
-
-fn square_convergence(scene: &Scene, full: bool, out: &Path) -> Result<()> {
-    let meshes: &[usize] = if full {
-        &[4, 8, 16, 32, 64]
-    } else {
-        &[4, 8, 16, 32]
-    };
-    let mut csv =
-        String::from("support,pair,mesh_size,centre_deflection,relative_error,difference,rate\n");
-    let mut series = Vec::new();
-    println!(
-        "\nconvergence: {}, centre deflection against the reference (simply supported: Navier's series; clamped: the tabulated 0.00126532, whose six digits floor the error near 7e-7)",
-        scene.name
-    );
-    println!(
-        "{:<17} {:<15} {:>4} {:>16} {:>11} {:>11} {:>6}",
-        "support", "pair", "N", "w(centre)", "rel. error", "difference", "rate"
-    );
-    for (support_name, support) in [
-        ("clamped", Support::Clamped),
-        ("simply-supported", Support::SimplySupported { hard: false }),
-    ] {
-        let posed = adjusted(scene, &Adjustment::Support(support))?;
-        for pair in ["argyris-p0", "morley-p0"] {
-            let mut values = Vec::new();
-            for &n in meshes {
-                let r = solve(&posed, pair, n, None, None)?;
-                values.push((
-                    n,
-                    quantity(&r, "centre_deflection"),
-                    quantity(&r, "relative_error"),
-                ));
-            }
-            let differences: Vec<f64> =
-                values.windows(2).map(|w| (w[1].1 - w[0].1).abs()).collect();
-            for (k, &(n, w, e)) in values.iter().enumerate() {
-                let difference = k.checked_sub(1).map(|j| differences[j]);
-                let rate = (k >= 2).then(|| (differences[k - 2] / differences[k - 1]).log2());
-                println!(
-                    "{support_name:<17} {pair:<15} {n:>4} {w:>16.9e} {e:>+11.2e} {:>11} {:>6}",
-                    difference.map_or("-".to_string(), |d| format!("{d:.2e}")),
-                    rate_text(rate)
-                );
-                csv += &format!(
-                    "{support_name},{pair},{n},{w:e},{e:e},{},{}\n",
-                    difference.map_or(String::new(), |d| format!("{d:e}")),
-                    rate.map_or(String::new(), |r| format!("{r}"))
-                );
-            }
-            series.push(Series::marked(
-                format!("{pair} {support_name}"),
-                values
-                    .iter()
-                    .map(|&(n, _, e)| (n as f64, e.abs().max(1e-12)))
-                    .collect(),
-            ));
-        }
-    }
-    write_text(&out.join(format!("{}-convergence.csv", scene.name)), &csv)?;
-    chart(
-        &out.join(format!("{}-convergence.svg", scene.name)),
-        &format!(
-            "{}: |relative error| of the centre deflection against N",
-            scene.name
-        ),
-        Axes {
-            x: "N (N×N×2 mesh)",
-            y: "|w_h(centre) / reference − 1|",
-            log_x: true,
-            log_y: true,
-        },
-        &series,
-    )
-}
-
-/// How a report gives one quantity of a table.
-type Of = fn(&Report) -> f64;
-
-/// The quantities of the obstacle convergence table: name, and how a report gives it.
-const OBSTACLE_QUANTITIES: [(&str, Of); 4] = [
-    ("J_h", |r| r.solve.energy.unwrap_or(f64::NAN)),
-    ("∫λ_h", |r| r.solve.total_contact_force),
-    ("contact area", |r| r.solve.contact_area.unwrap_or(f64::NAN)),
-    ("max w", |r| quantity(r, "max_deflection")),
-];
-
-fn obstacle_convergence(scene: &Scene, full: bool, out: &Path) -> Result<()> {
-    let meshes: &[usize] = if full {
-        &[8, 16, 32, 64, 128]
-    } else {
-        &[8, 16, 32, 64]
-    };
-    let pair = families::pair_of(scene, None)?.name;
-    let mut csv = String::from(
-        "load,obstacle,mesh_size,energy,total_contact_force,contact_area,max_deflection,iterations,kkt_residual,seconds\n",
-    );
-    let mut series = Vec::new();
-    println!(
-        "\nconvergence: {} ({pair}), successive differences |Q_N − Q_N/2| and their rates",
-        scene.name
-    );
-    for load in [5.0, 20.0] {
-        for obstacle in ["flat", "curved"] {
-            let posed = adjusted(scene, &Adjustment::Obstacle(obstacle.into()))?;
-            let reports = meshes
-                .iter()
-                .map(|&n| solve(&posed, pair, n, Some(load), None))
-                .collect::<Result<Vec<Report>>>()?;
-            println!("q = {load}, obstacle {obstacle}:");
-            println!(
-                "{:>5} {:>15} {:>13} {:>10} {:>13} {:>12} {:>9} {:>8}",
-                "N", "J_h", "∫λ_h", "area", "max w", "iterations", "KKT res", "seconds"
-            );
-            for r in &reports {
-                let s = &r.solve;
-                let levels: Vec<String> = s.levels.iter().map(|l| l[1].to_string()).collect();
-                let [energy, force, area, max_w] = OBSTACLE_QUANTITIES.map(|(_, f)| f(r));
-                println!(
-                    "{:>5} {energy:>15.9e} {force:>13.7e} {area:>10.6} {max_w:>13.7e} {:>12} {:>9.1e} {:>8.2}",
-                    r.mesh_size,
-                    levels.join(","),
-                    s.kkt_residual,
-                    s.seconds
-                );
-                csv += &format!(
-                    "{load},{obstacle},{},{energy:e},{force:e},{area:e},{max_w:e},{},{:e},{}\n",
-                    r.mesh_size,
-                    levels.join(" "),
-                    s.kkt_residual,
-                    s.seconds
-                );
-            }
-            for (name, of) in OBSTACLE_QUANTITIES {
-                let values: Vec<f64> = reports.iter().map(of).collect();
-                let differences: Vec<f64> =
-                    values.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-                let rates: Vec<String> = crate::studies::rates(&differences)
-                    .into_iter()
-                    .map(|r| rate_text(Some(r)))
-                    .collect();
-                println!(
-                    "  {name:<13} differences {} rates {}",
-                    differences
-                        .iter()
-                        .map(|d| format!("{d:.2e}"))
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                    rates.join(" ")
-                );
-                let finest = values.last().map_or(f64::NAN, |v| v.abs());
-                series.push(Series::marked(
-                    format!("{name} q = {load} {obstacle}"),
-                    meshes[1..]
-                        .iter()
-                        .zip(&differences)
-                        // a log axis has no 0: a difference of 0 (a contact area equal on
-                        // two meshes) is left out
-                        .map(|(&n, &d)| (n as f64, d / finest))
-                        .filter(|&(_, d)| d > 0.0 && d.is_finite())
-                        .collect(),
-                ));
-            }
-        }
-    }
-    write_text(&out.join(format!("{}-convergence.csv", scene.name)), &csv)?;
-    chart(
-        &out.join(format!("{}-convergence.svg", scene.name)),
-        &format!(
-            "{}: relative successive differences |Q_N − Q_N/2| / |Q_finest|",
-            scene.name
-        ),
-        Axes {
-            x: "N (N×N×2 mesh)",
-            y: "relative difference",
-            log_x: true,
-            log_y: true,
-        },
-        &series,
-    )
 }
 
 /// One method of the λ-scatter study: a pair, α as a multiple of `1/C_I` (or fixed for
