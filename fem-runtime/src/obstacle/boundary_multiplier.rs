@@ -24,7 +24,7 @@ use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::error::{Error, Result};
 use crate::lcp::{ConstraintRows, Lcp};
 use crate::mesh::TriangleMesh;
-use crate::model::{Coefficients, IntoFieldIndex, IntoPartIndex, Model};
+use crate::model::{Coefficients, FacetBlockInfo, IntoFieldIndex, IntoPartIndex, Model};
 use crate::obstacle::{multiplier_field, system_forms, Discretization, Multipliers};
 use crate::SparseMatrix;
 use faer::sparse::{SparseColMat, Triplet};
@@ -238,6 +238,23 @@ pub fn primal_dofs<M: Model>(mesh: &TriangleMesh) -> Result<SystemDofs> {
     SystemDofs::new::<M>(mesh, &primal)
 }
 
+/// The space of `M`'s boundary multiplier `multiplier`.
+///
+/// # Errors
+/// [`Error::Input`] for an element other than P0 and P1.
+fn multiplier_space<M: Model>(multiplier: usize) -> Result<BoundaryMultiplier> {
+    match M::FIELDS[multiplier].element {
+        ElementKind::P0 => Ok(BoundaryMultiplier::P0),
+        ElementKind::P1 => Ok(BoundaryMultiplier::P1),
+        other => Err(Error::Input(format!(
+            "the boundary multiplier `{}` of `{}` must be P0 (one value per edge) or P1 (one per vertex of its part), not {}",
+            M::FIELDS[multiplier].name,
+            M::NAME,
+            other.name()
+        ))),
+    }
+}
+
 /// The multiplier's DOFs on the edges of its part `part`, whose boundary markers are
 /// `markers`.
 ///
@@ -249,19 +266,7 @@ pub fn multiplier_dofs_on<M: Model>(
     part: usize,
     markers: &[u32],
 ) -> Result<BoundaryMultiplierDofs> {
-    let multiplier = multiplier_field::<M>()?;
-    let space = match M::FIELDS[multiplier].element {
-        ElementKind::P0 => BoundaryMultiplier::P0,
-        ElementKind::P1 => BoundaryMultiplier::P1,
-        other => {
-            return Err(Error::Input(format!(
-                "the boundary multiplier `{}` of `{}` must be P0 (one value per edge) or P1 (one per vertex of its part), not {}",
-                M::FIELDS[multiplier].name,
-                M::NAME,
-                other.name()
-            )))
-        }
-    };
+    let space = multiplier_space::<M>(multiplier_field::<M>()?)?;
     let edges = part_edges(mesh, markers);
     if edges.is_empty() {
         return Err(Error::Input(format!(
@@ -314,6 +319,74 @@ pub fn discretize<M: Model>(
     let (bilinear, linear) = (M::form(bilinear_id)?, M::form(linear_id)?);
     crate::model::require_symmetric::<M, TriangleMesh>(bilinear, mesh, coefficients)?;
     let multiplier = multiplier_field::<M>()?;
+    let (multiplier_part, edges_of_part) =
+        checked_parts::<M>(mesh, coefficients, parts, [bilinear, linear], multiplier)?;
+    let boundary = multiplier_dofs_on::<M>(mesh, multiplier_part, &parts[multiplier_part])?;
+    let n_full = dofs.dof_count();
+    // A: the cell part, then the facet blocks
+    let cell_part =
+        MatrixAssembler::new::<M>(bilinear_id, mesh, &dofs)?.assemble::<M>(mesh, coefficients)?;
+    let (ptr, rows, vals) = (
+        cell_part.symbolic().col_ptr(),
+        cell_part.symbolic().row_idx(),
+        cell_part.val(),
+    );
+    let mut system = FullSystem {
+        triplets: (0..n_full)
+            .flat_map(|j| (ptr[j]..ptr[j + 1]).map(move |k| Triplet::new(rows[k], j, vals[k])))
+            .collect(),
+        b: vec![Vec::new(); boundary.count()],
+        c: vec![0.0; boundary.count()],
+        f: assemble_vector::<M>(linear_id, mesh, &dofs, coefficients)?,
+        g: vec![0.0; boundary.count()],
+    };
+    let facets = Facets {
+        mesh,
+        coefficients,
+        dofs: &dofs,
+        multiplier,
+        space: boundary.space,
+        edge_dofs: &boundary.edge_dofs,
+    };
+    for (index, block) in M::FACET_BLOCKS.iter().enumerate() {
+        for (k, edge) in edges_of_part[block.part].iter().enumerate() {
+            if block.form == bilinear {
+                facets.add_matrix::<M>(index, block, k, edge, &mut system)?;
+            } else if block.form == linear {
+                facets.add_vector::<M>(index, block, k, edge, &mut system)?;
+            }
+        }
+    }
+    let (basis, reduction, lcp) = system.reduced(n_full, constraints)?;
+    let n = reduction.free().len();
+    Ok(Discretization {
+        mesh: mesh.clone(),
+        dofs,
+        reduction,
+        basis,
+        lcp,
+        multiplier_field: multiplier,
+        multipliers: Multipliers::Boundary(boundary),
+        roles: Vec::new(),
+        primal_reduced: (0..n).collect(),
+        multiplier_reduced: Vec::new(),
+    })
+}
+
+/// The part the multiplier of `M` lives on and the edges of each of the model's
+/// boundary parts, after the checks of [`discretize`]: one list of markers per part,
+/// each on the boundary, the bilinear form symmetric on every part's facets, and a P1
+/// multiplier in no boundary integral of another part.
+///
+/// # Errors
+/// Those checks', named.
+fn checked_parts<M: Model>(
+    mesh: &TriangleMesh,
+    coefficients: &Coefficients,
+    parts: &[Vec<u32>],
+    [bilinear, linear]: [usize; 2],
+    multiplier: usize,
+) -> Result<(usize, Vec<Vec<ContactEdge>>)> {
     let Some(multiplier_part) = multiplier_part::<M>()? else {
         return Err(Error::Input(format!(
             "the multiplier `{}` of `{}` appears in no boundary integral of `{}`: it has no boundary part to live on",
@@ -330,23 +403,19 @@ pub fn discretize<M: Model>(
             parts.len()
         )));
     }
-    // The edges of every part of the model.
     let mut edges_of_part = Vec::with_capacity(M::FACET_PARTS.len());
-    for (name, markers) in M::FACET_PARTS.iter().zip(parts) {
+    for (part, (name, markers)) in M::FACET_PARTS.iter().zip(parts).enumerate() {
         let edges = part_edges(mesh, markers);
         if edges.is_empty() {
             return Err(Error::Input(format!(
                 "the boundary part `{name}` (markers {markers:?}) holds no boundary edge of the mesh: it is not on the boundary"
             )));
         }
-        edges_of_part.push(edges);
-    }
-    for (part, edges) in edges_of_part.iter().enumerate() {
         let places: Vec<(usize, usize)> = edges.iter().map(|e| (e.cell, e.local)).collect();
         crate::model::require_symmetric_facets::<M>(bilinear, part, mesh, coefficients, &places)?;
+        edges_of_part.push(edges);
     }
-    let boundary = multiplier_dofs_on::<M>(mesh, multiplier_part, &parts[multiplier_part])?;
-    let space = boundary.space;
+    let space = multiplier_space::<M>(multiplier)?;
     if space == BoundaryMultiplier::P1 {
         if let Some(b) = M::FACET_BLOCKS.iter().find(|b| {
             (b.form == bilinear || b.form == linear)
@@ -363,197 +432,226 @@ pub fn discretize<M: Model>(
             )));
         }
     }
-    let n_full = dofs.dof_count();
-    let m = boundary.count();
-    let edge_dofs = &boundary.edge_dofs;
+    Ok((multiplier_part, edges_of_part))
+}
 
-    // A: the cell part, then the facet blocks.
-    let cell_part =
-        MatrixAssembler::new::<M>(bilinear_id, mesh, &dofs)?.assemble::<M>(mesh, coefficients)?;
-    let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
-    {
-        let (ptr, rows, vals) = (
-            cell_part.symbolic().col_ptr(),
-            cell_part.symbolic().row_idx(),
-            cell_part.val(),
+/// `B_h`, `L_h` on the full DOFs before the supports act: `A` as triplets, the rows of
+/// `B`, the diagonal of `C`, `F` and `G`.
+struct FullSystem {
+    triplets: Vec<Triplet<usize, usize, f64>>,
+    b: Vec<Vec<(usize, f64)>>,
+    c: Vec<f64>,
+    f: Vec<f64>,
+    g: Vec<f64>,
+}
+
+impl FullSystem {
+    /// The LCP on the free DOFs of `constraints` (`n_full` DOFs), with the change of
+    /// basis of its rotated groups and the reduction.
+    ///
+    /// # Errors
+    /// An assembly, change of basis or reduction that fails.
+    fn reduced(
+        self,
+        n_full: usize,
+        constraints: &Constraints,
+    ) -> Result<(ChangeOfBasis, crate::assembly::boundary::Reduction, Lcp)> {
+        let FullSystem {
+            triplets,
+            b,
+            c,
+            mut f,
+            mut g,
+        } = self;
+        let a_full: SparseMatrix =
+            SparseColMat::try_new_from_triplets(n_full, n_full, &triplets)
+                .map_err(|e| Error::Input(format!("assembling the system: {e:?}")))?;
+        // supports on combinations of DOFs (a roller along an oblique direction) rotate
+        // their groups: A' = Rᵀ A R, F' = Rᵀ F, each row of B to B R; the reduction is in
+        // the primed numbering
+        let basis = constraints.change_of_basis(n_full)?;
+        let a_full = if basis.is_identity() {
+            a_full
+        } else {
+            basis.transform_matrix(&a_full)?
+        };
+        basis.to_primed(&mut f);
+        let reduction = constraints.reduction(n_full)?;
+        let a = reduction.matrix(&a_full);
+        let f = reduction.rhs(&a_full, &f);
+        // B U_full = B U_free + B U_fixed: the fixed columns move to G
+        let b_rows: Vec<Vec<(usize, f64)>> = b
+            .into_iter()
+            .map(|row| rotate_row(&basis, row))
+            .zip(&mut g)
+            .map(|(row, g)| {
+                let mut out: Vec<(usize, f64)> = Vec::with_capacity(row.len());
+                for (col, v) in row {
+                    match reduction.free_index(col) {
+                        Some(j) => match out.iter_mut().find(|(c, _)| *c == j) {
+                            Some(e) => e.1 += v,
+                            None => out.push((j, v)),
+                        },
+                        None => *g -= v * reduction.fixed_value(col),
+                    }
+                }
+                out.sort_by_key(|e| e.0);
+                out
+            })
+            .collect();
+        let lcp = Lcp::new(a, ConstraintRows::from(b_rows), c, f, g);
+        Ok((basis, reduction, lcp))
+    }
+}
+
+/// What the facet blocks of [`discretize`] are added with: the mesh, coefficients and
+/// DOFs, the multiplier field, its space and its constraints per edge.
+struct Facets<'a> {
+    mesh: &'a TriangleMesh,
+    coefficients: &'a Coefficients<'a>,
+    dofs: &'a SystemDofs,
+    multiplier: usize,
+    space: BoundaryMultiplier,
+    edge_dofs: &'a [[usize; 2]],
+}
+
+impl Facets<'_> {
+    /// The global rows of a primal field's local DOFs on `cell`.
+    fn place(&self, field: usize, cell: usize) -> Vec<usize> {
+        let (map, offset) = (
+            self.dofs.map(field).expect("a primal field"),
+            self.dofs.offset(field).expect("a primal field"),
         );
-        for j in 0..n_full {
-            for k in ptr[j]..ptr[j + 1] {
-                triplets.push(Triplet::new(rows[k], j, vals[k]));
-            }
-        }
+        map.cell_dofs(cell).iter().map(|d| d + offset).collect()
     }
-    let mut b_full: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
-    let mut c = vec![0.0; m];
-    let mut f_full = assemble_vector::<M>(linear_id, mesh, &dofs, coefficients)?;
-    let mut g = vec![0.0; m];
-    let (params, data) = (&coefficients.params, &coefficients.data);
-    let largest = M::FIELDS
-        .iter()
-        .map(|f| f.element.local_dof_count(M::CELL))
-        .max()
-        .unwrap_or(0);
-    let mut out = vec![0.0; largest * largest];
-    // The global rows of a field's local DOFs on an edge's cell.
-    let place = |field: usize, cell: usize| -> Option<Vec<usize>> {
-        let map = dofs.map(field)?;
-        let offset = dofs.offset(field)?;
-        Some(map.cell_dofs(cell).iter().map(|d| d + offset).collect())
-    };
-    for (index, block) in M::FACET_BLOCKS.iter().enumerate() {
-        if block.form != bilinear && block.form != linear {
-            continue;
+
+    /// Adds facet block `index` (`block`, of the bilinear form) on the `k`-th edge of its
+    /// part to `system`: to A, to the rows of B (`−b`: B_h holds `−b(v, λ)`), or to C
+    /// (`−α S`); a P1 multiplier's rows are its edge's two end vertices, its C lumped by
+    /// rows (the chain of the part does not fit [`crate::lcp::CouplingBlocks`]).
+    ///
+    /// # Errors
+    /// A kernel's, a non-finite entry, a P1 term off the edge.
+    fn add_matrix<M: Model>(
+        &self,
+        index: usize,
+        block: &FacetBlockInfo,
+        k: usize,
+        edge: &ContactEdge,
+        system: &mut FullSystem,
+    ) -> Result<()> {
+        let Some(trial) = block.trial_field else {
+            return Ok(());
+        };
+        let multiplier = self.multiplier;
+        let rows = M::FIELDS[block.test_field].element.local_dof_count(M::CELL);
+        let cols = M::FIELDS[trial].element.local_dof_count(M::CELL);
+        let mut local = vec![0.0; rows * cols];
+        let x = self.mesh.cell_coordinates(edge.cell);
+        let (params, data) = (&self.coefficients.params, &self.coefficients.data);
+        M::facet_matrix(index, &x, edge.local, params, data, &mut local)?;
+        if local.iter().any(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "facet matrix",
+                cell: edge.cell,
+            });
         }
-        for (k, edge) in edges_of_part[block.part].iter().enumerate() {
-            let x = mesh.cell_coordinates(edge.cell);
-            let test_is_multiplier = block.test_field == multiplier;
-            let rows = M::FIELDS[block.test_field].element.local_dof_count(M::CELL);
-            if block.form == bilinear {
-                let Some(trial) = block.trial_field else {
-                    continue;
-                };
-                let cols = M::FIELDS[trial].element.local_dof_count(M::CELL);
-                let local = &mut out[..rows * cols];
-                M::facet_matrix(index, &x, edge.local, params, data, local)?;
-                if local.iter().any(|v| !v.is_finite()) {
-                    return Err(Error::NonFinite {
-                        what: "facet matrix",
-                        cell: edge.cell,
-                    });
+        let (test_is_multiplier, trial_is_multiplier) =
+            (block.test_field == multiplier, trial == multiplier);
+        // the multiplier's constraints among the rows: the edge's own (P0), or its two
+        // end vertices' (P1), whose local rows are `on_edge`
+        let (on_edge, constraints): (Vec<usize>, Vec<usize>) = if self.space
+            == BoundaryMultiplier::P1
+            && (test_is_multiplier || trial_is_multiplier)
+        {
+            let (on_edge, off) = edge_vertices(edge.local);
+            check_off_edge::<M>(
+                &local,
+                cols,
+                &|i, j| (test_is_multiplier && i == off) || (trial_is_multiplier && j == off),
+                multiplier,
+                edge,
+            )?;
+            (on_edge.to_vec(), self.edge_dofs[k].to_vec())
+        } else {
+            (vec![0], vec![k])
+        };
+        match (test_is_multiplier, trial_is_multiplier) {
+            (true, true) => {
+                for (&i, &constraint) in on_edge.iter().zip(&constraints) {
+                    let row: f64 = on_edge.iter().map(|&j| local[i * cols + j]).sum();
+                    system.c[constraint] -= row;
                 }
-                if space == BoundaryMultiplier::P1 && (test_is_multiplier || trial == multiplier) {
-                    let (on_edge, off) = edge_vertices(edge.local);
-                    let (mrows, mcols) = (test_is_multiplier, trial == multiplier);
-                    check_off_edge::<M>(
-                        local,
-                        cols,
-                        &|i, j| (mrows && i == off) || (mcols && j == off),
-                        multiplier,
-                        edge,
-                    )?;
-                    match (mrows, mcols) {
-                        // lumped by rows: the chain of the part does not fit CouplingBlocks
-                        (true, true) => {
-                            for (a, &i) in on_edge.iter().enumerate() {
-                                let row: f64 = on_edge.iter().map(|&j| local[i * cols + j]).sum();
-                                c[edge_dofs[k][a]] -= row;
-                            }
-                        }
-                        (true, false) => {
-                            let columns = place(trial, edge.cell).expect("a primal field");
-                            for (a, &i) in on_edge.iter().enumerate() {
-                                for (j, &col) in columns.iter().enumerate() {
-                                    let v = local[i * cols + j];
-                                    if v != 0.0 {
-                                        b_full[edge_dofs[k][a]].push((col, -v));
-                                    }
-                                }
-                            }
-                        }
-                        // the (v, λ) block is the transpose of (μ, v): B_h is symmetric
-                        _ => {}
-                    }
-                    continue;
-                }
-                match (test_is_multiplier, trial == multiplier) {
-                    (true, true) => c[k] -= local[0],
-                    (true, false) => {
-                        let columns = place(trial, edge.cell).expect("a primal field");
-                        for (j, &col) in columns.iter().enumerate() {
-                            if local[j] != 0.0 {
-                                b_full[k].push((col, -local[j]));
-                            }
-                        }
-                    }
-                    // the (v, λ) block is the transpose of (μ, v): B_h is symmetric
-                    (false, true) => {}
-                    (false, false) => {
-                        let r = place(block.test_field, edge.cell).expect("a primal field");
-                        let s = place(trial, edge.cell).expect("a primal field");
-                        for (i, &row) in r.iter().enumerate() {
-                            for (j, &col) in s.iter().enumerate() {
-                                triplets.push(Triplet::new(row, col, local[i * cols + j]));
-                            }
+            }
+            (true, false) => {
+                let columns = self.place(trial, edge.cell);
+                for (&i, &constraint) in on_edge.iter().zip(&constraints) {
+                    for (j, &col) in columns.iter().enumerate() {
+                        let v = local[i * cols + j];
+                        if v != 0.0 {
+                            system.b[constraint].push((col, -v));
                         }
                     }
                 }
-            } else {
-                let local = &mut out[..rows];
-                M::facet_vector(index, &x, edge.local, params, data, local)?;
-                if local.iter().any(|v| !v.is_finite()) {
-                    return Err(Error::NonFinite {
-                        what: "facet vector",
-                        cell: edge.cell,
-                    });
-                }
-                if test_is_multiplier && space == BoundaryMultiplier::P1 {
-                    let (on_edge, off) = edge_vertices(edge.local);
-                    check_off_edge::<M>(local, 1, &|i, _| i == off, multiplier, edge)?;
-                    for (a, &i) in on_edge.iter().enumerate() {
-                        g[edge_dofs[k][a]] -= local[i];
-                    }
-                } else if test_is_multiplier {
-                    g[k] -= local[0];
-                } else {
-                    let r = place(block.test_field, edge.cell).expect("a primal field");
-                    for (i, &row) in r.iter().enumerate() {
-                        f_full[row] += local[i];
+            }
+            // the (v, λ) block is the transpose of (μ, v): B_h is symmetric
+            (false, true) => {}
+            (false, false) => {
+                let r = self.place(block.test_field, edge.cell);
+                let s = self.place(trial, edge.cell);
+                for (i, &row) in r.iter().enumerate() {
+                    for (j, &col) in s.iter().enumerate() {
+                        system
+                            .triplets
+                            .push(Triplet::new(row, col, local[i * cols + j]));
                     }
                 }
             }
         }
+        Ok(())
     }
-    let a_full: SparseMatrix = SparseColMat::try_new_from_triplets(n_full, n_full, &triplets)
-        .map_err(|e| Error::Input(format!("assembling the system: {e:?}")))?;
-    // supports on combinations of DOFs (a roller along an oblique direction) rotate
-    // their groups: A' = Rᵀ A R, F' = Rᵀ F, each row of B to B R; the reduction is in
-    // the primed numbering
-    let basis = constraints.change_of_basis(n_full)?;
-    let a_full = if basis.is_identity() {
-        a_full
-    } else {
-        basis.transform_matrix(&a_full)?
-    };
-    basis.to_primed(&mut f_full);
-    let b_full: Vec<Vec<(usize, f64)>> = b_full
-        .into_iter()
-        .map(|row| rotate_row(&basis, row))
-        .collect();
-    let reduction = constraints.reduction(n_full)?;
-    let a = reduction.matrix(&a_full);
-    let f = reduction.rhs(&a_full, &f_full);
-    // B U_full = B U_free + B U_fixed: the fixed columns move to G
-    let b_rows: Vec<Vec<(usize, f64)>> = b_full
-        .into_iter()
-        .zip(&mut g)
-        .map(|(row, g)| {
-            let mut out: Vec<(usize, f64)> = Vec::with_capacity(row.len());
-            for (col, v) in row {
-                match reduction.free_index(col) {
-                    Some(j) => match out.iter_mut().find(|(c, _)| *c == j) {
-                        Some(e) => e.1 += v,
-                        None => out.push((j, v)),
-                    },
-                    None => *g -= v * reduction.fixed_value(col),
-                }
+
+    /// Adds facet block `index` (`block`, of the linear form) on the `k`-th edge of its
+    /// part to `system`: to F, or to G (`−ℓ_S`) on the multiplier's constraints.
+    ///
+    /// # Errors
+    /// A kernel's, a non-finite entry, a P1 term off the edge.
+    fn add_vector<M: Model>(
+        &self,
+        index: usize,
+        block: &FacetBlockInfo,
+        k: usize,
+        edge: &ContactEdge,
+        system: &mut FullSystem,
+    ) -> Result<()> {
+        let rows = M::FIELDS[block.test_field].element.local_dof_count(M::CELL);
+        let mut local = vec![0.0; rows];
+        let x = self.mesh.cell_coordinates(edge.cell);
+        let (params, data) = (&self.coefficients.params, &self.coefficients.data);
+        M::facet_vector(index, &x, edge.local, params, data, &mut local)?;
+        if local.iter().any(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "facet vector",
+                cell: edge.cell,
+            });
+        }
+        let test_is_multiplier = block.test_field == self.multiplier;
+        if test_is_multiplier && self.space == BoundaryMultiplier::P1 {
+            let (on_edge, off) = edge_vertices(edge.local);
+            check_off_edge::<M>(&local, 1, &|i, _| i == off, self.multiplier, edge)?;
+            for (a, &i) in on_edge.iter().enumerate() {
+                system.g[self.edge_dofs[k][a]] -= local[i];
             }
-            out.sort_by_key(|e| e.0);
-            out
-        })
-        .collect();
-    let n = reduction.free().len();
-    Ok(Discretization {
-        mesh: mesh.clone(),
-        dofs,
-        reduction,
-        basis,
-        lcp: Lcp::new(a, ConstraintRows::from(b_rows), c, f, g),
-        multiplier_field: multiplier,
-        multipliers: Multipliers::Boundary(boundary),
-        roles: Vec::new(),
-        primal_reduced: (0..n).collect(),
-        multiplier_reduced: Vec::new(),
-    })
+        } else if test_is_multiplier {
+            system.g[k] -= local[0];
+        } else {
+            let r = self.place(block.test_field, edge.cell);
+            for (i, &row) in r.iter().enumerate() {
+                system.f[row] += local[i];
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A sparse row `b` of B as `b R` in the primed DOFs of `basis`: at each rotated group

@@ -1079,7 +1079,12 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         )
     }
 
-    /// The report of a solution.
+    /// The report of a solution: the solve's numbers, and the guards every family shares
+    /// (multiplier noise, the plain pair's kernel, rounding of the primal answer, the
+    /// crossing of the obstacle and open gaps, errors against an exact solution).
+    ///
+    /// # Errors
+    /// A multiplier or a primal answer lost to rounding.
     fn report(
         &self,
         solution: &ObstacleSolution<G>,
@@ -1090,7 +1095,6 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     ) -> Result<Report> {
         let d = &solution.discretization;
         let lcp: &Lcp = &d.lcp;
-        let mut warnings = Vec::new();
         let (u, lambda) = (
             d.primal_part(&solution.values),
             d.multiplier_part(&solution.values),
@@ -1127,179 +1131,154 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             multiplier_noise: solution.multiplier_noise,
             ..Report::default()
         };
-        if solution.multiplier_noise > MAX_MULTIPLIER_NOISE {
-            return Err(Error::Input(format!(
-                "λ_h is rounding noise (estimated {:.0e} relative; ∫λ_h would be off by as much, and {} follows it): the multiplier's stabilization C = α h^p lies below the rounding of the gap G − BU; use fewer cells (elements) or a larger α",
-                solution.multiplier_noise,
-                answer_name::<M>()
-            )));
-        }
-        if solution.multiplier_noise > MULTIPLIER_NOISE_WARNING {
-            warnings.push(format!(
-                "λ_h may carry rounding noise of up to {:.0e} relative: C = α h^p approaches the rounding of G − BU at this mesh size, and its recovery is no guarantee at this conditioning (a larger α or a coarser mesh avoids it)",
-                solution.multiplier_noise
-            ));
-        }
-        if alpha == 0.0 && lcp.m() > lcp.n() {
-            warnings.push(format!(
-                "α = 0: the plain pair has {} multipliers for {} primal unknowns, so Bᵀ has a kernel of dimension at least {} (no discrete inf-sup condition, docs/mathematics.md §1): u_h is unique, but where that kernel meets the contact set λ_h is not, and the λ_h, ∫λ_h and contact set reported are one of many; α > 0 (the default) gives the unique stabilized λ_h",
-                lcp.m(),
-                lcp.n(),
-                lcp.m() - lcp.n()
-            ));
-        }
-        if options.linear_solver == crate::obstacle::hierarchy::LinearSolver::Multigrid
-            && solution.iterative_steps == 0
-        {
-            warnings.push(if options.solver == VariationalSolver::SemismoothNewton {
-                "--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level and elements with a prolongation; or CG did not converge), so they were factored".to_string()
-            } else {
-                "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string()
-            });
-        }
-        // the pointwise checks of the constrained field against the obstacle
-        let diameter = d.mesh.extent();
-        let size_of = |values: &[f64]| {
-            values
-                .iter()
-                .filter(|v| v.is_finite())
-                .fold(0.0f64, |m, v| m.max(v.abs()))
-        };
-        let (u_size, psi_size, u_range) = match M::OBSTACLE {
-            Some([field, obstacle]) => {
-                let u_values = G::field_at_vertices(solution, field);
-                let psi = d.mesh.at_vertices(coefficients.data[obstacle]);
-                let (lo, hi) = u_values
-                    .iter()
-                    .filter(|v| v.is_finite())
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                        (lo.min(v), hi.max(v))
-                    });
-                (
-                    size_of(&u_values),
-                    size_of(&psi),
-                    if hi >= lo { hi - lo } else { 0.0 },
-                )
-            }
-            None => (size_of(&u), 0.0, 0.0),
-        };
-        let level = answer_level(u_size, psi_size, diameter);
+        let mut warnings = solver_warnings::<M, G>(solution, alpha, options)?;
+        let sizes = AnswerSizes::of::<M, G>(solution, coefficients, &u);
         let primal_rounding = solution.primal_rounding();
-        report.primal_rounding = if level > 0.0 {
-            primal_rounding / level
+        report.primal_rounding = if sizes.level > 0.0 {
+            primal_rounding / sizes.level
         } else {
             0.0
         };
-        let large_alpha = self
-            .default_alpha(c_i)
-            .filter(|&default| alpha > LARGE_ALPHA * default);
-        if report.primal_rounding.is_nan() || report.primal_rounding > MAX_PRIMAL_ROUNDING {
-            if let Some(default) = large_alpha {
-                return Err(Error::Input(format!(
-                    "{} is lost to rounding: the load with α = {alpha:e} ({} times the default {default:e}) makes the terms of the constraint rows so large that their rounding moves it by {:.0e} of its own size (its KKT residual cannot show it): lower α first, then the load",
-                    answer_name::<M>(),
-                    number(alpha / default),
-                    report.primal_rounding
-                )));
-            }
-            return Err(Error::Input(format!(
-                "{} is lost to rounding: the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves {} by {:.0e} of its own size (its KKT residual cannot show it); use a smaller load (or α)",
-                answer_name::<M>(),
-                answer_name::<M>(),
-                report.primal_rounding
-            )));
-        }
-        if report.primal_rounding > PRIMAL_ROUNDING_WARNING {
-            warnings.push(format!(
-                "{} may be off by {:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)",
-                answer_name::<M>(),
-                report.primal_rounding
-            ));
-        }
+        self.judge_primal_rounding(report.primal_rounding, alpha, c_i, &mut warnings)?;
         // without a constraint there is nothing to cross
         if let (Some([field, obstacle]), false) = (M::OBSTACLE, self.unconstrained) {
-            let name = M::FIELDS[field].name;
-            let psi = coefficients.data[obstacle];
-            let side = self.side.sign();
-            let penetration = G::penetration(solution, field, psi, side);
-            let gap = if d.boundary().is_some() {
-                0.0
-            } else {
-                G::open_gap(solution, field, psi, side)
+            let crossing = Crossing {
+                field,
+                psi: coefficients.data[obstacle],
+                sizes,
+                // the rounding of the compared values: of their size, of the solve under
+                // its load, and of the solve through the rows in contact
+                rounding: value_rounding(sizes.u, sizes.psi)
+                    + load_rounding(
+                        largest_load::<M, G>(&d.mesh, coefficients),
+                        d.mesh.extent(),
+                        M::ORDER,
+                    )
+                    + primal_rounding,
             };
-            report.max_penetration = Some(penetration.depth);
-            report.max_open_contact_gap = Some(gap);
-            // the rounding of the compared values: of their size, of the solve under
-            // its load, and of the solve through the rows in contact
-            let load = largest_load::<M, G>(&d.mesh, coefficients);
-            let rounding = value_rounding(u_size, psi_size)
-                + load_rounding(load, diameter, M::ORDER)
-                + primal_rounding;
-            // a flat obstacle under a flat answer has ranges of rounding size: the depth is
-            // judged against the answer's size there (a percentage of 1e-17 meant nothing)
-            let size = u_size.max(psi_size);
-            let ranges = penetration.obstacle_range.max(u_range);
-            let (range, measure) = if ranges < FLAT_SHARE * size {
-                (size, "the larger of ψ's and {name}_h's sizes")
-            } else {
-                (ranges, "the larger of ψ's and {name}_h's ranges")
-            };
-            let measure = measure.replace("{name}", name);
-            if penetration.depth.is_nan() {
-                warnings.push(format!(
-                    "max_penetration is not a number: the obstacle ψ or {name}_h is not finite at some point the penetration check samples"
-                ));
-            } else if range > 0.0
-                && penetration.depth > PENETRATION_WARNING * range
-                && penetration.depth > rounding
-            {
-                warnings.push(format!(
-                    "{name}_h {} ψ by up to {:.2e}, {:.1} % of {measure} ({range:.2e}): the constraint holds on each cell's mean, so a mesh that does not resolve the contact lets {name}_h pass ψ by O(h²) inside cells; refine the mesh (or lower the load)",
-                    if side > 0.0 { "dips below" } else { "rises above" },
-                    penetration.depth,
-                    100.0 * penetration.depth / range
-                ));
-                if let Some(default) = self
-                    .default_alpha(c_i)
-                    .filter(|&default| alpha > 10.0 * default)
-                {
-                    warnings.push(format!(
-                        "α = {alpha:e} is {:.0e} times the default {default:.3e}: the stabilized constraint lets {name}_h cross ψ by about α h^p λ_h, so lower α before refining",
-                        alpha / default
-                    ));
-                }
-            }
-            if gap > OPEN_GAP_WARNING * level && gap > rounding {
-                let cure = if self
-                    .default_alpha(c_i)
-                    .is_some_and(|default| alpha > 10.0 * default)
-                {
-                    "lower α"
-                } else {
-                    "refine the mesh or lower α"
-                };
-                warnings.push(format!(
-                    "λ_h pushes on cells where {name}_h stays up to {gap:.2e} clear of ψ ({:.1} % of the answer's size max(|{name}_h|, |ψ|) = {level:.2e}): the stabilized constraint on contact cells lets α h^p(…) (α = {alpha:e}) open that gap, so this contact set is not real; {cure}",
-                    100.0 * gap / level
-                ));
-            }
+            self.judge_crossing(solution, &crossing, alpha, c_i, &mut report, &mut warnings);
         }
         if let (Some(exact), Some([field, _])) = (&self.exact, M::OBSTACLE) {
-            let errors = G::errors(solution, field, exact);
-            report.error_l2 = errors.l2;
-            report.error_h1 = errors.h1;
-            report.error_h2 = errors.h2;
-            report.error_multiplier = errors.multiplier;
-            report.error_vertex_max = errors.vertex_max;
-            report.error_vertex_mean = errors.vertex_mean;
-            let not_a_number = |e: Option<f64>| e.is_some_and(|e| !e.is_finite());
-            if not_a_number(errors.l2) || not_a_number(errors.h1) || not_a_number(errors.multiplier)
-            {
-                warnings.push("an error against the exact solution is not a number: the exact u, its gradient or λ is not finite at some quadrature point".into());
-            }
+            record_errors(solution, field, exact, &mut report, &mut warnings);
         }
         report.warnings = warnings;
         Ok(report)
+    }
+
+    /// Refuses a primal answer that rounding of the contact rows moves by more than
+    /// [`MAX_PRIMAL_ROUNDING`] of its size (`relative`), naming α where the user's is
+    /// far above the default; warns beyond [`PRIMAL_ROUNDING_WARNING`].
+    ///
+    /// # Errors
+    /// [`Error::Input`] for an answer lost to rounding.
+    fn judge_primal_rounding(
+        &self,
+        relative: f64,
+        alpha: f64,
+        c_i: f64,
+        warnings: &mut Vec<String>,
+    ) -> Result<()> {
+        if relative.is_nan() || relative > MAX_PRIMAL_ROUNDING {
+            let large_alpha = self
+                .default_alpha(c_i)
+                .filter(|&default| alpha > LARGE_ALPHA * default);
+            if let Some(default) = large_alpha {
+                return Err(Error::Input(format!(
+                    "{} is lost to rounding: the load with α = {alpha:e} ({} times the default {default:e}) makes the terms of the constraint rows so large that their rounding moves it by {relative:.0e} of its own size (its KKT residual cannot show it): lower α first, then the load",
+                    answer_name::<M>(),
+                    number(alpha / default),
+                )));
+            }
+            return Err(Error::Input(format!(
+                "{} is lost to rounding: the load dwarfs the obstacle: in contact the constraint rows subtract terms of the load's size, and their rounding moves {} by {relative:.0e} of its own size (its KKT residual cannot show it); use a smaller load (or α)",
+                answer_name::<M>(),
+                answer_name::<M>(),
+            )));
+        }
+        if relative > PRIMAL_ROUNDING_WARNING {
+            warnings.push(format!(
+                "{} may be off by {relative:.0e} of its size through the rounding of the contact rows (the load dwarfs the obstacle)",
+                answer_name::<M>(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Records the constrained field's crossing of the obstacle and the largest open
+    /// gap under a pushing multiplier, and warns where either is beyond rounding and
+    /// its share of the answer (naming α where the user's is the likelier cause).
+    fn judge_crossing(
+        &self,
+        solution: &ObstacleSolution<G>,
+        crossing: &Crossing<'_>,
+        alpha: f64,
+        c_i: f64,
+        report: &mut Report,
+        warnings: &mut Vec<String>,
+    ) {
+        let d = &solution.discretization;
+        let Crossing {
+            field,
+            psi,
+            sizes,
+            rounding,
+        } = *crossing;
+        let name = M::FIELDS[field].name;
+        let side = self.side.sign();
+        let penetration = G::penetration(solution, field, psi, side);
+        let gap = if d.boundary().is_some() {
+            0.0
+        } else {
+            G::open_gap(solution, field, psi, side)
+        };
+        report.max_penetration = Some(penetration.depth);
+        report.max_open_contact_gap = Some(gap);
+        let large_alpha = self
+            .default_alpha(c_i)
+            .filter(|&default| alpha > 10.0 * default);
+        // a flat obstacle under a flat answer has ranges of rounding size: the depth is
+        // judged against the answer's size there (a percentage of 1e-17 meant nothing)
+        let size = sizes.u.max(sizes.psi);
+        let ranges = penetration.obstacle_range.max(sizes.u_range);
+        let (range, measure) = if ranges < FLAT_SHARE * size {
+            (size, "the larger of ψ's and {name}_h's sizes")
+        } else {
+            (ranges, "the larger of ψ's and {name}_h's ranges")
+        };
+        let measure = measure.replace("{name}", name);
+        if penetration.depth.is_nan() {
+            warnings.push(format!(
+                "max_penetration is not a number: the obstacle ψ or {name}_h is not finite at some point the penetration check samples"
+            ));
+        } else if range > 0.0
+            && penetration.depth > PENETRATION_WARNING * range
+            && penetration.depth > rounding
+        {
+            warnings.push(format!(
+                "{name}_h {} ψ by up to {:.2e}, {:.1} % of {measure} ({range:.2e}): the constraint holds on each cell's mean, so a mesh that does not resolve the contact lets {name}_h pass ψ by O(h²) inside cells; refine the mesh (or lower the load)",
+                if side > 0.0 { "dips below" } else { "rises above" },
+                penetration.depth,
+                100.0 * penetration.depth / range
+            ));
+            if let Some(default) = large_alpha {
+                warnings.push(format!(
+                    "α = {alpha:e} is {:.0e} times the default {default:.3e}: the stabilized constraint lets {name}_h cross ψ by about α h^p λ_h, so lower α before refining",
+                    alpha / default
+                ));
+            }
+        }
+        let level = sizes.level;
+        if gap > OPEN_GAP_WARNING * level && gap > rounding {
+            let cure = if large_alpha.is_some() {
+                "lower α"
+            } else {
+                "refine the mesh or lower α"
+            };
+            warnings.push(format!(
+                "λ_h pushes on cells where {name}_h stays up to {gap:.2e} clear of ψ ({:.1} % of the answer's size max(|{name}_h|, |ψ|) = {level:.2e}): the stabilized constraint on contact cells lets α h^p(…) (α = {alpha:e}) open that gap, so this contact set is not real; {cure}",
+                100.0 * gap / level
+            ));
+        }
     }
 
     /// The rounding experiment: the largest relative change of the constrained field
@@ -1452,6 +1431,135 @@ fn unconstrained_solution<G: crate::DofNumbering>(
         iterative_steps: 0,
         krylov_iterations: 0,
     })
+}
+
+/// The sizes an answer's checks are judged against: the largest |u_h| and |ψ| at the
+/// vertices, the range of u_h there, and the answer's level
+/// ([`report::answer_level`]).
+#[derive(Clone, Copy, Debug)]
+struct AnswerSizes {
+    u: f64,
+    psi: f64,
+    u_range: f64,
+    level: f64,
+}
+
+impl AnswerSizes {
+    /// The sizes of `solution` (`u` its primal unknowns, the size of a model without an
+    /// obstacle).
+    fn of<M: Model, G: Domain>(
+        solution: &ObstacleSolution<G>,
+        coefficients: &Coefficients,
+        u: &[f64],
+    ) -> Self {
+        let d = &solution.discretization;
+        let size_of = |values: &[f64]| {
+            values
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold(0.0f64, |m, v| m.max(v.abs()))
+        };
+        let (u_size, psi_size, u_range) = match M::OBSTACLE {
+            Some([field, obstacle]) => {
+                let u_values = G::field_at_vertices(solution, field);
+                let psi = d.mesh.at_vertices(coefficients.data[obstacle]);
+                let (lo, hi) = u_values
+                    .iter()
+                    .filter(|v| v.is_finite())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                        (lo.min(v), hi.max(v))
+                    });
+                (
+                    size_of(&u_values),
+                    size_of(&psi),
+                    if hi >= lo { hi - lo } else { 0.0 },
+                )
+            }
+            None => (size_of(u), 0.0, 0.0),
+        };
+        Self {
+            u: u_size,
+            psi: psi_size,
+            u_range,
+            level: answer_level(u_size, psi_size, d.mesh.extent()),
+        }
+    }
+}
+
+/// What the check of the obstacle's crossing compares: the constrained field, ψ, the
+/// answer's sizes and the rounding of the compared values.
+struct Crossing<'a> {
+    field: usize,
+    psi: &'a DataFn,
+    sizes: AnswerSizes,
+    rounding: f64,
+}
+
+/// The warnings of how the solve went (a multiplier near rounding noise, the plain
+/// pair's kernel, multigrid asked for but not used).
+///
+/// # Errors
+/// [`Error::Input`] for a multiplier that is rounding noise.
+fn solver_warnings<M: Model, G>(
+    solution: &ObstacleSolution<G>,
+    alpha: f64,
+    options: ObstacleOptions,
+) -> Result<Vec<String>> {
+    let lcp = &solution.discretization.lcp;
+    let mut warnings = Vec::new();
+    if solution.multiplier_noise > MAX_MULTIPLIER_NOISE {
+        return Err(Error::Input(format!(
+            "λ_h is rounding noise (estimated {:.0e} relative; ∫λ_h would be off by as much, and {} follows it): the multiplier's stabilization C = α h^p lies below the rounding of the gap G − BU; use fewer cells (elements) or a larger α",
+            solution.multiplier_noise,
+            answer_name::<M>()
+        )));
+    }
+    if solution.multiplier_noise > MULTIPLIER_NOISE_WARNING {
+        warnings.push(format!(
+            "λ_h may carry rounding noise of up to {:.0e} relative: C = α h^p approaches the rounding of G − BU at this mesh size, and its recovery is no guarantee at this conditioning (a larger α or a coarser mesh avoids it)",
+            solution.multiplier_noise
+        ));
+    }
+    if alpha == 0.0 && lcp.m() > lcp.n() {
+        warnings.push(format!(
+            "α = 0: the plain pair has {} multipliers for {} primal unknowns, so Bᵀ has a kernel of dimension at least {} (no discrete inf-sup condition, docs/mathematics.md §1): u_h is unique, but where that kernel meets the contact set λ_h is not, and the λ_h, ∫λ_h and contact set reported are one of many; α > 0 (the default) gives the unique stabilized λ_h",
+            lcp.m(),
+            lcp.n(),
+            lcp.m() - lcp.n()
+        ));
+    }
+    if options.linear_solver == crate::obstacle::hierarchy::LinearSolver::Multigrid
+        && solution.iterative_steps == 0
+    {
+        warnings.push(if options.solver == VariationalSolver::SemismoothNewton {
+            "--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level and elements with a prolongation; or CG did not converge), so they were factored".to_string()
+        } else {
+            "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string()
+        });
+    }
+    Ok(warnings)
+}
+
+/// Records the errors of `solution`'s `field` against `exact`, with a warning where one
+/// is not a number.
+fn record_errors<G: Domain>(
+    solution: &ObstacleSolution<G>,
+    field: usize,
+    exact: &Exact<'_>,
+    report: &mut Report,
+    warnings: &mut Vec<String>,
+) {
+    let errors = G::errors(solution, field, exact);
+    report.error_l2 = errors.l2;
+    report.error_h1 = errors.h1;
+    report.error_h2 = errors.h2;
+    report.error_multiplier = errors.multiplier;
+    report.error_vertex_max = errors.vertex_max;
+    report.error_vertex_mean = errors.vertex_mean;
+    let not_a_number = |e: Option<f64>| e.is_some_and(|e| !e.is_finite());
+    if not_a_number(errors.l2) || not_a_number(errors.h1) || not_a_number(errors.multiplier) {
+        warnings.push("an error against the exact solution is not a number: the exact u, its gradient or λ is not finite at some quadrature point".into());
+    }
 }
 
 /// A user's number as a message prints it: as written for magnitudes in [10⁻³, 10⁶)
