@@ -838,33 +838,28 @@ pub(super) fn newton_iteration(
     let n = lcp.n();
     let mut u = lcp.start_vector(start)?;
     let hessian = &workspace.hessian;
-    let mut factorizations = 0;
-    let done = |u: Vec<f64>,
-                lambda: Vec<f64>,
-                iterations: usize,
-                residual: f64,
-                solves: (usize, usize, usize)| {
-        let multiplier_noise = lcp.elimination_noise(&lambda);
-        LcpSolution {
-            u,
-            lambda,
-            iterations,
-            kkt_residual: residual,
-            seconds: clock.elapsed().as_secs_f64(),
-            factorizations: solves.0,
-            low_rank_updates: solves.1,
-            multiplier_noise,
-            iterative_steps: solves.2,
-            krylov_iterations: 0,
-        }
-    };
-    let mut iterative_steps = 0;
+    let mut solves = StepCounts::default();
+    let done =
+        |u: Vec<f64>, lambda: Vec<f64>, iterations: usize, residual: f64, solves: StepCounts| {
+            let multiplier_noise = lcp.elimination_noise(&lambda);
+            LcpSolution {
+                u,
+                lambda,
+                iterations,
+                kkt_residual: residual,
+                seconds: clock.elapsed().as_secs_f64(),
+                factorizations: solves.factorizations,
+                low_rank_updates: solves.low_rank_updates,
+                multiplier_noise,
+                iterative_steps: solves.iterative_steps,
+                krylov_iterations: 0,
+            }
+        };
     let mut smooth_first = start.is_some() && options.smoothing_sweeps > 0;
     let mut last_exact = true;
     let mut previous_active: Option<Vec<bool>> = None;
     // the last factored Hessian and its faces, for low-rank updates
     let mut factored: Option<(CholeskyFactor, Vec<bool>)> = None;
-    let mut low_rank_updates = 0;
     let mut seen_faces = std::collections::HashSet::new();
     // the iterate after a full exact step with the smallest KKT residual
     let mut best: Option<(Vec<f64>, Vec<f64>, f64)> = None;
@@ -880,13 +875,7 @@ pub(super) fn newton_iteration(
         if last_exact && previous_active.as_ref() == Some(&active) {
             let residual = residual_here();
             if residual <= options.tolerance {
-                return Ok(done(
-                    u,
-                    lambda,
-                    iteration - 1,
-                    residual,
-                    (factorizations, low_rank_updates, iterative_steps),
-                ));
+                return Ok(done(u, lambda, iteration - 1, residual, solves));
             }
         }
         // Cycling: after full exact steps the faces come back to a set seen before. On
@@ -905,13 +894,7 @@ pub(super) fn newton_iteration(
             if (cycling && last_exact) || tracked {
                 let residual = residual_here();
                 if cycling && last_exact && residual <= options.tolerance {
-                    return Ok(done(
-                        u,
-                        lambda,
-                        iteration - 1,
-                        residual,
-                        (factorizations, low_rank_updates, iterative_steps),
-                    ));
+                    return Ok(done(u, lambda, iteration - 1, residual, solves));
                 }
                 if tracked && best.as_ref().is_none_or(|b| residual < b.2) {
                     best = Some((u.clone(), lambda.clone(), residual));
@@ -944,40 +927,19 @@ pub(super) fn newton_iteration(
             _ => (None, true),
         };
         let exact = full && solved_exact;
-        iterative_steps += usize::from(solved.is_some());
+        solves.iterative_steps += usize::from(solved.is_some());
         let d = match smoothed.or(solved) {
             Some(d) => d,
             None => {
-                let reusable = factored.as_ref().filter(|_| options.low_rank_updates);
-                let updated = reusable.and_then(|(factor, factored_active)| {
-                    updated_solve(
-                        lcp,
-                        &h,
-                        factor,
-                        factored_active,
-                        &active,
-                        &minus_gradient,
-                        options,
-                    )
-                });
-                match updated {
-                    Some(d) => {
-                        low_rank_updates += 1;
-                        d
-                    }
-                    None => {
-                        factorizations += 1;
-                        let factor = workspace
-                            .analyse()?
-                            .factor_cholesky(&h)
-                            .map_err(hessian_not_positive)?;
-                        let d = refined(&h, &minus_gradient, options.refinement_steps, |b| {
-                            factor.solve(b)
-                        })?;
-                        factored = Some((factor, active.clone()));
-                        d
-                    }
-                }
+                let direct = DirectStep {
+                    lcp,
+                    workspace,
+                    hessian: &h,
+                    active: &active,
+                    rhs: &minus_gradient,
+                    options,
+                };
+                direct.solve(&mut factored, &mut solves)?
             }
         };
         let slope: f64 = gradient.iter().zip(&d).map(|(g, d)| g * d).sum();
@@ -985,13 +947,7 @@ pub(super) fn newton_iteration(
             // No decrease along a Newton direction: at the minimizer up to rounding.
             let residual = residual_here();
             if residual <= options.tolerance.max(1e-8) {
-                return Ok(done(
-                    u,
-                    lambda,
-                    iteration,
-                    residual,
-                    (factorizations, low_rank_updates, iterative_steps),
-                ));
+                return Ok(done(u, lambda, iteration, residual, solves));
             }
             return Err(Error::NotConverged {
                 solver: "semismooth Newton",
@@ -1009,13 +965,7 @@ pub(super) fn newton_iteration(
             let lambda = lcp.eliminated_multiplier(&lcp.b_times(&u));
             let residual = lcp.kkt_residual(&u, &lambda);
             if residual <= options.tolerance {
-                return Ok(done(
-                    u,
-                    lambda,
-                    iteration,
-                    residual,
-                    (factorizations, low_rank_updates, iterative_steps),
-                ));
+                return Ok(done(u, lambda, iteration, residual, solves));
             }
         }
         // an inexact full step still tells whether the active set has settled
@@ -1025,13 +975,7 @@ pub(super) fn newton_iteration(
     // The active set never settled (constraints with λ and gap at rounding level flip
     // without end), but an iterate the KKT residual certifies is a solution all the same.
     if let Some((u, lambda, residual)) = best.filter(|b| b.2 <= options.tolerance) {
-        return Ok(done(
-            u,
-            lambda,
-            options.max_iterations,
-            residual,
-            (factorizations, low_rank_updates, iterative_steps),
-        ));
+        return Ok(done(u, lambda, options.max_iterations, residual, solves));
     }
     let lambda = lcp.eliminated_multiplier(&lcp.b_times(&u));
     Err(Error::NotConverged {
@@ -1042,6 +986,67 @@ pub(super) fn newton_iteration(
             lcp.kkt_residual(&u, &lambda)
         ),
     })
+}
+
+/// How the steps of a Newton solve were solved: factorizations of the Hessian, low-rank
+/// updates of a factored one, and steps the caller's [`StepSolver`] solved.
+#[derive(Clone, Copy, Debug, Default)]
+struct StepCounts {
+    factorizations: usize,
+    low_rank_updates: usize,
+    iterative_steps: usize,
+}
+
+/// A Newton step solved directly: `hessian d = rhs` on the faces `active`.
+struct DirectStep<'a> {
+    lcp: &'a Lcp,
+    workspace: &'a NewtonWorkspace,
+    hessian: &'a SparseMatrix,
+    active: &'a [bool],
+    rhs: &'a [f64],
+    options: NewtonOptions,
+}
+
+impl DirectStep<'_> {
+    /// The step, by a low-rank update of the last factored Hessian (`factored`, with
+    /// its faces) where the options allow it and the faces changed little, else by a
+    /// new factorization, which becomes `factored`; `counts` records which.
+    ///
+    /// # Errors
+    /// A Hessian that is not positive definite, and a failed refinement.
+    fn solve(
+        &self,
+        factored: &mut Option<(CholeskyFactor, Vec<bool>)>,
+        counts: &mut StepCounts,
+    ) -> Result<Vec<f64>> {
+        let reusable = factored.as_ref().filter(|_| self.options.low_rank_updates);
+        let updated = reusable.and_then(|(factor, factored_active)| {
+            updated_solve(
+                self.lcp,
+                self.hessian,
+                factor,
+                factored_active,
+                self.active,
+                self.rhs,
+                self.options,
+            )
+        });
+        if let Some(d) = updated {
+            counts.low_rank_updates += 1;
+            return Ok(d);
+        }
+        counts.factorizations += 1;
+        let factor = self
+            .workspace
+            .analyse()?
+            .factor_cholesky(self.hessian)
+            .map_err(hessian_not_positive)?;
+        let d = refined(self.hessian, self.rhs, self.options.refinement_steps, |b| {
+            factor.solve(b)
+        })?;
+        *factored = Some((factor, self.active.to_vec()));
+        Ok(d)
+    }
 }
 
 /// A 64-bit fingerprint of a set of active faces, for detecting cycles of the active set
