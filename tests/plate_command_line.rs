@@ -369,9 +369,9 @@ fn bad_disk_input_exits_with_a_message() {
     }
 }
 
-/// `study mindlin-disk` writes both charts and tables: nested iterations flat (at most 6
-/// on every level of every load), and J_h converging (its change to the next mesh
-/// shrinking).
+/// `study mindlin-disk` writes both charts and tables for each of its loads (its study
+/// variants q = 10, 20, 50): nested iterations flat (at most 6 on every mesh), and the
+/// Stenberg pair's J_h converging (its change to the next mesh shrinking).
 #[test]
 fn the_disk_studies_write_their_charts_and_tables() {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
@@ -386,30 +386,36 @@ fn the_disk_studies_write_their_charts_and_tables() {
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
-    for study in ["iterations", "convergence"] {
-        let svg = std::fs::read_to_string(out.join(format!("mindlin-disk-{study}.svg"))).unwrap();
-        assert!(svg.contains("<svg"));
-    }
-    let rows = |study: &str| -> Vec<Vec<f64>> {
-        std::fs::read_to_string(out.join(format!("mindlin-disk-{study}.csv")))
+    // the cells of a CSV file, by row
+    let rows = |file: &str| -> Vec<Vec<String>> {
+        std::fs::read_to_string(out.join(file))
             .unwrap()
             .lines()
             .skip(1)
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .map(|l| l.split(',').map(str::to_string).collect())
             .collect()
     };
-    let iterations = rows("iterations");
-    assert_eq!(iterations.len(), 3 * 4, "3 loads × rings 4, 8, 16, 32");
-    assert!(iterations.iter().all(|r| r[3] <= 6.0), "{iterations:?}");
-    let convergence = rows("convergence");
-    for q in [10.0, 20.0, 50.0] {
-        let j: Vec<f64> = convergence
+    let number = |cell: &str| -> f64 { cell.parse().unwrap() };
+    for q in ["q10", "q20", "q50"] {
+        for study in ["iterations", "convergence"] {
+            let svg =
+                std::fs::read_to_string(out.join(format!("mindlin-disk-{q}-{study}.svg"))).unwrap();
+            assert!(svg.contains("<svg"));
+        }
+        let iterations = rows(&format!("mindlin-disk-{q}-iterations.csv"));
+        assert_eq!(iterations.len(), 3, "rings 8, 16, 32");
+        assert!(
+            iterations.iter().all(|r| number(&r[1]) <= 6.0),
+            "{q}: {iterations:?}"
+        );
+        // pair, size, h, cells, dofs, five errors, energy, …
+        let j: Vec<f64> = rows(&format!("mindlin-disk-{q}-convergence.csv"))
             .iter()
-            .filter(|r| r[0] == q)
-            .map(|r| r[4])
+            .filter(|r| r[0] == "p1-p2-p0")
+            .map(|r| number(&r[10]))
             .collect();
         assert_eq!(j.len(), 3);
-        assert!((j[2] - j[1]).abs() < (j[1] - j[0]).abs(), "q = {q}: {j:?}");
+        assert!((j[2] - j[1]).abs() < (j[1] - j[0]).abs(), "{q}: {j:?}");
     }
     std::fs::remove_dir_all(&out).unwrap();
 }
