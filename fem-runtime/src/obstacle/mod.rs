@@ -189,17 +189,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
         let reduction = constraints.reduction(dofs.dof_count())?;
         let basis = constraints.change_of_basis(dofs.dof_count())?;
         let multiplier_range = dofs.range(multiplier).unwrap();
-        let mut roles = Vec::with_capacity(reduction.free().len());
-        let (mut primal_reduced, mut multiplier_reduced) = (Vec::new(), Vec::new());
-        for (r, &d) in reduction.free().iter().enumerate() {
-            if multiplier_range.contains(&d) {
-                roles.push(Role::Multiplier(multiplier_reduced.len()));
-                multiplier_reduced.push(r);
-            } else {
-                roles.push(Role::Primal(primal_reduced.len()));
-                primal_reduced.push(r);
-            }
-        }
+        let (roles, primal_reduced, multiplier_reduced) = roles_of(&reduction, &multiplier_range);
         let (n, m) = (primal_reduced.len(), multiplier_reduced.len());
         // Each full DOF's place in the LCP.
         let mut target: Vec<Target> = (0..dofs.dof_count())
@@ -211,31 +201,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 Role::Multiplier(k) => Target::Multiplier(k),
             };
         }
-        // A rotated group is assembled in its Cartesian DOFs, all of them primal unknowns
-        // (its fixed primed DOFs as extra unknowns n..), then rotated (T A Tᵀ, B Tᵀ, T F)
-        // and its fixed primed DOFs eliminated.
-        let mut extra_values = Vec::new();
-        let mut rotated = Vec::with_capacity(basis.blocks().len());
-        for block in basis.blocks() {
-            let mut indices = block.group;
-            for (k, index) in indices.dofs[..indices.len].iter_mut().enumerate() {
-                let d = block.group.dofs[k];
-                *index = match target[d] {
-                    Target::Primal(p) => p,
-                    Target::Fixed(v) => {
-                        target[d] = Target::Primal(n + extra_values.len());
-                        extra_values.push(v);
-                        n + extra_values.len() - 1
-                    }
-                    Target::Multiplier(_) => {
-                        return Err(Error::Input(format!(
-                            "DOF {d} of the multiplier has a condition combining DOFs: supports are for the primal fields"
-                        )))
-                    }
-                };
-            }
-            rotated.push((indices, block.t));
-        }
+        let (rotated, extra_values) = rotated_groups(&basis, &mut target, n)?;
         let n_ext = n + extra_values.len();
         // The LCP takes B from the multiplier rows of B_h alone (B_h is symmetric): the
         // blocks of primal rows and multiplier columns would be computed, given scatter
@@ -280,59 +246,20 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             rhs[row] -= v * fixed;
         }
         basis.to_primed(&mut rhs);
-        let rotation = BlockRotation::new(&rotated, n_ext);
         let (a_len, b_len) = (split.a_rows.len(), split.b_columns.len());
-        // B = −(the multiplier rows of B_h), without its zeros; rotated, B_h Tᵀ less the
-        // columns of the fixed primed DOFs (moved to the multiplier rows' right side)
-        let mut b_ptr = Vec::with_capacity(m + 1);
-        let mut b_entries = Vec::with_capacity(b_len);
-        let mut multiplier_shift = vec![0.0; m];
-        let mut row = Vec::new();
-        b_ptr.push(0);
-        for (k, shift) in multiplier_shift.iter_mut().enumerate() {
-            row.clear();
-            for e in split.b_ptr[k]..split.b_ptr[k + 1] {
-                let v = values[a_len + e];
-                if v != 0.0 {
-                    rotation.spread(split.b_columns[e], v, &mut row);
-                }
-            }
-            if !rotated.is_empty() {
-                row.sort_unstable_by_key(|&(q, _)| q);
-                let mut merged: Vec<(usize, f64)> = Vec::with_capacity(row.len());
-                for &(q, v) in &row {
-                    match merged.last_mut() {
-                        Some(last) if last.0 == q => last.1 += v,
-                        _ => merged.push((q, v)),
-                    }
-                }
-                row.clear();
-                for (q, v) in merged {
-                    if q >= n {
-                        *shift += v * extra_values[q - n];
-                    } else if v != 0.0 {
-                        row.push((q, v));
-                    }
-                }
-            }
-            b_entries.extend(row.iter().map(|&(q, v)| (q, -v)));
-            b_ptr.push(b_entries.len());
-        }
-        let c_start = a_len + b_len;
-        let c: Vec<f64> = values[c_start..c_start + m].iter().map(|v| -v).collect();
-        // off-diagonal entries of C: the multipliers of one cell (P1disc) are coupled
-        let coupling: Vec<(usize, usize, f64)> = split
-            .coupling
-            .iter()
-            .zip(&values[c_start + m..])
-            .filter(|(_, &v)| v != 0.0)
-            .map(|(&(k, l), &v)| (k, l, -v))
-            .collect();
-        let c_blocks = CouplingBlocks::from_entries(m, &coupling).map_err(|e| {
-            Error::Input(format!(
-                "the multiplier block of `{bilinear}`: {e}; this LCP form needs multipliers coupled only within a cell (P0, P1disc)"
-            ))
-        })?;
+        let (b_rows, multiplier_shift) = constraint_rows(
+            &split,
+            &values[a_len..a_len + b_len],
+            &rotated,
+            &extra_values,
+            [n, m],
+        )?;
+        let (c, c_blocks) = multiplier_block(&split, &values[a_len + b_len..], m)
+            .map_err(|e| {
+                Error::Input(format!(
+                    "the multiplier block of `{bilinear}`: {e}; this LCP form needs multipliers coupled only within a cell (P0, P1disc)"
+                ))
+            })?;
         // A's values lead the array: kept in place (a realloc that shrinks does not copy)
         // rather than copied out, 56 MB at 2M P1–P0 cells
         values.truncate(a_len);
@@ -368,7 +295,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             reduction,
             lcp: Lcp {
                 a,
-                b_rows: ConstraintRows::from_flat(b_ptr, b_entries)?,
+                b_rows,
                 c,
                 c_blocks,
                 f,
@@ -382,6 +309,149 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             multiplier_reduced,
         })
     }
+}
+
+/// The role of each free DOF of `reduction` (a multiplier where it lies in
+/// `multiplier_range`), and the reduced indices of the primal and the multiplier
+/// unknowns in order.
+fn roles_of(
+    reduction: &Reduction,
+    multiplier_range: &std::ops::Range<usize>,
+) -> (Vec<Role>, Vec<usize>, Vec<usize>) {
+    let mut roles = Vec::with_capacity(reduction.free().len());
+    let (mut primal_reduced, mut multiplier_reduced) = (Vec::new(), Vec::new());
+    for (r, &d) in reduction.free().iter().enumerate() {
+        if multiplier_range.contains(&d) {
+            roles.push(Role::Multiplier(multiplier_reduced.len()));
+            multiplier_reduced.push(r);
+        } else {
+            roles.push(Role::Primal(primal_reduced.len()));
+            primal_reduced.push(r);
+        }
+    }
+    (roles, primal_reduced, multiplier_reduced)
+}
+
+/// A rotated group of DOFs (an oblique roller) as LCP indices with its rotation `T`.
+type RotatedGroup = (
+    crate::assembly::change_of_basis::DofGroup,
+    [[f64; crate::assembly::change_of_basis::MAX_GROUP];
+        crate::assembly::change_of_basis::MAX_GROUP],
+);
+
+/// The rotated groups of `basis` in LCP indices, and the values of their fixed DOFs. A
+/// rotated group is assembled in its Cartesian DOFs, all of them primal unknowns (its
+/// fixed primed DOFs as extra unknowns `n..`, which `target` then names), then rotated
+/// (`T A Tᵀ`, `B Tᵀ`, `T F`) and its fixed primed DOFs eliminated.
+///
+/// # Errors
+/// A multiplier DOF in a rotated group: supports are for the primal fields.
+fn rotated_groups(
+    basis: &ChangeOfBasis,
+    target: &mut [Target],
+    n: usize,
+) -> Result<(Vec<RotatedGroup>, Vec<f64>)> {
+    let mut extra_values = Vec::new();
+    let mut rotated = Vec::with_capacity(basis.blocks().len());
+    for block in basis.blocks() {
+        let mut indices = block.group;
+        for (k, index) in indices.dofs[..indices.len].iter_mut().enumerate() {
+            let d = block.group.dofs[k];
+            *index = match target[d] {
+                Target::Primal(p) => p,
+                Target::Fixed(v) => {
+                    target[d] = Target::Primal(n + extra_values.len());
+                    extra_values.push(v);
+                    n + extra_values.len() - 1
+                }
+                Target::Multiplier(_) => {
+                    return Err(Error::Input(format!(
+                        "DOF {d} of the multiplier has a condition combining DOFs: supports are for the primal fields"
+                    )))
+                }
+            };
+        }
+        rotated.push((indices, block.t));
+    }
+    Ok((rotated, extra_values))
+}
+
+/// B = −(the multiplier rows of B_h), without its zeros (`values`: the assembled
+/// entries of `split`'s B pattern); rotated, `B_h Tᵀ` less the columns of the fixed
+/// primed DOFs `n..` (values `extra_values`), which move to the multiplier rows' right
+/// side: the `m` rows and that shift of each.
+///
+/// # Errors
+/// Rows that do not make [`ConstraintRows`].
+fn constraint_rows(
+    split: &SplitPattern,
+    values: &[f64],
+    rotated: &[RotatedGroup],
+    extra_values: &[f64],
+    [n, m]: [usize; 2],
+) -> Result<(ConstraintRows, Vec<f64>)> {
+    let rotation = BlockRotation::new(rotated, n + extra_values.len());
+    let mut b_ptr = Vec::with_capacity(m + 1);
+    let mut b_entries = Vec::with_capacity(values.len());
+    let mut multiplier_shift = vec![0.0; m];
+    let mut row = Vec::new();
+    b_ptr.push(0);
+    for (k, shift) in multiplier_shift.iter_mut().enumerate() {
+        row.clear();
+        for e in split.b_ptr[k]..split.b_ptr[k + 1] {
+            let v = values[e];
+            if v != 0.0 {
+                rotation.spread(split.b_columns[e], v, &mut row);
+            }
+        }
+        if !rotated.is_empty() {
+            row.sort_unstable_by_key(|&(q, _)| q);
+            let mut merged: Vec<(usize, f64)> = Vec::with_capacity(row.len());
+            for &(q, v) in &row {
+                match merged.last_mut() {
+                    Some(last) if last.0 == q => last.1 += v,
+                    _ => merged.push((q, v)),
+                }
+            }
+            row.clear();
+            for (q, v) in merged {
+                if q >= n {
+                    *shift += v * extra_values[q - n];
+                } else if v != 0.0 {
+                    row.push((q, v));
+                }
+            }
+        }
+        b_entries.extend(row.iter().map(|&(q, v)| (q, -v)));
+        b_ptr.push(b_entries.len());
+    }
+    Ok((
+        ConstraintRows::from_flat(b_ptr, b_entries)?,
+        multiplier_shift,
+    ))
+}
+
+/// C = −(the multiplier block of B_h) from `values` (the assembled entries of `split`'s
+/// C pattern: the `m` diagonal entries, then the couplings within a cell, P1disc).
+///
+/// # Errors
+/// Couplings that do not make [`CouplingBlocks`] (the message, for the caller to name
+/// the form).
+fn multiplier_block(
+    split: &SplitPattern,
+    values: &[f64],
+    m: usize,
+) -> std::result::Result<(Vec<f64>, CouplingBlocks), String> {
+    let c: Vec<f64> = values[..m].iter().map(|v| -v).collect();
+    let coupling: Vec<(usize, usize, f64)> = split
+        .coupling
+        .iter()
+        .zip(&values[m..])
+        .filter(|(_, &v)| v != 0.0)
+        .map(|(&(k, l), &v)| (k, l, -v))
+        .collect();
+    let blocks = CouplingBlocks::from_entries(m, &coupling).map_err(|e| e.to_string())?;
+    Ok((c, blocks))
 }
 
 /// Where a DOF of the full system goes in the LCP.
