@@ -94,38 +94,8 @@ pub fn nodal_active_set_level(
 ) -> Result<LcpSolution> {
     let clock = Instant::now();
     let n = f.len();
-    if psi.len() != n || a.nrows() != n || a.ncols() != n {
-        return Err(Error::Input(format!(
-            "nodal obstacle: {} obstacle values and a {} × {} matrix for {n} unknowns",
-            psi.len(),
-            a.nrows(),
-            a.ncols()
-        )));
-    }
-    if let Some(s) = start.filter(|s| s.len() != n) {
-        return Err(Error::Input(format!(
-            "nodal obstacle: a start of {} values for {n} unknowns",
-            s.len()
-        )));
-    }
-    let mut rows_expected = n;
-    for (l, p) in prolongations.iter().enumerate() {
-        if p.nrows() != rows_expected {
-            return Err(Error::Input(format!(
-                "nodal obstacle: prolongation {l} has {} rows for a level of order {rows_expected}",
-                p.nrows()
-            )));
-        }
-        rows_expected = p.ncols();
-    }
-    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let diagonal: Vec<f64> = (0..n)
-        .map(|j| {
-            (col_ptr[j]..col_ptr[j + 1])
-                .find(|&k| rows[k] == j)
-                .map_or(0.0, |k| vals[k])
-        })
-        .collect();
+    check_shapes(a, f, psi, start, prolongations)?;
+    let diagonal = diagonal_of(a);
     let mut cholesky = None;
     // the reduced matrices are symmetric when `a` is: checked once here rather than by
     // every hierarchy (`Multigrid::new` refuses a non-symmetric matrix, whose steps are
@@ -167,38 +137,7 @@ pub fn nodal_active_set_level(
         // Galerkin product of the multigrid path skips them with no change to any
         // value. The Cholesky path keeps `a`'s pattern, analysed once.
         let reduced = |compact: bool| -> Result<(SparseMatrix, Vec<f64>)> {
-            let mut rhs = f.to_vec();
-            let mut new_ptr = Vec::with_capacity(n + 1);
-            let mut new_rows = Vec::with_capacity(rows.len());
-            let mut values = Vec::with_capacity(rows.len());
-            new_ptr.push(0);
-            for j in 0..n {
-                for k in col_ptr[j]..col_ptr[j + 1] {
-                    let i = rows[k];
-                    if active[j] && !active[i] {
-                        rhs[i] -= vals[k] * psi[j];
-                    }
-                    let value = if i == j {
-                        diagonal[j]
-                    } else if active[i] || active[j] {
-                        0.0
-                    } else {
-                        vals[k]
-                    };
-                    if !compact || value != 0.0 || i == j {
-                        new_rows.push(i);
-                        values.push(value);
-                    }
-                }
-                new_ptr.push(new_rows.len());
-            }
-            for i in 0..n {
-                if active[i] {
-                    rhs[i] = diagonal[i] * psi[i];
-                }
-            }
-            let symbolic = SymbolicSparseColMat::new_checked(n, n, new_ptr, None, new_rows);
-            Ok((SparseColMat::new(symbolic, values), rhs))
+            Ok(reduced_system(a, f, psi, &diagonal, &active, compact))
         };
         for i in 0..n {
             if active[i] {
@@ -297,6 +236,109 @@ pub fn nodal_active_set_level(
         solver: "nodal primal-dual active set",
         detail: format!("no fixed active set after {max_iterations} iterations"),
     })
+}
+
+/// The shapes of a nodal obstacle problem: `psi`, `a` and a start of `f`'s length, each
+/// prolongation's rows the order of the level it maps to.
+///
+/// # Errors
+/// [`Error::Input`] naming the mismatch.
+fn check_shapes(
+    a: &SparseMatrix,
+    f: &[f64],
+    psi: &[f64],
+    start: Option<&[f64]>,
+    prolongations: &[SparseMatrix],
+) -> Result<()> {
+    let n = f.len();
+    if psi.len() != n || a.nrows() != n || a.ncols() != n {
+        return Err(Error::Input(format!(
+            "nodal obstacle: {} obstacle values and a {} × {} matrix for {n} unknowns",
+            psi.len(),
+            a.nrows(),
+            a.ncols()
+        )));
+    }
+    if let Some(s) = start.filter(|s| s.len() != n) {
+        return Err(Error::Input(format!(
+            "nodal obstacle: a start of {} values for {n} unknowns",
+            s.len()
+        )));
+    }
+    let mut rows_expected = n;
+    for (l, p) in prolongations.iter().enumerate() {
+        if p.nrows() != rows_expected {
+            return Err(Error::Input(format!(
+                "nodal obstacle: prolongation {l} has {} rows for a level of order {rows_expected}",
+                p.nrows()
+            )));
+        }
+        rows_expected = p.ncols();
+    }
+    Ok(())
+}
+
+/// The diagonal of `a` (0 where it stores none).
+fn diagonal_of(a: &SparseMatrix) -> Vec<f64> {
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    (0..a.ncols())
+        .map(|j| {
+            (col_ptr[j]..col_ptr[j + 1])
+                .find(|&k| rows[k] == j)
+                .map_or(0.0, |k| vals[k])
+        })
+        .collect()
+}
+
+/// The system of one active-set step: `a` with the rows and columns of the `active`
+/// nodes replaced by their diagonal (`u_i = ψ_i` there), and `f` less the active
+/// columns times ψ. `compact`: the exact zeros left out of the pattern (the
+/// right-diagonal P1 stiffness stores its diagonal couplings as 0, 28 % of the entries,
+/// and the active rows and columns keep only their diagonal): every product, sweep and
+/// Galerkin product of the multigrid path skips them with no change to any value. The
+/// Cholesky path keeps `a`'s pattern, analysed once.
+fn reduced_system(
+    a: &SparseMatrix,
+    f: &[f64],
+    psi: &[f64],
+    diagonal: &[f64],
+    active: &[bool],
+    compact: bool,
+) -> (SparseMatrix, Vec<f64>) {
+    let n = f.len();
+    let (col_ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let mut rhs = f.to_vec();
+    let mut new_ptr = Vec::with_capacity(n + 1);
+    let mut new_rows = Vec::with_capacity(rows.len());
+    let mut values = Vec::with_capacity(rows.len());
+    new_ptr.push(0);
+    for j in 0..n {
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            let i = rows[k];
+            if active[j] && !active[i] {
+                rhs[i] -= vals[k] * psi[j];
+            }
+            let value = if i == j {
+                diagonal[j]
+            } else if active[i] || active[j] {
+                0.0
+            } else {
+                vals[k]
+            };
+            if !compact || value != 0.0 || i == j {
+                new_rows.push(i);
+                values.push(value);
+            }
+        }
+        new_ptr.push(new_rows.len());
+    }
+    for i in 0..n {
+        if active[i] {
+            rhs[i] = diagonal[i] * psi[i];
+        }
+    }
+    let symbolic = SymbolicSparseColMat::new_checked(n, n, new_ptr, None, new_rows);
+    (SparseColMat::new(symbolic, values), rhs)
 }
 
 /// `matrix⁻¹ rhs` by a Cholesky factorization with one step of refinement, the symbolic

@@ -68,127 +68,17 @@ pub fn solve<M: Model>(
     linear_solver: LinearSolver,
 ) -> Result<ObstacleSolution<TriangleMesh>> {
     let clock = Instant::now();
-    if M::FIELDS.len() != 1
-        || M::FIELDS[0].nonnegative
-        || M::FIELDS[0].element != crate::ElementKind::P1
-    {
-        return Err(Error::Input(format!(
-            "the nodal method takes a model of one P1 field without multiplier; `{}` has {}",
-            M::NAME,
-            M::FIELDS
-                .iter()
-                .map(|f| format!("{} ({})", f.name, f.element.name()))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
-    }
-    let [stiffness, load] = M::ENERGY.ok_or_else(|| {
-        Error::Input(format!(
-            "the nodal method assembles the energy of `{}`, which declares none (`energy: a, ℓ;`)",
-            M::NAME
-        ))
-    })?;
-    let free_dofs = |mesh: &TriangleMesh| -> Result<(SystemDofs, Reduction)> {
-        let dofs = SystemDofs::all::<M>(mesh)?;
-        let constraints = mesh.constraints::<M>(&dofs, coefficients, supports)?;
-        let reduction = constraints.reduction(dofs.dof_count())?;
-        Ok((dofs, reduction))
+    let energy = nodal_energy::<M>()?;
+    let problem = NodalProblem {
+        meshes,
+        coefficients,
+        supports,
+        obstacle,
+        energy,
     };
-    let setup = |i: usize| -> Result<NodalLevel> {
-        let mesh = &meshes[i];
-        let (dofs, reduction) = free_dofs(mesh)?;
-        // the pattern moves into `k` and `k`'s arrays into `a` (no copies: peak memory)
-        let k = MatrixAssembler::new::<M>(FormId::new(stiffness), mesh, &dofs)?
-            .into_matrix::<M>(mesh, coefficients)?;
-        let l = assemble_vector::<M>(FormId::new(load), mesh, &dofs, coefficients)?;
-        let f = reduction.rhs(&k, &l);
-        drop(l);
-        let a = reduction.into_matrix(k);
-        let nodes = dofs.map(0).expect("one field").nodes(mesh);
-        let psi: Vec<f64> = reduction
-            .free()
-            .iter()
-            .map(|&d| obstacle(&nodes[d]))
-            .collect();
-        let prolongations = match i.checked_sub(1).map(|c| &meshes[c]) {
-            Some(coarse) => {
-                let (coarse_dofs, coarse_reduction) = free_dofs(coarse)?;
-                let parents = parents_by_location(coarse, mesh)?;
-                let level = |mesh, dofs, reduction| NestedLevel {
-                    mesh,
-                    dofs,
-                    reduction,
-                };
-                let all = prolongation(
-                    &level(coarse, &coarse_dofs, None),
-                    &level(mesh, &dofs, None),
-                    &parents,
-                )?;
-                let free = reduced_prolongation(&all, &coarse_reduction, &reduction)?;
-                Some((all, free))
-            }
-            None => None,
-        };
-        Ok(NodalLevel {
-            dofs,
-            reduction,
-            a,
-            f,
-            psi,
-            prolongations,
-        })
-    };
-    let level_count = meshes.len();
-    let step = |state: &mut NodalState, level: NodalLevel, cells: usize| -> Result<()> {
-        let NodalLevel {
-            dofs,
-            reduction,
-            a,
-            f,
-            psi,
-            prolongations,
-        } = level;
-        // the coarser level's system goes before this level's solve allocates
-        state.finest = None;
-        // the coarse solution interpolated at the fine nodes, boundary values included
-        let start = match (prolongations, state.values.take()) {
-            (Some((all, free)), Some(values)) => {
-                let fine = multiply(&all, &values);
-                state.prolongations.insert(0, free);
-                Some(
-                    reduction
-                        .free()
-                        .iter()
-                        .map(|&d| fine[d])
-                        .collect::<Vec<f64>>(),
-                )
-            }
-            _ => None,
-        };
-        let multigrid = match linear_solver {
-            LinearSolver::Direct => false,
-            LinearSolver::Multigrid => !state.prolongations.is_empty(),
-            LinearSolver::Auto => {
-                a.nrows() >= NODAL_AUTO_MULTIGRID_UNKNOWNS && state.prolongations.len() >= 2
-            }
-        };
-        let hierarchy: &[SparseMatrix] = if multigrid { &state.prolongations } else { &[] };
-        let last = state.levels.len() + 1 == level_count;
-        let solution =
-            nodal_active_set_level(&a, &f, &psi, start.as_deref(), 500, hierarchy, last)?;
-        state.levels.push((cells, solution.iterations));
-        state.values = Some(reduction.expand(&solution.u));
-        state.finest = Some((
-            NodalLevelSolved {
-                dofs,
-                reduction,
-                a,
-                f,
-                psi,
-            },
-            solution,
-        ));
-        Ok(())
+    let setup = |i: usize| problem.level::<M>(i);
+    let step = |state: &mut NodalState, level: NodalLevel, cells: usize| {
+        state.step(level, cells, linear_solver, meshes.len())
     };
     let mut state = NodalState::default();
     let count = meshes.len();
@@ -241,6 +131,166 @@ pub fn solve<M: Model>(
         levels: state.levels,
         seconds: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// The energy forms `[a, ℓ]` of `M`, a model the nodal method takes.
+///
+/// # Errors
+/// A model that is not one P1 field without multiplier, or that declares no energy.
+fn nodal_energy<M: Model>() -> Result<[usize; 2]> {
+    if M::FIELDS.len() != 1
+        || M::FIELDS[0].nonnegative
+        || M::FIELDS[0].element != crate::ElementKind::P1
+    {
+        return Err(Error::Input(format!(
+            "the nodal method takes a model of one P1 field without multiplier; `{}` has {}",
+            M::NAME,
+            M::FIELDS
+                .iter()
+                .map(|f| format!("{} ({})", f.name, f.element.name()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    M::ENERGY.ok_or_else(|| {
+        Error::Input(format!(
+            "the nodal method assembles the energy of `{}`, which declares none (`energy: a, ℓ;`)",
+            M::NAME
+        ))
+    })
+}
+
+/// What the levels of a nodal solve are built from.
+struct NodalProblem<'a> {
+    meshes: &'a [TriangleMesh],
+    coefficients: &'a Coefficients<'a>,
+    supports: &'a [Support],
+    obstacle: &'a DataFn,
+    /// The forms `[a, ℓ]`.
+    energy: [usize; 2],
+}
+
+impl NodalProblem<'_> {
+    /// The DOFs of `mesh` and the elimination of its supported ones.
+    fn free_dofs<M: Model>(&self, mesh: &TriangleMesh) -> Result<(SystemDofs, Reduction)> {
+        let dofs = SystemDofs::all::<M>(mesh)?;
+        let constraints = mesh.constraints::<M>(&dofs, self.coefficients, self.supports)?;
+        let reduction = constraints.reduction(dofs.dof_count())?;
+        Ok((dofs, reduction))
+    }
+
+    /// Level `i` before its solve, with the prolongations from level `i − 1`.
+    fn level<M: Model>(&self, i: usize) -> Result<NodalLevel> {
+        let mesh = &self.meshes[i];
+        let [stiffness, load] = self.energy;
+        let (dofs, reduction) = self.free_dofs::<M>(mesh)?;
+        // the pattern moves into `k` and `k`'s arrays into `a` (no copies: peak memory)
+        let k = MatrixAssembler::new::<M>(FormId::new(stiffness), mesh, &dofs)?
+            .into_matrix::<M>(mesh, self.coefficients)?;
+        let l = assemble_vector::<M>(FormId::new(load), mesh, &dofs, self.coefficients)?;
+        let f = reduction.rhs(&k, &l);
+        drop(l);
+        let a = reduction.into_matrix(k);
+        let nodes = dofs.map(0).expect("one field").nodes(mesh);
+        let psi: Vec<f64> = reduction
+            .free()
+            .iter()
+            .map(|&d| (self.obstacle)(&nodes[d]))
+            .collect();
+        let prolongations = match i.checked_sub(1).map(|c| &self.meshes[c]) {
+            Some(coarse) => {
+                let (coarse_dofs, coarse_reduction) = self.free_dofs::<M>(coarse)?;
+                let parents = parents_by_location(coarse, mesh)?;
+                let level = |mesh, dofs, reduction| NestedLevel {
+                    mesh,
+                    dofs,
+                    reduction,
+                };
+                let all = prolongation(
+                    &level(coarse, &coarse_dofs, None),
+                    &level(mesh, &dofs, None),
+                    &parents,
+                )?;
+                let free = reduced_prolongation(&all, &coarse_reduction, &reduction)?;
+                Some((all, free))
+            }
+            None => None,
+        };
+        Ok(NodalLevel {
+            dofs,
+            reduction,
+            a,
+            f,
+            psi,
+            prolongations,
+        })
+    }
+}
+
+impl NodalState {
+    /// Solves `level` (of `cells` triangles, one of `level_count`) from the last solved
+    /// level's solution interpolated at its nodes, by multigrid steps where
+    /// `linear_solver` asks for them and there are coarser levels.
+    ///
+    /// # Errors
+    /// The active-set method's.
+    fn step(
+        &mut self,
+        level: NodalLevel,
+        cells: usize,
+        linear_solver: LinearSolver,
+        level_count: usize,
+    ) -> Result<()> {
+        let NodalLevel {
+            dofs,
+            reduction,
+            a,
+            f,
+            psi,
+            prolongations,
+        } = level;
+        // the coarser level's system goes before this level's solve allocates
+        self.finest = None;
+        // the coarse solution interpolated at the fine nodes, boundary values included
+        let start = match (prolongations, self.values.take()) {
+            (Some((all, free)), Some(values)) => {
+                let fine = multiply(&all, &values);
+                self.prolongations.insert(0, free);
+                Some(
+                    reduction
+                        .free()
+                        .iter()
+                        .map(|&d| fine[d])
+                        .collect::<Vec<f64>>(),
+                )
+            }
+            _ => None,
+        };
+        let multigrid = match linear_solver {
+            LinearSolver::Direct => false,
+            LinearSolver::Multigrid => !self.prolongations.is_empty(),
+            LinearSolver::Auto => {
+                a.nrows() >= NODAL_AUTO_MULTIGRID_UNKNOWNS && self.prolongations.len() >= 2
+            }
+        };
+        let hierarchy: &[SparseMatrix] = if multigrid { &self.prolongations } else { &[] };
+        let last = self.levels.len() + 1 == level_count;
+        let solution =
+            nodal_active_set_level(&a, &f, &psi, start.as_deref(), 500, hierarchy, last)?;
+        self.levels.push((cells, solution.iterations));
+        self.values = Some(reduction.expand(&solution.u));
+        self.finest = Some((
+            NodalLevelSolved {
+                dofs,
+                reduction,
+                a,
+                f,
+                psi,
+            },
+            solution,
+        ));
+        Ok(())
+    }
 }
 
 /// The nodal method's contact set, per cell: the share of its vertices in contact. A
