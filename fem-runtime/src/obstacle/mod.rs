@@ -1265,20 +1265,13 @@ where
         (d, solved)
     };
     let values = discretization.full(&solution);
-    Ok(ObstacleSolution {
-        iterations: solution.iterations,
-        factorizations: solution.factorizations,
-        low_rank_updates: solution.low_rank_updates,
-        kkt_residual: solution.kkt_residual,
-        solve_seconds: solution.seconds,
-        multiplier_noise: solution.multiplier_noise,
-        iterative_steps: solution.iterative_steps,
-        krylov_iterations: solution.krylov_iterations,
+    Ok(ObstacleSolution::of(
+        &solution,
         discretization,
         values,
-        levels: counts,
-        seconds: clock.elapsed().as_secs_f64(),
-    })
+        counts,
+        clock.elapsed().as_secs_f64(),
+    ))
 }
 
 /// Runs `worker` on another thread while `main` runs on this one; returns `main`'s result
@@ -1405,6 +1398,32 @@ fn solve_levels<G: Mesh, B: FnOnce() -> Result<Discretization<G>>>(
 }
 
 impl<G> ObstacleSolution<G> {
+    /// The solution of `discretization` that the LCP's `solution` gives: its full
+    /// coefficients `values`, `(cells, iterations)` of each level solved and the whole
+    /// solve's `seconds`, with the LCP solver's counts.
+    pub(crate) fn of(
+        solution: &LcpSolution,
+        discretization: Discretization<G>,
+        values: Vec<f64>,
+        levels: Vec<(usize, usize)>,
+        seconds: f64,
+    ) -> Self {
+        Self {
+            iterations: solution.iterations,
+            factorizations: solution.factorizations,
+            low_rank_updates: solution.low_rank_updates,
+            kkt_residual: solution.kkt_residual,
+            solve_seconds: solution.seconds,
+            multiplier_noise: solution.multiplier_noise,
+            iterative_steps: solution.iterative_steps,
+            krylov_iterations: solution.krylov_iterations,
+            discretization,
+            values,
+            levels,
+            seconds,
+        }
+    }
+
     /// The coefficients of model field `field`.
     ///
     /// # Panics

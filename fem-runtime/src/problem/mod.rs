@@ -1417,20 +1417,13 @@ fn unconstrained_solution<G: crate::DofNumbering>(
     };
     let values = d.full(&solution);
     let cells = d.mesh.cell_count();
-    Ok(ObstacleSolution {
-        discretization: d,
+    Ok(ObstacleSolution::of(
+        &solution,
+        d,
         values,
-        iterations: 1,
-        factorizations: 1,
-        low_rank_updates: 0,
-        levels: vec![(cells, 1)],
-        kkt_residual: residual,
+        vec![(cells, 1)],
         seconds,
-        solve_seconds: seconds,
-        multiplier_noise: 0.0,
-        iterative_steps: 0,
-        krylov_iterations: 0,
-    })
+    ))
 }
 
 /// The sizes an answer's checks are judged against: the largest |u_h| and |ψ| at the

@@ -117,20 +117,17 @@ pub fn solve<M: Model>(
         primal_reduced: (0..n).collect(),
         multiplier_reduced: Vec::new(),
     };
-    Ok(ObstacleSolution {
-        iterations: solution.iterations,
-        factorizations: solution.factorizations,
-        low_rank_updates: solution.low_rank_updates,
-        kkt_residual: solution.kkt_residual,
-        solve_seconds: solution.seconds,
-        multiplier_noise: 0.0,
-        iterative_steps: solution.iterative_steps,
-        krylov_iterations: solution.krylov_iterations,
+    // the nodal method's multipliers are the nodal forces: no elimination to be noisy
+    Ok(ObstacleSolution::of(
+        &LcpSolution {
+            multiplier_noise: 0.0,
+            ..solution
+        },
         discretization,
         values,
-        levels: state.levels,
-        seconds: clock.elapsed().as_secs_f64(),
-    })
+        state.levels,
+        clock.elapsed().as_secs_f64(),
+    ))
 }
 
 /// The energy forms `[a, ℓ]` of `M`, a model the nodal method takes.

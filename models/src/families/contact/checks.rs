@@ -185,23 +185,14 @@ fn tipping(
     motions: &FreeMotions,
 ) -> Option<String> {
     let [s_min, s_max] = vertex_range(problem, n, rotation);
-    let Moments {
-        moment,
-        work,
-        slack,
-    } = moments(problem, rotation, motions);
-    if !tips(
-        motions.translation_free,
-        [s_min, s_max],
-        moment,
-        work,
-        slack,
-    ) {
+    let load = moments(problem, rotation, motions);
+    if !load.tips(motions.translation_free, [s_min, s_max]) {
         return None;
     }
     if !motions.translation_free {
         return Some(format!(
-            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {moment:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load"
+            "the load tips the body: the supports leave a rotation free, which only the contact can hold, and the load turns the body away from the contact boundary (its work on that rotation, {:e}, opens every contact): there is no equilibrium; fix the rotation with a support (a displacement component on a second, non-parallel part) or move the load",
+            load.moment
         ));
     }
     let across = Across::new(n, rotation.along);
@@ -209,7 +200,7 @@ fn tipping(
     let place = format!(
         " (its line {} = {:.3} misses Γ_C, which spans {a:.3} ≤ {} ≤ {b:.3})",
         across.name,
-        across.at(moment / work),
+        across.at(load.resultant()),
         across.name
     );
     Some(format!(
@@ -248,18 +239,8 @@ fn constraints_balance(
     let (r_min, r_max) = means.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
         (lo.min(r), hi.max(r))
     });
-    let Moments {
-        moment,
-        work,
-        slack,
-    } = moments(problem, rotation, motions);
-    if !tips(
-        motions.translation_free,
-        [r_min, r_max],
-        moment,
-        work,
-        slack,
-    ) {
+    let load = moments(problem, rotation, motions);
+    if !load.tips(motions.translation_free, [r_min, r_max]) {
         return None;
     }
     let reach = if motions.translation_free {
@@ -267,7 +248,7 @@ fn constraints_balance(
         let [a, b] = across.span([r_min, r_max]);
         format!(
             ": they act on {a:.3} ≤ {name} ≤ {b:.3}, and the load's resultant on {name} = {:.3}",
-            across.at(moment / work),
+            across.at(load.resultant()),
             name = across.name
         )
     } else {
@@ -339,6 +320,19 @@ struct Moments {
     moment: f64,
     work: f64,
     slack: f64,
+}
+
+impl Moments {
+    /// Whether this load tips the body, `[s_min, s_max]` the range of `s = Z·n_c` that
+    /// holds it ([`tips`]).
+    fn tips(&self, translation_free: bool, range: [f64; 2]) -> bool {
+        tips(translation_free, range, self.moment, self.work, self.slack)
+    }
+
+    /// The `s` where the load's resultant meets the contact plane: `f·Z / f·T`.
+    fn resultant(&self) -> f64 {
+        self.moment / self.work
+    }
 }
 
 fn moments(
