@@ -189,20 +189,169 @@ fn comma_list<T>(
     Ok(out)
 }
 
+/// The runtime's path: `@crate PATH;` before the model (the runtime's own tests), else
+/// `::fem_runtime`.
+fn runtime_path(input: ParseStream) -> syn::Result<TokenStream> {
+    if !input.peek(Token![@]) {
+        return Ok(quote::quote!(::fem_runtime));
+    }
+    input.parse::<Token![@]>()?;
+    input.parse::<Token![crate]>()?;
+    let mut path = TokenStream::new();
+    while !input.peek(Token![;]) {
+        path.extend([input.parse::<TokenTree>()?]);
+    }
+    input.parse::<Token![;]>()?;
+    Ok(path)
+}
+
+/// One entry of `unknowns:`: `θ: P2`, `u: [P1]^2`, `λ: P0 >= 0`.
+fn unknown(s: ParseStream) -> syn::Result<UnknownDecl> {
+    let name: Ident = s.parse()?;
+    s.parse::<Token![:]>()?;
+    let (element_name, vector) = if s.peek(syn::token::Bracket) {
+        let inner;
+        let brackets = syn::bracketed!(inner in s);
+        let element_name: Ident = inner.parse()?;
+        if !inner.is_empty() {
+            return Err(inner.error(format!(
+                "a vector field is declared `{name}: [{element_name}]^2`"
+            )));
+        }
+        if !s.peek(Token![^]) {
+            return Err(syn::Error::new(
+                brackets.span.join(),
+                format!("a vector field is declared `{name}: [{element_name}]^2` (the number of components after `^`)"),
+            ));
+        }
+        s.parse::<Token![^]>()?;
+        let n: LitInt = s.parse()?;
+        (element_name, Some((n.base10_parse::<usize>()?, n.span())))
+    } else {
+        (s.parse()?, None)
+    };
+    if !s.peek(Token![>=]) && (s.peek(Token![<]) || s.peek(Token![>])) {
+        let op: TokenTree = s.parse()?;
+        return Err(syn::Error::new(
+            op.span(),
+            format!(
+                "only `>= 0` is supported: `{name}: {element_name} >= 0` declares a multiplier {name} ≥ 0. \
+                 An upper bound u ≤ ψ is the obstacle seen from the other side: keep `>= 0` and flip the \
+                 constraint's sign with a parameter `s = −1` in the forms (as the beams' `b(η,v;μ) = ∫ s v μ`)"
+            ),
+        ));
+    }
+    let nonnegative = if s.peek(Token![>=]) {
+        s.parse::<Token![>=]>()?;
+        let zero: LitInt = s.parse()?;
+        if zero.base10_parse::<u64>()? != 0 {
+            return Err(syn::Error::new(
+                zero.span(),
+                "only `>= 0` constraints are supported (multipliers λ ≥ 0)",
+            ));
+        }
+        true
+    } else {
+        false
+    };
+    Ok(UnknownDecl {
+        element: ElementKind::from_name(&element_name.to_string()),
+        name,
+        element_name,
+        nonnegative,
+        vector,
+    })
+}
+
+/// One entry of `params:`: `t`, or `t > 0` (declared positive).
+fn param(s: ParseStream) -> syn::Result<(Ident, bool)> {
+    let name: Ident = s.parse()?;
+    let positive = if s.peek(Token![>]) && !s.peek(Token![>=]) {
+        s.parse::<Token![>]>()?;
+        let zero: Lit = s.parse()?;
+        let is_zero = match &zero {
+            Lit::Int(i) => i.base10_parse::<u64>().is_ok_and(|v| v == 0),
+            Lit::Float(f) => f.base10_parse::<f64>().is_ok_and(|v| v == 0.0),
+            _ => false,
+        };
+        if !is_zero {
+            return Err(syn::Error::new(
+                zero.span(),
+                format!("a parameter is declared positive with `{name} > 0`; other bounds are not supported"),
+            ));
+        }
+        true
+    } else if s.peek(Token![>=]) || s.peek(Token![<]) || s.peek(Token![<=]) {
+        let op: TokenTree = s.parse()?;
+        return Err(syn::Error::new(
+            op.span(),
+            format!("a parameter is declared positive with `{name} > 0`; other bounds are not supported"),
+        ));
+    } else {
+        false
+    };
+    Ok((name, positive))
+}
+
+/// One entry of `data:`: `f`, or `f: 4` (its polynomial degree for quadrature).
+fn data_function(s: ParseStream) -> syn::Result<DataDecl> {
+    let name: Ident = s.parse()?;
+    let degree = if s.peek(Token![:]) {
+        s.parse::<Token![:]>()?;
+        let literal = s.parse::<LitInt>()?;
+        let degree = literal.base10_parse::<usize>()?;
+        if degree > MAX_DEGREE {
+            return Err(syn::Error::new(
+                literal.span(),
+                format!("data degree {degree} is above the limit {MAX_DEGREE}: the quadrature of its terms would need too many points"),
+            ));
+        }
+        degree
+    } else {
+        2
+    };
+    Ok(DataDecl { name, degree })
+}
+
+/// The `stabilization:` role: `α S against a` or `S against a`.
+fn stabilization(content: ParseStream) -> syn::Result<StabilizationDecl> {
+    let first: Ident = content.parse()?;
+    let second: Ident = content.parse().map_err(|e| {
+        syn::Error::new(e.span(), "expected `stabilization: α S against a;` (the parameter, the stabilization form, `against` and the form it is bounded by)")
+    })?;
+    let (alpha, form) = if second == "against" {
+        (None, first)
+    } else {
+        let word: Ident = content.parse()?;
+        if word != "against" {
+            return Err(syn::Error::new(
+                word.span(),
+                format!("expected `against`, as in `stabilization: {first} {second} against a;`"),
+            ));
+        }
+        (Some(first), second)
+    };
+    let against: Ident = content.parse()?;
+    Ok(StabilizationDecl {
+        alpha,
+        form,
+        against,
+    })
+}
+
+/// The `obstacle:` role: `w >= ψ`.
+fn obstacle(content: ParseStream) -> syn::Result<(Ident, Ident)> {
+    let field: Ident = content.parse()?;
+    content.parse::<Token![>=]>().map_err(|e| {
+        syn::Error::new(e.span(), format!("expected `obstacle: {field} >= ψ;` (the constrained field, `>=`, the obstacle's data function; `side:` turns it into s·{field} ≥ s·ψ)"))
+    })?;
+    let data: Ident = content.parse()?;
+    Ok((field, data))
+}
+
 impl Parse for Declaration {
     fn parse(input: ParseStream) -> syn::Result<Self> {
-        let runtime = if input.peek(Token![@]) {
-            input.parse::<Token![@]>()?;
-            input.parse::<Token![crate]>()?;
-            let mut path = TokenStream::new();
-            while !input.peek(Token![;]) {
-                path.extend([input.parse::<TokenTree>()?]);
-            }
-            input.parse::<Token![;]>()?;
-            path
-        } else {
-            quote::quote!(::fem_runtime)
-        };
+        let runtime = runtime_path(input)?;
         let attrs = input.call(Attribute::parse_outer)?;
         let vis: Visibility = input.parse()?;
         input.parse::<Token![mod]>().map_err(|e| {
@@ -256,117 +405,14 @@ impl Parse for Declaration {
             }
             content.parse::<Token![:]>()?;
             match key.to_string().as_str() {
-                "unknowns" => {
-                    declaration.unknowns = comma_list(&content, |s| {
-                        let name: Ident = s.parse()?;
-                        s.parse::<Token![:]>()?;
-                        let (element_name, vector) = if s.peek(syn::token::Bracket) {
-                            let inner;
-                            let brackets = syn::bracketed!(inner in s);
-                            let element_name: Ident = inner.parse()?;
-                            if !inner.is_empty() {
-                                return Err(inner.error(format!(
-                                    "a vector field is declared `{name}: [{element_name}]^2`"
-                                )));
-                            }
-                            if !s.peek(Token![^]) {
-                                return Err(syn::Error::new(
-                                    brackets.span.join(),
-                                    format!("a vector field is declared `{name}: [{element_name}]^2` (the number of components after `^`)"),
-                                ));
-                            }
-                            s.parse::<Token![^]>()?;
-                            let n: LitInt = s.parse()?;
-                            (element_name, Some((n.base10_parse::<usize>()?, n.span())))
-                        } else {
-                            (s.parse()?, None)
-                        };
-                        if !s.peek(Token![>=]) && (s.peek(Token![<]) || s.peek(Token![>])) {
-                            let op: TokenTree = s.parse()?;
-                            return Err(syn::Error::new(
-                                op.span(),
-                                format!(
-                                    "only `>= 0` is supported: `{name}: {element_name} >= 0` declares a multiplier {name} ≥ 0. \
-                                     An upper bound u ≤ ψ is the obstacle seen from the other side: keep `>= 0` and flip the \
-                                     constraint's sign with a parameter `s = −1` in the forms (as the beams' `b(η,v;μ) = ∫ s v μ`)"
-                                ),
-                            ));
-                        }
-                        let nonnegative = if s.peek(Token![>=]) {
-                            s.parse::<Token![>=]>()?;
-                            let zero: LitInt = s.parse()?;
-                            if zero.base10_parse::<u64>()? != 0 {
-                                return Err(syn::Error::new(
-                                    zero.span(),
-                                    "only `>= 0` constraints are supported (multipliers λ ≥ 0)",
-                                ));
-                            }
-                            true
-                        } else {
-                            false
-                        };
-                        Ok(UnknownDecl {
-                            element: ElementKind::from_name(&element_name.to_string()),
-                            name,
-                            element_name,
-                            nonnegative,
-                            vector,
-                        })
-                    })?
-                }
+                "unknowns" => declaration.unknowns = comma_list(&content, unknown)?,
                 "tests" => declaration.tests = comma_list(&content, |s| s.parse())?,
                 "params" => {
-                    let params = comma_list(&content, |s| {
-                        let name: Ident = s.parse()?;
-                        let positive = if s.peek(Token![>]) && !s.peek(Token![>=]) {
-                            s.parse::<Token![>]>()?;
-                            let zero: Lit = s.parse()?;
-                            let is_zero = match &zero {
-                                Lit::Int(i) => i.base10_parse::<u64>().is_ok_and(|v| v == 0),
-                                Lit::Float(f) => f.base10_parse::<f64>().is_ok_and(|v| v == 0.0),
-                                _ => false,
-                            };
-                            if !is_zero {
-                                return Err(syn::Error::new(
-                                    zero.span(),
-                                    format!("a parameter is declared positive with `{name} > 0`; other bounds are not supported"),
-                                ));
-                            }
-                            true
-                        } else if s.peek(Token![>=]) || s.peek(Token![<]) || s.peek(Token![<=]) {
-                            let op: TokenTree = s.parse()?;
-                            return Err(syn::Error::new(
-                                op.span(),
-                                format!("a parameter is declared positive with `{name} > 0`; other bounds are not supported"),
-                            ));
-                        } else {
-                            false
-                        };
-                        Ok((name, positive))
-                    })?;
+                    let params = comma_list(&content, param)?;
                     declaration.positive = (0..params.len()).filter(|&i| params[i].1).collect();
                     declaration.params = params.into_iter().map(|(n, _)| n).collect();
                 }
-                "data" => {
-                    declaration.data = comma_list(&content, |s| {
-                        let name: Ident = s.parse()?;
-                        let degree = if s.peek(Token![:]) {
-                            s.parse::<Token![:]>()?;
-                            let literal = s.parse::<LitInt>()?;
-                            let degree = literal.base10_parse::<usize>()?;
-                            if degree > MAX_DEGREE {
-                                return Err(syn::Error::new(
-                                    literal.span(),
-                                    format!("data degree {degree} is above the limit {MAX_DEGREE}: the quadrature of its terms would need too many points"),
-                                ));
-                            }
-                            degree
-                        } else {
-                            2
-                        };
-                        Ok(DataDecl { name, degree })
-                    })?
-                }
+                "data" => declaration.data = comma_list(&content, data_function)?,
                 "boundary" => {
                     declaration.dirichlet = comma_list(&content, |s| {
                         let field: Ident = s.parse()?;
@@ -384,40 +430,9 @@ impl Parse for Declaration {
                     declaration.roles.system = Some(name_pair(&content, "system: B_h, L_h")?)
                 }
                 "energy" => declaration.roles.energy = Some(name_pair(&content, "energy: a, ℓ")?),
-                "stabilization" => {
-                    // `α S against a` or `S against a`
-                    let first: Ident = content.parse()?;
-                    let second: Ident = content.parse().map_err(|e| {
-                        syn::Error::new(e.span(), "expected `stabilization: α S against a;` (the parameter, the stabilization form, `against` and the form it is bounded by)")
-                    })?;
-                    let (alpha, form) = if second == "against" {
-                        (None, first)
-                    } else {
-                        let word: Ident = content.parse()?;
-                        if word != "against" {
-                            return Err(syn::Error::new(
-                                word.span(),
-                                format!("expected `against`, as in `stabilization: {first} {second} against a;`"),
-                            ));
-                        }
-                        (Some(first), second)
-                    };
-                    let against: Ident = content.parse()?;
-                    declaration.roles.stabilization = Some(StabilizationDecl {
-                        alpha,
-                        form,
-                        against,
-                    });
-                }
+                "stabilization" => declaration.roles.stabilization = Some(stabilization(&content)?),
                 "side" => declaration.roles.side = Some(content.parse()?),
-                "obstacle" => {
-                    let field: Ident = content.parse()?;
-                    content.parse::<Token![>=]>().map_err(|e| {
-                        syn::Error::new(e.span(), format!("expected `obstacle: {field} >= ψ;` (the constrained field, `>=`, the obstacle's data function; `side:` turns it into s·{field} ≥ s·ψ)"))
-                    })?;
-                    let data: Ident = content.parse()?;
-                    declaration.roles.obstacle = Some((field, data));
-                }
+                "obstacle" => declaration.roles.obstacle = Some(obstacle(&content)?),
                 other => {
                     let sections = SECTIONS;
                     let hint = closest(other, sections)
@@ -452,7 +467,18 @@ impl Declaration {
     /// Meaning-level checks of the declaration: elements, cells, pairing of tests, names.
     pub fn check(&self) -> Vec<Diagnostic> {
         let mut errors = Vec::new();
-        let cell = match self.cell {
+        let cell = self.checked_cell(&mut errors);
+        self.check_unknowns(cell, &mut errors);
+        self.check_tests(&mut errors);
+        self.check_dirichlet(&mut errors);
+        self.check_facets(cell, &mut errors);
+        self.check_names(&mut errors);
+        errors
+    }
+
+    /// The cell, or an error at its name.
+    fn checked_cell(&self, errors: &mut Vec<Diagnostic>) -> Option<CellKind> {
+        match self.cell {
             Some(c) => Some(c),
             None => {
                 errors.push(
@@ -464,7 +490,12 @@ impl Declaration {
                 );
                 None
             }
-        };
+        }
+    }
+
+    /// Each unknown's element: known, available on `cell`, a vector field of the cell's
+    /// dimension, a multiplier `>= 0` discontinuous (or P1 on a boundary part).
+    fn check_unknowns(&self, cell: Option<CellKind>, errors: &mut Vec<Diagnostic>) {
         for u in &self.unknowns {
             match u.element {
                 None => {
@@ -539,6 +570,10 @@ impl Declaration {
                 }
             }
         }
+    }
+
+    /// One test function per unknown.
+    fn check_tests(&self, errors: &mut Vec<Diagnostic>) {
         if self.tests.len() != self.unknowns.len() {
             let span = self
                 .tests
@@ -557,6 +592,10 @@ impl Declaration {
                 .help("list one test function per unknown, in the same order (`unknowns: θ: P2, w: P2; tests: η, v;`)"),
             );
         }
+    }
+
+    /// Boundary data `w = g`: `w` a continuous scalar unknown or a component, `g` data.
+    fn check_dirichlet(&self, errors: &mut Vec<Diagnostic>) {
         for (field, data) in &self.dirichlet {
             // A component `θ_x` of a vector field is prescribed like a scalar field.
             let component_of = self.unknowns.iter().find(|u| {
@@ -612,6 +651,11 @@ impl Declaration {
                 );
             }
         }
+    }
+
+    /// Boundary parts: on triangles, each declared once, and `n` (the outward normal)
+    /// not hidden by a declared name.
+    fn check_facets(&self, cell: Option<CellKind>, errors: &mut Vec<Diagnostic>) {
         if !self.facets.is_empty() && cell != Some(CellKind::Triangle) {
             errors.push(
                 Diagnostic::token(
@@ -648,6 +692,11 @@ impl Declaration {
                 );
             }
         }
+    }
+
+    /// Every name means one thing: not reserved, not `int_…`, declared once, and not a
+    /// component of a vector field.
+    fn check_names(&self, errors: &mut Vec<Diagnostic>) {
         // Every name means one thing.
         // (name, where declared, the vector it is a component of)
         let mut names: Vec<(String, &Ident, Option<&Ident>)> = Vec::new();
@@ -726,6 +775,5 @@ impl Declaration {
                 names.push(entry);
             }
         }
-        errors
     }
 }
