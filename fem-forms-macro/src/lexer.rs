@@ -223,61 +223,11 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
         } else if c.is_ascii_digit()
             || (c == '.' && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit()))
         {
-            while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
-                j += 1;
-            }
-            // exponent part: 1e-3, 2.5E+4
-            if j < chars.len() && (chars[j] == 'e' || chars[j] == 'E') {
-                let mut k = j + 1;
-                if k < chars.len() && (chars[k] == '-' || chars[k] == '+') {
-                    k += 1;
-                }
-                if k < chars.len() && chars[k].is_ascii_digit() {
-                    while k < chars.len() && chars[k].is_ascii_digit() {
-                        k += 1;
-                    }
-                    j = k;
-                }
-            }
-            let raw: String = chars[i..j].iter().collect();
-            // a literal with a non-zero digit that reads as 0 or a subnormal underflowed
-            // (a `1e-400` vanished from its form without a word)
-            let nonzero = raw
-                .chars()
-                .take_while(|c| !matches!(c, 'e' | 'E'))
-                .any(|c| c.is_ascii_digit() && c != '0');
-            match raw.parse::<f64>() {
-                Ok(v) if nonzero && (v == 0.0 || v.is_subnormal()) => errors.push(
-                    Diagnostic::text(
-                        Loc {
-                            len: j - i,
-                            ..start
-                        },
-                        format!("number `{raw}` is too small: it underflows a 64-bit float"),
-                    )
-                    .help("non-zero constants must be at least about 2.2e-308 in size; rescale the units"),
-                ),
-                Ok(v) if v.is_finite() => push(Tok::Number(v), j - i, &mut tokens),
-                Ok(_) => errors.push(
-                    Diagnostic::text(
-                        Loc {
-                            len: j - i,
-                            ..start
-                        },
-                        format!("number `{raw}` is too large: it overflows a 64-bit float"),
-                    )
-                    .help("constants must be finite, below about 1.8e308"),
-                ),
-                Err(_) => errors.push(
-                    Diagnostic::text(
-                        Loc {
-                            len: j - i,
-                            ..start
-                        },
-                        format!("malformed number `{raw}`"),
-                    )
-                    .help("write numbers like 2, 0.5 or 1e-3"),
-                ),
+            let (end, number) = number(&chars, i, start);
+            j = end;
+            match number {
+                Ok(v) => push(Tok::Number(v), j - i, &mut tokens),
+                Err(e) => errors.push(e),
             }
         } else if c == '_'
             && chars.get(i + 1) == Some(&'T')
@@ -297,123 +247,14 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
                 j += 1;
             }
             let name: String = chars[i..j].iter().collect();
-            let tok = match name.as_str() {
-                "int" => Tok::Integral,
-                "ds" => Tok::Ds,
-                // the domain's integral as many write it (a `∫_Ω T ∇u·∇v` was
-                // read as a boundary integral and cascaded)
-                "int_Omega" | "int_Ω" => Tok::Integral,
-                _ if name.len() > 4 && name.starts_with("int_") => {
-                    Tok::FacetIntegral(name["int_".len()..].to_string())
-                }
-                "Σ_T" | "sum_T" => Tok::SumT,
-                "grad" => Tok::Grad,
-                "lap" => Tok::Laplacian,
-                "dot" => Tok::Star,
-                "d_x" => Tok::Partial(0),
-                "d_y" => Tok::Partial(1),
-                "ε" | "eps" => Tok::SymGrad,
-                "div" => Tok::Divergence,
-                "tr" => Tok::Trace,
-                _ => Tok::Ident(name),
-            };
+            push(word(name), j - i, &mut tokens);
+        } else if let Some((end, error, tok)) = misread_partial(&chars, i, start) {
+            j = end;
+            errors.push(error);
             push(tok, j - i, &mut tokens);
-        } else if c == '∂'
-            && chars.get(i + 1) == Some(&'_')
-            && matches!(chars.get(i + 2), Some('x' | 'y'))
-            && matches!(chars.get(i + 3), Some('x' | 'y'))
-        {
-            // One error for the whole operator (`∂_xyz` too), and the first partial in
-            // its place, so that the parse goes on without a cascade about a symbol `_xy`.
-            j = i + 4;
-            while matches!(chars.get(j), Some('x' | 'y' | 'z')) {
-                j += 1;
-            }
-            let written: String = chars[i..j].iter().collect();
-            let (a, b) = (chars[i + 2], chars[i + 3]);
-            let help = if a == b {
-                format!("write ∂_{a}² for the second derivative (ASCII d_{a}^2)")
-            } else {
-                format!("write ∂_{a} ∂_{b} for the mixed derivative (ASCII d_{a} d_{b})")
-            };
-            errors.push(
-                Diagnostic::text(
-                    Loc { len: j - i, ..start },
-                    format!("`{written}` is ambiguous: a mixed derivative to some readers, ∂_{a} of a name `{b}…` to others"),
-                )
-                .help(help),
-            );
-            push(Tok::Partial(u8::from(a == 'y')), j - i, &mut tokens);
-        } else if c == '∂'
-            && chars.get(i + 1) == Some(&'_')
-            && chars.get(i + 2).is_some_and(|&d| is_ident_start(d))
-            && !matches!(chars.get(i + 2), Some('x' | 'y'))
-        {
-            // `∂_X u`, `∂_t u`: one error at the operator, not a cascade about `_X`
-            j = i + 2;
-            while j < chars.len() && is_ident_continue(chars[j]) {
-                j += 1;
-            }
-            let written: String = chars[i..j].iter().collect();
-            errors.push(
-                Diagnostic::text(
-                    Loc { len: j - i, ..start },
-                    format!("`{written}` is not a partial derivative of the forms: the coordinates are x and y"),
-                )
-                .help("write ∂_x or ∂_y (ASCII d_x, d_y), then the field: ∂_x u"),
-            );
-            push(Tok::Partial(0), j - i, &mut tokens);
         } else {
-            let tok = match c {
-                // `∫_Γ_C`: the boundary part's name follows the underscore.
-                '∫' if chars.get(i + 1) == Some(&'_')
-                    && chars.get(i + 2).is_some_and(|&d| is_ident_start(d)) =>
-                {
-                    j = i + 2;
-                    while j < chars.len() && is_ident_continue(chars[j]) {
-                        j += 1;
-                    }
-                    let part: String = chars[i + 2..j].iter().collect();
-                    Some(if part == "Ω" {
-                        Tok::Integral
-                    } else {
-                        Tok::FacetIntegral(part)
-                    })
-                }
-                '∫' => Some(Tok::Integral),
-                '∇' => Some(Tok::Grad),
-                'Δ' => Some(Tok::Laplacian),
-                // `∂_xu` is ∂_x u, as `Δu` is Δ u: no name starts with ∂ (a
-                // `∂_xu ∂_xv` was told that a partial derivative is written ∂_x); `∂_xy`
-                // stays an error, a mixed derivative to some readers
-                '∂' if chars.get(i + 1) == Some(&'_')
-                    && matches!(chars.get(i + 2), Some('x' | 'y'))
-                    && !matches!(chars.get(i + 3), Some('x' | 'y')) =>
-                {
-                    j = i + 3;
-                    Some(Tok::Partial(u8::from(chars[i + 2] == 'y')))
-                }
-                ':' => Some(Tok::Colon),
-                '∑' if chars.get(i + 1) == Some(&'_') && chars.get(i + 2) == Some(&'T') => {
-                    j = i + 3;
-                    Some(Tok::SumT)
-                }
-                '^' => Some(Tok::Caret),
-                '+' => Some(Tok::Plus),
-                '-' | '−' | '–' => Some(Tok::Minus),
-                '*' | '·' | '⋅' | '×' => Some(Tok::Star),
-                '/' => Some(Tok::Slash),
-                '(' => Some(Tok::LParen),
-                ')' => Some(Tok::RParen),
-                '[' => Some(Tok::LBracket),
-                ']' => Some(Tok::RBracket),
-                '{' => Some(Tok::LBrace),
-                '}' => Some(Tok::RBrace),
-                ',' => Some(Tok::Comma),
-                ';' => Some(Tok::Semicolon),
-                '=' => Some(Tok::Equals),
-                _ => None,
-            };
+            let (end, tok) = symbol(&chars, i);
+            j = end;
             match tok {
                 Some(tok) => push(tok, j - i, &mut tokens),
                 None => errors.push(
@@ -430,6 +271,192 @@ pub fn tokenize(text: &str) -> (Vec<Token>, Vec<Diagnostic>) {
         i = j;
     }
     (tokens, errors)
+}
+
+/// The number at `chars[i..]` (digits, a point, an exponent `1e-3`, `2.5E+4`): the end
+/// of its text and its value, or an error at `start` for a number that over- or
+/// underflows a 64-bit float or does not parse.
+fn number(chars: &[char], i: usize, start: Loc) -> (usize, Result<f64, Diagnostic>) {
+    let mut j = i + 1;
+    while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
+        j += 1;
+    }
+    // exponent part: 1e-3, 2.5E+4
+    if j < chars.len() && (chars[j] == 'e' || chars[j] == 'E') {
+        let mut k = j + 1;
+        if k < chars.len() && (chars[k] == '-' || chars[k] == '+') {
+            k += 1;
+        }
+        if k < chars.len() && chars[k].is_ascii_digit() {
+            while k < chars.len() && chars[k].is_ascii_digit() {
+                k += 1;
+            }
+            j = k;
+        }
+    }
+    let raw: String = chars[i..j].iter().collect();
+    let at = Loc {
+        len: j - i,
+        ..start
+    };
+    // a literal with a non-zero digit that reads as 0 or a subnormal underflowed
+    // (a `1e-400` vanished from its form without a word)
+    let nonzero = raw
+        .chars()
+        .take_while(|c| !matches!(c, 'e' | 'E'))
+        .any(|c| c.is_ascii_digit() && c != '0');
+    let value = match raw.parse::<f64>() {
+        Ok(v) if nonzero && (v == 0.0 || v.is_subnormal()) => Err(Diagnostic::text(
+            at,
+            format!("number `{raw}` is too small: it underflows a 64-bit float"),
+        )
+        .help("non-zero constants must be at least about 2.2e-308 in size; rescale the units")),
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(Diagnostic::text(
+            at,
+            format!("number `{raw}` is too large: it overflows a 64-bit float"),
+        )
+        .help("constants must be finite, below about 1.8e308")),
+        Err(_) => Err(Diagnostic::text(at, format!("malformed number `{raw}`"))
+            .help("write numbers like 2, 0.5 or 1e-3")),
+    };
+    (j, value)
+}
+
+/// The token of a word: a keyword's (`int`, `grad`, `d_x`, `eps`, …, `int_Γ` a boundary
+/// integral), else a name.
+fn word(name: String) -> Tok {
+    match name.as_str() {
+        "int" => Tok::Integral,
+        "ds" => Tok::Ds,
+        // the domain's integral as many write it (a `∫_Ω T ∇u·∇v` was
+        // read as a boundary integral and cascaded)
+        "int_Omega" | "int_Ω" => Tok::Integral,
+        _ if name.len() > 4 && name.starts_with("int_") => {
+            Tok::FacetIntegral(name["int_".len()..].to_string())
+        }
+        "Σ_T" | "sum_T" => Tok::SumT,
+        "grad" => Tok::Grad,
+        "lap" => Tok::Laplacian,
+        "dot" => Tok::Star,
+        "d_x" => Tok::Partial(0),
+        "d_y" => Tok::Partial(1),
+        "ε" | "eps" => Tok::SymGrad,
+        "div" => Tok::Divergence,
+        "tr" => Tok::Trace,
+        _ => Tok::Ident(name),
+    }
+}
+
+/// A partial derivative written as the forms do not read it, at `chars[i..]`: `∂_xy`
+/// (ambiguous: a mixed derivative to some readers) or `∂_X`, `∂_t` (not a coordinate).
+/// The end of its text, one error for the whole operator, and a partial to put in its
+/// place so that the parse goes on without a cascade about a symbol `_xy`.
+fn misread_partial(chars: &[char], i: usize, start: Loc) -> Option<(usize, Diagnostic, Tok)> {
+    if chars.get(i) != Some(&'∂') || chars.get(i + 1) != Some(&'_') {
+        return None;
+    }
+    let written = |j: usize| -> String { chars[i..j].iter().collect() };
+    if matches!(chars.get(i + 2), Some('x' | 'y')) && matches!(chars.get(i + 3), Some('x' | 'y')) {
+        let mut j = i + 4;
+        while matches!(chars.get(j), Some('x' | 'y' | 'z')) {
+            j += 1;
+        }
+        let (a, b) = (chars[i + 2], chars[i + 3]);
+        let help = if a == b {
+            format!("write ∂_{a}² for the second derivative (ASCII d_{a}^2)")
+        } else {
+            format!("write ∂_{a} ∂_{b} for the mixed derivative (ASCII d_{a} d_{b})")
+        };
+        let error = Diagnostic::text(
+            Loc { len: j - i, ..start },
+            format!(
+                "`{}` is ambiguous: a mixed derivative to some readers, ∂_{a} of a name `{b}…` to others",
+                written(j)
+            ),
+        )
+        .help(help);
+        return Some((j, error, Tok::Partial(u8::from(a == 'y'))));
+    }
+    if chars.get(i + 2).is_some_and(|&d| is_ident_start(d))
+        && !matches!(chars.get(i + 2), Some('x' | 'y'))
+    {
+        let mut j = i + 2;
+        while j < chars.len() && is_ident_continue(chars[j]) {
+            j += 1;
+        }
+        let error = Diagnostic::text(
+            Loc {
+                len: j - i,
+                ..start
+            },
+            format!(
+                "`{}` is not a partial derivative of the forms: the coordinates are x and y",
+                written(j)
+            ),
+        )
+        .help("write ∂_x or ∂_y (ASCII d_x, d_y), then the field: ∂_x u");
+        return Some((j, error, Tok::Partial(0)));
+    }
+    None
+}
+
+/// The symbol at `chars[i..]` (an operator, a bracket, `∫_Γ`, `∂_x`, `∑_T`): the end of
+/// its text and its token, `None` for a character the forms do not use.
+fn symbol(chars: &[char], i: usize) -> (usize, Option<Tok>) {
+    let c = chars[i];
+    let mut j = i + 1;
+    let tok = match c {
+        // `∫_Γ_C`: the boundary part's name follows the underscore.
+        '∫' if chars.get(i + 1) == Some(&'_')
+            && chars.get(i + 2).is_some_and(|&d| is_ident_start(d)) =>
+        {
+            j = i + 2;
+            while j < chars.len() && is_ident_continue(chars[j]) {
+                j += 1;
+            }
+            let part: String = chars[i + 2..j].iter().collect();
+            Some(if part == "Ω" {
+                Tok::Integral
+            } else {
+                Tok::FacetIntegral(part)
+            })
+        }
+        '∫' => Some(Tok::Integral),
+        '∇' => Some(Tok::Grad),
+        'Δ' => Some(Tok::Laplacian),
+        // `∂_xu` is ∂_x u, as `Δu` is Δ u: no name starts with ∂ (a
+        // `∂_xu ∂_xv` was told that a partial derivative is written ∂_x); `∂_xy`
+        // stays an error, a mixed derivative to some readers
+        '∂' if chars.get(i + 1) == Some(&'_')
+            && matches!(chars.get(i + 2), Some('x' | 'y'))
+            && !matches!(chars.get(i + 3), Some('x' | 'y')) =>
+        {
+            j = i + 3;
+            Some(Tok::Partial(u8::from(chars[i + 2] == 'y')))
+        }
+        ':' => Some(Tok::Colon),
+        '∑' if chars.get(i + 1) == Some(&'_') && chars.get(i + 2) == Some(&'T') => {
+            j = i + 3;
+            Some(Tok::SumT)
+        }
+        '^' => Some(Tok::Caret),
+        '+' => Some(Tok::Plus),
+        '-' | '−' | '–' => Some(Tok::Minus),
+        '*' | '·' | '⋅' | '×' => Some(Tok::Star),
+        '/' => Some(Tok::Slash),
+        '(' => Some(Tok::LParen),
+        ')' => Some(Tok::RParen),
+        '[' => Some(Tok::LBracket),
+        ']' => Some(Tok::RBracket),
+        '{' => Some(Tok::LBrace),
+        '}' => Some(Tok::RBrace),
+        ',' => Some(Tok::Comma),
+        ';' => Some(Tok::Semicolon),
+        '=' => Some(Tok::Equals),
+        _ => None,
+    };
+    (j, tok)
 }
 
 #[cfg(test)]
