@@ -1556,8 +1556,53 @@ fn a_nested_contact_solve_begins_on_the_first_level_that_holds_the_rotation() {
     // the one bottom edge acts at its midpoint, the resultant of q = x at 2/3
     assert!(
         e.contains("cannot hold the rotation")
-            && e.contains("act on 0.500 ≤ x ≤ 0.500, and the load's resultant on x = 0.667")
+            && e.contains("act on 0.500 ≤ x ≤ 0.500, and the load's resultant, as this mesh integrates the load, on x = 0.667")
             && e.contains("refine the mesh"),
+        "{e}"
+    );
+}
+
+/// A body on a tilted foundation (n_c = (0.287, −0.958)) held by a roller along x on its
+/// top: the free translation is vertical, neither along n_c nor across it, and only
+/// the contact holds it and the rotation about the top. Pressed by q = (x/2)² on its top
+/// (resultant P = 2/3 at x = 3/2, by hand; a quadratic the model's edge rule integrates
+/// exactly) it solves for every pair with the contact force
+/// P / |n_c·e_y| along n_c (the roller takes the horizontal part). Pressed by (x/2)⁵ the
+/// roller's reaction and the contact's horizontal part leave no equilibrium (the
+/// contact force would have to act beyond Γ_C's end): refused as a body that tips,
+/// where a P2 displacement was solved with an energy of 1.5e5 and a P1 one failed with
+/// "not positive definite".
+#[test]
+fn a_tilted_foundation_under_a_roller_holds_or_tips_the_body() {
+    let n = [0.28734788556634544f64, -0.9578262852211514f64];
+    let block = |power: u32| {
+        rectangle_scene(2.0, 1.0, [2, 1], "contact = \"bottom\"\n    load = \"top\"\n    fixed_x = \"top\"\n    [parameters]\n    contact_direction = [0.28734788556634544, -0.9578262852211514]", &format!("(x/2)^{power}"))
+            .replace("cells = [2, 1]", "cells = [2, 1]\n    refinements = 4")
+    };
+    let file = parse(&block(2)).unwrap();
+    for pair in ["p1-p0", "p2-p0", "p1-p1", "p2-p1"] {
+        let solved = solve(
+            &file,
+            &Overrides {
+                pair: Some(pair),
+                ..Overrides::default()
+            },
+        )
+        .unwrap();
+        let force = quantity(&solved.report, "total_contact_force");
+        let exact = 2.0 / 3.0 / n[1].abs();
+        assert!(
+            (force - exact).abs() <= 1e-9 * exact,
+            "{pair}: {force} against {exact}"
+        );
+        let energy = solved.report.solve.energy.unwrap();
+        assert!(energy.abs() < 1e-2, "{pair}: energy {energy}");
+    }
+    let e = solve(&parse(&block(5)).unwrap(), &Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tips the body") && e.contains("data.pressure"),
         "{e}"
     );
 }
