@@ -484,6 +484,20 @@ fn list() {
                 format!("; studies {}", scene.studies.join(", "))
             }
         );
+        if !scene.study_variants.is_empty() {
+            let labels: Vec<&str> = scene
+                .study_variants
+                .iter()
+                .map(|v| v.label.as_str())
+                .collect();
+            println!(
+                "  {:<18} studied as its variants {} (`study {}-{} …` runs one)",
+                "",
+                labels.join(", "),
+                scene.name,
+                labels[0]
+            );
+        }
     }
     for family in families::families() {
         let options: Vec<&str> = family.options().iter().map(|o| o.flag()).collect();
@@ -530,6 +544,16 @@ fn hosted_kinds() -> Vec<&'static str> {
 /// hosts it.
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
     if let Some(scene) = families::scene(name) {
+        return registry_study(scene, kind, full, out);
+    }
+    // a study variant of a scene (`mindlin-disk-q20`)
+    let variant = families::scenes()
+        .iter()
+        .filter(|s| !s.study_variants.is_empty() && name.starts_with(&*s.name))
+        .filter_map(|s| families::study_variants(s).ok())
+        .flatten()
+        .find(|v| v.name == name);
+    if let Some(scene) = variant {
         return registry_study(scene, kind, full, out);
     }
     let scene_names = || -> String {

@@ -428,7 +428,7 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
         print_convergence_header(scene.size_name(), contact_error);
     } else {
         println!(
-            "{}: no exact solution; J_h, ∫λ_h and the {contact} with their changes Δ from the mesh before and the rates log2 of the ratio of successive |Δ|",
+            "{}: no exact solution field; J_h, ∫λ_h and the {contact} with their changes Δ from the mesh before (rates: log2 of the ratio of successive |Δ|), and the relative error of the family's reference quantity where it has one",
             scene.setting()
         );
         print_changes_header(scene.size_name(), contact);

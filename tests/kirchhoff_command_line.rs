@@ -325,3 +325,42 @@ fn the_square_convergence_study_shows_each_elements_rate() {
     let navier = navier_centre_deflection();
     assert!((w / navier - 1.0).abs() < 1e-8, "{w} against {navier}");
 }
+
+/// A study variant runs on its own (`study kirchhoff-square-clamped convergence`
+/// writes that variant's files and not the other's), `list` names the variants, and a
+/// misspelt variant is an unknown scene.
+#[test]
+fn a_study_variant_runs_on_its_own() {
+    let run = common::fem_forms(
+        &["study", "kirchhoff-square-clamped", "convergence"],
+        "kirchhoff-variant",
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "fem-forms-kirchhoff-variant-{}",
+        std::process::id()
+    ));
+    assert!(out
+        .join("kirchhoff-square-clamped-convergence.csv")
+        .exists());
+    assert!(!out
+        .join("kirchhoff-square-simply-supported-convergence.csv")
+        .exists());
+    let list = fem_forms(&["list"]);
+    let text = String::from_utf8_lossy(&list.stdout);
+    assert!(
+        text.contains("studied as its variants clamped, simply-supported"),
+        "{text}"
+    );
+    let run = fem_forms(&["study", "kirchhoff-square-clampd", "convergence"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && stderr.contains("`kirchhoff-square-clampd` is not a scene"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+}
