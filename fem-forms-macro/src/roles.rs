@@ -47,15 +47,69 @@ pub fn resolve(
         side,
         obstacle,
     } = &declaration.roles;
-    let mut errors = Vec::new();
-    let form_names: Vec<&str> = forms.iter().map(|f| f.name.as_str()).collect();
-    // `role`: the section and its example, e.g. "`system:` (`system: B_h, L_h;`)"
-    let mut form = |ident: &Ident, arity: usize, role: &str| -> Option<usize> {
+    let mut lookup = Lookup {
+        forms,
+        symbols,
+        errors: Vec::new(),
+    };
+    let both = |a: Option<usize>, b: Option<usize>| Some([a?, b?]);
+    const SYSTEM: &str = "`system:` (`system: B_h, L_h;`)";
+    const ENERGY: &str = "`energy:` (`energy: a, ℓ;`)";
+    const STABILIZATION: &str = "`stabilization:` (`stabilization: α S against a;`)";
+    let system = system.as_ref().map(|(b, l)| {
+        let b = lookup.form(b, 2, SYSTEM);
+        both(b, lookup.form(l, 1, SYSTEM))
+    });
+    let energy = energy.as_ref().map(|(a, l)| {
+        let a = lookup.form(a, 2, ENERGY);
+        both(a, lookup.form(l, 1, ENERGY))
+    });
+    let stabilization = stabilization.as_ref().map(|s| {
+        let form = lookup.form(&s.form, 2, STABILIZATION);
+        let against = lookup.form(&s.against, 2, STABILIZATION);
+        let alpha = match &s.alpha {
+            Some(a) => Some(lookup.param(a, "the stabilization parameter α")?),
+            None => None,
+        };
+        Some((alpha, form?, against?))
+    });
+    let side = side
+        .as_ref()
+        .map(|s| lookup.param(s, "the obstacle side s"));
+    let obstacle = obstacle
+        .as_ref()
+        .map(|(field, data)| lookup.obstacle(field, data));
+    let conventional = Conventional { forms, symbols };
+    let roles = Roles {
+        system: system.unwrap_or_else(|| conventional.system()),
+        energy: energy.unwrap_or_else(|| conventional.energy()),
+        stabilization: stabilization.unwrap_or_else(|| conventional.stabilization()),
+        side: side.unwrap_or_else(|| conventional.param(&["s"])),
+        order: 0,
+        obstacle: obstacle.unwrap_or_else(|| conventional.obstacle()),
+    };
+    let order = operator_order(&roles, forms);
+    (Roles { order, ..roles }, lookup.errors)
+}
+
+/// The declared roles' names looked up among the forms, parameters, fields and data,
+/// with an error at each name that does not fit.
+struct Lookup<'a> {
+    forms: &'a [Form],
+    symbols: &'a Symbols,
+    errors: Vec<Diagnostic>,
+}
+
+impl Lookup<'_> {
+    /// The form `ident` of `arity` (2 bilinear, 1 linear) for `role`: the section and
+    /// its example, e.g. "`system:` (`system: B_h, L_h;`)".
+    fn form(&mut self, ident: &Ident, arity: usize, role: &str) -> Option<usize> {
         let name = ident.to_string();
+        let forms = self.forms;
         match forms.iter().position(|f| f.name == name) {
             Some(i) if forms[i].arity() == arity => Some(i),
             Some(i) => {
-                errors.push(Diagnostic::token(
+                self.errors.push(Diagnostic::token(
                     ident.span(),
                     format!(
                         "`{name}` is {}, but {role} takes {} here",
@@ -66,10 +120,10 @@ pub fn resolve(
                 None
             }
             None => {
-                let hint = closest(&name, form_names.iter().copied())
+                let hint = closest(&name, forms.iter().map(|f| f.name.as_str()))
                     .map(|s| format!("; did you mean `{s}`?"))
                     .unwrap_or_default();
-                errors.push(
+                self.errors.push(
                     Diagnostic::token(
                         ident.span(),
                         format!("`{name}` is not a form of the model ({role}){hint}"),
@@ -79,32 +133,18 @@ pub fn resolve(
                 None
             }
         }
-    };
-    let both = |a: Option<usize>, b: Option<usize>| Some([a?, b?]);
-    const SYSTEM: &str = "`system:` (`system: B_h, L_h;`)";
-    const ENERGY: &str = "`energy:` (`energy: a, ℓ;`)";
-    const STABILIZATION: &str = "`stabilization:` (`stabilization: α S against a;`)";
-    let system = system
-        .as_ref()
-        .map(|(b, l)| both(form(b, 2, SYSTEM), form(l, 1, SYSTEM)));
-    let energy = energy
-        .as_ref()
-        .map(|(a, l)| both(form(a, 2, ENERGY), form(l, 1, ENERGY)));
-    let stabilization_forms = stabilization.as_ref().map(|s| {
-        both(
-            form(&s.form, 2, STABILIZATION),
-            form(&s.against, 2, STABILIZATION),
-        )
-        .map(|[s, a]| (s, a))
-    });
-    let mut param = |ident: &Ident, role: &str| -> Option<usize> {
+    }
+
+    /// The parameter `ident` for `role`.
+    fn param(&mut self, ident: &Ident, role: &str) -> Option<usize> {
         let name = ident.to_string();
-        let found = symbols.params.iter().position(|p| *p == name);
+        let params = &self.symbols.params;
+        let found = params.iter().position(|p| *p == name);
         if found.is_none() {
-            let hint = closest(&name, symbols.params.iter().map(String::as_str))
+            let hint = closest(&name, params.iter().map(String::as_str))
                 .map(|s| format!("; did you mean `{s}`?"))
                 .unwrap_or_default();
-            errors.push(
+            self.errors.push(
                 Diagnostic::token(
                     ident.span(),
                     format!("`{name}` is not a parameter of the model ({role}){hint}"),
@@ -113,79 +153,98 @@ pub fn resolve(
             );
         }
         found
-    };
-    let stabilization = stabilization
-        .as_ref()
-        .zip(stabilization_forms)
-        .map(|(s, forms)| {
-            let alpha = match &s.alpha {
-                Some(a) => Some(param(a, "the stabilization parameter α")?),
-                None => None,
-            };
-            Some((alpha, forms?.0, forms?.1))
-        });
-    let side = side.as_ref().map(|s| param(s, "the obstacle side s"));
-    let obstacle = obstacle.as_ref().map(|(field, data)| {
+    }
+
+    /// `obstacle: field >= data`: a primal scalar field and a data function.
+    fn obstacle(&mut self, field: &Ident, data: &Ident) -> Option<(usize, usize)> {
         let (f, d) = (field.to_string(), data.to_string());
-        let found_field = symbols.fields.iter().position(|x| x.name == f && !x.nonnegative);
+        let found_field = self
+            .symbols
+            .fields
+            .iter()
+            .position(|x| x.name == f && !x.nonnegative);
         if found_field.is_none() {
-            errors.push(
+            self.errors.push(
                 Diagnostic::token(field.span(), format!("`{f}` is not a primal scalar field of the model (the constrained field of `obstacle:`)"))
                     .help("name an unknown declared under `unknowns:` that is not the multiplier"),
             );
         }
-        let found_data = symbols.data.iter().position(|x| x.0 == d);
+        let found_data = self.symbols.data.iter().position(|x| x.0 == d);
         if found_data.is_none() {
-            errors.push(
-                Diagnostic::token(data.span(), format!("`{d}` is not a data function of the model (the obstacle of `obstacle:`)"))
-                    .help("declare it under `data:`"),
+            self.errors.push(
+                Diagnostic::token(
+                    data.span(),
+                    format!(
+                        "`{d}` is not a data function of the model (the obstacle of `obstacle:`)"
+                    ),
+                )
+                .help("declare it under `data:`"),
             );
         }
         Some((found_field?, found_data?))
-    });
-    let by_name = |name: &str, arity: usize| {
-        forms
+    }
+}
+
+/// The roles a model that does not declare them has by the conventional names: `B_h`,
+/// `L_h`; `a`, `ℓ`; `α S against a`; `s`; `u ≥ ψ` or `w ≥ ψ` beside a multiplier.
+struct Conventional<'a> {
+    forms: &'a [Form],
+    symbols: &'a Symbols,
+}
+
+impl Conventional<'_> {
+    fn form(&self, name: &str, arity: usize) -> Option<usize> {
+        self.forms
             .iter()
             .position(|f| f.name == name && f.arity() == arity)
-    };
-    let param_named = |names: &[&str]| {
-        symbols
+    }
+
+    fn param(&self, names: &[&str]) -> Option<usize> {
+        self.symbols
             .params
             .iter()
             .position(|p| names.contains(&p.as_str()))
-    };
-    let roles = Roles {
-        system: system.unwrap_or_else(|| Some([by_name("B_h", 2)?, by_name("L_h", 1)?])),
-        energy: energy.unwrap_or_else(|| {
-            let load = ["ℓ", "l", "ell"].iter().find_map(|n| by_name(n, 1))?;
-            Some([by_name("a", 2)?, load])
-        }),
-        stabilization: stabilization.unwrap_or_else(|| {
-            Some((
-                param_named(&["α", "alpha"]),
-                by_name("S", 2)?,
-                by_name("a", 2)?,
-            ))
-        }),
-        side: side.unwrap_or_else(|| param_named(&["s"])),
-        order: 0,
-        obstacle: obstacle.unwrap_or_else(|| {
-            let data = symbols
-                .data
-                .iter()
-                .position(|d| d.0 == "ψ" || d.0 == "psi")?;
-            let field = symbols
-                .fields
-                .iter()
-                .position(|f| !f.nonnegative && (f.name == "u" || f.name == "w"))?;
-            symbols
-                .fields
-                .iter()
-                .any(|f| f.nonnegative)
-                .then_some((field, data))
-        }),
-    };
-    let order = roles
+    }
+
+    fn system(&self) -> Option<[usize; 2]> {
+        Some([self.form("B_h", 2)?, self.form("L_h", 1)?])
+    }
+
+    fn energy(&self) -> Option<[usize; 2]> {
+        let load = ["ℓ", "l", "ell"].iter().find_map(|n| self.form(n, 1))?;
+        Some([self.form("a", 2)?, load])
+    }
+
+    fn stabilization(&self) -> Option<(Option<usize>, usize, usize)> {
+        Some((
+            self.param(&["α", "alpha"]),
+            self.form("S", 2)?,
+            self.form("a", 2)?,
+        ))
+    }
+
+    fn obstacle(&self) -> Option<(usize, usize)> {
+        let fields = &self.symbols.fields;
+        let data = self
+            .symbols
+            .data
+            .iter()
+            .position(|d| d.0 == "ψ" || d.0 == "psi")?;
+        let field = fields
+            .iter()
+            .position(|f| !f.nonnegative && (f.name == "u" || f.name == "w"))?;
+        fields
+            .iter()
+            .any(|f| f.nonnegative)
+            .then_some((field, data))
+    }
+}
+
+/// The order `p` of the operator the stabilization measures ([`Roles::order`]): the
+/// largest power of h in the stabilization's terms, else the largest total derivative
+/// order of the energy's bilinear form's terms; 0 where neither is known.
+fn operator_order(roles: &Roles, forms: &[Form]) -> u8 {
+    roles
         .stabilization
         .map(|(_, s, _)| {
             forms[s]
@@ -206,8 +265,7 @@ pub fn resolve(
                     .unwrap_or(0)
             })
         })
-        .unwrap_or(0);
-    (Roles { order, ..roles }, errors)
+        .unwrap_or(0)
 }
 
 fn kind(arity: usize) -> &'static str {
