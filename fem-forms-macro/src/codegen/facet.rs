@@ -93,155 +93,19 @@ pub fn facet_kernel(
     }
 
     // One quadrature loop per (data set, number of points).
-    let mut groups: Vec<(&[usize], usize, Vec<&Term>)> = Vec::new();
-    for term in &block.terms {
-        let points = QuadratureRule::exact_for_degree(term_degree(term, block, symbols)).len();
-        match groups
-            .iter_mut()
-            .find(|(d, n, _)| *d == term.data.as_slice() && *n == points)
-        {
-            Some(g) => g.2.push(term),
-            None => groups.push((&term.data, points, vec![term])),
-        }
-    }
-    let loops = groups.iter().map(|(data, nq, terms)| {
-        let rule = fem_reference::quadrature::gauss_legendre(*nq);
-        let nq = *nq;
-        let mut tables: Vec<TokenStream> = Vec::new();
-        let mut made: Vec<(ElementKind, [u8; 2])> = Vec::new();
-        let mut table = |element: ElementKind, beta: [u8; 2]| -> Ident {
-            let ident = format_ident!(
-                "PHI_{}_D{}{}",
-                element.name().to_uppercase(),
-                beta[0],
-                beta[1]
-            );
-            if !made.contains(&(element, beta)) {
-                made.push((element, beta));
-                let basis = derivatives(element, beta);
-                let n = basis.len();
-                let per_edge = (0..3).map(|edge| {
-                    let per_point = rule.points.iter().map(|&s| {
-                        let x = edge_point(edge, s);
-                        let values = basis.iter().map(|p| float(p.eval(x)));
-                        quote!([#(#values),*])
-                    });
-                    quote!([#(#per_point),*])
-                });
-                tables.push(quote! {
-                    const #ident: [[[f64; #n]; #nq]; 3] = [#(#per_edge),*];
-                });
-            }
-            ident
-        };
-        // Σ_β T_αβ TABLE_β[edge][q][index]
-        let mut value = |element: ElementKind, alpha: [u8; 2], index: TokenStream| {
-            let parts: Vec<TokenStream> = transform(alpha)
-                .into_iter()
-                .map(|(beta, _)| {
-                    let t = table(element, beta);
-                    match t_code(alpha, beta) {
-                        Some(c) => quote!(#c * #t[edge][q][#index]),
-                        None => quote!(#t[edge][q][#index]),
-                    }
-                })
-                .collect();
-            quote!((#(#parts)+*))
-        };
-        let body: Vec<TokenStream> = terms
-            .iter()
-            .map(|term| {
-                let mut factors = vec![coefficient(
-                    term.coefficient,
-                    &term.params,
-                    term.h_power,
-                    &term.divisors,
-                )];
-                factors.extend(power(quote!(n_x), i32::from(term.normal[0])));
-                factors.extend(power(quote!(n_y), i32::from(term.normal[1])));
-                let c = product(factors);
-                let test = value(test_element, term.test_derivative, quote!(i));
-                let accumulate = match (trial_element, term.trial_derivative) {
-                    (Some(e), Some(dv)) => {
-                        let trial = value(e, dv, quote!(j));
-                        quote! {
-                            for i in 0..#rows {
-                                let a = g * #test;
-                                for j in 0..#cols {
-                                    k[i][j] += a * #trial;
-                                }
-                            }
-                        }
-                    }
-                    _ => quote! {
-                        for i in 0..#rows {
-                            k[i][0] += g * #test;
-                        }
-                    },
-                };
-                quote! {
-                    let g = w * (#c);
-                    #accumulate
-                }
-            })
-            .collect();
-        let points = (0..3).map(|edge| {
-            let per_point = rule.points.iter().map(|&s| {
-                let [a, b] = edge_point(edge, s).map(float);
-                quote!([#a, #b])
-            });
-            quote!([#(#per_point),*])
-        });
-        let weights = rule.weights.iter().map(|&v| float(v));
-        let data_product = product(
-            std::iter::once(quote!(W[q] * len)).chain(data.iter().map(|&i| quote!(d[#i](&xq)))),
-        );
-        let point = (!data.is_empty()).then(|| {
-            quote! {
-                let xq = [
-                    x[0] + j00 * XI[edge][q][0] + j01 * XI[edge][q][1],
-                    x[1] + j10 * XI[edge][q][0] + j11 * XI[edge][q][1],
-                ];
-            }
-        });
-        quote! {
-            {
-                const XI: [[[f64; 2]; #nq]; 3] = [#(#points),*];
-                const W: [f64; #nq] = [#(#weights),*];
-                #(#tables)*
-                for q in 0..#nq {
-                    #point
-                    let w = #data_product;
-                    #(#body)*
-                }
-            }
-        }
-    });
-    let loops: Vec<TokenStream> = loops.collect();
-
-    let test = &symbols.fields[block.test_field].test_name;
-    let doc_title = match block.trial_field {
-        Some(f) => format!(
-            " Block ({test}, {}) of `{form}` on the edges of the boundary part `{part}`: rows {test} ({}), columns {} ({}).",
-            symbols.fields[f].name,
-            test_element.name(),
-            symbols.fields[f].name,
-            symbols.fields[f].element.name()
-        ),
-        None => format!(
-            " Block {test} of `{form}` on the edges of the boundary part `{part}` ({}).",
-            test_element.name()
-        ),
+    let groups = quadrature_groups(block, symbols);
+    let shape = KernelShape {
+        test: test_element,
+        trial: trial_element,
+        rows,
+        cols,
     };
-    let doc_terms = format!(
-        " Terms: {}, integrated over local edge `edge` (joining local vertices `edge` and `(edge + 1) % 3`, `edge < 3`) of the triangle `x`, counter-clockwise or not; `h` is the edge's length and `n` the outward unit normal.",
-        block
-            .terms
-            .iter()
-            .map(|t| describe(t, block, symbols))
-            .collect::<Vec<_>>()
-            .join(" + ")
-    );
+    let loops: Vec<TokenStream> = groups
+        .iter()
+        .map(|(data, nq, terms)| quadrature_loop(&shape, data, *nq, terms))
+        .collect();
+
+    let (doc_title, doc_terms) = kernel_docs(block, symbols, form, part);
     let (signature_out, ret) = if block.trial_field.is_some() {
         (quote!([[f64; #cols]; #rows]), quote!(k))
     } else {
@@ -276,6 +140,186 @@ pub fn facet_kernel(
             #ret
         }
     }
+}
+
+/// The terms of `block` grouped by the quadrature loop that integrates them: one per
+/// (data functions, number of Gauss points exact for the term's degree).
+fn quadrature_groups<'a>(
+    block: &'a Block,
+    symbols: &Symbols,
+) -> Vec<(&'a [usize], usize, Vec<&'a Term>)> {
+    let mut groups: Vec<(&[usize], usize, Vec<&Term>)> = Vec::new();
+    for term in &block.terms {
+        let points = QuadratureRule::exact_for_degree(term_degree(term, block, symbols)).len();
+        match groups
+            .iter_mut()
+            .find(|(d, n, _)| *d == term.data.as_slice() && *n == points)
+        {
+            Some(g) => g.2.push(term),
+            None => groups.push((&term.data, points, vec![term])),
+        }
+    }
+    groups
+}
+
+/// The elements and local sizes of a facet kernel: the test field's (rows), the trial
+/// field's where the block has one (columns, else 1).
+struct KernelShape {
+    test: ElementKind,
+    trial: Option<ElementKind>,
+    rows: usize,
+    cols: usize,
+}
+
+/// One quadrature loop of a facet kernel: `terms` (on `data`) integrated by `nq`-point
+/// Gauss–Legendre on the edge, with the compile-time tables of the basis derivatives
+/// they use at the points of each of the three local edges.
+fn quadrature_loop(shape: &KernelShape, data: &[usize], nq: usize, terms: &[&Term]) -> TokenStream {
+    let KernelShape {
+        test: test_element,
+        trial: trial_element,
+        rows,
+        cols,
+    } = *shape;
+    let rule = fem_reference::quadrature::gauss_legendre(nq);
+    let mut tables: Vec<TokenStream> = Vec::new();
+    let mut made: Vec<(ElementKind, [u8; 2])> = Vec::new();
+    let mut table = |element: ElementKind, beta: [u8; 2]| -> Ident {
+        let ident = format_ident!(
+            "PHI_{}_D{}{}",
+            element.name().to_uppercase(),
+            beta[0],
+            beta[1]
+        );
+        if !made.contains(&(element, beta)) {
+            made.push((element, beta));
+            let basis = derivatives(element, beta);
+            let n = basis.len();
+            let per_edge = (0..3).map(|edge| {
+                let per_point = rule.points.iter().map(|&s| {
+                    let x = edge_point(edge, s);
+                    let values = basis.iter().map(|p| float(p.eval(x)));
+                    quote!([#(#values),*])
+                });
+                quote!([#(#per_point),*])
+            });
+            tables.push(quote! {
+                const #ident: [[[f64; #n]; #nq]; 3] = [#(#per_edge),*];
+            });
+        }
+        ident
+    };
+    // Σ_β T_αβ TABLE_β[edge][q][index]
+    let mut value = |element: ElementKind, alpha: [u8; 2], index: TokenStream| {
+        let parts: Vec<TokenStream> = transform(alpha)
+            .into_iter()
+            .map(|(beta, _)| {
+                let t = table(element, beta);
+                match t_code(alpha, beta) {
+                    Some(c) => quote!(#c * #t[edge][q][#index]),
+                    None => quote!(#t[edge][q][#index]),
+                }
+            })
+            .collect();
+        quote!((#(#parts)+*))
+    };
+    let body: Vec<TokenStream> = terms
+        .iter()
+        .map(|term| {
+            let mut factors = vec![coefficient(
+                term.coefficient,
+                &term.params,
+                term.h_power,
+                &term.divisors,
+            )];
+            factors.extend(power(quote!(n_x), i32::from(term.normal[0])));
+            factors.extend(power(quote!(n_y), i32::from(term.normal[1])));
+            let c = product(factors);
+            let test = value(test_element, term.test_derivative, quote!(i));
+            let accumulate = match (trial_element, term.trial_derivative) {
+                (Some(e), Some(dv)) => {
+                    let trial = value(e, dv, quote!(j));
+                    quote! {
+                        for i in 0..#rows {
+                            let a = g * #test;
+                            for j in 0..#cols {
+                                k[i][j] += a * #trial;
+                            }
+                        }
+                    }
+                }
+                _ => quote! {
+                    for i in 0..#rows {
+                        k[i][0] += g * #test;
+                    }
+                },
+            };
+            quote! {
+                let g = w * (#c);
+                #accumulate
+            }
+        })
+        .collect();
+    let points = (0..3).map(|edge| {
+        let per_point = rule.points.iter().map(|&s| {
+            let [a, b] = edge_point(edge, s).map(float);
+            quote!([#a, #b])
+        });
+        quote!([#(#per_point),*])
+    });
+    let weights = rule.weights.iter().map(|&v| float(v));
+    let data_product = product(
+        std::iter::once(quote!(W[q] * len)).chain(data.iter().map(|&i| quote!(d[#i](&xq)))),
+    );
+    let point = (!data.is_empty()).then(|| {
+        quote! {
+            let xq = [
+                x[0] + j00 * XI[edge][q][0] + j01 * XI[edge][q][1],
+                x[1] + j10 * XI[edge][q][0] + j11 * XI[edge][q][1],
+            ];
+        }
+    });
+    quote! {
+        {
+            const XI: [[[f64; 2]; #nq]; 3] = [#(#points),*];
+            const W: [f64; #nq] = [#(#weights),*];
+            #(#tables)*
+            for q in 0..#nq {
+                #point
+                let w = #data_product;
+                #(#body)*
+            }
+        }
+    }
+}
+
+/// The doc comment of a facet kernel: its title and its terms.
+fn kernel_docs(block: &Block, symbols: &Symbols, form: &str, part: &str) -> (String, String) {
+    let test_element = symbols.fields[block.test_field].element;
+    let test = &symbols.fields[block.test_field].test_name;
+    let doc_title = match block.trial_field {
+    Some(f) => format!(
+        " Block ({test}, {}) of `{form}` on the edges of the boundary part `{part}`: rows {test} ({}), columns {} ({}).",
+        symbols.fields[f].name,
+        test_element.name(),
+        symbols.fields[f].name,
+        symbols.fields[f].element.name()
+    ),
+    None => format!(
+        " Block {test} of `{form}` on the edges of the boundary part `{part}` ({}).",
+        test_element.name()
+    ),
+};
+    let doc_terms = format!(
+    " Terms: {}, integrated over local edge `edge` (joining local vertices `edge` and `(edge + 1) % 3`, `edge < 3`) of the triangle `x`, counter-clockwise or not; `h` is the edge's length and `n` the outward unit normal.",
+    block
+        .terms
+        .iter()
+        .map(|t| describe(t, block, symbols))
+        .collect::<Vec<_>>()
+        .join(" + ")
+);
+    (doc_title, doc_terms)
 }
 
 /// The facet items of the `Model` impl: `FACET_PARTS`, `FACET_BLOCKS` and the dispatch
