@@ -398,10 +398,13 @@ fn constraint_rows(
     b_ptr.push(0);
     for (k, shift) in multiplier_shift.iter_mut().enumerate() {
         row.clear();
-        for e in split.b_ptr[k]..split.b_ptr[k + 1] {
-            let v = values[e];
+        let entries = split.b_ptr[k]..split.b_ptr[k + 1];
+        for (&v, &column) in values[entries.clone()]
+            .iter()
+            .zip(&split.b_columns[entries])
+        {
             if v != 0.0 {
-                rotation.spread(split.b_columns[e], v, &mut row);
+                rotation.spread(column, v, &mut row);
             }
         }
         if !rotated.is_empty() {

@@ -181,7 +181,7 @@ fn oblique_translation(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> O
         [smallest - c, b]
     };
     let length = d[0].hypot(d[1]);
-    if !(length > 0.0) {
+    if length.is_nan() || length <= 0.0 {
         return None;
     }
     let d = [d[0] / length, d[1] / length];
