@@ -344,3 +344,194 @@ fn handles_and_names_agree() {
     assert!(Coefficients::from_ids(&[(params::α, 0.25)], &[(data::f, &load)]).is_err());
     assert!(Coefficients::from_ids::<M>(&[(params::α, f64::NAN)], &[]).is_err());
 }
+
+/// `η_T² = h_T² ‖f + Δu + λ‖²_T` by hand, for the local coefficients `u` and `lambda`.
+fn hand_cell_indicator(
+    ue: ElementKind,
+    le: ElementKind,
+    cell: &Cell,
+    u: &[f64],
+    lambda: &[f64],
+) -> f64 {
+    let residual = |b: [f64; 3]| {
+        let laplacian: f64 = (0..count(ue)).map(|i| u[i] * basis(ue, cell, i, b).2).sum();
+        let multiplier: f64 = (0..count(le))
+            .map(|i| lambda[i] * basis(le, cell, i, b).0)
+            .sum();
+        load(&cell.point(b)) + laplacian + multiplier
+    };
+    let integral: f64 = dunavant4()
+        .iter()
+        .map(|&(b, w)| w * residual(b).powi(2))
+        .sum();
+    cell.h * cell.h * integral * cell.area
+}
+
+/// The barycentric coordinates in `cell` of the point `p`.
+fn barycentric(cell: &Cell, p: [f64; 2]) -> [f64; 3] {
+    let d = [p[0] - cell.x[0][0], p[1] - cell.x[0][1]];
+    let (b1, b2) = (dot(cell.grad[1], d), dot(cell.grad[2], d));
+    [1.0 - b1 - b2, b1, b2]
+}
+
+/// `η_E² = h_E ‖[[∇u·n]]‖²_E` by hand on the edge `p`–`q` shared by `plus` and
+/// `minus`, `n` the outward normal of `plus`, by 3-point Gauss–Legendre.
+#[allow(clippy::too_many_arguments)]
+fn hand_edge_indicator(
+    ue: ElementKind,
+    plus: &Cell,
+    u: &[f64],
+    minus: &Cell,
+    w: &[f64],
+    p: [f64; 2],
+    q: [f64; 2],
+) -> f64 {
+    let len = (q[0] - p[0]).hypot(q[1] - p[1]);
+    let mut n = [(q[1] - p[1]) / len, -(q[0] - p[0]) / len];
+    // outward of `plus`: away from its third vertex
+    let centre = plus.point([1.0 / 3.0; 3]);
+    if dot(n, [centre[0] - p[0], centre[1] - p[1]]) > 0.0 {
+        n = [-n[0], -n[1]];
+    }
+    let gradient = |cell: &Cell, c: &[f64], x: [f64; 2]| {
+        let b = barycentric(cell, x);
+        (0..count(ue)).fold([0.0; 2], |g, i| {
+            let gi = basis(ue, cell, i, b).1;
+            [g[0] + c[i] * gi[0], g[1] + c[i] * gi[1]]
+        })
+    };
+    let s = 0.6f64.sqrt();
+    let rule = [
+        (0.5 * (1.0 - s), 5.0 / 18.0),
+        (0.5, 8.0 / 18.0),
+        (0.5 * (1.0 + s), 5.0 / 18.0),
+    ];
+    let integral: f64 = rule
+        .iter()
+        .map(|&(t, weight)| {
+            let x = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+            let (a, b) = (gradient(plus, u, x), gradient(minus, w, x));
+            weight * dot([a[0] - b[0], a[1] - b[1]], n).powi(2)
+        })
+        .sum();
+    len * integral * len
+}
+
+fn flat(cell: &Cell) -> Vec<f64> {
+    cell.x.iter().flatten().copied().collect()
+}
+
+/// The generated indicators of `M` against the hand-coded ones, on `cell` and its
+/// neighbour across local edge 0 (the neighbour's vertices rotated by `turn`, so the
+/// shared edge is any of its local edges).
+fn check_indicators<M: Model>(cell: &Cell, apex: [f64; 2], turn: usize, coefficients: &[f64]) {
+    let ue = M::FIELDS[0].element;
+    let le = M::FIELDS[1].element;
+    let (nu, nl) = (count(ue), count(le));
+    let take = |k: usize, n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| coefficients[(k + i) % coefficients.len()])
+            .collect()
+    };
+    let (u, lambda) = (take(0, nu), take(nu, nl));
+    let data: [&DataFn; 3] = [&load, &obstacle, &boundary];
+    let alpha = [0.3];
+    let generated = M::cell_indicator(&flat(cell), &[&u, &lambda], &alpha, &data).unwrap();
+    let hand = hand_cell_indicator(ue, le, cell, &u, &lambda);
+    assert!(
+        (generated - hand).abs() <= 1e-10 * hand.max(1e-300),
+        "{}: η_T² {generated:e} against {hand:e} by hand",
+        M::NAME
+    );
+    // the neighbour across edge 0 (x0 → x1): counter-clockwise [x1, x0, apex], rotated
+    let vertices = [cell.x[1], cell.x[0], apex];
+    let rotated: [[f64; 2]; 3] = std::array::from_fn(|i| vertices[(i + turn) % 3]);
+    let neighbour = Cell::new(rotated);
+    let other_edge = (3 - turn) % 3;
+    let (w, mu) = (take(3, nu), take(7, nl));
+    let generated = M::edge_indicator(
+        &flat(cell),
+        0,
+        &[&u, &lambda],
+        &flat(&neighbour),
+        other_edge,
+        &[&w, &mu],
+        &alpha,
+        &data,
+    )
+    .unwrap();
+    let hand = hand_edge_indicator(ue, cell, &u, &neighbour, &w, cell.x[0], cell.x[1]);
+    assert!(
+        (generated - hand).abs() <= 1e-10 * hand.max(1e-300),
+        "{}: η_E² {generated:e} against {hand:e} by hand",
+        M::NAME
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(100))]
+
+    #[test]
+    fn membrane_indicators_match_the_hand_coded_ones(
+        cell in triangle(),
+        height in 0.2..2.0f64,
+        along in -0.5..1.5f64,
+        turn in 0..3usize,
+        coefficients in proptest::collection::vec(-2.0..2.0f64, 11),
+    ) {
+        // the apex on the other side of edge 0 from the cell's third vertex
+        let [p, q, r] = cell.x;
+        let (tx, ty) = (q[0] - p[0], q[1] - p[1]);
+        let side = if (r[0] - p[0]) * -ty + (r[1] - p[1]) * tx > 0.0 { -1.0 } else { 1.0 };
+        let apex = [p[0] + along * tx - side * height * ty, p[1] + along * ty + side * height * tx];
+        check_indicators::<membrane_p1_p0::Model>(&cell, apex, turn, &coefficients);
+        check_indicators::<membrane_p2_p0::Model>(&cell, apex, turn, &coefficients);
+        check_indicators::<membrane_p2_p1disc::Model>(&cell, apex, turn, &coefficients);
+    }
+}
+
+/// A function that is a quadratic on the whole plane has no jumps, and its cell residual
+/// is that of its Laplacian: the indicators see the solution, not its numbering.
+#[test]
+fn a_global_quadratic_has_no_jump() {
+    type M = membrane_p2_p0::Model;
+    let quadratic = |x: [f64; 2]| {
+        0.3 + x[0] - 2.0 * x[1] + 0.7 * x[0] * x[0] - 0.4 * x[0] * x[1] + 1.1 * x[1] * x[1]
+    };
+    // P2 nodes: vertices, then the midpoints of the edges 0–1, 1–2, 2–0
+    let nodes = |c: &Cell| -> Vec<f64> {
+        let mid =
+            |i: usize, j: usize| [(c.x[i][0] + c.x[j][0]) / 2.0, (c.x[i][1] + c.x[j][1]) / 2.0];
+        [c.x[0], c.x[1], c.x[2], mid(0, 1), mid(1, 2), mid(2, 0)]
+            .map(quadratic)
+            .to_vec()
+    };
+    let plus = Cell::new([[0.1, 0.2], [1.3, 0.1], [0.4, 0.9]]);
+    let minus = Cell::new([[1.3, 0.1], [0.1, 0.2], [0.8, -0.7]]);
+    let data: [&DataFn; 3] = [&load, &obstacle, &boundary];
+    let jump = M::edge_indicator(
+        &flat(&plus),
+        0,
+        &[&nodes(&plus), &[0.0]],
+        &flat(&minus),
+        0,
+        &[&nodes(&minus), &[0.0]],
+        &[0.3],
+        &data,
+    )
+    .unwrap();
+    assert!(jump < 1e-26, "η_E² = {jump:e}");
+    // Δ = 2·0.7 + 2·1.1 = 3.6; with λ = −3.6 the residual is f alone
+    let cell = M::cell_indicator(&flat(&plus), &[&nodes(&plus), &[-3.6]], &[0.3], &data).unwrap();
+    let load_only: f64 = dunavant4()
+        .iter()
+        .map(|&(b, w)| w * load(&plus.point(b)).powi(2))
+        .sum::<f64>()
+        * plus.area
+        * plus.h
+        * plus.h;
+    assert!(
+        (cell - load_only).abs() < 1e-12 * load_only,
+        "{cell:e} against {load_only:e}"
+    );
+}

@@ -412,6 +412,28 @@ pub(crate) fn expand_expression(
     context.expand(&expr, true).ok_or(context.errors)
 }
 
+/// Expands an estimator's expression (a norm's body or its weight) with the analysed
+/// `forms` callable: on an edge (`edge`) the normal `n` and `h_E` are allowed.
+pub(crate) fn expand_estimator_expression(
+    symbols: &Symbols,
+    forms: &[Form],
+    expr: &crate::parser::Expr,
+    edge: bool,
+) -> Result<Expansion, Vec<Diagnostic>> {
+    let mut context = Context {
+        symbols,
+        forms,
+        later_forms: &[],
+        errors: Vec::new(),
+        facet: None,
+        in_expression: edge,
+    };
+    match context.expand(expr, true) {
+        Some(x) if context.errors.is_empty() => Ok(x),
+        _ => Err(context.errors),
+    }
+}
+
 /// What an expression expands to: a scalar, a vector (one scalar per axis) or a matrix
 /// (rows of scalars, `dimension × dimension`; `∇θ` has the components in its rows).
 #[derive(Clone, Debug)]

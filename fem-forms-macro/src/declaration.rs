@@ -138,6 +138,8 @@ pub struct Declaration {
     pub facets: Vec<Ident>,
     /// The forms text.
     pub forms: LitStr,
+    /// The estimator text (`estimator: "η_T² = …";`), if the model declares one.
+    pub estimator: Option<LitStr>,
     /// The roles of forms and parameters.
     pub roles: RolesDecl,
     /// Span of the section list, for "missing section" errors.
@@ -145,7 +147,7 @@ pub struct Declaration {
 }
 
 /// The sections a model may have.
-const SECTIONS: [&str; 12] = [
+const SECTIONS: [&str; 13] = [
     "unknowns",
     "tests",
     "params",
@@ -158,6 +160,7 @@ const SECTIONS: [&str; 12] = [
     "stabilization",
     "side",
     "obstacle",
+    "estimator",
 ];
 
 /// Two names separated by a comma (`B_h, L_h`); `example` for the error.
@@ -391,6 +394,7 @@ impl Parse for Declaration {
             dirichlet: Vec::new(),
             facets: Vec::new(),
             forms: LitStr::new("", brace.span.join()),
+            estimator: None,
             roles: RolesDecl::default(),
             body_span: brace.span.join(),
         };
@@ -422,6 +426,7 @@ impl Parse for Declaration {
                     })?
                 }
                 "facets" => declaration.facets = comma_list(&content, |s| s.parse())?,
+                "estimator" => declaration.estimator = Some(content.parse()?),
                 "forms" => {
                     declaration.forms = content.parse()?;
                     have_forms = true;

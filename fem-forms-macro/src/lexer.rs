@@ -87,6 +87,8 @@ pub enum Tok {
     Equals,
     /// `_T` right after `)`: closes an L² product `(X, Y)_T`.
     SubscriptT,
+    /// `‖` (or `||`): a norm's bar, in the `estimator:` text (`h_T² ‖f + Δu + λ‖²`).
+    Norm,
     /// End of a line (definitions start at the beginning of a line).
     Newline,
 }
@@ -454,6 +456,11 @@ fn symbol(chars: &[char], i: usize) -> (usize, Option<Tok>) {
         ',' => Some(Tok::Comma),
         ';' => Some(Tok::Semicolon),
         '=' => Some(Tok::Equals),
+        '‖' => Some(Tok::Norm),
+        '|' if chars.get(i + 1) == Some(&'|') => {
+            j = i + 2;
+            Some(Tok::Norm)
+        }
         _ => None,
     };
     (j, tok)

@@ -57,6 +57,12 @@
 //! - `facets: Γ_C, Γ_N;` (optional, triangles) names boundary parts that the forms
 //!   integrate over with `∫_Γ_C … ds`; the runtime says which edges a part holds (a
 //!   Gmsh physical name or a generator's marker).
+//! - `estimator: "…"` (optional, triangles) a residual a-posteriori estimator: lines
+//!   `η_T² = h_T² ‖f + Δu + λ‖²` (a cell's squared indicator: weighted squared L² norms
+//!   over the cell of residuals linear in the unknowns, plus data) and
+//!   `η_E² = h_E ‖[[∇u·n]]‖²` (an interior edge's: of jumps `X⁺ − X⁻`, `n` the edge's
+//!   unit normal). It generates `NAME::estimator::cell` and `::edge` and the `Model`
+//!   methods `cell_indicator` and `edge_indicator` (`estimator.rs`, `codegen/estimator.rs`).
 //! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may
 //!   want `#![allow(mixed_script_confusables)]`.
 //!
@@ -193,6 +199,7 @@ mod analysis;
 mod codegen;
 mod declaration;
 mod diagnostic;
+mod estimator;
 mod lexer;
 mod parser;
 mod roles;
@@ -232,6 +239,7 @@ fn expand(input: TokenStream) -> TokenStream {
             .collect();
     }
     // Named expressions (`Cε(θ) := …`) were substituted where called: no code of their own.
+    let all_forms = forms.clone();
     let forms: Vec<_> = forms.into_iter().filter(|f| f.value.is_none()).collect();
     let (roles, role_errors) = roles::resolve(&declaration, &symbols, &forms);
     if !role_errors.is_empty() {
@@ -241,7 +249,24 @@ fn expand(input: TokenStream) -> TokenStream {
             .map(|e| e.to_compile_error(&text, span))
             .collect();
     }
-    let code = codegen::generate(&declaration, &symbols, &forms, &roles);
+    let estimator = match &declaration.estimator {
+        None => None,
+        Some(literal) => {
+            let text = literal.value();
+            let (tokens, mut errors) = lexer::tokenize(&text);
+            let (estimator, more) = estimator::analyse(&tokens, &text, &symbols, &all_forms);
+            errors.extend(more);
+            if !errors.is_empty() {
+                let span = literal.span();
+                return errors
+                    .iter()
+                    .map(|e| e.to_compile_error(&text, span))
+                    .collect();
+            }
+            Some(estimator)
+        }
+    };
+    let code = codegen::generate(&declaration, &symbols, &forms, &roles, estimator.as_ref());
     if let Ok(dir) = std::env::var("FEM_FORMS_DUMP_DIR") {
         dump(&dir, &declaration.name.to_string(), &code);
     }

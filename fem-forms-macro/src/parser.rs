@@ -210,12 +210,21 @@ pub fn parse_forms(tokens: &[Token]) -> (Vec<Definition>, Vec<Diagnostic>) {
 /// Parses a lone expression (used by the tests of the symbolic layer).
 #[cfg(test)]
 pub(crate) fn parse_expression(tokens: &[Token]) -> Result<Expr> {
-    let names = HashSet::new();
+    parse_expression_calling(tokens, &HashSet::new(), &[])
+}
+
+/// Parses a lone expression that may call the forms and named expressions `forms`
+/// (the estimator's norms, which may use `Cε(θ)` of the forms text).
+pub(crate) fn parse_expression_calling(
+    tokens: &[Token],
+    form_names: &HashSet<String>,
+    forms: &[String],
+) -> Result<Expr> {
     let mut parser = Parser {
         tokens,
         pos: 0,
-        form_names: &names,
-        earlier_forms: &[],
+        form_names,
+        earlier_forms: forms,
         nesting: 0,
     };
     let e = parser.sum(false)?;
@@ -411,6 +420,7 @@ fn describe(tok: &Tok) -> String {
         Tok::Semicolon => "`;`".into(),
         Tok::Equals => "`=`".into(),
         Tok::SubscriptT => "`_T`".into(),
+        Tok::Norm => "`‖`".into(),
         Tok::Newline => "the end of the line".into(),
     }
 }

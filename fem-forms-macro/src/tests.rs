@@ -1214,3 +1214,77 @@ fn a_prime_on_a_parameter_is_refused() {
         "{errors}"
     );
 }
+
+fn membrane_with_estimator(estimator: &str) -> TokenStream {
+    quote! {
+        /// Membrane.
+        pub mod membrane on triangle {
+            unknowns: u: P2, λ: P0 >= 0;
+            tests: v, μ;
+            params: α;
+            data: f, ψ, g;
+            boundary: u = g;
+            forms: #MEMBRANE;
+            estimator: #estimator;
+        }
+    }
+}
+
+#[test]
+fn an_estimator_expands_to_kernels() {
+    for text in [
+        "η_T² = h_T² ‖f + Δu + λ‖²\n η_E² = h_E ‖[[∇u·n]]‖²",
+        "eta_T^2 = h_T^2 ||f + lap u + λ||^2\n eta_E^2 = h_E ||[[grad u dot n]]||^2",
+    ] {
+        let out = expand(membrane_with_estimator(text));
+        let text = out.to_string();
+        assert!(!text.contains("compile_error"), "{text}");
+        let _: syn::File = syn::parse2(out).expect("generated code parses");
+        assert!(text.contains("pub mod estimator"));
+        assert!(text.contains("HAS_ESTIMATOR"));
+    }
+}
+
+#[test]
+fn estimator_errors_point_at_the_place() {
+    let cases = [
+        ("η_T² = h_T² ‖f + Δu + λ‖", "must be squared"),
+        ("η_T² = h_T² ‖f + Δv + λ‖²", "test function `v`"),
+        ("η_T² = h_T² ‖f + uλ‖²", "linear in the unknowns"),
+        ("η_E² = h_E ‖∇u·n‖²", "jump"),
+        ("η_E² = h_E ‖[[f + ∇u·n]]‖²", "data alone in a jump"),
+        ("η_T² = h_T² ‖∇u·n‖²", "normal"),
+        ("η_T² = u ‖f + Δu‖²", "weight"),
+        ("η_T² = h_T² ‖f‖²", "does not depend on the solution"),
+        ("η_E² = h_T ‖[[∇u·n]]‖²", "`h_T`"),
+        ("η² = h_T² ‖f‖²", "expected `η_T² =`"),
+        ("", "declares no indicator"),
+    ];
+    for (text, expected) in cases {
+        let out = expand(membrane_with_estimator(text));
+        let errors = rendered_errors(&out);
+        assert!(
+            errors.iter().any(|e| e.contains(expected)),
+            "{text}: expected an error with `{expected}`, got {errors:?}"
+        );
+    }
+}
+
+#[test]
+fn an_estimator_on_an_interval_is_refused() {
+    let out = expand(quote! {
+        /// Beam.
+        pub mod beam on interval {
+            unknowns: w: P2, λ: P0 >= 0;
+            tests: v, μ;
+            data: f;
+            forms: "a(w;v) = ∫ w''v''";
+            estimator: "η_T² = h_T⁴ ‖f − w''''‖²";
+        }
+    });
+    let errors = rendered_errors(&out);
+    assert!(
+        errors.iter().any(|e| e.contains("triangles only")),
+        "{errors:?}"
+    );
+}

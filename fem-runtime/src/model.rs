@@ -362,6 +362,65 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         )))
     }
 
+    /// Whether the model declares an estimator (`estimator:`): then
+    /// [`Model::cell_indicator`] and [`Model::edge_indicator`] are its kernels.
+    const HAS_ESTIMATOR: bool = false;
+
+    /// The squared indicator `η_T²` of the model's `estimator:` on the affine triangle
+    /// with vertex coordinates `vertices` (`[x0, y0, x1, y1, x2, y2]`), for the local
+    /// coefficients of the discrete solution, one slice per field in the element's DOF
+    /// order.
+    ///
+    /// # Errors
+    /// [`Error::Input`] for slices of the wrong lengths, and always for a model without
+    /// an estimator.
+    fn cell_indicator(
+        vertices: &[f64],
+        coefficients: &[&[f64]],
+        params: &[f64],
+        data: &[&DataFn],
+    ) -> Result<f64> {
+        let _ = (vertices, coefficients, params, data);
+        Err(Error::Input(format!(
+            "model `{}` declares no estimator (`estimator:`)",
+            Self::NAME
+        )))
+    }
+
+    /// The squared indicator `η_E²` of the interior edge that is local edge `edge` of
+    /// the triangle `vertices` (coefficients `coefficients`) and local edge `other_edge`
+    /// of its neighbour `other_vertices` (`other_coefficients`); local edge `k` joins
+    /// local vertices `k` and `(k + 1) % 3`. As [`Model::cell_indicator`].
+    ///
+    /// # Errors
+    /// As [`Model::cell_indicator`], and for an edge above 2.
+    #[allow(clippy::too_many_arguments)]
+    fn edge_indicator(
+        vertices: &[f64],
+        edge: usize,
+        coefficients: &[&[f64]],
+        other_vertices: &[f64],
+        other_edge: usize,
+        other_coefficients: &[&[f64]],
+        params: &[f64],
+        data: &[&DataFn],
+    ) -> Result<f64> {
+        let _ = (
+            vertices,
+            edge,
+            coefficients,
+            other_vertices,
+            other_edge,
+            other_coefficients,
+            params,
+            data,
+        );
+        Err(Error::Input(format!(
+            "model `{}` declares no estimator (`estimator:`)",
+            Self::NAME
+        )))
+    }
+
     /// Index in `FACET_PARTS` of a boundary part the forms integrate over: its handle
     /// (`model::facets::Γ_C`) or its name (`"Γ_C"`).
     ///

@@ -31,6 +31,10 @@ macro_rules! membrane_model {
                 energy:        a, ℓ;
                 stabilization: α S against a;
                 obstacle:      u >= ψ;
+                estimator: "
+                    η_T² = h_T² ‖f + Δu + λ‖²
+                    η_E² = h_E ‖[[∇u·n]]‖²
+                ";
             }
         }
     };

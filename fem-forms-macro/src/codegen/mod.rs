@@ -13,6 +13,7 @@
 mod backend;
 mod curved;
 mod emit;
+mod estimator;
 mod facet;
 mod interval;
 mod triangle;
@@ -51,6 +52,9 @@ struct Dispatch {
     /// `FACET_PARTS`, `FACET_BLOCKS` and the facet dispatch (`facet.rs`; empty without
     /// `facets:`).
     facet_items: TokenStream,
+    /// `HAS_ESTIMATOR` and the indicator dispatch (`estimator.rs`; empty without
+    /// `estimator:`).
+    estimator_items: TokenStream,
 }
 
 /// What the driver generates for one form.
@@ -503,6 +507,7 @@ fn model_impl(
         matrix_curved,
         vector_curved,
         facet_items,
+        estimator_items,
     } = dispatch;
     let on_cell = transformed.then(|| {
         quote! {
@@ -664,6 +669,8 @@ fn model_impl(
             #curved
 
             #facet_items
+
+            #estimator_items
         }
     }
 }
@@ -674,6 +681,7 @@ pub fn generate(
     symbols: &Symbols,
     forms: &[Form],
     roles: &crate::roles::Roles,
+    estimator: Option<&crate::estimator::Estimator>,
 ) -> TokenStream {
     let runtime = &declaration.runtime;
     let backend = backend(declaration.cell);
@@ -688,6 +696,11 @@ pub fn generate(
         .unzip();
     dispatch.facet_items =
         facet::model_items(symbols, forms, runtime, &declaration.name.to_string());
+    let estimator_module = estimator.map(|e| estimator::module(e, symbols, runtime));
+    if estimator.is_some() {
+        dispatch.estimator_items =
+            estimator::model_items(symbols, runtime, &declaration.name.to_string());
+    }
     let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch, roles);
     let handles = handles(symbols, forms, runtime);
     let module = &declaration.name;
@@ -711,6 +724,8 @@ pub fn generate(
             #handles
 
             #(#form_modules)*
+
+            #estimator_module
 
             #model_impl
         }

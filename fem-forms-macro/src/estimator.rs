@@ -1,0 +1,397 @@
+//! The `estimator:` text: a residual a-posteriori estimator declared next to the forms.
+//!
+//! ```text
+//! estimator: "
+//!     η_T² = h_T² ‖f + Δu + λ‖²
+//!     η_E² = h_E ‖[[∇u·n]]‖²
+//! ";
+//! ```
+//!
+//! `η_T²` is the squared indicator of a cell T, a sum of weighted squared L² norms over
+//! T of residuals; `η_E²` that of an interior edge E, a sum of weighted squared L² norms
+//! over E of jumps `[[X]] = X⁺ − X⁻` across it (`n` the unit normal of E, pointing out
+//! of the cell on the `+` side; the square does not depend on the choice). A residual is
+//! an expression of the form language that is linear in the unknowns (written by their
+//! names: the estimator is a function of the discrete solution) plus data; it may call
+//! the named expressions of the forms text (`Cε(θ)`). A weight is a scalar of
+//! parameters and the element size (`h_T` on cells, `h_E` on edges).
+//!
+//! Every mistake is a compile error at the place in the estimator text.
+
+use crate::analysis::{expand_estimator_expression, Form, Symbols};
+use crate::diagnostic::{Diagnostic, Loc};
+use crate::lexer::{Tok, Token};
+use crate::symbolic::Expansion;
+use std::collections::HashSet;
+
+/// Where a term of the estimator is integrated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Region {
+    /// Over each cell: `h_T^p ‖R‖²_T`.
+    Cell,
+    /// Over each interior edge, of a jump: `h_E^p ‖[[X]]‖²_E`.
+    Edge,
+}
+
+/// One weighted squared norm of the estimator.
+#[derive(Clone, Debug)]
+pub struct IndicatorTerm {
+    /// Cells or interior edges.
+    pub region: Region,
+    /// The weight: a sum of scalar monomials (parameters, `h`, divisors).
+    pub weight: Expansion,
+    /// The residual (a cell's) or the quantity whose jump is taken (an edge's): each
+    /// monomial holds at most one unknown's derivative, the others are data terms.
+    pub residual: Expansion,
+    /// The term as written, for the docs.
+    pub source: String,
+}
+
+/// An analysed estimator.
+#[derive(Clone, Debug, Default)]
+pub struct Estimator {
+    /// Its terms, cells' and edges'.
+    pub terms: Vec<IndicatorTerm>,
+}
+
+impl Estimator {
+    /// The terms over `region`.
+    pub fn terms(&self, region: Region) -> impl Iterator<Item = &IndicatorTerm> {
+        self.terms.iter().filter(move |t| t.region == region)
+    }
+}
+
+/// The place of a token run, for errors (at least one character).
+fn span(tokens: &[Token]) -> Loc {
+    match (tokens.first(), tokens.last()) {
+        (Some(a), Some(b)) if a.loc.line == b.loc.line => Loc {
+            len: (b.loc.column + b.loc.len)
+                .saturating_sub(a.loc.column)
+                .max(1),
+            ..a.loc
+        },
+        (Some(a), _) => a.loc,
+        _ => Loc {
+            line: 1,
+            column: 1,
+            len: 1,
+        },
+    }
+}
+
+/// The region a line's head names: `η_T²` or `η_E²` (ASCII `eta_T^2`), with the number of
+/// tokens it takes.
+fn head(tokens: &[Token]) -> Option<(Region, usize)> {
+    let region = match &tokens.first()?.tok {
+        Tok::Ident(name) if name == "η_T" || name == "eta_T" => Region::Cell,
+        Tok::Ident(name) if name == "η_E" || name == "eta_E" => Region::Edge,
+        _ => return None,
+    };
+    let squared = match (&tokens.get(1)?.tok, tokens.get(2).map(|t| &t.tok)) {
+        (Tok::Superscript(Ok(2), _), _) => 2,
+        (Tok::Caret, Some(Tok::Number(n))) if *n == 2.0 => 3,
+        _ => return None,
+    };
+    (tokens.get(squared)?.tok == Tok::Equals).then_some((region, squared + 1))
+}
+
+/// Parses and analyses the estimator text's tokens against the model's symbols and its
+/// analysed forms (whose named expressions the norms may call).
+pub fn analyse(
+    tokens: &[Token],
+    text: &str,
+    symbols: &Symbols,
+    forms: &[Form],
+) -> (Estimator, Vec<Diagnostic>) {
+    let mut errors = Vec::new();
+    let mut estimator = Estimator::default();
+    let lines: Vec<&[Token]> = tokens
+        .split(|t| t.tok == Tok::Newline)
+        .filter(|l| !l.is_empty())
+        .collect();
+    if lines.is_empty() {
+        errors.push(
+            Diagnostic::text(span(&[]), "the estimator text declares no indicator").help(
+                "write `η_T² = h_T² ‖f + Δu + λ‖²` and `η_E² = h_E ‖[[∇u·n]]‖²`, one per line",
+            ),
+        );
+    }
+    let names: HashSet<String> = forms.iter().map(|f| f.name.clone()).collect();
+    let ordered: Vec<String> = forms.iter().map(|f| f.name.clone()).collect();
+    let context = Analysis {
+        symbols,
+        forms,
+        names: &names,
+        ordered: &ordered,
+        text,
+    };
+    for line in lines {
+        let Some((region, skip)) = head(line) else {
+            errors.push(
+                Diagnostic::text(line[0].loc, "expected `η_T² =` or `η_E² =`")
+                    .help("each line of the estimator is a cell's squared indicator `η_T² = …` or an interior edge's `η_E² = …`"),
+            );
+            continue;
+        };
+        for term in split_terms(&line[skip..]) {
+            match context.term(region, term) {
+                Ok(t) => estimator.terms.push(t),
+                Err(mut e) => errors.append(&mut e),
+            }
+        }
+    }
+    if errors.is_empty() && symbols.dimension != 2 {
+        errors.push(
+            Diagnostic::text(span(tokens), "estimators are generated on triangles only")
+                .help("on intervals the jumps sit at points; declare no `estimator:` for an interval model"),
+        );
+    }
+    (estimator, errors)
+}
+
+/// The terms of a line's right-hand side: split at the `+` signs outside norms and
+/// brackets.
+fn split_terms(tokens: &[Token]) -> Vec<&[Token]> {
+    let mut terms = Vec::new();
+    let (mut depth, mut inside_norm, mut start) = (0i32, false, 0);
+    for (i, t) in tokens.iter().enumerate() {
+        match t.tok {
+            Tok::LParen | Tok::LBracket | Tok::LBrace => depth += 1,
+            Tok::RParen | Tok::RBracket | Tok::RBrace => depth -= 1,
+            Tok::Norm => inside_norm = !inside_norm,
+            Tok::Plus if depth == 0 && !inside_norm && i > start => {
+                terms.push(&tokens[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    terms.push(&tokens[start..]);
+    terms
+}
+
+struct Analysis<'a> {
+    symbols: &'a Symbols,
+    forms: &'a [Form],
+    names: &'a HashSet<String>,
+    ordered: &'a [String],
+    text: &'a str,
+}
+
+impl Analysis<'_> {
+    /// One term `weight ‖body‖²` over `region`.
+    fn term(&self, region: Region, tokens: &[Token]) -> Result<IndicatorTerm, Vec<Diagnostic>> {
+        let example = match region {
+            Region::Cell => "h_T² ‖f + Δu + λ‖²",
+            Region::Edge => "h_E ‖[[∇u·n]]‖²",
+        };
+        let bars: Vec<usize> = (0..tokens.len())
+            .filter(|&i| tokens[i].tok == Tok::Norm)
+            .collect();
+        let squared = |i: usize| match (tokens.get(i).map(|t| &t.tok), tokens.get(i + 1)) {
+            (Some(Tok::Superscript(Ok(2), _)), _) => Some(i + 1),
+            (Some(Tok::Caret), Some(t)) if t.tok == Tok::Number(2.0) => Some(i + 2),
+            _ => None,
+        };
+        let [open, close] = bars[..] else {
+            return Err(vec![Diagnostic::text(
+                span(tokens),
+                "a term of an estimator is a weight times one squared norm",
+            )
+            .help(format!("write it as `{example}`"))]);
+        };
+        match squared(close + 1) {
+            Some(end) if end == tokens.len() => {}
+            _ => {
+                return Err(vec![Diagnostic::text(
+                    tokens[close].loc,
+                    "the norm must be squared, and end the term",
+                )
+                .help(format!("indicators are sums of squares: write `{example}`"))])
+            }
+        }
+        let weight_tokens = &tokens[..open];
+        let body = &tokens[open + 1..close];
+        let body = match region {
+            Region::Cell => body,
+            Region::Edge => jump_inside(body, example)?,
+        };
+        if body.is_empty() {
+            return Err(vec![Diagnostic::text(tokens[open].loc, "an empty norm")
+                .help(format!("write `{example}`"))]);
+        }
+        let edge = region == Region::Edge;
+        let weight = if weight_tokens.is_empty() {
+            vec![crate::symbolic::Monomial::constant(1.0, tokens[open].loc)]
+        } else {
+            self.expand(weight_tokens, edge)?
+        };
+        if let Some(m) = weight.iter().find(|m| !m.is_scalar() || m.normal != [0, 0]) {
+            return Err(vec![Diagnostic::text(
+                m.origin,
+                "the weight of a norm holds an unknown, data or the normal",
+            )
+            .help("a weight is a scalar of parameters and the element size (`h_T²`, `α h_E`); move the rest into the norm")]);
+        }
+        let residual = self.expand(body, edge)?;
+        self.check_residual(region, &residual, body)?;
+        check_sizes(region, weight_tokens, body)?;
+        let first = tokens[0].loc;
+        let last = tokens[tokens.len() - 1].loc;
+        let source = source_text(self.text, first, last);
+        Ok(IndicatorTerm {
+            region,
+            weight,
+            residual,
+            source,
+        })
+    }
+
+    fn expand(&self, tokens: &[Token], edge: bool) -> Result<Expansion, Vec<Diagnostic>> {
+        let expr = crate::parser::parse_expression_calling(tokens, self.names, self.ordered)
+            .map_err(|e| vec![e])?;
+        expand_estimator_expression(self.symbols, self.forms, &expr, edge)
+    }
+
+    /// A residual is linear in the unknowns (by their names) and, in a jump, holds no
+    /// data alone.
+    fn check_residual(
+        &self,
+        region: Region,
+        residual: &Expansion,
+        body: &[Token],
+    ) -> Result<(), Vec<Diagnostic>> {
+        let fields = self.symbols.fields.len();
+        for m in residual {
+            if m.args.len() > 1 {
+                return Err(vec![Diagnostic::text(
+                    m.origin,
+                    "a residual in an estimator is linear in the unknowns",
+                )
+                .help("an indicator is the norm of a residual `𝒜u − sλ − f`: a product of two unknowns has no place in it")]);
+            }
+            if let Some(a) = m.args.first() {
+                if a.symbol >= fields {
+                    return Err(vec![Diagnostic::text(
+                        m.origin,
+                        format!(
+                            "test function `{}` in an estimator",
+                            self.symbols.function_name(a.symbol)
+                        ),
+                    )
+                    .help(format!(
+                        "an estimator is a function of the discrete solution: write the unknown `{}`",
+                        self.symbols.fields[self.symbols.field_of(a.symbol)].name
+                    ))]);
+                }
+                let element = self.symbols.fields[a.symbol].element;
+                if element.needs_transformation() {
+                    return Err(vec![Diagnostic::text(
+                        m.origin,
+                        format!(
+                            "estimators are not generated for {} elements yet",
+                            element.name()
+                        ),
+                    )
+                    .help("their basis needs the per-cell DOF transformation; Lagrange and discontinuous elements are supported")]);
+                }
+            } else if region == Region::Edge && !m.data.is_empty() {
+                return Err(vec![Diagnostic::text(
+                    m.origin,
+                    "data alone in a jump: continuous data jump by zero",
+                )
+                .help(
+                    "a jump `[[X]]` is taken of the unknowns' traces; leave the data term out",
+                )]);
+            }
+            if region == Region::Cell && m.normal != [0, 0] {
+                return Err(vec![Diagnostic::text(
+                    span(body),
+                    "the normal `n` in a cell's residual",
+                )
+                .help("`n` exists on edges: use it in `η_E²`")]);
+            }
+        }
+        if residual.iter().all(|m| m.args.is_empty()) {
+            return Err(vec![Diagnostic::text(
+                span(body),
+                "this norm does not depend on the solution",
+            )
+            .help(
+                "an indicator measures a residual of the discrete solution: name an unknown in it",
+            )]);
+        }
+        Ok(())
+    }
+}
+
+/// `[[X]]` → `X`, or the error that says how to write a jump.
+fn jump_inside<'t>(body: &'t [Token], example: &str) -> Result<&'t [Token], Vec<Diagnostic>> {
+    let n = body.len();
+    let jump = n >= 5
+        && body[0].tok == Tok::LBracket
+        && body[1].tok == Tok::LBracket
+        && body[n - 2].tok == Tok::RBracket
+        && body[n - 1].tok == Tok::RBracket;
+    if jump {
+        Ok(&body[2..n - 2])
+    } else {
+        Err(vec![Diagnostic::text(
+            span(body),
+            "an edge's norm is that of a jump `[[X]]`",
+        )
+        .help(format!("write `{example}`"))])
+    }
+}
+
+/// `h_T` on an edge and `h_E` on a cell are errors at the name.
+fn check_sizes(region: Region, weight: &[Token], body: &[Token]) -> Result<(), Vec<Diagnostic>> {
+    let (wrong, right) = match region {
+        Region::Cell => ("h_E", "h_T"),
+        Region::Edge => ("h_T", "h_E"),
+    };
+    match weight
+        .iter()
+        .chain(body)
+        .find(|t| t.tok == Tok::Ident(wrong.into()))
+    {
+        Some(t) => Err(vec![Diagnostic::text(
+            t.loc,
+            format!(
+                "`{wrong}` in an `{}` line",
+                match region {
+                    Region::Cell => "η_T²",
+                    Region::Edge => "η_E²",
+                }
+            ),
+        )
+        .help(format!("the size there is `{right}`"))]),
+        None => Ok(()),
+    }
+}
+
+/// The text between two places of the estimator text (on one line or several).
+fn source_text(text: &str, first: Loc, last: Loc) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let take = |line: usize, from: usize, to: Option<usize>| -> String {
+        let chars: Vec<char> = lines
+            .get(line - 1)
+            .map_or(Vec::new(), |l| l.chars().collect());
+        let end = to.unwrap_or(chars.len()).min(chars.len());
+        chars[(from - 1).min(end)..end].iter().collect()
+    };
+    if first.line == last.line {
+        take(first.line, first.column, Some(last.column - 1 + last.len))
+    } else {
+        let mut s = take(first.line, first.column, None);
+        for line in first.line + 1..last.line {
+            s.push(' ');
+            s.push_str(take(line, 1, None).trim());
+        }
+        s.push(' ');
+        s.push_str(take(last.line, 1, Some(last.column - 1 + last.len)).trim());
+        s
+    }
+    .trim()
+    .to_string()
+}
