@@ -26,6 +26,7 @@
 // test models use the mathematical names (α, ℓ) next to ASCII ones
 #![cfg_attr(test, allow(confusable_idents, mixed_script_confusables))]
 
+pub mod adaptivity;
 pub mod assembly;
 pub mod element;
 pub mod error;

@@ -137,6 +137,37 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
         ))
     }
 
+    /// The a-posteriori estimate of `solution` with the model's `estimator:` kernels and
+    /// the contact terms ([`crate::adaptivity::triangle_estimate`]); `side` is the
+    /// obstacle's sign.
+    ///
+    /// # Errors
+    /// Meshes other than affine triangles (the default), and those of the estimate.
+    fn estimate<M: Model>(
+        solution: &ObstacleSolution<Self>,
+        params: &[f64],
+        data: &[&DataFn],
+        side: f64,
+    ) -> Result<crate::adaptivity::Estimate> {
+        let _ = (solution, params, data, side);
+        Err(Error::Input(format!(
+            "model `{}`: estimates and adaptive refinement are computed on affine triangle meshes",
+            M::NAME
+        )))
+    }
+
+    /// The mesh with the `marked` cells refined (and the closure that keeps it
+    /// conforming).
+    ///
+    /// # Errors
+    /// Meshes without local refinement (the default), and cells out of range.
+    fn refine_marked(&self, marked: &[usize]) -> Result<Self> {
+        let _ = marked;
+        Err(Error::Input(
+            "adaptive refinement is available on affine triangle meshes".into(),
+        ))
+    }
+
     /// The values of `field` of a solution at the mesh vertices.
     fn field_at_vertices(solution: &ObstacleSolution<Self>, field: usize) -> Vec<f64>;
 
@@ -576,6 +607,19 @@ fn triangle_constraints<M: Model>(
 }
 
 impl Domain for TriangleMesh {
+    fn estimate<M: Model>(
+        solution: &ObstacleSolution<Self>,
+        params: &[f64],
+        data: &[&DataFn],
+        side: f64,
+    ) -> Result<crate::adaptivity::Estimate> {
+        crate::adaptivity::triangle_estimate::<M>(solution, params, data, side)
+    }
+
+    fn refine_marked(&self, marked: &[usize]) -> Result<Self> {
+        Ok(self.refine(marked)?.0)
+    }
+
     fn extent(&self) -> f64 {
         bounding_diameter(self)
     }

@@ -186,6 +186,8 @@ pub struct Solved<M, G> {
     /// Where a level of [`Problem::solve_refining`] failed from the previous level's
     /// solution and was solved again from the problem's start: that failure.
     pub fell_back: Option<String>,
+    /// The a-posteriori estimate, for a model that declares an estimator.
+    pub estimate: Option<crate::adaptivity::Estimate>,
     model: PhantomData<M>,
 }
 
@@ -550,6 +552,87 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         Ok(current)
     }
 
+    /// Solves adaptively to a tolerance: solve → estimate → mark → refine → solve again
+    /// from the previous solution ([`Problem::solve_refining`]), from the problem's
+    /// finest mesh, until the estimate `(η² + S²)^{1/2}` is at most
+    /// `options.tolerance · ‖u_h‖_a`. `progress` sees every level as it is done. The
+    /// report lists the levels (`adaptive_levels`) and carries the last level's estimate.
+    ///
+    /// # Errors
+    /// A model without an estimator, a tolerance that is not positive and finite, the
+    /// next level's unknowns beyond `options.max_dofs` or no cell left to mark (the
+    /// message says how far the loop got), and the errors of [`Problem::solve`] and
+    /// [`Domain::estimate`].
+    pub fn solve_adaptive(
+        &self,
+        options: crate::adaptivity::AdaptiveOptions,
+        mut progress: impl FnMut(&crate::adaptivity::AdaptiveLevel),
+    ) -> Result<Solved<M, G>> {
+        use crate::adaptivity::AdaptiveLevel;
+        if !M::HAS_ESTIMATOR {
+            return Err(Error::Input(format!(
+                "model `{}` declares no estimator (`estimator:` in its model file): it cannot be solved to a tolerance",
+                M::NAME
+            )));
+        }
+        let tolerance = options.tolerance;
+        if !(tolerance > 0.0 && tolerance.is_finite()) {
+            return Err(Error::Input(format!(
+                "the tolerance {tolerance} is not a positive number"
+            )));
+        }
+        let mut levels: Vec<AdaptiveLevel> = Vec::new();
+        let mut clock = Instant::now();
+        let mut solved = self.solve_refining(|current| {
+            let estimate = current
+                .estimate
+                .as_ref()
+                .expect("a model with an estimator reports one");
+            let level = AdaptiveLevel {
+                cells: current.report.cells,
+                dofs: current.report.dofs,
+                estimate: estimate.total(),
+                estimate_contact: estimate.contact,
+                energy_norm: estimate.energy_norm,
+                error_energy: current.report.error_energy,
+                seconds: clock.elapsed().as_secs_f64(),
+            };
+            progress(&level);
+            levels.push(level);
+            if level.estimate <= tolerance * level.energy_norm {
+                return Ok(None);
+            }
+            let reached = |why: String| {
+                Error::Input(format!(
+                    "{why}: the estimate is {} of ‖u_h‖_a = {} after {} levels ({} cells, {} unknowns), above the tolerance {}",
+                    number(level.estimate / level.energy_norm),
+                    number(level.energy_norm),
+                    levels.len(),
+                    level.cells,
+                    level.dofs,
+                    number(tolerance)
+                ))
+            };
+            let marked = options.marking.mark(&estimate.indicators)?;
+            if marked.is_empty() {
+                return Err(reached("no cell has a positive indicator to refine".into()));
+            }
+            // bisecting a marked cell twice at most, with the closure: about 2–3 new
+            // unknowns per marked cell; the next level's size is estimated before it is made
+            let predicted = level.dofs + 3 * marked.len() * (level.dofs / level.cells.max(1)).max(1);
+            if predicted > options.max_dofs {
+                return Err(reached(format!(
+                    "the next level would have about {predicted} unknowns, beyond the limit of {}",
+                    options.max_dofs
+                )));
+            }
+            clock = Instant::now();
+            Ok(Some(current.mesh().refine_marked(&marked)?))
+        })?;
+        solved.report.adaptive_levels = levels;
+        Ok(solved)
+    }
+
     /// The input that sets the size, for the memory refusal.
     fn size_text(&self, finest: &G) -> String {
         self.size
@@ -654,13 +737,47 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 &mut report,
             )?;
         }
+        let estimate = if M::HAS_ESTIMATOR {
+            Some(self.record_estimate(&solution, &params, &data, &mut report)?)
+        } else {
+            None
+        };
         Ok(Solved {
             solution,
             report,
             params,
             fell_back: None,
+            estimate,
             model: PhantomData,
         })
+    }
+
+    /// The a-posteriori estimate of `solution`, recorded in `report` with the error in
+    /// the estimator's norm and the efficiency index where the exact solution gives them.
+    ///
+    /// # Errors
+    /// Those of [`Domain::estimate`].
+    fn record_estimate(
+        &self,
+        solution: &ObstacleSolution<G>,
+        params: &[f64],
+        data: &[&DataFn],
+        report: &mut Report,
+    ) -> Result<crate::adaptivity::Estimate> {
+        let estimate = G::estimate::<M>(solution, params, data, self.side.sign())?;
+        let total = estimate.total();
+        let relative = |x: f64| (estimate.energy_norm > 0.0).then(|| x / estimate.energy_norm);
+        report.estimate = Some(total);
+        report.estimate_contact = Some(estimate.contact);
+        report.estimate_relative = relative(total);
+        report.error_energy = if M::ORDER >= 4 {
+            report.error_h2
+        } else {
+            report.error_h1
+        };
+        report.error_energy_relative = report.error_energy.and_then(relative);
+        report.efficiency_index = report.error_energy.filter(|&e| e > 0.0).map(|e| total / e);
+        Ok(estimate)
     }
 
     /// Runs the rounding experiment on the solved levels and records it in `report`:
@@ -843,6 +960,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             report,
             params,
             fell_back: None,
+            estimate: None,
             model: PhantomData,
         })
     }

@@ -74,6 +74,32 @@ pub struct Report {
     /// The mean of `|u_h(v) − u(v)|` over the vertices.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error_vertex_mean: Option<f64>,
+    /// The a-posteriori estimate `(η² + S²)^{1/2}` of the model's `estimator:` with the
+    /// contact terms ([`crate::adaptivity::Estimate::total`]); absent for a model that
+    /// declares no estimator.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimate: Option<f64>,
+    /// The contact part `S` of the estimate (violation and complementarity defect).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimate_contact: Option<f64>,
+    /// The estimate relative to `‖u_h‖_a`, the energy norm of the constrained field:
+    /// what `--tol` bounds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimate_relative: Option<f64>,
+    /// The error in the estimator's norm, where an exact solution gives it: `|u − u_h|_H¹`
+    /// for second-order models, the broken H² seminorm for fourth-order ones.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_energy: Option<f64>,
+    /// `error_energy / ‖u_h‖_a`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_energy_relative: Option<f64>,
+    /// `estimate / error_energy`: bounded above and below over a refinement when the
+    /// estimator is reliable and efficient.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub efficiency_index: Option<f64>,
+    /// The levels of an adaptive solve (`Problem::solve_adaptive`), first to last.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub adaptive_levels: Vec<crate::adaptivity::AdaptiveLevel>,
     /// The KKT residual of the result, computed from it (equilibrium backward error and
     /// complementarity), not the solver's word.
     pub kkt_residual: f64,

@@ -1,0 +1,320 @@
+//! A-posteriori estimation and adaptive refinement (`docs/adaptivity.md`).
+//!
+//! A model declares its residual estimator in its model file (`estimator:`); the macro
+//! generates the cell and edge indicator kernels. This module sums them over a mesh
+//! ([`triangle_estimate`]), adds the contact terms every obstacle problem has (the
+//! violation `s(ψ − u_h)_+` in the energy norm and the complementarity defect
+//! `(Σ_T (λ_h, s(u_h − ψ))_T)_+^{1/2}`, `../shared/MODELS.md` §8), marks cells
+//! ([`Marking`]) and drives the adaptive loop of [`crate::problem::Problem::solve_adaptive`].
+
+pub mod marking;
+
+pub use marking::Marking;
+
+use crate::element::triangle::{TriangleBasis, TriangleField};
+use crate::mesh::TriangleMesh;
+use crate::model::{DataFn, Model};
+use crate::obstacle::{Multipliers, ObstacleSolution};
+use crate::{Error, Result};
+use fem_reference::triangle::TriangleRule;
+use fem_reference::ElementKind;
+
+/// One level of an adaptive solve, as the report lists it.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct AdaptiveLevel {
+    /// Cells of the level's mesh.
+    pub cells: usize,
+    /// Unknowns solved for (primal and multiplier, fixed DOFs eliminated).
+    pub dofs: usize,
+    /// `(η² + S²)^{1/2}`.
+    pub estimate: f64,
+    /// `S`.
+    pub estimate_contact: f64,
+    /// `‖u_h‖_a`.
+    pub energy_norm: f64,
+    /// The error in the estimator's norm, where an exact solution is known.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_energy: Option<f64>,
+    /// Wall time of the level's solve and estimate, in seconds.
+    pub seconds: f64,
+}
+
+/// How [`crate::problem::Problem::solve_adaptive`] refines.
+#[derive(Clone, Copy, Debug)]
+pub struct AdaptiveOptions {
+    /// Stop when `(η² + S²)^{1/2} ≤ tolerance · ‖u_h‖_a`.
+    pub tolerance: f64,
+    /// How cells are marked.
+    pub marking: Marking,
+    /// Refuse to solve a level with more unknowns than this (the loop then fails with
+    /// how far it got).
+    pub max_dofs: usize,
+}
+
+impl Default for AdaptiveOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-2,
+            marking: Marking::default(),
+            max_dofs: 2_000_000,
+        }
+    }
+}
+
+/// A discrete solution's a-posteriori estimate.
+#[derive(Clone, Debug, Default)]
+pub struct Estimate {
+    /// Per cell, what marking ranks: its `η_T²` plus half of `η_E²` of each of its
+    /// interior edges.
+    pub indicators: Vec<f64>,
+    /// `η = (Σ_T η_T² + Σ_E η_E²)^{1/2}`: the residual part.
+    pub residual: f64,
+    /// `S = (‖I_h s(ψ − u_h)_+‖_a² + (Σ_T (λ_h, s(u_h − ψ))_T)_+)^{1/2}`: the contact
+    /// part (`I_h` the nodal interpolant into the constrained field's space).
+    pub contact: f64,
+    /// `‖u_h‖_a = a(u_h, u_h)^{1/2}` of the constrained field with the model's energy
+    /// form: what a relative tolerance is relative to.
+    pub energy_norm: f64,
+}
+
+impl Estimate {
+    /// `(η² + S²)^{1/2}`: the bound on the error (up to a constant) that the reliability
+    /// of the estimator gives.
+    pub fn total(&self) -> f64 {
+        self.residual.hypot(self.contact)
+    }
+}
+
+/// The local coefficients of every field on cell `c` in the pulled-back reference basis
+/// (the field's own for Lagrange elements).
+fn cell_coefficients(fields: &[TriangleField], c: usize) -> Vec<Vec<f64>> {
+    fields.iter().map(|f| f.reference_coefficients(c)).collect()
+}
+
+/// The fields of a solution on a triangle mesh, or the error for a multiplier that is
+/// not on the cells.
+fn fields<'a, M: Model>(
+    solution: &'a ObstacleSolution<TriangleMesh>,
+) -> Result<Vec<TriangleField<'a>>> {
+    let d = &solution.discretization;
+    if !matches!(d.multipliers, Multipliers::Cells) {
+        return Err(Error::Input(format!(
+            "model `{}`: estimators are computed for multipliers on the cells; a multiplier on a boundary part has no generated estimator yet",
+            M::NAME
+        )));
+    }
+    (0..M::FIELDS.len())
+        .map(|f| {
+            let map = d.dofs.map(f).ok_or_else(|| {
+                Error::Input(format!(
+                    "model `{}`: field `{}` has no DOFs on the cells",
+                    M::NAME,
+                    M::FIELDS[f].name
+                ))
+            })?;
+            Ok(TriangleField {
+                mesh: &d.mesh,
+                map,
+                coefficients: solution.field(f),
+            })
+        })
+        .collect()
+}
+
+/// The estimate of `solution` with the model's `estimator:` kernels and the contact
+/// terms, for parameters `params` and data `data` as solved with; `side` is the
+/// obstacle's sign `s` (1: `u ≥ ψ`).
+///
+/// # Errors
+/// A model without an estimator or an energy form, a multiplier on a boundary part, a
+/// constrained field that is not of Lagrange type (the violation's interpolant), and
+/// indicators that are not finite (the message names the cell).
+pub fn triangle_estimate<M: Model>(
+    solution: &ObstacleSolution<TriangleMesh>,
+    params: &[f64],
+    data: &[&DataFn],
+    side: f64,
+) -> Result<Estimate> {
+    if !M::HAS_ESTIMATOR {
+        return Err(Error::Input(format!(
+            "model `{}` declares no estimator (`estimator:` in its model file)",
+            M::NAME
+        )));
+    }
+    let fields = fields::<M>(solution)?;
+    let mesh = &solution.discretization.mesh;
+    let mut indicators = vec![0.0; mesh.cell_count()];
+    let mut sum = 0.0;
+    for (c, indicator) in indicators.iter_mut().enumerate() {
+        let local = cell_coefficients(&fields, c);
+        let slices: Vec<&[f64]> = local.iter().map(Vec::as_slice).collect();
+        let eta2 = M::cell_indicator(&mesh.cell_coordinates(c), &slices, params, data)?;
+        *indicator += eta2;
+        sum += eta2;
+    }
+    for (e, _) in mesh.edges().iter().enumerate() {
+        let (c0, Some(c1)) = mesh.edge_cells(e) else {
+            continue;
+        };
+        let local_edge = |c: usize| {
+            mesh.cell_edges(c)
+                .iter()
+                .position(|&x| x == e)
+                .expect("an edge is an edge of its cells")
+        };
+        let (a, b) = (
+            cell_coefficients(&fields, c0),
+            cell_coefficients(&fields, c1),
+        );
+        let a: Vec<&[f64]> = a.iter().map(Vec::as_slice).collect();
+        let b: Vec<&[f64]> = b.iter().map(Vec::as_slice).collect();
+        let eta2 = M::edge_indicator(
+            &mesh.cell_coordinates(c0),
+            local_edge(c0),
+            &a,
+            &mesh.cell_coordinates(c1),
+            local_edge(c1),
+            &b,
+            params,
+            data,
+        )?;
+        indicators[c0] += 0.5 * eta2;
+        indicators[c1] += 0.5 * eta2;
+        sum += eta2;
+    }
+    if let Some(c) = indicators.iter().position(|e| !e.is_finite()) {
+        return Err(Error::Input(format!(
+            "the indicator of cell {c} is {}: the solution or the data are not finite there",
+            indicators[c]
+        )));
+    }
+    let (contact, energy_norm) = contact_terms::<M>(solution, &fields, params, data, side)?;
+    Ok(Estimate {
+        indicators,
+        residual: sum.sqrt(),
+        contact,
+        energy_norm,
+    })
+}
+
+/// `a(v, v)` of the coefficient vector `v` of `field` with the model's energy form,
+/// summed cell by cell from its element matrices.
+///
+/// # Errors
+/// A model without an energy form, or whose energy form has no (field, field) block.
+pub fn energy_product<M: Model>(
+    mesh: &TriangleMesh,
+    map: &crate::assembly::dof_map::DofMap,
+    field: usize,
+    v: &[f64],
+    params: &[f64],
+    data: &[&DataFn],
+) -> Result<f64> {
+    let [a, _] = M::ENERGY.ok_or_else(|| {
+        Error::Input(format!(
+            "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
+            M::NAME
+        ))
+    })?;
+    let block = M::FORMS[a]
+        .blocks
+        .iter()
+        .position(|b| b.test_field == field && b.trial_field == Some(field))
+        .ok_or_else(|| {
+            Error::Input(format!(
+                "the energy form `{}` of model `{}` has no block of field `{}` against itself",
+                M::FORMS[a].name,
+                M::NAME,
+                M::FIELDS[field].name
+            ))
+        })?;
+    let n = map.local_count();
+    let mut k = vec![0.0; n * n];
+    let mut total = 0.0;
+    for c in 0..mesh.cell_count() {
+        let dofs = map.cell_dofs(c);
+        if dofs.iter().all(|&d| v[d] == 0.0) {
+            continue;
+        }
+        M::element_matrix_on_cell(
+            a,
+            block,
+            &mesh.cell_coordinates(c),
+            &mesh.cell(c),
+            params,
+            data,
+            &mut k,
+        );
+        for (i, &di) in dofs.iter().enumerate() {
+            for (j, &dj) in dofs.iter().enumerate() {
+                total += v[di] * k[i * n + j] * v[dj];
+            }
+        }
+    }
+    Ok(total)
+}
+
+/// The contact part `S` of the estimate and `‖u_h‖_a`.
+fn contact_terms<M: Model>(
+    solution: &ObstacleSolution<TriangleMesh>,
+    fields: &[TriangleField],
+    params: &[f64],
+    data: &[&DataFn],
+    side: f64,
+) -> Result<(f64, f64)> {
+    let d = &solution.discretization;
+    let mesh = &d.mesh;
+    let field = M::constrained_field();
+    let u = &fields[field];
+    let energy = energy_product::<M>(mesh, u.map, field, u.coefficients, params, data)?;
+    let Some([_, psi]) = M::OBSTACLE else {
+        return Ok((0.0, energy.max(0.0).sqrt()));
+    };
+    let psi = data[psi];
+    let element = u.map.element();
+    if !matches!(element, ElementKind::P1 | ElementKind::P2 | ElementKind::P3) {
+        return Err(Error::Input(format!(
+            "model `{}`: the violation term of the estimate interpolates at the nodes of a Lagrange element, and `{}` is {}",
+            M::NAME,
+            M::FIELDS[field].name,
+            element.name()
+        )));
+    }
+    // ‖I_h s(ψ − u_h)_+‖_a
+    let violation: Vec<f64> = u
+        .map
+        .nodes(mesh)
+        .iter()
+        .zip(u.coefficients)
+        .map(|(x, &value)| (side * (psi(x) - value)).max(0.0))
+        .collect();
+    let violation2 = energy_product::<M>(mesh, u.map, field, &violation, params, data)?;
+    // Σ_T (λ_h, s(u_h − ψ))_T
+    let lambda = &fields[d.multiplier_field];
+    let degree = u.map.element().degree() + lambda.map.element().degree() + 2;
+    let rule = TriangleRule::exact_for_degree(degree);
+    let (u_basis, l_basis) = (
+        TriangleBasis::new(element),
+        TriangleBasis::new(lambda.map.element()),
+    );
+    let mut defect = 0.0;
+    for c in 0..mesh.cell_count() {
+        let x = mesh.cell_coordinates(c);
+        let area2 = ((x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1])).abs();
+        for (xi, w) in rule.points.iter().zip(&rule.weights) {
+            let l = lambda.value(&l_basis, c, *xi);
+            if l == 0.0 {
+                continue;
+            }
+            let p = [
+                x[0] + (x[2] - x[0]) * xi[0] + (x[4] - x[0]) * xi[1],
+                x[1] + (x[3] - x[1]) * xi[0] + (x[5] - x[1]) * xi[1],
+            ];
+            defect += w * area2 * l * side * (u.value(&u_basis, c, *xi) - psi(&p));
+        }
+    }
+    Ok((
+        (violation2.max(0.0) + defect.max(0.0)).sqrt(),
+        energy.max(0.0).sqrt(),
+    ))
+}
