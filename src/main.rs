@@ -149,6 +149,19 @@ struct SolveOptions {
     /// Hertz's (hertz, signorini-gap).
     #[arg(long)]
     plot: bool,
+    /// Solve adaptively until the a-posteriori estimate (η² + S²)^{1/2} is at most T
+    /// times the energy norm ‖u_h‖_a of the solution: solve, estimate, mark, refine by
+    /// newest-vertex bisection, solve again from the previous solution (membranes; the
+    /// scene's mesh is the first level: start coarse, e.g. --mesh-size 8).
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    tol: Option<f64>,
+    /// Marking of the adaptive loop: dorfler (default: the fewest cells holding θ of
+    /// η²) or max (every cell with η_T ≥ θ max η).
+    #[arg(long, value_name = "dorfler|max")]
+    marking: Option<String>,
+    /// The marking parameter θ in (0, 1] (default 0.5).
+    #[arg(long, allow_hyphen_values = true)]
+    theta: Option<f64>,
 }
 
 fn table_header() {

@@ -3,10 +3,11 @@
 //! summary or as JSON, with its chart or ParaView file where asked.
 
 use crate::{SolveOptions, SolverName};
+use fem_forms::adaptivity::{AdaptiveLevel, AdaptiveOptions, Marking};
 use fem_forms::models::families;
 use fem_forms::models::family::Opt;
 use fem_forms::models::geometry::Fields;
-use fem_forms::models::report::{Outcome, Profile, Report, Settings};
+use fem_forms::models::report::{Outcome, Profile, Progress, Report, Settings};
 use fem_forms::models::scene::Adjustment;
 use fem_forms::models::scene::{Scene, Support};
 use fem_forms::obstacle::hierarchy::LinearSolver;
@@ -34,6 +35,9 @@ impl SolveOptions {
             (self.support.is_some(), Opt::Support),
             (self.obstacle.is_some(), Opt::Obstacle),
             (self.no_obstacle, Opt::NoObstacle),
+            (self.tol.is_some(), Opt::Tol),
+            (self.marking.is_some(), Opt::Marking),
+            (self.theta.is_some(), Opt::Theta),
         ];
         flags
             .into_iter()
@@ -91,6 +95,7 @@ fn settings(options: &SolveOptions) -> Result<Settings, String> {
         parameters.push(("t".into(), t));
     }
     Ok(Settings {
+        adaptive: adaptive_options(options)?,
         pair: options.pair.clone(),
         mesh_size: options.elements.or(options.mesh_size),
         load: options.load,
@@ -105,6 +110,66 @@ fn settings(options: &SolveOptions) -> Result<Settings, String> {
         refinement: options.refinement,
         ..Settings::default()
     })
+}
+
+/// The adaptive loop's options from `--tol`, `--marking` and `--theta`.
+fn adaptive_options(options: &SolveOptions) -> Result<Option<AdaptiveOptions>, String> {
+    let theta = options.theta.unwrap_or(0.5);
+    if !(theta > 0.0 && theta <= 1.0) {
+        return Err(format!(
+            "--theta {theta}: the marking parameter θ must lie in (0, 1]"
+        ));
+    }
+    let marking = match options.marking.as_deref() {
+        None | Some("dorfler") => Marking::Dorfler(theta),
+        Some("max") => Marking::Maximum(theta),
+        Some(other) => {
+            return Err(format!(
+                "--marking {other}: the markings are dorfler (Dörfler's bulk criterion) and max (every cell with η_T ≥ θ max η)"
+            ))
+        }
+    };
+    let Some(tolerance) = options.tol else {
+        if options.marking.is_some() || options.theta.is_some() {
+            return Err("--marking and --theta choose how the adaptive loop marks: give --tol T to solve adaptively".into());
+        }
+        return Ok(None);
+    };
+    if !(tolerance > 0.0 && tolerance.is_finite()) {
+        return Err(format!(
+            "--tol {tolerance}: the tolerance is a positive number, relative to the solution's energy norm (e.g. 1e-2)"
+        ));
+    }
+    Ok(Some(AdaptiveOptions {
+        tolerance,
+        marking,
+        ..AdaptiveOptions::default()
+    }))
+}
+
+/// A progress bar on standard error for the levels of an adaptive solve (hidden where
+/// standard error is not a terminal).
+fn adaptive_progress() -> (Progress, indicatif::ProgressBar) {
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {elapsed_precise} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let shown = bar.clone();
+    let level = std::sync::atomic::AtomicUsize::new(0);
+    let progress = Progress(std::sync::Arc::new(move |l: &AdaptiveLevel| {
+        let k = level.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        shown.set_message(format!(
+            "level {k}: {} cells, {} unknowns, estimate {:.3e} ({:.2e} of ‖u_h‖_a), {:.2} s",
+            l.cells,
+            l.dofs,
+            l.estimate,
+            l.estimate / l.energy_norm,
+            l.seconds
+        ));
+    }));
+    (progress, bar)
 }
 
 /// Solves `scene` as `options` ask and prints the result.
@@ -195,7 +260,17 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
         scene = scene.on_mesh_file(path.clone());
         settings.mesh_size = Some(options.mesh_size.unwrap_or(0));
     }
-    let outcome = families::solve(&scene, &settings).map_err(|e| format!("{}: {e}", scene.name))?;
+    let adaptive = settings.adaptive.is_some() || scene.tolerance.is_some();
+    let bar = adaptive.then(|| {
+        let (progress, bar) = adaptive_progress();
+        settings.progress = Some(progress);
+        bar
+    });
+    let outcome = families::solve(&scene, &settings);
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let outcome = outcome.map_err(|e| format!("{}: {e}", scene.name))?;
     print(&outcome.report, options.json)?;
     write_outputs(&scene, &outcome, options, out)
 }
@@ -273,6 +348,27 @@ pub fn summary(r: &Report) -> String {
         lines.push(format!(
             "  error against the exact solution: {}",
             errors.join(", ")
+        ));
+    }
+    if let Some(estimate) = s.estimate {
+        let mut line = format!(
+            "  estimate: (η² + S²)^½ = {estimate:.3e} ({:.2e} of ‖u_h‖_a), contact part S {:.3e}",
+            s.estimate_relative.unwrap_or(f64::NAN),
+            s.estimate_contact.unwrap_or(0.0)
+        );
+        if let Some(index) = s.efficiency_index {
+            line.push_str(&format!(", efficiency index {index:.2}"));
+        }
+        lines.push(line);
+    }
+    if let (Some(first), Some(last)) = (s.adaptive_levels.first(), s.adaptive_levels.last()) {
+        lines.push(format!(
+            "  adaptive: {} levels, {} → {} cells, estimate {:.3e} → {:.3e}",
+            s.adaptive_levels.len(),
+            first.cells,
+            last.cells,
+            first.estimate,
+            last.estimate
         ));
     }
     let quantities: Vec<String> = r

@@ -784,3 +784,126 @@ fn refusals_echo_extreme_numbers_in_scientific_notation() {
         );
     }
 }
+
+/// `--tol` solves adaptively: the JSON lists every level with its estimate, the last
+/// one below the tolerance relative to ‖u_h‖_a, the estimate falls while the error does,
+/// and the `.vtu` carries the indicators. A scene file's `tol` does the same.
+#[test]
+fn tol_solves_adaptively_and_reports_every_level() {
+    let out = scratch("tol");
+    let args = [
+        "solve",
+        "membrane-radial",
+        "--mesh-size",
+        "8",
+        "--pair",
+        "p1-p0",
+        "--tol",
+        "0.2",
+        "--json",
+        "--vtk",
+    ];
+    let report = json_of(&args, &out);
+    let levels = report["adaptive_levels"].as_array().unwrap();
+    assert!(levels.len() >= 3, "{levels:?}");
+    let last = levels.last().unwrap();
+    let (estimate, norm) = (
+        last["estimate"].as_f64().unwrap(),
+        last["energy_norm"].as_f64().unwrap(),
+    );
+    assert!(estimate <= 0.2 * norm, "{last}");
+    assert_eq!(report["estimate"].as_f64(), Some(estimate));
+    assert!(report["efficiency_index"].as_f64().unwrap() > 1.0);
+    let errors: Vec<f64> = levels
+        .iter()
+        .map(|l| l["error_energy"].as_f64().unwrap())
+        .collect();
+    assert!(errors.last().unwrap() < &errors[0], "{errors:?}");
+    let vtu = std::fs::read_to_string(out.join("membrane-radial-p1-p0-8.vtu")).unwrap();
+    assert!(vtu.contains("indicator"), "the .vtu has no indicator field");
+
+    // a scene file's `tol`: the radial example, from a coarse mesh
+    let example = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/membrane-radial.toml"
+    ))
+    .unwrap()
+    .replace("size = 32", "size = 8")
+    .replace(
+        "model = \"membrane\"",
+        "model = \"membrane\"\npair = \"p1-p0\"\ntol = 0.3",
+    );
+    let file = out.join("radial-tol.toml");
+    std::fs::write(&file, example).unwrap();
+    let report = json_of(
+        &["solve", "--scene", file.to_str().unwrap(), "--json"],
+        &out,
+    );
+    let levels = report["adaptive_levels"].as_array().unwrap();
+    assert!(levels.len() >= 2, "{report}");
+    let last = levels.last().unwrap();
+    assert!(last["estimate"].as_f64().unwrap() <= 0.3 * last["energy_norm"].as_f64().unwrap());
+    let bad = out.join("radial-bad-tol.toml");
+    std::fs::write(
+        &bad,
+        std::fs::read_to_string(&file)
+            .unwrap()
+            .replace("tol = 0.3", "tol = -2"),
+    )
+    .unwrap();
+    let run = fem_forms(&["solve", "--scene", bad.to_str().unwrap()], &out);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && stderr.contains("tol"), "{stderr}");
+}
+
+/// The adaptive options are refused where they cannot act, with the reason.
+#[test]
+fn adaptive_options_are_checked() {
+    let out = scratch("tol-errors");
+    for (args, expected) in [
+        (
+            vec!["solve", "membrane-radial", "--marking", "max"],
+            "give --tol",
+        ),
+        (
+            vec!["solve", "membrane-radial", "--tol", "-1"],
+            "positive number",
+        ),
+        (
+            vec![
+                "solve",
+                "membrane-radial",
+                "--tol",
+                "0.1",
+                "--marking",
+                "greedy",
+            ],
+            "dorfler",
+        ),
+        (
+            vec!["solve", "membrane-radial", "--tol", "0.1", "--theta", "2"],
+            "(0, 1]",
+        ),
+        (
+            vec![
+                "solve",
+                "membrane-radial",
+                "--tol",
+                "0.1",
+                "--pair",
+                "p1-nodal",
+            ],
+            "declares no estimator",
+        ),
+        (
+            vec!["solve", "bernoulli-flat", "--tol", "0.1"],
+            "--tol does not apply",
+        ),
+    ] {
+        let run = fem_forms(&args, &out);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}

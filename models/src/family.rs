@@ -47,11 +47,17 @@ pub enum Opt {
     NoObstacle,
     /// `--plot`.
     Plot,
+    /// `--tol T`: solve adaptively to a relative tolerance.
+    Tol,
+    /// `--marking dorfler|max`.
+    Marking,
+    /// `--theta θ`: the marking parameter.
+    Theta,
 }
 
 impl Opt {
     /// Every option.
-    pub const ALL: [Opt; 16] = [
+    pub const ALL: [Opt; 19] = [
         Opt::Elements,
         Opt::MeshSize,
         Opt::Msh,
@@ -68,6 +74,9 @@ impl Opt {
         Opt::Obstacle,
         Opt::NoObstacle,
         Opt::Plot,
+        Opt::Tol,
+        Opt::Marking,
+        Opt::Theta,
     ];
 
     /// Its spelling on the command line.
@@ -89,6 +98,9 @@ impl Opt {
             Opt::Obstacle => "--obstacle",
             Opt::NoObstacle => "--no-obstacle",
             Opt::Plot => "--plot",
+            Opt::Tol => "--tol",
+            Opt::Marking => "--marking",
+            Opt::Theta => "--theta",
         }
     }
 }

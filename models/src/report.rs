@@ -3,6 +3,7 @@
 
 use crate::geometry::Fields;
 use crate::scene::Name;
+use fem_runtime::adaptivity::{AdaptiveLevel, AdaptiveOptions};
 use fem_runtime::obstacle::hierarchy::LinearSolver;
 use fem_runtime::obstacle::VariationalSolver;
 use fem_runtime::Diagonal;
@@ -37,6 +38,22 @@ pub struct Settings {
     /// Also form the multiplier's Schur complement of the finest mesh
     /// ([`Outcome::schur`]; the stability study).
     pub schur: bool,
+    /// Solve adaptively (`--tol`, or a scene file's `tol`): the loop's tolerance,
+    /// marking and limit (`None`: on the scene's mesh, or the scene file's `tol`).
+    pub adaptive: Option<AdaptiveOptions>,
+    /// What an adaptive solve tells of each level as it is done (the command line's
+    /// progress bar).
+    pub progress: Option<Progress>,
+}
+
+/// A callback that sees each level of an adaptive solve.
+#[derive(Clone)]
+pub struct Progress(pub std::sync::Arc<dyn Fn(&AdaptiveLevel) + Send + Sync>);
+
+impl std::fmt::Debug for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Progress(..)")
+    }
 }
 
 impl Default for Settings {
@@ -54,6 +71,8 @@ impl Default for Settings {
             diagonal: None,
             rounding_experiment: None,
             schur: false,
+            adaptive: None,
+            progress: None,
         }
     }
 }

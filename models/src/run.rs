@@ -9,6 +9,7 @@ use crate::family::Pair;
 use crate::geometry::{Fields, Geometry};
 pub use crate::report::{Outcome, Phases, Profile, Report, Schur, Settings, MAX_REFINEMENT_STEPS};
 use crate::scene::{ExactSolution, Part, Posed, Scene, Support};
+use fem_runtime::adaptivity::AdaptiveOptions;
 use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::{FirstStart, ObstacleOptions, VariationalSolver};
 use fem_runtime::problem::memory::check_memory;
@@ -231,7 +232,21 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         problem = problem.exact(fns.exact());
     }
     let cells = finest.cell_count();
-    let solved = problem.solve().map_err(|e| {
+    let adaptive = settings.adaptive.or_else(|| {
+        scene.tolerance.map(|tolerance| AdaptiveOptions {
+            tolerance,
+            ..AdaptiveOptions::default()
+        })
+    });
+    let solved = match adaptive {
+        Some(options) => problem.solve_adaptive(options, |level| {
+            if let Some(progress) = &settings.progress {
+                (progress.0)(level);
+            }
+        }),
+        None => problem.solve(),
+    }
+    .map_err(|e| {
         Q::explain(
             scene_field_of(e, scene),
             pair,
@@ -245,7 +260,10 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     let mut report = report_of(scene, pair, &domain, n, &posed, exact.as_ref(), &solved);
     report.solve.warnings.extend(supports.warnings);
     warn_defaulted::<M>(scene, &bound, &mut report);
-    let fields = G::fields::<M>(&solved.solution, psi);
+    let mut fields = G::fields::<M>(&solved.solution, psi);
+    if let (Some(estimate), Fields::Triangles { cell, .. }) = (&solved.estimate, &mut fields) {
+        cell.push(("indicator", estimate.indicators.clone()));
+    }
     let run = Run {
         scene,
         posed: &posed,

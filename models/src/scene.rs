@@ -420,6 +420,9 @@ pub struct Scene {
     pub exact: Exact,
     /// The L² error of the constrained field the scene asks for.
     pub accuracy: Option<f64>,
+    /// Solve adaptively to this tolerance, relative to `‖u_h‖_a` (a scene file's `tol`;
+    /// `--tol` wins).
+    pub tolerance: Option<f64>,
     /// The pairs that discretize it, the default first (empty: every pair of the family).
     pub pairs: Vec<&'static str>,
     /// The studies it hosts.
@@ -499,6 +502,7 @@ impl Scene {
             facets: Vec::new(),
             exact: Exact::Unknown,
             accuracy: None,
+            tolerance: None,
             pairs: Vec::new(),
             studies: Vec::new(),
             study_load: None,

@@ -361,6 +361,8 @@ struct FileToml {
     pair: Option<String>,
     /// The L² error of the constrained field the scene asks for (needs `[exact]`).
     accuracy: Option<f64>,
+    /// Solve adaptively to this tolerance relative to the solution's energy norm.
+    tol: Option<f64>,
     mesh: MeshToml,
     /// The family's material (contact's E, ν), read by the family.
     material: Option<toml::Table>,
@@ -608,6 +610,15 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
         scene.exact = Exact::AtDefaultLoad(exact_of(e, &scene.domain, path)?);
     }
     scene.accuracy = accuracy_of(&file, family).map_err(at)?;
+    if let Some(tol) = file.tol {
+        if !(tol > 0.0 && tol.is_finite()) {
+            return Err(at((
+                "tol".into(),
+                format!("{tol} is not a positive tolerance (relative to the solution's energy norm, e.g. 1e-2)"),
+            )));
+        }
+        scene.tolerance = Some(tol);
+    }
     if let Some(pair) = &file.pair {
         if let Err(e) = crate::families::pair_of(&scene, Some(pair)) {
             return Err(at(("pair".into(), e.to_string())));

@@ -194,6 +194,9 @@ impl Family for Membranes {
             Opt::Solver,
             Opt::Cold,
             Opt::LinearSolver,
+            Opt::Tol,
+            Opt::Marking,
+            Opt::Theta,
         ]
     }
 
