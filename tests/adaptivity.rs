@@ -239,3 +239,109 @@ fn l_shape_estimates_fall_at_the_optimal_rates() {
         );
     }
 }
+
+/// The manufactured clamped Kirchhoff plate `w = (x(1−x)y(1−y))²` under `f = DΔ²w`, its
+/// obstacle far below (λ = 0): over an adaptive run the estimate (cell residual, Kirchhoff
+/// shear and normal moment jumps; Morley's tangential-derivative jumps) stays within a
+/// band of the true broken H² error.
+mod kirchhoff {
+    use super::*;
+    use fem_forms::models::kirchhoff::{kirchhoff_argyris_p0, kirchhoff_morley_p0};
+    use fem_forms::problem::Condition;
+
+    const D: f64 = 1.3;
+
+    fn factor(x: f64) -> [f64; 5] {
+        let (p, dp) = (x * (1.0 - x), 1.0 - 2.0 * x);
+        [
+            p * p,
+            2.0 * p * dp,
+            2.0 * dp * dp - 4.0 * p,
+            -12.0 * dp,
+            24.0,
+        ]
+    }
+
+    fn w(x: &[f64]) -> f64 {
+        factor(x[0])[0] * factor(x[1])[0]
+    }
+
+    fn gradient(x: &[f64]) -> [f64; 2] {
+        let (a, b) = (factor(x[0]), factor(x[1]));
+        [a[1] * b[0], a[0] * b[1]]
+    }
+
+    fn hessian(x: &[f64]) -> [[f64; 2]; 2] {
+        let (a, b) = (factor(x[0]), factor(x[1]));
+        let xy = a[1] * b[1];
+        [[a[2] * b[0], xy], [xy, a[0] * b[2]]]
+    }
+
+    fn load(x: &[f64]) -> f64 {
+        let (a, b) = (factor(x[0]), factor(x[1]));
+        D * (a[4] * b[0] + 2.0 * a[2] * b[2] + a[0] * b[4])
+    }
+
+    fn below(_: &[f64]) -> f64 {
+        -1.0
+    }
+
+    fn run<M: Model>(n: usize, tolerance: f64) -> Vec<fem_forms::adaptivity::AdaptiveLevel> {
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, n, n, Diagonal::Right).unwrap();
+        Problem::<M, TriangleMesh>::new(vec![mesh])
+            .param("D", D)
+            .param("ν", 0.3)
+            .data("f", &load)
+            .data("ψ", &below)
+            .data("g", &zero)
+            .support(DirichletPart::All, "w", Condition::Clamped)
+            .exact(Exact {
+                value: &w,
+                gradient: Some(&gradient),
+                hessian: Some(&hessian),
+                multiplier: None,
+            })
+            .solve_adaptive(
+                AdaptiveOptions {
+                    tolerance,
+                    marking: Marking::default(),
+                    max_dofs: 100_000,
+                },
+                |_| {},
+            )
+            .unwrap_or_else(|e| panic!("{}: {e}", M::NAME))
+            .report
+            .adaptive_levels
+    }
+
+    fn bounded<M: Model>(n: usize, tolerance: f64) {
+        let levels = run::<M>(n, tolerance);
+        let indices: Vec<f64> = levels
+            .iter()
+            .map(|l| l.estimate / l.error_energy.unwrap())
+            .collect();
+        let (low, high) = indices
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &i| (a.min(i), b.max(i)));
+        assert!(
+            levels.len() >= 3 && low > 0.3 && high / low < 5.0,
+            "{}: efficiency indices {indices:?}",
+            M::NAME
+        );
+        let (first, last) = (&levels[0], levels.last().unwrap());
+        assert!(
+            last.error_energy.unwrap() < 0.3 * first.error_energy.unwrap(),
+            "{levels:?}"
+        );
+    }
+
+    #[test]
+    fn argyris_efficiency_stays_bounded() {
+        bounded::<kirchhoff_argyris_p0::Model>(2, 1e-3);
+    }
+
+    #[test]
+    fn morley_efficiency_stays_bounded() {
+        bounded::<kirchhoff_morley_p0::Model>(8, 0.05);
+    }
+}

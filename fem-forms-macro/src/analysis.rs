@@ -1128,6 +1128,25 @@ impl<'a> Context<'a> {
                 vec![m]
             };
             return Some(Some(Value::Vector(vec![component(0), component(1)])));
+        } else if (name == "τ" || name == "tau") && self.symbols.dimension == 2 {
+            // The unit tangent τ = (−n_y, n_x): n turned a quarter counter-clockwise.
+            if self.facet.is_none() && !self.in_expression {
+                return Some(self.fail_value(
+                    Diagnostic::text(loc, "the unit tangent `τ` exists only on edges").help(
+                        "use `τ` inside a boundary integral `∫_Γ … ds` or an estimator's edge term",
+                    ),
+                ));
+            }
+            let component = |axis: usize, sign: f64| {
+                let mut m = scalar(loc);
+                m.coefficient = sign;
+                m.normal[axis] = 1;
+                vec![m]
+            };
+            return Some(Some(Value::Vector(vec![
+                component(1, -1.0),
+                component(0, 1.0),
+            ])));
         } else if let Some(components) = self.vector_parameter(name) {
             // `n_c` of the parameters `n_c_x`, `n_c_y`: a constant vector.
             let component = |i: usize| {

@@ -81,7 +81,13 @@ impl Diagnostic {
     }
 
     /// The full message: the error, then for text places the line with a caret, then the hint.
+    #[cfg(test)]
     pub fn render(&self, forms_text: &str) -> String {
+        self.render_in(forms_text, "forms")
+    }
+
+    /// [`Diagnostic::render`] of a place in the text named `text_name` (`estimator`).
+    pub fn render_in(&self, forms_text: &str, text_name: &str) -> String {
         let mut out = self.message.clone();
         if let Place::Text(loc) = self.place {
             let line_text = forms_text
@@ -90,7 +96,7 @@ impl Diagnostic {
                 .unwrap_or("");
             let gutter = format!("{}", loc.line).len();
             out.push_str(&format!(
-                "\n{:gutter$}--> forms, line {}, column {}\n{:gutter$} |\n{} | {}\n{:gutter$} | {}{}",
+                "\n{:gutter$}--> {text_name}, line {}, column {}\n{:gutter$} |\n{} | {}\n{:gutter$} | {}{}",
                 "",
                 loc.line,
                 loc.column,
@@ -111,11 +117,16 @@ impl Diagnostic {
 
     /// `compile_error!` at the right span.
     pub fn to_compile_error(&self, forms_text: &str, forms_span: Span) -> TokenStream {
+        self.to_compile_error_in(forms_text, forms_span, "forms")
+    }
+
+    /// [`Diagnostic::to_compile_error`] for a place in the text named `text_name`.
+    pub fn to_compile_error_in(&self, text: &str, span: Span, text_name: &str) -> TokenStream {
         let span = match self.place {
             Place::Token(span) => span,
-            Place::Text(_) => forms_span,
+            Place::Text(_) => span,
         };
-        let message = self.render(forms_text);
+        let message = self.render_in(text, text_name);
         quote_spanned! {span=> ::core::compile_error!{ #message } }
     }
 }

@@ -14,7 +14,9 @@
 //! an expression of the form language that is linear in the unknowns (written by their
 //! names: the estimator is a function of the discrete solution) plus data; it may call
 //! the named expressions of the forms text (`Cε(θ)`). A weight is a scalar of
-//! parameters and the element size (`h_T` on cells, `h_E` on edges).
+//! parameters and the element size (`h_T` on cells, `h_E` on edges). On edges, `n` is
+//! the unit normal and `τ = (−n_y, n_x)` the unit tangent (`τ·∇X` the tangential
+//! derivative, as in the Kirchhoff shear `V_n = Q·n + ∂_s M_ns`).
 //!
 //! Every mistake is a compile error at the place in the estimator text.
 
@@ -125,15 +127,21 @@ pub fn analyse(
         ordered: &ordered,
         text,
     };
+    // a line that does not start with a head continues the one above
+    let mut definitions: Vec<(Region, Vec<Token>)> = Vec::new();
     for line in lines {
-        let Some((region, skip)) = head(line) else {
-            errors.push(
+        match (head(line), definitions.last_mut()) {
+            (Some((region, skip)), _) => definitions.push((region, line[skip..].to_vec())),
+            (None, Some((_, body))) => body.extend_from_slice(line),
+            (None, None) => errors.push(
                 Diagnostic::text(line[0].loc, "expected `η_T² =` or `η_E² =`")
-                    .help("each line of the estimator is a cell's squared indicator `η_T² = …` or an interior edge's `η_E² = …`"),
-            );
-            continue;
-        };
-        for term in split_terms(&line[skip..]) {
+                    .help("each line of the estimator is a cell's squared indicator `η_T² = …` or an interior edge's `η_E² = …` (a line that starts otherwise continues the one above)"),
+            ),
+        }
+    }
+    for (region, body) in &definitions {
+        let region = *region;
+        for term in split_terms(body) {
             match context.term(region, term) {
                 Ok(t) => estimator.terms.push(t),
                 Err(mut e) => errors.append(&mut e),
@@ -283,17 +291,6 @@ impl Analysis<'_> {
                         "an estimator is a function of the discrete solution: write the unknown `{}`",
                         self.symbols.fields[self.symbols.field_of(a.symbol)].name
                     ))]);
-                }
-                let element = self.symbols.fields[a.symbol].element;
-                if element.needs_transformation() {
-                    return Err(vec![Diagnostic::text(
-                        m.origin,
-                        format!(
-                            "estimators are not generated for {} elements yet",
-                            element.name()
-                        ),
-                    )
-                    .help("their basis needs the per-cell DOF transformation; Lagrange and discontinuous elements are supported")]);
                 }
             } else if region == Region::Edge && !m.data.is_empty() {
                 return Err(vec![Diagnostic::text(

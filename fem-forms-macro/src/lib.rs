@@ -260,7 +260,7 @@ fn expand(input: TokenStream) -> TokenStream {
                 let span = literal.span();
                 return errors
                     .iter()
-                    .map(|e| e.to_compile_error(&text, span))
+                    .map(|e| e.to_compile_error_in(&text, span, "estimator"))
                     .collect();
             }
             Some(estimator)

@@ -367,9 +367,10 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     const HAS_ESTIMATOR: bool = false;
 
     /// The squared indicator `η_T²` of the model's `estimator:` on the affine triangle
-    /// with vertex coordinates `vertices` (`[x0, y0, x1, y1, x2, y2]`), for the local
-    /// coefficients of the discrete solution, one slice per field in the element's DOF
-    /// order.
+    /// with vertex coordinates `vertices` (`[x0, y0, x1, y1, x2, y2]`), for the
+    /// coefficients of the discrete solution on the cell, one slice per field, in the
+    /// pulled-back reference basis ([`crate::element::triangle::TriangleField::reference_coefficients`]:
+    /// the local DOFs for Lagrange elements, `Mᵀ U` for Argyris and Morley).
     ///
     /// # Errors
     /// [`Error::Input`] for slices of the wrong lengths, and always for a model without

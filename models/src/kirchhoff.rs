@@ -44,7 +44,7 @@ kirchhoff_model! {
 /// `Constraints::support_plate` levels instead (the same forms: a support only fixes
 /// DOFs, so no clamped variant of the text is needed).
 macro_rules! kirchhoff_obstacle_model {
-    ($(#[$doc:meta])* $name:ident, w: $w:ident, λ: $lambda:ident) => {
+    ($(#[$doc:meta])* $name:ident, w: $w:ident, λ: $lambda:ident, estimator: $estimator:literal) => {
         fem_runtime::model! {
             $(#[$doc])*
             pub mod $name on triangle {
@@ -70,6 +70,7 @@ macro_rules! kirchhoff_obstacle_model {
                 stabilization: α S against a;
                 side:          s;
                 obstacle:      w >= ψ;
+                estimator:     $estimator;
             }
         }
     };
@@ -79,14 +80,27 @@ kirchhoff_obstacle_model! {
     /// Kirchhoff plate obstacle problem on Argyris–P0: deflection w ∈ Argyris, contact
     /// multiplier λ ∈ P0 (see `kirchhoff_obstacle_model!` for the forms); α: stable for
     /// `0 < α < 1/C_I` (C_I ≈ 1.9e5 on right isosceles cells, computed at run time).
-    kirchhoff_argyris_p0, w: Argyris, λ: P0
+    ///
+    /// The estimator is the residual one of Beirão da Veiga–Niiranen–Stenberg (2007)
+    /// with the weights `h/p` (p = 5) of Melenk–Wohlmuth (2001) in place of `h`: with
+    /// plain `h` the quintic's cell residual, dominated by `f − Π₁f`, overestimates the
+    /// error about 200-fold on a smooth plate; with `h/p` the efficiency index is 8–18.
+    kirchhoff_argyris_p0, w: Argyris, λ: P0,
+    estimator: "
+        η_T² = h_T⁴/625 ‖f − D Δ²w + sλ‖²
+        η_E² = h_E³/125 ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/5 ‖[[(M(w)·n)·n]]‖²
+    "
 }
 
 kirchhoff_obstacle_model! {
     /// Kirchhoff plate obstacle problem on Argyris–P1disc: w ∈ Argyris, λ piecewise linear
     /// and discontinuous (coefficient-wise λ ≥ 0 is λ ≥ 0 pointwise); α as for
     /// Argyris–P0 (the primal part of `S_h`, hence C_I, is the same).
-    kirchhoff_argyris_p1disc, w: Argyris, λ: P1disc
+    kirchhoff_argyris_p1disc, w: Argyris, λ: P1disc,
+    estimator: "
+        η_T² = h_T⁴/625 ‖f − D Δ²w + sλ‖²
+        η_E² = h_E³/125 ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/5 ‖[[(M(w)·n)·n]]‖²
+    "
 }
 
 kirchhoff_obstacle_model! {
@@ -94,5 +108,10 @@ kirchhoff_obstacle_model! {
     /// `Δ²w` vanishes on each cell for w ∈ P2, so `S_h = Σ_T h_T⁴ s² (λ, μ)_T` and
     /// `ℓ_S = −Σ_T h_T⁴ (f, sμ)_T`: C_I = 0, every α > 0 is stable and α is limited by
     /// accuracy (the obstacle shifts by about `α h⁴ |f − sλ|`, zero where the residual is).
-    kirchhoff_morley_p0, w: Morley, λ: P0
+    kirchhoff_morley_p0, w: Morley, λ: P0,
+    estimator: "
+        η_T² = h_T⁴ ‖f − D Δ²w + sλ‖²
+        η_E² = h_E³ ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E ‖[[(M(w)·n)·n]]‖²
+               + D² h_E⁻¹ ‖[[τ·∇w]]‖² + D² h_E⁻¹ ‖[[n·∇w]]‖²
+    "
 }

@@ -388,7 +388,7 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
             .join(" + ")
     };
     let cell_doc = format!(
-        " The squared indicator `η_T²` of the triangle `x` (`[x0, y0, x1, y1, x2, y2]`) for the coefficients `c` (one slice per field, the cell's local DOFs in the element's order): {}.",
+        " The squared indicator `η_T²` of the triangle `x` (`[x0, y0, x1, y1, x2, y2]`) for the coefficients `c`: one slice per field, the cell's coefficients in the pulled-back reference basis (the local DOFs for Lagrange elements, `Mᵀ U` for elements with a DOF transformation `M`): {}.",
         match describe(Region::Cell) {
             s if s.is_empty() => "no cell term (0)".to_string(),
             s => s,

@@ -70,7 +70,9 @@ pub struct Estimate {
     /// `η = (Σ_T η_T² + Σ_E η_E²)^{1/2}`: the residual part.
     pub residual: f64,
     /// `S = (‖I_h s(ψ − u_h)_+‖_a² + (Σ_T (λ_h, s(u_h − ψ))_T)_+)^{1/2}`: the contact
-    /// part (`I_h` the nodal interpolant into the constrained field's space).
+    /// part (`I_h` the nodal interpolant into the constrained field's space; for
+    /// Argyris and Morley, without nodes, `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T` with `m`
+    /// the energy's derivative order replaces the first term).
     pub contact: f64,
     /// `‖u_h‖_a = a(u_h, u_h)^{1/2}` of the constrained field with the model's energy
     /// form: what a relative tolerance is relative to.
@@ -127,8 +129,7 @@ fn fields<'a, M: Model>(
 ///
 /// # Errors
 /// A model without an estimator or an energy form, a multiplier on a boundary part, a
-/// constrained field that is not of Lagrange type (the violation's interpolant), and
-/// indicators that are not finite (the message names the cell).
+/// and indicators that are not finite (the message names the cell).
 pub fn triangle_estimate<M: Model>(
     solution: &ObstacleSolution<TriangleMesh>,
     params: &[f64],
@@ -272,23 +273,19 @@ fn contact_terms<M: Model>(
     };
     let psi = data[psi];
     let element = u.map.element();
-    if !matches!(element, ElementKind::P1 | ElementKind::P2 | ElementKind::P3) {
-        return Err(Error::Input(format!(
-            "model `{}`: the violation term of the estimate interpolates at the nodes of a Lagrange element, and `{}` is {}",
-            M::NAME,
-            M::FIELDS[field].name,
-            element.name()
-        )));
-    }
-    // ‖I_h s(ψ − u_h)_+‖_a
-    let violation: Vec<f64> = u
-        .map
-        .nodes(mesh)
-        .iter()
-        .zip(u.coefficients)
-        .map(|(x, &value)| (side * (psi(x) - value)).max(0.0))
-        .collect();
-    let violation2 = energy_product::<M>(mesh, u.map, field, &violation, params, data)?;
+    let violation2 = if matches!(element, ElementKind::P1 | ElementKind::P2 | ElementKind::P3) {
+        // ‖I_h s(ψ − u_h)_+‖_a
+        let violation: Vec<f64> = u
+            .map
+            .nodes(mesh)
+            .iter()
+            .zip(u.coefficients)
+            .map(|(x, &value)| (side * (psi(x) - value)).max(0.0))
+            .collect();
+        energy_product::<M>(mesh, u.map, field, &violation, params, data)?
+    } else {
+        weighted_violation::<M>(mesh, u, psi, side)
+    };
     // Σ_T (λ_h, s(u_h − ψ))_T
     let lambda = &fields[d.multiplier_field];
     let degree = u.map.element().degree() + lambda.map.element().degree() + 2;
@@ -317,4 +314,36 @@ fn contact_terms<M: Model>(
         (violation2.max(0.0) + defect.max(0.0)).sqrt(),
         energy.max(0.0).sqrt(),
     ))
+}
+
+/// `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T`, `m = ORDER/2` the energy's derivative order: the
+/// violation for fields without Lagrange nodes (Argyris, Morley), where the nodal
+/// interpolant of the positive part does not exist; the inverse inequality scales the
+/// L² norm of a discrete function to its energy norm this way (with unit coefficient).
+fn weighted_violation<M: Model>(
+    mesh: &TriangleMesh,
+    u: &TriangleField,
+    psi: &DataFn,
+    side: f64,
+) -> f64 {
+    let m = i32::from(M::ORDER / 2).max(1);
+    let element = u.map.element();
+    let rule = TriangleRule::exact_for_degree(2 * element.degree() + 2);
+    let basis = TriangleBasis::new(element);
+    let mut total = 0.0;
+    for c in 0..mesh.cell_count() {
+        let x = mesh.cell_coordinates(c);
+        let area2 = ((x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1])).abs();
+        let mut cell = 0.0;
+        for (xi, w) in rule.points.iter().zip(&rule.weights) {
+            let p = [
+                x[0] + (x[2] - x[0]) * xi[0] + (x[4] - x[0]) * xi[1],
+                x[1] + (x[3] - x[1]) * xi[0] + (x[5] - x[1]) * xi[1],
+            ];
+            let v = (side * (psi(&p) - u.value(&basis, c, *xi))).max(0.0);
+            cell += w * area2 * v * v;
+        }
+        total += cell * mesh.cell_diameter(c).powi(-2 * m);
+    }
+    total
 }
