@@ -854,6 +854,28 @@ fn tol_solves_adaptively_and_reports_every_level() {
     let run = fem_forms(&["solve", "--scene", bad.to_str().unwrap()], &out);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success() && stderr.contains("tol"), "{stderr}");
+
+    // a family without an estimator refuses a file's `tol` by name, before any solve
+    let winkler = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/winkler-free-plate.toml"
+    ))
+    .unwrap()
+    .replacen("\nname = ", "\ntol = 0.1\nname = ", 1);
+    assert!(
+        winkler.contains("tol = 0.1"),
+        "the example has no `name` line"
+    );
+    let file = out.join("winkler-tol.toml");
+    std::fs::write(&file, winkler).unwrap();
+    let run = fem_forms(&["solve", "--scene", file.to_str().unwrap()], &out);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success()
+            && stderr.contains("tol")
+            && stderr.contains("no a-posteriori estimator"),
+        "{stderr}"
+    );
 }
 
 /// The adaptive options are refused where they cannot act, with the reason.

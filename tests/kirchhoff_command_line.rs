@@ -364,3 +364,36 @@ fn a_study_variant_runs_on_its_own() {
     );
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// `--tol` on the plate obstacle: from a 4×4×2 mesh the adaptive run stops with the
+/// estimate below the tolerance, the contact found and the KKT conditions held on the
+/// final mesh.
+#[test]
+fn tol_refines_the_plate_obstacle_adaptively() {
+    for pair in ["argyris-p0", "morley-p0"] {
+        let tol = if pair == "morley-p0" { "0.2" } else { "2e-3" };
+        let report = solve_json(
+            "kirchhoff-obstacle",
+            &["--tol", tol, "--mesh-size", "4", "--pair", pair],
+        );
+        let levels = report["adaptive_levels"].as_array().unwrap();
+        assert!(levels.len() >= 3, "{pair}: {levels:?}");
+        let last = levels.last().unwrap();
+        let (estimate, norm) = (
+            last["estimate"].as_f64().unwrap(),
+            last["energy_norm"].as_f64().unwrap(),
+        );
+        let tol: f64 = tol.parse().unwrap();
+        assert!(estimate <= tol * norm, "{pair}: {last}");
+        let estimates: Vec<f64> = levels
+            .iter()
+            .map(|l| l["estimate"].as_f64().unwrap())
+            .collect();
+        assert!(
+            estimates.last().unwrap() < &(0.5 * estimates[0]),
+            "{pair}: {estimates:?}"
+        );
+        assert!(number(&report, "contact_area") > 0.0, "{pair}: {report}");
+        assert!(number(&report, "kkt_residual") < 1e-8, "{pair}: {report}");
+    }
+}

@@ -617,6 +617,15 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
                 format!("{tol} is not a positive tolerance (relative to the solution's energy norm, e.g. 1e-2)"),
             )));
         }
+        if !family.options().contains(&crate::family::Opt::Tol) {
+            return Err(at((
+                "tol".into(),
+                format!(
+                    "the {} family has no a-posteriori estimator yet: solve it on the file's mesh without `tol`",
+                    family.name()
+                ),
+            )));
+        }
         scene.tolerance = Some(tol);
     }
     if let Some(pair) = &file.pair {

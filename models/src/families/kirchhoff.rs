@@ -207,6 +207,9 @@ impl Family for KirchhoffPlates {
             Opt::Cold,
             Opt::Support,
             Opt::Obstacle,
+            Opt::Tol,
+            Opt::Marking,
+            Opt::Theta,
         ]
     }
 
