@@ -4,6 +4,9 @@
 //! is rough.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+#[path = "common/clamped_plate.rs"]
+mod clamped_plate;
+
 use fem_forms::adaptivity::{AdaptiveOptions, Marking};
 use fem_forms::models::membrane_scenes::{
     radial_gradient, radial_multiplier, radial_obstacle, radial_u,
@@ -54,13 +57,7 @@ fn efficiency_stays_bounded<M: Model>(tolerance: f64, rate: f64) {
     let solved = radial::<M>(8, tolerance, Marking::default());
     let levels = &solved.report.adaptive_levels;
     assert!(levels.len() >= 4, "{}: {levels:?}", M::NAME);
-    let indices: Vec<f64> = levels
-        .iter()
-        .map(|l| l.estimate / l.error_energy.unwrap())
-        .collect();
-    let (low, high) = indices
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(a, b), &i| (a.min(i), b.max(i)));
+    let (indices, low, high) = efficiency_indices(levels);
     assert!(
         low > 0.5 && high < 20.0 && high / low < 5.0,
         "{}: efficiency indices {indices:?}",
@@ -240,6 +237,19 @@ fn l_shape_estimates_fall_at_the_optimal_rates() {
     }
 }
 
+/// The efficiency indices `η / ‖e‖` of the levels of an adaptive run, with their least
+/// and largest.
+fn efficiency_indices(levels: &[fem_forms::adaptivity::AdaptiveLevel]) -> (Vec<f64>, f64, f64) {
+    let indices: Vec<f64> = levels
+        .iter()
+        .map(|l| l.estimate / l.error_energy.unwrap())
+        .collect();
+    let (low, high) = indices
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &i| (a.min(i), b.max(i)));
+    (indices, low, high)
+}
+
 /// The manufactured clamped Kirchhoff plate `w = (x(1−x)y(1−y))²` under `f = DΔ²w`, its
 /// obstacle far below (λ = 0): over an adaptive run the estimate (cell residual, Kirchhoff
 /// shear and normal moment jumps; Morley's tangential-derivative jumps) stays within a
@@ -249,38 +259,7 @@ mod kirchhoff {
     use fem_forms::models::kirchhoff::{kirchhoff_argyris_p0, kirchhoff_morley_p0};
     use fem_forms::problem::Condition;
 
-    const D: f64 = 1.3;
-
-    fn factor(x: f64) -> [f64; 5] {
-        let (p, dp) = (x * (1.0 - x), 1.0 - 2.0 * x);
-        [
-            p * p,
-            2.0 * p * dp,
-            2.0 * dp * dp - 4.0 * p,
-            -12.0 * dp,
-            24.0,
-        ]
-    }
-
-    fn w(x: &[f64]) -> f64 {
-        factor(x[0])[0] * factor(x[1])[0]
-    }
-
-    fn gradient(x: &[f64]) -> [f64; 2] {
-        let (a, b) = (factor(x[0]), factor(x[1]));
-        [a[1] * b[0], a[0] * b[1]]
-    }
-
-    fn hessian(x: &[f64]) -> [[f64; 2]; 2] {
-        let (a, b) = (factor(x[0]), factor(x[1]));
-        let xy = a[1] * b[1];
-        [[a[2] * b[0], xy], [xy, a[0] * b[2]]]
-    }
-
-    fn load(x: &[f64]) -> f64 {
-        let (a, b) = (factor(x[0]), factor(x[1]));
-        D * (a[4] * b[0] + 2.0 * a[2] * b[2] + a[0] * b[4])
-    }
+    use clamped_plate::{gradient, hessian, load, w, D};
 
     fn below(_: &[f64]) -> f64 {
         -1.0
@@ -316,13 +295,7 @@ mod kirchhoff {
 
     fn bounded<M: Model>(n: usize, tolerance: f64) {
         let levels = run::<M>(n, tolerance);
-        let indices: Vec<f64> = levels
-            .iter()
-            .map(|l| l.estimate / l.error_energy.unwrap())
-            .collect();
-        let (low, high) = indices
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(a, b), &i| (a.min(i), b.max(i)));
+        let (indices, low, high) = efficiency_indices(&levels);
         assert!(
             levels.len() >= 3 && low > 0.3 && high / low < 5.0,
             "{}: efficiency indices {indices:?}",

@@ -7,6 +7,9 @@
 //! O(h) in the broken H² seminorm and O(h²) in H¹ and L².
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+#[path = "common/clamped_plate.rs"]
+mod clamped_plate;
+
 use fem_forms::models::kirchhoff::{kirchhoff_argyris, kirchhoff_morley};
 use fem_forms::{
     solve_linear, Coefficients, Constraints, DataFn, Diagonal, DirichletPart, Factorization, Model,
@@ -15,36 +18,18 @@ use fem_forms::{
 use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use fem_runtime::reference::triangle::TriangleRule;
 
-const D: f64 = 1.3;
-const NU: f64 = 0.3;
+use clamped_plate::{load, D};
 
-/// `X = x(1−x)` and its derivatives.
-fn factor(x: f64) -> [f64; 5] {
-    // (X²), (X²)', (X²)'', (X²)''', (X²)''''
-    let (p, dp) = (x * (1.0 - x), 1.0 - 2.0 * x);
-    [
-        p * p,
-        2.0 * p * dp,
-        2.0 * dp * dp - 4.0 * p,
-        -12.0 * dp,
-        24.0,
-    ]
-}
+const NU: f64 = 0.3;
 
 /// The exact deflection, its gradient and its Hessian `[w_xx, w_xy, w_yy]`.
 fn exact(x: [f64; 2]) -> (f64, [f64; 2], [f64; 3]) {
-    let (a, b) = (factor(x[0]), factor(x[1]));
+    let h = clamped_plate::hessian(&x);
     (
-        a[0] * b[0],
-        [a[1] * b[0], a[0] * b[1]],
-        [a[2] * b[0], a[1] * b[1], a[0] * b[2]],
+        clamped_plate::w(&x),
+        clamped_plate::gradient(&x),
+        [h[0][0], h[0][1], h[1][1]],
     )
-}
-
-/// `f = DΔ²w = D(w_xxxx + 2 w_xxyy + w_yyyy)`.
-fn load(x: &[f64]) -> f64 {
-    let (a, b) = (factor(x[0]), factor(x[1]));
-    D * (a[4] * b[0] + 2.0 * a[2] * b[2] + a[0] * b[4])
 }
 
 /// `(‖w − w_h‖_L², |w − w_h|_H¹, |w − w_h|_H²,h)` of the clamped plate on the N×N×2 mesh
