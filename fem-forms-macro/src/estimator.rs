@@ -148,12 +148,6 @@ pub fn analyse(
             }
         }
     }
-    if errors.is_empty() && symbols.dimension != 2 {
-        errors.push(
-            Diagnostic::text(span(tokens), "estimators are generated on triangles only")
-                .help("on intervals the jumps sit at points; declare no `estimator:` for an interval model"),
-        );
-    }
     (estimator, errors)
 }
 

@@ -57,12 +57,13 @@
 //! - `facets: Γ_C, Γ_N;` (optional, triangles) names boundary parts that the forms
 //!   integrate over with `∫_Γ_C … ds`; the runtime says which edges a part holds (a
 //!   Gmsh physical name or a generator's marker).
-//! - `estimator: "…"` (optional, triangles) a residual a-posteriori estimator: lines
+//! - `estimator: "…"` (optional) a residual a-posteriori estimator: lines
 //!   `η_T² = h_T² ‖f + Δu + λ‖²` (a cell's squared indicator: weighted squared L² norms
 //!   over the cell of residuals linear in the unknowns, plus data) and
 //!   `η_E² = h_E ‖[[∇u·n]]‖²` (an interior edge's: of jumps `X⁺ − X⁻`, `n` the edge's
-//!   unit normal). It generates `NAME::estimator::cell` and `::edge` and the `Model`
-//!   methods `cell_indicator` and `edge_indicator` (`estimator.rs`, `codegen/estimator.rs`).
+//!   unit normal; on intervals an interior node's jumps). It generates
+//!   `NAME::estimator::cell` and `::edge` and the `Model` methods `cell_indicator` and
+//!   `edge_indicator` (`estimator.rs`, `codegen/estimator.rs`, `codegen/estimator_interval.rs`).
 //! - `forms: "…"` the forms text below. Greek names are fine; a crate using them may
 //!   want `#![allow(mixed_script_confusables)]`.
 //!

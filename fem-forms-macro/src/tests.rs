@@ -1271,20 +1271,38 @@ fn estimator_errors_point_at_the_place() {
 }
 
 #[test]
-fn an_estimator_on_an_interval_is_refused() {
+fn an_estimator_on_an_interval_expands_to_cell_and_node_kernels() {
     let out = expand(quote! {
         /// Beam.
         pub mod beam on interval {
-            unknowns: w: P2, λ: P0 >= 0;
+            unknowns: w: Hermite, λ: P0 >= 0;
             tests: v, μ;
             data: f;
             forms: "a(w;v) = ∫ w''v''";
-            estimator: "η_T² = h_T⁴ ‖f − w''''‖²";
+            estimator: "
+                η_T² = h_T⁴ ‖f + λ − w''''‖²
+                η_E² = h_E³ ‖[[w''']]‖² + h_E ‖[[w'']]‖²
+            ";
+        }
+    });
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    let _: syn::File = syn::parse2(out).expect("generated code parses");
+    assert!(text.contains("pub mod estimator") && text.contains("PHI_END_HERMITE_D3"));
+}
+
+#[test]
+fn an_interval_estimator_refuses_the_normal_on_cells() {
+    let out = expand(quote! {
+        /// Beam.
+        pub mod beam on interval {
+            unknowns: w: Hermite, λ: P0 >= 0;
+            tests: v, μ;
+            data: f;
+            forms: "a(w;v) = ∫ w''v''";
+            estimator: "η_T² = h_T⁴ ‖n w''''‖²";
         }
     });
     let errors = rendered_errors(&out);
-    assert!(
-        errors.iter().any(|e| e.contains("triangles only")),
-        "{errors:?}"
-    );
+    assert!(errors.iter().any(|e| e.contains("`n`")), "{errors:?}");
 }

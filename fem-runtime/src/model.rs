@@ -367,7 +367,8 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     const HAS_ESTIMATOR: bool = false;
 
     /// The squared indicator `η_T²` of the model's `estimator:` on the affine triangle
-    /// with vertex coordinates `vertices` (`[x0, y0, x1, y1, x2, y2]`), for the
+    /// with vertex coordinates `vertices` (`[x0, y0, x1, y1, x2, y2]`; on intervals
+    /// `[x0, x1]`, Hermite slopes times the cell's length), for the
     /// coefficients of the discrete solution on the cell, one slice per field, in the
     /// pulled-back reference basis ([`crate::element::triangle::TriangleField::reference_coefficients`]:
     /// the local DOFs for Lagrange elements, `Mᵀ U` for Argyris and Morley).
@@ -393,8 +394,11 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// of its neighbour `other_vertices` (`other_coefficients`); local edge `k` joins
     /// local vertices `k` and `(k + 1) % 3`. As [`Model::cell_indicator`].
     ///
+    /// On intervals (`vertices = [x0, x1]`) the "edge" is an interior node: end `edge`
+    /// (0 left, 1 right) of the cell and end `other_edge` of its neighbour.
+    ///
     /// # Errors
-    /// As [`Model::cell_indicator`], and for an edge above 2.
+    /// As [`Model::cell_indicator`], and for an edge above 2 (an end above 1).
     #[allow(clippy::too_many_arguments)]
     fn edge_indicator(
         vertices: &[f64],

@@ -3,6 +3,10 @@
 //!
 //! `w'''' ≡ 0` for cubics, so `S_h = Σ h⁴ s²(λ, μ)`; α ≤ 1e-2 keeps the obstacle shift
 //! `α h⁴ |f|` negligible.
+//!
+//! The estimator (`../shared/MODELS.md` §8): the cell residual of the contact equation
+//! and, at interior nodes, the jumps of the shear force `w'''` and the moment `w''`
+//! (h the mean length of the two neighbouring cells).
 
 fem_runtime::model! {
     /// Euler–Bernoulli beam obstacle problem, w ∈ Hermite cubics, λ ∈ P0.
@@ -26,5 +30,9 @@ fem_runtime::model! {
         stabilization: α S against a;
         side:          s;
         obstacle:      w >= ψ;
+        estimator:     "
+            η_T² = h_T⁴/81 ‖f + sλ − w''''‖²
+            η_E² = h_E³/27 ‖[[w''']]‖² + h_E/3 ‖[[w'']]‖²
+        ";
     }
 }

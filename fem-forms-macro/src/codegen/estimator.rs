@@ -51,7 +51,7 @@ fn t_lets(alphas: &[[u8; 2]], suffix: &str) -> Vec<TokenStream> {
 }
 
 /// The polynomial degree of a residual on the cell (of the monomial of highest degree).
-fn residual_degree(residual: &Expansion, symbols: &Symbols) -> usize {
+pub(super) fn residual_degree(residual: &Expansion, symbols: &Symbols) -> usize {
     residual
         .iter()
         .map(|m| {
@@ -66,7 +66,7 @@ fn residual_degree(residual: &Expansion, symbols: &Symbols) -> usize {
 }
 
 /// The coefficient of a monomial as code: numbers, parameters, `h`, divisors, normals.
-fn monomial_coefficient(m: &Monomial) -> TokenStream {
+pub(super) fn monomial_coefficient(m: &Monomial) -> TokenStream {
     let mut factors = vec![coefficient(
         m.coefficient,
         &m.params,
@@ -79,7 +79,7 @@ fn monomial_coefficient(m: &Monomial) -> TokenStream {
 }
 
 /// A term's weight as code (a sum of scalar monomials).
-fn weight_code(weight: &Expansion) -> TokenStream {
+pub(super) fn weight_code(weight: &Expansion) -> TokenStream {
     let parts = weight.iter().map(monomial_coefficient);
     quote!((#(#parts)+*))
 }
@@ -159,7 +159,7 @@ fn field_value(
 }
 
 /// The data product of a monomial at the point `xq`.
-fn data_product(m: &Monomial) -> Option<TokenStream> {
+pub(super) fn data_product(m: &Monomial) -> Option<TokenStream> {
     (!m.data.is_empty()).then(|| product(m.data.iter().map(|&i| quote!(d[#i](&xq)))))
 }
 
@@ -468,16 +468,36 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
 
 /// The estimator items of the `Model` impl: `HAS_ESTIMATOR` and the dispatch of
 /// `cell_indicator` / `edge_indicator` to the kernels (empty without `estimator:`).
-pub fn model_items(symbols: &Symbols, runtime: &TokenStream, model_name: &str) -> TokenStream {
+///
+/// On intervals (`interval`) a cell has two vertex coordinates and its "edges" are its
+/// ends 0 and 1; on triangles six coordinates and edges 0, 1 and 2.
+pub fn model_items(
+    symbols: &Symbols,
+    runtime: &TokenStream,
+    model_name: &str,
+    interval: bool,
+) -> TokenStream {
     let nf = symbols.fields.len();
     let np = symbols.params.len();
     let nd = symbols.data.len();
     let sizes: Vec<usize> = symbols
         .fields
         .iter()
-        .map(|f| f.element.triangle_basis().len())
+        .map(|f| {
+            if interval {
+                f.element.basis().len()
+            } else {
+                f.element.triangle_basis().len()
+            }
+        })
         .collect();
-    let message = format!("{model_name}: the indicator of a triangle takes six vertex coordinates and, per field, its local coefficients ({sizes:?})");
+    let (coordinates, last, cell) = if interval {
+        (2usize, 1usize, "an interval")
+    } else {
+        (6, 2, "a triangle")
+    };
+    let message = format!("{model_name}: the indicator of {cell} takes {coordinates} vertex coordinates and, per field, its local coefficients ({sizes:?})");
+    let sides = format!("{cell} has local edges (ends) 0 to {last}, not {{}} and {{}}");
     quote! {
         const HAS_ESTIMATOR: bool = true;
 
@@ -489,7 +509,7 @@ pub fn model_items(symbols: &Symbols, runtime: &TokenStream, model_name: &str) -
         ) -> #runtime::Result<f64> {
             const SIZES: [usize; #nf] = [#(#sizes),*];
             let (::core::result::Result::Ok(x), ::core::result::Result::Ok(c)) =
-                (<&[f64; 6]>::try_from(vertices), <&[&[f64]; #nf]>::try_from(coefficients))
+                (<&[f64; #coordinates]>::try_from(vertices), <&[&[f64]; #nf]>::try_from(coefficients))
             else {
                 return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
             };
@@ -519,9 +539,9 @@ pub fn model_items(symbols: &Symbols, runtime: &TokenStream, model_name: &str) -
                 ::core::result::Result::Ok(y),
                 ::core::result::Result::Ok(e),
             ) = (
-                <&[f64; 6]>::try_from(vertices),
+                <&[f64; #coordinates]>::try_from(vertices),
                 <&[&[f64]; #nf]>::try_from(coefficients),
-                <&[f64; 6]>::try_from(other_vertices),
+                <&[f64; #coordinates]>::try_from(other_vertices),
                 <&[&[f64]; #nf]>::try_from(other_coefficients),
             )
             else {
@@ -530,8 +550,8 @@ pub fn model_items(symbols: &Symbols, runtime: &TokenStream, model_name: &str) -
             if c.iter().chain(e.iter()).zip(SIZES.iter().chain(SIZES.iter())).any(|(c, &n)| c.len() != n) {
                 return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
             }
-            if edge > 2 || other_edge > 2 {
-                return ::core::result::Result::Err(#runtime::Error::Input(::std::format!("a triangle has local edges 0, 1 and 2, not {} and {}", edge, other_edge)));
+            if edge > #last || other_edge > #last {
+                return ::core::result::Result::Err(#runtime::Error::Input(::std::format!(#sides, edge, other_edge)));
             }
             let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
             let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");

@@ -14,6 +14,7 @@ mod backend;
 mod curved;
 mod emit;
 mod estimator;
+mod estimator_interval;
 mod facet;
 mod interval;
 mod triangle;
@@ -696,10 +697,17 @@ pub fn generate(
         .unzip();
     dispatch.facet_items =
         facet::model_items(symbols, forms, runtime, &declaration.name.to_string());
-    let estimator_module = estimator.map(|e| estimator::module(e, symbols, runtime));
+    let interval = declaration.cell != Some(CellKind::Triangle);
+    let estimator_module = estimator.map(|e| {
+        if interval {
+            estimator_interval::module(e, symbols, runtime)
+        } else {
+            estimator::module(e, symbols, runtime)
+        }
+    });
     if estimator.is_some() {
         dispatch.estimator_items =
-            estimator::model_items(symbols, runtime, &declaration.name.to_string());
+            estimator::model_items(symbols, runtime, &declaration.name.to_string(), interval);
     }
     let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch, roles);
     let handles = handles(symbols, forms, runtime);

@@ -7,7 +7,10 @@
 //! `(Σ_T (λ_h, s(u_h − ψ))_T)_+^{1/2}`, `../shared/MODELS.md` §8), marks cells
 //! ([`Marking`]) and drives the adaptive loop of [`crate::problem::Problem::solve_adaptive`].
 
+mod interval;
 pub mod marking;
+
+pub use interval::interval_estimate;
 
 pub use marking::Marking;
 
@@ -64,8 +67,8 @@ impl Default for AdaptiveOptions {
 /// A discrete solution's a-posteriori estimate.
 #[derive(Clone, Debug, Default)]
 pub struct Estimate {
-    /// Per cell, what marking ranks: its `η_T²` plus half of `η_E²` of each of its
-    /// interior edges.
+    /// Per cell, what marking ranks: its `η_T²`, half of `η_E²` of each of its interior
+    /// edges, and its share of `S²` (its violation and complementarity defect).
     pub indicators: Vec<f64>,
     /// `η = (Σ_T η_T² + Σ_E η_E²)^{1/2}`: the residual part.
     pub residual: f64,
@@ -80,6 +83,28 @@ pub struct Estimate {
 }
 
 impl Estimate {
+    /// The estimate from the cells' residual indicators (`indicators`, summing to
+    /// `residual2`), the contact terms and `‖u_h‖_a`: each cell's share of `S²` joins its
+    /// indicator, so that marking refines where the contact terms are large too (a point
+    /// contact's complementarity defect sits on the few cells around the point, where the
+    /// residual indicators may be small).
+    fn of(
+        mut indicators: Vec<f64>,
+        residual2: f64,
+        contact: ContactTerms,
+        energy_norm: f64,
+    ) -> Self {
+        for (i, c) in indicators.iter_mut().zip(&contact.cells) {
+            *i += c;
+        }
+        Self {
+            indicators,
+            residual: residual2.max(0.0).sqrt(),
+            contact: contact.total,
+            energy_norm,
+        }
+    }
+
     /// `(η² + S²)^{1/2}`: the bound on the error (up to a constant) that the reliability
     /// of the estimator gives.
     pub fn total(&self) -> f64 {
@@ -190,27 +215,14 @@ pub fn triangle_estimate<M: Model>(
         )));
     }
     let (contact, energy_norm) = contact_terms::<M>(solution, &fields, params, data, side)?;
-    Ok(Estimate {
-        indicators,
-        residual: sum.sqrt(),
-        contact,
-        energy_norm,
-    })
+    Ok(Estimate::of(indicators, sum, contact, energy_norm))
 }
 
-/// `a(v, v)` of the coefficient vector `v` of `field` with the model's energy form,
-/// summed cell by cell from its element matrices.
+/// The energy form of the model and its (`field`, `field`) block.
 ///
 /// # Errors
-/// A model without an energy form, or whose energy form has no (field, field) block.
-pub fn energy_product<M: Model>(
-    mesh: &TriangleMesh,
-    map: &crate::assembly::dof_map::DofMap,
-    field: usize,
-    v: &[f64],
-    params: &[f64],
-    data: &[&DataFn],
-) -> Result<f64> {
+/// A model without an energy form, or whose energy form has no such block.
+fn energy_block<M: Model>(field: usize) -> Result<(usize, usize)> {
     let [a, _] = M::ENERGY.ok_or_else(|| {
         Error::Input(format!(
             "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
@@ -229,10 +241,44 @@ pub fn energy_product<M: Model>(
                 M::FIELDS[field].name
             ))
         })?;
+    Ok((a, block))
+}
+
+/// `a(v, v)` of the coefficient vector `v` of `field` with the model's energy form,
+/// summed cell by cell from its element matrices.
+///
+/// # Errors
+/// A model without an energy form, or whose energy form has no (field, field) block.
+pub fn energy_product<M: Model>(
+    mesh: &TriangleMesh,
+    map: &crate::assembly::dof_map::DofMap,
+    field: usize,
+    v: &[f64],
+    params: &[f64],
+    data: &[&DataFn],
+) -> Result<f64> {
+    Ok(cell_energies::<M>(mesh, map, field, v, params, data)?
+        .iter()
+        .sum())
+}
+
+/// Each cell's `v_Tᵀ K_T v_T` of [`energy_product`]: its share of `a(v, v)`.
+///
+/// # Errors
+/// As [`energy_product`].
+fn cell_energies<M: Model>(
+    mesh: &TriangleMesh,
+    map: &crate::assembly::dof_map::DofMap,
+    field: usize,
+    v: &[f64],
+    params: &[f64],
+    data: &[&DataFn],
+) -> Result<Vec<f64>> {
+    let (a, block) = energy_block::<M>(field)?;
     let n = map.local_count();
     let mut k = vec![0.0; n * n];
-    let mut total = 0.0;
-    for c in 0..mesh.cell_count() {
+    let mut energies = vec![0.0; mesh.cell_count()];
+    for (c, energy) in energies.iter_mut().enumerate() {
         let dofs = map.cell_dofs(c);
         if dofs.iter().all(|&d| v[d] == 0.0) {
             continue;
@@ -248,32 +294,59 @@ pub fn energy_product<M: Model>(
         );
         for (i, &di) in dofs.iter().enumerate() {
             for (j, &dj) in dofs.iter().enumerate() {
-                total += v[di] * k[i * n + j] * v[dj];
+                *energy += v[di] * k[i * n + j] * v[dj];
             }
         }
     }
-    Ok(total)
+    Ok(energies)
 }
 
-/// The contact part `S` of the estimate and `‖u_h‖_a`.
+/// The contact part of the estimate: `S² = violation + (Σ_T defect_T)_+`, and each
+/// cell's share of it (its violation and its defect's positive part), which marking
+/// adds to the cell's indicator.
+#[derive(Clone, Debug, Default)]
+struct ContactTerms {
+    /// `S`.
+    total: f64,
+    /// Per cell, its share of `S²`.
+    cells: Vec<f64>,
+}
+
+impl ContactTerms {
+    /// From each cell's violation and complementarity defect.
+    fn of(violation: &[f64], defect: &[f64]) -> Self {
+        let sum_violation: f64 = violation.iter().sum();
+        let sum_defect: f64 = defect.iter().sum();
+        Self {
+            total: (sum_violation.max(0.0) + sum_defect.max(0.0)).sqrt(),
+            cells: violation
+                .iter()
+                .zip(defect)
+                .map(|(v, d)| v.max(0.0) + d.max(0.0))
+                .collect(),
+        }
+    }
+}
+
+/// The contact part `S` of the estimate (with each cell's share) and `‖u_h‖_a`.
 fn contact_terms<M: Model>(
     solution: &ObstacleSolution<TriangleMesh>,
     fields: &[TriangleField],
     params: &[f64],
     data: &[&DataFn],
     side: f64,
-) -> Result<(f64, f64)> {
+) -> Result<(ContactTerms, f64)> {
     let d = &solution.discretization;
     let mesh = &d.mesh;
     let field = M::constrained_field();
     let u = &fields[field];
     let energy = energy_product::<M>(mesh, u.map, field, u.coefficients, params, data)?;
     let Some([_, psi]) = M::OBSTACLE else {
-        return Ok((0.0, energy.max(0.0).sqrt()));
+        return Ok((ContactTerms::default(), energy.max(0.0).sqrt()));
     };
     let psi = data[psi];
     let element = u.map.element();
-    let violation2 = if matches!(element, ElementKind::P1 | ElementKind::P2 | ElementKind::P3) {
+    let violation = if matches!(element, ElementKind::P1 | ElementKind::P2 | ElementKind::P3) {
         // ‖I_h s(ψ − u_h)_+‖_a
         let violation: Vec<f64> = u
             .map
@@ -282,7 +355,7 @@ fn contact_terms<M: Model>(
             .zip(u.coefficients)
             .map(|(x, &value)| (side * (psi(x) - value)).max(0.0))
             .collect();
-        energy_product::<M>(mesh, u.map, field, &violation, params, data)?
+        cell_energies::<M>(mesh, u.map, field, &violation, params, data)?
     } else {
         weighted_violation::<M>(mesh, u, psi, side)
     };
@@ -294,8 +367,8 @@ fn contact_terms<M: Model>(
         TriangleBasis::new(element),
         TriangleBasis::new(lambda.map.element()),
     );
-    let mut defect = 0.0;
-    for c in 0..mesh.cell_count() {
+    let mut defect = vec![0.0; mesh.cell_count()];
+    for (c, defect) in defect.iter_mut().enumerate() {
         let x = mesh.cell_coordinates(c);
         let area2 = ((x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1])).abs();
         for (xi, w) in rule.points.iter().zip(&rule.weights) {
@@ -307,11 +380,11 @@ fn contact_terms<M: Model>(
                 x[0] + (x[2] - x[0]) * xi[0] + (x[4] - x[0]) * xi[1],
                 x[1] + (x[3] - x[1]) * xi[0] + (x[5] - x[1]) * xi[1],
             ];
-            defect += w * area2 * l * side * (u.value(&u_basis, c, *xi) - psi(&p));
+            *defect += w * area2 * l * side * (u.value(&u_basis, c, *xi) - psi(&p));
         }
     }
     Ok((
-        (violation2.max(0.0) + defect.max(0.0)).sqrt(),
+        ContactTerms::of(&violation, &defect),
         energy.max(0.0).sqrt(),
     ))
 }
@@ -325,13 +398,13 @@ fn weighted_violation<M: Model>(
     u: &TriangleField,
     psi: &DataFn,
     side: f64,
-) -> f64 {
+) -> Vec<f64> {
     let m = i32::from(M::ORDER / 2).max(1);
     let element = u.map.element();
     let rule = TriangleRule::exact_for_degree(2 * element.degree() + 2);
     let basis = TriangleBasis::new(element);
-    let mut total = 0.0;
-    for c in 0..mesh.cell_count() {
+    let mut violation = vec![0.0; mesh.cell_count()];
+    for (c, total) in violation.iter_mut().enumerate() {
         let x = mesh.cell_coordinates(c);
         let area2 = ((x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1])).abs();
         let mut cell = 0.0;
@@ -343,7 +416,7 @@ fn weighted_violation<M: Model>(
             let v = (side * (psi(&p) - u.value(&basis, c, *xi))).max(0.0);
             cell += w * area2 * v * v;
         }
-        total += cell * mesh.cell_diameter(c).powi(-2 * m);
+        *total = cell * mesh.cell_diameter(c).powi(-2 * m);
     }
-    total
+    violation
 }

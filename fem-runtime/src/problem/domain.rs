@@ -142,7 +142,8 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
     /// obstacle's sign.
     ///
     /// # Errors
-    /// Meshes other than affine triangles (the default), and those of the estimate.
+    /// Meshes other than affine triangles and intervals (the default), and those of the
+    /// estimate.
     fn estimate<M: Model>(
         solution: &ObstacleSolution<Self>,
         params: &[f64],
@@ -151,7 +152,7 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
     ) -> Result<crate::adaptivity::Estimate> {
         let _ = (solution, params, data, side);
         Err(Error::Input(format!(
-            "model `{}`: estimates and adaptive refinement are computed on affine triangle meshes",
+            "model `{}`: estimates and adaptive refinement are computed on intervals and affine triangle meshes",
             M::NAME
         )))
     }
@@ -265,6 +266,19 @@ fn boundary_data<M: Model>(field: usize) -> Result<usize> {
 }
 
 impl Domain for IntervalMesh {
+    fn estimate<M: Model>(
+        solution: &ObstacleSolution<Self>,
+        params: &[f64],
+        data: &[&DataFn],
+        side: f64,
+    ) -> Result<crate::adaptivity::Estimate> {
+        crate::adaptivity::interval_estimate::<M>(solution, params, data, side)
+    }
+
+    fn refine_marked(&self, marked: &[usize]) -> Result<Self> {
+        self.refine(marked)
+    }
+
     fn extent(&self) -> f64 {
         self.vertices()[self.vertex_count() - 1] - self.vertices()[0]
     }

@@ -562,7 +562,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// A model without an estimator, a tolerance that is not positive and finite, the
     /// next level's unknowns beyond `options.max_dofs` or no cell left to mark (the
     /// message says how far the loop got), and the errors of [`Problem::solve`] and
-    /// [`Domain::estimate`].
+    /// [`Domain::estimate`] (on a level after the first, as [`Error::Input`] that says
+    /// which level failed and what the one before reached).
     pub fn solve_adaptive(
         &self,
         options: crate::adaptivity::AdaptiveOptions,
@@ -583,7 +584,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         }
         let mut levels: Vec<AdaptiveLevel> = Vec::new();
         let mut clock = Instant::now();
-        let mut solved = self.solve_refining(|current| {
+        let mut stopped = false;
+        let solved = self.solve_refining(|current| {
             let estimate = current
                 .estimate
                 .as_ref()
@@ -602,6 +604,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             if level.estimate <= tolerance * level.energy_norm {
                 return Ok(None);
             }
+            stopped = true;
             let reached = |why: String| {
                 Error::Input(format!(
                     "{why}: the estimate is {} of ‖u_h‖_a = {} after {} levels ({} cells, {} unknowns), above the tolerance {}",
@@ -627,8 +630,25 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 )));
             }
             clock = Instant::now();
+            stopped = false;
             Ok(Some(current.mesh().refine_marked(&marked)?))
+        });
+        // A level's solve that fails (a refined mesh can take the stabilization below
+        // the rounding of the gap) is reported with how far the loop got.
+        let mut solved = solved.map_err(|e| match levels.last() {
+            Some(last) if !stopped => Error::Input(format!(
+                "level {} of the adaptive solve failed: {e}; level {} reached an estimate of {} of ‖u_h‖_a with {} cells and {} unknowns, above the tolerance {}",
+                levels.len() + 1,
+                levels.len(),
+                number(last.estimate / last.energy_norm),
+                last.cells,
+                last.dofs,
+                number(tolerance)
+            )),
+            _ => e,
         })?;
+        // every level's solve, estimate, marking and refinement is the adaptive solve's
+        solved.report.seconds = levels.iter().map(|l| l.seconds).sum();
         solved.report.adaptive_levels = levels;
         Ok(solved)
     }

@@ -35,7 +35,8 @@ pub struct Report {
     pub factorizations: usize,
     /// CG iterations of the finest level's multigrid-solved steps.
     pub krylov_iterations: usize,
-    /// Wall time of the solve: assembly and every level.
+    /// Wall time of the solve: assembly and every level (of an adaptive solve: every
+    /// level's solve, estimate, marking and refinement).
     pub seconds: f64,
     /// The memory the solve was estimated to need before any work, in bytes.
     pub memory_estimate: f64,

@@ -164,10 +164,14 @@ pub fn beam_scene(old: &crate::scenes::Scene) -> Scene {
         let q = posed.load.unwrap_or(1.0);
         let t = posed.parameter("t").unwrap_or(0.0);
         let e = Arc::new(exact_solution(&old, q, t)?);
-        let (value, slope) = (Arc::clone(&e), Arc::clone(&e));
+        let (value, slope, curvature) = (Arc::clone(&e), Arc::clone(&e), Arc::clone(&e));
         Some(ExactSolution {
             value: Some(Data::shared(move |x| (value.w)(x[0], 0))),
             gradient: Some(Data::shared(move |x| [(slope.w)(x[0], 1), 0.0])),
+            // w'' (the energy norm ‖w''‖ of Euler–Bernoulli, and its estimator's)
+            hessian: Some(Data::shared(move |x| {
+                [[(curvature.w)(x[0], 2), 0.0], [0.0, 0.0]]
+            })),
             multiplier: flat_obstacle_multiplier(&old, q, &e.contact_set),
             contact_area: Some(e.contact_set.iter().map(|c| c[1] - c[0]).sum()),
             contact_set: Some(e.contact_set.clone()),
@@ -212,6 +216,9 @@ impl Family for Beams {
             Opt::LinearSolver,
             Opt::Refinement,
             Opt::Plot,
+            Opt::Tol,
+            Opt::Marking,
+            Opt::Theta,
         ]
     }
 

@@ -1,0 +1,158 @@
+//! The estimate on interval meshes (beams): cells and interior nodes.
+
+use super::{ContactTerms, Estimate};
+use crate::element::interval::PhysicalBasis;
+use crate::mesh::IntervalMesh;
+use crate::model::{DataFn, Model};
+use crate::norms::FieldView;
+use crate::obstacle::ObstacleSolution;
+use crate::{Error, Result};
+use fem_reference::QuadratureRule;
+
+/// The local coefficients of `view` on cell `c` in the reference basis: the DOFs with
+/// each derivative DOF times `h^k` (Hermite slopes times the cell's length), what the
+/// generated interval kernels take.
+fn reference_coefficients(view: &FieldView, c: usize) -> Vec<f64> {
+    let h = view.mesh.h(c);
+    let element = view.map.element();
+    view.local(c)
+        .iter()
+        .enumerate()
+        .map(|(i, &u)| u * h.powi(element.dof_scaling_power(i)))
+        .collect()
+}
+
+/// The estimate of `solution` on an interval mesh with the model's `estimator:` kernels
+/// (cells, and interior nodes as the "edges") and the contact terms; as
+/// [`super::triangle_estimate`] on triangles. An interior node's `η_E²` is shared
+/// half-and-half by its two cells for marking.
+///
+/// The violation part of `S` is `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T` (`m` half the
+/// operator's order, [`Model::ORDER`]) for every element: the inverse-inequality scaling
+/// of the L² norm to the energy norm, which needs no nodal interpolant of the positive part
+/// (Hermite cubics have none).
+///
+/// # Errors
+/// A model without an estimator or an energy form, and indicators that are not finite
+/// (the message names the cell).
+pub fn interval_estimate<M: Model>(
+    solution: &ObstacleSolution<IntervalMesh>,
+    params: &[f64],
+    data: &[&DataFn],
+    side: f64,
+) -> Result<Estimate> {
+    if !M::HAS_ESTIMATOR {
+        return Err(Error::Input(format!(
+            "model `{}` declares no estimator (`estimator:` in its model file)",
+            M::NAME
+        )));
+    }
+    let mesh = &solution.discretization.mesh;
+    let views: Vec<FieldView> = (0..M::FIELDS.len()).map(|f| solution.view(f)).collect();
+    let local = |c: usize| -> Vec<Vec<f64>> {
+        views.iter().map(|v| reference_coefficients(v, c)).collect()
+    };
+    let cells = mesh.cell_count();
+    let mut indicators = vec![0.0; cells];
+    let mut sum = 0.0;
+    let mut previous = local(0);
+    for c in 0..cells {
+        let here = if c == 0 { previous.clone() } else { local(c) };
+        let slices: Vec<&[f64]> = here.iter().map(Vec::as_slice).collect();
+        let x = mesh.cell(c);
+        let eta2 = M::cell_indicator(&x, &slices, params, data)?;
+        indicators[c] += eta2;
+        sum += eta2;
+        if c > 0 {
+            // the node between cells c − 1 (its right end) and c (its left end)
+            let left: Vec<&[f64]> = previous.iter().map(Vec::as_slice).collect();
+            let eta2 =
+                M::edge_indicator(&mesh.cell(c - 1), 1, &left, &x, 0, &slices, params, data)?;
+            indicators[c - 1] += 0.5 * eta2;
+            indicators[c] += 0.5 * eta2;
+            sum += eta2;
+        }
+        previous = here;
+    }
+    if let Some(c) = indicators.iter().position(|e| !e.is_finite()) {
+        let [a, b] = mesh.cell(c);
+        return Err(Error::Input(format!(
+            "the indicator of cell {c} ([{a}, {b}]) is {}: the solution or the data are not finite there",
+            indicators[c]
+        )));
+    }
+    let field = M::constrained_field();
+    let energy = energy_product::<M>(&views[field], field, params, data)?;
+    let contact = match M::OBSTACLE {
+        Some([_, psi]) => {
+            let multiplier = &views[solution.discretization.multiplier_field];
+            contact_terms::<M>(&views[field], multiplier, data[psi], side)
+        }
+        None => ContactTerms::default(),
+    };
+    Ok(Estimate::of(
+        indicators,
+        sum,
+        contact,
+        energy.max(0.0).sqrt(),
+    ))
+}
+
+/// `a(u_h, u_h)` of field `field` with the model's energy form, summed from its element
+/// matrices.
+///
+/// # Errors
+/// A model without an energy form, or whose energy form has no (field, field) block.
+fn energy_product<M: Model>(
+    view: &FieldView,
+    field: usize,
+    params: &[f64],
+    data: &[&DataFn],
+) -> Result<f64> {
+    let (a, block) = super::energy_block::<M>(field)?;
+    let n = view.map.local_count();
+    let mut k = vec![0.0; n * n];
+    let mut total = 0.0;
+    for c in 0..view.mesh.cell_count() {
+        let u = view.local(c);
+        M::element_matrix(a, block, &view.mesh.cell(c), params, data, &mut k);
+        for i in 0..n {
+            for j in 0..n {
+                total += u[i] * k[i * n + j] * u[j];
+            }
+        }
+    }
+    Ok(total)
+}
+
+/// `S = (Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T + (Σ_T (λ_h, s(u_h − ψ))_T)_+)^{1/2}`.
+fn contact_terms<M: Model>(
+    u: &FieldView,
+    lambda: &FieldView,
+    psi: &DataFn,
+    side: f64,
+) -> ContactTerms {
+    let m = i32::from(M::ORDER / 2).max(1);
+    let element = u.map.element();
+    let rule = QuadratureRule::exact_for_degree(2 * element.degree() + 2);
+    let (u_basis, l_basis) = (
+        PhysicalBasis::new(element, 0),
+        PhysicalBasis::new(lambda.map.element(), 0),
+    );
+    let cells = u.mesh.cell_count();
+    let (mut violation, mut defect) = (vec![0.0; cells], vec![0.0; cells]);
+    for c in 0..cells {
+        let cell = u.mesh.cell(c);
+        let h = cell[1] - cell[0];
+        let (local, multiplier) = (u.local(c), lambda.local(c));
+        let mut cell_violation = 0.0;
+        for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+            let x = cell[0] + h * xi;
+            let gap = side * (u_basis.evaluate(&local, 0, cell, xi) - psi(&[x]));
+            cell_violation += w * h * gap.min(0.0).powi(2);
+            defect[c] += w * h * l_basis.evaluate(&multiplier, 0, cell, xi) * gap;
+        }
+        violation[c] = cell_violation * h.powi(-2 * m);
+    }
+    ContactTerms::of(&violation, &defect)
+}
