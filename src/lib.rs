@@ -11,6 +11,7 @@
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 pub mod accuracy;
+pub mod adaptivity_study;
 pub mod allocator;
 pub mod lambda_scatter;
 pub mod locking;

@@ -275,9 +275,115 @@ pub fn profiles(path: &Path, title: &str, fields: &Fields) -> std::io::Result<()
     stacked(path, &panels)
 }
 
+/// A mesh as a picture: on triangles every cell's outline, the cells in contact (cell
+/// field `contact` positive) shaded; on an interval the cell lengths against x (log
+/// scale), the cells in contact (λ_h > 0) marked.
+pub fn mesh(path: &Path, title: &str, fields: &Fields) -> std::io::Result<()> {
+    match fields {
+        Fields::Interval {
+            cell_x, lambda, x, ..
+        } => {
+            let lengths: Vec<(f64, f64)> = cell_x
+                .iter()
+                .copied()
+                .zip(cell_lengths(x, cell_x))
+                .collect();
+            let touching: Vec<(f64, f64)> = lengths
+                .iter()
+                .zip(lambda)
+                .filter(|(_, &l)| l > 0.0)
+                .map(|(p, _)| *p)
+                .collect();
+            chart(
+                path,
+                title,
+                Axes {
+                    x: "x",
+                    y: "cell length h",
+                    log_x: false,
+                    log_y: true,
+                },
+                &[
+                    Series::marked("cell length", lengths),
+                    Series::marked("cells in contact (λ_h > 0)", touching),
+                ],
+            )
+        }
+        Fields::Triangles { mesh, cell, .. } => {
+            let contact = cell.iter().find(|c| c.0 == "contact").map(|c| &c.1);
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for v in mesh.vertices() {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(v[k]);
+                    hi[k] = hi[k].max(v[k]);
+                }
+            }
+            let (w, h) = ((hi[0] - lo[0]).max(1e-300), (hi[1] - lo[1]).max(1e-300));
+            let height = (800.0 * h / w).clamp(200.0, 1200.0) as u32 + 60;
+            write_atomically(path, |tmp| {
+                let root = SVGBackend::new(tmp, (860, height)).into_drawing_area();
+                root.fill(&WHITE)?;
+                let mut chart = ChartBuilder::on(&root)
+                    .caption(title, ("sans-serif", 16))
+                    .margin(12)
+                    .x_label_area_size(30)
+                    .y_label_area_size(50)
+                    .build_cartesian_2d(lo[0]..hi[0], lo[1]..hi[1])?;
+                chart
+                    .configure_mesh()
+                    .disable_mesh()
+                    .x_desc("x")
+                    .y_desc("y")
+                    .x_label_formatter(&|v| tick(*v))
+                    .y_label_formatter(&|v| tick(*v))
+                    .draw()?;
+                let shade = RGBColor(250, 170, 160);
+                let grey = RGBColor(90, 90, 90);
+                let corners = |c: usize| -> Vec<(f64, f64)> {
+                    let x = mesh.cell_coordinates(c);
+                    vec![(x[0], x[1]), (x[2], x[3]), (x[4], x[5])]
+                };
+                chart.draw_series(
+                    (0..mesh.cell_count())
+                        .filter(|&c| contact.is_some_and(|s| s[c] > 0.0))
+                        .map(|c| Polygon::new(corners(c), shade.filled())),
+                )?;
+                chart.draw_series((0..mesh.cell_count()).map(|c| {
+                    let mut outline = corners(c);
+                    outline.push(outline[0]);
+                    PathElement::new(outline, grey.stroke_width(1))
+                }))?;
+                root.present()?;
+                Ok(())
+            })
+        }
+    }
+}
+
+/// The length of each cell of an interval mesh from its midpoints and the mesh's left
+/// end `x[0]`: each cell's right end is its midpoint mirrored from its left end.
+fn cell_lengths(x: &[f64], midpoints: &[f64]) -> Vec<f64> {
+    let mut left = x.first().copied().unwrap_or(0.0);
+    midpoints
+        .iter()
+        .map(|&m| {
+            let length = 2.0 * (m - left);
+            left += length;
+            length
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tick_tests {
     use super::tick;
+
+    /// Cells of lengths 0.5, 0.25, 0.25 on [1, 2] from their midpoints.
+    #[test]
+    fn cell_lengths_come_back_from_the_midpoints() {
+        let lengths = super::cell_lengths(&[1.0, 2.0], &[1.25, 1.625, 1.875]);
+        assert_eq!(lengths, vec![0.5, 0.25, 0.25]);
+    }
 
     #[test]
     fn ticks_keep_four_significant_digits_and_stay_distinct() {

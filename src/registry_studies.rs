@@ -314,6 +314,9 @@ impl StudyScene for RegistryStudies {
             contact_error: r.exact_contact_area.map(|e| (contact - e).abs()),
             iterations: s.iterations,
             seconds: s.seconds,
+            estimate: s.estimate,
+            estimate_relative: s.estimate_relative,
+            error_energy: s.error_energy,
             kkt_residual: s.kkt_residual,
             warnings: s.warnings.clone(),
         })
@@ -427,6 +430,31 @@ impl StudyScene for RegistryStudies {
             .map_or("h-weighted ‖λ − λ_h‖".into(), |(_, words)| {
                 words.into()
             })
+    }
+
+    /// The one adaptive loop ([`fem_runtime::problem::Problem::solve_adaptive`]) through
+    /// the scene's solve, at the studies' load.
+    fn adaptive(
+        &self,
+        pair: &'static str,
+        size: usize,
+        tolerance: f64,
+    ) -> Result<crate::adaptivity_study::AdaptiveRun> {
+        let settings = Settings {
+            pair: Some(pair.to_string()),
+            load: self.scene.study_load,
+            mesh_size: Some(size),
+            adaptive: Some(fem_runtime::adaptivity::AdaptiveOptions {
+                tolerance,
+                ..Default::default()
+            }),
+            ..Settings::default()
+        };
+        let outcome = families::solve(&self.scene, &settings)?;
+        Ok(crate::adaptivity_study::AdaptiveRun {
+            levels: outcome.report.solve.adaptive_levels,
+            fields: outcome.fields,
+        })
     }
 
     /// The one locking study ([`crate::locking`]).

@@ -32,17 +32,22 @@ pub enum Study {
     WorkPrecision,
     /// Newton iterations with nested iteration and from a cold start.
     Iterations,
+    /// Uniform refinement against the adaptive loop: error and estimate against
+    /// unknowns, the efficiency index, error against time, the final mesh
+    /// ([`crate::adaptivity_study`]).
+    Adaptivity,
 }
 
 impl Study {
     /// Every study kind.
-    pub const ALL: [Study; 6] = [
+    pub const ALL: [Study; 7] = [
         Study::Convergence,
         Study::Locking,
         Study::Stability,
         Study::Alpha,
         Study::WorkPrecision,
         Study::Iterations,
+        Study::Adaptivity,
     ];
 
     /// Its name on the command line and in the registry.
@@ -54,6 +59,7 @@ impl Study {
             Study::Alpha => "alpha",
             Study::WorkPrecision => "work-precision",
             Study::Iterations => "iterations",
+            Study::Adaptivity => "adaptivity",
         }
     }
 
@@ -139,6 +145,13 @@ pub struct Row {
     pub iterations: usize,
     /// Solve time in seconds.
     pub seconds: f64,
+    /// The a-posteriori estimate `(η² + S²)^{1/2}`, where the model declares an
+    /// estimator.
+    pub estimate: Option<f64>,
+    /// The estimate relative to `‖u_h‖_a`.
+    pub estimate_relative: Option<f64>,
+    /// The error in the estimator's (energy) norm, where the exact solution is known.
+    pub error_energy: Option<f64>,
     /// KKT residual.
     pub kkt_residual: f64,
     /// The solve's warnings.
@@ -251,6 +264,23 @@ pub trait StudyScene {
     /// What [`Row::error_multiplier`] measures, for tables and charts.
     fn multiplier_error_name(&self) -> String {
         "h-weighted ‖λ − λ_h‖".into()
+    }
+    /// An adaptive solve of `pair` from the mesh of `size` to the relative tolerance
+    /// `tolerance` (the adaptivity study).
+    ///
+    /// # Errors
+    /// Scenes without adaptive solves (the default), and the solve's.
+    fn adaptive(
+        &self,
+        pair: &'static str,
+        size: usize,
+        tolerance: f64,
+    ) -> Result<crate::adaptivity_study::AdaptiveRun> {
+        let _ = (pair, size, tolerance);
+        Err(Error::Input(format!(
+            "scene `{}` has no adaptive solve",
+            self.name()
+        )))
     }
     /// The locking study (Timoshenko beams only).
     fn locking(&self, _full: bool, _out: &Path) -> Result<()> {
@@ -1451,6 +1481,7 @@ pub fn run(scene: &dyn StudyScene, study: Study, full: bool, out: &Path) -> Resu
         Study::Alpha => run_alpha(scene, full, out),
         Study::WorkPrecision => run_work_precision(scene, full, out),
         Study::Iterations => run_iterations(scene, full, out),
+        Study::Adaptivity => crate::adaptivity_study::run(scene, full, out),
     }?;
     println!(
         "→ {}, .csv\n",
@@ -1483,6 +1514,9 @@ mod tests {
             contact_error: None,
             iterations: 1,
             seconds: 0.0,
+            estimate: None,
+            estimate_relative: None,
+            error_energy: None,
             kkt_residual: 0.0,
             warnings: Vec::new(),
         };

@@ -306,6 +306,49 @@ fn the_stability_study_writes_its_chart_and_table() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
+/// The adaptivity study: uniform and adaptive rows in one CSV and four charts; the
+/// adaptive run reaches a smaller true error than the finest uniform mesh with fewer
+/// unknowns (bernoulli-flat: the contact ends; membrane-radial: the free boundary).
+#[test]
+fn the_adaptivity_study_shows_adaptive_beating_uniform() {
+    let out = scratch("adaptivity-study");
+    for scene in ["bernoulli-flat", "membrane-radial"] {
+        let run = fem_forms(&["study", scene, "adaptivity"], &out);
+        assert!(
+            run.status.success(),
+            "{scene}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let csv = std::fs::read_to_string(out.join(format!("{scene}-adaptivity.csv"))).unwrap();
+        assert!(
+            csv.starts_with("run,cells,dofs,estimate,error_energy,seconds"),
+            "{csv}"
+        );
+        let last = |name: &str| -> Vec<f64> {
+            let line = csv
+                .lines()
+                .rfind(|l| l.starts_with(&format!("{name},")))
+                .unwrap_or_else(|| panic!("{scene}: no {name} row in {csv}"));
+            line.split(',')
+                .skip(1)
+                .map(|v| v.parse().unwrap())
+                .collect()
+        };
+        let (uniform, adaptive) = (last("uniform"), last("adaptive"));
+        // [cells, dofs, estimate, error, seconds]
+        assert!(
+            adaptive[3] < uniform[3] && adaptive[1] < uniform[1],
+            "{scene}: adaptive {adaptive:?} against uniform {uniform:?}"
+        );
+        for chart in ["", "-efficiency", "-time", "-mesh"] {
+            let svg = std::fs::read_to_string(out.join(format!("{scene}-adaptivity{chart}.svg")))
+                .unwrap_or_else(|e| panic!("{scene}{chart}: {e}"));
+            assert!(svg.contains("<svg"));
+        }
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
 /// Options are checked against the scene's family: one that does not apply is an error
 /// naming it, not silently ignored.
 #[test]

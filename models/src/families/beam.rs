@@ -121,6 +121,7 @@ fn studies(name: &str) -> Vec<&'static str> {
             "alpha",
             "work-precision",
             "iterations",
+            "adaptivity",
         ],
         "timoshenko-a" => vec!["locking", "stability", "iterations"],
         _ => Vec::new(),

@@ -153,7 +153,7 @@ fn kirchhoff_scene(
     scene.side = ObstacleSide::Above;
     place(&mut scene, obstacle);
     scene.studies = match obstacle {
-        Some(_) => vec!["convergence", "lambda-scatter", "stability"],
+        Some(_) => vec!["convergence", "lambda-scatter", "stability", "adaptivity"],
         None => vec!["convergence"],
     };
     scene.study_variants = match obstacle {

@@ -160,8 +160,9 @@ fn studies(name: &str) -> Vec<&'static str> {
             "alpha",
             "work-precision",
             "iterations",
+            "adaptivity",
         ],
-        "membrane-lshape" => vec!["iterations"],
+        "membrane-lshape" => vec!["iterations", "adaptivity"],
         _ => Vec::new(),
     }
 }
