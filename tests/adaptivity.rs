@@ -203,6 +203,28 @@ fn adaptive_errors_are_clear() {
     assert!(seen >= 1);
 }
 
+/// A solution held at zero (membrane-flat: u = 0, λ = q) has a norm of rounding size: a
+/// tolerance relative to it is refused at the first level, not chased to the DOF limit.
+#[test]
+fn a_vanishing_solution_is_refused_at_once() {
+    use fem_forms::models::families;
+    use fem_forms::models::report::Settings;
+    let scene = families::scene("membrane-flat").unwrap();
+    let settings = Settings {
+        mesh_size: Some(4),
+        adaptive: Some(AdaptiveOptions {
+            tolerance: 1e-2,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    let message = families::solve(&scene, &settings).unwrap_err().to_string();
+    assert!(
+        message.contains("zero up to rounding") && message.contains("after 1 levels"),
+        "{message}"
+    );
+}
+
 /// On the L-shaped membrane (re-entrant corner, free boundary) the adaptive estimate
 /// falls at the optimal rates N^{-1/2} (P1) and N^{-1} (P2), where uniform refinement
 /// is held to N^{-1/3} by the corner; through the registry's one solve path.

@@ -235,6 +235,11 @@ pub const ALPHA_WHEN_CI_VANISHES: f64 = 0.1;
 /// crossing of ψ is judged against the size instead.
 const FLAT_SHARE: f64 = 1e-3;
 
+/// The largest ratio of the estimate to `‖u_h‖_a` an adaptive solve goes on from: an
+/// estimate a million times the solution's norm means the norm is rounding (a solution
+/// held at zero), not a coarse mesh.
+const VANISHING_SOLUTION: f64 = 1e6;
+
 /// `α` times the stabilization's constant on a regular cell below which the
 /// stabilization is lost in rounding: λ_h's rounding noise grows like `ε / (α C_I)` (a
 /// needle mesh measured 2e-4 at 4e-12 and 2 at 4e-16).
@@ -616,6 +621,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                     number(tolerance)
                 ))
             };
+            // a solution held at zero (by the constraint or the supports) has a norm of
+            // rounding size, which no refinement makes the estimate small against
+            if level.estimate > VANISHING_SOLUTION * level.energy_norm {
+                return Err(reached(format!(
+                    "‖u_h‖_a is {} against an estimate of {}: the solution is zero up to rounding (the obstacle or the supports hold it there), so no refinement meets a tolerance relative to it",
+                    number(level.energy_norm),
+                    number(level.estimate)
+                )));
+            }
             let marked = options.marking.mark(&estimate.indicators)?;
             if marked.is_empty() {
                 return Err(reached("no cell has a positive indicator to refine".into()));
