@@ -225,6 +225,26 @@ fn a_vanishing_solution_is_refused_at_once() {
     );
 }
 
+/// A scene solved without its constraint (kirchhoff-square: no obstacle) has no contact
+/// part in its estimate: the runtime's multiplier is 0 there, but the data ψ of the
+/// model (unused) made a complementarity "defect" of 60 % of the estimate.
+#[test]
+fn an_unconstrained_solve_has_no_contact_part() {
+    use fem_forms::models::families;
+    use fem_forms::models::report::Settings;
+    let scene = families::scene("kirchhoff-square").unwrap();
+    for pair in ["argyris-p0", "morley-p0"] {
+        let settings = Settings {
+            pair: Some(pair.into()),
+            mesh_size: Some(8),
+            ..Settings::default()
+        };
+        let report = families::solve(&scene, &settings).unwrap().report.solve;
+        assert_eq!(report.estimate_contact, Some(0.0), "{pair}");
+        assert!(report.estimate.unwrap() > 0.0);
+    }
+}
+
 /// On the L-shaped membrane (re-entrant corner, free boundary) the adaptive estimate
 /// falls at the optimal rates N^{-1/2} (P1) and N^{-1} (P2), where uniform refinement
 /// is held to N^{-1/3} by the corner; through the registry's one solve path.
@@ -327,6 +347,44 @@ mod kirchhoff {
         assert!(
             last.error_energy.unwrap() < 0.3 * first.error_energy.unwrap(),
             "{levels:?}"
+        );
+    }
+
+    /// The estimate has the units of the energy norm: a plate 100 times stiffer under
+    /// 100 times the load has the same deflection, an estimate and an error √100 times
+    /// larger, and the same relative estimate and efficiency index.
+    #[test]
+    fn the_estimate_scales_with_the_energy_norm() {
+        let solve = |scale: f64| {
+            let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 8, 8, Diagonal::Right).unwrap();
+            let scaled = move |x: &[f64]| scale * load(x);
+            Problem::<kirchhoff_morley_p0::Model, TriangleMesh>::new(vec![mesh])
+                .param("D", scale * D)
+                .param("ν", 0.3)
+                .data("f", &scaled)
+                .data("ψ", &below)
+                .data("g", &zero)
+                .support(DirichletPart::All, "w", Condition::Clamped)
+                .exact(Exact {
+                    value: &w,
+                    gradient: Some(&gradient),
+                    hessian: Some(&hessian),
+                    multiplier: None,
+                })
+                .solve()
+                .unwrap()
+                .report
+        };
+        let (one, stiff) = (solve(1.0), solve(100.0));
+        let close = |a: Option<f64>, b: Option<f64>| {
+            let (a, b) = (a.unwrap(), b.unwrap());
+            (a - b).abs() <= 1e-6 * a.abs()
+        };
+        assert!(
+            close(one.estimate_relative, stiff.estimate_relative)
+                && close(one.efficiency_index, stiff.efficiency_index)
+                && close(one.estimate.map(|e| 10.0 * e), stiff.estimate),
+            "D: {one:?}\n100 D: {stiff:?}"
         );
     }
 

@@ -86,10 +86,12 @@ kirchhoff_obstacle_model! {
     /// Melenk–Wohlmuth (2001) in place of `h`: with
     /// plain `h` the quintic's cell residual, dominated by `f − Π₁f`, overestimates the
     /// error about 200-fold on a smooth plate; with `h/p` the efficiency index is 8–18.
+    /// Every term is divided by D so that η has the units of the energy norm
+    /// `‖w‖_a = (D ∫ |∇²w|²)^{1/2}` (its residuals carry one D each).
     kirchhoff_argyris_p0, w: Argyris, λ: P0,
     estimator: "
-        η_T² = h_T⁴/625 ‖f − D Δ²w + sλ‖²
-        η_E² = h_E³/125 ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/5 ‖[[(M(w)·n)·n]]‖²
+        η_T² = h_T⁴/(625 D) ‖f − D Δ²w + sλ‖²
+        η_E² = h_E³/(125 D) ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/(5 D) ‖[[(M(w)·n)·n]]‖²
     "
 }
 
@@ -99,8 +101,8 @@ kirchhoff_obstacle_model! {
     /// Argyris–P0 (the primal part of `S_h`, hence C_I, is the same).
     kirchhoff_argyris_p1disc, w: Argyris, λ: P1disc,
     estimator: "
-        η_T² = h_T⁴/625 ‖f − D Δ²w + sλ‖²
-        η_E² = h_E³/125 ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/5 ‖[[(M(w)·n)·n]]‖²
+        η_T² = h_T⁴/(625 D) ‖f − D Δ²w + sλ‖²
+        η_E² = h_E³/(125 D) ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/(5 D) ‖[[(M(w)·n)·n]]‖²
     "
 }
 
@@ -116,8 +118,8 @@ kirchhoff_obstacle_model! {
     /// tangential jump alone let it drift below 1).
     kirchhoff_morley_p0, w: Morley, λ: P0,
     estimator: "
-        η_T² = h_T⁴ ‖f − D Δ²w + sλ‖²
-        η_E² = h_E³ ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E ‖[[(M(w)·n)·n]]‖²
-               + D² h_E⁻¹ ‖[[τ·∇w]]‖² + D² h_E⁻¹ ‖[[n·∇w]]‖²
+        η_T² = h_T⁴/D ‖f − D Δ²w + sλ‖²
+        η_E² = h_E³/D ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/D ‖[[(M(w)·n)·n]]‖²
+               + D h_E⁻¹ ‖[[τ·∇w]]‖² + D h_E⁻¹ ‖[[n·∇w]]‖²
     "
 }

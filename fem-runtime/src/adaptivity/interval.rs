@@ -39,7 +39,7 @@ pub fn interval_estimate<M: Model>(
     solution: &ObstacleSolution<IntervalMesh>,
     params: &[f64],
     data: &[&DataFn],
-    side: f64,
+    side: Option<f64>,
 ) -> Result<Estimate> {
     if !M::HAS_ESTIMATOR {
         return Err(Error::Input(format!(
@@ -83,12 +83,12 @@ pub fn interval_estimate<M: Model>(
     }
     let field = M::constrained_field();
     let energy = energy_product::<M>(&views[field], field, params, data)?;
-    let contact = match M::OBSTACLE {
-        Some([_, psi]) => {
+    let contact = match (M::OBSTACLE, side) {
+        (Some([_, psi]), Some(side)) => {
             let multiplier = &views[solution.discretization.multiplier_field];
             contact_terms::<M>(&views[field], multiplier, data[psi], side)
         }
-        None => ContactTerms::default(),
+        _ => ContactTerms::default(),
     };
     Ok(Estimate::of(
         indicators,

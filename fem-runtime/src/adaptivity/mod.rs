@@ -150,7 +150,8 @@ fn fields<'a, M: Model>(
 
 /// The estimate of `solution` with the model's `estimator:` kernels and the contact
 /// terms, for parameters `params` and data `data` as solved with; `side` is the
-/// obstacle's sign `s` (1: `u ≥ ψ`).
+/// obstacle's sign `s` (1: `u ≥ ψ`), `None` for a problem solved without its constraint
+/// (no contact terms).
 ///
 /// # Errors
 /// A model without an estimator or an energy form, a multiplier on a boundary part, a
@@ -159,7 +160,7 @@ pub fn triangle_estimate<M: Model>(
     solution: &ObstacleSolution<TriangleMesh>,
     params: &[f64],
     data: &[&DataFn],
-    side: f64,
+    side: Option<f64>,
 ) -> Result<Estimate> {
     if !M::HAS_ESTIMATOR {
         return Err(Error::Input(format!(
@@ -334,14 +335,14 @@ fn contact_terms<M: Model>(
     fields: &[TriangleField],
     params: &[f64],
     data: &[&DataFn],
-    side: f64,
+    side: Option<f64>,
 ) -> Result<(ContactTerms, f64)> {
     let d = &solution.discretization;
     let mesh = &d.mesh;
     let field = M::constrained_field();
     let u = &fields[field];
     let energy = energy_product::<M>(mesh, u.map, field, u.coefficients, params, data)?;
-    let Some([_, psi]) = M::OBSTACLE else {
+    let (Some([_, psi]), Some(side)) = (M::OBSTACLE, side) else {
         return Ok((ContactTerms::default(), energy.max(0.0).sqrt()));
     };
     let psi = data[psi];

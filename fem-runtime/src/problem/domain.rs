@@ -139,7 +139,8 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
 
     /// The a-posteriori estimate of `solution` with the model's `estimator:` kernels and
     /// the contact terms ([`crate::adaptivity::triangle_estimate`]); `side` is the
-    /// obstacle's sign.
+    /// obstacle's sign, `None` for a problem solved without its constraint (no contact
+    /// terms).
     ///
     /// # Errors
     /// Meshes other than affine triangles and intervals (the default), and those of the
@@ -148,7 +149,7 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
         solution: &ObstacleSolution<Self>,
         params: &[f64],
         data: &[&DataFn],
-        side: f64,
+        side: Option<f64>,
     ) -> Result<crate::adaptivity::Estimate> {
         let _ = (solution, params, data, side);
         Err(Error::Input(format!(
@@ -270,7 +271,7 @@ impl Domain for IntervalMesh {
         solution: &ObstacleSolution<Self>,
         params: &[f64],
         data: &[&DataFn],
-        side: f64,
+        side: Option<f64>,
     ) -> Result<crate::adaptivity::Estimate> {
         crate::adaptivity::interval_estimate::<M>(solution, params, data, side)
     }
@@ -625,7 +626,7 @@ impl Domain for TriangleMesh {
         solution: &ObstacleSolution<Self>,
         params: &[f64],
         data: &[&DataFn],
-        side: f64,
+        side: Option<f64>,
     ) -> Result<crate::adaptivity::Estimate> {
         crate::adaptivity::triangle_estimate::<M>(solution, params, data, side)
     }

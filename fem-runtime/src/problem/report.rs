@@ -88,7 +88,10 @@ pub struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub estimate_relative: Option<f64>,
     /// The error in the estimator's norm, where an exact solution gives it: `|u − u_h|_H¹`
-    /// for second-order models, the broken H² seminorm for fourth-order ones.
+    /// for second-order models, the broken H² seminorm for fourth-order ones, in the
+    /// units of the energy norm (times `‖u_h‖_a / |u_h|`: exact where the energy density
+    /// is a constant times the seminorm's, as the plate's D; within the ν-dependent
+    /// norm equivalence for the plate).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error_energy: Option<f64>,
     /// `error_energy / ‖u_h‖_a`.
