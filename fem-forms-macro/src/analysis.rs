@@ -414,12 +414,15 @@ pub(crate) fn expand_expression(
 
 /// Expands an estimator's expression (a norm's body or its weight) with the analysed
 /// `forms` callable: on an edge (`edge`) the normal `n` and `h_E` are allowed.
+/// The entries of an estimator's expression: one for a scalar, one per component of a
+/// vector, one per entry of a matrix (a norm of a vector or matrix is the sum of its
+/// entries' squared norms).
 pub(crate) fn expand_estimator_expression(
     symbols: &Symbols,
     forms: &[Form],
     expr: &crate::parser::Expr,
     edge: bool,
-) -> Result<Expansion, Vec<Diagnostic>> {
+) -> Result<Vec<Expansion>, Vec<Diagnostic>> {
     let mut context = Context {
         symbols,
         forms,
@@ -428,8 +431,8 @@ pub(crate) fn expand_estimator_expression(
         facet: None,
         in_expression: edge,
     };
-    match context.expand(expr, true) {
-        Some(x) if context.errors.is_empty() => Ok(x),
+    match context.value(expr, true) {
+        Some(x) if context.errors.is_empty() => Ok(x.entries()),
         _ => Err(context.errors),
     }
 }

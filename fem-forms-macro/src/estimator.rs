@@ -143,7 +143,7 @@ pub fn analyse(
         let region = *region;
         for term in split_terms(body) {
             match context.term(region, term) {
-                Ok(t) => estimator.terms.push(t),
+                Ok(t) => estimator.terms.extend(t),
                 Err(mut e) => errors.append(&mut e),
             }
         }
@@ -181,8 +181,13 @@ struct Analysis<'a> {
 }
 
 impl Analysis<'_> {
-    /// One term `weight ‖body‖²` over `region`.
-    fn term(&self, region: Region, tokens: &[Token]) -> Result<IndicatorTerm, Vec<Diagnostic>> {
+    /// One term `weight ‖body‖²` over `region`: one indicator term per entry of the
+    /// body (a vector's components, a matrix's entries).
+    fn term(
+        &self,
+        region: Region,
+        tokens: &[Token],
+    ) -> Result<Vec<IndicatorTerm>, Vec<Diagnostic>> {
         let example = match region {
             Region::Cell => "h_T² ‖f + Δu + λ‖²",
             Region::Edge => "h_E ‖[[∇u·n]]‖²",
@@ -226,7 +231,18 @@ impl Analysis<'_> {
         let weight = if weight_tokens.is_empty() {
             vec![crate::symbolic::Monomial::constant(1.0, tokens[open].loc)]
         } else {
-            self.expand(weight_tokens, edge)?
+            match &self.expand(weight_tokens, edge)?[..] {
+                [weight] => weight.clone(),
+                _ => {
+                    return Err(vec![Diagnostic::text(
+                        span(weight_tokens),
+                        "the weight of a norm is a vector or a matrix",
+                    )
+                    .help(
+                        "a weight is a scalar of parameters and the element size (`h_T²`, `α h_E`)",
+                    )])
+                }
+            }
         };
         if let Some(m) = weight.iter().find(|m| !m.is_scalar() || m.normal != [0, 0]) {
             return Err(vec![Diagnostic::text(
@@ -235,21 +251,31 @@ impl Analysis<'_> {
             )
             .help("a weight is a scalar of parameters and the element size (`h_T²`, `α h_E`); move the rest into the norm")]);
         }
-        let residual = self.expand(body, edge)?;
-        self.check_residual(region, &residual, body)?;
+        let mut entries = self.expand(body, edge)?;
+        // a vector's vanishing component is no term; a norm of zero is an error below
+        entries.retain(|e| !e.is_empty());
+        if entries.is_empty() {
+            entries.push(Expansion::new());
+        }
+        for residual in &entries {
+            self.check_residual(region, residual, body)?;
+        }
         check_sizes(region, weight_tokens, body)?;
         let first = tokens[0].loc;
         let last = tokens[tokens.len() - 1].loc;
         let source = source_text(self.text, first, last);
-        Ok(IndicatorTerm {
-            region,
-            weight,
-            residual,
-            source,
-        })
+        Ok(entries
+            .into_iter()
+            .map(|residual| IndicatorTerm {
+                region,
+                weight: weight.clone(),
+                residual,
+                source: source.clone(),
+            })
+            .collect())
     }
 
-    fn expand(&self, tokens: &[Token], edge: bool) -> Result<Expansion, Vec<Diagnostic>> {
+    fn expand(&self, tokens: &[Token], edge: bool) -> Result<Vec<Expansion>, Vec<Diagnostic>> {
         let expr = crate::parser::parse_expression_calling(tokens, self.names, self.ordered)
             .map_err(|e| vec![e])?;
         expand_estimator_expression(self.symbols, self.forms, &expr, edge)
@@ -335,28 +361,40 @@ fn jump_inside<'t>(body: &'t [Token], example: &str) -> Result<&'t [Token], Vec<
     }
 }
 
-/// `h_T` on an edge and `h_E` on a cell are errors at the name.
+/// `h_E` on a cell, `h_T` in an edge's weight and `h_E` inside a jump are errors at the
+/// name: inside a jump `h_T` (or `h`) is the size of the cell on each side (a Stenberg
+/// weight `(t² + βh_T²)⁻¹` in a shear force), outside it the edge's length `h_E`.
 fn check_sizes(region: Region, weight: &[Token], body: &[Token]) -> Result<(), Vec<Diagnostic>> {
-    let (wrong, right) = match region {
-        Region::Cell => ("h_E", "h_T"),
-        Region::Edge => ("h_T", "h_E"),
+    let find = |tokens: &[Token], name: &str| {
+        tokens
+            .iter()
+            .find(|t| t.tok == Tok::Ident(name.into()))
+            .map(|t| t.loc)
     };
-    match weight
-        .iter()
-        .chain(body)
-        .find(|t| t.tok == Tok::Ident(wrong.into()))
-    {
-        Some(t) => Err(vec![Diagnostic::text(
-            t.loc,
-            format!(
-                "`{wrong}` in an `{}` line",
-                match region {
-                    Region::Cell => "η_T²",
-                    Region::Edge => "η_E²",
-                }
-            ),
-        )
-        .help(format!("the size there is `{right}`"))]),
+    let wrong = match region {
+        Region::Cell => find(weight, "h_E")
+            .or_else(|| find(body, "h_E"))
+            .map(|at| (at, "`h_E` in an `η_T²` line", "the size there is `h_T`")),
+        Region::Edge => find(weight, "h_T")
+            .map(|at| {
+                (
+                    at,
+                    "`h_T` in the weight of an `η_E²` line",
+                    "the size there is `h_E`; inside a jump `h_T` is each side's cell size",
+                )
+            })
+            .or_else(|| {
+                find(body, "h_E").map(|at| {
+                    (
+                        at,
+                        "`h_E` inside a jump",
+                        "inside `[[…]]` the size is each side's `h_T`; the edge's `h_E` goes in the weight",
+                    )
+                })
+            }),
+    };
+    match wrong {
+        Some((at, message, help)) => Err(vec![Diagnostic::text(at, message).help(help)]),
         None => Ok(()),
     }
 }

@@ -1234,6 +1234,8 @@ fn membrane_with_estimator(estimator: &str) -> TokenStream {
 fn an_estimator_expands_to_kernels() {
     for text in [
         "η_T² = h_T² ‖f + Δu + λ‖²\n η_E² = h_E ‖[[∇u·n]]‖²",
+        // a vector's norm (its components'), and each side's h_T inside a jump
+        "η_T² = h_T² ‖f + Δu + λ‖² + ‖∇u‖²\n η_E² = h_E ‖[[h_T ∇u·n]]‖² + ‖[[∇u]]‖²",
         "eta_T^2 = h_T^2 ||f + lap u + λ||^2\n eta_E^2 = h_E ||[[grad u dot n]]||^2",
     ] {
         let out = expand(membrane_with_estimator(text));
@@ -1257,6 +1259,8 @@ fn estimator_errors_point_at_the_place() {
         ("η_T² = u ‖f + Δu‖²", "weight"),
         ("η_T² = h_T² ‖f‖²", "does not depend on the solution"),
         ("η_E² = h_T ‖[[∇u·n]]‖²", "`h_T`"),
+        ("η_E² = h_E ‖[[h_E ∇u·n]]‖²", "`h_E` inside a jump"),
+        ("η_T² = ∇u ‖f + Δu + λ‖²", "weight of a norm is a vector"),
         ("η² = h_T² ‖f‖²", "expected `η_T² =`"),
         ("", "declares no indicator"),
     ];

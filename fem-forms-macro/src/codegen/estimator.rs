@@ -9,8 +9,9 @@
 //! the cell `x` (coefficients `c`, the `+` side, whose outward normal is `n`) and local
 //! edge `other` of its neighbour `y` (coefficients `e`); the jump `X⁺ − X⁻` is
 //! evaluated at Gauss–Legendre points of the edge, matched on the two sides whichever
-//! way the neighbour runs along it. `h` is the cell's longest edge in `cell` and the
-//! edge's length in `edge`. Neither allocates.
+//! way the neighbour runs along it. `h` is the cell's longest edge in `cell`; in `edge`
+//! it is the edge's length in the weight and each side's longest edge inside the jump
+//! (a Stenberg-weighted shear force on each side). Neither allocates.
 
 use super::emit::{coefficient, float, power, product};
 use super::triangle::{derivatives, k_polynomial_code, rule_for_degree, t_ident, transform};
@@ -314,10 +315,9 @@ fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
             "_m",
             &mut minus_table,
         );
-        let factors = std::iter::once(c)
-            .chain(data)
-            .chain(std::iter::once(quote!((#plus - #minus))));
-        let p = product(factors);
+        // inside a jump `h` is each side's cell size
+        let jump = quote!(({ let h = h_p; #c } * #plus - { let h = h_m; #c } * #minus));
+        let p = product(data.into_iter().chain(std::iter::once(jump)));
         body.push(quote!(r += #p;));
     }
     let weights = rule.weights.iter().map(|&w| float(w));
@@ -441,6 +441,14 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
                 d: &[&#runtime::DataFn; #nd],
             ) -> f64 {
                 assert!(edge < 3 && other < 3, "a triangle has local edges 0, 1 and 2");
+                // each side's size, as the cell kernel's `h`: its longest edge
+                let diameter = |z: &[f64; 6]| {
+                    let e = |a: usize, b: usize| {
+                        (z[2 * b] - z[2 * a]).powi(2) + (z[2 * b + 1] - z[2 * a + 1]).powi(2)
+                    };
+                    e(0, 1).max(e(1, 2)).max(e(2, 0)).sqrt()
+                };
+                let (h_p, h_m) = (diameter(x), diameter(y));
                 let (a, b) = (edge, (edge + 1) % 3);
                 let (tx, ty) = (x[2 * b] - x[2 * a], x[2 * b + 1] - x[2 * a + 1]);
                 let len = (tx * tx + ty * ty).sqrt();

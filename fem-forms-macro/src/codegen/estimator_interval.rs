@@ -9,7 +9,7 @@
 //! interior node: the node is end `end` (0: left, 1: right) of the cell `x` (the `+`
 //! side, whose outward normal is `n = ±1`) and end `other` of its neighbour `y`; a
 //! point's "norm" is the value of the jump `X⁺ − X⁻` there, and `h` the mean of the two
-//! cells' lengths (`../shared/MODELS.md` §8, Euler–Bernoulli). Neither allocates.
+//! cells' lengths in the weight, each side's length inside the jump (`../shared/MODELS.md` §8, Euler–Bernoulli). Neither allocates.
 
 use super::emit::{float, product};
 use super::estimator::{data_product, monomial_coefficient, residual_degree, weight_code};
@@ -159,11 +159,9 @@ fn node_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
             quote!(other),
             quote!(hinv_m),
         );
-        let p = product(
-            std::iter::once(c)
-                .chain(data)
-                .chain(std::iter::once(quote!((#plus - #minus)))),
-        );
+        // inside a jump `h` is each side's length
+        let jump = quote!(({ let h = h_p; #c } * #plus - { let h = h_m; #c } * #minus));
+        let p = product(data.into_iter().chain(std::iter::once(jump)));
         body.push(quote!(r += #p;));
     }
     let weight = weight_code(&term.weight);
@@ -241,7 +239,8 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
             ) -> f64 {
                 assert!(end < 2 && other < 2, "an interval has ends 0 and 1");
                 let (hinv_p, hinv_m) = (1.0 / (x[1] - x[0]), 1.0 / (y[1] - y[0]));
-                let h = 0.5 * ((x[1] - x[0]).abs() + (y[1] - y[0]).abs());
+                let (h_p, h_m) = ((x[1] - x[0]).abs(), (y[1] - y[0]).abs());
+                let h = 0.5 * (h_p + h_m);
                 let (n_x, n_y) = (if end == 1 { 1.0f64 } else { -1.0f64 }, 0.0f64);
                 let xq = [x[end]];
                 let mut eta2 = 0.0f64;

@@ -77,8 +77,9 @@ pub struct Estimate {
     /// Argyris and Morley, without nodes, `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T` with `m`
     /// the energy's derivative order replaces the first term).
     pub contact: f64,
-    /// `‖u_h‖_a = a(u_h, u_h)^{1/2}` of the constrained field with the model's energy
-    /// form: what a relative tolerance is relative to.
+    /// `‖u_h‖_a = a(u_h, u_h)^{1/2}` with the model's energy form over every primal
+    /// field (on intervals: of the constrained field): what a relative tolerance is
+    /// relative to.
     pub energy_norm: f64,
 }
 
@@ -329,6 +330,58 @@ impl ContactTerms {
     }
 }
 
+/// `a(u_h, u_h)` with the model's energy form over every primal field (every block of
+/// the form between two fields other than the multiplier): the plate's bending and shear
+/// energy together, where a field alone (w's shear block) would be no norm of the plate.
+///
+/// # Errors
+/// A model without an energy form, or whose energy form has no block.
+fn solution_energy<M: Model>(
+    mesh: &TriangleMesh,
+    fields: &[TriangleField],
+    multiplier: usize,
+    params: &[f64],
+    data: &[&DataFn],
+) -> Result<f64> {
+    let [a, _] = M::ENERGY.ok_or_else(|| {
+        Error::Input(format!(
+            "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
+            M::NAME
+        ))
+    })?;
+    let mut total = 0.0;
+    let mut k = Vec::new();
+    for (b, block) in M::FORMS[a].blocks.iter().enumerate() {
+        let (test, Some(trial)) = (block.test_field, block.trial_field) else {
+            continue;
+        };
+        if test == multiplier || trial == multiplier {
+            continue;
+        }
+        let (u, v) = (&fields[test], &fields[trial]);
+        let (nu, nv) = (u.map.local_count(), v.map.local_count());
+        k.resize(nu * nv, 0.0);
+        for c in 0..mesh.cell_count() {
+            let (du, dv) = (u.map.cell_dofs(c), v.map.cell_dofs(c));
+            M::element_matrix_on_cell(
+                a,
+                b,
+                &mesh.cell_coordinates(c),
+                &mesh.cell(c),
+                params,
+                data,
+                &mut k,
+            );
+            for (i, &di) in du.iter().enumerate() {
+                for (j, &dj) in dv.iter().enumerate() {
+                    total += u.coefficients[di] * k[i * nv + j] * v.coefficients[dj];
+                }
+            }
+        }
+    }
+    Ok(total)
+}
+
 /// The contact part `S` of the estimate (with each cell's share) and `‖u_h‖_a`.
 fn contact_terms<M: Model>(
     solution: &ObstacleSolution<TriangleMesh>,
@@ -341,7 +394,7 @@ fn contact_terms<M: Model>(
     let mesh = &d.mesh;
     let field = M::constrained_field();
     let u = &fields[field];
-    let energy = energy_product::<M>(mesh, u.map, field, u.coefficients, params, data)?;
+    let energy = solution_energy::<M>(mesh, fields, d.multiplier_field, params, data)?;
     let (Some([_, psi]), Some(side)) = (M::OBSTACLE, side) else {
         return Ok((ContactTerms::default(), energy.max(0.0).sqrt()));
     };

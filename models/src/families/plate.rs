@@ -188,6 +188,9 @@ impl Family for Plates {
             Opt::Cold,
             Opt::Support,
             Opt::NoObstacle,
+            Opt::Tol,
+            Opt::Marking,
+            Opt::Theta,
         ]
     }
 
