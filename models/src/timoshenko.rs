@@ -26,6 +26,10 @@ fem_runtime::model! {
         stabilization: α S against a;
         side:          s;
         obstacle:      w >= ψ;
+        estimator:     "
+            η_T² = h_T² ‖θ'' + t⁻²(w' − θ)‖² + h_T²(t² + h_T²) ‖t⁻²(w'' − θ') + f + sλ‖²
+            η_E² = h_E ‖[[θ']]‖² + h_E(t² + h_E²) ‖[[t⁻²(w' − θ)]]‖²
+        ";
     }
 }
 

@@ -82,7 +82,8 @@ pub fn interval_estimate<M: Model>(
         )));
     }
     let field = M::constrained_field();
-    let energy = energy_product::<M>(&views[field], field, params, data)?;
+    let multiplier = solution.discretization.multiplier_field;
+    let energy = energy_product::<M>(&views, multiplier, params, data)?;
     let contact = match (M::OBSTACLE, side) {
         (Some([_, psi]), Some(side)) => {
             let multiplier = &views[solution.discretization.multiplier_field];
@@ -98,27 +99,43 @@ pub fn interval_estimate<M: Model>(
     ))
 }
 
-/// `a(u_h, u_h)` of field `field` with the model's energy form, summed from its element
-/// matrices.
+/// `a(u_h, u_h)` with the model's energy form over every primal field (every block
+/// between two fields other than the multiplier: a Timoshenko beam's bending and shear
+/// together), summed from the element matrices.
 ///
 /// # Errors
-/// A model without an energy form, or whose energy form has no (field, field) block.
+/// A model without an energy form.
 fn energy_product<M: Model>(
-    view: &FieldView,
-    field: usize,
+    views: &[FieldView],
+    multiplier: usize,
     params: &[f64],
     data: &[&DataFn],
 ) -> Result<f64> {
-    let (a, block) = super::energy_block::<M>(field)?;
-    let n = view.map.local_count();
-    let mut k = vec![0.0; n * n];
+    let [a, _] = M::ENERGY.ok_or_else(|| {
+        Error::Input(format!(
+            "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
+            M::NAME
+        ))
+    })?;
     let mut total = 0.0;
-    for c in 0..view.mesh.cell_count() {
-        let u = view.local(c);
-        M::element_matrix(a, block, &view.mesh.cell(c), params, data, &mut k);
-        for i in 0..n {
-            for j in 0..n {
-                total += u[i] * k[i * n + j] * u[j];
+    let mut k = Vec::new();
+    for (b, block) in M::FORMS[a].blocks.iter().enumerate() {
+        let (test, Some(trial)) = (block.test_field, block.trial_field) else {
+            continue;
+        };
+        if test == multiplier || trial == multiplier {
+            continue;
+        }
+        let (u, v) = (&views[test], &views[trial]);
+        let (nu, nv) = (u.map.local_count(), v.map.local_count());
+        k.resize(nu * nv, 0.0);
+        for c in 0..u.mesh.cell_count() {
+            let (lu, lv) = (u.local(c), v.local(c));
+            M::element_matrix(a, b, &u.mesh.cell(c), params, data, &mut k);
+            for i in 0..nu {
+                for j in 0..nv {
+                    total += lu[i] * k[i * nv + j] * lv[j];
+                }
             }
         }
     }

@@ -78,8 +78,7 @@ pub struct Estimate {
     /// the energy's derivative order replaces the first term).
     pub contact: f64,
     /// `‖u_h‖_a = a(u_h, u_h)^{1/2}` with the model's energy form over every primal
-    /// field (on intervals: of the constrained field): what a relative tolerance is
-    /// relative to.
+    /// field: what a relative tolerance is relative to.
     pub energy_norm: f64,
 }
 
