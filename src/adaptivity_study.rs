@@ -11,18 +11,9 @@
 
 use crate::plot::{self, Axes, Series};
 use crate::studies::{io, output, write_csv_named, Row, Run, Study, StudyScene};
-use fem_models::geometry::Fields;
 use fem_runtime::adaptivity::AdaptiveLevel;
 use fem_runtime::Result;
 use std::path::Path;
-
-/// An adaptive run of a study: its levels and the final level's fields.
-pub struct AdaptiveRun {
-    /// Every level, first to last.
-    pub levels: Vec<AdaptiveLevel>,
-    /// The final mesh's fields (λ_h and the contact share per cell).
-    pub fields: Fields,
-}
 
 /// The least-squares slope of `ln y` against `ln x` over the second half of `points`
 /// (positive values only): the rate a run settles to, `NaN` with fewer than two points.

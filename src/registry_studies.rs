@@ -439,7 +439,7 @@ impl StudyScene for RegistryStudies {
         pair: &'static str,
         size: usize,
         tolerance: f64,
-    ) -> Result<crate::adaptivity_study::AdaptiveRun> {
+    ) -> Result<crate::studies::AdaptiveRun> {
         let settings = Settings {
             pair: Some(pair.to_string()),
             load: self.scene.study_load,
@@ -451,10 +451,15 @@ impl StudyScene for RegistryStudies {
             ..Settings::default()
         };
         let outcome = families::solve(&self.scene, &settings)?;
-        Ok(crate::adaptivity_study::AdaptiveRun {
+        Ok(crate::studies::AdaptiveRun {
             levels: outcome.report.solve.adaptive_levels,
             fields: outcome.fields,
         })
+    }
+
+    /// The one adaptivity study ([`crate::adaptivity_study`]).
+    fn adaptivity(&self, full: bool, out: &std::path::Path) -> Result<()> {
+        crate::adaptivity_study::run(self, full, out)
     }
 
     /// The one locking study ([`crate::locking`]).

@@ -351,9 +351,12 @@ pub fn summary(r: &Report) -> String {
         ));
     }
     if let Some(estimate) = s.estimate {
+        // relative to a norm of 0 (an unloaded plate) there is no ratio to show
+        let relative = s
+            .estimate_relative
+            .map_or(String::new(), |r| format!(" ({r:.2e} of ‖u_h‖_a)"));
         let mut line = format!(
-            "  estimate: (η² + S²)^½ = {estimate:.3e} ({:.2e} of ‖u_h‖_a), contact part S {:.3e}",
-            s.estimate_relative.unwrap_or(f64::NAN),
+            "  estimate: (η² + S²)^½ = {estimate:.3e}{relative}, contact part S {:.3e}",
             s.estimate_contact.unwrap_or(0.0)
         );
         if let Some(index) = s.efficiency_index {

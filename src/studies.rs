@@ -33,8 +33,8 @@ pub enum Study {
     /// Newton iterations with nested iteration and from a cold start.
     Iterations,
     /// Uniform refinement against the adaptive loop: error and estimate against
-    /// unknowns, the efficiency index, error against time, the final mesh
-    /// ([`crate::adaptivity_study`]).
+    /// unknowns, the efficiency index, error against time, the final mesh (the module
+    /// `adaptivity_study`).
     Adaptivity,
 }
 
@@ -158,6 +158,15 @@ pub struct Row {
     pub warnings: Vec<String>,
 }
 
+/// An adaptive run of the adaptivity study (the module `adaptivity_study`): its levels
+/// and the final level's fields.
+pub struct AdaptiveRun {
+    /// Every level, first to last.
+    pub levels: Vec<fem_runtime::adaptivity::AdaptiveLevel>,
+    /// The final mesh's fields (λ_h and the contact share per cell).
+    pub fields: fem_models::geometry::Fields,
+}
+
 /// One mesh and pair of the stability study: the family's measure of the multiplier
 /// problem for the plain (α = 0) and the stabilized method.
 #[derive(Clone, Debug)]
@@ -270,15 +279,17 @@ pub trait StudyScene {
     ///
     /// # Errors
     /// Scenes without adaptive solves (the default), and the solve's.
-    fn adaptive(
-        &self,
-        pair: &'static str,
-        size: usize,
-        tolerance: f64,
-    ) -> Result<crate::adaptivity_study::AdaptiveRun> {
+    fn adaptive(&self, pair: &'static str, size: usize, tolerance: f64) -> Result<AdaptiveRun> {
         let _ = (pair, size, tolerance);
         Err(Error::Input(format!(
             "scene `{}` has no adaptive solve",
+            self.name()
+        )))
+    }
+    /// The adaptivity study (scenes whose pair declares an estimator).
+    fn adaptivity(&self, _full: bool, _out: &Path) -> Result<()> {
+        Err(Error::Input(format!(
+            "scene `{}` has no adaptivity study",
             self.name()
         )))
     }
@@ -1481,7 +1492,7 @@ pub fn run(scene: &dyn StudyScene, study: Study, full: bool, out: &Path) -> Resu
         Study::Alpha => run_alpha(scene, full, out),
         Study::WorkPrecision => run_work_precision(scene, full, out),
         Study::Iterations => run_iterations(scene, full, out),
-        Study::Adaptivity => crate::adaptivity_study::run(scene, full, out),
+        Study::Adaptivity => scene.adaptivity(full, out),
     }?;
     println!(
         "→ {}, .csv\n",

@@ -961,8 +961,23 @@ fn adaptive_options_are_checked() {
             "declares no estimator",
         ),
         (
-            vec!["solve", "bernoulli-flat", "--tol", "0.1"],
+            vec!["solve", "signorini-patch", "--tol", "0.1"],
             "--tol does not apply",
+        ),
+        (
+            vec![
+                "solve",
+                "timoshenko-a",
+                "--tol",
+                "0.1",
+                "--pair",
+                "p1-p1-p0-reduced",
+            ],
+            "declares no estimator",
+        ),
+        (
+            vec!["solve", "mindlin-disk", "--tol", "0.1"],
+            "affine triangle meshes",
         ),
     ] {
         let run = fem_forms(&args, &out);

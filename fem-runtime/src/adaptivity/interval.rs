@@ -111,12 +111,7 @@ fn energy_product<M: Model>(
     params: &[f64],
     data: &[&DataFn],
 ) -> Result<f64> {
-    let [a, _] = M::ENERGY.ok_or_else(|| {
-        Error::Input(format!(
-            "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
-            M::NAME
-        ))
-    })?;
+    let a = super::energy_form::<M>()?;
     let mut total = 0.0;
     let mut k = Vec::new();
     for (b, block) in M::FORMS[a].blocks.iter().enumerate() {

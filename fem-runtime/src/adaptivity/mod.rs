@@ -219,17 +219,25 @@ pub fn triangle_estimate<M: Model>(
     Ok(Estimate::of(indicators, sum, contact, energy_norm))
 }
 
+/// The index of the model's energy form (`energy: a, ℓ;`).
+///
+/// # Errors
+/// A model without an energy form: the energy norm needs it.
+pub(crate) fn energy_form<M: Model>() -> Result<usize> {
+    M::ENERGY.map(|[a, _]| a).ok_or_else(|| {
+        Error::Input(format!(
+            "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
+            M::NAME
+        ))
+    })
+}
+
 /// The energy form of the model and its (`field`, `field`) block.
 ///
 /// # Errors
 /// A model without an energy form, or whose energy form has no such block.
 fn energy_block<M: Model>(field: usize) -> Result<(usize, usize)> {
-    let [a, _] = M::ENERGY.ok_or_else(|| {
-        Error::Input(format!(
-            "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
-            M::NAME
-        ))
-    })?;
+    let a = energy_form::<M>()?;
     let block = M::FORMS[a]
         .blocks
         .iter()
@@ -342,12 +350,7 @@ fn solution_energy<M: Model>(
     params: &[f64],
     data: &[&DataFn],
 ) -> Result<f64> {
-    let [a, _] = M::ENERGY.ok_or_else(|| {
-        Error::Input(format!(
-            "model `{}` declares no energy form (`energy: a, ℓ;`): the energy norm needs it",
-            M::NAME
-        ))
-    })?;
+    let a = energy_form::<M>()?;
     let mut total = 0.0;
     let mut k = Vec::new();
     for (b, block) in M::FORMS[a].blocks.iter().enumerate() {

@@ -137,6 +137,10 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
         ))
     }
 
+    /// Whether [`Domain::estimate`] and [`Domain::refine_marked`] exist on this geometry:
+    /// a plain solve of a model with an estimator reports no estimate where they do not.
+    const ESTIMATES: bool = false;
+
     /// The a-posteriori estimate of `solution` with the model's `estimator:` kernels and
     /// the contact terms ([`crate::adaptivity::triangle_estimate`]); `side` is the
     /// obstacle's sign, `None` for a problem solved without its constraint (no contact
@@ -267,6 +271,8 @@ fn boundary_data<M: Model>(field: usize) -> Result<usize> {
 }
 
 impl Domain for IntervalMesh {
+    const ESTIMATES: bool = true;
+
     fn estimate<M: Model>(
         solution: &ObstacleSolution<Self>,
         params: &[f64],
@@ -622,6 +628,8 @@ fn triangle_constraints<M: Model>(
 }
 
 impl Domain for TriangleMesh {
+    const ESTIMATES: bool = true;
+
     fn estimate<M: Model>(
         solution: &ObstacleSolution<Self>,
         params: &[f64],

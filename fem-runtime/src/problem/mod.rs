@@ -581,6 +581,12 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 M::NAME
             )));
         }
+        if !G::ESTIMATES {
+            return Err(Error::Input(format!(
+                "model `{}`: estimates and adaptive refinement are computed on intervals and affine triangle meshes, not on this mesh's curved cells",
+                M::NAME
+            )));
+        }
         let tolerance = options.tolerance;
         if !(tolerance > 0.0 && tolerance.is_finite()) {
             return Err(Error::Input(format!(
@@ -594,7 +600,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             let estimate = current
                 .estimate
                 .as_ref()
-                .expect("a model with an estimator reports one");
+                .expect("a model with an estimator reports one on a geometry that estimates");
             let level = AdaptiveLevel {
                 cells: current.report.cells,
                 dofs: current.report.dofs,
@@ -773,7 +779,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 &mut report,
             )?;
         }
-        let estimate = if M::HAS_ESTIMATOR {
+        let estimate = if M::HAS_ESTIMATOR && G::ESTIMATES {
             Some(self.record_estimate(&solution, &params, &data, &mut report)?)
         } else {
             None

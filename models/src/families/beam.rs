@@ -171,9 +171,8 @@ pub fn beam_scene(old: &crate::scenes::Scene) -> Scene {
             gradient: Some(Data::shared(move |x| [(slope.w)(x[0], 1), 0.0])),
             // w'' (the energy norm ‖w''‖ of Euler–Bernoulli, and its estimator's); a
             // Timoshenko beam's energy norm is not w's H² seminorm
-            hessian: (old.beam == Beam::EulerBernoulli).then(|| {
-                Data::shared(move |x| [[(curvature.w)(x[0], 2), 0.0], [0.0, 0.0]])
-            }),
+            hessian: (old.beam == Beam::EulerBernoulli)
+                .then(|| Data::shared(move |x| [[(curvature.w)(x[0], 2), 0.0], [0.0, 0.0]])),
             multiplier: flat_obstacle_multiplier(&old, q, &e.contact_set),
             contact_area: Some(e.contact_set.iter().map(|c| c[1] - c[0]).sum()),
             contact_set: Some(e.contact_set.clone()),
