@@ -41,12 +41,7 @@ pub fn interval_estimate<M: Model>(
     data: &[&DataFn],
     side: Option<f64>,
 ) -> Result<Estimate> {
-    if !M::HAS_ESTIMATOR {
-        return Err(Error::Input(format!(
-            "model `{}` declares no estimator (`estimator:` in its model file)",
-            M::NAME
-        )));
-    }
+    super::require_estimator::<M>()?;
     let mesh = &solution.discretization.mesh;
     let views: Vec<FieldView> = (0..M::FIELDS.len()).map(|f| solution.view(f)).collect();
     let local = |c: usize| -> Vec<Vec<f64>> {

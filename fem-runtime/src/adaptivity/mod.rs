@@ -154,7 +154,7 @@ fn fields<'a, M: Model>(
 /// (no contact terms).
 ///
 /// # Errors
-/// A model without an estimator or an energy form, a multiplier on a boundary part, a
+/// A model without an estimator or an energy form, a multiplier on a boundary part,
 /// and indicators that are not finite (the message names the cell).
 pub fn triangle_estimate<M: Model>(
     solution: &ObstacleSolution<TriangleMesh>,
@@ -162,12 +162,7 @@ pub fn triangle_estimate<M: Model>(
     data: &[&DataFn],
     side: Option<f64>,
 ) -> Result<Estimate> {
-    if !M::HAS_ESTIMATOR {
-        return Err(Error::Input(format!(
-            "model `{}` declares no estimator (`estimator:` in its model file)",
-            M::NAME
-        )));
-    }
+    require_estimator::<M>()?;
     let fields = fields::<M>(solution)?;
     let mesh = &solution.discretization.mesh;
     let mut indicators = vec![0.0; mesh.cell_count()];
@@ -217,6 +212,18 @@ pub fn triangle_estimate<M: Model>(
     }
     let (contact, energy_norm) = contact_terms::<M>(solution, &fields, params, data, side)?;
     Ok(Estimate::of(indicators, sum, contact, energy_norm))
+}
+
+/// An error for a model without an `estimator:` section.
+pub(crate) fn require_estimator<M: Model>() -> Result<()> {
+    if M::HAS_ESTIMATOR {
+        Ok(())
+    } else {
+        Err(Error::Input(format!(
+            "model `{}` declares no estimator (`estimator:` in its model file)",
+            M::NAME
+        )))
+    }
 }
 
 /// The index of the model's energy form (`energy: a, ℓ;`).
@@ -284,29 +291,15 @@ fn cell_energies<M: Model>(
     data: &[&DataFn],
 ) -> Result<Vec<f64>> {
     let (a, block) = energy_block::<M>(field)?;
-    let n = map.local_count();
-    let mut k = vec![0.0; n * n];
     let mut energies = vec![0.0; mesh.cell_count()];
-    for (c, energy) in energies.iter_mut().enumerate() {
-        let dofs = map.cell_dofs(c);
-        if dofs.iter().all(|&d| v[d] == 0.0) {
-            continue;
-        }
-        M::element_matrix_on_cell(
-            a,
-            block,
-            &mesh.cell_coordinates(c),
-            &mesh.cell(c),
-            params,
-            data,
-            &mut k,
-        );
-        for (i, &di) in dofs.iter().enumerate() {
-            for (j, &dj) in dofs.iter().enumerate() {
-                *energy += v[di] * k[i * n + j] * v[dj];
-            }
-        }
-    }
+    add_block_energies::<M>(
+        mesh,
+        [a, block],
+        [(map, v), (map, v)],
+        params,
+        data,
+        &mut energies,
+    );
     Ok(energies)
 }
 
@@ -337,6 +330,41 @@ impl ContactTerms {
     }
 }
 
+/// Adds to each cell's entry of `energies` its `u_Tᵀ K_T v_T` for block `[form, block]`
+/// of the model's forms, `u` and `v` the (map, coefficients) of the block's test and
+/// trial fields; cells where either vanishes are skipped.
+fn add_block_energies<M: Model>(
+    mesh: &TriangleMesh,
+    [form, block]: [usize; 2],
+    [(map_u, u), (map_v, v)]: [(&crate::assembly::dof_map::DofMap, &[f64]); 2],
+    params: &[f64],
+    data: &[&DataFn],
+    energies: &mut [f64],
+) {
+    let (nu, nv) = (map_u.local_count(), map_v.local_count());
+    let mut k = vec![0.0; nu * nv];
+    for (c, energy) in energies.iter_mut().enumerate() {
+        let (du, dv) = (map_u.cell_dofs(c), map_v.cell_dofs(c));
+        if du.iter().all(|&d| u[d] == 0.0) || dv.iter().all(|&d| v[d] == 0.0) {
+            continue;
+        }
+        M::element_matrix_on_cell(
+            form,
+            block,
+            &mesh.cell_coordinates(c),
+            &mesh.cell(c),
+            params,
+            data,
+            &mut k,
+        );
+        for (i, &di) in du.iter().enumerate() {
+            for (j, &dj) in dv.iter().enumerate() {
+                *energy += u[di] * k[i * nv + j] * v[dj];
+            }
+        }
+    }
+}
+
 /// `a(u_h, u_h)` with the model's energy form over every primal field (every block of
 /// the form between two fields other than the multiplier): the plate's bending and shear
 /// energy together, where a field alone (w's shear block) would be no norm of the plate.
@@ -351,8 +379,7 @@ fn solution_energy<M: Model>(
     data: &[&DataFn],
 ) -> Result<f64> {
     let a = energy_form::<M>()?;
-    let mut total = 0.0;
-    let mut k = Vec::new();
+    let mut energies = vec![0.0; mesh.cell_count()];
     for (b, block) in M::FORMS[a].blocks.iter().enumerate() {
         let (test, Some(trial)) = (block.test_field, block.trial_field) else {
             continue;
@@ -361,27 +388,16 @@ fn solution_energy<M: Model>(
             continue;
         }
         let (u, v) = (&fields[test], &fields[trial]);
-        let (nu, nv) = (u.map.local_count(), v.map.local_count());
-        k.resize(nu * nv, 0.0);
-        for c in 0..mesh.cell_count() {
-            let (du, dv) = (u.map.cell_dofs(c), v.map.cell_dofs(c));
-            M::element_matrix_on_cell(
-                a,
-                b,
-                &mesh.cell_coordinates(c),
-                &mesh.cell(c),
-                params,
-                data,
-                &mut k,
-            );
-            for (i, &di) in du.iter().enumerate() {
-                for (j, &dj) in dv.iter().enumerate() {
-                    total += u.coefficients[di] * k[i * nv + j] * v.coefficients[dj];
-                }
-            }
-        }
+        add_block_energies::<M>(
+            mesh,
+            [a, b],
+            [(u.map, u.coefficients), (v.map, v.coefficients)],
+            params,
+            data,
+            &mut energies,
+        );
     }
-    Ok(total)
+    Ok(energies.iter().sum())
 }
 
 /// The contact part `S` of the estimate (with each cell's share) and `‖u_h‖_a`.
