@@ -1584,6 +1584,27 @@ impl<'a> Context<'a> {
                 }
                 Some(Value::Scalar(p))
             }
+            ExprKind::Vector(a, b) => {
+                let x = self.value(a, inside_integral);
+                let y = self.value(b, inside_integral);
+                let (x, y) = (x?, y?);
+                if self.symbols.dimension != 2 {
+                    return self.fail_value(
+                        Diagnostic::text(loc, "a vector `(X, Y)` on an interval")
+                            .help("vectors have two components, on triangles; on intervals every quantity is a scalar"),
+                    );
+                }
+                match (x, y) {
+                    (Value::Scalar(x), Value::Scalar(y)) => Some(Value::Vector(vec![x, y])),
+                    (x, y) => {
+                        let wrong = if matches!(x, Value::Scalar(_)) { &y } else { &x };
+                        self.fail_value(
+                            Diagnostic::text(loc, format!("a vector `(X, Y)` of {}", wrong.shape()))
+                                .help("the components of a vector `(X, Y)` are scalars: `(n_c_x, n_c_y)`; an L² product over elements is written `(X, Y)_T`"),
+                        )
+                    }
+                }
+            }
             _ => self.scalar_value(e, inside_integral).map(Value::Scalar),
         }
     }

@@ -105,6 +105,9 @@ pub struct RolesDecl {
     pub side: Option<Ident>,
     /// `obstacle: w >= ψ;`: the constrained field and the obstacle's data function.
     pub obstacle: Option<(Ident, Ident)>,
+    /// `constraint: b, G;`: the constraint's forms, `b(v, μ) = (μ, sBv)` and
+    /// `G(μ) = (μ, sψ)`.
+    pub constraint: Option<(Ident, Ident)>,
 }
 
 /// Everything the macro input declares.
@@ -147,7 +150,7 @@ pub struct Declaration {
 }
 
 /// The sections a model may have.
-const SECTIONS: [&str; 13] = [
+const SECTIONS: [&str; 14] = [
     "unknowns",
     "tests",
     "params",
@@ -160,6 +163,7 @@ const SECTIONS: [&str; 13] = [
     "stabilization",
     "side",
     "obstacle",
+    "constraint",
     "estimator",
 ];
 
@@ -435,6 +439,9 @@ impl Parse for Declaration {
                     declaration.roles.system = Some(name_pair(&content, "system: B_h, L_h")?)
                 }
                 "energy" => declaration.roles.energy = Some(name_pair(&content, "energy: a, ℓ")?),
+                "constraint" => {
+                    declaration.roles.constraint = Some(name_pair(&content, "constraint: b, G")?)
+                }
                 "stabilization" => declaration.roles.stabilization = Some(stabilization(&content)?),
                 "side" => declaration.roles.side = Some(content.parse()?),
                 "obstacle" => declaration.roles.obstacle = Some(obstacle(&content)?),

@@ -18,6 +18,13 @@
 //! the unit normal and `τ = (−n_y, n_x)` the unit tangent (`τ·∇X` the tangential
 //! derivative, as in the Kirchhoff shear `V_n = Q·n + ∂_s M_ns`).
 //!
+//! `η_Γ²`, for a boundary part `Γ` of the model's `facets:` (`η_Γ_C²`, ASCII
+//! `eta_Gamma_C^2` for a part declared `Gamma_C`), is the squared indicator of each edge
+//! of that part: weighted squared norms over the edge of residuals of the boundary
+//! condition, traced from the one cell next to it (`n` its outward normal), with data
+//! (`h_E ‖σ(u)·n + q n‖²` on a loaded part, `h_E ‖σ(u)·n + λ (n_c_x, n_c_y)‖²` on a
+//! contact part).
+//!
 //! Every mistake is a compile error at the place in the estimator text.
 
 use crate::analysis::{expand_estimator_expression, Form, Symbols};
@@ -33,6 +40,17 @@ pub enum Region {
     Cell,
     /// Over each interior edge, of a jump: `h_E^p ‖[[X]]‖²_E`.
     Edge,
+    /// Over each edge of the boundary part with this index in the model's `facets:`, of
+    /// a residual traced from the edge's cell: `h_E^p ‖R‖²_E`.
+    Boundary(usize),
+}
+
+impl Region {
+    /// Whether the terms are integrated over edges (interior or boundary): `n`, `τ`
+    /// and `h_E` exist there.
+    pub fn on_edges(self) -> bool {
+        self != Region::Cell
+    }
 }
 
 /// One weighted squared norm of the estimator.
@@ -81,13 +99,19 @@ fn span(tokens: &[Token]) -> Loc {
     }
 }
 
-/// The region a line's head names: `η_T²` or `η_E²` (ASCII `eta_T^2`), with the number of
-/// tokens it takes.
-fn head(tokens: &[Token]) -> Option<(Region, usize)> {
-    let region = match &tokens.first()?.tok {
-        Tok::Ident(name) if name == "η_T" || name == "eta_T" => Region::Cell,
-        Tok::Ident(name) if name == "η_E" || name == "eta_E" => Region::Edge,
-        _ => return None,
+/// The region a line's head names: `η_T²`, `η_E²` or `η_Γ²` for a boundary part `Γ`
+/// of `facets` (ASCII `eta_T^2`), with the number of tokens it takes.
+fn head(tokens: &[Token], facets: &[String]) -> Option<(Region, usize)> {
+    let Tok::Ident(name) = &tokens.first()?.tok else {
+        return None;
+    };
+    let rest = name
+        .strip_prefix("η_")
+        .or_else(|| name.strip_prefix("eta_"))?;
+    let region = match rest {
+        "T" => Region::Cell,
+        "E" => Region::Edge,
+        part => Region::Boundary(facets.iter().position(|f| f == part)?),
     };
     let squared = match (&tokens.get(1)?.tok, tokens.get(2).map(|t| &t.tok)) {
         (Tok::Superscript(Ok(2), _), _) => 2,
@@ -130,12 +154,12 @@ pub fn analyse(
     // a line that does not start with a head continues the one above
     let mut definitions: Vec<(Region, Vec<Token>)> = Vec::new();
     for line in lines {
-        match (head(line), definitions.last_mut()) {
+        match (head(line, &symbols.facets), definitions.last_mut()) {
             (Some((region, skip)), _) => definitions.push((region, line[skip..].to_vec())),
             (None, Some((_, body))) => body.extend_from_slice(line),
             (None, None) => errors.push(
-                Diagnostic::text(line[0].loc, "expected `η_T² =` or `η_E² =`")
-                    .help("each line of the estimator is a cell's squared indicator `η_T² = …` or an interior edge's `η_E² = …` (a line that starts otherwise continues the one above)"),
+                Diagnostic::text(line[0].loc, "expected `η_T² =`, `η_E² =` or `η_Γ² =` of a boundary part")
+                    .help(format!("each line of the estimator is a cell's squared indicator `η_T² = …`, an interior edge's `η_E² = …` or the edges' of a boundary part declared under `facets:` ({}) (a line that starts otherwise continues the one above)", if symbols.facets.is_empty() { "this model declares none".to_string() } else { symbols.facets.iter().map(|f| format!("`η_{f}² = …`")).collect::<Vec<_>>().join(", ") })),
             ),
         }
     }
@@ -191,7 +215,15 @@ impl Analysis<'_> {
         let example = match region {
             Region::Cell => "h_T² ‖f + Δu + λ‖²",
             Region::Edge => "h_E ‖[[∇u·n]]‖²",
+            Region::Boundary(_) => "h_E ‖σ(u)·n + q n‖²",
         };
+        if matches!(region, Region::Boundary(_)) && self.symbols.dimension != 2 {
+            return Err(vec![Diagnostic::text(
+                span(tokens),
+                "a boundary part's indicator on an interval",
+            )
+            .help("boundary parts are edges of triangles; on an interval the indicators are `η_T²` and the interior nodes' `η_E²`")]);
+        }
         let bars: Vec<usize> = (0..tokens.len())
             .filter(|&i| tokens[i].tok == Tok::Norm)
             .collect();
@@ -220,14 +252,14 @@ impl Analysis<'_> {
         let weight_tokens = &tokens[..open];
         let body = &tokens[open + 1..close];
         let body = match region {
-            Region::Cell => body,
             Region::Edge => jump_inside(body, example)?,
+            Region::Cell | Region::Boundary(_) => body,
         };
         if body.is_empty() {
             return Err(vec![Diagnostic::text(tokens[open].loc, "an empty norm")
                 .help(format!("write `{example}`"))]);
         }
-        let edge = region == Region::Edge;
+        let edge = region.on_edges();
         let weight = if weight_tokens.is_empty() {
             vec![crate::symbolic::Monomial::constant(1.0, tokens[open].loc)]
         } else {
@@ -326,7 +358,9 @@ impl Analysis<'_> {
                     span(body),
                     "the normal `n` in a cell's residual",
                 )
-                .help("`n` exists on edges: use it in `η_E²`")]);
+                .help(
+                    "`n` exists on edges: use it in `η_E²` or a boundary part's `η_Γ²`",
+                )]);
             }
         }
         if residual.iter().all(|m| m.args.is_empty()) {
@@ -375,6 +409,23 @@ fn check_sizes(region: Region, weight: &[Token], body: &[Token]) -> Result<(), V
         Region::Cell => find(weight, "h_E")
             .or_else(|| find(body, "h_E"))
             .map(|at| (at, "`h_E` in an `η_T²` line", "the size there is `h_T`")),
+        Region::Boundary(_) => find(weight, "h_T")
+            .map(|at| {
+                (
+                    at,
+                    "`h_T` in the weight of a boundary part's line",
+                    "the size there is the edge's `h_E`; inside the norm `h_T` is the size of the edge's cell",
+                )
+            })
+            .or_else(|| {
+                find(body, "h_E").map(|at| {
+                    (
+                        at,
+                        "`h_E` inside the norm of a boundary part's line",
+                        "inside the norm the size is the edge's cell's `h_T`; the edge's `h_E` goes in the weight",
+                    )
+                })
+            }),
         Region::Edge => find(weight, "h_T")
             .map(|at| {
                 (

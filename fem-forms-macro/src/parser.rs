@@ -87,6 +87,8 @@ pub enum ExprKind {
     Contract(Box<Expr>, Box<Expr>),
     /// `(x, y)_T`
     InnerProduct(Box<Expr>, Box<Expr>),
+    /// `(x, y)`: the vector of two scalars (in 2D).
+    Vector(Box<Expr>, Box<Expr>),
     /// `∫ body`, `Σ_T body` or `∫_Γ body ds`
     Integral {
         /// Which notation.
@@ -304,7 +306,8 @@ fn too_deep(body: &Expr) -> Option<Loc> {
             ExprKind::Mul(a, b)
             | ExprKind::Div(a, b)
             | ExprKind::Contract(a, b)
-            | ExprKind::InnerProduct(a, b) => {
+            | ExprKind::InnerProduct(a, b)
+            | ExprKind::Vector(a, b) => {
                 stack.push((a, depth + 1));
                 stack.push((b, depth + 1));
             }
@@ -354,6 +357,7 @@ fn power_too_large(body: &Expr) -> Option<(Loc, f64)> {
             | ExprKind::Div(a, b)
             | ExprKind::Contract(a, b)
             | ExprKind::InnerProduct(a, b) => bound(a, worst) + bound(b, worst),
+            ExprKind::Vector(a, b) => bound(a, worst).max(bound(b, worst)),
             ExprKind::Neg(a)
             | ExprKind::Derivative(a, _)
             | ExprKind::Gradient(a)
@@ -1058,11 +1062,10 @@ impl<'a> Parser<'a> {
                             loc.to(end),
                         ))
                     }
-                    (Some(_), false) => Err(Diagnostic::text(
+                    (Some(second), false) => Ok(Expr::new(
+                        ExprKind::Vector(Box::new(first), Box::new(second)),
                         loc.to(close),
-                        "a pair `(X, Y)` is only meaningful as an L² product over elements",
-                    )
-                    .help("write `(X, Y)_T` inside `Σ_T`, or `∫ X·Y`")),
+                    )),
                     (None, true) => {
                         Err(Diagnostic::text(self.here(), "`(X)_T` needs two arguments")
                             .help("an L² product over an element is written `(X, Y)_T`"))
@@ -1230,6 +1233,7 @@ mod tests {
             Trace(a) => format!("(tr {})", sexpr(a)),
             Contract(a, b) => format!("(: {} {})", sexpr(a), sexpr(b)),
             InnerProduct(a, b) => format!("(ip {} {})", sexpr(a), sexpr(b)),
+            Vector(a, b) => format!("(vec {} {})", sexpr(a), sexpr(b)),
             Integral { degree, body, .. } => format!("(int{degree:?} {})", sexpr(body)),
             Call { name, groups } => format!(
                 "(call {name} {})",

@@ -27,6 +27,8 @@ pub struct Roles {
     pub side: Option<usize>,
     /// `(field, data)`: the constrained field and the obstacle.
     pub obstacle: Option<(usize, usize)>,
+    /// `[b, G]`: the constraint `b(v, μ) = (μ, sBv)`, `G(μ) = (μ, sψ)`.
+    pub constraint: Option<[usize; 2]>,
     /// The order `p` of the operator whose residual the stabilization measures: the
     /// power of h in the stabilization's terms (`Σ_T h_T^p (…)`), or else the total
     /// derivative order of the energy's bilinear form; 0 where neither is known.
@@ -46,6 +48,7 @@ pub fn resolve(
         stabilization,
         side,
         obstacle,
+        constraint,
     } = &declaration.roles;
     let mut lookup = Lookup {
         forms,
@@ -56,6 +59,11 @@ pub fn resolve(
     const SYSTEM: &str = "`system:` (`system: B_h, L_h;`)";
     const ENERGY: &str = "`energy:` (`energy: a, ℓ;`)";
     const STABILIZATION: &str = "`stabilization:` (`stabilization: α S against a;`)";
+    const CONSTRAINT: &str = "`constraint:` (`constraint: b, G;`)";
+    let constraint = constraint.as_ref().map(|(b, g)| {
+        let b = lookup.form(b, 2, CONSTRAINT);
+        both(b, lookup.form(g, 1, CONSTRAINT))
+    });
     let system = system.as_ref().map(|(b, l)| {
         let b = lookup.form(b, 2, SYSTEM);
         both(b, lookup.form(l, 1, SYSTEM))
@@ -87,6 +95,7 @@ pub fn resolve(
         side: side.unwrap_or_else(|| conventional.param(&["s"])),
         order: 0,
         obstacle: obstacle.unwrap_or_else(|| conventional.obstacle()),
+        constraint: constraint.unwrap_or_else(|| conventional.constraint()),
     };
     let order = operator_order(&roles, forms);
     (Roles { order, ..roles }, lookup.errors)
@@ -221,6 +230,10 @@ impl Conventional<'_> {
             self.form("S", 2)?,
             self.form("a", 2)?,
         ))
+    }
+
+    fn constraint(&self) -> Option<[usize; 2]> {
+        Some([self.form("b", 2)?, self.form("G", 1)?])
     }
 
     fn obstacle(&self) -> Option<(usize, usize)> {

@@ -1310,3 +1310,79 @@ fn an_interval_estimator_refuses_the_normal_on_cells() {
     let errors = rendered_errors(&out);
     assert!(errors.iter().any(|e| e.contains("`n`")), "{errors:?}");
 }
+
+fn loaded_membrane_with_estimator(estimator: &str) -> TokenStream {
+    quote! {
+        /// Membrane loaded on a boundary part.
+        pub mod loaded on triangle {
+            unknowns: u: P1;
+            tests: v;
+            data: q;
+            facets: Γ_N;
+            forms: "
+                a(u;v) = ∫ ∇u·∇v
+                ℓ(v)   = ∫_Γ_N q v ds
+            ";
+            estimator: #estimator;
+        }
+    }
+}
+
+#[test]
+fn a_boundary_part_has_its_own_indicator() {
+    for text in [
+        "η_T² = h_T² ‖Δu‖²\n η_Γ_N² = h_E ‖∇u·n − q‖²",
+        // a vector `(X, Y)` of scalars
+        "η_Γ_N² = h_E ‖(∂_x u, ∂_y u)·n − q‖² + h_E ‖∇u + (q, 0)‖²",
+    ] {
+        let out = expand(loaded_membrane_with_estimator(text));
+        let text = out.to_string();
+        assert!(!text.contains("compile_error"), "{text}");
+        let _: syn::File = syn::parse2(out).expect("generated code parses");
+        assert!(text.contains("fn boundary_indicator"));
+    }
+}
+
+#[test]
+fn boundary_indicator_errors_point_at_the_place() {
+    let cases = [
+        ("η_Γ_D² = h_E ‖∇u·n − q‖²", "`η_Γ_N² = …`"),
+        (
+            "η_Γ_N² = h_T ‖∇u·n − q‖²",
+            "`h_T` in the weight of a boundary part's line",
+        ),
+        (
+            "η_Γ_N² = h_E ‖h_E ∇u·n − q‖²",
+            "`h_E` inside the norm of a boundary part's line",
+        ),
+        ("η_Γ_N² = h_E ‖(∇u, q)‖²", "a vector `(X, Y)` of a vector"),
+        ("η_Γ_N² = h_E ‖q‖²", "does not depend on the solution"),
+    ];
+    for (text, expected) in cases {
+        let out = expand(loaded_membrane_with_estimator(text));
+        let errors = rendered_errors(&out);
+        assert!(
+            errors.iter().any(|e| e.contains(expected)),
+            "{text}: expected an error with `{expected}`, got {errors:?}"
+        );
+    }
+}
+
+#[test]
+fn a_vector_on_an_interval_is_refused() {
+    let out = expand(quote! {
+        /// Beam.
+        pub mod beam on interval {
+            unknowns: w: P1;
+            tests: v;
+            forms: "a(w;v) = ∫ (w', w')·(v', v')";
+        }
+    });
+    let errors = rendered_errors(&out);
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("a vector `(X, Y)` on an interval")),
+        "{errors:?}"
+    );
+}

@@ -152,6 +152,13 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// declared under `energy:`, or else `a` and `ℓ` (`l`, `ell`) where the model has
     /// them; `None` otherwise.
     const ENERGY: Option<[usize; 2]> = None;
+    /// The constraint of the obstacle problem as `[b, G]` (indices in `FORMS`):
+    /// `b(v, μ) = (μ, sBv)` and `G(μ) = (μ, sψ)`, so that `b(u_h, μ) − G(μ) =
+    /// (μ, s(Bu_h − ψ))` is the constraint's residual against μ (`../shared/MODELS.md`
+    /// §1). Declared under `constraint:`, or else the forms `b` and `G` where the model
+    /// has them; `None` otherwise. The estimate of a multiplier on a boundary part takes
+    /// its contact terms from it ([`crate::adaptivity`]).
+    const CONSTRAINT: Option<[usize; 2]> = None;
     /// The stabilization: the parameter α of `B_h = … − α S`, the form `S` and the form
     /// `a` that bounds it, `S_T(v, v) ≤ C_I a_T(v, v)` on the primal functions of a cell
     /// ([`crate::stabilization`]); declared under `stabilization: α S against a`, or else
@@ -422,6 +429,31 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         );
         Err(Error::Input(format!(
             "model `{}` declares no estimator (`estimator:`)",
+            Self::NAME
+        )))
+    }
+
+    /// The squared indicator `η_Γ²` of the model's `estimator:` on the boundary edge that
+    /// is local edge `edge` of the triangle `vertices`, an edge of the boundary part
+    /// `part` (index in [`Model::FACET_PARTS`]); 0 for a part without boundary terms. As
+    /// [`Model::cell_indicator`] (a multiplier on the part enters by its trace on the
+    /// edge: for P0 one coefficient, for P1 the cell's three vertex values, the one off
+    /// the edge unused).
+    ///
+    /// # Errors
+    /// As [`Model::cell_indicator`], for an edge above 2 and a part out of range; always
+    /// for a model without an estimator or on intervals.
+    fn boundary_indicator(
+        part: usize,
+        vertices: &[f64],
+        edge: usize,
+        coefficients: &[&[f64]],
+        params: &[f64],
+        data: &[&DataFn],
+    ) -> Result<f64> {
+        let _ = (part, vertices, edge, coefficients, params, data);
+        Err(Error::Input(format!(
+            "model `{}` declares no estimator on boundary parts",
             Self::NAME
         )))
     }

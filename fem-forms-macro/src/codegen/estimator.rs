@@ -352,6 +352,76 @@ fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     }
 }
 
+/// The loop of one boundary term: `weight · Σ_q w_q R(x_q)² |E|` added to `eta2`, `R`
+/// traced from the edge's cell `x` (coefficients `c`) at Gauss–Legendre points of its
+/// local edge `edge`, data evaluated at the physical points.
+fn boundary_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
+    let degree = 2 * residual_degree(&term.residual, symbols);
+    let nq = fem_reference::quadrature::QuadratureRule::exact_for_degree(degree).len();
+    let rule = fem_reference::quadrature::gauss_legendre(nq);
+    let mut tables = Tables {
+        items: Vec::new(),
+        made: Vec::new(),
+    };
+    let mut body = Vec::new();
+    for m in &term.residual {
+        // inside the norm `h` is the cell's size, in the weight the edge's length
+        let c = monomial_coefficient(m);
+        let c = quote!({ let h = h_c; #c });
+        let data = data_product(m);
+        let value = m.args.first().map(|a| {
+            let element = symbols.fields[a.symbol].element;
+            let field = a.symbol;
+            let mut table = |e: ElementKind, beta: [u8; 2]| -> TokenStream {
+                let ident = tables.get(
+                    e,
+                    beta,
+                    "",
+                    &|f| {
+                        let edges = (0..3).map(|edge| {
+                            let rows = rule.points.iter().map(|&s| {
+                                let v = f(super::facet::edge_point(edge, s)).into_iter().map(float);
+                                quote!([#(#v),*])
+                            });
+                            quote!([#(#rows),*])
+                        });
+                        quote!([#(#edges),*])
+                    },
+                    &|n| quote!([[[f64; #n]; #nq]; 3]),
+                );
+                quote!(#ident[edge][q])
+            };
+            field_value(element, a.derivative, quote!(c[#field]), "", &mut table)
+        });
+        let p = product(std::iter::once(c).chain(data).chain(value));
+        body.push(quote!(r += #p;));
+    }
+    let weights = rule.weights.iter().map(|&w| float(w));
+    let s = rule.points.iter().map(|&s| float(s));
+    let weight = weight_code(&term.weight);
+    let items = &tables.items;
+    let doc = &term.source;
+    quote! {
+        {
+            #[doc = #doc]
+            const W: [f64; #nq] = [#(#weights),*];
+            const S: [f64; #nq] = [#(#s),*];
+            #(#items)*
+            let mut s = 0.0f64;
+            for q in 0..#nq {
+                let xq = [
+                    x[2 * a] + S[q] * (x[2 * b] - x[2 * a]),
+                    x[2 * a + 1] + S[q] * (x[2 * b + 1] - x[2 * a + 1]),
+                ];
+                let mut r = 0.0f64;
+                #(#body)*
+                s += W[q] * r * r;
+            }
+            eta2 += #weight * s * len;
+        }
+    }
+}
+
 /// `K = J⁻¹` of the triangle `#x` as `k00 … k11`, with `det`.
 fn inverse_jacobian(x: &Ident) -> TokenStream {
     quote! {
@@ -377,9 +447,6 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
         .terms(Region::Edge)
         .map(|t| edge_term(t, symbols))
         .collect();
-    let cell_lets = t_lets(&alphas(estimator.terms(Region::Cell)), "");
-    let edge_alphas = alphas(estimator.terms(Region::Edge));
-    let (plus_lets, minus_lets) = (t_lets(&edge_alphas, "_p"), t_lets(&edge_alphas, "_m"));
     let describe = |region: Region| {
         estimator
             .terms(region)
@@ -387,6 +454,44 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
             .collect::<Vec<_>>()
             .join(" + ")
     };
+    let parts: Vec<TokenStream> = symbols
+        .facets
+        .iter()
+        .enumerate()
+        .map(|(k, _)| {
+            let terms = estimator
+                .terms(Region::Boundary(k))
+                .map(|t| boundary_term(t, symbols));
+            quote!(#k => { #(#terms)* })
+        })
+        .collect();
+    let boundary_lets = t_lets(
+        &alphas(
+            estimator
+                .terms
+                .iter()
+                .filter(|t| matches!(t.region, Region::Boundary(_))),
+        ),
+        "",
+    );
+    let boundary_doc = {
+        let lines: Vec<String> = symbols
+            .facets
+            .iter()
+            .enumerate()
+            .map(|(k, name)| match describe(Region::Boundary(k)) {
+                s if s.is_empty() => format!("`{name}` (part {k}): no term (0)"),
+                s => format!("`{name}` (part {k}): {s}"),
+            })
+            .collect();
+        format!(
+            " The squared indicator `η_Γ²` of the boundary edge that is local edge `edge` of the triangle `x` with coefficients `c`, on the boundary part `part` (its index under `facets:`); `n` is the outward normal, `h` the edge's length in the weight and the cell's size inside the norm. {}.",
+            if lines.is_empty() { "The model declares no boundary part (0)".to_string() } else { lines.join("; ") }
+        )
+    };
+    let cell_lets = t_lets(&alphas(estimator.terms(Region::Cell)), "");
+    let edge_alphas = alphas(estimator.terms(Region::Edge));
+    let (plus_lets, minus_lets) = (t_lets(&edge_alphas, "_p"), t_lets(&edge_alphas, "_m"));
     let cell_doc = format!(
         " The squared indicator `η_T²` of the triangle `x` (`[x0, y0, x1, y1, x2, y2]`) for the coefficients `c`: one slice per field, the cell's coefficients in the pulled-back reference basis (the local DOFs for Lagrange elements, `Mᵀ U` for elements with a DOF transformation `M`): {}.",
         match describe(Region::Cell) {
@@ -470,6 +575,42 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
                     }
                 }
             }
+
+            #[doc = #boundary_doc]
+            ///
+            /// # Panics
+            /// When `edge > 2`.
+            #[allow(unused_variables, unused_mut, unused_parens, clippy::all)]
+            pub fn boundary(
+                part: usize,
+                x: &[f64; 6],
+                edge: usize,
+                c: &[&[f64]; #nf],
+                p: &[f64; #np],
+                d: &[&#runtime::DataFn; #nd],
+            ) -> f64 {
+                assert!(edge < 3, "a triangle has local edges 0, 1 and 2");
+                let h_c = {
+                    let e = |a: usize, b: usize| {
+                        (x[2 * b] - x[2 * a]).powi(2) + (x[2 * b + 1] - x[2 * a + 1]).powi(2)
+                    };
+                    e(0, 1).max(e(1, 2)).max(e(2, 0)).sqrt()
+                };
+                let (a, b) = (edge, (edge + 1) % 3);
+                let (tx, ty) = (x[2 * b] - x[2 * a], x[2 * b + 1] - x[2 * a + 1]);
+                let len = (tx * tx + ty * ty).sqrt();
+                #kx
+                let side = if det > 0.0 { 1.0 } else { -1.0 };
+                let (n_x, n_y) = (side * ty / len, -side * tx / len);
+                let h = len;
+                #(#boundary_lets)*
+                let mut eta2 = 0.0f64;
+                match part {
+                    #(#parts)*
+                    _ => {}
+                }
+                eta2
+            }
         }
     }
 }
@@ -506,6 +647,41 @@ pub fn model_items(
     };
     let message = format!("{model_name}: the indicator of {cell} takes {coordinates} vertex coordinates and, per field, its local coefficients ({sizes:?})");
     let sides = format!("{cell} has local edges (ends) 0 to {last}, not {{}} and {{}}");
+    let parts = symbols.facets.len();
+    let boundary = (!interval).then(|| {
+        let wrong_part = format!("{model_name} has boundary parts 0 to {}, not {{}}", parts.saturating_sub(1));
+        quote! {
+            fn boundary_indicator(
+                part: usize,
+                vertices: &[f64],
+                edge: usize,
+                coefficients: &[&[f64]],
+                params: &[f64],
+                data: &[&#runtime::DataFn],
+            ) -> #runtime::Result<f64> {
+                const SIZES: [usize; #nf] = [#(#sizes),*];
+                let (::core::result::Result::Ok(x), ::core::result::Result::Ok(c)) =
+                    (<&[f64; #coordinates]>::try_from(vertices), <&[&[f64]; #nf]>::try_from(coefficients))
+                else {
+                    return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
+                };
+                if c.iter().zip(SIZES).any(|(c, n)| c.len() != n) {
+                    return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
+                }
+                if edge > #last {
+                    return ::core::result::Result::Err(#runtime::Error::Input(::std::format!(#sides, edge, edge)));
+                }
+                // a const, not a literal: `part >= 0` is no comparison for a model without parts
+                const PARTS: usize = #parts;
+                if part >= PARTS {
+                    return ::core::result::Result::Err(#runtime::Error::Input(::std::format!(#wrong_part, part)));
+                }
+                let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
+                let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
+                ::core::result::Result::Ok(estimator::boundary(part, x, edge, c, p, d))
+            }
+        }
+    });
     quote! {
         const HAS_ESTIMATOR: bool = true;
 
@@ -565,5 +741,7 @@ pub fn model_items(
             let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
             ::core::result::Result::Ok(estimator::edge(x, edge, c, y, other_edge, e, p, d))
         }
+
+        #boundary
     }
 }

@@ -437,6 +437,7 @@ fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream
     };
     let system = pair(roles.system);
     let energy = pair(roles.energy);
+    let constraint = pair(roles.constraint);
     let stabilization = match roles.stabilization {
         Some((alpha, form, against)) => {
             let alpha = match alpha {
@@ -467,6 +468,7 @@ fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream
         const OBSTACLE: ::core::option::Option<[usize; 2]> = #obstacle;
         const SYSTEM: ::core::option::Option<[usize; 2]> = #system;
         const ENERGY: ::core::option::Option<[usize; 2]> = #energy;
+        const CONSTRAINT: ::core::option::Option<[usize; 2]> = #constraint;
         const STABILIZATION: ::core::option::Option<#runtime::model::StabilizationRole> = #stabilization;
         const SIDE: ::core::option::Option<usize> = #side;
     }
