@@ -686,3 +686,173 @@ mod timoshenko {
         }
     }
 }
+
+/// Signorini contact: the boundary parts' indicators (`η_Γ_C²`, `η_Γ_N²`) against
+/// hand-coded ones, the patch test's vanishing estimate, and Hertz from a coarse mesh.
+mod signorini {
+    use super::*;
+    use fem_forms::models::families;
+    use fem_forms::models::report::Settings;
+    use fem_forms::models::signorini::signorini_p1_p1::Model as M;
+
+    const MU: f64 = 3.7;
+    const LAMBDA: f64 = 5.3;
+    const NC: [f64; 2] = [0.6, -0.8];
+
+    fn pressure(x: &[f64]) -> f64 {
+        1.0 + x[0] + 2.0 * x[1]
+    }
+
+    fn gap(_: &[f64]) -> f64 {
+        0.0
+    }
+
+    /// `η_Γ²` of local edge `edge` of the triangle `x` by hand, for the P1 displacement
+    /// with vertex values `ux`, `uy` and the P1 multiplier `lambda` (vertex values):
+    /// `h_E/(2μ) ∫_E |σn + t|² ds`, `t = λ n_c` on Γ_C (`contact`), `t = q n` on Γ_N,
+    /// with a 4-point Gauss rule and the normal pointing away from the third vertex.
+    fn by_hand(
+        x: &[f64; 6],
+        edge: usize,
+        ux: &[f64],
+        uy: &[f64],
+        lambda: &[f64],
+        contact: bool,
+    ) -> f64 {
+        let p = |i: usize| [x[2 * i], x[2 * i + 1]];
+        let det = (x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1]);
+        // gradients of the barycentric coordinates
+        let grad = |i: usize| {
+            let (a, b) = (p((i + 1) % 3), p((i + 2) % 3));
+            [(a[1] - b[1]) / det, (b[0] - a[0]) / det]
+        };
+        let mut g = [[0.0; 2]; 2];
+        for i in 0..3 {
+            let d = grad(i);
+            g[0] = [g[0][0] + ux[i] * d[0], g[0][1] + ux[i] * d[1]];
+            g[1] = [g[1][0] + uy[i] * d[0], g[1][1] + uy[i] * d[1]];
+        }
+        let eps = [
+            [g[0][0], 0.5 * (g[0][1] + g[1][0])],
+            [0.5 * (g[0][1] + g[1][0]), g[1][1]],
+        ];
+        let tr = eps[0][0] + eps[1][1];
+        let sigma =
+            |i: usize, j: usize| 2.0 * MU * eps[i][j] + if i == j { LAMBDA * tr } else { 0.0 };
+        let (a, b, c) = (p(edge), p((edge + 1) % 3), p((edge + 2) % 3));
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let mut n = [(b[1] - a[1]) / len, -(b[0] - a[0]) / len];
+        let mid = [0.5 * (a[0] + b[0]) - c[0], 0.5 * (a[1] + b[1]) - c[1]];
+        if n[0] * mid[0] + n[1] * mid[1] < 0.0 {
+            n = [-n[0], -n[1]];
+        }
+        let sn = [
+            sigma(0, 0) * n[0] + sigma(0, 1) * n[1],
+            sigma(1, 0) * n[0] + sigma(1, 1) * n[1],
+        ];
+        let (ga, gb) = (0.339_981_043_584_856_3, 0.861_136_311_594_052_6);
+        let (wa, wb) = (0.652_145_154_862_546_1, 0.347_854_845_137_453_9);
+        let mut integral = 0.0;
+        for (s, w) in [(-gb, wb), (-ga, wa), (ga, wa), (gb, wb)] {
+            let (s, w) = (0.5 * (1.0 + s), 0.5 * w);
+            let point = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
+            let t = if contact {
+                let l = (1.0 - s) * lambda[edge] + s * lambda[(edge + 1) % 3];
+                [l * NC[0], l * NC[1]]
+            } else {
+                let q = pressure(&point);
+                [q * n[0], q * n[1]]
+            };
+            integral += w * ((sn[0] + t[0]).powi(2) + (sn[1] + t[1]).powi(2));
+        }
+        len / (2.0 * MU) * integral * len
+    }
+
+    /// The generated `η_Γ_C²` and `η_Γ_N²` of the P1–P1 model against [`by_hand`] on
+    /// every local edge of triangles of both orientations, with a multiplier that
+    /// varies along the edge and a pressure that varies in space.
+    #[test]
+    fn boundary_indicators_match_the_hand_coded_ones() {
+        let params = [MU, LAMBDA, 0.2, NC[0], NC[1]];
+        let data: [&fem_forms::DataFn; 2] = [&pressure, &gap];
+        let (contact, loaded) = (M::facet_part("Γ_C").unwrap(), M::facet_part("Γ_N").unwrap());
+        let cells = [
+            [0.1, 0.2, 1.3, -0.1, 0.4, 0.9],
+            [0.1, 0.2, 0.4, 0.9, 1.3, -0.1],
+            [-1.0, 0.5, 0.2, -0.7, 0.9, 1.4],
+        ];
+        let (ux, uy, lambda) = ([0.3, -0.2, 0.5], [0.1, 0.7, -0.4], [1.5, 0.4, 2.2]);
+        for x in &cells {
+            for edge in 0..3 {
+                let coefficients: [&[f64]; 3] = [&ux, &uy, &lambda];
+                for (part, on_contact) in [(contact, true), (loaded, false)] {
+                    let generated =
+                        M::boundary_indicator(part, x, edge, &coefficients, &params, &data)
+                            .unwrap();
+                    let expected = by_hand(x, edge, &ux, &uy, &lambda, on_contact);
+                    assert!(
+                        (generated - expected).abs() <= 1e-12 * expected.abs().max(1.0),
+                        "cell {x:?}, edge {edge}, contact {on_contact}: {generated} against {expected}"
+                    );
+                }
+            }
+        }
+        assert!(
+            M::boundary_indicator(2, &cells[0], 0, &[&ux, &uy, &lambda], &params, &data).is_err()
+        );
+    }
+
+    /// The patch test's solution (`λ_h = q`, a uniform compression) is exact for every
+    /// pair: every indicator vanishes to rounding. A sign error in `σ(u)·n + λ n_c` or in
+    /// `σ(u)·n + q n` would leave `2q` on every edge of Γ_C or Γ_N.
+    #[test]
+    fn the_patch_test_has_a_vanishing_estimate() {
+        let scene = families::scene("signorini-patch").unwrap();
+        for pair in ["p1-p0", "p2-p0", "p1-p1", "p2-p1"] {
+            let settings = Settings {
+                pair: Some(pair.into()),
+                mesh_size: Some(4),
+                ..Settings::default()
+            };
+            let report = families::solve(&scene, &settings).unwrap().report.solve;
+            let relative = report.estimate_relative.unwrap();
+            assert!(relative < 1e-7, "{pair}: estimate {relative:e} of ‖u_h‖_a");
+        }
+    }
+
+    /// Hertz from the coarsest graded mesh (b/h = 1): the adaptive loop reaches a
+    /// smaller pressure error than the hand-graded b/h = 64 mesh with fewer unknowns,
+    /// and its estimate falls at P1's optimal rate, about N^{-1/2}.
+    #[test]
+    fn hertz_from_a_coarse_mesh_beats_the_hand_graded_one() {
+        let scene = families::scene("hertz").unwrap();
+        let solve = |mesh_size: usize, tolerance: Option<f64>| {
+            let settings = Settings {
+                mesh_size: Some(mesh_size),
+                adaptive: tolerance.map(|tolerance| AdaptiveOptions {
+                    tolerance,
+                    ..AdaptiveOptions::default()
+                }),
+                ..Settings::default()
+            };
+            families::solve(&scene, &settings).unwrap().report
+        };
+        let graded = solve(64, None);
+        let adaptive = solve(1, Some(0.07));
+        let error = |r: &fem_forms::models::report::Report| r.number("pressure_l2_error").unwrap();
+        assert!(
+            adaptive.solve.dofs < graded.solve.dofs && error(&adaptive) < error(&graded),
+            "adaptive: {} unknowns, pressure error {:.4}; graded b/h = 64: {} unknowns, {:.4}",
+            adaptive.solve.dofs,
+            error(&adaptive),
+            graded.solve.dofs,
+            error(&graded)
+        );
+        let levels = &adaptive.solve.adaptive_levels;
+        let points: Vec<(f64, f64)> = levels.iter().map(|l| (l.dofs as f64, l.estimate)).collect();
+        let half = &points[points.len() / 2..];
+        let (first, last) = (half[0], half[half.len() - 1]);
+        let rate = -(last.1 / first.1).ln() / (last.0 / first.0).ln();
+        assert!((0.4..0.7).contains(&rate), "estimate ~ N^-{rate:.2}");
+    }
+}

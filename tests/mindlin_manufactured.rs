@@ -288,9 +288,14 @@ fn the_estimator_is_robust_in_the_thickness() {
             let solution =
                 solve_obstacle_on_triangles::<M>(&[mesh], &c, ObstacleOptions::default()).unwrap();
             let data: [&fem_forms::DataFn; 3] = [&load, &far_below, &zero];
-            let estimate =
-                fem_forms::adaptivity::triangle_estimate::<M>(&solution, &values, &data, Some(1.0))
-                    .unwrap();
+            let estimate = fem_forms::adaptivity::triangle_estimate::<M>(
+                &solution,
+                &values,
+                &data,
+                Some(1.0),
+                &[],
+            )
+            .unwrap();
             let view = |name: &str| -> TriangleField<'_> { solution.view(M::field(name).unwrap()) };
             let exact_w = |p: [f64; 2]| deflection(t, p);
             let (_, tx) = view("θ_x").errors(&theta_x, RULE_DEGREE);

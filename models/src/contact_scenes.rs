@@ -4,6 +4,7 @@
 
 use crate::hertz::Hertz;
 use crate::signorini::Plane;
+use fem_runtime::mesh::BoundaryCurve;
 use fem_runtime::{Diagonal, Error, Result, TriangleMesh};
 
 /// The elastic body and how it meets the rigid foundation `y = 0`.
@@ -244,16 +245,21 @@ pub fn hertz_mesh(radius: f64, zone: f64, contact_h: f64, grading: f64) -> Resul
         };
         contact_h.max(grading * d).min(largest)
     };
-    let onto_circle = |marker: u32, p: [f64; 2]| {
-        if marker != HERTZ_ARC {
-            return p;
-        }
-        let (dx, dy) = (p[0], p[1] - radius);
-        let r = dx.hypot(dy);
-        [radius * dx / r, radius + radius * dy / r]
+    let arc = BoundaryCurve::Circle {
+        centre: [0.0, radius],
+        radius,
     };
-    // 4 rings: cells of R/4 to start, refined to the size field
+    let onto_circle = |marker: u32, p: [f64; 2]| {
+        if marker == HERTZ_ARC {
+            arc.project(p)
+        } else {
+            p
+        }
+    };
+    // 4 rings: cells of R/4 to start, refined to the size field; adaptive refinement
+    // keeps the arc's new vertices on the circle too
     Ok(TriangleMesh::quarter_disk(radius, 4)?
         .refine_to_size(size, onto_circle, 20_000_000)?
-        .0)
+        .0
+        .with_boundary_curve(HERTZ_ARC, arc))
 }

@@ -50,6 +50,12 @@ macro_rules! signorini_model {
                 system:        B_h, L_h;
                 energy:        a, ℓ;
                 stabilization: α S against a;
+                estimator: "
+                    η_T²   = h_T²/(2μ_L) ‖div σ(u)‖²
+                    η_E²   = h_E/(2μ_L) ‖[[σ(u)·n]]‖²
+                    η_Γ_C² = h_E/(2μ_L) ‖σ(u)·n + λ (n_c_x, n_c_y)‖²
+                    η_Γ_N² = h_E/(2μ_L) ‖σ(u)·n + q n‖²
+                ";
             }
         }
     };

@@ -7,6 +7,7 @@
 //! `(Σ_T (λ_h, s(u_h − ψ))_T)_+^{1/2}`, `../shared/MODELS.md` §8), marks cells
 //! ([`Marking`]) and drives the adaptive loop of [`crate::problem::Problem::solve_adaptive`].
 
+mod boundary;
 mod interval;
 pub mod marking;
 
@@ -113,25 +114,36 @@ impl Estimate {
 }
 
 /// The local coefficients of every field on cell `c` in the pulled-back reference basis
-/// (the field's own for Lagrange elements).
-fn cell_coefficients(fields: &[TriangleField], c: usize) -> Vec<Vec<f64>> {
-    fields.iter().map(|f| f.reference_coefficients(c)).collect()
+/// (the field's own for Lagrange elements); zeros for a multiplier on a boundary part
+/// (`None`), which has no values on the cells.
+fn cell_coefficients<M: Model>(fields: &[Option<TriangleField>], c: usize) -> Vec<Vec<f64>> {
+    fields
+        .iter()
+        .zip(M::FIELDS)
+        .map(|(f, info)| match f {
+            Some(f) => f.reference_coefficients(c),
+            None => vec![0.0; info.element.triangle_basis().len()],
+        })
+        .collect()
 }
 
-/// The fields of a solution on a triangle mesh, or the error for a multiplier that is
-/// not on the cells.
+/// The fields of a solution on a triangle mesh (`None` for a multiplier on a boundary
+/// part), or the error for the nodal method's contact forces.
 fn fields<'a, M: Model>(
     solution: &'a ObstacleSolution<TriangleMesh>,
-) -> Result<Vec<TriangleField<'a>>> {
+) -> Result<Vec<Option<TriangleField<'a>>>> {
     let d = &solution.discretization;
-    if !matches!(d.multipliers, Multipliers::Cells) {
+    if matches!(d.multipliers, Multipliers::Nodal) {
         return Err(Error::Input(format!(
-            "model `{}`: estimators are computed for multipliers on the cells; a multiplier on a boundary part has no generated estimator yet",
+            "model `{}`: the nodal method's contact forces have no generated estimator",
             M::NAME
         )));
     }
     (0..M::FIELDS.len())
         .map(|f| {
+            if f == d.multiplier_field && d.boundary().is_some() {
+                return Ok(None);
+            }
             let map = d.dofs.map(f).ok_or_else(|| {
                 Error::Input(format!(
                     "model `{}`: field `{}` has no DOFs on the cells",
@@ -139,11 +151,11 @@ fn fields<'a, M: Model>(
                     M::FIELDS[f].name
                 ))
             })?;
-            Ok(TriangleField {
+            Ok(Some(TriangleField {
                 mesh: &d.mesh,
                 map,
                 coefficients: solution.field(f),
-            })
+            }))
         })
         .collect()
 }
@@ -151,16 +163,20 @@ fn fields<'a, M: Model>(
 /// The estimate of `solution` with the model's `estimator:` kernels and the contact
 /// terms, for parameters `params` and data `data` as solved with; `side` is the
 /// obstacle's sign `s` (1: `u ≥ ψ`), `None` for a problem solved without its constraint
-/// (no contact terms).
+/// (no contact terms); `parts` the boundary markers of each of the model's
+/// `FACET_PARTS` (empty for a model without boundary parts), whose edges take the
+/// estimator's boundary terms (`η_Γ_C²`).
 ///
 /// # Errors
-/// A model without an estimator or an energy form, a multiplier on a boundary part,
+/// A model without an estimator or an energy form, a multiplier on a boundary part of a
+/// model without a constraint (`constraint: b, G;`), `parts` not one list per part,
 /// and indicators that are not finite (the message names the cell).
 pub fn triangle_estimate<M: Model>(
     solution: &ObstacleSolution<TriangleMesh>,
     params: &[f64],
     data: &[&DataFn],
     side: Option<f64>,
+    parts: &[Vec<u32>],
 ) -> Result<Estimate> {
     require_estimator::<M>()?;
     let fields = fields::<M>(solution)?;
@@ -168,7 +184,7 @@ pub fn triangle_estimate<M: Model>(
     let mut indicators = vec![0.0; mesh.cell_count()];
     let mut sum = 0.0;
     for (c, indicator) in indicators.iter_mut().enumerate() {
-        let local = cell_coefficients(&fields, c);
+        let local = cell_coefficients::<M>(&fields, c);
         let slices: Vec<&[f64]> = local.iter().map(Vec::as_slice).collect();
         let eta2 = M::cell_indicator(&mesh.cell_coordinates(c), &slices, params, data)?;
         *indicator += eta2;
@@ -185,8 +201,8 @@ pub fn triangle_estimate<M: Model>(
                 .expect("an edge is an edge of its cells")
         };
         let (a, b) = (
-            cell_coefficients(&fields, c0),
-            cell_coefficients(&fields, c1),
+            cell_coefficients::<M>(&fields, c0),
+            cell_coefficients::<M>(&fields, c1),
         );
         let a: Vec<&[f64]> = a.iter().map(Vec::as_slice).collect();
         let b: Vec<&[f64]> = b.iter().map(Vec::as_slice).collect();
@@ -204,6 +220,14 @@ pub fn triangle_estimate<M: Model>(
         indicators[c1] += 0.5 * eta2;
         sum += eta2;
     }
+    sum += boundary::boundary_indicators::<M>(
+        solution,
+        &fields,
+        params,
+        data,
+        parts,
+        &mut indicators,
+    )?;
     if let Some(c) = indicators.iter().position(|e| !e.is_finite()) {
         return Err(Error::Input(format!(
             "the indicator of cell {c} is {}: the solution or the data are not finite there",
@@ -373,7 +397,7 @@ fn add_block_energies<M: Model>(
 /// A model without an energy form, or whose energy form has no block.
 fn solution_energy<M: Model>(
     mesh: &TriangleMesh,
-    fields: &[TriangleField],
+    fields: &[Option<TriangleField>],
     multiplier: usize,
     params: &[f64],
     data: &[&DataFn],
@@ -387,7 +411,9 @@ fn solution_energy<M: Model>(
         if test == multiplier || trial == multiplier {
             continue;
         }
-        let (u, v) = (&fields[test], &fields[trial]);
+        let (Some(u), Some(v)) = (&fields[test], &fields[trial]) else {
+            continue;
+        };
         add_block_energies::<M>(
             mesh,
             [a, b],
@@ -403,18 +429,28 @@ fn solution_energy<M: Model>(
 /// The contact part `S` of the estimate (with each cell's share) and `‖u_h‖_a`.
 fn contact_terms<M: Model>(
     solution: &ObstacleSolution<TriangleMesh>,
-    fields: &[TriangleField],
+    fields: &[Option<TriangleField>],
     params: &[f64],
     data: &[&DataFn],
     side: Option<f64>,
 ) -> Result<(ContactTerms, f64)> {
     let d = &solution.discretization;
     let mesh = &d.mesh;
-    let field = M::constrained_field();
-    let u = &fields[field];
     let energy = solution_energy::<M>(mesh, fields, d.multiplier_field, params, data)?;
+    let norm = energy.max(0.0).sqrt();
+    if let (Some(b), Some(_)) = (d.boundary(), side) {
+        let terms = boundary::boundary_contact_terms::<M>(solution, fields, b, params, data)?;
+        return Ok((terms, norm));
+    }
     let (Some([_, psi]), Some(side)) = (M::OBSTACLE, side) else {
-        return Ok((ContactTerms::default(), energy.max(0.0).sqrt()));
+        return Ok((ContactTerms::default(), norm));
+    };
+    let field = M::constrained_field();
+    let (Some(u), Some(lambda)) = (&fields[field], &fields[d.multiplier_field]) else {
+        return Err(Error::Input(format!(
+            "model `{}`: the constrained field or the multiplier has no values on the cells",
+            M::NAME
+        )));
     };
     let psi = data[psi];
     let element = u.map.element();
@@ -432,7 +468,6 @@ fn contact_terms<M: Model>(
         weighted_violation::<M>(mesh, u, psi, side)
     };
     // Σ_T (λ_h, s(u_h − ψ))_T
-    let lambda = &fields[d.multiplier_field];
     let degree = u.map.element().degree() + lambda.map.element().degree() + 2;
     let rule = TriangleRule::exact_for_degree(degree);
     let (u_basis, l_basis) = (
@@ -455,10 +490,7 @@ fn contact_terms<M: Model>(
             *defect += w * area2 * l * side * (u.value(&u_basis, c, *xi) - psi(&p));
         }
     }
-    Ok((
-        ContactTerms::of(&violation, &defect),
-        energy.max(0.0).sqrt(),
-    ))
+    Ok((ContactTerms::of(&violation, &defect), norm))
 }
 
 /// `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T`, `m = ORDER/2` the energy's derivative order: the

@@ -8,7 +8,7 @@ pub mod interval;
 pub mod triangle;
 
 pub use interval::IntervalMesh;
-pub use triangle::{CurvedTriangleMesh, Diagonal, PointLocator, TriangleMesh};
+pub use triangle::{BoundaryCurve, CurvedTriangleMesh, Diagonal, PointLocator, TriangleMesh};
 
 use fem_reference::CellKind;
 

@@ -144,7 +144,7 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
     /// The a-posteriori estimate of `solution` with the model's `estimator:` kernels and
     /// the contact terms ([`crate::adaptivity::triangle_estimate`]); `side` is the
     /// obstacle's sign, `None` for a problem solved without its constraint (no contact
-    /// terms).
+    /// terms); `parts` the boundary markers of each of the model's `FACET_PARTS`.
     ///
     /// # Errors
     /// Meshes other than affine triangles and intervals (the default), and those of the
@@ -154,8 +154,9 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
         params: &[f64],
         data: &[&DataFn],
         side: Option<f64>,
+        parts: &[Vec<u32>],
     ) -> Result<crate::adaptivity::Estimate> {
-        let _ = (solution, params, data, side);
+        let _ = (solution, params, data, side, parts);
         Err(Error::Input(format!(
             "model `{}`: estimates and adaptive refinement are computed on intervals and affine triangle meshes",
             M::NAME
@@ -278,6 +279,7 @@ impl Domain for IntervalMesh {
         params: &[f64],
         data: &[&DataFn],
         side: Option<f64>,
+        _parts: &[Vec<u32>],
     ) -> Result<crate::adaptivity::Estimate> {
         crate::adaptivity::interval_estimate::<M>(solution, params, data, side)
     }
@@ -635,8 +637,9 @@ impl Domain for TriangleMesh {
         params: &[f64],
         data: &[&DataFn],
         side: Option<f64>,
+        parts: &[Vec<u32>],
     ) -> Result<crate::adaptivity::Estimate> {
-        crate::adaptivity::triangle_estimate::<M>(solution, params, data, side)
+        crate::adaptivity::triangle_estimate::<M>(solution, params, data, side, parts)
     }
 
     fn refine_marked(&self, marked: &[usize]) -> Result<Self> {

@@ -780,7 +780,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             )?;
         }
         let estimate = if M::HAS_ESTIMATOR && G::ESTIMATES {
-            Some(self.record_estimate(&solution, &params, &data, &mut report)?)
+            Some(self.record_estimate(&solution, &params, &data, &parts, &mut report)?)
         } else {
             None
         };
@@ -804,10 +804,11 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         solution: &ObstacleSolution<G>,
         params: &[f64],
         data: &[&DataFn],
+        parts: &[Vec<u32>],
         report: &mut Report,
     ) -> Result<crate::adaptivity::Estimate> {
         let side = (!self.unconstrained).then(|| self.side.sign());
-        let estimate = G::estimate::<M>(solution, params, data, side)?;
+        let estimate = G::estimate::<M>(solution, params, data, side, parts)?;
         let total = estimate.total();
         let relative = |x: f64| (estimate.energy_norm > 0.0).then(|| x / estimate.energy_norm);
         report.estimate = Some(total);

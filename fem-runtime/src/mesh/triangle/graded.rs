@@ -218,7 +218,7 @@ impl TriangleMesh {
 
     /// Moves the boundary vertices numbered from `first_new` to `snap(marker, x)`,
     /// checking that no cell turns inside out.
-    fn snap_new_boundary_vertices(
+    pub(super) fn snap_new_boundary_vertices(
         &mut self,
         first_new: usize,
         snap: &impl Fn(u32, [f64; 2]) -> [f64; 2],

@@ -18,6 +18,7 @@ pub use curved::{CurvedTriangleMesh, QuadraticGeometry};
 pub use graded::distance_to_segment;
 pub use locate::PointLocator;
 pub use parts::NamedGroup;
+
 pub use quality::{
     estimated_bytes, MeshQuality, REFUSE_MAX_ANGLE_DEG, WARN_MAX_ANGLE_DEG, WARN_MIN_ANGLE_DEG,
 };
@@ -90,6 +91,55 @@ pub struct TriangleMesh {
     boundary_edges: Vec<(usize, u32)>,
     /// Named groups (boundary parts by marker), kept by refinement.
     groups: Vec<NamedGroup>,
+    /// The curves the boundary edges of a marker approximate, kept by refinement: new
+    /// vertices on those edges are moved onto the curve ([`TriangleMesh::refine`]).
+    curves: Vec<(u32, BoundaryCurve)>,
+}
+
+/// A curve a part of the boundary approximates with straight edges: where refinement
+/// splits such an edge, the new vertex is projected onto the curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BoundaryCurve {
+    /// The circle of this centre and radius.
+    Circle {
+        /// Its centre.
+        centre: [f64; 2],
+        /// Its radius (positive).
+        radius: f64,
+    },
+}
+
+impl BoundaryCurve {
+    /// The point of the curve nearest `p` (the radial projection for a circle; `p` at
+    /// the centre is returned as is).
+    pub fn project(&self, p: [f64; 2]) -> [f64; 2] {
+        match *self {
+            BoundaryCurve::Circle { centre, radius } => {
+                let (dx, dy) = (p[0] - centre[0], p[1] - centre[1]);
+                let r = dx.hypot(dy);
+                if r == 0.0 {
+                    return p;
+                }
+                [centre[0] + radius * dx / r, centre[1] + radius * dy / r]
+            }
+        }
+    }
+}
+
+impl TriangleMesh {
+    /// The mesh with the boundary edges of `marker` declared to approximate `curve`:
+    /// [`TriangleMesh::refine`] moves the vertices it adds on them onto the curve (a
+    /// later declaration for the same marker replaces the earlier).
+    pub fn with_boundary_curve(mut self, marker: u32, curve: BoundaryCurve) -> Self {
+        self.curves.retain(|(m, _)| *m != marker);
+        self.curves.push((marker, curve));
+        self
+    }
+
+    /// The boundary curves by marker ([`TriangleMesh::with_boundary_curve`]).
+    pub fn boundary_curves(&self) -> &[(u32, BoundaryCurve)] {
+        &self.curves
+    }
 }
 
 fn mesh_error(message: String) -> Error {
@@ -299,6 +349,7 @@ impl TriangleMesh {
             edge_cells: Arc::new(edge_cells),
             boundary_edges,
             groups: Vec::new(),
+            curves: Vec::new(),
         })
     }
 

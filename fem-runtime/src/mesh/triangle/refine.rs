@@ -9,7 +9,12 @@ impl TriangleMesh {
     /// Returns the new mesh and, for each new cell, its parent cell in `self`. Indices may
     /// repeat; an out-of-range index is an error. Each cell is bisected at most twice in
     /// depth (into two, three or four children); boundary markers pass to edge halves and
-    /// the named groups are kept, so every boundary part stays the same part.
+    /// the named groups are kept, so every boundary part stays the same part. New vertices
+    /// on the edges of a marker with a boundary curve
+    /// ([`TriangleMesh::with_boundary_curve`]) are moved onto the curve.
+    ///
+    /// # Errors
+    /// A cell index out of range; a move onto a curve that turns a cell inside out.
     pub fn refine(&self, marked: &[usize]) -> Result<(TriangleMesh, Vec<usize>)> {
         let mut edge_marked = vec![false; self.edges.len()];
         let mut queue = Vec::new();
@@ -38,7 +43,18 @@ impl TriangleMesh {
                 }
             }
         }
-        self.bisect(&edge_marked)
+        let old_vertices = self.vertices.len();
+        let (mut fine, parents) = self.bisect(&edge_marked)?;
+        if !self.curves.is_empty() {
+            let curves = self.curves.clone();
+            fine.snap_new_boundary_vertices(old_vertices, &|marker, p| {
+                curves
+                    .iter()
+                    .find(|(m, _)| *m == marker)
+                    .map_or(p, |(_, curve)| curve.project(p))
+            })?;
+        }
+        Ok((fine, parents))
     }
 
     /// Splits every cell into four by two levels of bisection: cell count ×4, `h` halves
@@ -96,6 +112,59 @@ impl TriangleMesh {
         let mut mesh = Self::from_oriented(vertices, cells)?;
         mesh.apply_markers(&markers)?;
         mesh.set_named_groups(self.groups.clone());
+        mesh.curves = self.curves.clone();
         Ok((mesh, parents))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Marked refinement of a quarter disc whose arc is declared a circle puts every new
+    /// arc vertex on the circle (and leaves the straight parts straight); without the
+    /// declaration the midpoints stay on the chords, inside the circle.
+    #[test]
+    fn refinement_moves_new_arc_vertices_onto_the_circle() {
+        let radius = 2.0;
+        let centre = [0.0, radius];
+        let plain = TriangleMesh::quarter_disk(radius, 3).unwrap();
+        let curved = plain
+            .clone()
+            .with_boundary_curve(1, BoundaryCurve::Circle { centre, radius });
+        let distance = |p: [f64; 2]| (p[0] - centre[0]).hypot(p[1] - centre[1]);
+        let arc_vertices = |m: &TriangleMesh| -> Vec<[f64; 2]> {
+            m.boundary_edges()
+                .iter()
+                .filter(|&&(_, marker)| marker == 1)
+                .flat_map(|&(e, _)| m.edges()[e].map(|v| m.vertices()[v]))
+                .collect()
+        };
+        let mut mesh = curved;
+        let mut chords = plain;
+        for _ in 0..3 {
+            let marked: Vec<usize> = (0..mesh.cell_count()).step_by(2).collect();
+            mesh = mesh.refine(&marked).unwrap().0;
+            chords = chords.refine(&marked).unwrap().0;
+        }
+        assert_eq!(
+            mesh.boundary_curves().len(),
+            1,
+            "refinement keeps the curve"
+        );
+        for p in arc_vertices(&mesh) {
+            assert!((distance(p) - radius).abs() < 1e-12, "{p:?} off the circle");
+        }
+        assert!(arc_vertices(&chords)
+            .iter()
+            .any(|&p| distance(p) < radius - 1e-3));
+        for &(e, marker) in mesh.boundary_edges() {
+            let [a, b] = mesh.edges()[e].map(|v| mesh.vertices()[v]);
+            match marker {
+                2 => assert!((a[1] - radius).abs() < 1e-12 && (b[1] - radius).abs() < 1e-12),
+                3 => assert!(a[0].abs() < 1e-12 && b[0].abs() < 1e-12),
+                _ => {}
+            }
+        }
     }
 }

@@ -171,7 +171,7 @@ pub fn contact_scene(old: &ContactScene) -> Scene {
         _ => PAIRS.iter().map(|p| p.name).collect(),
     };
     scene.studies = match old.body {
-        ContactBody::Cylinder { .. } => vec!["convergence", "alpha"],
+        ContactBody::Cylinder { .. } => vec!["convergence", "alpha", "adaptivity"],
         _ => Vec::new(),
     };
     scene.in_default_job = true;
@@ -295,6 +295,9 @@ impl Family for Contact {
             Opt::Cold,
             Opt::Solver,
             Opt::Plot,
+            Opt::Tol,
+            Opt::Marking,
+            Opt::Theta,
         ]
     }
 
