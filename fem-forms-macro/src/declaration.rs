@@ -17,6 +17,8 @@
 //!     stabilization: α S against a; // α's parameter, S_h, and the form C_I bounds it by
 //!     side:          s;            // the parameter holding the obstacle side s = ±1
 //!     obstacle:      w >= ψ;       // the constrained field and the obstacle: s·w ≥ s·ψ
+//!     constraint:    b, G;         // b(v,μ) = (μ, sBv), G(μ) = (μ, sψ)
+//!     estimator:     "…";          // optional: the residual estimator (η_T², η_E², η_Γ²)
 //! }
 //! ```
 //!

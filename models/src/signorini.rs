@@ -50,6 +50,7 @@ macro_rules! signorini_model {
                 system:        B_h, L_h;
                 energy:        a, ℓ;
                 stabilization: α S against a;
+                constraint:    b, G;
                 estimator: "
                     η_T²   = h_T²/(2μ_L) ‖div σ(u)‖²
                     η_E²   = h_E/(2μ_L) ‖[[σ(u)·n]]‖²
