@@ -18,7 +18,7 @@ fem_runtime::model! {
             b(v;mu)        = int s v mu
             S(u,lam;v,mu)  = sum_T h_T^2 (u'' + s lam, v'' + s mu)_T
             l(v)           = int f v
-            lS(v,mu)       = sum_T h_T^2 (f, v'' + s mu)_T
+            lS(v,mu)       = sum_T h_T^2 (-f, v'' + s mu)_T
             g(mu)          = int s psi mu
             B_h(u,lam;v,mu) = a(u;v) - b(v;lam) - b(u;mu) - alpha S(u,lam;v,mu)
             L_h(v,mu)       = l(v) - g(mu) - alpha lS(v,mu)

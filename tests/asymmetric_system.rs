@@ -30,7 +30,7 @@ string_model!(
     b(v;μ)     = ∫ s v μ
     S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
     ℓ(v)       = ∫ f v
-    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    ℓ_S(v,μ)   = Σ_T h_T² (−f, v'' + sμ)_T
     g(μ)       = ∫ s ψ μ
     B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
     L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
@@ -44,7 +44,7 @@ string_model!(
     b(v;μ)     = ∫ s v μ
     S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
     ℓ(v)       = ∫ f v
-    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    ℓ_S(v,μ)   = Σ_T h_T² (−f, v'' + sμ)_T
     g(μ)       = ∫ s ψ μ
     B_h(u,λ;v,μ) = a(u;v) − b(v;λ) + b(u;μ) − α S(u,λ;v,μ)
     L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
@@ -58,7 +58,7 @@ string_model!(
     b(v;μ)     = ∫ s v μ
     S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
     ℓ(v)       = ∫ f v
-    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    ℓ_S(v,μ)   = Σ_T h_T² (−f, v'' + sμ)_T
     g(μ)       = ∫ s ψ μ
     B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) + α S(u,λ;v,μ)
     L_h(v,μ)     = ℓ(v) − g(μ) + α ℓ_S(v,μ)
@@ -94,7 +94,7 @@ string_model!(
     a(u;v)     = ∫ u'v'
     S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
     ℓ(v)       = ∫ f v
-    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    ℓ_S(v,μ)   = Σ_T h_T² (−f, v'' + sμ)_T
     g(μ)       = ∫ s ψ μ
     B_h(u,λ;v,μ) = a(u;v) − ∫[degree=1] s v λ − ∫ s u μ − α S(u,λ;v,μ)
     L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)
@@ -244,7 +244,7 @@ fem_runtime::model! {
     b(v;μ)     = ∫ s v μ
     S(u,λ;v,μ) = Σ_T h_T² (u'' + sλ, v'' + sμ)_T
     ℓ(v)       = ∫ f v
-    ℓ_S(v,μ)   = Σ_T h_T² (f, v'' + sμ)_T
+    ℓ_S(v,μ)   = Σ_T h_T² (−f, v'' + sμ)_T
     g(μ)       = ∫ s ψ μ
     B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
     L_h(v,μ)     = ℓ(v) − g(μ) − α ℓ_S(v,μ)

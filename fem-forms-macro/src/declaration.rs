@@ -18,7 +18,8 @@
 //!     side:          s;            // the parameter holding the obstacle side s = ±1
 //!     obstacle:      w >= ψ;       // the constrained field and the obstacle: s·w ≥ s·ψ
 //!     constraint:    b, G;         // b(v,μ) = (μ, sBv), G(μ) = (μ, sψ)
-//!     estimator:     "…";          // optional: the residual estimator (η_T², η_E², η_Γ²)
+//!     estimator:     "…";          // optional: the residual estimator (η_T², η_E², η_Γ²),
+//!                                  // or `derived` (from `a`, `ℓ`, `b`)
 //! }
 //! ```
 //!
@@ -112,6 +113,16 @@ pub struct RolesDecl {
     pub constraint: Option<(Ident, Ident)>,
 }
 
+/// The `estimator:` section.
+#[derive(Clone)]
+pub enum EstimatorDecl {
+    /// The lines `η_T² = …`, `η_E² = …`, `η_Γ² = …` as written.
+    Text(LitStr),
+    /// `derived`: the residual estimator of the strong form derived from `a`, `ℓ` and
+    /// `b` ([`crate::derived::residual_estimator`]).
+    Derived(Span),
+}
+
 /// Everything the macro input declares.
 #[derive(Clone)]
 pub struct Declaration {
@@ -143,8 +154,9 @@ pub struct Declaration {
     pub facets: Vec<Ident>,
     /// The forms text.
     pub forms: LitStr,
-    /// The estimator text (`estimator: "η_T² = …";`), if the model declares one.
-    pub estimator: Option<LitStr>,
+    /// The estimator (`estimator: "η_T² = …";` or `estimator: derived;`), if the model
+    /// declares one.
+    pub estimator: Option<EstimatorDecl>,
     /// The roles of forms and parameters.
     pub roles: RolesDecl,
     /// Span of the section list, for "missing section" errors.
@@ -432,7 +444,20 @@ impl Parse for Declaration {
                     })?
                 }
                 "facets" => declaration.facets = comma_list(&content, |s| s.parse())?,
-                "estimator" => declaration.estimator = Some(content.parse()?),
+                "estimator" => {
+                    declaration.estimator = Some(if content.peek(LitStr) {
+                        EstimatorDecl::Text(content.parse()?)
+                    } else {
+                        let word: Ident = content.parse()?;
+                        if word != "derived" {
+                            return Err(syn::Error::new(
+                                word.span(),
+                                "expected the estimator's text `\"η_T² = …\"` or `derived`",
+                            ));
+                        }
+                        EstimatorDecl::Derived(word.span())
+                    })
+                }
                 "forms" => {
                     declaration.forms = content.parse()?;
                     have_forms = true;

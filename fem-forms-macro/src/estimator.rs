@@ -65,6 +65,8 @@ pub struct IndicatorTerm {
     pub residual: Expansion,
     /// The term as written, for the docs.
     pub source: String,
+    /// Where the term starts in the estimator text, for errors.
+    pub loc: Loc,
 }
 
 /// An analysed estimator.
@@ -303,6 +305,7 @@ impl Analysis<'_> {
                 weight: weight.clone(),
                 residual,
                 source: source.clone(),
+                loc: span(tokens),
             })
             .collect())
     }

@@ -199,6 +199,7 @@
 mod analysis;
 mod codegen;
 mod declaration;
+mod derived;
 mod diagnostic;
 mod estimator;
 mod lexer;
@@ -250,13 +251,51 @@ fn expand(input: TokenStream) -> TokenStream {
             .map(|e| e.to_compile_error(&text, span))
             .collect();
     }
+    let derived = derived::derive(&symbols, &forms, &roles);
+    let roles = roles::Roles {
+        strong_form: derived.is_some(),
+        ..roles
+    };
+    if let Some(derived) = &derived {
+        let errors = derived::check_stabilization(&symbols, &forms, &roles, derived);
+        if !errors.is_empty() {
+            let span = declaration.forms.span();
+            return errors
+                .iter()
+                .map(|e| e.to_compile_error(&text, span))
+                .collect();
+        }
+    }
     let estimator = match &declaration.estimator {
         None => None,
-        Some(literal) => {
+        Some(declaration::EstimatorDecl::Derived(span)) => match &derived {
+            Some(derived) => Some(derived::residual_estimator(
+                &symbols,
+                &forms,
+                &roles,
+                derived,
+                diagnostic::Loc {
+                    line: 1,
+                    column: 1,
+                    len: 1,
+                },
+            )),
+            None => {
+                return syn::Error::new(
+                    *span,
+                    "the estimator cannot be derived: it needs `energy: a, ℓ;` with constant coefficients in `a` on the cells, no derivative of data in `ℓ`, and `constraint: b, G;` for a model with a multiplier; write it as `estimator: \"η_T² = …\";`",
+                )
+                .to_compile_error()
+            }
+        },
+        Some(declaration::EstimatorDecl::Text(literal)) => {
             let text = literal.value();
             let (tokens, mut errors) = lexer::tokenize(&text);
             let (estimator, more) = estimator::analyse(&tokens, &text, &symbols, &all_forms);
             errors.extend(more);
+            if let (true, Some(derived)) = (errors.is_empty(), &derived) {
+                errors.extend(derived::check_estimator(&symbols, &roles, derived, &estimator));
+            }
             if !errors.is_empty() {
                 let span = literal.span();
                 return errors

@@ -29,6 +29,10 @@ pub struct Roles {
     pub obstacle: Option<(usize, usize)>,
     /// `[b, G]`: the constraint `b(v, μ) = (μ, sBv)`, `G(μ) = (μ, sψ)`.
     pub constraint: Option<[usize; 2]>,
+    /// Whether the strong form was derived from `a`, `ℓ` and `b`
+    /// ([`crate::derived`]), so that the stabilization and the estimator were checked
+    /// against it; set after the roles are resolved.
+    pub strong_form: bool,
     /// The order `p` of the operator whose residual the stabilization measures: the
     /// power of h in the stabilization's terms (`Σ_T h_T^p (…)`), or else the total
     /// derivative order of the energy's bilinear form; 0 where neither is known.
@@ -96,6 +100,7 @@ pub fn resolve(
         order: 0,
         obstacle: obstacle.unwrap_or_else(|| conventional.obstacle()),
         constraint: constraint.unwrap_or_else(|| conventional.constraint()),
+        strong_form: false,
     };
     let order = operator_order(&roles, forms);
     (Roles { order, ..roles }, lookup.errors)
@@ -233,7 +238,8 @@ impl Conventional<'_> {
     }
 
     fn constraint(&self) -> Option<[usize; 2]> {
-        Some([self.form("b", 2)?, self.form("G", 1)?])
+        let gap = self.form("G", 1).or_else(|| self.form("g", 1))?;
+        Some([self.form("b", 2)?, gap])
     }
 
     fn obstacle(&self) -> Option<(usize, usize)> {

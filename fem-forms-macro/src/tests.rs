@@ -1386,3 +1386,244 @@ fn a_vector_on_an_interval_is_refused() {
         "{errors:?}"
     );
 }
+
+/// The stabilized membrane as shipped (`models/src/membrane.rs`), with `S` and `L_h`
+/// replaceable.
+fn stabilized_membrane(s: &str, l_h: &str, estimator: &str) -> TokenStream {
+    let forms = format!(
+        "
+        a(u;v)       = ∫ ∇u·∇v
+        b(v;μ)       = ∫ v μ
+        S(u,λ;v,μ)   = {s}
+        ℓ(v)         = ∫ f v
+        ℓ_S(v,μ)     = Σ_T h_T² (f, −Δv − μ)_T
+        G(μ)         = ∫ ψ μ
+        B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
+        L_h(v,μ)     = {l_h}
+    "
+    );
+    quote! {
+        /// Membrane.
+        pub mod membrane on triangle {
+            unknowns: u: P2, λ: P0 >= 0;
+            tests: v, μ;
+            params: α;
+            data: f, ψ, g;
+            boundary: u = g;
+            forms: #forms;
+            estimator: #estimator;
+        }
+    }
+}
+
+const CONSISTENT_S: &str = "Σ_T h_T² (−Δu − λ, −Δv − μ)_T";
+const CONSISTENT_L: &str = "ℓ(v) − G(μ) − α ℓ_S(v,μ)";
+const DECLARED: &str = "η_T² = h_T² ‖f + Δu + λ‖²\n η_E² = h_E ‖[[∇u·n]]‖²";
+
+#[test]
+fn a_consistent_membrane_is_derived_and_passes() {
+    let out = expand(stabilized_membrane(CONSISTENT_S, CONSISTENT_L, DECLARED));
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    assert!(text.contains("const STRONG_FORM : bool = true"), "{text}");
+}
+
+#[test]
+fn an_inconsistent_stabilization_is_a_compile_error() {
+    for (s, l_h, why) in [
+        (
+            "Σ_T h_T² (−Δu + λ, −Δv − μ)_T",
+            CONSISTENT_L,
+            "the sign of λ",
+        ),
+        (CONSISTENT_S, "ℓ(v) − G(μ)", "ℓ_S missing"),
+        (CONSISTENT_S, "ℓ(v) − G(μ) + α ℓ_S(v,μ)", "the sign of ℓ_S"),
+        (
+            "Σ_T h_T² (−2Δu − λ, −Δv − μ)_T",
+            CONSISTENT_L,
+            "another operator",
+        ),
+    ] {
+        let out = expand(stabilized_membrane(s, l_h, DECLARED));
+        let errors = rendered_errors(&out);
+        assert!(
+            errors
+                .iter()
+                .any(|e| e.contains("does not stabilize the residual of the equation of `v`")),
+            "{why}: {errors:?}"
+        );
+    }
+}
+
+#[test]
+fn an_estimator_that_is_not_the_models_residual_is_a_compile_error() {
+    for (text, expected) in [
+        (
+            "η_T² = h_T² ‖f − Δu + λ‖²",
+            "not a multiple of the residual",
+        ),
+        (
+            "η_T² = h_T² ‖f + Δu − λ‖²",
+            "not a multiple of the residual",
+        ),
+        ("η_E² = h_E ‖[[∇u·τ]]‖²", "not a multiple of a flux"),
+    ] {
+        let out = expand(stabilized_membrane(CONSISTENT_S, CONSISTENT_L, text));
+        let errors = rendered_errors(&out);
+        assert!(
+            errors.iter().any(|e| e.contains(expected)),
+            "{text}: expected `{expected}`, got {errors:?}"
+        );
+    }
+}
+
+/// The plate's stabilization measures `div div Cε(θ) − sλ`, the contact equation's
+/// residual after the rotation equation's `q = −div Cε(θ)`: consistent up to the
+/// derivative of another equation; the beam's `θ''' − sλ` likewise. Changing the sign
+/// of the third derivative is caught.
+#[test]
+fn a_stabilization_consistent_up_to_another_equation_passes() {
+    let beam = |s: &str| {
+        let forms = format!(
+            "
+            a(θ,w;η,v) = ∫ θ'η' + t⁻²(w'−θ)(v'−η)
+            b(η,v;μ)   = ∫ s v μ
+            S(θ,λ;η,μ) = {s}
+            ℓ(η,v)     = ∫ f v
+            ℓ_S(η,μ)   = Σ_T h_T⁴ (f, η''' − sμ)_T
+            g(μ)       = ∫ s ψ μ
+            B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(η,v;λ) − b(θ,w;μ) − α S(θ,λ;η,μ)
+            L_h(η,v,μ)       = ℓ(η,v) − g(μ) − α ℓ_S(η,μ)
+        "
+        );
+        quote! {
+            /// Timoshenko beam.
+            pub mod beam on interval {
+                unknowns: θ: P3, w: P3, λ: P0 >= 0;
+                tests: η, v, μ;
+                params: t > 0, α, s;
+                data: f, ψ;
+                forms: #forms;
+            }
+        }
+    };
+    let out = expand(beam("Σ_T h_T⁴ (θ''' − sλ, η''' − sμ)_T"));
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    assert!(text.contains("const STRONG_FORM : bool = true"));
+    let out = expand(beam("Σ_T h_T⁴ (−θ''' − sλ, η''' − sμ)_T"));
+    let errors = rendered_errors(&out);
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("does not stabilize the residual of the equation of `v`")),
+        "{errors:?}"
+    );
+}
+
+/// The plate's fluxes: the Kirchhoff shear `V_n = (div M)·n + ∂_s M_ns` and `M_nn` are
+/// what integration by parts of `a = ∫ M(w):K(v)` gives on an edge; the shear without
+/// its tangential part, `(div M)·n`, is not.
+#[test]
+fn the_kirchhoff_shear_is_the_plates_flux() {
+    let plate = |estimator: &str| {
+        quote! {
+            /// Plate.
+            pub mod plate on triangle {
+                unknowns: w: Argyris, λ: P0 >= 0;
+                tests: v, μ;
+                params: D > 0, ν, α, s;
+                data: f, ψ, g;
+                boundary: w = g;
+                forms: "
+                    K(w)         := −∇∇w
+                    M(w)         := D[(1−ν)K(w) + ν tr K(w) I]
+                    a(w;v)       = ∫ M(w):K(v)
+                    b(v;μ)       = ∫ s v μ
+                    S(w,λ;v,μ)   = Σ_T h_T⁴ (D Δ²w − sλ, D Δ²v − sμ)_T
+                    ℓ(v)         = ∫ f v
+                    ℓ_S(v,μ)     = Σ_T h_T⁴ (f, D Δ²v − sμ)_T
+                    G(μ)         = ∫ s ψ μ
+                    B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
+                    L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
+                ";
+                estimator: #estimator;
+            }
+        }
+    };
+    let shipped = "η_T² = h_T⁴/D ‖f − D Δ²w + sλ‖²\n η_E² = h_E³/D ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/D ‖[[(M(w)·n)·n]]‖²";
+    let out = expand(plate(shipped));
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    let out = expand(plate("η_E² = h_E³/D ‖[[(div M(w))·n]]‖²"));
+    let errors = rendered_errors(&out);
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("not a multiple of a flux")),
+        "{errors:?}"
+    );
+}
+
+#[test]
+fn a_derived_estimator_expands_on_intervals() {
+    let beam = quote! {
+        /// Beam.
+        pub mod beam on interval {
+            unknowns: w: Hermite, λ: P0 >= 0;
+            tests: v, μ;
+            params: s;
+            data: f, ψ;
+            forms: "
+                a(w;v) = ∫ w''v''
+                b(v;μ) = ∫ s v μ
+                ℓ(v)   = ∫ f v
+                G(μ)   = ∫ s ψ μ
+            ";
+            estimator: derived;
+        }
+    };
+    let out = expand(beam);
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    let _: syn::File = syn::parse2(out).expect("generated code parses");
+    // the cell residual and the two node fluxes, w''' and w''
+    assert!(text.contains("PHI_END_HERMITE_D3") && text.contains("PHI_END_HERMITE_D2"));
+}
+
+#[test]
+fn an_estimator_that_cannot_be_derived_says_why() {
+    let out = expand(quote! {
+        /// Membrane with a variable coefficient.
+        pub mod variable on triangle {
+            unknowns: u: P1;
+            tests: v;
+            data: k, f;
+            forms: "
+                a(u;v) = ∫ k ∇u·∇v
+                ℓ(v)   = ∫ f v
+            ";
+            estimator: derived;
+        }
+    });
+    let errors = rendered_errors(&out);
+    assert!(
+        errors.iter().any(|e| e.contains("cannot be derived")),
+        "{errors:?}"
+    );
+    let out = expand(quote! {
+        /// A misspelt estimator.
+        pub mod misspelt on triangle {
+            unknowns: u: P1;
+            tests: v;
+            data: f;
+            forms: "a(u;v) = ∫ ∇u·∇v";
+            estimator: derive;
+        }
+    });
+    let errors = rendered_errors(&out);
+    assert!(
+        errors.iter().any(|e| e.contains("or `derived`")),
+        "{errors:?}"
+    );
+}

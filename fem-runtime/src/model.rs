@@ -159,6 +159,11 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// has them; `None` otherwise. The estimate of a multiplier on a boundary part takes
     /// its contact terms from it ([`crate::adaptivity`]).
     const CONSTRAINT: Option<[usize; 2]> = None;
+    /// Whether the macro derived the strong form of the model from `a`, `ℓ` and `b` by
+    /// integration by parts (constant coefficients in `a`) and checked the cell
+    /// stabilization and the declared estimator against it (docs/adaptivity.md,
+    /// "Derived from `a`"); `false` where it could not, and by default.
+    const STRONG_FORM: bool = false;
     /// The stabilization: the parameter α of `B_h = … − α S`, the form `S` and the form
     /// `a` that bounds it, `S_T(v, v) ≤ C_I a_T(v, v)` on the primal functions of a cell
     /// ([`crate::stabilization`]); declared under `stabilization: α S against a`, or else

@@ -463,8 +463,10 @@ fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream
         None => quote!(::core::option::Option::None),
     };
     let order = roles.order;
+    let strong_form = roles.strong_form;
     quote! {
         const ORDER: u8 = #order;
+        const STRONG_FORM: bool = #strong_form;
         const OBSTACLE: ::core::option::Option<[usize; 2]> = #obstacle;
         const SYSTEM: ::core::option::Option<[usize; 2]> = #system;
         const ENERGY: ::core::option::Option<[usize; 2]> = #energy;
