@@ -7,8 +7,14 @@
 //! so `C_I ≤ h² k` (the runtime computes it from the declared roles and checks α
 //! against it). Its rule `α = ½/C_I` would grow like `1/h²` here and make `α S_h` of
 //! order one, so the string takes a fixed α = 0.1, well inside `0 < α < 1/C_I`.
+//!
+//! Its estimator is not written but derived from the forms (`estimator: derived`,
+//! docs/adaptivity.md): `h_T² ‖f + sλ + T u'' − k u‖²` on the cells and `h_E [[T u']]²` at
+//! the interior nodes, so the string can be solved to a tolerance
+//! ([`StringOnFoundation::solve_adaptive`]).
 
-use fem_runtime::problem::{Condition, Problem, Solved, ALPHA_WHEN_CI_VANISHES};
+use fem_runtime::adaptivity::AdaptiveOptions;
+use fem_runtime::problem::{Condition, Exact, Problem, Solved, ALPHA_WHEN_CI_VANISHES};
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{DirichletPart, IntervalMesh, Result};
 
@@ -34,6 +40,7 @@ fem_runtime::model! {
         stabilization: α S against a;
         side:          s;
         obstacle:      u >= ψ;
+        estimator:     derived;
     }
 }
 
@@ -61,17 +68,54 @@ impl StringOnFoundation {
     /// # Errors
     /// A mesh that cannot be built, and the solve's errors.
     pub fn solve(&self, cells: usize) -> Result<Solved<Model, IntervalMesh>> {
+        self.solve_with(cells, None, None)
+    }
+
+    /// Solves adaptively from a uniform mesh of `cells` cells until the derived
+    /// estimate is below `tolerance` times the energy norm (bisection of the cells
+    /// Dörfler marks), reporting the true error of every level against `exact` where
+    /// given.
+    ///
+    /// # Errors
+    /// As [`StringOnFoundation::solve`], and the adaptive loop's (the unknowns' limit).
+    pub fn solve_adaptive(
+        &self,
+        cells: usize,
+        tolerance: f64,
+        exact: Option<Exact>,
+    ) -> Result<Solved<Model, IntervalMesh>> {
+        self.solve_with(cells, Some(tolerance), exact)
+    }
+
+    fn solve_with(
+        &self,
+        cells: usize,
+        tolerance: Option<f64>,
+        exact: Option<Exact>,
+    ) -> Result<Solved<Model, IntervalMesh>> {
         let mesh = IntervalMesh::uniform(-self.half_length, self.half_length, cells)?;
         let (q, d) = (self.load, self.depth);
         let load = move |_: &[f64]| -q;
         let obstacle = move |_: &[f64]| -d;
-        Problem::<Model, IntervalMesh>::new(vec![mesh])
+        let mut problem = Problem::<Model, IntervalMesh>::new(vec![mesh])
             .param(params::T, self.tension)
             .param(params::k, self.stiffness)
             .alpha(Alpha::Fixed(0.1), ALPHA_WHEN_CI_VANISHES)
             .data(data::f, &load)
             .data(data::ψ, &obstacle)
-            .support(DirichletPart::All, fields::u, Condition::Zero)
-            .solve()
+            .support(DirichletPart::All, fields::u, Condition::Zero);
+        if let Some(exact) = exact {
+            problem = problem.exact(exact);
+        }
+        match tolerance {
+            None => problem.solve(),
+            Some(tolerance) => problem.solve_adaptive(
+                AdaptiveOptions {
+                    tolerance,
+                    ..AdaptiveOptions::default()
+                },
+                |_| {},
+            ),
+        }
     }
 }
