@@ -820,6 +820,39 @@ mod signorini {
         }
     }
 
+    /// The patch test presses the whole bottom with `λ = q`: the cells of the contact
+    /// edges, and those alone, are in contact with the mean multiplier `q` in the fields
+    /// the charts and `--vtk` take (a boundary multiplier has no cell values of its own).
+    #[test]
+    fn the_contact_edges_cells_carry_the_contact_set() {
+        use fem_forms::models::geometry::Fields;
+        let scene = families::scene("signorini-patch").unwrap();
+        for pair in ["p1-p0", "p2-p1"] {
+            let settings = Settings {
+                pair: Some(pair.into()),
+                mesh_size: Some(4),
+                load: Some(2.5),
+                ..Settings::default()
+            };
+            let outcome = families::solve(&scene, &settings).unwrap();
+            let Fields::Triangles { mesh, cell, .. } = &outcome.fields else {
+                panic!("triangles")
+            };
+            let field = |name: &str| &cell.iter().find(|(n, _)| *n == name).unwrap().1;
+            let (lambda, contact) = (field("lambda"), field("contact"));
+            for c in 0..mesh.cell_count() {
+                let x = mesh.cell_coordinates(c);
+                let on_bottom = (0..3).filter(|&i| x[2 * i + 1].abs() < 1e-12).count() == 2;
+                if on_bottom {
+                    assert!((contact[c] - 1.0).abs() < 1e-12, "{pair}: cell {c}");
+                    assert!((lambda[c] - 2.5).abs() < 1e-9, "{pair}: λ {}", lambda[c]);
+                } else {
+                    assert_eq!((contact[c], lambda[c]), (0.0, 0.0), "{pair}: cell {c}");
+                }
+            }
+        }
+    }
+
     /// Hertz from the coarsest graded mesh (b/h = 1): the adaptive loop reaches a
     /// smaller pressure error than the hand-graded b/h = 64 mesh with fewer unknowns,
     /// and its estimate falls at P1's optimal rate, about N^{-1/2}.

@@ -563,6 +563,9 @@ fn triangle_fields<M: Model, G: MeshKind>(
             .collect();
         cell.push(("lambda", mean));
         cell.push(("contact", solution.contact_shares()));
+    } else if let Some((mean, shares)) = G::boundary_contact_cells(solution) {
+        cell.push(("lambda", mean));
+        cell.push(("contact", shares));
     }
     Fields::Triangles {
         mesh: mesh.clone(),

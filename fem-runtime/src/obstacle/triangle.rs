@@ -612,6 +612,32 @@ impl ObstacleSolution<TriangleMesh> {
             .map(|(c, s)| s * mesh.area(c))
             .sum()
     }
+
+    /// For a multiplier on a boundary part, per cell: the mean of λ_h over the cell's
+    /// edges on the part, and the share of those edges' ends in contact (active or
+    /// touching, as [`ObstacleSolution::contact_shares`]); 0 for the cells off the part.
+    /// `None` for a multiplier on the cells.
+    pub fn boundary_contact_cells(&self) -> Option<(Vec<f64>, Vec<f64>)> {
+        let d = &self.discretization;
+        let boundary = d.boundary()?;
+        let lambda = self.multiplier_values();
+        let active = contact_indicator(
+            &d.lcp,
+            &d.primal_part(&self.values),
+            &d.multiplier_part(&self.values),
+        );
+        let cells = d.mesh.cell_count();
+        let (mut mean, mut share) = (vec![0.0; cells], vec![0.0; cells]);
+        for (edge, &[a, b]) in boundary.edges.iter().zip(&boundary.edge_dofs) {
+            mean[edge.cell] += 0.5 * (lambda[a] + lambda[b]);
+            share[edge.cell] +=
+                0.5 * (f64::from(u8::from(active[a])) + f64::from(u8::from(active[b])));
+        }
+        for s in &mut share {
+            *s = s.min(1.0);
+        }
+        Some((mean, share))
+    }
 }
 
 /// The largest penetration `max(ψ − u_h, 0)` of `u` into the obstacle `psi` at the

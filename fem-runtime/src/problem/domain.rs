@@ -178,6 +178,14 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
     /// The values of `field` of a solution at the mesh vertices.
     fn field_at_vertices(solution: &ObstacleSolution<Self>, field: usize) -> Vec<f64>;
 
+    /// For a multiplier on a boundary part, per cell the mean λ_h on its edges of the
+    /// part and their share in contact
+    /// ([`ObstacleSolution::boundary_contact_cells`]); `None` elsewhere (the default).
+    fn boundary_contact_cells(solution: &ObstacleSolution<Self>) -> Option<(Vec<f64>, Vec<f64>)> {
+        let _ = solution;
+        None
+    }
+
     /// `∫ λ_h` over the cells (or the boundary part) the multiplier lives on.
     fn total_contact_force(solution: &ObstacleSolution<Self>) -> f64;
 
@@ -644,6 +652,10 @@ impl Domain for TriangleMesh {
 
     fn refine_marked(&self, marked: &[usize]) -> Result<Self> {
         Ok(self.refine(marked)?.0)
+    }
+
+    fn boundary_contact_cells(solution: &ObstacleSolution<Self>) -> Option<(Vec<f64>, Vec<f64>)> {
+        solution.boundary_contact_cells()
     }
 
     fn extent(&self) -> f64 {
