@@ -151,9 +151,10 @@ struct SolveOptions {
     plot: bool,
     /// Solve adaptively until the a-posteriori estimate (η² + S²)^{1/2} is at most T
     /// times the energy norm ‖u_h‖_a of the solution: solve, estimate, mark, refine
-    /// (newest-vertex bisection; bisection on beams), solve again from the previous
-    /// solution (membranes, Kirchhoff and Reissner–Mindlin plates, beams; the scene's
-    /// mesh is the first level: start coarse, e.g. --mesh-size 8).
+    /// (newest-vertex bisection, new vertices on a curved boundary moved onto it;
+    /// bisection on beams), solve again from the previous solution (every family, on
+    /// the pairs whose model declares an estimator; the scene's mesh is the first
+    /// level: start coarse, e.g. --mesh-size 8).
     #[arg(long, value_name = "T", allow_hyphen_values = true)]
     tol: Option<f64>,
     /// Marking of the adaptive loop: dorfler (default: the fewest cells holding θ of

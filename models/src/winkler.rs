@@ -1,7 +1,9 @@
 //! A Kirchhoff plate on a Winkler foundation (docs/mathematics.md, ../MODELS.md §10): the
 //! foundation's modulus k adds `k w v` to the bending form, so `𝒜w = DΔ²w + k w` and the
 //! contact equation's residual is `DΔ²w + k w − sλ − f`, which the stabilization
-//! penalizes on each cell. Argyris (C¹) deflection, P0 multiplier.
+//! penalizes on each cell. Argyris (C¹) deflection, P0 multiplier. Its estimator is the
+//! Kirchhoff plate's (docs/adaptivity.md) with the foundation's `k w` in the cell
+//! residual; the macro checks both against the strong form it derives from `a`.
 
 fem_runtime::model! {
     /// Kirchhoff plate on a Winkler foundation with an obstacle, Argyris–P0, stabilized.
@@ -28,5 +30,9 @@ fem_runtime::model! {
         stabilization: α S against a;
         side:          s;
         obstacle:      w >= ψ;
+        estimator: "
+            η_T² = h_T⁴/(625 D) ‖f − D Δ²w − k w + sλ‖²
+            η_E² = h_E³/(125 D) ‖[[(div M(w))·n + τ·∇((M(w)·n)·τ)]]‖² + h_E/(5 D) ‖[[(M(w)·n)·n]]‖²
+        ";
     }
 }

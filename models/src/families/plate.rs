@@ -141,7 +141,7 @@ fn plate_scene(old: &plate_scenes::PlateScene) -> Scene {
         PlateSupport::SimplySupported => vec!["p1-p2-p0"],
     };
     scene.studies = match old.name {
-        "mindlin-square" => vec!["locking"],
+        "mindlin-square" => vec!["locking", "adaptivity"],
         "mindlin-disk" => vec!["convergence", "iterations"],
         _ => Vec::new(),
     };

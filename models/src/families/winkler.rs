@@ -53,6 +53,9 @@ impl Family for Winkler {
             Opt::NoObstacle,
             Opt::Solver,
             Opt::Cold,
+            Opt::Tol,
+            Opt::Marking,
+            Opt::Theta,
         ]
     }
 
@@ -74,7 +77,7 @@ impl Family for Winkler {
         .with_support(Part::All, Support::SimplySupported { hard: false });
         vec![Scene {
             // the kinds that need no exact solution, through the one study implementation
-            studies: vec!["alpha", "iterations", "stability"],
+            studies: vec!["alpha", "iterations", "stability", "adaptivity"],
             load: Some(Load {
                 default: 1.0,
                 scales: vec!["f".into()],
