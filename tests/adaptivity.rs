@@ -889,3 +889,63 @@ mod signorini {
         assert!((0.4..0.7).contains(&rate), "estimate ~ N^-{rate:.2}");
     }
 }
+
+/// The average `{X} = ½(X⁺ + X⁻)` on interior edges, against a hand computation: for a
+/// continuous P1 `u` the average of `u` is `u` (`h_E ∫_E u² ds`), of the normal
+/// derivative the mean of the two sides', and data enter an average (not a jump).
+mod average {
+    use fem_forms::Model;
+
+    fem_forms::model! {
+        /// A membrane with averages in its estimator.
+        pub mod averaged on triangle {
+            unknowns: u: P1;
+            tests: v;
+            data: f;
+            forms: "
+                a(u;v) = ∫ ∇u·∇v
+                ℓ(v)   = ∫ f v
+            ";
+            estimator: "
+                η_E² = h_E ‖{u}‖² + ‖{∇u·n + f}‖²
+            ";
+        }
+    }
+
+    fn f(x: &[f64]) -> f64 {
+        1.0 + x[0]
+    }
+
+    #[test]
+    fn an_average_is_the_mean_of_the_two_sides() {
+        use averaged::Model as M;
+        // two cells sharing the edge (1,0)–(0,1): local edge 1 of both
+        let x = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+        let y = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0];
+        let (ux, uy) = ([0.3, 1.1, -0.4], [2.0, -0.4, 1.1]);
+        let eta2 = M::edge_indicator(&x, 1, &[&ux], &y, 1, &[&uy], &[], &[&f]).unwrap();
+        let len = 2f64.sqrt();
+        // {u}: u is 1.1 at (1,0) and −0.4 at (0,1)
+        let (a, b) = (1.1, -0.4);
+        let values = len * len * (a * a + a * b + b * b) / 3.0;
+        // {∇u·n}: n = (1,1)/√2 out of x; ∇u = (0.8, −0.7) on x and (2.4, 0.9) on y (from
+        // y's vertex (1,1) with 2.0 and its neighbours), the mean of the two
+        let gx = [ux[1] - ux[0], ux[2] - ux[0]];
+        let gy = [uy[0] - uy[1], uy[0] - uy[2]];
+        let flux = 0.5 * ((gx[0] + gx[1]) + (gy[0] + gy[1])) / len;
+        // ∫_E (flux + f)² with f = 1 + x linear along the edge: 4-point Gauss
+        let (ga, gb) = (0.339_981_043_584_856_3, 0.861_136_311_594_052_6);
+        let (wa, wb) = (0.652_145_154_862_546_1, 0.347_854_845_137_453_9);
+        let mut fluxes = 0.0;
+        for (s, w) in [(-gb, wb), (-ga, wa), (ga, wa), (gb, wb)] {
+            let s = 0.5 * (1.0 + s);
+            let point = [1.0 - s, s];
+            fluxes += 0.5 * w * len * (flux + f(&point)).powi(2);
+        }
+        let expected = values + fluxes;
+        assert!(
+            (eta2 - expected).abs() < 1e-12 * expected,
+            "{eta2} against {expected}"
+        );
+    }
+}

@@ -67,6 +67,9 @@ pub struct IndicatorTerm {
     pub source: String,
     /// Where the term starts in the estimator text, for errors.
     pub loc: Loc,
+    /// On an interior edge: the average `{X} = ½(X⁺ + X⁻)` of the two sides instead of
+    /// the jump `[[X]] = X⁺ − X⁻`.
+    pub average: bool,
 }
 
 /// An analysed estimator.
@@ -253,8 +256,12 @@ impl Analysis<'_> {
         }
         let weight_tokens = &tokens[..open];
         let body = &tokens[open + 1..close];
+        let average = region == Region::Edge && average_inside(body).is_some();
         let body = match region {
-            Region::Edge => jump_inside(body, example)?,
+            Region::Edge => match average_inside(body) {
+                Some(inside) => inside,
+                None => jump_inside(body, example)?,
+            },
             Region::Cell | Region::Boundary(_) => body,
         };
         if body.is_empty() {
@@ -292,7 +299,7 @@ impl Analysis<'_> {
             entries.push(Expansion::new());
         }
         for residual in &entries {
-            self.check_residual(region, residual, body)?;
+            self.check_residual(region, residual, body, average)?;
         }
         check_sizes(region, weight_tokens, body)?;
         let first = tokens[0].loc;
@@ -306,6 +313,7 @@ impl Analysis<'_> {
                 residual,
                 source: source.clone(),
                 loc: span(tokens),
+                average,
             })
             .collect())
     }
@@ -323,6 +331,7 @@ impl Analysis<'_> {
         region: Region,
         residual: &Expansion,
         body: &[Token],
+        average: bool,
     ) -> Result<(), Vec<Diagnostic>> {
         let fields = self.symbols.fields.len();
         for m in residual {
@@ -347,7 +356,7 @@ impl Analysis<'_> {
                         self.symbols.fields[self.symbols.field_of(a.symbol)].name
                     ))]);
                 }
-            } else if region == Region::Edge && !m.data.is_empty() {
+            } else if region == Region::Edge && !average && !m.data.is_empty() {
                 return Err(vec![Diagnostic::text(
                     m.origin,
                     "data alone in a jump: continuous data jump by zero",
@@ -379,6 +388,29 @@ impl Analysis<'_> {
     }
 }
 
+/// `{X}` → `X` (the average of the two sides), where the whole body is one brace group.
+fn average_inside(body: &[Token]) -> Option<&[Token]> {
+    let n = body.len();
+    if n < 3 || body[0].tok != Tok::LBrace || body[n - 1].tok != Tok::RBrace {
+        return None;
+    }
+    // the opening brace must close at the end, not before (`{a} + {b}` is no average)
+    let mut depth = 0i32;
+    for (i, t) in body.iter().enumerate() {
+        match t.tok {
+            Tok::LBrace => depth += 1,
+            Tok::RBrace => {
+                depth -= 1;
+                if depth == 0 && i + 1 < n {
+                    return None;
+                }
+            }
+            _ => {}
+        }
+    }
+    Some(&body[1..n - 1])
+}
+
 /// `[[X]]` → `X`, or the error that says how to write a jump.
 fn jump_inside<'t>(body: &'t [Token], example: &str) -> Result<&'t [Token], Vec<Diagnostic>> {
     let n = body.len();
@@ -394,7 +426,9 @@ fn jump_inside<'t>(body: &'t [Token], example: &str) -> Result<&'t [Token], Vec<
             span(body),
             "an edge's norm is that of a jump `[[X]]`",
         )
-        .help(format!("write `{example}`"))])
+        .help(format!(
+            "write `{example}`, or the average `{{X}}` of the two sides"
+        ))])
     }
 }
 

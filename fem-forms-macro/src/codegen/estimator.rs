@@ -269,7 +269,14 @@ fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     };
     let mut body = Vec::new();
     for m in &term.residual {
-        let Some(a) = m.args.first() else { continue };
+        let Some(a) = m.args.first() else {
+            // data alone: continuous, its average is its value (in a jump it is refused)
+            let c = monomial_coefficient(m);
+            let data = data_product(m);
+            let p = product(std::iter::once(quote!({ let h = h_p; #c })).chain(data));
+            body.push(quote!(r += #p;));
+            continue;
+        };
         let c = monomial_coefficient(m);
         let data = data_product(m);
         let element = symbols.fields[a.symbol].element;
@@ -315,8 +322,12 @@ fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
             "_m",
             &mut minus_table,
         );
-        // inside a jump `h` is each side's cell size
-        let jump = quote!(({ let h = h_p; #c } * #plus - { let h = h_m; #c } * #minus));
+        // inside a jump or an average `h` is each side's cell size
+        let jump = if term.average {
+            quote!((0.5 * ({ let h = h_p; #c } * #plus + { let h = h_m; #c } * #minus)))
+        } else {
+            quote!(({ let h = h_p; #c } * #plus - { let h = h_m; #c } * #minus))
+        };
         let p = product(data.into_iter().chain(std::iter::once(jump)));
         body.push(quote!(r += #p;));
     }
