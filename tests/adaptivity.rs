@@ -949,3 +949,40 @@ mod average {
         );
     }
 }
+
+/// The clamped disk plate on isoparametric cells (mindlin-disk) refines adaptively: its
+/// curved boundary cells keep their quadratic edges (`CurvedTriangleMesh::refine`), the
+/// energy norm takes the curved cells' own element matrices, and the loop ends below
+/// its tolerance.
+#[test]
+fn a_curved_mesh_refines_adaptively() {
+    use fem_forms::models::families;
+    use fem_forms::models::report::Settings;
+    let scene = families::scene("mindlin-disk").unwrap();
+    let settings = Settings {
+        mesh_size: Some(4),
+        adaptive: Some(AdaptiveOptions {
+            tolerance: 0.6,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    let outcome = families::solve(&scene, &settings).unwrap();
+    let levels = &outcome.report.solve.adaptive_levels;
+    let (first, last) = (levels[0], levels[levels.len() - 1]);
+    assert!(levels.len() > 3, "{} levels", levels.len());
+    assert!(last.estimate <= 0.6 * last.energy_norm);
+    assert!(last.estimate < 0.5 * first.estimate, "{levels:?}");
+    // new boundary vertices sit on the quadratic edges (within 1e-4 of the unit circle
+    // at this size), not at the chords' midpoints (1e-2 inside it)
+    let fem_forms::models::geometry::Fields::Triangles { mesh, .. } = &outcome.fields else {
+        panic!("triangles")
+    };
+    assert_eq!(mesh.cell_count(), last.cells);
+    for &(e, _) in mesh.boundary_edges() {
+        for v in mesh.edges()[e] {
+            let p = mesh.vertices()[v];
+            assert!((p[0].hypot(p[1]) - 1.0).abs() < 1e-4, "{p:?}");
+        }
+    }
+}

@@ -976,10 +976,6 @@ fn adaptive_options_are_checked() {
             ],
             "declares no estimator",
         ),
-        (
-            vec!["solve", "mindlin-disk", "--tol", "0.1"],
-            "affine triangle meshes",
-        ),
     ] {
         let run = fem_forms(&args, &out);
         let stderr = String::from_utf8_lossy(&run.stderr);

@@ -288,7 +288,7 @@ fn the_estimator_is_robust_in_the_thickness() {
             let solution =
                 solve_obstacle_on_triangles::<M>(&[mesh], &c, ObstacleOptions::default()).unwrap();
             let data: [&fem_forms::DataFn; 3] = [&load, &far_below, &zero];
-            let estimate = fem_forms::adaptivity::triangle_estimate::<M>(
+            let estimate = fem_forms::adaptivity::triangle_estimate::<M, _>(
                 &solution,
                 &values,
                 &data,

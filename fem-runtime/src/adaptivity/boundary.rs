@@ -2,9 +2,8 @@
 //! edges of each part, and the contact terms of a multiplier that lives on a boundary
 //! part (Signorini's `λ` on `Γ_C`), from the model's constraint forms `b` and `G`.
 
-use super::{cell_coefficients, energy_form, ContactTerms};
+use super::{cell_coefficients, energy_form, ContactTerms, TriangleCells};
 use crate::element::triangle::TriangleField;
-use crate::mesh::TriangleMesh;
 use crate::model::{DataFn, Model};
 use crate::obstacle::boundary_multiplier::{
     part_edges, BoundaryMultiplier, BoundaryMultiplierDofs,
@@ -31,8 +30,8 @@ fn multiplier_on_edge(boundary: &BoundaryMultiplierDofs, k: usize, values: &[f64
 
 /// The local coefficients of every field on the cell of edge `k` of the multiplier's
 /// part, the multiplier's traced from its part.
-fn edge_coefficients<M: Model>(
-    solution: &ObstacleSolution<TriangleMesh>,
+fn edge_coefficients<M: Model, G>(
+    solution: &ObstacleSolution<G>,
     fields: &[Option<TriangleField>],
     boundary: &BoundaryMultiplierDofs,
     k: usize,
@@ -49,8 +48,8 @@ fn edge_coefficients<M: Model>(
 ///
 /// # Errors
 /// `parts` not one list per part of the model, and the kernels' errors.
-pub(super) fn boundary_indicators<M: Model>(
-    solution: &ObstacleSolution<TriangleMesh>,
+pub(super) fn boundary_indicators<M: Model, G: TriangleCells>(
+    solution: &ObstacleSolution<G>,
     fields: &[Option<TriangleField>],
     params: &[f64],
     data: &[&DataFn],
@@ -70,7 +69,7 @@ pub(super) fn boundary_indicators<M: Model>(
         )));
     }
     let d = &solution.discretization;
-    let mesh = &d.mesh;
+    let mesh = d.mesh.straight();
     let mut sum = 0.0;
     for (p, markers) in parts.iter().enumerate() {
         let on_multiplier_part = d.boundary().filter(|b| b.part == p);
@@ -80,7 +79,7 @@ pub(super) fn boundary_indicators<M: Model>(
         };
         for (k, e) in edges.iter().enumerate() {
             let local = match on_multiplier_part {
-                Some(b) => edge_coefficients::<M>(solution, fields, b, k),
+                Some(b) => edge_coefficients::<M, G>(solution, fields, b, k),
                 None => cell_coefficients::<M>(fields, e.cell),
             };
             let slices: Vec<&[f64]> = local.iter().map(Vec::as_slice).collect();
@@ -114,15 +113,15 @@ pub(super) fn boundary_indicators<M: Model>(
 /// # Errors
 /// A model without `constraint:`, a constraint form that is not between the multiplier
 /// and a primal field on the multiplier's part, and the kernels' errors.
-pub(super) fn boundary_contact_terms<M: Model>(
-    solution: &ObstacleSolution<TriangleMesh>,
+pub(super) fn boundary_contact_terms<M: Model, G: TriangleCells>(
+    solution: &ObstacleSolution<G>,
     fields: &[Option<TriangleField>],
     boundary: &BoundaryMultiplierDofs,
     params: &[f64],
     data: &[&DataFn],
 ) -> Result<ContactTerms> {
     let d = &solution.discretization;
-    let mesh = &d.mesh;
+    let mesh = d.mesh.straight();
     let [b, g] = M::CONSTRAINT.ok_or_else(|| {
         Error::Input(format!(
             "model `{}` declares no constraint (`constraint: b, G;`): the contact terms of a multiplier on a boundary part are measured with it",
@@ -159,7 +158,7 @@ pub(super) fn boundary_contact_terms<M: Model>(
     for k in 0..boundary.edges.len() {
         let edge = boundary.edges[k];
         let x = mesh.cell_coordinates(edge.cell);
-        let local = edge_coefficients::<M>(solution, fields, boundary, k);
+        let local = edge_coefficients::<M, G>(solution, fields, boundary, k);
         let lambda = &local[d.multiplier_field];
         let mut r = vec![0.0; lambda.len()];
         // β per primal field, over its local DOFs
@@ -191,7 +190,7 @@ pub(super) fn boundary_contact_terms<M: Model>(
                 .iter()
                 .map(|b| b.iter().map(|b| t * b).collect())
                 .collect();
-            violation[edge.cell] += cell_energy::<M>(mesh, edge.cell, a, &v, params, data);
+            violation[edge.cell] += cell_energy::<M, G>(&d.mesh, edge.cell, a, &v, params, data)?;
         }
     }
     Ok(ContactTerms::of(&violation, &defect))
@@ -199,15 +198,17 @@ pub(super) fn boundary_contact_terms<M: Model>(
 
 /// `a_T(v, v)` on cell `c` of the local coefficients `v` (one vector per field; the
 /// multiplier's and other zero vectors add nothing) with form `a`'s blocks.
-fn cell_energy<M: Model>(
-    mesh: &TriangleMesh,
+///
+/// # Errors
+/// Those of the element matrices ([`TriangleCells::cell_matrix`]).
+fn cell_energy<M: Model, G: TriangleCells>(
+    mesh: &G,
     c: usize,
     a: usize,
     v: &[Vec<f64>],
     params: &[f64],
     data: &[&DataFn],
-) -> f64 {
-    let x = mesh.cell_coordinates(c);
+) -> Result<f64> {
     let mut energy = 0.0;
     for (index, block) in M::FORMS[a].blocks.iter().enumerate() {
         let (test, Some(trial)) = (block.test_field, block.trial_field) else {
@@ -218,12 +219,12 @@ fn cell_energy<M: Model>(
             continue;
         }
         let mut k = vec![0.0; u.len() * w.len()];
-        M::element_matrix_on_cell(a, index, &x, &mesh.cell(c), params, data, &mut k);
+        mesh.cell_matrix::<M>(a, index, c, params, data, &mut k)?;
         for (i, ui) in u.iter().enumerate() {
             for (j, wj) in w.iter().enumerate() {
                 energy += ui * k[i * w.len() + j] * wj;
             }
         }
     }
-    energy
+    Ok(energy)
 }

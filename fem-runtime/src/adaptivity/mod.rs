@@ -16,7 +16,7 @@ pub use interval::interval_estimate;
 pub use marking::Marking;
 
 use crate::element::triangle::{TriangleBasis, TriangleField};
-use crate::mesh::TriangleMesh;
+use crate::mesh::{CurvedTriangleMesh, TriangleMesh};
 use crate::model::{DataFn, Model};
 use crate::obstacle::{Multipliers, ObstacleSolution};
 use crate::{Error, Result};
@@ -113,6 +113,80 @@ impl Estimate {
     }
 }
 
+/// The triangle meshes the estimate runs on: affine triangles, and isoparametric ones
+/// whose indicators are those of their straight cells (the generated indicator kernels
+/// are affine; a curved cell differs from its straight one by O(h²) of the boundary's
+/// curvature) while the energy norm takes each cell's own element matrix.
+pub trait TriangleCells {
+    /// The mesh of the vertices with straight cells.
+    fn straight(&self) -> &TriangleMesh;
+
+    /// The element matrix of block `block` of form `form` on cell `c`, as the assembly
+    /// computes it, row-major into `out`.
+    ///
+    /// # Errors
+    /// Those of the curved kernels (an element without them).
+    fn cell_matrix<M: Model>(
+        &self,
+        form: usize,
+        block: usize,
+        c: usize,
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) -> Result<()>;
+}
+
+impl TriangleCells for TriangleMesh {
+    fn straight(&self) -> &TriangleMesh {
+        self
+    }
+
+    fn cell_matrix<M: Model>(
+        &self,
+        form: usize,
+        block: usize,
+        c: usize,
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) -> Result<()> {
+        M::element_matrix_on_cell(
+            form,
+            block,
+            &self.cell_coordinates(c),
+            &self.cell(c),
+            params,
+            data,
+            out,
+        );
+        Ok(())
+    }
+}
+
+impl TriangleCells for CurvedTriangleMesh {
+    fn straight(&self) -> &TriangleMesh {
+        self.mesh()
+    }
+
+    fn cell_matrix<M: Model>(
+        &self,
+        form: usize,
+        block: usize,
+        c: usize,
+        params: &[f64],
+        data: &[&DataFn],
+        out: &mut [f64],
+    ) -> Result<()> {
+        if self.is_curved(c) {
+            M::element_matrix_curved(form, block, &self.cell_nodes(c), params, data, out)
+        } else {
+            self.mesh()
+                .cell_matrix::<M>(form, block, c, params, data, out)
+        }
+    }
+}
+
 /// The local coefficients of every field on cell `c` in the pulled-back reference basis
 /// (the field's own for Lagrange elements); zeros for a multiplier on a boundary part
 /// (`None`), which has no values on the cells.
@@ -129,8 +203,8 @@ fn cell_coefficients<M: Model>(fields: &[Option<TriangleField>], c: usize) -> Ve
 
 /// The fields of a solution on a triangle mesh (`None` for a multiplier on a boundary
 /// part), or the error for the nodal method's contact forces.
-fn fields<'a, M: Model>(
-    solution: &'a ObstacleSolution<TriangleMesh>,
+fn fields<'a, M: Model, G: TriangleCells>(
+    solution: &'a ObstacleSolution<G>,
 ) -> Result<Vec<Option<TriangleField<'a>>>> {
     let d = &solution.discretization;
     if matches!(d.multipliers, Multipliers::Nodal) {
@@ -152,7 +226,7 @@ fn fields<'a, M: Model>(
                 ))
             })?;
             Ok(Some(TriangleField {
-                mesh: &d.mesh,
+                mesh: d.mesh.straight(),
                 map,
                 coefficients: solution.field(f),
             }))
@@ -171,16 +245,16 @@ fn fields<'a, M: Model>(
 /// A model without an estimator or an energy form, a multiplier on a boundary part of a
 /// model without a constraint (`constraint: b, G;`), `parts` not one list per part,
 /// and indicators that are not finite (the message names the cell).
-pub fn triangle_estimate<M: Model>(
-    solution: &ObstacleSolution<TriangleMesh>,
+pub fn triangle_estimate<M: Model, G: TriangleCells>(
+    solution: &ObstacleSolution<G>,
     params: &[f64],
     data: &[&DataFn],
     side: Option<f64>,
     parts: &[Vec<u32>],
 ) -> Result<Estimate> {
     require_estimator::<M>()?;
-    let fields = fields::<M>(solution)?;
-    let mesh = &solution.discretization.mesh;
+    let fields = fields::<M, G>(solution)?;
+    let mesh = solution.discretization.mesh.straight();
     let mut indicators = vec![0.0; mesh.cell_count()];
     let mut sum = 0.0;
     for (c, indicator) in indicators.iter_mut().enumerate() {
@@ -220,7 +294,7 @@ pub fn triangle_estimate<M: Model>(
         indicators[c1] += 0.5 * eta2;
         sum += eta2;
     }
-    sum += boundary::boundary_indicators::<M>(
+    sum += boundary::boundary_indicators::<M, G>(
         solution,
         &fields,
         params,
@@ -234,7 +308,7 @@ pub fn triangle_estimate<M: Model>(
             indicators[c]
         )));
     }
-    let (contact, energy_norm) = contact_terms::<M>(solution, &fields, params, data, side)?;
+    let (contact, energy_norm) = contact_terms::<M, G>(solution, &fields, params, data, side)?;
     Ok(Estimate::of(indicators, sum, contact, energy_norm))
 }
 
@@ -289,15 +363,15 @@ fn energy_block<M: Model>(field: usize) -> Result<(usize, usize)> {
 ///
 /// # Errors
 /// A model without an energy form, or whose energy form has no (field, field) block.
-pub fn energy_product<M: Model>(
-    mesh: &TriangleMesh,
+pub fn energy_product<M: Model, G: TriangleCells>(
+    mesh: &G,
     map: &crate::assembly::dof_map::DofMap,
     field: usize,
     v: &[f64],
     params: &[f64],
     data: &[&DataFn],
 ) -> Result<f64> {
-    Ok(cell_energies::<M>(mesh, map, field, v, params, data)?
+    Ok(cell_energies::<M, G>(mesh, map, field, v, params, data)?
         .iter()
         .sum())
 }
@@ -306,8 +380,8 @@ pub fn energy_product<M: Model>(
 ///
 /// # Errors
 /// As [`energy_product`].
-fn cell_energies<M: Model>(
-    mesh: &TriangleMesh,
+fn cell_energies<M: Model, G: TriangleCells>(
+    mesh: &G,
     map: &crate::assembly::dof_map::DofMap,
     field: usize,
     v: &[f64],
@@ -315,15 +389,15 @@ fn cell_energies<M: Model>(
     data: &[&DataFn],
 ) -> Result<Vec<f64>> {
     let (a, block) = energy_block::<M>(field)?;
-    let mut energies = vec![0.0; mesh.cell_count()];
-    add_block_energies::<M>(
+    let mut energies = vec![0.0; mesh.straight().cell_count()];
+    add_block_energies::<M, G>(
         mesh,
         [a, block],
         [(map, v), (map, v)],
         params,
         data,
         &mut energies,
-    );
+    )?;
     Ok(energies)
 }
 
@@ -357,14 +431,17 @@ impl ContactTerms {
 /// Adds to each cell's entry of `energies` its `u_Tᵀ K_T v_T` for block `[form, block]`
 /// of the model's forms, `u` and `v` the (map, coefficients) of the block's test and
 /// trial fields; cells where either vanishes are skipped.
-fn add_block_energies<M: Model>(
-    mesh: &TriangleMesh,
+///
+/// # Errors
+/// Those of the element matrices ([`TriangleCells::cell_matrix`]).
+fn add_block_energies<M: Model, G: TriangleCells>(
+    mesh: &G,
     [form, block]: [usize; 2],
     [(map_u, u), (map_v, v)]: [(&crate::assembly::dof_map::DofMap, &[f64]); 2],
     params: &[f64],
     data: &[&DataFn],
     energies: &mut [f64],
-) {
+) -> Result<()> {
     let (nu, nv) = (map_u.local_count(), map_v.local_count());
     let mut k = vec![0.0; nu * nv];
     for (c, energy) in energies.iter_mut().enumerate() {
@@ -372,21 +449,14 @@ fn add_block_energies<M: Model>(
         if du.iter().all(|&d| u[d] == 0.0) || dv.iter().all(|&d| v[d] == 0.0) {
             continue;
         }
-        M::element_matrix_on_cell(
-            form,
-            block,
-            &mesh.cell_coordinates(c),
-            &mesh.cell(c),
-            params,
-            data,
-            &mut k,
-        );
+        mesh.cell_matrix::<M>(form, block, c, params, data, &mut k)?;
         for (i, &di) in du.iter().enumerate() {
             for (j, &dj) in dv.iter().enumerate() {
                 *energy += u[di] * k[i * nv + j] * v[dj];
             }
         }
     }
+    Ok(())
 }
 
 /// `a(u_h, u_h)` with the model's energy form over every primal field (every block of
@@ -395,15 +465,15 @@ fn add_block_energies<M: Model>(
 ///
 /// # Errors
 /// A model without an energy form, or whose energy form has no block.
-fn solution_energy<M: Model>(
-    mesh: &TriangleMesh,
+fn solution_energy<M: Model, G: TriangleCells>(
+    mesh: &G,
     fields: &[Option<TriangleField>],
     multiplier: usize,
     params: &[f64],
     data: &[&DataFn],
 ) -> Result<f64> {
     let a = energy_form::<M>()?;
-    let mut energies = vec![0.0; mesh.cell_count()];
+    let mut energies = vec![0.0; mesh.straight().cell_count()];
     for (b, block) in M::FORMS[a].blocks.iter().enumerate() {
         let (test, Some(trial)) = (block.test_field, block.trial_field) else {
             continue;
@@ -414,32 +484,33 @@ fn solution_energy<M: Model>(
         let (Some(u), Some(v)) = (&fields[test], &fields[trial]) else {
             continue;
         };
-        add_block_energies::<M>(
+        add_block_energies::<M, G>(
             mesh,
             [a, b],
             [(u.map, u.coefficients), (v.map, v.coefficients)],
             params,
             data,
             &mut energies,
-        );
+        )?;
     }
     Ok(energies.iter().sum())
 }
 
 /// The contact part `S` of the estimate (with each cell's share) and `‖u_h‖_a`.
-fn contact_terms<M: Model>(
-    solution: &ObstacleSolution<TriangleMesh>,
+fn contact_terms<M: Model, G: TriangleCells>(
+    solution: &ObstacleSolution<G>,
     fields: &[Option<TriangleField>],
     params: &[f64],
     data: &[&DataFn],
     side: Option<f64>,
 ) -> Result<(ContactTerms, f64)> {
     let d = &solution.discretization;
-    let mesh = &d.mesh;
-    let energy = solution_energy::<M>(mesh, fields, d.multiplier_field, params, data)?;
+    let cells = &d.mesh;
+    let mesh = cells.straight();
+    let energy = solution_energy::<M, G>(cells, fields, d.multiplier_field, params, data)?;
     let norm = energy.max(0.0).sqrt();
     if let (Some(b), Some(_)) = (d.boundary(), side) {
-        let terms = boundary::boundary_contact_terms::<M>(solution, fields, b, params, data)?;
+        let terms = boundary::boundary_contact_terms::<M, G>(solution, fields, b, params, data)?;
         return Ok((terms, norm));
     }
     let (Some([_, psi]), Some(side)) = (M::OBSTACLE, side) else {
@@ -463,7 +534,7 @@ fn contact_terms<M: Model>(
             .zip(u.coefficients)
             .map(|(x, &value)| (side * (psi(x) - value)).max(0.0))
             .collect();
-        cell_energies::<M>(mesh, u.map, field, &violation, params, data)?
+        cell_energies::<M, G>(cells, u.map, field, &violation, params, data)?
     } else {
         weighted_violation::<M>(mesh, u, psi, side)
     };

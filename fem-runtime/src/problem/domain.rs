@@ -647,7 +647,7 @@ impl Domain for TriangleMesh {
         side: Option<f64>,
         parts: &[Vec<u32>],
     ) -> Result<crate::adaptivity::Estimate> {
-        crate::adaptivity::triangle_estimate::<M>(solution, params, data, side, parts)
+        crate::adaptivity::triangle_estimate::<M, _>(solution, params, data, side, parts)
     }
 
     fn refine_marked(&self, marked: &[usize]) -> Result<Self> {
@@ -974,6 +974,22 @@ pub fn bounding_diameter(mesh: &TriangleMesh) -> f64 {
 }
 
 impl Domain for CurvedTriangleMesh {
+    const ESTIMATES: bool = true;
+
+    fn estimate<M: Model>(
+        solution: &ObstacleSolution<Self>,
+        params: &[f64],
+        data: &[&DataFn],
+        side: Option<f64>,
+        parts: &[Vec<u32>],
+    ) -> Result<crate::adaptivity::Estimate> {
+        crate::adaptivity::triangle_estimate::<M, _>(solution, params, data, side, parts)
+    }
+
+    fn refine_marked(&self, marked: &[usize]) -> Result<Self> {
+        Ok(self.refine(marked)?.0)
+    }
+
     fn extent(&self) -> f64 {
         bounding_diameter(self.mesh())
     }
