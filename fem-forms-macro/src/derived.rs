@@ -23,11 +23,13 @@
 //! 1. **Estimators**: each cell residual an `estimator:` declares must be a multiple of
 //!    some `R_i`; each edge jump a multiple of a flux, or a jump of derivatives of lower
 //!    order than the energy's (a nonconforming element's `[[∇w]]`).
-//! 2. **Stabilization**: `B_h = … − αS`, `L_h = … − αℓ_S` stabilize the residual the
-//!    solver sees in the multiplier's row, `(S(u, λ; 0, μ) − ℓ_S(0, μ)) / (α h^p)`; it must
-//!    be a multiple of the constrained field's residual `R_w`, up to derivatives of the
-//!    other equations' residuals (the plate's `div div Cε(θ) − sλ` is `R_w − div R_θ`).
-//!    A wrong sign, a missing `ℓ_S` or another operator is a compile error at the term.
+//! 2. **Stabilization**: `B_h = … − αS`, `L_h = … − αℓ_S` stabilize, in each row (each
+//!    test function's derivative, the multiplier's among them), the residual
+//!    `S(u, λ; ·) − ℓ_S(·)`; it must be a multiple of the constrained field's residual
+//!    `R_w` (the factor a function of the parameters and `h`), up to the other
+//!    equations' residuals and their divergence (the plate's `div div Cε(θ) − sλ` is
+//!    `R_w − div R_θ`). A wrong sign, a missing `ℓ_S` (or part of it) or another
+//!    operator is a compile error at the term.
 
 use crate::analysis::{Form, Symbols};
 use crate::diagnostic::Diagnostic;
@@ -45,6 +47,10 @@ pub struct Derived {
     pub fluxes: Vec<Vec<Expansion>>,
     /// Per field, the highest derivative order on its unknown in `a`.
     pub order: Vec<u8>,
+    /// Whether `a`, `ℓ` or `b` integrate over boundary parts: their boundary conditions
+    /// (a Neumann load, a Robin term, a multiplier on a part) are not in the derived
+    /// cell residuals and fluxes.
+    pub boundary_terms: bool,
 }
 
 /// The multiplier field of the model (declared `>= 0`), if any.
@@ -177,19 +183,22 @@ pub fn residual_estimator(
         vec![w]
     };
     for (i, field) in symbols.fields.iter().enumerate() {
-        if field.nonnegative || derived.cell[i].is_empty() {
+        if field.nonnegative {
             continue;
         }
         let m = i32::from(test_order[i]);
         let name = &field.test_name;
-        terms.push(IndicatorTerm {
-            region: Region::Cell,
-            weight: weight(2 * m),
-            residual: derived.cell[i].clone(),
-            source: format!("h_T^{} ‖R_{name}‖² (derived)", 2 * m),
-            loc: at,
-            average: false,
-        });
+        // a P1 field's cell residual may vanish (Δu, div σ): its jumps still count
+        if !derived.cell[i].is_empty() {
+            terms.push(IndicatorTerm {
+                region: Region::Cell,
+                weight: weight(2 * m),
+                residual: derived.cell[i].clone(),
+                source: format!("h_T^{} ‖R_{name}‖² (derived)", 2 * m),
+                loc: at,
+                average: false,
+            });
+        }
         for (j, flux) in derived.fluxes[i].iter().enumerate() {
             if flux.is_empty() {
                 continue;
@@ -219,8 +228,10 @@ pub fn derive(symbols: &Symbols, forms: &[Form], roles: &Roles) -> Option<Derive
     let mut cell = vec![Expansion::new(); fields];
     let mut fluxes = vec![vec![Expansion::new(), Expansion::new()]; fields];
     let mut order = vec![0u8; fields];
+    let mut boundary_terms = false;
     for m in forms[a].terms.iter().filter(|m| m.facet.is_none()) {
-        if !m.data.is_empty() {
+        // data are variable coefficients; a reduced rule integrates another operator
+        if !m.data.is_empty() || m.quadrature_degree.is_some() {
             return None;
         }
         let (u, v) = split(&forms[a], m)?;
@@ -276,25 +287,27 @@ pub fn derive(symbols: &Symbols, forms: &[Form], roles: &Roles) -> Option<Derive
             _ => return None,
         }
     }
+    boundary_terms |= forms[a].terms.iter().any(|m| m.facet.is_some());
+    boundary_terms |= forms[l].terms.iter().any(|m| m.facet.is_some());
     for m in forms[l].terms.iter().filter(|m| m.facet.is_none()) {
         let [v] = m.args.as_slice() else { return None };
-        let i = symbols.field_of(v.symbol);
-        match (v.order(), m.data.is_empty()) {
-            (0, _) => cell[i].push(strong(m, None, 1.0, [0, 0])),
-            (_, true) => {}
-            (_, false) => return None,
+        // a load on a derivative of v would leave a flux of its own
+        if v.order() != 0 {
+            return None;
         }
+        cell[symbols.field_of(v.symbol)].push(strong(m, None, 1.0, [0, 0]));
     }
     if let Some(lambda) = lambda {
         let [b, _] = roles.constraint?;
+        boundary_terms |= forms[b].terms.iter().any(|m| m.facet.is_some());
         for m in forms[b].terms.iter().filter(|m| m.facet.is_none()) {
             let (v, mu) = split(&forms[b], m)?;
-            if mu.order() != 0 || !m.data.is_empty() {
+            // B = identity on cells: a derivative of v would leave a flux of its own
+            if mu.order() != 0 || v.order() != 0 || !m.data.is_empty() {
                 return None;
             }
             let i = symbols.field_of(v.symbol);
-            let sign = if v.order() % 2 == 0 { 1.0 } else { -1.0 };
-            cell[i].push(strong(m, Some((lambda, v.derivative)), sign, [0, 0]));
+            cell[i].push(strong(m, Some((lambda, v.derivative)), 1.0, [0, 0]));
         }
     }
     let cell = cell.into_iter().map(|e| nonvanishing(symbols, e)).collect();
@@ -306,30 +319,35 @@ pub fn derive(symbols: &Symbols, forms: &[Form], roles: &Roles) -> Option<Derive
         cell,
         fluxes,
         order,
+        boundary_terms,
     })
 }
 
-/// A random point of the variables of the expansions: a deterministic pseudo-random
-/// value for every (kind, index, derivative), and the obstacle side `s = side`.
+/// A random point of the variables of the expansions: pseudo-random values of the
+/// unknowns' derivatives and the data (from `jet`), of the parameters, `h` and the unit
+/// normal (from `scalars`), and the obstacle side `s = side`. A factor allowed to
+/// depend on the parameters and `h` (a weight `h_T²(t² + h_T²)`, a `1/D`) is constant
+/// over the points that share `scalars`.
 struct Point<'a> {
-    seed: u64,
+    jet: u64,
+    scalars: u64,
     side: f64,
     roles: &'a Roles,
     dimension: usize,
 }
 
-/// SplitMix64 of `x`, as a number in [0.5, 1.5).
+/// SplitMix64 of `x`, as a number in [0, 1).
 fn uniform(x: u64) -> f64 {
     let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
-    0.5 + (z >> 11) as f64 / (1u64 << 53) as f64
+    (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
 impl Point<'_> {
-    fn value(&self, kind: u64, index: usize, derivative: [u8; 2]) -> f64 {
-        let key = self.seed.wrapping_mul(1_000_003)
+    fn value(&self, seed: u64, kind: u64, index: usize, derivative: [u8; 2]) -> f64 {
+        let key = seed.wrapping_mul(1_000_003)
             ^ (kind << 56)
             ^ ((index as u64) << 16)
             ^ (u64::from(derivative[0]) << 8)
@@ -337,30 +355,32 @@ impl Point<'_> {
         uniform(key)
     }
 
+    /// A parameter in [0.1, 0.4): clear of the singular values of the usual material
+    /// formulas (ν = ½ in `1/(1 − 2ν)`, ν = 1 in `1/(1 − ν)`); the side is ±1.
     fn param(&self, p: usize) -> f64 {
         if self.roles.side == Some(p) {
             self.side
         } else {
-            self.value(1, p, [0, 0])
+            0.1 + 0.3 * self.value(self.scalars, 1, p, [0, 0])
         }
     }
 
     fn h(&self) -> f64 {
-        self.value(2, 0, [0, 0])
+        0.5 + self.value(self.scalars, 2, 0, [0, 0])
     }
 
     fn normal(&self) -> [f64; 2] {
         if self.dimension == 1 {
-            return [if self.seed % 2 == 0 { 1.0 } else { -1.0 }, 0.0];
+            return [if self.scalars % 2 == 0 { 1.0 } else { -1.0 }, 0.0];
         }
-        let angle = std::f64::consts::TAU * (self.value(3, 0, [0, 0]) - 0.5);
+        let angle = std::f64::consts::TAU * self.value(self.scalars, 3, 0, [0, 0]);
         [angle.cos(), angle.sin()]
     }
 
-    /// The value of an unknown's derivative: the unknowns are symbols `< F`; a test
-    /// function's symbol is mapped to its field's (both stand for the same jet).
+    /// The value of an unknown's derivative: a test function's symbol is mapped to its
+    /// field's (both stand for the same jet).
     fn argument(&self, symbols: &Symbols, a: &ArgFactor) -> f64 {
-        self.value(4, symbols.field_of(a.symbol), a.derivative)
+        self.value(self.jet, 4, symbols.field_of(a.symbol), a.derivative) - 0.5
     }
 
     fn monomial(&self, symbols: &Symbols, m: &Monomial) -> f64 {
@@ -384,7 +404,7 @@ impl Point<'_> {
             v /= sum.powi(*e);
         }
         for &d in &m.data {
-            v *= self.value(5, d, [0, 0]);
+            v *= self.value(self.jet, 5, d, [0, 0]) - 0.5;
         }
         for a in &m.args {
             v *= self.argument(symbols, a);
@@ -398,26 +418,30 @@ impl Point<'_> {
     }
 }
 
-/// Random points for each obstacle side `s = ±1`.
-fn points<'a>(roles: &'a Roles, dimension: usize, per_side: u64) -> Vec<Vec<Point<'a>>> {
-    [1.0, -1.0]
-        .into_iter()
-        .enumerate()
-        .map(|(k, side)| {
-            (0..per_side)
-                .map(|seed| Point {
-                    seed: seed + 1000 * k as u64 + 17,
-                    side,
-                    roles,
-                    dimension,
-                })
-                .collect()
-        })
-        .collect()
+/// Blocks of random points: for each obstacle side `s = ±1` and each of a few draws of
+/// the parameters, `h` and the normal, `per_block` draws of the unknowns and data.
+fn blocks<'a>(roles: &'a Roles, dimension: usize, per_block: u64) -> Vec<Vec<Point<'a>>> {
+    let mut blocks = Vec::new();
+    for (k, side) in [1.0, -1.0].into_iter().enumerate() {
+        for draw in 0..3u64 {
+            blocks.push(
+                (0..per_block)
+                    .map(|jet| Point {
+                        jet: 7919 * jet + 104_729 * draw + 1_299_709 * k as u64 + 17,
+                        scalars: 31 * draw + 1000 * k as u64 + 3,
+                        side,
+                        roles,
+                        dimension,
+                    })
+                    .collect(),
+            );
+        }
+    }
+    blocks
 }
 
-/// Whether `x` is a multiple of `y` (a constant factor for each obstacle side; up to
-/// sign when `up_to_sign`), with `y` not zero.
+/// Whether `x` is a multiple of `y`, the factor a function of the parameters, `h`, the
+/// normal and the side only (up to sign when `up_to_sign`), with `y` not zero.
 fn multiple(
     symbols: &Symbols,
     roles: &Roles,
@@ -425,8 +449,8 @@ fn multiple(
     y: &[Monomial],
     up_to_sign: bool,
 ) -> bool {
-    points(roles, symbols.dimension, 8).iter().all(|side| {
-        let pairs: Vec<(f64, f64)> = side
+    blocks(roles, symbols.dimension, 6).iter().all(|block| {
+        let pairs: Vec<(f64, f64)> = block
             .iter()
             .map(|p| (p.expansion(symbols, x), p.expansion(symbols, y)))
             .collect();
@@ -500,13 +524,19 @@ pub fn check_estimator(
     errors
 }
 
-/// A jump of derivatives of lower order than the energy's on each field (`[[∇w]]` of a
-/// nonconforming plate element): not a flux, and allowed.
+/// A jump of derivatives of lower order than the energy's of a nonconforming or
+/// discontinuous field (`[[∇w]]` of Morley's plate element): not a flux, and allowed;
+/// on a conforming field such a jump vanishes and is refused as a misspelt flux.
 fn conformity_jump(symbols: &Symbols, derived: &Derived, residual: &[Monomial]) -> bool {
+    use fem_reference::ElementKind;
     residual.iter().all(|m| {
         m.args.iter().all(|a| {
             let j = symbols.field_of(a.symbol);
-            a.order() < derived.order[j]
+            let nonconforming = matches!(
+                symbols.fields[j].element,
+                ElementKind::Morley | ElementKind::P0 | ElementKind::P1Disc
+            );
+            nonconforming && a.order() < derived.order[j]
         })
     })
 }
@@ -535,10 +565,11 @@ fn mismatch(symbols: &Symbols, term: &IndicatorTerm, primal: &[usize]) -> Diagno
 }
 
 /// Errors for a cell stabilization that does not stabilize the constrained field's
-/// residual: the multiplier's row of `B_h`'s α-terms minus `L_h`'s, over `α h^p`, must
-/// be a multiple of `R_w` up to derivatives (of order ≤ 1) of the other equations'
-/// residuals. Facet stabilizations (Signorini's) and models without a cell
-/// stabilization, system or multiplier are not checked.
+/// residual: every row of `B_h`'s α-terms (each test function's derivative, the
+/// multiplier's among them) less `L_h`'s must be a multiple of `R_w`, the factor a
+/// function of the parameters and `h`, up to the other equations' residuals and their
+/// divergence (triangles) or derivative (intervals). Facet stabilizations (Signorini's)
+/// and models without a cell stabilization, system or multiplier are not checked.
 pub fn check_stabilization(
     symbols: &Symbols,
     forms: &[Form],
@@ -557,40 +588,34 @@ pub fn check_stabilization(
         return Vec::new();
     }
     let fields = symbols.fields.len();
-    let mu = fields + lambda;
-    let with_alpha = |m: &Monomial| m.params.iter().any(|&(p, e)| p == alpha && e == 1);
-    let on_mu = |m: &Monomial| {
-        m.args
-            .iter()
-            .any(|a| a.symbol == mu && a.derivative == [0, 0])
-    };
-    // the stabilized residual in the multiplier's row: B_h's trial part minus L_h's data
-    let mut row: Expansion = forms[bh]
-        .terms
-        .iter()
-        .filter(|m| m.facet.is_none() && with_alpha(m) && on_mu(m))
-        .map(|m| {
-            let mut t = m.clone();
-            t.args.retain(|a| a.symbol != mu);
-            t
-        })
-        .collect();
-    if row.is_empty() {
+    let with_alpha =
+        |m: &&Monomial| m.facet.is_none() && m.params.iter().any(|&(p, e)| p == alpha && e == 1);
+    // the test function's factor of a term: its argument of a test symbol
+    let test_of = |m: &Monomial| m.args.iter().find(|a| a.symbol >= fields).copied();
+    // every row of the stabilization: B_h's α-terms on one test coordinate (a test
+    // function's derivative), less L_h's on the same
+    let mut rows: Vec<(ArgFactor, Expansion)> = Vec::new();
+    for m in forms[bh].terms.iter().filter(with_alpha) {
+        let Some(test) = test_of(m) else { continue };
+        let mut t = m.clone();
+        t.args.retain(|a| *a != test);
+        match rows.iter_mut().find(|(c, _)| *c == test) {
+            Some((_, row)) => row.push(t),
+            None => rows.push((test, vec![t])),
+        }
+    }
+    if rows.is_empty() {
         return Vec::new();
     }
-    let origin = row[0].origin;
-    row.extend(
-        forms[lh]
-            .terms
-            .iter()
-            .filter(|m| m.facet.is_none() && with_alpha(m) && on_mu(m))
-            .map(|m| {
-                let mut t = m.clone();
-                t.args.clear();
-                t.coefficient = -t.coefficient;
-                t
-            }),
-    );
+    for m in forms[lh].terms.iter().filter(with_alpha) {
+        let Some(test) = test_of(m) else { continue };
+        if let Some((_, row)) = rows.iter_mut().find(|(c, _)| *c == test) {
+            let mut t = m.clone();
+            t.args.clear();
+            t.coefficient = -t.coefficient;
+            row.push(t);
+        }
+    }
     let constrained: Vec<usize> = forms[b]
         .terms
         .iter()
@@ -599,59 +624,95 @@ pub fn check_stabilization(
     let Some(&w) = constrained.first() else {
         return Vec::new();
     };
-    let p = roles.order as i32;
-    // candidates: R_w, and each other primal equation's residual and its first
-    // derivatives (without data: their derivatives are not known)
-    let mut candidates: Vec<Expansion> = vec![derived.cell[w].clone()];
-    for j in (0..fields).filter(|&j| j != w && j != lambda) {
-        let r = &derived.cell[j];
-        if r.is_empty() || r.iter().any(|m| !m.data.is_empty()) {
+    let candidates = candidates(symbols, derived, w, lambda);
+    for (test, row) in &rows {
+        let row = nonvanishing(symbols, row.clone());
+        if row.is_empty() {
             continue;
         }
-        candidates.push(r.clone());
-        for axis in 0..symbols.dimension {
-            let d: Expansion = r
+        let consistent = blocks(roles, symbols.dimension, 16).iter().all(|block| {
+            let target: Vec<f64> = block.iter().map(|p| p.expansion(symbols, &row)).collect();
+            let columns: Vec<Vec<f64>> = candidates
                 .iter()
-                .filter_map(|m| {
-                    let [a] = m.args.as_slice() else { return None };
-                    let mut t = m.clone();
-                    t.args = vec![ArgFactor {
-                        symbol: a.symbol,
-                        derivative: plus(a.derivative, unit(axis)),
-                    }];
-                    Some(t)
-                })
+                .map(|c| block.iter().map(|p| p.expansion(symbols, c)).collect())
                 .collect();
-            candidates.push(nonvanishing(symbols, d));
+            fits(&columns, &target)
+        });
+        if !consistent {
+            let origin = row[0].origin;
+            let at = if test.symbol == fields + lambda {
+                "the multiplier's row".to_string()
+            } else {
+                format!(
+                    "the row of `{}`",
+                    symbols.fields[test.symbol - fields].test_name
+                )
+            };
+            return vec![Diagnostic::text(
+                origin,
+                format!(
+                    "the stabilization does not stabilize the residual of {}: {at} of `α S` in `B_h`, less `α ℓ_S` in `L_h`, is not a multiple of `f + B*λ − 𝒜{}` derived from `a`, `ℓ` and `b`",
+                    equation(symbols, w),
+                    symbols.fields[w].name
+                ),
+            )
+            .help("S_h = Σ_T h^p (𝒜u − sλ, 𝒜v − sμ)_T with `ℓ_S = Σ_T h^p (f, 𝒜v − sμ)_T` subtracted in `L_h`: look for a wrong sign, an `ℓ_S` missing from `L_h` (or part of it), or an operator that is not `a`'s")];
         }
     }
-    let consistent = points(roles, symbols.dimension, 16).iter().all(|side| {
-        let target: Vec<f64> = side
-            .iter()
-            .map(|pt| pt.expansion(symbols, &row) / (pt.param(alpha) * pt.h().powi(p)))
-            .collect();
-        let columns: Vec<Vec<f64>> = candidates
-            .iter()
-            .map(|c| side.iter().map(|pt| pt.expansion(symbols, c)).collect())
-            .collect();
-        fits(&columns, &target) && columns[0].iter().any(|&x| x != 0.0)
-    });
-    if consistent {
-        return Vec::new();
+    Vec::new()
+}
+
+/// What a stabilized residual may be a combination of: the constrained field's
+/// residual `R_w` first, then the other equations' residuals (without data, whose
+/// derivatives are unknown) and, on intervals, their derivatives; on triangles the
+/// divergence of each vector field's residuals (the plate's `div R_θ`).
+fn candidates(symbols: &Symbols, derived: &Derived, w: usize, lambda: usize) -> Vec<Expansion> {
+    let derivative = |r: &Expansion, axis: usize| -> Expansion {
+        r.iter()
+            .filter_map(|m| {
+                let [a] = m.args.as_slice() else { return None };
+                let mut t = m.clone();
+                t.args = vec![ArgFactor {
+                    symbol: a.symbol,
+                    derivative: plus(a.derivative, unit(axis)),
+                }];
+                Some(t)
+            })
+            .collect()
+    };
+    let usable = |j: usize| {
+        j != w
+            && j != lambda
+            && !derived.cell[j].is_empty()
+            && derived.cell[j].iter().all(|m| m.data.is_empty())
+    };
+    let mut out = vec![derived.cell[w].clone()];
+    for j in (0..symbols.fields.len()).filter(|&j| usable(j)) {
+        out.push(derived.cell[j].clone());
+        if symbols.dimension == 1 {
+            out.push(nonvanishing(symbols, derivative(&derived.cell[j], 0)));
+        }
     }
-    vec![Diagnostic::text(
-        origin,
-        format!(
-            "the stabilization does not stabilize the residual of {}: the multiplier's row of `α S` in `B_h`, less `α ℓ_S` in `L_h`, is not a multiple of `f + B*λ − 𝒜{}` derived from `a`, `ℓ` and `b`",
-            equation(symbols, w),
-            symbols.fields[w].name
-        ),
-    )
-    .help("S_h = Σ_T h^p (𝒜u − sλ, 𝒜v − sμ)_T with `ℓ_S = Σ_T h^p (f, 𝒜v − sμ)_T` subtracted in `L_h`: look for a wrong sign, an `ℓ_S` missing from `L_h`, or an operator that is not `a`'s")]
+    if symbols.dimension == 2 {
+        for v in 0..symbols.vectors.len() {
+            let components: Vec<usize> = (0..symbols.fields.len())
+                .filter(|&j| symbols.fields[j].component.is_some_and(|(c, _)| c == v))
+                .collect();
+            if components.len() == 2 && components.iter().all(|&j| usable(j)) {
+                let mut div = Expansion::new();
+                for &j in &components {
+                    let axis = symbols.fields[j].component.map_or(0, |(_, a)| a);
+                    div.extend(derivative(&derived.cell[j], axis));
+                }
+                out.push(nonvanishing(symbols, div));
+            }
+        }
+    }
+    out
 }
 
 /// Whether `target` is a linear combination of `columns` (least squares through the
-/// normal equations, to 1e-8 of `target`'s size).
+/// normal equations, to 1e-8 of `target`'s size) in which the first column takes part.
 fn fits(columns: &[Vec<f64>], target: &[f64]) -> bool {
     let n = columns.len();
     let mut g = vec![vec![0.0; n + 1]; n];
@@ -701,5 +762,8 @@ fn fits(columns: &[Vec<f64>], target: &[f64]) -> bool {
         })
         .sum::<f64>()
         .sqrt();
-    scale > 0.0 && residual <= 1e-8 * scale
+    // the first column (R_w) must carry the target: derivatives of the other equations
+    // alone stabilize nothing of the contact equation
+    let first = x[0].abs() * columns[0].iter().map(|c| c * c).sum::<f64>().sqrt();
+    scale > 0.0 && residual <= 1e-8 * scale && first >= 1e-6 * scale
 }

@@ -356,13 +356,17 @@ impl Analysis<'_> {
                         self.symbols.fields[self.symbols.field_of(a.symbol)].name
                     ))]);
                 }
-            } else if region == Region::Edge && !average && !m.data.is_empty() {
+            } else if region == Region::Edge && !average {
                 return Err(vec![Diagnostic::text(
                     m.origin,
-                    "data alone in a jump: continuous data jump by zero",
+                    if m.data.is_empty() {
+                        "a term without an unknown in a jump: a constant jumps by zero"
+                    } else {
+                        "data alone in a jump: continuous data jump by zero"
+                    },
                 )
                 .help(
-                    "a jump `[[X]]` is taken of the unknowns' traces; leave the data term out",
+                    "a jump `[[X]]` is taken of the unknowns' traces; leave the term out",
                 )]);
             }
             if region == Region::Cell && m.normal != [0, 0] {

@@ -269,6 +269,13 @@ fn expand(input: TokenStream) -> TokenStream {
     let estimator = match &declaration.estimator {
         None => None,
         Some(declaration::EstimatorDecl::Derived(span)) => match &derived {
+            Some(derived) if derived.boundary_terms => {
+                return syn::Error::new(
+                    *span,
+                    "the estimator cannot be derived: the forms integrate over boundary parts (a load, a Robin term or a multiplier on `facets:`), whose boundary residuals a derived estimator does not have; write it as `estimator: \"η_T² = …  η_Γ² = …\";`",
+                )
+                .to_compile_error()
+            }
             Some(derived) => Some(derived::residual_estimator(
                 &symbols,
                 &forms,

@@ -1627,3 +1627,80 @@ fn an_estimator_that_cannot_be_derived_says_why() {
         "{errors:?}"
     );
 }
+
+/// The primal rows are checked too: a plate whose `ℓ_S` keeps `(f, −sμ)` but drops
+/// `(f, DΔ²v)` is consistent in the multiplier's row and not in `v`'s.
+#[test]
+fn a_stabilization_missing_part_of_its_load_is_refused() {
+    let out = expand(quote! {
+        /// Plate.
+        pub mod plate on triangle {
+            unknowns: w: Argyris, λ: P0 >= 0;
+            tests: v, μ;
+            params: D > 0, ν, α, s;
+            data: f, ψ, g;
+            boundary: w = g;
+            forms: "
+                K(w)         := −∇∇w
+                M(w)         := D[(1−ν)K(w) + ν tr K(w) I]
+                a(w;v)       = ∫ M(w):K(v)
+                b(v;μ)       = ∫ s v μ
+                S(w,λ;v,μ)   = Σ_T h_T⁴ (D Δ²w − sλ, D Δ²v − sμ)_T
+                ℓ(v)         = ∫ f v
+                ℓ_S(v,μ)     = Σ_T h_T⁴ (f, −sμ)_T
+                G(μ)         = ∫ s ψ μ
+                B_h(w,λ;v,μ) = a(w;v) − b(v;λ) − b(w;μ) − α S(w,λ;v,μ)
+                L_h(v,μ)     = ℓ(v) − G(μ) − α ℓ_S(v,μ)
+            ";
+        }
+    });
+    let errors = rendered_errors(&out);
+    assert!(
+        errors.iter().any(|e| e.contains("the row of `v`")),
+        "{errors:?}"
+    );
+}
+
+/// A derived estimator keeps the jumps of a field whose cell residual vanishes (P1
+/// elasticity: `div σ(u) = 0` on each cell), and is refused for forms with boundary
+/// integrals, whose boundary residuals it would miss.
+#[test]
+fn a_derived_estimator_keeps_jumps_and_refuses_boundary_loads() {
+    let body = |facets: bool| {
+        let load = if facets {
+            "ℓ(v) = ∫_Γ_N q v·n ds"
+        } else {
+            "ℓ(v) = ∫ (0, q)·v"
+        };
+        let forms = format!(
+            "
+            σ(u)   := 2μ_L ε(u) + λ_L tr ε(u) I
+            a(u;v) = ∫ σ(u):ε(v)
+            {load}
+        "
+        );
+        quote! {
+            /// Elasticity.
+            pub mod body on triangle {
+                unknowns: u: [P1]^2;
+                tests: v;
+                params: μ_L > 0, λ_L;
+                data: q;
+                facets: Γ_N;
+                forms: #forms;
+                estimator: derived;
+            }
+        }
+    };
+    let out = expand(body(false));
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    assert!(text.contains("F_v_x") && text.contains("F_v_y"), "{text}");
+    let errors = rendered_errors(&expand(body(true)));
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("integrate over boundary parts")),
+        "{errors:?}"
+    );
+}

@@ -270,10 +270,12 @@ fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     let mut body = Vec::new();
     for m in &term.residual {
         let Some(a) = m.args.first() else {
-            // data alone: continuous, its average is its value (in a jump it is refused)
+            // data alone (only in an average: a jump refuses it): continuous, the mean of
+            // the two sides' coefficients (which may hold each side's h) times the value
             let c = monomial_coefficient(m);
             let data = data_product(m);
-            let p = product(std::iter::once(quote!({ let h = h_p; #c })).chain(data));
+            let mean = quote!((0.5 * ({ let h = h_p; #c } + { let h = h_m; #c })));
+            let p = product(std::iter::once(mean).chain(data));
             body.push(quote!(r += #p;));
             continue;
         };

@@ -115,8 +115,8 @@ impl Estimate {
 
 /// The triangle meshes the estimate runs on: affine triangles, and isoparametric ones
 /// whose indicators are those of their straight cells (the generated indicator kernels
-/// are affine; a curved cell differs from its straight one by O(h²) of the boundary's
-/// curvature) while the energy norm takes each cell's own element matrix.
+/// are affine; a curved cell's map differs from its straight one's by O(hκ), relative,
+/// for a boundary of curvature κ) while the energy norm takes each cell's own element matrix.
 pub trait TriangleCells {
     /// The mesh of the vertices with straight cells.
     fn straight(&self) -> &TriangleMesh;

@@ -614,8 +614,9 @@ impl ObstacleSolution<TriangleMesh> {
     }
 
     /// For a multiplier on a boundary part, per cell: the mean of λ_h over the cell's
-    /// edges on the part, and the share of those edges' ends in contact (active or
-    /// touching, as [`ObstacleSolution::contact_shares`]); 0 for the cells off the part.
+    /// edges on the part (the mean of their means for a corner cell with two), and the
+    /// share of those edges' ends in contact (active or touching, as
+    /// [`ObstacleSolution::contact_shares`]); 0 for the cells off the part.
     /// `None` for a multiplier on the cells.
     pub fn boundary_contact_cells(&self) -> Option<(Vec<f64>, Vec<f64>)> {
         let d = &self.discretization;
@@ -628,13 +629,19 @@ impl ObstacleSolution<TriangleMesh> {
         );
         let cells = d.mesh.cell_count();
         let (mut mean, mut share) = (vec![0.0; cells], vec![0.0; cells]);
+        let mut count = vec![0.0f64; cells];
         for (edge, &[a, b]) in boundary.edges.iter().zip(&boundary.edge_dofs) {
             mean[edge.cell] += 0.5 * (lambda[a] + lambda[b]);
             share[edge.cell] +=
                 0.5 * (f64::from(u8::from(active[a])) + f64::from(u8::from(active[b])));
+            count[edge.cell] += 1.0;
         }
-        for s in &mut share {
-            *s = s.min(1.0);
+        // a cell with two edges on the part (a corner) takes their mean
+        for ((m, s), n) in mean.iter_mut().zip(&mut share).zip(&count) {
+            if *n > 1.0 {
+                *m /= n;
+                *s /= n;
+            }
         }
         Some((mean, share))
     }

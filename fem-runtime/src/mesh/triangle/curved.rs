@@ -278,45 +278,42 @@ impl CurvedTriangleMesh {
 
     /// Newest-vertex bisection of the marked cells (with the closure it needs, as
     /// [`TriangleMesh::refine`]) that keeps the quadratic geometry: a new vertex on a
-    /// boundary edge is that edge's node (the point `s = ½` of its quadratic), and the two
-    /// halves carry the quadratic's points at `s = ¼` and `s = ¾` as their nodes, so the
-    /// refined boundary is the same piecewise-quadratic curve. Interior edges stay
-    /// straight. Returns the mesh and each new cell's parent.
+    /// curved edge (on the boundary or inside, as a second-order Gmsh mesh may have) is
+    /// that edge's node (the point `s = ½` of its quadratic), and the two halves carry
+    /// the quadratic's points at `s = ¼` and `s = ¾` as their nodes, so the refined mesh
+    /// has the same piecewise-quadratic curves. New edges across a cell are straight.
+    /// Returns the mesh and each new cell's parent.
     ///
     /// # Errors
     /// Those of [`TriangleMesh::refine`], and a refined cell whose map folds.
     pub fn refine(&self, marked: &[usize]) -> Result<(Self, Vec<usize>)> {
         let coarse = &self.mesh;
         let old = coarse.vertices().len();
-        let key = |p: [f64; 2]| (p[0].to_bits(), p[1].to_bits());
-        // each bisected boundary edge by the chord midpoint its new vertex starts at
-        let mut by_midpoint = std::collections::HashMap::new();
         let v = coarse.vertices();
-        for &(e, _) in coarse.boundary_edges() {
-            let [a, b] = coarse.edges()[e];
+        let nodes = &self.geometry.edge_nodes;
+        let key = |p: [f64; 2]| (p[0].to_bits(), p[1].to_bits());
+        // each curved edge by the chord midpoint a new vertex on it starts at (the same
+        // arithmetic as the bisection's)
+        let mut by_midpoint = std::collections::HashMap::new();
+        for (e, &[a, b]) in coarse.edges().iter().enumerate() {
             let mid = [0.5 * (v[a][0] + v[b][0]), 0.5 * (v[a][1] + v[b][1])];
-            by_midpoint.insert(key(mid), e);
+            if nodes[e] != mid {
+                by_midpoint.insert(key(mid), e);
+            }
         }
         let plain = TriangleMesh {
             curves: Vec::new(),
             ..coarse.clone()
         };
         let (mut fine, parents) = plain.refine(marked)?;
-        // the new boundary vertices and the coarse edges they split
+        // the new vertices on curved edges, moved onto their edge's node
         let mut split = std::collections::HashMap::new();
-        for &(e, _) in fine.boundary_edges() {
-            for w in fine.edges()[e] {
-                if w >= old {
-                    if let Some(&coarse_edge) = by_midpoint.get(&key(fine.vertices()[w])) {
-                        split.insert(w, coarse_edge);
-                    }
-                }
+        for w in old..fine.vertices().len() {
+            if let Some(&e) = by_midpoint.get(&key(fine.vertices()[w])) {
+                split.insert(w, e);
+                std::sync::Arc::make_mut(&mut fine.vertices)[w] = nodes[e];
             }
         }
-        let nodes = &self.geometry.edge_nodes;
-        fine.snap_new_boundary_vertices(old, &|_, p| {
-            by_midpoint.get(&key(p)).map_or(p, |&e| nodes[e])
-        })?;
         fine.curves = coarse.curves.clone();
         // the point at s of coarse edge e's quadratic, from its first vertex
         let quadratic = |e: usize, s: f64| {
@@ -333,19 +330,26 @@ impl CurvedTriangleMesh {
             ]
         };
         let mut edge_nodes = QuadraticGeometry::straight(&fine).edge_nodes;
-        for &(e, _) in fine.boundary_edges() {
-            let [p, q] = fine.edges()[e];
+        for (e, &[p, q]) in fine.edges().iter().enumerate() {
             edge_nodes[e] = match (split.get(&p), split.get(&q)) {
-                (None, None) => match coarse.find_edge(p, q) {
+                // an edge of the coarse mesh, not split: its own node
+                (None, None) if p < old && q < old => match coarse.find_edge(p, q) {
                     Some(c) => nodes[c],
                     None => edge_nodes[e],
                 },
+                // half of a split curved edge: a quarter point of its quadratic
                 (Some(&c), None) | (None, Some(&c)) => {
                     let end = if split.contains_key(&p) { q } else { p };
-                    let first = coarse.edges()[c][0];
-                    quadratic(c, if end == first { 0.25 } else { 0.75 })
+                    let [first, last] = coarse.edges()[c];
+                    if end == first {
+                        quadratic(c, 0.25)
+                    } else if end == last {
+                        quadratic(c, 0.75)
+                    } else {
+                        edge_nodes[e]
+                    }
                 }
-                (Some(_), Some(_)) => edge_nodes[e],
+                _ => edge_nodes[e],
             };
         }
         let geometry = QuadraticGeometry::from_edge_nodes(&fine, edge_nodes)?;
@@ -524,5 +528,38 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("not finite"), "{error}");
+    }
+
+    /// An interior curved edge (a second-order Gmsh mesh may curve them) is split at
+    /// its node, not at its chord's midpoint, and its halves keep its quadratic: the two
+    /// cells' areas, which the bulge moves from one to the other, are kept.
+    #[test]
+    fn refinement_keeps_an_interior_curved_edge() {
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 1, 1, Diagonal::Right).unwrap();
+        let mut nodes = QuadraticGeometry::straight(&mesh).edge_nodes;
+        let diagonal = (0..mesh.edge_count())
+            .find(|&e| mesh.edge_cells(e).1.is_some())
+            .unwrap();
+        let mid = nodes[diagonal];
+        nodes[diagonal] = [mid[0] + 0.05, mid[1] + 0.05];
+        let geometry = QuadraticGeometry::from_edge_nodes(&mesh, nodes.clone()).unwrap();
+        let curved = CurvedTriangleMesh::new(mesh.clone(), geometry).unwrap();
+        let areas = |m: &CurvedTriangleMesh, parents: &[usize]| {
+            let mut a = [0.0; 2];
+            for (c, &p) in parents.iter().enumerate() {
+                a[p] += m.measures[c];
+            }
+            a
+        };
+        let before = [curved.measures[0], curved.measures[1]];
+        let (fine, parents) = curved.refine(&[0, 1]).unwrap();
+        let after = areas(&fine, &parents);
+        for k in 0..2 {
+            assert!(
+                (after[k] - before[k]).abs() < 1e-14,
+                "{after:?} against {before:?}"
+            );
+        }
+        assert!(fine.mesh().vertices().contains(&nodes[diagonal]));
     }
 }
