@@ -246,6 +246,17 @@ fn cell_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     }
 }
 
+/// `r += …` of a term of data alone in an average (a jump refuses it): continuous, the
+/// mean of the two sides' coefficients (which may hold each side's `h`, `h_p` and
+/// `h_m` in scope) times its value at `xq`.
+pub(super) fn averaged_data(m: &Monomial) -> TokenStream {
+    let c = monomial_coefficient(m);
+    let data = data_product(m);
+    let mean = quote!((0.5 * ({ let h = h_p; #c } + { let h = h_m; #c })));
+    let p = product(std::iter::once(mean).chain(data));
+    quote!(r += #p;)
+}
+
 /// The loop of one edge term: `weight · Σ_q w_q [[X]](x_q)² |E|` added to `eta2`.
 fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     let degree = 2 * residual_degree(&term.residual, symbols);
@@ -270,13 +281,7 @@ fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     let mut body = Vec::new();
     for m in &term.residual {
         let Some(a) = m.args.first() else {
-            // data alone (only in an average: a jump refuses it): continuous, the mean of
-            // the two sides' coefficients (which may hold each side's h) times the value
-            let c = monomial_coefficient(m);
-            let data = data_product(m);
-            let mean = quote!((0.5 * ({ let h = h_p; #c } + { let h = h_m; #c })));
-            let p = product(std::iter::once(mean).chain(data));
-            body.push(quote!(r += #p;));
+            body.push(averaged_data(m));
             continue;
         };
         let c = monomial_coefficient(m);
@@ -660,6 +665,19 @@ pub fn model_items(
     };
     let message = format!("{model_name}: the indicator of {cell} takes {coordinates} vertex coordinates and, per field, its local coefficients ({sizes:?})");
     let sides = format!("{cell} has local edges (ends) 0 to {last}, not {{}} and {{}}");
+    // one cell's vertices and coefficients checked into `x` and `c` (cell and boundary
+    // indicators)
+    let cell_inputs = quote! {
+        const SIZES: [usize; #nf] = [#(#sizes),*];
+        let (::core::result::Result::Ok(x), ::core::result::Result::Ok(c)) =
+            (<&[f64; #coordinates]>::try_from(vertices), <&[&[f64]; #nf]>::try_from(coefficients))
+        else {
+            return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
+        };
+        if c.iter().zip(SIZES).any(|(c, n)| c.len() != n) {
+            return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
+        }
+    };
     let parts = symbols.facets.len();
     let boundary = (!interval).then(|| {
         let wrong_part = format!("{model_name} has boundary parts 0 to {}, not {{}}", parts.saturating_sub(1));
@@ -672,15 +690,7 @@ pub fn model_items(
                 params: &[f64],
                 data: &[&#runtime::DataFn],
             ) -> #runtime::Result<f64> {
-                const SIZES: [usize; #nf] = [#(#sizes),*];
-                let (::core::result::Result::Ok(x), ::core::result::Result::Ok(c)) =
-                    (<&[f64; #coordinates]>::try_from(vertices), <&[&[f64]; #nf]>::try_from(coefficients))
-                else {
-                    return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
-                };
-                if c.iter().zip(SIZES).any(|(c, n)| c.len() != n) {
-                    return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
-                }
+                #cell_inputs
                 if edge > #last {
                     return ::core::result::Result::Err(#runtime::Error::Input(::std::format!(#sides, edge, edge)));
                 }
@@ -704,15 +714,7 @@ pub fn model_items(
             params: &[f64],
             data: &[&#runtime::DataFn],
         ) -> #runtime::Result<f64> {
-            const SIZES: [usize; #nf] = [#(#sizes),*];
-            let (::core::result::Result::Ok(x), ::core::result::Result::Ok(c)) =
-                (<&[f64; #coordinates]>::try_from(vertices), <&[&[f64]; #nf]>::try_from(coefficients))
-            else {
-                return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
-            };
-            if c.iter().zip(SIZES).any(|(c, n)| c.len() != n) {
-                return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
-            }
+            #cell_inputs
             let p: &[f64; #np] = params.try_into().expect("parameter count checked by the runtime");
             let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
             ::core::result::Result::Ok(estimator::cell(x, c, p, d))

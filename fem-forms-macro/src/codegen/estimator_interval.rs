@@ -12,7 +12,9 @@
 //! cells' lengths in the weight, each side's length inside the jump (`../shared/MODELS.md` §8, Euler–Bernoulli). Neither allocates.
 
 use super::emit::{float, product};
-use super::estimator::{data_product, monomial_coefficient, residual_degree, weight_code};
+use super::estimator::{
+    averaged_data, data_product, monomial_coefficient, residual_degree, weight_code,
+};
 use crate::analysis::Symbols;
 use crate::estimator::{Estimator, IndicatorTerm, Region};
 use fem_reference::ElementKind;
@@ -137,13 +139,7 @@ fn node_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     let mut body = Vec::new();
     for m in &term.residual {
         let Some(a) = m.args.first() else {
-            // data alone (only in an average: a jump refuses it): continuous, the mean of
-            // the two sides' coefficients (which may hold each side's h) times the value
-            let c = monomial_coefficient(m);
-            let data = data_product(m);
-            let mean = quote!((0.5 * ({ let h = h_p; #c } + { let h = h_m; #c })));
-            let p = product(std::iter::once(mean).chain(data));
-            body.push(quote!(r += #p;));
+            body.push(averaged_data(m));
             continue;
         };
         let c = monomial_coefficient(m);
