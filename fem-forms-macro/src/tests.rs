@@ -1483,16 +1483,17 @@ fn an_estimator_that_is_not_the_models_residual_is_a_compile_error() {
 /// of the third derivative is caught.
 #[test]
 fn a_stabilization_consistent_up_to_another_equation_passes() {
+    // `S` takes every field, so that a residual of the rotation equation can be written
     let beam = |s: &str| {
         let forms = format!(
             "
             a(θ,w;η,v) = ∫ θ'η' + t⁻²(w'−θ)(v'−η)
             b(η,v;μ)   = ∫ s v μ
-            S(θ,λ;η,μ) = {s}
+            S(θ,w,λ;η,v,μ) = {s}
             ℓ(η,v)     = ∫ f v
             ℓ_S(η,μ)   = Σ_T h_T⁴ (f, η''' − sμ)_T
             g(μ)       = ∫ s ψ μ
-            B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(η,v;λ) − b(θ,w;μ) − α S(θ,λ;η,μ)
+            B_h(θ,w,λ;η,v,μ) = a(θ,w;η,v) − b(η,v;λ) − b(θ,w;μ) − α S(θ,w,λ;η,v,μ)
             L_h(η,v,μ)       = ℓ(η,v) − g(μ) − α ℓ_S(η,μ)
         "
         );
@@ -1511,14 +1512,21 @@ fn a_stabilization_consistent_up_to_another_equation_passes() {
     let text = out.to_string();
     assert!(!text.contains("compile_error"), "{text}");
     assert!(text.contains("const STRONG_FORM : bool = true"));
-    let out = expand(beam("Σ_T h_T⁴ (−θ''' − sλ, η''' − sμ)_T"));
-    let errors = rendered_errors(&out);
-    assert!(
-        errors
-            .iter()
-            .any(|e| e.contains("does not stabilize the residual of the equation of `v`")),
-        "{errors:?}"
-    );
+    // a sign changed, and a residual of the rotation equation alone (its derivative
+    // `θ''' + t⁻²(w'' − θ')`, which no contact term enters: the contact equation's
+    // residual must take part)
+    for wrong in [
+        "Σ_T h_T⁴ (−θ''' − sλ, η''' − sμ)_T",
+        "Σ_T h_T⁴ (θ''' + t⁻²(w'' − θ'), η''' − sμ)_T",
+    ] {
+        let errors = rendered_errors(&expand(beam(wrong)));
+        assert!(
+            errors
+                .iter()
+                .any(|e| e.contains("does not stabilize the residual of the equation of `v`")),
+            "{wrong}: {errors:?}"
+        );
+    }
 }
 
 /// The plate's fluxes: the Kirchhoff shear `V_n = (div M)·n + ∂_s M_ns` and `M_nn` are
