@@ -257,6 +257,21 @@ pub(super) fn averaged_data(m: &Monomial) -> TokenStream {
     quote!(r += #p;)
 }
 
+/// A table's rows on each local edge of the reference triangle: the basis values `f` at
+/// the edge parameters `s_of(s)` for the rule's points `s` (one block of rows per edge).
+fn edge_rows(points: &[f64], s_of: &dyn Fn(f64) -> f64, f: AtPoint) -> TokenStream {
+    let edges = (0..3).map(|edge| {
+        let rows = points.iter().map(|&s| {
+            let v = f(super::facet::edge_point(edge, s_of(s)))
+                .into_iter()
+                .map(float);
+            quote!([#(#v),*])
+        });
+        quote!([#(#rows),*])
+    });
+    quote!([#(#edges),*])
+}
+
 /// The loop of one edge term: `weight · Σ_q w_q [[X]](x_q)² |E|` added to `eta2`.
 fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     let degree = 2 * residual_degree(&term.residual, symbols);
@@ -266,18 +281,7 @@ fn edge_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
         items: Vec::new(),
         made: Vec::new(),
     };
-    let per_edge = |s_of: &dyn Fn(f64) -> f64, f: AtPoint| {
-        let edges = (0..3).map(|edge| {
-            let rows = rule.points.iter().map(|&s| {
-                let v = f(super::facet::edge_point(edge, s_of(s)))
-                    .into_iter()
-                    .map(float);
-                quote!([#(#v),*])
-            });
-            quote!([#(#rows),*])
-        });
-        quote!([#(#edges),*])
-    };
+    let per_edge = |s_of: &dyn Fn(f64) -> f64, f: AtPoint| edge_rows(&rule.points, s_of, f);
     let mut body = Vec::new();
     for m in &term.residual {
         let Some(a) = m.args.first() else {
@@ -395,16 +399,7 @@ fn boundary_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
                     e,
                     beta,
                     "",
-                    &|f| {
-                        let edges = (0..3).map(|edge| {
-                            let rows = rule.points.iter().map(|&s| {
-                                let v = f(super::facet::edge_point(edge, s)).into_iter().map(float);
-                                quote!([#(#v),*])
-                            });
-                            quote!([#(#rows),*])
-                        });
-                        quote!([#(#edges),*])
-                    },
+                    &|f| edge_rows(&rule.points, &|s| s, f),
                     &|n| quote!([[[f64; #n]; #nq]; 3]),
                 );
                 quote!(#ident[edge][q])
