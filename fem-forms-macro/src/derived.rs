@@ -197,6 +197,7 @@ pub fn residual_estimator(
                 source: format!("h_T^{} ‖R_{name}‖² (derived)", 2 * m),
                 loc: at,
                 average: false,
+                quadrature_degree: None,
             });
         }
         for (j, flux) in derived.fluxes[i].iter().enumerate() {
@@ -212,6 +213,7 @@ pub fn residual_estimator(
                 source: format!("h_E^{power} ‖[[F_{name}]]‖² (derived: the coefficient of {what})"),
                 loc: at,
                 average: false,
+                quadrature_degree: None,
             });
         }
     }

@@ -70,6 +70,9 @@ pub struct IndicatorTerm {
     /// On an interior edge: the average `{X} = ½(X⁺ + X⁻)` of the two sides instead of
     /// the jump `[[X]] = X⁺ − X⁻`.
     pub average: bool,
+    /// On a cell, `‖X‖²[degree=N]`: the Gauss rule exact for degree N integrates the
+    /// norm (a reduced-integration form's quantity), instead of the rule exact for `X²`.
+    pub quadrature_degree: Option<usize>,
 }
 
 /// An analysed estimator.
@@ -244,8 +247,18 @@ impl Analysis<'_> {
             )
             .help(format!("write it as `{example}`"))]);
         };
-        match squared(close + 1) {
-            Some(end) if end == tokens.len() => {}
+        let quadrature_degree = match squared(close + 1) {
+            Some(end) if end == tokens.len() => None,
+            Some(end) if tokens[end].tok == Tok::LBracket => {
+                if region != Region::Cell {
+                    return Err(vec![Diagnostic::text(
+                        span(&tokens[end..]),
+                        "a quadrature option on an edge's norm",
+                    )
+                    .help("`[degree=N]` integrates a cell's norm as a reduced-integration form does; an edge's norm is integrated exactly (a point value on an interval)")]);
+                }
+                Some(quadrature_option(&tokens[end..], example)?)
+            }
             _ => {
                 return Err(vec![Diagnostic::text(
                     tokens[close].loc,
@@ -253,7 +266,7 @@ impl Analysis<'_> {
                 )
                 .help(format!("indicators are sums of squares: write `{example}`"))])
             }
-        }
+        };
         let weight_tokens = &tokens[..open];
         let body = &tokens[open + 1..close];
         let average = region == Region::Edge && average_inside(body).is_some();
@@ -314,6 +327,7 @@ impl Analysis<'_> {
                 source: source.clone(),
                 loc: span(tokens),
                 average,
+                quadrature_degree,
             })
             .collect())
     }
@@ -389,6 +403,35 @@ impl Analysis<'_> {
             )]);
         }
         Ok(())
+    }
+}
+
+/// The quadrature option `[degree=N]` after a cell's squared norm, as in the forms'
+/// `∫[degree=N]`: the norm is integrated by the Gauss rule exact for degree N, so that an
+/// indicator sees the reduced-integration quantity its form does (one point, `degree=1`:
+/// the shear strain `t⁻²(w' − θ)` of `∫[degree=1]` at the cell's midpoint).
+fn quadrature_option(tokens: &[Token], example: &str) -> Result<usize, Vec<Diagnostic>> {
+    let bad = || {
+        vec![Diagnostic::text(span(tokens), "malformed quadrature option of a norm")
+            .help(format!("write `{example}[degree=N]` to integrate the squared norm by the Gauss rule exact for degree N (`[degree=1]`: one point, as `∫[degree=1]` in a form)"))]
+    };
+    match tokens {
+        [open, key, equals, number, close]
+            if open.tok == Tok::LBracket
+                && key.tok == Tok::Ident("degree".into())
+                && equals.tok == Tok::Equals
+                && close.tok == Tok::RBracket =>
+        {
+            match number.tok {
+                Tok::Number(v)
+                    if v.fract() == 0.0 && v >= 0.0 && v <= crate::parser::MAX_DEGREE as f64 =>
+                {
+                    Ok(v as usize)
+                }
+                _ => Err(bad()),
+            }
+        }
+        _ => Err(bad()),
     }
 }
 

@@ -1262,6 +1262,18 @@ fn estimator_errors_point_at_the_place() {
         ("η_E² = h_E ‖[[h_E ∇u·n]]‖²", "`h_E` inside a jump"),
         ("η_T² = ∇u ‖f + Δu + λ‖²", "weight of a norm is a vector"),
         ("η² = h_T² ‖f‖²", "expected `η_T² =`"),
+        (
+            "η_E² = h_E ‖[[∇u·n]]‖²[degree=1]",
+            "quadrature option on an edge",
+        ),
+        (
+            "η_T² = h_T² ‖f + Δu + λ‖²[degre=1]",
+            "malformed quadrature option",
+        ),
+        (
+            "η_T² = h_T² ‖f + Δu + λ‖²[degree=x]",
+            "malformed quadrature option",
+        ),
         ("", "declares no indicator"),
     ];
     for (text, expected) in cases {

@@ -51,6 +51,13 @@ fn t_lets(alphas: &[[u8; 2]], suffix: &str) -> Vec<TokenStream> {
     lets
 }
 
+/// The degree the Gauss rule of a cell term is exact for: its `[degree=N]`, else that
+/// of the squared residual (exact).
+pub(super) fn cell_rule_degree(term: &IndicatorTerm, symbols: &Symbols) -> usize {
+    term.quadrature_degree
+        .unwrap_or_else(|| 2 * residual_degree(&term.residual, symbols))
+}
+
 /// The polynomial degree of a residual on the cell (of the monomial of highest degree).
 pub(super) fn residual_degree(residual: &Expansion, symbols: &Symbols) -> usize {
     residual
@@ -166,7 +173,7 @@ pub(super) fn data_product(m: &Monomial) -> Option<TokenStream> {
 
 /// The loop of one cell term: `weight · Σ_q w_q R(x_q)² |det J|` added to `eta2`.
 fn cell_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
-    let rule = rule_for_degree(2 * residual_degree(&term.residual, symbols));
+    let rule = rule_for_degree(cell_rule_degree(term, symbols));
     let nq = rule.points.len();
     let mut tables = Tables {
         items: Vec::new(),

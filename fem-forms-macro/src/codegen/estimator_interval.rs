@@ -13,7 +13,7 @@
 
 use super::emit::{float, product};
 use super::estimator::{
-    averaged_data, data_product, monomial_coefficient, residual_degree, weight_code,
+    averaged_data, cell_rule_degree, data_product, monomial_coefficient, weight_code,
 };
 use crate::analysis::Symbols;
 use crate::estimator::{Estimator, IndicatorTerm, Region};
@@ -81,9 +81,9 @@ fn field_value(
 
 /// The loop of one cell term: `weight · Σ_q w_q R(ξ_q)² h` added to `eta2`.
 fn cell_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
-    let rule = fem_reference::quadrature::QuadratureRule::exact_for_degree(
-        2 * residual_degree(&term.residual, symbols),
-    );
+    let rule = fem_reference::quadrature::QuadratureRule::exact_for_degree(cell_rule_degree(
+        term, symbols,
+    ));
     let nq = rule.len();
     let mut tables = Tables::default();
     let mut body = Vec::new();
