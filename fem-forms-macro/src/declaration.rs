@@ -593,19 +593,6 @@ impl Declaration {
                             }
                         }
                     }
-                    // A continuous P1 multiplier on a boundary part (Signorini's `λ: P1`
-                    // on Γ_C) is nonnegative pointwise iff its vertex values are; the
-                    // runtime gives it a DOF map on the part's vertices.
-                    let boundary_p1 = e == ElementKind::P1 && !self.facets.is_empty();
-                    if u.nonnegative && e.is_continuous() && !boundary_p1 {
-                        errors.push(
-                            Diagnostic::token(
-                                u.element_name.span(),
-                                format!("`{} >= 0` on a continuous {} field: a multiplier constrained coefficient-wise must be discontinuous", u.name, e.name()),
-                            )
-                            .help("declare the multiplier as `λ: P0 >= 0` or `λ: P1disc >= 0` (or `λ: P1 >= 0` on a model with `facets:`, a boundary multiplier)"),
-                        );
-                    }
                 }
             }
         }

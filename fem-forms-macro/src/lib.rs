@@ -35,7 +35,9 @@
 //! - `unknowns: NAME: ELEMENT, …` with elements `P0 P1 P2 P3 P1disc` (and `Hermite` on
 //!   intervals, `Argyris` and `Morley` on triangles: their kernels take the cell's global
 //!   vertex numbers too and apply the element's DOF transformation, docs/elements.md §5); `λ: P0 >= 0` (or `P1disc >= 0`) marks a multiplier constrained to be
-//!   non-negative. `θ: [P1]^2` (on triangles) declares a vector field of two P1
+//!   non-negative (`P1 >= 0` on a boundary part of `facets:`, or in a model without
+//!   `system:`, where it is the nodal method's force density that only the estimator
+//!   reads). `θ: [P1]^2` (on triangles) declares a vector field of two P1
 //!   components (`[P1]²` cannot be written: `²` is not a Rust token); it is lowered to
 //!   the scalar fields `θ_x` and `θ_y` (tests `η_x`, `η_y`), which is what the runtime
 //!   sees, so its DOF map, assembly and kernels are those of scalar fields.

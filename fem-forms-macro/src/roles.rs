@@ -12,6 +12,7 @@
 use crate::analysis::{Form, Symbols};
 use crate::declaration::{Declaration, RolesDecl};
 use crate::diagnostic::{closest, Diagnostic};
+use fem_reference::ElementKind;
 use syn::Ident;
 
 /// The resolved roles, as indices into the generated `FORMS` and `PARAMS`.
@@ -103,6 +104,9 @@ pub fn resolve(
         strong_form: false,
     };
     let order = operator_order(&roles, forms);
+    if roles.system.is_some() {
+        lookup.continuous_multipliers(declaration);
+    }
     (Roles { order, ..roles }, lookup.errors)
 }
 
@@ -167,6 +171,28 @@ impl Lookup<'_> {
             );
         }
         found
+    }
+
+    /// An error at each continuous multiplier of a model that solves for it (`system:`)
+    /// other than a P1 multiplier on a boundary part: the solvers eliminate a multiplier
+    /// constrained coefficient-wise cell by cell. A P1 one on a boundary part (Signorini's
+    /// `λ: P1` on Γ_C) is nonnegative pointwise iff its vertex values are, and the
+    /// runtime gives it a DOF map on the part's vertices; a model without a system (the
+    /// nodal method's) only reads its multiplier, the density of the nodal forces.
+    fn continuous_multipliers(&mut self, declaration: &Declaration) {
+        for u in &declaration.unknowns {
+            let Some(e) = u.element else { continue };
+            let boundary_p1 = e == ElementKind::P1 && !declaration.facets.is_empty();
+            if u.nonnegative && e.is_continuous() && !boundary_p1 {
+                self.errors.push(
+                    Diagnostic::token(
+                        u.element_name.span(),
+                        format!("`{} >= 0` on a continuous {} field: a multiplier the system solves for, constrained coefficient-wise, must be discontinuous", u.name, e.name()),
+                    )
+                    .help("declare the multiplier as `λ: P0 >= 0` or `λ: P1disc >= 0` (or `λ: P1 >= 0` on a model with `facets:`, a boundary multiplier, or on a model without `system:`, the nodal method's force density)"),
+                );
+            }
+        }
     }
 
     /// `obstacle: field >= data`: a primal scalar field and a data function.
