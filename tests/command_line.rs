@@ -954,28 +954,6 @@ fn adaptive_options_are_checked() {
             vec!["solve", "membrane-radial", "--tol", "0.1", "--theta", "2"],
             "(0, 1]",
         ),
-        (
-            vec![
-                "solve",
-                "membrane-radial",
-                "--tol",
-                "0.1",
-                "--pair",
-                "p1-nodal",
-            ],
-            "declares no estimator",
-        ),
-        (
-            vec![
-                "solve",
-                "timoshenko-a",
-                "--tol",
-                "0.1",
-                "--pair",
-                "p1-p1-p0-reduced",
-            ],
-            "declares no estimator",
-        ),
     ] {
         let run = fem_forms(&args, &out);
         let stderr = String::from_utf8_lossy(&run.stderr);

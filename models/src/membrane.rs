@@ -56,19 +56,29 @@ membrane_model! {
 }
 
 fem_runtime::model! {
-    /// The membrane without a multiplier, u ∈ P1: the stiffness and load of the classical
-    /// nodal-constraint method `u_i ≥ ψ(x_i)` (the obstacle enters at the nodes, not in
-    /// a form).
+    /// The membrane of the classical nodal-constraint method, u ∈ P1: the stiffness and
+    /// load it assembles (`energy: a, ℓ`; the obstacle enters at the nodes, `u_i ≥ ψ(x_i)`,
+    /// not in a form), and λ ∈ P1, the density of its nodal contact forces `r_i`,
+    /// `λ_h = Σ_i r_i/∫φ_i φ_i` (Braess, Numer. Math. 101, 2005), which only the estimator
+    /// reads. `b` and `G` with the vertex rule are the nodal constraint itself:
+    /// `Σ_i μ_i ∫φ_i (u_i − ψ_i) ≥ 0` for every `μ ≥ 0` is `u_i ≥ ψ_i`.
     pub mod membrane_p1 on triangle {
-        unknowns: u: P1;
-        tests: v;
+        unknowns: u: P1, λ: P1 >= 0;
+        tests: v, μ;
         data: f, ψ, g;
         boundary: u = g;
         forms: "
             a(u;v) = ∫ ∇u·∇v
             ℓ(v)   = ∫ f v
+            b(v;μ) = ∫ v μ
+            G(μ)   = ∫ ψ μ
         ";
         energy: a, ℓ;
+        constraint: b, G;
         obstacle: u >= ψ;
+        estimator: "
+            η_T² = h_T² ‖f + Δu + λ‖²
+            η_E² = h_E ‖[[∇u·n]]‖²
+        ";
     }
 }

@@ -81,7 +81,8 @@ fem_runtime::model! {
         boundary: θ_x = g, θ_y = g, w = g;
         forms: "
             Cε(θ)            := D[(1−ν)ε(θ) + ν tr ε(θ) I]
-            a(θ,w;η,v)       = ∫ Cε(θ):ε(η) + 6κ(1−ν)D t⁻² (∇w − θ)·(∇v − η)
+            q(θ,w)           := 6κ(1−ν)D t⁻² (∇w − θ)
+            a(θ,w;η,v)       = ∫ Cε(θ):ε(η) + ∫ q(θ,w)·(∇v − η)
             b(v;μ)           = ∫ s v μ
             S(θ,λ;η,μ)       = Σ_T h_T⁴ (div div Cε(θ) − sλ, div div Cε(η) − sμ)_T
             ℓ(v)             = ∫ f v
@@ -95,5 +96,11 @@ fem_runtime::model! {
         stabilization: α S against a;
         side:          s;
         obstacle:      w >= ψ;
+        // the Stenberg pairs' estimator with the physical shear: reliable, and it sees
+        // the locking (its shear terms grow with the locked shear as t falls below h)
+        estimator:     "
+            η_T² = h_T²/D ‖div Cε(θ) + q(θ,w)‖² + h_T²(t² + h_T²)/D ‖div q(θ,w) + f + sλ‖²
+            η_E² = h_E/D ‖[[Cε(θ)·n]]‖² + h_E(t² + h_E²)/D ‖[[q(θ,w)·n]]‖²
+        ";
     }
 }

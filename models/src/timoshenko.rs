@@ -55,6 +55,13 @@ fem_runtime::model! {
         stabilization: α S against a;
         side:          s;
         obstacle:      w >= ψ;
+        // The shear force is the cell constant γ_h = t⁻²(w' − θ) at the midpoint (as
+        // `∫[degree=1]` sees it), so `[degree=1]`; its derivative vanishes in the cell.
+        // The node jumps of θ' and γ_h are left out: the method's own equations give
+        // [[γ_h]] = ∫(f + sλ)φ_i and [[θ']] = −∫γ_hφ_i at a node, which the cell terms bound.
+        estimator:     "
+            η_T² = h_T² ‖θ'' + t⁻²(w' − θ)‖²[degree=1] + h_T²(t² + h_T²) ‖f + sλ‖²
+        ";
     }
 }
 
@@ -81,5 +88,10 @@ fem_runtime::model! {
         stabilization: α S against a;
         side:          s;
         obstacle:      w >= ψ;
+        // the P2 pair's estimator: exact integration has the same strong form
+        estimator:     "
+            eta_T^2 = h_T^2 ||θ'' + t^-2 (w' - θ)||^2 + h_T^2 (t^2 + h_T^2) ||t^-2 (w'' - θ') + f + s λ||^2
+            eta_E^2 = h_E ||[[θ']]||^2 + h_E (t^2 + h_E^2) ||[[t^-2 (w' - θ)]]||^2
+        ";
     }
 }

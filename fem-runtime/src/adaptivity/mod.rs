@@ -202,16 +202,35 @@ fn cell_coefficients<M: Model>(fields: &[Option<TriangleField>], c: usize) -> Ve
 }
 
 /// The fields of a solution on a triangle mesh (`None` for a multiplier on a boundary
-/// part), or the error for the nodal method's contact forces.
+/// part). The nodal method's multiplier field is `density`, its nodal forces' density
+/// ([`crate::problem::nodal::force_density_at_vertices`]) on the primal field's P1 DOFs.
+///
+/// # Errors
+/// The nodal method's solution of a model without a P1 multiplier field (its forces have
+/// no field for the kernels to read), and a field without DOFs on the cells.
 fn fields<'a, M: Model, G: TriangleCells>(
     solution: &'a ObstacleSolution<G>,
+    density: Option<&'a [f64]>,
 ) -> Result<Vec<Option<TriangleField<'a>>>> {
     let d = &solution.discretization;
+    let multiplier = multiplier_index::<M, G>(solution);
     if matches!(d.multipliers, Multipliers::Nodal) {
-        return Err(Error::Input(format!(
-            "model `{}`: the nodal method's contact forces have no generated estimator",
-            M::NAME
-        )));
+        let (Some(map), Some(density), true) =
+            (d.dofs.map(0), density, multiplier < M::FIELDS.len())
+        else {
+            return Err(Error::Input(format!(
+                "model `{}`: the nodal method's estimate needs a P1 multiplier field in the model (the density of its nodal forces)",
+                M::NAME
+            )));
+        };
+        let field = |coefficients| {
+            Some(TriangleField {
+                mesh: d.mesh.straight(),
+                map,
+                coefficients,
+            })
+        };
+        return Ok(vec![field(solution.field(0)), field(density)]);
     }
     (0..M::FIELDS.len())
         .map(|f| {
@@ -253,7 +272,9 @@ pub fn triangle_estimate<M: Model, G: TriangleCells>(
     parts: &[Vec<u32>],
 ) -> Result<Estimate> {
     require_estimator::<M>()?;
-    let fields = fields::<M, G>(solution)?;
+    let density = matches!(solution.discretization.multipliers, Multipliers::Nodal)
+        .then(|| crate::problem::nodal::force_density_at_vertices(solution));
+    let fields = fields::<M, G>(solution, density.as_deref())?;
     let mesh = solution.discretization.mesh.straight();
     let mut indicators = vec![0.0; mesh.cell_count()];
     let mut sum = 0.0;
@@ -496,6 +517,20 @@ fn solution_energy<M: Model, G: TriangleCells>(
     Ok(energies.iter().sum())
 }
 
+/// The model's field that is the multiplier: the discretization's, or for the nodal
+/// method (whose multipliers are its nodal forces, on no field) the model's nonnegative
+/// field, their density; `M::FIELDS.len()` where there is none.
+fn multiplier_index<M: Model, G>(solution: &ObstacleSolution<G>) -> usize {
+    let d = &solution.discretization;
+    match d.multipliers {
+        Multipliers::Nodal => M::FIELDS
+            .iter()
+            .position(|f| f.nonnegative)
+            .unwrap_or(M::FIELDS.len()),
+        _ => d.multiplier_field,
+    }
+}
+
 /// The contact part `S` of the estimate (with each cell's share) and `‖u_h‖_a`.
 fn contact_terms<M: Model, G: TriangleCells>(
     solution: &ObstacleSolution<G>,
@@ -507,7 +542,8 @@ fn contact_terms<M: Model, G: TriangleCells>(
     let d = &solution.discretization;
     let cells = &d.mesh;
     let mesh = cells.straight();
-    let energy = solution_energy::<M, G>(cells, fields, d.multiplier_field, params, data)?;
+    let multiplier = multiplier_index::<M, G>(solution);
+    let energy = solution_energy::<M, G>(cells, fields, multiplier, params, data)?;
     let norm = energy.max(0.0).sqrt();
     if let (Some(b), Some(_)) = (d.boundary(), side) {
         let terms = boundary::boundary_contact_terms::<M, G>(solution, fields, b, params, data)?;
@@ -517,7 +553,7 @@ fn contact_terms<M: Model, G: TriangleCells>(
         return Ok((ContactTerms::default(), norm));
     };
     let field = M::constrained_field();
-    let (Some(u), Some(lambda)) = (&fields[field], &fields[d.multiplier_field]) else {
+    let (Some(u), Some(Some(lambda))) = (&fields[field], fields.get(multiplier)) else {
         return Err(Error::Input(format!(
             "model `{}`: the constrained field or the multiplier has no values on the cells",
             M::NAME

@@ -248,9 +248,13 @@ impl SystemDofs {
         })
     }
 
-    /// All fields of the model.
+    /// All fields the model solves for: every field, except the multiplier of a model
+    /// without `system:` (the nodal method's, the density of its nodal forces, which no
+    /// form assembles and the estimator reads).
     pub fn all<M: Model>(mesh: &impl DofNumbering) -> Result<Self> {
-        let fields: Vec<usize> = (0..M::FIELDS.len()).collect();
+        let fields: Vec<usize> = (0..M::FIELDS.len())
+            .filter(|&f| M::SYSTEM.is_some() || !M::FIELDS[f].nonnegative)
+            .collect();
         Self::new::<M>(mesh, &fields)
     }
 

@@ -1487,7 +1487,7 @@ impl<G: DofNumbering> ObstacleSolution<G> {
     pub fn energy<M: Model>(&self, coefficients: &Coefficients) -> Result<f64> {
         let d = &self.discretization;
         let primal: Vec<usize> = (0..M::FIELDS.len())
-            .filter(|&f| f != d.multiplier_field)
+            .filter(|&f| f != d.multiplier_field && !M::FIELDS[f].nonnegative)
             .collect();
         let dofs = SystemDofs::new::<M>(&d.mesh, &primal)?;
         let mut u = Vec::with_capacity(dofs.dof_count());

@@ -518,7 +518,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             let finest = self.meshes.last().expect("checked");
             let memory_estimate = self.memory.bytes(finest.cell_count());
             memory::check_memory(memory_estimate, &self.size_text(finest))?;
-            return self.solve_nodal(obstacle, memory_estimate);
+            return self.solve_nodal(&self.meshes, obstacle, memory_estimate);
         }
         self.solve_on(&self.meshes, None)
     }
@@ -539,6 +539,10 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         let mut current = self.solve()?;
         while let Some(mesh) = next(&current)? {
             let previous = &current.solution;
+            if let Some(obstacle) = self.nodal {
+                current = self.refine_nodal(&current, mesh, obstacle)?;
+                continue;
+            }
             let solved = match self.solve_on(std::slice::from_ref(&mesh), Some(previous)) {
                 Err(e @ (Error::NotConverged { .. } | Error::LinearSolve(_)))
                     if self.start.is_some() =>
@@ -887,10 +891,40 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         Ok(())
     }
 
-    /// The nodal method: the model is one P1 field, the constraint `u_i ≥ ψ(x_i)` at the
-    /// free nodes, its multipliers the nodal forces.
-    fn solve_nodal(&self, obstacle: &'a DataFn, memory_estimate: f64) -> Result<Solved<M, G>> {
-        let finest = self.meshes.last().expect("checked");
+    /// The nodal method's next level of [`Problem::solve_refining`]: solved on `mesh` by
+    /// nested iteration from `current`'s mesh (the coarse level is solved again: the
+    /// nodal active sets start from an interpolated solution, not a multiplier), the
+    /// report's levels those of `current` and the new one.
+    ///
+    /// # Errors
+    /// Those of [`Problem::solve_nodal`].
+    fn refine_nodal(
+        &self,
+        current: &Solved<M, G>,
+        mesh: G,
+        obstacle: &'a DataFn,
+    ) -> Result<Solved<M, G>> {
+        let memory_estimate = self.memory.bytes(mesh.cell_count());
+        memory::check_memory(memory_estimate, &self.size_text(&mesh))?;
+        let meshes = [current.mesh().clone(), mesh];
+        let mut solved = self.solve_nodal(&meshes, obstacle, memory_estimate)?;
+        let mut levels = current.report.levels.clone();
+        levels.extend(solved.report.levels.last().copied());
+        solved.report.levels = levels;
+        Ok(solved)
+    }
+
+    /// The nodal method on nested `meshes` (the last one alone unless the options ask
+    /// for nested iteration): the model is one P1 field (and at most its nodal forces'
+    /// density), the constraint `u_i ≥ ψ(x_i)` at the free nodes, its multipliers the
+    /// nodal forces; with the estimate where the model declares an estimator.
+    fn solve_nodal(
+        &self,
+        meshes: &[G],
+        obstacle: &'a DataFn,
+        memory_estimate: f64,
+    ) -> Result<Solved<M, G>> {
+        let finest = meshes.last().expect("checked");
         let data = self.data_functions()?;
         self.check_data(finest, &data)?;
         let shape = finest.shape(false)?;
@@ -909,9 +943,9 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         )?;
         let options = self.options.obstacle;
         let meshes = if self.options.nested {
-            &self.meshes[..]
+            meshes
         } else {
-            &self.meshes[self.meshes.len() - 1..]
+            &meshes[meshes.len() - 1..]
         };
         let solution = G::solve_nodal::<M>(
             meshes,
@@ -1021,12 +1055,18 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 forced_alpha: None,
             });
         }
+        let estimate = if M::HAS_ESTIMATOR && G::ESTIMATES {
+            let parts = self.part_markers()?;
+            Some(self.record_estimate(&solution, &params, &data, &parts, &mut report)?)
+        } else {
+            None
+        };
         Ok(Solved {
             solution,
             report,
             params,
             fell_back: None,
-            estimate: None,
+            estimate,
             model: PhantomData,
         })
     }

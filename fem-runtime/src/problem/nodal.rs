@@ -5,6 +5,7 @@
 //! contact forces.
 
 use super::{Domain, Support};
+use crate::adaptivity::TriangleCells;
 use crate::assembly::dof_map::SystemDofs;
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::error::{Error, Result};
@@ -130,17 +131,22 @@ pub fn solve<M: Model>(
     ))
 }
 
-/// The energy forms `[a, ℓ]` of `M`, a model the nodal method takes.
+/// The energy forms `[a, ℓ]` of `M`, a model the nodal method takes: a primal P1 field
+/// first, then at most a P1 multiplier, the density of the nodal forces that the
+/// estimator reads (the solve assembles the first field's energy alone).
 ///
 /// # Errors
-/// A model that is not one P1 field without multiplier, or that declares no energy.
+/// A model of other fields, or that declares no energy.
 fn nodal_energy<M: Model>() -> Result<[usize; 2]> {
-    if M::FIELDS.len() != 1
-        || M::FIELDS[0].nonnegative
-        || M::FIELDS[0].element != crate::ElementKind::P1
-    {
+    let p1 = |f: &crate::model::FieldInfo| f.element == crate::ElementKind::P1;
+    let takes = match M::FIELDS {
+        [u] => p1(u) && !u.nonnegative,
+        [u, lambda] => p1(u) && !u.nonnegative && p1(lambda) && lambda.nonnegative,
+        _ => false,
+    };
+    if !takes {
         return Err(Error::Input(format!(
-            "the nodal method takes a model of one P1 field without multiplier; `{}` has {}",
+            "the nodal method takes a model of one P1 field, with at most a P1 multiplier (the density of its nodal forces); `{}` has {}",
             M::NAME,
             M::FIELDS
                 .iter()
@@ -338,29 +344,33 @@ pub fn contact_shares(
     (shares, boundary_contact)
 }
 
-/// The nodal forces as a density per cell: each vertex's force over its share of the
-/// area (a third of the cells around it), averaged over the cell's vertices.
-pub fn force_density(solution: &ObstacleSolution<TriangleMesh>) -> Vec<f64> {
+/// The density of the nodal forces at the vertices, `λ_v = r_v / ∫φ_v` (the force over
+/// a third of the area of the cells around the vertex), 0 at fixed vertices; indexed by
+/// vertex, which is the P1 DOF numbering. This is the mass-lumped multiplier of
+/// Braess (Numer. Math. 101, 2005) that the nodal method's estimator reads.
+pub fn force_density_at_vertices<G: TriangleCells>(solution: &ObstacleSolution<G>) -> Vec<f64> {
     let d = &solution.discretization;
-    let mesh = &d.mesh;
+    let mesh = d.mesh.straight();
     let lambda = solution.multiplier_values();
-    let mut vertex_force = vec![0.0; mesh.vertex_count()];
-    for (k, &dof) in d.reduction.free().iter().enumerate() {
-        vertex_force[dof] = lambda[k];
-    }
     let mut vertex_area = vec![0.0; mesh.vertex_count()];
     for c in 0..mesh.cell_count() {
         for v in mesh.cell(c) {
             vertex_area[v] += mesh.area(c) / 3.0;
         }
     }
+    let mut density = vec![0.0; mesh.vertex_count()];
+    for (k, &dof) in d.reduction.free().iter().enumerate() {
+        density[dof] = lambda[k] / vertex_area[dof];
+    }
+    density
+}
+
+/// The nodal forces as a density per cell: the vertices' densities
+/// ([`force_density_at_vertices`]) averaged over the cell's vertices.
+pub fn force_density(solution: &ObstacleSolution<TriangleMesh>) -> Vec<f64> {
+    let mesh = &solution.discretization.mesh;
+    let density = force_density_at_vertices(solution);
     (0..mesh.cell_count())
-        .map(|c| {
-            mesh.cell(c)
-                .iter()
-                .map(|&v| vertex_force[v] / vertex_area[v])
-                .sum::<f64>()
-                / 3.0
-        })
+        .map(|c| mesh.cell(c).iter().map(|&v| density[v]).sum::<f64>() / 3.0)
         .collect()
 }
