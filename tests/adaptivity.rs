@@ -378,6 +378,106 @@ mod kirchhoff {
         );
     }
 
+    /// An Argyris plate clamped on its bottom edge, simply supported on its right edge
+    /// and free on the top and left ones: the estimate is its cell and interior edge
+    /// indicators plus, one-sided, the normal moment `M_nn` on the simply supported edges
+    /// (where w is held but ∂_n w free) and both `M_nn` and the Kirchhoff shear `V_n` on
+    /// the free ones; the clamped edges take none. The shear term on the simply
+    /// supported edges, which the support's reaction makes nonzero, is left out.
+    #[test]
+    fn natural_boundary_terms_follow_the_supports() {
+        type M = kirchhoff_argyris_p0::Model;
+        let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap();
+        let one = |_: &[f64]| 1.0;
+        let solved = Problem::<M, TriangleMesh>::new(vec![mesh.clone()])
+            .param("D", 1.0)
+            .param("ν", 0.3)
+            .data("f", &one)
+            .data("ψ", &below)
+            .data("g", &zero)
+            .support(DirichletPart::Markers(vec![1]), "w", Condition::Clamped)
+            .support(DirichletPart::Markers(vec![2]), "w", Condition::Zero)
+            .solve()
+            .unwrap();
+        let names: Vec<(&str, u8)> = M::NATURAL_FLUXES
+            .iter()
+            .map(|&(f, j)| (M::FIELDS[f].name, j))
+            .collect();
+        assert_eq!(names, [("w", 0), ("w", 1)]);
+        let d = &solved.solution.discretization;
+        let field = |f: usize| fem_forms::element::triangle::TriangleField {
+            mesh: &mesh,
+            map: d.dofs.map(f).unwrap(),
+            coefficients: solved.solution.field(f),
+        };
+        let fields = [field(0), field(1)];
+        let local = |c: usize| -> Vec<Vec<f64>> {
+            fields.iter().map(|f| f.reference_coefficients(c)).collect()
+        };
+        let data: Vec<&fem_forms::DataFn> = M::DATA
+            .iter()
+            .map(|&n| -> &fem_forms::DataFn {
+                match n {
+                    "f" => &one,
+                    "ψ" => &below,
+                    _ => &zero,
+                }
+            })
+            .collect();
+        let p = &solved.params;
+        let mut interior = 0.0;
+        for c in 0..mesh.cell_count() {
+            let l = local(c);
+            let l: Vec<&[f64]> = l.iter().map(Vec::as_slice).collect();
+            interior += M::cell_indicator(&mesh.cell_coordinates(c), &l, p, &data).unwrap();
+        }
+        let position =
+            |c: usize, e: usize| mesh.cell_edges(c).iter().position(|&x| x == e).unwrap();
+        let (mut natural, mut supported_shear) = (0.0, 0.0);
+        for (e, _) in mesh.edges().iter().enumerate() {
+            let (c0, other) = mesh.edge_cells(e);
+            let (l0, x0) = (local(c0), mesh.cell_coordinates(c0));
+            let l0: Vec<&[f64]> = l0.iter().map(Vec::as_slice).collect();
+            if let Some(c1) = other {
+                let l1 = local(c1);
+                let l1: Vec<&[f64]> = l1.iter().map(Vec::as_slice).collect();
+                interior += M::edge_indicator(
+                    &x0,
+                    position(c0, e),
+                    &l0,
+                    &mesh.cell_coordinates(c1),
+                    position(c1, e),
+                    &l1,
+                    p,
+                    &data,
+                )
+                .unwrap();
+                continue;
+            }
+            let marker = mesh.boundary_edges().iter().find(|b| b.0 == e).unwrap().1;
+            let term =
+                |k: usize| M::boundary_indicator(k, &x0, position(c0, e), &l0, p, &data).unwrap();
+            match marker {
+                1 => {}
+                2 => {
+                    natural += term(1);
+                    supported_shear += term(0);
+                }
+                _ => natural += term(0) + term(1),
+            }
+        }
+        let total = solved.estimate.unwrap().residual.powi(2);
+        assert!(
+            natural > 1e-3 * total && supported_shear > 1e-3 * total,
+            "{natural}, {supported_shear}, {total}"
+        );
+        assert!(
+            (total - interior - natural).abs() <= 1e-10 * total,
+            "{total} against {} + {natural}",
+            interior
+        );
+    }
+
     /// The estimate has the units of the energy norm: a plate 100 times stiffer under
     /// 100 times the load has the same deflection, an estimate and an error √100 times
     /// larger, and the same relative estimate and efficiency index.
@@ -1106,4 +1206,63 @@ fn a_model_without_an_estimator_is_refused_a_tolerance() {
         panic!("solved to a tolerance without an estimator");
     };
     assert!(e.to_string().contains("declares no estimator"), "{e}");
+}
+
+/// A membrane held on its left side only (`u = 0` there, f = 1, no contact): the
+/// estimate by hand, `Σ_T h_T² |T| f² + Σ_E h_E |E| [[∇u_h·n]]²` over the interior edges
+/// plus `h_E |E| (∇u_h·n)²` over the bottom, right and top edges, where the natural
+/// condition `∂_n u = 0` holds and the flux of the P1 solution does not vanish; the
+/// clamped left edges take no term.
+#[test]
+fn free_edges_take_the_natural_boundary_term() {
+    type M = membrane_p1_p0::Model;
+    let one = |_: &[f64]| 1.0;
+    let far_below = |_: &[f64]| -10.0;
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Right).unwrap();
+    let solved = Problem::<M, TriangleMesh>::new(vec![mesh.clone()])
+        .data("f", &one)
+        .data("ψ", &far_below)
+        .data("g", &zero)
+        .boundary_data(DirichletPart::Markers(vec![4]))
+        .solve()
+        .unwrap();
+    assert_eq!(M::NATURAL_FLUXES, &[(0, 0)]);
+    let u = solved.solution.field(0);
+    let gradient = |c: usize| {
+        let [a, b, d] = mesh.cell(c);
+        let x = mesh.cell_coordinates(c);
+        let det = (x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1]);
+        let (du1, du2) = (u[b] - u[a], u[d] - u[a]);
+        [
+            (du1 * (x[5] - x[1]) - du2 * (x[3] - x[1])) / det,
+            (du2 * (x[2] - x[0]) - du1 * (x[4] - x[0])) / det,
+        ]
+    };
+    let mut hand = 0.0;
+    for c in 0..mesh.cell_count() {
+        hand += mesh.cell_diameter(c).powi(2) * mesh.area(c);
+    }
+    let mut natural = 0.0;
+    for (e, &[p, q]) in mesh.edges().iter().enumerate() {
+        let (x, y) = (mesh.vertices()[p], mesh.vertices()[q]);
+        let length = (y[0] - x[0]).hypot(y[1] - x[1]);
+        let n = [(y[1] - x[1]) / length, (x[0] - y[0]) / length];
+        let flux = |c: usize| {
+            let g = gradient(c);
+            g[0] * n[0] + g[1] * n[1]
+        };
+        match mesh.edge_cells(e) {
+            (c0, Some(c1)) => hand += length * length * (flux(c0) - flux(c1)).powi(2),
+            (c0, None) if x[0] > 0.0 || y[0] > 0.0 => natural += length * length * flux(c0).powi(2),
+            _ => {}
+        }
+    }
+    assert!(natural > 1e-3 * hand, "{natural} against {hand}");
+    let residual = solved.estimate.unwrap().residual;
+    let expected = (hand + natural).sqrt();
+    assert!(
+        (residual - expected).abs() <= 1e-10 * expected,
+        "{residual} against {expected} (without the natural part {})",
+        hand.sqrt()
+    );
 }

@@ -139,3 +139,40 @@ fn the_derived_membrane_estimator_is_the_declared_one() {
         );
     }
 }
+
+/// The natural boundary terms each shipped model on triangles takes from its edge terms
+/// (`Model::NATURAL_FLUXES`, `(field, j)`: the flux of `v` for j = 0, of `∂_n v` for
+/// j = 1): the membrane's `∂_n u`; the plate's `V_n` and `M_nn` (Morley's `[[∇w]]` is a
+/// conformity jump, no flux, and its `V_n` vanishes); Reissner–Mindlin's `Cε(θ)n` by component and `q·n`;
+/// elasticity's `σ(u)n` by component; the derived estimator's the declared one's.
+#[test]
+fn every_flux_of_an_edge_term_is_a_natural_boundary_term() {
+    fn named<M: Model>() -> Vec<(&'static str, u8)> {
+        M::NATURAL_FLUXES
+            .iter()
+            .map(|&(f, j)| (M::FIELDS[f].name, j))
+            .collect()
+    }
+    let membrane = vec![("u", 0)];
+    let plate = vec![("w", 0), ("w", 1)];
+    assert_eq!(named::<membrane::membrane_p1_p0::Model>(), membrane);
+    assert_eq!(named::<membrane::membrane_p1::Model>(), membrane);
+    assert_eq!(named::<membrane_derived::Model>(), membrane);
+    assert_eq!(named::<kirchhoff::kirchhoff_argyris_p0::Model>(), plate);
+    // Morley's quadratics have V_n = D(∇Δw·n + ∂_s M_ns) ≡ 0 on each cell
+    assert_eq!(
+        named::<kirchhoff::kirchhoff_morley_p0::Model>(),
+        vec![("w", 1)]
+    );
+    assert_eq!(named::<winkler::winkler_argyris_p0::Model>(), plate);
+    assert_eq!(
+        named::<mindlin::mindlin_stenberg::Model>(),
+        vec![("θ_x", 0), ("θ_y", 0), ("w", 0)]
+    );
+    assert_eq!(
+        named::<signorini::signorini_p1::Model>(),
+        vec![("u_x", 0), ("u_y", 0)]
+    );
+    // on intervals the boundary is two end points, which take no natural term yet
+    assert!(bernoulli::Model::NATURAL_FLUXES.is_empty());
+}

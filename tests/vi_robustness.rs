@@ -203,7 +203,7 @@ fn solve_nodal(
     let mut previous: Option<(TriangleMesh, SystemDofs, Vec<f64>)> = None;
     let mut last = None;
     for mesh in levels {
-        let dofs = SystemDofs::all::<M>(mesh)?;
+        let dofs = SystemDofs::named::<M>(mesh, &["u"])?;
         let constraints = dirichlet_constraints::<M>(mesh, &dofs, &coefficients)?;
         let k = MatrixAssembler::new::<M>("a", mesh, &dofs)?.assemble::<M>(mesh, &coefficients)?;
         let l = assemble_vector::<M>("ℓ", mesh, &dofs, &coefficients)?;
@@ -552,7 +552,7 @@ fn zero_p1_field<'a>(
 fn the_penetration_is_measured_at_vertices_and_quadrature_points() {
     type M = membrane_p1::Model;
     let mesh = TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 2, 2, Diagonal::Right).unwrap();
-    let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+    let dofs = SystemDofs::named::<M>(&mesh, &["u"]).unwrap();
     let coefficients = vec![0.0; dofs.map(0).unwrap().dof_count()];
     let u = zero_p1_field(&mesh, &dofs, &coefficients);
     let bump = |x: &[f64]| 1.0 - x[0] * x[0] - x[1] * x[1];
@@ -577,7 +577,7 @@ fn the_penetration_is_measured_at_vertices_and_quadrature_points() {
         (2, &|x: &[f64]| x[0] * x[0] - x[1]),
     ] {
         let dofs = if degree == 1 {
-            SystemDofs::all::<M>(&mesh).unwrap()
+            SystemDofs::named::<M>(&mesh, &["u"]).unwrap()
         } else {
             SystemDofs::all::<P2>(&mesh).unwrap()
         };
@@ -603,7 +603,7 @@ fn the_penetration_is_measured_at_vertices_and_quadrature_points() {
 fn the_penetration_of_a_coarse_mesh_is_sampled_on_a_lattice() {
     type M = membrane_p1::Model;
     let mesh = TriangleMesh::rectangle(-1.0, 1.0, -1.0, 1.0, 1, 1, Diagonal::Right).unwrap();
-    let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+    let dofs = SystemDofs::named::<M>(&mesh, &["u"]).unwrap();
     let coefficients = vec![0.0; dofs.map(0).unwrap().dof_count()];
     let u = zero_p1_field(&mesh, &dofs, &coefficients);
     // ψ = 1 − 4r² near the origin, −1 beyond r = 1/√2: the corners and the rule's
@@ -699,7 +699,7 @@ fn misfit_inputs_are_errors() {
     type M = membrane_p1::Model;
     let coefficients =
         Coefficients::new::<M>(&[], &[("f", &zero), ("ψ", &zero), ("g", &zero)]).unwrap();
-    let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+    let dofs = SystemDofs::named::<M>(&mesh, &["u"]).unwrap();
     let constraints = dirichlet_constraints::<M>(&mesh, &dofs, &coefficients).unwrap();
     let k = MatrixAssembler::new::<M>("a", &mesh, &dofs)
         .unwrap()

@@ -217,7 +217,10 @@ pub fn residual_estimator(
             });
         }
     }
-    Estimator { terms }
+    Estimator {
+        terms,
+        natural: Vec::new(),
+    }
 }
 
 /// The strong form of the model's primal equations, where the energy form has constant
@@ -517,13 +520,62 @@ pub fn check_estimator(
                             .any(|f| multiple(symbols, roles, &residual, f, true))
                     })
             }
-            Region::Boundary(_) => true,
+            Region::Boundary(_) | Region::Natural(_) => true,
         };
         if !ok {
             errors.push(mismatch(symbols, term, &primal));
         }
     }
     errors
+}
+
+/// The natural boundary terms of `estimator` on triangles: each interior edge term
+/// whose jumped quantity is a multiple of the flux `F_ij` of field `i` (the coefficient
+/// of `v` for `j = 0`, of `∂_n v` for `j = 1`) applies, with its weight, one-sided on the
+/// boundary edges where that test coordinate is free, since there the natural boundary
+/// condition is `F_ij = 0` (a load on a boundary part has that part's own lines). Adds
+/// the terms as [`Region::Natural`] and lists the coordinates in `estimator.natural`.
+/// Averages and conformity jumps (Morley's `[[∇w]]`) are no fluxes: they take no term.
+pub fn natural_terms(
+    symbols: &Symbols,
+    roles: &Roles,
+    derived: &Derived,
+    estimator: &mut Estimator,
+) {
+    if symbols.dimension != 2 {
+        return;
+    }
+    let primal: Vec<usize> = (0..symbols.fields.len())
+        .filter(|&i| !symbols.fields[i].nonnegative)
+        .collect();
+    let mut natural: Vec<(usize, u8)> = Vec::new();
+    let mut terms = Vec::new();
+    for term in estimator.terms(Region::Edge).filter(|t| !t.average) {
+        let residual = nonvanishing(symbols, term.residual.clone());
+        if residual.is_empty() {
+            continue;
+        }
+        let flux = primal.iter().find_map(|&i| {
+            derived.fluxes[i]
+                .iter()
+                .position(|f| multiple(symbols, roles, &residual, f, true))
+                .map(|j| (i, j as u8))
+        });
+        let Some(coordinate) = flux else { continue };
+        let k = natural
+            .iter()
+            .position(|&c| c == coordinate)
+            .unwrap_or_else(|| {
+                natural.push(coordinate);
+                natural.len() - 1
+            });
+        terms.push(IndicatorTerm {
+            region: Region::Natural(k),
+            ..term.clone()
+        });
+    }
+    estimator.terms.extend(terms);
+    estimator.natural = natural;
 }
 
 /// A jump of derivatives of lower order than the energy's of a nonconforming or

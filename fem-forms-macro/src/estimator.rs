@@ -43,6 +43,10 @@ pub enum Region {
     /// Over each edge of the boundary part with this index in the model's `facets:`, of
     /// a residual traced from the edge's cell: `h_E^p ‖R‖²_E`.
     Boundary(usize),
+    /// Over each boundary edge outside the boundary parts where the test coordinate
+    /// `Estimator::natural[k]` is free (a natural boundary condition: that flux vanishes
+    /// there): an interior edge term's flux traced from the edge's cell, `h_E^p ‖F‖²_E`.
+    Natural(usize),
 }
 
 impl Region {
@@ -80,6 +84,11 @@ pub struct IndicatorTerm {
 pub struct Estimator {
     /// Its terms, cells' and edges'.
     pub terms: Vec<IndicatorTerm>,
+    /// The test coordinates `(field, j)` (the coefficient of `v` for `j = 0`, of `∂_n v`
+    /// for `j = 1`) whose flux an interior edge term is, in the order of the
+    /// [`Region::Natural`] terms: where such a coordinate is free on the boundary its
+    /// flux vanishes, and the term applies one-sided ([`crate::derived::natural_terms`]).
+    pub natural: Vec<(usize, u8)>,
 }
 
 impl Estimator {
@@ -223,7 +232,7 @@ impl Analysis<'_> {
         let example = match region {
             Region::Cell => "h_T² ‖f + Δu + λ‖²",
             Region::Edge => "h_E ‖[[∇u·n]]‖²",
-            Region::Boundary(_) => "h_E ‖σ(u)·n + q n‖²",
+            Region::Boundary(_) | Region::Natural(_) => "h_E ‖σ(u)·n + q n‖²",
         };
         if matches!(region, Region::Boundary(_)) && self.symbols.dimension != 2 {
             return Err(vec![Diagnostic::text(
@@ -275,7 +284,7 @@ impl Analysis<'_> {
                 Some(inside) => inside,
                 None => jump_inside(body, example)?,
             },
-            Region::Cell | Region::Boundary(_) => body,
+            Region::Cell | Region::Boundary(_) | Region::Natural(_) => body,
         };
         if body.is_empty() {
             return Err(vec![Diagnostic::text(tokens[open].loc, "an empty norm")
@@ -493,7 +502,7 @@ fn check_sizes(region: Region, weight: &[Token], body: &[Token]) -> Result<(), V
         Region::Cell => find(weight, "h_E")
             .or_else(|| find(body, "h_E"))
             .map(|at| (at, "`h_E` in an `η_T²` line", "the size there is `h_T`")),
-        Region::Boundary(_) => find(weight, "h_T")
+        Region::Boundary(_) | Region::Natural(_) => find(weight, "h_T")
             .map(|at| {
                 (
                     at,

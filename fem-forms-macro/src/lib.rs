@@ -315,6 +315,12 @@ fn expand(input: TokenStream) -> TokenStream {
             Some(estimator)
         }
     };
+    let estimator = estimator.map(|mut estimator| {
+        if let Some(derived) = &derived {
+            derived::natural_terms(&symbols, &roles, derived, &mut estimator);
+        }
+        estimator
+    });
     let code = codegen::generate(&declaration, &symbols, &forms, &roles, estimator.as_ref());
     if let Ok(dir) = std::env::var("FEM_FORMS_DUMP_DIR") {
         dump(&dir, &declaration.name.to_string(), &code);

@@ -438,9 +438,20 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
         )))
     }
 
+    /// The test coordinates `(field, j)` with a natural boundary term in the estimator
+    /// (the coefficient of `v` for `j = 0`, of `∂_n v` for `j = 1`: the membrane's
+    /// `∂_n u`, elasticity's `σ(u)n` by component, the plate's `V_n` and `M_nn`): where
+    /// the coordinate is free on a boundary edge outside every boundary part its flux
+    /// vanishes, and the interior edge term of that flux applies one-sided there, as
+    /// [`Model::boundary_indicator`] of part `FACET_PARTS.len() + k`. Derived by the
+    /// macro from the edge terms that are fluxes of `a` (empty without a strong form and
+    /// on intervals).
+    const NATURAL_FLUXES: &'static [(usize, u8)] = &[];
+
     /// The squared indicator `η_Γ²` of the model's `estimator:` on the boundary edge that
     /// is local edge `edge` of the triangle `vertices`, an edge of the boundary part
-    /// `part` (index in [`Model::FACET_PARTS`]); 0 for a part without boundary terms. As
+    /// `part` (index in [`Model::FACET_PARTS`]), or for `part = FACET_PARTS.len() + k`
+    /// the natural boundary term of `NATURAL_FLUXES[k]`; 0 for a part without boundary terms. As
     /// [`Model::cell_indicator`] (a multiplier on the part enters by its trace on the
     /// edge: for P0 one coefficient, for P1 the cell's three vertex values, the one off
     /// the edge unused).

@@ -484,13 +484,20 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
                 .map(|t| boundary_term(t, symbols));
             quote!(#k => { #(#terms)* })
         })
+        .chain((0..estimator.natural.len()).map(|k| {
+            let index = symbols.facets.len() + k;
+            let terms = estimator
+                .terms(Region::Natural(k))
+                .map(|t| boundary_term(t, symbols));
+            quote!(#index => { #(#terms)* })
+        }))
         .collect();
     let boundary_lets = t_lets(
         &alphas(
             estimator
                 .terms
                 .iter()
-                .filter(|t| matches!(t.region, Region::Boundary(_))),
+                .filter(|t| matches!(t.region, Region::Boundary(_) | Region::Natural(_))),
         ),
         "",
     );
@@ -503,10 +510,19 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
                 s if s.is_empty() => format!("`{name}` (part {k}): no term (0)"),
                 s => format!("`{name}` (part {k}): {s}"),
             })
+            .chain(estimator.natural.iter().enumerate().map(|(k, &(i, j))| {
+                format!(
+                    "the natural boundary of `{}`{} (part {}): {} one-sided",
+                    symbols.fields[i].test_name,
+                    if j == 0 { "" } else { "'s normal derivative" },
+                    symbols.facets.len() + k,
+                    describe(Region::Natural(k))
+                )
+            }))
             .collect();
         format!(
             " The squared indicator `η_Γ²` of the boundary edge that is local edge `edge` of the triangle `x` with coefficients `c`, on the boundary part `part` (its index under `facets:`); `n` is the outward normal, `h` the edge's length in the weight and the cell's size inside the norm. {}.",
-            if lines.is_empty() { "The model declares no boundary part (0)".to_string() } else { lines.join("; ") }
+            if lines.is_empty() { "The model declares no boundary part and has no natural boundary term (0)".to_string() } else { lines.join("; ") }
         )
     };
     let cell_lets = t_lets(&alphas(estimator.terms(Region::Cell)), "");
@@ -642,6 +658,7 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
 /// ends 0 and 1; on triangles six coordinates and edges 0, 1 and 2.
 pub fn model_items(
     symbols: &Symbols,
+    estimator: &Estimator,
     runtime: &TokenStream,
     model_name: &str,
     interval: bool,
@@ -680,9 +697,10 @@ pub fn model_items(
             return ::core::result::Result::Err(#runtime::Error::Input(#message.into()));
         }
     };
-    let parts = symbols.facets.len();
+    let parts = symbols.facets.len() + estimator.natural.len();
+    let natural = estimator.natural.iter().map(|&(i, j)| quote!((#i, #j)));
     let boundary = (!interval).then(|| {
-        let wrong_part = format!("{model_name} has boundary parts 0 to {}, not {{}}", parts.saturating_sub(1));
+        let wrong_part = format!("{model_name} has boundary parts and natural boundaries 0 to {}, not {{}}", parts.saturating_sub(1));
         quote! {
             fn boundary_indicator(
                 part: usize,
@@ -758,6 +776,8 @@ pub fn model_items(
             let d: &[&#runtime::DataFn; #nd] = data.try_into().expect("data count checked by the runtime");
             ::core::result::Result::Ok(estimator::edge(x, edge, c, y, other_edge, e, p, d))
         }
+
+        const NATURAL_FLUXES: &'static [(usize, u8)] = &[#(#natural),*];
 
         #boundary
     }

@@ -709,9 +709,9 @@ pub fn generate(
             estimator::module(e, symbols, runtime)
         }
     });
-    if estimator.is_some() {
+    if let Some(e) = estimator {
         dispatch.estimator_items =
-            estimator::model_items(symbols, runtime, &declaration.name.to_string(), interval);
+            estimator::model_items(symbols, e, runtime, &declaration.name.to_string(), interval);
     }
     let model_impl = model_impl(declaration, symbols, backend, &form_infos, &dispatch, roles);
     let handles = handles(symbols, forms, runtime);

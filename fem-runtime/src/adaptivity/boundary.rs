@@ -3,7 +3,7 @@
 //! part (Signorini's `λ` on `Γ_C`), from the model's constraint forms `b` and `G`.
 
 use super::{cell_coefficients, energy_form, ContactTerms, TriangleCells};
-use crate::element::triangle::TriangleField;
+use crate::element::triangle::{TriangleBasis, TriangleField};
 use crate::model::{DataFn, Model};
 use crate::obstacle::boundary_multiplier::{
     part_edges, BoundaryMultiplier, BoundaryMultiplierDofs,
@@ -227,4 +227,126 @@ fn cell_energy<M: Model, G: TriangleCells>(
         }
     }
     Ok(energy)
+}
+
+/// Adds the natural boundary terms ([`Model::NATURAL_FLUXES`]) to each boundary edge's
+/// cell entry of `indicators` and returns their sum: on every boundary edge outside the
+/// boundary parts (`parts`, which have their own lines), the flux of each test
+/// coordinate that is free on the edge, one-sided. A coordinate is free where the
+/// discrete test functions do not all vanish on the edge (`j = 0`: their trace; `j = 1`:
+/// their normal derivative), found with one admissible test function of random free
+/// DOFs ([`admissible_probe`]): exact for any element and any support, a clamp, a
+/// roller along x or y, a simple support of a plate.
+///
+/// # Errors
+/// The kernels' errors.
+pub(super) fn natural_indicators<M: Model, G: TriangleCells>(
+    solution: &ObstacleSolution<G>,
+    fields: &[Option<TriangleField>],
+    params: &[f64],
+    data: &[&DataFn],
+    parts: &[Vec<u32>],
+    indicators: &mut [f64],
+) -> Result<f64> {
+    if M::NATURAL_FLUXES.is_empty() {
+        return Ok(0.0);
+    }
+    let d = &solution.discretization;
+    let mesh = d.mesh.straight();
+    let on_parts: std::collections::HashSet<usize> = parts
+        .iter()
+        .flat_map(|markers| part_edges(mesh, markers))
+        .map(|e| e.edge)
+        .collect();
+    let probe = admissible_probe(solution);
+    let mut sum = 0.0;
+    for &(e, _) in mesh.boundary_edges() {
+        if on_parts.contains(&e) {
+            continue;
+        }
+        let (cell, _) = mesh.edge_cells(e);
+        let local = mesh
+            .cell_edges(cell)
+            .iter()
+            .position(|&x| x == e)
+            .expect("an edge is an edge of its cell");
+        let coefficients = cell_coefficients::<M>(fields, cell);
+        let slices: Vec<&[f64]> = coefficients.iter().map(Vec::as_slice).collect();
+        for (k, &(field, j)) in M::NATURAL_FLUXES.iter().enumerate() {
+            let Some((map, range)) = d.dofs.map(field).zip(d.dofs.range(field)) else {
+                continue;
+            };
+            let test = TriangleField {
+                mesh,
+                map,
+                coefficients: &probe[range],
+            };
+            if !free_on_edge(&test, cell, local, j) {
+                continue;
+            }
+            let eta2 = M::boundary_indicator(
+                M::FACET_PARTS.len() + k,
+                &mesh.cell_coordinates(cell),
+                local,
+                &slices,
+                params,
+                data,
+            )?;
+            indicators[cell] += eta2;
+            sum += eta2;
+        }
+    }
+    Ok(sum)
+}
+
+/// A full coefficient vector of an admissible homogeneous test function: each free DOF
+/// (in the primed numbering of the discretization's change of basis) a pseudo-random
+/// number in [0.5, 1.5), each fixed one 0, mapped to the Cartesian DOFs. Its trace
+/// vanishes exactly on the edges where the supports hold every test function at 0.
+fn admissible_probe<G>(solution: &ObstacleSolution<G>) -> Vec<f64> {
+    let d = &solution.discretization;
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut full = vec![0.0; d.dofs.dof_count()];
+    for &dof in d.reduction.free() {
+        if dof < full.len() {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            full[dof] = 0.5 + (state >> 11) as f64 / (1u64 << 53) as f64;
+        }
+    }
+    d.basis.to_cartesian(&mut full);
+    full
+}
+
+/// Whether the test function `test` has a nonzero trace (`j = 0`) or normal derivative
+/// (`j = 1`) on local edge `edge` of cell `c`, at two points inside the edge, against
+/// the size of its coefficients on the cell (a fixed DOF's rotation leaves rounding).
+fn free_on_edge(test: &TriangleField, c: usize, edge: usize, j: u8) -> bool {
+    let element = test.map.element();
+    let basis = TriangleBasis::new(element);
+    let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    let (a, b) = (corners[edge], corners[(edge + 1) % 3]);
+    let mesh = test.mesh;
+    let size: f64 = test
+        .map
+        .cell_dofs(c)
+        .iter()
+        .map(|&dof| test.coefficients[dof].abs())
+        .sum();
+    let x = mesh.cell(c).map(|v| mesh.vertices()[v]);
+    let (p, q) = (x[edge], x[(edge + 1) % 3]);
+    let length = (q[0] - p[0]).hypot(q[1] - p[1]);
+    let normal = [(q[1] - p[1]) / length, (p[0] - q[0]) / length];
+    let map = crate::element::triangle::AffineMap::of(mesh, c);
+    [0.3, 0.7].iter().any(|&s| {
+        let xi = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
+        let (value, scale) = if j == 0 {
+            (test.value(&basis, c, xi), size)
+        } else {
+            let g = test.gradient(&basis, &map, c, xi);
+            (g[0] * normal[0] + g[1] * normal[1], size / length)
+        };
+        value.abs() > 1e-9 * scale
+    })
 }

@@ -203,7 +203,7 @@ fn cell_coefficients<M: Model>(fields: &[Option<TriangleField>], c: usize) -> Ve
 
 /// The fields of a solution on a triangle mesh (`None` for a multiplier on a boundary
 /// part). The nodal method's multiplier field is `density`, its nodal forces' density
-/// ([`crate::problem::nodal::force_density_at_vertices`]) on the primal field's P1 DOFs.
+/// ([`crate::obstacle::nodal::force_density_at_vertices`]) on the primal field's P1 DOFs.
 ///
 /// # Errors
 /// The nodal method's solution of a model without a P1 multiplier field (its forces have
@@ -272,8 +272,14 @@ pub fn triangle_estimate<M: Model, G: TriangleCells>(
     parts: &[Vec<u32>],
 ) -> Result<Estimate> {
     require_estimator::<M>()?;
-    let density = matches!(solution.discretization.multipliers, Multipliers::Nodal)
-        .then(|| crate::problem::nodal::force_density_at_vertices(solution));
+    let d = &solution.discretization;
+    let density = matches!(d.multipliers, Multipliers::Nodal).then(|| {
+        crate::obstacle::nodal::force_density_at_vertices(
+            d.mesh.straight(),
+            d.reduction.free(),
+            solution.multiplier_values(),
+        )
+    });
     let fields = fields::<M, G>(solution, density.as_deref())?;
     let mesh = solution.discretization.mesh.straight();
     let mut indicators = vec![0.0; mesh.cell_count()];
@@ -316,6 +322,14 @@ pub fn triangle_estimate<M: Model, G: TriangleCells>(
         sum += eta2;
     }
     sum += boundary::boundary_indicators::<M, G>(
+        solution,
+        &fields,
+        params,
+        data,
+        parts,
+        &mut indicators,
+    )?;
+    sum += boundary::natural_indicators::<M, G>(
         solution,
         &fields,
         params,

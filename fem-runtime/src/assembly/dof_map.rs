@@ -248,13 +248,9 @@ impl SystemDofs {
         })
     }
 
-    /// All fields the model solves for: every field, except the multiplier of a model
-    /// without `system:` (the nodal method's, the density of its nodal forces, which no
-    /// form assembles and the estimator reads).
+    /// All fields of the model.
     pub fn all<M: Model>(mesh: &impl DofNumbering) -> Result<Self> {
-        let fields: Vec<usize> = (0..M::FIELDS.len())
-            .filter(|&f| M::SYSTEM.is_some() || !M::FIELDS[f].nonnegative)
-            .collect();
+        let fields: Vec<usize> = (0..M::FIELDS.len()).collect();
         Self::new::<M>(mesh, &fields)
     }
 

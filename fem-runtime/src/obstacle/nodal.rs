@@ -626,3 +626,26 @@ pub fn truncated_hierarchy(prolongations: &[SparseMatrix], dropped: &[bool]) -> 
     }
     out
 }
+
+/// The density of the nodal forces at the vertices of `mesh`, `λ_v = r_v / ∫φ_v` (the
+/// force `forces[k]` of free DOF `free[k]` over a third of the area of the cells around
+/// its vertex), 0 at fixed vertices; indexed by vertex, which is the P1 DOF numbering.
+/// The mass-lumped multiplier of Braess (Numer. Math. 101, 2005) that the nodal
+/// method's estimator reads.
+pub fn force_density_at_vertices(
+    mesh: &crate::mesh::TriangleMesh,
+    free: &[usize],
+    forces: &[f64],
+) -> Vec<f64> {
+    let mut vertex_area = vec![0.0; mesh.vertex_count()];
+    for c in 0..mesh.cell_count() {
+        for v in mesh.cell(c) {
+            vertex_area[v] += mesh.area(c) / 3.0;
+        }
+    }
+    let mut density = vec![0.0; mesh.vertex_count()];
+    for (&dof, &force) in free.iter().zip(forces) {
+        density[dof] = force / vertex_area[dof];
+    }
+    density
+}

@@ -930,7 +930,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         let shape = finest.shape(false)?;
         let params = self.param_values(0.0)?;
         let coefficients = Coefficients::of_values::<M>(&params, &data)?;
-        let dofs = finest.system_dofs::<M>()?;
+        let dofs = nodal::primal_dofs::<M>(finest)?;
         let constraints = finest.constraints::<M>(&dofs, &coefficients, &self.supports)?;
         check_feasible_at(
             finest,

@@ -5,8 +5,7 @@
 //! contact forces.
 
 use super::{Domain, Support};
-use crate::adaptivity::TriangleCells;
-use crate::assembly::dof_map::SystemDofs;
+use crate::assembly::dof_map::{DofNumbering, SystemDofs};
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::error::{Error, Result};
 use crate::lcp::cholesky::multiply;
@@ -15,7 +14,9 @@ use crate::mesh::TriangleMesh;
 use crate::model::{Coefficients, DataFn, FormId, Model};
 use crate::multigrid::{parents_by_location, prolongation, reduced_prolongation, NestedLevel};
 use crate::obstacle::hierarchy::LinearSolver;
-use crate::obstacle::nodal::{nodal_active_set_level, nodal_lcp, NODAL_AUTO_MULTIGRID_UNKNOWNS};
+use crate::obstacle::nodal::{
+    force_density_at_vertices, nodal_active_set_level, nodal_lcp, NODAL_AUTO_MULTIGRID_UNKNOWNS,
+};
 use crate::obstacle::{alongside, Discretization, Multipliers, ObstacleSolution};
 use crate::{Reduction, SparseMatrix};
 use std::time::Instant;
@@ -163,6 +164,15 @@ fn nodal_energy<M: Model>() -> Result<[usize; 2]> {
     })
 }
 
+/// The DOFs the nodal method solves for on `mesh`: its first field's (a multiplier field
+/// is its forces' density, which the estimator reads and no form of the solve holds).
+///
+/// # Errors
+/// Those of [`SystemDofs::new`].
+pub fn primal_dofs<M: Model>(mesh: &impl DofNumbering) -> Result<SystemDofs> {
+    SystemDofs::new::<M>(mesh, &[0])
+}
+
 /// What the levels of a nodal solve are built from.
 struct NodalProblem<'a> {
     meshes: &'a [TriangleMesh],
@@ -176,7 +186,7 @@ struct NodalProblem<'a> {
 impl NodalProblem<'_> {
     /// The DOFs of `mesh` and the elimination of its supported ones.
     fn free_dofs<M: Model>(&self, mesh: &TriangleMesh) -> Result<(SystemDofs, Reduction)> {
-        let dofs = SystemDofs::all::<M>(mesh)?;
+        let dofs = primal_dofs::<M>(mesh)?;
         let constraints = mesh.constraints::<M>(&dofs, self.coefficients, self.supports)?;
         let reduction = constraints.reduction(dofs.dof_count())?;
         Ok((dofs, reduction))
@@ -344,32 +354,13 @@ pub fn contact_shares(
     (shares, boundary_contact)
 }
 
-/// The density of the nodal forces at the vertices, `λ_v = r_v / ∫φ_v` (the force over
-/// a third of the area of the cells around the vertex), 0 at fixed vertices; indexed by
-/// vertex, which is the P1 DOF numbering. This is the mass-lumped multiplier of
-/// Braess (Numer. Math. 101, 2005) that the nodal method's estimator reads.
-pub fn force_density_at_vertices<G: TriangleCells>(solution: &ObstacleSolution<G>) -> Vec<f64> {
-    let d = &solution.discretization;
-    let mesh = d.mesh.straight();
-    let lambda = solution.multiplier_values();
-    let mut vertex_area = vec![0.0; mesh.vertex_count()];
-    for c in 0..mesh.cell_count() {
-        for v in mesh.cell(c) {
-            vertex_area[v] += mesh.area(c) / 3.0;
-        }
-    }
-    let mut density = vec![0.0; mesh.vertex_count()];
-    for (k, &dof) in d.reduction.free().iter().enumerate() {
-        density[dof] = lambda[k] / vertex_area[dof];
-    }
-    density
-}
-
 /// The nodal forces as a density per cell: the vertices' densities
-/// ([`force_density_at_vertices`]) averaged over the cell's vertices.
+/// ([`crate::obstacle::nodal::force_density_at_vertices`]) averaged over the cell's
+/// vertices.
 pub fn force_density(solution: &ObstacleSolution<TriangleMesh>) -> Vec<f64> {
-    let mesh = &solution.discretization.mesh;
-    let density = force_density_at_vertices(solution);
+    let d = &solution.discretization;
+    let mesh = &d.mesh;
+    let density = force_density_at_vertices(mesh, d.reduction.free(), solution.multiplier_values());
     (0..mesh.cell_count())
         .map(|c| mesh.cell(c).iter().map(|&v| density[v]).sum::<f64>() / 3.0)
         .collect()
