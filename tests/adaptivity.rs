@@ -614,6 +614,78 @@ mod bernoulli {
         1.0 + 3.0 * x[0] - x[0] * x[0]
     }
 
+    /// A beam clamped at its left end, free or simply supported at its right end, under
+    /// f = 1 without contact: the estimate is its cell and interior node indicators plus,
+    /// at the right end, where the natural conditions say the shear `w'''` (free) and the
+    /// moment `w''` (free and simply supported) vanish, `h³/27 w_h'''(1)² + h/3 w_h''(1)²`
+    /// by hand, the simply supported end without the shear (its reaction); the clamped
+    /// end takes none.
+    #[test]
+    fn free_and_supported_ends_take_the_natural_terms() {
+        use fem_forms::models::bernoulli::Model as M;
+        use fem_forms::problem::Condition;
+        use fem_forms::IntervalMesh;
+        let one = |_: &[f64]| 1.0;
+        let far_below = |_: &[f64]| -10.0;
+        let names: Vec<(&str, u8)> = M::NATURAL_FLUXES
+            .iter()
+            .map(|&(f, j)| (M::FIELDS[f].name, j))
+            .collect();
+        assert_eq!(names, [("w", 0), ("w", 1)]);
+        for free in [true, false] {
+            let mesh = IntervalMesh::uniform(0.0, 1.0, 6).unwrap();
+            let problem = Problem::<M, IntervalMesh>::new(vec![mesh.clone()])
+                .data("f", &one)
+                .data("ψ", &far_below)
+                .support(DirichletPart::Markers(vec![1]), "w", Condition::Clamped);
+            let problem = if free {
+                problem
+            } else {
+                problem.support(DirichletPart::Markers(vec![2]), "w", Condition::Zero)
+            };
+            let solved = problem.solve().unwrap();
+            let views = [solved.solution.view(0), solved.solution.view(1)];
+            let n = mesh.cell_count();
+            let [a, b] = mesh.cell(n - 1);
+            let h = b - a;
+            let dofs = views[0].local(n - 1);
+            let moment = hermite(a, b, &dofs, 1.0, 2);
+            let shear = hermite(a, b, &dofs, 1.0, 3);
+            let natural = h / 3.0 * moment * moment
+                + if free {
+                    h.powi(3) / 27.0 * shear * shear
+                } else {
+                    0.0
+                };
+            let data: [&fem_forms::DataFn; 2] = [&one, &far_below];
+            let p = &solved.params;
+            let local = |c: usize| -> Vec<Vec<f64>> {
+                let hc = mesh.h(c);
+                let w = views[0].local(c);
+                vec![vec![w[0], w[1] * hc, w[2], w[3] * hc], views[1].local(c)]
+            };
+            let mut interior = 0.0;
+            for c in 0..n {
+                let l = local(c);
+                let l: Vec<&[f64]> = l.iter().map(Vec::as_slice).collect();
+                interior += M::cell_indicator(&mesh.cell(c), &l, p, &data).unwrap();
+                if c > 0 {
+                    let k = local(c - 1);
+                    let k: Vec<&[f64]> = k.iter().map(Vec::as_slice).collect();
+                    interior +=
+                        M::edge_indicator(&mesh.cell(c - 1), 1, &k, &mesh.cell(c), 0, &l, p, &data)
+                            .unwrap();
+                }
+            }
+            let total = solved.estimate.unwrap().residual.powi(2);
+            assert!(natural > 1e-6 * total, "free {free}: {natural} of {total}");
+            assert!(
+                (total - interior - natural).abs() <= 1e-9 * total,
+                "free {free}: {total} against {interior} + {natural}"
+            );
+        }
+    }
+
     /// The generated interval kernels of `bernoulli` against the indicators by hand
     /// (`h⁴/81 ‖f + sλ − w''''‖²` by 3-point Gauss–Legendre, and at the node
     /// `h³/27 [[w''']]² + h/3 [[w'']]²`, h the mean length), on pseudo-random cells and

@@ -140,7 +140,7 @@ fn the_derived_membrane_estimator_is_the_declared_one() {
     }
 }
 
-/// The natural boundary terms each shipped model on triangles takes from its edge terms
+/// The natural boundary terms each shipped model takes from its edge (node) terms
 /// (`Model::NATURAL_FLUXES`, `(field, j)`: the flux of `v` for j = 0, of `∂_n v` for
 /// j = 1): the membrane's `∂_n u`; the plate's `V_n` and `M_nn` (Morley's `[[∇w]]` is a
 /// conformity jump, no flux, and its `V_n` vanishes); Reissner–Mindlin's `Cε(θ)n` by component and `q·n`;
@@ -173,6 +173,9 @@ fn every_flux_of_an_edge_term_is_a_natural_boundary_term() {
         named::<signorini::signorini_p1::Model>(),
         vec![("u_x", 0), ("u_y", 0)]
     );
-    // on intervals the boundary is two end points, which take no natural term yet
-    assert!(bernoulli::Model::NATURAL_FLUXES.is_empty());
+    // on intervals the two ends: the beam's shear and moment, Timoshenko's θ' and shear
+    assert_eq!(named::<bernoulli::Model>(), plate);
+    assert_eq!(named::<timoshenko_p2::Model>(), vec![("θ", 0), ("w", 0)]);
+    // the one-point shear pair has no strong form to match its terms with
+    assert!(fem_forms::models::timoshenko_p1_reduced::Model::NATURAL_FLUXES.is_empty());
 }

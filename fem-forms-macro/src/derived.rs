@@ -529,7 +529,7 @@ pub fn check_estimator(
     errors
 }
 
-/// The natural boundary terms of `estimator` on triangles: each interior edge term
+/// The natural boundary terms of `estimator`: each interior edge (interval: node) term
 /// whose jumped quantity is a multiple of the flux `F_ij` of field `i` (the coefficient
 /// of `v` for `j = 0`, of `∂_n v` for `j = 1`) applies, with its weight, one-sided on the
 /// boundary edges where that test coordinate is free, since there the natural boundary
@@ -542,9 +542,6 @@ pub fn natural_terms(
     derived: &Derived,
     estimator: &mut Estimator,
 ) {
-    if symbols.dimension != 2 {
-        return;
-    }
     let primal: Vec<usize> = (0..symbols.fields.len())
         .filter(|&i| !symbols.fields[i].nonnegative)
         .collect();

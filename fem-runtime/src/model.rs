@@ -444,21 +444,23 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// the coordinate is free on a boundary edge outside every boundary part its flux
     /// vanishes, and the interior edge term of that flux applies one-sided there, as
     /// [`Model::boundary_indicator`] of part `FACET_PARTS.len() + k`. Derived by the
-    /// macro from the edge terms that are fluxes of `a` (empty without a strong form and
-    /// on intervals).
+    /// macro from the edge terms that are fluxes of `a` (empty without a strong form).
+    /// On intervals the boundary is the mesh's two ends, `j = 1` the slope's flux (the
+    /// beam's moment).
     const NATURAL_FLUXES: &'static [(usize, u8)] = &[];
 
     /// The squared indicator `η_Γ²` of the model's `estimator:` on the boundary edge that
     /// is local edge `edge` of the triangle `vertices`, an edge of the boundary part
     /// `part` (index in [`Model::FACET_PARTS`]), or for `part = FACET_PARTS.len() + k`
-    /// the natural boundary term of `NATURAL_FLUXES[k]`; 0 for a part without boundary terms. As
-    /// [`Model::cell_indicator`] (a multiplier on the part enters by its trace on the
-    /// edge: for P0 one coefficient, for P1 the cell's three vertex values, the one off
-    /// the edge unused).
+    /// the natural boundary term of `NATURAL_FLUXES[k]`; 0 for a part without boundary
+    /// terms. On intervals `vertices` is the end cell `[x0, x1]`, `edge` its end (0 left,
+    /// 1 right) and `part` the natural term `k`. As [`Model::cell_indicator`] (a
+    /// multiplier on the part enters by its trace on the edge: for P0 one coefficient,
+    /// for P1 the cell's three vertex values, the one off the edge unused).
     ///
     /// # Errors
-    /// As [`Model::cell_indicator`], for an edge above 2 and a part out of range; always
-    /// for a model without an estimator or on intervals.
+    /// As [`Model::cell_indicator`], for an edge above 2 (an end above 1) and a part out
+    /// of range; always for a model without an estimator.
     fn boundary_indicator(
         part: usize,
         vertices: &[f64],

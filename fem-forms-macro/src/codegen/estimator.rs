@@ -699,8 +699,12 @@ pub fn model_items(
     };
     let parts = symbols.facets.len() + estimator.natural.len();
     let natural = estimator.natural.iter().map(|&(i, j)| quote!((#i, #j)));
-    let boundary = (!interval).then(|| {
-        let wrong_part = format!("{model_name} has boundary parts and natural boundaries 0 to {}, not {{}}", parts.saturating_sub(1));
+    // on intervals the parts are the natural ends' terms alone
+    let boundary = {
+        let wrong_part = format!(
+            "{model_name} has boundary parts and natural boundaries 0 to {}, not {{}}",
+            parts.saturating_sub(1)
+        );
         quote! {
             fn boundary_indicator(
                 part: usize,
@@ -724,7 +728,7 @@ pub fn model_items(
                 ::core::result::Result::Ok(estimator::boundary(part, x, edge, c, p, d))
             }
         }
-    });
+    };
     quote! {
         const HAS_ESTIMATOR: bool = true;
 

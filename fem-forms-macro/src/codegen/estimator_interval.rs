@@ -187,6 +187,46 @@ fn node_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
     }
 }
 
+/// One natural end term: `weight · X²` added to `eta2`, `X` the node term's quantity at
+/// end `end` of the one cell `x` (`h` its length), where the boundary condition says
+/// the flux vanishes.
+fn end_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
+    let mut tables = Tables::default();
+    let ends = [0.0, 1.0];
+    let mut body = Vec::new();
+    for m in &term.residual {
+        let Some(a) = m.args.first() else { continue };
+        let c = monomial_coefficient(m);
+        let data = data_product(m);
+        let element = symbols.fields[a.symbol].element;
+        let field = a.symbol;
+        let k = a.derivative[0];
+        let table = tables.get(element, k, "_END", &ends);
+        let value = field_value(
+            element,
+            k,
+            quote!(c[#field]),
+            table,
+            quote!(end),
+            quote!(hinv),
+        );
+        let p = product(std::iter::once(c).chain(data).chain(std::iter::once(value)));
+        body.push(quote!(r += #p;));
+    }
+    let weight = weight_code(&term.weight);
+    let items = &tables.items;
+    let doc = &term.source;
+    quote! {
+        {
+            #[doc = #doc]
+            #(#items)*
+            let mut r = 0.0f64;
+            #(#body)*
+            eta2 += #weight * r * r;
+        }
+    }
+}
+
 /// The module `estimator` of an interval model with an `estimator:` text: the kernels
 /// `cell` and `edge` (an interior node).
 pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -> TokenStream {
@@ -200,6 +240,14 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
     let node_terms: Vec<TokenStream> = estimator
         .terms(Region::Edge)
         .map(|t| node_term(t, symbols))
+        .collect();
+    let natural: Vec<TokenStream> = (0..estimator.natural.len())
+        .map(|k| {
+            let terms = estimator
+                .terms(Region::Natural(k))
+                .map(|t| end_term(t, symbols));
+            quote!(#k => { #(#terms)* })
+        })
         .collect();
     let describe = |region: Region| match estimator
         .terms(region)
@@ -217,6 +265,21 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
     let node_doc = format!(
         " The squared indicator of the interior node that is end `end` (0: left, 1: right) of the interval `x` with coefficients `c` and end `other` of its neighbour `y` with coefficients `e`: the jump `X⁺ − X⁻` of each term at the node squared, `n = ±1` the outward normal of `x` there, `h` the mean of the two cells' lengths: {}.",
         describe(Region::Edge)
+    );
+    let boundary_doc = format!(
+        " The natural boundary term `k` at end `end` (0: left, 1: right) of the interval `x` (the mesh's first or last cell) with coefficients `c`: the node term of that flux with the one side, `n = ±1` the outward normal, `h` the cell's length: {}.",
+        estimator
+            .natural
+            .iter()
+            .enumerate()
+            .map(|(k, &(i, j))| format!(
+                "{k}: `{}`{}, {}",
+                symbols.fields[i].test_name,
+                if j == 0 { "" } else { "'" },
+                describe(Region::Natural(k))
+            ))
+            .collect::<Vec<_>>()
+            .join("; ")
     );
     quote! {
         /// The indicator kernels of the model's `estimator:` text.
@@ -254,6 +317,32 @@ pub fn module(estimator: &Estimator, symbols: &Symbols, runtime: &TokenStream) -
                 let xq = [x[end]];
                 let mut eta2 = 0.0f64;
                 #(#node_terms)*
+                eta2
+            }
+
+            #[doc = #boundary_doc]
+            ///
+            /// # Panics
+            /// When `end > 1`.
+            #[allow(unused_variables, unused_mut, unused_parens, clippy::all)]
+            pub fn boundary(
+                k: usize,
+                x: &[f64; 2],
+                end: usize,
+                c: &[&[f64]; #nf],
+                p: &[f64; #np],
+                d: &[&#runtime::DataFn; #nd],
+            ) -> f64 {
+                assert!(end < 2, "an interval has ends 0 and 1");
+                let hinv = 1.0 / (x[1] - x[0]);
+                let h = (x[1] - x[0]).abs();
+                let (n_x, n_y) = (if end == 1 { 1.0f64 } else { -1.0f64 }, 0.0f64);
+                let xq = [x[end]];
+                let mut eta2 = 0.0f64;
+                match k {
+                    #(#natural)*
+                    _ => {}
+                }
                 eta2
             }
         }

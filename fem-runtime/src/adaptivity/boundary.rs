@@ -235,7 +235,7 @@ fn cell_energy<M: Model, G: TriangleCells>(
 /// coordinate that is free on the edge, one-sided. A coordinate is free where the
 /// discrete test functions' edge means do not all vanish (`j = 0`: of their trace;
 /// `j = 1`: of their normal derivative), found with one admissible test function of
-/// random free DOFs ([`admissible_probe`], [`free_on_edge`]): exact for any element and
+/// random free DOFs ([`super::admissible_probe`], [`free_on_edge`]): exact for any element and
 /// any support, a clamp, a roller along x or y, a simple support of a plate.
 ///
 /// # Errors
@@ -258,7 +258,7 @@ pub(super) fn natural_indicators<M: Model, G: TriangleCells>(
         .flat_map(|markers| part_edges(mesh, markers))
         .map(|e| e.edge)
         .collect();
-    let probe = admissible_probe(solution);
+    let probe = super::admissible_probe(solution);
     let mut sum = 0.0;
     for &(e, _) in mesh.boundary_edges() {
         if on_parts.contains(&e) {
@@ -297,26 +297,6 @@ pub(super) fn natural_indicators<M: Model, G: TriangleCells>(
         }
     }
     Ok(sum)
-}
-
-/// A full coefficient vector of an admissible homogeneous test function: each free DOF
-/// (in the primed numbering of the discretization's change of basis) a pseudo-random
-/// number in [0.5, 1.5), each fixed one 0, mapped to the Cartesian DOFs. Its trace
-/// vanishes exactly on the edges where the supports hold every test function at 0.
-fn admissible_probe<G>(solution: &ObstacleSolution<G>) -> Vec<f64> {
-    let d = &solution.discretization;
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut full = vec![0.0; d.dofs.dof_count()];
-    for &dof in d.reduction.free() {
-        if dof < full.len() {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            full[dof] = 0.5 + (state >> 11) as f64 / (1u64 << 53) as f64;
-        }
-    }
-    d.basis.to_cartesian(&mut full);
-    full
 }
 
 /// Whether the test function `test` has a trace (`j = 0`) or normal derivative

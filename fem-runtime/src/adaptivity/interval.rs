@@ -69,6 +69,7 @@ pub fn interval_estimate<M: Model>(
         }
         previous = here;
     }
+    sum += natural_ends::<M>(solution, &local, params, data, &mut indicators)?;
     if let Some(c) = indicators.iter().position(|e| !e.is_finite()) {
         let [a, b] = mesh.cell(c);
         return Err(Error::Input(format!(
@@ -92,6 +93,57 @@ pub fn interval_estimate<M: Model>(
         contact,
         energy.max(0.0).sqrt(),
     ))
+}
+
+/// Adds the natural boundary terms ([`Model::NATURAL_FLUXES`]) at the mesh's two ends
+/// to their cells' entries of `indicators` and returns their sum: the flux of each test
+/// coordinate that is free at the end (`j = 0` the value, `j = 1` the slope; a free or
+/// simply supported beam's shear and moment), found with one admissible test function
+/// of random free DOFs ([`super::admissible_probe`]). `local` gives a cell's reference
+/// coefficients.
+///
+/// # Errors
+/// The kernels' errors.
+fn natural_ends<M: Model>(
+    solution: &ObstacleSolution<IntervalMesh>,
+    local: &dyn Fn(usize) -> Vec<Vec<f64>>,
+    params: &[f64],
+    data: &[&DataFn],
+    indicators: &mut [f64],
+) -> Result<f64> {
+    if M::NATURAL_FLUXES.is_empty() {
+        return Ok(0.0);
+    }
+    let d = &solution.discretization;
+    let mesh = &d.mesh;
+    let probe = super::admissible_probe(solution);
+    let last = mesh.cell_count() - 1;
+    let mut sum = 0.0;
+    for (cell, end) in [(0, 0), (last, 1)] {
+        let x = mesh.cell(cell);
+        let coefficients = local(cell);
+        let slices: Vec<&[f64]> = coefficients.iter().map(Vec::as_slice).collect();
+        for (k, &(field, j)) in M::NATURAL_FLUXES.iter().enumerate() {
+            let Some((map, range)) = d.dofs.map(field).zip(d.dofs.range(field)) else {
+                continue;
+            };
+            let test = FieldView {
+                mesh,
+                map,
+                coefficients: &probe[range],
+            };
+            let size: f64 = test.local(cell).iter().map(|v| v.abs()).sum();
+            let scale = size / mesh.h(cell).powi(i32::from(j));
+            let value = test.at(x[end], usize::from(j)).unwrap_or(0.0);
+            if value.abs() <= 1e-9 * scale {
+                continue;
+            }
+            let eta2 = M::boundary_indicator(k, &x, end, &slices, params, data)?;
+            indicators[cell] += eta2;
+            sum += eta2;
+        }
+    }
+    Ok(sum)
 }
 
 /// `a(u_h, u_h)` with the model's energy form over every primal field (every block

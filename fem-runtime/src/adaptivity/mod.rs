@@ -645,3 +645,23 @@ fn weighted_violation<M: Model>(
     }
     violation
 }
+
+/// A full coefficient vector of an admissible homogeneous test function: each free DOF
+/// (in the primed numbering of the discretization's change of basis) a pseudo-random
+/// number in [0.5, 1.5), each fixed one 0, mapped to the Cartesian DOFs. Its trace
+/// vanishes exactly on the edges where the supports hold every test function at 0.
+pub(crate) fn admissible_probe<G>(solution: &ObstacleSolution<G>) -> Vec<f64> {
+    let d = &solution.discretization;
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut full = vec![0.0; d.dofs.dof_count()];
+    for &dof in d.reduction.free() {
+        if dof < full.len() {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            full[dof] = 0.5 + (state >> 11) as f64 / (1u64 << 53) as f64;
+        }
+    }
+    d.basis.to_cartesian(&mut full);
+    full
+}
