@@ -152,6 +152,9 @@ fn a_system_form_with_couplings_of_different_signs_is_refused() {
 
 /// Signorini's forms with the contact couplings (boundary integrals over Γ_C) of
 /// different signs: the cell blocks are symmetric, so only the facet blocks show it.
+/// (The flipped model's stabilization follows its flipped coupling, `λ − σ_n(u)`, so
+/// that it passes the macro's check of the boundary equation and reaches the runtime's
+/// symmetry check.)
 macro_rules! contact_model {
     ($name:ident, $system:literal) => {
         fem_runtime::model! {
@@ -163,6 +166,7 @@ macro_rules! contact_model {
                 data: q: 2, g: 1;
                 facets: Γ_C, Γ_N;
                 forms: $system;
+                unit: n_c;
             }
         }
     };
@@ -190,7 +194,7 @@ contact_model!(
     σ_n(u)       := (σ(u)·n)·n_c
     a(u;v)       = ∫ σ(u):ε(v)
     b(v;μ)       = −∫_Γ_C μ v·n_c ds
-    S(u,λ;v,μ)   = ∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds
+    S(u,λ;v,μ)   = ∫_Γ_C h_E (λ − σ_n(u))(μ + σ_n(v)) ds
     ℓ(v)         = −∫_Γ_N q v·n ds
     G(μ)         = −∫_Γ_C g μ ds
     B_h(u,λ;v,μ) = a(u;v) + b(v;λ) − b(u;μ) − α S(u,λ;v,μ)

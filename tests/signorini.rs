@@ -379,3 +379,40 @@ fn bad_input_is_an_error_not_a_panic() {
         );
     }
 }
+
+/// The contact direction is declared a unit vector (`unit: n_c;`): the forms hold
+/// `σ_n(u) = n_c·σ(u)n`, which is the normal stress only for `|n_c| = 1`, so other
+/// lengths are refused, naming the parameters; a unit direction along no axis is taken.
+#[test]
+fn a_contact_direction_that_is_not_a_unit_vector_is_refused() {
+    use fem_forms::models::signorini::signorini_p1;
+    let zero = |_: &[f64]| 0.0;
+    let coefficients = |n: [f64; 2]| {
+        fem_forms::Coefficients::from_ids(
+            &[
+                (signorini_p1::params::μ_L, 1.0),
+                (signorini_p1::params::λ_L, 1.0),
+                (signorini_p1::params::α, 0.1),
+                (signorini_p1::params::n_c_x, n[0]),
+                (signorini_p1::params::n_c_y, n[1]),
+            ],
+            &[
+                (signorini_p1::data::q, &zero),
+                (signorini_p1::data::g, &zero),
+            ],
+        )
+    };
+    assert_eq!(
+        <signorini_p1::Model as fem_forms::Model>::UNIT_PARAMS,
+        &[(3, 4)]
+    );
+    let Err(e) = coefficients([0.0, -2.0]) else {
+        panic!("a contact direction of length 2 was taken");
+    };
+    let message = e.to_string();
+    assert!(
+        message.contains("n_c_x") && message.contains("unit vector"),
+        "{message}"
+    );
+    assert!(coefficients([0.6, -0.8]).is_ok());
+}

@@ -18,6 +18,7 @@
 //!     side:          s;            // the parameter holding the obstacle side s = ±1
 //!     obstacle:      w >= ψ;       // the constrained field and the obstacle: s·w ≥ s·ψ
 //!     constraint:    b, G;         // b(v,μ) = (μ, sBv), G(μ) = (μ, sψ)
+//!     unit:          n_c;          // the parameters n_c_x, n_c_y form a unit vector
 //!     estimator:     "…";          // optional: the residual estimator (η_T², η_E², η_Γ²),
 //!                                  // or `derived` (from `a`, `ℓ`, `b`)
 //! }
@@ -111,6 +112,8 @@ pub struct RolesDecl {
     /// `constraint: b, G;`: the constraint's forms, `b(v, μ) = (μ, sBv)` and
     /// `G(μ) = (μ, sψ)`.
     pub constraint: Option<(Ident, Ident)>,
+    /// `unit: n_c;`: vectors of parameters (`n_c_x`, `n_c_y`) that are unit vectors.
+    pub unit: Vec<Ident>,
 }
 
 /// The `estimator:` section.
@@ -164,7 +167,7 @@ pub struct Declaration {
 }
 
 /// The sections a model may have.
-const SECTIONS: [&str; 14] = [
+const SECTIONS: [&str; 15] = [
     "unknowns",
     "tests",
     "params",
@@ -178,6 +181,7 @@ const SECTIONS: [&str; 14] = [
     "side",
     "obstacle",
     "constraint",
+    "unit",
     "estimator",
 ];
 
@@ -471,6 +475,7 @@ impl Parse for Declaration {
                 }
                 "stabilization" => declaration.roles.stabilization = Some(stabilization(&content)?),
                 "side" => declaration.roles.side = Some(content.parse()?),
+                "unit" => declaration.roles.unit = comma_list(&content, |s| s.parse())?,
                 "obstacle" => declaration.roles.obstacle = Some(obstacle(&content)?),
                 other => {
                     let sections = SECTIONS;

@@ -361,13 +361,20 @@ impl Point<'_> {
     }
 
     /// A parameter in [0.1, 0.4): clear of the singular values of the usual material
-    /// formulas (ν = ½ in `1/(1 − 2ν)`, ν = 1 in `1/(1 − ν)`); the side is ±1.
+    /// formulas (ν = ½ in `1/(1 − 2ν)`, ν = 1 in `1/(1 − ν)`); the side is ±1; a unit
+    /// vector's components a point of the unit circle.
     fn param(&self, p: usize) -> f64 {
         if self.roles.side == Some(p) {
-            self.side
-        } else {
-            0.1 + 0.3 * self.value(self.scalars, 1, p, [0, 0])
+            return self.side;
         }
+        // a vector of parameters declared a unit vector lies on the unit circle
+        for &(x, y) in &self.roles.unit {
+            if p == x || p == y {
+                let angle = std::f64::consts::TAU * self.value(self.scalars, 6, x, [0, 0]);
+                return if p == x { angle.cos() } else { angle.sin() };
+            }
+        }
+        0.1 + 0.3 * self.value(self.scalars, 1, p, [0, 0])
     }
 
     fn h(&self) -> f64 {
@@ -687,7 +694,7 @@ pub fn check_stabilization(
                 .iter()
                 .map(|c| block.iter().map(|p| p.expansion(symbols, c)).collect())
                 .collect();
-            fits(&columns, &target)
+            fits(&columns, &target, true)
         });
         if !consistent {
             let origin = row[0].origin;
@@ -711,6 +718,137 @@ pub fn check_stabilization(
         }
     }
     Vec::new()
+}
+
+/// Errors for a stabilization on a boundary part (Signorini's `Σ_E h_E (λ + σ_n(u),
+/// μ + σ_n(v))_E` on `Γ_C`) that does not stabilize the part's boundary equation: every
+/// row of `B_h`'s α-terms on the part (each test coordinate, the multiplier's among
+/// them) less `L_h`'s must be a combination, with factors of the parameters, `h` and the
+/// normal, of the boundary residuals `R_i = F_i(u) − B_Γ*λ − g_i` of the primal
+/// equations there: the flux of `a` (`σ(u)n` by component; also the coefficient of
+/// `∂_n v`) with the system's own terms on the part, the coupling to the multiplier
+/// among them, less the load's (`σ(u)n + λ n_c` on `Γ_C`). A residual that holds a direction of parameters is
+/// consistent only where the direction is a unit vector: the model declares it
+/// `unit: n_c;`, which the random points honour.
+pub fn check_facet_stabilization(
+    symbols: &Symbols,
+    forms: &[Form],
+    roles: &Roles,
+    derived: &Derived,
+) -> Vec<Diagnostic> {
+    let (Some([bh, lh]), Some((Some(alpha), s, _)), Some(lambda)) =
+        (roles.system, roles.stabilization, multiplier(symbols))
+    else {
+        return Vec::new();
+    };
+    let fields = symbols.fields.len();
+    let parts: Vec<usize> = forms[s].terms.iter().filter_map(|m| m.facet).collect();
+    let mut errors = Vec::new();
+    for part in (0..symbols.facets.len()).filter(|p| parts.contains(p)) {
+        let on_part = |m: &&Monomial| {
+            m.facet == Some(part) && m.params.iter().any(|&(p, e)| p == alpha && e == 1)
+        };
+        let test_of = |m: &Monomial| m.args.iter().find(|x| x.symbol >= fields).copied();
+        let mut rows: Vec<(ArgFactor, Expansion)> = Vec::new();
+        for m in forms[bh].terms.iter().filter(on_part) {
+            let Some(test) = test_of(m) else { continue };
+            let mut t = m.clone();
+            t.args.retain(|x| *x != test);
+            match rows.iter_mut().find(|(c, _)| *c == test) {
+                Some((_, row)) => row.push(t),
+                None => rows.push((test, vec![t])),
+            }
+        }
+        for m in forms[lh].terms.iter().filter(on_part) {
+            let Some(test) = test_of(m) else { continue };
+            if let Some((_, row)) = rows.iter_mut().find(|(c, _)| *c == test) {
+                let mut t = m.clone();
+                t.args.clear();
+                t.coefficient = -t.coefficient;
+                row.push(t);
+            }
+        }
+        let candidates = boundary_residuals(symbols, forms, derived, [bh, lh], (part, alpha));
+        for (test, row) in &rows {
+            let row = nonvanishing(symbols, row.clone());
+            if row.is_empty() {
+                continue;
+            }
+            let consistent = blocks(roles, symbols.dimension, 16).iter().all(|block| {
+                let target: Vec<f64> = block.iter().map(|p| p.expansion(symbols, &row)).collect();
+                let columns: Vec<Vec<f64>> = candidates
+                    .iter()
+                    .map(|c| block.iter().map(|p| p.expansion(symbols, c)).collect())
+                    .collect();
+                fits(&columns, &target, false)
+            });
+            if !consistent {
+                let at = if test.symbol == fields + lambda {
+                    "the multiplier's row".to_string()
+                } else {
+                    format!(
+                        "the row of `{}`",
+                        symbols.fields[test.symbol - fields].test_name
+                    )
+                };
+                errors.push(
+                    Diagnostic::text(
+                        row[0].origin,
+                        format!(
+                            "the stabilization on `{}` does not stabilize the boundary equation there: {at} of `α S` in `B_h`, less `α ℓ_S` in `L_h`, is not a combination of the boundary residuals `F(u) − B*λ − g` that `a`, `b` and `ℓ` give on the part",
+                            symbols.facets[part]
+                        ),
+                    )
+                    .help("Signorini's is `Σ_E h_E (λ + σ_n(u), μ + σ_n(v))_E` with `σ_n(u) = (σ(u)·n)·n_c` and `b(v;μ) = −∫_Γ_C μ v·n_c`: look for a wrong sign or another operator; a direction of parameters in it must be a unit vector, declared `unit: n_c;`"),
+                );
+                break;
+            }
+        }
+    }
+    errors
+}
+
+/// The boundary residuals of the primal equations on boundary part `part`, one per
+/// field and flux: `F_i0(u) + (B_h's terms on the part) − (L_h's)` in the coefficient of
+/// `v_i` (the flux of `a`, then the system's own couplings there, the multiplier's
+/// `−b(v;λ)` and a Robin term, and the load), α-terms left out; and the coefficient of
+/// `∂_n v_i` alone where `a` has one.
+fn boundary_residuals(
+    symbols: &Symbols,
+    forms: &[Form],
+    derived: &Derived,
+    [bh, lh]: [usize; 2],
+    (part, alpha): (usize, usize),
+) -> Vec<Expansion> {
+    let fields = symbols.fields.len();
+    let on = |m: &&Monomial| {
+        m.facet == Some(part) && !m.params.iter().any(|&(p, e)| p == alpha && e != 0)
+    };
+    let mut out = Vec::new();
+    for i in (0..fields).filter(|&i| !symbols.fields[i].nonnegative) {
+        let mut r = derived.fluxes[i][0].clone();
+        for m in forms[bh].terms.iter().filter(on) {
+            if let Some((u, v)) = split(&forms[bh], m) {
+                if v.symbol == fields + i && v.order() == 0 {
+                    let j = symbols.field_of(u.symbol);
+                    r.push(strong(m, Some((j, u.derivative)), 1.0, [0, 0]));
+                }
+            }
+        }
+        for m in forms[lh].terms.iter().filter(on) {
+            if let [v] = m.args.as_slice() {
+                if v.symbol == fields + i && v.order() == 0 {
+                    r.push(strong(m, None, -1.0, [0, 0]));
+                }
+            }
+        }
+        out.push(nonvanishing(symbols, r));
+        if !derived.fluxes[i][1].is_empty() {
+            out.push(nonvanishing(symbols, derived.fluxes[i][1].clone()));
+        }
+    }
+    out.retain(|r| !r.is_empty());
+    out
 }
 
 /// What a stabilized residual may be a combination of: the constrained field's
@@ -763,8 +901,9 @@ fn candidates(symbols: &Symbols, derived: &Derived, w: usize, lambda: usize) -> 
 }
 
 /// Whether `target` is a linear combination of `columns` (least squares through the
-/// normal equations, to 1e-8 of `target`'s size) in which the first column takes part.
-fn fits(columns: &[Vec<f64>], target: &[f64]) -> bool {
+/// normal equations, to 1e-8 of `target`'s size), in which the first column takes part
+/// where `first_carries`.
+fn fits(columns: &[Vec<f64>], target: &[f64], first_carries: bool) -> bool {
     let n = columns.len();
     let mut g = vec![vec![0.0; n + 1]; n];
     for i in 0..n {
@@ -815,6 +954,9 @@ fn fits(columns: &[Vec<f64>], target: &[f64]) -> bool {
         .sqrt();
     // the first column (R_w) must carry the target: derivatives of the other equations
     // alone stabilize nothing of the contact equation
+    if n == 0 {
+        return false;
+    }
     let first = x[0].abs() * columns[0].iter().map(|c| c * c).sum::<f64>().sqrt();
-    scale > 0.0 && residual <= 1e-8 * scale && first >= 1e-6 * scale
+    scale > 0.0 && residual <= 1e-8 * scale && (!first_carries || first >= 1e-6 * scale)
 }

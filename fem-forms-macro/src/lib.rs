@@ -259,7 +259,10 @@ fn expand(input: TokenStream) -> TokenStream {
         ..roles
     };
     if let Some(derived) = &derived {
-        let errors = derived::check_stabilization(&symbols, &forms, &roles, derived);
+        let mut errors = derived::check_stabilization(&symbols, &forms, &roles, derived);
+        errors.extend(derived::check_facet_stabilization(
+            &symbols, &forms, &roles, derived,
+        ));
         if !errors.is_empty() {
             let span = declaration.forms.span();
             return errors

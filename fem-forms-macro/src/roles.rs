@@ -30,6 +30,10 @@ pub struct Roles {
     pub obstacle: Option<(usize, usize)>,
     /// `[b, G]`: the constraint `b(v, μ) = (μ, sBv)`, `G(μ) = (μ, sψ)`.
     pub constraint: Option<[usize; 2]>,
+    /// `(x, y)` parameter indices of each vector of parameters declared a unit vector
+    /// (`unit: n_c;` for `n_c_x`, `n_c_y`): checked at run time, and sampled on the unit
+    /// circle by the derived checks.
+    pub unit: Vec<(usize, usize)>,
     /// Whether the strong form was derived from `a`, `ℓ` and `b`
     /// ([`crate::derived`]), so that the stabilization and the estimator were checked
     /// against it; set after the roles are resolved.
@@ -54,6 +58,7 @@ pub fn resolve(
         side,
         obstacle,
         constraint,
+        unit,
     } = &declaration.roles;
     let mut lookup = Lookup {
         forms,
@@ -92,6 +97,7 @@ pub fn resolve(
     let obstacle = obstacle
         .as_ref()
         .map(|(field, data)| lookup.obstacle(field, data));
+    let unit = unit.iter().filter_map(|v| lookup.unit(v)).collect();
     let conventional = Conventional { forms, symbols };
     let roles = Roles {
         system: system.unwrap_or_else(|| conventional.system()),
@@ -101,6 +107,7 @@ pub fn resolve(
         order: 0,
         obstacle: obstacle.unwrap_or_else(|| conventional.obstacle()),
         constraint: constraint.unwrap_or_else(|| conventional.constraint()),
+        unit,
         strong_form: false,
     };
     let order = operator_order(&roles, forms);
@@ -193,6 +200,24 @@ impl Lookup<'_> {
                 );
             }
         }
+    }
+
+    /// `unit: X`: the parameters `X_x` and `X_y`, declared under `params:`.
+    fn unit(&mut self, ident: &Ident) -> Option<(usize, usize)> {
+        let name = ident.to_string();
+        let params = &self.symbols.params;
+        let find = |axis: &str| params.iter().position(|p| *p == format!("{name}_{axis}"));
+        let found = find("x").zip(find("y"));
+        if found.is_none() {
+            self.errors.push(
+                Diagnostic::token(
+                    ident.span(),
+                    format!("`unit: {name}` names the vector of the parameters `{name}_x` and `{name}_y`, which are not both declared"),
+                )
+                .help(format!("declare them under `params:` (`params: …, {name}_x, {name}_y;`)")),
+            );
+        }
+        found
     }
 
     /// `obstacle: field >= data`: a primal scalar field and a data function.

@@ -1724,3 +1724,73 @@ fn a_derived_estimator_keeps_jumps_and_refuses_boundary_loads() {
         "{errors:?}"
     );
 }
+
+/// Signorini's model as shipped (`models/src/signorini.rs`), with `S` and the `unit:`
+/// section replaceable.
+fn signorini(s: &str, unit: TokenStream) -> TokenStream {
+    let forms = format!(
+        "
+        σ(u)         := 2μ_L ε(u) + λ_L tr ε(u) I
+        σ_n(u)       := (σ(u)·n)·n_c
+        a(u;v)       = ∫ σ(u):ε(v)
+        b(v;μ)       = −∫_Γ_C μ v·n_c ds
+        S(u,λ;v,μ)   = {s}
+        ℓ(v)         = −∫_Γ_N q v·n ds
+        G(μ)         = −∫_Γ_C g μ ds
+        B_h(u,λ;v,μ) = a(u;v) − b(v;λ) − b(u;μ) − α S(u,λ;v,μ)
+        L_h(v,μ)     = ℓ(v) − G(μ)
+    "
+    );
+    quote! {
+        /// Signorini.
+        pub mod signorini on triangle {
+            unknowns: u: [P1]^2, λ: P0 >= 0;
+            tests: v, μ;
+            params: μ_L > 0, λ_L, α, n_c_x, n_c_y;
+            data: q: 2, g: 1;
+            facets: Γ_C, Γ_N;
+            forms: #forms;
+            #unit
+        }
+    }
+}
+
+/// The facet stabilization is checked against the boundary equation `a`, `b` and `ℓ`
+/// give on `Γ_C`: Signorini's passes with its direction declared a unit vector; a wrong
+/// sign, another operator, or the direction not declared `unit:` (then `λ + σ_n(u)` is
+/// not the normal part of `σ(u)n + λ n_c`) is a compile error at the term.
+#[test]
+fn a_facet_stabilization_is_checked_against_the_boundary_equation() {
+    const CONSISTENT: &str = "∫_Γ_C h_E (λ + σ_n(u))(μ + σ_n(v)) ds";
+    let unit = quote!(unit: n_c;);
+    let out = expand(signorini(CONSISTENT, unit.clone()));
+    let text = out.to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    assert!(text.contains("UNIT_PARAMS"), "{text}");
+    for (s, unit, why) in [
+        (
+            "∫_Γ_C h_E (λ − σ_n(u))(μ − σ_n(v)) ds",
+            unit.clone(),
+            "the sign of σ_n",
+        ),
+        (
+            "∫_Γ_C h_E (λ + 2σ_n(u))(μ + 2σ_n(v)) ds",
+            unit.clone(),
+            "another operator",
+        ),
+        (CONSISTENT, quote!(), "the direction not a unit vector"),
+    ] {
+        let errors = rendered_errors(&expand(signorini(s, unit)));
+        assert!(
+            errors
+                .iter()
+                .any(|e| e.contains("does not stabilize the boundary equation")),
+            "{why}: {errors:?}"
+        );
+    }
+    let errors = rendered_errors(&expand(signorini(CONSISTENT, quote!(unit: m;))));
+    assert!(
+        errors.iter().any(|e| e.contains("`m_x` and `m_y`")),
+        "{errors:?}"
+    );
+}

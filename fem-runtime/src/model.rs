@@ -188,6 +188,11 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// forms may divide by sums that are positive only for positive values of them, so
     /// [`Coefficients`] refuses other values.
     const POSITIVE_PARAMS: &'static [usize] = &[];
+    /// Index pairs in `PARAMS` of the vectors of parameters declared unit vectors
+    /// (`unit: n_c;` for `n_c_x`, `n_c_y`): the model's forms are consistent only for
+    /// `|n_c| = 1` (Signorini's `σ_n(u) = n_c·σ(u)n`), so [`Coefficients`] refuses
+    /// other lengths ([`UNIT_TOLERANCE`]).
+    const UNIT_PARAMS: &'static [(usize, usize)] = &[];
 
     /// The constrained field: the `obstacle:` role's field ([`Model::OBSTACLE`]), else
     /// the first field (a model without a pointwise obstacle, e.g. Signorini's).
@@ -848,12 +853,31 @@ impl<'a> Coefficients<'a> {
                 missing.join(", ")
             )));
         }
+        let params: Vec<f64> = values.into_iter().map(Option::unwrap).collect();
+        for &(x, y) in M::UNIT_PARAMS {
+            let length = params[x].hypot(params[y]);
+            if (length - 1.0).abs() > UNIT_TOLERANCE {
+                return Err(Error::Input(format!(
+                    "parameters `{}` = {} and `{}` = {} must form a unit vector (model `{}` declares it `unit:`), their length is {length}: normalize them",
+                    M::PARAMS[x],
+                    params[x],
+                    M::PARAMS[y],
+                    params[y],
+                    M::NAME
+                )));
+            }
+        }
         Ok(Self {
-            params: values.into_iter().map(Option::unwrap).collect(),
+            params,
             data: functions.into_iter().map(Option::unwrap).collect(),
         })
     }
 }
+
+/// How far from 1 the length of a vector of parameters declared `unit:` may be: a
+/// direction normalized in double precision is within a few ulps; a hand-written
+/// `(0.6, 0.8)` within rounding too.
+pub const UNIT_TOLERANCE: f64 = 1e-9;
 
 /// Cells whose blocks [`require_symmetric`] compares at most: every cell up to this
 /// many, else every k-th cell. At about 0.1 µs per kernel call that is well under a

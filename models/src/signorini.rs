@@ -51,6 +51,7 @@ macro_rules! signorini_model {
                 energy:        a, ℓ;
                 stabilization: α S against a;
                 constraint:    b, G;
+                unit:          n_c;
                 estimator: "
                     η_T²   = h_T²/(2μ_L) ‖div σ(u)‖²
                     η_E²   = h_E/(2μ_L) ‖[[σ(u)·n]]‖²

@@ -464,7 +464,13 @@ fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream
     };
     let order = roles.order;
     let strong_form = roles.strong_form;
+    // emitted only when there is one, so that models without keep their code
+    let unit = (!roles.unit.is_empty()).then(|| {
+        let pairs = roles.unit.iter().map(|&(x, y)| quote!((#x, #y)));
+        quote!(const UNIT_PARAMS: &'static [(usize, usize)] = &[#(#pairs),*];)
+    });
     quote! {
+        #unit
         const ORDER: u8 = #order;
         const STRONG_FORM: bool = #strong_form;
         const OBSTACLE: ::core::option::Option<[usize; 2]> = #obstacle;
