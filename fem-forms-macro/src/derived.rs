@@ -645,34 +645,11 @@ pub fn check_stabilization(
     if forms[s].terms.iter().any(|m| m.facet.is_some()) {
         return Vec::new();
     }
-    let fields = symbols.fields.len();
     let with_alpha =
-        |m: &&Monomial| m.facet.is_none() && m.params.iter().any(|&(p, e)| p == alpha && e == 1);
-    // the test function's factor of a term: its argument of a test symbol
-    let test_of = |m: &Monomial| m.args.iter().find(|a| a.symbol >= fields).copied();
-    // every row of the stabilization: B_h's α-terms on one test coordinate (a test
-    // function's derivative), less L_h's on the same
-    let mut rows: Vec<(ArgFactor, Expansion)> = Vec::new();
-    for m in forms[bh].terms.iter().filter(with_alpha) {
-        let Some(test) = test_of(m) else { continue };
-        let mut t = m.clone();
-        t.args.retain(|a| *a != test);
-        match rows.iter_mut().find(|(c, _)| *c == test) {
-            Some((_, row)) => row.push(t),
-            None => rows.push((test, vec![t])),
-        }
-    }
+        |m: &Monomial| m.facet.is_none() && m.params.iter().any(|&(p, e)| p == alpha && e == 1);
+    let rows = stabilization_rows(symbols, forms, [bh, lh], with_alpha);
     if rows.is_empty() {
         return Vec::new();
-    }
-    for m in forms[lh].terms.iter().filter(with_alpha) {
-        let Some(test) = test_of(m) else { continue };
-        if let Some((_, row)) = rows.iter_mut().find(|(c, _)| *c == test) {
-            let mut t = m.clone();
-            t.args.clear();
-            t.coefficient = -t.coefficient;
-            row.push(t);
-        }
     }
     let constrained: Vec<usize> = forms[b]
         .terms
@@ -684,28 +661,9 @@ pub fn check_stabilization(
     };
     let candidates = candidates(symbols, derived, w, lambda);
     for (test, row) in &rows {
-        let row = nonvanishing(symbols, row.clone());
-        if row.is_empty() {
-            continue;
-        }
-        let consistent = blocks(roles, symbols.dimension, 16).iter().all(|block| {
-            let target: Vec<f64> = block.iter().map(|p| p.expansion(symbols, &row)).collect();
-            let columns: Vec<Vec<f64>> = candidates
-                .iter()
-                .map(|c| block.iter().map(|p| p.expansion(symbols, c)).collect())
-                .collect();
-            fits(&columns, &target, true)
-        });
-        if !consistent {
+        if !fits_everywhere(symbols, roles, row, &candidates, true) {
             let origin = row[0].origin;
-            let at = if test.symbol == fields + lambda {
-                "the multiplier's row".to_string()
-            } else {
-                format!(
-                    "the row of `{}`",
-                    symbols.fields[test.symbol - fields].test_name
-                )
-            };
+            let at = row_name(symbols, *test, lambda);
             return vec![Diagnostic::text(
                 origin,
                 format!(
@@ -741,56 +699,17 @@ pub fn check_facet_stabilization(
     else {
         return Vec::new();
     };
-    let fields = symbols.fields.len();
     let parts: Vec<usize> = forms[s].terms.iter().filter_map(|m| m.facet).collect();
     let mut errors = Vec::new();
     for part in (0..symbols.facets.len()).filter(|p| parts.contains(p)) {
-        let on_part = |m: &&Monomial| {
+        let on_part = |m: &Monomial| {
             m.facet == Some(part) && m.params.iter().any(|&(p, e)| p == alpha && e == 1)
         };
-        let test_of = |m: &Monomial| m.args.iter().find(|x| x.symbol >= fields).copied();
-        let mut rows: Vec<(ArgFactor, Expansion)> = Vec::new();
-        for m in forms[bh].terms.iter().filter(on_part) {
-            let Some(test) = test_of(m) else { continue };
-            let mut t = m.clone();
-            t.args.retain(|x| *x != test);
-            match rows.iter_mut().find(|(c, _)| *c == test) {
-                Some((_, row)) => row.push(t),
-                None => rows.push((test, vec![t])),
-            }
-        }
-        for m in forms[lh].terms.iter().filter(on_part) {
-            let Some(test) = test_of(m) else { continue };
-            if let Some((_, row)) = rows.iter_mut().find(|(c, _)| *c == test) {
-                let mut t = m.clone();
-                t.args.clear();
-                t.coefficient = -t.coefficient;
-                row.push(t);
-            }
-        }
+        let rows = stabilization_rows(symbols, forms, [bh, lh], on_part);
         let candidates = boundary_residuals(symbols, forms, derived, [bh, lh], (part, alpha));
         for (test, row) in &rows {
-            let row = nonvanishing(symbols, row.clone());
-            if row.is_empty() {
-                continue;
-            }
-            let consistent = blocks(roles, symbols.dimension, 16).iter().all(|block| {
-                let target: Vec<f64> = block.iter().map(|p| p.expansion(symbols, &row)).collect();
-                let columns: Vec<Vec<f64>> = candidates
-                    .iter()
-                    .map(|c| block.iter().map(|p| p.expansion(symbols, c)).collect())
-                    .collect();
-                fits(&columns, &target, false)
-            });
-            if !consistent {
-                let at = if test.symbol == fields + lambda {
-                    "the multiplier's row".to_string()
-                } else {
-                    format!(
-                        "the row of `{}`",
-                        symbols.fields[test.symbol - fields].test_name
-                    )
-                };
+            if !fits_everywhere(symbols, roles, row, &candidates, false) {
+                let at = row_name(symbols, *test, lambda);
                 errors.push(
                     Diagnostic::text(
                         row[0].origin,
@@ -806,6 +725,76 @@ pub fn check_facet_stabilization(
         }
     }
     errors
+}
+
+/// The rows of a stabilization: `B_h`'s terms that `on` selects (α-terms on the cells or
+/// on a part), grouped by their test coordinate (a test function's derivative, the
+/// multiplier's among them) with that factor taken out, less `L_h`'s on the same
+/// coordinates; each row with its vanishing terms dropped, empty rows left out.
+fn stabilization_rows(
+    symbols: &Symbols,
+    forms: &[Form],
+    [bh, lh]: [usize; 2],
+    on: impl Fn(&Monomial) -> bool,
+) -> Vec<(ArgFactor, Expansion)> {
+    let fields = symbols.fields.len();
+    // the test function's factor of a term: its argument of a test symbol
+    let test_of = |m: &Monomial| m.args.iter().find(|a| a.symbol >= fields).copied();
+    let mut rows: Vec<(ArgFactor, Expansion)> = Vec::new();
+    for m in forms[bh].terms.iter().filter(|m| on(m)) {
+        let Some(test) = test_of(m) else { continue };
+        let mut t = m.clone();
+        t.args.retain(|a| *a != test);
+        match rows.iter_mut().find(|(c, _)| *c == test) {
+            Some((_, row)) => row.push(t),
+            None => rows.push((test, vec![t])),
+        }
+    }
+    for m in forms[lh].terms.iter().filter(|m| on(m)) {
+        let Some(test) = test_of(m) else { continue };
+        if let Some((_, row)) = rows.iter_mut().find(|(c, _)| *c == test) {
+            let mut t = m.clone();
+            t.args.clear();
+            t.coefficient = -t.coefficient;
+            row.push(t);
+        }
+    }
+    rows.into_iter()
+        .map(|(test, row)| (test, nonvanishing(symbols, row)))
+        .filter(|(_, row)| !row.is_empty())
+        .collect()
+}
+
+/// Whether `row` is a combination of `candidates` at the random points of every block
+/// ([`fits`]; the first candidate taking part where `first_carries`).
+fn fits_everywhere(
+    symbols: &Symbols,
+    roles: &Roles,
+    row: &[Monomial],
+    candidates: &[Expansion],
+    first_carries: bool,
+) -> bool {
+    blocks(roles, symbols.dimension, 16).iter().all(|block| {
+        let target: Vec<f64> = block.iter().map(|p| p.expansion(symbols, row)).collect();
+        let columns: Vec<Vec<f64>> = candidates
+            .iter()
+            .map(|c| block.iter().map(|p| p.expansion(symbols, c)).collect())
+            .collect();
+        fits(&columns, &target, first_carries)
+    })
+}
+
+/// "the multiplier's row" or "the row of `v`" for a row's test coordinate.
+fn row_name(symbols: &Symbols, test: ArgFactor, lambda: usize) -> String {
+    let fields = symbols.fields.len();
+    if test.symbol == fields + lambda {
+        "the multiplier's row".to_string()
+    } else {
+        format!(
+            "the row of `{}`",
+            symbols.fields[test.symbol - fields].test_name
+        )
+    }
 }
 
 /// The boundary residuals of the primal equations on boundary part `part`, one per
