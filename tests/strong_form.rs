@@ -179,3 +179,23 @@ fn every_flux_of_an_edge_term_is_a_natural_boundary_term() {
     // the one-point shear pair has no strong form to match its terms with
     assert!(fem_forms::models::timoshenko_p1_reduced::Model::NATURAL_FLUXES.is_empty());
 }
+
+/// The energy order of each shipped model's constrained field (the `m` of `|w|_m` that
+/// scales the violation term of the estimate): not the stabilization's order, which is 4
+/// for Timoshenko's `θ''' − sλ` while its deflection's energy is `|w|₁`.
+#[test]
+fn the_constrained_fields_energy_orders() {
+    assert_eq!(membrane::membrane_p1_p0::Model::CONSTRAINED_ORDER, 1);
+    assert_eq!(membrane::membrane_p1::Model::CONSTRAINED_ORDER, 1);
+    assert_eq!(bernoulli::Model::CONSTRAINED_ORDER, 2);
+    assert_eq!(timoshenko_p2::Model::CONSTRAINED_ORDER, 1);
+    assert_eq!(timoshenko_p2::Model::ORDER, 4);
+    assert_eq!(
+        fem_forms::models::timoshenko_p1_reduced::Model::CONSTRAINED_ORDER,
+        1
+    );
+    assert_eq!(kirchhoff::kirchhoff_argyris_p0::Model::CONSTRAINED_ORDER, 2);
+    assert_eq!(kirchhoff::kirchhoff_morley_p0::Model::CONSTRAINED_ORDER, 2);
+    assert_eq!(mindlin::mindlin_stenberg::Model::CONSTRAINED_ORDER, 1);
+    assert_eq!(winkler::winkler_argyris_p0::Model::CONSTRAINED_ORDER, 2);
+}

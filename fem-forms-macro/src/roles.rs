@@ -38,6 +38,10 @@ pub struct Roles {
     /// ([`crate::derived`]), so that the stabilization and the estimator were checked
     /// against it; set after the roles are resolved.
     pub strong_form: bool,
+    /// The highest derivative of the constrained field (`obstacle:`) in the energy form
+    /// `a`: the order `m` of its energy norm `|w|_m` (1 for a membrane and Timoshenko's
+    /// deflection, 2 for plates and Euler–Bernoulli); 0 where unknown.
+    pub constrained_order: u8,
     /// The order `p` of the operator whose residual the stabilization measures: the
     /// power of h in the stabilization's terms (`Σ_T h_T^p (…)`), or else the total
     /// derivative order of the energy's bilinear form; 0 where neither is known.
@@ -109,12 +113,21 @@ pub fn resolve(
         constraint: constraint.unwrap_or_else(|| conventional.constraint()),
         unit,
         strong_form: false,
+        constrained_order: 0,
     };
     let order = operator_order(&roles, forms);
+    let constrained_order = constrained_order(&roles, symbols, forms);
     if roles.system.is_some() {
         lookup.continuous_multipliers(declaration);
     }
-    (Roles { order, ..roles }, lookup.errors)
+    (
+        Roles {
+            order,
+            constrained_order,
+            ..roles
+        },
+        lookup.errors,
+    )
 }
 
 /// The declared roles' names looked up among the forms, parameters, fields and data,
@@ -335,6 +348,22 @@ fn operator_order(roles: &Roles, forms: &[Form]) -> u8 {
                     .unwrap_or(0)
             })
         })
+        .unwrap_or(0)
+}
+
+/// [`Roles::constrained_order`]: the largest derivative order of the constrained field's
+/// arguments (trial or test) in the energy's bilinear form.
+fn constrained_order(roles: &Roles, symbols: &Symbols, forms: &[Form]) -> u8 {
+    let (Some((field, _)), Some([a, _])) = (roles.obstacle, roles.energy) else {
+        return 0;
+    };
+    forms[a]
+        .terms
+        .iter()
+        .flat_map(|t| t.args.iter())
+        .filter(|x| symbols.field_of(x.symbol) == field)
+        .map(|x| x.order())
+        .max()
         .unwrap_or(0)
 }
 

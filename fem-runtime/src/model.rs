@@ -184,6 +184,11 @@ pub trait Model: Copy + Default + Send + Sync + 'static {
     /// or else the total derivative order of the energy's bilinear form; 0 where
     /// neither is known. A load `f` bends the structure by about `f·L^p` over a length L.
     const ORDER: u8 = 0;
+    /// The highest derivative of the constrained field ([`Model::OBSTACLE`]) in the
+    /// energy form: the order `m` of the seminorm `|w|_m` its energy is equivalent to (1
+    /// for a membrane and for Timoshenko's deflection, whose stabilization is of order 4,
+    /// 2 for plates and Euler–Bernoulli); 0 where unknown.
+    const CONSTRAINED_ORDER: u8 = 0;
     /// Indices in `PARAMS` of the parameters declared `> 0` (`params: β > 0`): the
     /// forms may divide by sums that are positive only for positive values of them, so
     /// [`Coefficients`] refuses other values.

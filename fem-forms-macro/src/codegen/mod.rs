@@ -463,6 +463,7 @@ fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream
         None => quote!(::core::option::Option::None),
     };
     let order = roles.order;
+    let constrained_order = roles.constrained_order;
     let strong_form = roles.strong_form;
     // emitted only when there is one, so that models without keep their code
     let unit = (!roles.unit.is_empty()).then(|| {
@@ -472,6 +473,7 @@ fn role_items(roles: &crate::roles::Roles, runtime: &TokenStream) -> TokenStream
     quote! {
         #unit
         const ORDER: u8 = #order;
+        const CONSTRAINED_ORDER: u8 = #constrained_order;
         const STRONG_FORM: bool = #strong_form;
         const OBSTACLE: ::core::option::Option<[usize; 2]> = #obstacle;
         const SYSTEM: ::core::option::Option<[usize; 2]> = #system;

@@ -27,8 +27,8 @@ fn reference_coefficients(view: &FieldView, c: usize) -> Vec<f64> {
 /// [`super::triangle_estimate`] on triangles. An interior node's `η_E²` is shared
 /// half-and-half by its two cells for marking.
 ///
-/// The violation part of `S` is `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T` (`m` half the
-/// operator's order, [`Model::ORDER`]) for every element: the inverse-inequality scaling
+/// The violation part of `S` is `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T` (`m` the energy's
+/// derivative order of the constrained field, [`super::energy_order`]) for every element: the inverse-inequality scaling
 /// of the L² norm to the energy norm, which needs no nodal interpolant of the positive part
 /// (Hermite cubics have none).
 ///
@@ -191,7 +191,7 @@ fn contact_terms<M: Model>(
     psi: &DataFn,
     side: f64,
 ) -> ContactTerms {
-    let m = i32::from(M::ORDER / 2).max(1);
+    let m = super::energy_order::<M>();
     let element = u.map.element();
     let rule = QuadratureRule::exact_for_degree(2 * element.degree() + 2);
     let (u_basis, l_basis) = (

@@ -663,7 +663,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         // the rounding of the gap) is reported with how far the loop got.
         let mut solved = solved.map_err(|e| match levels.last() {
             Some(last) if !stopped => Error::Input(format!(
-                "level {} of the adaptive solve failed: {e}; level {} reached an estimate of {} of ‖u_h‖_a with {} cells and {} unknowns, above the tolerance {}",
+                "level {} of the adaptive solve failed: {e}; level {} reached an estimate of {} of ‖u_h‖_a with {} cells and {} unknowns, above the tolerance {} (an adaptive mesh's smallest cells are far smaller than a uniform mesh's of as many unknowns: a looser tolerance stops before them, a finer first mesh grades them less)",
                 levels.len() + 1,
                 levels.len(),
                 number(last.estimate / last.energy_norm),
