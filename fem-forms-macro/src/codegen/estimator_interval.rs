@@ -173,6 +173,11 @@ fn node_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
         let p = product(data.into_iter().chain(std::iter::once(jump)));
         body.push(quote!(r += #p;));
     }
+    squared(term, &tables, &body)
+}
+
+/// A point term's code: its tables, `r = Σ body`, and `weight · r²` added to `eta2`.
+fn squared(term: &IndicatorTerm, tables: &Tables, body: &[TokenStream]) -> TokenStream {
     let weight = weight_code(&term.weight);
     let items = &tables.items;
     let doc = &term.source;
@@ -213,18 +218,7 @@ fn end_term(term: &IndicatorTerm, symbols: &Symbols) -> TokenStream {
         let p = product(std::iter::once(c).chain(data).chain(std::iter::once(value)));
         body.push(quote!(r += #p;));
     }
-    let weight = weight_code(&term.weight);
-    let items = &tables.items;
-    let doc = &term.source;
-    quote! {
-        {
-            #[doc = #doc]
-            #(#items)*
-            let mut r = 0.0f64;
-            #(#body)*
-            eta2 += #weight * r * r;
-        }
-    }
+    squared(term, &tables, &body)
 }
 
 /// The module `estimator` of an interval model with an `estimator:` text: the kernels

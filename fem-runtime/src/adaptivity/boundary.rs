@@ -266,9 +266,7 @@ pub(super) fn natural_indicators<M: Model, G: TriangleCells>(
         }
         let (cell, _) = mesh.edge_cells(e);
         let local = mesh
-            .cell_edges(cell)
-            .iter()
-            .position(|&x| x == e)
+            .local_edge(cell, e)
             .expect("an edge is an edge of its cell");
         let coefficients = cell_coefficients::<M>(fields, cell);
         let slices: Vec<&[f64]> = coefficients.iter().map(Vec::as_slice).collect();

@@ -296,9 +296,7 @@ pub fn triangle_estimate<M: Model, G: TriangleCells>(
             continue;
         };
         let local_edge = |c: usize| {
-            mesh.cell_edges(c)
-                .iter()
-                .position(|&x| x == e)
+            mesh.local_edge(c, e)
                 .expect("an edge is an edge of its cells")
         };
         let (a, b) = (

@@ -122,7 +122,7 @@ impl DirichletPart {
                 continue;
             }
             let (c, _) = mesh.edge_cells(e);
-            let Some(k) = mesh.cell_edges(c).iter().position(|&x| x == e) else {
+            let Some(k) = mesh.local_edge(c, e) else {
                 continue;
             };
             let local = map.cell_dofs(c);
@@ -307,7 +307,7 @@ impl DirichletPart {
                 // the edge's normal-derivative DOF (a physical normal derivative whatever
                 // the edge's direction), found through a cell as in `dofs`
                 let (c, _) = mesh.edge_cells(e);
-                if let Some(k) = mesh.cell_edges(c).iter().position(|&x| x == e) {
+                if let Some(k) = mesh.local_edge(c, e) {
                     out.dofs.push((
                         map.cell_dofs(c)[3 * per_vertex + k],
                         PlateFunctional::EdgeNormal(e),
@@ -796,7 +796,7 @@ impl Constraints {
             let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
             let t = [(pb[0] - pa[0]) / length, (pb[1] - pa[1]) / length];
             let (c, _) = mesh.edge_cells(e);
-            let Some(k) = mesh.cell_edges(c).iter().position(|&x| x == e) else {
+            let Some(k) = mesh.local_edge(c, e) else {
                 continue;
             };
             let local = map_x.cell_dofs(c);

@@ -1587,7 +1587,7 @@ $EndElements
         for e in 0..ne {
             let map_node = (0..mesh.cell_count())
                 .find_map(|c| {
-                    let k = mesh.cell_edges(c).iter().position(|&x| x == e)?;
+                    let k = mesh.local_edge(c, e)?;
                     Some(geometry.cell_map(&mesh, c).nodes()[3 + k])
                 })
                 .unwrap();

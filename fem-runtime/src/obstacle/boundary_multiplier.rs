@@ -125,9 +125,7 @@ pub fn part_edges(mesh: &TriangleMesh, markers: &[u32]) -> Vec<ContactEdge> {
         .map(|&(e, _)| {
             let (cell, _) = mesh.edge_cells(e);
             let local = mesh
-                .cell_edges(cell)
-                .iter()
-                .position(|&x| x == e)
+                .local_edge(cell, e)
                 .expect("an edge is an edge of its cell");
             let c = mesh.cell(cell);
             ContactEdge {

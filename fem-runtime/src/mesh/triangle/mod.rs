@@ -725,6 +725,13 @@ impl TriangleMesh {
         self.cell_edges[c].map(|e| e as usize)
     }
 
+    /// The local index of edge `e` in cell `c` (local edge `k` joins local vertices `k`
+    /// and `(k + 1) % 3`), `None` where `e` is not an edge of `c`.
+    #[inline]
+    pub fn local_edge(&self, c: usize, e: usize) -> Option<usize> {
+        self.cell_edges(c).iter().position(|&x| x == e)
+    }
+
     /// The cells of edge `e`: one, or two for an interior edge.
     pub fn edge_cells(&self, e: usize) -> (usize, Option<usize>) {
         let [c0, c1] = self.edge_cells[e];
