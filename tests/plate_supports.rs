@@ -864,3 +864,27 @@ fn contradictory_or_non_finite_plate_data_are_refused() {
         .to_string();
     assert!(message.contains("not finite"), "{message}");
 }
+
+/// An Argyris plate simply supported on two sides (`w = 0` there, imposed as rows over
+/// each vertex's DOFs) above an obstacle `w ≥ 0.05`: no admissible deflection exists,
+/// and the solve says so naming the point, as it does for Morley's fixed value DOFs.
+#[test]
+fn a_simple_support_below_the_obstacle_is_infeasible() {
+    use fem_forms::problem::{Condition, Problem};
+    use fem_forms::{Diagonal, DirichletPart, TriangleMesh};
+    let (one, above, zero) = (|_: &[f64]| 1.0, |_: &[f64]| 0.05, |_: &[f64]| 0.0);
+    let mesh = TriangleMesh::rectangle(0.0, 2.0, 0.0, 1.0, 4, 2, Diagonal::Right).unwrap();
+    let Err(e) = Problem::<kirchhoff_argyris_p0::Model, TriangleMesh>::new(vec![mesh])
+        .param("D", 1.0)
+        .param("ν", 0.3)
+        .data("f", &one)
+        .data("ψ", &above)
+        .data("g", &zero)
+        .support(DirichletPart::Markers(vec![2, 4]), "w", Condition::Zero)
+        .solve()
+    else {
+        panic!("a plate held at 0 below an obstacle at 0.05 was solved");
+    };
+    let message = e.to_string();
+    assert!(message.contains("infeasible"), "{message}");
+}

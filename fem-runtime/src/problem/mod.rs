@@ -1849,8 +1849,17 @@ fn check_feasible_at<G: Domain>(
     let (Some(map), Some(offset)) = (dofs.map(field), dofs.offset(field)) else {
         return Ok(());
     };
-    let fixed: std::collections::HashMap<usize, f64> =
+    let mut fixed: std::collections::HashMap<usize, f64> =
         constraints.fixed().iter().copied().collect();
+    // a condition on one DOF of a group fixes it too (an Argyris vertex's `u = 0` among
+    // the rows of a simple support)
+    for (group, row, value) in constraints.combinations() {
+        let g = group.as_slice();
+        let mut nonzero = (0..g.len()).filter(|&k| row[k] != 0.0);
+        if let (Some(k), None) = (nonzero.next(), nonzero.next()) {
+            fixed.entry(g[k]).or_insert(value / row[k]);
+        }
+    }
     for (v, x) in mesh.vertex_points().iter().enumerate() {
         let Some(&value) = fixed.get(&(offset + map.vertex_dofs(v).start)) else {
             continue;
