@@ -119,6 +119,20 @@ fn scene_file_mistakes_are_refused_or_named() {
         "{}",
         stderr(&o)
     );
+    // the obstacle side is the scene's, not a parameter: named, not sent to the API
+    let o = run_file(
+        &dir,
+        "side.toml",
+        &single.replace("nu = 0.3", "nu = 0.3\ns = -1.0"),
+    );
+    assert!(
+        !o.status.success()
+            && stderr(&o).contains("parameters.s")
+            && stderr(&o).contains("obstacle's side")
+            && !stderr(&o).contains("Problem::side"),
+        "{}",
+        stderr(&o)
+    );
     let o = run_file(&dir, "nopsi.toml", &single.replace("psi = \"-1\"\n", ""));
     assert!(o.status.success(), "{}", stderr(&o));
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();

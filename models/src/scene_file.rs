@@ -707,6 +707,12 @@ fn read_parameters(
                 return Err((field, "`alpha` and `α` both name α: give it once".into()));
             }
             alpha = Some(v);
+        } else if key == "s" {
+            // the models' obstacle side: the solve sets it from the scene's side
+            return Err((
+                field,
+                "`s` is the obstacle's side (+1 below the structure, −1 above), which the scene sets, not a parameter: a scene file poses its obstacle below (`w ≥ ψ`)".into(),
+            ));
         } else {
             let name = model_name(family, key);
             if let Some(other) = parameters
