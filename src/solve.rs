@@ -451,10 +451,14 @@ fn write_outputs(
                 scene.name
             ));
         };
-        let path = out.join(format!(
-            "{}-{}-{}.vtu",
-            scene.name, outcome.report.pair, outcome.report.mesh_size
-        ));
+        // an adaptive run's mesh is not the uniform mesh of its starting size: the file
+        // says how many cells it has instead
+        let size = if outcome.report.solve.adaptive_levels.is_empty() {
+            outcome.report.mesh_size.to_string()
+        } else {
+            format!("adaptive-{}-cells", outcome.report.solve.cells)
+        };
+        let path = out.join(format!("{}-{}-{size}.vtu", scene.name, outcome.report.pair));
         std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
         outcome.fields.write_vtu(&path).map_err(|e| e.to_string())?;
         eprintln!("→ {}", path.display());

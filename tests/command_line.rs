@@ -862,8 +862,15 @@ fn tol_solves_adaptively_and_reports_every_level() {
         .map(|l| l["error_energy"].as_f64().unwrap())
         .collect();
     assert!(errors.last().unwrap() < &errors[0], "{errors:?}");
-    let vtu = std::fs::read_to_string(out.join("membrane-radial-p1-p0-8.vtu")).unwrap();
+    // named after the final mesh's cells, not the starting size
+    let cells = last["cells"].as_u64().unwrap();
+    let name = format!("membrane-radial-p1-p0-adaptive-{cells}-cells.vtu");
+    let vtu = std::fs::read_to_string(out.join(&name)).unwrap();
     assert!(vtu.contains("indicator"), "the .vtu has no indicator field");
+    assert!(
+        vtu.contains(&format!("NumberOfCells=\"{cells}\"")),
+        "{name}"
+    );
 
     // a scene file's `tol`: the radial example, from a coarse mesh
     let example = std::fs::read_to_string(concat!(
