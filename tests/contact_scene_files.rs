@@ -1606,3 +1606,15 @@ fn a_tilted_foundation_under_a_roller_holds_or_tips_the_body() {
         "{e}"
     );
 }
+
+/// `obstacle_side = "above"` has no meaning for a foundation with a direction: the
+/// contact model has no side parameter, and the solve refuses it rather than solve the
+/// foundation where it is.
+#[test]
+fn an_obstacle_above_is_refused_for_contact() {
+    let file = parse(&format!("obstacle_side = \"above\"\n{RECTANGLE}")).unwrap();
+    let Err(e) = families::solve(&file.scene, &file.settings()) else {
+        panic!("a contact scene solved with its obstacle above");
+    };
+    assert!(e.to_string().contains("cannot be posed above"), "{e}");
+}

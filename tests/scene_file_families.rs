@@ -128,8 +128,32 @@ fn scene_file_mistakes_are_refused_or_named() {
     assert!(
         !o.status.success()
             && stderr(&o).contains("parameters.s")
-            && stderr(&o).contains("obstacle's side")
+            && stderr(&o).contains("obstacle_side")
             && !stderr(&o).contains("Problem::side"),
+        "{}",
+        stderr(&o)
+    );
+    // an obstacle above (`w ≤ ψ`): pushed up into it, touching; a misspelt side named
+    let above = format!(
+        "obstacle_side = \"above\"\n{}",
+        single
+            .replace("f = \"-1\"", "f = \"1\"")
+            .replace("psi = \"-1\"", "psi = \"0.001\"")
+    );
+    let o = run_file(&dir, "above.toml", &above);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        json["total_contact_force"].as_f64().unwrap() > 0.0,
+        "{json}"
+    );
+    let o = run_file(
+        &dir,
+        "sideways.toml",
+        &above.replace("\"above\"", "\"sideways\""),
+    );
+    assert!(
+        !o.status.success() && stderr(&o).contains("field `obstacle_side`"),
         "{}",
         stderr(&o)
     );

@@ -363,6 +363,8 @@ struct FileToml {
     accuracy: Option<f64>,
     /// Solve adaptively to this tolerance relative to the solution's energy norm.
     tol: Option<f64>,
+    /// Which side of the structure the obstacle is on: "below" (the default) or "above".
+    obstacle_side: Option<String>,
     mesh: MeshToml,
     /// The family's material (contact's E, ν), read by the family.
     material: Option<toml::Table>,
@@ -610,6 +612,19 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
         scene.exact = Exact::AtDefaultLoad(exact_of(e, &scene.domain, path)?);
     }
     scene.accuracy = accuracy_of(&file, family).map_err(at)?;
+    if let Some(side) = &file.obstacle_side {
+        scene.side =
+            match side.as_str() {
+                "below" => fem_runtime::problem::ObstacleSide::Below,
+                "above" => fem_runtime::problem::ObstacleSide::Above,
+                other => return Err(at((
+                    "obstacle_side".into(),
+                    format!(
+                        "`{other}` is no side: \"below\" (w ≥ ψ, the default) or \"above\" (w ≤ ψ)"
+                    ),
+                ))),
+            };
+    }
     if let Some(tol) = file.tol {
         if !(tol > 0.0 && tol.is_finite()) {
             return Err(at((
@@ -711,7 +726,7 @@ fn read_parameters(
             // the models' obstacle side: the solve sets it from the scene's side
             return Err((
                 field,
-                "`s` is the obstacle's side (+1 below the structure, −1 above), which the scene sets, not a parameter: a scene file poses its obstacle below (`w ≥ ψ`)".into(),
+                "`s` is the obstacle's side (+1 below the structure, −1 above), not a parameter: write `obstacle_side = \"above\"` (or \"below\", the default) at the top of the file".into(),
             ));
         } else {
             let name = model_name(family, key);

@@ -365,6 +365,13 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// The obstacle's side (needs the model's `side:` role for `Above`).
     pub fn side(mut self, side: ObstacleSide) -> Self {
         self.side = side;
+        if side == ObstacleSide::Above && M::SIDE.is_none() {
+            // a model without the side parameter would solve the obstacle below
+            return self.refuse(Error::Input(format!(
+                "model `{}` has no obstacle side parameter (`side:`): its obstacle cannot be posed above",
+                M::NAME
+            )));
+        }
         self
     }
 
