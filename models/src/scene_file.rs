@@ -613,17 +613,18 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
     }
     scene.accuracy = accuracy_of(&file, family).map_err(at)?;
     if let Some(side) = &file.obstacle_side {
-        scene.side =
-            match side.as_str() {
-                "below" => fem_runtime::problem::ObstacleSide::Below,
-                "above" => fem_runtime::problem::ObstacleSide::Above,
-                other => return Err(at((
+        scene.side = match side.as_str() {
+            "below" => fem_runtime::problem::ObstacleSide::Below,
+            "above" => fem_runtime::problem::ObstacleSide::Above,
+            other => {
+                return Err(at((
                     "obstacle_side".into(),
                     format!(
                         "`{other}` is no side: \"below\" (w ≥ ψ, the default) or \"above\" (w ≤ ψ)"
                     ),
-                ))),
-            };
+                )))
+            }
+        };
     }
     if let Some(tol) = file.tol {
         if !(tol > 0.0 && tol.is_finite()) {
