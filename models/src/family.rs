@@ -251,6 +251,24 @@ pub trait Family: Sync {
         None
     }
 
+    /// The model a scene of the family poses, in words (`Timoshenko`, `Kirchhoff`): what
+    /// a report's `chosen_model` names.
+    fn model_words(&self, scene: &Scene) -> &'static str {
+        let _ = scene;
+        self.name()
+    }
+
+    /// The cheaper neighbour of `scene`'s model, where the family declares one: the
+    /// same scene posed for the thinner model (Euler–Bernoulli for a Timoshenko beam,
+    /// Kirchhoff for a Reissner–Mindlin plate), possibly of another family, its
+    /// [`Scene::richer`] set to `scene`'s parameters so that its solve reports the
+    /// modelling estimate (`modelling_estimate`). [`crate::choice`] weighs it against
+    /// `scene` for a tolerance.
+    fn cheaper(&self, scene: &Scene) -> Option<Scene> {
+        let _ = scene;
+        None
+    }
+
     /// The `[exact]` key of the quantity a scene file's `accuracy` is measured on (`u`;
     /// contact's `pressure`).
     fn accuracy_key(&self) -> &'static str {

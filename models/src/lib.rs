@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
+pub mod choice;
 pub mod contact_scenes;
 pub mod data;
 pub mod euler_bernoulli;

@@ -38,6 +38,8 @@ pub struct Settings {
     /// Also form the multiplier's Schur complement of the finest mesh
     /// ([`Outcome::schur`]; the stability study).
     pub schur: bool,
+    /// Also keep the discrete solution ([`Outcome::solution`]).
+    pub keep_solution: bool,
     /// Solve adaptively (`--tol`, or a scene file's `tol`): the loop's tolerance,
     /// marking and limit (`None`: on the scene's mesh, or the scene file's `tol`).
     pub adaptive: Option<AdaptiveOptions>,
@@ -71,6 +73,7 @@ impl Default for Settings {
             diagonal: None,
             rounding_experiment: None,
             schur: false,
+            keep_solution: false,
             adaptive: None,
             progress: None,
         }
@@ -217,6 +220,29 @@ pub struct Outcome {
     /// The multiplier's Schur complement on the finest mesh, where the settings ask for
     /// it ([`Settings::schur`]) and the pair has a multiplier space.
     pub schur: Option<Schur>,
+    /// The discrete solution, where the settings ask for it
+    /// ([`Settings::keep_solution`]).
+    pub solution: Option<KeptSolution>,
+}
+
+/// The discrete solution of a solve, kept for comparisons across models and pairs (the
+/// distance of a chosen cheaper model's solution to a reference of the scene's own).
+#[derive(Clone)]
+pub struct KeptSolution {
+    /// The model's fields by name, in its order.
+    pub fields: Vec<&'static str>,
+    /// The runtime's `ObstacleSolution` of the mesh kind solved on
+    /// (`ObstacleSolution<IntervalMesh>` for beams, `<TriangleMesh>` or
+    /// `<CurvedTriangleMesh>` on triangles): downcast it.
+    pub solution: std::sync::Arc<dyn std::any::Any + Send + Sync>,
+}
+
+impl std::fmt::Debug for KeptSolution {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("KeptSolution")
+            .field("fields", &self.fields)
+            .finish_non_exhaustive()
+    }
 }
 
 /// The multiplier problem of a solve's finest mesh once the primal unknowns are

@@ -285,11 +285,16 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         (true, true) => Some(schur_of(&solved, report.solve.alpha)?),
         _ => None,
     };
+    let solution = settings.keep_solution.then(|| crate::report::KeptSolution {
+        fields: M::FIELDS.iter().map(|f| f.name).collect(),
+        solution: std::sync::Arc::new(solved.solution),
+    });
     Ok(Outcome {
         report,
         fields,
         profile,
         schur,
+        solution,
     })
 }
 

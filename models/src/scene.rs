@@ -439,6 +439,10 @@ pub struct Scene {
     /// The keys a scene file gave its data under, by the model's name (`q` was
     /// `pressure`): errors about a datum name the user's key.
     pub file_keys: Vec<(Name, String)>,
+    /// Where the scene is the cheaper neighbour of a richer model's scene
+    /// ([`crate::family::Family::cheaper`]): that model's parameters as posed (its
+    /// thickness `t`), from which the solve estimates the modelling error.
+    pub richer: Option<Vec<(Name, f64)>>,
 }
 
 impl fmt::Debug for Scene {
@@ -510,6 +514,7 @@ impl Scene {
             in_default_job: false,
             reference: None,
             file_keys: Vec::new(),
+            richer: None,
         }
     }
 

@@ -56,6 +56,8 @@ pub struct Scene {
     pub load_sign: f64,
     /// Thickness (Timoshenko).
     pub thickness: f64,
+    /// The load magnitude q a solve poses unless asked otherwise.
+    pub load: f64,
 }
 
 const CASE_A: Obstacle = Obstacle::Parabola {
@@ -66,7 +68,7 @@ const CASE_A: Obstacle = Obstacle::Parabola {
 const CASE_B: Obstacle = Obstacle::Constant(0.05);
 
 /// Every scene.
-pub const SCENES: [Scene; 5] = [
+pub const SCENES: [Scene; 8] = [
     Scene {
         name: "timoshenko-a",
         description: "Timoshenko beam pressed down onto ψ = −0.4x²+0.4x−0.15 (w ≥ ψ, f = −q)",
@@ -75,6 +77,7 @@ pub const SCENES: [Scene; 5] = [
         side: 1.0,
         load_sign: -1.0,
         thickness: 1e-3,
+        load: 1.0,
     },
     Scene {
         name: "timoshenko-b",
@@ -84,6 +87,7 @@ pub const SCENES: [Scene; 5] = [
         side: -1.0,
         load_sign: 1.0,
         thickness: 1e-3,
+        load: 1.0,
     },
     Scene {
         name: "bernoulli-a",
@@ -93,6 +97,7 @@ pub const SCENES: [Scene; 5] = [
         side: 1.0,
         load_sign: -1.0,
         thickness: 0.0,
+        load: 1.0,
     },
     Scene {
         name: "bernoulli-b",
@@ -102,6 +107,7 @@ pub const SCENES: [Scene; 5] = [
         side: -1.0,
         load_sign: 1.0,
         thickness: 0.0,
+        load: 1.0,
     },
     Scene {
         name: "bernoulli-flat",
@@ -111,6 +117,37 @@ pub const SCENES: [Scene; 5] = [
         side: 1.0,
         load_sign: -1.0,
         thickness: 0.0,
+        load: 1.0,
+    },
+    Scene {
+        name: "timoshenko-t1e-1",
+        description: "thick Timoshenko beam (t = 0.1) pressed down by q = 40 onto ψ = −0.4x²+0.4x−0.15: the shear matters at every tolerance",
+        beam: Beam::Timoshenko,
+        obstacle: CASE_A,
+        side: 1.0,
+        load_sign: -1.0,
+        thickness: 1e-1,
+        load: 40.0,
+    },
+    Scene {
+        name: "timoshenko-t1e-2",
+        description: "Timoshenko beam (t = 0.01) pressed down by q = 40 onto ψ = −0.4x²+0.4x−0.15: Euler–Bernoulli only at loose tolerances",
+        beam: Beam::Timoshenko,
+        obstacle: CASE_A,
+        side: 1.0,
+        load_sign: -1.0,
+        thickness: 1e-2,
+        load: 40.0,
+    },
+    Scene {
+        name: "timoshenko-t1e-3",
+        description: "thin Timoshenko beam (t = 0.001) pressed down by q = 40 onto ψ = −0.4x²+0.4x−0.15: Euler–Bernoulli is adequate to about 2 %",
+        beam: Beam::Timoshenko,
+        obstacle: CASE_A,
+        side: 1.0,
+        load_sign: -1.0,
+        thickness: 1e-3,
+        load: 40.0,
     },
 ];
 

@@ -144,7 +144,7 @@ pub fn beam_scene(old: &crate::scenes::Scene) -> Scene {
     .with_data("ψ", Data::shared(move |x| obstacle.at(x[0])))
     .with_support(Part::All, Support::Clamped);
     scene.load = Some(Load {
-        default: 1.0,
+        default: old.load,
         scales: vec!["f".into()],
         symbol: "q",
         sign: crate::scene::LoadSign::NonNegative,
@@ -182,7 +182,7 @@ pub fn beam_scene(old: &crate::scenes::Scene) -> Scene {
     }));
     scene.studies = studies(old.name);
     // at the default q = 1 no beam touches its obstacle
-    scene.study_load = Some(STUDY_LOAD);
+    scene.study_load = (old.load == 1.0).then_some(STUDY_LOAD);
     scene.reference = Some(Arc::new(old));
     scene.in_default_job = true;
     scene
@@ -238,6 +238,26 @@ impl Family for Beams {
         })
     }
 
+    fn model_words(&self, scene: &Scene) -> &'static str {
+        if scene.parameter("t").is_some() {
+            "Timoshenko"
+        } else {
+            "Euler–Bernoulli"
+        }
+    }
+
+    /// A Timoshenko scene's Euler–Bernoulli beam: the same obstacle, load and supports
+    /// on Hermite cubics, without the thickness.
+    fn cheaper(&self, scene: &Scene) -> Option<Scene> {
+        scene.parameter("t")?;
+        let mut thin = scene.clone();
+        thin.name = format!("{}-euler-bernoulli", scene.name).into();
+        thin.richer = Some(scene.parameters.clone());
+        thin.parameters.retain(|(name, _)| &**name != "t");
+        thin.pairs = vec!["hermite-p0"];
+        Some(thin)
+    }
+
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[
             ("thickness", "t"),
@@ -246,6 +266,29 @@ impl Family for Beams {
             ("psi", "ψ"),
         ]
     }
+}
+
+/// The modelling error of an Euler–Bernoulli deflection `w` as a Timoshenko beam of
+/// thickness `t`, and `‖w''‖`: the shear force `Q = −w'''` that w implies is in
+/// equilibrium with the load and carries the shear compliance `t²` of the Timoshenko
+/// beam, so by the hypercircle (Prager–Synge) identity the Timoshenko energy norm of the
+/// difference of the two models' solutions is at most `t ‖w'''‖`, and equal to it to
+/// leading order in t: the shear energy the thinner model leaves out
+/// (`../shared/MODELS.md` §9).
+fn shear_implied(w: &fem_runtime::norms::FieldView<'_>, t: f64) -> (f64, f64) {
+    let rule = fem_runtime::gauss_legendre(3);
+    let (mut shear, mut bending) = (0.0, 0.0);
+    for c in 0..w.mesh.cell_count() {
+        let [a, b] = w.mesh.cell(c);
+        for (&xi, &weight) in rule.points.iter().zip(&rule.weights) {
+            let x = a + (b - a) * xi;
+            let q = w.at(x, 3).unwrap_or(0.0);
+            let m = w.at(x, 2).unwrap_or(0.0);
+            shear += weight * (b - a) * q * q;
+            bending += weight * (b - a) * m * m;
+        }
+    }
+    (t * shear.sqrt(), bending.sqrt())
 }
 
 /// `ε t⁻² h⁻²` on `elements` elements of the unit beam: the relative size of the rounding
@@ -293,6 +336,17 @@ impl Quantities<IntervalMesh> for Beams {
         report.set("contact_set", solution.contact_set());
         let thickness = run.posed.parameter("t");
         report.set("thickness", thickness);
+        if let Some(t) = run
+            .scene
+            .richer
+            .as_ref()
+            .and_then(|p| p.iter().find(|(name, _)| &**name == "t"))
+            .map(|(_, t)| *t)
+        {
+            let (estimate, norm) = shear_implied(&w, t);
+            report.set("modelling_estimate", estimate);
+            report.set("modelling_estimate_relative", estimate / norm);
+        }
 
         if let (Some(t), "p1-p1-p0-full") = (thickness, run.pair.name) {
             let h = 1.0 / cells as f64;

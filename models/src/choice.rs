@@ -1,0 +1,389 @@
+//! The cheapest adequate model, pair and mesh for a tolerance (`solve SCENE --tol T`
+//! without `--pair`, or a scene file's `tol`): one mechanism for every family.
+//!
+//! The candidates are the scene's own model with each of its pairs and, where its family
+//! declares one ([`crate::family::Family::cheaper`]), the cheaper neighbour model with
+//! each of its pairs. Each candidate is probed by two uniform solves (N and 2N), which
+//! give its a-posteriori estimate, its rate in the unknowns and its time per solve, and
+//! for a cheaper model the modelling estimate its own solution implies (the shear
+//! energy an Euler–Bernoulli or Kirchhoff solution leaves out, [`Report`]'s
+//! `modelling_estimate_relative`). A cheaper model is adequate where its modelling
+//! estimate is at most [`MODEL_SHARE`] of T; it is then solved to `T − modelling`, so
+//! that the triangle inequality keeps the total within T. Among the adequate candidates
+//! the one with the least predicted time is solved adaptively from the probe's coarse
+//! mesh; the report lists every candidate with its estimates and its predicted cost,
+//! and the chosen one's actual cost.
+//!
+//! The prediction: with the relative estimates `e₀, e₁` at `d₀, d₁` unknowns, the rate
+//! `r = ln(e₀/e₁) / ln(d₁/d₀)`, the unknowns `d* = d₁ (e₁/target)^{1/r}` and the time
+//! `s₁ (d*/d₁)^{1.2}` times [`ADAPTIVE_OVERHEAD`]. Adaptive meshes converge at least at
+//! the uniform rate, so the prediction errs on the side of more work alike for every
+//! candidate.
+
+use crate::families;
+use crate::report::{Outcome, Report, Settings};
+use crate::scene::{Domain, Exact, Posed, Scene};
+use fem_runtime::adaptivity::AdaptiveOptions;
+use fem_runtime::{Error, Result};
+use serde::Serialize;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The share of the tolerance that the modelling error of a cheaper model may take.
+pub const MODEL_SHARE: f64 = 0.5;
+
+/// The growth of a solve's time with its unknowns (`s ∝ d^1.2`: sparse factorizations
+/// and semismooth Newton steps on the beams and plates, measured from 10³ to 10⁵
+/// unknowns).
+pub const TIME_EXPONENT: f64 = 1.2;
+
+/// An adaptive solve's time over its last level's: the levels grow geometrically (by
+/// about 1.5–2 in unknowns with Dörfler marking at θ = ½), so the sum is about twice
+/// the last.
+pub const ADAPTIVE_OVERHEAD: f64 = 2.0;
+
+/// Below this rate (estimate against unknowns) a candidate is taken not to converge
+/// at the probe's meshes (a locking pair): it is not predicted to reach the target.
+pub const MIN_RATE: f64 = 0.05;
+
+/// One probe solve of a candidate.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ProbeLevel {
+    /// The mesh size N.
+    pub mesh_size: usize,
+    /// Unknowns.
+    pub dofs: usize,
+    /// Wall time of the solve, in seconds.
+    pub seconds: f64,
+    /// The estimate relative to `‖u_h‖_a`.
+    pub estimate_relative: f64,
+}
+
+/// A candidate of the choice: a model and one of its pairs.
+#[derive(Clone, Debug, Serialize)]
+pub struct Candidate {
+    /// The model in words (`Timoshenko`).
+    pub model: &'static str,
+    /// Its family.
+    pub family: &'static str,
+    /// The pair.
+    pub pair: &'static str,
+    /// Its probe solves (coarse, fine).
+    pub probe: Vec<ProbeLevel>,
+    /// The estimate's rate in the unknowns, `e ∝ d^{−rate}`, between the probes.
+    pub rate: Option<f64>,
+    /// The modelling estimate relative to `‖u_h‖_a` (0 for the scene's own model).
+    pub modelling_estimate: f64,
+    /// The discretization tolerance it must reach: `T − modelling`.
+    pub discretization_target: f64,
+    /// Predicted unknowns of the adaptive solve to that target.
+    pub predicted_dofs: Option<f64>,
+    /// Predicted wall time of that solve, in seconds.
+    pub predicted_seconds: Option<f64>,
+    /// The actual wall time, for the one solved.
+    pub actual_seconds: Option<f64>,
+    /// The actual unknowns of its final mesh, for the one solved.
+    pub actual_dofs: Option<usize>,
+    /// Whether its model is adequate (modelling estimate within the share of T) and its
+    /// target predicted to be reached.
+    pub adequate: bool,
+    /// Whether it was taken.
+    pub chosen: bool,
+    /// Why it is or is not adequate.
+    pub note: String,
+}
+
+/// Whether a tolerance chooses among several candidates for `scene`: its family
+/// declares a cheaper model, or the scene takes more than one pair.
+pub fn has_choice(scene: &Scene) -> bool {
+    let Some(family) = families::family(scene.family) else {
+        return false;
+    };
+    families::pairs_of(scene).len() > 1 || family.cheaper(scene).is_some()
+}
+
+/// The two mesh sizes the probes solve on: N and 2N on generated meshes (16, 32
+/// elements of a beam; 8×8 and 16×16 squares), 0 and 1 refinements of a mesh file;
+/// `given` (the request's size) replaces the coarser.
+fn probe_sizes(scene: &Scene, given: Option<usize>) -> [usize; 2] {
+    match (&scene.domain, given) {
+        (Domain::Gmsh(_) | Domain::Refined { .. }, n) => {
+            let n = n.unwrap_or(0);
+            [n, n + 1]
+        }
+        (_, Some(n)) => [n.max(1), 2 * n.max(1)],
+        (Domain::Interval { .. }, None) => [16, 32],
+        (_, None) => [8, 16],
+    }
+}
+
+/// Solves `scene` to the relative tolerance `tolerance` with the cheapest adequate
+/// candidate (module docs), and reports the choice in the outcome's report:
+/// `chosen_model`, `chosen_pair`, `tolerance`, `candidates` (every [`Candidate`]) and
+/// `choice_seconds` (the probes' time).
+///
+/// # Errors
+/// A load or parameter the scene refuses; the chosen solve's failure. A candidate whose
+/// probe fails is listed with its failure and not taken; where every probe fails, the
+/// first failure.
+pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outcome> {
+    let clock = Instant::now();
+    let family = families::family(scene.family)
+        .ok_or_else(|| Error::Input(format!("scene `{}` has no family", scene.name)))?;
+    let posed = crate::run::pose(scene, settings)?;
+    // the scene as posed: a request's parameters (--thickness) are the model's values
+    let mut rich = scene.clone();
+    rich.parameters = posed.parameters.clone();
+    rich.tolerance = None;
+    let mut models = vec![(family.model_words(&rich), rich.clone())];
+    if let Some(mut thin) = family.cheaper(&rich) {
+        thin.tolerance = None;
+        thin.exact = exact_of(&rich, &posed);
+        let words = families::family(thin.family).map_or("", |f| f.model_words(&thin));
+        models.push((words, thin));
+    }
+    let sizes = probe_sizes(scene, settings.mesh_size);
+    let mut candidates = Vec::new();
+    let mut scenes = Vec::new();
+    let mut first_failure = None;
+    for (words, model_scene) in &models {
+        for pair in families::pairs_of(model_scene) {
+            match probe(model_scene, pair.name, settings, sizes) {
+                Ok((probe, modelling)) => {
+                    candidates.push(judge(
+                        words,
+                        model_scene,
+                        pair.name,
+                        probe,
+                        modelling,
+                        tolerance,
+                    ));
+                }
+                Err(e) => {
+                    candidates.push(Candidate {
+                        model: words,
+                        family: model_scene.family,
+                        pair: pair.name,
+                        probe: Vec::new(),
+                        rate: None,
+                        modelling_estimate: f64::NAN,
+                        discretization_target: f64::NAN,
+                        predicted_dofs: None,
+                        predicted_seconds: None,
+                        actual_seconds: None,
+                        actual_dofs: None,
+                        adequate: false,
+                        chosen: false,
+                        note: format!("the probe failed: {e}"),
+                    });
+                    first_failure.get_or_insert(e);
+                }
+            }
+            scenes.push(model_scene);
+        }
+    }
+    let cost = |c: &Candidate| c.predicted_seconds.unwrap_or(f64::INFINITY);
+    let best = candidates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.adequate)
+        .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
+        .or_else(|| {
+            // none predicted to reach the target: the scene's own model's cheapest
+            // probed pair, whose adaptive loop then says how far it got
+            candidates
+                .iter()
+                .enumerate()
+                .filter(|(k, c)| !c.probe.is_empty() && scenes[*k].richer.is_none())
+                .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
+        })
+        .map(|(k, _)| k);
+    let Some(best) = best else {
+        return Err(first_failure.unwrap_or_else(|| {
+            Error::Input(format!(
+                "scene `{}` has no pair to solve it with",
+                scene.name
+            ))
+        }));
+    };
+    let probe_seconds = clock.elapsed().as_secs_f64();
+
+    let chosen_scene = scenes[best];
+    let target = candidates[best].discretization_target;
+    let solve_clock = Instant::now();
+    let final_settings = Settings {
+        pair: Some(candidates[best].pair.to_string()),
+        mesh_size: Some(sizes[0]),
+        adaptive: Some(AdaptiveOptions {
+            tolerance: target,
+            ..settings.adaptive.unwrap_or_default()
+        }),
+        ..settings.clone()
+    };
+    let mut outcome = families::solve(chosen_scene, &final_settings)?;
+    let chosen = &mut candidates[best];
+    chosen.chosen = true;
+    chosen.actual_seconds = Some(solve_clock.elapsed().as_secs_f64());
+    chosen.actual_dofs = Some(outcome.report.solve.dofs);
+    record(
+        &mut outcome.report,
+        scene,
+        &candidates,
+        best,
+        tolerance,
+        probe_seconds,
+    );
+    Ok(outcome)
+}
+
+/// The thick model's exact solution at its posed parameters, for the cheaper model's
+/// scene: the cheaper solve's errors are then against what the scene poses.
+fn exact_of(rich: &Scene, posed: &Posed) -> Exact {
+    if matches!(rich.exact, Exact::Unknown) {
+        return Exact::Unknown;
+    }
+    let rich = rich.clone();
+    let parameters = posed.parameters.clone();
+    Exact::Of(Arc::new(move |p: &Posed| {
+        rich.exact_at(&Posed {
+            load: p.load,
+            parameters: parameters.clone(),
+        })
+    }))
+}
+
+/// The two probe solves of `pair` on `scene`, and the modelling estimate of the finer
+/// one where the scene is a cheaper model's.
+fn probe(
+    scene: &Scene,
+    pair: &'static str,
+    settings: &Settings,
+    sizes: [usize; 2],
+) -> Result<(Vec<ProbeLevel>, f64)> {
+    let mut levels = Vec::new();
+    let mut modelling = 0.0;
+    for n in sizes {
+        let probe_settings = Settings {
+            pair: Some(pair.to_string()),
+            mesh_size: Some(n),
+            adaptive: None,
+            progress: None,
+            ..settings.clone()
+        };
+        let clock = Instant::now();
+        let outcome = families::solve(scene, &probe_settings)?;
+        let seconds = clock.elapsed().as_secs_f64();
+        let s = &outcome.report.solve;
+        let estimate_relative = s.estimate_relative.ok_or_else(|| {
+            Error::Input(format!(
+                "pair `{pair}` reports no relative estimate (its model declares no estimator, or ‖u_h‖_a = 0)"
+            ))
+        })?;
+        if scene.richer.is_some() {
+            modelling = outcome
+                .report
+                .number("modelling_estimate_relative")
+                .ok_or_else(|| {
+                    Error::Input(format!(
+                        "the cheaper model of scene `{}` reports no modelling estimate",
+                        scene.name
+                    ))
+                })?;
+        }
+        levels.push(ProbeLevel {
+            mesh_size: n,
+            dofs: s.dofs,
+            seconds,
+            estimate_relative,
+        });
+    }
+    Ok((levels, modelling))
+}
+
+/// A probed candidate judged against the tolerance: its target, rate and predicted cost.
+fn judge(
+    model: &'static str,
+    scene: &Scene,
+    pair: &'static str,
+    probe: Vec<ProbeLevel>,
+    modelling: f64,
+    tolerance: f64,
+) -> Candidate {
+    let target = tolerance - modelling;
+    let mut candidate = Candidate {
+        model,
+        family: scene.family,
+        pair,
+        probe,
+        rate: None,
+        modelling_estimate: modelling,
+        discretization_target: target,
+        predicted_dofs: None,
+        predicted_seconds: None,
+        actual_seconds: None,
+        actual_dofs: None,
+        adequate: false,
+        chosen: false,
+        note: String::new(),
+    };
+    if modelling > MODEL_SHARE * tolerance {
+        candidate.note = format!(
+            "the modelling estimate {modelling:.2e} exceeds {MODEL_SHARE} of the tolerance {tolerance:.0e}"
+        );
+        return candidate;
+    }
+    let [coarse, fine] = [candidate.probe[0], candidate.probe[1]];
+    let rate = (coarse.estimate_relative / fine.estimate_relative).ln()
+        / (fine.dofs as f64 / coarse.dofs as f64).ln();
+    candidate.rate = rate.is_finite().then_some(rate);
+    if fine.estimate_relative <= target {
+        candidate.predicted_dofs = Some(fine.dofs as f64);
+        candidate.predicted_seconds = Some(coarse.seconds + fine.seconds);
+        candidate.adequate = true;
+        candidate.note = "the probe's finer mesh already reaches the target".into();
+        return candidate;
+    }
+    if rate.is_nan() || rate < MIN_RATE {
+        candidate.note = format!(
+            "its estimate does not fall between the probes (rate {rate:.2}): it does not converge at these meshes"
+        );
+        return candidate;
+    }
+    let dofs = fine.dofs as f64 * (fine.estimate_relative / target).powf(1.0 / rate);
+    let limit = AdaptiveOptions::default().max_dofs as f64;
+    candidate.predicted_dofs = Some(dofs);
+    candidate.predicted_seconds =
+        Some(fine.seconds * (dofs / fine.dofs as f64).powf(TIME_EXPONENT) * ADAPTIVE_OVERHEAD);
+    candidate.adequate = dofs <= limit;
+    candidate.note = if candidate.adequate {
+        format!("predicted to reach {target:.2e} at rate {rate:.2}")
+    } else {
+        format!("predicted to need {dofs:.1e} unknowns, beyond the adaptive loop's {limit:.0e}")
+    };
+    candidate
+}
+
+/// The choice in the chosen solve's report.
+fn record(
+    report: &mut Report,
+    scene: &Scene,
+    candidates: &[Candidate],
+    best: usize,
+    tolerance: f64,
+    probe_seconds: f64,
+) {
+    let chosen = &candidates[best];
+    report.scene = scene.name.to_string();
+    report.set("chosen_model", chosen.model);
+    report.set("chosen_pair", chosen.pair);
+    report.set("tolerance", tolerance);
+    report.set("modelling_estimate_relative", chosen.modelling_estimate);
+    report.set("candidates", candidates);
+    report.set("choice_seconds", probe_seconds);
+    if !chosen.adequate {
+        report.warn(format!(
+            "no candidate was predicted to reach the tolerance {tolerance:.0e}: solved with {} ({}), the scene's own model",
+            chosen.pair, chosen.model
+        ));
+    }
+}

@@ -1,0 +1,189 @@
+//! The choice of model, pair and mesh for a tolerance (`fem_forms::models::choice`):
+//! the modelling estimate against the distance of the two models' fine solutions, and
+//! the chosen solution's true error against a fine reference of the scene's own model,
+//! both measured in the richer model's energy norm by quadrature on the union of the
+//! two meshes (independent of the estimators the choice uses).
+
+use fem_forms::adaptivity::AdaptiveOptions;
+use fem_forms::models::families;
+use fem_forms::models::report::{Outcome, Settings};
+use fem_forms::models::scene::Scene;
+use fem_forms::obstacle::ObstacleSolution;
+use fem_forms::IntervalMesh;
+
+/// A beam solution as a Timoshenko pair (θ, θ', γ) at x: an Euler–Bernoulli deflection
+/// as θ = w′ with no shear; the one-point shear of the reduced P1 pair at its cell's
+/// midpoint (the strain its energy holds).
+fn timoshenko_jet(outcome: &Outcome, x: f64) -> [f64; 3] {
+    let kept = outcome.solution.as_ref().expect("kept solution");
+    let solution = kept
+        .solution
+        .downcast_ref::<ObstacleSolution<IntervalMesh>>()
+        .expect("a beam solution");
+    let field = |name: &str| kept.fields.iter().position(|f| *f == name).unwrap();
+    let w = solution.view(field("w"));
+    match kept.fields.iter().position(|f| *f == "θ") {
+        None => [w.at(x, 1).unwrap(), w.at(x, 2).unwrap(), 0.0],
+        Some(theta) => {
+            let theta = solution.view(theta);
+            let at = if outcome.report.pair == "p1-p1-p0-reduced" {
+                let mesh = &solution.discretization.mesh;
+                let [a, b] = mesh.cell(mesh.locate(x).unwrap());
+                0.5 * (a + b)
+            } else {
+                x
+            };
+            [
+                theta.at(x, 0).unwrap(),
+                theta.at(x, 1).unwrap(),
+                w.at(at, 1).unwrap() - theta.at(at, 0).unwrap(),
+            ]
+        }
+    }
+}
+
+/// The cells' ends of a beam solution.
+fn breakpoints(outcome: &Outcome) -> Vec<f64> {
+    let kept = outcome.solution.as_ref().unwrap();
+    let solution = kept
+        .solution
+        .downcast_ref::<ObstacleSolution<IntervalMesh>>()
+        .unwrap();
+    solution.discretization.mesh.vertices().to_vec()
+}
+
+/// `(‖u_a − u_b‖, ‖u_b‖)` in the Timoshenko energy norm `∫ θ′² + t⁻² ∫ γ²`, by a
+/// 5-point Gauss rule on each interval of the union of the two meshes.
+fn timoshenko_distance(a: &Outcome, b: &Outcome, t: f64) -> (f64, f64) {
+    let mut points = breakpoints(a);
+    points.extend(breakpoints(b));
+    points.sort_by(f64::total_cmp);
+    points.dedup_by(|x, y| (*x - *y).abs() < 1e-14);
+    let rule = fem_forms::gauss_legendre(5);
+    let (mut distance, mut norm) = (0.0, 0.0);
+    for pair in points.windows(2) {
+        let (x0, x1) = (pair[0], pair[1]);
+        for (&xi, &weight) in rule.points.iter().zip(&rule.weights) {
+            // inside the interval, away from the breakpoints where a jet jumps
+            let x = x0 + (x1 - x0) * xi;
+            let [_, da, ga] = timoshenko_jet(a, x);
+            let [_, db, gb] = timoshenko_jet(b, x);
+            let dx = weight * (x1 - x0);
+            distance += dx * ((da - db).powi(2) + (ga - gb).powi(2) / (t * t));
+            norm += dx * (db * db + gb * gb / (t * t));
+        }
+    }
+    (distance.sqrt(), norm.sqrt())
+}
+
+fn scene(name: &str) -> Scene {
+    families::scene(name).unwrap_or_else(|| panic!("scene {name}"))
+}
+
+fn settings(pair: Option<&str>, elements: Option<usize>, t: Option<f64>) -> Settings {
+    Settings {
+        pair: pair.map(str::to_string),
+        mesh_size: elements,
+        parameters: t.map(|t| vec![("t".into(), t)]).unwrap_or_default(),
+        keep_solution: true,
+        ..Settings::default()
+    }
+}
+
+/// The fine Timoshenko P2 solution of `scene` at thickness t: the reference.
+fn reference(scene: &Scene, t: f64, elements: usize) -> Outcome {
+    families::solve(scene, &settings(Some("p2-p2-p0"), Some(elements), Some(t))).unwrap()
+}
+
+#[test]
+fn the_euler_bernoulli_modelling_estimate_is_the_distance_of_the_two_beams() {
+    let thick = scene("timoshenko-t1e-2");
+    let family = families::family("beam").unwrap();
+    for t in [1e-1, 1e-2, 1e-3, 1e-4] {
+        let mut posed = thick.clone();
+        posed.parameters = vec![("t".into(), t)];
+        let thin = family.cheaper(&posed).unwrap();
+        let bernoulli = families::solve(&thin, &settings(None, Some(1024), None)).unwrap();
+        let estimate = bernoulli.report.number("modelling_estimate").unwrap();
+        // λ concentrates in layers of width t at the contact's ends: an adaptive
+        // reference resolves them, where t⁻²h⁻² rounding forbids uniform meshes fine
+        // enough (docs/mathematics.md §3)
+        let request = Settings {
+            adaptive: Some(AdaptiveOptions {
+                tolerance: 1e-3,
+                ..AdaptiveOptions::default()
+            }),
+            ..settings(Some("p2-p2-p0"), None, Some(t))
+        };
+        let timoshenko = families::solve(&posed, &request).unwrap();
+        let uncertainty = timoshenko.report.solve.estimate.unwrap();
+        let (distance, norm) = timoshenko_distance(&bernoulli, &timoshenko, t);
+        let ratio = estimate / distance;
+        println!(
+            "t = {t:e}: estimate {estimate:.4e}, distance {distance:.4e} ({:.3e} of ‖u‖), ratio {ratio:.4}, reference's estimate {uncertainty:.1e}",
+            distance / norm
+        );
+        // reliable (the hypercircle bound) and asymptotically exact as t → 0, up to the
+        // reference's own error
+        assert!(
+            estimate >= distance - uncertainty && estimate <= 1.15 * distance + uncertainty,
+            "t = {t}: ratio {ratio}"
+        );
+        if (1e-3..=1e-2).contains(&t) {
+            assert!((0.99..1.02).contains(&ratio), "t = {t}: ratio {ratio}");
+        }
+    }
+}
+
+#[test]
+fn the_chosen_beam_is_within_the_tolerance_of_the_timoshenko_reference() {
+    for (name, t) in [
+        ("timoshenko-t1e-1", 1e-1),
+        ("timoshenko-t1e-2", 1e-2),
+        ("timoshenko-t1e-3", 1e-3),
+    ] {
+        let scene = scene(name);
+        let reference = reference(&scene, t, 2048);
+        for tolerance in [5e-2, 1e-2, 2e-3] {
+            let request = Settings {
+                adaptive: Some(AdaptiveOptions {
+                    tolerance,
+                    ..AdaptiveOptions::default()
+                }),
+                ..settings(None, None, None)
+            };
+            let chosen = families::solve(&scene, &request).unwrap();
+            let model = chosen.report.quantities["chosen_model"].as_str().unwrap();
+            let (distance, norm) = timoshenko_distance(&chosen, &reference, t);
+            println!(
+                "{name}, T = {tolerance:e}: {model} {} with {} unknowns, true error {:.3e}",
+                chosen.report.pair,
+                chosen.report.solve.dofs,
+                distance / norm
+            );
+            assert!(distance / norm <= tolerance, "{name}, T = {tolerance}");
+            // the modelling error of Euler–Bernoulli is about 9.4 t of ‖u‖ here: adequate
+            // (at most half of T) for the thin beam at the loosest tolerance alone
+            let thin = t == 1e-3 && tolerance == 5e-2;
+            assert_eq!(model == "Euler–Bernoulli", thin, "{name}, T = {tolerance}");
+            let candidates = chosen.report.quantities["candidates"].as_array().unwrap();
+            assert_eq!(candidates.len(), 4, "three Timoshenko pairs and Hermite");
+            assert_eq!(candidates.iter().filter(|c| c["chosen"] == true).count(), 1);
+        }
+    }
+}
+
+#[test]
+fn a_pair_given_fixes_the_model_and_the_pair() {
+    let scene = scene("timoshenko-t1e-3");
+    let request = Settings {
+        adaptive: Some(AdaptiveOptions {
+            tolerance: 5e-2,
+            ..AdaptiveOptions::default()
+        }),
+        ..settings(Some("p2-p2-p0"), None, None)
+    };
+    let outcome = families::solve(&scene, &request).unwrap();
+    assert_eq!(outcome.report.pair, "p2-p2-p0");
+    assert!(!outcome.report.quantities.contains_key("chosen_model"));
+}
