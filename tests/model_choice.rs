@@ -5,9 +5,9 @@
 //! two meshes (independent of the estimators the choice uses).
 
 use fem_forms::adaptivity::AdaptiveOptions;
-use fem_forms::models::families;
 use fem_forms::models::report::{Outcome, Settings};
-use fem_forms::models::scene::Scene;
+use fem_forms::models::scene::{Adjustment, Scene, Support};
+use fem_forms::models::{choice, families};
 use fem_forms::obstacle::ObstacleSolution;
 use fem_forms::IntervalMesh;
 
@@ -186,4 +186,70 @@ fn a_pair_given_fixes_the_model_and_the_pair() {
     let outcome = families::solve(&scene, &request).unwrap();
     assert_eq!(outcome.report.pair, "p2-p2-p0");
     assert!(!outcome.report.quantities.contains_key("chosen_model"));
+}
+
+/// The Kirchhoff plate of a Reissner–Mindlin scene at thickness t (its cheaper model).
+fn kirchhoff_of(name: &str, t: f64, adjust: Option<Adjustment>) -> Scene {
+    let plates = families::family("plate").unwrap();
+    let mut posed = scene(name);
+    if let Some(adjustment) = adjust {
+        plates.adjust(&mut posed, &adjustment).unwrap();
+    }
+    for (n, v) in &mut posed.parameters {
+        if &**n == "t" {
+            *v = t;
+        }
+    }
+    plates.cheaper(&posed).unwrap()
+}
+
+#[test]
+fn the_soft_simple_supports_layer_keeps_a_thin_plate_from_kirchhoff() {
+    let mut layers = Vec::new();
+    for t in [1e-1, 1e-2, 1e-3, 1e-4] {
+        let soft = kirchhoff_of("mindlin-ss-t1e-2", t, None);
+        let outcome =
+            families::solve(&soft, &settings(Some("argyris-p0"), Some(16), None)).unwrap();
+        let shear = outcome.report.number("modelling_estimate_shear").unwrap();
+        let layer = outcome.report.number("modelling_estimate_layer").unwrap();
+        println!("t = {t:e}: shear {shear:.4e}, layer {layer:.4e}");
+        // the layer's energy is of order t, the shear's t²: the layer dominates thin plates
+        assert!(layer > shear, "t = {t}");
+        layers.push(layer);
+    }
+    for pair in layers.windows(2) {
+        let ratio = pair[0] / pair[1];
+        assert!((ratio / 10f64.sqrt() - 1.0).abs() < 1e-9, "ratio {ratio}");
+    }
+    // at t = 0.001 and T = 5 %: Kirchhoff is adequate clamped (its modelling error is
+    // the shear's, ~1e-3 of ‖u‖) and not on the soft support (the layer's, ~3 %)
+    let request = Settings {
+        adaptive: Some(AdaptiveOptions {
+            tolerance: 5e-2,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    let plates = families::family("plate").unwrap();
+    for (support, kirchhoff_adequate) in [
+        (Support::Clamped, true),
+        (Support::SimplySupported { hard: false }, false),
+    ] {
+        let mut scene = scene("mindlin-ss-t1e-3");
+        plates
+            .adjust(&mut scene, &Adjustment::Support(support))
+            .unwrap();
+        let candidates = choice::candidates(&scene, &request, 5e-2).unwrap();
+        for c in candidates.iter().filter(|c| c.model == "Kirchhoff") {
+            println!(
+                "{support:?}: {} {:.3e} {}",
+                c.pair, c.modelling_estimate, c.note
+            );
+            assert_eq!(
+                c.modelling_estimate <= 0.5 * 5e-2,
+                kirchhoff_adequate,
+                "{support:?}"
+            );
+        }
+    }
 }

@@ -162,6 +162,7 @@ fn sign_test_both_sides_press_onto_the_obstacle_everywhere() {
                     side: s,
                     load_sign: -s,
                     thickness: 1e-2,
+                    load: 1.0,
                 };
                 let r = Settings {
                     pair: Some(pair.to_string()),

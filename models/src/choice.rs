@@ -128,6 +128,85 @@ fn probe_sizes(scene: &Scene, given: Option<usize>) -> [usize; 2] {
 /// first failure.
 pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outcome> {
     let clock = Instant::now();
+    let Probed {
+        mut candidates,
+        scenes,
+        sizes,
+        first_failure,
+    } = probe_all(scene, settings, tolerance)?;
+    let cost = |c: &Candidate| c.predicted_seconds.unwrap_or(f64::INFINITY);
+    let best = candidates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.adequate)
+        .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
+        .or_else(|| {
+            // none predicted to reach the target: the scene's own model's cheapest
+            // probed pair, whose adaptive loop then says how far it got
+            candidates
+                .iter()
+                .enumerate()
+                .filter(|(k, c)| !c.probe.is_empty() && scenes[*k].richer.is_none())
+                .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
+        })
+        .map(|(k, _)| k);
+    let Some(best) = best else {
+        return Err(first_failure.unwrap_or_else(|| {
+            Error::Input(format!(
+                "scene `{}` has no pair to solve it with",
+                scene.name
+            ))
+        }));
+    };
+    let probe_seconds = clock.elapsed().as_secs_f64();
+
+    let chosen_scene = &scenes[best];
+    let target = candidates[best].discretization_target;
+    let solve_clock = Instant::now();
+    let final_settings = Settings {
+        pair: Some(candidates[best].pair.to_string()),
+        mesh_size: Some(sizes[0]),
+        adaptive: Some(AdaptiveOptions {
+            tolerance: target,
+            ..settings.adaptive.unwrap_or_default()
+        }),
+        ..settings.clone()
+    };
+    let mut outcome = families::solve(chosen_scene, &final_settings)?;
+    let chosen = &mut candidates[best];
+    chosen.chosen = true;
+    chosen.actual_seconds = Some(solve_clock.elapsed().as_secs_f64());
+    chosen.actual_dofs = Some(outcome.report.solve.dofs);
+    record(
+        &mut outcome.report,
+        scene,
+        &candidates,
+        best,
+        tolerance,
+        probe_seconds,
+    );
+    Ok(outcome)
+}
+
+/// The candidates of `scene` for `tolerance`, probed and judged, without the final
+/// solve: what [`choose`] weighs (the model-choice tests read it).
+///
+/// # Errors
+/// Those of [`choose`] before its solve.
+pub fn candidates(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Vec<Candidate>> {
+    Ok(probe_all(scene, settings, tolerance)?.candidates)
+}
+
+/// Every candidate probed: the candidates, the scene each is posed on, the probes'
+/// mesh sizes and the first probe failure.
+struct Probed {
+    candidates: Vec<Candidate>,
+    scenes: Vec<Scene>,
+    sizes: [usize; 2],
+    first_failure: Option<Error>,
+}
+
+fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probed> {
     let family = families::family(scene.family)
         .ok_or_else(|| Error::Input(format!("scene `{}` has no family", scene.name)))?;
     let posed = crate::run::pose(scene, settings)?;
@@ -179,61 +258,15 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
                     first_failure.get_or_insert(e);
                 }
             }
-            scenes.push(model_scene);
+            scenes.push(model_scene.clone());
         }
     }
-    let cost = |c: &Candidate| c.predicted_seconds.unwrap_or(f64::INFINITY);
-    let best = candidates
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.adequate)
-        .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
-        .or_else(|| {
-            // none predicted to reach the target: the scene's own model's cheapest
-            // probed pair, whose adaptive loop then says how far it got
-            candidates
-                .iter()
-                .enumerate()
-                .filter(|(k, c)| !c.probe.is_empty() && scenes[*k].richer.is_none())
-                .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
-        })
-        .map(|(k, _)| k);
-    let Some(best) = best else {
-        return Err(first_failure.unwrap_or_else(|| {
-            Error::Input(format!(
-                "scene `{}` has no pair to solve it with",
-                scene.name
-            ))
-        }));
-    };
-    let probe_seconds = clock.elapsed().as_secs_f64();
-
-    let chosen_scene = scenes[best];
-    let target = candidates[best].discretization_target;
-    let solve_clock = Instant::now();
-    let final_settings = Settings {
-        pair: Some(candidates[best].pair.to_string()),
-        mesh_size: Some(sizes[0]),
-        adaptive: Some(AdaptiveOptions {
-            tolerance: target,
-            ..settings.adaptive.unwrap_or_default()
-        }),
-        ..settings.clone()
-    };
-    let mut outcome = families::solve(chosen_scene, &final_settings)?;
-    let chosen = &mut candidates[best];
-    chosen.chosen = true;
-    chosen.actual_seconds = Some(solve_clock.elapsed().as_secs_f64());
-    chosen.actual_dofs = Some(outcome.report.solve.dofs);
-    record(
-        &mut outcome.report,
-        scene,
-        &candidates,
-        best,
-        tolerance,
-        probe_seconds,
-    );
-    Ok(outcome)
+    Ok(Probed {
+        candidates,
+        scenes,
+        sizes,
+        first_failure,
+    })
 }
 
 /// The thick model's exact solution at its posed parameters, for the cheaper model's

@@ -255,5 +255,58 @@ pub const MINDLIN_DISK: PlateScene = PlateScene {
     reference: PlateReference::ClampedDisk,
 };
 
+/// A simply supported (soft: w = 0, rotations free) unit square pushed up by q = 20
+/// against a flat obstacle w ≤ 0.05, at thickness t: the Mindlin rotations' boundary
+/// layer at the soft support keeps the Kirchhoff model from being adequate on
+/// thickness alone (the model-choice scenes).
+const fn simply_supported_obstacle(
+    name: &'static str,
+    description: &'static str,
+    thickness: f64,
+) -> PlateScene {
+    PlateScene {
+        name,
+        description,
+        support: PlateSupport::SimplySupported,
+        load: 20.0,
+        loads: &[20.0],
+        obstacle: PlateObstacle::FlatAbove { height: 0.05 },
+        thickness,
+        mesh_size: 16,
+        reference: PlateReference::KirchhoffCentre {
+            coefficient: 0.00406235,
+        },
+        ..MINDLIN_SQUARE
+    }
+}
+
+/// The simply supported square against its obstacle at t = 0.1.
+pub const MINDLIN_SS_T1E1: PlateScene = simply_supported_obstacle(
+    "mindlin-ss-t1e-1",
+    "simply supported unit square Reissner–Mindlin plate (t = 0.1) pushed up by q = 20 against w ≤ 0.05",
+    1e-1,
+);
+
+/// The simply supported square against its obstacle at t = 0.01.
+pub const MINDLIN_SS_T1E2: PlateScene = simply_supported_obstacle(
+    "mindlin-ss-t1e-2",
+    "simply supported unit square Reissner–Mindlin plate (t = 0.01) pushed up by q = 20 against w ≤ 0.05",
+    1e-2,
+);
+
+/// The simply supported square against its obstacle at t = 0.001.
+pub const MINDLIN_SS_T1E3: PlateScene = simply_supported_obstacle(
+    "mindlin-ss-t1e-3",
+    "simply supported unit square Reissner–Mindlin plate (t = 0.001) pushed up by q = 20 against w ≤ 0.05",
+    1e-3,
+);
+
 /// Every built-in plate scene.
-pub const PLATE_SCENES: &[PlateScene] = &[MINDLIN_SQUARE, MINDLIN_SQUARE_SS, MINDLIN_DISK];
+pub const PLATE_SCENES: &[PlateScene] = &[
+    MINDLIN_SQUARE,
+    MINDLIN_SQUARE_SS,
+    MINDLIN_DISK,
+    MINDLIN_SS_T1E1,
+    MINDLIN_SS_T1E2,
+    MINDLIN_SS_T1E3,
+];

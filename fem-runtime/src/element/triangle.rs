@@ -418,6 +418,8 @@ pub struct TriangleBasis {
     dy: Vec<Polynomial2>,
     /// `∂²/∂ξ², ∂²/∂ξ∂η, ∂²/∂η²` of each basis function.
     second: [Vec<Polynomial2>; 3],
+    /// `∂³/∂ξ³, ∂³/∂ξ²∂η, ∂³/∂ξ∂η², ∂³/∂η³` of each basis function.
+    third: [Vec<Polynomial2>; 4],
 }
 
 impl TriangleBasis {
@@ -428,11 +430,14 @@ impl TriangleBasis {
         let dy = values.iter().map(|p| p.derivative(0, 1)).collect();
         let second = [(2, 0), (1, 1), (0, 2)]
             .map(|(i, j)| values.iter().map(|p| p.derivative(i, j)).collect());
+        let third = [(3, 0), (2, 1), (1, 2), (0, 3)]
+            .map(|(i, j)| values.iter().map(|p| p.derivative(i, j)).collect());
         Self {
             values,
             dx,
             dy,
             second,
+            third,
         }
     }
 }
@@ -577,6 +582,53 @@ impl TriangleField<'_> {
             }
         }
         map.hessian([[h[0], h[1]], [h[1], h[2]]])
+    }
+
+    /// The physical third derivatives `D³u_h[i][j][k]` at reference point `ξ` of cell
+    /// `c` (zero for elements of degree below 3): a Kirchhoff plate's shear force is
+    /// `Q = −D ∇(Δw)`, `(∇Δw)_i = Σ_j D³w[i][j][j]`.
+    pub fn third_derivatives(
+        &self,
+        basis: &TriangleBasis,
+        map: &AffineMap,
+        c: usize,
+        xi: [f64; 2],
+    ) -> [[[f64; 2]; 2]; 2] {
+        let local = self.transformed(c).unwrap_or_else(|| {
+            let dofs = self.map.cell_dofs(c);
+            dofs.iter().map(|&d| self.coefficients[d]).collect()
+        });
+        // ∂ξξξ, ∂ξξη, ∂ξηη, ∂ηηη of the reference function
+        let mut t = [0.0; 4];
+        for (i, u) in local.iter().enumerate() {
+            for (k, derivative) in basis.third.iter().enumerate() {
+                t[k] += u * derivative[i].eval(xi);
+            }
+        }
+        let reference = |a: usize, b: usize, d: usize| t[a + b + d];
+        // each index mapped to physical coordinates in turn: ∂/∂x = Kᵀ ∂/∂ξ
+        let mut out = [[[0.0; 2]; 2]; 2];
+        let once: [[[f64; 2]; 2]; 2] = std::array::from_fn(|a| {
+            std::array::from_fn(|b| map.gradient([reference(a, b, 0), reference(a, b, 1)]))
+        });
+        let mut twice = [[[0.0; 2]; 2]; 2];
+        for a in 0..2 {
+            for k in 0..2 {
+                let g = map.gradient([once[a][0][k], once[a][1][k]]);
+                for j in 0..2 {
+                    twice[a][j][k] = g[j];
+                }
+            }
+        }
+        for j in 0..2 {
+            for k in 0..2 {
+                let g = map.gradient([twice[0][j][k], twice[1][j][k]]);
+                for i in 0..2 {
+                    out[i][j][k] = g[i];
+                }
+            }
+        }
+        out
     }
 
     /// Value at a physical point, `None` outside the mesh.
@@ -962,6 +1014,40 @@ mod tests {
             for r in 0..2 {
                 for s in 0..2 {
                     assert!((h[r][s] - exact[r][s]).abs() < 1e-9, "cell {c}: {h:?}");
+                }
+            }
+        }
+    }
+
+    /// A P3 field interpolating `u = x³ + 2x²y − xy² + 3y³` has its third derivatives at
+    /// any point of any cell of a disk mesh: the map of each index to physical
+    /// coordinates.
+    #[test]
+    fn p3_field_reproduces_third_derivatives_of_a_cubic() {
+        let mesh = TriangleMesh::disk([0.3, -0.1], 1.5, 3).unwrap();
+        let map = DofMap::on_triangles(&mesh, ElementKind::P3);
+        let coefficients: Vec<f64> = map
+            .nodes(&mesh)
+            .iter()
+            .map(|&[x, y]| x * x * x + 2.0 * x * x * y - x * y * y + 3.0 * y * y * y)
+            .collect();
+        let field = TriangleField {
+            mesh: &mesh,
+            map: &map,
+            coefficients: &coefficients,
+        };
+        let basis = TriangleBasis::new(ElementKind::P3);
+        // u_xxx = 6, u_xxy = 4, u_xyy = −2, u_yyy = 18
+        let exact = [[[6.0, 4.0], [4.0, -2.0]], [[4.0, -2.0], [-2.0, 18.0]]];
+        for c in 0..mesh.cell_count() {
+            let affine = AffineMap::of(&mesh, c);
+            let d3 = field.third_derivatives(&basis, &affine, c, [0.21, 0.37]);
+            for i in 0..2 {
+                for j in 0..2 {
+                    for k in 0..2 {
+                        let e = (d3[i][j][k] - exact[i][j][k]).abs();
+                        assert!(e < 1e-7, "cell {c}: {d3:?}");
+                    }
                 }
             }
         }

@@ -6,11 +6,12 @@
 
 use crate::data::Data;
 use crate::family::{Family, Opt, Pair, PairSolve};
+use crate::geometry::Geometry;
 use crate::geometry::{halving_sizes, Fields};
 use crate::kirchhoff::{kirchhoff_argyris_p0, kirchhoff_argyris_p1disc, kirchhoff_morley_p0};
 use crate::run::{run, Quantities, Report, Run};
 use crate::scene::{Adjustment, Domain, Load, Part, Posed, Scene, StudyVariant, Support};
-use fem_runtime::element::triangle::TriangleBasis;
+use fem_runtime::element::triangle::{AffineMap, TriangleBasis};
 use fem_runtime::problem::{MemoryModel, ObstacleSide};
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{Error, Model, Result, TriangleMesh};
@@ -232,6 +233,10 @@ impl Family for KirchhoffPlates {
         ]
     }
 
+    fn model_words(&self, _: &Scene) -> &'static str {
+        "Kirchhoff"
+    }
+
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[
             ("bending_stiffness", "D"),
@@ -399,6 +404,17 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 .join(", "),
         );
         report.set("obstacle", facts.map_or("ψ", |f| f.obstacle));
+        if run.scene.richer.is_some() {
+            if let Some([interior, layer]) = modelling_estimate(run) {
+                let estimate = interior.hypot(layer);
+                report.set("modelling_estimate", estimate);
+                report.set("modelling_estimate_shear", interior);
+                report.set("modelling_estimate_layer", layer);
+                if let Some(norm) = run.solved.estimate.as_ref().map(|e| e.energy_norm) {
+                    report.set("modelling_estimate_relative", estimate / norm);
+                }
+            }
+        }
         let w = run.constrained_field();
         let view = solution.view(w);
         let basis = TriangleBasis::new(view.map.element());
@@ -747,6 +763,97 @@ pub fn interior_statistics(
         mean: values.iter().sum::<f64>() / values.len() as f64,
         max_relative_error: (max - q).abs().max((min - q).abs()) / q,
     })
+}
+
+/// The modelling error of a Kirchhoff deflection as a Reissner–Mindlin plate whose
+/// parameters `richer` holds (thickness `t`, shear correction `κ`), as
+/// `[interior, layer]` in the energy norm.
+///
+/// - Interior: the shear force `Q = −D ∇(Δw)` that w implies is in equilibrium with the
+///   load and carries the Mindlin shear compliance `t² / (6κ(1−ν)D)`; by the hypercircle
+///   identity the shear energy the thinner model leaves out is
+///   `t² D / (6κ(1−ν)) ‖∇Δw‖²` (`../shared/MODELS.md` §9).
+/// - Layer: where the Mindlin rotations are free on the boundary (a soft simple support,
+///   a free edge) the twisting moment `M_ns = −D(1−ν) n·∇∇w·τ` of the Kirchhoff solution
+///   does not vanish as the Mindlin one must; the rotation's boundary layer of width
+///   `δ = t/√(12κ)` (Arnold–Falk) that cancels it holds the energy
+///   `2δ/(D(1−ν)) ∫ M_ns² ds` (the layer `φ(ρ) = A e^{−ρ/δ}` of
+///   `D(1−ν)/2 φ″ = S φ` with `D(1−ν)/2 φ′(0) = M_ns`).
+///
+/// `None` for elements of degree below 3, whose `∇Δw` vanishes on every cell (Morley:
+/// its shear lives in the jumps, which this estimate does not read).
+fn modelling_estimate<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Option<[f64; 2]> {
+    let richer = run.scene.richer.as_ref()?;
+    let get = |name: &str| richer.iter().find(|(n, _)| &**n == name).map(|(_, v)| *v);
+    let t = get("t")?;
+    let kappa = get("κ").unwrap_or(5.0 / 6.0);
+    let own = |name: &str| {
+        M::PARAMS
+            .iter()
+            .position(|p| *p == name)
+            .map(|k| run.solved.params[k])
+    };
+    let (d, nu) = (own("D")?, own("ν")?);
+    let solution = &run.solved.solution;
+    let view = solution.view(run.constrained_field());
+    if view.map.element().degree() < 3 {
+        return None;
+    }
+    let mesh = view.mesh;
+    let basis = TriangleBasis::new(view.map.element());
+    let rule = fem_runtime::reference::triangle::TriangleRule::exact_for_degree(
+        2 * (view.map.element().degree() - 3),
+    );
+    let mut shear = 0.0;
+    for c in 0..mesh.cell_count() {
+        let map = AffineMap::of(mesh, c);
+        for (&xi, &weight) in rule.points.iter().zip(&rule.weights) {
+            let third = view.third_derivatives(&basis, &map, c, xi);
+            let grad_laplacian = [0, 1].map(|i| third[i][0][0] + third[i][1][1]);
+            shear += weight * map.det * (grad_laplacian[0].powi(2) + grad_laplacian[1].powi(2));
+        }
+    }
+    let interior = t * (d / (6.0 * kappa * (1.0 - nu))).sqrt() * shear.sqrt();
+
+    // the support that holds each boundary edge: the last whose part holds its marker
+    let parts: Vec<(fem_runtime::DirichletPart, Support)> = run
+        .scene
+        .supports
+        .iter()
+        .filter_map(|s| Some((Geometry::part(mesh, &s.part).ok()?, s.support)))
+        .collect();
+    let rotations_free =
+        |marker: u32| match parts.iter().rev().find(|(part, _)| part.contains(marker)) {
+            None => true,
+            Some((_, support)) => matches!(
+                support,
+                Support::Free | Support::SimplySupported { hard: false }
+            ),
+        };
+    let line = fem_runtime::gauss_legendre(4);
+    let mut twisting = 0.0;
+    for &(e, marker) in mesh.boundary_edges() {
+        if !rotations_free(marker) {
+            continue;
+        }
+        let (c, _) = mesh.edge_cells(e);
+        let map = AffineMap::of(mesh, c);
+        let [a, b] = mesh.edges()[e].map(|v| mesh.vertices()[v]);
+        let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let tau = [(b[0] - a[0]) / length, (b[1] - a[1]) / length];
+        let n = [tau[1], -tau[0]];
+        for (&s, &weight) in line.points.iter().zip(&line.weights) {
+            let x = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
+            let h = view.hessian(&basis, &map, c, map.reference_point(x));
+            let m = (0..2)
+                .map(|i| (0..2).map(|j| n[i] * h[i][j] * tau[j]).sum::<f64>())
+                .sum::<f64>();
+            twisting += weight * length * m * m;
+        }
+    }
+    let delta = t / (12.0 * kappa).sqrt();
+    let layer = (2.0 * delta * d * (1.0 - nu) * twisting).sqrt();
+    Some([interior, layer])
 }
 
 #[cfg(test)]

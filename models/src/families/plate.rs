@@ -208,6 +208,32 @@ impl Family for Plates {
         })
     }
 
+    fn model_words(&self, _: &Scene) -> &'static str {
+        "Reissner–Mindlin"
+    }
+
+    /// The Kirchhoff plate of the same domain, supports, load and obstacle, on Argyris
+    /// (whose ∇Δw gives the modelling estimate; Morley's vanishes on every cell).
+    fn cheaper(&self, scene: &Scene) -> Option<Scene> {
+        scene.parameter("t")?;
+        let mut thin = scene.clone();
+        thin.name = format!("{}-kirchhoff", scene.name).into();
+        thin.family = "kirchhoff";
+        thin.richer = Some(scene.parameters.clone());
+        let kirchhoff = ["D", "ν"];
+        thin.parameters
+            .retain(|(name, _)| kirchhoff.contains(&&**name));
+        thin.pairs = vec!["argyris-p0", "argyris-p1disc"];
+        // Argyris elements are straight: the disk becomes its inscribed polygon
+        if let Domain::Disk { curved, .. } = &mut thin.domain {
+            *curved = false;
+        }
+        thin.reference = None;
+        thin.studies = Vec::new();
+        thin.study_variants = Vec::new();
+        Some(thin)
+    }
+
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[
             ("thickness", "t"),
