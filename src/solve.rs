@@ -1,5 +1,5 @@
 //! `fem-forms solve`: a scene (built-in or from a file) with the command line's options,
-//! through the registry's one path ([`fem_forms::models::families::solve`]), printed as a
+//! through the registry's one path ([`fem_forms::models::choice::solve`]), printed as a
 //! summary or as JSON, with its chart or ParaView file where asked.
 
 use crate::{SolveOptions, SolverName};
@@ -266,7 +266,7 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
         settings.progress = Some(progress);
         bar
     });
-    let outcome = families::solve(&scene, &settings);
+    let outcome = fem_forms::models::choice::solve(&scene, &settings);
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }

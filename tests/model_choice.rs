@@ -152,7 +152,7 @@ fn the_chosen_beam_is_within_the_tolerance_of_the_timoshenko_reference() {
                 }),
                 ..settings(None, None, None)
             };
-            let chosen = families::solve(&scene, &request).unwrap();
+            let chosen = choice::solve(&scene, &request).unwrap();
             let model = chosen.report.quantities["chosen_model"].as_str().unwrap();
             let (distance, norm) = timoshenko_distance(&chosen, &reference, t);
             println!(
@@ -183,7 +183,7 @@ fn a_pair_given_fixes_the_model_and_the_pair() {
         }),
         ..settings(Some("p2-p2-p0"), None, None)
     };
-    let outcome = families::solve(&scene, &request).unwrap();
+    let outcome = choice::solve(&scene, &request).unwrap();
     assert_eq!(outcome.report.pair, "p2-p2-p0");
     assert!(!outcome.report.quantities.contains_key("chosen_model"));
 }

@@ -12,7 +12,8 @@
 //! that the triangle inequality keeps the total within T. Among the adequate candidates
 //! the one with the least predicted time is solved adaptively from the probe's coarse
 //! mesh; the report lists every candidate with its estimates and its predicted cost,
-//! and the chosen one's actual cost.
+//! and the chosen one's actual cost. Where none is adequate, the scene's own model with
+//! its default pair is solved, as without a choice.
 //!
 //! The prediction: with the relative estimates `e₀, e₁` at `d₀, d₁` unknowns, the rate
 //! `r = ln(e₀/e₁) / ln(d₁/d₀)`, the unknowns `d* = d₁ (e₁/target)^{1/r}` and the time
@@ -93,6 +94,22 @@ pub struct Candidate {
     pub note: String,
 }
 
+/// Solves `scene` as `settings` ask: asked for a tolerance (`settings.adaptive`, or the
+/// scene's `tol`) without a pair, with the cheapest adequate candidate where the scene has
+/// more than one ([`choose`]); otherwise with [`families::solve`].
+///
+/// # Errors
+/// Those of [`choose`] and [`families::solve`].
+pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
+    if settings.pair.is_none() {
+        let tolerance = settings.adaptive.map(|a| a.tolerance).or(scene.tolerance);
+        if let Some(tolerance) = tolerance.filter(|_| has_choice(scene)) {
+            return choose(scene, settings, tolerance);
+        }
+    }
+    families::solve(scene, settings)
+}
+
 /// Whether a tolerance chooses among several candidates for `scene`: its family
 /// declares a cheaper model, or the scene takes more than one pair.
 pub fn has_choice(scene: &Scene) -> bool {
@@ -141,13 +158,13 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
         .filter(|(_, c)| c.adequate)
         .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
         .or_else(|| {
-            // none predicted to reach the target: the scene's own model's cheapest
-            // probed pair, whose adaptive loop then says how far it got
+            // none predicted to reach the target: the scene's own model with its default
+            // pair, whose adaptive loop then says how far it got (or that the solution
+            // vanishes)
             candidates
                 .iter()
                 .enumerate()
-                .filter(|(k, c)| !c.probe.is_empty() && scenes[*k].richer.is_none())
-                .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
+                .find(|(k, _)| scenes[*k].richer.is_none())
         })
         .map(|(k, _)| k);
     let Some(best) = best else {

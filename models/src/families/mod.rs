@@ -88,20 +88,12 @@ pub fn pairs_of(scene: &Scene) -> Vec<&'static Pair> {
     }
 }
 
-/// Solves `scene` with the pair `settings` name (its default otherwise). Asked for a
-/// tolerance (`settings.adaptive`, or the scene's `tol`) without a pair, a scene with
-/// more than one candidate model or pair is solved with the cheapest adequate one
-/// ([`crate::choice::choose`]).
+/// Solves `scene` with the pair `settings` name (its default otherwise); a tolerance
+/// refines its mesh adaptively. [`crate::choice::solve`] also chooses the model and pair.
 ///
 /// # Errors
 /// A pair the scene's family does not have or the scene does not take, and the solve's.
 pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
-    if settings.pair.is_none() {
-        let tolerance = settings.adaptive.map(|a| a.tolerance).or(scene.tolerance);
-        if let Some(tolerance) = tolerance.filter(|_| crate::choice::has_choice(scene)) {
-            return crate::choice::choose(scene, settings, tolerance);
-        }
-    }
     let pair = pair_of(scene, settings.pair.as_deref())?;
     (pair.solve)(pair, scene, settings)
 }
