@@ -13,6 +13,7 @@
 pub mod accuracy;
 pub mod adaptivity_study;
 pub mod allocator;
+pub mod choice_study;
 pub mod lambda_scatter;
 pub mod locking;
 pub mod plot;

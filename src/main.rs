@@ -617,6 +617,12 @@ fn registry_study(
 ) -> Result<(), String> {
     let name = scene.name.to_string();
     let hosted = scene.studies.clone();
+    let work_precision = Study::WorkPrecision.name();
+    if kind == Some(work_precision) && !hosted.contains(&work_precision) {
+        // every scene has the chart of its candidates and of the choice made for them
+        return fem_forms::choice_study::run(&scene, full, out)
+            .map_err(|e| format!("study {name} {work_precision}: {e}"));
+    }
     if hosted.is_empty() {
         let hosts: Vec<String> = families::scenes()
             .iter()
@@ -651,6 +657,9 @@ fn registry_study(
             vec![scene.clone()]
         };
         for posed in scenes {
+            if study == Study::WorkPrecision {
+                fem_forms::choice_study::run(&posed, full, out).map_err(failed)?;
+            }
             let studies = fem_forms::registry_studies::RegistryStudies::new(posed);
             studies::run(&studies, study, full, out).map_err(failed)?;
         }

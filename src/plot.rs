@@ -13,6 +13,9 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Draw markers at the points as well as the line.
     pub markers: bool,
+    /// Draw large triangles at the points and no line (a point singled out on
+    /// the curves, such as a choice made), in the colour of the series with this index.
+    pub highlight: Option<usize>,
 }
 
 impl Series {
@@ -22,6 +25,7 @@ impl Series {
             name: name.into(),
             points,
             markers: false,
+            highlight: None,
         }
     }
 
@@ -31,6 +35,18 @@ impl Series {
             name: name.into(),
             points,
             markers: true,
+            highlight: None,
+        }
+    }
+
+    /// Points singled out: large triangles, no line, in the colour of the
+    /// series with index `like` (the curve they sit on).
+    pub fn highlighted(name: impl Into<String>, points: Vec<(f64, f64)>, like: usize) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            markers: false,
+            highlight: Some(like),
         }
     }
 }
@@ -150,6 +166,20 @@ where
                             && (!axes.log_y || p.1 > 0.0)
                     })
                     .collect();
+                if let Some(like) = s.highlight {
+                    let color = COLORS[like % COLORS.len()];
+                    let marker = move |p: (f64, f64)| {
+                        EmptyElement::at(p) + TriangleMarker::new((0, 0), 9, color.filled())
+                    };
+                    chart
+                        .draw_series(points.iter().map(|&p| marker(p)))?
+                        .label(s.name.clone())
+                        .legend(move |(x, y)| {
+                            EmptyElement::at((x + 10, y))
+                                + TriangleMarker::new((0, 0), 6, color.filled())
+                        });
+                    continue;
+                }
                 chart
                     .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))?
                     .label(s.name.clone())

@@ -253,3 +253,131 @@ fn the_soft_simple_supports_layer_keeps_a_thin_plate_from_kirchhoff() {
         }
     }
 }
+
+#[test]
+fn the_work_precision_chart_has_every_candidate_and_the_choice_within_t() {
+    let scene = scene("timoshenko-t1e-3");
+    let study = fem_forms::choice_study::work_precision(&scene, false).unwrap();
+    for pair in [
+        "p2-p2-p0",
+        "p1-p1-p0-reduced",
+        "p1-p1-p0-full",
+        "hermite-p0",
+    ] {
+        assert!(
+            study
+                .curves
+                .iter()
+                .any(|c| c.label.ends_with(&format!("{pair} uniform")) && c.points.len() == 4),
+            "{pair}"
+        );
+    }
+    assert!(
+        !study.true_error,
+        "a scene with a cheaper model charts the bound"
+    );
+    assert_eq!(study.marks.len(), 3);
+    for mark in &study.marks {
+        assert!(mark.point.bound <= mark.tolerance, "{mark:?}");
+    }
+    assert!(study.marks[0].chosen.starts_with("Euler–Bernoulli"));
+    // the chart and its numbers: one row per point and per choice
+    let out = std::env::temp_dir().join(format!("model-choice-{}", std::process::id()));
+    fem_forms::choice_study::run(&scene, false, &out).unwrap();
+    let csv =
+        std::fs::read_to_string(fem_forms::choice_study::output(&out, &scene.name, "csv")).unwrap();
+    let svg =
+        std::fs::read_to_string(fem_forms::choice_study::output(&out, &scene.name, "svg")).unwrap();
+    let _ = std::fs::remove_dir_all(&out);
+    let points: usize = study.curves.iter().map(|c| c.points.len()).sum();
+    // a second run's adaptive levels are the same meshes: the row count is fixed
+    assert_eq!(csv.lines().count(), 1 + points + study.marks.len());
+    assert!(svg.contains("choice at T = 1e-1: Euler–Bernoulli hermite-p0"));
+}
+
+/// The report of `fem-forms ARGS --json`.
+fn json_of(args: &[&str]) -> serde_json::Value {
+    let out = std::env::temp_dir().join(format!("model-choice-cli-{}", std::process::id()));
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&out);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).unwrap()
+}
+
+#[test]
+fn the_command_line_and_a_scene_file_tolerance_choose() {
+    let report = json_of(&["solve", "timoshenko-t1e-3", "--tol", "5e-2", "--json"]);
+    assert_eq!(report["chosen_model"], "Euler–Bernoulli");
+    assert_eq!(report["chosen_pair"], "hermite-p0");
+    assert_eq!(report["pair"], "hermite-p0");
+    assert_eq!(report["scene"], "timoshenko-t1e-3");
+    let candidates = report["candidates"].as_array().unwrap();
+    assert_eq!(candidates.len(), 4);
+    for c in candidates {
+        for key in [
+            "model",
+            "pair",
+            "probe",
+            "modelling_estimate",
+            "discretization_target",
+            "predicted_seconds",
+            "adequate",
+            "chosen",
+            "note",
+        ] {
+            assert!(c.get(key).is_some(), "{key} in {c}");
+        }
+    }
+    let chosen = candidates.iter().find(|c| c["chosen"] == true).unwrap();
+    assert!(chosen["actual_seconds"].as_f64().unwrap() > 0.0);
+    // `--pair` fixes the pair: no choice
+    let fixed = json_of(&[
+        "solve",
+        "timoshenko-t1e-3",
+        "--tol",
+        "5e-2",
+        "--pair",
+        "p2-p2-p0",
+        "--json",
+    ]);
+    assert!(fixed.get("chosen_model").is_none());
+    assert_eq!(fixed["pair"], "p2-p2-p0");
+
+    // a scene file's `tol` without `pair`: the membrane's pairs are weighed
+    let example = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/membrane-lshape.toml"
+    ))
+    .unwrap()
+    .replace("model = \"membrane\"", "model = \"membrane\"\ntol = 0.05");
+    let file = std::env::temp_dir().join(format!("lshape-tol-{}.toml", std::process::id()));
+    std::fs::write(&file, example).unwrap();
+    let report = json_of(&["solve", "--scene", file.to_str().unwrap(), "--json"]);
+    let _ = std::fs::remove_file(&file);
+    assert_eq!(report["chosen_model"], "membrane");
+    assert!(report["candidates"].as_array().unwrap().len() >= 3);
+    let last = report["adaptive_levels"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()
+        .clone();
+    let target = report["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["chosen"] == true)
+        .unwrap()["discretization_target"]
+        .as_f64()
+        .unwrap();
+    assert!(last["estimate"].as_f64().unwrap() <= target * last["energy_norm"].as_f64().unwrap());
+}

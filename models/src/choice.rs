@@ -223,7 +223,14 @@ struct Probed {
     first_failure: Option<Error>,
 }
 
-fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probed> {
+/// The models a tolerance weighs for `scene` as `settings` pose it: `(model in words,
+/// scene)`, the scene's own first, then its family's cheaper neighbour (with the
+/// scene's exact solution, so that its errors are against what the scene poses); each
+/// model's candidates are its scene's pairs ([`families::pairs_of`]).
+///
+/// # Errors
+/// A scene without a family; a load or parameter the scene refuses.
+pub fn models(scene: &Scene, settings: &Settings) -> Result<Vec<(&'static str, Scene)>> {
     let family = families::family(scene.family)
         .ok_or_else(|| Error::Input(format!("scene `{}` has no family", scene.name)))?;
     let posed = crate::run::pose(scene, settings)?;
@@ -238,6 +245,11 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
         let words = families::family(thin.family).map_or("", |f| f.model_words(&thin));
         models.push((words, thin));
     }
+    Ok(models)
+}
+
+fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probed> {
+    let models = models(scene, settings)?;
     let sizes = probe_sizes(scene, settings.mesh_size);
     let mut candidates = Vec::new();
     let mut scenes = Vec::new();
@@ -318,6 +330,9 @@ fn probe(
             mesh_size: Some(n),
             adaptive: None,
             progress: None,
+            // the probes weigh the candidates; the rounding experiment (a beam's solve
+            // repeated on a moved mesh) is the final solve's to run
+            rounding_experiment: Some(false),
             ..settings.clone()
         };
         let clock = Instant::now();
