@@ -547,3 +547,77 @@ fn the_kirchhoff_modelling_estimate_is_the_soft_supported_plates_distance() {
         assert!((1.0..1.4).contains(&(estimate / distance)), "t = {t}");
     }
 }
+
+/// Asked for T, the choice's solve with a tolerance `tolerance` and no pair.
+fn chosen(scene: &Scene, tolerance: f64, adjust: Option<Adjustment>) -> Outcome {
+    let mut scene = scene.clone();
+    if let Some(adjustment) = adjust {
+        families::family(scene.family)
+            .unwrap()
+            .adjust(&mut scene, &adjustment)
+            .unwrap();
+    }
+    let request = Settings {
+        adaptive: Some(AdaptiveOptions {
+            tolerance,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    choice::solve(&scene, &request).unwrap()
+}
+
+#[test]
+fn the_chosen_membrane_is_within_the_tolerance_of_the_exact_solution() {
+    let radial = scene("membrane-radial");
+    for tolerance in [5e-2, 1e-2] {
+        let outcome = chosen(&radial, tolerance, None);
+        let error = outcome.report.solve.error_energy_relative.unwrap();
+        println!(
+            "T = {tolerance:e}: {} with {} unknowns, true error {error:.3e}",
+            outcome.report.pair, outcome.report.solve.dofs
+        );
+        assert!(error <= tolerance, "T = {tolerance}: {error}");
+        let candidates = outcome.report.quantities["candidates"].as_array().unwrap();
+        assert_eq!(candidates.len(), families::pairs_of(&radial).len());
+    }
+}
+
+#[test]
+fn the_chosen_kirchhoff_plate_is_within_the_tolerance_of_navier() {
+    // the simply supported unit square under q = 1 (D = 1): Navier's series gives
+    // ∫w = Σ_{m,n odd} 64 q / (π⁸ D m² n² (m² + n²)²), the energy J = −½ q ∫w and
+    // ‖u‖_a² = q ∫w; for a conforming (Argyris) solution without contact
+    // ‖u − u_h‖_a² = 2 (J_h − J), the energy identity of Galerkin's method
+    let pi8 = std::f64::consts::PI.powi(8);
+    let mut integral = 0.0;
+    for m in (1..4000).step_by(2) {
+        for n in (1..4000).step_by(2) {
+            let (m, n) = (m as f64, n as f64);
+            integral += 64.0 / (pi8 * m * m * n * n * (m * m + n * n).powi(2));
+        }
+    }
+    let exact_energy = -0.5 * integral;
+    let square = scene("kirchhoff-square");
+    for tolerance in [1e-2, 1e-3] {
+        let outcome = chosen(
+            &square,
+            tolerance,
+            Some(Adjustment::Support(Support::SimplySupported {
+                hard: false,
+            })),
+        );
+        let pair = outcome.report.pair;
+        assert!(
+            pair.starts_with("argyris"),
+            "{pair}: the identity needs a conforming pair"
+        );
+        let energy = outcome.report.solve.energy.unwrap();
+        let error = (2.0 * (energy - exact_energy)).max(0.0).sqrt() / integral.sqrt();
+        println!(
+            "T = {tolerance:e}: {pair} with {} unknowns, true error {error:.3e}",
+            outcome.report.solve.dofs
+        );
+        assert!(error <= tolerance, "T = {tolerance}: {error}");
+    }
+}
