@@ -374,10 +374,11 @@ pub fn summary(r: &Report) -> String {
             last.estimate
         ));
     }
+    lines.extend(choice_lines(r));
     let quantities: Vec<String> = r
         .quantities
         .iter()
-        .filter(|(_, v)| !v.is_null())
+        .filter(|(k, v)| !v.is_null() && !CHOICE_KEYS.contains(&k.as_str()))
         .map(|(k, v)| match v.as_f64() {
             Some(x) if !v.is_u64() && !v.is_i64() => format!("{k} {x:.8e}"),
             _ => format!("{k} {v}"),
@@ -387,6 +388,55 @@ pub fn summary(r: &Report) -> String {
         lines.push(format!("  {}", quantities.join(", ")));
     }
     lines.join("\n")
+}
+
+/// The report keys of the model choice ([`fem_forms::models::choice`]): summarized by
+/// [`choice_lines`], not listed among the family's quantities.
+const CHOICE_KEYS: [&str; 6] = [
+    "chosen_model",
+    "chosen_pair",
+    "tolerance",
+    "modelling_estimate_relative",
+    "candidates",
+    "choice_seconds",
+];
+
+/// What the choice of model and pair weighed and took, a line per candidate.
+fn choice_lines(r: &Report) -> Vec<String> {
+    let (Some(model), Some(candidates)) = (
+        r.quantities.get("chosen_model").and_then(|v| v.as_str()),
+        r.quantities.get("candidates").and_then(|v| v.as_array()),
+    ) else {
+        return Vec::new();
+    };
+    let number = |key: &str| r.number(key).unwrap_or(f64::NAN);
+    let mut lines = vec![format!(
+        "  chosen for T = {:.0e}: {model} {} (modelling estimate {:.2e} of ‖u_h‖_a), after {:.3} s of probes:",
+        number("tolerance"),
+        r.pair,
+        number("modelling_estimate_relative"),
+        number("choice_seconds"),
+    )];
+    for c in candidates {
+        let text = |key: &str| c[key].as_str().unwrap_or("?").to_string();
+        let value = |key: &str| c[key].as_f64();
+        let predicted =
+            value("predicted_seconds").map_or("—".to_string(), |s| format!("{s:.3} s predicted"));
+        let actual = value("actual_seconds").map_or(String::new(), |s| format!(", {s:.3} s taken"));
+        let modelling = match value("modelling_estimate") {
+            Some(m) if m > 0.0 => format!("modelling {m:.1e}"),
+            Some(_) => "the scene's model".to_string(),
+            None => "modelling ?".to_string(),
+        };
+        lines.push(format!(
+            "    {} {:<16} {:<18} {modelling}, {predicted}{actual}: {}",
+            if c["chosen"] == true { "→" } else { " " },
+            text("model"),
+            text("pair"),
+            text("note"),
+        ));
+    }
+    lines
 }
 
 /// Writes `out/<scene>-pressure.svg`: the multiplier along its boundary part against its

@@ -365,12 +365,6 @@ fn the_command_line_and_a_scene_file_tolerance_choose() {
     let _ = std::fs::remove_file(&file);
     assert_eq!(report["chosen_model"], "membrane");
     assert!(report["candidates"].as_array().unwrap().len() >= 3);
-    let last = report["adaptive_levels"]
-        .as_array()
-        .unwrap()
-        .last()
-        .unwrap()
-        .clone();
     let target = report["candidates"]
         .as_array()
         .unwrap()
@@ -379,7 +373,8 @@ fn the_command_line_and_a_scene_file_tolerance_choose() {
         .unwrap()["discretization_target"]
         .as_f64()
         .unwrap();
-    assert!(last["estimate"].as_f64().unwrap() <= target * last["energy_norm"].as_f64().unwrap());
+    // solved adaptively, or on the probe's finer mesh where that already reaches it
+    assert!(report["estimate_relative"].as_f64().unwrap() <= target);
 }
 
 /// `∫ |Q_h|² / S` of a Reissner–Mindlin solution: its discrete shear force

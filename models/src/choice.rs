@@ -11,8 +11,9 @@
 //! estimate is at most [`MODEL_SHARE`] of T; it is then solved to `T − modelling`, so
 //! that the triangle inequality keeps the total within T. Among the adequate candidates
 //! the one with the least predicted time is solved adaptively from the probe's coarse
-//! mesh; the report lists every candidate with its estimates and its predicted cost,
-//! and the chosen one's actual cost. Where none is adequate, the scene's own model with
+//! mesh (where its finer probe already reaches its target, that probe is the answer);
+//! the report lists every candidate with its estimates and its predicted cost, and the
+//! chosen one's actual cost. Where none is adequate, the scene's own model with
 //! its default pair is solved, as without a choice.
 //!
 //! The prediction: with the relative estimates `e₀, e₁` at `d₀, d₁` unknowns, the rate
@@ -148,6 +149,7 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
     let Probed {
         mut candidates,
         scenes,
+        mut finished,
         sizes,
         first_failure,
     } = probe_all(scene, settings, tolerance)?;
@@ -189,10 +191,16 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
         }),
         ..settings.clone()
     };
-    let mut outcome = families::solve(chosen_scene, &final_settings)?;
+    let (mut outcome, seconds) = match finished[best].take() {
+        Some(probe) => (probe, candidates[best].probe[1].seconds),
+        None => {
+            let outcome = families::solve(chosen_scene, &final_settings)?;
+            (outcome, solve_clock.elapsed().as_secs_f64())
+        }
+    };
     let chosen = &mut candidates[best];
     chosen.chosen = true;
-    chosen.actual_seconds = Some(solve_clock.elapsed().as_secs_f64());
+    chosen.actual_seconds = Some(seconds);
     chosen.actual_dofs = Some(outcome.report.solve.dofs);
     record(
         &mut outcome.report,
@@ -219,6 +227,8 @@ pub fn candidates(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<
 struct Probed {
     candidates: Vec<Candidate>,
     scenes: Vec<Scene>,
+    /// Per candidate, its finer probe's outcome where that already reaches its target.
+    finished: Vec<Option<Outcome>>,
     sizes: [usize; 2],
     first_failure: Option<Error>,
 }
@@ -253,19 +263,19 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
     let sizes = probe_sizes(scene, settings.mesh_size);
     let mut candidates = Vec::new();
     let mut scenes = Vec::new();
+    let mut finished = Vec::new();
     let mut first_failure = None;
     for (words, model_scene) in &models {
         for pair in families::pairs_of(model_scene) {
             match probe(model_scene, pair.name, settings, sizes) {
-                Ok((probe, modelling)) => {
-                    candidates.push(judge(
-                        words,
-                        model_scene,
-                        pair.name,
-                        probe,
-                        modelling,
-                        tolerance,
-                    ));
+                Ok((probe, modelling, finer)) => {
+                    let candidate =
+                        judge(words, model_scene, pair.name, probe, modelling, tolerance);
+                    // a probe that already reaches the target is the answer, if chosen
+                    let reached = candidate.adequate
+                        && candidate.probe[1].estimate_relative <= candidate.discretization_target;
+                    finished.push(reached.then_some(finer));
+                    candidates.push(candidate);
                 }
                 Err(e) => {
                     candidates.push(Candidate {
@@ -285,6 +295,7 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
                         note: format!("the probe failed: {e}"),
                     });
                     first_failure.get_or_insert(e);
+                    finished.push(None);
                 }
             }
             scenes.push(model_scene.clone());
@@ -293,6 +304,7 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
     Ok(Probed {
         candidates,
         scenes,
+        finished,
         sizes,
         first_failure,
     })
@@ -321,9 +333,10 @@ fn probe(
     pair: &'static str,
     settings: &Settings,
     sizes: [usize; 2],
-) -> Result<(Vec<ProbeLevel>, f64)> {
+) -> Result<(Vec<ProbeLevel>, f64, Outcome)> {
     let mut levels = Vec::new();
     let mut modelling = 0.0;
+    let mut finer = None;
     for n in sizes {
         let probe_settings = Settings {
             pair: Some(pair.to_string()),
@@ -361,8 +374,10 @@ fn probe(
             seconds,
             estimate_relative,
         });
+        finer = Some(outcome);
     }
-    Ok((levels, modelling))
+    let finer = finer.ok_or_else(|| Error::Input("no probe size".into()))?;
+    Ok((levels, modelling, finer))
 }
 
 /// A probed candidate judged against the tolerance: its target, rate and predicted cost.
