@@ -69,15 +69,10 @@ const CASES: [Case; 7] = [
 
 /// The error of a solve as the module docs define it.
 fn error(outcome: &Outcome, true_error: bool) -> Option<f64> {
-    let s = &outcome.report.solve;
     if true_error {
-        return s.error_energy_relative;
+        return outcome.report.solve.error_energy_relative;
     }
-    let modelling = outcome
-        .report
-        .number("modelling_estimate_relative")
-        .unwrap_or(0.0);
-    Some(s.estimate_relative? + modelling)
+    choice::error_bound(&outcome.report)
 }
 
 fn main() {
@@ -126,13 +121,7 @@ fn main() {
             println!("{:<20} the chosen solve reports no error", case.scene);
             continue;
         };
-        let label = format!(
-            "{} {}",
-            chosen.report.quantities["chosen_model"]
-                .as_str()
-                .unwrap_or("?"),
-            chosen.report.pair
-        );
+        let label = choice::chosen_words(&chosen.report);
         let default = families::pairs_of(&scene)[0].name;
         let mut n = case.start;
         let mut reached = None;

@@ -89,16 +89,11 @@ fn sizes(scene: &Scene, full: bool) -> Vec<usize> {
 }
 
 fn point(outcome: &Outcome, seconds: f64) -> Option<Point> {
-    let s = &outcome.report.solve;
-    let modelling = outcome
-        .report
-        .number("modelling_estimate_relative")
-        .unwrap_or(0.0);
     Some(Point {
         seconds,
-        dofs: s.dofs,
-        error: s.error_energy_relative,
-        bound: s.estimate_relative? + modelling,
+        dofs: outcome.report.solve.dofs,
+        error: outcome.report.solve.error_energy_relative,
+        bound: choice::error_bound(&outcome.report)?,
     })
 }
 
@@ -204,13 +199,7 @@ pub fn work_precision(scene: &Scene, full: bool) -> Result<WorkPrecision> {
         match choice::solve(scene, &settings) {
             Ok(outcome) => {
                 let seconds = clock.elapsed().as_secs_f64();
-                let chosen = format!(
-                    "{} {}",
-                    outcome.report.quantities["chosen_model"]
-                        .as_str()
-                        .unwrap_or("?"),
-                    outcome.report.pair
-                );
+                let chosen = choice::chosen_words(&outcome.report);
                 if let Some(point) = point(&outcome, seconds) {
                     marks.push(Mark {
                         tolerance,

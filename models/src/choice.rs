@@ -111,6 +111,47 @@ pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
     families::solve(scene, settings)
 }
 
+/// The error bound of a solve relative to `‖u_h‖_a`: its relative estimate plus, for a
+/// cheaper model's solve, its modelling estimate; `None` without an estimate.
+pub fn error_bound(report: &Report) -> Option<f64> {
+    let modelling = report.number("modelling_estimate_relative").unwrap_or(0.0);
+    Some(report.solve.estimate_relative? + modelling)
+}
+
+/// What a chosen solve took: `Euler–Bernoulli hermite-p0` (`?` for the model of a
+/// report without a choice).
+pub fn chosen_words(report: &Report) -> String {
+    let model = report
+        .quantities
+        .get("chosen_model")
+        .and_then(|v| v.as_str())
+        .unwrap_or("?");
+    format!("{model} {}", report.pair)
+}
+
+impl Candidate {
+    /// A candidate not judged yet: no estimate, target, rate or prediction (NaN, `None`),
+    /// not adequate, not chosen.
+    fn new(model: &'static str, scene: &Scene, pair: &'static str, probe: Vec<ProbeLevel>) -> Self {
+        Self {
+            model,
+            family: scene.family,
+            pair,
+            probe,
+            rate: None,
+            modelling_estimate: f64::NAN,
+            discretization_target: f64::NAN,
+            predicted_dofs: None,
+            predicted_seconds: None,
+            actual_seconds: None,
+            actual_dofs: None,
+            adequate: false,
+            chosen: false,
+            note: String::new(),
+        }
+    }
+}
+
 /// Whether a tolerance chooses among several candidates for `scene`: its family
 /// declares a cheaper model, or the scene takes more than one pair.
 pub fn has_choice(scene: &Scene) -> bool {
@@ -278,22 +319,9 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
                     candidates.push(candidate);
                 }
                 Err(e) => {
-                    candidates.push(Candidate {
-                        model: words,
-                        family: model_scene.family,
-                        pair: pair.name,
-                        probe: Vec::new(),
-                        rate: None,
-                        modelling_estimate: f64::NAN,
-                        discretization_target: f64::NAN,
-                        predicted_dofs: None,
-                        predicted_seconds: None,
-                        actual_seconds: None,
-                        actual_dofs: None,
-                        adequate: false,
-                        chosen: false,
-                        note: format!("the probe failed: {e}"),
-                    });
+                    let mut failed = Candidate::new(words, model_scene, pair.name, Vec::new());
+                    failed.note = format!("the probe failed: {e}");
+                    candidates.push(failed);
                     first_failure.get_or_insert(e);
                     finished.push(None);
                 }
@@ -391,20 +419,9 @@ fn judge(
 ) -> Candidate {
     let target = tolerance - modelling;
     let mut candidate = Candidate {
-        model,
-        family: scene.family,
-        pair,
-        probe,
-        rate: None,
         modelling_estimate: modelling,
         discretization_target: target,
-        predicted_dofs: None,
-        predicted_seconds: None,
-        actual_seconds: None,
-        actual_dofs: None,
-        adequate: false,
-        chosen: false,
-        note: String::new(),
+        ..Candidate::new(model, scene, pair, probe)
     };
     if modelling > MODEL_SHARE * tolerance {
         candidate.note = format!(
