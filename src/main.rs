@@ -154,7 +154,10 @@ struct SolveOptions {
     /// (newest-vertex bisection, new vertices on a curved boundary moved onto it;
     /// bisection on beams), solve again from the previous solution (every family, on
     /// the pairs whose model declares an estimator; the scene's mesh is the first
-    /// level: start coarse, e.g. --mesh-size 8).
+    /// level: start coarse, e.g. --mesh-size 8). Without --pair, T also chooses the
+    /// model and pair: every pair of the scene and its family's cheaper model
+    /// (Euler–Bernoulli for Timoshenko, Kirchhoff for Reissner–Mindlin) are probed, and
+    /// the one predicted fastest within T is solved (docs/model-choice.md).
     #[arg(long, value_name = "T", allow_hyphen_values = true)]
     tol: Option<f64>,
     /// Marking of the adaptive loop: dorfler (default: the fewest cells holding θ of

@@ -66,13 +66,18 @@ pub struct Axes<'a> {
 
 type DrawResult<T> = Result<T, Box<dyn std::error::Error>>;
 
-const COLORS: [RGBColor; 6] = [
+// ten colours before one repeats: a model choice's chart has up to eight curves
+const COLORS: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(255, 127, 14),
     RGBColor(148, 103, 189),
     RGBColor(80, 80, 80),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
 ];
 
 /// A short axis label with four significant digits, trailing zeros dropped: plain for

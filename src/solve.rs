@@ -135,9 +135,9 @@ fn adaptive_options(options: &SolveOptions) -> Result<Option<AdaptiveOptions>, S
         }
         return Ok(None);
     };
-    if !(tolerance > 0.0 && tolerance.is_finite()) {
+    if !(tolerance > 0.0 && tolerance < 1.0) {
         return Err(format!(
-            "--tol {tolerance}: the tolerance is a positive number, relative to the solution's energy norm (e.g. 1e-2)"
+            "--tol {tolerance}: the tolerance is a relative error of the solution's energy norm, in (0, 1) (e.g. 1e-2)"
         ));
     }
     Ok(Some(AdaptiveOptions {

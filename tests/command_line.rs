@@ -942,10 +942,8 @@ fn adaptive_options_are_checked() {
             vec!["solve", "membrane-radial", "--marking", "max"],
             "give --tol",
         ),
-        (
-            vec!["solve", "membrane-radial", "--tol", "-1"],
-            "positive number",
-        ),
+        (vec!["solve", "membrane-radial", "--tol", "-1"], "in (0, 1)"),
+        (vec!["solve", "membrane-radial", "--tol", "2"], "in (0, 1)"),
         (
             vec![
                 "solve",

@@ -616,3 +616,56 @@ fn the_chosen_kirchhoff_plate_is_within_the_tolerance_of_navier() {
         assert!(error <= tolerance, "T = {tolerance}: {error}");
     }
 }
+
+/// `fem-forms ARGS`'s failure message (standard error).
+fn failure_of(args: &[&str]) -> String {
+    let out = std::env::temp_dir().join(format!("model-choice-fail-{}", std::process::id()));
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&out);
+    assert!(!output.status.success(), "{args:?} succeeded");
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+#[test]
+fn the_requests_options_reach_each_model_as_it_takes_them() {
+    // --thickness is the Timoshenko beam's: the Euler–Bernoulli candidate is posed
+    // without it, not refused for it
+    let report = json_of(&[
+        "solve",
+        "timoshenko-t1e-3",
+        "--tol",
+        "5e-2",
+        "--thickness",
+        "0.001",
+        "--json",
+    ]);
+    assert_eq!(report["chosen_model"], "Euler–Bernoulli", "{report}");
+    // --alpha is the Mindlin pair's: the Kirchhoff pairs keep their own rule
+    let report = json_of(&[
+        "solve",
+        "mindlin-ss-t1e-3",
+        "--tol",
+        "0.1",
+        "--alpha",
+        "0.1",
+        "--json",
+    ]);
+    assert_eq!(report["chosen_model"], "Kirchhoff", "{report}");
+    // a tolerance is a relative error below 1
+    assert!(failure_of(&["solve", "timoshenko-t1e-1", "--tol", "1e300"]).contains("in (0, 1)"));
+    // where every probe fails, the failure says why, not that a tolerance is NaN
+    let message = failure_of(&[
+        "solve",
+        "timoshenko-t1e-2",
+        "--load",
+        "1e30",
+        "--tol",
+        "0.05",
+    ]);
+    assert!(!message.contains("NaN"), "{message}");
+}

@@ -10,11 +10,14 @@
 //! `modelling_estimate_relative`). A cheaper model is adequate where its modelling
 //! estimate is at most [`MODEL_SHARE`] of T; it is then solved to `T − modelling`, so
 //! that the triangle inequality keeps the total within T. Among the adequate candidates
-//! the one with the least predicted time is solved adaptively from the probe's coarse
-//! mesh (where its finer probe already reaches its target, that probe is the answer);
-//! the report lists every candidate with its estimates and its predicted cost, and the
-//! chosen one's actual cost. Where none is adequate, the scene's own model with
-//! its default pair is solved, as without a choice.
+//! the one with the least predicted time (predictions within a factor [`TIE`] count as
+//! equal: then the fewest unknowns, then the listing order) is solved adaptively from
+//! the probe's coarse mesh (where its finer probe already reaches its target, that probe
+//! is the answer; where its adaptive solve fails, the next is tried); the report lists
+//! every candidate with its estimates and its predicted cost, and the chosen one's
+//! actual cost. Where none is adequate, the scene's own model with its default pair is
+//! solved, as without a choice. A request's `--alpha` applies to the scene's own model's
+//! pairs, not to the cheaper model's, whose stability ranges are their own.
 //!
 //! The prediction: with the relative estimates `e₀, e₁` at `d₀, d₁` unknowns, the rate
 //! `r = ln(e₀/e₁) / ln(d₁/d₀)`, the unknowns `d* = d₁ (e₁/target)^{1/r}` and the time
@@ -194,64 +197,124 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
         sizes,
         first_failure,
     } = probe_all(scene, settings, tolerance)?;
-    let cost = |c: &Candidate| c.predicted_seconds.unwrap_or(f64::INFINITY);
-    let best = candidates
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.adequate)
-        .min_by(|a, b| cost(a.1).total_cmp(&cost(b.1)))
-        .or_else(|| {
-            // none predicted to reach the target: the scene's own model with its default
-            // pair, whose adaptive loop then says how far it got (or that the solution
-            // vanishes)
-            candidates
-                .iter()
-                .enumerate()
-                .find(|(k, _)| scenes[*k].richer.is_none())
-        })
-        .map(|(k, _)| k);
-    let Some(best) = best else {
-        return Err(first_failure.unwrap_or_else(|| {
-            Error::Input(format!(
-                "scene `{}` has no pair to solve it with",
-                scene.name
-            ))
-        }));
-    };
+    let mut order = ranking(&candidates);
+    if order.is_empty() {
+        // none predicted to reach the target: the scene's own model with its default
+        // pair, whose adaptive loop then says how far it got (or that the solution
+        // vanishes); where even its probe failed, that failure
+        match (0..candidates.len()).find(|&k| scenes[k].richer.is_none()) {
+            Some(k) if !candidates[k].probe.is_empty() => order.push(k),
+            _ => {
+                return Err(first_failure.unwrap_or_else(|| {
+                    Error::Input(format!(
+                        "scene `{}` has no pair to solve it with",
+                        scene.name
+                    ))
+                }))
+            }
+        }
+    }
     let probe_seconds = clock.elapsed().as_secs_f64();
 
-    let chosen_scene = &scenes[best];
-    let target = candidates[best].discretization_target;
-    let solve_clock = Instant::now();
-    let final_settings = Settings {
-        pair: Some(candidates[best].pair.to_string()),
-        mesh_size: Some(sizes[0]),
-        adaptive: Some(AdaptiveOptions {
-            tolerance: target,
-            ..settings.adaptive.unwrap_or_default()
-        }),
-        ..settings.clone()
-    };
-    let (mut outcome, seconds) = match finished[best].take() {
-        Some(probe) => (probe, candidates[best].probe[1].seconds),
-        None => {
-            let outcome = families::solve(chosen_scene, &final_settings)?;
-            (outcome, solve_clock.elapsed().as_secs_f64())
+    // the best first; where its adaptive solve fails (a user's α out of range on graded
+    // cells), the next, the failure noted on the candidate
+    let mut failure = None;
+    for best in order {
+        let target = candidates[best]
+            .discretization_target
+            .max(f64::MIN_POSITIVE);
+        let solve_clock = Instant::now();
+        let solved = match finished[best].take() {
+            Some(probe) => Ok((probe, candidates[best].probe[1].seconds)),
+            None => {
+                let final_settings = Settings {
+                    pair: Some(candidates[best].pair.to_string()),
+                    mesh_size: Some(sizes[0]),
+                    adaptive: Some(AdaptiveOptions {
+                        tolerance: if candidates[best].adequate {
+                            target
+                        } else {
+                            tolerance
+                        },
+                        ..settings.adaptive.unwrap_or_default()
+                    }),
+                    ..candidate_settings(settings, &scenes[best])
+                };
+                families::solve(&scenes[best], &final_settings)
+                    .map(|outcome| (outcome, solve_clock.elapsed().as_secs_f64()))
+            }
+        };
+        match solved {
+            Ok((mut outcome, seconds)) => {
+                let chosen = &mut candidates[best];
+                chosen.chosen = true;
+                chosen.actual_seconds = Some(seconds);
+                chosen.actual_dofs = Some(outcome.report.solve.dofs);
+                record(
+                    &mut outcome.report,
+                    scene,
+                    &candidates,
+                    best,
+                    tolerance,
+                    probe_seconds,
+                );
+                return Ok(outcome);
+            }
+            Err(e) => {
+                candidates[best].note = format!("its adaptive solve failed: {e}");
+                failure.get_or_insert(e);
+            }
         }
-    };
-    let chosen = &mut candidates[best];
-    chosen.chosen = true;
-    chosen.actual_seconds = Some(seconds);
-    chosen.actual_dofs = Some(outcome.report.solve.dofs);
-    record(
-        &mut outcome.report,
-        scene,
-        &candidates,
-        best,
-        tolerance,
-        probe_seconds,
-    );
-    Ok(outcome)
+    }
+    Err(failure.expect("at least one candidate was tried"))
+}
+
+/// Two predicted times within this factor are a tie: the probes' times of small solves
+/// (milliseconds) vary by as much from run to run, and a choice that flips between runs
+/// is no choice.
+pub const TIE: f64 = 2.0;
+
+/// The adequate candidates, best first: by predicted time, where two are within [`TIE`]
+/// of each other by fewer predicted unknowns, then in the listing order (the scene's own
+/// model first, each model's default pair first).
+fn ranking(candidates: &[Candidate]) -> Vec<usize> {
+    let mut adequate: Vec<usize> = (0..candidates.len())
+        .filter(|&k| candidates[k].adequate)
+        .collect();
+    let cost = |k: usize| candidates[k].predicted_seconds.unwrap_or(f64::INFINITY);
+    let dofs = |k: usize| candidates[k].predicted_dofs.unwrap_or(f64::INFINITY);
+    let mut ranked = Vec::new();
+    while !adequate.is_empty() {
+        let fastest = adequate
+            .iter()
+            .map(|&k| cost(k))
+            .fold(f64::INFINITY, f64::min);
+        // among those tied with the fastest, the fewest unknowns, then the first listed
+        let (position, _) = adequate
+            .iter()
+            .enumerate()
+            .filter(|(_, &k)| cost(k) <= TIE * fastest)
+            .min_by(|a, b| dofs(*a.1).total_cmp(&dofs(*b.1)).then(a.1.cmp(b.1)))
+            .expect("the fastest is tied with itself");
+        ranked.push(adequate.remove(position));
+    }
+    ranked
+}
+
+/// The settings of a candidate's solves: the request's, without its parameters (the
+/// scenes are posed with them already: a cheaper model has not the richer one's `t`) and,
+/// for a cheaper model's scene, without its α (a stability range is a pair's own: the
+/// cheaper model's pairs take their own rule).
+fn candidate_settings(settings: &Settings, scene: &Scene) -> Settings {
+    Settings {
+        parameters: Vec::new(),
+        alpha: if scene.richer.is_some() {
+            None
+        } else {
+            settings.alpha
+        },
+        ..settings.clone()
+    }
 }
 
 /// The candidates of `scene` for `tolerance`, probed and judged, without the final
@@ -374,7 +437,7 @@ fn probe(
             // the probes weigh the candidates; the rounding experiment (a beam's solve
             // repeated on a moved mesh) is the final solve's to run
             rounding_experiment: Some(false),
-            ..settings.clone()
+            ..candidate_settings(settings, scene)
         };
         let clock = Instant::now();
         let outcome = families::solve(scene, &probe_settings)?;
@@ -417,7 +480,8 @@ fn judge(
     modelling: f64,
     tolerance: f64,
 ) -> Candidate {
-    let target = tolerance - modelling;
+    // a cheaper model whose modelling error alone exceeds T has nothing left to reach
+    let target = (tolerance - modelling).max(0.0);
     let mut candidate = Candidate {
         modelling_estimate: modelling,
         discretization_target: target,
@@ -482,5 +546,34 @@ fn record(
             "no candidate was predicted to reach the tolerance {tolerance:.0e}: solved with {} ({}), the scene's own model",
             chosen.pair, chosen.model
         ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn candidate(seconds: Option<f64>, dofs: f64, adequate: bool) -> Candidate {
+        let scene = Scene::new("s", "", "beam", Domain::UNIT_INTERVAL, 4);
+        Candidate {
+            predicted_seconds: seconds,
+            predicted_dofs: Some(dofs),
+            adequate,
+            ..Candidate::new("m", &scene, "p", Vec::new())
+        }
+    }
+
+    /// Predictions within a factor 2 tie, and the fewer unknowns win the tie; an
+    /// inadequate candidate is not ranked however fast.
+    #[test]
+    fn ties_in_time_go_to_the_fewer_unknowns_then_the_first_listed() {
+        let candidates = [
+            candidate(Some(1.0), 100.0, true),
+            candidate(Some(1.5), 50.0, true),
+            candidate(Some(10.0), 10.0, true),
+            candidate(Some(0.1), 1.0, false),
+            candidate(Some(1.2), 50.0, true),
+        ];
+        assert_eq!(ranking(&candidates), vec![1, 4, 0, 2]);
     }
 }

@@ -627,10 +627,10 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
         };
     }
     if let Some(tol) = file.tol {
-        if !(tol > 0.0 && tol.is_finite()) {
+        if !(tol > 0.0 && tol < 1.0) {
             return Err(at((
                 "tol".into(),
-                format!("{tol} is not a positive tolerance (relative to the solution's energy norm, e.g. 1e-2)"),
+                format!("{tol} is not a tolerance: a relative error of the solution's energy norm lies in (0, 1), e.g. 1e-2"),
             )));
         }
         if !family.options().contains(&crate::family::Opt::Tol) {
