@@ -1398,3 +1398,35 @@ fn free_edges_take_the_natural_boundary_term() {
         hand.sqrt()
     );
 }
+
+/// Bisection appends a beam's refined cells out of order: the output fields list them by
+/// position (a chart joining them in storage order crossed itself), each with its own λ.
+#[test]
+fn an_adaptive_beams_cells_are_output_in_order() {
+    use fem_forms::models::families;
+    use fem_forms::models::geometry::Fields;
+    use fem_forms::models::report::Settings;
+    let scene = families::scene("bernoulli-a").unwrap();
+    let settings = Settings {
+        pair: Some("hermite-p0".into()),
+        load: Some(100.0),
+        mesh_size: Some(16),
+        adaptive: Some(AdaptiveOptions {
+            tolerance: 1e-2,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    let outcome = families::solve(&scene, &settings).unwrap();
+    assert!(outcome.report.solve.adaptive_levels.len() >= 2);
+    let Fields::Interval { cell_x, lambda, .. } = &outcome.fields else {
+        panic!("a beam's fields are on an interval");
+    };
+    assert!(cell_x.windows(2).all(|w| w[0] < w[1]), "{cell_x:?}");
+    // the contact is at ½ (the obstacle's top): λ_h lives there and nowhere near the ends
+    let at = |x: f64| {
+        let k = cell_x.partition_point(|&c| c < x).min(cell_x.len() - 1);
+        lambda[k]
+    };
+    assert!(at(0.5) > 0.0 && at(0.05) == 0.0 && at(0.95) == 0.0);
+}

@@ -221,13 +221,19 @@ impl Geometry for IntervalMesh {
                 (M::FIELDS[f].name, values)
             })
             .collect();
+        // by position: bisection appends a refined mesh's cells out of order, and a chart
+        // joining them in storage order crossed itself
+        let mut cells_by_x: Vec<(f64, f64)> = (0..cells)
+            .map(|c| 0.5 * (mesh.cell(c)[0] + mesh.cell(c)[1]))
+            .zip(solution.multiplier().iter().copied())
+            .collect();
+        cells_by_x.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (cell_x, lambda) = cells_by_x.into_iter().unzip();
         Fields::Interval {
             psi: x.iter().map(|&x| psi(&[x])).collect(),
             fields,
-            cell_x: (0..cells)
-                .map(|c| 0.5 * (mesh.cell(c)[0] + mesh.cell(c)[1]))
-                .collect(),
-            lambda: solution.multiplier().to_vec(),
+            cell_x,
+            lambda,
             x,
         }
     }
