@@ -295,9 +295,9 @@ fn the_work_precision_chart_has_every_candidate_and_the_choice_within_t() {
     assert!(svg.contains("choice at T = 1e-1: Euler–Bernoulli hermite-p0"));
 }
 
-/// The report of `fem-forms ARGS --json`.
-fn json_of(args: &[&str]) -> serde_json::Value {
-    let out = std::env::temp_dir().join(format!("model-choice-cli-{}", std::process::id()));
+/// `fem-forms ARGS --out DIR` run in a directory of its own (removed after).
+fn fem_forms(args: &[&str], tag: &str) -> std::process::Output {
+    let out = std::env::temp_dir().join(format!("model-choice-{tag}-{}", std::process::id()));
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(args)
         .arg("--out")
@@ -305,6 +305,12 @@ fn json_of(args: &[&str]) -> serde_json::Value {
         .output()
         .unwrap();
     let _ = std::fs::remove_dir_all(&out);
+    output
+}
+
+/// The report of `fem-forms ARGS --json`.
+fn json_of(args: &[&str]) -> serde_json::Value {
+    let output = fem_forms(args, "cli");
     assert!(
         output.status.success(),
         "{}",
@@ -619,14 +625,7 @@ fn the_chosen_kirchhoff_plate_is_within_the_tolerance_of_navier() {
 
 /// `fem-forms ARGS`'s failure message (standard error).
 fn failure_of(args: &[&str]) -> String {
-    let out = std::env::temp_dir().join(format!("model-choice-fail-{}", std::process::id()));
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_fem-forms"))
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let _ = std::fs::remove_dir_all(&out);
+    let output = fem_forms(args, "fail");
     assert!(!output.status.success(), "{args:?} succeeded");
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
