@@ -78,14 +78,20 @@ fn tolerances(scene: &Scene, full: bool) -> Vec<f64> {
     t
 }
 
-/// The uniform sizes of each candidate's curve: from the probes' coarser size, doubling.
+/// The uniform sizes of each candidate's curve: from the choice's probe sizes on,
+/// doubling (one refinement more each on a mesh file); fewer on triangles.
 fn sizes(scene: &Scene, full: bool) -> Vec<usize> {
-    let steps = if full { 6 } else { 4 };
-    match scene.domain {
-        Domain::Gmsh(_) | Domain::Refined { .. } => (0..steps.min(4)).collect(),
-        Domain::Interval { .. } => (0..steps).map(|k| 16 << k).collect(),
-        _ => (0..steps - 1).map(|k| 8 << k).collect(),
-    }
+    let steps = match (&scene.domain, full) {
+        (Domain::Interval { .. }, true) => 6,
+        (Domain::Interval { .. }, false) => 4,
+        (_, true) => 5,
+        (_, false) => 3,
+    };
+    let [first, second] = choice::probe_sizes(scene, None);
+    let refined = second == first + 1;
+    (0..steps)
+        .map(|k| if refined { first + k } else { first << k })
+        .collect()
 }
 
 fn point(outcome: &Outcome, seconds: f64) -> Option<Point> {
@@ -146,7 +152,7 @@ pub fn work_precision(scene: &Scene, full: bool) -> Result<WorkPrecision> {
             let seen = Arc::clone(&levels);
             let settings = Settings {
                 pair: Some(pair.name.into()),
-                mesh_size: Some(sizes(scene, false)[0]),
+                mesh_size: Some(choice::probe_sizes(scene, None)[0]),
                 adaptive: Some(AdaptiveOptions {
                     tolerance: tightest,
                     // a candidate far from the tolerance (a locking pair) is charted

@@ -167,7 +167,7 @@ pub fn has_choice(scene: &Scene) -> bool {
 /// The two mesh sizes the probes solve on: N and 2N on generated meshes (16, 32
 /// elements of a beam; 8×8 and 16×16 squares), 0 and 1 refinements of a mesh file;
 /// `given` (the request's size) replaces the coarser.
-fn probe_sizes(scene: &Scene, given: Option<usize>) -> [usize; 2] {
+pub fn probe_sizes(scene: &Scene, given: Option<usize>) -> [usize; 2] {
     match (&scene.domain, given) {
         (Domain::Gmsh(_) | Domain::Refined { .. }, n) => {
             let n = n.unwrap_or(0);

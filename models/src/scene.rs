@@ -566,6 +566,26 @@ impl Scene {
             .map(|(_, v)| *v)
     }
 
+    /// The scene posed for a cheaper neighbour model ([`crate::family::Family::cheaper`]):
+    /// named `<scene>-<model>`, of `family`, taking `pairs`, with the parameters `keep`
+    /// accepts, and this scene's parameters as [`Scene::richer`] (from which its solve
+    /// estimates the modelling error); the data, supports, load and obstacle as they are.
+    pub fn posed_for_cheaper(
+        &self,
+        model: &str,
+        family: &'static str,
+        pairs: Vec<&'static str>,
+        keep: impl Fn(&str) -> bool,
+    ) -> Scene {
+        let mut thin = self.clone();
+        thin.name = format!("{}-{model}", self.name).into();
+        thin.family = family;
+        thin.richer = Some(self.parameters.clone());
+        thin.parameters.retain(|(name, _)| keep(name));
+        thin.pairs = pairs;
+        thin
+    }
+
     /// Data function `name`, if the scene sets it.
     pub fn data_fn(&self, name: &str) -> Option<&Data> {
         self.data.iter().find(|(n, _)| n == name).map(|(_, d)| d)

@@ -216,14 +216,9 @@ impl Family for Plates {
     /// (whose ∇Δw gives the modelling estimate; Morley's vanishes on every cell).
     fn cheaper(&self, scene: &Scene) -> Option<Scene> {
         scene.parameter("t")?;
-        let mut thin = scene.clone();
-        thin.name = format!("{}-kirchhoff", scene.name).into();
-        thin.family = "kirchhoff";
-        thin.richer = Some(scene.parameters.clone());
-        let kirchhoff = ["D", "ν"];
-        thin.parameters
-            .retain(|(name, _)| kirchhoff.contains(&&**name));
-        thin.pairs = vec!["argyris-p0", "argyris-p1disc"];
+        let pairs = vec!["argyris-p0", "argyris-p1disc"];
+        let mut thin =
+            scene.posed_for_cheaper("kirchhoff", "kirchhoff", pairs, |p| ["D", "ν"].contains(&p));
         // Argyris elements are straight: the disk becomes its inscribed polygon
         if let Domain::Disk { curved, .. } = &mut thin.domain {
             *curved = false;
