@@ -667,4 +667,14 @@ fn the_requests_options_reach_each_model_as_it_takes_them() {
         "0.05",
     ]);
     assert!(!message.contains("NaN"), "{message}");
+    // a probe mesh whose supports fix every unknown has no relative error: say so
+    let message = failure_of(&[
+        "solve",
+        "kirchhoff-obstacle",
+        "--mesh-size",
+        "1",
+        "--tol",
+        "0.1",
+    ]);
+    assert!(message.contains("start from a finer mesh"), "{message}");
 }

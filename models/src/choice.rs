@@ -446,9 +446,15 @@ fn probe(
         let seconds = clock.elapsed().as_secs_f64();
         let s = &outcome.report.solve;
         let estimate_relative = s.estimate_relative.ok_or_else(|| {
-            Error::Input(format!(
-                "pair `{pair}` reports no relative estimate (its model declares no estimator, or ‖u_h‖_a = 0)"
-            ))
+            Error::Input(match s.estimate {
+                None => format!(
+                    "pair `{pair}` has no a-posteriori estimate (its model declares no estimator): a tolerance cannot be met with it; give --pair with a pair that has one"
+                ),
+                Some(_) => format!(
+                    "pair `{pair}` solves to ‖u_h‖_a = 0 on the probe's mesh N = {n} ({} unknowns), so no error relative to it exists there: the supports fix every unknown of so coarse a mesh, or the solution vanishes; start from a finer mesh (--mesh-size)",
+                    s.dofs
+                ),
+            })
         })?;
         if scene.richer.is_some() {
             modelling = outcome
