@@ -195,6 +195,7 @@ pub fn run(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
             y: "energy norm",
             log_x: true,
             log_y: true,
+            rates: false,
         },
         &series,
     )
@@ -234,6 +235,7 @@ pub fn run(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
                 y: "η / ‖e‖",
                 log_x: true,
                 log_y: false,
+                rates: false,
             },
             &[
                 Series::marked("uniform", u_index),
@@ -269,6 +271,7 @@ pub fn run(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()> {
             y: "energy norm",
             log_x: true,
             log_y: true,
+            rates: false,
         },
         &[
             Series::marked("uniform", u_time),

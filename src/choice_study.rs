@@ -335,6 +335,7 @@ pub fn run(scene: &Scene, full: bool, out: &Path) -> Result<()> {
             y: words,
             log_x: true,
             log_y: true,
+            rates: false,
         },
         &series,
     )

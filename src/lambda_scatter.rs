@@ -16,6 +16,9 @@ use std::path::Path;
 /// The study's name on the command line and in a scene's list of studies.
 pub const NAME: &str = "lambda-scatter";
 
+/// What the study's charts check, and against what (the report page's words).
+pub const CHECKS: &str = "The scatter of λ_h in the interior of the contact set of a Kirchhoff plate on a flat obstacle, where λ = q exactly: the spread of λ_h for each pair, α and recovery (raw, patch-averaged once or twice) against h, and its layer next to the free boundary.";
+
 /// `scene` with `adjustment` applied by its family.
 fn adjusted(scene: &Scene, adjustment: &Adjustment) -> Result<Scene> {
     let mut scene = scene.clone();
@@ -277,6 +280,7 @@ pub fn scatter_run(scene: &Scene, full: bool, out: &Path) -> Result<()> {
             y: "λ_h / q",
             log_x: true,
             log_y: false,
+            rates: false,
         },
         &series,
     )
@@ -350,6 +354,7 @@ fn layer_run(scene: &Scene, rows: &[ScatterRow], load: f64, out: &Path) -> Resul
             y: "max |λ_h − q| / q",
             log_x: false,
             log_y: true,
+            rates: false,
         },
         &layer_series,
     )

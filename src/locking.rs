@@ -211,6 +211,7 @@ pub fn run(scene: &Scene, full: bool, out: &Path) -> Result<()> {
             y: &y,
             log_x: true,
             log_y: true,
+            rates: false,
         },
         &series,
     )

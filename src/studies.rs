@@ -63,6 +63,19 @@ impl Study {
         }
     }
 
+    /// What the study's charts check, and against what (the report page's words).
+    pub fn checks(self) -> &'static str {
+        match self {
+            Study::Convergence => "Errors against the exact solution on uniformly refined meshes (where the scene has none, the change to the next mesh), for every pair, with the observed rate of each curve's finest segment in a triangle; the rates the theory predicts are in docs/mathematics.md.",
+            Study::Locking => "The energy-norm distance of the thick model's solution to its thin limit (Euler–Bernoulli, Kirchhoff) as the thickness t → 0, for the locking-free pair and the plain pair that locks beside it: a locking-free pair's error does not grow as t falls.",
+            Study::Stability => "The inf-sup constants γ₁ ≤ γ₂ of the multiplier's Schur complement B A⁻¹ Bᵀ + C in the stabilization's norm against h, for the plain (α = 0) and the stabilized pairs: a plain pair's γ₁ at rounding or falling with h is the instability the stabilization removes; below, λ_h along a line of the plain method (oscillating) against the stabilized one and the exact λ where known.",
+            Study::Alpha => "Errors and the contact measure on one mesh against α, with α = 1/C_I (beyond which the stabilized matrix loses definiteness) and the automatic choice ½/C_I: the working range of α·C_I.",
+            Study::WorkPrecision => "The model choice: every candidate (model, pair, uniform and adaptive meshes) as its error (the true error where a reference exists, else the estimate plus the modelling estimate) against wall time, with the choice made at three tolerances marked; where the scene has an exact solution, also the error against solve time of every solver (nested and cold semismooth Newton, PDAS, clarabel's QP).",
+            Study::Iterations => "Newton iterations on each mesh with nested iteration (from the coarser mesh's solution) and from a cold start: with nesting the count stays flat as the mesh is refined.",
+            Study::Adaptivity => "Uniform refinement against the adaptive loop (the model's estimator, Dörfler marking, newest-vertex bisection): error and estimate against unknowns, the efficiency index estimate/error (bounded above and below where the estimator is reliable and efficient), error against wall time, and the final mesh with the contact set.",
+        }
+    }
+
     /// The study called `name`.
     pub fn parse(name: &str) -> Option<Study> {
         Self::ALL.into_iter().find(|s| s.name() == name)
@@ -415,6 +428,15 @@ fn log_axes<'a>(x: &'a str, y: &'a str) -> Axes<'a> {
         y,
         log_x: true,
         log_y: true,
+        rates: false,
+    }
+}
+
+/// [`log_axes`] against the mesh size, with rate triangles.
+fn rate_axes<'a>(x: &'a str, y: &'a str) -> Axes<'a> {
+    Axes {
+        rates: true,
+        ..log_axes(x, y)
     }
 }
 
@@ -678,33 +700,33 @@ impl ConvergencePanels {
         };
         panel(
             format!("{setting}: L² error of u"),
-            log_axes("h", "‖u − u_h‖_L2"),
+            rate_axes("h", "‖u − u_h‖_L2"),
             self.l2,
         );
         panel(
             format!("{setting}: H¹ error of u"),
-            log_axes("h", "|u − u_h|_H1"),
+            rate_axes("h", "|u − u_h|_H1"),
             self.h1,
         );
         panel(
             format!("{setting}: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½"),
-            log_axes("h", "h-weighted error of λ"),
+            rate_axes("h", "h-weighted error of λ"),
             self.multiplier,
         );
         panel(
             format!("{setting}: error of the total contact force"),
-            log_axes("h", "|∫λ_h − ∫λ|"),
+            rate_axes("h", "|∫λ_h − ∫λ|"),
             self.force,
         );
         panel(
             format!("{setting}: relative error of the reference quantity"),
-            log_axes("h", "|relative error|"),
+            rate_axes("h", "|relative error|"),
             self.reference,
         );
         if !exact {
             panel(
                 format!("{setting}: change of J_h, ∫λ_h and the {contact} to the next mesh"),
-                log_axes("h", "|change to the next mesh|"),
+                rate_axes("h", "|change to the next mesh|"),
                 self.changes,
             );
         }
@@ -1191,6 +1213,7 @@ fn alpha_chart(
                     y: contact,
                     log_x: true,
                     log_y: false,
+                    rates: false,
                 },
                 contact_series,
             ),
