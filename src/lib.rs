@@ -18,6 +18,7 @@ pub mod lambda_scatter;
 pub mod locking;
 pub mod plot;
 pub mod registry_studies;
+pub mod report_page;
 pub mod studies;
 
 pub use fem_models as models;

@@ -6,7 +6,6 @@ use fem_forms::models::families;
 use fem_forms::models::report::{Report, Settings};
 use fem_forms::models::scene::Scene;
 use fem_forms::plot;
-use fem_forms::studies::{self, Study};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -67,6 +66,19 @@ enum Command {
         /// Larger meshes (longer).
         #[arg(long)]
         full: bool,
+    },
+    /// Run every study of every family and write one self-contained web page,
+    /// <out>/index.html (charts inline, opens from disk; their data and the studies'
+    /// tables under <out>/studies/), with each scene's accuracy against its reference
+    /// and the machine, date, commit and time of each study. A progress bar shows the
+    /// studies as they run; the quick settings take a few minutes on 2 cores.
+    Report {
+        /// The studies' larger meshes (much longer).
+        #[arg(long)]
+        full: bool,
+        /// Only these scenes' studies (and their families' accuracy tables).
+        #[arg(long = "scene", value_name = "SCENE")]
+        scenes: Vec<String>,
     },
 }
 
@@ -341,7 +353,7 @@ fn registry_job(names: &[&str], out: &Path) -> Result<(), String> {
 /// Every study each of `scenes` hosts, quick versions.
 fn hosted_studies(scenes: &[Scene], out: &Path) -> Result<(), String> {
     for scene in scenes.iter().filter(|s| !s.studies.is_empty()) {
-        registry_study(scene.clone(), None, false, out)?;
+        fem_forms::registry_studies::run_hosted(scene.clone(), None, false, out)?;
     }
     Ok(())
 }
@@ -562,7 +574,7 @@ fn hosted_kinds() -> Vec<&'static str> {
 /// hosts it.
 fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), String> {
     if let Some(scene) = families::scene(name) {
-        return registry_study(scene, kind, full, out);
+        return fem_forms::registry_studies::run_hosted(scene, kind, full, out);
     }
     // a study variant of a scene (`mindlin-disk-q20`)
     let variant = families::scenes()
@@ -572,7 +584,7 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
         .flatten()
         .find(|v| v.name == name);
     if let Some(scene) = variant {
-        return registry_study(scene, kind, full, out);
+        return fem_forms::registry_studies::run_hosted(scene, kind, full, out);
     }
     let scene_names = || -> String {
         let names: Vec<String> = families::scenes()
@@ -603,69 +615,7 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
         ));
     }
     for scene in hosts {
-        registry_study(scene, Some(name), full, out)?;
-    }
-    Ok(())
-}
-
-/// A study of a registry scene through the one implementation over the one solve
-/// ([`fem_forms::registry_studies`]), on each of its study variants where the study
-/// depends on the data ([`Study::depends_on_data`]); the λ-scatter through its own
-/// ([`fem_forms::lambda_scatter`]).
-fn registry_study(
-    scene: fem_forms::models::scene::Scene,
-    kind: Option<&str>,
-    full: bool,
-    out: &Path,
-) -> Result<(), String> {
-    let name = scene.name.to_string();
-    let hosted = scene.studies.clone();
-    let work_precision = Study::WorkPrecision.name();
-    if kind == Some(work_precision) && !hosted.contains(&work_precision) {
-        // every scene has the chart of its candidates and of the choice made for them
-        return fem_forms::choice_study::run(&scene, full, out)
-            .map_err(|e| format!("study {name} {work_precision}: {e}"));
-    }
-    if hosted.is_empty() {
-        let hosts: Vec<String> = families::scenes()
-            .iter()
-            .filter(|s| !s.studies.is_empty())
-            .map(|s| s.name.to_string())
-            .collect();
-        return Err(format!(
-            "scene `{name}` hosts no study; the scenes that do are {}",
-            hosts.join(", ")
-        ));
-    }
-    let kinds: Vec<&str> = match kind {
-        Some(k) if hosted.contains(&k) => vec![k],
-        Some(k) => {
-            return Err(format!(
-                "scene `{name}` hosts no study `{k}`; its studies are {}",
-                hosted.join(", ")
-            ))
-        }
-        None => hosted.clone(),
-    };
-    for k in kinds {
-        let failed = |e: fem_forms::Error| format!("study {name} {k}: {e}");
-        if k == fem_forms::lambda_scatter::NAME {
-            fem_forms::lambda_scatter::scatter_run(&scene, full, out).map_err(failed)?;
-            continue;
-        }
-        let study = Study::parse(k).ok_or_else(|| format!("unknown study `{k}`"))?;
-        let scenes = if study.depends_on_data() {
-            families::study_variants(&scene).map_err(failed)?
-        } else {
-            vec![scene.clone()]
-        };
-        for posed in scenes {
-            if study == Study::WorkPrecision {
-                fem_forms::choice_study::run(&posed, full, out).map_err(failed)?;
-            }
-            let studies = fem_forms::registry_studies::RegistryStudies::new(posed);
-            studies::run(&studies, study, full, out).map_err(failed)?;
-        }
+        fem_forms::registry_studies::run_hosted(scene, Some(name), full, out)?;
     }
     Ok(())
 }
@@ -693,6 +643,25 @@ fn run(cli: Cli) -> Result<(), String> {
     let _ = std::fs::remove_file(&probe);
     match cli.command {
         None => default_job(&cli.out),
+        Some(Command::Report { full, scenes }) => {
+            for name in &scenes {
+                let scene = families::scene(name)
+                    .ok_or_else(|| format!("--scene {name}: no such scene (see `list`)"))?;
+                if scene.studies.is_empty() {
+                    return Err(format!(
+                        "--scene {name}: hosts no study (see `list` for the scenes that do)"
+                    ));
+                }
+            }
+            let options = fem_forms::report_page::Options {
+                full,
+                out: cli.out.clone(),
+                scenes,
+            };
+            let page = fem_forms::report_page::write(&options)?;
+            println!("→ {}", page.display());
+            Ok(())
+        }
         Some(Command::List) => {
             list();
             Ok(())

@@ -9,9 +9,10 @@
 use crate::models::families;
 use crate::models::geometry::Fields;
 use crate::models::report::{Outcome, Schur, Settings};
-use crate::models::scene::{Domain, ExactSolution, Scene};
+use crate::models::scene::{Domain, Exact, ExactSolution, Scene};
 use crate::studies::{ExactMultiplier, Measure, Plan, Row, Run, StabilityRow, Study, StudyScene};
 use fem_runtime::{Error, Result};
+use std::path::Path;
 
 /// A registry scene as the studies see it.
 pub struct RegistryStudies {
@@ -479,4 +480,70 @@ impl StudyScene for RegistryStudies {
         let points = self.multiplier_profile(&run).unwrap_or_default();
         extent(&points).map_or([0.0, 1.0], |(lo, hi)| [lo, hi])
     }
+}
+
+/// A study of a registry scene through the one implementation over the one solve
+/// ([`fem_forms::registry_studies`]), on each of its study variants where the study
+/// depends on the data ([`Study::depends_on_data`]); the λ-scatter through its own
+/// ([`crate::lambda_scatter`]).
+pub fn run_hosted(
+    scene: Scene,
+    kind: Option<&str>,
+    full: bool,
+    out: &Path,
+) -> std::result::Result<(), String> {
+    let name = scene.name.to_string();
+    let hosted = scene.studies.clone();
+    let work_precision = Study::WorkPrecision.name();
+    if kind == Some(work_precision) && !hosted.contains(&work_precision) {
+        // every scene has the chart of its candidates and of the choice made for them
+        return crate::choice_study::run(&scene, full, out)
+            .map_err(|e| format!("study {name} {work_precision}: {e}"));
+    }
+    if hosted.is_empty() {
+        let hosts: Vec<String> = families::scenes()
+            .iter()
+            .filter(|s| !s.studies.is_empty())
+            .map(|s| s.name.to_string())
+            .collect();
+        return Err(format!(
+            "scene `{name}` hosts no study; the scenes that do are {}",
+            hosts.join(", ")
+        ));
+    }
+    let kinds: Vec<&str> = match kind {
+        Some(k) if hosted.contains(&k) => vec![k],
+        Some(k) => {
+            return Err(format!(
+                "scene `{name}` hosts no study `{k}`; its studies are {}",
+                hosted.join(", ")
+            ))
+        }
+        None => hosted.clone(),
+    };
+    for k in kinds {
+        let failed = |e: fem_runtime::Error| format!("study {name} {k}: {e}");
+        if k == crate::lambda_scatter::NAME {
+            crate::lambda_scatter::scatter_run(&scene, full, out).map_err(failed)?;
+            continue;
+        }
+        let study = Study::parse(k).ok_or_else(|| format!("unknown study `{k}`"))?;
+        let scenes = if study.depends_on_data() {
+            families::study_variants(&scene).map_err(failed)?
+        } else {
+            vec![scene.clone()]
+        };
+        for posed in scenes {
+            if study == Study::WorkPrecision {
+                crate::choice_study::run(&posed, full, out).map_err(failed)?;
+                // the solvers' error against time needs the exact solution
+                if matches!(posed.exact, Exact::Unknown) {
+                    continue;
+                }
+            }
+            let studies = RegistryStudies::new(posed);
+            crate::studies::run(&studies, study, full, out).map_err(failed)?;
+        }
+    }
+    Ok(())
 }

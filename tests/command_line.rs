@@ -967,3 +967,41 @@ fn adaptive_options_are_checked() {
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
 }
+
+/// `report`: a scene that is not there, or hosts no study, is refused by name before
+/// any study runs; a scene's studies give a page with its charts.
+#[test]
+fn report_checks_its_scenes_and_writes_the_page() {
+    let out = scratch("report");
+    for (scene, words) in [
+        ("no-such-scene", "--scene no-such-scene: no such scene"),
+        ("membrane-flat", "--scene membrane-flat: hosts no study"),
+    ] {
+        let output = fem_forms(&["report", "--scene", scene], &out);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success());
+        assert!(stderr.contains(words), "{stderr}");
+        assert!(!out.join("index.html").exists());
+    }
+    let output = fem_forms(&["report", "--scene", "timoshenko-a"], &out);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    for chart in [
+        "studies/timoshenko-a-locking/timoshenko-a-locking.svg",
+        "studies/timoshenko-a-stability/timoshenko-a-stability.svg",
+        "studies/timoshenko-a-iterations/timoshenko-a-iterations.svg",
+    ] {
+        assert!(page.contains(chart), "{chart}");
+        assert!(out.join(chart).exists(), "{chart}");
+    }
+    // the studies' printing went to their logs, not to the terminal
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(
+        stdout.trim(),
+        format!("→ {}", out.join("index.html").display())
+    );
+}

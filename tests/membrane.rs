@@ -749,11 +749,7 @@ fn a_nested_solve_inside_a_level_builder_finishes() {
 /// same discrete problem must give them to the four digits printed.
 #[test]
 fn the_nodal_method_reproduces_petsc_ex9_errors() {
-    for (n, mean, max) in [
-        (16, 2.707e-3, 1.428e-2),
-        (32, 8.182e-4, 5.747e-3),
-        (64, 9.818e-5, 5.991e-4),
-    ] {
+    for (n, mean, max) in fem_forms::models::membrane_scenes::PETSC_EX9_ERRORS {
         let r = solve(radial(), "p1-nodal", n).solve;
         let (m, x) = (r.error_vertex_mean.unwrap(), r.error_vertex_max.unwrap());
         assert_eq!(

@@ -156,6 +156,17 @@ impl MembraneScene {
     }
 }
 
+/// An independent solver's errors on the radial problem: PETSc's SNES tutorial ex9
+/// (Bueler's obstacle problem, p4pdes), PETSc 3.18, `ex9 -snes_type vinewtonrsls
+/// -snes_grid_sequence K -pc_type mg` with K = 2, 3, 4, printed `av |u-uexact|` and
+/// `|u-uexact|_inf` on the 17², 33² and 65² grids: (N, mean, max) for the N×N right-diagonal
+/// mesh, whose nodal P1 method (`p1-nodal`) is ex9's 5-point scheme.
+pub const PETSC_EX9_ERRORS: [(usize, f64, f64); 3] = [
+    (16, 2.707e-3, 1.428e-2),
+    (32, 8.182e-4, 5.747e-3),
+    (64, 9.818e-5, 5.991e-4),
+];
+
 /// The free-boundary radius `r*` of the radial problem: `r*²(ln 2 − ln r*) = 1 − r*²`.
 pub const RADIAL_R: f64 = 0.697965148223374;
 /// `A = r*²/√(1 − r*²)`.

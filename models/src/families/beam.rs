@@ -124,6 +124,8 @@ fn studies(name: &str) -> Vec<&'static str> {
             "adaptivity",
         ],
         "timoshenko-a" => vec!["locking", "stability", "iterations"],
+        // the model choice's chart: Euler–Bernoulli adequate at loose tolerances only
+        "timoshenko-t1e-2" => vec!["work-precision"],
         _ => Vec::new(),
     }
 }

@@ -155,7 +155,7 @@ fn kirchhoff_scene(
     place(&mut scene, obstacle);
     scene.studies = match obstacle {
         Some(_) => vec!["convergence", "lambda-scatter", "stability", "adaptivity"],
-        None => vec!["convergence"],
+        None => vec!["convergence", "work-precision"],
     };
     scene.study_variants = match obstacle {
         // two loads, flat and curved: contact sets of different shapes and sizes
@@ -428,8 +428,9 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
             })?;
             report.set("centre_deflection", deflection);
             if !run.scene.obstacle {
-                if let Some(reference) = series_reference(run.scene, run.posed) {
+                if let Some((reference, source)) = series_reference(run.scene, run.posed) {
                     report.set("reference_centre_deflection", reference);
+                    report.set("reference_source", source);
                     // q = 0: both deflections are 0 exactly, and so is the error
                     let relative = if reference != 0.0 {
                         Some((deflection - reference) / reference)
@@ -492,9 +493,9 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
 }
 
 /// The series' centre deflection of an unobstructed unit square, `c q a⁴/D` (clamped:
-/// the tabulated coefficient; simply supported: Navier's series summed); `None` for
-/// another domain or mixed supports.
-fn series_reference(scene: &Scene, posed: &Posed) -> Option<f64> {
+/// the tabulated coefficient; simply supported: Navier's series summed), with its
+/// source; `None` for another domain or mixed supports.
+fn series_reference(scene: &Scene, posed: &Posed) -> Option<(f64, &'static str)> {
     let Domain::Rectangle { x, y, .. } = scene.domain else {
         return None;
     };
@@ -502,12 +503,18 @@ fn series_reference(scene: &Scene, posed: &Posed) -> Option<f64> {
         return None;
     }
     let supports: Vec<Support> = scene.supports.iter().map(|s| s.support).collect();
-    let coefficient = match supports.as_slice() {
-        [Support::Clamped] => CLAMPED_CENTRE_COEFFICIENT,
-        [Support::SimplySupported { .. }] => navier_centre_coefficient(),
+    let (coefficient, source) = match supports.as_slice() {
+        [Support::Clamped] => (
+            CLAMPED_CENTRE_COEFFICIENT,
+            "Timoshenko and Woinowsky-Krieger, Theory of Plates and Shells, Table 35 (ν = 0.3)",
+        ),
+        [Support::SimplySupported { .. }] => (
+            navier_centre_coefficient(),
+            "Navier's double series, summed (Timoshenko and Woinowsky-Krieger §30)",
+        ),
         _ => return None,
     };
-    Some(coefficient * posed.load? / posed.parameter("D")?)
+    Some((coefficient * posed.load? / posed.parameter("D")?, source))
 }
 
 /// `max |w_h|` over each cell's vertices, edge midpoints and centroid.

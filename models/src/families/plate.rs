@@ -143,6 +143,8 @@ fn plate_scene(old: &plate_scenes::PlateScene) -> Scene {
     scene.studies = match old.name {
         "mindlin-square" => vec!["locking", "adaptivity"],
         "mindlin-disk" => vec!["convergence", "iterations"],
+        // the model choice's chart: Kirchhoff against Reissner–Mindlin
+        "mindlin-ss-t1e-2" => vec!["work-precision"],
         _ => Vec::new(),
     };
     // a scene that lists several loads is studied at each
@@ -484,6 +486,14 @@ impl<G: Geometry> Quantities<G> for Plates {
                     let reference = closed.unwrap_or(kirchhoff);
                     report.set("unobstructed_reference", closed);
                     report.set("reference_centre_deflection", reference);
+                    report.set(
+                        "reference_source",
+                        if closed.is_some() {
+                            "the clamped disk's Reissner–Mindlin closed form q R⁴/(64D) + q R²/(4S)"
+                        } else {
+                            "the Kirchhoff plate's series (Timoshenko and Woinowsky-Krieger), the limit t → 0"
+                        },
+                    );
                     // q = 0: both deflections are 0 exactly, and so is the error
                     let relative = if reference == 0.0 && deflection == 0.0 {
                         0.0

@@ -77,7 +77,13 @@ impl Family for Winkler {
         .with_support(Part::All, Support::SimplySupported { hard: false });
         vec![Scene {
             // the kinds that need no exact solution, through the one study implementation
-            studies: vec!["alpha", "iterations", "stability", "adaptivity"],
+            studies: vec![
+                "alpha",
+                "iterations",
+                "stability",
+                "work-precision",
+                "adaptivity",
+            ],
             load: Some(Load {
                 default: 1.0,
                 scales: vec!["f".into()],

@@ -171,7 +171,9 @@ pub fn contact_scene(old: &ContactScene) -> Scene {
         _ => PAIRS.iter().map(|p| p.name).collect(),
     };
     scene.studies = match old.body {
-        ContactBody::Cylinder { .. } => vec!["convergence", "alpha", "adaptivity"],
+        ContactBody::Cylinder { .. } => {
+            vec!["convergence", "alpha", "work-precision", "adaptivity"]
+        }
         _ => Vec::new(),
     };
     scene.in_default_job = true;
@@ -761,6 +763,10 @@ fn add_hertz<M: Model>(
             (r.pressure_l2_error, r.best_fit_l2_error, r.oscillation)
         }
     };
+    report.set(
+        "reference_source",
+        "Hertz's line contact (K. L. Johnson, Contact Mechanics, 1985, §4.2)",
+    );
     report.set("exact_half_width", hertz.half_width());
     report.set("exact_max_pressure", hertz.max_pressure());
     report.set("pressure_l2_error", error);
