@@ -79,6 +79,10 @@ enum Command {
         /// Only these scenes' studies (and their families' accuracy tables).
         #[arg(long = "scene", value_name = "SCENE")]
         scenes: Vec<String>,
+        /// PETSc's SNES tutorial ex9, built (default: $FEM_FORMS_PETSC_EX9): run on the
+        /// radial membrane's grids beside the nodal method, errors and solve times.
+        #[arg(long, value_name = "PATH")]
+        petsc_ex9: Option<PathBuf>,
     },
 }
 
@@ -643,7 +647,21 @@ fn run(cli: Cli) -> Result<(), String> {
     let _ = std::fs::remove_file(&probe);
     match cli.command {
         None => default_job(&cli.out),
-        Some(Command::Report { full, scenes }) => {
+        Some(Command::Report {
+            full,
+            scenes,
+            petsc_ex9,
+        }) => {
+            let petsc_ex9 =
+                petsc_ex9.or_else(|| std::env::var_os("FEM_FORMS_PETSC_EX9").map(PathBuf::from));
+            if let Some(ex9) = &petsc_ex9 {
+                if !ex9.is_file() {
+                    return Err(format!(
+                        "--petsc-ex9 {}: no such file (build PETSc's src/snes/tutorials/ex9.c, e.g. `mpicc ex9.c $(pkg-config --cflags --libs PETSc) -lm -o ex9`)",
+                        ex9.display()
+                    ));
+                }
+            }
             for name in &scenes {
                 let scene = families::scene(name)
                     .ok_or_else(|| format!("--scene {name}: no such scene (see `list`)"))?;
@@ -657,6 +675,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 full,
                 out: cli.out.clone(),
                 scenes,
+                petsc_ex9,
             };
             let page = fem_forms::report_page::write(&options)?;
             println!("→ {}", page.display());

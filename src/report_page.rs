@@ -30,6 +30,9 @@ pub struct Options {
     /// Only the studies of these scenes (empty: every scene that hosts one); the
     /// accuracy tables then cover these scenes' families only.
     pub scenes: Vec<String>,
+    /// PETSc's SNES tutorial ex9, built, to run beside the nodal method on the radial
+    /// membrane (`None`: its published errors only).
+    pub petsc_ex9: Option<PathBuf>,
 }
 
 /// One study of one scene.
@@ -215,6 +218,171 @@ fn petsc_ex9() -> Result<Vec<Comparison>, String> {
         }
     }
     Ok(rows)
+}
+
+/// The grids PETSc's ex9 is run on beside the nodal method: N + 1 points a side, from
+/// grid sequencing `-snes_grid_sequence K` on its 5×5 start (N = 2^(K+2)).
+const EX9_SIZES: [usize; 5] = [16, 32, 64, 128, 256];
+
+/// One solve of ex9: the grid's N, the errors it printed (mean, max at the grid's
+/// points) and its `SNESSolve` time from `-log_view` (every level of the sequence).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ex9Run {
+    /// N of the (N + 1)² grid.
+    pub size: usize,
+    /// `av |u-uexact|`.
+    pub mean: f64,
+    /// `|u-uexact|_inf`.
+    pub max: f64,
+    /// Seconds in SNESSolve.
+    pub seconds: f64,
+}
+
+/// Reads what ex9 printed with `-snes_converged_reason -log_view`: its error line and
+/// the SNESSolve event's time. A diverged solve is an error naming its reason (ex9
+/// itself exits 0 on DIVERGED_MAX_IT).
+///
+/// # Errors
+/// A divergence, or output without the error line or the SNESSolve event.
+pub fn parse_ex9(size: usize, output: &str) -> Result<Ex9Run, String> {
+    if let Some(line) = output.lines().find(|l| l.contains("DIVERGED")) {
+        return Err(format!("ex9 on the {}² grid: {}", size + 1, line.trim()));
+    }
+    let number_after = |line: &str, key: &str| -> Option<f64> {
+        let rest = &line[line.find(key)? + key.len()..];
+        let rest = rest.trim_start().strip_prefix('=')?.trim_start();
+        rest.split([',', ' ']).next()?.parse().ok()
+    };
+    let errors = output
+        .lines()
+        .find(|l| l.starts_with("errors on"))
+        .ok_or_else(|| format!("ex9 on the {}² grid printed no `errors on` line", size + 1))?;
+    let (mean, max) = number_after(errors, "av |u-uexact|")
+        .zip(number_after(errors, "|u-uexact|_inf"))
+        .ok_or_else(|| format!("ex9's error line is not as expected: {errors}"))?;
+    let seconds = output
+        .lines()
+        .find(|l| l.starts_with("SNESSolve "))
+        .and_then(|l| l.split_whitespace().nth(3)?.parse().ok())
+        .ok_or_else(|| {
+            format!(
+                "ex9 on the {}² grid printed no SNESSolve time (-log_view)",
+                size + 1
+            )
+        })?;
+    Ok(Ex9Run {
+        size,
+        mean,
+        max,
+        seconds,
+    })
+}
+
+/// Runs ex9 (`vinewtonrsls`, grid sequencing, PCMG: the run whose printed errors
+/// [`PETSC_EX9_ERRORS`] records) on the grid of N.
+fn run_ex9(ex9: &Path, size: usize) -> Result<Ex9Run, String> {
+    let sequence = size.trailing_zeros().saturating_sub(2);
+    let output = std::process::Command::new(ex9)
+        .args([
+            "-snes_type",
+            "vinewtonrsls",
+            "-snes_grid_sequence",
+            &sequence.to_string(),
+            "-pc_type",
+            "mg",
+            "-snes_converged_reason",
+            "-log_view",
+        ])
+        // Open MPI's singleton refuses root without these
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .output()
+        .map_err(|e| format!("{}: {e}", ex9.display()))?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    if !output.status.success() {
+        return Err(format!(
+            "{} exited with {}: {}",
+            ex9.display(),
+            output.status,
+            String::from_utf8_lossy(&output.stderr).trim()
+        ));
+    }
+    parse_ex9(size, &text)
+}
+
+/// PETSc's ex9 beside the nodal method on the radial membrane, both run now on the same
+/// grids: the mean error at the grid points against solve time, as a chart and a table
+/// (`studies/membrane-radial-petsc-ex9/`). Returns the page's HTML.
+fn ex9_beside(ex9: &Path, out: &Path) -> Result<String, String> {
+    let scene = families::scene("membrane-radial").ok_or("the registry has no membrane-radial")?;
+    let dir = out.join("studies/membrane-radial-petsc-ex9");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut ours = Vec::new();
+    let mut theirs = Vec::new();
+    let mut table = String::from("<table class=\"ex9\"><tr><th>grid</th><th>p1-nodal mean error</th><th>ex9 mean error</th><th>p1-nodal max error</th><th>ex9 max error</th><th>p1-nodal seconds</th><th>ex9 seconds (SNESSolve)</th></tr>\n");
+    let mut csv =
+        String::from("n,nodal_mean,ex9_mean,nodal_max,ex9_max,nodal_seconds,ex9_seconds\n");
+    for size in EX9_SIZES {
+        let settings = Settings {
+            pair: Some("p1-nodal".into()),
+            mesh_size: Some(size),
+            ..Settings::default()
+        };
+        let report = families::solve(&scene, &settings)
+            .map_err(|e| format!("membrane-radial p1-nodal N = {size}: {e}"))?
+            .report;
+        let (mean, max) = (
+            report.solve.error_vertex_mean.unwrap_or(f64::NAN),
+            report.solve.error_vertex_max.unwrap_or(f64::NAN),
+        );
+        let run = run_ex9(ex9, size)?;
+        ours.push((report.solve.seconds, mean));
+        theirs.push((run.seconds, run.mean));
+        let _ = writeln!(
+            table,
+            "<tr><td>{0}²</td><td class=\"n\">{1:.3e}</td><td class=\"n\">{2:.3e}</td><td class=\"n\">{3:.3e}</td><td class=\"n\">{4:.3e}</td><td class=\"n\">{5:.4}</td><td class=\"n\">{6:.4}</td></tr>",
+            size + 1,
+            mean,
+            run.mean,
+            max,
+            run.max,
+            report.solve.seconds,
+            run.seconds
+        );
+        let _ = writeln!(
+            csv,
+            "{size},{mean:e},{:e},{max:e},{:e},{:e},{:e}",
+            run.mean, run.max, report.solve.seconds, run.seconds
+        );
+    }
+    table.push_str("</table>\n");
+    let chart = dir.join("membrane-radial-petsc-ex9.svg");
+    crate::plot::chart(
+        &chart,
+        "membrane-radial: the nodal method and PETSc's ex9 on the same grids",
+        crate::plot::Axes {
+            x: "solve time (s)",
+            y: "mean |u − u_h| at the grid points",
+            log_x: true,
+            log_y: true,
+            rates: false,
+        },
+        &[
+            crate::plot::Series::marked("p1-nodal (fem-forms, nested semismooth Newton)", ours),
+            crate::plot::Series::marked("PETSc ex9 (vinewtonrsls, grid sequencing, PCMG)", theirs),
+        ],
+    )
+    .map_err(|e| format!("{}: {e}", chart.display()))?;
+    let table_path = dir.join("membrane-radial-petsc-ex9.csv");
+    std::fs::write(&table_path, csv).map_err(|e| format!("{}: {e}", table_path.display()))?;
+    let svg = inline_chart(
+        out,
+        "studies/membrane-radial-petsc-ex9/membrane-radial-petsc-ex9.svg",
+    )?;
+    Ok(format!(
+        "<h3 id=\"membrane-radial-petsc-ex9\">membrane-radial: PETSc's ex9 beside the nodal method</h3>\n<p class=\"checks\">An independent solver run now: PETSc's SNES tutorial ex9 ({}), the same 5-point discrete problem as the p1-nodal pair on the right-diagonal mesh, so the errors must agree to the digits printed; the times are fem-forms' whole nested solve against ex9's SNESSolve over every level of its grid sequence.</p>\n{table}<figure id=\"chart-ex9\" data-csv=\"studies/membrane-radial-petsc-ex9/membrane-radial-petsc-ex9.chart.csv\">\n{svg}\n<figcaption>studies/membrane-radial-petsc-ex9/membrane-radial-petsc-ex9.svg · table: <a href=\"studies/membrane-radial-petsc-ex9/membrane-radial-petsc-ex9.csv\">membrane-radial-petsc-ex9.csv</a></figcaption>\n</figure>\n",
+        escape(&ex9.display().to_string())
+    ))
 }
 
 /// The stdout of this process sent to a file while a study runs: the studies print their
@@ -637,6 +805,20 @@ pub fn write(options: &Options) -> Result<PathBuf, String> {
                 escape(failure)
             );
             failed.push(failure.clone());
+        }
+        let radial = families::scenes()
+            .iter()
+            .any(|s| s.family == *family && *s.name == *"membrane-radial");
+        match (&options.petsc_ex9, radial) {
+            (Some(ex9), true) => match ex9_beside(ex9, out) {
+                Ok(part) => html.push_str(&part),
+                Err(e) => {
+                    let _ = writeln!(html, "<p class=\"failed\">PETSc's ex9: {}</p>", escape(&e));
+                    failed.push(e);
+                }
+            },
+            (None, true) => html.push_str("<p>PETSc's ex9 was not run beside the nodal method (<code>--petsc-ex9 PATH</code>, or <code>FEM_FORMS_PETSC_EX9</code>, gives a built ex9); the errors it printed on the same grids are in the table above.</p>\n"),
+            _ => {}
         }
         for d in done.iter().filter(|d| d.job.scene.family == *family) {
             let _ = writeln!(

@@ -18,6 +18,7 @@ fn page() -> &'static (PathBuf, String) {
             full: false,
             out: out.clone(),
             scenes: vec!["bernoulli-flat".into(), "timoshenko-a".into()],
+            petsc_ex9: None,
         };
         let path = report_page::write(&options).expect("the report");
         assert_eq!(path, out.join("index.html"));
@@ -315,4 +316,63 @@ fn a_headless_browser_renders_every_chart_without_console_messages() {
     let size = std::fs::metadata(&shot).map_or(0, |m| m.len());
     assert!(size > 10_000, "screenshot of {size} bytes");
     eprintln!("screenshot: {}", shot.display());
+}
+
+/// What ex9 prints is read back, and a diverged ex9 (which exits 0) is an error.
+#[test]
+fn ex9s_output_is_read_and_its_divergence_refused() {
+    let printed = "errors on 17 x 17 grid:  av |u-uexact|  = 2.707e-03,  |u-uexact|_inf = 1.428e-02\n\
+        Time (sec):           9.001e-02     1.000   9.001e-02\n\
+        SNESSolve              5 1.0 7.0732e-02 1.0 1.69e+07 1.0 0.0e+00 0.0e+00 0.0e+00 79 100  0  0  0  79 100  0  0  0   239\n";
+    let run = report_page::parse_ex9(16, printed).unwrap();
+    assert_eq!(
+        (run.size, run.mean, run.max, run.seconds),
+        (16, 2.707e-3, 1.428e-2, 7.0732e-2)
+    );
+    let diverged =
+        format!("Nonlinear solve did not converge due to DIVERGED_MAX_IT iterations 50\n{printed}");
+    let error = report_page::parse_ex9(16, &diverged).unwrap_err();
+    assert!(
+        error.contains("DIVERGED_MAX_IT") && error.contains("17²"),
+        "{error}"
+    );
+    assert!(report_page::parse_ex9(16, "nothing").is_err());
+}
+
+/// Where a built ex9 is given (`FEM_FORMS_PETSC_EX9`; `.ci/run` builds it when PETSc is
+/// installed): run beside the nodal method, it prints the same errors to its four
+/// digits on every grid (the same discrete problem, solved independently).
+#[test]
+fn petscs_ex9_run_now_agrees_with_the_nodal_method() {
+    let Some(ex9) = std::env::var_os("FEM_FORMS_PETSC_EX9").map(PathBuf::from) else {
+        eprintln!("skipped: FEM_FORMS_PETSC_EX9 names no built ex9");
+        return;
+    };
+    let out = std::env::temp_dir().join(format!("fem-forms-report-ex9-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let options = Options {
+        full: false,
+        out: out.clone(),
+        scenes: vec!["membrane-lshape".into()],
+        petsc_ex9: Some(ex9),
+    };
+    report_page::write(&options).expect("the report");
+    let table = std::fs::read_to_string(
+        out.join("studies/membrane-radial-petsc-ex9/membrane-radial-petsc-ex9.csv"),
+    )
+    .unwrap();
+    let mut grids = 0;
+    for line in table.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        for (ours, theirs) in [(v[1], v[2]), (v[3], v[4])] {
+            assert_eq!(
+                format!("{ours:.3e}"),
+                format!("{theirs:.3e}"),
+                "N = {}",
+                v[0]
+            );
+        }
+        grids += 1;
+    }
+    assert_eq!(grids, 5);
 }
