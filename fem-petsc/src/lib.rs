@@ -1,0 +1,691 @@
+//! PETSc driven from Rust: the bindings bindgen generates from Debian's `petsc.h` ([`sys`])
+//! and a thin safe layer over the parts fem-forms uses — MPI through the `mpi` crate,
+//! distributed vectors, preallocated `MATMPIAIJ` matrices, and SNES / SNESVI with the
+//! residual and Jacobian as Rust closures.
+//!
+//! Safety of the layer: every PETSc object is owned by one value and destroyed on drop;
+//! every call's error code becomes a [`Result`] with PETSc's own message; callbacks go
+//! through `extern "C"` trampolines to a boxed closure that the SNES keeps alive, and a
+//! panic inside one is caught and returned to PETSc as an error (unwinding through C is
+//! undefined). A diverged or not-converged SNES is an [`Error`] naming PETSc's reason,
+//! never a result (PETSc's own ex9 exits 0 on DIVERGED_MAX_IT).
+//!
+//! Not in the default build: the crate needs PETSc, Open MPI and libclang, so it is
+//! outside the workspace's members and built through the root crate's `petsc` feature
+//! (docs/petsc.md).
+
+use std::ffi::{c_void, CStr, CString};
+use std::ops::Range;
+
+/// The raw bindings (bindgen over `wrapper.h`).
+#[allow(
+    non_upper_case_globals,
+    non_camel_case_types,
+    non_snake_case,
+    dead_code,
+    missing_docs,
+    clippy::all
+)]
+pub mod sys {
+    include!(concat!(env!("OUT_DIR"), "/bindings.rs"));
+}
+
+/// A failed PETSc call, or a SNES that did not converge.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Error {
+    /// The call that failed (`VecCreateMPI`, `SNESSolve`).
+    pub call: &'static str,
+    /// PETSc's error code (0 for a SNES that stopped without converging).
+    pub code: i32,
+    /// PETSc's message, or the SNES's converged reason.
+    pub message: String,
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: {} (PETSc error {})",
+            self.call, self.message, self.code
+        )
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// The result of a PETSc call.
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// `code` of `call` as a [`Result`], with PETSc's text for the code.
+fn check(call: &'static str, code: sys::PetscErrorCode) -> Result<()> {
+    if code == 0 {
+        return Ok(());
+    }
+    let mut text: *const std::os::raw::c_char = std::ptr::null();
+    // SAFETY: PetscErrorMessage stores a pointer to a static string (or leaves null)
+    let message = unsafe {
+        sys::PetscErrorMessage(code, &mut text, std::ptr::null_mut());
+        if text.is_null() {
+            "unknown error".to_string()
+        } else {
+            CStr::from_ptr(text).to_string_lossy().into_owned()
+        }
+    };
+    Err(Error {
+        call,
+        code,
+        message,
+    })
+}
+
+/// PETSc initialized on MPI's world communicator (from the `mpi` crate); finalized, then
+/// MPI, when dropped. One per process.
+pub struct Petsc {
+    universe: Option<mpi::environment::Universe>,
+}
+
+impl Petsc {
+    /// Initializes MPI and PETSc, then inserts `options` (PETSc's command-line options as
+    /// one string, `-snes_monitor -pc_type gamg`) into its options database.
+    ///
+    /// # Errors
+    /// MPI was initialized already (a second `Petsc`), PETSc's initialization failed, or
+    /// an option string PETSc cannot parse.
+    pub fn initialize(options: &str) -> Result<Self> {
+        let universe = mpi::initialize().ok_or(Error {
+            call: "MPI_Init",
+            code: 0,
+            message: "MPI is initialized already: one Petsc per process".into(),
+        })?;
+        let world = {
+            use mpi::raw::AsRaw;
+            use mpi::traits::Communicator;
+            let world = universe.world();
+            let _ = world.rank();
+            world.as_raw()
+        };
+        // SAFETY: PETSC_COMM_WORLD is read by PetscInitialize, which has not run yet;
+        // both are pointers to Open MPI's communicator object
+        unsafe {
+            sys::PETSC_COMM_WORLD = std::mem::transmute::<mpi::ffi::MPI_Comm, sys::MPI_Comm>(world);
+        }
+        let (mut argc, mut argv) = (0, std::ptr::null_mut());
+        // SAFETY: an empty argument list; no options file, no help text
+        check("PetscInitialize", unsafe {
+            sys::PetscInitialize(&mut argc, &mut argv, std::ptr::null(), std::ptr::null())
+        })?;
+        let petsc = Self {
+            universe: Some(universe),
+        };
+        if !options.trim().is_empty() {
+            petsc.insert_options(options)?;
+        }
+        Ok(petsc)
+    }
+
+    /// Inserts more options (`-snes_type vinewtonssls`) into PETSc's database; later
+    /// solves read them.
+    ///
+    /// # Errors
+    /// An option string PETSc cannot parse, or one with a NUL byte.
+    pub fn insert_options(&self, options: &str) -> Result<()> {
+        let text = CString::new(options).map_err(|_| Error {
+            call: "PetscOptionsInsertString",
+            code: 0,
+            message: "the options contain a NUL byte".into(),
+        })?;
+        // SAFETY: the global options database, a NUL-terminated string
+        check("PetscOptionsInsertString", unsafe {
+            sys::PetscOptionsInsertString(std::ptr::null_mut(), text.as_ptr())
+        })
+    }
+
+    /// This process's rank in the world communicator.
+    pub fn rank(&self) -> usize {
+        use mpi::traits::Communicator;
+        self.universe
+            .as_ref()
+            .map_or(0, |u| u.world().rank() as usize)
+    }
+
+    /// The number of processes.
+    pub fn size(&self) -> usize {
+        use mpi::traits::Communicator;
+        self.universe
+            .as_ref()
+            .map_or(1, |u| u.world().size() as usize)
+    }
+
+    fn comm(&self) -> sys::MPI_Comm {
+        // SAFETY: set before PetscInitialize and constant since
+        unsafe { sys::PETSC_COMM_WORLD }
+    }
+}
+
+impl Drop for Petsc {
+    fn drop(&mut self) {
+        // SAFETY: every PETSc object borrows `self`, so all are destroyed by now
+        unsafe {
+            sys::PetscFinalize();
+        }
+        // MPI_Finalize after PETSc's
+        self.universe.take();
+    }
+}
+
+/// Global indices as PETSc's 32-bit `PetscInt`.
+///
+/// # Errors
+/// An index beyond `i32::MAX`.
+fn petsc_ints(call: &'static str, indices: &[usize]) -> Result<Vec<sys::PetscInt>> {
+    indices
+        .iter()
+        .map(|&i| {
+            sys::PetscInt::try_from(i).map_err(|_| Error {
+                call,
+                code: 0,
+                message: format!("index {i} beyond PETSc's 32-bit PetscInt"),
+            })
+        })
+        .collect()
+}
+
+/// A distributed vector (`VECMPI`): each rank owns a contiguous range of entries.
+pub struct Vector<'p> {
+    raw: sys::Vec,
+    _petsc: std::marker::PhantomData<&'p Petsc>,
+}
+
+impl<'p> Vector<'p> {
+    /// A vector of which this rank owns `local` entries (the global size is their sum).
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn new(petsc: &'p Petsc, local: usize) -> Result<Self> {
+        let local = petsc_ints("VecCreateMPI", &[local])?[0];
+        let mut raw = std::ptr::null_mut();
+        // SAFETY: creates a vector in `raw`
+        check("VecCreateMPI", unsafe {
+            sys::VecCreateMPI(petsc.comm(), local, sys::PETSC_DETERMINE, &mut raw)
+        })?;
+        Ok(Self {
+            raw,
+            _petsc: std::marker::PhantomData,
+        })
+    }
+
+    /// The global indices this rank owns.
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn ownership(&self) -> Result<Range<usize>> {
+        let (mut start, mut end) = (0, 0);
+        // SAFETY: a live vector
+        check("VecGetOwnershipRange", unsafe {
+            sys::VecGetOwnershipRange(self.raw, &mut start, &mut end)
+        })?;
+        Ok(start as usize..end as usize)
+    }
+
+    /// Sets (or, with `add`, adds) `values` at global `indices`, on any rank; takes
+    /// effect at [`Vector::assemble`].
+    ///
+    /// # Errors
+    /// Lengths that differ, or PETSc's.
+    pub fn set(&mut self, indices: &[usize], values: &[f64], add: bool) -> Result<()> {
+        if indices.len() != values.len() {
+            return Err(Error {
+                call: "VecSetValues",
+                code: 0,
+                message: format!("{} indices for {} values", indices.len(), values.len()),
+            });
+        }
+        let indices = petsc_ints("VecSetValues", indices)?;
+        let mode = if add {
+            sys::InsertMode_ADD_VALUES
+        } else {
+            sys::InsertMode_INSERT_VALUES
+        };
+        // SAFETY: arrays of the length passed
+        check("VecSetValues", unsafe {
+            sys::VecSetValues(
+                self.raw,
+                indices.len() as sys::PetscInt,
+                indices.as_ptr(),
+                values.as_ptr(),
+                mode,
+            )
+        })
+    }
+
+    /// Communicates the values set for entries other ranks own.
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn assemble(&mut self) -> Result<()> {
+        // SAFETY: a live vector
+        check("VecAssemblyBegin", unsafe {
+            sys::VecAssemblyBegin(self.raw)
+        })?;
+        check("VecAssemblyEnd", unsafe { sys::VecAssemblyEnd(self.raw) })
+    }
+
+    /// The entries this rank owns, in order.
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn local(&self) -> Result<Vec<f64>> {
+        let mut n = 0;
+        let mut array: *const f64 = std::ptr::null();
+        // SAFETY: the array is valid for the local size until restored
+        unsafe {
+            check("VecGetLocalSize", sys::VecGetLocalSize(self.raw, &mut n))?;
+            check(
+                "VecGetArrayRead",
+                sys::VecGetArrayRead(self.raw, &mut array),
+            )?;
+            let values = std::slice::from_raw_parts(array, n as usize).to_vec();
+            check(
+                "VecRestoreArrayRead",
+                sys::VecRestoreArrayRead(self.raw, &mut array),
+            )?;
+            Ok(values)
+        }
+    }
+
+    /// Every entry, on every rank (`VecScatterCreateToAll`).
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn gather(&self) -> Result<Vec<f64>> {
+        let mut scatter = std::ptr::null_mut();
+        let mut all = std::ptr::null_mut();
+        // SAFETY: creates a scatter and a sequential vector, both destroyed below
+        unsafe {
+            check(
+                "VecScatterCreateToAll",
+                sys::VecScatterCreateToAll(self.raw, &mut scatter, &mut all),
+            )?;
+            let moved = check(
+                "VecScatterBegin",
+                sys::VecScatterBegin(
+                    scatter,
+                    self.raw,
+                    all,
+                    sys::InsertMode_INSERT_VALUES,
+                    sys::ScatterMode_SCATTER_FORWARD,
+                ),
+            )
+            .and_then(|()| {
+                check(
+                    "VecScatterEnd",
+                    sys::VecScatterEnd(
+                        scatter,
+                        self.raw,
+                        all,
+                        sys::InsertMode_INSERT_VALUES,
+                        sys::ScatterMode_SCATTER_FORWARD,
+                    ),
+                )
+            });
+            let whole = Vector {
+                raw: all,
+                _petsc: std::marker::PhantomData,
+            };
+            sys::VecScatterDestroy(&mut scatter);
+            moved?;
+            whole.local()
+        }
+    }
+}
+
+impl Drop for Vector<'_> {
+    fn drop(&mut self) {
+        // SAFETY: owned
+        unsafe {
+            sys::VecDestroy(&mut self.raw);
+        }
+    }
+}
+
+/// A sparse matrix in PETSc's AIJ format (`MATMPIAIJ` on several ranks), preallocated
+/// row by row: an entry outside the preallocation is an error, not a silent
+/// reallocation.
+pub struct Matrix<'p> {
+    raw: sys::Mat,
+    _petsc: std::marker::PhantomData<&'p Petsc>,
+}
+
+impl<'p> Matrix<'p> {
+    /// A square matrix of which this rank owns `diagonal.len()` rows; row `i` has at
+    /// most `diagonal[i]` entries in the owned columns and `off_diagonal[i]` in others.
+    ///
+    /// # Errors
+    /// Lengths that differ, or PETSc's.
+    pub fn new(petsc: &'p Petsc, diagonal: &[usize], off_diagonal: &[usize]) -> Result<Self> {
+        if diagonal.len() != off_diagonal.len() {
+            return Err(Error {
+                call: "MatCreateAIJ",
+                code: 0,
+                message: "preallocations of different lengths".into(),
+            });
+        }
+        let d = petsc_ints("MatCreateAIJ", diagonal)?;
+        let o = petsc_ints("MatCreateAIJ", off_diagonal)?;
+        let m = d.len() as sys::PetscInt;
+        let mut raw = std::ptr::null_mut();
+        // SAFETY: arrays of the local row count
+        unsafe {
+            check(
+                "MatCreateAIJ",
+                sys::MatCreateAIJ(
+                    petsc.comm(),
+                    m,
+                    m,
+                    sys::PETSC_DETERMINE,
+                    sys::PETSC_DETERMINE,
+                    0,
+                    d.as_ptr(),
+                    0,
+                    o.as_ptr(),
+                    &mut raw,
+                ),
+            )?;
+            check(
+                "MatSetOption",
+                sys::MatSetOption(
+                    raw,
+                    sys::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
+                    sys::PetscBool_PETSC_TRUE,
+                ),
+            )?;
+        }
+        Ok(Self {
+            raw,
+            _petsc: std::marker::PhantomData,
+        })
+    }
+
+    /// Adds the dense block `values` (row-major, `rows.len() × columns.len()`) at global
+    /// `rows` and `columns`, on any rank; takes effect at [`Matrix::assemble`].
+    ///
+    /// # Errors
+    /// A block of the wrong size, or PETSc's (an entry outside the preallocation).
+    pub fn add(&mut self, rows: &[usize], columns: &[usize], values: &[f64]) -> Result<()> {
+        if values.len() != rows.len() * columns.len() {
+            return Err(Error {
+                call: "MatSetValues",
+                code: 0,
+                message: format!(
+                    "{} values for a {}×{} block",
+                    values.len(),
+                    rows.len(),
+                    columns.len()
+                ),
+            });
+        }
+        let r = petsc_ints("MatSetValues", rows)?;
+        let c = petsc_ints("MatSetValues", columns)?;
+        // SAFETY: arrays of the lengths passed
+        check("MatSetValues", unsafe {
+            sys::MatSetValues(
+                self.raw,
+                r.len() as sys::PetscInt,
+                r.as_ptr(),
+                c.len() as sys::PetscInt,
+                c.as_ptr(),
+                values.as_ptr(),
+                sys::InsertMode_ADD_VALUES,
+            )
+        })
+    }
+
+    /// Communicates the entries added for rows other ranks own.
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn assemble(&mut self) -> Result<()> {
+        // SAFETY: a live matrix
+        unsafe {
+            check(
+                "MatAssemblyBegin",
+                sys::MatAssemblyBegin(self.raw, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+            )?;
+            check(
+                "MatAssemblyEnd",
+                sys::MatAssemblyEnd(self.raw, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+            )
+        }
+    }
+
+    /// `y = A x`.
+    ///
+    /// # Errors
+    /// PETSc's (sizes that do not match).
+    pub fn multiply(&self, x: &VectorView, y: &mut VectorView) -> Result<()> {
+        // SAFETY: live objects
+        check("MatMult", unsafe { sys::MatMult(self.raw, x.raw, y.raw) })
+    }
+}
+
+impl Drop for Matrix<'_> {
+    fn drop(&mut self) {
+        // SAFETY: owned
+        unsafe {
+            sys::MatDestroy(&mut self.raw);
+        }
+    }
+}
+
+/// A vector a SNES callback sees (PETSc's, borrowed for the call).
+pub struct VectorView {
+    raw: sys::Vec,
+}
+
+impl VectorView {
+    /// `self += a x`.
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn axpy(&mut self, a: f64, x: &VectorView) -> Result<()> {
+        // SAFETY: live vectors
+        check("VecAXPY", unsafe { sys::VecAXPY(self.raw, a, x.raw) })
+    }
+
+    /// The view of a vector of ours.
+    pub fn of(vector: &Vector) -> Self {
+        Self { raw: vector.raw }
+    }
+}
+
+/// The residual `F(x)` of a SNES, written into its second argument.
+pub type Residual<'a> = Box<dyn FnMut(&VectorView, &mut VectorView) -> Result<()> + 'a>;
+
+/// What a converged SNES reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Converged {
+    /// PETSc's converged reason (`CONVERGED_FNORM_RELATIVE`).
+    pub reason: String,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Linear solver iterations over all Newton steps.
+    pub linear_iterations: usize,
+}
+
+/// The name of a SNES converged reason.
+pub fn reason_name(reason: sys::SNESConvergedReason) -> &'static str {
+    match reason {
+        2 => "CONVERGED_FNORM_ABS",
+        3 => "CONVERGED_FNORM_RELATIVE",
+        4 => "CONVERGED_SNORM_RELATIVE",
+        5 => "CONVERGED_ITS",
+        6 => "BREAKOUT_INNER_ITER",
+        0 => "CONVERGED_ITERATING",
+        -1 => "DIVERGED_FUNCTION_DOMAIN",
+        -2 => "DIVERGED_FUNCTION_COUNT",
+        -3 => "DIVERGED_LINEAR_SOLVE",
+        -4 => "DIVERGED_FNORM_NAN",
+        -5 => "DIVERGED_MAX_IT",
+        -6 => "DIVERGED_LINE_SEARCH",
+        -7 => "DIVERGED_INNER",
+        -8 => "DIVERGED_LOCAL_MIN",
+        -9 => "DIVERGED_DTOL",
+        -10 => "DIVERGED_JACOBIAN_DOMAIN",
+        -11 => "DIVERGED_TR_DELTA",
+        _ => "an unknown reason",
+    }
+}
+
+struct Callbacks<'a> {
+    residual: Residual<'a>,
+}
+
+unsafe extern "C" fn residual_trampoline(
+    _snes: sys::SNES,
+    x: sys::Vec,
+    f: sys::Vec,
+    context: *mut c_void,
+) -> sys::PetscErrorCode {
+    // SAFETY: `context` is the Callbacks the solve boxed, alive for the whole SNESSolve
+    let callbacks = unsafe { &mut *(context as *mut Callbacks) };
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        (callbacks.residual)(&VectorView { raw: x }, &mut VectorView { raw: f })
+    }));
+    match result {
+        Ok(Ok(())) => 0,
+        Ok(Err(e)) if e.code != 0 => e.code,
+        _ => sys::PETSC_ERR_USER as sys::PetscErrorCode,
+    }
+}
+
+/// The Jacobian callback of a constant Jacobian: copies the caller's matrix (the
+/// context) into the SNES's working one, which SNESVI's semismooth method scales in place
+/// (`vinewtonssls` forms the Fischer–Burmeister Jacobian in the matrix it is given: handed
+/// the caller's own, it corrupted both the Jacobian and every later residual).
+unsafe extern "C" fn constant_jacobian(
+    _snes: sys::SNES,
+    _x: sys::Vec,
+    jacobian: sys::Mat,
+    _preconditioner: sys::Mat,
+    context: *mut c_void,
+) -> sys::PetscErrorCode {
+    // SAFETY: the context is the caller's matrix, alive for the whole solve
+    unsafe {
+        sys::MatCopy(
+            context as sys::Mat,
+            jacobian,
+            sys::MatStructure_SAME_NONZERO_PATTERN,
+        )
+    }
+}
+
+/// Solves `F(x) = 0` subject to `lower ≤ x ≤ upper` (SNESVI; `vinewtonrsls` unless the
+/// options say otherwise) from the start in `x`, where `F` has the constant Jacobian
+/// `jacobian` (a quadratic energy's gradient, as the nodal method's): `residual` writes
+/// `F(x)`. Options from the database apply (`-snes_type vinewtonssls`, `-pc_type gamg`,
+/// `-snes_monitor`); without bounds (`None`) it is a plain SNES.
+///
+/// # Errors
+/// PETSc's, or a SNES that stopped without converging: its reason, named.
+pub fn solve(
+    jacobian: &Matrix,
+    residual: Residual<'_>,
+    bounds: Option<(&Vector, &Vector)>,
+    x: &mut Vector,
+) -> Result<Converged> {
+    let mut snes = std::ptr::null_mut();
+    let mut callbacks = Box::new(Callbacks { residual });
+    let context = &mut *callbacks as *mut Callbacks as *mut c_void;
+    // SAFETY: the SNES is created, used and destroyed here; `callbacks` outlives it
+    unsafe {
+        let mut comm = std::ptr::null_mut();
+        check(
+            "PetscObjectGetComm",
+            sys::PetscObjectGetComm(x.raw as sys::PetscObject, &mut comm),
+        )?;
+        check("SNESCreate", sys::SNESCreate(comm, &mut snes))?;
+        let result = (|| {
+            if bounds.is_some() {
+                check(
+                    "SNESSetType",
+                    sys::SNESSetType(snes, c"vinewtonrsls".as_ptr()),
+                )?;
+            }
+            let mut r = std::ptr::null_mut();
+            check("VecDuplicate", sys::VecDuplicate(x.raw, &mut r))?;
+            let r = Vector {
+                raw: r,
+                _petsc: std::marker::PhantomData,
+            };
+            check(
+                "SNESSetFunction",
+                sys::SNESSetFunction(snes, r.raw, Some(residual_trampoline), context),
+            )?;
+            let mut working = std::ptr::null_mut();
+            check(
+                "MatDuplicate",
+                sys::MatDuplicate(
+                    jacobian.raw,
+                    sys::MatDuplicateOption_MAT_COPY_VALUES,
+                    &mut working,
+                ),
+            )?;
+            let working = Matrix {
+                raw: working,
+                _petsc: std::marker::PhantomData,
+            };
+            check(
+                "SNESSetJacobian",
+                sys::SNESSetJacobian(
+                    snes,
+                    working.raw,
+                    working.raw,
+                    Some(constant_jacobian),
+                    jacobian.raw as *mut c_void,
+                ),
+            )?;
+            if let Some((lower, upper)) = bounds {
+                check(
+                    "SNESVISetVariableBounds",
+                    sys::SNESVISetVariableBounds(snes, lower.raw, upper.raw),
+                )?;
+            }
+            check("SNESSetFromOptions", sys::SNESSetFromOptions(snes))?;
+            check(
+                "SNESSolve",
+                sys::SNESSolve(snes, std::ptr::null_mut(), x.raw),
+            )?;
+            let mut reason = 0;
+            check(
+                "SNESGetConvergedReason",
+                sys::SNESGetConvergedReason(snes, &mut reason),
+            )?;
+            let (mut iterations, mut linear) = (0, 0);
+            check(
+                "SNESGetIterationNumber",
+                sys::SNESGetIterationNumber(snes, &mut iterations),
+            )?;
+            check(
+                "SNESGetLinearSolveIterations",
+                sys::SNESGetLinearSolveIterations(snes, &mut linear),
+            )?;
+            if reason <= 0 {
+                return Err(Error {
+                    call: "SNESSolve",
+                    code: 0,
+                    message: format!(
+                        "did not converge: {} after {iterations} iterations",
+                        reason_name(reason)
+                    ),
+                });
+            }
+            Ok(Converged {
+                reason: reason_name(reason).to_string(),
+                iterations: iterations as usize,
+                linear_iterations: linear as usize,
+            })
+        })();
+        sys::SNESDestroy(&mut snes);
+        result
+    }
+}
