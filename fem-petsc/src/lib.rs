@@ -14,6 +14,8 @@
 //! outside the workspace's members and built through the root crate's `petsc` feature
 //! (docs/petsc.md).
 
+pub mod nodal;
+
 use std::ffi::{c_void, CStr, CString};
 use std::ops::Range;
 
@@ -156,7 +158,7 @@ impl Petsc {
             .map_or(1, |u| u.world().size() as usize)
     }
 
-    fn comm(&self) -> sys::MPI_Comm {
+    pub(crate) fn comm(&self) -> sys::MPI_Comm {
         // SAFETY: set before PetscInitialize and constant since
         unsafe { sys::PETSC_COMM_WORLD }
     }
