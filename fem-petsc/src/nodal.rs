@@ -89,8 +89,8 @@ fn partition(petsc: &Petsc, mesh: &TriangleMesh) -> Result<Vec<usize>> {
     let neighbours = cell_neighbours(mesh);
     let mut offsets = vec![0 as sys::PetscInt];
     let mut columns = Vec::new();
-    for c in start..end {
-        columns.extend(neighbours[c].iter().map(|&n| n as sys::PetscInt));
+    for cell in &neighbours[start..end] {
+        columns.extend(cell.iter().map(|&n| n as sys::PetscInt));
         offsets.push(columns.len() as sys::PetscInt);
     }
     let too_large = |_| Error {
