@@ -30,6 +30,8 @@ pub struct Series {
     /// Draw large triangles at the points and no line (a point singled out on
     /// the curves, such as a choice made), in the colour of the series with this index.
     pub highlight: Option<usize>,
+    /// Draw a line through the points.
+    pub line: bool,
 }
 
 impl Series {
@@ -40,6 +42,7 @@ impl Series {
             points,
             markers: false,
             highlight: None,
+            line: true,
         }
     }
 
@@ -50,6 +53,18 @@ impl Series {
             points,
             markers: true,
             highlight: None,
+            line: true,
+        }
+    }
+
+    /// Points without a line (runs that failed, drawn where the chart says).
+    pub fn points(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            markers: true,
+            highlight: None,
+            line: false,
         }
     }
 
@@ -61,6 +76,7 @@ impl Series {
             points,
             markers: false,
             highlight: Some(like),
+            line: false,
         }
     }
 }
@@ -201,7 +217,7 @@ fn styles(series: &[Series]) -> Vec<Style> {
                     MARKERS[k % MARKERS.len()]
                 },
                 markers: s.markers || highlight,
-                line: !highlight,
+                line: s.line && !highlight,
                 size: if highlight { 9.0 } else { 3.5 },
             }
         })
@@ -384,8 +400,10 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     if log {
         // within the normal doubles: a log axis up to infinity has no end to its ticks
         ((lo / 1.5).max(1e-300), (hi * 1.5).min(1e300))
-    } else if hi - lo < 1e-300 {
-        (lo - 1.0, hi + 1.0)
+    } else if hi - lo <= 1e-12 * lo.abs().max(hi.abs()) {
+        // one value: a tenth of it either side (±1 made 0.0039 look like 0)
+        let pad = if hi == 0.0 { 1.0 } else { 0.1 * hi.abs() };
+        (lo - pad, hi + pad)
     } else {
         let pad = 0.05 * (hi - lo);
         (lo - pad, hi + pad)
@@ -797,6 +815,27 @@ fn write_panels(
     panels: &[(&str, Axes, &[Series])],
 ) -> std::io::Result<()> {
     let to_io = |e: Box<dyn std::error::Error>| std::io::Error::other(e.to_string());
+    // tall enough for the longest legend (drawn from the plot's top, 16 px a line)
+    let chars = characters_in(f64::from(LEGEND_WIDTH) - 48.0, LEGEND_FONT);
+    let legend = panels
+        .iter()
+        .map(|(title, _, series)| {
+            let lines: usize = series
+                .iter()
+                .map(|s| {
+                    wrap(
+                        &format!("{} (on the same points as {})", s.name, s.name),
+                        chars,
+                    )
+                    .len()
+                })
+                .sum();
+            let title_lines = wrap(title, characters_in(f64::from(WIDTH) - 24.0, TITLE_FONT)).len();
+            (16 * lines + 6 * series.len() + 21 * title_lines + 40) as u32
+        })
+        .max()
+        .unwrap_or(0);
+    let panel_height = panel_height.max(legend);
     let height = panel_height * panels.len().max(1) as u32;
     let mut frame = String::new();
     let mut drawn = Vec::with_capacity(panels.len());
@@ -997,7 +1036,7 @@ pub fn mesh(path: &Path, title: &str, fields: &Fields) -> std::io::Result<()> {
 
 /// The length of each cell of an interval mesh from its midpoints and the mesh's left
 /// end `x[0]`: each cell's right end is its midpoint mirrored from its left end.
-fn cell_lengths(x: &[f64], midpoints: &[f64]) -> Vec<f64> {
+pub fn cell_lengths(x: &[f64], midpoints: &[f64]) -> Vec<f64> {
     let mut left = x.first().copied().unwrap_or(0.0);
     midpoints
         .iter()
@@ -1150,5 +1189,18 @@ mod tick_tests {
         // the rate triangle of the finest segment: slope 2 between h = 1/16 and 1/4
         assert!(svg.contains(">2.00</text>"), "no rate 2.00");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A single value spans a tenth of itself either side (not ±1, which drew 0.0039
+    /// as 0), and failed runs drawn as points have no line through them.
+    #[test]
+    fn a_constant_curve_keeps_its_scale_and_points_stay_points() {
+        assert_eq!(
+            super::range([0.004, 0.004].into_iter(), false),
+            (0.0036, 0.0044)
+        );
+        assert_eq!(super::range([0.0].into_iter(), false), (-1.0, 1.0));
+        let styles = super::styles(&[super::Series::points("failed", vec![(1.0, 1.0)])]);
+        assert!(!styles[0].line && styles[0].markers);
     }
 }

@@ -173,7 +173,10 @@ pub fn line_profile(fields: &Fields) -> (Vec<(f64, f64)>, f64) {
 /// The largest cell diameter of a solve's mesh.
 fn largest_h(fields: &Fields) -> f64 {
     match fields {
-        Fields::Interval { x, .. } => x.windows(2).map(|w| w[1] - w[0]).fold(0.0f64, f64::max),
+        // the cells' lengths (x holds the plot's samples, several to a cell)
+        Fields::Interval { x, cell_x, .. } => crate::plot::cell_lengths(x, cell_x)
+            .into_iter()
+            .fold(0.0f64, f64::max),
         Fields::Triangles { mesh, .. } => mesh.max_h(),
     }
 }

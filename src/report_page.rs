@@ -171,6 +171,14 @@ pub fn comparisons(report: &Report) -> Vec<Comparison> {
     if let Some(e) = report.solve.error_h1 {
         rows.push(row("H¹ error of the constrained field", e, None, EXACT));
     }
+    if let Some(e) = report.number("patch_pressure_error") {
+        rows.push(row(
+            "largest relative error of λ_h against λ = q",
+            e,
+            None,
+            EXACT,
+        ));
+    }
     if let Some(e) = report.number("pressure_l2_error") {
         rows.push(row("relative L² error of the pressure", e, None, &source));
     }
@@ -486,32 +494,8 @@ fn run_facts() -> Vec<(&'static str, String)> {
             format!("{:.1} GiB", kb / 1024.0 / 1024.0)
         });
     let host = read("/etc/hostname").trim().to_string();
-    // the checkout this program was built from, wherever it is run
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .arg("-C")
-            .arg(env!("CARGO_MANIFEST_DIR"))
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    let commit = match git(&["rev-parse", "HEAD"]) {
-        Some(hash) => {
-            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
-                .is_some_and(|s| !s.is_empty());
-            if dirty {
-                format!("{hash} with uncommitted changes")
-            } else {
-                hash
-            }
-        }
-        None => format!(
-            "unknown (not run in a git checkout; version {})",
-            env!("CARGO_PKG_VERSION")
-        ),
-    };
+    // recorded at build time (build.rs): the checkout this program was built from
+    let commit = env!("FEM_FORMS_COMMIT").to_string();
     vec![
         ("date", utc_now()),
         ("commit", commit),
@@ -686,6 +670,20 @@ fn accuracy_table(html: &mut String, rows: &[Comparison]) {
     html.push_str("</table>\n");
 }
 
+/// `Ok` where the error is that the file was not there.
+trait NotFoundIsFine {
+    fn filter_not_found(self) -> std::io::Result<()>;
+}
+
+impl NotFoundIsFine for std::io::Result<()> {
+    fn filter_not_found(self) -> std::io::Result<()> {
+        match self {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+            other => other,
+        }
+    }
+}
+
 /// A chart inline: the SVG file's text, which `write` checks is one `<svg>` element.
 fn inline_chart(out: &Path, chart: &str) -> Result<String, String> {
     let text = std::fs::read_to_string(out.join(chart)).map_err(|e| format!("{chart}: {e}"))?;
@@ -706,6 +704,18 @@ pub fn write(options: &Options) -> Result<PathBuf, String> {
     let start = Instant::now();
     let out = &options.out;
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    // a page of an earlier run would link this run's files (and its studies would stay
+    // beside them): both go before anything runs, so an interrupted run leaves no page
+    for old in [out.join("index.html"), out.join("studies")] {
+        let removed = if old.is_dir() {
+            std::fs::remove_dir_all(&old)
+        } else {
+            std::fs::remove_file(&old)
+        };
+        if let Err(e) = removed.filter_not_found() {
+            return Err(format!("{}: {e}", old.display()));
+        }
+    }
     let jobs = jobs(&options.scenes);
     if jobs.is_empty() {
         return Err(format!(
@@ -785,10 +795,8 @@ pub fn write(options: &Options) -> Result<PathBuf, String> {
             "<section id=\"family-{family}\">\n<h2>{family}: {}</h2>",
             escape(description)
         );
-        html.push_str("<h3>Accuracy against references</h3>\n<p class=\"checks\">Each scene of the family (each variant its studies pose) solved at its defaults and its studies' load (and, for the radial membrane, the nodal method on the grids of PETSc's ex9): every quantity its report gives beside a reference, the relative difference, and where the reference comes from. Error norms have the reference 0.</p>\n");
-        if rows.is_empty() {
-            html.push_str("<p>No scene of this family has a reference value.</p>\n");
-        } else {
+        html.push_str("<h3>Accuracy against references</h3>\n<p class=\"checks\">Each scene of the family (each variant its studies pose) solved at its defaults and its studies' load: every quantity its report gives beside a reference, the relative difference, and where the reference comes from. Error norms have the reference 0.</p>\n");
+        if !rows.is_empty() {
             accuracy_table(&mut html, rows);
         }
         if !accuracy.without.is_empty() {
@@ -851,6 +859,14 @@ pub fn write(options: &Options) -> Result<PathBuf, String> {
                     }
                 };
                 let data = chart.replace(".svg", ".chart.csv");
+                let points = std::fs::read_to_string(out.join(&data))
+                    .map_or(usize::MAX, |text| text.lines().count().saturating_sub(1));
+                if points == 0 {
+                    let e = format!("{chart}: a chart without a single point");
+                    let _ = writeln!(html, "<p class=\"failed\">{}</p>", escape(&e));
+                    failed.push(e);
+                    continue;
+                }
                 let data_attribute = if out.join(&data).exists() {
                     format!(" data-csv=\"{}\"", escape(&data))
                 } else {

@@ -1144,7 +1144,8 @@ fn alpha_chart(
     let (low, high) = finite.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
     // no error measured (no exact solution): the markers span a unit decade, not the
     // sentinels f64::MAX and f64::MIN (a log axis over them never finished its ticks)
-    let (low, high) = if low <= high { (low, high) } else { (0.1, 1.0) };
+    let measured = low <= high;
+    let (low, high) = if measured { (low, high) } else { (0.1, 1.0) };
     let marker = |a: f64| vec![(a, low.max(1e-12)), (a, high)];
     let multiplier_error = scene.multiplier_error_name();
     let labels = [
@@ -1175,7 +1176,10 @@ fn alpha_chart(
         .map(|r| (r.alpha, high))
         .collect();
     if !failed.is_empty() {
-        series.push(Series::marked("failed (drawn at the top)", failed));
+        series.push(Series::points(
+            "failed: no solution (drawn at the top)",
+            failed,
+        ));
     }
     let (first, last) = (
         alphas
@@ -1185,41 +1189,65 @@ fn alpha_chart(
             .fold(f64::MAX, f64::min),
         alphas.iter().copied().fold(0.0, f64::max),
     );
-    let mut contact_series = vec![Series::marked("computed", contacts)];
+    let mut contact_series = vec![Series::marked("computed", contacts.clone())];
     if let Some(c) = exact_contact {
         contact_series.push(Series::line("exact", vec![(first, c), (last, c)]));
     }
-    plot::stacked(
-        &output(out, &name, Study::Alpha, "svg"),
-        &[
-            (
-                format!(
-                    "{}, {pair}, {} = {n}: errors against α{}",
-                    scene.setting(),
-                    scene.size_name(),
-                    if c_i > 0.0 {
-                        " (breaks down at α ≥ 1/C_I)"
-                    } else {
-                        " (1/C_I = ∞)"
-                    }
-                ),
-                log_axes("α", "error"),
-                series,
+    let mut panels = Vec::new();
+    if measured {
+        panels.push((
+            format!(
+                "{}, {pair}, {} = {n}: errors against α{}",
+                scene.setting(),
+                scene.size_name(),
+                if c_i > 0.0 {
+                    " (breaks down at α ≥ 1/C_I)"
+                } else {
+                    " (1/C_I = ∞)"
+                }
             ),
-            (
-                format!("{contact} against α (an overlarge α shifts the contact set)"),
-                Axes {
-                    x: "α",
-                    y: contact,
-                    log_x: true,
-                    log_y: false,
-                    rates: false,
-                },
-                contact_series,
-            ),
-        ],
-    )
-    .map_err(io)?;
+            log_axes("α", "error"),
+            series,
+        ));
+    } else {
+        // no error to chart (no exact solution): 1/C_I and ½/C_I on the contact panel
+        println!("no exact solution: the chart shows the {contact} against α only");
+        let (lo, hi) = contacts
+            .iter()
+            .map(|p| p.1)
+            .filter(|v| v.is_finite())
+            .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+        if c_i > 0.0 && lo <= hi {
+            // a measure constant in α still gets markers of a visible length
+            let pad = if hi > lo {
+                0.0
+            } else {
+                0.05 * hi.abs().max(1e-300)
+            };
+            for (label, a) in [("1/C_I", 1.0 / c_i), ("default ½/C_I", 0.5 / c_i)] {
+                contact_series.push(Series::line(
+                    format!("{label} = {a:.2e}"),
+                    vec![(a, lo - pad), (a, hi + pad)],
+                ));
+            }
+        }
+    }
+    panels.push((
+        format!(
+            "{}, {pair}, {} = {n}: {contact} against α (an overlarge α shifts the contact set)",
+            scene.setting(),
+            scene.size_name()
+        ),
+        Axes {
+            x: "α",
+            y: contact,
+            log_x: true,
+            log_y: false,
+            rates: false,
+        },
+        contact_series,
+    ));
+    plot::stacked(&output(out, &name, Study::Alpha, "svg"), &panels).map_err(io)?;
     Ok(())
 }
 
@@ -1340,6 +1368,19 @@ fn run_work_precision(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<
     let name = scene.name();
     let plan = scene.plan(Study::WorkPrecision, scene.pairs()[0], full);
     let rows = work_precision(scene, plan.pair, &plan.sizes, plan.cold_max);
+    let measured = rows.iter().any(|w| {
+        w.result
+            .as_ref()
+            .is_ok_and(|r| nan(r.error_l2).is_finite() || nan(r.error_h1).is_finite())
+    });
+    if !measured {
+        // without an exact solution at this load there is no error to chart
+        println!(
+            "{}: no exact solution at this load, so no error against solve time (the model choice's chart measures by the estimate)",
+            scene.setting()
+        );
+        return Ok(());
+    }
     println!(
         "{}, {}: error against solve time",
         scene.setting(),

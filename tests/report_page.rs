@@ -79,7 +79,7 @@ fn the_page_is_well_formed_html_with_a_section_per_family_and_every_study() {
         .map(|c| c.text().collect())
         .collect();
     assert!(facts[0].ends_with(" UTC"), "{facts:?}");
-    let hash = facts[1].split_whitespace().next().unwrap_or("");
+    let hash = facts[1].split([' ', ',']).next().unwrap_or("");
     assert!(
         hash.len() == 40 && hash.chars().all(|c| c.is_ascii_hexdigit()),
         "no commit hash in {facts:?}"

@@ -123,14 +123,14 @@ pub fn error_bound(report: &Report) -> Option<f64> {
     Some(report.solve.estimate_relative? + modelling)
 }
 
-/// What a chosen solve took: `Euler–Bernoulli hermite-p0` (`?` for the model of a
-/// report without a choice).
+/// What a chosen solve took: `Euler–Bernoulli hermite-p0` (the family's name for the
+/// model of a report without a choice: a scene with one candidate).
 pub fn chosen_words(report: &Report) -> String {
     let model = report
         .quantities
         .get("chosen_model")
         .and_then(|v| v.as_str())
-        .unwrap_or("?");
+        .unwrap_or(report.family);
     format!("{model} {}", report.pair)
 }
 

@@ -506,7 +506,7 @@ fn series_reference(scene: &Scene, posed: &Posed) -> Option<(f64, &'static str)>
     let (coefficient, source) = match supports.as_slice() {
         [Support::Clamped] => (
             CLAMPED_CENTRE_COEFFICIENT,
-            "Timoshenko and Woinowsky-Krieger, Theory of Plates and Shells, Table 35 (ν = 0.3)",
+            "Timoshenko and Woinowsky-Krieger, Theory of Plates and Shells, Table 35 (ν = 0.3), six digits: a relative difference below 4e-6 is the table's rounding",
         ),
         [Support::SimplySupported { .. }] => (
             navier_centre_coefficient(),
