@@ -540,7 +540,8 @@ fn run_convergence(scene: &dyn StudyScene, full: bool, out: &Path) -> Result<()>
         }
         panels.add(pair, rows, [&l2, &h1, &lm, &force, &reference], &changes);
     }
-    let panels = panels.finish(&scene.setting(), contact, exact);
+    let multiplier = scene.multiplier_error_name();
+    let panels = panels.finish(&scene.setting(), (contact, &multiplier), exact);
     plot::stacked(&output(out, &name, Study::Convergence, "svg"), &panels).map_err(io)?;
     write_csv_named(
         &output(out, &name, Study::Convergence, "csv"),
@@ -632,6 +633,8 @@ struct ConvergencePanels {
     reference: Vec<Series>,
     changes: Vec<Series>,
     work: Vec<Series>,
+    /// What each work curve measures (the H¹ error, the reference's, or |ΔJ_h|).
+    precision: Vec<&'static str>,
 }
 
 impl ConvergencePanels {
@@ -668,15 +671,19 @@ impl ConvergencePanels {
             }
         }
         // precision: the H¹ error where known, else the reference's, else |ΔJ_h|
-        let precision: Vec<f64> = if any(h1) {
-            h1.to_vec()
+        let (precision, measure): (Vec<f64>, &'static str) = if any(h1) {
+            (h1.to_vec(), "|u − u_h|_H1")
         } else if any(reference) {
-            reference.to_vec()
+            (reference.to_vec(), "|relative error of the reference|")
         } else {
-            changes.changes[0].iter().map(|d| d.abs()).collect()
+            (
+                changes.changes[0].iter().map(|d| d.abs()).collect(),
+                "|ΔJ_h| to the next mesh",
+            )
         };
+        self.precision.push(measure);
         self.work.push(Series::marked(
-            format!("{pair} against seconds"),
+            format!("{pair} against seconds ({measure})"),
             rows.iter()
                 .zip(&precision)
                 .map(|(r, &e)| (r.seconds.max(1e-5), e))
@@ -689,7 +696,7 @@ impl ConvergencePanels {
     fn finish(
         self,
         setting: &str,
-        contact: &str,
+        (contact, multiplier): (&str, &str),
         exact: bool,
     ) -> Vec<(String, Axes<'static>, Vec<Series>)> {
         let mut panels = Vec::new();
@@ -709,8 +716,8 @@ impl ConvergencePanels {
             self.h1,
         );
         panel(
-            format!("{setting}: error of λ, (Σ h_T² ‖λ − λ_h‖²_T)^½"),
-            rate_axes("h", "h-weighted error of λ"),
+            format!("{setting}: error of λ, {multiplier}"),
+            rate_axes("h", "error of λ"),
             self.multiplier,
         );
         panel(
@@ -730,10 +737,10 @@ impl ConvergencePanels {
                 self.changes,
             );
         }
-        let precision = if exact {
-            "|u − u_h|_H1"
-        } else {
-            "H¹ error, reference error or |ΔJ_h|"
+        // the curves' own measure where they share one, else each names its own
+        let precision = match self.precision.first() {
+            Some(first) if self.precision.iter().all(|p| p == first) => *first,
+            _ => "each curve's measure (in its legend)",
         };
         panel(
             format!("{setting}: work against precision (complete nested solve)"),
