@@ -181,6 +181,16 @@ fn largest_h(fields: &Fields) -> f64 {
     }
 }
 
+/// The smallest cell diameter of a solve's mesh.
+fn smallest_h(fields: &Fields) -> f64 {
+    match fields {
+        Fields::Interval { x, cell_x, .. } => crate::plot::cell_lengths(x, cell_x)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min),
+        Fields::Triangles { mesh, .. } => mesh.min_h(),
+    }
+}
+
 impl StudyScene for RegistryStudies {
     fn name(&self) -> String {
         self.scene.name.to_string()
@@ -296,6 +306,7 @@ impl StudyScene for RegistryStudies {
             pair: run.pair,
             size: run.size,
             h: largest_h(&outcome.fields),
+            h_min: smallest_h(&outcome.fields),
             cells: s.cells,
             dofs: s.dofs,
             alpha: s.alpha.unwrap_or(0.0),

@@ -734,9 +734,17 @@ pub fn write(options: &Options) -> Result<PathBuf, String> {
             .map_err(|e| e.to_string())?
             .progress_chars("=> "),
     );
+    // the clock moves during a long study too
+    bar.enable_steady_tick(std::time::Duration::from_millis(500));
+    // without a terminal the bar draws nothing: a line per study instead
+    let lines = bar.is_hidden();
+    let total = jobs.len();
     let mut done = Vec::with_capacity(jobs.len());
-    for job in &jobs {
+    for (k, job) in jobs.iter().enumerate() {
         bar.set_message(format!("study {} {}", job.scene.name, job.kind));
+        if lines {
+            eprintln!("[{}/{total}] study {} {}", k + 1, job.scene.name, job.kind);
+        }
         let result = run_job(job, options.full, out);
         if let Some(e) = &result.error {
             bar.println(format!("failed: {e}"));
@@ -747,6 +755,9 @@ pub fn write(options: &Options) -> Result<PathBuf, String> {
     let mut accuracies = Vec::new();
     for family in &family_names {
         bar.set_message(format!("accuracy of the {family} scenes"));
+        if lines {
+            eprintln!("accuracy of the {family} scenes");
+        }
         accuracies.push(accuracy(family));
         bar.inc(1);
     }

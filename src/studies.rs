@@ -127,6 +127,8 @@ pub struct Row {
     pub size: usize,
     /// Largest cell diameter.
     pub h: f64,
+    /// Smallest cell diameter (where a graded mesh refines: Hertz's contact zone).
+    pub h_min: f64,
     /// Cells of the mesh (elements, or triangles).
     pub cells: usize,
     /// Unknowns after eliminating boundary DOFs (primal and multiplier).
@@ -642,8 +644,18 @@ impl ConvergencePanels {
     /// changes; a measure no row has is left out.
     fn add(&mut self, pair: &str, rows: &[Row], errors: [&[f64]; 5], changes: &Changes) {
         let [l2, h1, lm, force, reference] = errors;
-        let against_h =
-            |v: &[f64]| -> Vec<(f64, f64)> { rows.iter().zip(v).map(|(r, &e)| (r.h, e)).collect() };
+        // a graded mesh keeps its largest cell (Hertz's far field) as it refines: its
+        // curves are drawn against the smallest cell, which the refinement halves
+        let graded = rows.len() > 1 && rows.iter().all(|r| (r.h - rows[0].h).abs() <= 1e-12 * r.h);
+        let h_of = |r: &Row| if graded { r.h_min } else { r.h };
+        let against_h = |v: &[f64]| -> Vec<(f64, f64)> {
+            rows.iter().zip(v).map(|(r, &e)| (h_of(r), e)).collect()
+        };
+        let graded_words = if graded {
+            " (against the smallest cell: graded mesh)"
+        } else {
+            ""
+        };
         let any = |v: &[f64]| v.iter().any(|e| e.is_finite());
         for (target, values, label) in [
             (&mut self.l2, l2, "L²"),
@@ -653,7 +665,10 @@ impl ConvergencePanels {
             (&mut self.reference, reference, "reference"),
         ] {
             if any(values) {
-                target.push(Series::marked(format!("{pair} {label}"), against_h(values)));
+                target.push(Series::marked(
+                    format!("{pair} {label}{graded_words}"),
+                    against_h(values),
+                ));
             }
         }
         for (name, d) in Changes::NAMES.iter().zip(&changes.changes) {
@@ -662,7 +677,7 @@ impl ConvergencePanels {
             let points: Vec<(f64, f64)> = rows
                 .iter()
                 .zip(d)
-                .map(|(r, d)| (r.h, d.abs()))
+                .map(|(r, d)| (h_of(r), d.abs()))
                 .filter(|(_, d)| d.is_finite() && *d > 0.0)
                 .collect();
             if !points.is_empty() {
@@ -1582,6 +1597,7 @@ mod tests {
             pair: "p",
             size: 1,
             h,
+            h_min: h,
             cells: 1,
             dofs: 1,
             alpha: 0.0,

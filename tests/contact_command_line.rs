@@ -202,6 +202,19 @@ fn the_hertz_study_and_chart_are_written() {
         (error - number(&single, "pressure_l2_error")).abs() <= 1e-12,
         "{row}"
     );
+    // the graded mesh keeps its largest cell as b/h grows: the chart draws each curve
+    // against the smallest cell, which halves with each refinement (not on one vertical)
+    let chart = std::fs::read_to_string(out.join("hertz-convergence.chart.csv")).unwrap();
+    let hs: Vec<f64> = chart
+        .lines()
+        .filter(|l| l.starts_with("1,p1-p0 λ"))
+        .map(|l| l.rsplit(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(hs.len(), 3, "{chart}");
+    for pair in hs.windows(2) {
+        let ratio = pair[0] / pair[1];
+        assert!((ratio - 2.0).abs() < 0.2, "{hs:?}");
+    }
     let run = Command::new(env!("CARGO_BIN_EXE_fem-forms"))
         .args(["solve", "hertz", "--plot", "--mesh-size", "8", "--out"])
         .arg(&out)
