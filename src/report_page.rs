@@ -185,20 +185,25 @@ pub fn comparisons(report: &Report) -> Vec<Comparison> {
     rows
 }
 
+/// The radial membrane (`scene`) by the nodal method on the N×N mesh: the grid of ex9.
+fn nodal_radial(scene: &Scene, n: usize) -> Result<Report, String> {
+    let settings = Settings {
+        pair: Some("p1-nodal".into()),
+        mesh_size: Some(n),
+        ..Settings::default()
+    };
+    families::solve(scene, &settings)
+        .map(|outcome| outcome.report)
+        .map_err(|e| format!("membrane-radial p1-nodal N = {n}: {e}"))
+}
+
 /// The radial membrane's nodal method against PETSc's ex9 on the same grids
 /// ([`PETSC_EX9_ERRORS`]): both errors on each grid.
 fn petsc_ex9() -> Result<Vec<Comparison>, String> {
     let scene = families::scene("membrane-radial").ok_or("the registry has no membrane-radial")?;
     let mut rows = Vec::new();
     for (n, mean, max) in PETSC_EX9_ERRORS {
-        let settings = Settings {
-            pair: Some("p1-nodal".into()),
-            mesh_size: Some(n),
-            ..Settings::default()
-        };
-        let report = families::solve(&scene, &settings)
-            .map_err(|e| format!("membrane-radial p1-nodal N = {n}: {e}"))?
-            .report;
+        let report = nodal_radial(&scene, n)?;
         let source = format!(
             "PETSc 3.18 SNES tutorial ex9 (Bueler, p4pdes), {}² grid, as printed",
             n + 1
@@ -331,14 +336,7 @@ fn ex9_beside(ex9: &Path, out: &Path) -> Result<String, String> {
     let mut csv =
         String::from("n,nodal_mean,ex9_mean,nodal_max,ex9_max,nodal_seconds,ex9_seconds\n");
     for size in EX9_SIZES {
-        let settings = Settings {
-            pair: Some("p1-nodal".into()),
-            mesh_size: Some(size),
-            ..Settings::default()
-        };
-        let report = families::solve(&scene, &settings)
-            .map_err(|e| format!("membrane-radial p1-nodal N = {size}: {e}"))?
-            .report;
+        let report = nodal_radial(&scene, size)?;
         let (mean, max) = (
             report.solve.error_vertex_mean.unwrap_or(f64::NAN),
             report.solve.error_vertex_max.unwrap_or(f64::NAN),
