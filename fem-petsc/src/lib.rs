@@ -55,6 +55,18 @@ impl std::fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+impl Error {
+    /// A refusal of ours at `call` (bad arguments, a SNES that did not converge): no
+    /// PETSc error code.
+    fn refused(call: &'static str, message: impl Into<String>) -> Self {
+        Self {
+            call,
+            code: 0,
+            message: message.into(),
+        }
+    }
+}
+
 /// The result of a PETSc call.
 pub type Result<T> = std::result::Result<T, Error>;
 
@@ -94,11 +106,10 @@ impl Petsc {
     /// MPI was initialized already (a second `Petsc`), PETSc's initialization failed, or
     /// an option string PETSc cannot parse.
     pub fn initialize(options: &str) -> Result<Self> {
-        let universe = mpi::initialize().ok_or(Error {
-            call: "MPI_Init",
-            code: 0,
-            message: "MPI is initialized already: one Petsc per process".into(),
-        })?;
+        let universe = mpi::initialize().ok_or(Error::refused(
+            "MPI_Init",
+            "MPI is initialized already: one Petsc per process",
+        ))?;
         let world = {
             use mpi::raw::AsRaw;
             use mpi::traits::Communicator;
@@ -131,10 +142,8 @@ impl Petsc {
     /// # Errors
     /// An option string PETSc cannot parse, or one with a NUL byte.
     pub fn insert_options(&self, options: &str) -> Result<()> {
-        let text = CString::new(options).map_err(|_| Error {
-            call: "PetscOptionsInsertString",
-            code: 0,
-            message: "the options contain a NUL byte".into(),
+        let text = CString::new(options).map_err(|_| {
+            Error::refused("PetscOptionsInsertString", "the options contain a NUL byte")
         })?;
         // SAFETY: the global options database, a NUL-terminated string
         check("PetscOptionsInsertString", unsafe {
@@ -183,10 +192,8 @@ fn petsc_ints(call: &'static str, indices: &[usize]) -> Result<Vec<sys::PetscInt
     indices
         .iter()
         .map(|&i| {
-            sys::PetscInt::try_from(i).map_err(|_| Error {
-                call,
-                code: 0,
-                message: format!("index {i} beyond PETSc's 32-bit PetscInt"),
+            sys::PetscInt::try_from(i).map_err(|_| {
+                Error::refused(call, format!("index {i} beyond PETSc's 32-bit PetscInt"))
             })
         })
         .collect()
@@ -236,11 +243,10 @@ impl<'p> Vector<'p> {
     /// Lengths that differ, or PETSc's.
     pub fn set(&mut self, indices: &[usize], values: &[f64], add: bool) -> Result<()> {
         if indices.len() != values.len() {
-            return Err(Error {
-                call: "VecSetValues",
-                code: 0,
-                message: format!("{} indices for {} values", indices.len(), values.len()),
-            });
+            return Err(Error::refused(
+                "VecSetValues",
+                format!("{} indices for {} values", indices.len(), values.len()),
+            ));
         }
         let indices = petsc_ints("VecSetValues", indices)?;
         let mode = if add {
@@ -366,11 +372,10 @@ impl<'p> Matrix<'p> {
     /// Lengths that differ, or PETSc's.
     pub fn new(petsc: &'p Petsc, diagonal: &[usize], off_diagonal: &[usize]) -> Result<Self> {
         if diagonal.len() != off_diagonal.len() {
-            return Err(Error {
-                call: "MatCreateAIJ",
-                code: 0,
-                message: "preallocations of different lengths".into(),
-            });
+            return Err(Error::refused(
+                "MatCreateAIJ",
+                "preallocations of different lengths",
+            ));
         }
         let d = petsc_ints("MatCreateAIJ", diagonal)?;
         let o = petsc_ints("MatCreateAIJ", off_diagonal)?;
@@ -415,16 +420,15 @@ impl<'p> Matrix<'p> {
     /// A block of the wrong size, or PETSc's (an entry outside the preallocation).
     pub fn add(&mut self, rows: &[usize], columns: &[usize], values: &[f64]) -> Result<()> {
         if values.len() != rows.len() * columns.len() {
-            return Err(Error {
-                call: "MatSetValues",
-                code: 0,
-                message: format!(
+            return Err(Error::refused(
+                "MatSetValues",
+                format!(
                     "{} values for a {}×{} block",
                     values.len(),
                     rows.len(),
                     columns.len()
                 ),
-            });
+            ));
         }
         let r = petsc_ints("MatSetValues", rows)?;
         let c = petsc_ints("MatSetValues", columns)?;
@@ -672,14 +676,13 @@ pub fn solve(
                 sys::SNESGetLinearSolveIterations(snes, &mut linear),
             )?;
             if reason <= 0 {
-                return Err(Error {
-                    call: "SNESSolve",
-                    code: 0,
-                    message: format!(
+                return Err(Error::refused(
+                    "SNESSolve",
+                    format!(
                         "did not converge: {} after {iterations} iterations",
                         reason_name(reason)
                     ),
-                });
+                ));
             }
             Ok(Converged {
                 reason: reason_name(reason).to_string(),

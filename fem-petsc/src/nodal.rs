@@ -93,10 +93,11 @@ fn partition(petsc: &Petsc, mesh: &TriangleMesh) -> Result<Vec<usize>> {
         columns.extend(cell.iter().map(|&n| n as sys::PetscInt));
         offsets.push(columns.len() as sys::PetscInt);
     }
-    let too_large = |_| Error {
-        call: "MatCreateMPIAdj",
-        code: 0,
-        message: "more cells than PETSc's 32-bit PetscInt holds".into(),
+    let too_large = |_| {
+        Error::refused(
+            "MatCreateMPIAdj",
+            "more cells than PETSc's 32-bit PetscInt holds",
+        )
     };
     let (local, global) = (
         sys::PetscInt::try_from(end - start).map_err(too_large)?,
@@ -160,14 +161,13 @@ fn partition(petsc: &Petsc, mesh: &TriangleMesh) -> Result<Vec<usize>> {
         sys::MatDestroy(&mut adjacency);
         let ranks = result?;
         if ranks.len() != cells || ranks.iter().any(|&r| r >= size) {
-            return Err(Error {
-                call: "MatPartitioningApply",
-                code: 0,
-                message: format!(
+            return Err(Error::refused(
+                "MatPartitioningApply",
+                format!(
                     "a partition of {} cells into ranks beyond {size}",
                     ranks.len()
                 ),
-            });
+            ));
         }
         Ok(ranks)
     }
@@ -188,11 +188,10 @@ pub fn solve_nodal<M: Model>(
     psi: &dyn Fn([f64; 2]) -> f64,
     g: &dyn Fn([f64; 2]) -> f64,
 ) -> Result<NodalSolution> {
-    let [a, l] = M::ENERGY.ok_or(Error {
-        call: "solve_nodal",
-        code: 0,
-        message: format!("model {} declares no energy forms", M::NAME),
-    })?;
+    let [a, l] = M::ENERGY.ok_or(Error::refused(
+        "solve_nodal",
+        format!("model {} declares no energy forms", M::NAME),
+    ))?;
     let rank = petsc.rank();
     let owner_of_cell = partition(petsc, mesh)?;
     let vertices = mesh.vertex_count();
