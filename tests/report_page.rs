@@ -376,3 +376,25 @@ fn petscs_ex9_run_now_agrees_with_the_nodal_method() {
     }
     assert_eq!(grids, 5);
 }
+
+/// The beams' convergence is charted against the cell length 1/N (it once took the
+/// spacing of the plot's samples, h/8).
+#[test]
+fn beam_convergence_is_against_the_cell_length() {
+    let (out, _) = page();
+    let csv = std::fs::read_to_string(
+        out.join("studies/bernoulli-flat-convergence/bernoulli-flat-convergence.csv"),
+    )
+    .unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let mut rows = 0;
+    for line in csv.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        let size: f64 = cells[column("size")].parse().unwrap();
+        let h: f64 = cells[column("h")].parse().unwrap();
+        assert!((h * size - 1.0).abs() < 1e-12, "{line}");
+        rows += 1;
+    }
+    assert!(rows >= 3, "{csv}");
+}
