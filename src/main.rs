@@ -9,6 +9,7 @@ use fem_forms::plot;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod backend;
 mod solve;
 
 #[derive(Parser)]
@@ -183,6 +184,18 @@ struct SolveOptions {
     /// The marking parameter θ in (0, 1] (default 0.5).
     #[arg(long, allow_hyphen_values = true)]
     theta: Option<f64>,
+    /// Who solves the complementarity problems: native (default) or petsc (PETSc's SNES
+    /// and SNESVI over MPI, in a binary built with `--features petsc`; run it as
+    /// `mpirun -n N fem-forms solve SCENE --backend petsc`; docs/petsc.md).
+    #[arg(long, value_name = "native|petsc")]
+    backend: Option<String>,
+    /// PETSc's options, as one string (`"-snes_monitor -ksp_type cg -pc_type gamg"`).
+    #[arg(long, value_name = "OPTIONS", allow_hyphen_values = true)]
+    petsc_options: Option<String>,
+    /// How PETSc is given a stabilized pair's problem: eliminated (default where the
+    /// multipliers are P0: SNES on Φ(U)) or mixed (SNESVI on (U, Λ), bounds on Λ).
+    #[arg(long, value_name = "eliminated|mixed")]
+    petsc_formulation: Option<String>,
 }
 
 fn table_header() {

@@ -2,6 +2,7 @@
 //! through the registry's one path ([`fem_forms::models::choice::solve`]), printed as a
 //! summary or as JSON, with its chart or ParaView file where asked.
 
+use crate::backend::{Backend, BackendOptions};
 use crate::{SolveOptions, SolverName};
 use fem_forms::adaptivity::{AdaptiveLevel, AdaptiveOptions, Marking};
 use fem_forms::models::families;
@@ -44,6 +45,15 @@ impl SolveOptions {
             .filter(|(given, _)| *given)
             .map(|(_, o)| o)
             .collect()
+    }
+
+    /// The backend's options (`--backend`, `--petsc-options`, `--petsc-formulation`).
+    pub fn backend_options(&self) -> BackendOptions {
+        BackendOptions {
+            backend: self.backend.clone(),
+            petsc_options: self.petsc_options.clone(),
+            petsc_formulation: self.petsc_formulation.clone(),
+        }
     }
 
     /// An error naming the first given option of `not_applicable`, with `why`.
@@ -256,6 +266,21 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
         )?;
     }
     let mut settings = settings(options)?;
+    let backend_options = options.backend_options();
+    let backend = if backend_options.wants_petsc()? {
+        if options.solver == Some(SolverName::Clarabel) {
+            return Err("--solver clarabel does not apply with --backend petsc: PETSc solves the complementarity problems".into());
+        }
+        options.refuse_options(
+            &[Opt::LinearSolver],
+            "with --backend petsc, PETSc's options choose the linear solver (--petsc-options \"-ksp_type cg -pc_type gamg\")",
+        )?;
+        let backend = Backend::start(&backend_options)?;
+        settings.solver = backend.solver();
+        Some(backend)
+    } else {
+        None
+    };
     if let Some(path) = &options.msh {
         scene = scene.on_mesh_file(path.clone());
         settings.mesh_size = Some(options.mesh_size.unwrap_or(0));
@@ -270,7 +295,13 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    let outcome = outcome.map_err(|e| format!("{}: {e}", scene.name))?;
+    let mut outcome = outcome.map_err(|e| format!("{}: {e}", scene.name))?;
+    if let Some(backend) = &backend {
+        if !backend.is_root() {
+            return Ok(());
+        }
+        backend.describe(&mut outcome.report, &backend_options);
+    }
     print(&outcome.report, options.json)?;
     write_outputs(&scene, &outcome, options, out)
 }

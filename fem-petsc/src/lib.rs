@@ -14,6 +14,7 @@
 //! outside the workspace's members and built through the root crate's `petsc` feature
 //! (docs/petsc.md).
 
+pub mod lcp;
 pub mod nodal;
 
 use std::ffi::{c_void, CStr, CString};
@@ -306,44 +307,49 @@ impl<'p> Vector<'p> {
     /// # Errors
     /// PETSc's.
     pub fn gather(&self) -> Result<Vec<f64>> {
-        let mut scatter = std::ptr::null_mut();
-        let mut all = std::ptr::null_mut();
-        // SAFETY: creates a scatter and a sequential vector, both destroyed below
-        unsafe {
+        gather(self.raw)
+    }
+}
+
+/// Every entry of the vector `raw`, on every rank (`VecScatterCreateToAll`).
+fn gather(raw: sys::Vec) -> Result<Vec<f64>> {
+    let mut scatter = std::ptr::null_mut();
+    let mut all = std::ptr::null_mut();
+    // SAFETY: creates a scatter and a sequential vector, both destroyed below
+    unsafe {
+        check(
+            "VecScatterCreateToAll",
+            sys::VecScatterCreateToAll(raw, &mut scatter, &mut all),
+        )?;
+        let moved = check(
+            "VecScatterBegin",
+            sys::VecScatterBegin(
+                scatter,
+                raw,
+                all,
+                sys::InsertMode_INSERT_VALUES,
+                sys::ScatterMode_SCATTER_FORWARD,
+            ),
+        )
+        .and_then(|()| {
             check(
-                "VecScatterCreateToAll",
-                sys::VecScatterCreateToAll(self.raw, &mut scatter, &mut all),
-            )?;
-            let moved = check(
-                "VecScatterBegin",
-                sys::VecScatterBegin(
+                "VecScatterEnd",
+                sys::VecScatterEnd(
                     scatter,
-                    self.raw,
+                    raw,
                     all,
                     sys::InsertMode_INSERT_VALUES,
                     sys::ScatterMode_SCATTER_FORWARD,
                 ),
             )
-            .and_then(|()| {
-                check(
-                    "VecScatterEnd",
-                    sys::VecScatterEnd(
-                        scatter,
-                        self.raw,
-                        all,
-                        sys::InsertMode_INSERT_VALUES,
-                        sys::ScatterMode_SCATTER_FORWARD,
-                    ),
-                )
-            });
-            let whole = Vector {
-                raw: all,
-                _petsc: std::marker::PhantomData,
-            };
-            sys::VecScatterDestroy(&mut scatter);
-            moved?;
-            whole.local()
-        }
+        });
+        let whole = Vector {
+            raw: all,
+            _petsc: std::marker::PhantomData,
+        };
+        sys::VecScatterDestroy(&mut scatter);
+        moved?;
+        whole.local()
     }
 }
 
@@ -464,6 +470,32 @@ impl<'p> Matrix<'p> {
         }
     }
 
+    /// A copy (pattern and values).
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn duplicate(&self) -> Result<Matrix<'p>> {
+        let mut raw = std::ptr::null_mut();
+        // SAFETY: a live matrix; the copy is owned by the result
+        check("MatDuplicate", unsafe {
+            sys::MatDuplicate(self.raw, sys::MatDuplicateOption_MAT_COPY_VALUES, &mut raw)
+        })?;
+        Ok(Matrix {
+            raw,
+            _petsc: std::marker::PhantomData,
+        })
+    }
+
+    /// Sets every entry to zero, keeping the pattern (before a new
+    /// [`Matrix::add`] and [`Matrix::assemble`]).
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn zero_entries(&mut self) -> Result<()> {
+        // SAFETY: a live matrix
+        check("MatZeroEntries", unsafe { sys::MatZeroEntries(self.raw) })
+    }
+
     /// `y = A x`.
     ///
     /// # Errors
@@ -501,6 +533,39 @@ impl VectorView {
     /// The view of a vector of ours.
     pub fn of(vector: &Vector) -> Self {
         Self { raw: vector.raw }
+    }
+
+    /// Every entry, on every rank.
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn gather(&self) -> Result<Vec<f64>> {
+        gather(self.raw)
+    }
+
+    /// Writes the entries this rank owns, in order.
+    ///
+    /// # Errors
+    /// `values` not of the local size, or PETSc's.
+    pub fn write_local(&mut self, values: &[f64]) -> Result<()> {
+        let mut n = 0;
+        let mut array: *mut f64 = std::ptr::null_mut();
+        // SAFETY: the array is valid for the local size until restored
+        unsafe {
+            check("VecGetLocalSize", sys::VecGetLocalSize(self.raw, &mut n))?;
+            if n as usize != values.len() {
+                return Err(Error::refused(
+                    "VecGetArray",
+                    format!("{} values for {n} local entries", values.len()),
+                ));
+            }
+            check("VecGetArray", sys::VecGetArray(self.raw, &mut array))?;
+            std::ptr::copy_nonoverlapping(values.as_ptr(), array, values.len());
+            check(
+                "VecRestoreArray",
+                sys::VecRestoreArray(self.raw, &mut array),
+            )
+        }
     }
 }
 
@@ -542,8 +607,112 @@ pub fn reason_name(reason: sys::SNESConvergedReason) -> &'static str {
     }
 }
 
-struct Callbacks<'a> {
+/// The update of a SNES's Jacobian at `x`, written into the matrix (its entries
+/// replaced; the pattern is the one preallocated).
+pub type JacobianUpdate<'a, 'p> = Box<dyn FnMut(&VectorView, &mut Matrix<'p>) -> Result<()> + 'a>;
+
+/// An objective whose gradient is the residual: the line search decreases it
+/// (`SNESSetObjective`) instead of the residual's norm.
+pub type Objective<'a> = Box<dyn FnMut(&VectorView) -> Result<f64> + 'a>;
+
+/// Choices a solve makes before PETSc reads its options database, so that any option the
+/// user gives (`-ksp_type cg -pc_type gamg`, `-snes_linesearch_type bt`) overrides them;
+/// `None` leaves PETSc's own default.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Defaults {
+    /// The Krylov method (`preonly` for a direct solve).
+    pub ksp_type: Option<&'static CStr>,
+    /// The preconditioner (`lu`, `cholesky`, `gamg`).
+    pub pc_type: Option<&'static CStr>,
+    /// The package that factors (`mumps`).
+    pub factor_package: Option<&'static CStr>,
+    /// The line search (`basic`: full Newton steps).
+    pub line_search: Option<&'static CStr>,
+    /// SNES's relative tolerance on the residual norm.
+    pub rtol: Option<f64>,
+}
+
+impl Defaults {
+    /// Sets these defaults on `snes` (before `SNESSetFromOptions`).
+    ///
+    /// # Safety
+    /// `snes` is a live SNES.
+    unsafe fn apply(&self, snes: sys::SNES) -> Result<()> {
+        // SAFETY: the caller's live SNES; the KSP, PC and line search it owns
+        unsafe {
+            let mut ksp = std::ptr::null_mut();
+            check("SNESGetKSP", sys::SNESGetKSP(snes, &mut ksp))?;
+            if let Some(t) = self.ksp_type {
+                check("KSPSetType", sys::KSPSetType(ksp, t.as_ptr()))?;
+            }
+            let mut pc = std::ptr::null_mut();
+            check("KSPGetPC", sys::KSPGetPC(ksp, &mut pc))?;
+            if let Some(t) = self.pc_type {
+                check("PCSetType", sys::PCSetType(pc, t.as_ptr()))?;
+            }
+            if let Some(t) = self.factor_package {
+                check(
+                    "PCFactorSetMatSolverType",
+                    sys::PCFactorSetMatSolverType(pc, t.as_ptr()),
+                )?;
+            }
+            if let Some(t) = self.line_search {
+                let mut search = std::ptr::null_mut();
+                check(
+                    "SNESGetLineSearch",
+                    sys::SNESGetLineSearch(snes, &mut search),
+                )?;
+                check(
+                    "SNESLineSearchSetType",
+                    sys::SNESLineSearchSetType(search, t.as_ptr()),
+                )?;
+            }
+            if let Some(rtol) = self.rtol {
+                let (mut atol, mut r, mut stol, mut its, mut evaluations) = (0.0, 0.0, 0.0, 0, 0);
+                check(
+                    "SNESGetTolerances",
+                    sys::SNESGetTolerances(
+                        snes,
+                        &mut atol,
+                        &mut r,
+                        &mut stol,
+                        &mut its,
+                        &mut evaluations,
+                    ),
+                )?;
+                check(
+                    "SNESSetTolerances",
+                    sys::SNESSetTolerances(snes, atol, rtol, stol, its, evaluations),
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How a SNES gets its Jacobian.
+enum Jacobian<'a, 'p> {
+    /// A constant matrix, copied into the working one at each callback.
+    Constant(&'a Matrix<'p>),
+    /// The working matrix, rewritten by the closure at each callback.
+    Computed(JacobianUpdate<'a, 'p>),
+}
+
+struct Callbacks<'a, 'p> {
     residual: Residual<'a>,
+    jacobian: Jacobian<'a, 'p>,
+    working: Matrix<'p>,
+    objective: Option<Objective<'a>>,
+}
+
+/// `result` of a callback as PETSc's error code (a panic is a user error: unwinding
+/// through C is undefined).
+fn callback_code(result: std::thread::Result<Result<()>>) -> sys::PetscErrorCode {
+    match result {
+        Ok(Ok(())) => 0,
+        Ok(Err(e)) if e.code != 0 => e.code,
+        _ => sys::PETSC_ERR_USER as sys::PetscErrorCode,
+    }
 }
 
 unsafe extern "C" fn residual_trampoline(
@@ -554,35 +723,60 @@ unsafe extern "C" fn residual_trampoline(
 ) -> sys::PetscErrorCode {
     // SAFETY: `context` is the Callbacks the solve boxed, alive for the whole SNESSolve
     let callbacks = unsafe { &mut *(context as *mut Callbacks) };
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        (callbacks.residual)(&VectorView { raw: x }, &mut VectorView { raw: f })
-    }));
-    match result {
-        Ok(Ok(())) => 0,
-        Ok(Err(e)) if e.code != 0 => e.code,
-        _ => sys::PETSC_ERR_USER as sys::PetscErrorCode,
-    }
+    callback_code(std::panic::catch_unwind(std::panic::AssertUnwindSafe(
+        || (callbacks.residual)(&VectorView { raw: x }, &mut VectorView { raw: f }),
+    )))
 }
 
-/// The Jacobian callback of a constant Jacobian: copies the caller's matrix (the
-/// context) into the SNES's working one, which SNESVI's semismooth method scales in place
-/// (`vinewtonssls` forms the Fischer–Burmeister Jacobian in the matrix it is given: handed
-/// the caller's own, it corrupted both the Jacobian and every later residual).
-unsafe extern "C" fn constant_jacobian(
+/// The Jacobian callback. A constant Jacobian is copied into the SNES's working matrix,
+/// which SNESVI's semismooth method scales in place (`vinewtonssls` forms the
+/// Fischer–Burmeister Jacobian in the matrix it is given: handed the caller's own, it
+/// corrupted both the Jacobian and every later residual).
+unsafe extern "C" fn jacobian_trampoline(
     _snes: sys::SNES,
-    _x: sys::Vec,
-    jacobian: sys::Mat,
+    x: sys::Vec,
+    _jacobian: sys::Mat,
     _preconditioner: sys::Mat,
     context: *mut c_void,
 ) -> sys::PetscErrorCode {
-    // SAFETY: the context is the caller's matrix, alive for the whole solve
-    unsafe {
-        sys::MatCopy(
-            context as sys::Mat,
-            jacobian,
-            sys::MatStructure_SAME_NONZERO_PATTERN,
-        )
-    }
+    // SAFETY: `context` is the Callbacks the solve boxed, alive for the whole SNESSolve;
+    // the matrices PETSc passes are its `working` one
+    let callbacks = unsafe { &mut *(context as *mut Callbacks) };
+    callback_code(std::panic::catch_unwind(std::panic::AssertUnwindSafe(
+        || match &mut callbacks.jacobian {
+            Jacobian::Constant(matrix) => check("MatCopy", unsafe {
+                sys::MatCopy(
+                    matrix.raw,
+                    callbacks.working.raw,
+                    sys::MatStructure_SAME_NONZERO_PATTERN,
+                )
+            }),
+            Jacobian::Computed(update) => update(&VectorView { raw: x }, &mut callbacks.working),
+        },
+    )))
+}
+
+unsafe extern "C" fn objective_trampoline(
+    _snes: sys::SNES,
+    x: sys::Vec,
+    value: *mut sys::PetscReal,
+    context: *mut c_void,
+) -> sys::PetscErrorCode {
+    // SAFETY: `context` is the Callbacks the solve boxed, alive for the whole SNESSolve;
+    // `value` is PETSc's
+    let callbacks = unsafe { &mut *(context as *mut Callbacks) };
+    callback_code(std::panic::catch_unwind(std::panic::AssertUnwindSafe(
+        || {
+            let objective = callbacks
+                .objective
+                .as_mut()
+                .ok_or(Error::refused("SNESSetObjective", "no objective"))?;
+            let v = objective(&VectorView { raw: x })?;
+            // SAFETY: PETSc's pointer to the value
+            unsafe { *value = v };
+            Ok(())
+        },
+    )))
 }
 
 /// Solves `F(x) = 0` subject to `lower ≤ x ≤ upper` (SNESVI; `vinewtonrsls` unless the
@@ -599,8 +793,74 @@ pub fn solve(
     bounds: Option<(&Vector, &Vector)>,
     x: &mut Vector,
 ) -> Result<Converged> {
+    solve_with(&Defaults::default(), jacobian, residual, bounds, x)
+}
+
+/// [`solve`] with `defaults` in place of PETSc's own (the options still override them).
+///
+/// # Errors
+/// Those of [`solve`].
+pub fn solve_with(
+    defaults: &Defaults,
+    jacobian: &Matrix,
+    residual: Residual<'_>,
+    bounds: Option<(&Vector, &Vector)>,
+    x: &mut Vector,
+) -> Result<Converged> {
+    let working = jacobian.duplicate()?;
+    run(
+        Callbacks {
+            residual,
+            jacobian: Jacobian::Constant(jacobian),
+            working,
+            objective: None,
+        },
+        defaults,
+        bounds,
+        x,
+    )
+}
+
+/// Minimizes `objective` from the start in `x` by Newton's method (a plain SNES, its
+/// line search on the objective; `defaults` before the options): `gradient` writes the
+/// objective's gradient, `hessian` its (generalized) Hessian into `matrix`, which is
+/// preallocated for every entry the Hessian can have. For convex C¹ objectives with a semismooth gradient, as the
+/// multiplier-eliminated obstacle problem's Φ (docs/mathematics.md §1).
+///
+/// # Errors
+/// PETSc's, or a SNES that stopped without converging: its reason, named.
+pub fn minimize<'p>(
+    defaults: &Defaults,
+    objective: Objective<'_>,
+    gradient: Residual<'_>,
+    hessian: JacobianUpdate<'_, 'p>,
+    matrix: Matrix<'p>,
+    x: &mut Vector,
+) -> Result<Converged> {
+    run(
+        Callbacks {
+            residual: gradient,
+            jacobian: Jacobian::Computed(hessian),
+            working: matrix,
+            objective: Some(objective),
+        },
+        defaults,
+        None,
+        x,
+    )
+}
+
+/// The SNES of [`solve`] and [`minimize`].
+fn run(
+    callbacks: Callbacks<'_, '_>,
+    defaults: &Defaults,
+    bounds: Option<(&Vector, &Vector)>,
+    x: &mut Vector,
+) -> Result<Converged> {
     let mut snes = std::ptr::null_mut();
-    let mut callbacks = Box::new(Callbacks { residual });
+    let mut callbacks = Box::new(callbacks);
+    let working = callbacks.working.raw;
+    let has_objective = callbacks.objective.is_some();
     let context = &mut *callbacks as *mut Callbacks as *mut c_void;
     // SAFETY: the SNES is created, used and destroyed here; `callbacks` outlives it
     unsafe {
@@ -627,35 +887,23 @@ pub fn solve(
                 "SNESSetFunction",
                 sys::SNESSetFunction(snes, r.raw, Some(residual_trampoline), context),
             )?;
-            let mut working = std::ptr::null_mut();
-            check(
-                "MatDuplicate",
-                sys::MatDuplicate(
-                    jacobian.raw,
-                    sys::MatDuplicateOption_MAT_COPY_VALUES,
-                    &mut working,
-                ),
-            )?;
-            let working = Matrix {
-                raw: working,
-                _petsc: std::marker::PhantomData,
-            };
             check(
                 "SNESSetJacobian",
-                sys::SNESSetJacobian(
-                    snes,
-                    working.raw,
-                    working.raw,
-                    Some(constant_jacobian),
-                    jacobian.raw as *mut c_void,
-                ),
+                sys::SNESSetJacobian(snes, working, working, Some(jacobian_trampoline), context),
             )?;
+            if has_objective {
+                check(
+                    "SNESSetObjective",
+                    sys::SNESSetObjective(snes, Some(objective_trampoline), context),
+                )?;
+            }
             if let Some((lower, upper)) = bounds {
                 check(
                     "SNESVISetVariableBounds",
                     sys::SNESVISetVariableBounds(snes, lower.raw, upper.raw),
                 )?;
             }
+            defaults.apply(snes)?;
             check("SNESSetFromOptions", sys::SNESSetFromOptions(snes))?;
             check(
                 "SNESSolve",

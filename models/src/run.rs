@@ -11,7 +11,7 @@ pub use crate::report::{Outcome, Phases, Profile, Report, Schur, Settings, MAX_R
 use crate::scene::{ExactSolution, Part, Posed, Scene, Support};
 use fem_runtime::adaptivity::AdaptiveOptions;
 use fem_runtime::lcp::NewtonOptions;
-use fem_runtime::obstacle::{FirstStart, ObstacleOptions, VariationalSolver};
+use fem_runtime::obstacle::{FirstStart, ObstacleOptions};
 use fem_runtime::problem::memory::check_memory;
 use fem_runtime::problem::{
     self, Condition, Exact, GradientFn, HessianFn, MemoryModel, Problem, SolveOptions, Solved,
@@ -354,10 +354,7 @@ fn levels<M: Model, G: Geometry, Q: Quantities<G>>(
     let memory = Q::memory::<M>(pair, scene, n);
     let size_text = size_text(scene, pair, n, settings.mesh_size.is_some());
     // without an obstacle the problem is one linear solve: nothing to nest for
-    let nested = Q::NESTED
-        && settings.nested
-        && settings.solver == VariationalSolver::SemismoothNewton
-        && scene.obstacle;
+    let nested = Q::NESTED && settings.nested && settings.solver.nests() && scene.obstacle;
     let mut domain = scene.domain.clone();
     if let (Some(diagonal), crate::scene::Domain::Rectangle { diagonal: d, .. }) =
         (settings.diagonal, &mut domain)

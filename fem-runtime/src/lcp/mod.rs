@@ -21,6 +21,7 @@
 mod active_set;
 mod blocks;
 pub mod cholesky;
+pub mod external;
 mod factor_tree;
 mod newton;
 mod qp;
@@ -250,6 +251,14 @@ impl CouplingBlocks {
     /// The coupled groups as `(first constraint, size)`.
     pub fn groups(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         self.starts.iter().copied().zip(self.sizes.iter().copied())
+    }
+
+    /// The coupled groups with their entries: `(first constraint, size, s × s row-major
+    /// entries)`, zero on the diagonal (the diagonal is [`Lcp::c`]).
+    pub fn blocks(&self) -> impl Iterator<Item = (usize, usize, &[f64])> + '_ {
+        self.groups()
+            .zip(&self.offsets)
+            .map(|((k, s), &o)| (k, s, &self.values[o..o + s * s]))
     }
 
     /// One past the last constraint of any group (0 without groups).

@@ -40,6 +40,26 @@ pub enum VariationalSolver {
     SemismoothNewton,
     /// clarabel's interior-point method on the equivalent QP.
     Clarabel,
+    /// A solver outside this crate ([`crate::lcp::external`]: PETSc over MPI), given each
+    /// level's LCP and nested iteration's start.
+    External(crate::lcp::external::External),
+}
+
+impl VariationalSolver {
+    /// Whether levels nest: each solved from the coarser level's prolonged solution (the
+    /// QP solver takes the finest level alone).
+    pub fn nests(self) -> bool {
+        !matches!(self, Self::Clarabel)
+    }
+
+    /// Its name in reports: `pdas`, `clarabel`, or the external solver's.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::SemismoothNewton => "pdas",
+            Self::Clarabel => "clarabel",
+            Self::External(e) => e.0.name(),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -1016,6 +1036,7 @@ pub fn solve_lcp_on_hierarchy(
             }
         }
         VariationalSolver::Clarabel => quadratic_program(lcp),
+        VariationalSolver::External(external) => external.0.solve(lcp, start),
     }
 }
 
@@ -1046,9 +1067,7 @@ pub fn solve_obstacle<M: Model>(
     .unwrap_or(false);
     let (bilinear, linear) = system_forms::<M>()?;
     let mut sizes = vec![mesh.cell_count()];
-    if let (Some(min), true, VariationalSolver::SemismoothNewton) =
-        (options.nested_from, uniform, options.solver)
-    {
+    if let (Some(min), true, true) = (options.nested_from, uniform, options.solver.nests()) {
         while sizes[0] % 2 == 0 && sizes[0] / 2 >= min.max(1) {
             sizes.insert(0, sizes[0] / 2);
         }

@@ -238,9 +238,9 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
         coefficients: &Coefficients,
         supports: &[Support],
         obstacle: &DataFn,
-        linear_solver: crate::obstacle::hierarchy::LinearSolver,
+        options: crate::obstacle::ObstacleOptions,
     ) -> Result<ObstacleSolution<Self>> {
-        let _ = (meshes, coefficients, supports, obstacle, linear_solver);
+        let _ = (meshes, coefficients, supports, obstacle, options);
         Err(Error::Input(
             "the nodal method is solved on affine triangle meshes".into(),
         ))
@@ -817,9 +817,9 @@ impl Domain for TriangleMesh {
         coefficients: &Coefficients,
         supports: &[Support],
         obstacle: &DataFn,
-        linear_solver: crate::obstacle::hierarchy::LinearSolver,
+        options: crate::obstacle::ObstacleOptions,
     ) -> Result<ObstacleSolution<Self>> {
-        super::nodal::solve::<M>(meshes, coefficients, supports, obstacle, linear_solver)
+        super::nodal::solve::<M>(meshes, coefficients, supports, obstacle, options)
     }
 
     fn worst_cell(&self) -> Option<String> {

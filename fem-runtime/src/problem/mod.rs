@@ -737,7 +737,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             warnings.push("α = 0 (the plain mixed method): C = 0 leaves nothing to eliminate Λ with, so the QP solver (clarabel) is used".into());
             options.solver = VariationalSolver::Clarabel;
         }
-        let nested = self.options.nested && options.solver == VariationalSolver::SemismoothNewton;
+        let nested = self.options.nested && options.solver.nests();
         let first = if nested { 0 } else { meshes.len() - 1 };
         let solution = if self.unconstrained {
             let d = finest.discretize::<M>(&coefficients, dofs, &constraints, &parts)?;
@@ -954,13 +954,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         } else {
             &meshes[meshes.len() - 1..]
         };
-        let solution = G::solve_nodal::<M>(
-            meshes,
-            &coefficients,
-            &self.supports,
-            obstacle,
-            options.linear_solver,
-        )?;
+        let solution =
+            G::solve_nodal::<M>(meshes, &coefficients, &self.supports, obstacle, options)?;
         let d = &solution.discretization;
         let (u, lambda) = (
             d.primal_part(&solution.values),
@@ -975,7 +970,10 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             multiplier_dofs: d.lcp.m(),
             alpha: None,
             inverse_constant: 0.0,
-            solver: "nodal active set",
+            solver: match options.solver {
+                VariationalSolver::External(e) => e.0.name(),
+                _ => "nodal active set",
+            },
             // every free node in contact (or the start already the solution): no system
             linear_solver: if solution.krylov_iterations > 0 {
                 "multigrid"
@@ -1343,10 +1341,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             multiplier_dofs: lcp.m(),
             alpha: Some(alpha),
             inverse_constant: c_i,
-            solver: match options.solver {
-                VariationalSolver::SemismoothNewton => "pdas",
-                VariationalSolver::Clarabel => "clarabel",
-            },
+            solver: options.solver.name(),
             linear_solver: solution.linear_solver_name(),
             iterations: solution.iterations,
             levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
@@ -1548,12 +1543,11 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 .iter()
                 .map(|m| m.scaled(factor))
                 .collect::<Result<Vec<G>>>()?;
-            let first =
-                if self.options.nested && options.solver == VariationalSolver::SemismoothNewton {
-                    0
-                } else {
-                    meshes.len() - 1
-                };
+            let first = if self.options.nested && options.solver.nests() {
+                0
+            } else {
+                meshes.len() - 1
+            };
             let moved =
                 self.solve_levels(&meshes[first..], coefficients, None, parts, options, None)?;
             let values = G::field_at_vertices(&moved, field);
@@ -1755,10 +1749,10 @@ fn solver_warnings<M: Model, G>(
     if options.linear_solver == crate::obstacle::hierarchy::LinearSolver::Multigrid
         && solution.iterative_steps == 0
     {
-        warnings.push(if options.solver == VariationalSolver::SemismoothNewton {
-            "--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level and elements with a prolongation; or CG did not converge), so they were factored".to_string()
-        } else {
-            "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string()
+        warnings.push(match options.solver {
+            VariationalSolver::SemismoothNewton => "--linear-solver multigrid: no Newton step of the finest level was solved by multigrid (it needs a coarser nested level and elements with a prolongation; or CG did not converge), so they were factored".to_string(),
+            VariationalSolver::Clarabel => "--linear-solver multigrid: the QP solver (clarabel) has no Newton steps; it factors its own systems".to_string(),
+            VariationalSolver::External(e) => format!("--linear-solver multigrid: the {} solver chooses its own linear solver (its options say which)", e.0.name()),
         });
     }
     Ok(warnings)

@@ -17,7 +17,9 @@ use crate::obstacle::hierarchy::LinearSolver;
 use crate::obstacle::nodal::{
     force_density_at_vertices, nodal_active_set_level, nodal_lcp, NODAL_AUTO_MULTIGRID_UNKNOWNS,
 };
-use crate::obstacle::{alongside, Discretization, Multipliers, ObstacleSolution};
+use crate::obstacle::{
+    alongside, Discretization, Multipliers, ObstacleOptions, ObstacleSolution, VariationalSolver,
+};
 use crate::{Reduction, SparseMatrix};
 use std::time::Instant;
 
@@ -67,7 +69,7 @@ pub fn solve<M: Model>(
     coefficients: &Coefficients,
     supports: &[Support],
     obstacle: &DataFn,
-    linear_solver: LinearSolver,
+    options: ObstacleOptions,
 ) -> Result<ObstacleSolution<TriangleMesh>> {
     let clock = Instant::now();
     let energy = nodal_energy::<M>()?;
@@ -80,7 +82,7 @@ pub fn solve<M: Model>(
     };
     let setup = |i: usize| problem.level::<M>(i);
     let step = |state: &mut NodalState, level: NodalLevel, cells: usize| {
-        state.step(level, cells, linear_solver, meshes.len())
+        state.step(level, cells, options, meshes.len())
     };
     let mut state = NodalState::default();
     let count = meshes.len();
@@ -243,7 +245,8 @@ impl NodalProblem<'_> {
 impl NodalState {
     /// Solves `level` (of `cells` triangles, one of `level_count`) from the last solved
     /// level's solution interpolated at its nodes, by multigrid steps where
-    /// `linear_solver` asks for them and there are coarser levels.
+    /// `options.linear_solver` asks for them and there are coarser levels; by the
+    /// external solver of `options.solver` where it names one.
     ///
     /// # Errors
     /// The active-set method's.
@@ -251,7 +254,7 @@ impl NodalState {
         &mut self,
         level: NodalLevel,
         cells: usize,
-        linear_solver: LinearSolver,
+        options: ObstacleOptions,
         level_count: usize,
     ) -> Result<()> {
         let NodalLevel {
@@ -279,7 +282,7 @@ impl NodalState {
             }
             _ => None,
         };
-        let multigrid = match linear_solver {
+        let multigrid = match options.linear_solver {
             LinearSolver::Direct => false,
             LinearSolver::Multigrid => !self.prolongations.is_empty(),
             LinearSolver::Auto => {
@@ -288,8 +291,12 @@ impl NodalState {
         };
         let hierarchy: &[SparseMatrix] = if multigrid { &self.prolongations } else { &[] };
         let last = self.levels.len() + 1 == level_count;
-        let solution =
-            nodal_active_set_level(&a, &f, &psi, start.as_deref(), 500, hierarchy, last)?;
+        let solution = match options.solver {
+            VariationalSolver::External(external) => external
+                .0
+                .solve(&nodal_lcp(&a, &f, &psi), start.as_deref())?,
+            _ => nodal_active_set_level(&a, &f, &psi, start.as_deref(), 500, hierarchy, last)?,
+        };
         self.levels.push((cells, solution.iterations));
         self.values = Some(reduction.expand(&solution.u));
         self.finest = Some((

@@ -479,8 +479,7 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 report.set("multiplier_layer", layer_profile(solution, &contact, q));
             }
             let n = run.settings.mesh_size.unwrap_or(run.scene.mesh_size);
-            let newton =
-                run.settings.solver == fem_runtime::obstacle::VariationalSolver::SemismoothNewton;
+            let newton = run.settings.solver.nests();
             if run.settings.nested && newton {
                 let sizes = halving_sizes(n, true, Self::COARSEST, false);
                 if let Some(w) = super::plate::cold_coarsest_warning(&sizes, Self::COARSEST) {

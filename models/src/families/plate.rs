@@ -529,8 +529,7 @@ impl<G: Geometry> Quantities<G> for Plates {
                 ));
             }
             let n = run.settings.mesh_size.unwrap_or(run.scene.mesh_size);
-            let newton =
-                run.settings.solver == fem_runtime::obstacle::VariationalSolver::SemismoothNewton;
+            let newton = run.settings.solver.nests();
             if run.settings.nested && newton {
                 let sizes = halving_sizes(n, true, <Self as Quantities<G>>::COARSEST, false);
                 if let Some(w) = cold_coarsest_warning(&sizes, <Self as Quantities<G>>::COARSEST) {

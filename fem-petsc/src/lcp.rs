@@ -1,0 +1,630 @@
+//! Any level's LCP `A U − Bᵀ Λ = F, 0 ≤ Λ ⊥ B U + C Λ − G ≥ 0` solved by PETSc over MPI:
+//! the [`fem_runtime::lcp::external::ExternalSolver`] that `fem-forms solve --backend
+//! petsc` hands to the one pipeline (problem, nested levels, report, estimators, output
+//! stay those of a native solve).
+//!
+//! Three formulations ([`Formulation`]):
+//! - **primal** (the nodal method, `B = I`, `C = 0`), SNESVI (`vinewtonrsls` unless the
+//!   options say otherwise): `F(U) = A U − F` with the bounds `U ≥ G = ψ` on the primal
+//!   unknowns themselves;
+//! - **eliminated** (the default where `C` is diagonal and positive: P0 multipliers on
+//!   cells or boundary edges), a plain SNES without bounds: Λ eliminated constraint by
+//!   constraint, `Λ = C⁻¹(G − B U)₊`, leaves the convex C¹ function
+//!   `Φ(U) = ½ UᵀAU − FᵀU + ½ Σ_k (G − BU)²₊,k / C_k` (docs/mathematics.md §1), whose
+//!   gradient `AU − F − BᵀC⁻¹(G − BU)₊` SNES zeroes with the generalized Hessian
+//!   `A + Bᵀ D B` (`D = C⁻¹` on the active constraints, 0 elsewhere; SPD, so CG + GAMG
+//!   apply) and its line search on Φ itself (`SNESSetObjective`). This avoids PETSc's
+//!   reduced-space VI on a saddle point (Firedrake #2608, #4232), which on the beams
+//!   runs out of iterations;
+//! - **mixed** (any block-diagonal `C`: P1disc multipliers, or asked for), SNESVI: the
+//!   mixed complementarity problem in `x = (U, Λ)`,
+//!   `F(x) = [A U − Bᵀ Λ − F; B U + C Λ − G]`, `U` free and the bounds `Λ ≥ 0` on the
+//!   multiplier unknowns only. Its Jacobian `[[A, −Bᵀ], [B, C]]` is not symmetric.
+//!
+//! The Newton systems are solved by MUMPS (LU, or Cholesky where they are SPD) unless
+//! the options choose (`-ksp_type cg -pc_type gamg`).
+//!
+//! Every rank receives the same LCP (each assembles it through the one pipeline) and
+//! inserts the rows it owns: contiguous blocks of `U` and of `Λ`, rank `r`'s unknowns
+//! numbered `U` block then `Λ` block, so PETSc's rows stay contiguous per rank. The
+//! answer comes back to every rank and is checked there by the pipeline's KKT residual.
+
+use crate::{
+    minimize, solve_with, Converged, Defaults, Error, Matrix, Petsc, Result, Vector, VectorView,
+};
+use fem_runtime::lcp::external::ExternalSolver;
+use fem_runtime::lcp::{recover_multiplier, Lcp, LcpSolution, NewtonOptions};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// How an LCP is posed to PETSc (see the module's docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Formulation {
+    /// SNESVI on the primal unknowns with the bounds `U ≥ ψ` (the nodal method).
+    Primal,
+    /// SNES on Φ(U), the multipliers eliminated (diagonal positive `C`).
+    Eliminated,
+    /// SNESVI on `(U, Λ)` with the bounds `Λ ≥ 0`.
+    Mixed,
+}
+
+impl Formulation {
+    /// `primal`, `eliminated`, `mixed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Primal => "primal",
+            Self::Eliminated => "eliminated",
+            Self::Mixed => "mixed",
+        }
+    }
+
+    /// The formulation called `name` (`eliminated` or `mixed`: the nodal method's is
+    /// always primal).
+    ///
+    /// # Errors
+    /// An unknown name (the message lists the known ones).
+    pub fn parse(name: &str) -> std::result::Result<Self, String> {
+        match name {
+            "eliminated" => Ok(Self::Eliminated),
+            "mixed" => Ok(Self::Mixed),
+            _ => Err(format!(
+                "unknown formulation `{name}`: `eliminated` (SNES on Φ(U), the default where C is diagonal) or `mixed` (SNESVI on (U, Λ)); the nodal method is always `primal`"
+            )),
+        }
+    }
+}
+
+/// What one LCP solve by PETSc reported, for the command line's report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LevelRecord {
+    /// The formulation.
+    pub formulation: Formulation,
+    /// Primal unknowns `n` and multipliers `m`.
+    pub unknowns: [usize; 2],
+    /// SNES's reason and iteration counts.
+    pub converged: Converged,
+    /// Wall time of the solve on this rank, in seconds (assembly into PETSc included).
+    pub seconds: f64,
+}
+
+/// PETSc as the pipeline's complementarity solver (see the module's docs). Made once per
+/// process by the command line and leaked for the process's life
+/// ([`fem_runtime::lcp::external::External`] holds a `'static` reference);
+/// [`PetscLcpSolver::finalize`] ends PETSc and MPI before the process exits.
+pub struct PetscLcpSolver {
+    petsc: Mutex<Option<OnThread>>,
+    preferred: Mutex<Option<Formulation>>,
+    records: Mutex<Vec<LevelRecord>>,
+}
+
+/// PETSc and the thread that initialized it, the only one that may call it: MPI is
+/// initialized without thread support (`MPI_THREAD_SINGLE`).
+struct OnThread {
+    petsc: Petsc,
+    thread: std::thread::ThreadId,
+}
+
+// SAFETY: PETSc is only reached through the mutex, and only from the thread that
+// initialized it (checked at each call, a solve from another thread is refused), so the
+// raw handles inside never cross threads.
+unsafe impl Send for OnThread {}
+
+impl PetscLcpSolver {
+    /// Initializes MPI and PETSc with `options` (PETSc's command-line options as one
+    /// string) on this thread, which alone may solve; `formulation` asks for
+    /// [`Formulation::Eliminated`] or [`Formulation::Mixed`] where both apply (`None`:
+    /// eliminated where `C` is diagonal and positive, mixed elsewhere).
+    ///
+    /// # Errors
+    /// Those of [`Petsc::initialize`].
+    pub fn new(options: &str, formulation: Option<Formulation>) -> Result<Self> {
+        let petsc = Petsc::initialize(options)?;
+        Ok(Self {
+            preferred: Mutex::new(formulation),
+            petsc: Mutex::new(Some(OnThread {
+                petsc,
+                thread: std::thread::current().id(),
+            })),
+            records: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// This process's rank and the number of ranks (`(0, 1)` once finalized).
+    pub fn rank_and_size(&self) -> (usize, usize) {
+        let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
+        guard
+            .as_ref()
+            .map_or((0, 1), |p| (p.petsc.rank(), p.petsc.size()))
+    }
+
+    /// Asks for `formulation` in later solves (`None`: the default).
+    pub fn set_formulation(&self, formulation: Option<Formulation>) {
+        *self.preferred.lock().unwrap_or_else(|e| e.into_inner()) = formulation;
+    }
+
+    /// The solves so far, in order (nested iteration: coarsest level first).
+    pub fn records(&self) -> Vec<LevelRecord> {
+        self.records
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+    }
+
+    /// Ends PETSc, then MPI; later solves are refused.
+    pub fn finalize(&self) {
+        self.petsc.lock().unwrap_or_else(|e| e.into_inner()).take();
+    }
+}
+
+impl ExternalSolver for PetscLcpSolver {
+    fn name(&self) -> &'static str {
+        "petsc"
+    }
+
+    fn solve(&self, lcp: &Lcp, start: Option<&[f64]>) -> fem_runtime::Result<LcpSolution> {
+        let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
+        let on = guard.as_ref().ok_or_else(|| {
+            fem_runtime::Error::Input("PETSc was finalized: no more solves".into())
+        })?;
+        if std::thread::current().id() != on.thread {
+            return Err(fem_runtime::Error::Input(
+                "PETSc is called from a thread other than the one that initialized MPI".into(),
+            ));
+        }
+        let clock = Instant::now();
+        let formulation = formulation_of(
+            lcp,
+            *self.preferred.lock().unwrap_or_else(|e| e.into_inner()),
+        )
+        .map_err(fem_runtime::Error::Input)?;
+        let solved = match formulation {
+            Formulation::Eliminated => solve_eliminated(&on.petsc, lcp, start),
+            _ => solve_lcp(&on.petsc, lcp, start, formulation),
+        };
+        let (u, lambda, converged) = solved.map_err(|e| fem_runtime::Error::NotConverged {
+            solver: match formulation {
+                Formulation::Eliminated => "PETSc SNES on Φ(U)",
+                _ => "PETSc SNESVI",
+            },
+            detail: e.to_string(),
+        })?;
+        let seconds = clock.elapsed().as_secs_f64();
+        self.records
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(LevelRecord {
+                formulation,
+                unknowns: [lcp.n(), lcp.m()],
+                converged: converged.clone(),
+                seconds,
+            });
+        let noise = match formulation {
+            Formulation::Eliminated => lcp.elimination_noise(&lambda),
+            _ => 0.0,
+        };
+        let solution = LcpSolution {
+            kkt_residual: lcp.kkt_residual(&u, &lambda),
+            u,
+            lambda,
+            iterations: converged.iterations,
+            seconds,
+            factorizations: 0,
+            low_rank_updates: 0,
+            multiplier_noise: noise,
+            iterative_steps: 0,
+            krylov_iterations: converged.linear_iterations,
+        };
+        // as the native solver does: where the eliminated Λ loses digits to cancellation
+        // (C = αh^p below the rounding of G − BU), Λ from one saddle-point solve on the
+        // converged active set
+        if noise > MAX_ELIMINATION_NOISE {
+            return recover_multiplier(lcp, solution, NewtonOptions::default().refinement_steps);
+        }
+        Ok(solution)
+    }
+}
+
+/// The relative rounding noise of an eliminated Λ above which it is recovered by a
+/// saddle-point solve (the native solver's threshold).
+const MAX_ELIMINATION_NOISE: f64 = 1e-6;
+
+/// The formulation of `lcp`: primal for the nodal method, else `preferred`, else
+/// eliminated where `C` is diagonal and positive and mixed elsewhere.
+///
+/// # Errors
+/// The eliminated formulation asked for where `C` is not diagonal and positive.
+fn formulation_of(
+    lcp: &Lcp,
+    preferred: Option<Formulation>,
+) -> std::result::Result<Formulation, String> {
+    if is_nodal(lcp) {
+        return Ok(Formulation::Primal);
+    }
+    let diagonal = lcp.c_blocks.is_empty() && lcp.c.iter().all(|&c| c > 0.0);
+    match preferred {
+        Some(Formulation::Eliminated) if !diagonal => Err(
+            "the eliminated formulation needs a diagonal positive C (P0 multipliers, α > 0); this LCP has coupled multipliers or C = 0: use `mixed`".into(),
+        ),
+        Some(f @ (Formulation::Eliminated | Formulation::Mixed)) => Ok(f),
+        _ if diagonal => Ok(Formulation::Eliminated),
+        _ => Ok(Formulation::Mixed),
+    }
+}
+
+/// Whether `lcp` is the nodal method's: `B = I` (one unit entry per row, on the
+/// diagonal) and `C = 0`.
+fn is_nodal(lcp: &Lcp) -> bool {
+    lcp.m() == lcp.n()
+        && lcp.c.iter().all(|&c| c == 0.0)
+        && lcp.c_blocks.is_empty()
+        && lcp
+            .b_rows
+            .iter()
+            .enumerate()
+            .all(|(k, row)| row == [(k, 1.0)])
+}
+
+/// The first index of each of `size` contiguous blocks of `0..count`, and `count`.
+fn blocks(count: usize, size: usize) -> Vec<usize> {
+    (0..=size).map(|r| count * r / size).collect()
+}
+
+/// Where each unknown of `(U, Λ)` lives in PETSc's numbering: rank `r` owns its block of
+/// `U` then its block of `Λ`.
+struct Layout {
+    u_blocks: Vec<usize>,
+    l_blocks: Vec<usize>,
+    rank: usize,
+}
+
+impl Layout {
+    fn new(n: usize, m: usize, rank: usize, size: usize) -> Self {
+        Self {
+            u_blocks: blocks(n, size),
+            l_blocks: blocks(m, size),
+            rank,
+        }
+    }
+
+    /// The first PETSc row of rank `r`.
+    fn offset(&self, r: usize) -> usize {
+        self.u_blocks[r] + self.l_blocks[r]
+    }
+
+    /// The rank whose block of `blocks` holds `i`.
+    fn owner(blocks: &[usize], i: usize) -> usize {
+        blocks.partition_point(|&b| b <= i) - 1
+    }
+
+    fn u(&self, i: usize) -> usize {
+        let r = Self::owner(&self.u_blocks, i);
+        self.offset(r) + i - self.u_blocks[r]
+    }
+
+    fn lambda(&self, k: usize) -> usize {
+        let r = Self::owner(&self.l_blocks, k);
+        self.offset(r) + (self.u_blocks[r + 1] - self.u_blocks[r]) + k - self.l_blocks[r]
+    }
+
+    fn local_u(&self) -> std::ops::Range<usize> {
+        self.u_blocks[self.rank]..self.u_blocks[self.rank + 1]
+    }
+
+    fn local_lambda(&self) -> std::ops::Range<usize> {
+        self.l_blocks[self.rank]..self.l_blocks[self.rank + 1]
+    }
+
+    fn first_row(&self) -> usize {
+        self.offset(self.rank)
+    }
+
+    fn local_len(&self) -> usize {
+        self.local_u().len() + self.local_lambda().len()
+    }
+
+    /// Whether PETSc row `row` is this rank's.
+    fn is_local(&self, row: usize) -> bool {
+        (self.first_row()..self.first_row() + self.local_len()).contains(&row)
+    }
+}
+
+/// This rank's rows of a square matrix, as `(row, column, value)` in PETSc's numbering,
+/// added to a matrix preallocated for exactly them.
+fn matrix_of<'p>(
+    petsc: &'p Petsc,
+    layout: &Layout,
+    entries: &[(usize, usize, f64)],
+) -> Result<Matrix<'p>> {
+    let first = layout.first_row();
+    let (mut diagonal, mut off) = (vec![0; layout.local_len()], vec![0; layout.local_len()]);
+    let mut sorted: Vec<(usize, usize)> = entries.iter().map(|&(i, j, _)| (i, j)).collect();
+    sorted.sort_unstable();
+    sorted.dedup();
+    for (i, j) in sorted {
+        if layout.is_local(j) {
+            diagonal[i - first] += 1;
+        } else {
+            off[i - first] += 1;
+        }
+    }
+    let mut matrix = Matrix::new(petsc, &diagonal, &off)?;
+    for &(i, j, v) in entries {
+        matrix.add(&[i], &[j], &[v])?;
+    }
+    matrix.assemble()?;
+    Ok(matrix)
+}
+
+/// Solves `lcp` (see the module's docs): `(U, Λ)` on every rank, the formulation used
+/// and SNES's report.
+fn solve_lcp(
+    petsc: &Petsc,
+    lcp: &Lcp,
+    start: Option<&[f64]>,
+    formulation: Formulation,
+) -> Result<(Vec<f64>, Vec<f64>, Converged)> {
+    check_start(lcp, start)?;
+    let nodal = formulation == Formulation::Primal;
+    let (n, m) = (lcp.n(), if nodal { 0 } else { lcp.m() });
+    let layout = Layout::new(n, m, petsc.rank(), petsc.size());
+    let mut entries = Vec::new();
+    // A is symmetric and stored whole: column i is row i
+    let (col_ptr, row_idx, values) = (
+        lcp.a.symbolic().col_ptr(),
+        lcp.a.symbolic().row_idx(),
+        lcp.a.val(),
+    );
+    for i in layout.local_u() {
+        for p in col_ptr[i]..col_ptr[i + 1] {
+            entries.push((layout.u(i), layout.u(row_idx[p]), values[p]));
+        }
+    }
+    if !nodal {
+        let mine = layout.local_lambda();
+        let u_mine = layout.local_u();
+        for (k, row) in lcp.b_rows.iter().enumerate() {
+            for &(j, v) in row {
+                if mine.contains(&k) {
+                    entries.push((layout.lambda(k), layout.u(j), v));
+                }
+                if u_mine.contains(&j) {
+                    entries.push((layout.u(j), layout.lambda(k), -v));
+                }
+            }
+        }
+        for k in mine.clone() {
+            entries.push((layout.lambda(k), layout.lambda(k), lcp.c[k]));
+        }
+        for (first, s, block) in lcp.c_blocks.blocks() {
+            for a in 0..s {
+                if !mine.contains(&(first + a)) {
+                    continue;
+                }
+                for b in (0..s).filter(|&b| b != a) {
+                    let v = block[a * s + b];
+                    if v != 0.0 {
+                        entries.push((layout.lambda(first + a), layout.lambda(first + b), v));
+                    }
+                }
+            }
+        }
+    }
+    let jacobian = matrix_of(petsc, &layout, &entries)?;
+    drop(entries);
+    let rows: Vec<usize> = (layout.first_row()..layout.first_row() + layout.local_len()).collect();
+    let (u_mine, l_mine) = (layout.local_u(), layout.local_lambda());
+    let of_mine = |u: &dyn Fn(usize) -> f64, l: &dyn Fn(usize) -> f64| -> Vec<f64> {
+        u_mine.clone().map(u).chain(l_mine.clone().map(l)).collect()
+    };
+    let mut right = Vector::new(petsc, layout.local_len())?;
+    right.set(&rows, &of_mine(&|i| lcp.f[i], &|k| lcp.g[k]), false)?;
+    let infinity = crate::sys::FEM_PETSC_INFINITY;
+    let (floor, ceiling) = if nodal {
+        (of_mine(&|i| lcp.g[i], &|_| 0.0), vec![infinity; rows.len()])
+    } else {
+        (
+            of_mine(&|_| -infinity, &|_| 0.0),
+            vec![infinity; rows.len()],
+        )
+    };
+    let mut x = Vector::new(petsc, layout.local_len())?;
+    let begin = |i: usize| start.map_or(0.0, |s| s[i]);
+    x.set(&rows, &of_mine(&begin, &|_| 0.0), false)?;
+    let mut lower = Vector::new(petsc, layout.local_len())?;
+    let mut upper = Vector::new(petsc, layout.local_len())?;
+    lower.set(&rows, &floor, false)?;
+    upper.set(&rows, &ceiling, false)?;
+    for v in [&mut right, &mut x, &mut lower, &mut upper] {
+        v.assemble()?;
+    }
+    // direct solves unless the user chose (`-ksp_type cg -pc_type gamg`): the reduced
+    // Newton systems change with the active set, and GAMG under vinewtonrsls fails in
+    // PETSc 3.18; the mixed Jacobian is indefinite and not symmetric (LU), the primal one
+    // SPD (Cholesky). Full steps: on the mixed system the backtracking search on ‖F‖
+    // stalls (DIVERGED_LINE_SEARCH on the P2–P1disc membrane at N = 4) where full
+    // semismooth steps converge in 3–6.
+    let defaults = Defaults {
+        ksp_type: Some(c"preonly"),
+        pc_type: Some(if nodal { c"cholesky" } else { c"lu" }),
+        factor_package: Some(c"mumps"),
+        line_search: Some(c"basic"),
+        rtol: Some(1e-12),
+    };
+    let residual = |x: &VectorView, r: &mut VectorView| {
+        jacobian.multiply(x, r)?;
+        r.axpy(-1.0, &VectorView::of(&right))
+    };
+    let converged = solve_with(
+        &defaults,
+        &jacobian,
+        Box::new(residual),
+        Some((&lower, &upper)),
+        &mut x,
+    )?;
+    let whole = x.gather()?;
+    let mut u = vec![0.0; n];
+    let mut lambda = vec![0.0; m];
+    for i in 0..n {
+        u[i] = whole[layout.u(i)];
+    }
+    for (k, l) in lambda.iter_mut().enumerate() {
+        *l = whole[layout.lambda(k)];
+    }
+    if nodal {
+        // the nodal forces: A U − F, the contact force at each node (≥ 0 up to the
+        // solver's tolerance where U = ψ, 0 elsewhere)
+        let au = fem_runtime::lcp::cholesky::multiply(&lcp.a, &u);
+        lambda = au
+            .iter()
+            .zip(&lcp.f)
+            .map(|(a, f)| (a - f).max(0.0))
+            .collect();
+    }
+    Ok((u, lambda, converged))
+}
+
+/// Refuses an LCP of inconsistent shapes and a start of the wrong length.
+fn check_start(lcp: &Lcp, start: Option<&[f64]>) -> Result<()> {
+    lcp.check_shapes()
+        .map_err(|e| Error::refused("solve_lcp", e.to_string()))?;
+    match start {
+        Some(s) if s.len() != lcp.n() => Err(Error::refused(
+            "solve_lcp",
+            format!("a start of {} unknowns for {}", s.len(), lcp.n()),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// `(G − B U)₊,k / C_k` for every constraint: the eliminated multipliers.
+fn eliminated_multipliers(lcp: &Lcp, u: &[f64]) -> Vec<f64> {
+    lcp.b_rows
+        .iter()
+        .zip(lcp.g.iter().zip(&lcp.c))
+        .map(|(row, (g, c))| {
+            let r = g - row.iter().map(|&(j, v)| v * u[j]).sum::<f64>();
+            r.max(0.0) / c
+        })
+        .collect()
+}
+
+/// Solves `lcp` by SNES on Φ(U) (see the module's docs): `(U, Λ)` on every rank and
+/// SNES's report. Each rank owns a contiguous block of `U` and writes its rows of the
+/// gradient and of the generalized Hessian, whose pattern (that of `A + BᵀB`) is
+/// preallocated once; the callbacks read the whole `U` (gathered), as the LCP is whole
+/// on every rank.
+fn solve_eliminated(
+    petsc: &Petsc,
+    lcp: &Lcp,
+    start: Option<&[f64]>,
+) -> Result<(Vec<f64>, Vec<f64>, Converged)> {
+    check_start(lcp, start)?;
+    let n = lcp.n();
+    let bounds = blocks(n, petsc.size());
+    let mine = bounds[petsc.rank()]..bounds[petsc.rank() + 1];
+    // the constraints that touch each of this rank's unknowns, with B's entry
+    let mut touching: Vec<Vec<(usize, f64)>> = vec![Vec::new(); mine.len()];
+    for (k, row) in lcp.b_rows.iter().enumerate() {
+        for &(j, v) in row {
+            if mine.contains(&j) {
+                touching[j - mine.start].push((k, v));
+            }
+        }
+    }
+    let (col_ptr, row_idx, values) = (
+        lcp.a.symbolic().col_ptr(),
+        lcp.a.symbolic().row_idx(),
+        lcp.a.val(),
+    );
+    let (mut diagonal, mut off) = (
+        Vec::with_capacity(mine.len()),
+        Vec::with_capacity(mine.len()),
+    );
+    for i in mine.clone() {
+        let mut columns: Vec<usize> = row_idx[col_ptr[i]..col_ptr[i + 1]].to_vec();
+        for &(k, _) in &touching[i - mine.start] {
+            columns.extend(lcp.b_rows[k].iter().map(|&(j, _)| j));
+        }
+        columns.sort_unstable();
+        columns.dedup();
+        let here = columns.iter().filter(|j| mine.contains(j)).count();
+        diagonal.push(here);
+        off.push(columns.len() - here);
+    }
+    let matrix = Matrix::new(petsc, &diagonal, &off)?;
+    let mut x = Vector::new(petsc, mine.len())?;
+    let rows: Vec<usize> = mine.clone().collect();
+    let begin: Vec<f64> = mine.clone().map(|i| start.map_or(0.0, |s| s[i])).collect();
+    x.set(&rows, &begin, false)?;
+    x.assemble()?;
+    // the Hessian is SPD: Cholesky unless the user chose (`-ksp_type cg -pc_type gamg`);
+    // the line search backtracks on Φ (the objective), PETSc's default `bt`
+    let defaults = Defaults {
+        ksp_type: Some(c"preonly"),
+        pc_type: Some(c"cholesky"),
+        factor_package: Some(c"mumps"),
+        line_search: None,
+        rtol: Some(1e-12),
+    };
+    let objective = |x: &VectorView| -> Result<f64> {
+        let u = x.gather()?;
+        let au = fem_runtime::lcp::cholesky::multiply(&lcp.a, &u);
+        let mut phi = 0.0;
+        for ((ui, ai), fi) in u.iter().zip(&au).zip(&lcp.f) {
+            phi += 0.5 * ui * ai - fi * ui;
+        }
+        for (z, c) in eliminated_multipliers(lcp, &u).iter().zip(&lcp.c) {
+            phi += 0.5 * z * z * c;
+        }
+        Ok(phi)
+    };
+    let gradient = |x: &VectorView, r: &mut VectorView| -> Result<()> {
+        let u = x.gather()?;
+        let z = eliminated_multipliers(lcp, &u);
+        let local: Vec<f64> = mine
+            .clone()
+            .map(|i| {
+                let au: f64 = (col_ptr[i]..col_ptr[i + 1])
+                    .map(|p| values[p] * u[row_idx[p]])
+                    .sum();
+                let btz: f64 = touching[i - mine.start]
+                    .iter()
+                    .map(|&(k, v)| v * z[k])
+                    .sum();
+                au - lcp.f[i] - btz
+            })
+            .collect();
+        r.write_local(&local)
+    };
+    let hessian = |x: &VectorView, matrix: &mut Matrix| -> Result<()> {
+        let u = x.gather()?;
+        let z = eliminated_multipliers(lcp, &u);
+        matrix.zero_entries()?;
+        let mut row: Vec<(usize, f64)> = Vec::new();
+        for i in mine.clone() {
+            row.clear();
+            row.extend((col_ptr[i]..col_ptr[i + 1]).map(|p| (row_idx[p], values[p])));
+            for &(k, v) in &touching[i - mine.start] {
+                // active where (G − BU)_k > 0, i.e. where the eliminated Λ_k is
+                if z[k] > 0.0 {
+                    let scale = v / lcp.c[k];
+                    row.extend(lcp.b_rows[k].iter().map(|&(j, w)| (j, scale * w)));
+                }
+            }
+            let (columns, entries): (Vec<usize>, Vec<f64>) = row.iter().copied().unzip();
+            matrix.add(&[i], &columns, &entries)?;
+        }
+        matrix.assemble()
+    };
+    let converged = minimize(
+        &defaults,
+        Box::new(objective),
+        Box::new(gradient),
+        Box::new(hessian),
+        matrix,
+        &mut x,
+    )?;
+    let u = x.gather()?;
+    let lambda = eliminated_multipliers(lcp, &u);
+    Ok((u, lambda, converged))
+}

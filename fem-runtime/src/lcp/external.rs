@@ -1,0 +1,45 @@
+//! Complementarity solvers that live outside this crate: PETSc's SNES and SNESVI driven
+//! over MPI (the `fem-petsc` crate) plugs in here, so that the one pipeline (problem,
+//! nested levels, report, estimators, output) runs unchanged around it.
+//!
+//! An [`ExternalSolver`] receives each level's LCP
+//! `A U − Bᵀ Λ = F, 0 ≤ Λ ⊥ B U + C Λ − G ≥ 0` ([`Lcp`]) and the primal start that
+//! nested iteration prolonged from the coarser level, and returns `(U, Λ)`; the caller
+//! checks the answer by its KKT residual as it checks its own solvers'.
+
+use super::{Lcp, LcpSolution};
+use crate::error::Result;
+
+/// A solver of one LCP outside this crate, chosen by
+/// [`crate::obstacle::VariationalSolver::External`].
+pub trait ExternalSolver: Send + Sync {
+    /// Its name in reports (`"petsc"`).
+    fn name(&self) -> &'static str;
+
+    /// Solves `lcp` from the primal unknowns `start` (nested iteration's prolonged
+    /// solution; `None`: the solver's own start).
+    ///
+    /// # Errors
+    /// A problem the solver does not take, and a solve that does not converge (named by
+    /// the solver's reason), never an unconverged answer.
+    fn solve(&self, lcp: &Lcp, start: Option<&[f64]>) -> Result<LcpSolution>;
+}
+
+/// A handle on an [`ExternalSolver`] that lives for the whole process (a solver set up
+/// once by the command line, e.g. PETSc after `MPI_Init`); compared by identity.
+#[derive(Clone, Copy)]
+pub struct External(pub &'static dyn ExternalSolver);
+
+impl std::fmt::Debug for External {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "External({})", self.0.name())
+    }
+}
+
+impl PartialEq for External {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::addr_eq(self.0, other.0)
+    }
+}
+
+impl Eq for External {}

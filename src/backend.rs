@@ -1,0 +1,171 @@
+//! `fem-forms solve --backend petsc`: the scene solved through the one pipeline with
+//! PETSc over MPI as its complementarity solver (`fem_petsc::lcp`), in a binary built
+//! with the `petsc` feature (docs/petsc.md). Every rank runs the same command and
+//! assembles the same levels; each inserts its own rows into PETSc, which solves them
+//! together; rank 0 alone prints the report (with PETSc's reasons and iteration counts
+//! added) and writes the outputs.
+
+use fem_forms::models::report::Report;
+use fem_runtime::obstacle::VariationalSolver;
+
+/// The backend's command-line options.
+#[derive(Clone, Debug, Default)]
+pub struct BackendOptions {
+    /// `native` (default) or `petsc`.
+    pub backend: Option<String>,
+    /// PETSc's options, as one string.
+    pub petsc_options: Option<String>,
+    /// `eliminated` or `mixed`.
+    pub petsc_formulation: Option<String>,
+}
+
+impl BackendOptions {
+    /// Whether `--backend petsc` was given.
+    ///
+    /// # Errors
+    /// An unknown backend, and PETSc's options without it.
+    pub fn wants_petsc(&self) -> Result<bool, String> {
+        let petsc = match self.backend.as_deref() {
+            None | Some("native") => false,
+            Some("petsc") => true,
+            Some(other) => {
+                return Err(format!(
+                    "--backend {other}: unknown backend; `native` (default) or `petsc`"
+                ))
+            }
+        };
+        if !petsc && (self.petsc_options.is_some() || self.petsc_formulation.is_some()) {
+            return Err(
+                "--petsc-options and --petsc-formulation apply with --backend petsc".into(),
+            );
+        }
+        Ok(petsc)
+    }
+}
+
+/// PETSc started for one solve: finalized (PETSc, then MPI) when dropped, on every path.
+pub struct Backend {
+    #[cfg(feature = "petsc")]
+    solver: &'static fem_petsc::lcp::PetscLcpSolver,
+    /// Without PETSc no backend can exist ([`Backend::start`] refuses).
+    #[cfg(not(feature = "petsc"))]
+    never: std::convert::Infallible,
+}
+
+impl Backend {
+    /// Starts MPI and PETSc with the options given; on ranks other than 0 the standard
+    /// output and error are closed (rank 0 speaks for all).
+    ///
+    /// # Errors
+    /// A binary built without the `petsc` feature, a formulation PETSc does not know,
+    /// PETSc's initialization.
+    pub fn start(options: &BackendOptions) -> Result<Self, String> {
+        #[cfg(feature = "petsc")]
+        {
+            let formulation = options
+                .petsc_formulation
+                .as_deref()
+                .map(fem_petsc::lcp::Formulation::parse)
+                .transpose()
+                .map_err(|e| format!("--petsc-formulation: {e}"))?;
+            let solver = fem_petsc::lcp::PetscLcpSolver::new(
+                options.petsc_options.as_deref().unwrap_or(""),
+                formulation,
+            )
+            .map_err(|e| format!("--backend petsc: {e}"))?;
+            let solver: &'static _ = Box::leak(Box::new(solver));
+            let backend = Self { solver };
+            if !backend.is_root() {
+                silence_output();
+            }
+            Ok(backend)
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            let _ = options;
+            Err("--backend petsc: this fem-forms was built without PETSc; build it with `cargo build --release --features petsc` (needs Debian's petsc-dev, libclang-dev and libopenmpi-dev; docs/petsc.md)".into())
+        }
+    }
+
+    /// The solver the pipeline is given.
+    pub fn solver(&self) -> VariationalSolver {
+        #[cfg(feature = "petsc")]
+        {
+            VariationalSolver::External(fem_runtime::lcp::external::External(self.solver))
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            match self.never {}
+        }
+    }
+
+    /// Whether this is rank 0, the one that prints and writes.
+    pub fn is_root(&self) -> bool {
+        #[cfg(feature = "petsc")]
+        {
+            self.solver.rank_and_size().0 == 0
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            match self.never {}
+        }
+    }
+
+    /// Adds `petsc` to the report: the ranks, the options, and per level solved the
+    /// formulation, SNES's converged reason, its Newton and linear iterations and time.
+    pub fn describe(&self, report: &mut Report, options: &BackendOptions) {
+        #[cfg(feature = "petsc")]
+        {
+            let levels: Vec<serde_json::Value> = self
+                .solver
+                .records()
+                .iter()
+                .map(|r| {
+                    serde_json::json!({
+                        "formulation": r.formulation.name(),
+                        "primal_unknowns": r.unknowns[0],
+                        "multipliers": r.unknowns[1],
+                        "converged_reason": r.converged.reason,
+                        "snes_iterations": r.converged.iterations,
+                        "linear_iterations": r.converged.linear_iterations,
+                        "seconds": r.seconds,
+                    })
+                })
+                .collect();
+            report.set(
+                "petsc",
+                serde_json::json!({
+                    "ranks": self.solver.rank_and_size().1,
+                    "options": options.petsc_options.clone().unwrap_or_default(),
+                    "levels": levels,
+                }),
+            );
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            let _ = (report, options);
+            match self.never {}
+        }
+    }
+}
+
+impl Drop for Backend {
+    fn drop(&mut self) {
+        #[cfg(feature = "petsc")]
+        self.solver.finalize();
+    }
+}
+
+/// Points this process's standard output and error at /dev/null.
+#[cfg(feature = "petsc")]
+fn silence_output() {
+    // SAFETY: open(2) and dup2(2) on this process's own descriptors
+    unsafe {
+        let null = libc::open(c"/dev/null".as_ptr(), libc::O_WRONLY);
+        if null >= 0 {
+            libc::dup2(null, 1);
+            libc::dup2(null, 2);
+            libc::close(null);
+        }
+    }
+}

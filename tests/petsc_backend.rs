@@ -1,0 +1,140 @@
+//! `fem-forms solve SCENE --backend petsc` under `mpirun -n 2`, in a binary built with
+//! the `petsc` feature (`cargo test --release --features petsc --test petsc_backend`,
+//! which `.ci/run` runs): the report equals the native solve's to the solvers'
+//! tolerance (energy, ∫λ_h, contact area), carries PETSc's reasons and iteration counts,
+//! and a SNES that stops without converging is an error naming its reason, not an answer.
+#![cfg(feature = "petsc")]
+
+use std::process::{Command, Output};
+
+fn fem_forms(ranks: Option<usize>, args: &[&str]) -> Output {
+    let binary = env!("CARGO_BIN_EXE_fem-forms");
+    let mut command = match ranks {
+        Some(n) => {
+            let mut c = Command::new("mpirun");
+            c.args([
+                "--allow-run-as-root",
+                "--oversubscribe",
+                "-n",
+                &n.to_string(),
+                binary,
+            ]);
+            c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+                .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+            c
+        }
+        None => Command::new(binary),
+    };
+    command
+        .args(args)
+        .output()
+        .expect("fem-forms (and mpirun) run")
+}
+
+fn json(output: &Output) -> serde_json::Value {
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("one JSON report, from rank 0 alone")
+}
+
+#[test]
+fn the_report_of_two_ranks_equals_the_native_one() {
+    for (scene, pair, n) in [
+        ("membrane-radial", "p2-p0", "16"),
+        ("membrane-radial", "p1-nodal", "16"),
+        ("kirchhoff-obstacle", "morley-p0", "16"),
+        ("hertz", "p1-p0", "4"),
+    ] {
+        let args = ["solve", scene, "--pair", pair, "--mesh-size", n, "--json"];
+        let native = json(&fem_forms(None, &args));
+        let mut distributed = args.to_vec();
+        distributed.extend(["--backend", "petsc"]);
+        let ours = json(&fem_forms(Some(2), &distributed));
+        assert_eq!(ours["solver"], "petsc", "{scene} {pair}");
+        let number = |r: &serde_json::Value, key: &str| r[key].as_f64();
+        for key in [
+            "energy",
+            "total_contact_force",
+            "contact_area",
+            "contact_length",
+        ] {
+            match (number(&native, key), number(&ours, key)) {
+                (Some(a), Some(b)) => assert!(
+                    (a - b).abs() <= 1e-8 * a.abs().max(1e-12),
+                    "{scene} {pair}: {key} {a} native, {b} by PETSc"
+                ),
+                (a, b) => assert_eq!(a.is_some(), b.is_some(), "{scene} {pair}: {key}"),
+            }
+        }
+        let petsc = &ours["petsc"];
+        assert_eq!(petsc["ranks"], 2);
+        let levels = petsc["levels"].as_array().expect("levels");
+        assert_eq!(
+            levels.len(),
+            ours["levels"].as_array().map_or(0, Vec::len),
+            "{scene} {pair}: one PETSc solve per nested level"
+        );
+        for level in levels {
+            let reason = level["converged_reason"].as_str().unwrap_or("");
+            assert!(reason.starts_with("CONVERGED_"), "{scene} {pair}: {reason}");
+        }
+        let formulation = levels[0]["formulation"].as_str().unwrap_or("");
+        let expected = if pair == "p1-nodal" {
+            "primal"
+        } else {
+            "eliminated"
+        };
+        assert_eq!(formulation, expected, "{scene} {pair}");
+    }
+}
+
+#[test]
+fn a_snes_that_stops_short_is_an_error_naming_its_reason() {
+    let output = fem_forms(
+        Some(2),
+        &[
+            "solve",
+            "membrane-radial",
+            "--mesh-size",
+            "16",
+            "--cold",
+            "--backend",
+            "petsc",
+            "--petsc-options",
+            "-snes_max_it 1",
+        ],
+    );
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("DIVERGED_MAX_IT"), "{stderr}");
+    assert!(output.stdout.is_empty(), "no answer printed");
+}
+
+#[test]
+fn options_that_do_not_apply_are_refused() {
+    for (args, words) in [
+        (
+            vec!["--backend", "petsc", "--petsc-formulation", "bogus"],
+            "unknown formulation",
+        ),
+        (
+            vec!["--backend", "petsc", "--solver", "clarabel"],
+            "clarabel",
+        ),
+        (
+            vec!["--backend", "petsc", "--linear-solver", "direct"],
+            "PETSc's options choose",
+        ),
+        (vec!["--backend", "cuda"], "unknown backend"),
+    ] {
+        let mut all = vec!["solve", "membrane-radial", "--mesh-size", "8"];
+        all.extend(args);
+        let output = fem_forms(None, &all);
+        assert!(!output.status.success(), "{all:?}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains(words), "{all:?}: {stderr}");
+    }
+}
