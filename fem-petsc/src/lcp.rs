@@ -30,10 +30,11 @@
 //! answer comes back to every rank and is checked there by the pipeline's KKT residual.
 
 use crate::{
-    minimize, solve_with, Converged, Defaults, Error, Matrix, Petsc, Result, Vector, VectorView,
+    minimize, solve_with, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
+    VectorView,
 };
 use fem_runtime::lcp::external::ExternalSolver;
-use fem_runtime::lcp::{recover_multiplier, Lcp, LcpSolution, NewtonOptions};
+use fem_runtime::lcp::{recover_multiplier, ConstraintRows, Lcp, LcpSolution, NewtonOptions};
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -514,11 +515,130 @@ fn eliminated_multipliers(lcp: &Lcp, u: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// What one rank of the eliminated formulation reads and writes: its block of `U`, the
+/// entries of `U` its rows couple to (its own and its ghosts, `needed`, ascending), and
+/// the constraints that touch its rows or that it owns (a constraint belongs to the rank
+/// of its first column), with `B`'s entries in local columns.
+struct EliminatedRows {
+    needed: Vec<usize>,
+    /// Per own row, its `A` entries as (local column, value).
+    a_rows: ConstraintRows,
+    /// Per own row, the constraints touching it as (index into `constraints`, `B` entry).
+    touching: ConstraintRows,
+    /// The constraints this rank evaluates (their `k`).
+    constraints: Vec<usize>,
+    /// Their entries of `B`, in local columns.
+    constraint_rows: ConstraintRows,
+    /// Those of `constraints` this rank owns (each counted once in Φ).
+    owned: Vec<usize>,
+}
+
+impl EliminatedRows {
+    fn new(
+        lcp: &Lcp,
+        mine: std::ops::Range<usize>,
+        owner_of: impl Fn(usize) -> usize,
+        rank: usize,
+    ) -> Self {
+        let (col_ptr, row_idx, values) = (
+            lcp.a.symbolic().col_ptr(),
+            lcp.a.symbolic().row_idx(),
+            lcp.a.val(),
+        );
+        let mut relevant: Vec<usize> = Vec::new();
+        let mut owned_k: Vec<usize> = Vec::new();
+        for (k, row) in lcp.b_rows.iter().enumerate() {
+            let owner = row.first().map_or(0, |&(j, _)| owner_of(j));
+            let touches = row.iter().any(|&(j, _)| mine.contains(&j));
+            if touches || owner == rank {
+                relevant.push(k);
+            }
+            if owner == rank {
+                owned_k.push(k);
+            }
+        }
+        let mut needed: Vec<usize> = mine.clone().collect();
+        for i in mine.clone() {
+            needed.extend(&row_idx[col_ptr[i]..col_ptr[i + 1]]);
+        }
+        for &k in &relevant {
+            needed.extend(lcp.b_rows[k].iter().map(|&(j, _)| j));
+        }
+        needed.sort_unstable();
+        needed.dedup();
+        let local = |j: usize| {
+            needed
+                .binary_search(&j)
+                .expect("every column read is needed")
+        };
+        let mut offsets = vec![0];
+        let mut entries = Vec::new();
+        for i in mine.clone() {
+            entries.extend((col_ptr[i]..col_ptr[i + 1]).map(|p| (local(row_idx[p]), values[p])));
+            offsets.push(entries.len());
+        }
+        let a_rows = ConstraintRows::from_flat(offsets, entries).expect("offsets ascend");
+        let mut touching = vec![Vec::new(); mine.len()];
+        let (mut offsets, mut entries) = (vec![0], Vec::new());
+        for (r, &k) in relevant.iter().enumerate() {
+            for &(j, v) in &lcp.b_rows[k] {
+                if mine.contains(&j) {
+                    touching[j - mine.start].push((r, v));
+                }
+                entries.push((local(j), v));
+            }
+            offsets.push(entries.len());
+        }
+        let constraint_rows = ConstraintRows::from_flat(offsets, entries).expect("offsets ascend");
+        let touching = ConstraintRows::from(touching);
+        let owned = owned_k
+            .iter()
+            .map(|k| {
+                relevant
+                    .binary_search(k)
+                    .expect("owned constraints are evaluated")
+            })
+            .collect();
+        Self {
+            needed,
+            a_rows,
+            touching,
+            constraints: relevant,
+            constraint_rows,
+            owned,
+        }
+    }
+
+    /// The eliminated multipliers `(G − BU)₊,k / C_k` of the evaluated constraints, from
+    /// the needed entries `u` of `U`.
+    fn multipliers(&self, lcp: &Lcp, u: &[f64]) -> Vec<f64> {
+        self.constraints
+            .iter()
+            .zip(self.constraint_rows.iter())
+            .map(|(&k, row)| {
+                let r = lcp.g[k] - row.iter().map(|&(j, v)| v * u[j]).sum::<f64>();
+                r.max(0.0) / lcp.c[k]
+            })
+            .collect()
+    }
+
+    /// `(AU)_i` for own row `i` (local), from the needed entries `u`.
+    fn a_times(&self, i: usize, u: &[f64]) -> f64 {
+        self.a_rows[i].iter().map(|&(j, v)| v * u[j]).sum()
+    }
+
+    /// The local index of own row `i` (global) among the needed entries.
+    fn local_of_own(&self, i: usize) -> usize {
+        self.needed.binary_search(&i).expect("own rows are needed")
+    }
+}
+
 /// Solves `lcp` by SNES on Φ(U) (see the module's docs): `(U, Λ)` on every rank and
 /// SNES's report. Each rank owns a contiguous block of `U` and writes its rows of the
 /// gradient and of the generalized Hessian, whose pattern (that of `A + BᵀB`) is
-/// preallocated once; the callbacks read the whole `U` (gathered), as the LCP is whole
-/// on every rank.
+/// preallocated once; the callbacks read only the entries of `U` their rows couple to
+/// (one `VecScatter` of the ghosts), and Φ is the sum of the ranks' shares (one
+/// `MPI_Allreduce`). The whole `U` is gathered once, at the end, for the pipeline.
 fn solve_eliminated(
     petsc: &Petsc,
     lcp: &Lcp,
@@ -527,42 +647,35 @@ fn solve_eliminated(
     check_start(lcp, start)?;
     let n = lcp.n();
     let bounds = blocks(n, petsc.size());
-    let mine = bounds[petsc.rank()]..bounds[petsc.rank() + 1];
-    // the constraints that touch each of this rank's unknowns, with B's entry
-    let mut touching: Vec<Vec<(usize, f64)>> = vec![Vec::new(); mine.len()];
-    for (k, row) in lcp.b_rows.iter().enumerate() {
-        for &(j, v) in row {
-            if mine.contains(&j) {
-                touching[j - mine.start].push((k, v));
-            }
-        }
-    }
-    let (col_ptr, row_idx, values) = (
-        lcp.a.symbolic().col_ptr(),
-        lcp.a.symbolic().row_idx(),
-        lcp.a.val(),
-    );
+    let rank = petsc.rank();
+    let mine = bounds[rank]..bounds[rank + 1];
+    let owner_of = |j: usize| Layout::owner(&bounds, j);
+    let rows = EliminatedRows::new(lcp, mine.clone(), owner_of, rank);
     let (mut diagonal, mut off) = (
         Vec::with_capacity(mine.len()),
         Vec::with_capacity(mine.len()),
     );
-    for i in mine.clone() {
-        let mut columns: Vec<usize> = row_idx[col_ptr[i]..col_ptr[i + 1]].to_vec();
-        for &(k, _) in &touching[i - mine.start] {
-            columns.extend(lcp.b_rows[k].iter().map(|&(j, _)| j));
+    for i in 0..mine.len() {
+        let mut columns: Vec<usize> = rows.a_rows[i].iter().map(|&(j, _)| j).collect();
+        for &(r, _) in &rows.touching[i] {
+            columns.extend(rows.constraint_rows[r].iter().map(|&(j, _)| j));
         }
         columns.sort_unstable();
         columns.dedup();
-        let here = columns.iter().filter(|j| mine.contains(j)).count();
+        let here = columns
+            .iter()
+            .filter(|&&j| mine.contains(&rows.needed[j]))
+            .count();
         diagonal.push(here);
         off.push(columns.len() - here);
     }
     let matrix = Matrix::new(petsc, &diagonal, &off)?;
     let mut x = Vector::new(petsc, mine.len())?;
-    let rows: Vec<usize> = mine.clone().collect();
+    let own: Vec<usize> = mine.clone().collect();
     let begin: Vec<f64> = mine.clone().map(|i| start.map_or(0.0, |s| s[i])).collect();
-    x.set(&rows, &begin, false)?;
+    x.set(&own, &begin, false)?;
     x.assemble()?;
+    let ghosts = std::cell::RefCell::new(Ghosts::new(petsc, &x, &rows.needed)?);
     // the Hessian is SPD: Cholesky unless the user chose (`-ksp_type cg -pc_type gamg`);
     // the line search backtracks on Φ (the objective), PETSc's default `bt`
     let defaults = Defaults {
@@ -572,53 +685,57 @@ fn solve_eliminated(
         line_search: None,
         rtol: Some(RELATIVE_TOLERANCE),
     };
+    let rows = &rows;
     let objective = |x: &VectorView| -> Result<f64> {
-        let u = x.gather()?;
-        let au = fem_runtime::lcp::cholesky::multiply(&lcp.a, &u);
-        let mut phi = 0.0;
-        for ((ui, ai), fi) in u.iter().zip(&au).zip(&lcp.f) {
-            phi += 0.5 * ui * ai - fi * ui;
+        let u = ghosts.borrow_mut().read(x)?;
+        let mut share = 0.0;
+        for (i, global) in mine.clone().enumerate() {
+            let ui = u[rows.local_of_own(global)];
+            share += 0.5 * ui * rows.a_times(i, &u) - lcp.f[global] * ui;
         }
-        for (z, c) in eliminated_multipliers(lcp, &u).iter().zip(&lcp.c) {
-            phi += 0.5 * z * z * c;
+        let z = rows.multipliers(lcp, &u);
+        for &r in &rows.owned {
+            share += 0.5 * z[r] * z[r] * lcp.c[rows.constraints[r]];
         }
-        Ok(phi)
+        Ok(petsc.sum(share))
     };
-    let gradient = |x: &VectorView, r: &mut VectorView| -> Result<()> {
-        let u = x.gather()?;
-        let z = eliminated_multipliers(lcp, &u);
+    let gradient = |x: &VectorView, out: &mut VectorView| -> Result<()> {
+        let u = ghosts.borrow_mut().read(x)?;
+        let z = rows.multipliers(lcp, &u);
         let local: Vec<f64> = mine
             .clone()
-            .map(|i| {
-                let au: f64 = (col_ptr[i]..col_ptr[i + 1])
-                    .map(|p| values[p] * u[row_idx[p]])
-                    .sum();
-                let btz: f64 = touching[i - mine.start]
-                    .iter()
-                    .map(|&(k, v)| v * z[k])
-                    .sum();
-                au - lcp.f[i] - btz
+            .enumerate()
+            .map(|(i, global)| {
+                let btz: f64 = rows.touching[i].iter().map(|&(r, v)| v * z[r]).sum();
+                rows.a_times(i, &u) - lcp.f[global] - btz
             })
             .collect();
-        r.write_local(&local)
+        out.write_local(&local)
     };
     let hessian = |x: &VectorView, matrix: &mut Matrix| -> Result<()> {
-        let u = x.gather()?;
-        let z = eliminated_multipliers(lcp, &u);
+        let u = ghosts.borrow_mut().read(x)?;
+        let z = rows.multipliers(lcp, &u);
         matrix.zero_entries()?;
-        let mut row: Vec<(usize, f64)> = Vec::new();
-        for i in mine.clone() {
-            row.clear();
-            row.extend((col_ptr[i]..col_ptr[i + 1]).map(|p| (row_idx[p], values[p])));
-            for &(k, v) in &touching[i - mine.start] {
+        let (mut columns, mut entries) = (Vec::new(), Vec::new());
+        for (i, global) in mine.clone().enumerate() {
+            columns.clear();
+            entries.clear();
+            for &(j, v) in &rows.a_rows[i] {
+                columns.push(rows.needed[j]);
+                entries.push(v);
+            }
+            for &(r, v) in &rows.touching[i] {
                 // active where (G − BU)_k > 0, i.e. where the eliminated Λ_k is
-                if z[k] > 0.0 {
-                    let scale = v / lcp.c[k];
-                    row.extend(lcp.b_rows[k].iter().map(|&(j, w)| (j, scale * w)));
+                if z[r] > 0.0 {
+                    let scale = v / lcp.c[rows.constraints[r]];
+                    for &(j, w) in &rows.constraint_rows[r] {
+                        columns.push(rows.needed[j]);
+                        entries.push(scale * w);
+                    }
                 }
             }
-            let (columns, entries): (Vec<usize>, Vec<f64>) = row.iter().copied().unzip();
-            matrix.add(&[i], &columns, &entries)?;
+            // repeated columns add up (ADD_VALUES)
+            matrix.add(&[global], &columns, &entries)?;
         }
         matrix.assemble()
     };

@@ -172,6 +172,29 @@ impl Petsc {
         // SAFETY: set before PetscInitialize and constant since
         unsafe { sys::PETSC_COMM_WORLD }
     }
+
+    /// `MPI_COMM_SELF`, which PETSc's header spells as a macro bindgen drops.
+    fn comm_self(&self) -> sys::MPI_Comm {
+        use mpi::raw::AsRaw;
+        let raw = mpi::topology::SimpleCommunicator::self_comm().as_raw();
+        // SAFETY: both are pointers to Open MPI's communicator object
+        unsafe { std::mem::transmute::<mpi::ffi::MPI_Comm, sys::MPI_Comm>(raw) }
+    }
+
+    /// The sum of `value` over the ranks (`MPI_Allreduce`; every rank must call it).
+    pub fn sum(&self, value: f64) -> f64 {
+        use mpi::collective::{CommunicatorCollectives, SystemOperation};
+        match &self.universe {
+            Some(universe) => {
+                let mut total = 0.0;
+                universe
+                    .world()
+                    .all_reduce_into(&value, &mut total, SystemOperation::sum());
+                total
+            }
+            None => value,
+        }
+    }
 }
 
 impl Drop for Petsc {
@@ -511,6 +534,104 @@ impl Drop for Matrix<'_> {
         // SAFETY: owned
         unsafe {
             sys::MatDestroy(&mut self.raw);
+        }
+    }
+}
+
+/// The entries of a distributed vector that one rank reads — its own and its ghosts
+/// (those of other ranks its rows couple to) — brought in by one `VecScatter` per
+/// [`Ghosts::read`], instead of the whole vector.
+pub struct Ghosts {
+    scatter: sys::VecScatter,
+    local: sys::Vec,
+}
+
+impl Ghosts {
+    /// The scatter from vectors laid out as `x` to the entries `indices` (global, in the
+    /// order given), on this rank.
+    ///
+    /// # Errors
+    /// An index beyond PETSc's `PetscInt` or `x`'s size, or PETSc's.
+    pub fn new(petsc: &Petsc, x: &Vector, indices: &[usize]) -> Result<Self> {
+        let global = petsc_ints("ISCreateGeneral", indices)?;
+        let n = global.len() as sys::PetscInt;
+        let (mut is, mut local, mut scatter) = (
+            std::ptr::null_mut(),
+            std::ptr::null_mut(),
+            std::ptr::null_mut(),
+        );
+        let self_comm = petsc.comm_self();
+        // SAFETY: the index set copies `global`; the sequential vector and the scatter
+        // are owned by the result, the index set destroyed here
+        unsafe {
+            check(
+                "ISCreateGeneral",
+                sys::ISCreateGeneral(
+                    self_comm,
+                    n,
+                    global.as_ptr(),
+                    sys::PetscCopyMode_PETSC_COPY_VALUES,
+                    &mut is,
+                ),
+            )?;
+            let created = check("VecCreateSeq", sys::VecCreateSeq(self_comm, n, &mut local))
+                .and_then(|()| {
+                    check(
+                        "VecScatterCreate",
+                        sys::VecScatterCreate(x.raw, is, local, std::ptr::null_mut(), &mut scatter),
+                    )
+                });
+            sys::ISDestroy(&mut is);
+            if let Err(e) = created {
+                sys::VecDestroy(&mut local);
+                return Err(e);
+            }
+        }
+        Ok(Self { scatter, local })
+    }
+
+    /// The entries of `x` at the indices given to [`Ghosts::new`], in their order.
+    ///
+    /// # Errors
+    /// PETSc's (a vector of another layout).
+    pub fn read(&mut self, x: &VectorView) -> Result<Vec<f64>> {
+        // SAFETY: live objects; the scatter was made for vectors of x's layout
+        unsafe {
+            for (call, begin) in [("VecScatterBegin", true), ("VecScatterEnd", false)] {
+                let step = if begin {
+                    sys::VecScatterBegin
+                } else {
+                    sys::VecScatterEnd
+                };
+                check(
+                    call,
+                    step(
+                        self.scatter,
+                        x.raw,
+                        self.local,
+                        sys::InsertMode_INSERT_VALUES,
+                        sys::ScatterMode_SCATTER_FORWARD,
+                    ),
+                )?;
+            }
+        }
+        let local = Vector {
+            raw: self.local,
+            _petsc: std::marker::PhantomData,
+        };
+        let values = local.local();
+        // the sequential vector stays ours
+        std::mem::forget(local);
+        values
+    }
+}
+
+impl Drop for Ghosts {
+    fn drop(&mut self) {
+        // SAFETY: owned
+        unsafe {
+            sys::VecScatterDestroy(&mut self.scatter);
+            sys::VecDestroy(&mut self.local);
         }
     }
 }
