@@ -170,8 +170,8 @@ struct SolveOptions {
     /// times the energy norm ‖u_h‖_a of the solution: solve, estimate, mark, refine
     /// (newest-vertex bisection, new vertices on a curved boundary moved onto it;
     /// bisection on beams), solve again from the previous solution (every family, on
-    /// the pairs whose model declares an estimator; the scene's mesh is the first
-    /// level: start coarse, e.g. --mesh-size 8). Without --pair, T also chooses the
+    /// the pairs whose model declares an estimator; the first level is --mesh-size,
+    /// else the probes' coarse mesh: 16 elements, 8 of a square's N). Without --pair, T also chooses the
     /// model and pair: every pair of the scene and its family's cheaper model
     /// (Euler–Bernoulli for Timoshenko, Kirchhoff for Reissner–Mindlin) are probed, and
     /// the one predicted fastest within T is solved (docs/model-choice.md).
@@ -638,6 +638,18 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
 }
 
 fn run(cli: Cli) -> Result<(), String> {
+    let out = cli.out.clone();
+    let created = !out.exists();
+    let result = run_in(cli);
+    // a command refused before it wrote anything leaves no empty --out behind
+    if result.is_err() && created {
+        let _ = std::fs::remove_dir(&out);
+    }
+    result
+}
+
+/// [`run`] once `--out` may be created.
+fn run_in(cli: Cli) -> Result<(), String> {
     // checked before any solve: a study found its --out unusable only after running
     if cli.out.exists() && !cli.out.is_dir() {
         return Err(format!(
@@ -676,8 +688,18 @@ fn run(cli: Cli) -> Result<(), String> {
                 }
             }
             for name in &scenes {
-                let scene = families::scene(name)
-                    .ok_or_else(|| format!("--scene {name}: no such scene (see `list`)"))?;
+                let scene = families::scene(name).ok_or_else(|| {
+                    // `mindlin-disk-q10` names a study variant: the report runs them all
+                    match families::scenes().into_iter().find(|s| {
+                        !s.study_variants.is_empty() && name.starts_with(&format!("{}-", s.name))
+                    }) {
+                        Some(parent) => format!(
+                            "--scene {name}: a study variant of `{0}`, whose every variant the report runs: --scene {0}",
+                            parent.name
+                        ),
+                        None => format!("--scene {name}: no such scene (see `list`)"),
+                    }
+                })?;
                 if scene.studies.is_empty() {
                     return Err(format!(
                         "--scene {name}: hosts no study (see `list` for the scenes that do)"

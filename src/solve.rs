@@ -211,7 +211,15 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
     for (option, why) in unused {
         options.refuse_options(&[option], &why)?;
     }
-    let pair = families::pair_of(&scene, options.pair.as_deref()).map_err(|e| e.to_string())?;
+    // a pair of the scene's cheaper neighbour model solves that model (choice::solve)
+    let pair = match families::pair_of(&scene, options.pair.as_deref()) {
+        Ok(pair) => pair,
+        Err(e) => options
+            .pair
+            .as_deref()
+            .and_then(|name| fem_forms::models::choice::cheaper_pair(&scene, name))
+            .ok_or_else(|| e.to_string())?,
+    };
     if pair.nodal {
         options.refuse_options(
             &[Opt::Alpha, Opt::Solver],

@@ -976,12 +976,18 @@ fn report_checks_its_scenes_and_writes_the_page() {
     for (scene, words) in [
         ("no-such-scene", "--scene no-such-scene: no such scene"),
         ("membrane-flat", "--scene membrane-flat: hosts no study"),
+        ("mindlin-disk-q10", "a study variant of `mindlin-disk`"),
     ] {
         let output = fem_forms(&["report", "--scene", scene], &out);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(!output.status.success());
         assert!(stderr.contains(words), "{stderr}");
         assert!(!out.join("index.html").exists());
+        // a refused command leaves no --out it created
+        let fresh = out.join("not-yet");
+        let refused = fem_forms(&["report", "--scene", scene], &fresh);
+        assert!(!refused.status.success());
+        assert!(!fresh.exists(), "{}", fresh.display());
     }
     let output = fem_forms(&["report", "--scene", "timoshenko-a"], &out);
     assert!(

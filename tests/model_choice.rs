@@ -188,6 +188,61 @@ fn a_pair_given_fixes_the_model_and_the_pair() {
     assert!(!outcome.report.quantities.contains_key("chosen_model"));
 }
 
+#[test]
+fn a_pair_of_the_cheaper_model_solves_that_model() {
+    // Euler–Bernoulli's pair on a Timoshenko scene, Kirchhoff's on a Reissner–Mindlin one:
+    // the cheaper model is solved, said so, with its modelling estimate, and its answer is
+    // that of the cheaper model's scene solved directly
+    for (name, pair, size) in [
+        ("timoshenko-t1e-3", "hermite-p0", 64),
+        ("mindlin-ss-t1e-3", "argyris-p0", 8),
+    ] {
+        let rich = scene(name);
+        let outcome = choice::solve(&rich, &settings(Some(pair), Some(size), None))
+            .unwrap_or_else(|e| panic!("{name} with {pair}: {e}"));
+        assert_eq!(outcome.report.pair, pair);
+        assert!(
+            outcome.report.quantities.contains_key("chosen_model"),
+            "{name}"
+        );
+        let modelling = outcome.report.number("modelling_estimate_relative");
+        assert!(modelling.is_some_and(|m| m > 0.0), "{name}: {modelling:?}");
+        let family = families::family(rich.family).unwrap();
+        let thin = family.cheaper(&rich).unwrap();
+        let direct = families::solve(&thin, &settings(Some(pair), Some(size), None)).unwrap();
+        let (a, b) = (outcome.report.solve.energy, direct.report.solve.energy);
+        assert_eq!(a, b, "{name}: the cheaper model's own solve");
+        assert!(choice::cheaper_pair(&rich, "no-such-pair").is_none());
+    }
+    // the scene's own pair is not the cheaper model's
+    assert!(choice::cheaper_pair(&scene("timoshenko-t1e-3"), "p2-p2-p0").is_none());
+}
+
+#[test]
+fn a_tolerance_without_a_choice_starts_from_the_probes_coarse_mesh() {
+    // bernoulli-flat has one model and one pair: a tolerance refines adaptively, from the
+    // probes' 16 elements rather than the scene's 256 (a loose T wants fewer)
+    let flat = scene("bernoulli-flat");
+    assert!(!choice::has_choice(&flat));
+    let request = Settings {
+        load: Some(100.0),
+        adaptive: Some(AdaptiveOptions {
+            tolerance: 5e-2,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    let outcome = choice::solve(&flat, &request).unwrap();
+    let levels = &outcome.report.solve.adaptive_levels;
+    assert_eq!(
+        levels.first().map(|l| l.cells),
+        Some(choice::probe_sizes(&flat, None)[0])
+    );
+    let last = levels.last().unwrap();
+    assert!(last.estimate <= 5e-2 * last.energy_norm, "{last:?}");
+    assert!(last.cells < flat.mesh_size, "{} cells", last.cells);
+}
+
 /// The Kirchhoff plate of a Reissner–Mindlin scene at thickness t (its cheaper model).
 fn kirchhoff_of(name: &str, t: f64, adjust: Option<Adjustment>) -> Scene {
     let plates = families::family("plate").unwrap();

@@ -180,7 +180,7 @@ impl ExternalSolver for PetscLcpSolver {
         .map_err(fem_runtime::Error::Input)?;
         let solved = match formulation {
             Formulation::Eliminated => solve_eliminated(&on.petsc, lcp, start),
-            _ => solve_lcp(&on.petsc, lcp, start, formulation),
+            _ => solve_vi(&on.petsc, lcp, start, formulation),
         };
         let (u, lambda, converged) = solved.map_err(|e| fem_runtime::Error::NotConverged {
             solver: match formulation {
@@ -362,9 +362,9 @@ fn matrix_of<'p>(
     Ok(matrix)
 }
 
-/// Solves `lcp` (see the module's docs): `(U, Λ)` on every rank, the formulation used
-/// and SNES's report.
-fn solve_lcp(
+/// Solves `lcp` by SNESVI in the `primal` or `mixed` formulation (see the module's
+/// docs): `(U, Λ)` on every rank and SNES's report.
+fn solve_vi(
     petsc: &Petsc,
     lcp: &Lcp,
     start: Option<&[f64]>,
@@ -493,10 +493,10 @@ fn solve_lcp(
 /// Refuses an LCP of inconsistent shapes and a start of the wrong length.
 fn check_start(lcp: &Lcp, start: Option<&[f64]>) -> Result<()> {
     lcp.check_shapes()
-        .map_err(|e| Error::refused("solve_lcp", e.to_string()))?;
+        .map_err(|e| Error::refused("PetscLcpSolver::solve", e.to_string()))?;
     match start {
         Some(s) if s.len() != lcp.n() => Err(Error::refused(
-            "solve_lcp",
+            "PetscLcpSolver::solve",
             format!("a start of {} unknowns for {}", s.len(), lcp.n()),
         )),
         _ => Ok(()),

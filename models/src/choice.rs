@@ -102,18 +102,86 @@ pub struct Candidate {
 
 /// Solves `scene` as `settings` ask: asked for a tolerance (`settings.adaptive`, or the
 /// scene's `tol`) without a pair, with the cheapest adequate candidate where the scene has
-/// more than one ([`choose`]); otherwise with [`families::solve`].
+/// more than one ([`choose`]); a pair of the scene's cheaper neighbour model
+/// (`--pair hermite-p0` on a Timoshenko scene) with that model ([`solve_cheaper`]);
+/// otherwise with [`families::solve`], a tolerance's adaptive loop starting from the
+/// probes' coarse mesh where no mesh size is given (a loose tolerance wants no more than
+/// it).
 ///
 /// # Errors
 /// Those of [`choose`] and [`families::solve`].
 pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
-    if settings.pair.is_none() {
-        let tolerance = settings.adaptive.map(|a| a.tolerance).or(scene.tolerance);
-        if let Some(tolerance) = tolerance.filter(|_| has_choice(scene)) {
-            return choose(scene, settings, tolerance);
+    let tolerance = settings.adaptive.map(|a| a.tolerance).or(scene.tolerance);
+    if let Some(pair) = settings.pair.as_deref() {
+        if let Some(outcome) = solve_cheaper(scene, settings, pair)? {
+            return Ok(outcome);
         }
+    } else if let Some(tolerance) = tolerance.filter(|_| has_choice(scene)) {
+        return choose(scene, settings, tolerance);
+    }
+    if tolerance.is_some() && settings.mesh_size.is_none() {
+        let coarse = Settings {
+            mesh_size: Some(probe_sizes(scene, None)[0]),
+            ..settings.clone()
+        };
+        return families::solve(scene, &coarse);
     }
     families::solve(scene, settings)
+}
+
+/// Solves `scene`'s cheaper neighbour model with `pair` where `pair` is one of that
+/// model's and not of the scene's own: the report says so (`chosen_model`,
+/// `chosen_pair`) and carries the cheaper model's modelling estimate. `None` where
+/// `pair` is the scene's own or the family has no cheaper model (the caller's solve
+/// then names the pairs it takes).
+///
+/// # Errors
+/// Those of [`models`] and of the solve.
+fn solve_cheaper(scene: &Scene, settings: &Settings, pair: &str) -> Result<Option<Outcome>> {
+    if cheaper_pair(scene, pair).is_none() {
+        return Ok(None);
+    }
+    let models = models(scene, settings)?;
+    let Some((words, thin)) = models
+        .iter()
+        .skip(1)
+        .find(|(_, thin)| families::pairs_of(thin).iter().any(|p| p.name == pair))
+    else {
+        return Ok(None);
+    };
+    let mut thin = thin.clone();
+    thin.tolerance = scene.tolerance;
+    let request = Settings {
+        pair: Some(pair.to_string()),
+        ..candidate_settings(settings, &thin)
+    };
+    let mut outcome = if request.adaptive.is_some() || thin.tolerance.is_some() {
+        solve(&thin, &request)?
+    } else {
+        families::solve(&thin, &request)?
+    };
+    outcome.report.set("chosen_model", *words);
+    outcome.report.set("chosen_pair", pair);
+    Ok(Some(outcome))
+}
+
+/// The pair called `name` of `scene`'s cheaper neighbour model, where it is not one of
+/// the scene's own (`hermite-p0` for a Timoshenko scene, `argyris-p0` for a
+/// Reissner–Mindlin one): a request for it solves the cheaper model.
+pub fn cheaper_pair(scene: &Scene, name: &str) -> Option<&'static crate::family::Pair> {
+    let family = families::family(scene.family)?;
+    let own = families::pairs_of(scene).iter().any(|p| p.name == name)
+        || family
+            .pair_aliases()
+            .iter()
+            .any(|(alias, _)| *alias == name);
+    if own {
+        return None;
+    }
+    let thin = family.cheaper(scene)?;
+    families::pairs_of(&thin)
+        .into_iter()
+        .find(|p| p.name == name)
 }
 
 /// The error bound of a solve relative to `‖u_h‖_a`: its relative estimate plus, for a
