@@ -438,6 +438,17 @@ fn the_command_line_and_a_scene_file_tolerance_choose() {
     assert!(report["estimate_relative"].as_f64().unwrap() <= target);
 }
 
+/// The longest edge of a triangle given as `[x₀, y₀, x₁, y₁, x₂, y₂]`: the `h_T` of the
+/// Stenberg weight.
+fn longest_edge(x: &[f64]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (a, b) = (k, (k + 1) % 3);
+            (x[2 * a] - x[2 * b]).hypot(x[2 * a + 1] - x[2 * b + 1])
+        })
+        .fold(0.0, f64::max)
+}
+
 /// `∫ |Q_h|² / S` of a Reissner–Mindlin solution: its discrete shear force
 /// `Q_h = S_T (∇w_h − θ_h)` with the Stenberg weight `S_T = 6κ(1−ν)D/(t² + β h_T²)`
 /// (h_T the longest edge), against the physical shear stiffness `S = 6κ(1−ν)D/t²`: the
@@ -472,12 +483,7 @@ fn mindlin_shear_energy(outcome: &Outcome, [d, nu, kappa, t, beta]: [f64; 5]) ->
     for c in 0..mesh.cell_count() {
         let map = AffineMap::of(mesh, c);
         let x = mesh.cell_coordinates(c);
-        let h = (0..3)
-            .map(|k| {
-                let (a, b) = (k, (k + 1) % 3);
-                (x[2 * a] - x[2 * b]).hypot(x[2 * a + 1] - x[2 * b + 1])
-            })
-            .fold(0.0, f64::max);
+        let h = longest_edge(&x);
         let stenberg = 6.0 * kappa * (1.0 - nu) * d / (t * t + beta * h * h);
         for (&xi, &weight) in rule.points.iter().zip(&rule.weights) {
             let g = w.gradient(&bw, &map, c, xi);
@@ -753,12 +759,7 @@ fn lee_reddy_relative_error(outcome: &Outcome, t: f64) -> (f64, f64) {
     for c in 0..mesh.cell_count() {
         let map = AffineMap::of(mesh, c);
         let x = mesh.cell_coordinates(c);
-        let h = (0..3)
-            .map(|k| {
-                let (a, b) = (k, (k + 1) % 3);
-                (x[2 * a] - x[2 * b]).hypot(x[2 * a + 1] - x[2 * b + 1])
-            })
-            .fold(0.0, f64::max);
+        let h = longest_edge(&x);
         // the discrete shear strain as the strain of its shear force: S_T γ_h / S
         let share = t * t / (t * t + 0.1 * h * h);
         for (&xi, &weight) in rule.points.iter().zip(&rule.weights) {
