@@ -75,6 +75,8 @@ impl Backend {
             .map_err(|e| format!("--backend petsc: {e}"))?;
             let solver: &'static _ = Box::leak(Box::new(solver));
             let backend = Self { solver };
+            // the launcher's variables silenced the other ranks already; this covers a
+            // launcher that sets none
             if !backend.is_root() {
                 silence_output();
             }
@@ -132,6 +134,7 @@ impl Backend {
                     })
                 })
                 .collect();
+            let solved_nothing = levels.is_empty();
             report.set(
                 "petsc",
                 serde_json::json!({
@@ -140,6 +143,9 @@ impl Backend {
                     "levels": levels,
                 }),
             );
+            if solved_nothing {
+                report.warn("PETSc solved nothing: the problem has no contact constraint to solve (a linear solve, done natively on every rank); --petsc-options did not apply");
+            }
         }
         #[cfg(not(feature = "petsc"))]
         {
@@ -156,9 +162,21 @@ impl Drop for Backend {
     }
 }
 
+/// This process's rank and the number of ranks where an MPI launcher started it
+/// (Open MPI's `OMPI_COMM_WORLD_RANK`/`_SIZE`, MPICH's `PMI_RANK`/`PMI_SIZE`), read
+/// before MPI is initialized.
+pub fn launcher_ranks() -> Option<(usize, usize)> {
+    let read = |name: &str| std::env::var(name).ok()?.parse::<usize>().ok();
+    [
+        ("OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE"),
+        ("PMI_RANK", "PMI_SIZE"),
+    ]
+    .into_iter()
+    .find_map(|(rank, size)| Some((read(rank)?, read(size)?)))
+}
+
 /// Points this process's standard output and error at /dev/null.
-#[cfg(feature = "petsc")]
-fn silence_output() {
+pub fn silence_output() {
     // SAFETY: open(2) and dup2(2) on this process's own descriptors
     unsafe {
         let null = libc::open(c"/dev/null".as_ptr(), libc::O_WRONLY);

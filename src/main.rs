@@ -638,6 +638,17 @@ fn study(name: &str, kind: Option<&str>, full: bool, out: &Path) -> Result<(), S
 }
 
 fn run(cli: Cli) -> Result<(), String> {
+    if let Some((_, size)) = backend::launcher_ranks().filter(|&(_, size)| size > 1) {
+        let distributed = matches!(
+            &cli.command,
+            Some(Command::Solve { options, .. }) if options.backend.as_deref() == Some("petsc")
+        );
+        if !distributed {
+            return Err(format!(
+                "started as {size} processes (mpirun): only `solve … --backend petsc` runs distributed; any other command would run {size} times over"
+            ));
+        }
+    }
     let out = cli.out.clone();
     let created = !out.exists();
     let result = run_in(cli);
@@ -789,6 +800,11 @@ fn main() -> ExitCode {
     // before any thread allocates
     fem_forms::allocator::keep_freed_memory();
     fem_forms::allocator::small_pages();
+    // under mpirun every rank runs this; rank 0 alone speaks, from the first message on
+    // (an argument refused by clap, too)
+    if backend::launcher_ranks().is_some_and(|(rank, _)| rank != 0) {
+        backend::silence_output();
+    }
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -280,8 +280,8 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
             return Err("--solver clarabel does not apply with --backend petsc: PETSc solves the complementarity problems".into());
         }
         options.refuse_options(
-            &[Opt::LinearSolver],
-            "with --backend petsc, PETSc's options choose the linear solver (--petsc-options \"-ksp_type cg -pc_type gamg\")",
+            &[Opt::LinearSolver, Opt::Solver, Opt::Refinement],
+            "with --backend petsc, PETSc solves the complementarity problems and its options choose the method and the linear solver (--petsc-options \"-ksp_type cg -pc_type gamg\")",
         )?;
         let backend = Backend::start(&backend_options)?;
         settings.solver = backend.solver();

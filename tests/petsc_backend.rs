@@ -114,6 +114,45 @@ fn a_snes_that_stops_short_is_an_error_naming_its_reason() {
 }
 
 #[test]
+fn an_answer_petsc_calls_converged_is_checked_by_its_kkt_residual() {
+    // `ksponly` takes one Newton step and reports CONVERGED_ITS: far from the solution
+    let output = fem_forms(
+        Some(2),
+        &[
+            "solve",
+            "kirchhoff-obstacle",
+            "--mesh-size",
+            "8",
+            "--backend",
+            "petsc",
+            "--petsc-options",
+            "-snes_type ksponly",
+        ],
+    );
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("KKT residual"), "{stderr}");
+    assert_eq!(
+        stderr.matches("error:").count(),
+        1,
+        "one rank speaks: {stderr}"
+    );
+    assert!(output.stdout.is_empty(), "no answer printed");
+}
+
+#[test]
+fn mpirun_without_the_backend_is_refused_once() {
+    let output = fem_forms(Some(2), &["solve", "membrane-radial", "--mesh-size", "8"]);
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("only `solve … --backend petsc` runs distributed"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.matches("error:").count(), 1, "{stderr}");
+}
+
+#[test]
 fn options_that_do_not_apply_are_refused() {
     for (args, words) in [
         (
@@ -126,7 +165,11 @@ fn options_that_do_not_apply_are_refused() {
         ),
         (
             vec!["--backend", "petsc", "--linear-solver", "direct"],
-            "PETSc's options choose",
+            "its options choose",
+        ),
+        (
+            vec!["--backend", "petsc", "--solver", "pdas"],
+            "its options choose",
         ),
         (vec!["--backend", "cuda"], "unknown backend"),
     ] {

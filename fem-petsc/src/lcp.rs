@@ -182,12 +182,25 @@ impl ExternalSolver for PetscLcpSolver {
             Formulation::Eliminated => solve_eliminated(&on.petsc, lcp, start),
             _ => solve_vi(&on.petsc, lcp, start, formulation),
         };
-        let (u, lambda, converged) = solved.map_err(|e| fem_runtime::Error::NotConverged {
-            solver: match formulation {
-                Formulation::Eliminated => "PETSc SNES on Φ(U)",
-                _ => "PETSc SNESVI",
-            },
-            detail: e.to_string(),
+        let solver = match formulation {
+            Formulation::Eliminated => "PETSc SNES on Φ(U)",
+            _ => "PETSc SNESVI",
+        };
+        let (u, lambda, converged) = solved.map_err(|e| {
+            if e.code == 0 {
+                fem_runtime::Error::NotConverged {
+                    solver,
+                    detail: format!(
+                        "{} ({})",
+                        e.message.trim_start_matches("did not converge: "),
+                        e.call
+                    ),
+                }
+            } else {
+                // a PETSc error (an option it refuses, a failed factorization), not a
+                // Newton iteration that ran out
+                fem_runtime::Error::Input(format!("PETSc: {e}"))
+            }
         })?;
         let seconds = clock.elapsed().as_secs_f64();
         self.records
@@ -199,12 +212,25 @@ impl ExternalSolver for PetscLcpSolver {
                 converged: converged.clone(),
                 seconds,
             });
+        let kkt_residual = lcp.kkt_residual(&u, &lambda);
+        if kkt_residual.is_nan() || kkt_residual > MAX_KKT_RESIDUAL {
+            // PETSc's word is not the answer's certificate: options that stop it early
+            // (`-snes_type ksponly`, `-snes_rtol 0.5`) report convergence on a point far
+            // from the solution
+            return Err(fem_runtime::Error::NotConverged {
+                solver,
+                detail: format!(
+                    "PETSc reported {} after {} iterations, but the KKT residual of its answer is {kkt_residual:.1e} (at most {MAX_KKT_RESIDUAL:.0e} is a solution): not an answer; check --petsc-options",
+                    converged.reason, converged.iterations
+                ),
+            });
+        }
         let noise = match formulation {
             Formulation::Eliminated => lcp.elimination_noise(&lambda),
             _ => 0.0,
         };
         let solution = LcpSolution {
-            kkt_residual: lcp.kkt_residual(&u, &lambda),
+            kkt_residual,
             u,
             lambda,
             iterations: converged.iterations,
@@ -231,6 +257,35 @@ impl ExternalSolver for PetscLcpSolver {
 /// the pipeline's KKT residual certifies the answer whatever the tolerance.
 const RELATIVE_TOLERANCE: f64 = 1e-10;
 
+/// The largest KKT residual ([`Lcp::kkt_residual`], relative) of an answer PETSc's
+/// solve may return: its converged solves certify to 10⁻¹⁵–10⁻¹⁰; beyond this the
+/// options stopped it early.
+const MAX_KKT_RESIDUAL: f64 = 1e-8;
+
+/// SNES's absolute tolerance relative to the residual at zero: a start that is already
+/// the solution (membrane-flat, pressed onto ψ = 0 everywhere, from its nested start)
+/// has a residual at rounding, 10⁻¹⁴ of that scale, from which no relative decrease
+/// exists and the line search on Φ failed (DIVERGED_LINE_SEARCH).
+const ABSOLUTE_TOLERANCE: f64 = 1e-12;
+
+/// The Euclidean norm.
+fn norm2<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
+    values.into_iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// `‖F‖ + ‖BᵀC⁻¹G₊‖`, the sizes of the two terms of `∇Φ(0)`: not `‖∇Φ(0)‖`, which
+/// vanishes where `U = 0` is the solution (membrane-flat).
+fn gradient_scale(lcp: &Lcp) -> f64 {
+    let mut pressed = vec![0.0; lcp.n()];
+    for ((row, g), c) in lcp.b_rows.iter().zip(&lcp.g).zip(&lcp.c) {
+        let z = g.max(0.0) / c;
+        for &(j, v) in row {
+            pressed[j] += v * z;
+        }
+    }
+    norm2(&lcp.f) + norm2(&pressed)
+}
+
 /// The relative rounding noise of an eliminated Λ above which it is recovered by a
 /// saddle-point solve (the native solver's threshold).
 const MAX_ELIMINATION_NOISE: f64 = 1e-6;
@@ -248,6 +303,12 @@ fn formulation_of(
         return Ok(Formulation::Primal);
     }
     let diagonal = lcp.c_blocks.is_empty() && lcp.c.iter().all(|&c| c > 0.0);
+    let plain = lcp.c_blocks.is_empty() && lcp.c.iter().all(|&c| c == 0.0);
+    if plain && preferred.is_none() {
+        // measured: the membrane, the Euler–Bernoulli beam and Hertz at α = 0 all ran
+        // out of SNESVI iterations; a refusal that says so beats 50 wasted iterations
+        return Err("the plain mixed method (α = 0: C = 0) has no multiplier to eliminate, and PETSc's reduced-space VI on its saddle point does not converge here (DIVERGED_MAX_IT on the membrane, the beam and Hertz); solve it natively (clarabel), or ask for `--petsc-formulation mixed` to try".into());
+    }
     match preferred {
         Some(Formulation::Eliminated) if !diagonal => Err(
             "the eliminated formulation needs a diagonal positive C (P0 multipliers, α > 0); this LCP has coupled multipliers or C = 0: use `mixed`".into(),
@@ -456,6 +517,8 @@ fn solve_vi(
         factor_package: Some(c"mumps"),
         line_search: Some(c"basic"),
         rtol: Some(RELATIVE_TOLERANCE),
+        // the residual at x = 0 is −(F, G): its size sets the rounding floor
+        atol: Some(ABSOLUTE_TOLERANCE * norm2(lcp.f.iter().chain(&lcp.g))),
     };
     let residual = |x: &VectorView, r: &mut VectorView| {
         jacobian.multiply(x, r)?;
@@ -684,6 +747,8 @@ fn solve_eliminated(
         factor_package: Some(c"mumps"),
         line_search: None,
         rtol: Some(RELATIVE_TOLERANCE),
+        // the gradient at U = 0 is −F − BᵀC⁻¹G₊: its terms' sizes set the rounding floor
+        atol: Some(ABSOLUTE_TOLERANCE * gradient_scale(lcp)),
     };
     let rows = &rows;
     let objective = |x: &VectorView| -> Result<f64> {

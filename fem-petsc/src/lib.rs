@@ -128,6 +128,23 @@ impl Petsc {
         check("PetscInitialize", unsafe {
             sys::PetscInitialize(&mut argc, &mut argv, std::ptr::null(), std::ptr::null())
         })?;
+        // SAFETY: PETSc is initialized; both are PETSc's own globals and handlers
+        unsafe {
+            // errors come back as codes with PETSc's message (each call's `check`), not
+            // as a traceback: the default handler also sleeps 10 s on the other ranks,
+            // during which rank 0 finalized MPI and mpirun killed the job before its
+            // error line was printed
+            check(
+                "PetscPushErrorHandler",
+                sys::PetscPushErrorHandler(
+                    Some(sys::PetscReturnErrorHandler),
+                    std::ptr::null_mut(),
+                ),
+            )?;
+            // monitors (`-snes_monitor`) to standard error: standard output carries the
+            // report, which must stay one JSON object with --json
+            sys::PETSC_STDOUT = sys::PETSC_STDERR;
+        }
         let petsc = Self {
             universe: Some(universe),
         };
@@ -751,6 +768,9 @@ pub struct Defaults {
     pub line_search: Option<&'static CStr>,
     /// SNES's relative tolerance on the residual norm.
     pub rtol: Option<f64>,
+    /// SNES's absolute tolerance on the residual norm (a start that is the solution
+    /// already has a residual at rounding, which no relative decrease can follow).
+    pub atol: Option<f64>,
 }
 
 impl Defaults {
@@ -788,7 +808,7 @@ impl Defaults {
                     sys::SNESLineSearchSetType(search, t.as_ptr()),
                 )?;
             }
-            if let Some(rtol) = self.rtol {
+            if self.rtol.is_some() || self.atol.is_some() {
                 let (mut atol, mut r, mut stol, mut its, mut evaluations) = (0.0, 0.0, 0.0, 0, 0);
                 check(
                     "SNESGetTolerances",
@@ -803,7 +823,14 @@ impl Defaults {
                 )?;
                 check(
                     "SNESSetTolerances",
-                    sys::SNESSetTolerances(snes, atol, rtol, stol, its, evaluations),
+                    sys::SNESSetTolerances(
+                        snes,
+                        self.atol.unwrap_or(atol),
+                        self.rtol.unwrap_or(r),
+                        stol,
+                        its,
+                        evaluations,
+                    ),
                 )?;
             }
         }
