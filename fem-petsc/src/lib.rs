@@ -324,22 +324,7 @@ impl<'p> Vector<'p> {
     /// # Errors
     /// PETSc's.
     pub fn local(&self) -> Result<Vec<f64>> {
-        let mut n = 0;
-        let mut array: *const f64 = std::ptr::null();
-        // SAFETY: the array is valid for the local size until restored
-        unsafe {
-            check("VecGetLocalSize", sys::VecGetLocalSize(self.raw, &mut n))?;
-            check(
-                "VecGetArrayRead",
-                sys::VecGetArrayRead(self.raw, &mut array),
-            )?;
-            let values = std::slice::from_raw_parts(array, n as usize).to_vec();
-            check(
-                "VecRestoreArrayRead",
-                sys::VecRestoreArrayRead(self.raw, &mut array),
-            )?;
-            Ok(values)
-        }
+        local_values(self.raw)
     }
 
     /// Every entry, on every rank (`VecScatterCreateToAll`).
@@ -361,28 +346,7 @@ fn gather(raw: sys::Vec) -> Result<Vec<f64>> {
             "VecScatterCreateToAll",
             sys::VecScatterCreateToAll(raw, &mut scatter, &mut all),
         )?;
-        let moved = check(
-            "VecScatterBegin",
-            sys::VecScatterBegin(
-                scatter,
-                raw,
-                all,
-                sys::InsertMode_INSERT_VALUES,
-                sys::ScatterMode_SCATTER_FORWARD,
-            ),
-        )
-        .and_then(|()| {
-            check(
-                "VecScatterEnd",
-                sys::VecScatterEnd(
-                    scatter,
-                    raw,
-                    all,
-                    sys::InsertMode_INSERT_VALUES,
-                    sys::ScatterMode_SCATTER_FORWARD,
-                ),
-            )
-        });
+        let moved = scatter_forward(scatter, raw, all);
         let whole = Vector {
             raw: all,
             _petsc: std::marker::PhantomData,
@@ -390,6 +354,45 @@ fn gather(raw: sys::Vec) -> Result<Vec<f64>> {
         sys::VecScatterDestroy(&mut scatter);
         moved?;
         whole.local()
+    }
+}
+
+/// The entries of the vector `raw` this rank owns, in order.
+fn local_values(raw: sys::Vec) -> Result<Vec<f64>> {
+    let mut n = 0;
+    let mut array: *const f64 = std::ptr::null();
+    // SAFETY: the array is valid for the local size until restored
+    unsafe {
+        check("VecGetLocalSize", sys::VecGetLocalSize(raw, &mut n))?;
+        check("VecGetArrayRead", sys::VecGetArrayRead(raw, &mut array))?;
+        let values = std::slice::from_raw_parts(array, n as usize).to_vec();
+        check(
+            "VecRestoreArrayRead",
+            sys::VecRestoreArrayRead(raw, &mut array),
+        )?;
+        Ok(values)
+    }
+}
+
+/// Moves `from`'s entries into `to` by `scatter` (begin and end).
+///
+/// # Safety
+/// Live objects; `scatter` made for vectors of `from`'s and `to`'s layouts.
+unsafe fn scatter_forward(scatter: sys::VecScatter, from: sys::Vec, to: sys::Vec) -> Result<()> {
+    let (insert, forward) = (
+        sys::InsertMode_INSERT_VALUES,
+        sys::ScatterMode_SCATTER_FORWARD,
+    );
+    // SAFETY: the caller's
+    unsafe {
+        check(
+            "VecScatterBegin",
+            sys::VecScatterBegin(scatter, from, to, insert, forward),
+        )?;
+        check(
+            "VecScatterEnd",
+            sys::VecScatterEnd(scatter, from, to, insert, forward),
+        )
     }
 }
 
@@ -613,33 +616,8 @@ impl Ghosts {
     /// PETSc's (a vector of another layout).
     pub fn read(&mut self, x: &VectorView) -> Result<Vec<f64>> {
         // SAFETY: live objects; the scatter was made for vectors of x's layout
-        unsafe {
-            for (call, begin) in [("VecScatterBegin", true), ("VecScatterEnd", false)] {
-                let step = if begin {
-                    sys::VecScatterBegin
-                } else {
-                    sys::VecScatterEnd
-                };
-                check(
-                    call,
-                    step(
-                        self.scatter,
-                        x.raw,
-                        self.local,
-                        sys::InsertMode_INSERT_VALUES,
-                        sys::ScatterMode_SCATTER_FORWARD,
-                    ),
-                )?;
-            }
-        }
-        let local = Vector {
-            raw: self.local,
-            _petsc: std::marker::PhantomData,
-        };
-        let values = local.local();
-        // the sequential vector stays ours
-        std::mem::forget(local);
-        values
+        unsafe { scatter_forward(self.scatter, x.raw, self.local)? };
+        local_values(self.local)
     }
 }
 
