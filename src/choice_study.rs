@@ -4,9 +4,9 @@
 //! the choice made for a few tolerances marked on it, so that a reader sees whether the
 //! choice sits on the lower-left front.
 //!
-//! The error: where the scene has an exact solution and no cheaper model, the true
+//! The error: where the scene has an exact solution and no neighbour model, the true
 //! error in the energy norm relative to `‖u_h‖_a`; otherwise the relative estimate plus,
-//! for a cheaper model, its modelling estimate (a bound on its distance to the scene's
+//! for the thinner of two neighbours, its modelling estimate (a bound on its distance to the scene's
 //! own model's solution, docs/model-choice.md). The time of a marked choice includes its
 //! probes. `out/<scene>-work-precision-choice.svg`, the numbers in `.csv`.
 

@@ -79,7 +79,11 @@ fn unused(scene: &Scene, options: &[Opt]) -> Vec<(Opt, String)> {
                 Opt::Load if scene.load.is_none() => {
                     format!("the load of `{name}` is fixed (not a scaled field)")
                 }
-                Opt::Thickness if scene.parameter("t").is_none() => {
+                Opt::Thickness
+                    if scene.parameter("t").is_none()
+                        && !families::family(scene.family)
+                            .is_some_and(|f| f.richer_parameters().contains(&"t")) =>
+                {
                     format!("`{name}` has no thickness t")
                 }
                 Opt::NoObstacle if !scene.obstacle => format!("`{name}` has no obstacle"),
@@ -211,13 +215,19 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
     for (option, why) in unused {
         options.refuse_options(&[option], &why)?;
     }
-    // a pair of the scene's cheaper neighbour model solves that model (choice::solve)
+    // a Kirchhoff plate's thickness poses its richer neighbour, whose pairs it then takes
+    if let Some(t) = options.thickness {
+        if family.richer_parameters().contains(&"t") {
+            scene.set_richer_parameter("t", t);
+        }
+    }
+    // a pair of a neighbour model of the scene solves that model (choice::solve)
     let pair = match families::pair_of(&scene, options.pair.as_deref()) {
         Ok(pair) => pair,
         Err(e) => options
             .pair
             .as_deref()
-            .and_then(|name| fem_forms::models::choice::cheaper_pair(&scene, name))
+            .and_then(|name| fem_forms::models::choice::neighbour_pair(&scene, name))
             .ok_or_else(|| e.to_string())?,
     };
     if pair.nodal {

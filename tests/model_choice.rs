@@ -212,10 +212,10 @@ fn a_pair_of_the_cheaper_model_solves_that_model() {
         let direct = families::solve(&thin, &settings(Some(pair), Some(size), None)).unwrap();
         let (a, b) = (outcome.report.solve.energy, direct.report.solve.energy);
         assert_eq!(a, b, "{name}: the cheaper model's own solve");
-        assert!(choice::cheaper_pair(&rich, "no-such-pair").is_none());
+        assert!(choice::neighbour_pair(&rich, "no-such-pair").is_none());
     }
     // the scene's own pair is not the cheaper model's
-    assert!(choice::cheaper_pair(&scene("timoshenko-t1e-3"), "p2-p2-p0").is_none());
+    assert!(choice::neighbour_pair(&scene("timoshenko-t1e-3"), "p2-p2-p0").is_none());
 }
 
 #[test]
@@ -847,6 +847,138 @@ fn the_chosen_mindlin_plate_is_within_the_tolerance_of_the_exact_solution() {
             "t = {t}, T = {tolerance}: true error {error}"
         );
     }
+}
+
+/// The same plate posed from either side: a Reissner–Mindlin scene's Kirchhoff
+/// candidate and a Kirchhoff scene given the same thickness have the same modelling
+/// estimate, and the Kirchhoff scene's Mindlin candidate the Mindlin scene's estimates
+/// (one plate, one set of parameters and supports, whichever model the scene names).
+#[test]
+fn a_kirchhoff_scene_given_its_thickness_weighs_the_same_mindlin_plate() {
+    let t = 1e-2;
+    let soft = Adjustment::Support(Support::SimplySupported { hard: false });
+    let mut kirchhoff = scene("kirchhoff-square");
+    families::family("kirchhoff")
+        .unwrap()
+        .adjust(&mut kirchhoff, &soft)
+        .unwrap();
+    let mindlin = scene("mindlin-square-ss");
+    let tolerance = 5e-2;
+    let from_kirchhoff =
+        choice::candidates(&kirchhoff, &settings(None, None, Some(t)), tolerance).unwrap();
+    let from_mindlin =
+        choice::candidates(&mindlin, &settings(None, None, Some(t)), tolerance).unwrap();
+    let find = |candidates: &[choice::Candidate], pair: &str| {
+        candidates
+            .iter()
+            .find(|c| c.pair == pair)
+            .unwrap_or_else(|| panic!("no {pair} among {candidates:?}"))
+            .clone()
+    };
+    for pair in ["argyris-p0", "p1-p2-p0"] {
+        let (a, b) = (find(&from_kirchhoff, pair), find(&from_mindlin, pair));
+        assert!(a.probe.len() == 2 && b.probe.len() == 2, "{a:?}\n{b:?}");
+        println!(
+            "{pair}: modelling {:.6e} / {:.6e}, estimate {:.6e} / {:.6e}",
+            a.modelling_estimate,
+            b.modelling_estimate,
+            a.probe[1].estimate_relative,
+            b.probe[1].estimate_relative
+        );
+        assert_eq!(a.model, b.model);
+        assert!((a.modelling_estimate - b.modelling_estimate).abs() <= 1e-12);
+        for (p, q) in a.probe.iter().zip(&b.probe) {
+            assert_eq!(p.dofs, q.dofs);
+            assert!(
+                (p.estimate_relative - q.estimate_relative).abs() <= 1e-9 * q.estimate_relative
+            );
+        }
+    }
+    // the soft support's layer: the Kirchhoff plate is 10 % off at t = 1e-2, above
+    // half of T
+    let argyris = find(&from_kirchhoff, "argyris-p0");
+    assert!(argyris.modelling_estimate > 0.5 * tolerance, "{argyris:?}");
+    assert!(!argyris.adequate);
+    // Morley gives no modelling estimate: not adequate, and it says why
+    let morley = find(&from_kirchhoff, "morley-p0");
+    assert!(
+        !morley.adequate && morley.note.contains("no modelling estimate"),
+        "{morley:?}"
+    );
+    // a Kirchhoff scene without a thickness has no richer neighbour to weigh
+    let alone = choice::candidates(&kirchhoff, &settings(None, None, None), tolerance).unwrap();
+    assert!(alone.iter().all(|c| c.model == "Kirchhoff"), "{alone:?}");
+}
+
+#[test]
+fn the_chosen_plate_of_a_kirchhoff_scene_is_within_the_tolerance_of_the_mindlin_solution() {
+    // the Kirchhoff square on hard simple supports given its thickness: the plate it
+    // stands for is Lee–Reddy's; at t = 1e-1 the shear matters and the Reissner–Mindlin
+    // plate is taken, at t = 1e-3 the Kirchhoff one
+    let hard = Adjustment::Support(Support::SimplySupported { hard: true });
+    for (t, tolerance, model) in [(1e-1, 5e-2, "Reissner–Mindlin"), (1e-3, 5e-2, "Kirchhoff")] {
+        let mut square = scene("kirchhoff-square");
+        families::family(square.family)
+            .unwrap()
+            .adjust(&mut square, &hard)
+            .unwrap();
+        let request = Settings {
+            adaptive: Some(AdaptiveOptions {
+                tolerance,
+                ..AdaptiveOptions::default()
+            }),
+            ..settings(None, None, Some(t))
+        };
+        let outcome = choice::solve(&square, &request).unwrap();
+        let (error, centre) = lee_reddy_relative_error(&outcome, t);
+        println!(
+            "t = {t:e}, T = {tolerance:e}: {} with {} unknowns, true error {error:.3e}, w(½,½) = {centre:.6e}",
+            choice::chosen_words(&outcome.report),
+            outcome.report.solve.dofs
+        );
+        assert_eq!(outcome.report.quantities["chosen_model"], model);
+        assert!(centre > 0.004, "t = {t}: w(½,½) = {centre}");
+        assert!(
+            error <= tolerance,
+            "t = {t}, T = {tolerance}: true error {error}"
+        );
+    }
+    // `--thickness` reaches the Kirchhoff scene, and a Mindlin pair solves the richer
+    // model
+    let report = json_of(&[
+        "solve",
+        "kirchhoff-square",
+        "--thickness",
+        "0.1",
+        "--pair",
+        "p1-p2-p0",
+        "--mesh-size",
+        "8",
+        "--json",
+    ]);
+    assert_eq!(report["chosen_model"], "Reissner–Mindlin");
+    assert_eq!(report["thickness"], 0.1);
+    // a scene file's `thickness` too: the soft supports' layer puts Kirchhoff 42 % off
+    // at t = 0.1 (the shear alone 15 %), 3 % at t = 1e-3
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/kirchhoff-thick-plate.toml"
+    );
+    let thick = json_of(&["solve", "--scene", file, "--json"]);
+    assert!(thick["modelling_estimate_relative"].as_f64().unwrap() > 0.3);
+    assert!(thick["modelling_estimate_layer"].as_f64().unwrap() > 0.0);
+    let thin = json_of(&[
+        "solve",
+        "--scene",
+        file,
+        "--thickness",
+        "1e-3",
+        "--tol",
+        "0.1",
+        "--json",
+    ]);
+    assert_eq!(thin["chosen_model"], "Kirchhoff");
+    assert!(thin["modelling_estimate_relative"].as_f64().unwrap() < 0.05);
 }
 
 /// `fem-forms ARGS`'s failure message (standard error).

@@ -2,14 +2,17 @@
 //! without `--pair`, or a scene file's `tol`): one mechanism for every family.
 //!
 //! The candidates are the scene's own model with each of its pairs and, where its family
-//! declares one ([`crate::family::Family::cheaper`]), the cheaper neighbour model with
-//! each of its pairs. Each candidate is probed by two uniform solves (N and 2N), which
-//! give its a-posteriori estimate, its rate in the unknowns and its time per solve, and
-//! for a cheaper model the modelling estimate its own solution implies (the shear
-//! energy an Euler–Bernoulli or Kirchhoff solution leaves out, [`Report`]'s
-//! `modelling_estimate_relative`). A cheaper model is adequate where its modelling
-//! estimate is at most [`MODEL_SHARE`] of T; it is then solved to `T − modelling`, so
-//! that the triangle inequality keeps the total within T. Among the adequate candidates
+//! declares them, the cheaper neighbour model ([`crate::family::Family::cheaper`]:
+//! Euler–Bernoulli for a Timoshenko beam, Kirchhoff for a Reissner–Mindlin plate) and
+//! the richer one ([`crate::family::Family::richer`]: Reissner–Mindlin for a Kirchhoff
+//! plate given its thickness), each with its pairs. Each candidate is probed by two
+//! uniform solves (N and 2N), which give its a-posteriori estimate, its rate in the
+//! unknowns and its time per solve, and for the thinner model of a pair of neighbours
+//! the modelling estimate its own solution implies (the shear energy an Euler–Bernoulli
+//! or Kirchhoff solution leaves out, [`Report`]'s `modelling_estimate_relative`). The
+//! thinner model is adequate where its modelling estimate is at most [`MODEL_SHARE`] of
+//! T; it is then solved to `T − modelling`, so that the triangle inequality keeps the
+//! total within T. Among the adequate candidates
 //! the one with the least predicted time (predictions within a factor [`TIE`] count as
 //! equal: then the fewest unknowns, then the listing order) is solved adaptively from
 //! the probe's coarse mesh (where its finer probe already reaches its target, that probe
@@ -17,7 +20,7 @@
 //! every candidate with its estimates and its predicted cost, and the chosen one's
 //! actual cost. Where none is adequate, the scene's own model with its default pair is
 //! solved, as without a choice. A request's `--alpha` applies to the scene's own model's
-//! pairs, not to the cheaper model's, whose stability ranges are their own.
+//! pairs, not to a neighbour model's, whose stability ranges are their own.
 //!
 //! The prediction: with the relative estimates `e₀, e₁` at `d₀, d₁` unknowns, the rate
 //! `r = ln(e₀/e₁) / ln(d₁/d₀)`, the unknowns `d* = d₁ (e₁/target)^{1/r}` and the time
@@ -102,8 +105,8 @@ pub struct Candidate {
 
 /// Solves `scene` as `settings` ask: asked for a tolerance (`settings.adaptive`, or the
 /// scene's `tol`) without a pair, with the cheapest adequate candidate where the scene has
-/// more than one ([`choose`]); a pair of the scene's cheaper neighbour model
-/// (`--pair hermite-p0` on a Timoshenko scene) with that model ([`solve_cheaper`]);
+/// more than one ([`choose`]); a pair of the scene's neighbour model (`--pair hermite-p0`
+/// on a Timoshenko scene) with that model ([`solve_neighbour`]);
 /// otherwise with [`families::solve`], a tolerance's adaptive loop starting from the
 /// probes' coarse mesh where no mesh size is given (a loose tolerance wants no more than
 /// it).
@@ -111,9 +114,12 @@ pub struct Candidate {
 /// # Errors
 /// Those of [`choose`] and [`families::solve`].
 pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
+    if let Some((scene, settings)) = families::richer_parameters_moved(scene, settings) {
+        return solve(&scene, &settings);
+    }
     let tolerance = settings.adaptive.map(|a| a.tolerance).or(scene.tolerance);
     if let Some(pair) = settings.pair.as_deref() {
-        if let Some(outcome) = solve_cheaper(scene, settings, pair)? {
+        if let Some(outcome) = solve_neighbour(scene, settings, pair)? {
             return Ok(outcome);
         }
     } else if let Some(tolerance) = tolerance.filter(|_| has_choice(scene)) {
@@ -129,16 +135,16 @@ pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
     families::solve(scene, settings)
 }
 
-/// Solves `scene`'s cheaper neighbour model with `pair` where `pair` is one of that
-/// model's and not of the scene's own: the report says so (`chosen_model`,
-/// `chosen_pair`) and carries the cheaper model's modelling estimate. `None` where
-/// `pair` is the scene's own or the family has no cheaper model (the caller's solve
-/// then names the pairs it takes).
+/// Solves `scene`'s neighbour model with `pair` where `pair` is one of that model's and
+/// not of the scene's own: the report says so (`chosen_model`, `chosen_pair`), and a
+/// cheaper model's carries its modelling estimate. The request's α applies: it names
+/// the pair. `None` where `pair` is the scene's own or no neighbour takes it (the
+/// caller's solve then names the pairs it takes).
 ///
 /// # Errors
 /// Those of [`models`] and of the solve.
-fn solve_cheaper(scene: &Scene, settings: &Settings, pair: &str) -> Result<Option<Outcome>> {
-    if cheaper_pair(scene, pair).is_none() {
+fn solve_neighbour(scene: &Scene, settings: &Settings, pair: &str) -> Result<Option<Outcome>> {
+    if neighbour_pair(scene, pair).is_none() {
         return Ok(None);
     }
     let models = models(scene, settings)?;
@@ -153,7 +159,7 @@ fn solve_cheaper(scene: &Scene, settings: &Settings, pair: &str) -> Result<Optio
     thin.tolerance = scene.tolerance;
     let request = Settings {
         pair: Some(pair.to_string()),
-        ..candidate_settings(settings, &thin)
+        ..candidate_settings(settings, true)
     };
     let mut outcome = if request.adaptive.is_some() || thin.tolerance.is_some() {
         solve(&thin, &request)?
@@ -165,10 +171,11 @@ fn solve_cheaper(scene: &Scene, settings: &Settings, pair: &str) -> Result<Optio
     Ok(Some(outcome))
 }
 
-/// The pair called `name` of `scene`'s cheaper neighbour model, where it is not one of
-/// the scene's own (`hermite-p0` for a Timoshenko scene, `argyris-p0` for a
-/// Reissner–Mindlin one): a request for it solves the cheaper model.
-pub fn cheaper_pair(scene: &Scene, name: &str) -> Option<&'static crate::family::Pair> {
+/// The pair called `name` of `scene`'s neighbour models, where it is not one of the
+/// scene's own (`hermite-p0` for a Timoshenko scene, `argyris-p0` for a Reissner–Mindlin
+/// one, `p1-p2-p0` for a Kirchhoff one given its thickness): a request for it solves
+/// that model.
+pub fn neighbour_pair(scene: &Scene, name: &str) -> Option<&'static crate::family::Pair> {
     let family = families::family(scene.family)?;
     let own = families::pairs_of(scene).iter().any(|p| p.name == name)
         || family
@@ -178,9 +185,10 @@ pub fn cheaper_pair(scene: &Scene, name: &str) -> Option<&'static crate::family:
     if own {
         return None;
     }
-    let thin = family.cheaper(scene)?;
-    families::pairs_of(&thin)
+    [family.cheaper(scene), family.richer(scene)]
         .into_iter()
+        .flatten()
+        .flat_map(|neighbour| families::pairs_of(&neighbour))
         .find(|p| p.name == name)
 }
 
@@ -226,12 +234,14 @@ impl Candidate {
 }
 
 /// Whether a tolerance chooses among several candidates for `scene`: its family
-/// declares a cheaper model, or the scene takes more than one pair.
+/// declares a neighbour model for it, or the scene takes more than one pair.
 pub fn has_choice(scene: &Scene) -> bool {
     let Some(family) = families::family(scene.family) else {
         return false;
     };
-    families::pairs_of(scene).len() > 1 || family.cheaper(scene).is_some()
+    families::pairs_of(scene).len() > 1
+        || family.cheaper(scene).is_some()
+        || family.richer(scene).is_some()
 }
 
 /// The two mesh sizes the probes solve on: N and 2N on generated meshes (16, 32
@@ -264,6 +274,7 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
         mut candidates,
         scenes,
         mut finished,
+        own,
         sizes,
         first_failure,
     } = probe_all(scene, settings, tolerance)?;
@@ -272,7 +283,7 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
         // none predicted to reach the target: the scene's own model with its default
         // pair, whose adaptive loop then says how far it got (or that the solution
         // vanishes); where even its probe failed, that failure
-        match (0..candidates.len()).find(|&k| scenes[k].richer.is_none()) {
+        match (0..candidates.len()).find(|&k| own[k]) {
             Some(k) if !candidates[k].probe.is_empty() => order.push(k),
             _ => {
                 return Err(first_failure.unwrap_or_else(|| {
@@ -301,14 +312,16 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
                     pair: Some(candidates[best].pair.to_string()),
                     mesh_size: Some(sizes[0]),
                     adaptive: Some(AdaptiveOptions {
-                        tolerance: if candidates[best].adequate {
+                        // the scene's own model taken for want of an adequate one: its
+                        // modelling estimate is still its share of T where it is below T
+                        tolerance: if target > f64::MIN_POSITIVE {
                             target
                         } else {
                             tolerance
                         },
                         ..settings.adaptive.unwrap_or_default()
                     }),
-                    ..candidate_settings(settings, &scenes[best])
+                    ..candidate_settings(settings, own[best])
                 };
                 families::solve(&scenes[best], &final_settings)
                     .map(|outcome| (outcome, solve_clock.elapsed().as_secs_f64()))
@@ -373,16 +386,12 @@ fn ranking(candidates: &[Candidate]) -> Vec<usize> {
 
 /// The settings of a candidate's solves: the request's, without its parameters (the
 /// scenes are posed with them already: a cheaper model has not the richer one's `t`) and,
-/// for a cheaper model's scene, without its α (a stability range is a pair's own: the
-/// cheaper model's pairs take their own rule).
-fn candidate_settings(settings: &Settings, scene: &Scene) -> Settings {
+/// unless the candidate is of the scene's own model (`own`), without its α (a stability
+/// range is a pair's own: a neighbour model's pairs take their own rule).
+fn candidate_settings(settings: &Settings, own: bool) -> Settings {
     Settings {
         parameters: Vec::new(),
-        alpha: if scene.richer.is_some() {
-            None
-        } else {
-            settings.alpha
-        },
+        alpha: if own { settings.alpha } else { None },
         ..settings.clone()
     }
 }
@@ -403,18 +412,23 @@ struct Probed {
     scenes: Vec<Scene>,
     /// Per candidate, its finer probe's outcome where that already reaches its target.
     finished: Vec<Option<Outcome>>,
+    /// Per candidate, whether it is of the scene's own model.
+    own: Vec<bool>,
     sizes: [usize; 2],
     first_failure: Option<Error>,
 }
 
 /// The models a tolerance weighs for `scene` as `settings` pose it: `(model in words,
 /// scene)`, the scene's own first, then its family's cheaper neighbour (with the
-/// scene's exact solution, so that its errors are against what the scene poses); each
-/// model's candidates are its scene's pairs ([`families::pairs_of`]).
+/// scene's exact solution, so that its errors are against what the scene poses) and
+/// its richer one (without: the thinner model's closed forms are not the thicker
+/// one's); each model's candidates are its scene's pairs ([`families::pairs_of`]).
 ///
 /// # Errors
 /// A scene without a family; a load or parameter the scene refuses.
 pub fn models(scene: &Scene, settings: &Settings) -> Result<Vec<(&'static str, Scene)>> {
+    let moved = families::richer_parameters_moved(scene, settings);
+    let (scene, settings) = moved.as_ref().map_or((scene, settings), |(s, t)| (s, t));
     let family = families::family(scene.family)
         .ok_or_else(|| Error::Input(format!("scene `{}` has no family", scene.name)))?;
     let posed = crate::run::pose(scene, settings)?;
@@ -429,6 +443,11 @@ pub fn models(scene: &Scene, settings: &Settings) -> Result<Vec<(&'static str, S
         let words = families::family(thin.family).map_or("", |f| f.model_words(&thin));
         models.push((words, thin));
     }
+    if let Some(mut thick) = family.richer(&rich) {
+        thick.tolerance = None;
+        let words = families::family(thick.family).map_or("", |f| f.model_words(&thick));
+        models.push((words, thick));
+    }
     Ok(models)
 }
 
@@ -438,10 +457,12 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
     let mut candidates = Vec::new();
     let mut scenes = Vec::new();
     let mut finished = Vec::new();
+    let mut own = Vec::new();
     let mut first_failure = None;
-    for (words, model_scene) in &models {
+    for (k, (words, model_scene)) in models.iter().enumerate() {
         for pair in families::pairs_of(model_scene) {
-            match probe(model_scene, pair.name, settings, sizes) {
+            own.push(k == 0);
+            match probe(model_scene, pair.name, settings, sizes, k == 0) {
                 Ok((probe, modelling, finer)) => {
                     let candidate =
                         judge(words, model_scene, pair.name, probe, modelling, tolerance);
@@ -466,6 +487,7 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
         candidates,
         scenes,
         finished,
+        own,
         sizes,
         first_failure,
     })
@@ -487,13 +509,15 @@ fn exact_of(rich: &Scene, posed: &Posed) -> Exact {
     }))
 }
 
-/// The two probe solves of `pair` on `scene`, and the modelling estimate of the finer
-/// one where the scene is a cheaper model's.
+/// The two probe solves of `pair` on `scene` (of the scene's `own` model or not), and
+/// the modelling estimate of the finer one where the scene is the thinner of two
+/// neighbours ([`Scene::richer`]).
 fn probe(
     scene: &Scene,
     pair: &'static str,
     settings: &Settings,
     sizes: [usize; 2],
+    own: bool,
 ) -> Result<(Vec<ProbeLevel>, f64, Outcome)> {
     let mut levels = Vec::new();
     let mut modelling = 0.0;
@@ -507,7 +531,7 @@ fn probe(
             // the probes weigh the candidates; the rounding experiment (a beam's solve
             // repeated on a moved mesh) is the final solve's to run
             rounding_experiment: Some(false),
-            ..candidate_settings(settings, scene)
+            ..candidate_settings(settings, own)
         };
         let clock = Instant::now();
         let outcome = families::solve(scene, &probe_settings)?;
@@ -525,15 +549,11 @@ fn probe(
             })
         })?;
         if scene.richer.is_some() {
+            // NaN where the pair gives none (Morley): [`judge`] says so
             modelling = outcome
                 .report
                 .number("modelling_estimate_relative")
-                .ok_or_else(|| {
-                    Error::Input(format!(
-                        "the cheaper model of scene `{}` reports no modelling estimate",
-                        scene.name
-                    ))
-                })?;
+                .unwrap_or(f64::NAN);
         }
         levels.push(ProbeLevel {
             mesh_size: n,
@@ -563,6 +583,10 @@ fn judge(
         discretization_target: target,
         ..Candidate::new(model, scene, pair, probe)
     };
+    if modelling.is_nan() {
+        candidate.note = "its solution gives no modelling estimate (Morley's ∇Δw vanishes on every cell), so its distance to the richer model is unknown".into();
+        return candidate;
+    }
     if modelling > MODEL_SHARE * tolerance {
         candidate.note = format!(
             "the modelling estimate {modelling:.2e} exceeds {MODEL_SHARE} of the tolerance {tolerance:.0e}"
@@ -618,8 +642,14 @@ fn record(
     report.set("candidates", candidates);
     report.set("choice_seconds", probe_seconds);
     if !chosen.adequate {
+        let bound = error_bound(report).map_or(String::new(), |b| {
+            format!(
+                "; its error bound (estimate plus modelling estimate) is {b:.2e}, {} the tolerance",
+                if b <= tolerance { "within" } else { "above" }
+            )
+        });
         report.warn(format!(
-            "no candidate was predicted to reach the tolerance {tolerance:.0e}: solved with {} ({}), the scene's own model",
+            "no candidate was predicted to reach the tolerance {tolerance:.0e}: solved with {} ({}), the scene's own model{bound}",
             chosen.pair, chosen.model
         ));
     }

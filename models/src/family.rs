@@ -269,6 +269,24 @@ pub trait Family: Sync {
         None
     }
 
+    /// The richer neighbour of `scene`'s model, where the family declares one and the
+    /// scene states what it needs ([`Family::richer_parameters`]): the same scene posed
+    /// for the thicker model (Reissner–Mindlin for a Kirchhoff plate given a thickness),
+    /// possibly of another family. `scene`'s own solves then report their modelling
+    /// estimate against it, and [`crate::choice`] weighs the two for a tolerance.
+    fn richer(&self, scene: &Scene) -> Option<Scene> {
+        let _ = scene;
+        None
+    }
+
+    /// The richer model's parameters that a scene of this family may state beside its
+    /// own model's (the Kirchhoff plate's thickness `t` and shear correction `κ`): they
+    /// pose no term of its model; kept in [`Scene::richer`], they give the modelling
+    /// estimate and pose [`Family::richer`].
+    fn richer_parameters(&self) -> &'static [&'static str] {
+        &[]
+    }
+
     /// The `[exact]` key of the quantity a scene file's `accuracy` is measured on (`u`;
     /// contact's `pressure`).
     fn accuracy_key(&self) -> &'static str {

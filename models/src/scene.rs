@@ -440,8 +440,10 @@ pub struct Scene {
     /// `pressure`): errors about a datum name the user's key.
     pub file_keys: Vec<(Name, String)>,
     /// Where the scene is the cheaper neighbour of a richer model's scene
-    /// ([`crate::family::Family::cheaper`]): that model's parameters as posed (its
-    /// thickness `t`), from which the solve estimates the modelling error.
+    /// ([`crate::family::Family::cheaper`]), or states a richer model's parameters
+    /// ([`crate::family::Family::richer_parameters`]: a Kirchhoff plate's thickness):
+    /// that model's parameters (its thickness `t`), from which the solve estimates the
+    /// modelling error.
     pub richer: Option<Vec<(Name, f64)>>,
 }
 
@@ -531,6 +533,26 @@ impl Scene {
             Some(entry) => entry.1 = value,
             None => self.parameters.push((name, value)),
         }
+    }
+
+    /// Sets the richer model's parameter `name` ([`Scene::richer`], replacing an
+    /// earlier value).
+    pub fn set_richer_parameter(&mut self, name: impl Into<Name>, value: f64) {
+        let name = name.into();
+        let richer = self.richer.get_or_insert_with(Vec::new);
+        match richer.iter_mut().find(|(n, _)| *n == name) {
+            Some(entry) => entry.1 = value,
+            None => richer.push((name, value)),
+        }
+    }
+
+    /// The richer model's parameter `name` ([`Scene::richer`]), if the scene states it.
+    pub fn richer_parameter(&self, name: &str) -> Option<f64> {
+        self.richer
+            .as_ref()?
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
     }
 
     /// Sets data function `name` (replacing an earlier one).

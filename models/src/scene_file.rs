@@ -741,7 +741,11 @@ fn read_parameters(
                     format!("`{key}` and `{other}` both name the model's `{name}`: give it once"),
                 ));
             }
-            scene.set_parameter(name, v);
+            if family.richer_parameters().contains(&name.as_str()) {
+                scene.set_richer_parameter(name, v);
+            } else {
+                scene.set_parameter(name, v);
+            }
         }
     }
     Ok(alpha)

@@ -202,6 +202,7 @@ impl Family for KirchhoffPlates {
         &[
             Opt::MeshSize,
             Opt::Load,
+            Opt::Thickness,
             Opt::Alpha,
             Opt::Pair,
             Opt::Solver,
@@ -245,7 +246,39 @@ impl Family for KirchhoffPlates {
             ("load", "f"),
             ("obstacle", "ψ"),
             ("psi", "ψ"),
+            ("thickness", "t"),
+            ("shear_correction", "κ"),
+            ("kappa", "κ"),
         ]
+    }
+
+    /// A Kirchhoff plate given its thickness is the thin limit of a Reissner–Mindlin
+    /// plate: `t` (and `κ`, 5/6 where not given) say how far it is from it.
+    fn richer_parameters(&self) -> &'static [&'static str] {
+        &["t", "κ"]
+    }
+
+    /// The Reissner–Mindlin plate of the same domain, supports, load and obstacle, with
+    /// the scene's `D`, `ν` and its stated thickness (a simple support is the soft one,
+    /// `w = 0` alone, whose boundary layer the modelling estimate counts; write
+    /// `simply-supported-hard` for the other), on the locking-free pair (the plain pair
+    /// locks as t → 0). `None` where the scene states no thickness.
+    fn richer(&self, scene: &Scene) -> Option<Scene> {
+        let t = scene.richer_parameter("t")?;
+        let kappa = scene.richer_parameter("κ").unwrap_or(5.0 / 6.0);
+        let mut thick = scene.clone();
+        thick.name = format!("{}-mindlin", scene.name).into();
+        thick.family = "plate";
+        thick.richer = None;
+        thick.set_parameter("κ", kappa);
+        thick.set_parameter("t", t);
+        thick.pairs = vec!["p1-p2-p0"];
+        // the Kirchhoff closed forms are not the thicker plate's
+        thick.exact = crate::scene::Exact::Unknown;
+        thick.reference = None;
+        thick.studies = Vec::new();
+        thick.study_variants = Vec::new();
+        Some(thick)
     }
 
     /// `--obstacle none|flat|curved` places the named obstacle; supports as every family.
@@ -379,12 +412,27 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
         }
     }
 
-    fn check(_: &Scene, posed: &Posed) -> Result<()> {
+    fn check(scene: &Scene, posed: &Posed) -> Result<()> {
         if let Some(nu) = posed.parameter("ν") {
             if !(nu > -1.0 && nu < 0.5) {
                 return Err(Error::Input(format!(
                     "Poisson's ratio ν = {nu} must lie in (−1, ½)"
                 )));
+            }
+        }
+        if scene.richer_parameter("κ").is_some() && scene.richer_parameter("t").is_none() {
+            return Err(Error::Input(
+                "the shear correction κ is given without a thickness t: κ belongs to the Reissner–Mindlin plate of that thickness that the Kirchhoff plate stands for; give the thickness too".into(),
+            ));
+        }
+        for (name, words) in [("t", "thickness"), ("κ", "shear correction")] {
+            if let Some(v) = scene.richer_parameter(name) {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(Error::Input(format!(
+                        "{words} {name} = {} must be positive and finite",
+                        fem_runtime::problem::number(v)
+                    )));
+                }
             }
         }
         Ok(())

@@ -94,8 +94,32 @@ pub fn pairs_of(scene: &Scene) -> Vec<&'static Pair> {
 /// # Errors
 /// A pair the scene's family does not have or the scene does not take, and the solve's.
 pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
+    if let Some((scene, settings)) = richer_parameters_moved(scene, settings) {
+        return solve(&scene, &settings);
+    }
     let pair = pair_of(scene, settings.pair.as_deref())?;
     (pair.solve)(pair, scene, settings)
+}
+
+/// `scene` and `settings` with the request's parameters of the family's richer model
+/// ([`Family::richer_parameters`]: `--thickness` on a Kirchhoff scene) moved into the
+/// scene's [`Scene::richer`], where they pose the richer neighbour and the modelling
+/// estimate; `None` where the request gives none.
+pub fn richer_parameters_moved(scene: &Scene, settings: &Settings) -> Option<(Scene, Settings)> {
+    let names = family(scene.family)?.richer_parameters();
+    let moved = |name: &str| names.contains(&name);
+    if !settings.parameters.iter().any(|(name, _)| moved(name)) {
+        return None;
+    }
+    let mut scene = scene.clone();
+    let mut settings = settings.clone();
+    for (name, value) in &settings.parameters {
+        if moved(name) {
+            scene.set_richer_parameter(name.clone(), *value);
+        }
+    }
+    settings.parameters.retain(|(name, _)| !moved(name));
+    Some((scene, settings))
 }
 
 /// The pair called `name` (`None`: the scene's default) of the scene's family.
