@@ -164,9 +164,10 @@ fn bad_kirchhoff_input_is_refused_by_name() {
             &["solve", "kirchhoff-obstacle", "--alpha", "1e-12"],
             "or a larger α",
         ),
+        // a thickness poses the Reissner–Mindlin plate the Kirchhoff one stands for
         (
-            &["solve", "kirchhoff-obstacle", "--thickness", "0.1"],
-            "--thickness",
+            &["solve", "kirchhoff-obstacle", "--thickness", "0"],
+            "thickness t = 0 must be positive",
         ),
         (
             &["solve", "membrane-flat", "--support", "clamped"],
