@@ -124,12 +124,14 @@ impl Backend {
                 .iter()
                 .map(|r| {
                     serde_json::json!({
+                        "purpose": r.purpose.name(),
                         "formulation": r.formulation.name(),
                         "primal_unknowns": r.unknowns[0],
                         "multipliers": r.unknowns[1],
                         "converged_reason": r.converged.reason,
                         "snes_iterations": r.converged.iterations,
                         "linear_iterations": r.converged.linear_iterations,
+                        "linear_solver": r.converged.linear_solver,
                         "seconds": r.seconds,
                     })
                 })

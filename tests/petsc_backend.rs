@@ -80,7 +80,12 @@ fn the_report_of_two_ranks_equals_the_native_one() {
         for level in levels {
             let reason = level["converged_reason"].as_str().unwrap_or("");
             assert!(reason.starts_with("CONVERGED_"), "{scene} {pair}: {reason}");
+            assert_eq!(level["purpose"], "answer", "{scene} {pair}");
+            // the default: MUMPS's Cholesky or LU, whatever the report's native names
+            let linear = level["linear_solver"].as_str().unwrap_or("");
+            assert!(linear.ends_with("(mumps)"), "{scene} {pair}: {linear}");
         }
+        assert_eq!(ours["linear_solver"], "petsc", "{scene} {pair}");
         let formulation = levels[0]["formulation"].as_str().unwrap_or("");
         let expected = if pair == "p1-nodal" {
             "primal"
@@ -89,6 +94,47 @@ fn the_report_of_two_ranks_equals_the_native_one() {
         };
         assert_eq!(formulation, expected, "{scene} {pair}");
     }
+}
+
+#[test]
+fn the_levels_say_what_each_solve_served_and_its_linear_solver() {
+    // the beam runs the rounding experiment: two more nested solves on moved meshes
+    let report = json(&fem_forms(
+        Some(2),
+        &[
+            "solve",
+            "bernoulli-flat",
+            "--backend",
+            "petsc",
+            "--petsc-options",
+            "-ksp_type cg -pc_type jacobi",
+            "--json",
+        ],
+    ));
+    let levels = report["petsc"]["levels"].as_array().expect("levels");
+    let nested = report["levels"].as_array().map_or(0, Vec::len);
+    let count = |purpose: &str| levels.iter().filter(|l| l["purpose"] == purpose).count();
+    assert_eq!(count("answer"), nested, "{levels:?}");
+    assert_eq!(count("rounding experiment"), 2 * nested, "{levels:?}");
+    assert!(
+        levels.iter().all(|l| l["linear_solver"] == "cg + jacobi"),
+        "{levels:?}"
+    );
+    // the model choice's probes
+    let chosen = json(&fem_forms(
+        Some(2),
+        &[
+            "solve",
+            "timoshenko-t1e-3",
+            "--backend",
+            "petsc",
+            "--tol",
+            "5e-2",
+            "--json",
+        ],
+    ));
+    let levels = chosen["petsc"]["levels"].as_array().expect("levels");
+    assert!(levels.iter().any(|l| l["purpose"] == "probe"), "{levels:?}");
 }
 
 #[test]

@@ -33,7 +33,7 @@ use crate::{
     minimize, solve_with, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
     VectorView,
 };
-use fem_runtime::lcp::external::ExternalSolver;
+use fem_runtime::lcp::external::{ExternalSolver, Purpose};
 use fem_runtime::lcp::{recover_multiplier, ConstraintRows, Lcp, LcpSolution, NewtonOptions};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -86,6 +86,9 @@ pub struct LevelRecord {
     pub converged: Converged,
     /// Wall time of the solve on this rank, in seconds (assembly into PETSc included).
     pub seconds: f64,
+    /// What the solve served (the answer, a probe of the model choice, the rounding
+    /// experiment).
+    pub purpose: Purpose,
 }
 
 /// PETSc as the pipeline's complementarity solver (see the module's docs). Made once per
@@ -96,6 +99,7 @@ pub struct PetscLcpSolver {
     petsc: Mutex<Option<OnThread>>,
     preferred: Mutex<Option<Formulation>>,
     records: Mutex<Vec<LevelRecord>>,
+    purpose: Mutex<Purpose>,
 }
 
 /// PETSc and the thread that initialized it, the only one that may call it: MPI is
@@ -127,6 +131,7 @@ impl PetscLcpSolver {
                 thread: std::thread::current().id(),
             })),
             records: Mutex::new(Vec::new()),
+            purpose: Mutex::new(Purpose::Answer),
         })
     }
 
@@ -160,6 +165,10 @@ impl PetscLcpSolver {
 impl ExternalSolver for PetscLcpSolver {
     fn name(&self) -> &'static str {
         "petsc"
+    }
+
+    fn set_purpose(&self, purpose: Purpose) {
+        *self.purpose.lock().unwrap_or_else(|e| e.into_inner()) = purpose;
     }
 
     fn solve(&self, lcp: &Lcp, start: Option<&[f64]>) -> fem_runtime::Result<LcpSolution> {
@@ -211,6 +220,7 @@ impl ExternalSolver for PetscLcpSolver {
                 unknowns: [lcp.n(), lcp.m()],
                 converged: converged.clone(),
                 seconds,
+                purpose: *self.purpose.lock().unwrap_or_else(|e| e.into_inner()),
             });
         let kkt_residual = lcp.kkt_residual(&u, &lambda);
         if kkt_residual.is_nan() || kkt_residual > MAX_KKT_RESIDUAL {

@@ -697,6 +697,47 @@ pub struct Converged {
     pub iterations: usize,
     /// Linear solver iterations over all Newton steps.
     pub linear_iterations: usize,
+    /// The linear solver the options made: KSP and PC types, and the factorization's
+    /// package where the PC factors (`cg + gamg`, `preonly + lu (mumps)`).
+    pub linear_solver: String,
+}
+
+/// The linear solver of a solved SNES, as [`Converged::linear_solver`] names it.
+///
+/// # Safety
+/// `snes` is a live SNES.
+unsafe fn linear_solver_of(snes: sys::SNES) -> Result<String> {
+    let text = |name: *const std::os::raw::c_char| {
+        if name.is_null() {
+            "none".to_string()
+        } else {
+            // SAFETY: PETSc's type names are NUL-terminated strings it owns
+            unsafe { CStr::from_ptr(name) }
+                .to_string_lossy()
+                .into_owned()
+        }
+    };
+    // SAFETY: the caller's live SNES; the KSP and PC it owns
+    unsafe {
+        let mut ksp = std::ptr::null_mut();
+        check("SNESGetKSP", sys::SNESGetKSP(snes, &mut ksp))?;
+        let mut pc = std::ptr::null_mut();
+        check("KSPGetPC", sys::KSPGetPC(ksp, &mut pc))?;
+        let (mut ksp_type, mut pc_type, mut package) =
+            (std::ptr::null(), std::ptr::null(), std::ptr::null());
+        check("KSPGetType", sys::KSPGetType(ksp, &mut ksp_type))?;
+        check("PCGetType", sys::PCGetType(pc, &mut pc_type))?;
+        // null where the PC does not factor
+        check(
+            "PCFactorGetMatSolverType",
+            sys::PCFactorGetMatSolverType(pc, &mut package),
+        )?;
+        let mut name = format!("{} + {}", text(ksp_type), text(pc_type));
+        if !package.is_null() {
+            name.push_str(&format!(" ({})", text(package)));
+        }
+        Ok(name)
+    }
 }
 
 /// The name of a SNES converged reason.
@@ -1049,6 +1090,7 @@ fn run(
                 "SNESGetLinearSolveIterations",
                 sys::SNESGetLinearSolveIterations(snes, &mut linear),
             )?;
+            let linear_solver = linear_solver_of(snes)?;
             if reason <= 0 {
                 return Err(Error::refused(
                     "SNESSolve",
@@ -1062,6 +1104,7 @@ fn run(
                 reason: reason_name(reason).to_string(),
                 iterations: iterations as usize,
                 linear_iterations: linear as usize,
+                linear_solver,
             })
         })();
         sys::SNESDestroy(&mut snes);

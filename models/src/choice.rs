@@ -534,7 +534,11 @@ fn probe(
             ..candidate_settings(settings, own)
         };
         let clock = Instant::now();
-        let outcome = families::solve(scene, &probe_settings)?;
+        let outcome = fem_runtime::lcp::external::during(
+            settings.solver,
+            fem_runtime::lcp::external::Purpose::Probe,
+            || families::solve(scene, &probe_settings),
+        )?;
         let seconds = clock.elapsed().as_secs_f64();
         let s = &outcome.report.solve;
         let estimate_relative = s.estimate_relative.ok_or_else(|| {

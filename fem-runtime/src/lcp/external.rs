@@ -23,6 +23,51 @@ pub trait ExternalSolver: Send + Sync {
     /// A problem the solver does not take, and a solve that does not converge (named by
     /// the solver's reason), never an unconverged answer.
     fn solve(&self, lcp: &Lcp, start: Option<&[f64]>) -> Result<LcpSolution>;
+
+    /// Marks the solves that follow as serving `purpose`, for the solver's own records
+    /// (a report that lists its solves says which gave the answer); by default nothing.
+    fn set_purpose(&self, purpose: Purpose) {
+        let _ = purpose;
+    }
+}
+
+/// What an LCP solve serves, as an [`ExternalSolver`]'s records name it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Purpose {
+    /// The answer: the levels of a nested solve, and each level of an adaptive one.
+    #[default]
+    Answer,
+    /// A probe of the model choice (a candidate on a coarse mesh).
+    Probe,
+    /// The rounding experiment's solves on the mesh moved in its last bits.
+    RoundingExperiment,
+}
+
+impl Purpose {
+    /// Its name in reports (`answer`, `probe`, `rounding experiment`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Purpose::Answer => "answer",
+            Purpose::Probe => "probe",
+            Purpose::RoundingExperiment => "rounding experiment",
+        }
+    }
+}
+
+/// Runs `work` with the solves of `solver`, where it is an [`External`] one, marked as
+/// serving `purpose`, and marks them [`Purpose::Answer`] again after it.
+pub fn during<T>(
+    solver: crate::obstacle::VariationalSolver,
+    purpose: Purpose,
+    work: impl FnOnce() -> T,
+) -> T {
+    let crate::obstacle::VariationalSolver::External(external) = solver else {
+        return work();
+    };
+    external.0.set_purpose(purpose);
+    let result = work();
+    external.0.set_purpose(Purpose::Answer);
+    result
 }
 
 /// A handle on an [`ExternalSolver`] that lives for the whole process (a solver set up

@@ -873,9 +873,12 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         report: &mut Report,
     ) -> Result<()> {
         let clock = Instant::now();
-        let rounding = self
-            .rounding_experiment(meshes, solution, coefficients, parts, options)
-            .unwrap_or(f64::INFINITY);
+        let rounding = crate::lcp::external::during(
+            options.solver,
+            crate::lcp::external::Purpose::RoundingExperiment,
+            || self.rounding_experiment(meshes, solution, coefficients, parts, options),
+        )
+        .unwrap_or(f64::INFINITY);
         report.rounding_seconds = Some(clock.elapsed().as_secs_f64());
         report.rounding = Some(rounding);
         if rounding.is_nan() || rounding > MAX_ROUNDING {
@@ -975,7 +978,9 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                 _ => "nodal active set",
             },
             // every free node in contact (or the start already the solution): no system
-            linear_solver: if solution.krylov_iterations > 0 {
+            linear_solver: if let VariationalSolver::External(e) = options.solver {
+                e.0.name()
+            } else if solution.krylov_iterations > 0 {
                 "multigrid"
             } else if solution.factorizations > 0 {
                 "direct"
@@ -1342,7 +1347,11 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             alpha: Some(alpha),
             inverse_constant: c_i,
             solver: options.solver.name(),
-            linear_solver: solution.linear_solver_name(),
+            linear_solver: match options.solver {
+                // its options choose it; its records name it
+                VariationalSolver::External(e) => e.0.name(),
+                _ => solution.linear_solver_name(),
+            },
             iterations: solution.iterations,
             levels: solution.levels.iter().map(|&(c, i)| [c, i]).collect(),
             factorizations: solution.factorizations,
