@@ -118,7 +118,9 @@ struct SolveOptions {
     /// 1), the scale of a contact scene file's pressure.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_load)]
     load: Option<f64>,
-    /// Thickness t (Timoshenko beams and the Reissner–Mindlin plates).
+    /// Thickness t (Timoshenko beams and the Reissner–Mindlin plates; on a Kirchhoff
+    /// scene, that of the Reissner–Mindlin plate it stands for: its modelling estimate,
+    /// and that plate weighed by --tol or solved by --pair p1-p2-p0).
     #[arg(long, allow_hyphen_values = true)]
     thickness: Option<f64>,
     /// Stabilization parameter α (negative values are refused with a reason; not for
@@ -148,7 +150,8 @@ struct SolveOptions {
     /// wants 2 or 3).
     #[arg(long)]
     refinement: Option<usize>,
-    /// Plate support (Kirchhoff scenes): clamped or simply-supported.
+    /// Plate support (plate scenes): clamped, simply-supported (soft: w = 0),
+    /// simply-supported-hard (and the rotations' tangential part), free, dirichlet.
     #[arg(long)]
     support: Option<String>,
     /// Obstacle above the plate (Kirchhoff scenes): none, flat (w ≤ 0.002) or curved
@@ -796,6 +799,13 @@ fn parse_load(text: &str) -> Result<f64, String> {
 }
 
 fn main() -> ExitCode {
+    // a reader that stops early (`fem-forms solve … | head -1`) ends the process as it
+    // ends any Unix filter, instead of `println!` panicking on the closed pipe (Rust
+    // ignores SIGPIPE by default)
+    // SAFETY: at the start of main, before any thread exists; SIG_DFL is a valid handler
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     fem_forms::lcp::cholesky::factor_sequentially();
     // before any thread allocates
     fem_forms::allocator::keep_freed_memory();

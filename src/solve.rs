@@ -221,14 +221,30 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
             scene.set_richer_parameter("t", t);
         }
     }
-    // a pair of a neighbour model of the scene solves that model (choice::solve)
+    // a pair of a neighbour model of the scene solves that model (choice::solve), which
+    // takes its own family's options
     let pair = match families::pair_of(&scene, options.pair.as_deref()) {
         Ok(pair) => pair,
-        Err(e) => options
-            .pair
-            .as_deref()
-            .and_then(|name| fem_forms::models::choice::neighbour_pair(&scene, name))
-            .ok_or_else(|| e.to_string())?,
+        Err(e) => {
+            let name = options.pair.as_deref().unwrap_or_default();
+            let neighbour = fem_forms::models::choice::neighbour_of(&scene, name)
+                .ok_or_else(|| e.to_string())?;
+            if let Some(other) = families::family(neighbour.family) {
+                let foreign: Vec<Opt> = Opt::ALL
+                    .into_iter()
+                    .filter(|o| !other.options().contains(o) && *o != Opt::Thickness)
+                    .collect();
+                options.refuse_options(
+                    &foreign,
+                    &format!(
+                        "pair {name} solves the {} model ({} family)",
+                        other.model_words(&neighbour),
+                        other.name()
+                    ),
+                )?;
+            }
+            fem_forms::models::choice::neighbour_pair(&scene, name).ok_or_else(|| e.to_string())?
+        }
     };
     if pair.nodal {
         options.refuse_options(
@@ -460,8 +476,8 @@ fn choice_lines(r: &Report) -> Vec<String> {
     };
     let number = |key: &str| r.number(key).unwrap_or(f64::NAN);
     let mut lines = vec![format!(
-        "  chosen for T = {:.0e}: {model} {} (modelling estimate {:.2e} of ‖u_h‖_a), after {:.3} s of probes:",
-        number("tolerance"),
+        "  chosen for T = {}: {model} {} (modelling estimate {:.2e} of ‖u_h‖_a), after {:.3} s of probes:",
+        fem_forms::number(number("tolerance")),
         r.pair,
         number("modelling_estimate_relative"),
         number("choice_seconds"),
@@ -474,8 +490,9 @@ fn choice_lines(r: &Report) -> Vec<String> {
         let actual = value("actual_seconds").map_or(String::new(), |s| format!(", {s:.3} s taken"));
         let modelling = match value("modelling_estimate") {
             Some(m) if m > 0.0 => format!("modelling {m:.1e}"),
-            Some(_) => "the scene's model".to_string(),
-            None => "modelling ?".to_string(),
+            // the thicker model of the two, or a scene without a neighbour
+            Some(_) => "modelling 0".to_string(),
+            None => "no modelling estimate".to_string(),
         };
         lines.push(format!(
             "    {} {:<16} {:<18} {modelling}, {predicted}{actual}: {}",

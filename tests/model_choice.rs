@@ -1047,6 +1047,126 @@ fn failure_of(args: &[&str]) -> String {
 }
 
 #[test]
+fn a_kirchhoff_plates_thickness_is_refused_or_warned_where_it_cannot_serve() {
+    for (args, named) in [
+        // nothing holds the plate: singular, whichever model
+        (
+            &["solve", "kirchhoff-square", "--support", "free"][..],
+            "holds nothing",
+        ),
+        (
+            &["solve", "mindlin-square-ss", "--support", "free"][..],
+            "holds nothing",
+        ),
+        // the two models' own boundary data are not one support
+        (
+            &[
+                "solve",
+                "kirchhoff-square",
+                "--support",
+                "dirichlet",
+                "--thickness",
+                "0.01",
+            ][..],
+            "`dirichlet` support",
+        ),
+        (
+            &["solve", "kirchhoff-square", "--thickness", "10"][..],
+            "exceeds the plate's side",
+        ),
+        // a Mindlin pair needs the thickness, and takes the plate family's options
+        (
+            &["solve", "kirchhoff-square", "--pair", "p1-p2-p0"][..],
+            "once given its `thickness`",
+        ),
+        (
+            &[
+                "solve",
+                "kirchhoff-square",
+                "--thickness",
+                "0.1",
+                "--pair",
+                "p1-p2-p0",
+                "--solver",
+                "clarabel",
+            ][..],
+            "--solver does not apply",
+        ),
+    ] {
+        let stderr = failure_of(args);
+        assert!(stderr.contains(named), "{args:?}: {stderr}");
+    }
+    // the Mindlin plate posed with `dirichlet` has no Kirchhoff neighbour: one candidate
+    let report = json_of(&[
+        "solve",
+        "mindlin-square-ss",
+        "--support",
+        "dirichlet",
+        "--thickness",
+        "0.01",
+        "--tol",
+        "0.2",
+        "--json",
+    ]);
+    assert!(report.get("chosen_model").is_none(), "{report}");
+
+    let warnings = |report: &serde_json::Value| report["warnings"].to_string();
+    // Morley cannot use the thickness, and says so; the report names the thickness
+    let morley = json_of(&[
+        "solve",
+        "kirchhoff-square",
+        "--support",
+        "simply-supported",
+        "--thickness",
+        "0.1",
+        "--pair",
+        "morley-p0",
+        "--json",
+    ]);
+    assert!(warnings(&morley).contains("is not used"), "{morley}");
+    assert_eq!(morley["thickness"], 0.1);
+    // a fixed Kirchhoff pair meets T in its discretization only: the bound is warned
+    let fixed = json_of(&[
+        "solve",
+        "kirchhoff-square",
+        "--support",
+        "simply-supported",
+        "--thickness",
+        "0.1",
+        "--pair",
+        "argyris-p0",
+        "--tol",
+        "0.05",
+        "--json",
+    ]);
+    assert!(warnings(&fixed).contains("above the tolerance"), "{fixed}");
+    // α is the scene's own model's: taken to the Mindlin plate, the report says so
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/kirchhoff-thick-plate.toml"
+    );
+    let chosen = json_of(&[
+        "solve", "--scene", file, "--tol", "0.2", "--alpha", "1e-6", "--json",
+    ]);
+    assert_eq!(chosen["chosen_model"], "Reissner–Mindlin");
+    assert!(
+        warnings(&chosen).contains("--alpha 1e-6 applies"),
+        "{chosen}"
+    );
+    // a scene file's Mindlin pair with its thickness
+    let text = std::fs::read_to_string(file).unwrap().replace(
+        "model = \"kirchhoff\"",
+        "model = \"kirchhoff\"\npair = \"p1-p2-p0\"",
+    );
+    let path = std::env::temp_dir().join(format!("thick-pair-{}.toml", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    let paired = json_of(&["solve", "--scene", path.to_str().unwrap(), "--json"]);
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(paired["chosen_model"], "Reissner–Mindlin");
+    assert_eq!(paired["pair"], "p1-p2-p0");
+}
+
+#[test]
 fn the_requests_options_reach_each_model_as_it_takes_them() {
     // --thickness is the Timoshenko beam's: the Euler–Bernoulli candidate is posed
     // without it, not refused for it

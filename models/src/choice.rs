@@ -125,14 +125,34 @@ pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
     } else if let Some(tolerance) = tolerance.filter(|_| has_choice(scene)) {
         return choose(scene, settings, tolerance);
     }
-    if tolerance.is_some() && settings.mesh_size.is_none() {
+    let mut outcome = if tolerance.is_some() && settings.mesh_size.is_none() {
         let coarse = Settings {
             mesh_size: Some(probe_sizes(scene, None)[0]),
             ..settings.clone()
         };
-        return families::solve(scene, &coarse);
+        families::solve(scene, &coarse)?
+    } else {
+        families::solve(scene, settings)?
+    };
+    if let Some(tolerance) = tolerance {
+        warn_beyond(&mut outcome.report, tolerance);
     }
-    families::solve(scene, settings)
+    Ok(outcome)
+}
+
+/// Warns where a solve to `tolerance` carries a modelling estimate (a thinner model's,
+/// its pair fixed) that puts its error bound above the tolerance, which bounds the
+/// discretization error alone.
+fn warn_beyond(report: &mut Report, tolerance: f64) {
+    let Some(modelling) = report.number("modelling_estimate_relative") else {
+        return;
+    };
+    if let Some(bound) = error_bound(report).filter(|&b| b > tolerance) {
+        report.warn(format!(
+            "the error bound {bound:.2e} (estimate plus modelling estimate {modelling:.2e}) is above the tolerance {}: with the pair fixed the tolerance bounds the discretization error alone, and the model's own distance to the richer one is {modelling:.2e}; without --pair the choice weighs the richer model",
+            fem_runtime::problem::number(tolerance)
+        ));
+    }
 }
 
 /// Solves `scene`'s neighbour model with `pair` where `pair` is one of that model's and
@@ -176,6 +196,15 @@ fn solve_neighbour(scene: &Scene, settings: &Settings, pair: &str) -> Result<Opt
 /// one, `p1-p2-p0` for a Kirchhoff one given its thickness): a request for it solves
 /// that model.
 pub fn neighbour_pair(scene: &Scene, name: &str) -> Option<&'static crate::family::Pair> {
+    let neighbour = neighbour_of(scene, name)?;
+    families::pairs_of(&neighbour)
+        .into_iter()
+        .find(|p| p.name == name)
+}
+
+/// The neighbour model's scene whose pair `name` is, where it is not one of `scene`'s
+/// own ([`neighbour_pair`]): its family says which options it takes.
+pub fn neighbour_of(scene: &Scene, name: &str) -> Option<Scene> {
     let family = families::family(scene.family)?;
     let own = families::pairs_of(scene).iter().any(|p| p.name == name)
         || family
@@ -188,8 +217,7 @@ pub fn neighbour_pair(scene: &Scene, name: &str) -> Option<&'static crate::famil
     [family.cheaper(scene), family.richer(scene)]
         .into_iter()
         .flatten()
-        .flat_map(|neighbour| families::pairs_of(&neighbour))
-        .find(|p| p.name == name)
+        .find(|neighbour| families::pairs_of(neighbour).iter().any(|p| p.name == name))
 }
 
 /// The error bound of a solve relative to `‖u_h‖_a`: its relative estimate plus, for a
@@ -340,6 +368,8 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
                     best,
                     tolerance,
                     probe_seconds,
+                    settings.alpha,
+                    own[best],
                 );
                 return Ok(outcome);
             }
@@ -593,7 +623,9 @@ fn judge(
     }
     if modelling > MODEL_SHARE * tolerance {
         candidate.note = format!(
-            "the modelling estimate {modelling:.2e} exceeds {MODEL_SHARE} of the tolerance {tolerance:.0e}"
+            "the modelling estimate {modelling:.3e} exceeds {MODEL_SHARE} of the tolerance {} ({:.3e})",
+            fem_runtime::problem::number(tolerance),
+            MODEL_SHARE * tolerance
         );
         return candidate;
     }
@@ -628,7 +660,9 @@ fn judge(
     candidate
 }
 
-/// The choice in the chosen solve's report.
+/// The choice in the chosen solve's report; `own`: whether the chosen candidate is of
+/// the scene's own model, to which alone the request's `alpha` applies.
+#[allow(clippy::too_many_arguments)]
 fn record(
     report: &mut Report,
     scene: &Scene,
@@ -636,13 +670,19 @@ fn record(
     best: usize,
     tolerance: f64,
     probe_seconds: f64,
+    alpha: Option<f64>,
+    own: bool,
 ) {
     let chosen = &candidates[best];
     report.scene = scene.name.to_string();
     report.set("chosen_model", chosen.model);
     report.set("chosen_pair", chosen.pair);
     report.set("tolerance", tolerance);
-    report.set("modelling_estimate_relative", chosen.modelling_estimate);
+    // the final solve's own where it has one: a fallback solved on another mesh than
+    // the probe's
+    if report.number("modelling_estimate_relative").is_none() {
+        report.set("modelling_estimate_relative", chosen.modelling_estimate);
+    }
     report.set("candidates", candidates);
     report.set("choice_seconds", probe_seconds);
     if !chosen.adequate {
@@ -653,8 +693,18 @@ fn record(
             )
         });
         report.warn(format!(
-            "no candidate was predicted to reach the tolerance {tolerance:.0e}: solved with {} ({}), the scene's own model{bound}",
-            chosen.pair, chosen.model
+            "no candidate was predicted to reach the tolerance {}: solved with {} ({}), the scene's own model{bound}",
+            fem_runtime::problem::number(tolerance),
+            chosen.pair,
+            chosen.model
+        ));
+    }
+    if let (Some(alpha), false) = (alpha, own) {
+        report.warn(format!(
+            "--alpha {} applies to the scene's own model's pairs: {} ({}) was solved with its own rule for α (the report's alpha)",
+            fem_runtime::problem::number(alpha),
+            chosen.pair,
+            chosen.model
         ));
     }
 }

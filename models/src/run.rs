@@ -401,6 +401,7 @@ fn pose_checked<G: Geometry, Q: Quantities<G>>(
     settings: &Settings,
 ) -> Result<Posed> {
     let posed = pose(scene, settings)?;
+    check_held(scene)?;
     Q::check(scene, &posed)?;
     for (name, value) in &posed.parameters {
         if !value.is_finite() {
@@ -411,6 +412,26 @@ fn pose_checked<G: Geometry, Q: Quantities<G>>(
         }
     }
     Ok(posed)
+}
+
+/// Refuses a scene that nothing holds: every edge free and no obstacle, where its
+/// family's model has rigid motions ([`crate::family::Family::rigid_motions`]); the
+/// stiffness matrix is then singular, and a factorization of its rounding returns
+/// anything (a free Kirchhoff square: a deflection of 5.6e8).
+///
+/// # Errors
+/// [`Error::Input`] naming the motions.
+fn check_held(scene: &Scene) -> Result<()> {
+    // no support named: a plate's boundary is free
+    let all_free = scene.supports.iter().all(|s| s.support == Support::Free);
+    let motions = crate::families::family(scene.family).and_then(|f| f.rigid_motions());
+    match motions {
+        Some(motions) if all_free && !scene.obstacle => Err(Error::Input(format!(
+            "scene `{}` holds nothing: every edge is free and there is no obstacle, so {motions} cost no energy and the solution is not unique; support an edge (--support) or give an obstacle",
+            scene.name
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// `problem` with the scene as bound to the model: its parameters and data, the
@@ -572,7 +593,12 @@ fn bind<M: Model>(scene: &Scene, pair: &Pair, posed: &Posed) -> Result<Bound> {
         let p = M::PARAMS
             .iter()
             .position(|p| *p == &**name)
-            .ok_or_else(|| unknown("parameter", name, M::PARAMS.to_vec()))?;
+            .ok_or_else(|| {
+                // and those of the richer model the scene may state (a Kirchhoff plate's t)
+                let richer = crate::families::family(scene.family)
+                    .map_or(&[][..], |f| f.richer_parameters());
+                unknown("parameter", name, [M::PARAMS, richer].concat())
+            })?;
         params.push((p, *value));
     }
     for &(name, value) in pair.parameters {

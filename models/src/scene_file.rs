@@ -645,8 +645,12 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
         scene.tolerance = Some(tol);
     }
     if let Some(pair) = &file.pair {
+        // a neighbour model's pair (a Kirchhoff file's thickness takes p1-p2-p0) solves
+        // that model
         if let Err(e) = crate::families::pair_of(&scene, Some(pair)) {
-            return Err(at(("pair".into(), e.to_string())));
+            if crate::choice::neighbour_pair(&scene, pair).is_none() {
+                return Err(at(("pair".into(), e.to_string())));
+            }
         }
     }
     family.check_file(&scene).map_err(at)?;

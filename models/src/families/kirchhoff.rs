@@ -238,6 +238,10 @@ impl Family for KirchhoffPlates {
         "Kirchhoff"
     }
 
+    fn rigid_motions(&self) -> Option<&'static str> {
+        Some("the rigid motions w = a + bx + cy")
+    }
+
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[
             ("bending_stiffness", "D"),
@@ -265,6 +269,10 @@ impl Family for KirchhoffPlates {
     /// locks as t → 0). `None` where the scene states no thickness.
     fn richer(&self, scene: &Scene) -> Option<Scene> {
         let t = scene.richer_parameter("t")?;
+        // the models' own boundary data are not the same support
+        if scene.supports.iter().any(|s| s.support == Support::Data) {
+            return None;
+        }
         let kappa = scene.richer_parameter("κ").unwrap_or(5.0 / 6.0);
         let mut thick = scene.clone();
         thick.name = format!("{}-mindlin", scene.name).into();
@@ -420,6 +428,13 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 )));
             }
         }
+        if scene.richer_parameter("t").is_some()
+            && scene.supports.iter().any(|s| s.support == Support::Data)
+        {
+            return Err(Error::Input(
+                "a thickness poses the Reissner–Mindlin plate this Kirchhoff plate stands for, but a `dirichlet` support (the model's own w = g) names no support of that plate (its `dirichlet` holds the rotations too): name the supports (clamped, simply-supported, simply-supported-hard, free)".into(),
+            ));
+        }
         if scene.richer_parameter("κ").is_some() && scene.richer_parameter("t").is_none() {
             return Err(Error::Input(
                 "the shear correction κ is given without a thickness t: κ belongs to the Reissner–Mindlin plate of that thickness that the Kirchhoff plate stands for; give the thickness too".into(),
@@ -434,6 +449,9 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                     )));
                 }
             }
+        }
+        if let Some(t) = scene.richer_parameter("t") {
+            super::plate::thin_enough(scene, t)?;
         }
         Ok(())
     }
@@ -451,7 +469,32 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 .collect::<Vec<_>>()
                 .join(", "),
         );
-        report.set("obstacle", facts.map_or("ψ", |f| f.obstacle));
+        report.set(
+            "obstacle",
+            match (run.scene.obstacle, facts) {
+                (false, _) => "none",
+                (true, Some(f)) => f.obstacle,
+                (true, None) => "ψ",
+            },
+        );
+        if let Some(t) = run.scene.richer_parameter("t") {
+            // the Reissner–Mindlin plate it stands for
+            report.set("thickness", t);
+            report.set(
+                "shear_correction",
+                run.scene.richer_parameter("κ").unwrap_or(5.0 / 6.0),
+            );
+            if matches!(run.scene.domain, Domain::Disk { .. }) {
+                report.warn("on a disk the Argyris plate is its inscribed polygon, whose corners make ∇Δw singular: the modelling estimate grows with refinement (clamped, t = 0.01: 5.4 %, 8.0 %, 11.5 % at N = 4, 8, 16) and bounds nothing here");
+            }
+            if modelling_estimate(run).is_none() {
+                report.warn(format!(
+                    "the thickness t = {} is not used: {} gives no modelling estimate (its ∇Δw vanishes on every cell), so how far this Kirchhoff plate is from the Reissner–Mindlin one is not known; argyris-p0 gives it",
+                    fem_runtime::problem::number(t),
+                    run.pair.name
+                ));
+            }
+        }
         if run.scene.richer.is_some() {
             if let Some([interior, layer]) = modelling_estimate(run) {
                 let estimate = interior.hypot(layer);

@@ -158,6 +158,17 @@ pub fn pair_of(scene: &Scene, name: Option<&str>) -> Result<&'static Pair> {
             scene.name,
             names.join(", ")
         )
+    } else if let Some(given) = richer_pair_given(scene, family, name) {
+        format!(
+            "pair `{name}` solves the richer model of scene `{}`, which the scene poses once given its `{}` (`{given}`); without it the scene takes {}",
+            scene.name,
+            family
+                .aliases()
+                .iter()
+                .find(|(_, model_name)| *model_name == given)
+                .map_or(given, |(alias, _)| *alias),
+            names.join(", ")
+        )
     } else {
         format!(
             "unknown pair `{name}`; scene `{}` takes {}",
@@ -165,6 +176,20 @@ pub fn pair_of(scene: &Scene, name: Option<&str>) -> Result<&'static Pair> {
             names.join(", ")
         )
     }))
+}
+
+/// The richer model's parameter whose value would let `scene` take `pair` (its richer
+/// neighbour's), where one would.
+fn richer_pair_given(scene: &Scene, family: &dyn Family, pair: &str) -> Option<&'static str> {
+    let &given = family.richer_parameters().first()?;
+    let mut stated = scene.clone();
+    // any admissible value: the neighbour's pairs do not depend on it
+    stated.set_richer_parameter(given, 1e-2);
+    let richer = family.richer(&stated)?;
+    pairs_of(&richer)
+        .iter()
+        .any(|p| p.name == pair)
+        .then_some(given)
 }
 
 #[cfg(test)]

@@ -218,6 +218,10 @@ impl Family for Plates {
     /// (whose ∇Δw gives the modelling estimate; Morley's vanishes on every cell).
     fn cheaper(&self, scene: &Scene) -> Option<Scene> {
         scene.parameter("t")?;
+        // its `dirichlet` holds w and θ, the Kirchhoff one w alone: not the same plate
+        if scene.supports.iter().any(|s| s.support == Support::Data) {
+            return None;
+        }
         let pairs = vec!["argyris-p0", "argyris-p1disc"];
         let mut thin =
             scene.posed_for_cheaper("kirchhoff", "kirchhoff", pairs, |p| ["D", "ν"].contains(&p));
@@ -229,6 +233,10 @@ impl Family for Plates {
         thin.studies = Vec::new();
         thin.study_variants = Vec::new();
         Some(thin)
+    }
+
+    fn rigid_motions(&self) -> Option<&'static str> {
+        Some("the rigid motions w = a + bx + cy")
     }
 
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
@@ -275,6 +283,27 @@ fn mindlin_deflection(facts: &PlateFacts, q: f64, posed: &Posed) -> Option<f64> 
     let shear = 6.0 * kappa * (1.0 - nu) * d / (t * t);
     let r = facts.length;
     Some(kirchhoff_deflection(facts, q, d) + q * r * r / (4.0 * shear))
+}
+
+/// Refuses a thickness `t` above the plate's size (the square's side, the disk's
+/// diameter): plate theory, Kirchhoff's or Reissner–Mindlin's, describes thin bodies.
+///
+/// # Errors
+/// [`Error::Input`] naming t and the size.
+pub(crate) fn thin_enough(scene: &Scene, t: f64) -> Result<()> {
+    if let Some(size) = scene.domain.size() {
+        let name = match scene.domain {
+            Domain::Disk { .. } => "diameter",
+            _ => "side",
+        };
+        if t > size {
+            return Err(Error::Input(format!(
+                "thickness t = {} exceeds the plate's {name} {size}: plate theory describes thin bodies (t well below the {name}); a thicker body is a problem of elasticity",
+                fem_runtime::problem::number(t)
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Rays of the contact radius.
@@ -416,18 +445,7 @@ impl<G: Geometry> Quantities<G> for Plates {
                     "thickness t = {t:e} is below {MIN_THICKNESS:e}: the Mindlin plate is then Kirchhoff's to t² (rounding), and the plain pair's shear weight 6κ(1−ν)D/t² overflows; use t ≥ {MIN_THICKNESS:e}"
                 ));
             }
-            if let Some(size) = scene.domain.size() {
-                let name = match scene.domain {
-                    Domain::Disk { .. } => "diameter",
-                    _ => "side",
-                };
-                if t > size {
-                    return bad(format!(
-                        "thickness t = {} exceeds the plate's {name} {size}: plate theory describes thin bodies (t well below the {name}); a thicker body is a problem of elasticity",
-                        fem_runtime::problem::number(t)
-                    ));
-                }
-            }
+            thin_enough(scene, t)?;
         }
         if let Some(nu) = posed.parameter("ν") {
             if !(nu > -1.0 && nu < 0.5) {
