@@ -32,6 +32,7 @@ use crate::families;
 use crate::report::{Outcome, Report, Settings};
 use crate::scene::{Domain, Exact, Posed, Scene};
 use fem_runtime::adaptivity::AdaptiveOptions;
+use fem_runtime::lcp::external::Purpose;
 use fem_runtime::{Error, Result};
 use serde::Serialize;
 use std::sync::Arc;
@@ -564,11 +565,9 @@ fn probe(
             ..candidate_settings(settings, own)
         };
         let clock = Instant::now();
-        let outcome = fem_runtime::lcp::external::during(
-            settings.solver,
-            fem_runtime::lcp::external::Purpose::Probe,
-            || families::solve(scene, &probe_settings),
-        )?;
+        let outcome = settings
+            .solver
+            .during(Purpose::Probe, || families::solve(scene, &probe_settings))?;
         let seconds = clock.elapsed().as_secs_f64();
         let s = &outcome.report.solve;
         let estimate_relative = s.estimate_relative.ok_or_else(|| {

@@ -54,22 +54,6 @@ impl Purpose {
     }
 }
 
-/// Runs `work` with the solves of `solver`, where it is an [`External`] one, marked as
-/// serving `purpose`, and marks them [`Purpose::Answer`] again after it.
-pub fn during<T>(
-    solver: crate::obstacle::VariationalSolver,
-    purpose: Purpose,
-    work: impl FnOnce() -> T,
-) -> T {
-    let crate::obstacle::VariationalSolver::External(external) = solver else {
-        return work();
-    };
-    external.0.set_purpose(purpose);
-    let result = work();
-    external.0.set_purpose(Purpose::Answer);
-    result
-}
-
 /// A handle on an [`ExternalSolver`] that lives for the whole process (a solver set up
 /// once by the command line, e.g. PETSc after `MPI_Init`); compared by identity.
 #[derive(Clone, Copy)]

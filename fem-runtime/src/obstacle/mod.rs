@@ -17,6 +17,7 @@ use crate::assembly::{assemble_vector, block_plans, for_each_entry, BlockPlan};
 use crate::element::interval::PhysicalBasis;
 use crate::element::mapping::Affine;
 use crate::error::{Error, Result};
+use crate::lcp::external::Purpose;
 use crate::lcp::{
     primal_dual_active_set, quadratic_program, recover_multiplier, semismooth_newton,
     semismooth_newton_prepared, semismooth_newton_with, ConstraintRows, CouplingBlocks, Lcp,
@@ -59,6 +60,21 @@ impl VariationalSolver {
             Self::Clarabel => "clarabel",
             Self::External(e) => e.0.name(),
         }
+    }
+
+    /// Runs `work` with this solver's solves, where it is an external one, marked as
+    /// serving `purpose` ([`ExternalSolver::set_purpose`]), and marks them
+    /// [`Purpose::Answer`] again after it.
+    ///
+    /// [`ExternalSolver::set_purpose`]: crate::lcp::external::ExternalSolver::set_purpose
+    pub fn during<T>(self, purpose: Purpose, work: impl FnOnce() -> T) -> T {
+        let Self::External(external) = self else {
+            return work();
+        };
+        external.0.set_purpose(purpose);
+        let result = work();
+        external.0.set_purpose(Purpose::Answer);
+        result
     }
 }
 

@@ -59,6 +59,7 @@ pub use report::{MeshQualityReport, Report};
 
 use crate::assembly::boundary::{Constraints, DirichletPart};
 use crate::error::{Error, Result};
+use crate::lcp::external::Purpose;
 use crate::lcp::Lcp;
 use crate::mesh::Mesh;
 use crate::model::{
@@ -873,12 +874,12 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         report: &mut Report,
     ) -> Result<()> {
         let clock = Instant::now();
-        let rounding = crate::lcp::external::during(
-            options.solver,
-            crate::lcp::external::Purpose::RoundingExperiment,
-            || self.rounding_experiment(meshes, solution, coefficients, parts, options),
-        )
-        .unwrap_or(f64::INFINITY);
+        let rounding = options
+            .solver
+            .during(Purpose::RoundingExperiment, || {
+                self.rounding_experiment(meshes, solution, coefficients, parts, options)
+            })
+            .unwrap_or(f64::INFINITY);
         report.rounding_seconds = Some(clock.elapsed().as_secs_f64());
         report.rounding = Some(rounding);
         if rounding.is_nan() || rounding > MAX_ROUNDING {
