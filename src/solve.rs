@@ -232,7 +232,11 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
             if let Some(other) = families::family(neighbour.family) {
                 let foreign: Vec<Opt> = Opt::ALL
                     .into_iter()
-                    .filter(|o| !other.options().contains(o) && *o != Opt::Thickness)
+                    // the scene's own family applies these before posing the neighbour
+                    .filter(|o| {
+                        !other.options().contains(o)
+                            && ![Opt::Thickness, Opt::Obstacle, Opt::Support].contains(o)
+                    })
                     .collect();
                 options.refuse_options(
                     &foreign,

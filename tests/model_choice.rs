@@ -1167,6 +1167,77 @@ fn a_kirchhoff_plates_thickness_is_refused_or_warned_where_it_cannot_serve() {
 }
 
 #[test]
+fn a_neighbour_takes_its_own_familys_options_and_the_scenes_own() {
+    // the Reissner–Mindlin plate takes no --solver: chosen by a tolerance, it is solved
+    // by its default and the report says so
+    let chosen = json_of(&[
+        "solve",
+        "kirchhoff-obstacle",
+        "--thickness",
+        "0.3",
+        "--tol",
+        "0.5",
+        "--solver",
+        "clarabel",
+        "--json",
+    ]);
+    assert_eq!(chosen["chosen_model"], "Reissner–Mindlin");
+    assert_eq!(chosen["solver"], "pdas");
+    assert!(
+        chosen["warnings"]
+            .to_string()
+            .contains("--solver clarabel applies"),
+        "{chosen}"
+    );
+    // an α outside the Kirchhoff pairs' range is refused, not a reason to take the
+    // Reissner–Mindlin plate
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/kirchhoff-thick-plate.toml"
+    );
+    let refused = failure_of(&["solve", "--scene", file, "--tol", "0.05", "--alpha", "0.01"]);
+    assert!(refused.contains("stability range"), "{refused}");
+    // the scene's own family applies --obstacle before the neighbour is posed
+    let bare = json_of(&[
+        "solve",
+        "--scene",
+        file,
+        "--obstacle",
+        "none",
+        "--pair",
+        "p1-p2-p0",
+        "--mesh-size",
+        "8",
+        "--json",
+    ]);
+    assert_eq!(bare["chosen_model"], "Reissner–Mindlin");
+    assert_eq!(bare["obstacle"], "none");
+    // a file's Mindlin pair posed by a thickness given on the command line
+    let text = std::fs::read_to_string(file)
+        .unwrap()
+        .replace("thickness = 0.1\n", "")
+        .replace(
+            "model = \"kirchhoff\"",
+            "model = \"kirchhoff\"\npair = \"p1-p2-p0\"",
+        );
+    let path = std::env::temp_dir().join(format!("thin-pair-{}.toml", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    let given = json_of(&[
+        "solve",
+        "--scene",
+        path.to_str().unwrap(),
+        "--thickness",
+        "0.02",
+        "--json",
+    ]);
+    let missing = failure_of(&["solve", "--scene", path.to_str().unwrap()]);
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(given["chosen_model"], "Reissner–Mindlin");
+    assert_eq!(given["thickness"], 0.02);
+    assert!(missing.contains("once given its `thickness`"), "{missing}");
+}
+
+#[test]
 fn the_requests_options_reach_each_model_as_it_takes_them() {
     // --thickness is the Timoshenko beam's: the Euler–Bernoulli candidate is posed
     // without it, not refused for it

@@ -540,3 +540,34 @@ fn a_thick_plates_error_against_kirchhoff_is_explained() {
     let thin = solve_json(&["--mesh-size", "8"]);
     assert!(!warned(&thin), "{thin}");
 }
+
+/// A support changed on the command line changes the reference: the square's series of
+/// the new support, and none where no closed form exists (a disk not clamped).
+#[test]
+fn the_reference_follows_the_support_asked_for() {
+    let clamped = scene_json(
+        "mindlin-square-ss",
+        &["--support", "clamped", "--thickness", "1e-3"],
+    );
+    // q = D = a = 1: the clamped square's Kirchhoff coefficient itself
+    assert_eq!(clamped["reference_centre_deflection"], 0.00126532);
+    let relative = clamped["relative_error"].as_f64().unwrap();
+    assert!(relative.abs() < 2e-2, "{relative}");
+    let simple = scene_json(
+        "mindlin-square",
+        &["--support", "simply-supported-hard", "--thickness", "1e-3"],
+    );
+    assert_eq!(simple["reference_centre_deflection"], 0.00406235);
+    let disk = scene_json(
+        "mindlin-disk",
+        &[
+            "--support",
+            "simply-supported",
+            "--no-obstacle",
+            "--mesh-size",
+            "4",
+        ],
+    );
+    assert!(disk.get("reference_centre_deflection").is_none(), "{disk}");
+    assert!(disk.get("kirchhoff_reference").is_none(), "{disk}");
+}

@@ -33,6 +33,7 @@ use crate::report::{Outcome, Report, Settings};
 use crate::scene::{Domain, Exact, Posed, Scene};
 use fem_runtime::adaptivity::AdaptiveOptions;
 use fem_runtime::lcp::external::Purpose;
+use fem_runtime::obstacle::VariationalSolver;
 use fem_runtime::{Error, Result};
 use serde::Serialize;
 use std::sync::Arc;
@@ -180,7 +181,7 @@ fn solve_neighbour(scene: &Scene, settings: &Settings, pair: &str) -> Result<Opt
     thin.tolerance = scene.tolerance;
     let request = Settings {
         pair: Some(pair.to_string()),
-        ..candidate_settings(settings, true)
+        ..candidate_settings(settings, &thin, true)
     };
     let mut outcome = if request.adaptive.is_some() || thin.tolerance.is_some() {
         solve(&thin, &request)?
@@ -307,6 +308,16 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
         sizes,
         first_failure,
     } = probe_all(scene, settings, tolerance)?;
+    // the request's α is the scene's own pairs': where it fails one of their probes
+    // (outside its stability range), that is the answer, as it is without a tolerance,
+    // not a reason to weigh the others without it
+    if settings.alpha.is_some()
+        && (0..candidates.len()).any(|k| own[k] && candidates[k].probe.is_empty())
+    {
+        if let Some(e) = first_failure {
+            return Err(e);
+        }
+    }
     let mut order = ranking(&candidates);
     if order.is_empty() {
         // none predicted to reach the target: the scene's own model with its default
@@ -350,7 +361,7 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
                         },
                         ..settings.adaptive.unwrap_or_default()
                     }),
-                    ..candidate_settings(settings, own[best])
+                    ..candidate_settings(settings, &scenes[best], own[best])
                 };
                 families::solve(&scenes[best], &final_settings)
                     .map(|outcome| (outcome, solve_clock.elapsed().as_secs_f64()))
@@ -362,6 +373,7 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
                 chosen.chosen = true;
                 chosen.actual_seconds = Some(seconds);
                 chosen.actual_dofs = Some(outcome.report.solve.dofs);
+                let dropped = dropped_options(settings, &scenes[best], own[best]);
                 record(
                     &mut outcome.report,
                     scene,
@@ -369,8 +381,7 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
                     best,
                     tolerance,
                     probe_seconds,
-                    settings.alpha,
-                    own[best],
+                    &dropped,
                 );
                 return Ok(outcome);
             }
@@ -418,13 +429,41 @@ fn ranking(candidates: &[Candidate]) -> Vec<usize> {
 /// The settings of a candidate's solves: the request's, without its parameters (the
 /// scenes are posed with them already: a cheaper model has not the richer one's `t`) and,
 /// unless the candidate is of the scene's own model (`own`), without its α (a stability
-/// range is a pair's own: a neighbour model's pairs take their own rule).
-fn candidate_settings(settings: &Settings, own: bool) -> Settings {
+/// range is a pair's own: a neighbour model's pairs take their own rule) and, where the
+/// candidate's family takes no `--solver` (the Reissner–Mindlin plate), with the default
+/// solver (an external one, PETSc, solves every candidate).
+fn candidate_settings(settings: &Settings, scene: &Scene, own: bool) -> Settings {
+    let solver = if takes_solver(settings, scene, own) {
+        settings.solver
+    } else {
+        Settings::default().solver
+    };
     Settings {
         parameters: Vec::new(),
         alpha: if own { settings.alpha } else { None },
+        solver,
         ..settings.clone()
     }
+}
+
+/// Whether the request's solver applies to a candidate posed on `scene`.
+fn takes_solver(settings: &Settings, scene: &Scene, own: bool) -> bool {
+    own || matches!(settings.solver, VariationalSolver::External(_))
+        || families::family(scene.family)
+            .is_some_and(|f| f.options().contains(&crate::family::Opt::Solver))
+}
+
+/// The request's options that a candidate posed on `scene` does not take, in words
+/// (`--alpha 1e-6`): the chosen solve's report says so.
+fn dropped_options(settings: &Settings, scene: &Scene, own: bool) -> Vec<String> {
+    let mut dropped = Vec::new();
+    if let (Some(alpha), false) = (settings.alpha, own) {
+        dropped.push(format!("--alpha {}", fem_runtime::problem::number(alpha)));
+    }
+    if settings.solver != Settings::default().solver && !takes_solver(settings, scene, own) {
+        dropped.push(format!("--solver {}", settings.solver.name()));
+    }
+    dropped
 }
 
 /// The candidates of `scene` for `tolerance`, probed and judged, without the final
@@ -562,7 +601,7 @@ fn probe(
             // the probes weigh the candidates; the rounding experiment (a beam's solve
             // repeated on a moved mesh) is the final solve's to run
             rounding_experiment: Some(false),
-            ..candidate_settings(settings, own)
+            ..candidate_settings(settings, scene, own)
         };
         let clock = Instant::now();
         let outcome = settings
@@ -659,9 +698,8 @@ fn judge(
     candidate
 }
 
-/// The choice in the chosen solve's report; `own`: whether the chosen candidate is of
-/// the scene's own model, to which alone the request's `alpha` applies.
-#[allow(clippy::too_many_arguments)]
+/// The choice in the chosen solve's report; `dropped`: the request's options the chosen
+/// candidate did not take ([`dropped_options`]).
 fn record(
     report: &mut Report,
     scene: &Scene,
@@ -669,8 +707,7 @@ fn record(
     best: usize,
     tolerance: f64,
     probe_seconds: f64,
-    alpha: Option<f64>,
-    own: bool,
+    dropped: &[String],
 ) {
     let chosen = &candidates[best];
     report.scene = scene.name.to_string();
@@ -698,10 +735,11 @@ fn record(
             chosen.model
         ));
     }
-    if let (Some(alpha), false) = (alpha, own) {
+    if !dropped.is_empty() {
         report.warn(format!(
-            "--alpha {} applies to the scene's own model's pairs: {} ({}) was solved with its own rule for α (the report's alpha)",
-            fem_runtime::problem::number(alpha),
+            "{} {} to the scene's own model's pairs: {} ({}) was solved with its own (the report's alpha and solver)",
+            dropped.join(" and "),
+            if dropped.len() == 1 { "applies" } else { "apply" },
             chosen.pair,
             chosen.model
         ));

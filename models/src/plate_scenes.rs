@@ -116,6 +116,14 @@ impl PlateObstacle {
     }
 }
 
+/// The Kirchhoff centre deflection of the clamped square in units of `q a⁴/D`
+/// (Timoshenko & Woinowsky-Krieger, table 35).
+pub const CLAMPED_SQUARE_CENTRE: f64 = 0.00126532;
+
+/// The Kirchhoff (Navier) centre deflection of the simply supported square in units of
+/// `q a⁴/D` (Timoshenko & Woinowsky-Krieger, table 8).
+pub const SIMPLY_SUPPORTED_SQUARE_CENTRE: f64 = 0.00406235;
+
 /// What a scene's centre deflection is checked against.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PlateReference {
@@ -218,7 +226,7 @@ pub const MINDLIN_SQUARE: PlateScene = PlateScene {
     thickness: 1e-3,
     mesh_size: 32,
     reference: PlateReference::KirchhoffCentre {
-        coefficient: 0.00126532,
+        coefficient: CLAMPED_SQUARE_CENTRE,
     },
 };
 
@@ -230,7 +238,7 @@ pub const MINDLIN_SQUARE_SS: PlateScene = PlateScene {
     description: "simply supported unit square Reissner–Mindlin plate, uniform load, no contact; → Navier's value as t → 0",
     support: PlateSupport::SimplySupported,
     reference: PlateReference::KirchhoffCentre {
-        coefficient: 0.00406235,
+        coefficient: SIMPLY_SUPPORTED_SQUARE_CENTRE,
     },
     ..MINDLIN_SQUARE
 };
@@ -274,7 +282,7 @@ const fn simply_supported_obstacle(
         thickness,
         mesh_size: 16,
         reference: PlateReference::KirchhoffCentre {
-            coefficient: 0.00406235,
+            coefficient: SIMPLY_SUPPORTED_SQUARE_CENTRE,
         },
         ..MINDLIN_SQUARE
     }

@@ -646,9 +646,12 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
     }
     if let Some(pair) = &file.pair {
         // a neighbour model's pair (a Kirchhoff file's thickness takes p1-p2-p0) solves
-        // that model
+        // that model; one that a thickness given on the command line would pose is
+        // checked by the solve
         if let Err(e) = crate::families::pair_of(&scene, Some(pair)) {
-            if crate::choice::neighbour_pair(&scene, pair).is_none() {
+            if crate::choice::neighbour_pair(&scene, pair).is_none()
+                && crate::families::richer_pair_given(&scene, family, pair).is_none()
+            {
                 return Err(at(("pair".into(), e.to_string())));
             }
         }

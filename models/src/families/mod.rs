@@ -179,8 +179,8 @@ pub fn pair_of(scene: &Scene, name: Option<&str>) -> Result<&'static Pair> {
 }
 
 /// The richer model's parameter whose value would let `scene` take `pair` (its richer
-/// neighbour's), where one would.
-fn richer_pair_given(scene: &Scene, family: &dyn Family, pair: &str) -> Option<&'static str> {
+/// neighbour's: a Kirchhoff scene's thickness poses p1-p2-p0), where one would.
+pub fn richer_pair_given(scene: &Scene, family: &dyn Family, pair: &str) -> Option<&'static str> {
     let &given = family.richer_parameters().first()?;
     let mut stated = scene.clone();
     // any admissible value: the neighbour's pairs do not depend on it

@@ -88,8 +88,10 @@ static PAIRS: [Pair; 2] = [
 /// deflection, or the Mindlin closed form, and how it names its obstacle.
 #[derive(Clone, Debug)]
 pub struct PlateFacts {
-    /// The reference of the centre deflection.
-    pub reference: PlateReference,
+    /// The reference of the centre deflection (`None`: none for the scene's supports).
+    pub reference: Option<PlateReference>,
+    /// The support `reference` is for, on every edge.
+    pub support: Support,
     /// The obstacle in words (`flat above, w ≤ 0.05`).
     pub obstacle: String,
     /// The length `L` the Kirchhoff deflections scale with (`w ~ q L⁴/D`): the side of a
@@ -160,7 +162,8 @@ fn plate_scene(old: &plate_scenes::PlateScene) -> Scene {
             .collect();
     }
     scene.reference = Some(std::sync::Arc::new(PlateFacts {
-        reference: old.reference,
+        reference: Some(old.reference),
+        support,
         obstacle: old.obstacle.describe(),
         length: old.domain.length(),
     }));
@@ -254,15 +257,37 @@ impl Family for Plates {
     }
 }
 
-/// The facts of a plate scene, or those a scene without them implies: no closed form.
-fn facts(scene: &Scene) -> Option<&PlateFacts> {
-    scene.reference::<PlateFacts>()
+/// The facts of a plate scene for its supports as posed: where a request changed them
+/// (`--support`), the reference of the new support (the square's series, clamped or
+/// simply supported), or none (a disk not clamped, mixed or free edges); `None`
+/// without facts (a scene file: no closed form).
+fn facts(scene: &Scene) -> Option<PlateFacts> {
+    let mut facts = scene.reference::<PlateFacts>()?.clone();
+    let first = scene.supports.first().map(|s| s.support);
+    let uniform = first.filter(|&f| scene.supports.iter().all(|s| s.support == f));
+    if uniform != Some(facts.support) {
+        let square =
+            matches!(scene.domain, Domain::Rectangle { x, y, .. } if x[1] - x[0] == y[1] - y[0]);
+        let coefficient = match uniform {
+            Some(Support::Clamped) => Some(plate_scenes::CLAMPED_SQUARE_CENTRE),
+            // the Kirchhoff limit of both: w = 0 on the edge fixes ∂w/∂s
+            Some(Support::SimplySupported { .. }) => {
+                Some(plate_scenes::SIMPLY_SUPPORTED_SQUARE_CENTRE)
+            }
+            _ => None,
+        };
+        facts.reference = coefficient
+            .filter(|_| square)
+            .map(|coefficient| PlateReference::KirchhoffCentre { coefficient });
+    }
+    Some(facts)
 }
 
-/// The Kirchhoff centre deflection of `facts` at load `q`, bending stiffness `d`.
-fn kirchhoff_deflection(facts: &PlateFacts, q: f64, d: f64) -> f64 {
-    let scale = q * facts.length.powi(4) / d;
-    match facts.reference {
+/// The Kirchhoff centre deflection of `reference` for a plate of size `length` at load
+/// `q`, bending stiffness `d`.
+fn kirchhoff_deflection(reference: PlateReference, length: f64, q: f64, d: f64) -> f64 {
+    let scale = q * length.powi(4) / d;
+    match reference {
         PlateReference::KirchhoffCentre { coefficient } => coefficient * scale,
         PlateReference::ClampedDisk => scale / 64.0,
     }
@@ -270,8 +295,13 @@ fn kirchhoff_deflection(facts: &PlateFacts, q: f64, d: f64) -> f64 {
 
 /// The exact Mindlin centre deflection where it has a closed form (the clamped disk:
 /// `q R⁴/(64D) + q R²/(4S)`, `S = 6κ(1−ν)D/t²`).
-fn mindlin_deflection(facts: &PlateFacts, q: f64, posed: &Posed) -> Option<f64> {
-    let PlateReference::ClampedDisk = facts.reference else {
+fn mindlin_deflection(
+    reference: PlateReference,
+    length: f64,
+    q: f64,
+    posed: &Posed,
+) -> Option<f64> {
+    let PlateReference::ClampedDisk = reference else {
         return None;
     };
     let (d, nu, kappa, t) = (
@@ -281,8 +311,7 @@ fn mindlin_deflection(facts: &PlateFacts, q: f64, posed: &Posed) -> Option<f64> 
         posed.parameter("t")?,
     );
     let shear = 6.0 * kappa * (1.0 - nu) * d / (t * t);
-    let r = facts.length;
-    Some(kirchhoff_deflection(facts, q, d) + q * r * r / (4.0 * shear))
+    Some(kirchhoff_deflection(reference, length, q, d) + q * length * length / (4.0 * shear))
 }
 
 /// Refuses a thickness `t` above the plate's size (the square's side, the disk's
@@ -475,7 +504,7 @@ impl<G: Geometry> Quantities<G> for Plates {
         let in_contact = run.scene.obstacle;
         report.set(
             "obstacle",
-            match (in_contact, facts) {
+            match (in_contact, &facts) {
                 (false, _) => "none".to_string(),
                 (true, Some(f)) => f.obstacle.clone(),
                 (true, None) => "ψ".to_string(),
@@ -496,11 +525,12 @@ impl<G: Geometry> Quantities<G> for Plates {
                 ))
             })?;
             report.set("centre_deflection", deflection);
-            if let (Some(facts), Some(d)) = (facts, posed.parameter("D")) {
-                let kirchhoff = kirchhoff_deflection(facts, q, d);
+            let reference = facts.as_ref().and_then(|f| Some((f.reference?, f.length)));
+            if let (Some((reference, length)), Some(d)) = (reference, posed.parameter("D")) {
+                let kirchhoff = kirchhoff_deflection(reference, length, q, d);
                 report.set("kirchhoff_reference", kirchhoff);
                 if !in_contact {
-                    let closed = mindlin_deflection(facts, q, posed);
+                    let closed = mindlin_deflection(reference, length, q, posed);
                     let reference = closed.unwrap_or(kirchhoff);
                     report.set("unobstructed_reference", closed);
                     report.set("reference_centre_deflection", reference);
