@@ -546,6 +546,13 @@ impl Scene {
         }
     }
 
+    /// Whether some part is held by the model's own boundary data (`dirichlet`: `w = g`
+    /// for Kirchhoff, `w` and `θ` for Reissner–Mindlin), which names no support shared
+    /// by two neighbour models.
+    pub fn has_model_boundary_data(&self) -> bool {
+        self.supports.iter().any(|s| s.support == Support::Data)
+    }
+
     /// The richer model's parameter `name` ([`Scene::richer`]), if the scene states it.
     pub fn richer_parameter(&self, name: &str) -> Option<f64> {
         self.richer

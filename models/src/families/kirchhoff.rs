@@ -270,7 +270,7 @@ impl Family for KirchhoffPlates {
     fn richer(&self, scene: &Scene) -> Option<Scene> {
         let t = scene.richer_parameter("t")?;
         // the models' own boundary data are not the same support
-        if scene.supports.iter().any(|s| s.support == Support::Data) {
+        if scene.has_model_boundary_data() {
             return None;
         }
         let kappa = scene.richer_parameter("κ").unwrap_or(5.0 / 6.0);
@@ -428,9 +428,7 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 )));
             }
         }
-        if scene.richer_parameter("t").is_some()
-            && scene.supports.iter().any(|s| s.support == Support::Data)
-        {
+        if scene.richer_parameter("t").is_some() && scene.has_model_boundary_data() {
             return Err(Error::Input(
                 "a thickness poses the Reissner–Mindlin plate this Kirchhoff plate stands for, but a `dirichlet` support (the model's own w = g) names no support of that plate (its `dirichlet` holds the rotations too): name the supports (clamped, simply-supported, simply-supported-hard, free)".into(),
             ));

@@ -222,7 +222,7 @@ impl Family for Plates {
     fn cheaper(&self, scene: &Scene) -> Option<Scene> {
         scene.parameter("t")?;
         // its `dirichlet` holds w and θ, the Kirchhoff one w alone: not the same plate
-        if scene.supports.iter().any(|s| s.support == Support::Data) {
+        if scene.has_model_boundary_data() {
             return None;
         }
         let pairs = vec!["argyris-p0", "argyris-p1disc"];
