@@ -801,3 +801,40 @@ fn judgements_of_the_answer_do_not_depend_on_the_data_scale() {
         "{pressed:?}"
     );
 }
+
+/// A plate simply supported on one straight edge only keeps a motion without energy
+/// (`w = x`, which vanishes there): pushed up, away from its obstacle below, nothing
+/// stops it and there is no solution (the solvers returned w ≈ 1e10 with exit 0);
+/// pushed down, the obstacle holds it, and the solution balances the moment of the
+/// load about the supported edge (the motion `w = x` is a test function without
+/// energy: `∫ f x + ∫ λ x = 0`, exactly for P0 multipliers).
+#[test]
+fn a_plate_the_supports_leave_free_is_refused_unless_its_obstacle_holds_it() {
+    let text = |load: &str| {
+        format!(
+            "model = \"kirchhoff\"\nobstacle_side = \"below\"\n[mesh]\ngenerator = \"rectangle\"\nx = [0.0, 1.0]\nsize = 8\n[boundary]\nsimply_supported = \"left\"\n[parameters]\nD = 1.0\nnu = 0.3\n[data]\nf = \"{load}\"\npsi = \"-0.01\"\n"
+        )
+    };
+    let file = scene_file::parse(&text("1"), Path::new("hinged.toml")).unwrap();
+    let Err(e) = solve(&file) else {
+        panic!("a plate pulled off its obstacle was solved");
+    };
+    let e = e.to_string();
+    for words in ["a motion of the body without energy", "no solution"] {
+        assert!(e.contains(words), "{words}: {e}");
+    }
+    let file = scene_file::parse(&text("-1"), Path::new("hinged.toml")).unwrap();
+    let (report, fields) = solve(&file).unwrap();
+    assert!(report.solve.contact_area.unwrap() > 0.1);
+    let Fields::Triangles { mesh, .. } = &fields else {
+        panic!("a plate is solved on triangles");
+    };
+    let moment: f64 = (0..mesh.cell_count())
+        .map(|c| {
+            let x = mesh.cell_coordinates(c);
+            lambda(&fields)[c] * mesh.area(c) * (x[0] + x[2] + x[4]) / 3.0
+        })
+        .sum();
+    // ∫ f x = −1/2
+    assert!((moment - 0.5).abs() < 1e-9, "∫ λ x = {moment}");
+}

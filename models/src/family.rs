@@ -287,14 +287,6 @@ pub trait Family: Sync {
         &[]
     }
 
-    /// The motions its model leaves without energy where nothing holds it (`w = a + bx +
-    /// cy` for a plate), in words: a scene whose every edge is free and which has no
-    /// obstacle is refused, its solution not unique. `None` where the model's energy
-    /// holds every motion (a plate on a foundation).
-    fn rigid_motions(&self) -> Option<&'static str> {
-        None
-    }
-
     /// The `[exact]` key of the quantity a scene file's `accuracy` is measured on (`u`;
     /// contact's `pressure`).
     fn accuracy_key(&self) -> &'static str {

@@ -401,7 +401,6 @@ fn pose_checked<G: Geometry, Q: Quantities<G>>(
     settings: &Settings,
 ) -> Result<Posed> {
     let posed = pose(scene, settings)?;
-    check_held(scene)?;
     Q::check(scene, &posed)?;
     for (name, value) in &posed.parameters {
         if !value.is_finite() {
@@ -412,26 +411,6 @@ fn pose_checked<G: Geometry, Q: Quantities<G>>(
         }
     }
     Ok(posed)
-}
-
-/// Refuses a scene that nothing holds: every edge free and no obstacle, where its
-/// family's model has rigid motions ([`crate::family::Family::rigid_motions`]); the
-/// stiffness matrix is then singular, and a factorization of its rounding returns
-/// anything (a free Kirchhoff square: a deflection of 5.6e8).
-///
-/// # Errors
-/// [`Error::Input`] naming the motions.
-fn check_held(scene: &Scene) -> Result<()> {
-    // no support named: a plate's boundary is free
-    let all_free = scene.supports.iter().all(|s| s.support == Support::Free);
-    let motions = crate::families::family(scene.family).and_then(|f| f.rigid_motions());
-    match motions {
-        Some(motions) if all_free && !scene.obstacle => Err(Error::Input(format!(
-            "scene `{}` holds nothing: every edge is free and there is no obstacle, so {motions} cost no energy and the solution is not unique; support an edge (--support) or give an obstacle",
-            scene.name
-        ))),
-        _ => Ok(()),
-    }
 }
 
 /// `problem` with the scene as bound to the model: its parameters and data, the

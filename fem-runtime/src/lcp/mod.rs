@@ -24,6 +24,7 @@ pub mod cholesky;
 pub mod external;
 mod factor_tree;
 mod newton;
+pub mod null_space;
 mod qp;
 mod recovery;
 pub mod woodbury;

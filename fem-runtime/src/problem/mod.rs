@@ -738,6 +738,9 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             warnings.push("α = 0 (the plain mixed method): C = 0 leaves nothing to eliminate Λ with, so the QP solver (clarabel) is used".into());
             options.solver = VariationalSolver::Clarabel;
         }
+        if previous.is_none() {
+            self.check_held(meshes, &coefficients, &parts)?;
+        }
         let nested = self.options.nested && options.solver.nests();
         let first = if nested { 0 } else { meshes.len() - 1 };
         let solution = if self.unconstrained {
@@ -1135,6 +1138,39 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             start,
             options,
         )
+    }
+
+    /// Refuses a problem whose supports leave the body a motion without energy that the
+    /// obstacle and the load do not fix ([`crate::lcp::null_space::check_held`]), judged
+    /// on the coarsest mesh: the null space of conforming nested spaces under the same
+    /// supports is the same on every level (the rigid motions the supports leave), and
+    /// there it costs one small factorization. An obstacle over the domain (a multiplier
+    /// on cells) sees a motion through its sign on each cell on every level alike.
+    ///
+    /// A multiplier on a boundary part (contact) is not judged here: a coarse level's
+    /// few contact edges can leave a rotation free that finer levels hold, so the
+    /// compatibility condition depends on the level; the contact family judges it per
+    /// level in its first start (`models::families::contact::checks`, levels too coarse
+    /// skipped) against the rigid motions of the elastic body.
+    ///
+    /// # Errors
+    /// Those of [`crate::lcp::null_space::check_held`], and of building the level.
+    fn check_held(
+        &self,
+        meshes: &[G],
+        coefficients: &Coefficients,
+        parts: &[Vec<u32>],
+    ) -> Result<()> {
+        let boundary = crate::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
+        if boundary && !self.unconstrained {
+            return Ok(());
+        }
+        let mesh = &meshes[0];
+        let dofs = mesh.system_dofs::<M>()?;
+        let constraints = mesh.constraints::<M>(&dofs, coefficients, &self.supports)?;
+        let d = mesh.discretize::<M>(coefficients, dofs, &constraints, parts)?;
+        let name = format!("a mesh of {} cells", mesh.cell_count());
+        crate::lcp::null_space::check_held(&d.lcp, !self.unconstrained, &name)
     }
 
     /// The α the default policy would give, where the problem's α is a value of the

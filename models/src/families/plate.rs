@@ -238,10 +238,6 @@ impl Family for Plates {
         Some(thin)
     }
 
-    fn rigid_motions(&self) -> Option<&'static str> {
-        Some("the rigid motions w = a + bx + cy")
-    }
-
     fn aliases(&self) -> &'static [(&'static str, &'static str)] {
         &[
             ("thickness", "t"),
