@@ -1285,3 +1285,32 @@ fn the_requests_options_reach_each_model_as_it_takes_them() {
     ]);
     assert!(message.contains("start from a finer mesh"), "{message}");
 }
+
+/// When every candidate's solve fails (here: a limit on the unknowns below what the
+/// tolerance needs), the error lists every candidate weighed and why, not only the
+/// first failure.
+#[test]
+fn a_choice_whose_every_solve_fails_lists_its_candidates() {
+    let radial = scene("membrane-radial");
+    let request = Settings {
+        adaptive: Some(AdaptiveOptions {
+            tolerance: 1e-3,
+            max_dofs: 300,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    let Err(e) = choice::solve(&radial, &request) else {
+        panic!("solved within 300 unknowns");
+    };
+    let e = e.to_string();
+    assert!(e.contains("no candidate's solve succeeded"), "{e}");
+    for pair in families::pairs_of(&radial) {
+        assert!(
+            e.contains(&format!(" {}: ", pair.name)),
+            "{}: {e}",
+            pair.name
+        );
+    }
+    assert!(e.contains("its adaptive solve failed"), "{e}");
+}

@@ -295,9 +295,11 @@ pub fn probe_sizes(scene: &Scene, given: Option<usize>) -> [usize; 2] {
 /// `choice_seconds` (the probes' time).
 ///
 /// # Errors
-/// A load or parameter the scene refuses; the chosen solve's failure. A candidate whose
-/// probe fails is listed with its failure and not taken; where every probe fails, the
-/// first failure.
+/// A load or parameter the scene refuses. A candidate whose probe fails is listed with
+/// its failure and not taken; where every probe fails, the first failure. Where the
+/// chosen candidate's solve fails the next is tried; where every one tried fails,
+/// [`Error::Input`] listing every candidate weighed with its failure or why it was not
+/// adequate.
 pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outcome> {
     let clock = Instant::now();
     let Probed {
@@ -339,7 +341,6 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
 
     // the best first; where its adaptive solve fails (a user's α out of range on graded
     // cells), the next, the failure noted on the candidate
-    let mut failure = None;
     for best in order {
         let target = candidates[best]
             .discretization_target
@@ -387,11 +388,45 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
             }
             Err(e) => {
                 candidates[best].note = format!("its adaptive solve failed: {e}");
-                failure.get_or_insert(e);
             }
         }
     }
-    Err(failure.expect("at least one candidate was tried"))
+    // every candidate tried failed: each failure is in its candidate's line
+    Err(Error::Input(format!(
+        "scene `{}` to the tolerance {}: no candidate's solve succeeded; the candidates weighed:\n{}",
+        scene.name,
+        fem_runtime::problem::number(tolerance),
+        candidate_lines(&candidates)
+    )))
+}
+
+/// The candidates weighed, one line each (model, pair, estimates, prediction, and why it
+/// was or was not taken), for an error that ends the choice.
+fn candidate_lines(candidates: &[Candidate]) -> String {
+    candidates
+        .iter()
+        .map(|c| {
+            let predicted = match (c.predicted_dofs, c.predicted_seconds) {
+                (Some(dofs), Some(seconds)) => {
+                    format!("predicted {dofs:.1e} unknowns in {seconds:.2e} s")
+                }
+                _ => "no prediction".to_string(),
+            };
+            format!(
+                "  {} {}: modelling estimate {:.2e}, {predicted}, {}: {}",
+                c.model,
+                c.pair,
+                c.modelling_estimate,
+                if c.adequate {
+                    "adequate"
+                } else {
+                    "not adequate"
+                },
+                c.note
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// Two predicted times within this factor are a tie: the probes' times of small solves
