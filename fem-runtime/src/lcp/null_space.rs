@@ -155,6 +155,17 @@ pub fn null_space(a: &SparseMatrix) -> Option<Vec<Vec<f64>>> {
     Some(basis)
 }
 
+/// What holds the body of an LCP that [`check_held`] accepts.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Held {
+    /// The supports: `A` has no null space (or it could not be judged).
+    BySupports,
+    /// The obstacle alone holds the motions of this basis of `A`'s null space (vectors of
+    /// `A`'s order): Newton's matrix is singular on an active set that does not hold
+    /// them, such as the empty one of a start at zero ([`pressed_start`]).
+    ByObstacle(Vec<Vec<f64>>),
+}
+
 /// Refuses an LCP whose solution is not unique or does not exist because of a motion
 /// without energy (see the module's docs); `obstacle` false: the problem is solved
 /// without its constraints, and any such motion is refused. `mesh` names the mesh in
@@ -163,12 +174,12 @@ pub fn null_space(a: &SparseMatrix) -> Option<Vec<Vec<f64>>> {
 /// # Errors
 /// [`Error::Input`] saying which of the three cases holds (no obstacle; the load pulls
 /// the body off; nothing acts on the motion) and how many motions the supports leave.
-pub fn check_held(lcp: &Lcp, obstacle: bool, mesh: &str) -> Result<()> {
+pub fn check_held(lcp: &Lcp, obstacle: bool, mesh: &str) -> Result<Held> {
     let Some(basis) = null_space(&lcp.a) else {
-        return Ok(());
+        return Ok(Held::BySupports);
     };
     if basis.is_empty() {
-        return Ok(());
+        return Ok(Held::BySupports);
     }
     let count = match basis.len() {
         BLOCK => format!("at least {BLOCK} motions"),
@@ -190,8 +201,114 @@ pub fn check_held(lcp: &Lcp, obstacle: bool, mesh: &str) -> Result<()> {
         Some(_) => Err(Error::Input(format!(
             "{singular}, and one of them moves away from the obstacle (or along it) without the load acting on it: the solution is not unique; support the body so that it cannot move freely"
         ))),
-        None => Ok(()),
+        None => Ok(Held::ByObstacle(basis)),
     }
+}
+
+/// A start pressed onto the obstacle for a body it alone holds: `U₀ = −s R c`, with `Rc`
+/// a motion of the null space basis `basis` that moves into every constraint it moves
+/// (`(BRc)_k > 0`) and `s` twice the least that makes each of those constraints active
+/// (`BU₀ < G`). Newton's first matrix `A + BᵀC⁻¹B` is then positive definite, and its
+/// first step is the body pressed onto the obstacle wherever that motion reaches it
+/// (the contact family's start does the same with its rigid motions). `None` where no
+/// such motion exists, or all those constraints are active at zero already.
+pub fn pressed_start(lcp: &Lcp, basis: &[Vec<f64>]) -> Option<Vec<f64>> {
+    let k = basis.len();
+    let columns: Vec<Vec<f64>> = basis.iter().map(|r| lcp.b_times(r)).collect();
+    let size = |i: usize| (0..k).map(|l| columns[l][i].abs()).fold(0.0, f64::max);
+    let largest = (0..lcp.m()).map(size).fold(0.0f64, f64::max);
+    let moved: Vec<usize> = (0..lcp.m())
+        .filter(|&i| size(i) > CONE_SLACK * largest)
+        .collect();
+    if moved.is_empty() {
+        return None;
+    }
+    let c = pressing_coefficients(&columns, &moved, size)?;
+    let pressed: Vec<f64> = (0..lcp.m())
+        .map(|i| (0..k).map(|l| c[l] * columns[l][i]).sum())
+        .collect();
+    let s = moved
+        .iter()
+        .map(|&i| (-lcp.g[i]).max(0.0) / pressed[i])
+        .fold(0.0f64, f64::max);
+    if s == 0.0 {
+        return None;
+    }
+    let n = lcp.n();
+    Some(
+        (0..n)
+            .map(|j| -2.0 * s * (0..k).map(|l| c[l] * basis[l][j]).sum::<f64>())
+            .collect(),
+    )
+}
+
+/// `c` maximizing `t` subject to `(BRc)_i ≥ t·size(i)` on the rows `moved`, `t ≤ 1`,
+/// `|c| ≤ 1` (clarabel), where `t` exceeds [`NONTRIVIAL`].
+fn pressing_coefficients(
+    columns: &[Vec<f64>],
+    moved: &[usize],
+    size: impl Fn(usize) -> f64,
+) -> Option<Vec<f64>> {
+    let k = columns.len();
+    // variables (c, t); rows −BRc/size + t ≤ 0 and t ≤ 1
+    let mut rows: Vec<(Vec<f64>, f64)> = moved
+        .iter()
+        .map(|&i| {
+            let s = size(i);
+            let mut row: Vec<f64> = columns.iter().map(|column| -column[i] / s).collect();
+            row.push(1.0);
+            (row, 0.0)
+        })
+        .collect();
+    let mut top = vec![0.0; k + 1];
+    top[k] = 1.0;
+    rows.push((top.clone(), 1.0));
+    let x = lp_maximizer(&rows, &top, k)?;
+    (x[k] > NONTRIVIAL).then(|| x[..k].to_vec())
+}
+
+/// The maximizer of `objectiveᵀx` subject to `row·x ≤ bound` for each `(row, bound)` of
+/// `rows` and `|x_l| ≤ 1` for the first `boxed` variables, by clarabel; `None` where
+/// clarabel does not solve it (the checks then let the solvers judge).
+fn lp_maximizer(rows: &[(Vec<f64>, f64)], objective: &[f64], boxed: usize) -> Option<Vec<f64>> {
+    use clarabel::algebra::CscMatrix;
+    use clarabel::solver::{DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+    let n = objective.len();
+    let count = rows.len() + 2 * boxed;
+    let mut ptr = vec![0];
+    let mut row_index = Vec::new();
+    let mut values = Vec::new();
+    for l in 0..n {
+        for (i, (row, _)) in rows.iter().enumerate() {
+            if row[l] != 0.0 {
+                row_index.push(i);
+                values.push(row[l]);
+            }
+        }
+        if l < boxed {
+            row_index.extend([rows.len() + l, rows.len() + boxed + l]);
+            values.extend([1.0, -1.0]);
+        }
+        ptr.push(row_index.len());
+    }
+    let a = CscMatrix::new(count, n, ptr, row_index, values);
+    let mut b: Vec<f64> = rows.iter().map(|(_, bound)| *bound).collect();
+    b.resize(count, 1.0);
+    let p = CscMatrix::zeros((n, n));
+    let q: Vec<f64> = objective.iter().map(|o| -o).collect();
+    let settings = clarabel::solver::DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(200)
+        .build()
+        .ok()?;
+    let cones = [NonnegativeConeT(count)];
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
+    solver.solve();
+    matches!(
+        solver.solution.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    )
+    .then(|| solver.solution.x.clone())
 }
 
 /// The largest work `FᵀRc` of the load on a nonzero motion `Rc` of the null space
@@ -263,67 +380,29 @@ impl Cone {
         }
     }
 
-    /// `max objectiveᵀc` over the cone by clarabel; `None` where clarabel does not solve
-    /// it (the check then lets the solvers judge).
+    /// `max objectiveᵀc` over the cone; `None` where clarabel does not solve it.
     fn maximum(&self, objective: &[f64]) -> Option<f64> {
-        use clarabel::algebra::CscMatrix;
-        use clarabel::solver::{DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
         let k = self.columns.len();
         let m = self.columns.first().map_or(0, Vec::len);
-        // rows: −B R c ≤ slack (m), −Fᵀ R c ≤ slack (1), c ≤ 1 (k), −c ≤ 1 (k)
-        let rows = m + 1 + 2 * k;
-        let mut dense = vec![vec![0.0; k]; rows];
-        let mut b = vec![0.0; rows];
+        // −B R c ≤ slack and −Fᵀ R c ≤ slack, each row scaled to a unit largest entry
+        let mut rows = Vec::with_capacity(m + 1);
         for i in 0..m {
             let size = (0..k).map(|l| self.columns[l][i].abs()).fold(0.0, f64::max);
             // a constraint the null space barely moves cannot bind it
             if size > CONE_SLACK * self.largest_row {
-                for (entry, column) in dense[i].iter_mut().zip(&self.columns) {
-                    *entry = -column[i] / size;
-                }
-                b[i] = CONE_SLACK * self.largest_row / size;
+                let row = self
+                    .columns
+                    .iter()
+                    .map(|column| -column[i] / size)
+                    .collect();
+                rows.push((row, CONE_SLACK * self.largest_row / size));
             }
         }
         if self.work_scale > 0.0 {
-            for (entry, work) in dense[m].iter_mut().zip(&self.work) {
-                *entry = -work / self.work_scale;
-            }
-            b[m] = CONE_SLACK;
+            let row = self.work.iter().map(|w| -w / self.work_scale).collect();
+            rows.push((row, CONE_SLACK));
         }
-        for l in 0..k {
-            dense[m + 1 + l][l] = 1.0;
-            b[m + 1 + l] = 1.0;
-            dense[m + 1 + k + l][l] = -1.0;
-            b[m + 1 + k + l] = 1.0;
-        }
-        let mut ptr = vec![0];
-        let mut row_index = Vec::new();
-        let mut values = Vec::new();
-        for l in 0..k {
-            for (i, row) in dense.iter().enumerate() {
-                if row[l] != 0.0 {
-                    row_index.push(i);
-                    values.push(row[l]);
-                }
-            }
-            ptr.push(row_index.len());
-        }
-        let a = CscMatrix::new(rows, k, ptr, row_index, values);
-        let p = CscMatrix::zeros((k, k));
-        let q: Vec<f64> = objective.iter().map(|o| -o).collect();
-        let settings = clarabel::solver::DefaultSettingsBuilder::default()
-            .verbose(false)
-            .max_iter(200)
-            .build()
-            .ok()?;
-        let cones = [NonnegativeConeT(rows)];
-        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
-        solver.solve();
-        matches!(
-            solver.solution.status,
-            SolverStatus::Solved | SolverStatus::AlmostSolved
-        )
-        .then(|| dot(objective, &solver.solution.x))
+        lp_maximizer(&rows, objective, k).map(|c| dot(objective, &c))
     }
 }
 
@@ -443,7 +522,10 @@ mod tests {
         let n = 20;
         let rows: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
         let down = lcp(laplacian(n, false), vec![-1.0; n], rows.clone());
-        check_held(&down, true, "test").unwrap();
+        assert!(matches!(
+            check_held(&down, true, "test").unwrap(),
+            Held::ByObstacle(_)
+        ));
         let up = lcp(laplacian(n, false), vec![1.0; n], rows.clone());
         let e = check_held(&up, true, "test").unwrap_err().to_string();
         assert!(e.contains("no solution"), "{e}");
@@ -461,7 +543,10 @@ mod tests {
         // the constraint at the middle node only: a load pushing down is held there
         let n = 21;
         let held = lcp(laplacian(n, false), vec![-1.0; n], vec![vec![(10, 1.0)]]);
-        check_held(&held, true, "test").unwrap();
+        assert!(matches!(
+            check_held(&held, true, "test").unwrap(),
+            Held::ByObstacle(_)
+        ));
         // an obstacle row that does not see the motion (a difference of two nodes)
         let blind = lcp(
             laplacian(n, false),
@@ -469,5 +554,23 @@ mod tests {
             vec![vec![(3, 1.0), (4, -1.0)]],
         );
         assert!(check_held(&blind, true, "test").is_err());
+    }
+
+    #[test]
+    fn the_pressed_start_makes_every_constraint_the_motion_moves_active() {
+        // u ≥ −½ at every node: at zero none is active; pressed, all are
+        let n = 20;
+        let rows: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
+        let mut down = lcp(laplacian(n, false), vec![-1.0; n], rows);
+        down.g = vec![-0.5; n];
+        let Held::ByObstacle(basis) = check_held(&down, true, "test").unwrap() else {
+            panic!("the free string is held by its obstacle alone");
+        };
+        let start = pressed_start(&down, &basis).unwrap();
+        let bu = down.b_times(&start);
+        assert!(bu.iter().zip(&down.g).all(|(b, g)| b < g), "{bu:?}");
+        // already active at zero: no start needed
+        down.g = vec![0.5; n];
+        assert!(pressed_start(&down, &basis).is_none());
     }
 }

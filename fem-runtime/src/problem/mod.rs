@@ -738,24 +738,37 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             warnings.push("α = 0 (the plain mixed method): C = 0 leaves nothing to eliminate Λ with, so the QP solver (clarabel) is used".into());
             options.solver = VariationalSolver::Clarabel;
         }
-        if previous.is_none() {
-            self.check_held(meshes, &coefficients, &parts)?;
-        }
+        let held = match previous {
+            None => self.check_held(meshes, &coefficients, &parts)?,
+            Some(_) => None,
+        };
+        // a body the obstacle alone holds starts pressed onto it on the checked level
+        let pressed = |d: &Discretization<G>| -> Result<LevelStart> {
+            Ok(match &held {
+                Some((cells, basis))
+                    if d.mesh.cell_count() == *cells
+                        && basis.first().map(Vec::len) == Some(d.lcp.n()) =>
+                {
+                    crate::lcp::null_space::pressed_start(&d.lcp, basis)
+                        .map_or(LevelStart::Zero, LevelStart::At)
+                }
+                _ => LevelStart::Zero,
+            })
+        };
+        let setup = LevelSetup {
+            coefficients: &coefficients,
+            parts: &parts,
+            options,
+            pressed: held.is_some().then_some(&pressed as &FirstStart<'_, G>),
+        };
         let nested = self.options.nested && options.solver.nests();
         let first = if nested { 0 } else { meshes.len() - 1 };
         let solution = if self.unconstrained {
             let d = finest.discretize::<M>(&coefficients, dofs, &constraints, &parts)?;
             unconstrained_solution(d).map_err(|e| alpha_hint(e, alpha, c_i))?
         } else {
-            self.solve_levels(
-                &meshes[first..],
-                &coefficients,
-                Some((dofs, constraints)),
-                &parts,
-                options,
-                previous,
-            )
-            .map_err(|e| alpha_hint(e, alpha, c_i))?
+            self.solve_levels(&meshes[first..], setup, Some((dofs, constraints)), previous)
+                .map_err(|e| alpha_hint(e, alpha, c_i))?
         };
         let mut report = self.report(&solution, &coefficients, alpha, c_i, options)?;
         if self.unconstrained {
@@ -785,14 +798,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             record_mesh_quality(finest, alpha_from_inverse_constant, c_i, &mut report)?;
         }
         if self.options.rounding_experiment && !self.unconstrained {
-            self.judge_rounding(
-                meshes,
-                &solution,
-                &coefficients,
-                &parts,
-                options,
-                &mut report,
-            )?;
+            self.judge_rounding(meshes, &solution, setup, &mut report)?;
         }
         let estimate = if M::HAS_ESTIMATOR && G::ESTIMATES {
             Some(self.record_estimate(&solution, &params, &data, &parts, &mut report)?)
@@ -871,16 +877,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         &self,
         meshes: &[G],
         solution: &ObstacleSolution<G>,
-        coefficients: &Coefficients,
-        parts: &[Vec<u32>],
-        options: ObstacleOptions,
+        setup: LevelSetup<'_, '_, G>,
         report: &mut Report,
     ) -> Result<()> {
         let clock = Instant::now();
-        let rounding = options
+        let rounding = setup
+            .options
             .solver
             .during(Purpose::RoundingExperiment, || {
-                self.rounding_experiment(meshes, solution, coefficients, parts, options)
+                self.rounding_experiment(meshes, solution, setup)
             })
             .unwrap_or(f64::INFINITY);
         report.rounding_seconds = Some(clock.elapsed().as_secs_f64());
@@ -1090,12 +1095,16 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     fn solve_levels(
         &self,
         meshes: &[G],
-        coefficients: &Coefficients,
+        setup: LevelSetup<'_, '_, G>,
         finest: Option<(crate::SystemDofs, Constraints)>,
-        parts: &[Vec<u32>],
-        options: ObstacleOptions,
         previous: Option<&ObstacleSolution<G>>,
     ) -> Result<ObstacleSolution<G>> {
+        let LevelSetup {
+            coefficients,
+            parts,
+            options,
+            pressed,
+        } = setup;
         let supports = &self.supports;
         let last = meshes.len() - 1;
         let mut finest = finest;
@@ -1129,7 +1138,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         };
         let start: Option<&FirstStart<'_, G>> = match previous {
             Some(_) => Some(&from_previous),
-            None => self.start,
+            None => self.start.or(pressed),
         };
         solve_nested_from(
             levels,
@@ -1153,6 +1162,10 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// level in its first start (`models::families::contact::checks`, levels too coarse
     /// skipped) against the rigid motions of the elastic body.
     ///
+    /// Where the obstacle alone holds the body, the checked mesh's cell count and the
+    /// null space's basis there ([`crate::lcp::null_space::Held::ByObstacle`]), for the
+    /// start pressed onto the obstacle.
+    ///
     /// # Errors
     /// Those of [`crate::lcp::null_space::check_held`], and of building the level.
     fn check_held(
@@ -1160,17 +1173,22 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         meshes: &[G],
         coefficients: &Coefficients,
         parts: &[Vec<u32>],
-    ) -> Result<()> {
+    ) -> Result<Option<(usize, Vec<Vec<f64>>)>> {
         let boundary = crate::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
         if boundary && !self.unconstrained {
-            return Ok(());
+            return Ok(None);
         }
         let mesh = &meshes[0];
         let dofs = mesh.system_dofs::<M>()?;
         let constraints = mesh.constraints::<M>(&dofs, coefficients, &self.supports)?;
         let d = mesh.discretize::<M>(coefficients, dofs, &constraints, parts)?;
         let name = format!("a mesh of {} cells", mesh.cell_count());
-        crate::lcp::null_space::check_held(&d.lcp, !self.unconstrained, &name)
+        Ok(
+            match crate::lcp::null_space::check_held(&d.lcp, !self.unconstrained, &name)? {
+                crate::lcp::null_space::Held::ByObstacle(basis) => Some((mesh.cell_count(), basis)),
+                crate::lcp::null_space::Held::BySupports => None,
+            },
+        )
     }
 
     /// The α the default policy would give, where the problem's α is a value of the
@@ -1566,10 +1584,9 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         &self,
         meshes: &[G],
         solution: &ObstacleSolution<G>,
-        coefficients: &Coefficients,
-        parts: &[Vec<u32>],
-        options: ObstacleOptions,
+        setup: LevelSetup<'_, '_, G>,
     ) -> Result<f64> {
+        let options = setup.options;
         let d = &solution.discretization;
         let field = M::OBSTACLE.map_or(0, |[f, _]| f);
         let reference = G::field_at_vertices(solution, field);
@@ -1594,8 +1611,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             } else {
                 meshes.len() - 1
             };
-            let moved =
-                self.solve_levels(&meshes[first..], coefficients, None, parts, options, None)?;
+            let moved = self.solve_levels(&meshes[first..], setup, None, None)?;
             let values = G::field_at_vertices(&moved, field);
             let change = values
                 .iter()
@@ -1651,6 +1667,25 @@ fn free_unknowns<M: Model>(
         )
     }))
 }
+
+/// What every level of one solve shares: the coefficients, the boundary parts'
+/// markers, the solver's options, and the start of a body the obstacle alone holds
+/// (`None` where the supports hold it).
+struct LevelSetup<'s, 'f, G> {
+    coefficients: &'s Coefficients<'f>,
+    parts: &'s [Vec<u32>],
+    options: ObstacleOptions,
+    pressed: Option<&'s FirstStart<'f, G>>,
+}
+
+// by hand: a derive would ask `G: Copy`
+impl<G> Clone for LevelSetup<'_, '_, G> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<G> Copy for LevelSetup<'_, '_, G> {}
 
 /// The solution of `d` with every constraint inactive: `Λ = 0` and `A U = F` by sparse
 /// Cholesky (`A`, the primal block of `B_h`, is SPD for `α < 1/C_I`); its residual is
