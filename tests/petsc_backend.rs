@@ -135,6 +135,29 @@ fn the_levels_say_what_each_solve_served_and_its_linear_solver() {
     ));
     let levels = chosen["petsc"]["levels"].as_array().expect("levels");
     assert!(levels.iter().any(|l| l["purpose"] == "probe"), "{levels:?}");
+    // Euler–Bernoulli's finer probe already reaches T and is the answer: its solves are
+    // relabelled (they were all "probe")
+    let taken = chosen["candidates"]
+        .as_array()
+        .expect("candidates")
+        .iter()
+        .find(|c| c["chosen"] == true)
+        .expect("a chosen candidate");
+    assert_eq!(
+        taken["note"], "the probe's finer mesh already reaches the target",
+        "{taken}"
+    );
+    let answers = count_of(levels, "answer");
+    assert!(answers >= 1, "{levels:?}");
+    assert_eq!(
+        levels.last().map(|l| l["purpose"].clone()),
+        Some("answer".into()),
+        "{levels:?}"
+    );
+}
+
+fn count_of(levels: &[serde_json::Value], purpose: &str) -> usize {
+    levels.iter().filter(|l| l["purpose"] == purpose).count()
 }
 
 #[test]

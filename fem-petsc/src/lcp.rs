@@ -171,6 +171,18 @@ impl ExternalSolver for PetscLcpSolver {
         *self.purpose.lock().unwrap_or_else(|e| e.into_inner()) = purpose;
     }
 
+    fn recorded(&self) -> usize {
+        self.records.lock().unwrap_or_else(|e| e.into_inner()).len()
+    }
+
+    fn relabel(&self, records: std::ops::Range<usize>, purpose: Purpose) {
+        let mut all = self.records.lock().unwrap_or_else(|e| e.into_inner());
+        let end = records.end.min(all.len());
+        for record in &mut all[records.start.min(end)..end] {
+            record.purpose = purpose;
+        }
+    }
+
     fn solve(&self, lcp: &Lcp, start: Option<&[f64]>) -> fem_runtime::Result<LcpSolution> {
         let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
         let on = guard.as_ref().ok_or_else(|| {

@@ -347,7 +347,10 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
             .max(f64::MIN_POSITIVE);
         let solve_clock = Instant::now();
         let solved = match finished[best].take() {
-            Some(probe) => Ok((probe, candidates[best].probe[1].seconds)),
+            Some(probe) => {
+                settings.solver.relabel(probe.records, Purpose::Answer);
+                Ok((probe.outcome, candidates[best].probe[1].seconds))
+            }
             None => {
                 let final_settings = Settings {
                     pair: Some(candidates[best].pair.to_string()),
@@ -515,8 +518,8 @@ pub fn candidates(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<
 struct Probed {
     candidates: Vec<Candidate>,
     scenes: Vec<Scene>,
-    /// Per candidate, its finer probe's outcome where that already reaches its target.
-    finished: Vec<Option<Outcome>>,
+    /// Per candidate, its finer probe where that already reaches its target.
+    finished: Vec<Option<Probe>>,
     /// Per candidate, whether it is of the scene's own model.
     own: Vec<bool>,
     sizes: [usize; 2],
@@ -623,10 +626,11 @@ fn probe(
     settings: &Settings,
     sizes: [usize; 2],
     own: bool,
-) -> Result<(Vec<ProbeLevel>, f64, Outcome)> {
+) -> Result<(Vec<ProbeLevel>, f64, Probe)> {
     let mut levels = Vec::new();
     let mut modelling = 0.0;
     let mut finer = None;
+    let mut records = 0..0;
     for n in sizes {
         let probe_settings = Settings {
             pair: Some(pair.to_string()),
@@ -639,10 +643,12 @@ fn probe(
             ..candidate_settings(settings, scene, own)
         };
         let clock = Instant::now();
+        let first_record = settings.solver.recorded();
         let outcome = settings
             .solver
             .during(Purpose::Probe, || families::solve(scene, &probe_settings))?;
         let seconds = clock.elapsed().as_secs_f64();
+        records = first_record..settings.solver.recorded();
         let s = &outcome.report.solve;
         let estimate_relative = s.estimate_relative.ok_or_else(|| {
             Error::Input(match s.estimate {
@@ -671,7 +677,21 @@ fn probe(
         finer = Some(outcome);
     }
     let finer = finer.ok_or_else(|| Error::Input("no probe size".into()))?;
-    Ok((levels, modelling, finer))
+    Ok((
+        levels,
+        modelling,
+        Probe {
+            outcome: finer,
+            records,
+        },
+    ))
+}
+
+/// The finer probe's solve: its outcome, and the external solver's records of it
+/// ([`VariationalSolver::recorded`]), relabelled as the answer where the choice takes it.
+struct Probe {
+    outcome: Outcome,
+    records: std::ops::Range<usize>,
 }
 
 /// A probed candidate judged against the tolerance: its target, rate and predicted cost.

@@ -29,12 +29,26 @@ pub trait ExternalSolver: Send + Sync {
     fn set_purpose(&self, purpose: Purpose) {
         let _ = purpose;
     }
+
+    /// The number of solves recorded so far: a mark for [`ExternalSolver::relabel`]; by
+    /// default 0 (no records).
+    fn recorded(&self) -> usize {
+        0
+    }
+
+    /// Marks the recorded solves `records` (marks of [`ExternalSolver::recorded`]) as
+    /// serving `purpose`: a probe of the model choice that it takes as the answer; by
+    /// default nothing.
+    fn relabel(&self, records: std::ops::Range<usize>, purpose: Purpose) {
+        let _ = (records, purpose);
+    }
 }
 
 /// What an LCP solve serves, as an [`ExternalSolver`]'s records name it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Purpose {
-    /// The answer: the levels of a nested solve, and each level of an adaptive one.
+    /// The answer: the levels of a nested solve, each level of an adaptive one, and a
+    /// probe the model choice takes as its answer (relabelled).
     #[default]
     Answer,
     /// A probe of the model choice (a candidate on a coarse mesh).

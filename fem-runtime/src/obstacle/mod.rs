@@ -76,6 +76,27 @@ impl VariationalSolver {
         external.0.set_purpose(Purpose::Answer);
         result
     }
+
+    /// The external solver's solves recorded so far (0 for the others):
+    /// [`ExternalSolver::recorded`].
+    ///
+    /// [`ExternalSolver::recorded`]: crate::lcp::external::ExternalSolver::recorded
+    pub fn recorded(self) -> usize {
+        match self {
+            Self::External(external) => external.0.recorded(),
+            _ => 0,
+        }
+    }
+
+    /// Marks the external solver's recorded solves `records` as serving `purpose`
+    /// ([`ExternalSolver::relabel`]); nothing for the others.
+    ///
+    /// [`ExternalSolver::relabel`]: crate::lcp::external::ExternalSolver::relabel
+    pub fn relabel(self, records: std::ops::Range<usize>, purpose: Purpose) {
+        if let Self::External(external) = self {
+            external.0.relabel(records, purpose);
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
