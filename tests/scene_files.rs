@@ -874,3 +874,24 @@ fn free_bodies_only_the_obstacle_holds_are_solved_in_equilibrium() {
     // rounding: the thin beam's matrix has a condition near 1e7 (t = 1e-3)
     assert!((force - 40.0).abs() < 1e-8 * 40.0, "∫λ = {force}");
 }
+
+/// A membrane free on its whole boundary keeps the constants: pulled off its obstacle
+/// it has no solution (the nodal method returned an energy of −2.5e14 with exit 0),
+/// pressed onto it it lies on the obstacle with `∫λ = −∫f`; every pair alike.
+#[test]
+fn a_free_membrane_is_refused_pulled_off_and_solved_pressed_on() {
+    for pair in ["p1-p0", "p2-p0", "p1-nodal"] {
+        let text = |load: &str| {
+            format!("model = \"membrane\"\npair = \"{pair}\"\n[mesh]\ngenerator = \"rectangle\"\nx = [0.0, 1.0]\nsize = 8\n[boundary]\nfree = \"all\"\n[data]\nf = \"{load}\"\npsi = \"-0.1\"\ng = \"0\"\n")
+        };
+        let file = scene_file::parse(&text("1"), Path::new("free.toml")).unwrap();
+        let Err(e) = solve(&file) else {
+            panic!("{pair}: a membrane pulled off its obstacle was solved");
+        };
+        assert!(e.to_string().contains("no solution"), "{pair}: {e}");
+        let file = scene_file::parse(&text("-1"), Path::new("free.toml")).unwrap();
+        let (report, _) = solve(&file).unwrap();
+        let force = report.solve.total_contact_force;
+        assert!((force - 1.0).abs() < 1e-9, "{pair}: ∫λ = {force}");
+    }
+}

@@ -290,6 +290,14 @@ impl NodalState {
             }
         };
         let hierarchy: &[SparseMatrix] = if multigrid { &self.prolongations } else { &[] };
+        if self.levels.is_empty() {
+            // the coarsest level judges whether the problem is held (docs/mathematics.md §5)
+            crate::lcp::null_space::check_held(
+                &nodal_lcp(&a, &f, &psi),
+                true,
+                &format!("a mesh of {cells} cells"),
+            )?;
+        }
         let last = self.levels.len() + 1 == level_count;
         let solution = match options.solver {
             VariationalSolver::External(external) => external
