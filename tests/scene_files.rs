@@ -895,3 +895,25 @@ fn a_free_membrane_is_refused_pulled_off_and_solved_pressed_on() {
         assert!((force - 1.0).abs() < 1e-9, "{pair}: ∫λ = {force}");
     }
 }
+
+/// The plate held on one edge, at extreme scales. Half-width 1e4: the obstacle holds it
+/// (the cone test once read the Argyris DOFs' mixed units as rounding and refused it);
+/// its reaction balances the load. Half-width 1e-3 with D = 1e9: the solve loses the
+/// contact that holds it and returned w ≈ 0 without a reaction, exit 0; the answer is
+/// refused by its unbalanced moment.
+#[test]
+fn a_hinged_plate_at_extreme_scales_is_balanced_or_refused() {
+    let text = |half_width: &str, d: &str| {
+        format!(
+            "model = \"kirchhoff\"\nobstacle_side = \"below\"\n[mesh]\ngenerator = \"square\"\nhalf_width = {half_width}\nsize = 8\n[boundary]\nsimply_supported = \"left\"\n[parameters]\nD = {d}\nnu = 0.3\n[data]\nf = \"-1\"\npsi = \"-0.01*{half_width}\"\n"
+        )
+    };
+    let file = scene_file::parse(&text("1e4", "1"), Path::new("large.toml")).unwrap();
+    let (report, _) = solve(&file).unwrap();
+    assert!(report.solve.total_contact_force > 0.5 * 4e8);
+    let file = scene_file::parse(&text("1e-3", "1e9"), Path::new("small.toml")).unwrap();
+    let Err(e) = solve(&file) else {
+        panic!("the unbalanced answer was returned");
+    };
+    assert!(e.to_string().contains("does not balance the load"), "{e}");
+}

@@ -311,24 +311,62 @@ fn lp_maximizer(rows: &[(Vec<f64>, f64)], objective: &[f64], boxed: usize) -> Op
     .then(|| solver.solution.x.clone())
 }
 
+/// How far `(U, Λ)` is from balancing the load on the motions without energy `motions`
+/// (vectors of `A`'s order): testing `AU − BᵀΛ = F` with `r`, `AU` drops out, so
+/// `Fᵀr + Λᵀ(Br) = 0`; the largest `|Fᵀr + ΛᵀBr|` relative to its terms' size
+/// `Σ|F_i r_i| + Σ|Λ_k (Br)_k|` (0 where both vanish). An answer of a singular system
+/// whose active set lost the contact that held a motion fails it, whatever its
+/// residual.
+pub fn unbalanced_work(lcp: &Lcp, lambda: &[f64], motions: &[Vec<f64>]) -> f64 {
+    motions
+        .iter()
+        .map(|r| {
+            let br = lcp.b_times(r);
+            let load: f64 = lcp.f.iter().zip(r).map(|(f, r)| f * r).sum();
+            let reaction: f64 = lambda.iter().zip(&br).map(|(l, b)| l * b).sum();
+            let size: f64 = lcp.f.iter().zip(r).map(|(f, r)| (f * r).abs()).sum::<f64>()
+                + lambda
+                    .iter()
+                    .zip(&br)
+                    .map(|(l, b)| (l * b).abs())
+                    .sum::<f64>();
+            if size > 0.0 {
+                (load + reaction).abs() / size
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
 /// The largest work `FᵀRc` of the load on a nonzero motion `Rc` of the null space
 /// spanned by `basis` that keeps `BRc ≥ 0` and `FᵀRc ≥ 0` (0 where that work is
 /// rounding), where one exists. The cone `{c : BRc ≥ 0, FᵀRc ≥ 0}` is nontrivial when
 /// one of the `2k` LPs `max ±c_j` over it (with `|c| ≤ 1`) exceeds [`NONTRIVIAL`].
 fn free_motion(lcp: &Lcp, basis: &[Vec<f64>]) -> Option<f64> {
     let k = basis.len();
-    // what B R c could be for |c| ≤ 1: a column of B R far below it is zero
-    let b_norm = lcp
+    // the rounding scale of each (B R_l)_i and Fᵀ R_l: the sums of the magnitudes of
+    // their terms (DOFs of different units, as Argyris', make any norm-wise bound far
+    // too large for some rows)
+    let row_scales: Vec<f64> = lcp
         .b_rows
         .iter()
-        .map(|row| row.iter().map(|(_, v)| v.abs()).sum::<f64>())
+        .map(|row| {
+            basis
+                .iter()
+                .map(|r| row.iter().map(|&(j, v)| (v * r[j]).abs()).sum::<f64>())
+                .fold(0.0f64, f64::max)
+        })
+        .collect();
+    let largest_work = basis
+        .iter()
+        .map(|r| lcp.f.iter().zip(r).map(|(f, r)| (f * r).abs()).sum::<f64>())
         .fold(0.0f64, f64::max);
-    let r_norm = basis.iter().flatten().fold(0.0f64, |s, &x| s.max(x.abs()));
     let cone = Cone::new(
         basis.iter().map(|r| lcp.b_times(r)).collect(),
         basis.iter().map(|r| dot(&lcp.f, r)).collect(),
-        b_norm * r_norm,
-        lcp.f.iter().map(|f| f.abs()).sum::<f64>() * r_norm,
+        row_scales,
+        largest_work,
     );
     let nontrivial = (0..k).any(|j| {
         [1.0, -1.0].into_iter().any(|sign| {
@@ -357,15 +395,20 @@ fn free_motion(lcp: &Lcp, basis: &[Vec<f64>]) -> Option<f64> {
 struct Cone {
     columns: Vec<Vec<f64>>,
     work: Vec<f64>,
-    largest_row: f64,
+    row_scales: Vec<f64>,
     work_scale: f64,
 }
 
 impl Cone {
-    /// `largest_row`: the size `B R c` could have (`‖B‖∞ max|R|`); `largest_work`:
-    /// the size `Fᵀ R c` could have (`‖F‖₁ max|R|`), against which a smaller work is
-    /// rounding (a load balanced on the null space).
-    fn new(columns: Vec<Vec<f64>>, work: Vec<f64>, largest_row: f64, largest_work: f64) -> Self {
+    /// `row_scales`: per constraint, the rounding scale of `(B R_l)_i` (the largest over
+    /// `l` of `Σ_j |B_ij R_jl|`); `largest_work`: that of `Fᵀ R_l`, against which a
+    /// smaller work is rounding (a load balanced on the null space).
+    fn new(
+        columns: Vec<Vec<f64>>,
+        work: Vec<f64>,
+        row_scales: Vec<f64>,
+        largest_work: f64,
+    ) -> Self {
         let work_scale = work.iter().fold(0.0f64, |s, &w| s.max(w.abs()));
         let work_scale = if work_scale > CONE_SLACK * largest_work {
             work_scale
@@ -375,7 +418,7 @@ impl Cone {
         Self {
             columns,
             work,
-            largest_row,
+            row_scales,
             work_scale,
         }
     }
@@ -389,13 +432,14 @@ impl Cone {
         for i in 0..m {
             let size = (0..k).map(|l| self.columns[l][i].abs()).fold(0.0, f64::max);
             // a constraint the null space barely moves cannot bind it
-            if size > CONE_SLACK * self.largest_row {
+            let scale = self.row_scales[i];
+            if size > CONE_SLACK * scale {
                 let row = self
                     .columns
                     .iter()
                     .map(|column| -column[i] / size)
                     .collect();
-                rows.push((row, CONE_SLACK * self.largest_row / size));
+                rows.push((row, CONE_SLACK * scale / size));
             }
         }
         if self.work_scale > 0.0 {

@@ -745,9 +745,11 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         // a body the obstacle alone holds starts pressed onto it on the checked level
         let pressed = |d: &Discretization<G>| -> Result<LevelStart> {
             Ok(match &held {
-                Some((cells, basis))
-                    if d.mesh.cell_count() == *cells
-                        && basis.first().map(Vec::len) == Some(d.lcp.n()) =>
+                Some(HeldByObstacle {
+                    checked,
+                    motions: basis,
+                }) if d.mesh.cell_count() == checked.mesh.cell_count()
+                    && basis.first().map(Vec::len) == Some(d.lcp.n()) =>
                 {
                     crate::lcp::null_space::pressed_start(&d.lcp, basis)
                         .map_or(LevelStart::Zero, LevelStart::At)
@@ -770,6 +772,9 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             self.solve_levels(&meshes[first..], setup, Some((dofs, constraints)), previous)
                 .map_err(|e| alpha_hint(e, alpha, c_i))?
         };
+        if let Some(HeldByObstacle { checked, motions }) = &held {
+            check_balanced::<M, G>(checked, motions, &solution)?;
+        }
         let mut report = self.report(&solution, &coefficients, alpha, c_i, options)?;
         if self.unconstrained {
             report.solver = "linear";
@@ -1162,8 +1167,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// level in its first start (`models::families::contact::checks`, levels too coarse
     /// skipped) against the rigid motions of the elastic body.
     ///
-    /// Where the obstacle alone holds the body, the checked mesh's cell count and the
-    /// null space's basis there ([`crate::lcp::null_space::Held::ByObstacle`]), for the
+    /// Where the obstacle alone holds the body, the checked level and the null space's
+    /// basis there ([`crate::lcp::null_space::Held::ByObstacle`]), for the
     /// start pressed onto the obstacle.
     ///
     /// # Errors
@@ -1173,7 +1178,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         meshes: &[G],
         coefficients: &Coefficients,
         parts: &[Vec<u32>],
-    ) -> Result<Option<(usize, Vec<Vec<f64>>)>> {
+    ) -> Result<Option<HeldByObstacle<G>>> {
         let boundary = crate::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
         if boundary && !self.unconstrained {
             return Ok(None);
@@ -1185,7 +1190,10 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         let name = format!("a mesh of {} cells", mesh.cell_count());
         Ok(
             match crate::lcp::null_space::check_held(&d.lcp, !self.unconstrained, &name)? {
-                crate::lcp::null_space::Held::ByObstacle(basis) => Some((mesh.cell_count(), basis)),
+                crate::lcp::null_space::Held::ByObstacle(motions) => Some(HeldByObstacle {
+                    checked: d,
+                    motions,
+                }),
                 crate::lcp::null_space::Held::BySupports => None,
             },
         )
@@ -1667,6 +1675,68 @@ fn free_unknowns<M: Model>(
         )
     }))
 }
+
+/// A body the obstacle alone holds: the level its null space was found on, and a
+/// basis of it (vectors of that level's free unknowns).
+struct HeldByObstacle<G> {
+    checked: Discretization<G>,
+    motions: Vec<Vec<f64>>,
+}
+
+/// Refuses an answer that does not balance the load on the motions the obstacle alone
+/// holds (`basis`, on the level `checked`), prolonged to the answer's level
+/// ([`crate::lcp::null_space::unbalanced_work`] above [`MAX_UNBALANCED_WORK`]).
+///
+/// # Errors
+/// [`Error::Input`] saying that the contact that holds the body was lost.
+fn check_balanced<M: Model, G: Domain>(
+    checked: &Discretization<G>,
+    basis: &[Vec<f64>],
+    solution: &ObstacleSolution<G>,
+) -> Result<()> {
+    let fine = &solution.discretization;
+    let expand = |u: Vec<f64>| {
+        checked.full(&crate::lcp::LcpSolution {
+            u,
+            lambda: vec![0.0; checked.lcp.m()],
+            iterations: 0,
+            kkt_residual: 0.0,
+            seconds: 0.0,
+            factorizations: 0,
+            low_rank_updates: 0,
+            multiplier_noise: 0.0,
+            iterative_steps: 0,
+            krylov_iterations: 0,
+        })
+    };
+    // the motion alone: the fixed values (a support's data) subtracted
+    let offset = expand(vec![0.0; checked.lcp.n()]);
+    let motions: Vec<Vec<f64>> = basis
+        .iter()
+        .map(|r| {
+            let full: Vec<f64> = expand(r.clone())
+                .iter()
+                .zip(&offset)
+                .map(|(a, b)| a - b)
+                .collect();
+            fine.primal_part(&G::prolong::<M>(checked, &full, fine))
+        })
+        .collect();
+    let lambda = fine.multiplier_part(&solution.values);
+    let unbalanced = crate::lcp::null_space::unbalanced_work(&fine.lcp, &lambda, &motions);
+    if unbalanced > MAX_UNBALANCED_WORK {
+        return Err(Error::Input(format!(
+            "the answer does not balance the load on a motion that only the obstacle holds (its work is unbalanced by {unbalanced:.1e} of its size): the solve lost the contact that holds the body, and its answer is the rounding of a singular system; support the body, or make its data less extreme in scale"
+        )));
+    }
+    Ok(())
+}
+
+/// The relative unbalanced work above which an answer is refused. Measured: the free
+/// bodies of the tests balance to 1e-9; a plate held on one edge whose scale is
+/// extreme (half-width 1e-3, or D = 1e9) to 7e-6 and 3e-5, from rounding; an answer
+/// that lost its contact (w ≈ 0, no reaction) is off by 0.99.
+const MAX_UNBALANCED_WORK: f64 = 1e-3;
 
 /// What every level of one solve shares: the coefficients, the boundary parts'
 /// markers, the solver's options, and the start of a body the obstacle alone holds
