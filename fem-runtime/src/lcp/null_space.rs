@@ -9,10 +9,12 @@
 //! problem is judged before it is solved.
 //!
 //! With `K` the null space of `A` (the motions of zero energy the supports leave), the
-//! energy `½UᵀAU − FᵀU` on `{BU ≥ G}` has a unique minimizer only if no motion `r ≠ 0`
-//! of `K` both keeps every constraint (`Br ≥ 0`: it moves away from the obstacle) and
-//! costs the load nothing (`Fᵀr ≥ 0`): along such an `r` the energy falls without bound
-//! (`Fᵀr > 0`, no solution) or stays flat (`Fᵀr = 0`, not unique). This is the
+//! energy `½UᵀAU − FᵀU` on `{BU ≥ G}` has a minimizer, unique along `K`, only if no
+//! motion `r ≠ 0` of `K` both keeps every constraint (`Br ≥ 0`: it moves away from the
+//! obstacle) and costs the load nothing (`Fᵀr ≥ 0`): along such an `r` the energy falls
+//! without bound (`Fᵀr > 0`, no solution) or stays flat (`Fᵀr = 0`, not unique). (The
+//! condition is necessary, not sufficient: a contact set of one P0 cell leaves the tilts
+//! about it free.) This is the
 //! compatibility condition of semicoercive variational inequalities (Fichera; Kinderlehrer
 //! and Stampacchia, *An Introduction to Variational Inequalities*, ch. II; for contact,
 //! Kikuchi and Oden, *Contact Problems in Elasticity*, §6.4). Without an obstacle, any
@@ -24,6 +26,10 @@
 //! projection with `S A S`: a Ritz value below [`ZERO_ENERGY`] is a motion without
 //! energy. The Jacobi scaling makes the test blind to the units of the DOFs (Argyris'
 //! second derivatives are `h²` smaller than its values).
+//!
+//! A body the obstacle alone holds ([`Held::ByObstacle`]) starts pressed onto it
+//! ([`pressed_start`]), and its answer is checked by the balance of the load on `K`
+//! ([`unbalanced_work`]); `crate::problem` does both.
 
 use super::cholesky::{multiply, Cholesky};
 use super::Lcp;
