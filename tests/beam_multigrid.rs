@@ -9,7 +9,6 @@
 mod beams;
 
 use fem_forms::element::interval::PhysicalBasis;
-use fem_forms::lcp::LcpSolution;
 use fem_forms::models::report::Settings;
 use fem_forms::norms::FieldView;
 use fem_forms::obstacle::hierarchy::{interval_primal_prolongation, LinearSolver};
@@ -18,22 +17,6 @@ use fem_forms::obstacle::Discretization;
 /// The problem of `name` with `pair` on `elements` elements at q = 1 (α = 1).
 fn discretize(name: &str, pair: &str, elements: usize) -> Discretization {
     beams::discretize(name, pair, elements, 1.0, 1.0).unwrap()
-}
-
-/// The full coefficient vector of the primal unknowns `u` (multipliers zero).
-fn full(d: &Discretization, u: Vec<f64>) -> Vec<f64> {
-    d.full(&LcpSolution {
-        u,
-        lambda: vec![0.0; d.lcp.m()],
-        iterations: 0,
-        kkt_residual: 0.0,
-        seconds: 0.0,
-        factorizations: 0,
-        low_rank_updates: 0,
-        multiplier_noise: 0.0,
-        iterative_steps: 0,
-        krylov_iterations: 0,
-    })
 }
 
 /// Value and slope of every primal field of `values` at `x`, on `d`'s mesh.
@@ -71,8 +54,9 @@ fn the_prolongation_reproduces_every_coarse_function_with_its_slope() {
         for j in 0..coarse.lcp.n() {
             let mut unit = vec![0.0; coarse.lcp.n()];
             unit[j] = 1.0;
-            let coarse_values = full(&coarse, unit);
-            let fine_values = full(&fine, (0..fine.lcp.n()).map(|i| dense[(i, j)]).collect());
+            let coarse_values = coarse.full_of_primal(unit);
+            let fine_values =
+                fine.full_of_primal((0..fine.lcp.n()).map(|i| dense[(i, j)]).collect());
             // points inside cells of both meshes (slopes of P1/P2 jump at vertices)
             for k in 0..64 {
                 let x = (k as f64 + 0.37) / 64.0;

@@ -731,6 +731,22 @@ impl<G> Discretization<G> {
             .collect()
     }
 
+    /// [`Discretization::full`] of the primal unknowns `u` with every multiplier 0.
+    pub fn full_of_primal(&self, u: Vec<f64>) -> Vec<f64> {
+        self.full(&LcpSolution {
+            u,
+            lambda: vec![0.0; self.lcp.m()],
+            iterations: 0,
+            kkt_residual: 0.0,
+            seconds: 0.0,
+            factorizations: 0,
+            low_rank_updates: 0,
+            multiplier_noise: 0.0,
+            iterative_steps: 0,
+            krylov_iterations: 0,
+        })
+    }
+
     /// The full coefficient vector (all fields, boundary values included, Cartesian
     /// DOFs: mapped back from the primed ones of [`Discretization::basis`]) of an LCP
     /// solution: the DOFs of `dofs`, followed on a boundary part by the multiplier's.

@@ -1695,20 +1695,7 @@ fn check_balanced<M: Model, G: Domain>(
     solution: &ObstacleSolution<G>,
 ) -> Result<()> {
     let fine = &solution.discretization;
-    let expand = |u: Vec<f64>| {
-        checked.full(&crate::lcp::LcpSolution {
-            u,
-            lambda: vec![0.0; checked.lcp.m()],
-            iterations: 0,
-            kkt_residual: 0.0,
-            seconds: 0.0,
-            factorizations: 0,
-            low_rank_updates: 0,
-            multiplier_noise: 0.0,
-            iterative_steps: 0,
-            krylov_iterations: 0,
-        })
-    };
+    let expand = |u: Vec<f64>| checked.full_of_primal(u);
     // the motion alone: the fixed values (a support's data) subtracted
     let offset = expand(vec![0.0; checked.lcp.n()]);
     let motions: Vec<Vec<f64>> = basis
