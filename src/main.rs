@@ -118,6 +118,13 @@ struct SolveOptions {
     /// 1), the scale of a contact scene file's pressure.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_load)]
     load: Option<f64>,
+    /// The plate's bending and twisting moments and shear force along its boundary
+    /// (plates: the report's `edge_resultants`). Under --tol a Reissner–Mindlin mesh is
+    /// refined along its free and soft simply supported edges until it resolves the
+    /// rotations' boundary layer (width t/√(12κ)), and the Kirchhoff plate is weighed by
+    /// its error in these resultants too, not by its energy alone.
+    #[arg(long)]
+    edge_resultants: bool,
     /// Thickness t (Timoshenko beams and the Reissner–Mindlin plates; on a Kirchhoff
     /// scene, that of the Reissner–Mindlin plate it stands for: its modelling estimate,
     /// and that plate weighed by --tol or solved by --pair p1-p2-p0).

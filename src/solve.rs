@@ -39,6 +39,7 @@ impl SolveOptions {
             (self.tol.is_some(), Opt::Tol),
             (self.marking.is_some(), Opt::Marking),
             (self.theta.is_some(), Opt::Theta),
+            (self.edge_resultants, Opt::EdgeResultants),
         ];
         flags
             .into_iter()
@@ -275,6 +276,9 @@ pub fn solve_scene(mut scene: Scene, options: &SolveOptions, out: &Path) -> Resu
             return Err("--solver pdas does not apply with α = 0: the plain mixed method has C = 0, which leaves semismooth Newton nothing to eliminate the multiplier with; it is solved by clarabel".into());
         }
     }
+    if options.edge_resultants {
+        scene.edge_resultants = true;
+    }
     if let Some(name) = &options.support {
         let support = Support::parse(name).ok_or_else(|| {
             format!(
@@ -444,10 +448,13 @@ pub fn summary(r: &Report) -> String {
         ));
     }
     lines.extend(choice_lines(r));
+    lines.extend(edge_resultant_lines(r));
     let quantities: Vec<String> = r
         .quantities
         .iter()
-        .filter(|(k, v)| !v.is_null() && !CHOICE_KEYS.contains(&k.as_str()))
+        .filter(|(k, v)| {
+            !v.is_null() && !CHOICE_KEYS.contains(&k.as_str()) && k.as_str() != "edge_resultants"
+        })
         .map(|(k, v)| match v.as_f64() {
             Some(x) if !v.is_u64() && !v.is_i64() => format!("{k} {x:.8e}"),
             _ => format!("{k} {v}"),
@@ -457,6 +464,45 @@ pub fn summary(r: &Report) -> String {
         lines.push(format!("  {}", quantities.join(", ")));
     }
     lines.join("\n")
+}
+
+/// The summary of a plate's edge resultants (`edge_resultants`; its profile along the
+/// boundary is in the JSON report alone).
+fn edge_resultant_lines(r: &Report) -> Vec<String> {
+    let Some(e) = r.quantities.get("edge_resultants") else {
+        return Vec::new();
+    };
+    let number = |key: &str| {
+        e.get(key)
+            .and_then(serde_json::Value::as_f64)
+            .map_or("–".to_string(), |x| format!("{x:.4e}"))
+    };
+    let mut lines = vec![
+        format!(
+            "  edge resultants: max |M_nn| {}, max |M_ns| on free and soft edges {}, max |shear force| {}, ∫ shear force ds {}",
+            number("bending_moment_max"),
+            number("twisting_moment_max"),
+            number("shear_force_max"),
+            number("shear_force_integral")
+        ),
+        format!(
+            "    shear force: {} (the profile along the boundary: --json)",
+            e.get("shear_force_kind").and_then(|v| v.as_str()).unwrap_or("")
+        ),
+    ];
+    if e.get("layer_width").is_some_and(|v| !v.is_null()) {
+        let resolved = match e.get("layer_resolved").and_then(serde_json::Value::as_bool) {
+            Some(true) => "resolved",
+            Some(false) => "not resolved",
+            None => "not modelled (Kirchhoff)",
+        };
+        lines.push(format!(
+            "    boundary layer t/√(12κ) = {}: {resolved}, the longest edge along it {}",
+            number("layer_width"),
+            number("layer_longest_edge")
+        ));
+    }
+    lines
 }
 
 /// The report keys of the model choice ([`fem_forms::models::choice`]): summarized by

@@ -59,6 +59,7 @@ fn radial_by<M: Model>(
                 tolerance,
                 marking,
                 max_dofs: 200_000,
+                ..AdaptiveOptions::default()
             },
             |_| {},
         )
@@ -211,6 +212,7 @@ fn adaptive_errors_are_clear() {
         tolerance,
         marking: Marking::default(),
         max_dofs,
+        ..AdaptiveOptions::default()
     };
     let e = problem
         .solve_adaptive(options(-1.0, 1000), |_| {})
@@ -229,6 +231,62 @@ fn adaptive_errors_are_clear() {
     let mut seen = 0;
     let _ = problem.solve_adaptive(options(1e-6, 300), |_| seen += 1);
     assert!(seen >= 1);
+}
+
+/// A boundary layer given to the loop is resolved whatever the estimate: at a tolerance
+/// the first mesh already meets, the loop goes on refining along the layer's edges
+/// (marker 1, y = −2) until they are no longer than its width, and nowhere else; a limit
+/// too small for it says how many of its cells are still too long.
+#[test]
+fn a_boundary_layer_is_refined_to_its_width_whatever_the_estimate() {
+    use fem_forms::adaptivity::BoundaryLayer;
+    let mesh = TriangleMesh::rectangle(-2.0, 2.0, -2.0, 2.0, 8, 8, Diagonal::Right).unwrap();
+    let problem = Problem::<membrane_p1_p0::Model, TriangleMesh>::new(vec![mesh])
+        .data("f", &zero)
+        .data("ψ", &radial_obstacle)
+        .data("g", &radial_u)
+        .boundary_data(DirichletPart::All);
+    let layer = BoundaryLayer {
+        width: 0.05,
+        markers: vec![1],
+    };
+    let options = |max_dofs| AdaptiveOptions {
+        tolerance: 0.9,
+        max_dofs,
+        boundary_layer: Some(layer.clone()),
+        ..AdaptiveOptions::default()
+    };
+    let plain = problem
+        .solve_adaptive(
+            AdaptiveOptions {
+                tolerance: 0.9,
+                ..AdaptiveOptions::default()
+            },
+            |_| {},
+        )
+        .unwrap();
+    let solved = problem.solve_adaptive(options(100_000), |_| {}).unwrap();
+    assert!(solved.report.adaptive_levels.len() > plain.report.adaptive_levels.len());
+    let longest = |mesh: &TriangleMesh| {
+        let mut longest = [0.0f64; 5];
+        for &(e, marker) in mesh.boundary_edges() {
+            let [a, b] = mesh.edges()[e].map(|v| mesh.vertices()[v]);
+            let m = marker as usize;
+            longest[m] = longest[m].max((b[0] - a[0]).hypot(b[1] - a[1]));
+        }
+        longest
+    };
+    let (before, after) = (longest(plain.mesh()), longest(solved.mesh()));
+    println!("longest boundary edge per marker: {before:?} without the layer, {after:?} with it");
+    assert!(before[1] > 0.05 && after[1] <= 0.05, "{after:?}");
+    // the opposite edge (marker 3) no finer than the estimate alone made it
+    assert!(after[3] >= before[3], "{after:?}");
+    let message = problem
+        .solve_adaptive(options(400), |_| {})
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(message.contains("longer than its width 0.05"), "{message}");
 }
 
 /// A solution held at zero (membrane-flat: u = 0, λ = q) has a norm of rounding size: a
@@ -355,6 +413,7 @@ mod kirchhoff {
                     tolerance,
                     marking: Marking::default(),
                     max_dofs: 100_000,
+                    ..AdaptiveOptions::default()
                 },
                 |_| {},
             )

@@ -119,7 +119,11 @@ pub fn solve(scene: &Scene, settings: &Settings) -> Result<Outcome> {
     if let Some((scene, settings)) = families::richer_parameters_moved(scene, settings) {
         return solve(&scene, &settings);
     }
-    let tolerance = settings.adaptive.map(|a| a.tolerance).or(scene.tolerance);
+    let tolerance = settings
+        .adaptive
+        .as_ref()
+        .map(|a| a.tolerance)
+        .or(scene.tolerance);
     if let Some(pair) = settings.pair.as_deref() {
         if let Some(outcome) = solve_neighbour(scene, settings, pair)? {
             return Ok(outcome);
@@ -363,7 +367,7 @@ pub fn choose(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Outc
                         } else {
                             tolerance
                         },
-                        ..settings.adaptive.unwrap_or_default()
+                        ..settings.adaptive.clone().unwrap_or_default()
                     }),
                     ..candidate_settings(settings, &scenes[best], own[best])
                 };
@@ -572,11 +576,22 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
             own.push(k == 0);
             match probe(model_scene, pair.name, settings, sizes, k == 0) {
                 Ok((probe, modelling, finer)) => {
-                    let candidate =
+                    let mut candidate =
                         judge(words, model_scene, pair.name, probe, modelling, tolerance);
-                    // a probe that already reaches the target is the answer, if chosen
+                    let report = &finer.outcome.report;
+                    if let Some(edge) = report.number("modelling_estimate_edge") {
+                        if model_scene.edge_resultants && edge > MODEL_SHARE * tolerance {
+                            candidate.note = format!(
+                                "the scene asks for the edge resultants, and the twisting moment of this model on the edges that leave the Reissner–Mindlin rotations free (where the Reissner–Mindlin one vanishes) is {edge:.3e} of its edge moments, above {MODEL_SHARE} of the tolerance {}",
+                                fem_runtime::problem::number(tolerance)
+                            );
+                        }
+                    }
+                    // a probe that already reaches the target is the answer, if chosen,
+                    // unless it leaves a boundary layer asked about unresolved
                     let reached = candidate.adequate
-                        && candidate.probe[1].estimate_relative <= candidate.discretization_target;
+                        && candidate.probe[1].estimate_relative <= candidate.discretization_target
+                        && !report.layer_unresolved();
                     finished.push(reached.then_some(finer));
                     candidates.push(candidate);
                 }
@@ -667,6 +682,13 @@ fn probe(
                 .report
                 .number("modelling_estimate_relative")
                 .unwrap_or(f64::NAN);
+            if scene.edge_resultants {
+                // the edge resultants asked for: the thinner model's error in them too
+                modelling = match outcome.report.number("modelling_estimate_edge") {
+                    Some(edge) => modelling.max(edge),
+                    None => f64::NAN,
+                };
+            }
         }
         levels.push(ProbeLevel {
             mesh_size: n,

@@ -53,11 +53,13 @@ pub enum Opt {
     Marking,
     /// `--theta θ`: the marking parameter.
     Theta,
+    /// `--edge-resultants`: a plate's moments and shear force along its boundary.
+    EdgeResultants,
 }
 
 impl Opt {
     /// Every option.
-    pub const ALL: [Opt; 19] = [
+    pub const ALL: [Opt; 20] = [
         Opt::Elements,
         Opt::MeshSize,
         Opt::Msh,
@@ -77,6 +79,7 @@ impl Opt {
         Opt::Tol,
         Opt::Marking,
         Opt::Theta,
+        Opt::EdgeResultants,
     ];
 
     /// Its spelling on the command line.
@@ -101,6 +104,7 @@ impl Opt {
             Opt::Tol => "--tol",
             Opt::Marking => "--marking",
             Opt::Theta => "--theta",
+            Opt::EdgeResultants => "--edge-resultants",
         }
     }
 }

@@ -76,6 +76,18 @@ pub trait Geometry: MeshKind {
 
     /// The sampled fields of a solution for charts and ParaView.
     fn fields<M: Model>(solution: &ObstacleSolution<Self>, psi: &DataFn) -> Fields;
+
+    /// The mesh as straight triangles, where it is one (not an interval mesh, not curved
+    /// cells): what boundary resultants are evaluated on.
+    fn straight(&self) -> Option<&TriangleMesh> {
+        None
+    }
+
+    /// A view of `field` of a solution on straight triangles ([`Geometry::straight`]).
+    fn straight_view(solution: &ObstacleSolution<Self>, field: usize) -> Option<TriangleField<'_>> {
+        let _ = (solution, field);
+        None
+    }
 }
 
 /// The fields of a solved scene, sampled for output.
@@ -240,6 +252,14 @@ impl Geometry for IntervalMesh {
 }
 
 impl Geometry for TriangleMesh {
+    fn straight(&self) -> Option<&TriangleMesh> {
+        Some(self)
+    }
+
+    fn straight_view(solution: &ObstacleSolution<Self>, field: usize) -> Option<TriangleField<'_>> {
+        Some(solution.view(field))
+    }
+
     fn levels(
         domain: &Domain,
         n: usize,

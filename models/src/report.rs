@@ -201,6 +201,20 @@ impl Report {
         self.quantities.get(key).and_then(serde_json::Value::as_f64)
     }
 
+    /// A family quantity as it was set (`None` where absent).
+    pub fn quantity(&self, key: &str) -> Option<&serde_json::Value> {
+        self.quantities.get(key)
+    }
+
+    /// Whether the solve's mesh leaves a boundary layer the scene asks about unresolved
+    /// (`edge_resultants.layer_resolved` false).
+    pub fn layer_unresolved(&self) -> bool {
+        self.quantity("edge_resultants")
+            .and_then(|r| r.get("layer_resolved"))
+            .and_then(serde_json::Value::as_bool)
+            == Some(false)
+    }
+
     /// Adds a warning.
     pub fn warn(&mut self, warning: impl Into<String>) {
         self.solve.warnings.push(warning.into());

@@ -9,7 +9,7 @@ use crate::family::Pair;
 use crate::geometry::{Fields, Geometry};
 pub use crate::report::{Outcome, Phases, Profile, Report, Schur, Settings, MAX_REFINEMENT_STEPS};
 use crate::scene::{ExactSolution, Part, Posed, Scene, Support};
-use fem_runtime::adaptivity::AdaptiveOptions;
+use fem_runtime::adaptivity::{AdaptiveOptions, BoundaryLayer};
 use fem_runtime::lcp::NewtonOptions;
 use fem_runtime::obstacle::{FirstStart, ObstacleOptions};
 use fem_runtime::problem::memory::check_memory;
@@ -87,6 +87,14 @@ pub trait Quantities<G: Geometry>: 'static {
     /// its foundation); `None`: from zero.
     fn start(scene: &Scene, posed: &Posed) -> Option<Box<FirstStart<'static, G>>> {
         let _ = (scene, posed);
+        None
+    }
+
+    /// A boundary layer an adaptive solve of `scene` on `mesh` must resolve besides its
+    /// tolerance (a quantity the scene asks for along the boundary varies across it);
+    /// `None` by default.
+    fn boundary_layer(scene: &Scene, posed: &Posed, mesh: &G) -> Option<BoundaryLayer> {
+        let _ = (scene, posed, mesh);
         None
     }
 
@@ -232,11 +240,17 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
         problem = problem.exact(fns.exact());
     }
     let cells = finest.cell_count();
-    let adaptive = settings.adaptive.or_else(|| {
+    let adaptive = settings.adaptive.clone().or_else(|| {
         scene.tolerance.map(|tolerance| AdaptiveOptions {
             tolerance,
             ..AdaptiveOptions::default()
         })
+    });
+    let adaptive = adaptive.map(|mut options| {
+        if options.boundary_layer.is_none() {
+            options.boundary_layer = Q::boundary_layer(scene, &posed, &finest);
+        }
+        options
     });
     let solved = match adaptive {
         Some(options) => problem.solve_adaptive(options, |level| {

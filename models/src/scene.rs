@@ -445,6 +445,11 @@ pub struct Scene {
     /// that model's parameters (its thickness `t`), from which the solve estimates the
     /// modelling error.
     pub richer: Option<Vec<(Name, f64)>>,
+    /// Whether the scene asks for a plate's stress resultants along its boundary
+    /// ([`crate::families::edge_resultants`]): the report then gives them, the
+    /// Reissner–Mindlin mesh of a tolerance resolves the boundary layer, and the model
+    /// choice weighs the Kirchhoff plate's error in them.
+    pub edge_resultants: bool,
 }
 
 impl fmt::Debug for Scene {
@@ -517,6 +522,7 @@ impl Scene {
             reference: None,
             file_keys: Vec::new(),
             richer: None,
+            edge_resultants: false,
         }
     }
 

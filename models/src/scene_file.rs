@@ -363,6 +363,9 @@ struct FileToml {
     accuracy: Option<f64>,
     /// Solve adaptively to this tolerance relative to the solution's energy norm.
     tol: Option<f64>,
+    /// Plates: report the moments and shear force along the boundary (and resolve the
+    /// Reissner–Mindlin boundary layer under `tol`).
+    edge_resultants: Option<bool>,
     /// Which side of the structure the obstacle is on: "below" (the default) or "above".
     obstacle_side: Option<String>,
     mesh: MeshToml,
@@ -643,6 +646,21 @@ pub fn read_scene(text: &str, path: &Path, family: &dyn Family) -> Result<FileSc
             )));
         }
         scene.tolerance = Some(tol);
+    }
+    if file.edge_resultants == Some(true) {
+        if !family
+            .options()
+            .contains(&crate::family::Opt::EdgeResultants)
+        {
+            return Err(at((
+                "edge_resultants".into(),
+                format!(
+                    "the {} family has no edge resultants: they are a plate's moments and shear force along its boundary (families plate and kirchhoff)",
+                    family.name()
+                ),
+            )));
+        }
+        scene.edge_resultants = true;
     }
     if let Some(pair) = &file.pair {
         // a neighbour model's pair (a Kirchhoff file's thickness takes p1-p2-p0) solves

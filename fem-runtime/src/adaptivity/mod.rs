@@ -44,7 +44,7 @@ pub struct AdaptiveLevel {
 }
 
 /// How [`crate::problem::Problem::solve_adaptive`] refines.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct AdaptiveOptions {
     /// Stop when `(η² + S²)^{1/2} ≤ tolerance · ‖u_h‖_a`.
     pub tolerance: f64,
@@ -53,6 +53,10 @@ pub struct AdaptiveOptions {
     /// Refuse to solve a level with more unknowns than this (the loop then fails with
     /// how far it got).
     pub max_dofs: usize,
+    /// A boundary layer the mesh must resolve whatever the estimate says: the loop also
+    /// refines the cells on its boundary edges until they are no longer than its width,
+    /// and stops only when both the tolerance is met and the layer is resolved.
+    pub boundary_layer: Option<BoundaryLayer>,
 }
 
 impl Default for AdaptiveOptions {
@@ -61,8 +65,22 @@ impl Default for AdaptiveOptions {
             tolerance: 1e-2,
             marking: Marking::default(),
             max_dofs: 2_000_000,
+            boundary_layer: None,
         }
     }
+}
+
+/// A boundary layer to resolve: a quantity asked for on the boundary (a Reissner–Mindlin
+/// plate's twisting moment and shear force along an edge where its rotations are free)
+/// varies across a strip of width `width` along the boundary edges of `markers`, which
+/// an energy estimate, its share of the energy being small, does not refine for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoundaryLayer {
+    /// The layer's width (length units of the mesh): the longest boundary edge allowed
+    /// on its part of the boundary (a Reissner–Mindlin plate's `t/√(12κ)`).
+    pub width: f64,
+    /// The boundary markers of the edges it lies along.
+    pub markers: Vec<u32>,
 }
 
 /// A discrete solution's a-posteriori estimate.

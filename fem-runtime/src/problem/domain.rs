@@ -175,6 +175,19 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
         ))
     }
 
+    /// The cells with a boundary edge of one of `markers` longer than `width`: those a
+    /// boundary layer of that width ([`crate::adaptivity::BoundaryLayer`]) still wants
+    /// refined.
+    ///
+    /// # Errors
+    /// Meshes without boundary edges to refine along (the default: intervals).
+    fn cells_coarser_than_layer(&self, markers: &[u32], width: f64) -> Result<Vec<usize>> {
+        let _ = (markers, width);
+        Err(Error::Input(
+            "a boundary layer is resolved on affine triangle meshes".into(),
+        ))
+    }
+
     /// The values of `field` of a solution at the mesh vertices.
     fn field_at_vertices(solution: &ObstacleSolution<Self>, field: usize) -> Vec<f64>;
 
@@ -652,6 +665,22 @@ impl Domain for TriangleMesh {
 
     fn refine_marked(&self, marked: &[usize]) -> Result<Self> {
         Ok(self.refine(marked)?.0)
+    }
+
+    fn cells_coarser_than_layer(&self, markers: &[u32], width: f64) -> Result<Vec<usize>> {
+        let mut cells: Vec<usize> = self
+            .boundary_edges()
+            .iter()
+            .filter(|(_, marker)| markers.contains(marker))
+            .filter(|&&(e, _)| {
+                let [a, b] = self.edges()[e].map(|v| self.vertices()[v]);
+                (b[0] - a[0]).hypot(b[1] - a[1]) > width
+            })
+            .map(|&(e, _)| self.edge_cells(e).0)
+            .collect();
+        cells.sort_unstable();
+        cells.dedup();
+        Ok(cells)
     }
 
     fn boundary_contact_cells(solution: &ObstacleSolution<Self>) -> Option<(Vec<f64>, Vec<f64>)> {

@@ -572,7 +572,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// Solves adaptively to a tolerance: solve → estimate → mark → refine → solve again
     /// from the previous solution ([`Problem::solve_refining`]), from the problem's
     /// finest mesh, until the estimate `(η² + S²)^{1/2}` is at most
-    /// `options.tolerance · ‖u_h‖_a`. `progress` sees every level as it is done. The
+    /// `options.tolerance · ‖u_h‖_a` and the cells along `options.boundary_layer`, where
+    /// one is given, are no longer than its width. `progress` sees every level as it is done. The
     /// report lists the levels (`adaptive_levels`) and carries the last level's estimate.
     ///
     /// # Errors
@@ -624,18 +625,34 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             };
             progress(&level);
             levels.push(level);
-            if level.estimate <= tolerance * level.energy_norm {
+            let met = level.estimate <= tolerance * level.energy_norm;
+            let layer_cells = match &options.boundary_layer {
+                Some(layer) => current
+                    .mesh()
+                    .cells_coarser_than_layer(&layer.markers, layer.width)?,
+                None => Vec::new(),
+            };
+            if met && layer_cells.is_empty() {
                 return Ok(None);
             }
             stopped = true;
             let reached = |why: String| {
+                let layer = match &options.boundary_layer {
+                    Some(layer) if !layer_cells.is_empty() => format!(
+                        "; {} cells along the boundary layer are still longer than its width {}",
+                        layer_cells.len(),
+                        number(layer.width)
+                    ),
+                    _ => String::new(),
+                };
                 Error::Input(format!(
-                    "{why}: the estimate is {} of ‖u_h‖_a = {} after {} levels ({} cells, {} unknowns), above the tolerance {}",
+                    "{why}: the estimate is {} of ‖u_h‖_a = {} after {} levels ({} cells, {} unknowns), {} the tolerance {}{layer}",
                     number(level.estimate / level.energy_norm),
                     number(level.energy_norm),
                     levels.len(),
                     level.cells,
                     level.dofs,
+                    if met { "within" } else { "above" },
                     number(tolerance)
                 ))
             };
@@ -643,17 +660,29 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             // rounding size, which no refinement makes the estimate small against; an
             // exact 0 is a mesh without free unknowns (a first mesh of one cell per
             // corner), which refinement gives some
-            if level.energy_norm > 0.0 && level.estimate > VANISHING_SOLUTION * level.energy_norm {
+            if !met
+                && level.energy_norm > 0.0
+                && level.estimate > VANISHING_SOLUTION * level.energy_norm
+            {
                 return Err(reached(format!(
                     "‖u_h‖_a is {} against an estimate of {}: the solution is zero up to rounding (the obstacle or the supports hold it there), so no refinement meets a tolerance relative to it",
                     number(level.energy_norm),
                     number(level.estimate)
                 )));
             }
-            let marked = options.marking.mark(&estimate.indicators)?;
-            if marked.is_empty() {
+            let mut marked = if met {
+                Vec::new()
+            } else {
+                options.marking.mark(&estimate.indicators)?
+            };
+            if marked.is_empty() && layer_cells.is_empty() {
                 return Err(reached("no cell has a positive indicator to refine".into()));
             }
+            // the layer's cells besides the estimate's: its share of the energy is too
+            // small for Dörfler marking to reach its width
+            marked.extend(&layer_cells);
+            marked.sort_unstable();
+            marked.dedup();
             // bisecting a marked cell twice at most, with the closure: about 2–3 new
             // unknowns per marked cell; the next level's size is estimated before it is made
             let predicted = level.dofs + 3 * marked.len() * (level.dofs / level.cells.max(1)).max(1);

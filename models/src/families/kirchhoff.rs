@@ -5,13 +5,13 @@
 //! patch-averaged (the cure of the Argyris multiplier's scatter).
 
 use crate::data::Data;
+use crate::families::edge_resultants;
 use crate::family::{Family, Opt, Pair, PairSolve};
-use crate::geometry::Geometry;
 use crate::geometry::{halving_sizes, Fields};
 use crate::kirchhoff::{kirchhoff_argyris_p0, kirchhoff_argyris_p1disc, kirchhoff_morley_p0};
 use crate::run::{run, Quantities, Report, Run};
 use crate::scene::{Adjustment, Domain, Load, Part, Posed, Scene, StudyVariant, Support};
-use fem_runtime::element::triangle::{AffineMap, TriangleBasis};
+use fem_runtime::element::triangle::{AffineMap, TriangleBasis, TriangleField};
 use fem_runtime::problem::{MemoryModel, ObstacleSide};
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{Error, Model, Result, TriangleMesh};
@@ -212,6 +212,7 @@ impl Family for KirchhoffPlates {
             Opt::Tol,
             Opt::Marking,
             Opt::Theta,
+            Opt::EdgeResultants,
         ]
     }
 
@@ -502,6 +503,9 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
         }
         let w = run.constrained_field();
         let view = solution.view(w);
+        if run.scene.edge_resultants {
+            add_edge_resultants(run, &view, report);
+        }
         let basis = TriangleBasis::new(view.map.element());
         report.set("max_deflection", max_deflection(&view, &basis));
         if let Some(centre) = run.scene.domain.centre() {
@@ -856,6 +860,45 @@ pub fn interior_statistics(
     })
 }
 
+/// The edge resultants of a Kirchhoff solve ([`edge_resultants::kirchhoff`]) and, where
+/// the scene has a thickness, their modelling estimate `modelling_estimate_edge`
+/// ([`edge_resultants::twisting_share`]); a warning for elements without third
+/// derivatives.
+fn add_edge_resultants<M: Model>(
+    run: &Run<'_, M, TriangleMesh>,
+    view: &TriangleField<'_>,
+    report: &mut Report,
+) {
+    let own = |name: &str| {
+        M::PARAMS
+            .iter()
+            .position(|p| *p == name)
+            .map(|k| run.solved.params[k])
+    };
+    let (Some(d), Some(nu)) = (own("D"), own("ν")) else {
+        return;
+    };
+    if view.map.element().degree() < 3 {
+        report.warn(format!(
+            "{} gives no edge resultants (its shear force −D∇Δw vanishes on every cell and its moments are constant per cell); argyris-p0 gives them",
+            run.pair.name
+        ));
+        return;
+    }
+    let layered = edge_resultants::rotations_free_markers(run.scene, view.mesh);
+    let layer = run.scene.richer_parameter("t").map(|t| {
+        edge_resultants::layer_width(t, run.scene.richer_parameter("κ").unwrap_or(5.0 / 6.0))
+    });
+    let resultants = edge_resultants::kirchhoff(view, d, nu, &layered, layer);
+    if run.scene.richer.is_some() {
+        report.set(
+            "modelling_estimate_edge",
+            edge_resultants::twisting_share(&resultants, &layered),
+        );
+    }
+    report.set("edge_resultants", resultants);
+}
+
 /// The modelling error of a Kirchhoff deflection as a Reissner–Mindlin plate whose
 /// parameters `richer` holds (thickness `t`, shear correction `κ`), as
 /// `[interior, layer]` in the energy norm.
@@ -906,25 +949,11 @@ fn modelling_estimate<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Option<[f64; 
     }
     let interior = t * (d / (6.0 * kappa * (1.0 - nu))).sqrt() * shear.sqrt();
 
-    // the support that holds each boundary edge: the last whose part holds its marker
-    let parts: Vec<(fem_runtime::DirichletPart, Support)> = run
-        .scene
-        .supports
-        .iter()
-        .filter_map(|s| Some((Geometry::part(mesh, &s.part).ok()?, s.support)))
-        .collect();
-    let rotations_free =
-        |marker: u32| match parts.iter().rev().find(|(part, _)| part.contains(marker)) {
-            None => true,
-            Some((_, support)) => matches!(
-                support,
-                Support::Free | Support::SimplySupported { hard: false }
-            ),
-        };
+    let layered = edge_resultants::rotations_free_markers(run.scene, mesh);
     let line = fem_runtime::gauss_legendre(4);
     let mut twisting = 0.0;
     for &(e, marker) in mesh.boundary_edges() {
-        if !rotations_free(marker) {
+        if !layered.contains(&marker) {
             continue;
         }
         let (c, _) = mesh.edge_cells(e);
@@ -942,7 +971,7 @@ fn modelling_estimate<M: Model>(run: &Run<'_, M, TriangleMesh>) -> Option<[f64; 
             twisting += weight * length * m * m;
         }
     }
-    let delta = t / (12.0 * kappa).sqrt();
+    let delta = edge_resultants::layer_width(t, kappa);
     let layer = (2.0 * delta * d * (1.0 - nu) * twisting).sqrt();
     Some([interior, layer])
 }

@@ -3,6 +3,7 @@
 
 pub mod beam;
 pub mod contact;
+pub mod edge_resultants;
 pub mod kirchhoff;
 pub mod membrane;
 pub mod plate;

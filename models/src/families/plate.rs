@@ -5,12 +5,14 @@
 //! deflection's integral, the contact radius and λ_h over the contact interior, and the
 //! warnings of locking and of the soft simple support's boundary layer.
 
+use crate::families::edge_resultants::{self, MindlinParameters};
 use crate::family::{Family, Opt, Pair, PairSolve};
 use crate::geometry::{halving_sizes, Fields, Geometry};
 use crate::mindlin::{mindlin_plain_p1, mindlin_stenberg};
 use crate::plate_scenes::{self, PlateDomain, PlateReference, PlateSupport};
 use crate::run::{run_on_triangles, Quantities, Report, Run};
 use crate::scene::{Domain, Load, Part, Posed, Scene, Support};
+use fem_runtime::adaptivity::BoundaryLayer;
 use fem_runtime::mesh::triangle::PointLocator;
 use fem_runtime::problem::{MemoryModel, ObstacleSide};
 use fem_runtime::stabilization::Alpha;
@@ -196,6 +198,7 @@ impl Family for Plates {
             Opt::Tol,
             Opt::Marking,
             Opt::Theta,
+            Opt::EdgeResultants,
         ]
     }
 
@@ -442,6 +445,56 @@ pub fn cold_coarsest_warning(sizes: &[usize], coarsest: usize) -> Option<String>
     })
 }
 
+/// The edge resultants of a Reissner–Mindlin solve ([`edge_resultants::mindlin`]), with a
+/// warning where its mesh does not resolve the boundary layer.
+fn add_edge_resultants<M: Model, G: Geometry>(run: &Run<'_, M, G>, report: &mut Report) {
+    let solution = &run.solved.solution;
+    let field = |name: &str| M::FIELDS.iter().position(|f| f.name == name);
+    let param = |name: &str| {
+        M::PARAMS
+            .iter()
+            .position(|p| *p == name)
+            .map(|k| run.solved.params[k])
+    };
+    let views = (|| {
+        let mesh = run.solved.mesh().straight()?;
+        let [tx, ty, w] = [field("θ_x")?, field("θ_y")?, field("w")?];
+        Some((
+            mesh,
+            G::straight_view(solution, tx)?,
+            G::straight_view(solution, ty)?,
+            G::straight_view(solution, w)?,
+        ))
+    })();
+    let parameters = (|| {
+        Some(MindlinParameters {
+            d: param("D")?,
+            nu: param("ν")?,
+            kappa: param("κ")?,
+            t: param("t")?,
+            beta: param("β").unwrap_or(0.0),
+        })
+    })();
+    let (Some((mesh, tx, ty, w)), Some(p)) = (views, parameters) else {
+        report.warn("the edge resultants are evaluated on straight triangles: this mesh's curved cells give none");
+        return;
+    };
+    let layered = edge_resultants::rotations_free_markers(run.scene, mesh);
+    let resultants = edge_resultants::mindlin([&tx, &ty], &w, p, &layered);
+    if let (Some(false), Some(longest), Some(width)) = (
+        resultants.layer_resolved,
+        resultants.layer_longest_edge,
+        resultants.layer_width,
+    ) {
+        report.warn(format!(
+            "the edge resultants are not resolved: the boundary edges that leave the rotations free (soft simple supports, free edges) are up to {} long, the rotations' boundary layer {} = t/√(12κ) wide, where the twisting moment falls to 0 and the shear force gains −∂M_ns/∂s; solve with --tol, which refines along those edges to the layer's width",
+            fem_runtime::problem::number(longest),
+            fem_runtime::problem::number(width)
+        ));
+    }
+    report.set("edge_resultants", resultants);
+}
+
 /// The centre deflection's relative difference from Kirchhoff that the soft simple
 /// support's boundary layer adds, per unit of `t/L`: the layer of width O(t) where θ
 /// turns to satisfy the free moment makes the difference O(t), not O(t²) (the unit
@@ -480,6 +533,12 @@ impl<G: Geometry> Quantities<G> for Plates {
         Ok(())
     }
 
+    fn boundary_layer(scene: &Scene, posed: &Posed, mesh: &G) -> Option<BoundaryLayer> {
+        let t = posed.parameter("t")?;
+        let kappa = posed.parameter("κ").unwrap_or(5.0 / 6.0);
+        edge_resultants::boundary_layer(scene, mesh.straight()?, t, kappa)
+    }
+
     fn add<M: Model>(run: &Run<'_, M, G>, report: &mut Report) -> Result<()> {
         let posed = run.posed;
         let q = posed.load.unwrap_or(0.0);
@@ -487,6 +546,9 @@ impl<G: Geometry> Quantities<G> for Plates {
         let solution = &run.solved.solution;
         let w = run.constrained_field();
         report.set("thickness", t);
+        if run.scene.edge_resultants {
+            add_edge_resultants(run, report);
+        }
         report.set(
             "support",
             run.scene
