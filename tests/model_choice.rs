@@ -742,6 +742,52 @@ fn the_chosen_kirchhoff_plate_is_within_the_tolerance_of_navier() {
     }
 }
 
+#[test]
+fn the_chosen_winkler_plate_is_within_the_tolerance_of_navier() {
+    // winkler-square without its obstacle: the simply supported unit square (D = 1) on a
+    // foundation k = 100 under q = 1; Navier's series with the foundation,
+    // w = Σ a_mn sin mπx sin nπy, a_mn = 16 q / (π² m n (D π⁴ (m² + n²)² + k)), gives
+    // ∫w = Σ_{m,n odd} 64 q / (π⁴ m² n² (D π⁴ (m² + n²)² + k)) and ‖u‖_a² = q ∫w; the
+    // energy identity of the conforming Argyris solve, ‖u − u_h‖_a² = 2 (J_h − J)
+    let (pi, k) = (std::f64::consts::PI, 100.0);
+    let mut integral = 0.0;
+    for m in (1..4000).step_by(2) {
+        for n in (1..4000).step_by(2) {
+            let (m, n) = (m as f64, n as f64);
+            integral +=
+                64.0 / (pi.powi(4) * m * m * n * n * (pi.powi(4) * (m * m + n * n).powi(2) + k));
+        }
+    }
+    let exact_energy = -0.5 * integral;
+    for tolerance in [1e-2, 1e-3] {
+        let outcome = chosen(
+            &scene("winkler-square"),
+            tolerance,
+            Some(Adjustment::NoObstacle),
+        );
+        let energy = outcome.report.solve.energy.unwrap();
+        let error = (2.0 * (energy - exact_energy)).max(0.0).sqrt() / integral.sqrt();
+        println!(
+            "T = {tolerance:e}: {} with {} unknowns, true error {error:.3e}",
+            outcome.report.pair, outcome.report.solve.dofs
+        );
+        assert!(error <= tolerance, "T = {tolerance}: {error}");
+        // the identity holds: a solve's energy is above the exact one
+        assert!(energy >= exact_energy - 1e-15);
+    }
+}
+
+#[test]
+fn the_chosen_contact_pressure_is_the_patch_tests() {
+    // signorini-patch: the block under a uniform pressure q is compressed uniformly, and
+    // the exact contact pressure is q on every contact edge
+    let outcome = chosen(&scene("signorini-patch"), 5e-2, None);
+    let error = outcome.report.number("patch_pressure_error").unwrap();
+    println!("{}: pressure error {error:.3e}", outcome.report.pair);
+    assert!(error <= 5e-2 * 1.0, "{error}");
+    assert!((outcome.report.solve.total_contact_force - 2.0).abs() < 1e-9);
+}
+
 /// The hard simply supported unit square under q = 1 (D = 1, ν = 0.3, κ = 5/6) as a
 /// Reissner–Mindlin plate, exactly: for a polygonal plate with hard simple supports the
 /// Mindlin solution is the Kirchhoff one shifted by the Marcus moment,
