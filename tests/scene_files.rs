@@ -875,6 +875,46 @@ fn free_bodies_only_the_obstacle_holds_are_solved_in_equilibrium() {
     assert!((force - 40.0).abs() < 1e-8 * 40.0, "∫λ = {force}");
 }
 
+/// A free Kirchhoff plate pushed up against a flat obstacle above by a load with a
+/// moment: where the load's resultant meets the plate it lies flat on the obstacle with
+/// `λ = f` (balanced in force and moments), where it passes outside the plate there is
+/// no equilibrium and the problem is refused; the interior multiplier is compared with
+/// `q` only where the scene's load is uniform (a built-in scene), not with a file's `f`.
+#[test]
+fn a_free_plate_tipped_against_an_obstacle_above_is_balanced_or_refused() {
+    let text = |f: &str| {
+        format!("model = \"kirchhoff\"\nobstacle_side = \"above\"\n[mesh]\ngenerator = \"rectangle\"\nx = [0.0, 1.0]\nsize = 8\n[boundary]\nfree = \"all\"\n[parameters]\nD = 1.0\nnu = 0.3\n[data]\nload = 20.0\nf = \"{f}\"\npsi = \"0.05\"\n")
+    };
+    // resultant at x = 0.5 + 2/12: inside the plate
+    let file = scene_file::parse(&text("1 + 2*(x-0.5)"), Path::new("tipped.toml")).unwrap();
+    let (report, fields) = solve(&file).unwrap();
+    assert!((report.solve.total_contact_force - 20.0).abs() < 1e-9);
+    let Fields::Triangles { mesh, .. } = &fields else {
+        panic!("a plate is solved on triangles");
+    };
+    let moment: f64 = (0..mesh.cell_count())
+        .map(|c| {
+            let x = mesh.cell_coordinates(c);
+            lambda(&fields)[c] * mesh.area(c) * ((x[0] + x[2] + x[4]) / 3.0 - 0.5)
+        })
+        .sum();
+    // ∫ 20 (1 + 2(x − ½)) (x − ½) = 40/12
+    assert!(
+        (moment - 40.0 / 12.0).abs() < 1e-8,
+        "∫ λ (x − ½) = {moment}"
+    );
+    assert!(report.quantities["interior_multiplier"].is_null());
+    // resultant at x = 0.5 + 10/12: outside
+    let file = scene_file::parse(&text("1 + 10*(x-0.5)"), Path::new("tipped.toml")).unwrap();
+    let Err(e) = solve(&file) else {
+        panic!("a plate tipped off its obstacle was solved");
+    };
+    assert!(
+        e.to_string().contains("moves away from the obstacle"),
+        "{e}"
+    );
+}
+
 /// A membrane free on its whole boundary keeps the constants: pulled off its obstacle
 /// it has no solution (the nodal method returned an energy of −2.5e14 with exit 0),
 /// pressed onto it it lies on the obstacle with `∫λ = −∫f`; every pair alike.

@@ -540,7 +540,10 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 .map(|(_, v)| v.iter().map(|&s| s > 0.0).collect())
                 .unwrap_or_default();
             report.solve.contact_area = Some(filled_area(mesh, &contact));
-            let interior = if q > 0.0 {
+            // λ = q in the contact interior holds for the built-in scenes' uniform load
+            // and obstacles with Δ²ψ = 0 (their facts); a scene file's f and ψ make λ
+            // another function, against which q would report a false error
+            let interior = if q > 0.0 && facts.is_some() {
                 interior_cells(mesh, &contact)
             } else {
                 Vec::new()
@@ -564,7 +567,7 @@ impl Quantities<TriangleMesh> for KirchhoffPlates {
                 "interior_multiplier_twice_averaged",
                 statistics(MultiplierRecovery::TwicePatchAverage),
             );
-            if q > 0.0 {
+            if q > 0.0 && facts.is_some() {
                 report.set("multiplier_layer", layer_profile(solution, &contact, q));
             }
             let n = run.settings.mesh_size.unwrap_or(run.scene.mesh_size);
