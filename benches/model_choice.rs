@@ -22,7 +22,7 @@ struct Case {
     largest: usize,
 }
 
-const CASES: [Case; 7] = [
+const CASES: [Case; 8] = [
     Case {
         scene: "timoshenko-t1e-3",
         tolerance: [5e-2, 5e-2],
@@ -58,6 +58,12 @@ const CASES: [Case; 7] = [
         tolerance: [3e-2, 5e-2],
         start: 1,
         largest: 64,
+    },
+    Case {
+        scene: "winkler-square",
+        tolerance: [1e-2, 3e-2],
+        start: 4,
+        largest: 128,
     },
     Case {
         scene: "mindlin-ss-t1e-3",
