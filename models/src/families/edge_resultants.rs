@@ -175,6 +175,34 @@ fn boundary_edges(mesh: &TriangleMesh) -> impl Iterator<Item = Edge> + '_ {
     })
 }
 
+/// Samples every boundary edge of `mesh` at its midpoint: `at` gives the moment tensor
+/// and the shear force there (from the edge's cell and the midpoint's reference
+/// coordinates); also the longest edge among those of `layered`.
+fn sample(
+    mesh: &TriangleMesh,
+    layered: &[u32],
+    mut at: impl FnMut(&Edge, [f64; 2]) -> ([[f64; 2]; 2], f64),
+) -> (Profile, Option<f64>) {
+    let mut profile = Profile::default();
+    let mut longest: Option<f64> = None;
+    for edge in boundary_edges(mesh) {
+        let [a, b] = edge.ends;
+        let mid = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+        let (m, shear) = at(&edge, edge.map.reference_point(mid));
+        if layered.contains(&edge.marker) {
+            longest = Some(longest.unwrap_or(0.0).max(edge.length));
+        }
+        profile.x.push(mid[0]);
+        profile.y.push(mid[1]);
+        profile.marker.push(edge.marker);
+        profile.m_nn.push(bilinear(m, edge.normal, edge.normal));
+        profile.m_ns.push(bilinear(m, edge.normal, edge.tangent));
+        profile.shear_force.push(shear);
+        profile.length.push(edge.length);
+    }
+    (profile, longest)
+}
+
 fn bilinear(m: [[f64; 2]; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     (0..2)
         .map(|i| (0..2).map(|j| a[i] * m[i][j] * b[j]).sum::<f64>())
@@ -248,15 +276,9 @@ pub fn mindlin(
     p: MindlinParameters,
     layered: &[u32],
 ) -> EdgeResultants {
-    let mesh = w.mesh;
     let [bx, by] = theta.map(|f| TriangleBasis::new(f.map.element()));
     let bw = TriangleBasis::new(w.map.element());
-    let mut profile = Profile::default();
-    let mut longest: Option<f64> = None;
-    for edge in boundary_edges(mesh) {
-        let [a, b] = edge.ends;
-        let mid = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
-        let xi = edge.map.reference_point(mid);
+    let (profile, longest) = sample(w.mesh, layered, |edge, xi| {
         let (c, map) = (edge.cell, &edge.map);
         let (gx, gy) = (
             theta[0].gradient(&bx, map, c, xi),
@@ -264,26 +286,15 @@ pub fn mindlin(
         );
         let off = 0.5 * (gx[1] + gy[0]);
         let m = moment([[gx[0], off], [off, gy[1]]], p.d, p.nu);
-        let h = longest_edge(&mesh.cell_coordinates(c));
+        let h = w.mesh.cell_diameter(c);
         let weight = 6.0 * p.kappa * (1.0 - p.nu) * p.d / (p.t * p.t + p.beta * h * h);
         let g = w.gradient(&bw, map, c, xi);
         let q = [
             weight * (g[0] - theta[0].value(&bx, c, xi)),
             weight * (g[1] - theta[1].value(&by, c, xi)),
         ];
-        if layered.contains(&edge.marker) {
-            longest = Some(longest.unwrap_or(0.0).max(edge.length));
-        }
-        profile.x.push(mid[0]);
-        profile.y.push(mid[1]);
-        profile.marker.push(edge.marker);
-        profile.m_nn.push(bilinear(m, edge.normal, edge.normal));
-        profile.m_ns.push(bilinear(m, edge.normal, edge.tangent));
-        profile
-            .shear_force
-            .push(q[0] * edge.normal[0] + q[1] * edge.normal[1]);
-        profile.length.push(edge.length);
-    }
+        (m, q[0] * edge.normal[0] + q[1] * edge.normal[1])
+    });
     let width = layer_width(p.t, p.kappa);
     EdgeResultants {
         layer_width: Some(width),
@@ -305,14 +316,8 @@ pub fn kirchhoff(
     layered: &[u32],
     layer: Option<f64>,
 ) -> EdgeResultants {
-    let mesh = w.mesh;
     let basis = TriangleBasis::new(w.map.element());
-    let mut profile = Profile::default();
-    let mut longest: Option<f64> = None;
-    for edge in boundary_edges(mesh) {
-        let [a, b] = edge.ends;
-        let mid = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
-        let xi = edge.map.reference_point(mid);
+    let (profile, longest) = sample(w.mesh, layered, |edge, xi| {
         let (c, map) = (edge.cell, &edge.map);
         let m = moment(w.hessian(&basis, map, c, xi), d, nu);
         let third = w.third_derivatives(&basis, map, c, xi);
@@ -326,17 +331,8 @@ pub fn kirchhoff(
                 .zip(edge.normal)
                 .map(|(third_i, n)| n * bilinear(*third_i, edge.tangent, edge.tangent))
                 .sum::<f64>();
-        if layered.contains(&edge.marker) {
-            longest = Some(longest.unwrap_or(0.0).max(edge.length));
-        }
-        profile.x.push(mid[0]);
-        profile.y.push(mid[1]);
-        profile.marker.push(edge.marker);
-        profile.m_nn.push(bilinear(m, edge.normal, edge.normal));
-        profile.m_ns.push(bilinear(m, edge.normal, edge.tangent));
-        profile.shear_force.push(q_n - twist_slope);
-        profile.length.push(edge.length);
-    }
+        (m, q_n - twist_slope)
+    });
     EdgeResultants {
         layer_width: layer,
         layer_longest_edge: longest,
@@ -369,15 +365,4 @@ pub fn twisting_share(resultants: &EdgeResultants, layered: &[u32]) -> f64 {
     } else {
         0.0
     }
-}
-
-/// The longest edge of a triangle `[x₀, y₀, x₁, y₁, x₂, y₂]`: the `h_T` of the Stenberg
-/// weight.
-fn longest_edge(x: &[f64]) -> f64 {
-    (0..3)
-        .map(|k| {
-            let (a, b) = (k, (k + 1) % 3);
-            (x[2 * a] - x[2 * b]).hypot(x[2 * a + 1] - x[2 * b + 1])
-        })
-        .fold(0.0, f64::max)
 }
