@@ -194,6 +194,12 @@ struct SolveOptions {
     /// The marking parameter θ in (0, 1] (default 0.5).
     #[arg(long, allow_hyphen_values = true)]
     theta: Option<f64>,
+    /// The adaptive loop's limit on a level's unknowns (default 2000000): the loop stops
+    /// before a larger level with an error saying how far it got. Memory is about 2 KB
+    /// per unknown (a Reissner–Mindlin plate at t = 1e-4 with its edge layer resolved:
+    /// 2.3 million unknowns, 4.6 GB, 55 s). With --tol; the model choice predicts against it.
+    #[arg(long, value_name = "N")]
+    max_dofs: Option<usize>,
     /// Who solves the complementarity problems: native (default) or petsc (PETSc's SNES
     /// and SNESVI over MPI, in a binary built with `--features petsc`; run it as
     /// `mpirun -n N fem-forms solve SCENE --backend petsc`; docs/petsc.md).

@@ -145,8 +145,8 @@ fn adaptive_options(options: &SolveOptions) -> Result<Option<AdaptiveOptions>, S
         }
     };
     let Some(tolerance) = options.tol else {
-        if options.marking.is_some() || options.theta.is_some() {
-            return Err("--marking and --theta choose how the adaptive loop marks: give --tol T to solve adaptively".into());
+        if options.marking.is_some() || options.theta.is_some() || options.max_dofs.is_some() {
+            return Err("--marking, --theta and --max-dofs set the adaptive loop: give --tol T to solve adaptively".into());
         }
         return Ok(None);
     };
@@ -155,9 +155,17 @@ fn adaptive_options(options: &SolveOptions) -> Result<Option<AdaptiveOptions>, S
             "--tol {tolerance}: the tolerance is a relative error of the solution's energy norm, in (0, 1) (e.g. 1e-2)"
         ));
     }
+    let max_dofs = match options.max_dofs {
+        Some(0) => {
+            return Err("--max-dofs 0: the limit on a level's unknowns must be positive".into())
+        }
+        Some(n) => n,
+        None => AdaptiveOptions::default().max_dofs,
+    };
     Ok(Some(AdaptiveOptions {
         tolerance,
         marking,
+        max_dofs,
         ..AdaptiveOptions::default()
     }))
 }

@@ -225,7 +225,7 @@ fn adaptive_errors_are_clear() {
         .unwrap();
     let message = e.to_string();
     assert!(
-        message.contains("beyond the limit of 300") && message.contains("after"),
+        message.contains("beyond the adaptive loop's limit of 300") && message.contains("after"),
         "{message}"
     );
     let mut seen = 0;

@@ -959,6 +959,37 @@ fn adaptive_options_are_checked() {
             vec!["solve", "membrane-radial", "--tol", "0.1", "--theta", "2"],
             "(0, 1]",
         ),
+        (
+            vec!["solve", "membrane-radial", "--max-dofs", "100"],
+            "give --tol",
+        ),
+        (
+            vec![
+                "solve",
+                "membrane-radial",
+                "--tol",
+                "0.1",
+                "--max-dofs",
+                "0",
+            ],
+            "must be positive",
+        ),
+        // the limit stops the loop before a larger level, saying how far it got
+        (
+            vec![
+                "solve",
+                "membrane-lshape",
+                "--tol",
+                "1e-3",
+                "--mesh-size",
+                "4",
+                "--pair",
+                "p1-p0",
+                "--max-dofs",
+                "400",
+            ],
+            "beyond the adaptive loop's limit of 400",
+        ),
     ] {
         let run = fem_forms(&args, &out);
         let stderr = String::from_utf8_lossy(&run.stderr);

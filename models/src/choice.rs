@@ -571,13 +571,24 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
     let mut finished = Vec::new();
     let mut own = Vec::new();
     let mut first_failure = None;
+    let limit = settings
+        .adaptive
+        .as_ref()
+        .map_or(AdaptiveOptions::default().max_dofs, |a| a.max_dofs);
     for (k, (words, model_scene)) in models.iter().enumerate() {
         for pair in families::pairs_of(model_scene) {
             own.push(k == 0);
             match probe(model_scene, pair.name, settings, sizes, k == 0) {
                 Ok((probe, modelling, finer)) => {
-                    let mut candidate =
-                        judge(words, model_scene, pair.name, probe, modelling, tolerance);
+                    let mut candidate = judge(
+                        words,
+                        model_scene,
+                        pair.name,
+                        probe,
+                        modelling,
+                        tolerance,
+                        limit,
+                    );
                     let report = &finer.outcome.report;
                     if let Some(edge) = report.number("modelling_estimate_edge") {
                         if model_scene.edge_resultants && edge > MODEL_SHARE * tolerance {
@@ -724,6 +735,7 @@ fn judge(
     probe: Vec<ProbeLevel>,
     modelling: f64,
     tolerance: f64,
+    max_dofs: usize,
 ) -> Candidate {
     // a cheaper model whose modelling error alone exceeds T has nothing left to reach
     let target = (tolerance - modelling).max(0.0);
@@ -762,7 +774,7 @@ fn judge(
         return candidate;
     }
     let dofs = fine.dofs as f64 * (fine.estimate_relative / target).powf(1.0 / rate);
-    let limit = AdaptiveOptions::default().max_dofs as f64;
+    let limit = max_dofs as f64;
     candidate.predicted_dofs = Some(dofs);
     candidate.predicted_seconds =
         Some(fine.seconds * (dofs / fine.dofs as f64).powf(TIME_EXPONENT) * ADAPTIVE_OVERHEAD);

@@ -688,7 +688,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             let predicted = level.dofs + 3 * marked.len() * (level.dofs / level.cells.max(1)).max(1);
             if predicted > options.max_dofs {
                 return Err(reached(format!(
-                    "the next level would have about {predicted} unknowns, beyond the limit of {}",
+                    "the next level would have about {predicted} unknowns, beyond the adaptive loop's limit of {} (`AdaptiveOptions::max_dofs`; `--max-dofs` on the command line)",
                     options.max_dofs
                 )));
             }
