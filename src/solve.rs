@@ -502,12 +502,27 @@ fn edge_resultant_lines(r: &Report) -> Vec<String> {
         let resolved = match e.get("layer_resolved").and_then(serde_json::Value::as_bool) {
             Some(true) => "resolved",
             Some(false) => "not resolved",
+            // the Mindlin plate with every edge clamped or hard simply supported
+            None if e
+                .get("shear_force_kind")
+                .and_then(serde_json::Value::as_str)
+                .is_some_and(|k| k.starts_with("Q·n")) =>
+            {
+                "none (no edge leaves the rotations free)"
+            }
             None => "not modelled (Kirchhoff)",
         };
+        let longest = if e.get("layer_resolved").is_some_and(|v| !v.is_null()) {
+            format!(
+                ", the longest edge along it {}",
+                number("layer_longest_edge")
+            )
+        } else {
+            String::new()
+        };
         lines.push(format!(
-            "    boundary layer t/√(12κ) = {}: {resolved}, the longest edge along it {}",
-            number("layer_width"),
-            number("layer_longest_edge")
+            "    boundary layer t/√(12κ) = {}: {resolved}{longest}",
+            number("layer_width")
         ));
     }
     lines

@@ -258,3 +258,114 @@ fn edge_resultants_are_a_plates_and_need_third_derivatives_from_kirchhoff() {
         .iter()
         .any(|w| w.contains("gives no edge resultants")));
 }
+
+/// The Kirchhoff plate on the simply supported square, asked for its edge resultants,
+/// solved adaptively to `tolerance` from N = 4 (a mesh whose edges are stored in either
+/// order along the boundary).
+fn adaptive_kirchhoff_square(tolerance: f64, pair: Option<&str>) -> Outcome {
+    let mut square = asking(scene("kirchhoff-square"));
+    families::family("kirchhoff")
+        .unwrap()
+        .adjust(
+            &mut square,
+            &Adjustment::Support(Support::SimplySupported { hard: false }),
+        )
+        .unwrap();
+    let settings = Settings {
+        pair: pair.map(str::to_string),
+        mesh_size: Some(4),
+        adaptive: Some(AdaptiveOptions {
+            tolerance,
+            ..AdaptiveOptions::default()
+        }),
+        ..Settings::default()
+    };
+    if pair.is_some() {
+        families::solve(&square, &settings).unwrap()
+    } else {
+        choice::solve(&square, &settings).unwrap()
+    }
+}
+
+#[test]
+fn the_twisting_moment_is_odd_about_each_edges_middle_on_an_adaptive_mesh() {
+    // Navier's M_xy is odd about x = ½ on the edge y = 0 (and so on round the square);
+    // M_ns = n·M·τ with τ the outward normal turned counter-clockwise keeps that sign
+    // pattern whatever order the refined mesh stores an edge's vertices in
+    let outcome = adaptive_kirchhoff_square(1e-4, Some("argyris-p0"));
+    let p = &resultants(&outcome)["profile"];
+    let column = |k: &str| -> Vec<f64> {
+        p[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (xs, ys, m_ns) = (column("x"), column("y"), column("m_ns"));
+    // the sign of M_ns against that of ½ − s, s the counter-clockwise coordinate along
+    // the edge from its first corner: one sign for every sample
+    let mut signs = Vec::new();
+    for k in 0..xs.len() {
+        let (x, y) = (xs[k], ys[k]);
+        let along = if y.abs() < 1e-12 {
+            x
+        } else if (x - 1.0).abs() < 1e-12 {
+            y
+        } else if (y - 1.0).abs() < 1e-12 {
+            1.0 - x
+        } else {
+            1.0 - y
+        };
+        if (along - 0.5).abs() > 0.05 {
+            signs.push((m_ns[k].signum() * (0.5 - along).signum(), x, y, m_ns[k]));
+        }
+    }
+    assert!(signs.len() > 40, "{} samples", signs.len());
+    for &(sign, x, y, m) in &signs {
+        assert_eq!(sign, signs[0].0, "M_ns {m} at ({x}, {y})");
+    }
+}
+
+#[test]
+fn a_tolerance_with_edge_resultants_does_not_take_morley() {
+    // Morley gives no resultants: asked for them, the choice takes Argyris even where
+    // Morley is faster and accurate enough
+    let outcome = adaptive_kirchhoff_square(0.3, None);
+    assert!(outcome.report.quantity("edge_resultants").is_some());
+    assert_ne!(outcome.report.pair, "morley-p0");
+}
+
+#[test]
+fn supports_that_overlap_combine_for_the_layer_as_in_the_solve() {
+    // `free` on an edge that a clamped support also names adds no condition: the plate
+    // is clamped all round, so no edge leaves the rotations free and there is no layer
+    let mut plate = asking(scene("mindlin-square"));
+    let clamped_free_right = |scene: &mut Scene| {
+        scene.supports = vec![
+            fem_forms::models::scene::PartSupport {
+                part: fem_forms::models::scene::Part::All,
+                support: Support::Clamped,
+                key: None,
+            },
+            fem_forms::models::scene::PartSupport {
+                part: fem_forms::models::scene::Part::Named(vec!["right".into()]),
+                support: Support::Free,
+                key: None,
+            },
+        ];
+    };
+    clamped_free_right(&mut plate);
+    let settings = Settings {
+        mesh_size: Some(8),
+        ..Settings::default()
+    };
+    let outcome = families::solve(&plate, &settings).unwrap();
+    let r = resultants(&outcome);
+    assert!(r["layer_resolved"].is_null(), "{}", r["layer_resolved"]);
+    assert_eq!(number(r, "twisting_moment_max"), 0.0);
+    let clamped = families::solve(&asking(scene("mindlin-square")), &settings).unwrap();
+    assert_eq!(
+        outcome.report.solve.energy, clamped.report.solve.energy,
+        "the free line changes the solve"
+    );
+}

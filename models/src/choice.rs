@@ -598,6 +598,13 @@ fn probe_all(scene: &Scene, settings: &Settings, tolerance: f64) -> Result<Probe
                             );
                         }
                     }
+                    if model_scene.edge_resultants
+                        && candidate.adequate
+                        && report.quantity("edge_resultants").is_none()
+                    {
+                        candidate.adequate = false;
+                        candidate.note = "the scene asks for the edge resultants, and this pair gives none (Morley's moments are constant on a cell and its shear force vanishes; a curved disk's edges are not sampled)".into();
+                    }
                     // a probe that already reaches the target is the answer, if chosen,
                     // unless it leaves a boundary layer asked about unresolved
                     let reached = candidate.adequate

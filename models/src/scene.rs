@@ -411,7 +411,8 @@ pub struct Scene {
     /// Whether the obstacle `ψ` is in place (`false`: the unconstrained problem
     /// `a(u, v) = ℓ(v)`, `--no-obstacle`).
     pub obstacle: bool,
-    /// The supports, by boundary part; later entries win where parts overlap.
+    /// The supports, by boundary part. Where parts overlap the conditions combine: an
+    /// edge holds every condition of every support naming it (`free` adds none).
     pub supports: Vec<PartSupport>,
     /// The boundary parts of the model's `facets:` declaration (a contact boundary Γ_C
     /// where the multiplier lives, a loaded part Γ_N), by the model's names.

@@ -1204,7 +1204,8 @@ fn part_of(key: &str, value: &toml::Value) -> std::result::Result<Part, String> 
 }
 
 /// The supports of `[boundary]`, in the order clamped, simply supported (soft, hard),
-/// free, dirichlet, rollers: later entries win where parts overlap. Without any, the
+/// free, dirichlet, rollers; where parts overlap the conditions combine (`free` adds
+/// none, so `clamped = "all"` with `free = "right"` is clamped). Without any, the
 /// family's default ([`Family::default_support`]) on the whole boundary.
 fn supports(
     b: &BoundaryToml,

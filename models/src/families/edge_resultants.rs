@@ -38,9 +38,10 @@ pub fn layer_width(t: f64, kappa: f64) -> f64 {
 }
 
 /// The boundary markers of `mesh` whose edges leave the Mindlin rotations free: those
-/// the scene's supports leave free or hold by a soft simple support (`w = 0` alone);
-/// an edge belongs to the last support whose part holds its marker, as the solve's
-/// supports do, and an edge no support names is free.
+/// the scene's supports leave free or hold by a soft simple support (`w = 0` alone).
+/// Supports combine where their parts overlap, as the solve's conditions do (an edge
+/// holds every condition of every support naming it; `free` adds none): an edge is
+/// rotation-free when every support naming it is free or soft, or none names it.
 pub fn rotations_free_markers(scene: &Scene, mesh: &TriangleMesh) -> Vec<u32> {
     let parts: Vec<(fem_runtime::DirichletPart, Support)> = scene
         .supports
@@ -51,15 +52,17 @@ pub fn rotations_free_markers(scene: &Scene, mesh: &TriangleMesh) -> Vec<u32> {
         .boundary_edges()
         .iter()
         .map(|&(_, marker)| marker)
-        .filter(
-            |&marker| match parts.iter().rev().find(|(part, _)| part.contains(marker)) {
-                None => true,
-                Some((_, support)) => matches!(
-                    support,
-                    Support::Free | Support::SimplySupported { hard: false }
-                ),
-            },
-        )
+        .filter(|&marker| {
+            parts
+                .iter()
+                .filter(|(part, _)| part.contains(marker))
+                .all(|(_, support)| {
+                    matches!(
+                        support,
+                        Support::Free | Support::SimplySupported { hard: false }
+                    )
+                })
+        })
         .collect();
     markers.sort_unstable();
     markers.dedup();
@@ -135,8 +138,10 @@ pub struct Profile {
     pub shear_force: Vec<f64>,
 }
 
-/// One boundary edge: its cell, the cell's map, the edge's end points, length, normal
-/// and tangent.
+/// One boundary edge: its cell, the cell's map, the edge's end points, length, outward
+/// normal and tangent (the normal turned counter-clockwise, so that the boundary is
+/// walked with the domain on the left and `M_ns` does not depend on the order in which
+/// the mesh stores the edge's vertices).
 struct Edge {
     cell: usize,
     map: AffineMap,
@@ -153,16 +158,17 @@ fn boundary_edges(mesh: &TriangleMesh) -> impl Iterator<Item = Edge> + '_ {
         let ends = mesh.edges()[e].map(|v| mesh.vertices()[v]);
         let [a, b] = ends;
         let length = (b[0] - a[0]).hypot(b[1] - a[1]);
-        let tangent = [(b[0] - a[0]) / length, (b[1] - a[1]) / length];
+        let along = [(b[0] - a[0]) / length, (b[1] - a[1]) / length];
         // outward: away from the cell's third vertex
         let centre = {
             let x = mesh.cell_coordinates(cell);
             [(x[0] + x[2] + x[4]) / 3.0, (x[1] + x[3] + x[5]) / 3.0]
         };
-        let mut normal = [tangent[1], -tangent[0]];
+        let mut normal = [along[1], -along[0]];
         if normal[0] * (a[0] - centre[0]) + normal[1] * (a[1] - centre[1]) < 0.0 {
             normal = [-normal[0], -normal[1]];
         }
+        let tangent = [-normal[1], normal[0]];
         Edge {
             cell,
             map: AffineMap::of(mesh, cell),

@@ -487,9 +487,7 @@ fn add_edge_resultants<M: Model, G: Geometry>(run: &Run<'_, M, G>, report: &mut 
         resultants.layer_width,
     ) {
         report.warn(format!(
-            "the edge resultants are not resolved: the boundary edges that leave the rotations free (soft simple supports, free edges) are up to {} long, the rotations' boundary layer {} = t/√(12κ) wide, where the twisting moment falls to 0 and the shear force gains −∂M_ns/∂s; solve with --tol, which refines along those edges to the layer's width",
-            fem_runtime::problem::number(longest),
-            fem_runtime::problem::number(width)
+            "the edge resultants are not resolved: the boundary edges that leave the rotations free (soft simple supports, free edges) are up to {longest:.3e} long, the rotations' boundary layer {width:.3e} = t/√(12κ) wide, where the twisting moment falls to 0 and the shear force gains −∂M_ns/∂s; solve with --tol, which refines along those edges to the layer's width"
         ));
     }
     report.set("edge_resultants", resultants);
