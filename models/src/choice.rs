@@ -689,7 +689,7 @@ fn probe(
                     "pair `{pair}` has no a-posteriori estimate (its model declares no estimator): a tolerance cannot be met with it; give --pair with a pair that has one"
                 ),
                 Some(_) => format!(
-                    "pair `{pair}` solves to ‖u_h‖_a = 0 on the probe's mesh N = {n} ({} unknowns), so no error relative to it exists there: the supports fix every unknown of so coarse a mesh, or the solution vanishes; start from a finer mesh (--mesh-size)",
+                    "pair `{pair}` solves to ‖u_h‖_a = 0 on the probe's mesh N = {n} ({} unknowns), so no error relative to it exists there: either the supports fix every unknown of so coarse a mesh (start from a finer one: --mesh-size) or the solution is 0 (no load and no obstacle above 0: there is nothing to estimate, solve without a tolerance)",
                     s.dofs
                 ),
             })
