@@ -81,8 +81,9 @@ fn soft_square(t: f64) -> Scene {
     scene
 }
 
-#[test]
-fn the_kirchhoff_edge_resultants_are_the_tables() {
+/// The Kirchhoff plate on the simply supported unit square (q = 1, ν = 0.3), asked for its
+/// edge resultants.
+fn simply_supported_kirchhoff_square() -> Scene {
     let mut square = asking(scene("kirchhoff-square"));
     families::family("kirchhoff")
         .unwrap()
@@ -91,6 +92,12 @@ fn the_kirchhoff_edge_resultants_are_the_tables() {
             &Adjustment::Support(Support::SimplySupported { hard: false }),
         )
         .unwrap();
+    square
+}
+
+#[test]
+fn the_kirchhoff_edge_resultants_are_the_tables() {
+    let square = simply_supported_kirchhoff_square();
     let settings = Settings {
         mesh_size: Some(32),
         ..Settings::default()
@@ -263,14 +270,7 @@ fn edge_resultants_are_a_plates_and_need_third_derivatives_from_kirchhoff() {
 /// solved adaptively to `tolerance` from N = 4 (a mesh whose edges are stored in either
 /// order along the boundary).
 fn adaptive_kirchhoff_square(tolerance: f64, pair: Option<&str>) -> Outcome {
-    let mut square = asking(scene("kirchhoff-square"));
-    families::family("kirchhoff")
-        .unwrap()
-        .adjust(
-            &mut square,
-            &Adjustment::Support(Support::SimplySupported { hard: false }),
-        )
-        .unwrap();
+    let square = simply_supported_kirchhoff_square();
     let settings = Settings {
         pair: pair.map(str::to_string),
         mesh_size: Some(4),

@@ -1355,7 +1355,10 @@ fn the_requests_options_reach_each_model_as_it_takes_them() {
         "--tol",
         "0.1",
     ]);
-    assert!(message.contains("start from a finer mesh"), "{message}");
+    assert!(message.contains("start from a finer one"), "{message}");
+    // nor has a solution that is 0
+    let message = failure_of(&["solve", "kirchhoff-square", "--load", "0", "--tol", "0.1"]);
+    assert!(message.contains("solve without a tolerance"), "{message}");
 }
 
 /// When every candidate's solve fails (here: a limit on the unknowns below what the
