@@ -53,16 +53,19 @@ fn number(v: &serde_json::Value, key: &str) -> f64 {
     v[key].as_f64().unwrap_or_else(|| panic!("{key} in {v}"))
 }
 
+/// The column `key` of the edge resultants' `profile` (one value per boundary edge).
+fn profile_column(v: &serde_json::Value, key: &str) -> Vec<f64> {
+    v["profile"][key]
+        .as_array()
+        .unwrap_or_else(|| panic!("profile.{key}"))
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
 /// The shear force of the profile at the midpoint sample nearest `(x, y)`.
 fn shear_near(v: &serde_json::Value, [x, y]: [f64; 2]) -> f64 {
-    let p = &v["profile"];
-    let column = |k: &str| -> Vec<f64> {
-        p[k].as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect()
-    };
+    let column = |k| profile_column(v, k);
     let (xs, ys, q) = (column("x"), column("y"), column("shear_force"));
     let k = (0..xs.len())
         .min_by(|&a, &b| {
@@ -293,14 +296,7 @@ fn the_twisting_moment_is_odd_about_each_edges_middle_on_an_adaptive_mesh() {
     // M_ns = n·M·τ with τ the outward normal turned counter-clockwise keeps that sign
     // pattern whatever order the refined mesh stores an edge's vertices in
     let outcome = adaptive_kirchhoff_square(1e-4, Some("argyris-p0"));
-    let p = &resultants(&outcome)["profile"];
-    let column = |k: &str| -> Vec<f64> {
-        p[k].as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect()
-    };
+    let column = |k| profile_column(resultants(&outcome), k);
     let (xs, ys, m_ns) = (column("x"), column("y"), column("m_ns"));
     // the sign of M_ns against that of ½ − s, s the counter-clockwise coordinate along
     // the edge from its first corner: one sign for every sample
