@@ -100,8 +100,9 @@ pub(crate) fn for_each_entry<G: Mesh>(
         })
         .collect();
     for c in 0..mesh.cell_count() {
+        let number = mesh.cell_number(c);
         for (plan, (test, trial)) in plans.iter().zip(&maps) {
-            let (rows, cols) = (test.cell_dofs(c), trial.cell_dofs(c));
+            let (rows, cols) = (test.cell_dofs(number), trial.cell_dofs(number));
             for &r in rows {
                 for &col in cols {
                     visit(r + plan.row_offset, col + plan.col_offset);
@@ -382,6 +383,10 @@ impl<G: Mesh> Mesh for CellRange<'_, G> {
     fn curved_cell_nodes_into(&self, c: usize, out: &mut [f64]) -> bool {
         self.mesh.curved_cell_nodes_into(self.start + c, out)
     }
+    #[inline]
+    fn cell_number(&self, c: usize) -> usize {
+        self.mesh.cell_number(self.start + c)
+    }
 }
 
 /// A value array shared by the threads of one colour, each adding into entries no
@@ -524,7 +529,7 @@ fn pattern_by_incidence<G: Mesh>(
     for &f in &trial_fields {
         let (map, offset) = (dofs.map(f).unwrap(), dofs.offset(f).unwrap());
         for c in 0..cells {
-            for &d in map.cell_dofs(c) {
+            for &d in map.cell_dofs(mesh.cell_number(c)) {
                 incidence_ptr[offset + d + 1] += 1;
             }
         }
@@ -537,7 +542,7 @@ fn pattern_by_incidence<G: Mesh>(
     for &f in &trial_fields {
         let (map, offset) = (dofs.map(f).unwrap(), dofs.offset(f).unwrap());
         for c in 0..cells {
-            for &d in map.cell_dofs(c) {
+            for &d in map.cell_dofs(mesh.cell_number(c)) {
                 let slot = &mut fill[offset + d];
                 incidence[*slot] = c as u32;
                 *slot += 1;
@@ -571,7 +576,7 @@ fn pattern_by_incidence<G: Mesh>(
             let mut distinct = 0;
             for &c in &incidence[incidence_ptr[j]..incidence_ptr[j + 1]] {
                 for &(row_offset, test) in acting {
-                    for &r in test.cell_dofs(c as usize) {
+                    for &r in test.cell_dofs(mesh.cell_number(c as usize)) {
                         if std::mem::replace(&mut stamp[r + row_offset], j) != j {
                             distinct += 1;
                         }
@@ -588,7 +593,7 @@ fn pattern_by_incidence<G: Mesh>(
             let start = row_idx.len();
             for &c in &incidence[incidence_ptr[j]..incidence_ptr[j + 1]] {
                 for &(row_offset, test) in acting {
-                    for &r in test.cell_dofs(c as usize) {
+                    for &r in test.cell_dofs(mesh.cell_number(c as usize)) {
                         if std::mem::replace(&mut stamp[r + row_offset], j) != j {
                             row_idx.push(r + row_offset);
                         }
@@ -814,14 +819,14 @@ fn add_vectors<M: Model, G: Mesh>(
             } else {
                 M::element_vector(form, plan.block, x, params, data, element);
             }
-            let rows = map.cell_dofs(c);
+            let rows = map.cell_dofs(mesh.cell_number(c));
             for (&r, &v) in rows.iter().zip(&local[..plan.rows]) {
                 out.add(r + plan.row_offset, v);
             }
             if local[..plan.rows].iter().any(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
                     what: "vector",
-                    cell: c,
+                    cell: mesh.cell_number(c),
                 });
             }
         }

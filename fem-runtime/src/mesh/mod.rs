@@ -48,6 +48,77 @@ pub trait Mesh: Sync {
         let _ = (c, out);
         false
     }
+    /// The number of cell `c` in the whole mesh that the DOF maps were built on: `c`
+    /// itself, except in a view of some of its cells ([`CellSubset`]), whose cell `c`
+    /// is the mesh's cell `cells[c]`. Assembly reads the DOF maps through it.
+    #[inline]
+    fn cell_number(&self, c: usize) -> usize {
+        c
+    }
+}
+
+/// Some cells of a mesh, as a mesh: what one MPI rank assembles of a partitioned mesh.
+/// Its cell `c` is the mesh's cell `cells[c]` ([`Mesh::cell_number`]), so the DOF maps
+/// of the whole mesh serve it, and a form assembled on it is the sum of the element
+/// contributions of those cells alone: summed over a partition of the cells, the whole
+/// form.
+#[derive(Clone, Copy, Debug)]
+pub struct CellSubset<'a, G> {
+    mesh: &'a G,
+    cells: Option<&'a [usize]>,
+}
+
+impl<'a, G: Mesh> CellSubset<'a, G> {
+    /// The cells `cells` of `mesh` (`None`: all of them, in order).
+    ///
+    /// # Panics
+    /// Never here; a cell number beyond the mesh's makes the accessors panic, so callers
+    /// check them ([`crate::obstacle::Discretization::with_constraints_on`] does).
+    pub fn new(mesh: &'a G, cells: Option<&'a [usize]>) -> Self {
+        Self { mesh, cells }
+    }
+
+    /// The whole mesh.
+    pub fn mesh(&self) -> &'a G {
+        self.mesh
+    }
+}
+
+impl<G: Mesh> Mesh for CellSubset<'_, G> {
+    const CELL: CellKind = G::CELL;
+    #[inline]
+    fn cell_count(&self) -> usize {
+        self.cells.map_or(self.mesh.cell_count(), <[usize]>::len)
+    }
+    #[inline]
+    fn cell_number(&self, c: usize) -> usize {
+        self.mesh
+            .cell_number(self.cells.map_or(c, |cells| cells[c]))
+    }
+    #[inline]
+    fn cell_coordinates_into(&self, c: usize, out: &mut [f64]) {
+        self.mesh
+            .cell_coordinates_into(self.cells.map_or(c, |cells| cells[c]), out)
+    }
+    fn diameter(&self, c: usize) -> f64 {
+        self.mesh.diameter(self.cells.map_or(c, |cells| cells[c]))
+    }
+    fn measure(&self, c: usize) -> f64 {
+        self.mesh.measure(self.cells.map_or(c, |cells| cells[c]))
+    }
+    #[inline]
+    fn cell_vertex_numbers_into(&self, c: usize, out: &mut [usize]) -> bool {
+        self.mesh
+            .cell_vertex_numbers_into(self.cells.map_or(c, |cells| cells[c]), out)
+    }
+    fn has_curved_cells(&self) -> bool {
+        self.mesh.has_curved_cells()
+    }
+    #[inline]
+    fn curved_cell_nodes_into(&self, c: usize, out: &mut [f64]) -> bool {
+        self.mesh
+            .curved_cell_nodes_into(self.cells.map_or(c, |cells| cells[c]), out)
+    }
 }
 
 impl Mesh for IntervalMesh {

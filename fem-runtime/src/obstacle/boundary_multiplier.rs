@@ -313,6 +313,35 @@ pub fn discretize<M: Model>(
     dofs: SystemDofs,
     constraints: &Constraints,
 ) -> Result<Discretization<TriangleMesh>> {
+    discretize_on::<M>(mesh, None, coefficients, parts, dofs, constraints)
+}
+
+/// [`discretize`] with the contributions of the cells `cells` alone (`None`: every
+/// cell), the facet terms of a boundary edge with its cell's: one MPI rank's share of a
+/// partition of the cells, whose LCPs sum to the whole one (as
+/// [`Discretization::with_constraints_on`]). A P0 multiplier's constraint lives on one
+/// edge, so its rows of `B`, `C` and `G` are complete on the part holding the edge's
+/// cell; a P1 multiplier's are split between the parts of its two edges.
+///
+/// # Errors
+/// Those of [`discretize`]; a cell number beyond the mesh's.
+pub fn discretize_on<M: Model>(
+    mesh: &TriangleMesh,
+    cells: Option<&[usize]>,
+    coefficients: &Coefficients,
+    parts: &[Vec<u32>],
+    dofs: SystemDofs,
+    constraints: &Constraints,
+) -> Result<Discretization<TriangleMesh>> {
+    crate::obstacle::check_cells(cells, mesh.cell_count())?;
+    let part = crate::mesh::CellSubset::new(mesh, cells);
+    let owned: Option<Vec<bool>> = cells.map(|cells| {
+        let mut owned = vec![false; mesh.cell_count()];
+        for &c in cells {
+            owned[c] = true;
+        }
+        owned
+    });
     let (bilinear_id, linear_id) = system_forms::<M>()?;
     let (bilinear, linear) = (M::form(bilinear_id)?, M::form(linear_id)?);
     crate::model::require_symmetric::<M, TriangleMesh>(bilinear, mesh, coefficients)?;
@@ -323,7 +352,7 @@ pub fn discretize<M: Model>(
     let n_full = dofs.dof_count();
     // A: the cell part, then the facet blocks
     let cell_part =
-        MatrixAssembler::new::<M>(bilinear_id, mesh, &dofs)?.assemble::<M>(mesh, coefficients)?;
+        MatrixAssembler::new::<M>(bilinear_id, &part, &dofs)?.assemble::<M>(&part, coefficients)?;
     let (ptr, rows, vals) = (
         cell_part.symbolic().col_ptr(),
         cell_part.symbolic().row_idx(),
@@ -335,7 +364,7 @@ pub fn discretize<M: Model>(
             .collect(),
         b: vec![Vec::new(); boundary.count()],
         c: vec![0.0; boundary.count()],
-        f: assemble_vector::<M>(linear_id, mesh, &dofs, coefficients)?,
+        f: assemble_vector::<M>(linear_id, &part, &dofs, coefficients)?,
         g: vec![0.0; boundary.count()],
     };
     let facets = Facets {
@@ -348,6 +377,9 @@ pub fn discretize<M: Model>(
     };
     for (index, block) in M::FACET_BLOCKS.iter().enumerate() {
         for (k, edge) in edges_of_part[block.part].iter().enumerate() {
+            if owned.as_ref().is_some_and(|owned| !owned[edge.cell]) {
+                continue;
+            }
             if block.form == bilinear {
                 facets.add_matrix::<M>(index, block, k, edge, &mut system)?;
             } else if block.form == linear {

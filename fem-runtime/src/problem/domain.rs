@@ -96,6 +96,23 @@ pub trait Domain: DofNumbering + Clone + Send + Sync + Sized + 'static {
         dofs: SystemDofs,
         constraints: &Constraints,
         parts: &[Vec<u32>],
+    ) -> Result<Discretization<Self>> {
+        self.discretize_on::<M>(None, coefficients, dofs, constraints, parts)
+    }
+
+    /// [`Domain::discretize`] with the element contributions of the cells `cells` alone
+    /// (`None`: every cell): one MPI rank's share, whose LCPs summed over a partition of
+    /// the cells are the whole one ([`Discretization::with_constraints_on`]).
+    ///
+    /// # Errors
+    /// Those of [`Domain::discretize`]; a cell number beyond the mesh's.
+    fn discretize_on<M: Model>(
+        &self,
+        cells: Option<&[usize]>,
+        coefficients: &Coefficients,
+        dofs: SystemDofs,
+        constraints: &Constraints,
+        parts: &[Vec<u32>],
     ) -> Result<Discretization<Self>>;
 
     /// The full coefficients of the coarse solution `values` interpolated at the fine
@@ -374,16 +391,18 @@ impl Domain for IntervalMesh {
         Ok(constraints)
     }
 
-    fn discretize<M: Model>(
+    fn discretize_on<M: Model>(
         &self,
+        cells: Option<&[usize]>,
         coefficients: &Coefficients,
         dofs: SystemDofs,
         constraints: &Constraints,
         _parts: &[Vec<u32>],
     ) -> Result<Discretization<Self>> {
         let (bilinear, linear) = crate::obstacle::system_forms::<M>()?;
-        Discretization::with_constraints::<M>(
+        Discretization::with_constraints_on::<M>(
             self,
+            cells,
             coefficients,
             dofs,
             constraints,
@@ -718,16 +737,18 @@ impl Domain for TriangleMesh {
         })
     }
 
-    fn discretize<M: Model>(
+    fn discretize_on<M: Model>(
         &self,
+        cells: Option<&[usize]>,
         coefficients: &Coefficients,
         dofs: SystemDofs,
         constraints: &Constraints,
         parts: &[Vec<u32>],
     ) -> Result<Discretization<Self>> {
         if boundary_multiplier::multiplier_part::<M>()?.is_some() {
-            return boundary_multiplier::discretize::<M>(
+            return boundary_multiplier::discretize_on::<M>(
                 self,
+                cells,
                 coefficients,
                 parts,
                 dofs,
@@ -735,8 +756,9 @@ impl Domain for TriangleMesh {
             );
         }
         let (bilinear, linear) = crate::obstacle::system_forms::<M>()?;
-        Discretization::with_constraints::<M>(
+        Discretization::with_constraints_on::<M>(
             self,
+            cells,
             coefficients,
             dofs,
             constraints,
@@ -1060,16 +1082,18 @@ impl Domain for CurvedTriangleMesh {
         })
     }
 
-    fn discretize<M: Model>(
+    fn discretize_on<M: Model>(
         &self,
+        cells: Option<&[usize]>,
         coefficients: &Coefficients,
         dofs: SystemDofs,
         constraints: &Constraints,
         _parts: &[Vec<u32>],
     ) -> Result<Discretization<Self>> {
         let (bilinear, linear) = crate::obstacle::system_forms::<M>()?;
-        Discretization::with_constraints::<M>(
+        Discretization::with_constraints_on::<M>(
             self,
+            cells,
             coefficients,
             dofs,
             constraints,

@@ -1,0 +1,295 @@
+//! Assembly over a part of the cells, one MPI rank's share of a partitioned mesh
+//! (`Discretization::with_constraints_on`, `Domain::discretize_on`,
+//! `boundary_multiplier::discretize_on`): summed over a partition of the cells, the
+//! parts' LCPs must be the whole LCP entry by entry (`A`, `B`, the diagonal and the
+//! blocks of `C`, `F`, `G`), with the supports, the rotated plate supports (Argyris on a
+//! disk), the extra multiplier couplings (P2–P1disc) and the multipliers on boundary
+//! edges (Signorini, P0 and P1) as the whole mesh has them. A multiplier on cells or on
+//! boundary edges (P0) must also find each of its constraints on exactly one part,
+//! complete there: what lets a rank evaluate its own constraints without communication.
+//! The parts are the cells `c ≡ r (mod 3)`, scattered over the mesh, so that no part is
+//! a contiguous block that would hide a cell numbered wrongly.
+#![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
+
+use fem_forms::lcp::Lcp;
+use fem_forms::obstacle::Discretization;
+use fem_forms::problem::Domain;
+use fem_forms::{Coefficients, Constraints, DataFn, Diagonal, Model, SystemDofs, TriangleMesh};
+use std::collections::BTreeMap;
+
+/// The blocks of an LCP as sums by entry.
+#[derive(Default)]
+struct Blocks {
+    a: BTreeMap<(usize, usize), f64>,
+    b: BTreeMap<(usize, usize), f64>,
+    c: BTreeMap<usize, f64>,
+    c_coupling: BTreeMap<(usize, usize), f64>,
+    f: BTreeMap<usize, f64>,
+    g: BTreeMap<usize, f64>,
+}
+
+impl Blocks {
+    fn add(&mut self, lcp: &Lcp) {
+        let (ptr, rows, values) = (
+            lcp.a.symbolic().col_ptr(),
+            lcp.a.symbolic().row_idx(),
+            lcp.a.val(),
+        );
+        for j in 0..lcp.n() {
+            for p in ptr[j]..ptr[j + 1] {
+                *self.a.entry((rows[p], j)).or_default() += values[p];
+            }
+        }
+        for (k, row) in lcp.b_rows.iter().enumerate() {
+            for &(j, v) in row {
+                *self.b.entry((k, j)).or_default() += v;
+            }
+        }
+        for (k, &c) in lcp.c.iter().enumerate() {
+            *self.c.entry(k).or_default() += c;
+        }
+        for (first, s, block) in lcp.c_blocks.blocks() {
+            for i in 0..s {
+                for j in (0..s).filter(|&j| j != i) {
+                    *self.c_coupling.entry((first + i, first + j)).or_default() += block[i * s + j];
+                }
+            }
+        }
+        for (i, &f) in lcp.f.iter().enumerate() {
+            *self.f.entry(i).or_default() += f;
+        }
+        for (k, &g) in lcp.g.iter().enumerate() {
+            *self.g.entry(k).or_default() += g;
+        }
+    }
+}
+
+/// `sum` equals `whole` entry by entry, to rounding of the block's largest entry.
+fn same<K: Ord + Copy + std::fmt::Debug>(
+    what: &str,
+    sum: &BTreeMap<K, f64>,
+    whole: &BTreeMap<K, f64>,
+) {
+    let scale = whole.values().fold(0.0f64, |m, v| m.max(v.abs()));
+    let keys: std::collections::BTreeSet<K> = sum.keys().chain(whole.keys()).copied().collect();
+    for key in keys {
+        let (s, w) = (
+            sum.get(&key).copied().unwrap_or(0.0),
+            whole.get(&key).copied().unwrap_or(0.0),
+        );
+        assert!(
+            (s - w).abs() <= 1e-12 * scale.max(f64::MIN_POSITIVE),
+            "{what} at {key:?}: the parts sum to {s:e}, the whole mesh has {w:e} (largest entry {scale:e})"
+        );
+    }
+}
+
+/// The parts `c ≡ r (mod 3)` of `cells` cells.
+fn parts(cells: usize) -> Vec<Vec<usize>> {
+    (0..3).map(|r| (r..cells).step_by(3).collect()).collect()
+}
+
+/// Builds the LCP of every part of the cells and of the whole mesh, and checks that the
+/// parts sum to the whole; with `one_part_per_constraint`, that each constraint's rows
+/// of `B`, `C` and `G` are on one part only.
+fn parts_sum_to_whole<G>(
+    cells: usize,
+    build: impl Fn(Option<&[usize]>) -> Discretization<G>,
+    one_part_per_constraint: bool,
+) {
+    let whole = build(None);
+    let mut sum = Blocks::default();
+    let mut holders = vec![0usize; whole.lcp.m()];
+    for part in parts(cells) {
+        let d = build(Some(&part));
+        assert_eq!((d.lcp.n(), d.lcp.m()), (whole.lcp.n(), whole.lcp.m()));
+        sum.add(&d.lcp);
+        for (k, holder) in holders.iter_mut().enumerate() {
+            if !d.lcp.b_rows[k].is_empty() || d.lcp.c[k] != 0.0 || d.lcp.g[k] != 0.0 {
+                *holder += 1;
+            }
+        }
+    }
+    let mut expected = Blocks::default();
+    expected.add(&whole.lcp);
+    same("A", &sum.a, &expected.a);
+    same("B", &sum.b, &expected.b);
+    same("diag C", &sum.c, &expected.c);
+    same("C's couplings", &sum.c_coupling, &expected.c_coupling);
+    same("F", &sum.f, &expected.f);
+    same("G", &sum.g, &expected.g);
+    assert!(
+        !expected.b.is_empty() && expected.c.values().any(|&c| c != 0.0),
+        "a case without constraints tests nothing"
+    );
+    if one_part_per_constraint {
+        for (k, &holder) in holders.iter().enumerate() {
+            assert_eq!(holder, 1, "constraint {k} is on {holder} parts");
+        }
+    }
+}
+
+fn load(_: &[f64]) -> f64 {
+    -8.0
+}
+
+fn obstacle(x: &[f64]) -> f64 {
+    -0.2 + 0.1 * x[0] - 0.05 * x.get(1).copied().unwrap_or(0.0)
+}
+
+fn boundary(x: &[f64]) -> f64 {
+    0.01 * x[0]
+}
+
+/// A membrane on the unit square with `u = g` on the boundary: the supports' columns
+/// move to `F` and `G` on every part that touches them.
+fn membrane<M: Model>(one_part_per_constraint: bool) {
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 6, 6, Diagonal::Alternating).unwrap();
+    let data: [(&str, &DataFn); 3] = [("f", &load), ("ψ", &obstacle), ("g", &boundary)];
+    let c = Coefficients::new::<M>(&[("α", 0.1)], &data).unwrap();
+    let build = |cells: Option<&[usize]>| {
+        let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+        let constraints = fem_forms::obstacle::triangle::dirichlet_constraints_on::<M>(
+            &mesh,
+            &dofs,
+            &c,
+            &fem_forms::DirichletPart::All,
+        )
+        .unwrap();
+        mesh.discretize_on::<M>(cells, &c, dofs, &constraints, &[])
+            .unwrap()
+    };
+    parts_sum_to_whole(mesh.cell_count(), build, one_part_per_constraint);
+}
+
+#[test]
+fn membrane_p1_p0_parts_sum_to_the_whole_lcp() {
+    membrane::<fem_forms::models::membrane_p1_p0::Model>(true);
+}
+
+/// P1disc multipliers: three constraints per cell, coupled within it (blocks of `C`).
+#[test]
+fn membrane_p2_p1disc_parts_sum_to_the_whole_lcp() {
+    membrane::<fem_forms::models::membrane_p2_p1disc::Model>(true);
+}
+
+/// A simply supported Argyris plate on a polygonal disk: the supports along edges that
+/// are not along x or y rotate the vertex DOFs (a congruence of `A`, rows of `B` spread
+/// over the rotated group, extra unknowns eliminated into `F`).
+#[test]
+fn an_argyris_plate_on_a_disk_parts_sum_to_the_whole_lcp() {
+    use fem_forms::models::kirchhoff::kirchhoff_argyris_p0::Model as M;
+    use fem_forms::PlateSupport;
+    let mesh = TriangleMesh::disk([0.0, 0.0], 1.0, 3).unwrap();
+    let zero = |_: &[f64]| 0.0;
+    let data: [(&str, &DataFn); 3] = [("f", &load), ("ψ", &obstacle), ("g", &zero)];
+    let c =
+        Coefficients::new::<M>(&[("D", 1.0), ("ν", 0.3), ("α", 1e-3), ("s", -1.0)], &data).unwrap();
+    let build = |cells: Option<&[usize]>| {
+        let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+        let mut constraints = Constraints::new();
+        constraints
+            .support_plate::<M>(
+                &mesh,
+                &dofs,
+                "w",
+                &fem_forms::DirichletPart::All,
+                PlateSupport::SimplySupported,
+            )
+            .unwrap();
+        assert!(
+            !constraints.combinations().is_empty(),
+            "the disk's supports rotate vertex DOFs"
+        );
+        mesh.discretize_on::<M>(cells, &c, dofs, &constraints, &[])
+            .unwrap()
+    };
+    parts_sum_to_whole(mesh.cell_count(), build, true);
+}
+
+/// A clamped Timoshenko beam on an interval mesh.
+#[test]
+fn a_timoshenko_beam_parts_sum_to_the_whole_lcp() {
+    use fem_forms::models::timoshenko::timoshenko_p2::Model as M;
+    use fem_forms::{IntervalMesh, Side};
+    let mesh = IntervalMesh::uniform(0.0, 1.0, 10).unwrap();
+    let data: [(&str, &DataFn); 2] = [("f", &load), ("ψ", &obstacle)];
+    let c = Coefficients::new::<M>(&[("t", 0.05), ("α", 0.1), ("s", -1.0)], &data).unwrap();
+    let build = |cells: Option<&[usize]>| {
+        let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+        let mut constraints = Constraints::new();
+        for field in ["θ", "w"] {
+            for side in [Side::Left, Side::Right] {
+                constraints.clamp::<M>(&mesh, &dofs, field, side).unwrap();
+            }
+        }
+        Discretization::with_constraints_on::<M>(&mesh, cells, &c, dofs, &constraints, "B_h", "L_h")
+            .unwrap()
+    };
+    parts_sum_to_whole(mesh.cell_count(), build, true);
+}
+
+fn pressure(_: &[f64]) -> f64 {
+    -5.0
+}
+
+fn gap(x: &[f64]) -> f64 {
+    0.02 * (x[0] - 0.5) * (x[0] - 0.5)
+}
+
+/// Signorini contact with the multiplier on the bottom edges (marker 1), `u_x = 0` on
+/// the left (marker 4): the facet terms go with their edge's cell.
+fn signorini<M: Model>(one_part_per_constraint: bool) {
+    use fem_forms::obstacle::boundary_multiplier::{discretize_on, primal_dofs};
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 6, 6, Diagonal::Alternating).unwrap();
+    let data: [(&str, &DataFn); 2] = [("q", &pressure), ("g", &gap)];
+    let c = Coefficients::new::<M>(
+        &[
+            ("μ_L", 400.0),
+            ("λ_L", 600.0),
+            ("α", 3e-4),
+            ("n_c_x", 0.0),
+            ("n_c_y", -1.0),
+        ],
+        &data,
+    )
+    .unwrap();
+    let parts_markers = [vec![1], vec![3]];
+    let build = |cells: Option<&[usize]>| {
+        let dofs = primal_dofs::<M>(&mesh).unwrap();
+        let mut constraints = Constraints::new();
+        let (map, offset) = (dofs.map(0).unwrap(), dofs.offset(0).unwrap());
+        for d in fem_forms::DirichletPart::Markers(vec![4]).dofs(map, &mesh) {
+            constraints.fix_dof(offset + d, 0.0).unwrap();
+        }
+        discretize_on::<M>(&mesh, cells, &c, &parts_markers, dofs, &constraints).unwrap()
+    };
+    parts_sum_to_whole(mesh.cell_count(), build, one_part_per_constraint);
+}
+
+#[test]
+fn signorini_p0_on_edges_parts_sum_to_the_whole_lcp() {
+    signorini::<fem_forms::models::signorini::signorini_p1::Model>(true);
+}
+
+/// A P1 multiplier's constraint sits on a vertex shared by two contact edges: its rows
+/// are split between their parts, and still sum to the whole.
+#[test]
+fn signorini_p1_on_edges_parts_sum_to_the_whole_lcp() {
+    signorini::<fem_forms::models::signorini::signorini_p1_p1::Model>(false);
+}
+
+/// A part naming a cell the mesh does not have is refused with the cell's number.
+#[test]
+fn a_cell_beyond_the_mesh_is_refused() {
+    use fem_forms::models::membrane_p1_p0::Model as M;
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 2, 2, Diagonal::Alternating).unwrap();
+    let data: [(&str, &DataFn); 3] = [("f", &load), ("ψ", &obstacle), ("g", &boundary)];
+    let c = Coefficients::new::<M>(&[("α", 0.1)], &data).unwrap();
+    let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+    let error = mesh
+        .discretize_on::<M>(Some(&[0, 8]), &c, dofs, &Constraints::new(), &[])
+        .err()
+        .expect("refused");
+    assert!(error.to_string().contains("cell 8"), "{error}");
+}
