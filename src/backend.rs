@@ -114,7 +114,9 @@ impl Backend {
     }
 
     /// Adds `petsc` to the report: the ranks, the options, and per level solved the
-    /// formulation, SNES's converged reason, its Newton and linear iterations and time.
+    /// formulation, how it was assembled (`partitioned`: each rank its own cells, with
+    /// rank 0's share of PETSc's rows; `whole`), SNES's converged reason, its Newton and
+    /// linear iterations and time.
     pub fn describe(&self, report: &mut Report, options: &BackendOptions) {
         #[cfg(feature = "petsc")]
         {
@@ -128,6 +130,9 @@ impl Backend {
                         "formulation": r.formulation.name(),
                         "primal_unknowns": r.unknowns[0],
                         "multipliers": r.unknowns[1],
+                        // each rank its own cells, or the whole LCP on every rank
+                        "assembly": if r.rows_here.is_some() { "partitioned" } else { "whole" },
+                        "rows_on_rank_0": r.rows_here,
                         "converged_reason": r.converged.reason,
                         "snes_iterations": r.converged.iterations,
                         "linear_iterations": r.converged.linear_iterations,

@@ -293,3 +293,72 @@ fn a_cell_beyond_the_mesh_is_refused() {
         .expect("refused");
     assert!(error.to_string().contains("cell 8"), "{error}");
 }
+
+/// One process holding every cell, as a solver that partitions would see it: its
+/// reductions change nothing.
+struct OneProcess;
+
+impl fem_forms::lcp::external::ExternalSolver for OneProcess {
+    fn name(&self) -> &'static str {
+        "one process"
+    }
+
+    fn solve(&self, _: &Lcp, _: Option<&[f64]>) -> fem_forms::Result<fem_forms::lcp::LcpSolution> {
+        Err(fem_forms::Error::Input("a test of reductions only".into()))
+    }
+}
+
+/// The measures of the whole LCP on a shared one (`Lcp::share`) are computed from
+/// reduced sums, not the plain loops: on one process holding every cell they must be
+/// the plain ones, exactly (the KKT and complementarity residuals, the multiplier
+/// scale, the rounding estimates, the contact indicator), for P0 and P1disc
+/// multipliers; and a native solver refuses a shared LCP.
+#[test]
+fn the_measures_of_a_shared_lcp_on_one_process_are_the_whole_ones() {
+    use fem_forms::lcp::external::External;
+    use fem_forms::lcp::Share;
+    use fem_forms::obstacle::triangle::contact_indicator;
+    use fem_forms::obstacle::{solve_lcp, ObstacleOptions};
+    fn check<M: Model>() {
+        let mesh =
+            TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 6, 6, Diagonal::Alternating).unwrap();
+        let data: [(&str, &DataFn); 3] = [("f", &load), ("ψ", &obstacle), ("g", &boundary)];
+        // α below ½/C_I of P2 (0.1 makes a − αS indefinite there)
+        let c = Coefficients::new::<M>(&[("α", 0.01)], &data).unwrap();
+        let dofs = SystemDofs::all::<M>(&mesh).unwrap();
+        let constraints = fem_forms::obstacle::triangle::dirichlet_constraints_on::<M>(
+            &mesh,
+            &dofs,
+            &c,
+            &fem_forms::DirichletPart::All,
+        )
+        .unwrap();
+        let whole = mesh
+            .discretize_on::<M>(None, &c, dofs, &constraints, &[])
+            .unwrap()
+            .lcp;
+        let s = solve_lcp(&whole, None, ObstacleOptions::default()).unwrap();
+        assert!(s.lambda.iter().any(|&l| l > 0.0), "contact somewhere");
+        let mut shared = whole.clone();
+        shared.share = Some(Share::new(External(Box::leak(Box::new(OneProcess)))));
+        let (u, l) = (&s.u, &s.lambda);
+        assert_eq!(shared.kkt_residual(u, l), whole.kkt_residual(u, l));
+        assert_eq!(
+            shared.complementarity_residual(u, l),
+            whole.complementarity_residual(u, l)
+        );
+        assert_eq!(shared.multiplier_scale(), whole.multiplier_scale());
+        assert_eq!(shared.primal_rounding(u, l), whole.primal_rounding(u, l));
+        assert_eq!(shared.elimination_noise(l), whole.elimination_noise(l));
+        assert_eq!(
+            contact_indicator(&shared, u, l),
+            contact_indicator(&whole, u, l)
+        );
+        let refused = solve_lcp(&shared, None, ObstacleOptions::default())
+            .err()
+            .expect("refused");
+        assert!(refused.to_string().contains("partitioned"), "{refused}");
+    }
+    check::<fem_forms::models::membrane_p1_p0::Model>();
+    check::<fem_forms::models::membrane_p2_p1disc::Model>();
+}

@@ -24,16 +24,22 @@
 //! The Newton systems are solved by MUMPS (LU, or Cholesky where they are SPD) unless
 //! the options choose (`-ksp_type cg -pc_type gamg`).
 //!
-//! Every rank receives the same LCP (each assembles it through the one pipeline) and
-//! inserts the rows it owns: contiguous blocks of `U` and of `Λ`, rank `r`'s unknowns
-//! numbered `U` block then `Λ` block, so PETSc's rows stay contiguous per rank. The
-//! answer comes back to every rank and is checked there by the pipeline's KKT residual.
+//! Two ways in. Where the pipeline partitions a level (a multiplier on the cells, on
+//! triangles: [`PetscLcpSolver`] partitions the cells with PT-Scotch through
+//! [`ExternalSolver::partition`]), each rank assembles its own cells and its LCP is one
+//! part of the whole ([`Lcp::share`]): every block goes into PETSc with `ADD_VALUES`
+//! (the `shared` module), and the whole LCP exists only inside PETSc. Elsewhere (a
+//! multiplier on boundary edges, the beams, the nodal method) every rank receives the
+//! whole LCP and inserts the rows it owns: contiguous blocks of `U` and of `Λ`, rank
+//! `r`'s unknowns numbered `U` block then `Λ` block. Either way the answer comes back
+//! whole to every rank and is checked there by the pipeline's KKT residual (reduced over
+//! the ranks for a shared LCP, scaled by the assembled `‖A‖∞`).
 
 use crate::{
     minimize, solve_with, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
     VectorView,
 };
-use fem_runtime::lcp::external::{ExternalSolver, Purpose};
+use fem_runtime::lcp::external::{CellGraph, ExternalSolver, Purpose};
 use fem_runtime::lcp::{recover_multiplier, ConstraintRows, Lcp, LcpSolution, NewtonOptions};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -82,6 +88,10 @@ pub struct LevelRecord {
     pub formulation: Formulation,
     /// Primal unknowns `n` and multipliers `m`.
     pub unknowns: [usize; 2],
+    /// Where the LCP was assembled in parts (each rank its own cells, [`Lcp::share`]),
+    /// PETSc's rows this rank owned; `None` where every rank held the whole LCP (a
+    /// multiplier on boundary edges, the beams, the nodal method).
+    pub rows_here: Option<usize>,
     /// SNES's reason and iteration counts.
     pub converged: Converged,
     /// Wall time of the solve on this rank, in seconds (assembly into PETSc included).
@@ -160,6 +170,22 @@ impl PetscLcpSolver {
     pub fn finalize(&self) {
         self.petsc.lock().unwrap_or_else(|e| e.into_inner()).take();
     }
+
+    /// PETSc, where it is still running and this is the thread that initialized MPI.
+    ///
+    /// # Errors
+    /// PETSc finalized, or another thread.
+    fn on_this_thread<'g>(&self, guard: &'g Option<OnThread>) -> fem_runtime::Result<&'g OnThread> {
+        let on = guard.as_ref().ok_or_else(|| {
+            fem_runtime::Error::Input("PETSc was finalized: no more solves".into())
+        })?;
+        if std::thread::current().id() != on.thread {
+            return Err(fem_runtime::Error::Input(
+                "PETSc is called from a thread other than the one that initialized MPI".into(),
+            ));
+        }
+        Ok(on)
+    }
 }
 
 impl ExternalSolver for PetscLcpSolver {
@@ -175,6 +201,39 @@ impl ExternalSolver for PetscLcpSolver {
         self.records.lock().unwrap_or_else(|e| e.into_inner()).len()
     }
 
+    /// Every rank assembles its own cells: PT-Scotch's partition of `graph` (on one
+    /// rank, all of them), unless the nodal method or a whole LCP is asked for.
+    fn partition(&self, graph: &CellGraph) -> fem_runtime::Result<Option<Vec<usize>>> {
+        let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
+        let on = self.on_this_thread(&guard)?;
+        let ranks = crate::nodal::partition(&on.petsc, graph)
+            .map_err(|e| fem_runtime::Error::Input(format!("PETSc's partitioner: {e}")))?;
+        let rank = on.petsc.rank();
+        Ok(Some(
+            (0..ranks.len()).filter(|&c| ranks[c] == rank).collect(),
+        ))
+    }
+
+    /// `MPI_Allreduce`; called on another thread than MPI's (never, in the pipeline) or
+    /// after [`PetscLcpSolver::finalize`], it makes every value NaN: a measure of the
+    /// whole that is not one fails its check instead of passing silently.
+    fn sum(&self, values: &mut [f64]) {
+        let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
+        match self.on_this_thread(&guard) {
+            Ok(on) => on.petsc.sum_all(values),
+            Err(_) => values.fill(f64::NAN),
+        }
+    }
+
+    /// `MPI_Allreduce` (NaN where [`ExternalSolver::sum`] would be).
+    fn max(&self, value: f64) -> f64 {
+        let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
+        match self.on_this_thread(&guard) {
+            Ok(on) => on.petsc.max(value),
+            Err(_) => f64::NAN,
+        }
+    }
+
     fn relabel(&self, records: std::ops::Range<usize>, purpose: Purpose) {
         let mut all = self.records.lock().unwrap_or_else(|e| e.into_inner());
         let end = records.end.min(all.len());
@@ -185,23 +244,24 @@ impl ExternalSolver for PetscLcpSolver {
 
     fn solve(&self, lcp: &Lcp, start: Option<&[f64]>) -> fem_runtime::Result<LcpSolution> {
         let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
-        let on = guard.as_ref().ok_or_else(|| {
-            fem_runtime::Error::Input("PETSc was finalized: no more solves".into())
-        })?;
-        if std::thread::current().id() != on.thread {
-            return Err(fem_runtime::Error::Input(
-                "PETSc is called from a thread other than the one that initialized MPI".into(),
-            ));
-        }
+        let on = self.on_this_thread(&guard)?;
         let clock = Instant::now();
-        let formulation = formulation_of(
-            lcp,
-            *self.preferred.lock().unwrap_or_else(|e| e.into_inner()),
-        )
+        let preferred = *self.preferred.lock().unwrap_or_else(|e| e.into_inner());
+        let formulation = match &lcp.share {
+            None => formulation_of(lcp, preferred),
+            Some(_) => shared_formulation(&on.petsc, lcp, preferred),
+        }
         .map_err(fem_runtime::Error::Input)?;
-        let solved = match formulation {
-            Formulation::Eliminated => solve_eliminated(&on.petsc, lcp, start),
-            _ => solve_vi(&on.petsc, lcp, start, formulation),
+        let mut rows_here = None;
+        let solved = match (&lcp.share, formulation) {
+            (None, Formulation::Eliminated) => solve_eliminated(&on.petsc, lcp, start),
+            (None, _) => solve_vi(&on.petsc, lcp, start, formulation),
+            (Some(share), _) => solve_shared(&on.petsc, lcp, start, formulation).map(|s| {
+                // the KKT residual below scales by the assembled ‖A‖∞
+                share.set_a_norm(s.a_norm);
+                rows_here = Some(s.rows_here);
+                (s.u, s.lambda, s.converged)
+            }),
         };
         let solver = match formulation {
             Formulation::Eliminated => "PETSc SNES on Φ(U)",
@@ -223,6 +283,8 @@ impl ExternalSolver for PetscLcpSolver {
                 fem_runtime::Error::Input(format!("PETSc: {e}"))
             }
         })?;
+        // the checks below reduce over the ranks through `sum` and `max`, which lock it
+        drop(guard);
         let seconds = clock.elapsed().as_secs_f64();
         self.records
             .lock()
@@ -230,6 +292,7 @@ impl ExternalSolver for PetscLcpSolver {
             .push(LevelRecord {
                 formulation,
                 unknowns: [lcp.n(), lcp.m()],
+                rows_here,
                 converged: converged.clone(),
                 seconds,
                 purpose: *self.purpose.lock().unwrap_or_else(|e| e.into_inner()),
@@ -263,6 +326,14 @@ impl ExternalSolver for PetscLcpSolver {
             iterative_steps: 0,
             krylov_iterations: converged.linear_iterations,
         };
+        if noise > MAX_ELIMINATION_NOISE && lcp.share.is_some() {
+            return Err(fem_runtime::Error::NotConverged {
+                solver,
+                detail: format!(
+                    "the eliminated Λ is rounding noise ({noise:.0e} relative: C = αh^p lies below the rounding of G − BU), and its recovery by a saddle-point solve needs the whole LCP, which a partitioned assembly does not hold: ask for `--petsc-formulation mixed`, or a larger α"
+                ),
+            });
+        }
         // as the native solver does: where the eliminated Λ loses digits to cancellation
         // (C = αh^p below the rounding of G − BU), Λ from one saddle-point solve on the
         // converged active set
@@ -324,8 +395,36 @@ fn formulation_of(
     if is_nodal(lcp) {
         return Ok(Formulation::Primal);
     }
-    let diagonal = lcp.c_blocks.is_empty() && lcp.c.iter().all(|&c| c > 0.0);
-    let plain = lcp.c_blocks.is_empty() && lcp.c.iter().all(|&c| c == 0.0);
+    choose(lcp.c_blocks.is_empty(), &lcp.c, preferred)
+}
+
+/// [`formulation_of`] for an LCP held in parts by the ranks ([`Lcp::share`]): judged on
+/// the whole `C`, summed over them (the nodal method is never partitioned).
+fn shared_formulation(
+    petsc: &Petsc,
+    lcp: &Lcp,
+    preferred: Option<Formulation>,
+) -> std::result::Result<Formulation, String> {
+    let mut c = lcp.c.clone();
+    petsc.sum_all(&mut c);
+    let coupled = petsc.max(f64::from(u8::from(!lcp.c_blocks.is_empty()))) > 0.0;
+    choose(!coupled, &c, preferred)
+}
+
+/// The formulation for a `C` with diagonal `c` (and blocks unless `diagonal_only`):
+/// `preferred` where it applies, else eliminated where `C` is diagonal and positive and
+/// mixed elsewhere.
+///
+/// # Errors
+/// The eliminated formulation asked for where `C` is not diagonal and positive; the
+/// plain mixed method (`C = 0`) without `mixed` asked for.
+fn choose(
+    diagonal_only: bool,
+    c: &[f64],
+    preferred: Option<Formulation>,
+) -> std::result::Result<Formulation, String> {
+    let diagonal = diagonal_only && c.iter().all(|&c| c > 0.0);
+    let plain = diagonal_only && c.iter().all(|&c| c == 0.0);
     if plain && preferred.is_none() {
         // measured: the membrane, the Euler–Bernoulli beam and Hertz at α = 0 all ran
         // out of SNESVI iterations; a refusal that says so beats 50 wasted iterations
@@ -573,6 +672,50 @@ fn solve_vi(
             .collect();
     }
     Ok((u, lambda, converged))
+}
+
+/// Solves an LCP held in parts by the ranks ([`Lcp::share`], each rank's own cells) in
+/// `formulation`: `(U, Λ)` whole on every rank, SNES's report, `‖A‖∞` of the
+/// assembled `A` and this rank's rows (see the `shared` module).
+fn solve_shared(
+    petsc: &Petsc,
+    lcp: &Lcp,
+    start: Option<&[f64]>,
+    formulation: Formulation,
+) -> Result<crate::shared::Shared> {
+    check_start(lcp, start)?;
+    match formulation {
+        Formulation::Eliminated => crate::shared::solve_eliminated(
+            petsc,
+            lcp,
+            start,
+            Defaults {
+                ksp_type: Some(c"preonly"),
+                pc_type: Some(c"cholesky"),
+                factor_package: Some(c"mumps"),
+                line_search: None,
+                rtol: Some(RELATIVE_TOLERANCE),
+                atol: Some(ABSOLUTE_TOLERANCE),
+            },
+        ),
+        Formulation::Mixed => crate::shared::solve_mixed(
+            petsc,
+            lcp,
+            start,
+            Defaults {
+                ksp_type: Some(c"preonly"),
+                pc_type: Some(c"lu"),
+                factor_package: Some(c"mumps"),
+                line_search: Some(c"basic"),
+                rtol: Some(RELATIVE_TOLERANCE),
+                atol: Some(ABSOLUTE_TOLERANCE),
+            },
+        ),
+        Formulation::Primal => Err(Error::refused(
+            "PetscLcpSolver::solve",
+            "the nodal method is not assembled in parts",
+        )),
+    }
 }
 
 /// Refuses an LCP of inconsistent shapes and a start of the wrong length.

@@ -16,6 +16,7 @@
 
 pub mod lcp;
 pub mod nodal;
+mod shared;
 
 use std::ffi::{c_void, CStr, CString};
 use std::ops::Range;
@@ -196,6 +197,45 @@ impl Petsc {
         let raw = mpi::topology::SimpleCommunicator::self_comm().as_raw();
         // SAFETY: both are pointers to Open MPI's communicator object
         unsafe { std::mem::transmute::<mpi::ffi::MPI_Comm, sys::MPI_Comm>(raw) }
+    }
+
+    /// `values` summed entry by entry over the ranks, in place (`MPI_Allreduce`; every
+    /// rank must call it with the same length).
+    pub fn sum_all(&self, values: &mut [f64]) {
+        use mpi::collective::{CommunicatorCollectives, SystemOperation};
+        if let Some(universe) = &self.universe {
+            let send = values.to_vec();
+            universe
+                .world()
+                .all_reduce_into(&send[..], values, SystemOperation::sum());
+        }
+    }
+
+    /// `values` replaced entry by entry by their smallest over the ranks, in place
+    /// (`MPI_Allreduce`; every rank must call it with the same length).
+    pub fn min_all(&self, values: &mut [u64]) {
+        use mpi::collective::{CommunicatorCollectives, SystemOperation};
+        if let Some(universe) = &self.universe {
+            let send = values.to_vec();
+            universe
+                .world()
+                .all_reduce_into(&send[..], values, SystemOperation::min());
+        }
+    }
+
+    /// The largest of `value` over the ranks (`MPI_Allreduce`; every rank must call it).
+    pub fn max(&self, value: f64) -> f64 {
+        use mpi::collective::{CommunicatorCollectives, SystemOperation};
+        match &self.universe {
+            Some(universe) => {
+                let mut largest = 0.0;
+                universe
+                    .world()
+                    .all_reduce_into(&value, &mut largest, SystemOperation::max());
+                largest
+            }
+            None => value,
+        }
     }
 
     /// The sum of `value` over the ranks (`MPI_Allreduce`; every rank must call it).
@@ -513,6 +553,114 @@ impl<'p> Matrix<'p> {
         }
     }
 
+    /// A square matrix of which this rank owns `local` rows, preallocated for exactly the
+    /// entries `declare` names to the [`Pattern`] it is given, on any rank (PETSc's
+    /// `MATPREALLOCATOR`: entries of rows other ranks own are counted where they land,
+    /// as one rank cannot count them from its own cells). The entries start at zero,
+    /// assembled.
+    ///
+    /// # Errors
+    /// `declare`'s, or PETSc's.
+    pub fn with_pattern(
+        petsc: &'p Petsc,
+        local: usize,
+        declare: impl FnOnce(&mut Pattern) -> Result<()>,
+    ) -> Result<Self> {
+        let m = petsc_ints("MatSetSizes", &[local])?[0];
+        let (mut pre, mut raw) = (std::ptr::null_mut(), std::ptr::null_mut());
+        // SAFETY: both matrices are created here; the preallocator is destroyed before
+        // returning, the matrix owned by the result (or destroyed on an error)
+        unsafe {
+            let result = (|| {
+                check("MatCreate", sys::MatCreate(petsc.comm(), &mut pre))?;
+                check("MatSetType", sys::MatSetType(pre, c"preallocator".as_ptr()))?;
+                check(
+                    "MatSetSizes",
+                    sys::MatSetSizes(pre, m, m, sys::PETSC_DETERMINE, sys::PETSC_DETERMINE),
+                )?;
+                check("MatSetUp", sys::MatSetUp(pre))?;
+                declare(&mut Pattern {
+                    raw: pre,
+                    zeros: Vec::new(),
+                })?;
+                for (call, code) in [
+                    (
+                        "MatAssemblyBegin",
+                        sys::MatAssemblyBegin(pre, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+                    ),
+                    (
+                        "MatAssemblyEnd",
+                        sys::MatAssemblyEnd(pre, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+                    ),
+                ] {
+                    check(call, code)?;
+                }
+                check("MatCreate", sys::MatCreate(petsc.comm(), &mut raw))?;
+                check(
+                    "MatSetSizes",
+                    sys::MatSetSizes(raw, m, m, sys::PETSC_DETERMINE, sys::PETSC_DETERMINE),
+                )?;
+                check("MatSetType", sys::MatSetType(raw, c"aij".as_ptr()))?;
+                check(
+                    "MatPreallocatorPreallocate",
+                    sys::MatPreallocatorPreallocate(pre, sys::PetscBool_PETSC_TRUE, raw),
+                )?;
+                // the zeros filled in, assembled: a matrix SNES may read before its first
+                // values
+                check(
+                    "MatAssemblyBegin",
+                    sys::MatAssemblyBegin(raw, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+                )?;
+                check(
+                    "MatAssemblyEnd",
+                    sys::MatAssemblyEnd(raw, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+                )?;
+                check(
+                    "MatSetOption",
+                    sys::MatSetOption(
+                        raw,
+                        sys::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
+                        sys::PetscBool_PETSC_TRUE,
+                    ),
+                )
+            })();
+            sys::MatDestroy(&mut pre);
+            if let Err(e) = result {
+                sys::MatDestroy(&mut raw);
+                return Err(e);
+            }
+        }
+        Ok(Self {
+            raw,
+            _petsc: std::marker::PhantomData,
+        })
+    }
+
+    /// `‖A‖∞`, the largest row sum of `|A|` of the assembled matrix (`MatNorm`).
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn norm_infinity(&self) -> Result<f64> {
+        let mut norm = 0.0;
+        // SAFETY: a live, assembled matrix
+        check("MatNorm", unsafe {
+            sys::MatNorm(self.raw, sys::NormType_NORM_INFINITY, &mut norm)
+        })?;
+        Ok(norm)
+    }
+
+    /// `self += a x`, `x`'s entries a subset of `self`'s pattern (`MatAXPY`); both
+    /// assembled.
+    ///
+    /// # Errors
+    /// PETSc's (an entry of `x` outside `self`'s pattern).
+    pub fn add_scaled(&mut self, a: f64, x: &Matrix) -> Result<()> {
+        // SAFETY: live matrices of one layout
+        check("MatAXPY", unsafe {
+            sys::MatAXPY(self.raw, a, x.raw, sys::MatStructure_SUBSET_NONZERO_PATTERN)
+        })
+    }
+
     /// A copy (pattern and values).
     ///
     /// # Errors
@@ -555,6 +703,37 @@ impl Drop for Matrix<'_> {
         unsafe {
             sys::MatDestroy(&mut self.raw);
         }
+    }
+}
+
+/// The entries a matrix will hold, declared to [`Matrix::with_pattern`] before any
+/// value (rows of any rank).
+pub struct Pattern {
+    raw: sys::Mat,
+    zeros: Vec<f64>,
+}
+
+impl Pattern {
+    /// Declares the entries `rows × columns` (global indices).
+    ///
+    /// # Errors
+    /// PETSc's (an index beyond the matrix).
+    pub fn add(&mut self, rows: &[usize], columns: &[usize]) -> Result<()> {
+        let r = petsc_ints("MatSetValues", rows)?;
+        let c = petsc_ints("MatSetValues", columns)?;
+        self.zeros.resize(r.len() * c.len(), 0.0);
+        // SAFETY: arrays of the lengths passed
+        check("MatSetValues", unsafe {
+            sys::MatSetValues(
+                self.raw,
+                r.len() as sys::PetscInt,
+                r.as_ptr(),
+                c.len() as sys::PetscInt,
+                c.as_ptr(),
+                self.zeros.as_ptr(),
+                sys::InsertMode_ADD_VALUES,
+            )
+        })
     }
 }
 
@@ -657,6 +836,56 @@ impl VectorView {
     /// PETSc's.
     pub fn gather(&self) -> Result<Vec<f64>> {
         gather(self.raw)
+    }
+
+    /// Adds `values` at global `indices`, on any rank; takes effect at
+    /// [`VectorView::assemble`].
+    ///
+    /// # Errors
+    /// Lengths that differ, or PETSc's.
+    pub fn add(&mut self, indices: &[usize], values: &[f64]) -> Result<()> {
+        if indices.len() != values.len() {
+            return Err(Error::refused(
+                "VecSetValues",
+                format!("{} indices for {} values", indices.len(), values.len()),
+            ));
+        }
+        let indices = petsc_ints("VecSetValues", indices)?;
+        // SAFETY: arrays of the length passed
+        check("VecSetValues", unsafe {
+            sys::VecSetValues(
+                self.raw,
+                indices.len() as sys::PetscInt,
+                indices.as_ptr(),
+                values.as_ptr(),
+                sys::InsertMode_ADD_VALUES,
+            )
+        })
+    }
+
+    /// Communicates the values added for entries other ranks own.
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn assemble(&mut self) -> Result<()> {
+        // SAFETY: a live vector
+        check("VecAssemblyBegin", unsafe {
+            sys::VecAssemblyBegin(self.raw)
+        })?;
+        check("VecAssemblyEnd", unsafe { sys::VecAssemblyEnd(self.raw) })
+    }
+
+    /// The dot product with `other` over all ranks (`VecDot`; every rank calls it).
+    ///
+    /// # Errors
+    /// PETSc's.
+    pub fn dot(&self, other: &VectorView) -> Result<f64> {
+        let mut value = 0.0;
+        // SAFETY: live vectors of one layout
+        check("VecDot", unsafe {
+            sys::VecDot(self.raw, other.raw, &mut value)
+        })?;
+        Ok(value)
     }
 
     /// Writes the entries this rank owns, in order.

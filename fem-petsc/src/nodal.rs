@@ -11,6 +11,7 @@
 //! The boundary values are imposed by `MatZeroRowsColumns`, which keeps `K` symmetric.
 
 use crate::{check, solve, sys, Converged, Error, Matrix, Petsc, Result, Vector, VectorView};
+use fem_runtime::lcp::external::CellGraph;
 use fem_runtime::mesh::TriangleMesh;
 use fem_runtime::model::DataFn;
 use fem_runtime::Model;
@@ -27,29 +28,6 @@ pub struct NodalSolution {
     pub cells_here: usize,
     /// Unknowns this rank owns.
     pub rows_here: usize,
-}
-
-/// The cells of `mesh` that share an edge with each cell.
-fn cell_neighbours(mesh: &TriangleMesh) -> Vec<Vec<usize>> {
-    let mut by_edge: std::collections::HashMap<(usize, usize), Vec<usize>> =
-        std::collections::HashMap::new();
-    for (c, cell) in mesh.cells().iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (cell[k], cell[(k + 1) % 3]);
-            by_edge.entry((a.min(b), a.max(b))).or_default().push(c);
-        }
-    }
-    let mut neighbours = vec![Vec::new(); mesh.cell_count()];
-    for cells in by_edge.values() {
-        if let [a, b] = cells[..] {
-            neighbours[a].push(b);
-            neighbours[b].push(a);
-        }
-    }
-    for n in &mut neighbours {
-        n.sort_unstable();
-    }
-    neighbours
 }
 
 /// `values` in an array PETSc allocated, which a `MATMPIADJ` takes over and frees.
@@ -75,10 +53,10 @@ fn petsc_array(values: &[sys::PetscInt]) -> Result<*mut sys::PetscInt> {
     Ok(pointer)
 }
 
-/// The rank each cell goes to: PT-Scotch over the cells' adjacency (on one rank, every
-/// cell to rank 0).
-fn partition(petsc: &Petsc, mesh: &TriangleMesh) -> Result<Vec<usize>> {
-    let cells = mesh.cell_count();
+/// The rank each cell goes to: PT-Scotch over the cells' adjacency `graph` (on one rank,
+/// every cell to rank 0). Every rank calls it with the same graph.
+pub(crate) fn partition(petsc: &Petsc, graph: &CellGraph) -> Result<Vec<usize>> {
+    let cells = graph.cell_count();
     let (rank, size) = (petsc.rank(), petsc.size());
     if size == 1 {
         return Ok(vec![0; cells]);
@@ -86,11 +64,11 @@ fn partition(petsc: &Petsc, mesh: &TriangleMesh) -> Result<Vec<usize>> {
     // the graph's rows start spread in contiguous blocks
     let start = cells * rank / size;
     let end = cells * (rank + 1) / size;
-    let neighbours = cell_neighbours(mesh);
     let mut offsets = vec![0 as sys::PetscInt];
     let mut columns = Vec::new();
-    for cell in &neighbours[start..end] {
-        columns.extend(cell.iter().map(|&n| n as sys::PetscInt));
+    for c in start..end {
+        let row = &graph.neighbours[graph.offsets[c]..graph.offsets[c + 1]];
+        columns.extend(row.iter().map(|&n| n as sys::PetscInt));
         offsets.push(columns.len() as sys::PetscInt);
     }
     let too_large = |_| {
@@ -193,7 +171,7 @@ pub fn solve_nodal<M: Model>(
         format!("model {} declares no energy forms", M::NAME),
     ))?;
     let rank = petsc.rank();
-    let owner_of_cell = partition(petsc, mesh)?;
+    let owner_of_cell = partition(petsc, &CellGraph::of(mesh))?;
     let vertices = mesh.vertex_count();
     let mut owner = vec![usize::MAX; vertices];
     for (cell, &r) in mesh.cells().iter().zip(&owner_of_cell) {

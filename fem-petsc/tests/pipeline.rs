@@ -6,12 +6,16 @@
 //! (P1–P0, P2–P0, P2–P1disc whose `C` has 3 × 3 blocks, and the nodal method with its
 //! bounds on the primal unknowns), the Timoshenko and Euler–Bernoulli beams, the
 //! Reissner–Mindlin plate, the Kirchhoff plate (Argyris, Morley), the Winkler plate and
-//! Signorini contact with its multiplier on boundary edges.
+//! Signorini contact with its multiplier on boundary edges. Where the multiplier lives
+//! on the cells of triangles, each rank assembles only its own cells (PT-Scotch's
+//! partition) and the whole LCP exists only in PETSc: the ranks' rows must add up to
+//! PETSc's; elsewhere every rank holds the whole LCP.
 
 use fem_models::families;
 use fem_models::report::{Outcome, Settings};
 use fem_petsc::lcp::{Formulation, PetscLcpSolver};
 use fem_runtime::lcp::external::External;
+use fem_runtime::lcp::external::ExternalSolver;
 use fem_runtime::obstacle::VariationalSolver;
 
 /// (scene, pair, mesh size, load)
@@ -99,11 +103,32 @@ fn main() {
             "{case}: KKT residual {}",
             b.kkt_residual
         );
+        // each rank assembled its own cells where the multiplier lives on them (on
+        // triangles; the nodal method has its own path), and the ranks' rows are PETSc's
+        let record = petsc.records().last().cloned().expect("a record");
+        let on_cells = !matches!(scene, "signorini-patch" | "hertz")
+            && !scene.starts_with("timoshenko")
+            && !scene.starts_with("bernoulli")
+            && pair != "p1-nodal";
+        match record.rows_here {
+            Some(rows) => {
+                assert!(on_cells, "{case}: partitioned");
+                let mut total = [rows as f64];
+                petsc.sum(&mut total);
+                let [n, m] = record.unknowns;
+                let expected = match record.formulation {
+                    Formulation::Mixed => n + m,
+                    _ => n,
+                };
+                assert_eq!(total[0] as usize, expected, "{case}: the ranks' rows");
+            }
+            None => assert!(!on_cells, "{case}: assembled whole on every rank"),
+        }
         if rank == 0 {
-            let record = petsc.records().last().cloned().expect("a record");
             println!(
-                "{case}: {} formulation, {} ({} SNES its), energy {:?} vs {:?}, ∫λ {y:.12e} vs {x:.12e}, KKT {:.1e}",
+                "{case}: {} formulation, {} assembly, {} ({} SNES its), energy {:?} vs {:?}, ∫λ {y:.12e} vs {x:.12e}, KKT {:.1e}",
                 record.formulation.name(),
+                if record.rows_here.is_some() { "partitioned" } else { "whole" },
                 record.converged.reason,
                 record.converged.iterations,
                 b.energy,

@@ -143,6 +143,64 @@ pub struct Lcp {
     pub f: Vec<f64>,
     /// Constraint right-hand side (m).
     pub g: Vec<f64>,
+    /// `Some` where this process holds one part of an LCP assembled over a partition of
+    /// the cells (one MPI rank's share, [`crate::obstacle::Discretization::with_constraints_on`]):
+    /// every block is then this part's contribution, the whole LCP the sum over the
+    /// processes, and the methods that measure the whole (the KKT and complementarity
+    /// residuals, [`Lcp::multiplier_scale`], the rounding estimates) reduce over them.
+    pub share: Option<Share>,
+}
+
+/// How the parts of an LCP held by several processes add up ([`Lcp::share`]): the
+/// reductions of the solver that runs them, and `‖A‖∞` of the assembled `A` once that
+/// solver has it (the parts' row sums of `|A_r|` only bound it from above: entries of
+/// opposite sign from cells on two processes cancel in `A` and not in the bound).
+///
+/// Each constraint of a multiplier on cells (P0, P1disc) or on boundary edges (P0)
+/// lives on one part, complete there: the per-constraint measures are then exact. A
+/// constraint split between parts (a P1 multiplier's vertex on two edges) makes the
+/// sizes of its terms (`Σ_j |B_kj U_j|`, `‖Bᵀ‖∞`) upper bounds.
+#[derive(Clone)]
+pub struct Share {
+    solver: external::External,
+    a_norm: std::sync::Arc<std::sync::OnceLock<f64>>,
+}
+
+impl Share {
+    /// The share of an LCP whose parts `solver` reduces over.
+    pub fn new(solver: external::External) -> Self {
+        Self {
+            solver,
+            a_norm: Default::default(),
+        }
+    }
+
+    /// The solver whose processes hold the parts.
+    pub fn solver(&self) -> external::External {
+        self.solver
+    }
+
+    /// Records `‖A‖∞` of the assembled `A` (the largest row sum of `|A|`), computed by a
+    /// solver that assembled it; a later value is ignored.
+    pub fn set_a_norm(&self, norm: f64) {
+        let _ = self.a_norm.set(norm);
+    }
+
+    /// `values` summed entry by entry over the processes, in place.
+    pub fn sum(&self, values: &mut [f64]) {
+        self.solver.0.sum(values);
+    }
+
+    /// The largest of `value` over the processes.
+    pub fn max(&self, value: f64) -> f64 {
+        self.solver.0.max(value)
+    }
+}
+
+impl std::fmt::Debug for Share {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Share({:?}, ‖A‖∞ {:?})", self.solver, self.a_norm.get())
+    }
 }
 
 /// The off-diagonal part of a block-diagonal `C`: groups of consecutive constraints whose
@@ -315,7 +373,23 @@ impl Lcp {
             c_blocks: CouplingBlocks::none(),
             f,
             g,
+            share: None,
         }
+    }
+
+    /// `v` summed over the processes that hold the parts of this LCP ([`Lcp::share`]);
+    /// `v` itself for a whole LCP.
+    pub fn whole(&self, mut v: Vec<f64>) -> Vec<f64> {
+        if let Some(share) = &self.share {
+            share.sum(&mut v);
+        }
+        v
+    }
+
+    /// The largest of `value` over the processes that hold the parts; `value` itself
+    /// for a whole LCP.
+    pub fn largest(&self, value: f64) -> f64 {
+        self.share.as_ref().map_or(value, |share| share.max(value))
     }
 
     /// Number of primal unknowns.
@@ -438,7 +512,15 @@ impl Lcp {
         for &(j, v) in self.b_rows.entries() {
             column_sums[j] += v.abs();
         }
-        column_sums.iter().fold(0.0f64, |m, x| m.max(*x))
+        norm_inf(&self.whole(column_sums))
+    }
+
+    /// `‖F‖∞` of the whole LCP.
+    fn f_norm(&self) -> f64 {
+        match &self.share {
+            Some(_) => norm_inf(&self.whole(self.f.clone())),
+            None => norm_inf(&self.f),
+        }
     }
 
     /// The natural size of a multiplier: `‖F‖∞ / ‖Bᵀ‖∞` (equilibrium `BᵀΛ ~ F`), so that
@@ -447,7 +529,7 @@ impl Lcp {
         KktScales {
             a_norm: 0.0,
             bt_norm: self.bt_norm(),
-            f_norm: norm_inf(&self.f),
+            f_norm: self.f_norm(),
         }
         .multiplier_scale()
     }
@@ -477,18 +559,30 @@ impl Lcp {
         } else {
             0.0
         };
-        let c_lambda = self.c_times(lambda);
-        let c_terms = self.c_times_abs(lambda);
-        let mut complementarity = 0.0f64;
-        for (k, row) in self.b_rows.iter().enumerate() {
-            let terms: f64 = row
-                .iter()
+        // each constraint's `B_k U`, `(CΛ)_k`, `G_k` and the sizes of their terms, whole
+        // (summed over the parts of a shared LCP)
+        let m = self.m();
+        let mut sums = Vec::with_capacity(4 * m);
+        sums.extend(self.b_rows.iter().map(|row| {
+            row.iter()
                 .map(|&(j, v)| (v * u[j]).abs() + v.abs() * u_star)
                 .sum::<f64>()
-                + c_terms[k]
-                + self.g[k].abs();
-            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
-            let residual = bu + c_lambda[k] - self.g[k];
+        }));
+        sums.extend(self.b_times(u));
+        sums.extend(self.c_product(lambda, false));
+        sums.extend(self.c_product(lambda, true));
+        let sums = self.whole(sums);
+        let (b_terms, rest) = sums.split_at(m);
+        let (bu, rest) = rest.split_at(m);
+        let (c_lambda, c_terms) = rest.split_at(m);
+        let g: std::borrow::Cow<[f64]> = match &self.share {
+            Some(_) => self.whole(self.g.clone()).into(),
+            None => (&self.g[..]).into(),
+        };
+        let mut complementarity = 0.0f64;
+        for k in 0..m {
+            let terms = b_terms[k] + c_terms[k] + g[k].abs();
+            let residual = bu[k] + c_lambda[k] - g[k];
             let r = if terms > 0.0 {
                 residual / terms
             } else {
@@ -510,9 +604,14 @@ impl Lcp {
     /// of the plain method (`C = 0`), lifted by `C` for the stabilized one.
     ///
     /// # Errors
-    /// More than [`MAX_DENSE_MULTIPLIERS`] multipliers (the matrix is dense), and `A` not
-    /// positive definite.
+    /// More than [`MAX_DENSE_MULTIPLIERS`] multipliers (the matrix is dense), `A` not
+    /// positive definite, and a shared LCP ([`Lcp::share`]).
     pub fn schur_complement(&self) -> Result<nalgebra::DMatrix<f64>> {
+        if self.share.is_some() {
+            return Err(Error::Input(
+                "the Schur complement needs the whole LCP, and this process holds one part of a partitioned assembly: compute it in a native solve".into(),
+            ));
+        }
         let (n, m) = (self.n(), self.m());
         if m > MAX_DENSE_MULTIPLIERS {
             return Err(Error::Input(format!(
@@ -577,18 +676,45 @@ impl Lcp {
             self.n(),
             self.m()
         );
-        let au = multiply(&self.a, u);
-        let btl = self.bt_times(lambda);
-        self.kkt_residual_from(u, lambda, &au, &btl, &self.kkt_scales())
+        match &self.share {
+            None => {
+                let au = multiply(&self.a, u);
+                let btl = self.bt_times(lambda);
+                self.kkt_residual_from(u, lambda, &au, &btl, &self.kkt_scales())
+            }
+            Some(_) => {
+                // AU − BᵀΛ − F summed over the parts: the equilibrium of the whole
+                let mut equilibrium = multiply(&self.a, u);
+                for ((e, b), f) in equilibrium
+                    .iter_mut()
+                    .zip(self.bt_times(lambda))
+                    .zip(&self.f)
+                {
+                    *e -= b + f;
+                }
+                let equilibrium = self.whole(equilibrium);
+                let zero = vec![0.0; self.n()];
+                // with AU the whole residual, BᵀΛ = 0 and F = 0; its complementarity
+                // reduces itself
+                self.kkt_residual_with_f(u, lambda, &equilibrium, &zero, &zero, &self.kkt_scales())
+            }
+        }
     }
 
     /// The norms of the data that [`Lcp::kkt_residual`] scales by; they do not change
     /// during a solve, so an iteration computes them once.
     pub(crate) fn kkt_scales(&self) -> KktScales {
+        let a_norm = match &self.share {
+            None => row_sum_norm(&self.a),
+            Some(share) => match share.a_norm.get() {
+                Some(&norm) => norm,
+                None => norm_inf(&self.whole(row_sums(&self.a))),
+            },
+        };
         KktScales {
-            a_norm: row_sum_norm(&self.a),
+            a_norm,
             bt_norm: self.bt_norm(),
-            f_norm: norm_inf(&self.f),
+            f_norm: self.f_norm(),
         }
     }
 
@@ -603,6 +729,19 @@ impl Lcp {
         btl: &[f64],
         scales: &KktScales,
     ) -> f64 {
+        self.kkt_residual_with_f(u, lambda, au, btl, &self.f, scales)
+    }
+
+    /// [`Lcp::kkt_residual_from`] with the right side `f` of the equilibrium given.
+    fn kkt_residual_with_f(
+        &self,
+        u: &[f64],
+        lambda: &[f64],
+        au: &[f64],
+        btl: &[f64],
+        f: &[f64],
+        scales: &KktScales,
+    ) -> f64 {
         debug_assert!(
             u.len() == self.n() && au.len() == self.n() && btl.len() == self.n(),
             "AU and BᵀΛ of U's length"
@@ -614,7 +753,7 @@ impl Lcp {
         let equilibrium: f64 = au
             .iter()
             .zip(btl)
-            .zip(&self.f)
+            .zip(f)
             .map(|((a, b), f)| (a - b - f).abs())
             .fold(0.0, f64::max);
         let scale = a_norm * norm_inf(u) + bt_norm * norm_inf(lambda) + scales.f_norm;
@@ -681,7 +820,11 @@ pub(crate) fn norm2(v: &[f64]) -> f64 {
 }
 
 fn row_sum_norm(a: &SparseMatrix) -> f64 {
-    // symmetric: the largest column sum equals the largest row sum
+    norm_inf(&row_sums(a))
+}
+
+/// The row sums of `|A|` (`A` symmetric: its column sums).
+fn row_sums(a: &SparseMatrix) -> Vec<f64> {
     let (col_ptr, vals) = (a.symbolic().col_ptr(), a.val());
     (0..a.ncols())
         .map(|j| {
@@ -690,7 +833,7 @@ fn row_sum_norm(a: &SparseMatrix) -> f64 {
                 .map(|v| v.abs())
                 .sum::<f64>()
         })
-        .fold(0.0, f64::max)
+        .collect()
 }
 
 #[cfg(test)]

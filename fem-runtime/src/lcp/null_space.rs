@@ -336,6 +336,11 @@ pub fn unbalanced_work(lcp: &Lcp, lambda: &[f64], motions: &[Vec<f64>]) -> f64 {
                     .zip(&br)
                     .map(|(l, b)| (l * b).abs())
                     .sum::<f64>();
+            // the works summed over the parts of a shared LCP (the size: a bound)
+            let [load, reaction, size] = match lcp.whole(vec![load, reaction, size])[..] {
+                [load, reaction, size] => [load, reaction, size],
+                _ => unreachable!("three sums"),
+            };
             if size > 0.0 {
                 (load + reaction).abs() / size
             } else {
@@ -525,6 +530,7 @@ mod tests {
             c_blocks: super::super::CouplingBlocks::none(),
             f,
             g: vec![0.0; m],
+            share: None,
         }
     }
 

@@ -38,7 +38,8 @@ impl Lcp {
         };
         let mut dense = [0.0; BLOCK_ENTRIES];
         let mut inverse = [0.0; BLOCK_ENTRIES];
-        self.blocks()
+        let noise = self
+            .blocks()
             .filter_map(|block| {
                 if !carries(block.range()) {
                     return None;
@@ -61,7 +62,9 @@ impl Lcp {
                     .fold(0.0f64, |m, g| m.max(g.abs()));
                 Some(f64::EPSILON * g * inverse_norm / scale)
             })
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max);
+        // each constraint is complete on one part of a shared LCP (empty elsewhere)
+        self.largest(noise)
     }
 
     /// An estimate of the 1-norm condition number `κ₁(A) = ‖A‖₁‖A⁻¹‖₁` of the primal
@@ -125,7 +128,8 @@ impl Lcp {
     pub fn primal_rounding(&self, u: &[f64], lambda: &[f64]) -> f64 {
         assert!(u.len() == self.n() && lambda.len() == self.m());
         let c_terms = self.c_times_abs(lambda);
-        self.b_rows
+        let rounding = self
+            .b_rows
             .iter()
             .enumerate()
             .filter(|&(k, _)| lambda[k] > 0.0)
@@ -140,7 +144,9 @@ impl Lcp {
                     0.0
                 }
             })
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max);
+        // each constraint is complete on one part of a shared LCP (empty elsewhere)
+        self.largest(rounding)
     }
 }
 

@@ -400,6 +400,7 @@ pub fn discretize_on<M: Model>(
         roles: Vec::new(),
         primal_reduced: (0..n).collect(),
         multiplier_reduced: Vec::new(),
+        cells: cells.map(<[usize]>::to_vec),
     })
 }
 

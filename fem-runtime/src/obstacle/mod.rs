@@ -128,6 +128,10 @@ pub struct Discretization<G = IntervalMesh> {
     pub(crate) roles: Vec<Role>,
     pub(crate) primal_reduced: Vec<usize>,
     pub(crate) multiplier_reduced: Vec<usize>,
+    /// The cells whose element contributions the LCP holds: `None`, every cell; `Some`,
+    /// this process's part of a partition of them ([`Discretization::with_constraints_on`],
+    /// [`Lcp::share`] set by the caller that partitioned).
+    pub cells: Option<Vec<usize>>,
 }
 
 /// Where a discretization's multiplier lives.
@@ -390,6 +394,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 c_blocks,
                 f,
                 g,
+                share: None,
             },
             multiplier_field: multiplier,
             multipliers: Multipliers::Cells,
@@ -397,6 +402,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
             roles,
             primal_reduced,
             multiplier_reduced,
+            cells: cells.map(<[usize]>::to_vec),
         })
     }
 }
@@ -1069,6 +1075,12 @@ pub fn solve_lcp_on_hierarchy(
     start: Option<&[f64]>,
     options: ObstacleOptions,
 ) -> Result<LcpSolution> {
+    if lcp.share.is_some() && !matches!(options.solver, VariationalSolver::External(_)) {
+        return Err(Error::Input(format!(
+            "this LCP is one process's part of a partitioned assembly: only the solver that partitioned it solves it, not {}",
+            options.solver.name()
+        )));
+    }
     let multigrid = prolongations.first().is_some_and(|p| p.nrows() == lcp.n())
         && options.linear_solver.uses_multigrid(prolongations.len());
     match options.solver {
@@ -1628,11 +1640,21 @@ impl<G: DofNumbering> ObstacleSolution<G> {
                 M::NAME
             ))
         })?;
-        let a = crate::assembly::MatrixAssembler::new::<M>(FormId::new(a), &d.mesh, &dofs)?
-            .assemble::<M>(&d.mesh, coefficients)?;
-        let l = assemble_vector::<M>(FormId::new(load), &d.mesh, &dofs, coefficients)?;
-        Ok(0.5 * crate::lcp::cholesky::quadratic_form(&a, &u, &u)
-            - crate::lcp::cholesky::dot(&l, &u))
+        // on a partitioned level, this process's cells, the energy summed over them all
+        let cells = crate::mesh::CellSubset::new(&d.mesh, d.cells.as_deref());
+        let a = crate::assembly::MatrixAssembler::new::<M>(FormId::new(a), &cells, &dofs)?
+            .assemble::<M>(&cells, coefficients)?;
+        let l = assemble_vector::<M>(FormId::new(load), &cells, &dofs, coefficients)?;
+        let energy = 0.5 * crate::lcp::cholesky::quadratic_form(&a, &u, &u)
+            - crate::lcp::cholesky::dot(&l, &u);
+        Ok(match &d.lcp.share {
+            Some(share) if d.cells.is_some() => {
+                let mut total = [energy];
+                share.sum(&mut total);
+                total[0]
+            }
+            _ => energy,
+        })
     }
 }
 

@@ -854,17 +854,35 @@ pub fn max_open_contact_gap(
 pub fn contact_indicator(lcp: &Lcp, u: &[f64], lambda: &[f64]) -> Vec<bool> {
     let largest = lambda.iter().cloned().fold(0.0, f64::max);
     let scale = largest.max(lcp.multiplier_scale());
-    let (c_lambda, c_terms) = (lcp.c_times(lambda), lcp.c_times_abs(lambda));
     use rayon::prelude::*;
-    (0..lambda.len())
+    let m = lambda.len();
+    // per constraint: B_k U, G_k, the sizes of their terms, (CΛ)_k and its terms' sizes,
+    // summed over the parts of a shared LCP (each part holds its constraints' rows, the
+    // others none)
+    let mut sums: Vec<f64> = (0..m)
         .into_par_iter()
         .map(|k| {
             let row = &lcp.b_rows[k];
-            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
-            let terms: f64 = row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>()
-                + lcp.g[k].abs()
-                + c_terms[k];
-            lambda[k] > 1e-8 * scale || (bu + c_lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
+            row.iter().map(|&(j, v)| v * u[j]).sum::<f64>()
+        })
+        .collect();
+    sums.extend_from_slice(&lcp.g);
+    sums.par_extend((0..m).into_par_iter().map(|k| {
+        let row = &lcp.b_rows[k];
+        row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>() + lcp.g[k].abs()
+    }));
+    sums.extend(lcp.c_times(lambda));
+    sums.extend(lcp.c_times_abs(lambda));
+    let sums = lcp.whole(sums);
+    let (bu, rest) = sums.split_at(m);
+    let (g, rest) = rest.split_at(m);
+    let (terms, rest) = rest.split_at(m);
+    let (c_lambda, c_terms) = rest.split_at(m);
+    (0..m)
+        .into_par_iter()
+        .map(|k| {
+            lambda[k] > 1e-8 * scale
+                || (bu[k] + c_lambda[k] - g[k]).abs() <= 1e-6 * (terms[k] + c_terms[k])
         })
         .collect()
 }

@@ -59,7 +59,7 @@ pub use report::{MeshQualityReport, Report};
 
 use crate::assembly::boundary::{Constraints, DirichletPart};
 use crate::error::{Error, Result};
-use crate::lcp::external::Purpose;
+use crate::lcp::external::{External, Purpose};
 use crate::lcp::Lcp;
 use crate::mesh::Mesh;
 use crate::model::{
@@ -1142,10 +1142,24 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         let supports = &self.supports;
         let last = meshes.len() - 1;
         let mut finest = finest;
+        // Where the external solver runs on several processes, each assembles its own
+        // cells of each level (partitioned here, on the thread that set the solver up),
+        // except a level the start pressed onto the obstacle reads whole.
+        let partitioned = self.partitioned(options)?;
+        let mut cells: Vec<Option<Vec<usize>>> = Vec::with_capacity(meshes.len());
+        for (k, mesh) in meshes.iter().enumerate() {
+            cells.push(match partitioned {
+                Some(e) if !(k == 0 && pressed.is_some()) => {
+                    e.0.partition(&crate::lcp::external::CellGraph::of(mesh))?
+                }
+                _ => None,
+            });
+        }
         let levels: Vec<_> = meshes
             .iter()
+            .zip(cells)
             .enumerate()
-            .map(|(k, mesh)| {
+            .map(|(k, (mesh, cells))| {
                 let built = if k == last { finest.take() } else { None };
                 move || -> Result<Discretization<G>> {
                     let (dofs, constraints) = match built {
@@ -1157,7 +1171,17 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                             (dofs, constraints)
                         }
                     };
-                    mesh.discretize::<M>(coefficients, dofs, &constraints, parts)
+                    let mut d = mesh.discretize_on::<M>(
+                        cells.as_deref(),
+                        coefficients,
+                        dofs,
+                        &constraints,
+                        parts,
+                    )?;
+                    if let (Some(e), Some(_)) = (partitioned, &cells) {
+                        d.lcp.share = Some(crate::lcp::Share::new(e));
+                    }
+                    Ok(d)
                 }
             })
             .collect();
@@ -1181,6 +1205,28 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             start,
             options,
         )
+    }
+
+    /// The external solver that partitions the levels' assembly among its processes
+    /// ([`ExternalSolver::partition`]), where the problem allows it: triangles, a
+    /// multiplier on the cells (a multiplier on a boundary part keeps the whole LCP: the
+    /// contact family's checks of each level multiply by `A`), a constraint to solve (a
+    /// problem without one is solved natively), and no start of the problem's own (a
+    /// start may read the LCP). Beams stay whole: small, and their contact set reads
+    /// every constraint's row on every process.
+    ///
+    /// [`ExternalSolver::partition`]: crate::lcp::external::ExternalSolver::partition
+    ///
+    /// # Errors
+    /// A model without a single multiplier.
+    fn partitioned(&self, options: ObstacleOptions) -> Result<Option<External>> {
+        let VariationalSolver::External(e) = options.solver else {
+            return Ok(None);
+        };
+        let boundary = crate::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
+        // an interval's contact set reads each constraint's row on every process
+        let triangles = G::CELL == crate::CellKind::Triangle;
+        Ok((triangles && !boundary && !self.unconstrained && self.start.is_none()).then_some(e))
     }
 
     /// Refuses a problem whose supports leave the body a motion without energy that the

@@ -120,6 +120,7 @@ pub fn solve<M: Model>(
         roles: Vec::new(),
         primal_reduced: (0..n).collect(),
         multiplier_reduced: Vec::new(),
+        cells: None,
     };
     // the nodal method's multipliers are the nodal forces: no elimination to be noisy
     Ok(ObstacleSolution::of(
