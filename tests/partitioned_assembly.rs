@@ -354,9 +354,7 @@ fn the_measures_of_a_shared_lcp_on_one_process_are_the_whole_ones() {
             contact_indicator(&shared, u, l),
             contact_indicator(&whole, u, l)
         );
-        let refused = solve_lcp(&shared, None, ObstacleOptions::default())
-            .err()
-            .expect("refused");
+        let refused = solve_lcp(&shared, None, ObstacleOptions::default()).expect_err("refused");
         assert!(refused.to_string().contains("partitioned"), "{refused}");
     }
     check::<fem_forms::models::membrane_p1_p0::Model>();
