@@ -36,7 +36,7 @@
 //! the ranks for a shared LCP, scaled by the assembled `‖A‖∞`).
 
 use crate::{
-    minimize, solve_with, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
+    minimize, solve_affine, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
     VectorView,
 };
 use fem_runtime::lcp::external::{CellGraph, ExternalSolver, Purpose};
@@ -676,17 +676,7 @@ fn solve_vi(
         // the residual at x = 0 is −(F, G): its size sets the rounding floor
         atol: Some(ABSOLUTE_TOLERANCE * norm2(lcp.f.iter().chain(&lcp.g))),
     };
-    let residual = |x: &VectorView, r: &mut VectorView| {
-        jacobian.multiply(x, r)?;
-        r.axpy(-1.0, &VectorView::of(&right))
-    };
-    let converged = solve_with(
-        &defaults,
-        &jacobian,
-        Box::new(residual),
-        Some((&lower, &upper)),
-        &mut x,
-    )?;
+    let converged = solve_affine(&defaults, &jacobian, &right, Some((&lower, &upper)), &mut x)?;
     let whole = x.gather()?;
     let mut u = vec![0.0; n];
     let mut lambda = vec![0.0; m];

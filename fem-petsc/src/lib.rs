@@ -1217,6 +1217,26 @@ pub fn solve_with(
     )
 }
 
+/// [`solve_with`] for the affine `F(x) = J x − b`: `jacobian` is `J`, `right` is `b`
+/// (a quadratic energy's gradient, as the nodal method's, or the mixed complementarity
+/// system of an LCP).
+///
+/// # Errors
+/// Those of [`solve`].
+pub fn solve_affine(
+    defaults: &Defaults,
+    jacobian: &Matrix,
+    right: &Vector,
+    bounds: Option<(&Vector, &Vector)>,
+    x: &mut Vector,
+) -> Result<Converged> {
+    let residual = |x: &VectorView, r: &mut VectorView| {
+        jacobian.multiply(x, r)?;
+        r.axpy(-1.0, &VectorView::of(right))
+    };
+    solve_with(defaults, jacobian, Box::new(residual), bounds, x)
+}
+
 /// Minimizes `objective` from the start in `x` by Newton's method (a plain SNES, its
 /// line search on the objective; `defaults` before the options): `gradient` writes the
 /// objective's gradient, `hessian` its (generalized) Hessian into `matrix`, which is

@@ -10,7 +10,7 @@
 //! are numbered rank by rank, so each rank's rows are contiguous as PETSc lays them out.
 //! The boundary values are imposed by `MatZeroRowsColumns`, which keeps `K` symmetric.
 
-use crate::{check, solve, sys, Converged, Error, Matrix, Petsc, Result, Vector, VectorView};
+use crate::{check, solve_affine, sys, Converged, Error, Matrix, Petsc, Result, Vector};
 use fem_runtime::lcp::external::CellGraph;
 use fem_runtime::mesh::TriangleMesh;
 use fem_runtime::model::DataFn;
@@ -277,11 +277,13 @@ pub fn solve_nodal<M: Model>(
             f.raw,
         )
     })?;
-    let residual = |x: &VectorView, r: &mut VectorView| {
-        k.multiply(x, r)?;
-        r.axpy(-1.0, &VectorView::of(&f))
-    };
-    let converged = solve(&k, Box::new(residual), Some((&lower, &upper)), &mut x)?;
+    let converged = solve_affine(
+        &crate::Defaults::default(),
+        &k,
+        &f,
+        Some((&lower, &upper)),
+        &mut x,
+    )?;
     let whole = x.gather()?;
     let values = (0..vertices).map(|v| whole[index[v]]).collect();
     Ok(NodalSolution {

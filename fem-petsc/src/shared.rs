@@ -12,7 +12,7 @@
 //! `(G − BU)₊,k / C_k` needs no communication beyond the entries of `U` its row reads).
 
 use crate::{
-    minimize, solve_with, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
+    minimize, solve_affine, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
     VectorView,
 };
 use fem_runtime::lcp::Lcp;
@@ -466,17 +466,7 @@ pub(crate) fn solve_mixed(
         atol: defaults.atol.map(|relative| relative * scale),
         ..defaults
     };
-    let residual = |x: &VectorView, r: &mut VectorView| {
-        jacobian.multiply(x, r)?;
-        r.axpy(-1.0, &VectorView::of(&right))
-    };
-    let converged = solve_with(
-        &defaults,
-        &jacobian,
-        Box::new(residual),
-        Some((&lower, &upper)),
-        &mut x,
-    )?;
+    let converged = solve_affine(&defaults, &jacobian, &right, Some((&lower, &upper)), &mut x)?;
     let whole = x.gather()?;
     let u = (0..n).map(|j| whole[numbering.u[j]]).collect();
     let lambda = (0..m).map(|k| whole[numbering.lambda[k]]).collect();
