@@ -151,7 +151,7 @@ impl Backend {
                 }),
             );
             if solved_nothing {
-                report.warn("PETSc solved nothing: the problem has no contact constraint to solve (a linear solve, done natively on every rank); --petsc-options did not apply");
+                report.warn("PETSc solved nothing: the problem has no contact constraint to solve (a linear solve, done natively on every rank), or no free primal unknown (Λ = C⁻¹G₊ directly); --petsc-options did not apply");
             }
         }
         #[cfg(not(feature = "petsc"))]

@@ -314,6 +314,9 @@ impl ExternalSolver for PetscLcpSolver {
 
     fn solve(&self, lcp: &Lcp, start: Option<&[f64]>) -> fem_runtime::Result<LcpSolution> {
         let clock = Instant::now();
+        if lcp.n() == 0 {
+            return without_primal_unknowns(lcp);
+        }
         let (mut u, mut lambda, mut converged, formulation) = self.attempt(lcp, start, false)?;
         let solver = match formulation {
             Formulation::Eliminated => "PETSc SNES on Φ(U)",
@@ -377,6 +380,35 @@ impl ExternalSolver for PetscLcpSolver {
         }
         Ok(solution)
     }
+}
+
+/// An LCP without primal unknowns (a mesh whose every vertex is held: membrane-radial
+/// at N = 1): `Λ = C⁻¹ G₊` for a diagonal positive `C`, without PETSc, whose solvers
+/// fail on empty matrices (`DIVERGED_LINEAR_SOLVE`).
+///
+/// # Errors
+/// A `C` that is not diagonal and positive.
+fn without_primal_unknowns(lcp: &Lcp) -> fem_runtime::Result<LcpSolution> {
+    let coupled = lcp.largest(f64::from(u8::from(!lcp.c_blocks.is_empty()))) > 0.0;
+    let (c, g) = (lcp.whole(lcp.c.clone()), lcp.whole(lcp.g.clone()));
+    if coupled || c.iter().any(|&c| c <= 0.0) {
+        return Err(fem_runtime::Error::Input(
+            "the level has no free primal unknown and its C is not diagonal and positive: solve it natively (or refine the mesh)".into(),
+        ));
+    }
+    let lambda: Vec<f64> = g.iter().zip(&c).map(|(g, c)| g.max(0.0) / c).collect();
+    Ok(LcpSolution {
+        kkt_residual: lcp.kkt_residual(&[], &lambda),
+        u: Vec::new(),
+        lambda,
+        iterations: 0,
+        seconds: 0.0,
+        factorizations: 0,
+        low_rank_updates: 0,
+        multiplier_noise: 0.0,
+        iterative_steps: 0,
+        krylov_iterations: 0,
+    })
 }
 
 /// SNES's relative tolerance on the residual norm: from a nested start the last Newton

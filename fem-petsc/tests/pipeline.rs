@@ -137,6 +137,27 @@ fn main() {
             );
         }
     }
+    // a level without free primal unknowns (N = 1: every vertex on the boundary): Λ
+    // directly, no PETSc solve (its solvers fail on empty matrices), as natively
+    let native = solve(
+        "membrane-radial",
+        "p1-p0",
+        1,
+        None,
+        VariationalSolver::SemismoothNewton,
+    );
+    let ours = solve("membrane-radial", "p1-p0", 1, None, external);
+    assert_eq!(
+        (
+            ours.report.solve.energy,
+            ours.report.solve.total_contact_force
+        ),
+        (
+            native.report.solve.energy,
+            native.report.solve.total_contact_force
+        ),
+        "membrane-radial N = 1"
+    );
     // both formulations where both apply: the mixed one on P0 multipliers
     petsc.set_formulation(Some(Formulation::Mixed));
     for (scene, pair, n) in [
