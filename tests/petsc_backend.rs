@@ -93,6 +93,15 @@ fn the_report_of_two_ranks_equals_the_native_one() {
             "eliminated"
         };
         assert_eq!(formulation, expected, "{scene} {pair}");
+        // each rank assembled its own cells of the finest level, contact's too; the
+        // nodal method keeps the whole LCP
+        let assembly = levels.last().map(|l| l["assembly"].clone());
+        let expected = if pair == "p1-nodal" {
+            "whole"
+        } else {
+            "partitioned"
+        };
+        assert_eq!(assembly, Some(expected.into()), "{scene} {pair}");
     }
 }
 

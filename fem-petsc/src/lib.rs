@@ -223,6 +223,36 @@ impl Petsc {
         }
     }
 
+    /// Every rank's `values`, concatenated in rank order, on every rank
+    /// (`MPI_Allgatherv`; every rank must call it, with a length of its own).
+    pub fn gather_all<T: mpi::datatype::Equivalence + Copy + Default>(
+        &self,
+        values: &[T],
+    ) -> Vec<T> {
+        use mpi::collective::CommunicatorCollectives;
+        use mpi::datatype::PartitionMut;
+        use mpi::traits::Communicator;
+        let Some(universe) = &self.universe else {
+            return values.to_vec();
+        };
+        let world = universe.world();
+        let mut counts = vec![0 as mpi::Count; world.size() as usize];
+        world.all_gather_into(&(values.len() as mpi::Count), &mut counts[..]);
+        let offsets: Vec<mpi::Count> = counts
+            .iter()
+            .scan(0, |at, &c| {
+                let here = *at;
+                *at += c;
+                Some(here)
+            })
+            .collect();
+        let total = counts.iter().map(|&c| c as usize).sum();
+        let mut all = vec![T::default(); total];
+        let mut partition = PartitionMut::new(&mut all[..], &counts[..], &offsets[..]);
+        world.all_gather_varcount_into(values, &mut partition);
+        all
+    }
+
     /// The largest of `value` over the ranks (`MPI_Allreduce`; every rank must call it).
     pub fn max(&self, value: f64) -> f64 {
         use mpi::collective::{CommunicatorCollectives, SystemOperation};
@@ -397,6 +427,20 @@ fn gather(raw: sys::Vec) -> Result<Vec<f64>> {
     }
 }
 
+/// The `n` values at `data`, which PETSc leaves null for an empty array (a rank that
+/// owns no rows), where `slice::from_raw_parts` needs a non-null pointer.
+///
+/// # Safety
+/// `data` valid for `n` reads while the slice lives, where `n > 0`.
+pub(crate) unsafe fn raw_slice<'a, T>(data: *const T, n: sys::PetscInt) -> &'a [T] {
+    if n <= 0 || data.is_null() {
+        &[]
+    } else {
+        // SAFETY: the caller's
+        unsafe { std::slice::from_raw_parts(data, n as usize) }
+    }
+}
+
 /// The entries of the vector `raw` this rank owns, in order.
 fn local_values(raw: sys::Vec) -> Result<Vec<f64>> {
     let mut n = 0;
@@ -405,7 +449,7 @@ fn local_values(raw: sys::Vec) -> Result<Vec<f64>> {
     unsafe {
         check("VecGetLocalSize", sys::VecGetLocalSize(raw, &mut n))?;
         check("VecGetArrayRead", sys::VecGetArrayRead(raw, &mut array))?;
-        let values = std::slice::from_raw_parts(array, n as usize).to_vec();
+        let values = raw_slice(array, n).to_vec();
         check(
             "VecRestoreArrayRead",
             sys::VecRestoreArrayRead(raw, &mut array),

@@ -126,7 +126,7 @@ pub(crate) fn partition(petsc: &Petsc, graph: &CellGraph) -> Result<Vec<usize>> 
             check("ISGetLocalSize", sys::ISGetLocalSize(all, &mut n))?;
             let mut indices: *const sys::PetscInt = std::ptr::null();
             check("ISGetIndices", sys::ISGetIndices(all, &mut indices))?;
-            let ranks: Vec<usize> = std::slice::from_raw_parts(indices, n as usize)
+            let ranks: Vec<usize> = crate::raw_slice(indices, n)
                 .iter()
                 .map(|&r| r as usize)
                 .collect();

@@ -7,9 +7,12 @@
 //! `MATPREALLOCATOR` from the same entries. An unknown belongs to the lowest rank whose
 //! cells touch it, and PETSc's rows are numbered rank by rank, so a rank's rows are
 //! those of its own cells except on the partition's interfaces. A constraint of a
-//! multiplier on cells lives on one cell: its rows of `B`, `C`, `G` are complete on the
-//! rank of that cell, which evaluates it alone (the eliminated formulation's
-//! `(G − BU)₊,k / C_k` needs no communication beyond the entries of `U` its row reads).
+//! multiplier on cells (or P0 on an edge) lives on one cell: its rows of `B`, `C`, `G`
+//! are complete on the rank of that cell, which evaluates it alone (the eliminated
+//! formulation's `(G − BU)₊,k / C_k` needs no communication beyond the entries of `U`
+//! its row reads). A continuous P1 multiplier's constraint on a vertex where two ranks'
+//! edges meet is held in part by both: the eliminated formulation gathers its parts to
+//! the lower rank once ([`Rows`]); the mixed one adds them inside PETSc.
 
 use crate::{
     minimize, solve_affine, Converged, Defaults, Error, Ghosts, Matrix, Petsc, Result, Vector,
@@ -189,27 +192,121 @@ fn vector_of<'p>(
     Ok(out)
 }
 
-/// Refuses a constraint held by several ranks (a multiplier split between parts): the
-/// eliminated formulation evaluates each constraint on one rank, from its whole row.
-fn check_one_holder(petsc: &Petsc, held: &[bool]) -> Result<()> {
-    let mut count: Vec<f64> = held.iter().map(|&h| f64::from(u8::from(h))).collect();
-    petsc.sum_all(&mut count);
-    match count.iter().position(|&c| c > 1.0) {
-        Some(k) => Err(Error::refused(
-            "PetscLcpSolver::solve",
-            format!(
-                "constraint {k} is held by {} ranks: a multiplier split between parts (on vertices) has no eliminated form here",
-                count[k]
-            ),
-        )),
-        None => Ok(()),
+/// The constraints this rank evaluates in the eliminated formulation, each with its
+/// whole row. A constraint held by one rank keeps that rank's row; one split between
+/// ranks (a P1 multiplier on a vertex where two parts' contact edges meet) is summed on
+/// the lowest of its holders from every holder's part, gathered from all ranks: few,
+/// the partition's interfaces on the multiplier's part.
+struct Rows {
+    /// The constraints, ascending.
+    held: Vec<usize>,
+    /// Their rows of `B` (columns ascending), of `C`'s diagonal and of `G`, in the
+    /// order of `held`.
+    b: Vec<Vec<(usize, f64)>>,
+    c: Vec<f64>,
+    g: Vec<f64>,
+}
+
+impl Rows {
+    /// This rank's constraints of `lcp`, `holds` the ones it has entries of ([`held`]).
+    ///
+    /// # Errors
+    /// A block of coupled multipliers (`C`'s off-diagonal blocks) split between ranks:
+    /// its inverse needs the whole block on one rank.
+    fn new(petsc: &Petsc, lcp: &Lcp, holds: &[bool]) -> Result<Self> {
+        let (rank, size, n) = (petsc.rank(), petsc.size(), lcp.n());
+        let mut holder: Vec<u64> = holds
+            .iter()
+            .map(|&h| if h { rank } else { size } as u64)
+            .collect();
+        petsc.min_all(&mut holder);
+        let mut count: Vec<f64> = holds.iter().map(|&h| f64::from(u8::from(h))).collect();
+        petsc.sum_all(&mut count);
+        let split = |k: usize| count[k] > 1.0;
+        for (first, s) in lcp.c_blocks.groups() {
+            if let Some(k) = (first..first + s).find(|&k| split(k)) {
+                return Err(Error::refused(
+                    "PetscLcpSolver::solve",
+                    format!(
+                        "constraint {k} of a coupled block of C is held by {} ranks: the block's inverse needs it whole on one",
+                        count[k]
+                    ),
+                ));
+            }
+        }
+        // this rank's parts of the split rows as triples (k, j, v): column j of B, or
+        // j = n for C's diagonal and j = n + 1 for G (indices exact in f64 below 2⁵³)
+        let mut mine: Vec<f64> = Vec::new();
+        for k in (0..lcp.m()).filter(|&k| holds[k] && split(k)) {
+            for &(j, v) in &lcp.b_rows[k] {
+                mine.extend([k as f64, j as f64, v]);
+            }
+            mine.extend([k as f64, n as f64, lcp.c[k]]);
+            mine.extend([k as f64, (n + 1) as f64, lcp.g[k]]);
+        }
+        let mut pieces: std::collections::BTreeMap<usize, Vec<(usize, f64)>> = Default::default();
+        for t in petsc.gather_all(&mine).chunks_exact(3) {
+            let k = t[0] as usize;
+            if holder[k] as usize == rank {
+                pieces.entry(k).or_default().push((t[1] as usize, t[2]));
+            }
+        }
+        let mut rows = Self {
+            held: Vec::new(),
+            b: Vec::new(),
+            c: Vec::new(),
+            g: Vec::new(),
+        };
+        for (k, &here) in holds.iter().enumerate() {
+            if split(k) {
+                if let Some(mut entries) = pieces.remove(&k) {
+                    entries.sort_by_key(|&(j, _)| j);
+                    let (mut row, mut c, mut g) = (Vec::<(usize, f64)>::new(), 0.0, 0.0);
+                    for (j, v) in entries {
+                        match j {
+                            j if j == n => c += v,
+                            j if j == n + 1 => g += v,
+                            j => match row.last_mut() {
+                                Some((last, w)) if *last == j => *w += v,
+                                _ => row.push((j, v)),
+                            },
+                        }
+                    }
+                    rows.push(k, row, c, g);
+                }
+            } else if here {
+                rows.push(k, lcp.b_rows[k].to_vec(), lcp.c[k], lcp.g[k]);
+            }
+        }
+        Ok(rows)
+    }
+
+    fn push(&mut self, k: usize, row: Vec<(usize, f64)>, c: f64, g: f64) {
+        self.held.push(k);
+        self.b.push(row);
+        self.c.push(c);
+        self.g.push(g);
+    }
+
+    /// The eliminated multipliers `(G − BU)₊,k / C_k` of the held constraints, `u(j)`
+    /// the unknown of column `j` of `B`.
+    fn multipliers(&self, u: impl Fn(usize) -> f64) -> Vec<f64> {
+        self.b
+            .iter()
+            .zip(&self.c)
+            .zip(&self.g)
+            .map(|((row, c), g)| {
+                let r = g - row.iter().map(|&(j, v)| v * u(j)).sum::<f64>();
+                r.max(0.0) / c
+            })
+            .collect()
     }
 }
 
 /// `‖F‖₂ + ‖BᵀC⁻¹G₊‖₂` of the whole LCP, the sizes of the two terms of `∇Φ(0)`.
-fn gradient_scale(petsc: &Petsc, lcp: &Lcp) -> f64 {
+fn gradient_scale(petsc: &Petsc, lcp: &Lcp, rows: &Rows) -> f64 {
     let mut pressed = vec![0.0; lcp.n()];
-    for ((row, g), c) in lcp.b_rows.iter().zip(&lcp.g).zip(&lcp.c) {
+    for ((row, g), c) in rows.b.iter().zip(&rows.g).zip(&rows.c) {
         if *c > 0.0 {
             let z = g.max(0.0) / c;
             for &(j, v) in row {
@@ -226,8 +323,8 @@ fn gradient_scale(petsc: &Petsc, lcp: &Lcp) -> f64 {
 
 /// Solves the shared `lcp` by SNES on Φ(U), the multipliers eliminated (see the crate's
 /// `lcp` module): `A` and `F` added into PETSc from every rank's cells, the constraints
-/// evaluated on the ranks that hold them, the Hessian `A + BᵀDB` preallocated for every
-/// constraint. Returns the whole `(U, Λ)` on every rank, SNES's report and `‖A‖∞` ([`Shared`]).
+/// evaluated on the ranks that hold them ([`Rows`]), the Hessian `A + BᵀDB` preallocated
+/// for every constraint. Returns the whole `(U, Λ)` on every rank, SNES's report and `‖A‖∞` ([`Shared`]).
 pub(crate) fn solve_eliminated(
     petsc: &Petsc,
     lcp: &Lcp,
@@ -235,17 +332,16 @@ pub(crate) fn solve_eliminated(
     defaults: Defaults,
 ) -> Result<Shared> {
     let holds = held(lcp);
-    check_one_holder(petsc, &holds)?;
+    let rows = Rows::new(petsc, lcp, &holds)?;
     let numbering = Numbering::new(petsc, lcp, &holds, false);
-    let held: Vec<usize> = (0..lcp.m()).filter(|&k| holds[k]).collect();
     let columns_of =
-        |k: usize| -> Vec<usize> { lcp.b_rows[k].iter().map(|&(j, _)| numbering.u[j]).collect() };
+        |i: usize| -> Vec<usize> { rows.b[i].iter().map(|&(j, _)| numbering.u[j]).collect() };
     let mut a = matrix_of_a(petsc, lcp, &numbering, true, |_| Ok(()))?;
     a.assemble()?;
     let a_norm = a.norm_infinity()?;
     let hessian_matrix = matrix_of_a(petsc, lcp, &numbering, false, |pattern| {
-        for &k in &held {
-            let columns = columns_of(k);
+        for i in 0..rows.held.len() {
+            let columns = columns_of(i);
             pattern.add(&columns, &columns)?;
         }
         Ok(())
@@ -260,14 +356,14 @@ pub(crate) fn solve_eliminated(
     x.set(&numbering.rows(), &begin, false)?;
     x.assemble()?;
     // the entries of U the held rows read, and each row in their local indices
-    let mut needed: Vec<usize> = held.iter().flat_map(|&k| columns_of(k)).collect();
+    let mut needed: Vec<usize> = (0..rows.held.len()).flat_map(columns_of).collect();
     needed.sort_unstable();
     needed.dedup();
-    let local_rows: Vec<Vec<(usize, f64)>> = held
+    let local_rows: Vec<Vec<(usize, f64)>> = rows
+        .b
         .iter()
-        .map(|&k| {
-            lcp.b_rows[k]
-                .iter()
+        .map(|row| {
+            row.iter()
                 .map(|&(j, v)| {
                     let at = needed
                         .binary_search(&numbering.u[j])
@@ -284,16 +380,18 @@ pub(crate) fn solve_eliminated(
     let defaults = Defaults {
         atol: defaults
             .atol
-            .map(|relative| relative * gradient_scale(petsc, lcp)),
+            .map(|relative| relative * gradient_scale(petsc, lcp, &rows)),
         ..defaults
     };
     // the eliminated multipliers of the held constraints from the needed entries of U
     let multipliers = |u: &[f64]| -> Vec<f64> {
-        held.iter()
-            .zip(&local_rows)
-            .map(|(&k, row)| {
-                let r = lcp.g[k] - row.iter().map(|&(j, v)| v * u[j]).sum::<f64>();
-                r.max(0.0) / lcp.c[k]
+        local_rows
+            .iter()
+            .zip(&rows.c)
+            .zip(&rows.g)
+            .map(|((row, c), g)| {
+                let r = g - row.iter().map(|&(j, v)| v * u[j]).sum::<f64>();
+                r.max(0.0) / c
             })
             .collect()
     };
@@ -304,27 +402,23 @@ pub(crate) fn solve_eliminated(
         a.multiply(x, &mut ax)?;
         let quadratic = 0.5 * x.dot(&ax)? - x.dot(&VectorView::of(f))?;
         let z = multipliers(&ghosts.borrow_mut().read(x)?);
-        let share: f64 = held
-            .iter()
-            .zip(&z)
-            .map(|(&k, z)| 0.5 * z * z * lcp.c[k])
-            .sum();
+        let share: f64 = rows.c.iter().zip(&z).map(|(c, z)| 0.5 * z * z * c).sum();
         Ok(quadratic + petsc.sum(share))
     };
     let gradient = |x: &VectorView, out: &mut VectorView| -> Result<()> {
         a.multiply(x, out)?;
         out.axpy(-1.0, &VectorView::of(f))?;
         let z = multipliers(&ghosts.borrow_mut().read(x)?);
-        let (mut rows, mut values) = (Vec::new(), Vec::new());
-        for (&zk, &k) in z.iter().zip(&held) {
+        let (mut indices, mut values) = (Vec::new(), Vec::new());
+        for (&zk, row) in z.iter().zip(&rows.b) {
             if zk != 0.0 {
-                for &(j, v) in &lcp.b_rows[k] {
-                    rows.push(numbering.u[j]);
+                for &(j, v) in row {
+                    indices.push(numbering.u[j]);
                     values.push(-v * zk);
                 }
             }
         }
-        out.add(&rows, &values)?;
+        out.add(&indices, &values)?;
         out.assemble()
     };
     let hessian = |x: &VectorView, matrix: &mut Matrix| -> Result<()> {
@@ -332,14 +426,14 @@ pub(crate) fn solve_eliminated(
         matrix.zero_entries()?;
         matrix.add_scaled(1.0, a)?;
         let mut block = Vec::new();
-        for (&k, &zk) in held.iter().zip(&z) {
+        for (i, &zk) in z.iter().enumerate() {
             // active where (G − BU)_k > 0, i.e. where the eliminated Λ_k is
             if zk > 0.0 {
-                let row = &lcp.b_rows[k];
-                let columns = columns_of(k);
+                let (row, c) = (&rows.b[i], rows.c[i]);
+                let columns = columns_of(i);
                 block.clear();
                 for &(_, v) in row {
-                    block.extend(row.iter().map(|&(_, w)| v * w / lcp.c[k]));
+                    block.extend(row.iter().map(|&(_, w)| v * w / c));
                 }
                 matrix.add(&columns, &columns, &block)?;
             }
@@ -357,9 +451,8 @@ pub(crate) fn solve_eliminated(
     let whole = x.gather()?;
     let u: Vec<f64> = (0..lcp.n()).map(|j| whole[numbering.u[j]]).collect();
     let mut lambda = vec![0.0; lcp.m()];
-    for &k in &held {
-        let r = lcp.g[k] - lcp.b_rows[k].iter().map(|&(j, v)| v * u[j]).sum::<f64>();
-        lambda[k] = r.max(0.0) / lcp.c[k];
+    for (&k, z) in rows.held.iter().zip(rows.multipliers(|j| u[j])) {
+        lambda[k] = z;
     }
     petsc.sum_all(&mut lambda);
     Ok(Shared {

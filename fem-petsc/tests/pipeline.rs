@@ -6,10 +6,10 @@
 //! (P1–P0, P2–P0, P2–P1disc whose `C` has 3 × 3 blocks, and the nodal method with its
 //! bounds on the primal unknowns), the Timoshenko and Euler–Bernoulli beams, the
 //! Reissner–Mindlin plate, the Kirchhoff plate (Argyris, Morley), the Winkler plate and
-//! Signorini contact with its multiplier on boundary edges. Where the multiplier lives
-//! on the cells of triangles, each rank assembles only its own cells (PT-Scotch's
-//! partition) and the whole LCP exists only in PETSc: the ranks' rows must add up to
-//! PETSc's; elsewhere every rank holds the whole LCP.
+//! Signorini contact with its multiplier (P0 or continuous P1) on boundary edges. On
+//! triangles each rank assembles only its own cells (PT-Scotch's partition) and the
+//! whole LCP exists only in PETSc: the ranks' rows must add up to PETSc's; the beams and
+//! the nodal method keep the whole LCP on every rank.
 
 use fem_models::families;
 use fem_models::report::{Outcome, Settings};
@@ -19,7 +19,7 @@ use fem_runtime::lcp::external::ExternalSolver;
 use fem_runtime::obstacle::VariationalSolver;
 
 /// (scene, pair, mesh size, load)
-const CASES: [(&str, &str, usize, Option<f64>); 16] = [
+const CASES: [(&str, &str, usize, Option<f64>); 18] = [
     ("membrane-radial", "p1-p0", 8, None),
     ("membrane-radial", "p2-p0", 4, None),
     ("membrane-radial", "p2-p1d", 4, None),
@@ -37,6 +37,10 @@ const CASES: [(&str, &str, usize, Option<f64>); 16] = [
     ("winkler-square", "argyris-p0", 8, None),
     ("signorini-patch", "p1-p0", 8, None),
     ("hertz", "p1-p0", 4, None),
+    // a continuous P1 multiplier: a constraint on a vertex where two ranks' contact
+    // edges meet is held by both
+    ("hertz", "p1-p1", 4, None),
+    ("signorini-patch", "p2-p1", 4, None),
 ];
 
 fn solve(
@@ -103,11 +107,10 @@ fn main() {
             "{case}: KKT residual {}",
             b.kkt_residual
         );
-        // each rank assembled its own cells where the multiplier lives on them (on
-        // triangles; the nodal method has its own path), and the ranks' rows are PETSc's
+        // each rank assembled its own cells on triangles (the nodal method has its own
+        // path), and the ranks' rows are PETSc's
         let record = petsc.records().last().cloned().expect("a record");
-        let on_cells = !matches!(scene, "signorini-patch" | "hertz")
-            && !scene.starts_with("timoshenko")
+        let on_cells = !scene.starts_with("timoshenko")
             && !scene.starts_with("bernoulli")
             && pair != "p1-nodal";
         match record.rows_here {
@@ -196,8 +199,122 @@ fn main() {
         .expect_err("refused")
         .to_string();
     assert!(refused.contains("diagonal positive C"), "{refused}");
+    petsc.set_formulation(None);
+    contact_checks_on_parts(external, size);
     petsc.finalize();
     if rank == 0 {
         println!("pipeline: {} cases equal on {size} ranks", CASES.len());
     }
+}
+
+/// A block (0,2)×(0,1) of the contact family as a scene file, `boundary` its lines of
+/// `[boundary]`, `pressure` the load's expression.
+fn block(cells: [usize; 2], boundary: &str, pressure: &str) -> String {
+    format!(
+        r#"
+    model = "contact"
+    [mesh]
+    generator = "rectangle"
+    x = [0.0, 2.0]
+    y = [0.0, 1.0]
+    cells = [{}, {}]
+    [material]
+    young = 1000.0
+    poisson = 0.3
+    [boundary]
+    {boundary}
+    [data]
+    pressure = "{pressure}"
+    gap = "0"
+"#,
+        cells[0], cells[1]
+    )
+}
+
+/// The contact family's checks of each level (the free rigid motions through `A`, the
+/// load's work on them through `F`, the constraints' reach through `B`) read a level
+/// each rank holds a part of through the ranks' reductions: the same answer, or the
+/// same refusal word for word, as natively. Cases: a tilted foundation under a roller
+/// (a free oblique translation, held by the contact; with q = (x/2)⁵ the body tips), a
+/// held translation with a one-sided tipping condition (held, and turned away), and a
+/// coarse level whose one contact edge cannot hold the rotation (skipped for a finer).
+fn contact_checks_on_parts(external: VariationalSolver, size: usize) {
+    let tilted = |power: u32| {
+        block(
+            [2, 1],
+            "contact = \"bottom\"\n    load = \"top\"\n    fixed_x = \"top\"\n    [parameters]\n    contact_direction = [0.28734788556634544, -0.9578262852211514]",
+            &format!("(x/2)^{power}"),
+        )
+        .replace("cells = [2, 1]", "cells = [2, 1]\n    refinements = 3")
+    };
+    let one_sided = |load: &str, pressure: &str| {
+        block(
+            [8, 4],
+            &format!("contact = \"bottom\"\n    load = {load}\n    fixed_y = \"left\"\n    fixed_x = \"top\""),
+            pressure,
+        )
+    };
+    let cases = [
+        (tilted(2), "p1-p0", None),
+        (tilted(2), "p1-p1", None),
+        (tilted(5), "p1-p0", Some("tips the body")),
+        (one_sided("[\"top\", \"right\"]", "10 - 9*y"), "p2-p1", None),
+        (
+            one_sided("[\"left\", \"top\"]", "0.01 + 10*(1 - y)^8"),
+            "p1-p0",
+            Some("turns the body away"),
+        ),
+    ];
+    let path = std::path::Path::new("scene.toml");
+    for (text, pair, refused) in &cases {
+        let file = fem_models::scene_file::parse(text, path).expect("a scene file");
+        let mut settings = file.settings();
+        settings.pair = Some((*pair).into());
+        let native = families::solve(&file.scene, &settings).map(|o| o.report);
+        settings.solver = external;
+        let ours = families::solve(&file.scene, &settings).map(|o| o.report);
+        let case = format!("contact scene file, {pair}, on {size} ranks");
+        match (native, ours) {
+            (Ok(a), Ok(b)) => {
+                assert!(refused.is_none(), "{case}: solved");
+                let (x, y) = (a.solve.total_contact_force, b.solve.total_contact_force);
+                assert!(
+                    (x - y).abs() <= 1e-7 * x.abs().max(y.abs()),
+                    "{case}: ∫λ {x} and {y}"
+                );
+                assert!(b.solve.kkt_residual < 1e-8, "{case}");
+                assert_eq!(b.solve.solver, "petsc", "{case}");
+            }
+            (Err(a), Err(b)) => {
+                assert!(
+                    refused.is_some_and(|words| a.to_string().contains(words)),
+                    "{case}: {a}"
+                );
+                assert_eq!(a.to_string(), b.to_string(), "{case}");
+            }
+            (a, b) => panic!(
+                "{case}: natively {:?}, by PETSc {:?}",
+                a.map(|r| r.solve.total_contact_force),
+                b.map(|r| r.solve.total_contact_force)
+            ),
+        }
+    }
+    // a unit square free to rotate, pressed by q = x⁸ (its resultant meets the bottom at
+    // x = 9/10): nested iteration begins on the first level whose P0 constraints reach
+    // it, 128 cells, the coarser ones judged too coarse on every rank alike
+    let square = block(
+        [1, 1],
+        "contact = \"bottom\"\n    load = \"top\"\n    fixed_x = \"top\"",
+        "x^8",
+    )
+    .replace("x = [0.0, 2.0]", "x = [0.0, 1.0]")
+    .replace("cells = [1, 1]", "cells = [1, 1]\n    refinements = 4");
+    let file = fem_models::scene_file::parse(&square, path).expect("a scene file");
+    let mut settings = file.settings();
+    settings.pair = Some("p1-p0".into());
+    settings.solver = external;
+    let report = families::solve(&file.scene, &settings)
+        .unwrap_or_else(|e| panic!("the square on {size} ranks: {e}"))
+        .report;
+    assert_eq!(report.solve.levels[0][0], 128, "the square on {size} ranks");
 }

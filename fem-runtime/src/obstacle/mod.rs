@@ -1255,6 +1255,14 @@ where
 /// The first start of a nested solve: its judgement of a level ([`LevelStart`]), where
 /// Newton starts on the first level solved (and again where a prolonged start fails);
 /// an error refuses the problem (e.g. a body whose rigid motion nothing holds).
+///
+/// The level may be one process's part of a partitioned assembly ([`Lcp::share`]): a
+/// start reads the whole LCP through the parts' reductions ([`Lcp::whole`],
+/// [`Lcp::largest`]), called on every process alike.
+///
+/// [`Lcp::share`]: crate::lcp::Lcp::share
+/// [`Lcp::whole`]: crate::lcp::Lcp::whole
+/// [`Lcp::largest`]: crate::lcp::Lcp::largest
 pub type FirstStart<'a, G> = dyn Fn(&Discretization<G>) -> Result<LevelStart> + Sync + 'a;
 
 /// How a level of a nested solve starts when no coarser solution is prolonged to it.

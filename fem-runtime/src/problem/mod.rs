@@ -389,7 +389,8 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         self
     }
 
-    /// The start of the coarsest level (it may also refuse the problem).
+    /// The start of the coarsest level (it may also refuse the problem); it reads a
+    /// level's LCP as [`FirstStart`] says, the level possibly one process's part.
     pub fn start(mut self, start: &'a FirstStart<'a, G>) -> Self {
         self.start = Some(start);
         self
@@ -1145,7 +1146,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
         // Where the external solver runs on several processes, each assembles its own
         // cells of each level (partitioned here, on the thread that set the solver up),
         // except a level the start pressed onto the obstacle reads whole.
-        let partitioned = self.partitioned(options)?;
+        let partitioned = self.partitioned(options);
         let mut cells: Vec<Option<Vec<usize>>> = Vec::with_capacity(meshes.len());
         for (k, mesh) in meshes.iter().enumerate() {
             cells.push(match partitioned {
@@ -1208,25 +1209,20 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     }
 
     /// The external solver that partitions the levels' assembly among its processes
-    /// ([`ExternalSolver::partition`]), where the problem allows it: triangles, a
-    /// multiplier on the cells (a multiplier on a boundary part keeps the whole LCP: the
-    /// contact family's checks of each level multiply by `A`), a constraint to solve (a
-    /// problem without one is solved natively), and no start of the problem's own (a
-    /// start may read the LCP). Beams stay whole: small, and their contact set reads
-    /// every constraint's row on every process.
+    /// ([`ExternalSolver::partition`]), where the problem allows it: triangles and a
+    /// constraint to solve (a problem without one is solved natively). The multiplier
+    /// lives on the cells or on a boundary part (contact, whose start reads the level
+    /// through the parts' reductions, [`FirstStart`]). Beams stay whole: small, and their
+    /// contact set reads every constraint's row on every process.
     ///
     /// [`ExternalSolver::partition`]: crate::lcp::external::ExternalSolver::partition
-    ///
-    /// # Errors
-    /// A model without a single multiplier.
-    fn partitioned(&self, options: ObstacleOptions) -> Result<Option<External>> {
+    fn partitioned(&self, options: ObstacleOptions) -> Option<External> {
         let VariationalSolver::External(e) = options.solver else {
-            return Ok(None);
+            return None;
         };
-        let boundary = crate::obstacle::boundary_multiplier::multiplier_part::<M>()?.is_some();
         // an interval's contact set reads each constraint's row on every process
         let triangles = G::CELL == crate::CellKind::Triangle;
-        Ok((triangles && !boundary && !self.unconstrained && self.start.is_none()).then_some(e))
+        (triangles && !self.unconstrained).then_some(e)
     }
 
     /// Refuses a problem whose supports leave the body a motion without energy that the

@@ -25,21 +25,24 @@ pub(super) fn pressed_start(
         return Ok(LevelStart::TooCoarse(reason));
     }
     let b = d.boundary().expect("a boundary multiplier");
+    let lcp = &d.lcp;
     // -g_k / ∫μ_k ds: the gap at constraint k (∫μ_k ds is |E| for P0)
-    let depth = d
-        .lcp
-        .g
+    let depth = lcp
+        .whole(lcp.g.clone())
         .iter()
         .zip(b.integrals())
         .fold(0.0f64, |m, (g, w)| m.max(-g / w));
     // beyond the gaps by the size of the elastic displacement (‖F‖∞/‖A‖∞, both in the
     // units of E): a fixed 1e-3 h was 1e22 times it at E = 1e25, and its multipliers
-    // C⁻¹(G − BU) left Newton a Hessian that was not positive definite
-    let lcp = &d.lcp;
-    let a_norm = (0..lcp.n())
-        .map(|j| lcp.a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0f64, f64::max);
-    let f_norm = lcp.f.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    // C⁻¹(G − BU) left Newton a Hessian that was not positive definite; of a shared
+    // LCP, ‖A‖∞ is the largest of the parts' (a scale, within the few parts sharing a
+    // row of the whole)
+    let a_norm = lcp.largest(
+        (0..lcp.n())
+            .map(|j| lcp.a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0f64, f64::max),
+    );
+    let f_norm = norm(&lcp.whole(lcp.f.clone()));
     let elastic = f_norm / a_norm.max(f64::MIN_POSITIVE);
     let scale = 2.0 * depth + elastic.min(1e-3 * d.mesh.max_h());
     Ok(LevelStart::At(
@@ -117,10 +120,10 @@ struct FreeMotions {
 /// # Errors
 /// [`Error::Input`] where the translation along the foundation is free.
 fn free_motions(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Result<FreeMotions> {
-    let f = &problem.lcp.f;
+    let f = &problem.lcp.whole(problem.lcp.f.clone());
     let translation = towards_foundation(problem, n);
-    let scale = norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
-    let product = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, x);
+    let scale = scale_of_a(problem);
+    let product = |x: &[f64]| a_times(problem, x);
     let translation_free =
         norm(&translation) > 0.0 && norm(&product(&translation)) <= 1e-10 * scale;
     let tangent = towards_foundation(problem, [-n[1], n[0]]);
@@ -165,8 +168,8 @@ fn free_motions(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Result<F
 /// translation `d` free and `d` is neither along `n_c` nor across it: the smallest
 /// eigenvector of the Gram matrix of `A e_x`, `A e_y`, where `A d` vanishes to rounding.
 fn oblique_translation(problem: &Discretization<TriangleMesh>, n: [f64; 2]) -> Option<Vec<f64>> {
-    let scale = norm(problem.lcp.a.val()).max(f64::MIN_POSITIVE);
-    let product = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(&problem.lcp.a, x);
+    let scale = scale_of_a(problem);
+    let product = |x: &[f64]| a_times(problem, x);
     let (x, y) = (
         towards_foundation(problem, [1.0, 0.0]),
         towards_foundation(problem, [0.0, 1.0]),
@@ -200,7 +203,9 @@ fn load_holds(
     motions: &FreeMotions,
     n: [f64; 2],
 ) -> Option<String> {
-    let work = dot(&motions.translation, &problem.lcp.f);
+    let work = problem
+        .lcp
+        .whole(vec![dot(&motions.translation, &problem.lcp.f)])[0];
     if motions.translation_free && (work.is_nan() || work <= 0.0) {
         return Some(format!(
             "the load does not press the body onto the contact boundary (its work on a translation towards the foundation is {work:e} ≤ 0, with q at the quadrature points of the edges of Γ_N: a pressure confined within an edge can fall between them; refine the mesh): the rigid motion is not prevented"
@@ -270,11 +275,15 @@ fn constraints_balance(
     let rotation = motions.rotation.as_ref()?;
     let lcp = &problem.lcp;
     let w: Vec<f64> = lcp
-        .b_times(&motions.translation)
+        .whole(lcp.b_times(&motions.translation))
         .iter()
         .map(|b| -b)
         .collect();
-    let zeta: Vec<f64> = lcp.b_times(&rotation.motion).iter().map(|b| -b).collect();
+    let zeta: Vec<f64> = lcp
+        .whole(lcp.b_times(&rotation.motion))
+        .iter()
+        .map(|b| -b)
+        .collect();
     // a constraint whose DOFs supports hold along n_c weighs nothing; only its sign of
     // ζ counts then (the translation is held, and the range's signs are what matter)
     let means = w
@@ -387,7 +396,7 @@ fn moments(
     rotation: &FreeRotation,
     motions: &FreeMotions,
 ) -> Moments {
-    let f = &problem.lcp.f;
+    let f = &problem.lcp.whole(problem.lcp.f.clone());
     let motion = &rotation.motion;
     // rounding of the sums: a load doing (almost) no work on a motion is not refused
     let terms: f64 = motion.iter().zip(f).map(|(z, f)| (z * f).abs()).sum();
@@ -427,8 +436,7 @@ fn free_rotation(
     // in the primed DOFs of the supports' rotated groups (oblique rollers)
     problem.basis.to_primed(&mut full);
     let rotation: Vec<f64> = problem.reduction.free().iter().map(|&d| full[d]).collect();
-    let a = &problem.lcp.a;
-    let multiply = |x: &[f64]| fem_runtime::lcp::cholesky::multiply(a, x);
+    let multiply = |x: &[f64]| a_times(problem, x);
     let (at, as_, ar) = (
         multiply(translation),
         multiply(tangent),
@@ -450,7 +458,7 @@ fn free_rotation(
     let residual: Vec<f64> = (0..rotation.len())
         .map(|i| ar[i] + a_t * at[i] + b_s * as_[i])
         .collect();
-    let scale = norm(a.val()).max(f64::MIN_POSITIVE) * norm(&motion);
+    let scale = scale_of_a(problem) * norm(&motion);
     (norm(&motion) > 0.0 && norm(&residual) <= 1e-10 * scale)
         .then_some(FreeRotation { motion, along: a_t })
 }
@@ -483,6 +491,20 @@ fn tips(
         // s changes sign: no βZ opens every contact
         (false, true, true) => false,
     }
+}
+
+/// `A x` of the whole LCP of `problem`, also where this process holds one part of it
+/// ([`fem_runtime::lcp::Lcp::share`]): the parts' products summed.
+fn a_times(problem: &Discretization<TriangleMesh>, x: &[f64]) -> Vec<f64> {
+    let lcp = &problem.lcp;
+    lcp.whole(fem_runtime::lcp::cholesky::multiply(&lcp.a, x))
+}
+
+/// The largest absolute entry of `A`, the scale of its rounding (of a shared LCP the
+/// largest of the parts', within the few parts that share an entry of the whole).
+fn scale_of_a(problem: &Discretization<TriangleMesh>) -> f64 {
+    let lcp = &problem.lcp;
+    lcp.largest(norm(lcp.a.val())).max(f64::MIN_POSITIVE)
 }
 
 fn dot(x: &[f64], y: &[f64]) -> f64 {

@@ -211,11 +211,11 @@ pub fn solution_of<M: Model>(
         edge_dofs: boundary.edge_dofs.clone(),
         total_contact_force: force,
         applied_load: load,
-        discretized_load: towards_foundation(problem, direction)
+        discretized_load: lcp.whole(vec![towards_foundation(problem, direction)
             .iter()
             .zip(&lcp.f)
             .map(|(t, f)| t * f)
-            .sum(),
+            .sum()])[0],
         contact_half_width: half_width,
         max_contact_pressure: largest,
     }
