@@ -197,23 +197,25 @@ fn vector_of<'p>(
 /// ranks (a P1 multiplier on a vertex where two parts' contact edges meet) is summed on
 /// the lowest of its holders from every holder's part, gathered from all ranks: few,
 /// the partition's interfaces on the multiplier's part.
-struct Rows {
+struct Rows<'l> {
+    lcp: &'l Lcp,
     /// The constraints, ascending.
     held: Vec<usize>,
-    /// Their rows of `B` (columns ascending), of `C`'s diagonal and of `G`, in the
-    /// order of `held`.
-    b: Vec<Vec<(usize, f64)>>,
-    c: Vec<f64>,
-    g: Vec<f64>,
+    /// The split constraints among them, each with its whole row of `B` (columns
+    /// ascending), `C`'s diagonal entry and `G`; the others' rows are `lcp`'s.
+    merged: std::collections::BTreeMap<usize, WholeRow>,
 }
 
-impl Rows {
+/// A constraint's whole row of `B` (columns ascending), `C`'s diagonal entry and `G`.
+type WholeRow = (Vec<(usize, f64)>, f64, f64);
+
+impl<'l> Rows<'l> {
     /// This rank's constraints of `lcp`, `holds` the ones it has entries of ([`held`]).
     ///
     /// # Errors
     /// A block of coupled multipliers (`C`'s off-diagonal blocks) split between ranks:
     /// its inverse needs the whole block on one rank.
-    fn new(petsc: &Petsc, lcp: &Lcp, holds: &[bool]) -> Result<Self> {
+    fn new(petsc: &Petsc, lcp: &'l Lcp, holds: &[bool]) -> Result<Self> {
         let (rank, size, n) = (petsc.rank(), petsc.size(), lcp.n());
         let mut holder: Vec<u64> = holds
             .iter()
@@ -251,51 +253,58 @@ impl Rows {
                 pieces.entry(k).or_default().push((t[1] as usize, t[2]));
             }
         }
-        let mut rows = Self {
-            held: Vec::new(),
-            b: Vec::new(),
-            c: Vec::new(),
-            g: Vec::new(),
-        };
-        for (k, &here) in holds.iter().enumerate() {
-            if split(k) {
-                if let Some(mut entries) = pieces.remove(&k) {
-                    entries.sort_by_key(|&(j, _)| j);
-                    let (mut row, mut c, mut g) = (Vec::<(usize, f64)>::new(), 0.0, 0.0);
-                    for (j, v) in entries {
-                        match j {
-                            j if j == n => c += v,
-                            j if j == n + 1 => g += v,
-                            j => match row.last_mut() {
-                                Some((last, w)) if *last == j => *w += v,
-                                _ => row.push((j, v)),
-                            },
-                        }
-                    }
-                    rows.push(k, row, c, g);
+        let mut merged = std::collections::BTreeMap::new();
+        for (k, mut entries) in pieces {
+            entries.sort_by_key(|&(j, _)| j);
+            let (mut row, mut c, mut g) = (Vec::<(usize, f64)>::new(), 0.0, 0.0);
+            for (j, v) in entries {
+                match j {
+                    j if j == n => c += v,
+                    j if j == n + 1 => g += v,
+                    j => match row.last_mut() {
+                        Some((last, w)) if *last == j => *w += v,
+                        _ => row.push((j, v)),
+                    },
                 }
-            } else if here {
-                rows.push(k, lcp.b_rows[k].to_vec(), lcp.c[k], lcp.g[k]);
             }
+            merged.insert(k, (row, c, g));
         }
-        Ok(rows)
+        let held = (0..lcp.m())
+            .filter(|&k| {
+                if split(k) {
+                    merged.contains_key(&k)
+                } else {
+                    holds[k]
+                }
+            })
+            .collect();
+        Ok(Self { lcp, held, merged })
     }
 
-    fn push(&mut self, k: usize, row: Vec<(usize, f64)>, c: f64, g: f64) {
-        self.held.push(k);
-        self.b.push(row);
-        self.c.push(c);
-        self.g.push(g);
+    /// The number of constraints this rank evaluates.
+    fn len(&self) -> usize {
+        self.held.len()
+    }
+
+    /// The `i`-th held constraint's row of `B`, `C`'s diagonal entry and `G`.
+    fn row(&self, i: usize) -> (&[(usize, f64)], f64, f64) {
+        let k = self.held[i];
+        match self.merged.get(&k) {
+            Some((row, c, g)) => (row, *c, *g),
+            None => (&self.lcp.b_rows[k], self.lcp.c[k], self.lcp.g[k]),
+        }
+    }
+
+    /// The held constraints' rows, in order ([`Rows::row`]).
+    fn rows(&self) -> impl Iterator<Item = (&[(usize, f64)], f64, f64)> + '_ {
+        (0..self.len()).map(|i| self.row(i))
     }
 
     /// The eliminated multipliers `(G − BU)₊,k / C_k` of the held constraints, `u(j)`
     /// the unknown of column `j` of `B`.
     fn multipliers(&self, u: impl Fn(usize) -> f64) -> Vec<f64> {
-        self.b
-            .iter()
-            .zip(&self.c)
-            .zip(&self.g)
-            .map(|((row, c), g)| {
+        self.rows()
+            .map(|(row, c, g)| {
                 let r = g - row.iter().map(|&(j, v)| v * u(j)).sum::<f64>();
                 r.max(0.0) / c
             })
@@ -306,10 +315,10 @@ impl Rows {
 /// `‖F‖₂ + ‖BᵀC⁻¹G₊‖₂` of the whole LCP, the sizes of the two terms of `∇Φ(0)`.
 fn gradient_scale(petsc: &Petsc, lcp: &Lcp, rows: &Rows) -> f64 {
     let mut pressed = vec![0.0; lcp.n()];
-    for ((row, g), c) in rows.b.iter().zip(&rows.g).zip(&rows.c) {
-        if *c > 0.0 {
+    for (row, c, g) in rows.rows() {
+        if c > 0.0 {
             let z = g.max(0.0) / c;
-            for &(j, v) in row {
+            for &(j, v) in row.iter() {
                 pressed[j] += v * z;
             }
         }
@@ -335,12 +344,12 @@ pub(crate) fn solve_eliminated(
     let rows = Rows::new(petsc, lcp, &holds)?;
     let numbering = Numbering::new(petsc, lcp, &holds, false);
     let columns_of =
-        |i: usize| -> Vec<usize> { rows.b[i].iter().map(|&(j, _)| numbering.u[j]).collect() };
+        |i: usize| -> Vec<usize> { rows.row(i).0.iter().map(|&(j, _)| numbering.u[j]).collect() };
     let mut a = matrix_of_a(petsc, lcp, &numbering, true, |_| Ok(()))?;
     a.assemble()?;
     let a_norm = a.norm_infinity()?;
     let hessian_matrix = matrix_of_a(petsc, lcp, &numbering, false, |pattern| {
-        for i in 0..rows.held.len() {
+        for i in 0..rows.len() {
             let columns = columns_of(i);
             pattern.add(&columns, &columns)?;
         }
@@ -355,24 +364,23 @@ pub(crate) fn solve_eliminated(
         .collect();
     x.set(&numbering.rows(), &begin, false)?;
     x.assemble()?;
-    // the entries of U the held rows read, and each row in their local indices
-    let mut needed: Vec<usize> = (0..rows.held.len()).flat_map(columns_of).collect();
+    // the entries of U the held rows read, and the rows in their local indices (row i's
+    // entries at `local[starts[i]..starts[i + 1]]`)
+    let mut needed: Vec<usize> = (0..rows.len()).flat_map(columns_of).collect();
     needed.sort_unstable();
     needed.dedup();
-    let local_rows: Vec<Vec<(usize, f64)>> = rows
-        .b
-        .iter()
-        .map(|row| {
-            row.iter()
-                .map(|&(j, v)| {
-                    let at = needed
-                        .binary_search(&numbering.u[j])
-                        .expect("every column read is needed");
-                    (at, v)
-                })
-                .collect()
-        })
-        .collect();
+    let mut starts = Vec::with_capacity(rows.len() + 1);
+    starts.push(0);
+    let mut local: Vec<(usize, f64)> = Vec::new();
+    for (row, _, _) in rows.rows() {
+        local.extend(row.iter().map(|&(j, v)| {
+            let at = needed
+                .binary_search(&numbering.u[j])
+                .expect("every column read is needed");
+            (at, v)
+        }));
+        starts.push(local.len());
+    }
     let ghosts = std::cell::RefCell::new(Ghosts::new(petsc, &x, &needed)?);
     let mut work = Vector::new(petsc, numbering.local)?;
     work.assemble()?;
@@ -385,11 +393,11 @@ pub(crate) fn solve_eliminated(
     };
     // the eliminated multipliers of the held constraints from the needed entries of U
     let multipliers = |u: &[f64]| -> Vec<f64> {
-        local_rows
-            .iter()
-            .zip(&rows.c)
-            .zip(&rows.g)
-            .map(|((row, c), g)| {
+        starts
+            .windows(2)
+            .zip(rows.rows())
+            .map(|(at, (_, c, g))| {
+                let row = &local[at[0]..at[1]];
                 let r = g - row.iter().map(|&(j, v)| v * u[j]).sum::<f64>();
                 r.max(0.0) / c
             })
@@ -402,7 +410,11 @@ pub(crate) fn solve_eliminated(
         a.multiply(x, &mut ax)?;
         let quadratic = 0.5 * x.dot(&ax)? - x.dot(&VectorView::of(f))?;
         let z = multipliers(&ghosts.borrow_mut().read(x)?);
-        let share: f64 = rows.c.iter().zip(&z).map(|(c, z)| 0.5 * z * z * c).sum();
+        let share: f64 = rows
+            .rows()
+            .zip(&z)
+            .map(|((_, c, _), z)| 0.5 * z * z * c)
+            .sum();
         Ok(quadratic + petsc.sum(share))
     };
     let gradient = |x: &VectorView, out: &mut VectorView| -> Result<()> {
@@ -410,9 +422,9 @@ pub(crate) fn solve_eliminated(
         out.axpy(-1.0, &VectorView::of(f))?;
         let z = multipliers(&ghosts.borrow_mut().read(x)?);
         let (mut indices, mut values) = (Vec::new(), Vec::new());
-        for (&zk, row) in z.iter().zip(&rows.b) {
+        for (&zk, (row, _, _)) in z.iter().zip(rows.rows()) {
             if zk != 0.0 {
-                for &(j, v) in row {
+                for &(j, v) in row.iter() {
                     indices.push(numbering.u[j]);
                     values.push(-v * zk);
                 }
@@ -429,10 +441,10 @@ pub(crate) fn solve_eliminated(
         for (i, &zk) in z.iter().enumerate() {
             // active where (G − BU)_k > 0, i.e. where the eliminated Λ_k is
             if zk > 0.0 {
-                let (row, c) = (&rows.b[i], rows.c[i]);
+                let (row, c, _) = rows.row(i);
                 let columns = columns_of(i);
                 block.clear();
-                for &(_, v) in row {
+                for &(_, v) in row.iter() {
                     block.extend(row.iter().map(|&(_, w)| v * w / c));
                 }
                 matrix.add(&columns, &columns, &block)?;
