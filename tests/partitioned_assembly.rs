@@ -7,8 +7,9 @@
 //! edges (Signorini, P0 and P1) as the whole mesh has them. A multiplier on cells or on
 //! boundary edges (P0) must also find each of its constraints on exactly one part,
 //! complete there: what lets a rank evaluate its own constraints without communication.
-//! The parts are the cells `c ≡ r (mod 3)`, scattered over the mesh, so that no part is
-//! a contiguous block that would hide a cell numbered wrongly.
+//! The nodal method's levels are assembled in parts through the pipeline itself (a
+//! recording solver). The parts are the cells `c ≡ r (mod 3)`, scattered over the
+//! mesh, so that no part is a contiguous block that would hide a cell numbered wrongly.
 #![allow(mixed_script_confusables, confusable_idents, uncommon_codepoints)]
 
 use fem_forms::lcp::Lcp;
@@ -359,4 +360,127 @@ fn the_measures_of_a_shared_lcp_on_one_process_are_the_whole_ones() {
     }
     check::<fem_forms::models::membrane_p1_p0::Model>();
     check::<fem_forms::models::membrane_p2_p1disc::Model>();
+}
+
+/// A solver that gives this process the cells `c ≡ part (mod 3)` of each level it is
+/// asked to partition (all of them for `None`) and records the LCPs it is handed:
+/// a whole one (the coarsest level, never partitioned) it solves natively as the nodal
+/// LCP it is, a part it records and refuses, which ends the solve there.
+struct Recording {
+    part: Option<usize>,
+    lcps: std::sync::Mutex<Vec<Lcp>>,
+}
+
+impl fem_forms::lcp::external::ExternalSolver for Recording {
+    fn name(&self) -> &'static str {
+        "recording"
+    }
+
+    fn partition(
+        &self,
+        graph: &fem_forms::lcp::external::CellGraph,
+    ) -> fem_forms::Result<Option<Vec<usize>>> {
+        Ok(self
+            .part
+            .map(|r| (r..graph.cell_count()).step_by(3).collect()))
+    }
+
+    fn solve(
+        &self,
+        lcp: &Lcp,
+        start: Option<&[f64]>,
+    ) -> fem_forms::Result<fem_forms::lcp::LcpSolution> {
+        self.lcps.lock().unwrap().push(lcp.clone());
+        if lcp.share.is_some() {
+            return Err(fem_forms::Error::Input("a part, recorded".into()));
+        }
+        // the nodal LCP: B = I, C = 0, G = ψ
+        fem_forms::obstacle::nodal::nodal_active_set_level(
+            &lcp.a,
+            &lcp.f,
+            &lcp.g,
+            start,
+            500,
+            &[],
+            true,
+        )
+    }
+}
+
+/// The nodal method assembled in parts (`problem::nodal`, each process its cells of
+/// every level but the coarsest): over the parts `c ≡ r (mod 3)` of the second level,
+/// the parts' `A` and `F` sum to the whole level's, and each constraint `U_k ≥ ψ_k` is
+/// on exactly one part (its row `e_k` and `G_k = ψ_k` there), so the parts' LCPs sum to
+/// the whole nodal LCP. Checked to fail when every part owns every node.
+#[test]
+fn the_nodal_methods_parts_sum_to_the_whole_lcp() {
+    use fem_forms::lcp::external::External;
+    use fem_forms::obstacle::{ObstacleOptions, VariationalSolver};
+    use fem_forms::problem::{Problem, SolveOptions};
+    type M = fem_forms::models::membrane_p1::Model;
+    fn level_lcp(part: Option<usize>) -> Lcp {
+        let coarse =
+            TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Diagonal::Alternating).unwrap();
+        let fine = coarse.refine_uniformly();
+        let solver: &'static Recording = Box::leak(Box::new(Recording {
+            part,
+            lcps: Default::default(),
+        }));
+        let outcome = Problem::<M, TriangleMesh>::new(vec![coarse, fine])
+            .nodal(&obstacle)
+            .data("f", &load)
+            .data("ψ", &obstacle)
+            .data("g", &boundary)
+            .boundary_data(fem_forms::DirichletPart::All)
+            .options(SolveOptions {
+                obstacle: ObstacleOptions {
+                    solver: VariationalSolver::External(External(solver)),
+                    ..ObstacleOptions::default()
+                },
+                ..SolveOptions::default()
+            })
+            .solve();
+        match (&outcome, part) {
+            (Ok(_), None) => {}
+            (Err(e), Some(_)) => assert!(e.to_string().contains("a part, recorded"), "{e}"),
+            (Err(e), None) => panic!("the whole solve: {e}"),
+            (Ok(_), Some(r)) => panic!("part {r} solved"),
+        }
+        let mut lcps = solver.lcps.lock().unwrap();
+        assert_eq!(lcps.len(), 2, "the coarse level whole, then the fine one");
+        assert!(lcps[0].share.is_none(), "the coarsest level is whole");
+        lcps.pop().unwrap()
+    }
+    let whole = level_lcp(None);
+    assert!(whole.share.is_none());
+    let mut sum = Blocks::default();
+    let mut holders = vec![0usize; whole.m()];
+    for r in 0..3 {
+        let part = level_lcp(Some(r));
+        assert!(part.share.is_some(), "part {r} is shared");
+        assert_eq!((part.n(), part.m()), (whole.n(), whole.m()));
+        sum.add(&part);
+        for (k, row) in part.b_rows.iter().enumerate() {
+            if !row.is_empty() {
+                assert_eq!(row, [(k, 1.0)], "part {r}: constraint {k}");
+                holders[k] += 1;
+            } else {
+                assert_eq!(
+                    part.g[k], 0.0,
+                    "part {r}: G of constraint {k} it does not hold"
+                );
+            }
+        }
+    }
+    let mut expected = Blocks::default();
+    expected.add(&whole);
+    same("A", &sum.a, &expected.a);
+    same("B", &sum.b, &expected.b);
+    same("F", &sum.f, &expected.f);
+    same("G", &sum.g, &expected.g);
+    assert!(sum.c.values().all(|&c| c == 0.0));
+    assert!(whole.g.iter().any(|&g| g != 0.0), "an obstacle somewhere");
+    for (k, &holder) in holders.iter().enumerate() {
+        assert_eq!(holder, 1, "constraint {k} is on {holder} parts");
+    }
 }

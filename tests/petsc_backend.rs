@@ -93,15 +93,10 @@ fn the_report_of_two_ranks_equals_the_native_one() {
             "eliminated"
         };
         assert_eq!(formulation, expected, "{scene} {pair}");
-        // each rank assembled its own cells of the finest level, contact's too; the
-        // nodal method keeps the whole LCP
+        // each rank assembled its own cells of the finest level, contact's and the
+        // nodal method's too
         let assembly = levels.last().map(|l| l["assembly"].clone());
-        let expected = if pair == "p1-nodal" {
-            "whole"
-        } else {
-            "partitioned"
-        };
-        assert_eq!(assembly, Some(expected.into()), "{scene} {pair}");
+        assert_eq!(assembly, Some("partitioned".into()), "{scene} {pair}");
     }
 }
 

@@ -477,12 +477,16 @@ fn formulation_of(
 }
 
 /// [`formulation_of`] for an LCP held in parts by the ranks ([`Lcp::share`]): judged on
-/// the whole `C`, summed over them (the nodal method is never partitioned).
+/// the whole `C`, summed over them; primal for the nodal method's parts
+/// ([`crate::shared::is_nodal`]).
 fn shared_formulation(
     petsc: &Petsc,
     lcp: &Lcp,
     preferred: Option<Formulation>,
 ) -> std::result::Result<Formulation, String> {
+    if crate::shared::is_nodal(petsc, lcp) {
+        return Ok(Formulation::Primal);
+    }
     let mut c = lcp.c.clone();
     petsc.sum_all(&mut c);
     let coupled = petsc.max(f64::from(u8::from(!lcp.c_blocks.is_empty()))) > 0.0;
@@ -781,10 +785,19 @@ fn solve_shared(
                 atol: Some(ABSOLUTE_TOLERANCE),
             },
         ),
-        Formulation::Primal => Err(Error::refused(
-            "PetscLcpSolver::solve",
-            "the nodal method is not assembled in parts",
-        )),
+        Formulation::Primal => crate::shared::solve_primal(
+            petsc,
+            lcp,
+            start,
+            Defaults {
+                ksp_type: Some(c"preonly"),
+                pc_type: Some(c"cholesky"),
+                factor_package: Some(c"mumps"),
+                line_search: Some(c"basic"),
+                rtol: Some(RELATIVE_TOLERANCE),
+                atol: Some(ABSOLUTE_TOLERANCE),
+            },
+        ),
     }
 }
 

@@ -583,3 +583,98 @@ pub(crate) fn solve_mixed(
         rows_here: numbering.local,
     })
 }
+
+/// Whether the shared `lcp` is the nodal method's (`B = I`, `C = 0`, `U_k ≥ ψ_k`): every
+/// rank's rows empty or `e_k`, `C` zero without blocks, and each constraint held by
+/// exactly one rank (collective: every rank must call it).
+pub(crate) fn is_nodal(petsc: &Petsc, lcp: &Lcp) -> bool {
+    let here = lcp.m() == lcp.n()
+        && lcp.c.iter().all(|&c| c == 0.0)
+        && lcp.c_blocks.is_empty()
+        && lcp
+            .b_rows
+            .iter()
+            .enumerate()
+            .all(|(k, row)| row.is_empty() || row == [(k, 1.0)]);
+    // every rank must take part in the count below, whatever its rows
+    let mut count: Vec<f64> = lcp
+        .b_rows
+        .iter()
+        .map(|row| f64::from(u8::from(!row.is_empty())))
+        .collect();
+    let length = count.len() as f64;
+    let same_length = petsc.max(length) == -petsc.max(-length);
+    if petsc.max(f64::from(u8::from(!here))) > 0.0 || !same_length {
+        return false;
+    }
+    petsc.sum_all(&mut count);
+    count.iter().all(|&c| c == 1.0)
+}
+
+/// Solves the shared nodal LCP ([`is_nodal`]) by SNESVI with the bounds `U ≥ ψ` on the
+/// primal unknowns: `A` and `F` added into PETSc from every rank's cells, each bound
+/// set by the rank that owns its constraint. Returns the whole `U` and the nodal forces
+/// `Λ = (AU − F)₊` on every rank, SNES's report and `‖A‖∞` ([`Shared`]).
+pub(crate) fn solve_primal(
+    petsc: &Petsc,
+    lcp: &Lcp,
+    start: Option<&[f64]>,
+    defaults: Defaults,
+) -> Result<Shared> {
+    let holds = held(lcp);
+    let numbering = Numbering::new(petsc, lcp, &holds, false);
+    let mut a = matrix_of_a(petsc, lcp, &numbering, true, |_| Ok(()))?;
+    a.assemble()?;
+    let a_norm = a.norm_infinity()?;
+    let f = vector_of(petsc, numbering.local, &lcp.f, |i| numbering.u[i])?;
+    let rows = numbering.rows();
+    let infinity = crate::sys::FEM_PETSC_INFINITY;
+    // ψ_k from the rank holding constraint k (B = I: it bounds unknown k)
+    let (bounded, floor): (Vec<usize>, Vec<f64>) = (0..lcp.m())
+        .filter(|&k| holds[k])
+        .map(|k| (numbering.u[k], lcp.g[k]))
+        .unzip();
+    let mut lower = Vector::new(petsc, numbering.local)?;
+    lower.set(&bounded, &floor, false)?;
+    let mut upper = Vector::new(petsc, numbering.local)?;
+    upper.set(&rows, &vec![infinity; rows.len()], false)?;
+    let mut x = Vector::new(petsc, numbering.local)?;
+    let begin: Vec<f64> = numbering
+        .own_u
+        .iter()
+        .map(|&i| start.map_or(0.0, |s| s[i]))
+        .collect();
+    x.set(&rows, &begin, false)?;
+    for v in [&mut x, &mut lower, &mut upper] {
+        v.assemble()?;
+    }
+    // the residual at x = 0 is −F: its size sets the rounding floor
+    let mut whole_f = lcp.f.clone();
+    petsc.sum_all(&mut whole_f);
+    let scale = whole_f.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let defaults = Defaults {
+        atol: defaults.atol.map(|relative| relative * scale),
+        ..defaults
+    };
+    let converged = solve_affine(&defaults, &a, &f, Some((&lower, &upper)), &mut x)?;
+    // the nodal forces A U − F, ≥ 0 up to the solver's tolerance where U = ψ
+    let mut residual = Vector::new(petsc, numbering.local)?;
+    residual.assemble()?;
+    {
+        let mut r = VectorView::of(&residual);
+        a.multiply(&VectorView::of(&x), &mut r)?;
+        r.axpy(-1.0, &VectorView::of(&f))?;
+    }
+    let (whole, forces) = (x.gather()?, residual.gather()?);
+    let u = (0..lcp.n()).map(|j| whole[numbering.u[j]]).collect();
+    let lambda = (0..lcp.m())
+        .map(|k| forces[numbering.u[k]].max(0.0))
+        .collect();
+    Ok(Shared {
+        u,
+        lambda,
+        converged,
+        a_norm,
+        rows_here: numbering.local,
+    })
+}

@@ -363,6 +363,43 @@ fn linear(e: impl std::fmt::Debug) -> Error {
 
 /// The LCP of the nodal method (`B = I`, `C = 0`, `G = ψ`), for its KKT residual.
 pub fn nodal_lcp(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
+    nodal_lcp_on(a, f, psi, None)
+}
+
+/// [`nodal_lcp`] of one process's part of a partitioned assembly (`a`, `f` over its
+/// cells alone): the constraints `U_k ≥ ψ_k` it owns (`owned[k]`; `None`: all), each
+/// owned by exactly one part, so that the parts' LCPs sum to the whole one
+/// ([`crate::lcp::Lcp::share`]); a constraint it does not own has an empty row and
+/// `G_k = 0`.
+///
+/// # Panics
+/// If `owned` is not one flag per unknown.
+pub fn nodal_lcp_on(a: &SparseMatrix, f: &[f64], psi: &[f64], owned: Option<&[bool]>) -> Lcp {
+    let n = f.len();
+    let Some(owned) = owned else {
+        return nodal_whole(a, f, psi);
+    };
+    assert_eq!(owned.len(), n, "one ownership flag per unknown");
+    let mut ptr = Vec::with_capacity(n + 1);
+    ptr.push(0);
+    let mut entries = Vec::with_capacity(owned.iter().filter(|&&own| own).count());
+    for (k, &own) in owned.iter().enumerate() {
+        if own {
+            entries.push((k, 1.0));
+        }
+        ptr.push(entries.len());
+    }
+    let rows = ConstraintRows::from_flat(ptr, entries).expect("offsets from 0, not decreasing");
+    let g = psi
+        .iter()
+        .zip(owned)
+        .map(|(&p, &own)| if own { p } else { 0.0 })
+        .collect();
+    Lcp::new(a.clone(), rows, vec![0.0; n], f.to_vec(), g)
+}
+
+/// [`nodal_lcp`] whole.
+fn nodal_whole(a: &SparseMatrix, f: &[f64], psi: &[f64]) -> Lcp {
     let n = f.len();
     // `B = I` built flat: one row each, no allocation per row (1M of them at 1025²)
     let identity = ConstraintRows::from_flat((0..=n).collect(), (0..n).map(|i| (i, 1.0)).collect())

@@ -9,13 +9,15 @@ use crate::assembly::dof_map::{DofNumbering, SystemDofs};
 use crate::assembly::{assemble_vector, MatrixAssembler};
 use crate::error::{Error, Result};
 use crate::lcp::cholesky::multiply;
+use crate::lcp::external::{CellGraph, External};
 use crate::lcp::LcpSolution;
 use crate::mesh::TriangleMesh;
 use crate::model::{Coefficients, DataFn, FormId, Model};
 use crate::multigrid::{parents_by_location, prolongation, reduced_prolongation, NestedLevel};
 use crate::obstacle::hierarchy::LinearSolver;
 use crate::obstacle::nodal::{
-    force_density_at_vertices, nodal_active_set_level, nodal_lcp, NODAL_AUTO_MULTIGRID_UNKNOWNS,
+    force_density_at_vertices, nodal_active_set_level, nodal_lcp, nodal_lcp_on,
+    NODAL_AUTO_MULTIGRID_UNKNOWNS,
 };
 use crate::obstacle::{
     alongside, Discretization, Multipliers, ObstacleOptions, ObstacleSolution, VariationalSolver,
@@ -29,7 +31,8 @@ const PIPELINED_CELLS: usize = 32_768;
 
 /// One level before its solve: DOFs, elimination of the boundary DOFs, stiffness `a`,
 /// load `f` and obstacle `ψ` on the free nodes, and the prolongations from the next
-/// coarser level (all DOFs; free DOFs) if there is one.
+/// coarser level (all DOFs; free DOFs) if there is one. Of a level assembled in parts,
+/// `a` and `f` are this process's cells' and `part` says which.
 struct NodalLevel {
     dofs: SystemDofs,
     reduction: Reduction,
@@ -37,6 +40,26 @@ struct NodalLevel {
     f: Vec<f64>,
     psi: Vec<f64>,
     prolongations: Option<(SparseMatrix, SparseMatrix)>,
+    part: Option<Part>,
+}
+
+/// This process's share of a level assembled in parts: its cells, the constraints it
+/// owns ([`owned_unknowns`]), and the solver whose processes hold the other parts.
+struct Part {
+    cells: Vec<usize>,
+    owned: Vec<bool>,
+    solver: External,
+}
+
+impl Part {
+    /// The level's LCP as this process holds it ([`nodal_lcp_on`], [`Lcp::share`]).
+    ///
+    /// [`Lcp::share`]: crate::lcp::Lcp::share
+    fn lcp(part: Option<&Part>, a: &SparseMatrix, f: &[f64], psi: &[f64]) -> crate::lcp::Lcp {
+        let mut lcp = nodal_lcp_on(a, f, psi, part.map(|p| p.owned.as_slice()));
+        lcp.share = part.map(|p| crate::lcp::Share::new(p.solver));
+        lcp
+    }
 }
 
 /// The nested iteration so far: (cells, iterations) per level, the prolongations of the
@@ -56,6 +79,7 @@ struct NodalLevelSolved {
     a: SparseMatrix,
     f: Vec<f64>,
     psi: Vec<f64>,
+    part: Option<Part>,
 }
 
 /// Solves the nodal method of `M` (one P1 field, no multiplier) on the nested
@@ -73,12 +97,25 @@ pub fn solve<M: Model>(
 ) -> Result<ObstacleSolution<TriangleMesh>> {
     let clock = Instant::now();
     let energy = nodal_energy::<M>()?;
+    // Where an external solver runs on several processes, each assembles its own cells
+    // of every level but the coarsest, whose null-space check reads the whole matrix
+    // (partitioned here, on the thread that set the solver up).
+    let mut parts = Vec::with_capacity(meshes.len());
+    for (i, mesh) in meshes.iter().enumerate() {
+        parts.push(match options.solver {
+            VariationalSolver::External(e) if i > 0 => {
+                e.0.partition(&CellGraph::of(mesh))?.map(|cells| (cells, e))
+            }
+            _ => None,
+        });
+    }
     let problem = NodalProblem {
         meshes,
         coefficients,
         supports,
         obstacle,
         energy,
+        parts,
     };
     let setup = |i: usize| problem.level::<M>(i);
     let step = |state: &mut NodalState, level: NodalLevel, cells: usize| {
@@ -114,13 +151,13 @@ pub fn solve<M: Model>(
         dofs: level.dofs,
         reduction: level.reduction,
         basis: Default::default(),
-        lcp: nodal_lcp(&level.a, &level.f, &level.psi),
+        lcp: Part::lcp(level.part.as_ref(), &level.a, &level.f, &level.psi),
         multiplier_field: M::FIELDS.len(),
         multipliers: Multipliers::Nodal,
         roles: Vec::new(),
         primal_reduced: (0..n).collect(),
         multiplier_reduced: Vec::new(),
-        cells: None,
+        cells: level.part.map(|p| p.cells),
     };
     // the nodal method's multipliers are the nodal forces: no elimination to be noisy
     Ok(ObstacleSolution::of(
@@ -184,6 +221,9 @@ struct NodalProblem<'a> {
     obstacle: &'a DataFn,
     /// The forms `[a, ℓ]`.
     energy: [usize; 2],
+    /// This process's cells of each level and the solver that partitioned them, where
+    /// the level is assembled in parts.
+    parts: Vec<Option<(Vec<usize>, External)>>,
 }
 
 impl NodalProblem<'_> {
@@ -200,10 +240,13 @@ impl NodalProblem<'_> {
         let mesh = &self.meshes[i];
         let [stiffness, load] = self.energy;
         let (dofs, reduction) = self.free_dofs::<M>(mesh)?;
+        let cells = self.parts[i].as_ref().map(|(cells, _)| cells.as_slice());
+        crate::obstacle::check_cells(cells, mesh.cell_count())?;
+        let on = crate::mesh::CellSubset::new(mesh, cells);
         // the pattern moves into `k` and `k`'s arrays into `a` (no copies: peak memory)
-        let k = MatrixAssembler::new::<M>(FormId::new(stiffness), mesh, &dofs)?
-            .into_matrix::<M>(mesh, self.coefficients)?;
-        let l = assemble_vector::<M>(FormId::new(load), mesh, &dofs, self.coefficients)?;
+        let k = MatrixAssembler::new::<M>(FormId::new(stiffness), &on, &dofs)?
+            .into_matrix::<M>(&on, self.coefficients)?;
+        let l = assemble_vector::<M>(FormId::new(load), &on, &dofs, self.coefficients)?;
         let f = reduction.rhs(&k, &l);
         drop(l);
         let a = reduction.into_matrix(k);
@@ -232,6 +275,11 @@ impl NodalProblem<'_> {
             }
             None => None,
         };
+        let part = self.parts[i].as_ref().map(|(cells, solver)| Part {
+            owned: owned_unknowns(mesh, &dofs, &reduction, cells),
+            cells: cells.clone(),
+            solver: *solver,
+        });
         Ok(NodalLevel {
             dofs,
             reduction,
@@ -239,6 +287,7 @@ impl NodalProblem<'_> {
             f,
             psi,
             prolongations,
+            part,
         })
     }
 }
@@ -265,6 +314,7 @@ impl NodalState {
             f,
             psi,
             prolongations,
+            part,
         } = level;
         // the coarser level's system goes before this level's solve allocates
         self.finest = None;
@@ -303,7 +353,7 @@ impl NodalState {
         let solution = match options.solver {
             VariationalSolver::External(external) => external
                 .0
-                .solve(&nodal_lcp(&a, &f, &psi), start.as_deref())?,
+                .solve(&Part::lcp(part.as_ref(), &a, &f, &psi), start.as_deref())?,
             _ => nodal_active_set_level(&a, &f, &psi, start.as_deref(), 500, hierarchy, last)?,
         };
         self.levels.push((cells, solution.iterations));
@@ -315,11 +365,46 @@ impl NodalState {
                 a,
                 f,
                 psi,
+                part,
             },
             solution,
         ));
         Ok(())
     }
+}
+
+/// Which free unknowns' constraints `U_k ≥ ψ_k` this process owns, `cells` its cells of
+/// `mesh`: a node belongs to the part of the lowest-numbered cell that has it, so each
+/// constraint is owned by exactly one part of a partition, decided by each process
+/// from the whole mesh without communication.
+fn owned_unknowns(
+    mesh: &TriangleMesh,
+    dofs: &SystemDofs,
+    reduction: &Reduction,
+    cells: &[usize],
+) -> Vec<bool> {
+    let (map, offset) = (
+        dofs.map(0).expect("one field"),
+        dofs.offset(0).expect("one field"),
+    );
+    let mut first = vec![usize::MAX; dofs.dof_count()];
+    for c in 0..mesh.cell_count() {
+        for &d in map.cell_dofs(c) {
+            let d = offset + d;
+            if first[d] == usize::MAX {
+                first[d] = c;
+            }
+        }
+    }
+    let mut mine = vec![false; mesh.cell_count()];
+    for &c in cells {
+        mine[c] = true;
+    }
+    reduction
+        .free()
+        .iter()
+        .map(|&d| first[d] != usize::MAX && mine[first[d]])
+        .collect()
 }
 
 /// The nodal method's contact set, per cell: the share of its vertices in contact. A
