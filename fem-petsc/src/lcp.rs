@@ -276,7 +276,7 @@ impl ExternalSolver for PetscLcpSolver {
     fn partition(&self, graph: &CellGraph) -> fem_runtime::Result<Option<Vec<usize>>> {
         let guard = self.petsc.lock().unwrap_or_else(|e| e.into_inner());
         let on = self.on_this_thread(&guard)?;
-        let ranks = crate::nodal::partition(&on.petsc, graph)
+        let ranks = crate::partition::partition(&on.petsc, graph)
             .map_err(|e| fem_runtime::Error::Input(format!("PETSc's partitioner: {e}")))?;
         let rank = on.petsc.rank();
         Ok(Some(

@@ -15,7 +15,7 @@
 //! (docs/petsc.md).
 
 pub mod lcp;
-pub mod nodal;
+mod partition;
 mod shared;
 
 use std::ffi::{c_void, CStr, CString};
