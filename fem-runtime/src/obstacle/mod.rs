@@ -1701,16 +1701,22 @@ impl ObstacleSolution<IntervalMesh> {
         let active: Vec<bool> = lambda.iter().map(|&l| l > 1e-8 * scale).collect();
         // A cell touches when its constraint residual R_k is negligible against the
         // terms it is made of: holes of touching cells are filled, real gaps are not.
+        // Of an LCP held in parts (`Lcp::share`) the residuals are sums over the parts,
+        // and a constraint on cells lives on one part, where its terms are complete.
         let lcp = &self.discretization.lcp;
         let u = self.discretization.primal_part(&self.values);
         let c_lambda = lcp.c_times(lambda);
-        let touching = |k: usize| {
-            let row = &lcp.b_rows[k];
-            let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
-            let terms: f64 =
-                row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>() + lcp.g[k].abs();
-            (bu + c_lambda[k] - lcp.g[k]).abs() <= 1e-6 * terms
-        };
+        let (residual, terms): (Vec<f64>, Vec<f64>) = (0..lcp.m())
+            .map(|k| {
+                let row = &lcp.b_rows[k];
+                let bu: f64 = row.iter().map(|&(j, v)| v * u[j]).sum();
+                let terms =
+                    row.iter().map(|&(j, v)| (v * u[j]).abs()).sum::<f64>() + lcp.g[k].abs();
+                (bu + c_lambda[k] - lcp.g[k], terms)
+            })
+            .unzip();
+        let (residual, terms) = (lcp.whole(residual), lcp.whole(terms));
+        let touching = |k: usize| residual[k].abs() <= 1e-6 * terms[k];
         let mut runs: Vec<(usize, usize)> = Vec::new();
         for (c, &on) in active.iter().enumerate() {
             if on {

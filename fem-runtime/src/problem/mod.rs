@@ -1209,20 +1209,17 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     }
 
     /// The external solver that partitions the levels' assembly among its processes
-    /// ([`ExternalSolver::partition`]), where the problem allows it: triangles and a
-    /// constraint to solve (a problem without one is solved natively). The multiplier
-    /// lives on the cells or on a boundary part (contact, whose start reads the level
-    /// through the parts' reductions, [`FirstStart`]). Beams stay whole: small, and their
-    /// contact set reads every constraint's row on every process.
+    /// ([`ExternalSolver::partition`]), where the problem has a constraint to solve (a
+    /// problem without one is solved natively): triangles and intervals alike, the
+    /// multiplier on the cells or on a boundary part (contact, whose start reads the
+    /// level through the parts' reductions, [`FirstStart`]).
     ///
     /// [`ExternalSolver::partition`]: crate::lcp::external::ExternalSolver::partition
     fn partitioned(&self, options: ObstacleOptions) -> Option<External> {
         let VariationalSolver::External(e) = options.solver else {
             return None;
         };
-        // an interval's contact set reads each constraint's row on every process
-        let triangles = G::CELL == crate::CellKind::Triangle;
-        (triangles && !self.unconstrained).then_some(e)
+        (!self.unconstrained).then_some(e)
     }
 
     /// Refuses a problem whose supports leave the body a motion without energy that the
