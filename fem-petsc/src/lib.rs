@@ -1061,7 +1061,10 @@ pub struct Defaults {
     /// SNES's relative tolerance on the residual norm.
     pub rtol: Option<f64>,
     /// SNES's absolute tolerance on the residual norm (a start that is the solution
-    /// already has a residual at rounding, which no relative decrease can follow).
+    /// already has a residual at rounding, which no relative decrease can follow); at
+    /// least the smallest positive double, since PETSc's test is `‖F‖ < atol`: a problem
+    /// whose solution is exactly the start (no load, nothing pressed: ‖F‖ = 0 and a
+    /// scale of 0) otherwise took a zero Newton step and failed its line search.
     pub atol: Option<f64>,
 }
 
@@ -1117,7 +1120,7 @@ impl Defaults {
                     "SNESSetTolerances",
                     sys::SNESSetTolerances(
                         snes,
-                        self.atol.unwrap_or(atol),
+                        self.atol.map_or(atol, |a| a.max(f64::MIN_POSITIVE)),
                         self.rtol.unwrap_or(r),
                         stol,
                         its,
