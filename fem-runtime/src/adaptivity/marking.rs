@@ -7,12 +7,23 @@ use crate::{Error, Result};
 pub enum Marking {
     /// Dörfler (bulk) marking with parameter `θ ∈ (0, 1]`: the fewest cells, largest
     /// indicators first, whose squared indicators sum to at least `θ Σ_T η_T²`
-    /// (Dörfler, SIAM J. Numer. Anal. 33 (1996); the marking of the optimality proofs).
+    /// (Dörfler, SIAM J. Numer. Anal. 33 (1996); the marking of the optimality proofs),
+    /// and the cells tied with the last of them ([`TIE`]).
     Dorfler(f64),
     /// Maximum marking with parameter `θ ∈ (0, 1]`: every cell with `η_T ≥ θ max η`
-    /// (scikit-fem's `adaptive_theta`).
+    /// (scikit-fem's `adaptive_theta`), ties with the bar included ([`TIE`]).
     Maximum(f64),
 }
+
+/// The relative difference of squared indicators below which two cells count as tied
+/// and are marked together. A symmetric problem has its indicators in equal pairs, equal
+/// only to the rounding of the solve: marking one cell of a pair and not the other
+/// breaks the mesh's symmetry, and which one depends on that rounding, so solves that
+/// agree to their tolerance (the native solver and PETSc, on any number of ranks) refined
+/// different cells (an adaptive Euler–Bernoulli beam: 57 cells natively, 58 and 60 on one
+/// and two ranks). 10⁻⁶ lies far above a converged solve's rounding of an indicator
+/// (10⁻¹⁰ relative) and marks no cell that is not tied in substance.
+pub const TIE: f64 = 1e-6;
 
 impl Default for Marking {
     /// Dörfler marking with `θ = ½`.
@@ -68,11 +79,16 @@ impl Marking {
                         sum >= goal
                     })
                     .map_or(order.len(), |k| k + 1);
-                order.truncate(count);
+                let last = indicators[order[count - 1]];
+                let tied = order[count..]
+                    .iter()
+                    .take_while(|&&c| indicators[c] >= last * (1.0 - TIE))
+                    .count();
+                order.truncate(count + tied);
                 order
             }
             Marking::Maximum(theta) => {
-                let bar = theta * theta * largest;
+                let bar = theta * theta * largest * (1.0 - TIE);
                 order.retain(|&c| indicators[c] >= bar);
                 order
             }
@@ -93,6 +109,25 @@ mod tests {
         assert_eq!(Marking::Dorfler(0.65).mark(&eta).unwrap(), vec![1, 4]);
         assert_eq!(Marking::Dorfler(0.66).mark(&eta).unwrap(), vec![1, 4, 3]);
         assert_eq!(Marking::Dorfler(1.0).mark(&eta).unwrap().len(), 5);
+    }
+
+    #[test]
+    fn cells_tied_to_rounding_are_marked_together() {
+        // a symmetric pair, equal to rounding: θ = 0.3 of 5 needs one of them, and
+        // whichever rounding made larger, both are marked
+        for pair in [[2.0, 2.0 * (1.0 + 1e-12)], [2.0 * (1.0 + 1e-12), 2.0]] {
+            let eta = [pair[0], 1.0, pair[1]];
+            let mut marked = Marking::Dorfler(0.3).mark(&eta).unwrap();
+            marked.sort_unstable();
+            assert_eq!(marked, vec![0, 2], "{pair:?}");
+            let mut marked = Marking::Maximum(1.0).mark(&eta).unwrap();
+            marked.sort_unstable();
+            assert_eq!(marked, vec![0, 2], "{pair:?}");
+        }
+        // apart by more than the tie: the fewest cells
+        let eta = [2.0, 1.0, 2.0 * (1.0 - 1e-3)];
+        assert_eq!(Marking::Dorfler(0.3).mark(&eta).unwrap(), vec![0]);
+        assert_eq!(Marking::Maximum(1.0).mark(&eta).unwrap(), vec![0]);
     }
 
     #[test]
