@@ -133,7 +133,8 @@ impl PetscLcpSolver {
     /// # Errors
     /// Those of [`Petsc::initialize`].
     pub fn new(options: &str, formulation: Option<Formulation>) -> Result<Self> {
-        let petsc = Petsc::initialize(options)?;
+        // ahead of the user's, which override it
+        let petsc = Petsc::initialize(&format!("{MUMPS_WORKSPACE} {options}"))?;
         Ok(Self {
             preferred: Mutex::new(formulation),
             petsc: Mutex::new(Some(OnThread {
@@ -421,6 +422,14 @@ fn without_primal_unknowns(lcp: &Lcp) -> fem_runtime::Result<LcpSolution> {
         krylov_iterations: 0,
     })
 }
+
+/// MUMPS's workspace relaxation, `ICNTL(14)` (percent beyond its analysis's estimate),
+/// unless the options set it: at PETSc's default of 20 the adaptive membrane's Hessians
+/// on three ranks failed their factorization now and then with `INFOG(1) = −9` (the
+/// workspace short by a few thousand entries, 9900 of a 41k-unknown level; the
+/// partition, and so the shortfall, varies from run to run), even factored as
+/// `LLᵀ` without pivoting ([`crate::Matrix::set_spd`]).
+const MUMPS_WORKSPACE: &str = "-mat_mumps_icntl_14 50";
 
 /// SNES's relative tolerance on the residual norm: from a nested start the last Newton
 /// step lands on rounding, which on fine levels sits near 10⁻¹² of the start's residual
