@@ -767,46 +767,29 @@ fn solve_shared(
     full_steps: bool,
 ) -> Result<crate::shared::Shared> {
     check_start(lcp, start)?;
+    // MUMPS's factorization (Cholesky of the SPD Hessians, LU of the mixed Jacobian),
+    // the tolerances of the whole LCP's solves; full steps but where the eliminated
+    // formulation's line search on Φ applies
+    let direct = |pc: &'static std::ffi::CStr, line_search| Defaults {
+        ksp_type: Some(c"preonly"),
+        pc_type: Some(pc),
+        factor_package: Some(c"mumps"),
+        line_search,
+        rtol: Some(RELATIVE_TOLERANCE),
+        atol: Some(ABSOLUTE_TOLERANCE),
+    };
+    let basic = Some(c"basic");
     match formulation {
         Formulation::Eliminated => crate::shared::solve_eliminated(
             petsc,
             lcp,
             start,
-            Defaults {
-                ksp_type: Some(c"preonly"),
-                pc_type: Some(c"cholesky"),
-                factor_package: Some(c"mumps"),
-                line_search: full_steps.then_some(c"basic"),
-                rtol: Some(RELATIVE_TOLERANCE),
-                atol: Some(ABSOLUTE_TOLERANCE),
-            },
+            direct(c"cholesky", if full_steps { basic } else { None }),
         ),
-        Formulation::Mixed => crate::shared::solve_mixed(
-            petsc,
-            lcp,
-            start,
-            Defaults {
-                ksp_type: Some(c"preonly"),
-                pc_type: Some(c"lu"),
-                factor_package: Some(c"mumps"),
-                line_search: Some(c"basic"),
-                rtol: Some(RELATIVE_TOLERANCE),
-                atol: Some(ABSOLUTE_TOLERANCE),
-            },
-        ),
-        Formulation::Primal => crate::shared::solve_primal(
-            petsc,
-            lcp,
-            start,
-            Defaults {
-                ksp_type: Some(c"preonly"),
-                pc_type: Some(c"cholesky"),
-                factor_package: Some(c"mumps"),
-                line_search: Some(c"basic"),
-                rtol: Some(RELATIVE_TOLERANCE),
-                atol: Some(ABSOLUTE_TOLERANCE),
-            },
-        ),
+        Formulation::Mixed => crate::shared::solve_mixed(petsc, lcp, start, direct(c"lu", basic)),
+        Formulation::Primal => {
+            crate::shared::solve_primal(petsc, lcp, start, direct(c"cholesky", basic))
+        }
     }
 }
 

@@ -192,6 +192,22 @@ fn vector_of<'p>(
     Ok(out)
 }
 
+/// The rows this rank holds ([`held`]), the numbering of the unknowns (of the
+/// multipliers too, `with_multipliers`), and the whole `A` assembled in PETSc from every
+/// rank's part, with its `‖A‖∞`.
+fn assembled_a<'p>(
+    petsc: &'p Petsc,
+    lcp: &Lcp,
+    with_multipliers: bool,
+) -> Result<(Vec<bool>, Numbering, Matrix<'p>, f64)> {
+    let holds = held(lcp);
+    let numbering = Numbering::new(petsc, lcp, &holds, with_multipliers);
+    let mut a = matrix_of_a(petsc, lcp, &numbering, true, |_| Ok(()))?;
+    a.assemble()?;
+    let a_norm = a.norm_infinity()?;
+    Ok((holds, numbering, a, a_norm))
+}
+
 /// The constraints this rank evaluates in the eliminated formulation, each with its
 /// whole row. A constraint held by one rank keeps that rank's row; one split between
 /// ranks (a P1 multiplier on a vertex where two parts' contact edges meet) is summed on
@@ -340,14 +356,10 @@ pub(crate) fn solve_eliminated(
     start: Option<&[f64]>,
     defaults: Defaults,
 ) -> Result<Shared> {
-    let holds = held(lcp);
+    let (holds, numbering, a, a_norm) = assembled_a(petsc, lcp, false)?;
     let rows = Rows::new(petsc, lcp, &holds)?;
-    let numbering = Numbering::new(petsc, lcp, &holds, false);
     let columns_of =
         |i: usize| -> Vec<usize> { rows.row(i).0.iter().map(|&(j, _)| numbering.u[j]).collect() };
-    let mut a = matrix_of_a(petsc, lcp, &numbering, true, |_| Ok(()))?;
-    a.assemble()?;
-    let a_norm = a.norm_infinity()?;
     let hessian_matrix = matrix_of_a(petsc, lcp, &numbering, false, |pattern| {
         for i in 0..rows.len() {
             let columns = columns_of(i);
@@ -486,11 +498,7 @@ pub(crate) fn solve_mixed(
     start: Option<&[f64]>,
     defaults: Defaults,
 ) -> Result<Shared> {
-    let holds = held(lcp);
-    let numbering = Numbering::new(petsc, lcp, &holds, true);
-    let mut a = matrix_of_a(petsc, lcp, &numbering, true, |_| Ok(()))?;
-    a.assemble()?;
-    let a_norm = a.norm_infinity()?;
+    let (holds, numbering, a, a_norm) = assembled_a(petsc, lcp, true)?;
     drop(a);
     // the constraint rows: (λ_k, u_j) = B_kj and (u_j, λ_k) = −B_kj, C's diagonal and
     // blocks, each entry from the one rank that holds the constraint
@@ -621,11 +629,7 @@ pub(crate) fn solve_primal(
     start: Option<&[f64]>,
     defaults: Defaults,
 ) -> Result<Shared> {
-    let holds = held(lcp);
-    let numbering = Numbering::new(petsc, lcp, &holds, false);
-    let mut a = matrix_of_a(petsc, lcp, &numbering, true, |_| Ok(()))?;
-    a.assemble()?;
-    let a_norm = a.norm_infinity()?;
+    let (holds, numbering, a, a_norm) = assembled_a(petsc, lcp, false)?;
     let f = vector_of(petsc, numbering.local, &lcp.f, |i| numbering.u[i])?;
     let rows = numbering.rows();
     let infinity = crate::sys::FEM_PETSC_INFINITY;
