@@ -534,6 +534,13 @@ fn choose(
 /// Whether `lcp` is the nodal method's: `B = I` (one unit entry per row, on the
 /// diagonal) and `C = 0`.
 fn is_nodal(lcp: &Lcp) -> bool {
+    nodal_shape(lcp, false)
+}
+
+/// The nodal method's shape: as many constraints as unknowns, `C = 0` without blocks,
+/// row `k` of `B` the unit entry `e_k` (or empty, `part`: one rank's part, which holds
+/// some of the rows).
+pub(crate) fn nodal_shape(lcp: &Lcp, part: bool) -> bool {
     lcp.m() == lcp.n()
         && lcp.c.iter().all(|&c| c == 0.0)
         && lcp.c_blocks.is_empty()
@@ -541,7 +548,7 @@ fn is_nodal(lcp: &Lcp) -> bool {
             .b_rows
             .iter()
             .enumerate()
-            .all(|(k, row)| row == [(k, 1.0)])
+            .all(|(k, row)| (part && row.is_empty()) || row == [(k, 1.0)])
 }
 
 /// The first index of each of `size` contiguous blocks of `0..count`, and `count`.

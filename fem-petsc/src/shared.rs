@@ -596,14 +596,7 @@ pub(crate) fn solve_mixed(
 /// rank's rows empty or `e_k`, `C` zero without blocks, and each constraint held by
 /// exactly one rank (collective: every rank must call it).
 pub(crate) fn is_nodal(petsc: &Petsc, lcp: &Lcp) -> bool {
-    let here = lcp.m() == lcp.n()
-        && lcp.c.iter().all(|&c| c == 0.0)
-        && lcp.c_blocks.is_empty()
-        && lcp
-            .b_rows
-            .iter()
-            .enumerate()
-            .all(|(k, row)| row.is_empty() || row == [(k, 1.0)]);
+    let here = crate::lcp::nodal_shape(lcp, true);
     // every rank must take part in the count below, whatever its rows
     let mut count: Vec<f64> = lcp
         .b_rows
