@@ -484,3 +484,188 @@ fn the_nodal_methods_parts_sum_to_the_whole_lcp() {
         assert_eq!(holder, 1, "constraint {k} is on {holder} parts");
     }
 }
+
+/// Evaluates `solved` as each part `c ≡ r (mod 3)` of a partition would
+/// (`Discretization::cells`, `Lcp::share`; the reductions of one process, so each part's
+/// own sums come back) and checks that the parts add up to the whole mesh's evaluation:
+/// each cell's indicator (its residual terms, half of each interior edge's, its contact
+/// terms), the squares of the residual estimate η and of ‖u_h‖_a, and the squared error
+/// norms against `exact`. `data` by name, `markers` the model's boundary parts.
+fn evaluation_parts_sum_to_whole<M: Model>(
+    mut solved: fem_forms::problem::Solved<M, TriangleMesh>,
+    data: &[(&str, &DataFn)],
+    markers: &[Vec<u32>],
+    exact: &fem_forms::problem::Exact,
+) {
+    use fem_forms::lcp::external::External;
+    use fem_forms::lcp::Share;
+    use fem_forms::problem::Domain;
+    let ordered: Vec<&DataFn> = M::DATA
+        .iter()
+        .map(|d| {
+            data.iter()
+                .find(|(name, _)| name == d)
+                .unwrap_or_else(|| panic!("data {d}"))
+                .1
+        })
+        .collect();
+    let field = M::constrained_field();
+    let evaluate = |solution: &fem_forms::obstacle::ObstacleSolution<TriangleMesh>| {
+        let estimate = fem_forms::adaptivity::triangle_estimate::<M, _>(
+            solution,
+            &solved.params,
+            &ordered,
+            Some(1.0),
+            markers,
+        )
+        .unwrap();
+        let errors = TriangleMesh::errors(solution, field, exact);
+        let square = |x: Option<f64>| x.expect("measured").powi(2);
+        let squares = [
+            estimate.residual.powi(2),
+            estimate.energy_norm.powi(2),
+            square(errors.l2),
+            square(errors.h1),
+            square(errors.h2),
+            errors.multiplier.map_or(0.0, |m| m * m),
+        ];
+        (estimate.indicators, squares)
+    };
+    let (whole_indicators, whole) = evaluate(&solved.solution);
+    assert!(
+        whole_indicators.iter().any(|&i| i > 0.0)
+            && whole[..5].iter().all(|&s| s > 0.0)
+            && (whole[5] > 0.0) == exact.multiplier.is_some(),
+        "a case that measures nothing tests nothing: {whole:?}"
+    );
+    let cells = solved.solution.discretization.mesh.cell_count();
+    let mut indicators = vec![0.0; cells];
+    let mut sums = [0.0; 6];
+    for part in parts(cells) {
+        let d = &mut solved.solution.discretization;
+        d.cells = Some(part);
+        d.lcp.share = Some(Share::new(External(&OneProcess)));
+        let (i, s) = evaluate(&solved.solution);
+        for (sum, x) in indicators.iter_mut().zip(&i) {
+            *sum += x;
+        }
+        for (sum, x) in sums.iter_mut().zip(&s) {
+            *sum += x;
+        }
+    }
+    let largest = whole_indicators.iter().fold(0.0f64, |m, x| m.max(*x));
+    for (c, (sum, expected)) in indicators.iter().zip(&whole_indicators).enumerate() {
+        assert!(
+            (sum - expected).abs() <= 1e-12 * largest,
+            "cell {c}: the parts' indicators sum to {sum}, the whole's is {expected}"
+        );
+    }
+    let names = [
+        "η²",
+        "‖u_h‖_a²",
+        "L² error²",
+        "H¹ error²",
+        "H² error²",
+        "λ error²",
+    ];
+    for ((name, sum), expected) in names.iter().zip(sums).zip(whole) {
+        assert!(
+            (sum - expected).abs() <= 1e-12 * expected.abs().max(1e-300),
+            "{name}: the parts sum to {sum}, the whole's is {expected}"
+        );
+    }
+}
+
+fn exact_value(x: &[f64]) -> f64 {
+    x[0] * x[1] - 0.1
+}
+
+fn exact_gradient(x: &[f64]) -> [f64; 2] {
+    [x[1], x[0]]
+}
+
+fn exact_hessian(_: &[f64]) -> [[f64; 2]; 2] {
+    [[0.0, 1.0], [1.0, 0.0]]
+}
+
+fn exact_multiplier(x: &[f64]) -> f64 {
+    1.0 + x[0]
+}
+
+const EXACT: fem_forms::problem::Exact<'static> = fem_forms::problem::Exact {
+    value: &exact_value,
+    gradient: Some(&exact_gradient),
+    hessian: Some(&exact_hessian),
+    multiplier: Some(&exact_multiplier),
+};
+
+/// The membrane of [`membrane`] solved whole, then evaluated in parts.
+fn membrane_evaluated_in_parts<M: Model>() {
+    use fem_forms::problem::Problem;
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 6, 6, Diagonal::Alternating).unwrap();
+    let data: [(&str, &DataFn); 3] = [("f", &load), ("ψ", &obstacle), ("g", &boundary)];
+    let solved = Problem::<M, TriangleMesh>::new(vec![mesh])
+        .data("f", &load)
+        .data("ψ", &obstacle)
+        .data("g", &boundary)
+        .boundary_data(fem_forms::DirichletPart::All)
+        .solve()
+        .unwrap();
+    assert!(solved.report.total_contact_force > 0.0, "contact somewhere");
+    evaluation_parts_sum_to_whole(solved, &data, &[], &EXACT);
+}
+
+/// The estimate and the error norms over each process's own cells add up to the whole
+/// mesh's (what lets each MPI rank evaluate only its cells, the report's numbers then
+/// reduced): P0 multipliers. Checked to fail when every part evaluates every cell and
+/// when an interior edge is counted by both its cells' parts.
+#[test]
+fn membrane_p1_p0_evaluation_parts_sum_to_the_whole() {
+    membrane_evaluated_in_parts::<fem_forms::models::membrane_p1_p0::Model>();
+}
+
+/// P2 displacements and P1disc multipliers (the contact terms' defect per cell).
+#[test]
+fn membrane_p2_p1disc_evaluation_parts_sum_to_the_whole() {
+    membrane_evaluated_in_parts::<fem_forms::models::membrane_p2_p1disc::Model>();
+}
+
+/// Signorini contact (the multiplier on the bottom edges, P0): the boundary parts'
+/// indicators and the contact terms of a multiplier on edges go with their edge's cell.
+#[test]
+fn signorini_evaluation_parts_sum_to_the_whole() {
+    use fem_forms::models::signorini::signorini_p1::Model as M;
+    use fem_forms::problem::{Condition, Problem};
+    let mesh = TriangleMesh::rectangle(0.0, 1.0, 0.0, 1.0, 6, 6, Diagonal::Alternating).unwrap();
+    let pressure = |_: &[f64]| 50.0;
+    let data: [(&str, &DataFn); 2] = [("q", &pressure), ("g", &gap)];
+    let solved = Problem::<M, TriangleMesh>::new(vec![mesh])
+        .param("μ_L", 400.0)
+        .param("λ_L", 600.0)
+        .param("n_c_x", 0.0)
+        .param("n_c_y", -1.0)
+        .data("q", &pressure)
+        .data("g", &gap)
+        .part("Γ_C", vec![1])
+        .part("Γ_N", vec![3])
+        // held without contact (the native solver starts from zero): u_x = 0 on the
+        // left, u_y = 0 on the right
+        .support(
+            fem_forms::DirichletPart::Markers(vec![4]),
+            "u_x",
+            Condition::Zero,
+        )
+        .support(
+            fem_forms::DirichletPart::Markers(vec![2]),
+            "u_y",
+            Condition::Zero,
+        )
+        .solve()
+        .unwrap();
+    assert!(solved.report.total_contact_force > 0.0, "contact somewhere");
+    let exact = fem_forms::problem::Exact {
+        multiplier: None,
+        ..EXACT
+    };
+    evaluation_parts_sum_to_whole(solved, &data, &[vec![1], vec![3]], &exact);
+}

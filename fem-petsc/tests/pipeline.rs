@@ -2,7 +2,8 @@
 //! (`fem-forms solve SCENE --backend petsc`), under `mpirun -n N` (N = 1, 2, 3 in
 //! `.ci/run`): on every rank count the answer must be the native solver's to the
 //! solvers' tolerance — the energy, the total contact force ∫λ_h and the contact set's
-//! measure — and certified by the same KKT residual. The scenes cover the membrane
+//! measure, the error norms and the a-posteriori estimate (each rank evaluating its own
+//! cells) — and certified by the same KKT residual. The scenes cover the membrane
 //! (P1–P0, P2–P0, P2–P1disc whose `C` has 3 × 3 blocks, and the nodal method with its
 //! bounds on the primal unknowns), the Timoshenko and Euler–Bernoulli beams, the
 //! Reissner–Mindlin plate, the Kirchhoff plate (Argyris, Morley), the Winkler plate and
@@ -109,6 +110,43 @@ fn main() {
             "{case}: KKT residual {}",
             b.kkt_residual
         );
+        // the error norms and the estimate, each rank evaluating its own cells and the
+        // sums reduced: the native ones to the solvers' tolerance. Absolute floors for
+        // answers that are rounding (membrane-flat's u_h = 0 pressed flat, where the
+        // estimate's residual f + λ_h cancels to the solves' KKT tolerance, 1e-8 of the
+        // scenes' O(1) loads, differently in each solver)
+        for (what, x, y, floor) in [
+            ("L² error", a.error_l2, b.error_l2, 1e-10),
+            ("H¹ error", a.error_h1, b.error_h1, 1e-10),
+            ("H² error", a.error_h2, b.error_h2, 1e-10),
+            (
+                "multiplier error",
+                a.error_multiplier,
+                b.error_multiplier,
+                1e-10,
+            ),
+            ("estimate", a.estimate, b.estimate, 1e-7),
+            (
+                "estimate's contact part",
+                a.estimate_contact,
+                b.estimate_contact,
+                1e-7,
+            ),
+            (
+                "error in the energy norm",
+                a.error_energy,
+                b.error_energy,
+                1e-10,
+            ),
+        ] {
+            match (x, y) {
+                (Some(x), Some(y)) => assert!(
+                    relative(x, y) < 1e-6 || (x - y).abs() < floor,
+                    "{case}: {what} {x} and {y}"
+                ),
+                _ => assert_eq!(x.is_some(), y.is_some(), "{case}: {what} {x:?} and {y:?}"),
+            }
+        }
         // each rank assembled its own cells of the finest level, and the ranks' rows are
         // PETSc's
         let record = petsc.records().last().cloned().expect("a record");

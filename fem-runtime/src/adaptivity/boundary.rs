@@ -2,7 +2,7 @@
 //! edges of each part, and the contact terms of a multiplier that lives on a boundary
 //! part (Signorini's `λ` on `Γ_C`), from the model's constraint forms `b` and `G`.
 
-use super::{cell_coefficients, energy_form, ContactTerms, TriangleCells};
+use super::{cell_coefficients, energy_form, TriangleCells};
 use crate::element::triangle::{TriangleBasis, TriangleField};
 use crate::model::{DataFn, Model};
 use crate::obstacle::boundary_multiplier::{
@@ -44,7 +44,8 @@ fn edge_coefficients<M: Model, G>(
 
 /// Adds each boundary edge's `η_Γ²` to its cell's entry of `indicators` and returns
 /// their sum: the model's boundary lines on the edges of each part (`parts[p]` the
-/// markers of `FACET_PARTS[p]`), the multiplier of its part entering by its trace.
+/// markers of `FACET_PARTS[p]`), the multiplier of its part entering by its trace;
+/// only the edges whose cells `owned` holds (all where `None`).
 ///
 /// # Errors
 /// `parts` not one list per part of the model, and the kernels' errors.
@@ -54,6 +55,7 @@ pub(super) fn boundary_indicators<M: Model, G: TriangleCells>(
     params: &[f64],
     data: &[&DataFn],
     parts: &[Vec<u32>],
+    owned: Option<&[bool]>,
     indicators: &mut [f64],
 ) -> Result<f64> {
     if parts.is_empty() && M::FACET_PARTS.is_empty() {
@@ -78,6 +80,9 @@ pub(super) fn boundary_indicators<M: Model, G: TriangleCells>(
             None => part_edges(mesh, markers),
         };
         for (k, e) in edges.iter().enumerate() {
+            if !super::counts(owned, e.cell) {
+                continue;
+            }
             let local = match on_multiplier_part {
                 Some(b) => edge_coefficients::<M, G>(solution, fields, b, k),
                 None => cell_coefficients::<M>(fields, e.cell),
@@ -108,7 +113,8 @@ pub(super) fn boundary_indicators<M: Model, G: TriangleCells>(
 /// constraint on E equals the violation's (for P1 displacements, the violation at the
 /// edge's two nodes along the contact direction). Neighbouring cells that share those
 /// nodes carry the lifting too; counting the edge's cell alone changes the term by a
-/// bounded factor.
+/// bounded factor. Per cell of the mesh, `(violation, defect)`, over the edges whose
+/// cells `owned` holds (all where `None`).
 ///
 /// # Errors
 /// A model without `constraint:`, a constraint form that is not between the multiplier
@@ -119,7 +125,8 @@ pub(super) fn boundary_contact_terms<M: Model, G: TriangleCells>(
     boundary: &BoundaryMultiplierDofs,
     params: &[f64],
     data: &[&DataFn],
-) -> Result<ContactTerms> {
+    owned: Option<&[bool]>,
+) -> Result<(Vec<f64>, Vec<f64>)> {
     let d = &solution.discretization;
     let mesh = d.mesh.straight();
     let [b, g] = M::CONSTRAINT.ok_or_else(|| {
@@ -157,6 +164,9 @@ pub(super) fn boundary_contact_terms<M: Model, G: TriangleCells>(
     let mut defect = vec![0.0; mesh.cell_count()];
     for k in 0..boundary.edges.len() {
         let edge = boundary.edges[k];
+        if !super::counts(owned, edge.cell) {
+            continue;
+        }
         let x = mesh.cell_coordinates(edge.cell);
         let local = edge_coefficients::<M, G>(solution, fields, boundary, k);
         let lambda = &local[d.multiplier_field];
@@ -193,7 +203,7 @@ pub(super) fn boundary_contact_terms<M: Model, G: TriangleCells>(
             violation[edge.cell] += cell_energy::<M, G>(&d.mesh, edge.cell, a, &v, params, data)?;
         }
     }
-    Ok(ContactTerms::of(&violation, &defect))
+    Ok((violation, defect))
 }
 
 /// `a_T(v, v)` on cell `c` of the local coefficients `v` (one vector per field; the
@@ -236,7 +246,8 @@ fn cell_energy<M: Model, G: TriangleCells>(
 /// discrete test functions' edge means do not all vanish (`j = 0`: of their trace;
 /// `j = 1`: of their normal derivative), found with one admissible test function of
 /// random free DOFs ([`super::admissible_probe`], [`free_on_edge`]): exact for any element and
-/// any support, a clamp, a roller along x or y, a simple support of a plate.
+/// any support, a clamp, a roller along x or y, a simple support of a plate. Only the
+/// edges whose cells `owned` holds (all where `None`).
 ///
 /// # Errors
 /// The kernels' errors.
@@ -246,6 +257,7 @@ pub(super) fn natural_indicators<M: Model, G: TriangleCells>(
     params: &[f64],
     data: &[&DataFn],
     parts: &[Vec<u32>],
+    owned: Option<&[bool]>,
     indicators: &mut [f64],
 ) -> Result<f64> {
     if M::NATURAL_FLUXES.is_empty() {
@@ -265,6 +277,9 @@ pub(super) fn natural_indicators<M: Model, G: TriangleCells>(
             continue;
         }
         let (cell, _) = mesh.edge_cells(e);
+        if !super::counts(owned, cell) {
+            continue;
+        }
         let local = mesh
             .local_edge(cell, e)
             .expect("an edge is an edge of its cell");

@@ -16,7 +16,7 @@ pub use interval::interval_estimate;
 pub use marking::Marking;
 
 use crate::element::triangle::{TriangleBasis, TriangleField};
-use crate::mesh::{CurvedTriangleMesh, TriangleMesh};
+use crate::mesh::{Cells, CurvedTriangleMesh, TriangleMesh};
 use crate::model::{DataFn, Model};
 use crate::obstacle::{Multipliers, ObstacleSolution};
 use crate::{Error, Result};
@@ -135,7 +135,7 @@ impl Estimate {
 /// whose indicators are those of their straight cells (the generated indicator kernels
 /// are affine; a curved cell's map differs from its straight one's by O(hκ), relative,
 /// for a boundary of curvature κ) while the energy norm takes each cell's own element matrix.
-pub trait TriangleCells {
+pub trait TriangleCells: crate::mesh::Mesh {
     /// The mesh of the vertices with straight cells.
     fn straight(&self) -> &TriangleMesh;
 
@@ -299,27 +299,99 @@ pub fn triangle_estimate<M: Model, G: TriangleCells>(
         )
     });
     let fields = fields::<M, G>(solution, density.as_deref())?;
+    // each process its own cells and their facets (an interior edge counted by the
+    // process of its first cell), the per-cell terms then added up over the processes
+    let evaluation = d.evaluation();
+    let owned = evaluation.owned();
+    let on = Own {
+        cells: evaluation.cells(),
+        owned: owned.as_deref(),
+    };
+    let mut local = evaluation.agree(local_estimate::<M, G>(
+        solution, &fields, params, data, side, parts, on,
+    ))?;
+    for terms in [
+        &mut local.indicators,
+        &mut local.violation,
+        &mut local.defect,
+    ] {
+        evaluation.sum_each(terms);
+    }
+    let [residual2, energy] = evaluation.sum([local.residual2, local.energy]);
+    let indicators = local.indicators;
+    if let Some(c) = indicators.iter().position(|e| !e.is_finite()) {
+        return Err(Error::Input(format!(
+            "the indicator of cell {c} is {}: the solution or the data are not finite there",
+            indicators[c]
+        )));
+    }
+    Ok(Estimate::of(
+        indicators,
+        residual2,
+        ContactTerms::of(&local.violation, &local.defect),
+        energy.max(0.0).sqrt(),
+    ))
+}
+
+/// The cells one process evaluates ([`crate::obstacle::Evaluation`]): the list, and per
+/// cell of the mesh whether it is one (`None`: every cell).
+#[derive(Clone, Copy)]
+struct Own<'a> {
+    cells: Cells<'a>,
+    owned: Option<&'a [bool]>,
+}
+
+/// Whether cell `c` is one of the cells `owned` marks (every cell where `None`).
+fn counts(owned: Option<&[bool]>, c: usize) -> bool {
+    owned.is_none_or(|owned| owned[c])
+}
+
+/// One process's share of an estimate: per cell of the whole mesh its residual
+/// indicator (with half of each interior edge's), violation and complementarity defect
+/// (both empty without contact terms), and the sums of the residual terms and of
+/// `a(u_h, u_h)` over its cells.
+struct LocalEstimate {
+    indicators: Vec<f64>,
+    residual2: f64,
+    violation: Vec<f64>,
+    defect: Vec<f64>,
+    energy: f64,
+}
+
+/// [`LocalEstimate`] over the cells `on`.
+fn local_estimate<M: Model, G: TriangleCells>(
+    solution: &ObstacleSolution<G>,
+    fields: &[Option<TriangleField>],
+    params: &[f64],
+    data: &[&DataFn],
+    side: Option<f64>,
+    parts: &[Vec<u32>],
+    on: Own<'_>,
+) -> Result<LocalEstimate> {
     let mesh = solution.discretization.mesh.straight();
     let mut indicators = vec![0.0; mesh.cell_count()];
     let mut sum = 0.0;
-    for (c, indicator) in indicators.iter_mut().enumerate() {
-        let local = cell_coefficients::<M>(&fields, c);
+    for c in on.cells.iter() {
+        let local = cell_coefficients::<M>(fields, c);
         let slices: Vec<&[f64]> = local.iter().map(Vec::as_slice).collect();
         let eta2 = M::cell_indicator(&mesh.cell_coordinates(c), &slices, params, data)?;
-        *indicator += eta2;
+        indicators[c] += eta2;
         sum += eta2;
     }
     for (e, _) in mesh.edges().iter().enumerate() {
         let (c0, Some(c1)) = mesh.edge_cells(e) else {
             continue;
         };
+        if !counts(on.owned, c0) {
+            continue;
+        }
         let local_edge = |c: usize| {
             mesh.local_edge(c, e)
                 .expect("an edge is an edge of its cells")
         };
         let (a, b) = (
-            cell_coefficients::<M>(&fields, c0),
-            cell_coefficients::<M>(&fields, c1),
+            cell_coefficients::<M>(fields, c0),
+            cell_coefficients::<M>(fields, c1),
         );
         let a: Vec<&[f64]> = a.iter().map(Vec::as_slice).collect();
         let b: Vec<&[f64]> = b.iter().map(Vec::as_slice).collect();
@@ -339,28 +411,31 @@ pub fn triangle_estimate<M: Model, G: TriangleCells>(
     }
     sum += boundary::boundary_indicators::<M, G>(
         solution,
-        &fields,
+        fields,
         params,
         data,
         parts,
+        on.owned,
         &mut indicators,
     )?;
     sum += boundary::natural_indicators::<M, G>(
         solution,
-        &fields,
+        fields,
         params,
         data,
         parts,
+        on.owned,
         &mut indicators,
     )?;
-    if let Some(c) = indicators.iter().position(|e| !e.is_finite()) {
-        return Err(Error::Input(format!(
-            "the indicator of cell {c} is {}: the solution or the data are not finite there",
-            indicators[c]
-        )));
-    }
-    let (contact, energy_norm) = contact_terms::<M, G>(solution, &fields, params, data, side)?;
-    Ok(Estimate::of(indicators, sum, contact, energy_norm))
+    let (violation, defect, energy) =
+        contact_terms::<M, G>(solution, fields, params, data, side, on)?;
+    Ok(LocalEstimate {
+        indicators,
+        residual2: sum,
+        violation,
+        defect,
+        energy,
+    })
 }
 
 /// An error for a model without an `estimator:` section.
@@ -422,12 +497,16 @@ pub fn energy_product<M: Model, G: TriangleCells>(
     params: &[f64],
     data: &[&DataFn],
 ) -> Result<f64> {
-    Ok(cell_energies::<M, G>(mesh, map, field, v, params, data)?
-        .iter()
-        .sum())
+    let cells = Cells::All(mesh.straight().cell_count());
+    Ok(
+        cell_energies::<M, G>(mesh, map, field, v, params, data, cells)?
+            .iter()
+            .sum(),
+    )
 }
 
-/// Each cell's `v_Tᵀ K_T v_T` of [`energy_product`]: its share of `a(v, v)`.
+/// Each cell's `v_Tᵀ K_T v_T` of [`energy_product`] (its share of `a(v, v)`), on the
+/// cells `cells` (0 on the others).
 ///
 /// # Errors
 /// As [`energy_product`].
@@ -438,6 +517,7 @@ fn cell_energies<M: Model, G: TriangleCells>(
     v: &[f64],
     params: &[f64],
     data: &[&DataFn],
+    cells: Cells<'_>,
 ) -> Result<Vec<f64>> {
     let (a, block) = energy_block::<M>(field)?;
     let mut energies = vec![0.0; mesh.straight().cell_count()];
@@ -447,6 +527,7 @@ fn cell_energies<M: Model, G: TriangleCells>(
         [(map, v), (map, v)],
         params,
         data,
+        cells,
         &mut energies,
     )?;
     Ok(energies)
@@ -479,9 +560,9 @@ impl ContactTerms {
     }
 }
 
-/// Adds to each cell's entry of `energies` its `u_Tᵀ K_T v_T` for block `[form, block]`
-/// of the model's forms, `u` and `v` the (map, coefficients) of the block's test and
-/// trial fields; cells where either vanishes are skipped.
+/// Adds to the entry of each cell of `cells` in `energies` its `u_Tᵀ K_T v_T` for block
+/// `[form, block]` of the model's forms, `u` and `v` the (map, coefficients) of the
+/// block's test and trial fields; cells where either vanishes are skipped.
 ///
 /// # Errors
 /// Those of the element matrices ([`TriangleCells::cell_matrix`]).
@@ -491,11 +572,13 @@ fn add_block_energies<M: Model, G: TriangleCells>(
     [(map_u, u), (map_v, v)]: [(&crate::assembly::dof_map::DofMap, &[f64]); 2],
     params: &[f64],
     data: &[&DataFn],
+    cells: Cells<'_>,
     energies: &mut [f64],
 ) -> Result<()> {
     let (nu, nv) = (map_u.local_count(), map_v.local_count());
     let mut k = vec![0.0; nu * nv];
-    for (c, energy) in energies.iter_mut().enumerate() {
+    for c in cells.iter() {
+        let energy = &mut energies[c];
         let (du, dv) = (map_u.cell_dofs(c), map_v.cell_dofs(c));
         if du.iter().all(|&d| u[d] == 0.0) || dv.iter().all(|&d| v[d] == 0.0) {
             continue;
@@ -513,6 +596,7 @@ fn add_block_energies<M: Model, G: TriangleCells>(
 /// `a(u_h, u_h)` with the model's energy form over every primal field (every block of
 /// the form between two fields other than the multiplier): the plate's bending and shear
 /// energy together, where a field alone (w's shear block) would be no norm of the plate.
+/// Summed over the cells `cells`.
 ///
 /// # Errors
 /// A model without an energy form, or whose energy form has no block.
@@ -522,6 +606,7 @@ fn solution_energy<M: Model, G: TriangleCells>(
     multiplier: usize,
     params: &[f64],
     data: &[&DataFn],
+    cells: Cells<'_>,
 ) -> Result<f64> {
     let a = energy_form::<M>()?;
     let mut energies = vec![0.0; mesh.straight().cell_count()];
@@ -541,6 +626,7 @@ fn solution_energy<M: Model, G: TriangleCells>(
             [(u.map, u.coefficients), (v.map, v.coefficients)],
             params,
             data,
+            cells,
             &mut energies,
         )?;
     }
@@ -561,26 +647,29 @@ fn multiplier_index<M: Model, G>(solution: &ObstacleSolution<G>) -> usize {
     }
 }
 
-/// The contact part `S` of the estimate (with each cell's share) and `‖u_h‖_a`.
+/// The contact terms of the estimate on the cells `on`, per cell of the mesh (0 on the
+/// others): `(violation, defect)`, both empty without contact terms; and `a(u_h, u_h)`
+/// summed over those cells.
 fn contact_terms<M: Model, G: TriangleCells>(
     solution: &ObstacleSolution<G>,
     fields: &[Option<TriangleField>],
     params: &[f64],
     data: &[&DataFn],
     side: Option<f64>,
-) -> Result<(ContactTerms, f64)> {
+    on: Own<'_>,
+) -> Result<(Vec<f64>, Vec<f64>, f64)> {
     let d = &solution.discretization;
     let cells = &d.mesh;
     let mesh = cells.straight();
     let multiplier = multiplier_index::<M, G>(solution);
-    let energy = solution_energy::<M, G>(cells, fields, multiplier, params, data)?;
-    let norm = energy.max(0.0).sqrt();
+    let energy = solution_energy::<M, G>(cells, fields, multiplier, params, data, on.cells)?;
     if let (Some(b), Some(_)) = (d.boundary(), side) {
-        let terms = boundary::boundary_contact_terms::<M, G>(solution, fields, b, params, data)?;
-        return Ok((terms, norm));
+        let (violation, defect) =
+            boundary::boundary_contact_terms::<M, G>(solution, fields, b, params, data, on.owned)?;
+        return Ok((violation, defect, energy));
     }
     let (Some([_, psi]), Some(side)) = (M::OBSTACLE, side) else {
-        return Ok((ContactTerms::default(), norm));
+        return Ok((Vec::new(), Vec::new(), energy));
     };
     let field = M::constrained_field();
     let (Some(u), Some(Some(lambda))) = (&fields[field], fields.get(multiplier)) else {
@@ -600,9 +689,9 @@ fn contact_terms<M: Model, G: TriangleCells>(
             .zip(u.coefficients)
             .map(|(x, &value)| (side * (psi(x) - value)).max(0.0))
             .collect();
-        cell_energies::<M, G>(cells, u.map, field, &violation, params, data)?
+        cell_energies::<M, G>(cells, u.map, field, &violation, params, data, on.cells)?
     } else {
-        weighted_violation::<M>(mesh, u, psi, side)
+        weighted_violation::<M>(mesh, u, psi, side, on.cells)
     };
     // Σ_T (λ_h, s(u_h − ψ))_T
     let degree = u.map.element().degree() + lambda.map.element().degree() + 2;
@@ -612,7 +701,8 @@ fn contact_terms<M: Model, G: TriangleCells>(
         TriangleBasis::new(lambda.map.element()),
     );
     let mut defect = vec![0.0; mesh.cell_count()];
-    for (c, defect) in defect.iter_mut().enumerate() {
+    for c in on.cells.iter() {
+        let defect = &mut defect[c];
         let x = mesh.cell_coordinates(c);
         let area2 = ((x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1])).abs();
         for (xi, w) in rule.points.iter().zip(&rule.weights) {
@@ -627,25 +717,28 @@ fn contact_terms<M: Model, G: TriangleCells>(
             *defect += w * area2 * l * side * (u.value(&u_basis, c, *xi) - psi(&p));
         }
     }
-    Ok((ContactTerms::of(&violation, &defect), norm))
+    Ok((violation, defect, energy))
 }
 
 /// `Σ_T h_T^{−2m} ‖s(ψ − u_h)_+‖²_T`, `m` the energy's derivative order ([`energy_order`]): the
 /// violation for fields without Lagrange nodes (Argyris, Morley), where the nodal
 /// interpolant of the positive part does not exist; the inverse inequality scales the
 /// L² norm of a discrete function to its energy norm this way (with unit coefficient).
+/// Per cell of `cells` (0 on the others).
 fn weighted_violation<M: Model>(
     mesh: &TriangleMesh,
     u: &TriangleField,
     psi: &DataFn,
     side: f64,
+    cells: Cells<'_>,
 ) -> Vec<f64> {
     let m = energy_order::<M>();
     let element = u.map.element();
     let rule = TriangleRule::exact_for_degree(2 * element.degree() + 2);
     let basis = TriangleBasis::new(element);
     let mut violation = vec![0.0; mesh.cell_count()];
-    for (c, total) in violation.iter_mut().enumerate() {
+    for c in cells.iter() {
+        let total = &mut violation[c];
         let x = mesh.cell_coordinates(c);
         let area2 = ((x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1])).abs();
         let mut cell = 0.0;

@@ -4,6 +4,7 @@
 use crate::assembly::dof_map::DofMap;
 use crate::element::mapping::Affine;
 use crate::mesh::triangle::{PointLocator, TriangleMesh};
+use crate::mesh::{CellIter, Cells};
 use fem_reference::triangle::{Polynomial2, TriangleRule};
 
 /// A field given by its coefficients on a DOF map of a triangle mesh.
@@ -656,10 +657,27 @@ impl TriangleField<'_> {
         exact: &(dyn Fn([f64; 2]) -> (f64, [f64; 2]) + Sync),
         degree: usize,
     ) -> (f64, f64) {
+        let (l2, h1) = self.squared_errors(self.all_cells(), exact, degree);
+        (l2.sqrt(), h1.sqrt())
+    }
+
+    /// Every cell of the field's mesh.
+    fn all_cells(&self) -> Cells<'static> {
+        Cells::All(self.mesh.cell_count())
+    }
+
+    /// `(‖u − u_h‖²_{L²}, |u − u_h|²_{H¹})` of [`TriangleField::errors`] over `cells`
+    /// only: one process's share of the squares, which the processes add up.
+    pub fn squared_errors(
+        &self,
+        cells: Cells<'_>,
+        exact: &(dyn Fn([f64; 2]) -> (f64, [f64; 2]) + Sync),
+        degree: usize,
+    ) -> (f64, f64) {
         let basis = TriangleBasis::new(self.map.element());
         let rule = TriangleRule::exact_for_degree(degree);
         let table = Tabulation::new(&basis, &rule.points);
-        let squares = over_cell_chunks(self.mesh.cell_count(), |cells| {
+        let squares = over_cell_chunks(cells, |cells| {
             let (mut l2, mut h1) = (0.0, 0.0);
             let mut local = Vec::new();
             for c in cells {
@@ -676,10 +694,9 @@ impl TriangleField<'_> {
             }
             (l2, h1)
         });
-        let (l2, h1) = squares
+        squares
             .into_iter()
-            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
-        (l2.sqrt(), h1.sqrt())
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y))
     }
 
     /// The broken H² seminorm `(Σ_T ∫_T |∇²u − ∇²u_h|²)^{1/2}` (Frobenius norm of the
@@ -689,9 +706,20 @@ impl TriangleField<'_> {
         exact: &(dyn Fn([f64; 2]) -> [[f64; 2]; 2] + Sync),
         degree: usize,
     ) -> f64 {
+        self.squared_hessian_error(self.all_cells(), exact, degree)
+            .sqrt()
+    }
+
+    /// The square of [`TriangleField::hessian_error`] over `cells` only.
+    pub fn squared_hessian_error(
+        &self,
+        cells: Cells<'_>,
+        exact: &(dyn Fn([f64; 2]) -> [[f64; 2]; 2] + Sync),
+        degree: usize,
+    ) -> f64 {
         let basis = TriangleBasis::new(self.map.element());
         let rule = TriangleRule::exact_for_degree(degree);
-        let sums = over_cell_chunks(self.mesh.cell_count(), |cells| {
+        let sums = over_cell_chunks(cells, |cells| {
             let mut sum = 0.0;
             for c in cells {
                 let map = AffineMap::of(self.mesh, c);
@@ -707,7 +735,7 @@ impl TriangleField<'_> {
             }
             sum
         });
-        sums.into_iter().sum::<f64>().sqrt()
+        sums.into_iter().sum()
     }
 
     /// `(Σ_T h_T^{2·power} ‖λ − λ_h‖²_T)^{1/2}` against `exact(x)`; `power = 0` is the L² norm.
@@ -717,10 +745,22 @@ impl TriangleField<'_> {
         power: i32,
         degree: usize,
     ) -> f64 {
+        self.squared_weighted_error(self.all_cells(), exact, power, degree)
+            .sqrt()
+    }
+
+    /// The square of [`TriangleField::weighted_error`] over `cells` only.
+    pub fn squared_weighted_error(
+        &self,
+        cells: Cells<'_>,
+        exact: &(dyn Fn([f64; 2]) -> f64 + Sync),
+        power: i32,
+        degree: usize,
+    ) -> f64 {
         let basis = TriangleBasis::new(self.map.element());
         let rule = TriangleRule::exact_for_degree(degree);
         let table = Tabulation::new(&basis, &rule.points);
-        let sums = over_cell_chunks(self.mesh.cell_count(), |cells| {
+        let sums = over_cell_chunks(cells, |cells| {
             let mut sum = 0.0;
             let mut local = Vec::new();
             for c in cells {
@@ -736,7 +776,7 @@ impl TriangleField<'_> {
             }
             sum
         });
-        sums.into_iter().sum::<f64>().sqrt()
+        sums.into_iter().sum()
     }
 
     /// The coefficients of cell `c` in the pulled-back reference basis into `out`
@@ -800,17 +840,18 @@ impl TriangleField<'_> {
 /// rayon's scheduling, small enough to balance two threads on 100k-cell meshes.
 const CELL_CHUNK: usize = 4096;
 
-/// `work` on consecutive ranges of [`CELL_CHUNK`] cells out of `0..cells`, on rayon's
-/// threads, and the results in the order of the ranges: a sum over them in that order
-/// is the same on any number of threads.
+/// `work` on consecutive runs of [`CELL_CHUNK`] of `cells`, on rayon's threads, and the
+/// results in the order of the runs: a sum over them in that order is the same on any
+/// number of threads.
 pub fn over_cell_chunks<T: Send>(
-    cells: usize,
-    work: impl Fn(std::ops::Range<usize>) -> T + Sync,
+    cells: Cells<'_>,
+    work: impl Fn(CellIter<'_>) -> T + Sync,
 ) -> Vec<T> {
     use rayon::prelude::*;
-    (0..cells.div_ceil(CELL_CHUNK))
+    let count = cells.len();
+    (0..count.div_ceil(CELL_CHUNK))
         .into_par_iter()
-        .map(|k| work(k * CELL_CHUNK..((k + 1) * CELL_CHUNK).min(cells)))
+        .map(|k| work(cells.slice(k * CELL_CHUNK..((k + 1) * CELL_CHUNK).min(count))))
         .collect()
 }
 

@@ -57,6 +57,78 @@ pub trait Mesh: Sync {
     }
 }
 
+/// The cells a sum over a mesh runs over: all of them, or one process's part of a
+/// partition (its cells of [`crate::obstacle::Discretization::cells`]), whose sums the
+/// processes then add up ([`crate::obstacle::Evaluation`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cells<'a> {
+    /// Cells `0..count` of a mesh of `count` cells.
+    All(usize),
+    /// These cells, by their numbers in the whole mesh.
+    Part(&'a [usize]),
+}
+
+impl<'a> Cells<'a> {
+    /// The part `part` of a mesh of `count` cells (`None`: all of them).
+    pub fn of(count: usize, part: Option<&'a [usize]>) -> Self {
+        part.map_or(Cells::All(count), Cells::Part)
+    }
+
+    /// How many cells.
+    pub fn len(self) -> usize {
+        match self {
+            Cells::All(count) => count,
+            Cells::Part(cells) => cells.len(),
+        }
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(self) -> bool {
+        self.len() == 0
+    }
+
+    /// The cells at positions `positions` of the list (`All`: the cells themselves).
+    pub fn slice(self, positions: std::ops::Range<usize>) -> CellIter<'a> {
+        match self {
+            Cells::All(_) => CellIter::Range(positions),
+            Cells::Part(cells) => CellIter::Listed(cells[positions].iter()),
+        }
+    }
+
+    /// Every cell, in the list's order.
+    pub fn iter(self) -> CellIter<'a> {
+        self.slice(0..self.len())
+    }
+}
+
+/// The cells of [`Cells::slice`], by number.
+#[derive(Clone, Debug)]
+pub enum CellIter<'a> {
+    /// A range of cell numbers.
+    Range(std::ops::Range<usize>),
+    /// A run of a part's list.
+    Listed(std::slice::Iter<'a, usize>),
+}
+
+impl Iterator for CellIter<'_> {
+    type Item = usize;
+
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        match self {
+            CellIter::Range(range) => range.next(),
+            CellIter::Listed(cells) => cells.next().copied(),
+        }
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        match self {
+            CellIter::Range(range) => range.size_hint(),
+            CellIter::Listed(cells) => cells.size_hint(),
+        }
+    }
+}
+
 /// Some cells of a mesh, as a mesh: what one MPI rank assembles of a partitioned mesh.
 /// Its cell `c` is the mesh's cell `cells[c]` ([`Mesh::cell_number`]), so the DOF maps
 /// of the whole mesh serve it, and a form assembled on it is the sum of the element

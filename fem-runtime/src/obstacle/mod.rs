@@ -418,6 +418,102 @@ pub(crate) fn check_cells(cells: Option<&[usize]>, count: usize) -> Result<()> {
     }
 }
 
+/// This process's share of evaluating a solution cell by cell (the error norms, the
+/// a-posteriori estimate): where the LCP was assembled in parts by several processes
+/// that each hold the whole solution ([`Discretization::cells`], [`Lcp::share`]), each
+/// evaluates its own cells and the sums add up over the processes, instead of every
+/// process evaluating every cell. Every process calls the reductions in the same order
+/// (they are collective); on one process they return their argument.
+#[derive(Clone, Copy, Debug)]
+pub struct Evaluation<'a> {
+    cells: crate::mesh::Cells<'a>,
+    count: usize,
+    share: Option<&'a crate::lcp::Share>,
+}
+
+impl<'a> Evaluation<'a> {
+    /// Every cell of a mesh of `count` cells, on one process.
+    pub fn whole(count: usize) -> Self {
+        Self {
+            cells: crate::mesh::Cells::All(count),
+            count,
+            share: None,
+        }
+    }
+
+    /// The cells this process evaluates.
+    pub fn cells(self) -> crate::mesh::Cells<'a> {
+        self.cells
+    }
+
+    /// Whether the evaluation is shared among processes.
+    pub fn is_shared(self) -> bool {
+        self.share.is_some()
+    }
+
+    /// Per cell of the whole mesh, whether this process evaluates it (`None`: every cell,
+    /// on one process): what decides which process counts a facet between two cells.
+    pub fn owned(self) -> Option<Vec<bool>> {
+        let crate::mesh::Cells::Part(cells) = self.cells else {
+            return None;
+        };
+        let mut owned = vec![false; self.count];
+        for &c in cells {
+            owned[c] = true;
+        }
+        Some(owned)
+    }
+
+    /// `values` summed entry by entry over the processes.
+    pub fn sum<const N: usize>(self, mut values: [f64; N]) -> [f64; N] {
+        self.sum_each(&mut values);
+        values
+    }
+
+    /// `values` summed entry by entry over the processes, in place (every process with
+    /// the same length).
+    pub fn sum_each(self, values: &mut [f64]) {
+        if let Some(share) = self.share {
+            share.sum(values);
+        }
+    }
+
+    /// `result` where it and every other process's succeeded; this process's error, or
+    /// an error saying another process failed, where one did: every process then leaves
+    /// the evaluation together, so none waits in a reduction for one that returned.
+    ///
+    /// # Errors
+    /// As said.
+    pub fn agree<T>(self, result: Result<T>) -> Result<T> {
+        let Some(share) = self.share else {
+            return result;
+        };
+        let failed = share.max(if result.is_err() { 1.0 } else { 0.0 });
+        match result {
+            Ok(_) if failed > 0.0 => Err(Error::Input(
+                "the evaluation of the solution failed on another MPI process (its own error is printed there)"
+                    .into(),
+            )),
+            other => other,
+        }
+    }
+}
+
+impl<G: Mesh> Discretization<G> {
+    /// This process's share of evaluating the solution cell by cell: its own cells where
+    /// the LCP is held in parts, every cell otherwise.
+    pub fn evaluation(&self) -> Evaluation<'_> {
+        match (&self.cells, &self.lcp.share) {
+            (Some(cells), Some(share)) => Evaluation {
+                cells: crate::mesh::Cells::Part(cells),
+                count: self.mesh.cell_count(),
+                share: Some(share),
+            },
+            _ => Evaluation::whole(self.mesh.cell_count()),
+        }
+    }
+}
+
 /// The role of each free DOF of `reduction` (a multiplier where it lies in
 /// `multiplier_range`), and the reduced indices of the primal and the multiplier
 /// unknowns in order.

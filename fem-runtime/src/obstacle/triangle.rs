@@ -708,6 +708,7 @@ pub fn penetration(
     degree: usize,
 ) -> Penetration {
     use crate::element::triangle::{over_cell_chunks, AffineMap, Tabulation};
+    use crate::mesh::Cells;
     use rayon::prelude::*;
     let basis = TriangleBasis::new(u.map.element());
     let rule = fem_reference::triangle::TriangleRule::exact_for_degree(degree);
@@ -744,7 +745,7 @@ pub fn penetration(
         obstacle_min: f64::INFINITY,
         obstacle_max: f64::NEG_INFINITY,
     };
-    let chunks = over_cell_chunks(u.mesh.cell_count(), |cells| {
+    let chunks = over_cell_chunks(Cells::All(u.mesh.cell_count()), |cells| {
         let mut found = none;
         let mut local = Vec::new();
         for c in cells {
@@ -816,32 +817,35 @@ pub fn max_open_contact_gap(
     ];
     let table = crate::element::triangle::Tabulation::new(&basis, &points);
     // on rayon's threads: at 2M cells the serial scan took 0.04 s of every report
-    let widths = crate::element::triangle::over_cell_chunks(u.mesh.cell_count(), |cells| {
-        let mut widest = 0.0f64;
-        let mut local = Vec::new();
-        for c in cells {
-            let pushing = multiplier
-                .map
-                .cell_dofs(c)
-                .iter()
-                .any(|&k| multiplier.coefficients[k] > 1e-6 * largest);
-            if !pushing {
-                continue;
-            }
-            let map = crate::element::triangle::AffineMap::of(u.mesh, c);
-            u.local_coefficients(c, &mut local);
-            let mut narrowest = f64::INFINITY;
-            for (q, &xi) in points.iter().enumerate() {
-                let gap = side * (table.value(q, &local) - psi(&map.point(xi)));
-                if gap.is_nan() {
-                    return f64::NAN;
+    let widths = crate::element::triangle::over_cell_chunks(
+        crate::mesh::Cells::All(u.mesh.cell_count()),
+        |cells| {
+            let mut widest = 0.0f64;
+            let mut local = Vec::new();
+            for c in cells {
+                let pushing = multiplier
+                    .map
+                    .cell_dofs(c)
+                    .iter()
+                    .any(|&k| multiplier.coefficients[k] > 1e-6 * largest);
+                if !pushing {
+                    continue;
                 }
-                narrowest = narrowest.min(gap);
+                let map = crate::element::triangle::AffineMap::of(u.mesh, c);
+                u.local_coefficients(c, &mut local);
+                let mut narrowest = f64::INFINITY;
+                for (q, &xi) in points.iter().enumerate() {
+                    let gap = side * (table.value(q, &local) - psi(&map.point(xi)));
+                    if gap.is_nan() {
+                        return f64::NAN;
+                    }
+                    narrowest = narrowest.min(gap);
+                }
+                widest = widest.max(narrowest);
             }
-            widest = widest.max(narrowest);
-        }
-        widest
-    });
+            widest
+        },
+    );
     // `f64::max` would skip a NaN
     if widths.iter().any(|w| w.is_nan()) {
         return f64::NAN;

@@ -965,14 +965,18 @@ where
 {
     let degree = error_rule_degree(u.map.element().degree());
     let value = exact.value;
-    let (l2, h1) = match exact.gradient {
-        Some(gradient) => {
-            let (l2, h1) = u.errors(&|x| (value(&x), gradient(&x)), degree);
-            (l2, Some(h1))
-        }
-        None => (u.errors(&|x| (value(&x), [0.0, 0.0]), degree).0, None),
-    };
     let d = &solution.discretization;
+    // each process its own cells' squares, added up over the processes in one reduction
+    let evaluation = d.evaluation();
+    let cells = evaluation.cells();
+    let (l2, h1) = match exact.gradient {
+        Some(gradient) => u.squared_errors(cells, &|x| (value(&x), gradient(&x)), degree),
+        None => (
+            u.squared_errors(cells, &|x| (value(&x), [0.0, 0.0]), degree)
+                .0,
+            0.0,
+        ),
+    };
     let multiplier = match (exact.multiplier, &d.multipliers) {
         (Some(lambda), Multipliers::Cells) => d.dofs.map(d.multiplier_field).map(|map| {
             let view = TriangleField {
@@ -980,10 +984,15 @@ where
                 map,
                 coefficients: solution.field(d.multiplier_field),
             };
-            view.weighted_error(&|x| lambda(&x), 1, degree)
+            view.squared_weighted_error(cells, &|x| lambda(&x), 1, degree)
         }),
         _ => None,
     };
+    let h2 = exact
+        .hessian
+        .map(|hessian| u.squared_hessian_error(cells, &|x| hessian(&x), degree));
+    let [l2, h1, multiplier_sum, h2_sum] =
+        evaluation.sum([l2, h1, multiplier.unwrap_or(0.0), h2.unwrap_or(0.0)]);
     let lagrange = matches!(
         u.map.element(),
         ElementKind::P1 | ElementKind::P2 | ElementKind::P3
@@ -997,14 +1006,11 @@ where
     } else {
         (None, None)
     };
-    let h2 = exact
-        .hessian
-        .map(|hessian| u.hessian_error(&|x| hessian(&x), degree));
     Errors {
-        l2: Some(l2),
-        h1,
-        h2,
-        multiplier,
+        l2: Some(l2.sqrt()),
+        h1: exact.gradient.map(|_| h1.sqrt()),
+        h2: h2.map(|_| h2_sum.sqrt()),
+        multiplier: multiplier.map(|_| multiplier_sum.sqrt()),
         vertex_max,
         vertex_mean,
     }
