@@ -980,9 +980,11 @@ fn solve_eliminated(
         diagonal.push(here);
         off.push(columns.len() - here);
     }
-    let matrix = Matrix::new(petsc, &diagonal, &off)?;
-    let mut x = Vector::new(petsc, mine.len())?;
+    let mut matrix = Matrix::new(petsc, &diagonal, &off)?;
     let own: Vec<usize> = mine.clone().collect();
+    // PETSc's rows are the unknowns here
+    matrix.set_near_null_space(petsc, &own, &lcp.near_null_space)?;
+    let mut x = Vector::new(petsc, mine.len())?;
     let begin: Vec<f64> = mine.clone().map(|i| start.map_or(0.0, |s| s[i])).collect();
     x.set(&own, &begin, false)?;
     x.assemble()?;

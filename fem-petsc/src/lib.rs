@@ -698,6 +698,82 @@ impl<'p> Matrix<'p> {
         Ok(())
     }
 
+    /// Declares `vectors` the matrix's near null space (`MatSetNearNullSpace`): the
+    /// modes on which the operator without its supports vanishes (an elastic body's
+    /// rigid motions), which GAMG's aggregation must reproduce on its coarse levels
+    /// instead of the constants it assumes otherwise. Each vector is given whole, by
+    /// PETSc's row (every rank the same vectors); each rank sets its `rows`. The vectors
+    /// are orthonormalized first (modified Gram–Schmidt, the same on every rank), as
+    /// `MatNullSpaceCreate` requires; a vector dependent on the ones before is dropped.
+    ///
+    /// # Errors
+    /// Vectors of different lengths, or PETSc's.
+    pub fn set_near_null_space(
+        &mut self,
+        petsc: &'p Petsc,
+        rows: &[usize],
+        vectors: &[Vec<f64>],
+    ) -> Result<()> {
+        let Some(length) = vectors.first().map(Vec::len) else {
+            return Ok(());
+        };
+        if vectors.iter().any(|v| v.len() != length) || rows.iter().any(|&r| r >= length) {
+            return Err(Error::refused(
+                "MatSetNearNullSpace",
+                "near null space vectors of different lengths, or shorter than the matrix"
+                    .to_string(),
+            ));
+        }
+        let mut basis: Vec<Vec<f64>> = Vec::with_capacity(vectors.len());
+        for v in vectors {
+            let mut v = v.clone();
+            let size = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            for b in &basis {
+                let projection: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
+                for (x, y) in v.iter_mut().zip(b) {
+                    *x -= projection * y;
+                }
+            }
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm > 1e-10 * size && norm > 0.0 {
+                v.iter_mut().for_each(|x| *x /= norm);
+                basis.push(v);
+            }
+        }
+        if basis.is_empty() {
+            return Ok(());
+        }
+        let mut petsc_vectors = Vec::with_capacity(basis.len());
+        for b in &basis {
+            let mut v = Vector::new(petsc, rows.len())?;
+            let values: Vec<f64> = rows.iter().map(|&r| b[r]).collect();
+            v.set(rows, &values, false)?;
+            v.assemble()?;
+            petsc_vectors.push(v);
+        }
+        let raw: Vec<sys::Vec> = petsc_vectors.iter().map(|v| v.raw).collect();
+        let mut space: sys::MatNullSpace = std::ptr::null_mut();
+        // SAFETY: live vectors, which the null space references (so they may drop after)
+        check("MatNullSpaceCreate", unsafe {
+            sys::MatNullSpaceCreate(
+                petsc.comm(),
+                sys::PetscBool_PETSC_FALSE,
+                raw.len() as sys::PetscInt,
+                raw.as_ptr(),
+                &mut space,
+            )
+        })?;
+        // SAFETY: a live matrix and null space; the matrix takes its own reference
+        let set = check("MatSetNearNullSpace", unsafe {
+            sys::MatSetNearNullSpace(self.raw, space)
+        });
+        // SAFETY: drops this function's reference
+        let destroyed = check("MatNullSpaceDestroy", unsafe {
+            sys::MatNullSpaceDestroy(&mut space)
+        });
+        set.and(destroyed)
+    }
+
     /// `‖A‖∞`, the largest row sum of `|A|` of the assembled matrix (`MatNorm`).
     ///
     /// # Errors

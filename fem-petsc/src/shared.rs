@@ -367,6 +367,19 @@ pub(crate) fn solve_eliminated(
         }
         Ok(())
     })?;
+    let mut hessian_matrix = hessian_matrix;
+    let by_row: Vec<Vec<f64>> = lcp
+        .near_null_space
+        .iter()
+        .map(|v| {
+            let mut row = vec![0.0; v.len()];
+            for (j, &x) in v.iter().enumerate() {
+                row[numbering.u[j]] = x;
+            }
+            row
+        })
+        .collect();
+    hessian_matrix.set_near_null_space(petsc, &numbering.rows(), &by_row)?;
     let f = vector_of(petsc, numbering.local, &lcp.f, |i| numbering.u[i])?;
     let mut x = Vector::new(petsc, numbering.local)?;
     let begin: Vec<f64> = numbering

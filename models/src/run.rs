@@ -11,7 +11,7 @@ pub use crate::report::{Outcome, Phases, Profile, Report, Schur, Settings, MAX_R
 use crate::scene::{ExactSolution, Part, Posed, Scene, Support};
 use fem_runtime::adaptivity::{AdaptiveOptions, BoundaryLayer};
 use fem_runtime::lcp::NewtonOptions;
-use fem_runtime::obstacle::{FirstStart, ObstacleOptions};
+use fem_runtime::obstacle::{FirstStart, NearNullSpace, ObstacleOptions};
 use fem_runtime::problem::memory::check_memory;
 use fem_runtime::problem::{
     self, Condition, Exact, GradientFn, HessianFn, MemoryModel, Problem, SolveOptions, Solved,
@@ -87,6 +87,13 @@ pub trait Quantities<G: Geometry>: 'static {
     /// its foundation); `None`: from zero.
     fn start(scene: &Scene, posed: &Posed) -> Option<Box<FirstStart<'static, G>>> {
         let _ = (scene, posed);
+        None
+    }
+
+    /// The near null space of the family's operator without supports, for an external
+    /// solver's algebraic multigrid (an elastic body's rigid motions); `None`: the
+    /// solver's default (the constants).
+    fn near_null_space() -> Option<Box<NearNullSpace<'static, G>>> {
         None
     }
 
@@ -235,6 +242,10 @@ pub fn run<M: Model, G: Geometry, Q: Quantities<G>>(
     problem = posed_on(problem, &bound, &supports, scene, &finest)?;
     if let Some(start) = &start {
         problem = problem.start(&**start);
+    }
+    let near_null_space = Q::near_null_space();
+    if let Some(space) = &near_null_space {
+        problem = problem.near_null_space(&**space);
     }
     if let Some(fns) = &exact_fns {
         problem = problem.exact(fns.exact());

@@ -149,6 +149,13 @@ pub struct Lcp {
     /// processes, and the methods that measure the whole (the KKT and complementarity
     /// residuals, [`Lcp::multiplier_scale`], the rounding estimates) reduce over them.
     pub share: Option<Share>,
+    /// Vectors of the primal unknowns (n entries each) on which `A` without its
+    /// supports vanishes: an elastic body's rigid motions, restricted to the free
+    /// unknowns. Read only by an algebraic multigrid preconditioner (an external solver's
+    /// GAMG, `MatSetNearNullSpace`), whose coarse spaces must reproduce them; empty where
+    /// its default (the constants) serves. Set by the problem's poser
+    /// ([`crate::problem::Problem::near_null_space`]).
+    pub near_null_space: Vec<Vec<f64>>,
 }
 
 /// How the parts of an LCP held by several processes add up ([`Lcp::share`]): the
@@ -374,6 +381,7 @@ impl Lcp {
             f,
             g,
             share: None,
+            near_null_space: Vec::new(),
         }
     }
 

@@ -531,6 +531,7 @@ mod tests {
             f,
             g: vec![0.0; m],
             share: None,
+            near_null_space: Vec::new(),
         }
     }
 

@@ -395,6 +395,7 @@ impl<G: DofNumbering + Clone> Discretization<G> {
                 f,
                 g,
                 share: None,
+                near_null_space: Vec::new(),
             },
             multiplier_field: multiplier,
             multipliers: Multipliers::Cells,
@@ -1360,6 +1361,14 @@ where
 /// [`Lcp::whole`]: crate::lcp::Lcp::whole
 /// [`Lcp::largest`]: crate::lcp::Lcp::largest
 pub type FirstStart<'a, G> = dyn Fn(&Discretization<G>) -> Result<LevelStart> + Sync + 'a;
+
+/// The near null space of a level's `A` without its supports, as vectors of the
+/// level's free primal unknowns ([`Lcp::near_null_space`]): an elastic body's rigid
+/// motions. Called on each level (possibly one process's part: it reads the mesh, the
+/// DOFs and the reduction, not the LCP's blocks) where an external solver solves.
+///
+/// [`Lcp::near_null_space`]: crate::lcp::Lcp::near_null_space
+pub type NearNullSpace<'a, G> = dyn Fn(&Discretization<G>) -> Vec<Vec<f64>> + Sync + 'a;
 
 /// How a level of a nested solve starts when no coarser solution is prolonged to it.
 #[derive(Clone, Debug, PartialEq)]

@@ -66,8 +66,8 @@ use crate::model::{
     Coefficients, DataFn, IntoDataIndex, IntoFieldIndex, IntoParamIndex, IntoPartIndex, Model,
 };
 use crate::obstacle::{
-    multiplier_field, solve_nested_from, Discretization, FirstStart, LevelStart, ObstacleOptions,
-    ObstacleSolution, VariationalSolver,
+    multiplier_field, solve_nested_from, Discretization, FirstStart, LevelStart, NearNullSpace,
+    ObstacleOptions, ObstacleSolution, VariationalSolver,
 };
 use crate::stabilization::Alpha;
 use report::{
@@ -219,6 +219,7 @@ pub struct Problem<'a, M: Model, G: Domain> {
     alpha_when_zero: f64,
     options: SolveOptions,
     start: Option<&'a FirstStart<'a, G>>,
+    near_null_space: Option<&'a NearNullSpace<'a, G>>,
     exact: Option<Exact<'a>>,
     nodal: Option<&'a DataFn>,
     unconstrained: bool,
@@ -267,6 +268,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             alpha_when_zero: ALPHA_WHEN_CI_VANISHES,
             options: SolveOptions::default(),
             start: None,
+            near_null_space: None,
             exact: None,
             nodal: None,
             unconstrained: false,
@@ -393,6 +395,15 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
     /// level's LCP as [`FirstStart`] says, the level possibly one process's part.
     pub fn start(mut self, start: &'a FirstStart<'a, G>) -> Self {
         self.start = Some(start);
+        self
+    }
+
+    /// The near null space of the levels' `A` without supports (an elastic body's rigid
+    /// motions), handed to an external solver with each level's LCP
+    /// ([`crate::lcp::Lcp::near_null_space`]) for its algebraic multigrid; the native
+    /// solvers do not read it.
+    pub fn near_null_space(mut self, space: &'a NearNullSpace<'a, G>) -> Self {
+        self.near_null_space = Some(space);
         self
     }
 
@@ -1142,6 +1153,7 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
             pressed,
         } = setup;
         let supports = &self.supports;
+        let near_null_space = self.near_null_space;
         let last = meshes.len() - 1;
         let mut finest = finest;
         // Where the external solver runs on several processes, each assembles its own
@@ -1182,6 +1194,11 @@ impl<'a, M: Model, G: Domain> Problem<'a, M, G> {
                     )?;
                     if let (Some(e), Some(_)) = (partitioned, &cells) {
                         d.lcp.share = Some(crate::lcp::Share::new(e));
+                    }
+                    if let (VariationalSolver::External(_), Some(space)) =
+                        (options.solver, near_null_space)
+                    {
+                        d.lcp.near_null_space = space(&d);
                     }
                     Ok(d)
                 }

@@ -22,10 +22,10 @@ use crate::run::{run, Quantities, Run};
 use crate::scene::{Domain, Generator, Load, LoadSign, Part, PartSupport, Posed, Scene, Support};
 pub use crate::signorini::{lame, Plane};
 use crate::signorini::{signorini_p1, signorini_p1_p1, signorini_p2, signorini_p2_p1, Multiplier};
-use checks::{pressed_start, refuse_pressure_on_contact};
+use checks::{pressed_start, refuse_pressure_on_contact, rigid_motions};
 use facts::ContactData;
 pub use facts::{contact_tangent, material_parameters, ContactFacts, CONTACT_PART, LOAD_PART};
-use fem_runtime::obstacle::{Discretization, FirstStart, LevelStart};
+use fem_runtime::obstacle::{Discretization, FirstStart, LevelStart, NearNullSpace};
 use fem_runtime::problem::ALPHA_WHEN_CI_VANISHES;
 use fem_runtime::stabilization::Alpha;
 use fem_runtime::{DirichletPart, Error, Model, TriangleMesh};
@@ -464,6 +464,10 @@ impl Quantities<TriangleMesh> for Contact {
                 other => other,
             })
         }))
+    }
+
+    fn near_null_space() -> Option<Box<NearNullSpace<'static, TriangleMesh>>> {
+        Some(Box::new(rigid_motions))
     }
 
     fn add<M: Model>(run: &Run<'_, M, TriangleMesh>, report: &mut Report) -> Result<()> {
