@@ -738,6 +738,8 @@ fn solve_vi(
         rtol: Some(RELATIVE_TOLERANCE),
         // the residual at x = 0 is −(F, G): its size sets the rounding floor
         atol: Some(ABSOLUTE_TOLERANCE * norm2(lcp.f.iter().chain(&lcp.g))),
+        // a problem with (F, G) = 0 has its solution at the start: no step to force
+        force_iteration: !nodal && norm2(lcp.f.iter().chain(&lcp.g)) > 0.0,
     };
     let converged = solve_affine(&defaults, &jacobian, &right, Some((&lower, &upper)), &mut x)?;
     let whole = x.gather()?;
@@ -784,6 +786,7 @@ fn solve_shared(
         line_search,
         rtol: Some(RELATIVE_TOLERANCE),
         atol: Some(ABSOLUTE_TOLERANCE),
+        force_iteration: false,
     };
     let basic = Some(c"basic");
     match formulation {
@@ -793,7 +796,15 @@ fn solve_shared(
             start,
             direct(c"cholesky", if full_steps { basic } else { None }),
         ),
-        Formulation::Mixed => crate::shared::solve_mixed(petsc, lcp, start, direct(c"lu", basic)),
+        Formulation::Mixed => crate::shared::solve_mixed(
+            petsc,
+            lcp,
+            start,
+            Defaults {
+                force_iteration: true,
+                ..direct(c"lu", basic)
+            },
+        ),
         Formulation::Primal => {
             crate::shared::solve_primal(petsc, lcp, start, direct(c"cholesky", basic))
         }
@@ -999,6 +1010,7 @@ fn solve_eliminated(
         rtol: Some(RELATIVE_TOLERANCE),
         // the gradient at U = 0 is −F − BᵀC⁻¹G₊: its terms' sizes set the rounding floor
         atol: Some(ABSOLUTE_TOLERANCE * gradient_scale(lcp)),
+        force_iteration: false,
     };
     let rows = &rows;
     let objective = |x: &VectorView| -> Result<f64> {

@@ -368,10 +368,15 @@ pub(crate) fn solve_eliminated(
         Ok(())
     })?;
     let mut hessian_matrix = hessian_matrix;
+    // by PETSc's row; a vector of another length than U's is left as it is, for
+    // `set_near_null_space` to refuse on every rank
     let by_row: Vec<Vec<f64>> = lcp
         .near_null_space
         .iter()
         .map(|v| {
+            if v.len() != lcp.n() {
+                return v.clone();
+            }
             let mut row = vec![0.0; v.len()];
             for (j, &x) in v.iter().enumerate() {
                 row[numbering.u[j]] = x;
@@ -590,6 +595,8 @@ pub(crate) fn solve_mixed(
     let scale = sizes.iter().map(|x| x * x).sum::<f64>().sqrt();
     let defaults = Defaults {
         atol: defaults.atol.map(|relative| relative * scale),
+        // a problem with (F, G) = 0 has its solution at the start: no step to force
+        force_iteration: defaults.force_iteration && scale > 0.0,
         ..defaults
     };
     let converged = solve_affine(&defaults, &jacobian, &right, Some((&lower, &upper)), &mut x)?;

@@ -65,6 +65,36 @@ fn solve(
         .unwrap_or_else(|e| panic!("{} {pair} N = {n} by {solver:?}: {e}", scene.name))
 }
 
+/// `text` with every decimal number in it rounded to ten significant digits: a refusal
+/// quotes sums (a load's work on a rigid motion) whose last bits depend on the order the
+/// ranks' parts are added in, which changes with the partition (PT-Scotch's, whose
+/// random state moves on with every earlier partition in the process).
+fn to_ten_digits(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        out.push_str(&rest[..start]);
+        let tail = &rest[start..];
+        let end = tail
+            .char_indices()
+            .find(|&(i, c)| {
+                !(c.is_ascii_digit()
+                    || c == '.'
+                    || c == 'e'
+                    || ((c == '-' || c == '+') && tail[..i].ends_with('e')))
+            })
+            .map_or(tail.len(), |(i, _)| i);
+        let token = tail[..end].trim_end_matches(['.', 'e']);
+        match token.parse::<f64>() {
+            Ok(x) if token.contains(['.', 'e']) => out.push_str(&format!("{x:.9e}")),
+            _ => out.push_str(token),
+        }
+        rest = &tail[token.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
 fn relative(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs()).max(1e-300)
 }
@@ -195,10 +225,13 @@ fn main() {
         ),
         "membrane-radial N = 1"
     );
-    // both formulations where both apply: the mixed one on P0 multipliers
+    // both formulations where both apply: the mixed one on P0 multipliers; at N = 2 the
+    // load on the one free vertex is rounding, so the start U = 0 meets SNESVI's
+    // absolute tolerance (scaled by (F, G)) and must still take a Newton step
     petsc.set_formulation(Some(Formulation::Mixed));
     for (scene, pair, n) in [
         ("membrane-radial", "p1-p0", 8),
+        ("membrane-radial", "p1-p0", 2),
         ("kirchhoff-obstacle", "morley-p0", 16),
     ] {
         let native = solve(scene, pair, n, None, VariationalSolver::SemismoothNewton).report;
@@ -270,8 +303,9 @@ fn block(cells: [usize; 2], boundary: &str, pressure: &str) -> String {
 /// The contact family's checks of each level (the free rigid motions through `A`, the
 /// load's work on them through `F`, the constraints' reach through `B`) read a level
 /// each rank holds a part of through the ranks' reductions: the same answer, or the
-/// same refusal word for word, as natively. Cases: a tilted foundation under a roller
-/// (a free oblique translation, held by the contact; with q = (x/2)⁵ the body tips), a
+/// same refusal word for word (its numbers to ten digits), as natively. Cases: a tilted
+/// foundation under a roller (a free oblique translation, held by the contact; with
+/// q = (x/2)⁵ the body tips), a
 /// held translation with a one-sided tipping condition (held, and turned away), and a
 /// coarse level whose one contact edge cannot hold the rotation (skipped for a finer).
 fn contact_checks_on_parts(external: VariationalSolver, size: usize) {
@@ -326,7 +360,11 @@ fn contact_checks_on_parts(external: VariationalSolver, size: usize) {
                     refused.is_some_and(|words| a.to_string().contains(words)),
                     "{case}: {a}"
                 );
-                assert_eq!(a.to_string(), b.to_string(), "{case}");
+                assert_eq!(
+                    to_ten_digits(&a.to_string()),
+                    to_ten_digits(&b.to_string()),
+                    "{case}"
+                );
             }
             (a, b) => panic!(
                 "{case}: natively {:?}, by PETSc {:?}",
