@@ -69,11 +69,6 @@ pub enum Cells<'a> {
 }
 
 impl<'a> Cells<'a> {
-    /// The part `part` of a mesh of `count` cells (`None`: all of them).
-    pub fn of(count: usize, part: Option<&'a [usize]>) -> Self {
-        part.map_or(Cells::All(count), Cells::Part)
-    }
-
     /// How many cells.
     pub fn len(self) -> usize {
         match self {

@@ -447,11 +447,6 @@ impl<'a> Evaluation<'a> {
         self.cells
     }
 
-    /// Whether the evaluation is shared among processes.
-    pub fn is_shared(self) -> bool {
-        self.share.is_some()
-    }
-
     /// Per cell of the whole mesh, whether this process evaluates it (`None`: every cell,
     /// on one process): what decides which process counts a facet between two cells.
     pub fn owned(self) -> Option<Vec<bool>> {
